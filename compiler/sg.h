@@ -1,0 +1,179 @@
+/* sg.h — the graph language front end: diagnostics, sources, lexer, parser,
+ * name resolution, type checking and lowering to the IR.
+ *
+ * Public part (used by the scene compiler, the CLI and the runtime's hot
+ * reload).  The front end's internals (tokens, AST) are declared in
+ * sg_internal.h.
+ */
+#ifndef SPLAT_SG_H
+#define SPLAT_SG_H
+
+#include <stdbool.h>
+#include <stdio.h>
+
+#include "ir.h"
+
+/* ---- diagnostics (diag.c) ---------------------------------------------- */
+
+typedef struct sg_loc {
+    const char *file;   /* path as given (owned by the source registry) */
+    int line, col;      /* 1-based; 0 if unknown                         */
+} sg_loc;
+
+/* Error identities, one X-macro list so tests can assert on the id.
+ * X(id, format) — format is printf-style. */
+#define SG_ERRORS(X)                                                        \
+    X(IO,            "cannot read '%s': %s")                                \
+    X(SYNTAX,        "expected %s, found %s")                               \
+    X(UNTERMINATED,  "unterminated %s (opened at line %d)")                 \
+    X(BAD_LITERAL,   "bad literal '%s': %s")                                \
+    X(BAD_CHAR,      "unexpected character %s")                             \
+    X(UNKNOWN_NODE,  "unknown node type '%s'")                              \
+    X(UNKNOWN_PORT,  "'%s' has no %s port '%s'")                            \
+    X(UNKNOWN_NAME,  "unknown name '%s'")                                   \
+    X(DUPLICATE,     "duplicate %s '%s' (first defined at %s:%d:%d)")       \
+    X(TYPE_MISMATCH, "type mismatch: %s expects %s, found %s")              \
+    X(MISSING_INPUT, "'%s' needs a value for input '%s'")                   \
+    X(CYCLE,         "cycle: %s")                                           \
+    X(MISSING_IMPORT,"cannot import '%s': %s")                              \
+    X(IMPORT_CYCLE,  "import cycle: %s")                                    \
+    X(BAD_OUTPUT,    "'%s' is not a material output (mask, albedo, normal, roughness, height)") \
+    X(BAD_VALUE,     "%s")                                                  \
+    X(TOO_DEEP,      "nesting deeper than %d levels")                       \
+    X(TOO_LARGE,     "%s")                                                  \
+    X(SCENE,         "%s")                                                  \
+    X(INTERNAL,      "internal compiler error: %s")
+
+typedef enum sg_error_id {
+#define X(id, fmt) SG_E_##id,
+    SG_ERRORS(X)
+#undef X
+    SG_E_COUNT
+} sg_error_id;
+
+typedef enum sg_severity { SG_ERROR, SG_WARNING, SG_NOTE } sg_severity;
+
+typedef struct sg_diag {
+    sg_loc       loc;
+    sg_severity  severity;
+    sg_error_id  id;
+    char        *msg;
+} sg_diag;
+
+typedef struct sg_diags {
+    sg_diag *items;
+    int      n, cap;
+    int      nerrors;
+} sg_diags;
+
+void sg_diags_init(sg_diags *d);
+void sg_diags_free(sg_diags *d);
+/* Record a diagnostic; the message is formatted from the id's format. */
+void sg_error(sg_diags *d, sg_loc loc, sg_error_id id, ...);
+void sg_note(sg_diags *d, sg_loc loc, const char *fmt, ...)
+    __attribute__((format(printf, 3, 4)));
+/* GCC style: "file:line:col: error: msg", the source line, a caret. */
+void sg_diags_print(const sg_diags *d, FILE *out);
+
+/* ---- programs ---------------------------------------------------------- */
+
+typedef struct sg_program sg_program;
+
+/* Parse `path` and everything it imports (import paths are relative to the
+ * importing file, then to the search paths), resolve names and type-check.
+ * Returns NULL only on allocation failure; check d->nerrors. */
+sg_program *sg_load(const char *path, const char *const *search_paths,
+                    sg_diags *d);
+/* Same, from memory (`name` is used in diagnostics and for imports). */
+sg_program *sg_load_string(const char *name, const char *text,
+                           const char *const *search_paths, sg_diags *d);
+void        sg_free(sg_program *p);
+
+/* Every file the program read (for hot reload and cache keys). */
+int         sg_file_count(const sg_program *p);
+const char *sg_file_path(const sg_program *p, int i);
+
+int         sg_material_count(const sg_program *p);
+const char *sg_material_name(const sg_program *p, int i);
+sg_loc      sg_material_loc(const sg_program *p, int i);
+int         sg_material_find(const sg_program *p, const char *name); /* -1 */
+
+/* Lower material `name` into `out` (which may already hold other
+ * materials: shared subtrees are shared).  Sets the roots
+ * "<name>.mask", ".albedo", ".normal", ".roughness", ".height", filling
+ * missing outputs with the defaults (mask 1, albedo 0.5 grey, normal
+ * terrain.normal, roughness 0.8, height 0.5).  Params are named
+ * "<name>.<param>".  Returns false with diagnostics on error. */
+bool sg_lower_material(sg_program *p, const char *name, ir *out, sg_diags *d);
+
+/* Inline instance shader `name` into `out` with its inputs bound to
+ * `in_vals` (by name; inputs not given take their defaults) and return
+ * the refs of the outputs named in `out_names`.  Compositors are plain
+ * shaders with agreed port names (nodes/compositors.sg), lowered this way
+ * once per layer.  Returns false with diagnostics on error (unknown
+ * shader or port, type mismatch). */
+bool sg_lower_shader(sg_program *p, const char *name, ir *out,
+                     const char *const *in_names, const ir_ref *in_vals, int nin,
+                     const char *const *out_names, ir_ref *out_vals, int nout,
+                     sg_diags *d);
+
+/* Standard material outputs, in the order used everywhere. */
+#define SG_OUTPUTS(X)            \
+    X(MASK,      "mask",      IR_T_FLOAT) \
+    X(ALBEDO,    "albedo",    IR_T_VEC3)  \
+    X(NORMAL,    "normal",    IR_T_VEC3)  \
+    X(ROUGHNESS, "roughness", IR_T_FLOAT) \
+    X(HEIGHT,    "height",    IR_T_FLOAT)
+
+typedef enum sg_output {
+#define X(id, name, type) SG_OUT_##id,
+    SG_OUTPUTS(X)
+#undef X
+    SG_OUT_COUNT
+} sg_output;
+extern const char *const sg_output_names[SG_OUT_COUNT];
+
+/* Graphviz DOT of the program's graphs (of one material if non-NULL). */
+void sg_write_dot(const sg_program *p, const char *material, FILE *out);
+
+/* ---- scenes ------------------------------------------------------------ */
+
+/* A `scene` block (one per scene.sg).  Paths are resolved relative to the
+ * scene file.  Every field keeps its location for later errors. */
+typedef enum sg_hf_format { SG_HF_PNG, SG_HF_R16 } sg_hf_format;
+
+typedef struct sg_scene_painted {
+    char  *name;       /* the name materials use: painted { mask = "fields" } */
+    char  *file;       /* 8-bit greyscale PNG, same size as the heightfield  */
+    sg_loc loc;
+} sg_scene_painted;
+
+typedef struct sg_scene_camera {
+    char  *name;
+    double position[3], look[3];   /* terrain-local metres */
+    sg_loc loc;
+} sg_scene_camera;
+
+typedef struct sg_scene {
+    char  *name;
+    sg_loc loc;
+    char  *heightfield;      sg_loc heightfield_loc;
+    sg_hf_format hf_format;  /* from the extension: .png or .r16/.raw      */
+    int    hf_width, hf_height; /* required for raw R16, 0 otherwise       */
+    double size[2];          sg_loc size_loc;      /* x, z metres          */
+    double max_height;       sg_loc max_height_loc;
+    double height_offset;                          /* default 0            */
+    char **materials;        sg_loc *material_locs; int nmaterials; /* bottom first */
+    char  *compositor;       sg_loc compositor_loc; /* default "linear_alpha" */
+    sg_scene_painted *painted; int npainted;
+    bool   has_destruction;
+    double destruction_origin[2], destruction_size[2];
+    double destruction_cell;                       /* default 16 m         */
+    int    cell_texels;      sg_loc cell_texels_loc; /* default 32         */
+    sg_scene_camera *cameras; int ncameras;
+} sg_scene;
+
+/* The scene of the program's root file, or NULL if it declares none. */
+const sg_scene *sg_program_scene(const sg_program *p);
+
+#endif
