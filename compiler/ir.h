@@ -54,12 +54,14 @@ ir_type     ir_type_from_name(const char *s); /* IR_T_ERROR if unknown       */
     X(VIEW_DISTANCE, "view.distance",    IR_T_FLOAT) /* metres to camera  */ \
     X(DESTRUCTION,   "terrain.destruction", IR_T_FLOAT) /* 0 = untouched */
 
+/* The type is `enum ir_input` (alias ir_input_kind): the plain name
+ * `ir_input` is the builder function below. */
 typedef enum ir_input {
 #define X(id, name, type) IR_IN_##id,
     IR_INPUTS(X)
 #undef X
     IR_IN_COUNT
-} ir_input;
+} ir_input_kind;
 
 /* The op list.  X(id, sg_name, nargs, flags).  The table in ir_ops.c gives
  * each op its ports, type rule, GLSL, eval and interval functions.
@@ -122,6 +124,9 @@ typedef enum ir_op {
 #define IR_SWZ_N(imm)    ((int)((imm) & 15))
 #define IR_SWZ_C(imm, i) ((int)(((imm) >> (4 + 2 * (i))) & 3))
 
+typedef struct ir_iv ir_iv;    /* an interval, defined with the evaluators */
+struct ir_node;
+
 typedef struct ir_opinfo {
     const char *name;          /* .sg node type, NULL for internal ops   */
     const char *ports[4];      /* input port names, in arg order          */
@@ -131,6 +136,15 @@ typedef struct ir_opinfo {
     /* Result type for operand types, or IR_T_ERROR.  The front end's type
      * checker calls this too, so the two cannot disagree. */
     ir_type   (*type)(const ir_type *args, int nargs);
+    /* The op's meaning, written once beside its type rule and GLSL and
+     * read by ir_eval, ir_interval and opt_fold.  `atype[i]` is operand
+     * i's type, a[4 * i + c] its component c; `out` receives the result's
+     * components.  NULL for the leaves and SAMPLE, whose values come from
+     * the evaluator's environment. */
+    void      (*eval)(const struct ir_node *n, const ir_type *atype,
+                      const double *a, double out[4]);
+    void      (*interval)(const struct ir_node *n, const ir_type *atype,
+                          const ir_iv *a, ir_iv *out);
 } ir_opinfo;
 
 const ir_opinfo *ir_opinfo_get(ir_op op);
@@ -212,7 +226,7 @@ static inline ir_type ir_typeof(const ir *ir, ir_ref r) { return (ir_type)ir->no
  * no folding: that is opt_fold's job, so tests see the pass work. */
 ir_ref ir_const(ir *ir, ir_type t, const double *v);
 ir_ref ir_constf(ir *ir, double v);
-ir_ref ir_input(ir *ir, ir_input which);
+ir_ref ir_input(ir *ir, ir_input_kind which);
 ir_ref ir_param_ref(ir *ir, int param);
 ir_ref ir_texture_ref(ir *ir, int texture);
 ir_ref ir_painted_ref(ir *ir, int painted);
