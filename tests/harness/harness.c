@@ -1,0 +1,734 @@
+/* harness.c — the harness's Vulkan device and compute dispatch (harness.h).
+ *
+ * One instance, one device, one compute queue, one command buffer reused for
+ * every run.  A run creates its buffers, images, pipeline and descriptor set,
+ * submits once, waits on a fence, reads back and destroys what it created:
+ * simple and leak-free rather than fast (tests dispatch a few times). */
+#include "harness.h"
+
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <vulkan/vulkan.h>
+
+#include "spv.h"
+
+struct harness {
+    VkInstance               instance;
+    VkDebugUtilsMessengerEXT messenger;
+    VkPhysicalDevice         phys;
+    VkPhysicalDeviceProperties props;
+    VkPhysicalDeviceMemoryProperties mem;
+    VkDevice                 device;
+    uint32_t                 family;
+    VkQueue                  queue;
+    VkCommandPool            pool;
+    VkCommandBuffer          cmd;
+    VkFence                  fence;
+    bool                     validate;
+    int                      messages;    /* validation warnings + errors */
+};
+
+/* ---- errors ------------------------------------------------------------ */
+
+static const char *vk_result_name(VkResult r)
+{
+    switch (r) {
+#define R(x) case x: return #x;
+    R(VK_SUCCESS) R(VK_NOT_READY) R(VK_TIMEOUT) R(VK_INCOMPLETE)
+    R(VK_ERROR_OUT_OF_HOST_MEMORY) R(VK_ERROR_OUT_OF_DEVICE_MEMORY)
+    R(VK_ERROR_INITIALIZATION_FAILED) R(VK_ERROR_DEVICE_LOST)
+    R(VK_ERROR_MEMORY_MAP_FAILED) R(VK_ERROR_LAYER_NOT_PRESENT)
+    R(VK_ERROR_EXTENSION_NOT_PRESENT) R(VK_ERROR_FEATURE_NOT_PRESENT)
+    R(VK_ERROR_INCOMPATIBLE_DRIVER) R(VK_ERROR_TOO_MANY_OBJECTS)
+    R(VK_ERROR_FORMAT_NOT_SUPPORTED) R(VK_ERROR_FRAGMENTED_POOL)
+    R(VK_ERROR_OUT_OF_POOL_MEMORY) R(VK_ERROR_INVALID_SHADER_NV)
+    R(VK_ERROR_UNKNOWN)
+#undef R
+    default: return "VkResult(?)";
+    }
+}
+
+__attribute__((format(printf, 2, 3)))
+static void set_err(char **err, const char *fmt, ...)
+{
+    if (!err || *err)          /* keep the first message */
+        return;
+    va_list ap;
+    va_start(ap, fmt);
+    int n = vsnprintf(NULL, 0, fmt, ap);
+    va_end(ap);
+    if (n < 0 || !(*err = malloc((size_t)n + 1)))
+        return;
+    va_start(ap, fmt);
+    vsnprintf(*err, (size_t)n + 1, fmt, ap);
+    va_end(ap);
+}
+
+/* Check a VkResult at run time (never inside assert); on failure record
+ * "harness.c:LINE: call: VK_ERROR_…" and jump to the function's `fail`. */
+#define VK(call)                                                          \
+    do {                                                                  \
+        VkResult vk_r_ = (call);                                          \
+        if (vk_r_ != VK_SUCCESS) {                                        \
+            set_err(err, "%s:%d: %s: %s", __FILE__, __LINE__, #call,      \
+                    vk_result_name(vk_r_));                               \
+            goto fail;                                                    \
+        }                                                                 \
+    } while (0)
+
+/* ---- instance and device ------------------------------------------------ */
+
+static VKAPI_ATTR VkBool32 VKAPI_CALL
+on_message(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
+           VkDebugUtilsMessageTypeFlagsEXT type,
+           const VkDebugUtilsMessengerCallbackDataEXT *data, void *user)
+{
+    harness *h = user;
+    if (severity & (VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT |
+                    VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT)) {
+        h->messages++;
+        fprintf(stderr, "vulkan validation: %s\n",
+                data && data->pMessage ? data->pMessage : "(no message)");
+    }
+    return VK_FALSE;
+}
+
+static bool has_layer(const char *name)
+{
+    uint32_t n = 0;
+    if (vkEnumerateInstanceLayerProperties(&n, NULL) != VK_SUCCESS)
+        return false;
+    VkLayerProperties *l = calloc(n ? n : 1, sizeof *l);
+    bool found = false;
+    if (l && vkEnumerateInstanceLayerProperties(&n, l) == VK_SUCCESS)
+        for (uint32_t i = 0; i < n && !found; i++)
+            found = strcmp(l[i].layerName, name) == 0;
+    free(l);
+    return found;
+}
+
+/* Rank a device: a name match wins; otherwise discrete > integrated >
+ * virtual > CPU (lavapipe) > other. */
+static int device_rank(const VkPhysicalDeviceProperties *p, const char *want)
+{
+    if (want && *want)
+        return strstr(p->deviceName, want) ? 100 : -1;
+    switch (p->deviceType) {
+    case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU:   return 5;
+    case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU: return 4;
+    case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU:    return 3;
+    case VK_PHYSICAL_DEVICE_TYPE_CPU:            return 2;
+    default:                                     return 1;
+    }
+}
+
+static bool pick_device(harness *h, const char *want, char **err)
+{
+    uint32_t n = 0;
+    VkPhysicalDevice *devs = NULL;
+    VK(vkEnumeratePhysicalDevices(h->instance, &n, NULL));
+    if (n == 0) {
+        set_err(err, "no Vulkan device (is mesa-vulkan-drivers installed?)");
+        return false;
+    }
+    devs = calloc(n, sizeof *devs);
+    if (!devs) {
+        set_err(err, "out of memory");
+        return false;
+    }
+    VK(vkEnumeratePhysicalDevices(h->instance, &n, devs));
+    int best = -1;
+    for (uint32_t i = 0; i < n; i++) {
+        VkPhysicalDeviceProperties p;
+        vkGetPhysicalDeviceProperties(devs[i], &p);
+        if (p.apiVersion < VK_API_VERSION_1_2)
+            continue;
+        uint32_t nq = 0;
+        vkGetPhysicalDeviceQueueFamilyProperties(devs[i], &nq, NULL);
+        VkQueueFamilyProperties q[16];
+        if (nq > 16)
+            nq = 16;
+        vkGetPhysicalDeviceQueueFamilyProperties(devs[i], &nq, q);
+        uint32_t fam = UINT32_MAX;
+        for (uint32_t k = 0; k < nq && fam == UINT32_MAX; k++)
+            if (q[k].queueFlags & VK_QUEUE_COMPUTE_BIT)
+                fam = k;
+        int rank = device_rank(&p, want);
+        if (fam != UINT32_MAX && rank > best) {
+            best = rank;
+            h->phys = devs[i];
+            h->props = p;
+            h->family = fam;
+        }
+    }
+    free(devs);
+    if (best < 0) {
+        if (want && *want)
+            set_err(err, "no Vulkan 1.2 device with compute named like '%s'", want);
+        else
+            set_err(err, "no Vulkan 1.2 device with a compute queue");
+        return false;
+    }
+    vkGetPhysicalDeviceMemoryProperties(h->phys, &h->mem);
+    return true;
+fail:
+    free(devs);
+    return false;
+}
+
+harness *harness_create(const harness_desc *desc, char **err)
+{
+    harness_desc dd = desc ? *desc : (harness_desc){0};
+    if (err)
+        *err = NULL;
+    harness *h = calloc(1, sizeof *h);
+    if (!h) {
+        set_err(err, "out of memory");
+        return NULL;
+    }
+    const char *env = getenv("SPLAT_VALIDATE");
+    h->validate = dd.validate || (env && strcmp(env, "1") == 0);
+    if (!dd.device)
+        dd.device = getenv("SPLAT_DEVICE");
+
+    const char *layers[] = { "VK_LAYER_KHRONOS_validation" };
+    const char *exts[] = { VK_EXT_DEBUG_UTILS_EXTENSION_NAME };
+    if (h->validate && !has_layer(layers[0])) {
+        set_err(err, "validation requested (SPLAT_VALIDATE=1) but %s is not "
+                "installed (Debian: vulkan-validationlayers)", layers[0]);
+        goto fail;
+    }
+    VkApplicationInfo app = {
+        .sType = VK_STRUCTURE_TYPE_APPLICATION_INFO,
+        .pApplicationName = "splat-harness",
+        .pEngineName = "splatc",
+        .apiVersion = VK_API_VERSION_1_2,
+    };
+    VkDebugUtilsMessengerCreateInfoEXT mci = {
+        .sType = VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT,
+        .messageSeverity = VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT |
+                           VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT,
+        .messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT |
+                       VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |
+                       VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT,
+        .pfnUserCallback = on_message,
+        .pUserData = h,
+    };
+    VkInstanceCreateInfo ici = {
+        .sType = VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO,
+        /* chained so instance creation and destruction are covered too */
+        .pNext = h->validate ? &mci : NULL,
+        .pApplicationInfo = &app,
+        .enabledLayerCount = h->validate ? 1 : 0,
+        .ppEnabledLayerNames = layers,
+        .enabledExtensionCount = h->validate ? 1 : 0,
+        .ppEnabledExtensionNames = exts,
+    };
+    VK(vkCreateInstance(&ici, NULL, &h->instance));
+    if (h->validate) {
+        PFN_vkCreateDebugUtilsMessengerEXT create =
+            (PFN_vkCreateDebugUtilsMessengerEXT)vkGetInstanceProcAddr(
+                h->instance, "vkCreateDebugUtilsMessengerEXT");
+        if (!create) {
+            set_err(err, "vkCreateDebugUtilsMessengerEXT not found");
+            goto fail;
+        }
+        VK(create(h->instance, &mci, NULL, &h->messenger));
+    }
+    if (!pick_device(h, dd.device, err))
+        goto fail;
+
+    float prio = 1.0f;
+    VkDeviceQueueCreateInfo qci = {
+        .sType = VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO,
+        .queueFamilyIndex = h->family,
+        .queueCount = 1,
+        .pQueuePriorities = &prio,
+    };
+    VkDeviceCreateInfo dci = {
+        .sType = VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO,
+        .queueCreateInfoCount = 1,
+        .pQueueCreateInfos = &qci,
+    };
+    VK(vkCreateDevice(h->phys, &dci, NULL, &h->device));
+    vkGetDeviceQueue(h->device, h->family, 0, &h->queue);
+    VkCommandPoolCreateInfo pci = {
+        .sType = VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO,
+        .flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT,
+        .queueFamilyIndex = h->family,
+    };
+    VK(vkCreateCommandPool(h->device, &pci, NULL, &h->pool));
+    VkCommandBufferAllocateInfo cai = {
+        .sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO,
+        .commandPool = h->pool,
+        .level = VK_COMMAND_BUFFER_LEVEL_PRIMARY,
+        .commandBufferCount = 1,
+    };
+    VK(vkAllocateCommandBuffers(h->device, &cai, &h->cmd));
+    VkFenceCreateInfo fci = { .sType = VK_STRUCTURE_TYPE_FENCE_CREATE_INFO };
+    VK(vkCreateFence(h->device, &fci, NULL, &h->fence));
+    return h;
+fail:
+    harness_destroy(h);
+    return NULL;
+}
+
+int harness_destroy(harness *h)
+{
+    if (!h)
+        return 0;
+    if (h->device) {
+        vkDeviceWaitIdle(h->device);
+        if (h->fence)
+            vkDestroyFence(h->device, h->fence, NULL);
+        if (h->pool)
+            vkDestroyCommandPool(h->device, h->pool, NULL);
+        vkDestroyDevice(h->device, NULL);
+    }
+    if (h->messenger) {
+        PFN_vkDestroyDebugUtilsMessengerEXT destroy =
+            (PFN_vkDestroyDebugUtilsMessengerEXT)vkGetInstanceProcAddr(
+                h->instance, "vkDestroyDebugUtilsMessengerEXT");
+        if (destroy)
+            destroy(h->instance, h->messenger, NULL);
+    }
+    if (h->instance)
+        vkDestroyInstance(h->instance, NULL);
+    int n = h->messages;
+    free(h);
+    return n;
+}
+
+const char *harness_device_name(const harness *h) { return h->props.deviceName; }
+bool harness_validating(const harness *h) { return h->validate; }
+int harness_validation_count(const harness *h) { return h->messages; }
+
+/* ---- resources of one run ----------------------------------------------- */
+
+typedef struct hbuffer {
+    VkBuffer       buf;
+    VkDeviceMemory mem;
+    void          *map;
+    VkDeviceSize   size;
+} hbuffer;
+
+typedef struct himage {
+    VkImage        img;
+    VkDeviceMemory mem;
+    VkImageView    view;
+    VkSampler      sampler;
+} himage;
+
+static bool find_memory(const harness *h, uint32_t bits, VkMemoryPropertyFlags want,
+                        uint32_t *type)
+{
+    for (uint32_t i = 0; i < h->mem.memoryTypeCount; i++)
+        if ((bits & (1u << i)) &&
+            (h->mem.memoryTypes[i].propertyFlags & want) == want) {
+            *type = i;
+            return true;
+        }
+    return false;
+}
+
+static bool alloc_memory(harness *h, VkMemoryRequirements req,
+                         VkMemoryPropertyFlags want, VkDeviceMemory *mem,
+                         char **err)
+{
+    uint32_t type;
+    if (!find_memory(h, req.memoryTypeBits, want, &type)) {
+        set_err(err, "no Vulkan memory type with properties 0x%x", (unsigned)want);
+        return false;
+    }
+    VkMemoryAllocateInfo mai = {
+        .sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO,
+        .allocationSize = req.size,
+        .memoryTypeIndex = type,
+    };
+    VK(vkAllocateMemory(h->device, &mai, NULL, mem));
+    return true;
+fail:
+    return false;
+}
+
+/* A host-visible, coherent buffer, mapped, zero-filled. */
+static bool buffer_create(harness *h, VkDeviceSize size, VkBufferUsageFlags usage,
+                          hbuffer *b, char **err)
+{
+    VkBufferCreateInfo bci = {
+        .sType = VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO,
+        .size = size,
+        .usage = usage,
+        .sharingMode = VK_SHARING_MODE_EXCLUSIVE,
+    };
+    VK(vkCreateBuffer(h->device, &bci, NULL, &b->buf));
+    VkMemoryRequirements req;
+    vkGetBufferMemoryRequirements(h->device, b->buf, &req);
+    if (!alloc_memory(h, req, VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT |
+                              VK_MEMORY_PROPERTY_HOST_COHERENT_BIT, &b->mem, err))
+        return false;
+    VK(vkBindBufferMemory(h->device, b->buf, b->mem, 0));
+    VK(vkMapMemory(h->device, b->mem, 0, VK_WHOLE_SIZE, 0, &b->map));
+    memset(b->map, 0, size);
+    b->size = size;
+    return true;
+fail:
+    return false;
+}
+
+static void buffer_destroy(harness *h, hbuffer *b)
+{
+    if (b->buf)
+        vkDestroyBuffer(h->device, b->buf, NULL);
+    if (b->mem)
+        vkFreeMemory(h->device, b->mem, NULL);   /* unmaps */
+    memset(b, 0, sizeof *b);
+}
+
+static VkSamplerAddressMode address_mode(ir_wrap w)
+{
+    switch (w) {
+    case IR_WRAP_CLAMP:  return VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE;
+    case IR_WRAP_MIRROR: return VK_SAMPLER_ADDRESS_MODE_MIRRORED_REPEAT;
+    default:             return VK_SAMPLER_ADDRESS_MODE_REPEAT;
+    }
+}
+
+/* An RGBA32F image with its view and sampler; the texels are copied in by
+ * the run's command buffer from `staging` (see record_upload). */
+static bool image_create(harness *h, const harness_image *src, himage *im,
+                         char **err)
+{
+    const VkFormat fmt = VK_FORMAT_R32G32B32A32_SFLOAT;
+    VkFormatProperties fp;
+    vkGetPhysicalDeviceFormatProperties(h->phys, fmt, &fp);
+    VkFormatFeatureFlags need = VK_FORMAT_FEATURE_SAMPLED_IMAGE_BIT;
+    if (src->filter == IR_FILTER_LINEAR)
+        need |= VK_FORMAT_FEATURE_SAMPLED_IMAGE_FILTER_LINEAR_BIT;
+    if ((fp.optimalTilingFeatures & need) != need) {
+        set_err(err, "%s cannot sample RGBA32F images with this filter",
+                h->props.deviceName);
+        return false;
+    }
+    VkImageCreateInfo ici = {
+        .sType = VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO,
+        .imageType = VK_IMAGE_TYPE_2D,
+        .format = fmt,
+        .extent = { (uint32_t)src->width, (uint32_t)src->height, 1 },
+        .mipLevels = 1,
+        .arrayLayers = 1,
+        .samples = VK_SAMPLE_COUNT_1_BIT,
+        .tiling = VK_IMAGE_TILING_OPTIMAL,
+        .usage = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT,
+        .sharingMode = VK_SHARING_MODE_EXCLUSIVE,
+        .initialLayout = VK_IMAGE_LAYOUT_UNDEFINED,
+    };
+    VK(vkCreateImage(h->device, &ici, NULL, &im->img));
+    VkMemoryRequirements req;
+    vkGetImageMemoryRequirements(h->device, im->img, &req);
+    if (!alloc_memory(h, req, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT, &im->mem, err))
+        return false;
+    VK(vkBindImageMemory(h->device, im->img, im->mem, 0));
+    VkImageViewCreateInfo vci = {
+        .sType = VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO,
+        .image = im->img,
+        .viewType = VK_IMAGE_VIEW_TYPE_2D,
+        .format = fmt,
+        .subresourceRange = { VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1 },
+    };
+    VK(vkCreateImageView(h->device, &vci, NULL, &im->view));
+    VkFilter f = src->filter == IR_FILTER_NEAREST ? VK_FILTER_NEAREST : VK_FILTER_LINEAR;
+    VkSamplerAddressMode am = address_mode(src->wrap);
+    VkSamplerCreateInfo sci = {
+        .sType = VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO,
+        .magFilter = f,
+        .minFilter = f,
+        .mipmapMode = VK_SAMPLER_MIPMAP_MODE_NEAREST,
+        .addressModeU = am,
+        .addressModeV = am,
+        .addressModeW = am,
+        .maxLod = 0.0f,
+    };
+    VK(vkCreateSampler(h->device, &sci, NULL, &im->sampler));
+    return true;
+fail:
+    return false;
+}
+
+static void image_destroy(harness *h, himage *im)
+{
+    if (im->sampler)
+        vkDestroySampler(h->device, im->sampler, NULL);
+    if (im->view)
+        vkDestroyImageView(h->device, im->view, NULL);
+    if (im->img)
+        vkDestroyImage(h->device, im->img, NULL);
+    if (im->mem)
+        vkFreeMemory(h->device, im->mem, NULL);
+    memset(im, 0, sizeof *im);
+}
+
+static void image_barrier(VkCommandBuffer cmd, VkImage img, VkImageLayout from,
+                          VkImageLayout to, VkAccessFlags src_access,
+                          VkAccessFlags dst_access, VkPipelineStageFlags src,
+                          VkPipelineStageFlags dst)
+{
+    VkImageMemoryBarrier b = {
+        .sType = VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER,
+        .srcAccessMask = src_access,
+        .dstAccessMask = dst_access,
+        .oldLayout = from,
+        .newLayout = to,
+        .srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED,
+        .dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED,
+        .image = img,
+        .subresourceRange = { VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1 },
+    };
+    vkCmdPipelineBarrier(cmd, src, dst, 0, 0, NULL, 0, NULL, 1, &b);
+}
+
+/* ---- the run ------------------------------------------------------------- */
+
+static bool check_dispatch(const harness_dispatch *d, char **err)
+{
+    if (!d->spv || d->nwords < 5) {
+        set_err(err, "harness_run: no SPIR-V");
+        return false;
+    }
+    /* Invalid SPIR-V is undefined behaviour for the driver: refuse it. */
+    char *log = NULL;
+    if (!spv_validate(d->spv, d->nwords, &log)) {
+        set_err(err, "harness_run: invalid SPIR-V: %s", log ? log : "");
+        free(log);
+        return false;
+    }
+    if (!d->input || !d->input_bytes || !d->output || !d->output_bytes) {
+        set_err(err, "harness_run: input and output buffers are required");
+        return false;
+    }
+    if (d->push_bytes > 128 || d->push_bytes % 4 || (d->push_bytes && !d->push)) {
+        set_err(err, "harness_run: push constants must be 4-byte multiples, at most 128");
+        return false;
+    }
+    for (int i = 0; i < d->nimages; i++) {
+        const harness_image *im = &d->images[i];
+        if (im->width <= 0 || im->height <= 0 || !im->rgba) {
+            set_err(err, "harness_run: image %d has no texels", i);
+            return false;
+        }
+    }
+    return true;
+}
+
+bool harness_run(harness *h, const harness_dispatch *d, char **err)
+{
+    if (err)
+        *err = NULL;
+    if (!check_dispatch(d, err))
+        return false;
+
+    const int nimg = d->nimages;
+    const uint32_t nbind = 2 + (uint32_t)nimg;
+    bool ok = false;
+    hbuffer in = {0}, out = {0};
+    hbuffer *staging = calloc((size_t)nimg + 1, sizeof *staging);
+    himage *images = calloc((size_t)nimg + 1, sizeof *images);
+    VkDescriptorSetLayoutBinding *binds = calloc(nbind, sizeof *binds);
+    VkDescriptorImageInfo *iinfo = calloc((size_t)nimg + 1, sizeof *iinfo);
+    VkWriteDescriptorSet *writes = calloc(nbind, sizeof *writes);
+    VkShaderModule module = VK_NULL_HANDLE;
+    VkDescriptorSetLayout dsl = VK_NULL_HANDLE;
+    VkPipelineLayout layout = VK_NULL_HANDLE;
+    VkPipeline pipeline = VK_NULL_HANDLE;
+    VkDescriptorPool dpool = VK_NULL_HANDLE;
+    VkDescriptorSet set = VK_NULL_HANDLE;
+    if (!staging || !images || !binds || !iinfo || !writes) {
+        set_err(err, "out of memory");
+        goto fail;
+    }
+
+    /* Buffers and images. */
+    if (!buffer_create(h, d->input_bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, &in, err) ||
+        !buffer_create(h, d->output_bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, &out, err))
+        goto fail;
+    memcpy(in.map, d->input, d->input_bytes);
+    for (int i = 0; i < nimg; i++) {
+        const harness_image *src = &d->images[i];
+        size_t bytes = (size_t)src->width * (size_t)src->height * 4 * sizeof(float);
+        if (!buffer_create(h, bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, &staging[i], err) ||
+            !image_create(h, src, &images[i], err))
+            goto fail;
+        memcpy(staging[i].map, src->rgba, bytes);
+    }
+
+    /* Pipeline. */
+    VkShaderModuleCreateInfo smci = {
+        .sType = VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO,
+        .codeSize = d->nwords * sizeof(uint32_t),
+        .pCode = d->spv,
+    };
+    VK(vkCreateShaderModule(h->device, &smci, NULL, &module));
+    for (uint32_t b = 0; b < nbind; b++)
+        binds[b] = (VkDescriptorSetLayoutBinding){
+            .binding = b,
+            .descriptorType = b < 2 ? VK_DESCRIPTOR_TYPE_STORAGE_BUFFER
+                                    : VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+            .descriptorCount = 1,
+            .stageFlags = VK_SHADER_STAGE_COMPUTE_BIT,
+        };
+    VkDescriptorSetLayoutCreateInfo dslci = {
+        .sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO,
+        .bindingCount = nbind,
+        .pBindings = binds,
+    };
+    VK(vkCreateDescriptorSetLayout(h->device, &dslci, NULL, &dsl));
+    VkPushConstantRange pcr = {
+        .stageFlags = VK_SHADER_STAGE_COMPUTE_BIT,
+        .offset = 0,
+        .size = d->push_bytes,
+    };
+    VkPipelineLayoutCreateInfo plci = {
+        .sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO,
+        .setLayoutCount = 1,
+        .pSetLayouts = &dsl,
+        .pushConstantRangeCount = d->push_bytes ? 1 : 0,
+        .pPushConstantRanges = &pcr,
+    };
+    VK(vkCreatePipelineLayout(h->device, &plci, NULL, &layout));
+    VkComputePipelineCreateInfo cpci = {
+        .sType = VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO,
+        .stage = {
+            .sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO,
+            .stage = VK_SHADER_STAGE_COMPUTE_BIT,
+            .module = module,
+            .pName = "main",
+        },
+        .layout = layout,
+    };
+    VK(vkCreateComputePipelines(h->device, VK_NULL_HANDLE, 1, &cpci, NULL, &pipeline));
+
+    /* Descriptors. */
+    VkDescriptorPoolSize sizes[2] = {
+        { VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 2 },
+        { VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, (uint32_t)nimg },
+    };
+    VkDescriptorPoolCreateInfo dpci = {
+        .sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO,
+        .maxSets = 1,
+        .poolSizeCount = nimg ? 2 : 1,
+        .pPoolSizes = sizes,
+    };
+    VK(vkCreateDescriptorPool(h->device, &dpci, NULL, &dpool));
+    VkDescriptorSetAllocateInfo dsai = {
+        .sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO,
+        .descriptorPool = dpool,
+        .descriptorSetCount = 1,
+        .pSetLayouts = &dsl,
+    };
+    VK(vkAllocateDescriptorSets(h->device, &dsai, &set));
+    VkDescriptorBufferInfo binfo[2] = {
+        { in.buf, 0, VK_WHOLE_SIZE },
+        { out.buf, 0, VK_WHOLE_SIZE },
+    };
+    for (uint32_t b = 0; b < nbind; b++) {
+        writes[b] = (VkWriteDescriptorSet){
+            .sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET,
+            .dstSet = set,
+            .dstBinding = b,
+            .descriptorCount = 1,
+            .descriptorType = binds[b].descriptorType,
+        };
+        if (b < 2) {
+            writes[b].pBufferInfo = &binfo[b];
+        } else {
+            iinfo[b - 2] = (VkDescriptorImageInfo){
+                images[b - 2].sampler, images[b - 2].view,
+                VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+            };
+            writes[b].pImageInfo = &iinfo[b - 2];
+        }
+    }
+    vkUpdateDescriptorSets(h->device, nbind, writes, 0, NULL);
+
+    /* Record: upload images, dispatch, make the output visible to the host. */
+    VK(vkResetCommandBuffer(h->cmd, 0));
+    VkCommandBufferBeginInfo cbbi = {
+        .sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO,
+        .flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT,
+    };
+    VK(vkBeginCommandBuffer(h->cmd, &cbbi));
+    for (int i = 0; i < nimg; i++) {
+        image_barrier(h->cmd, images[i].img, VK_IMAGE_LAYOUT_UNDEFINED,
+                      VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 0,
+                      VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT,
+                      VK_PIPELINE_STAGE_TRANSFER_BIT);
+        VkBufferImageCopy region = {
+            .imageSubresource = { VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1 },
+            .imageExtent = { (uint32_t)d->images[i].width,
+                             (uint32_t)d->images[i].height, 1 },
+        };
+        vkCmdCopyBufferToImage(h->cmd, staging[i].buf, images[i].img,
+                               VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
+        image_barrier(h->cmd, images[i].img, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+                      VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+                      VK_ACCESS_TRANSFER_WRITE_BIT, VK_ACCESS_SHADER_READ_BIT,
+                      VK_PIPELINE_STAGE_TRANSFER_BIT,
+                      VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT);
+    }
+    vkCmdBindPipeline(h->cmd, VK_PIPELINE_BIND_POINT_COMPUTE, pipeline);
+    vkCmdBindDescriptorSets(h->cmd, VK_PIPELINE_BIND_POINT_COMPUTE, layout, 0, 1,
+                            &set, 0, NULL);
+    if (d->push_bytes)
+        vkCmdPushConstants(h->cmd, layout, VK_SHADER_STAGE_COMPUTE_BIT, 0,
+                           d->push_bytes, d->push);
+    vkCmdDispatch(h->cmd, d->groups, 1, 1);
+    VkMemoryBarrier mb = {
+        .sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER,
+        .srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT,
+        .dstAccessMask = VK_ACCESS_HOST_READ_BIT,
+    };
+    vkCmdPipelineBarrier(h->cmd, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+                         VK_PIPELINE_STAGE_HOST_BIT, 0, 1, &mb, 0, NULL, 0, NULL);
+    VK(vkEndCommandBuffer(h->cmd));
+
+    VkSubmitInfo si = {
+        .sType = VK_STRUCTURE_TYPE_SUBMIT_INFO,
+        .commandBufferCount = 1,
+        .pCommandBuffers = &h->cmd,
+    };
+    VK(vkResetFences(h->device, 1, &h->fence));
+    VK(vkQueueSubmit(h->queue, 1, &si, h->fence));
+    /* 60 s: lavapipe on two busy cores is slow, but never that slow. */
+    VK(vkWaitForFences(h->device, 1, &h->fence, VK_TRUE, 60ull * 1000000000ull));
+    memcpy(d->output, out.map, d->output_bytes);
+    ok = true;
+
+fail:
+    if (h->device)
+        vkQueueWaitIdle(h->queue);
+    if (pipeline)
+        vkDestroyPipeline(h->device, pipeline, NULL);
+    if (layout)
+        vkDestroyPipelineLayout(h->device, layout, NULL);
+    if (dpool)
+        vkDestroyDescriptorPool(h->device, dpool, NULL);
+    if (dsl)
+        vkDestroyDescriptorSetLayout(h->device, dsl, NULL);
+    if (module)
+        vkDestroyShaderModule(h->device, module, NULL);
+    for (int i = 0; images && staging && i < nimg; i++) {
+        image_destroy(h, &images[i]);
+        buffer_destroy(h, &staging[i]);
+    }
+    buffer_destroy(h, &in);
+    buffer_destroy(h, &out);
+    free(staging);
+    free(images);
+    free(binds);
+    free(iinfo);
+    free(writes);
+    return ok;
+}

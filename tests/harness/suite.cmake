@@ -1,0 +1,27 @@
+# The Vulkan compute harness (tests/harness) and its GPU tests, label `gpu`.
+# Included by tests/CMakeLists.txt.
+set(HARNESS_DIR ${CMAKE_CURRENT_LIST_DIR})
+
+set(HARNESS_SOURCES ${HARNESS_DIR}/harness.c)
+# harness_ir.c drives the compiler's GLSL emitter; until compiler/glsl.c
+# exists the harness is dispatch-only (the glob over compiler/*.c re-runs
+# CMake when it appears).
+if(EXISTS ${PROJECT_SOURCE_DIR}/compiler/glsl.c)
+  list(APPEND HARNESS_SOURCES ${HARNESS_DIR}/harness_ir.c)
+endif()
+add_library(splat_harness STATIC ${HARNESS_SOURCES})
+target_include_directories(splat_harness PUBLIC ${HARNESS_DIR})
+target_link_libraries(splat_harness PUBLIC splatc Vulkan::Vulkan m)
+
+function(splat_gpu_test name)
+  add_executable(${name} ${HARNESS_DIR}/${name}.c ${ARGN})
+  target_link_libraries(${name} splat_harness PkgConfig::CMOCKA)
+  add_test(NAME gpu.${name} COMMAND ${name} WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
+  # lavapipe on two shared cores: allow for a slow machine.
+  set_tests_properties(gpu.${name} PROPERTIES LABELS gpu TIMEOUT 600)
+endfunction()
+
+splat_gpu_test(test_harness)
+if(EXISTS ${PROJECT_SOURCE_DIR}/compiler/glsl.c)
+  splat_gpu_test(test_gpu_agree ${HARNESS_DIR}/random_graph.c)
+endif()
