@@ -43,6 +43,11 @@ void   splat_terrain_normal(const splat_terrain *t, double u, double v, double n
  * has its height, slope, normal and position inside the returned bounds. */
 void splat_terrain_ranges(const splat_terrain *t, int x0, int z0, int x1, int z1,
                           ir_ienv *out);
+/* Widen `env` (from splat_terrain_ranges) for an area whose heights change
+ * at run time (craters only lower texels, down to 0): normal and slope to
+ * every value the filter can give on this terrain, height down to the
+ * offset.  Used for cells the destructible area reaches. */
+void splat_terrain_any_shape(const splat_terrain *t, ir_ienv *env);
 
 /* ---- scene.c: a loaded scene ------------------------------------------- */
 

@@ -1,0 +1,371 @@
+/* terrain.c — the heightfield on the CPU.
+ *
+ * Loading (16-bit PNG, 8-bit PNG scaled by 257, raw little-endian R16), the
+ * CPU twins of the ABI's GLSL height and normal functions (abi.c), and sound
+ * bounds of the terrain inputs over a rectangle of texels for the interval
+ * analysis (analysis.c).
+ *
+ * Why the bounds are sound.  A fragment whose uv lies in texels
+ * [x0, x1) x [z0, z1) sits at texel coordinate x = u*W - 0.5 in
+ * [x0 - 0.5, x1 - 0.5], so bilinear filtering reads texels x0-1 .. x1 (the
+ * rectangle plus a one-texel ring, clamped to the edges): the "footprint".
+ *  - Height is a convex combination of footprint texels: [min, max].
+ *  - Listing 1's unnormalised normal is (a, 2, b) with
+ *      a = (H(x-1) - H(x+1)) * maxh/dx,  b = (H(z-1) - H(z+1)) * maxh/dz,
+ *    and because both taps share their bilinear weights, a is the bilinear
+ *    interpolation of the per-texel differences gx(i,j) = h(i-1,j) - h(i+1,j)
+ *    (indices clamped *after* the +-1; gx = 0 beyond the edge), likewise b.
+ *    So a and b lie in [min, max] of gx, gz over the footprint; the
+ *    normalised components and slope = 1 - n.y then follow by monotonicity
+ *    (normal_bounds below).
+ * GPU error, so the bounds hold on real pixels (documented constants):
+ *  - the two taps of a difference may get bilinear weights that differ by
+ *    one step of sub-texel precision (8 bits on lavapipe, NVIDIA and AMD;
+ *    SUBTEXEL_EPS adds margin for the float uv + texel offset): widens gx,
+ *    gz by SUBTEXEL_EPS * (largest difference of neighbouring texels);
+ *  - texel conversion and filtering arithmetic: UNORM16_EPS (one 16-bit
+ *    step) on gx, gz; FLOAT_EPS on the normalised normal, slope, heights
+ *    (relative) and positions.
+ * Painted masks (analysis.c) are convex combinations of 8-bit texels and
+ * are not widened when constant, so an all-0 / all-1 area stays exact.
+ */
+#include "scene.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <stb_image.h>
+
+#include "abi.h"
+
+#define SUBTEXEL_EPS (1.0 / 256.0 + 1.0 / 4096.0)
+#define UNORM16_EPS  (1.0 / 65536.0)
+#define FLOAT_EPS    2e-6
+
+/* ---- loading ------------------------------------------------------------ */
+
+static bool load_png(splat_terrain *t, const char *path, sg_loc loc, sg_diags *d)
+{
+    int w, h, comp;
+    if (!stbi_info(path, &w, &h, &comp)) {
+        FILE *f = fopen(path, "rb");
+        if (!f) {
+            sg_error(d, loc, SG_E_IO, path, strerror(errno));
+        } else {
+            fclose(f);
+            sg_error(d, loc, SG_E_IO, path, "not a PNG image");
+        }
+        return false;
+    }
+    if (comp != 1) {
+        char msg[256];
+        snprintf(msg, sizeof msg, "heightfield '%s' has %d channels; expected a "
+                 "greyscale image (1 channel, 8 or 16 bits)", path, comp);
+        sg_error(d, loc, SG_E_SCENE, msg);
+        return false;
+    }
+    size_t n = (size_t)w * (size_t)h;
+    t->texels = malloc(n * sizeof *t->texels);
+    if (!t->texels) {
+        sg_error(d, loc, SG_E_TOO_LARGE, "heightfield does not fit in memory");
+        return false;
+    }
+    int lw, lh, lc;
+    if (stbi_is_16_bit(path)) {
+        stbi_us *px = stbi_load_16(path, &lw, &lh, &lc, 1);
+        if (!px) goto fail;
+        memcpy(t->texels, px, n * sizeof *t->texels);
+        stbi_image_free(px);
+    } else {
+        stbi_uc *px = stbi_load(path, &lw, &lh, &lc, 1);
+        if (!px) goto fail;
+        for (size_t i = 0; i < n; i++)
+            t->texels[i] = (uint16_t)(px[i] * 257u);   /* 255 -> 65535 */
+        stbi_image_free(px);
+    }
+    t->width = w;
+    t->height = h;
+    return true;
+fail:
+    sg_error(d, loc, SG_E_IO, path, stbi_failure_reason());
+    free(t->texels);
+    t->texels = NULL;
+    return false;
+}
+
+static bool load_r16(splat_terrain *t, const char *path, int w, int h,
+                     sg_loc loc, sg_diags *d)
+{
+    char msg[512];
+    if (w <= 0 || h <= 0) {
+        snprintf(msg, sizeof msg, "raw heightfield '%s' needs its size: "
+                 "heightfield_size = WIDTH HEIGHT", path);
+        sg_error(d, loc, SG_E_SCENE, msg);
+        return false;
+    }
+    FILE *f = fopen(path, "rb");
+    if (!f) {
+        sg_error(d, loc, SG_E_IO, path, strerror(errno));
+        return false;
+    }
+    size_t n = (size_t)w * (size_t)h;
+    long len = -1;
+    if (fseek(f, 0, SEEK_END) == 0)
+        len = ftell(f);
+    if (len < 0 || fseek(f, 0, SEEK_SET) != 0) {
+        sg_error(d, loc, SG_E_IO, path, "cannot determine its size");
+        fclose(f);
+        return false;
+    }
+    if ((unsigned long)len != n * 2) {
+        snprintf(msg, sizeof msg, "raw heightfield '%s' is %ld bytes; "
+                 "heightfield_size = %d %d needs %zu (16-bit little-endian)",
+                 path, len, w, h, n * 2);
+        sg_error(d, loc, SG_E_SCENE, msg);
+        fclose(f);
+        return false;
+    }
+    uint8_t *raw = malloc(n * 2);
+    t->texels = malloc(n * sizeof *t->texels);
+    if (!raw || !t->texels) {
+        free(raw);
+        free(t->texels);
+        t->texels = NULL;
+        fclose(f);
+        sg_error(d, loc, SG_E_TOO_LARGE, "heightfield does not fit in memory");
+        return false;
+    }
+    size_t got = fread(raw, 1, n * 2, f);
+    fclose(f);
+    if (got != n * 2) {
+        sg_error(d, loc, SG_E_IO, path, "short read");
+        free(raw);
+        free(t->texels);
+        t->texels = NULL;
+        return false;
+    }
+    for (size_t i = 0; i < n; i++)
+        t->texels[i] = (uint16_t)(raw[2 * i] | raw[2 * i + 1] << 8);
+    free(raw);
+    t->width = w;
+    t->height = h;
+    return true;
+}
+
+bool splat_terrain_load(splat_terrain *t, const char *path, sg_hf_format fmt,
+                        int raw_width, int raw_height, sg_loc loc, sg_diags *d)
+{
+    /* Keep the caller's size / max_height / offset; reset the raster. */
+    t->texels = NULL;
+    t->width = t->height = 0;
+    if (fmt == SG_HF_R16)
+        return load_r16(t, path, raw_width, raw_height, loc, d);
+    return load_png(t, path, loc, d);
+}
+
+void splat_terrain_free(splat_terrain *t)
+{
+    free(t->texels);
+    t->texels = NULL;
+    t->width = t->height = 0;
+}
+
+/* ---- sampling: the CPU twins of abi.c ----------------------------------- */
+
+static inline int clampi(int v, int lo, int hi)
+{
+    return v < lo ? lo : v > hi ? hi : v;
+}
+
+static inline double texel(const splat_terrain *t, int x, int z)
+{
+    x = clampi(x, 0, t->width - 1);
+    z = clampi(z, 0, t->height - 1);
+    return t->texels[(size_t)z * (size_t)t->width + (size_t)x] / 65535.0;
+}
+
+double splat_terrain_texel(const splat_terrain *t, int x, int z)
+{
+    return texel(t, x, z);
+}
+
+/* Normalised bilinear sample, clamp to edge, texel i centred at (i+0.5)/W. */
+static double bilinear(const splat_terrain *t, double u, double v)
+{
+    double x = u * t->width - 0.5, z = v * t->height - 0.5;
+    /* Far outside, every tap clamps to the edge; keep floor() in int range
+     * (fmax/fmin also map NaN to the edge). */
+    x = fmin(fmax(x, -1.0), (double)t->width);
+    z = fmin(fmax(z, -1.0), (double)t->height);
+    double fx = floor(x), fz = floor(z);
+    int ix = (int)fx, iz = (int)fz;
+    double ax = x - fx, az = z - fz;
+    double h00 = texel(t, ix, iz), h10 = texel(t, ix + 1, iz);
+    double h01 = texel(t, ix, iz + 1), h11 = texel(t, ix + 1, iz + 1);
+    double top = h00 + (h10 - h00) * ax, bot = h01 + (h11 - h01) * ax;
+    return top + (bot - top) * az;
+}
+
+double splat_terrain_height(const splat_terrain *t, double u, double v)
+{
+    return bilinear(t, u, v) * t->max_height + t->height_offset;
+}
+
+void splat_terrain_normal(const splat_terrain *t, double u, double v, double n[3])
+{
+    double tx = 1.0 / t->width, tz = 1.0 / t->height;
+    double hd = bilinear(t, u, v - tz);
+    double hl = bilinear(t, u - tx, v);
+    double hr = bilinear(t, u + tx, v);
+    double hu = bilinear(t, u, v + tz);
+    splat_normal_filter(hl, hr, hd, hu, t->max_height,
+                        t->size[0] * tx, t->size[1] * tz, n);
+}
+
+/* ---- ranges ------------------------------------------------------------- */
+
+static inline ir_iv iv(double lo, double hi) { return (ir_iv){ lo, hi }; }
+
+/* Smallest and largest square of a value in [lo, hi]. */
+static double sq_min(double lo, double hi)
+{
+    if (lo <= 0 && hi >= 0) return 0;
+    return fmin(lo * lo, hi * hi);
+}
+static double sq_max(double lo, double hi) { return fmax(lo * lo, hi * hi); }
+
+/* a / sqrt(a^2 + 4 + b2), the normalised x (or z) component. */
+static double ncomp(double a, double b2)
+{
+    if (isinf(a)) return copysign(1.0, a);
+    if (isinf(b2)) return 0.0;
+    return a / sqrt(a * a + 4.0 + b2);
+}
+
+/* Bounds of normalize(a, 2, b) for a in A, b in B, and of 1 - n.y.
+ * n.x grows with a and shrinks in magnitude as b^2 grows, so its extremes
+ * are at a's ends with b^2 at whichever end pulls towards them; n.y is
+ * 2 / |(a, 2, b)|, extreme at the extremes of a^2 + b^2. */
+static void normal_bounds(ir_iv A, ir_iv B, ir_iv n[3], ir_iv *slope)
+{
+    double a2lo = sq_min(A.lo, A.hi), a2hi = sq_max(A.lo, A.hi);
+    double b2lo = sq_min(B.lo, B.hi), b2hi = sq_max(B.lo, B.hi);
+    n[0].hi = ncomp(A.hi, A.hi >= 0 ? b2lo : b2hi);
+    n[0].lo = ncomp(A.lo, A.lo <= 0 ? b2lo : b2hi);
+    n[2].hi = ncomp(B.hi, B.hi >= 0 ? a2lo : a2hi);
+    n[2].lo = ncomp(B.lo, B.lo <= 0 ? a2lo : a2hi);
+    double big = a2hi + b2hi, small = a2lo + b2lo;
+    n[1].lo = isinf(big) ? 0.0 : 2.0 / sqrt(4.0 + big);
+    n[1].hi = 2.0 / sqrt(4.0 + small);
+    for (int c = 0; c < 3; c++) {
+        n[c].lo -= FLOAT_EPS;
+        n[c].hi += FLOAT_EPS;
+    }
+    *slope = iv(1.0 - n[1].hi, 1.0 - n[1].lo);
+}
+
+/* Metres per normalised height unit over metres per texel, per axis. */
+static void gradient_scale(const splat_terrain *t, double *kx, double *kz)
+{
+    *kx = t->max_height / (t->size[0] / t->width);
+    *kz = t->max_height / (t->size[1] / t->height);
+}
+
+/* Widen [lo, hi] by a relative float error (zero stays exactly zero). */
+static ir_iv widen_rel(double lo, double hi)
+{
+    return iv(lo - fabs(lo) * FLOAT_EPS, hi + fabs(hi) * FLOAT_EPS);
+}
+
+void splat_terrain_ranges(const splat_terrain *t, int x0, int z0, int x1, int z1,
+                          ir_ienv *out)
+{
+    x0 = clampi(x0, 0, t->width - 1);
+    z0 = clampi(z0, 0, t->height - 1);
+    x1 = clampi(x1, x0 + 1, t->width);
+    z1 = clampi(z1, z0 + 1, t->height);
+
+    const uint16_t *h = t->texels;
+    size_t W = (size_t)t->width;
+    int hmin = 65535, hmax = 0;            /* footprint heights, raw units */
+    int gxmin = 65535, gxmax = -65535;     /* h(i-1) - h(i+1)              */
+    int gzmin = 65535, gzmax = -65535;
+    int step = 0;                          /* largest neighbour difference */
+    for (int j = z0 - 1; j <= z1; j++) {
+        size_t row = (size_t)clampi(j, 0, t->height - 1) * W;
+        size_t rowd = (size_t)clampi(j - 1, 0, t->height - 1) * W;
+        size_t rowu = (size_t)clampi(j + 1, 0, t->height - 1) * W;
+        for (int i = x0 - 1; i <= x1; i++) {
+            size_t c = (size_t)clampi(i, 0, t->width - 1);
+            size_t l = (size_t)clampi(i - 1, 0, t->width - 1);
+            size_t r = (size_t)clampi(i + 1, 0, t->width - 1);
+            int hc = h[row + c], hl = h[row + l], hr = h[row + r];
+            int hd = h[rowd + c], hu = h[rowu + c];
+            if (hc < hmin) hmin = hc;
+            if (hc > hmax) hmax = hc;
+            int gx = hl - hr, gz = hd - hu;
+            if (gx < gxmin) gxmin = gx;
+            if (gx > gxmax) gxmax = gx;
+            if (gz < gzmin) gzmin = gz;
+            if (gz > gzmax) gzmax = gz;
+            int s = abs(hc - hl);
+            if (abs(hr - hc) > s) s = abs(hr - hc);
+            if (abs(hc - hd) > s) s = abs(hc - hd);
+            if (abs(hu - hc) > s) s = abs(hu - hc);
+            if (s > step) step = s;
+        }
+    }
+
+    double maxh = t->max_height, off = t->height_offset;
+    double lo = hmin / 65535.0 * maxh + off, hi = hmax / 65535.0 * maxh + off;
+    if (lo > hi) {                         /* negative max_height */
+        double tmp = lo; lo = hi; hi = tmp;
+    }
+    if (hmin != hmax) {                    /* filtering arithmetic */
+        lo -= UNORM16_EPS * fabs(maxh);
+        hi += UNORM16_EPS * fabs(maxh);
+    }
+    out->height = widen_rel(lo, hi);       /* scale and offset in float */
+
+    double kx, kz;
+    gradient_scale(t, &kx, &kz);
+    double eg = SUBTEXEL_EPS * step / 65535.0 + UNORM16_EPS;
+    ir_iv A = iv((gxmin / 65535.0 - eg) * kx, (gxmax / 65535.0 + eg) * kx);
+    ir_iv B = iv((gzmin / 65535.0 - eg) * kz, (gzmax / 65535.0 + eg) * kz);
+    if (A.lo > A.hi) A = iv(A.hi, A.lo);
+    if (B.lo > B.hi) B = iv(B.hi, B.lo);
+    if (isnan(A.lo) || isnan(A.hi)) A = iv(-INFINITY, INFINITY);
+    if (isnan(B.lo) || isnan(B.hi)) B = iv(-INFINITY, INFINITY);
+    normal_bounds(A, B, out->normal, &out->slope);
+
+    double u0 = (double)x0 / t->width, u1 = (double)x1 / t->width;
+    double v0 = (double)z0 / t->height, v1 = (double)z1 / t->height;
+    out->uv[0] = iv(u0 - FLOAT_EPS, u1 + FLOAT_EPS);
+    out->uv[1] = iv(v0 - FLOAT_EPS, v1 + FLOAT_EPS);
+    double ex = FLOAT_EPS * fabs(t->size[0]), ez = FLOAT_EPS * fabs(t->size[1]);
+    out->position[0] = iv(u0 * t->size[0] - ex, u1 * t->size[0] + ex);
+    out->position[1] = out->height;
+    out->position[2] = iv(v0 * t->size[1] - ez, v1 * t->size[1] + ez);
+    out->view_distance = iv(0.0, INFINITY);
+    out->destruction = iv(0.0, 0.0);
+}
+
+void splat_terrain_any_shape(const splat_terrain *t, ir_ienv *env)
+{
+    /* Any heightfield: neighbour differences span [-1, 1]; heights only go
+     * down, to texel value 0. */
+    double kx, kz;
+    gradient_scale(t, &kx, &kz);
+    ir_iv A = iv(-fabs(kx), fabs(kx)), B = iv(-fabs(kz), fabs(kz));
+    if (isnan(kx)) A = iv(-INFINITY, INFINITY);
+    if (isnan(kz)) B = iv(-INFINITY, INFINITY);
+    normal_bounds(A, B, env->normal, &env->slope);
+    double floor_h = t->max_height >= 0 ? t->height_offset
+                                        : t->height_offset + t->max_height;
+    if (floor_h < env->height.lo)
+        env->height.lo = floor_h - fabs(floor_h) * FLOAT_EPS;
+    env->position[1] = env->height;
+}
