@@ -1,0 +1,387 @@
+/* analysis.c — the material combinations a scene really has (DESIGN §7).
+ *
+ * Leaf cells are cell_texels x cell_texels heightfield texels.  For each
+ * cell: splat_terrain_ranges bounds height, slope, normal, position and uv
+ * (terrain.c says why soundly), the painted masks are bounded by the min and
+ * max of their texels in the bilinear footprint (the cell plus a one-texel
+ * ring), the destruction mask is [0, 1] where the destructible area reaches
+ * the cell (and there heights and slopes may change: splat_terrain_any_shape)
+ * and 0 elsewhere.  Then, from the top of the stack down, ir_interval bounds
+ * each material's "<name>.mask": the material is present if the upper bound
+ * is above 0, opaque if the lower bound is at least 1; the cell's
+ * combination is the present materials down to the first opaque one (the
+ * bottom material counts as mask 1: always present and opaque).
+ *
+ * Quadtree nodes above the leaves (level L+1 halves each side, rounding up,
+ * until one node remains) take the union of their children: a material is
+ * in the node's combination if it is in any child's.  With "present" read as
+ * "in the child's combination" that is PACK.md's rule (present if present in
+ * any child, opaque only if opaque in all): a child's combination ends at its
+ * first opaque material, so a material opaque in every child is the lowest
+ * of every child's combination and nothing below it is in the union.  It is
+ * sound: on a child's fragments, materials of the union that the child lacks
+ * are either absent there (w = 0) or below its opaque one (T = 0).
+ *
+ * Example: stack [grass, dirt, cliff] (bottom first), cliff opaque on a steep
+ * cell, dirt partial on a sloped one:
+ *     leaf A: {cliff}            leaf B: {dirt, grass}
+ *     parent: {cliff, dirt, grass}
+ *
+ * Combination ids follow first occurrence: level 0 row-major, then each
+ * higher level, so the same scene always gives the same ids.
+ *
+ * Cost: each cell's terrain and painted ranges are O(its footprint), so the
+ * whole analysis is linear in texels; masks are bounded once per cell and
+ * material (not per texel).
+ */
+#include "scene.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+static double now_seconds(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + ts.tv_nsec * 1e-9;
+}
+
+/* ---- combination table -------------------------------------------------- */
+
+/* Combinations interned by their member bitset (bit i = scene material i). */
+typedef struct combo_set {
+    splat_analysis *a;
+    int             words;     /* uint64 words per member bitset          */
+    uint64_t       *keys;      /* ncombos * words, the members of each    */
+    int            *slots;     /* hash table: combo index + 1, 0 = empty  */
+    int             capslots, capcombos;
+} combo_set;
+
+static uint64_t hash_bits(const uint64_t *bits, int words)
+{
+    uint64_t h = 0xcbf29ce484222325ull;
+    for (int w = 0; w < words; w++) {
+        h ^= bits[w];
+        h *= 0x100000001b3ull;
+        h ^= h >> 29;
+    }
+    return h;
+}
+
+static bool set_grow(combo_set *cs)
+{
+    int cap = cs->capslots ? cs->capslots * 2 : 64;
+    int *slots = calloc((size_t)cap, sizeof *slots);
+    if (!slots) return false;
+    for (int i = 0; i < cs->a->ncombos; i++) {
+        uint64_t h = hash_bits(cs->keys + (size_t)i * cs->words, cs->words);
+        size_t k = h & (size_t)(cap - 1);
+        while (slots[k]) k = (k + 1) & (size_t)(cap - 1);
+        slots[k] = i + 1;
+    }
+    free(cs->slots);
+    cs->slots = slots;
+    cs->capslots = cap;
+    return true;
+}
+
+/* The id of the combination with members `bits`, added if new; -1 on
+ * allocation failure. */
+static int set_intern(combo_set *cs, const uint64_t *bits, int nmaterials)
+{
+    splat_analysis *a = cs->a;
+    if ((a->ncombos + 1) * 2 > cs->capslots && !set_grow(cs)) return -1;
+    uint64_t h = hash_bits(bits, cs->words);
+    size_t k = h & (size_t)(cs->capslots - 1);
+    size_t bytes = (size_t)cs->words * sizeof *bits;
+    while (cs->slots[k]) {
+        int i = cs->slots[k] - 1;
+        if (memcmp(cs->keys + (size_t)i * cs->words, bits, bytes) == 0) return i;
+        k = (k + 1) & (size_t)(cs->capslots - 1);
+    }
+    if (a->ncombos == cs->capcombos) {
+        int cap = cs->capcombos ? cs->capcombos * 2 : 16;
+        uint64_t *keys = realloc(cs->keys, (size_t)cap * bytes);
+        if (!keys) return -1;
+        cs->keys = keys;
+        splat_combo *combos = realloc(a->combos, (size_t)cap * sizeof *combos);
+        if (!combos) return -1;
+        a->combos = combos;
+        cs->capcombos = cap;
+    }
+    int id = a->ncombos;
+    splat_combo *c = &a->combos[id];
+    memset(c, 0, sizeof *c);
+    int n = 0;
+    for (int m = 0; m < nmaterials; m++)
+        n += (int)(bits[m / 64] >> (m % 64) & 1);
+    c->materials = malloc((size_t)(n ? n : 1) * sizeof *c->materials);
+    if (!c->materials) return -1;
+    for (int m = nmaterials - 1; m >= 0; m--)      /* top first */
+        if (bits[m / 64] >> (m % 64) & 1)
+            c->materials[c->nmaterials++] = m;
+    memcpy(cs->keys + (size_t)id * cs->words, bits, bytes);
+    cs->slots[k] = id + 1;
+    a->ncombos++;
+    return id;
+}
+
+/* set_intern with the errors reported: ids are uint16 (PACK.md). */
+static int intern_checked(combo_set *cs, const uint64_t *bits, int nmaterials,
+                          const sg_scene *sc, sg_diags *d)
+{
+    int id = set_intern(cs, bits, nmaterials);
+    if (id < 0) {
+        sg_error(d, sc->loc, SG_E_TOO_LARGE, "out of memory in the analysis");
+    } else if (id > UINT16_MAX) {
+        sg_error(d, sc->loc, SG_E_TOO_LARGE,
+                 "the scene has more than 65536 material combinations");
+        id = -1;
+    }
+    return id;
+}
+
+/* ---- per-cell ranges ---------------------------------------------------- */
+
+static inline int clampi(int v, int lo, int hi)
+{
+    return v < lo ? lo : v > hi ? hi : v;
+}
+
+/* Painted mask bounds over the bilinear footprint of [x0,x1) x [z0,z1).
+ * Constant footprints stay exact (a convex combination of equal 8-bit
+ * values is that value), so all-0 and all-1 areas stay absent / opaque. */
+static ir_iv painted_range(const uint8_t *px, int w, int h,
+                           int x0, int z0, int x1, int z1)
+{
+    int lo = 255, hi = 0;
+    for (int j = z0 - 1; j <= z1; j++) {
+        const uint8_t *row = px + (size_t)clampi(j, 0, h - 1) * (size_t)w;
+        for (int i = x0 - 1; i <= x1; i++) {
+            int v = row[clampi(i, 0, w - 1)];
+            if (v < lo) lo = v;
+            if (v > hi) hi = v;
+        }
+    }
+    ir_iv r = { lo / 255.0, hi / 255.0 };
+    if (lo != hi) {             /* filtering arithmetic in float */
+        r.lo -= 1e-6;
+        r.hi += 1e-6;
+    }
+    return r;
+}
+
+/* Whether the destructible area can reach positions in env's x/z range.
+ * The runtime's indirection grid covers whole cells, as many per side as
+ * the longer side needs, so the reachable area is rounded up to that. */
+static bool destruction_reaches(const sg_scene *sc, const ir_ienv *env)
+{
+    double cell = sc->destruction_cell;
+    double side = fmax(sc->destruction_size[0], sc->destruction_size[1]);
+    double extent = ceil(side / cell) * cell;
+    double ox = sc->destruction_origin[0], oz = sc->destruction_origin[1];
+    return env->position[0].hi >= ox && env->position[0].lo <= ox + extent &&
+           env->position[2].hi >= oz && env->position[2].lo <= oz + extent;
+}
+
+/* ---- the analysis ------------------------------------------------------- */
+
+bool splat_analyze(const splat_scene *s, splat_analysis *a, sg_diags *d)
+{
+    double t0 = now_seconds();
+    memset(a, 0, sizeof *a);
+    const sg_scene *sc = s->desc;
+    const splat_terrain *t = &s->terrain;
+    int n = s->nmaterials;
+    int T = sc->cell_texels > 0 ? sc->cell_texels : 32;
+    a->cell_texels = T;
+    a->cells_x = (t->width + T - 1) / T;
+    a->cells_z = (t->height + T - 1) / T;
+    a->naive_subsets = n > 0 ? ldexp(1.0, n - 1) : 0;
+
+    combo_set cs = { .a = a, .words = (n + 63) / 64 };
+    if (cs.words == 0) cs.words = 1;
+    ir_ref *masks = calloc((size_t)(n ? n : 1), sizeof *masks);
+    ir_iv *painted = calloc((size_t)(s->ir.npainted ? s->ir.npainted : 1),
+                            sizeof *painted);
+    uint64_t *bits = NULL;
+    bool ok = masks && painted;
+    if (!ok) sg_error(d, sc->loc, SG_E_TOO_LARGE, "out of memory in the analysis");
+
+    for (int m = 1; ok && m < n; m++) {
+        char name[512];
+        snprintf(name, sizeof name, "%s.mask", sc->materials[m]);
+        masks[m] = ir_find_root(&s->ir, name);
+        if (!ir_ref_ok(masks[m])) {
+            char msg[600];
+            snprintf(msg, sizeof msg, "material '%s' has no mask root", sc->materials[m]);
+            sg_error(d, sc->loc, SG_E_INTERNAL, msg);
+            ok = false;
+        }
+    }
+
+    /* Levels: 0 = cells, each next one halves the sides (rounding up). */
+    int nlevels = 1;
+    for (int w = a->cells_x, h = a->cells_z; w > 1 || h > 1; nlevels++) {
+        w = (w + 1) / 2;
+        h = (h + 1) / 2;
+    }
+    if (ok) {
+        a->levels = calloc((size_t)nlevels, sizeof *a->levels);
+        ok = a->levels != NULL;
+        if (!ok) sg_error(d, sc->loc, SG_E_TOO_LARGE, "out of memory in the analysis");
+    }
+    if (ok) a->nlevels = nlevels;
+    for (int L = 0, w = a->cells_x, h = a->cells_z; ok && L < nlevels; L++) {
+        a->levels[L].width = w;
+        a->levels[L].height = h;
+        a->levels[L].ids = calloc((size_t)w * (size_t)h, sizeof(uint16_t));
+        if (!a->levels[L].ids) {
+            sg_error(d, sc->loc, SG_E_TOO_LARGE, "out of memory in the analysis");
+            ok = false;
+        }
+        w = (w + 1) / 2;
+        h = (h + 1) / 2;
+    }
+
+    /* Member bitsets of the current level's nodes. */
+    size_t ncells = (size_t)a->cells_x * (size_t)a->cells_z;
+    if (ok) {
+        bits = calloc(ncells * (size_t)cs.words, sizeof *bits);
+        ok = bits != NULL;
+        if (!ok) sg_error(d, sc->loc, SG_E_TOO_LARGE, "out of memory in the analysis");
+    }
+
+    /* Level 0: the cells. */
+    for (int cz = 0; ok && cz < a->cells_z; cz++) {
+        for (int cx = 0; ok && cx < a->cells_x; cx++) {
+            int x0 = cx * T, z0 = cz * T;
+            int x1 = x0 + T < t->width ? x0 + T : t->width;
+            int z1 = z0 + T < t->height ? z0 + T : t->height;
+            ir_ienv env;
+            memset(&env, 0, sizeof env);
+            splat_terrain_ranges(t, x0, z0, x1, z1, &env);
+            if (sc->has_destruction && destruction_reaches(sc, &env)) {
+                env.destruction = (ir_iv){ 0.0, 1.0 };
+                splat_terrain_any_shape(t, &env);
+            }
+            for (int k = 0; k < s->ir.npainted; k++) {
+                if (k < sc->npainted && s->painted && s->painted[k])
+                    painted[k] = painted_range(s->painted[k], t->width, t->height,
+                                               x0, z0, x1, z1);
+                else
+                    painted[k] = (ir_iv){ 0.0, 1.0 };
+            }
+            env.painted = painted;
+            env.params = NULL;      /* every param over its [lo, hi] */
+
+            uint64_t *cell = bits + ((size_t)cz * a->cells_x + cx) * cs.words;
+            int m = n - 1;
+            for (; m > 0; m--) {
+                ir_iv out[4];
+                ir_interval(&s->ir, masks[m], &env, out);
+                bool present = !(out[0].hi <= 0.0);     /* NaN: present */
+                bool opaque = out[0].lo >= 1.0;
+                if (present) cell[m / 64] |= 1ull << (m % 64);
+                if (present && opaque) break;
+            }
+            if (m == 0 && n > 0) cell[0] |= 1ull;       /* the base: mask 1 */
+            int id = intern_checked(&cs, cell, n, sc, d);
+            if (id < 0) {
+                ok = false;
+                break;
+            }
+            a->levels[0].ids[(size_t)cz * a->cells_x + cx] = (uint16_t)id;
+            a->combos[id].ncells++;
+            a->combos[id].nnodes++;
+        }
+    }
+
+    /* Higher levels: the union of the (up to four) children. */
+    for (int L = 1; ok && L < a->nlevels; L++) {
+        const splat_level *below = &a->levels[L - 1];
+        splat_level *lv = &a->levels[L];
+        size_t nn = (size_t)lv->width * (size_t)lv->height;
+        uint64_t *up = calloc(nn * (size_t)cs.words, sizeof *up);
+        if (!up) {
+            sg_error(d, sc->loc, SG_E_TOO_LARGE, "out of memory in the analysis");
+            ok = false;
+            break;
+        }
+        for (int z = 0; ok && z < lv->height; z++) {
+            for (int x = 0; ok && x < lv->width; x++) {
+                uint64_t *node = up + ((size_t)z * lv->width + x) * cs.words;
+                for (int dz = 0; dz < 2; dz++) {
+                    for (int dx = 0; dx < 2; dx++) {
+                        int bx = 2 * x + dx, bz = 2 * z + dz;
+                        if (bx >= below->width || bz >= below->height) continue;
+                        const uint64_t *child =
+                            bits + ((size_t)bz * below->width + bx) * cs.words;
+                        for (int w = 0; w < cs.words; w++) node[w] |= child[w];
+                    }
+                }
+                int id = intern_checked(&cs, node, n, sc, d);
+                if (id < 0) {
+                    ok = false;
+                    break;
+                }
+                lv->ids[(size_t)z * lv->width + x] = (uint16_t)id;
+                a->combos[id].nnodes++;
+            }
+        }
+        free(bits);
+        bits = up;
+    }
+    for (int i = 0; i < a->ncombos; i++)
+        if (a->combos[i].nmaterials > a->largest)
+            a->largest = a->combos[i].nmaterials;
+
+    free(bits);
+    free(painted);
+    free(masks);
+    free(cs.keys);
+    free(cs.slots);
+    a->seconds = now_seconds() - t0;
+    if (!ok) splat_analysis_free(a);
+    return ok;
+}
+
+void splat_analysis_free(splat_analysis *a)
+{
+    for (int i = 0; i < a->ncombos; i++)
+        free(a->combos[i].materials);
+    free(a->combos);
+    for (int L = 0; L < a->nlevels; L++)
+        free(a->levels[L].ids);
+    free(a->levels);
+    memset(a, 0, sizeof *a);
+}
+
+void splat_analysis_report(const splat_scene *s, const splat_analysis *a, FILE *out)
+{
+    const sg_scene *sc = s->desc;
+    int leaf = 0;
+    for (int i = 0; i < a->ncombos; i++)
+        leaf += a->combos[i].ncells > 0;
+    fprintf(out, "scene '%s': %d materials, heightfield %d x %d texels, "
+            "%g x %g m\n", sc->name, s->nmaterials, s->terrain.width,
+            s->terrain.height, s->terrain.size[0], s->terrain.size[1]);
+    fprintf(out, "cells: %d x %d = %d of %d x %d texels, %d quadtree levels\n",
+            a->cells_x, a->cells_z, a->cells_x * a->cells_z, a->cell_texels,
+            a->cell_texels, a->nlevels);
+    fprintf(out, "combinations: %d in leaf cells, %d with quadtree nodes "
+            "(naive all subsets: %.0f)\n", leaf, a->ncombos, a->naive_subsets);
+    fprintf(out, "largest combination: %d materials\n", a->largest);
+    fprintf(out, "  id  cells  nodes  materials (top first)\n");
+    for (int i = 0; i < a->ncombos; i++) {
+        const splat_combo *c = &a->combos[i];
+        fprintf(out, "%4d %6d %6d  ", i, c->ncells, c->nnodes);
+        for (int k = 0; k < c->nmaterials; k++)
+            fprintf(out, "%s%s", k ? ", " : "", sc->materials[c->materials[k]]);
+        fputc('\n', out);
+    }
+    fprintf(out, "analysis time: %.3f ms\n", a->seconds * 1e3);
+}

@@ -1,0 +1,359 @@
+/* scene.c — a loaded scene: the scene file and its imports parsed and
+ * checked, the heightfield and painted rasters loaded, every material of
+ * the stack lowered into one shared IR.
+ *
+ * Pipeline (splat_scene_load):
+ *   sg_load(scene.sg)            parse, resolve imports, type-check
+ *   check_scene                  every scene field, all errors at once
+ *   splat_terrain_load           the heightfield (terrain.c)
+ *   load_painted                 8-bit greyscale rasters, heightfield size
+ *   lower_materials              "<name>.mask", ".albedo", … roots in s->ir
+ *
+ * s->ir.painted[i] is the scene's painted mask i (registered first, in the
+ * scene's order), so a painted index is the same everywhere: the scene, the
+ * IR, the analysis and the pack's painted layers.
+ *
+ * Imports are searched relative to the importing file, then the scene's
+ * folder, then the caller's search paths; without any, the nearest folder
+ * at or above the scene's that has a `nodes/` folder (the project root, so
+ * `import "graphs/grass.sg"` works from examples/NAME/scene.sg), then ".".
+ */
+#include "scene.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include <stb_image.h>
+
+/* ---- search paths ------------------------------------------------------- */
+
+static char *xstrdup(const char *s)
+{
+    size_t n = strlen(s) + 1;
+    char *p = malloc(n);
+    if (p) memcpy(p, s, n);
+    return p;
+}
+
+static char *dir_of(const char *path)
+{
+    const char *slash = strrchr(path, '/');
+    if (!slash) return xstrdup(".");
+    if (slash == path) return xstrdup("/");
+    size_t n = (size_t)(slash - path);
+    char *d = malloc(n + 1);
+    if (!d) return NULL;
+    memcpy(d, path, n);
+    d[n] = 0;
+    return d;
+}
+
+static bool is_dir(const char *dir, const char *sub)
+{
+    size_t n = strlen(dir) + strlen(sub) + 2;
+    char *p = malloc(n);
+    if (!p) return false;
+    snprintf(p, n, "%s/%s", dir, sub);
+    struct stat st;
+    bool ok = stat(p, &st) == 0 && S_ISDIR(st.st_mode);
+    free(p);
+    return ok;
+}
+
+/* The parent of a folder path, kept relative where it was relative:
+ * "a/b" -> "a" -> "." -> ".." -> "../.."; NULL above "/". */
+static char *parent_dir(const char *dir)
+{
+    if (strcmp(dir, "/") == 0) return NULL;
+    if (strcmp(dir, ".") == 0) return xstrdup("..");
+    size_t n = strlen(dir);
+    if (n >= 2 && strcmp(dir + n - 2, "..") == 0 && (n == 2 || dir[n - 3] == '/')) {
+        char *p = malloc(n + 4);
+        if (p) snprintf(p, n + 4, "%s/..", dir);
+        return p;
+    }
+    return dir_of(dir);
+}
+
+/* The nearest folder at or above `dir` holding a nodes/ folder, or NULL. */
+static char *project_root(const char *dir)
+{
+    char *d = xstrdup(dir);
+    for (int depth = 0; d && depth < 32; depth++) {
+        if (is_dir(d, "nodes")) return d;
+        char *up = parent_dir(d);
+        free(d);
+        d = up;
+    }
+    free(d);
+    return NULL;
+}
+
+/* ---- checks ------------------------------------------------------------- */
+
+static sg_loc loc_or(sg_loc loc, sg_loc fallback)
+{
+    return loc.line > 0 ? loc : fallback;
+}
+
+static void scene_error(sg_diags *d, sg_loc loc, const char *fmt, ...)
+    __attribute__((format(printf, 3, 4)));
+
+static void scene_error(sg_diags *d, sg_loc loc, const char *fmt, ...)
+{
+    char msg[512];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(msg, sizeof msg, fmt, ap);
+    va_end(ap);
+    sg_error(d, loc, SG_E_SCENE, msg);
+}
+
+static bool is_pow2(int v) { return v > 0 && (v & (v - 1)) == 0; }
+
+/* Every scene field that can be checked without reading files. */
+static void check_scene(sg_program *p, const sg_scene *sc, sg_diags *d)
+{
+    if (!sc->heightfield)
+        scene_error(d, sc->loc, "scene '%s' has no heightfield "
+                    "(heightfield = \"FILE.png\")", sc->name);
+    if (!(sc->size[0] > 0) || !(sc->size[1] > 0) || !isfinite(sc->size[0]) ||
+        !isfinite(sc->size[1]))
+        scene_error(d, loc_or(sc->size_loc, sc->loc), "world size must be two "
+                    "positive lengths in metres, found %g %g",
+                    sc->size[0], sc->size[1]);
+    if (!(sc->max_height >= 0) || !isfinite(sc->max_height))
+        scene_error(d, loc_or(sc->max_height_loc, sc->loc), "max_height must "
+                    "be 0 or more metres, found %g", sc->max_height);
+    if (!isfinite(sc->height_offset))
+        scene_error(d, sc->loc, "height_offset must be finite, found %g",
+                    sc->height_offset);
+    if (sc->nmaterials == 0)
+        scene_error(d, sc->loc, "scene '%s' has an empty material stack "
+                    "(materials = [BOTTOM, …, TOP])", sc->name);
+    for (int i = 0; i < sc->nmaterials; i++) {
+        sg_loc loc = sc->material_locs ? loc_or(sc->material_locs[i], sc->loc)
+                                       : sc->loc;
+        if (sg_material_find(p, sc->materials[i]) < 0) {
+            sg_error(d, loc, SG_E_UNKNOWN_NAME, sc->materials[i]);
+            continue;
+        }
+        for (int j = 0; j < i; j++) {
+            if (strcmp(sc->materials[i], sc->materials[j]) == 0) {
+                sg_loc first = sc->material_locs ? sc->material_locs[j] : sc->loc;
+                sg_error(d, loc, SG_E_DUPLICATE, "material in the stack",
+                         sc->materials[i], first.file, first.line, first.col);
+                break;
+            }
+        }
+    }
+    int cell = sc->cell_texels;
+    if (cell != 0 || sc->cell_texels_loc.line > 0) {   /* 0 unset: default */
+        if (!is_pow2(cell) || cell > 4096)
+            scene_error(d, loc_or(sc->cell_texels_loc, sc->loc), "cell must be "
+                        "a power of two from 1 to 4096 heightfield texels, "
+                        "found %d", cell);
+    }
+    for (int i = 0; i < sc->npainted; i++) {
+        const sg_scene_painted *pm = &sc->painted[i];
+        for (int j = 0; j < i; j++) {
+            if (strcmp(pm->name, sc->painted[j].name) == 0) {
+                sg_error(d, loc_or(pm->loc, sc->loc), SG_E_DUPLICATE,
+                         "painted mask", pm->name, sc->painted[j].loc.file,
+                         sc->painted[j].loc.line, sc->painted[j].loc.col);
+                break;
+            }
+        }
+    }
+    if (sc->has_destruction) {
+        if (!(sc->destruction_size[0] > 0) || !(sc->destruction_size[1] > 0) ||
+            !isfinite(sc->destruction_size[0]) || !isfinite(sc->destruction_size[1]) ||
+            !isfinite(sc->destruction_origin[0]) || !isfinite(sc->destruction_origin[1]))
+            scene_error(d, sc->loc, "the destructible area needs a finite "
+                        "origin and a positive size, found origin %g %g, "
+                        "size %g %g", sc->destruction_origin[0],
+                        sc->destruction_origin[1], sc->destruction_size[0],
+                        sc->destruction_size[1]);
+        if (!(sc->destruction_cell > 0) || !isfinite(sc->destruction_cell))
+            scene_error(d, sc->loc, "the destructible area's cell must be a "
+                        "positive size in metres, found %g", sc->destruction_cell);
+    }
+}
+
+/* ---- rasters ------------------------------------------------------------ */
+
+/* An 8-bit greyscale raster of exactly w x h texels, or NULL (error at loc). */
+static uint8_t *load_mask(const char *name, const char *file, int w, int h,
+                          sg_loc loc, sg_diags *d)
+{
+    int fw, fh, comp;
+    if (!stbi_info(file, &fw, &fh, &comp)) {
+        FILE *f = fopen(file, "rb");
+        if (!f) {
+            sg_error(d, loc, SG_E_IO, file, strerror(errno));
+        } else {
+            fclose(f);
+            sg_error(d, loc, SG_E_IO, file, "not a PNG image");
+        }
+        return NULL;
+    }
+    if (comp != 1 || stbi_is_16_bit(file)) {
+        scene_error(d, loc, "painted mask '%s' ('%s') must be an 8-bit "
+                    "greyscale image, found %d channels of %d bits", name, file,
+                    comp, stbi_is_16_bit(file) ? 16 : 8);
+        return NULL;
+    }
+    if (fw != w || fh != h) {
+        scene_error(d, loc, "painted mask '%s' ('%s') is %d x %d texels; the "
+                    "heightfield is %d x %d", name, file, fw, fh, w, h);
+        return NULL;
+    }
+    int lw, lh, lc;
+    uint8_t *px = stbi_load(file, &lw, &lh, &lc, 1);
+    if (!px) {
+        sg_error(d, loc, SG_E_IO, file, stbi_failure_reason());
+        return NULL;
+    }
+    /* Own the pixels with malloc so splat_scene_free needs no stb. */
+    size_t n = (size_t)w * (size_t)h;
+    uint8_t *out = malloc(n);
+    if (out) memcpy(out, px, n);
+    else sg_error(d, loc, SG_E_TOO_LARGE, "painted mask does not fit in memory");
+    stbi_image_free(px);
+    return out;
+}
+
+static bool load_painted(splat_scene *s, sg_diags *d)
+{
+    const sg_scene *sc = s->desc;
+    if (sc->npainted == 0) return true;
+    s->painted = calloc((size_t)sc->npainted, sizeof *s->painted);
+    if (!s->painted) {
+        sg_error(d, sc->loc, SG_E_TOO_LARGE, "painted masks do not fit in memory");
+        return false;
+    }
+    bool ok = true;
+    for (int i = 0; i < sc->npainted; i++) {
+        const sg_scene_painted *pm = &sc->painted[i];
+        s->painted[i] = load_mask(pm->name, pm->file, s->terrain.width,
+                                  s->terrain.height, loc_or(pm->loc, sc->loc), d);
+        ok &= s->painted[i] != NULL;
+    }
+    return ok;
+}
+
+/* ---- materials ---------------------------------------------------------- */
+
+static bool lower_materials(splat_scene *s, sg_diags *d)
+{
+    const sg_scene *sc = s->desc;
+    for (int i = 0; i < sc->npainted; i++) {
+        int k = ir_add_painted(&s->ir, sc->painted[i].name);
+        (void)k;   /* == i: names are unique (check_scene) */
+    }
+    bool ok = true;
+    for (int i = 0; i < sc->nmaterials; i++) {
+        int before = s->ir.npainted;
+        if (!sg_lower_material(s->prog, sc->materials[i], &s->ir, d)) {
+            ok = false;
+            continue;
+        }
+        /* Painted masks first named by this material are not the scene's. */
+        for (int k = before; k < s->ir.npainted; k++) {
+            int m = sg_material_find(s->prog, sc->materials[i]);
+            sg_loc loc = m >= 0 ? sg_material_loc(s->prog, m) : sc->loc;
+            scene_error(d, loc, "material '%s' reads painted mask '%s', which "
+                        "scene '%s' does not declare (painted %s = \"FILE.png\")",
+                        sc->materials[i], s->ir.painted[k].name, sc->name,
+                        s->ir.painted[k].name);
+            ok = false;
+        }
+    }
+    return ok;
+}
+
+/* ---- the scene ---------------------------------------------------------- */
+
+bool splat_scene_load(splat_scene *s, const char *path,
+                      const char *const *search_paths, sg_diags *d)
+{
+    memset(s, 0, sizeof *s);
+    ir_init(&s->ir);
+    int errors = d->nerrors;
+    s->path = xstrdup(path);
+    char *dir = dir_of(path);
+    char *root = search_paths ? NULL : project_root(dir ? dir : ".");
+    int nsearch = 0;
+    while (search_paths && search_paths[nsearch]) nsearch++;
+    const char **paths = calloc((size_t)nsearch + 4, sizeof *paths);
+    if (!s->path || !dir || !paths) {
+        sg_error(d, (sg_loc){ path, 0, 0 }, SG_E_TOO_LARGE, "out of memory");
+        goto fail;
+    }
+    int np = 0;
+    paths[np++] = dir;
+    for (int i = 0; i < nsearch; i++) paths[np++] = search_paths[i];
+    if (!search_paths) {
+        if (root) paths[np++] = root;
+        paths[np++] = ".";
+    }
+    paths[np] = NULL;
+
+    s->prog = sg_load(path, paths, d);
+    if (!s->prog) {
+        sg_error(d, (sg_loc){ path, 0, 0 }, SG_E_TOO_LARGE, "out of memory");
+        goto fail;
+    }
+    if (d->nerrors > errors) goto fail;
+    s->desc = sg_program_scene(s->prog);
+    if (!s->desc) {
+        scene_error(d, (sg_loc){ path, 1, 1 }, "'%s' declares no scene "
+                    "(scene NAME { heightfield = …, materials = […] })", path);
+        goto fail;
+    }
+    const sg_scene *sc = s->desc;
+    s->nmaterials = sc->nmaterials;
+    check_scene(s->prog, sc, d);
+    if (d->nerrors > errors) goto fail;
+
+    s->terrain.size[0] = sc->size[0];
+    s->terrain.size[1] = sc->size[1];
+    s->terrain.max_height = sc->max_height;
+    s->terrain.height_offset = sc->height_offset;
+    if (!splat_terrain_load(&s->terrain, sc->heightfield, sc->hf_format,
+                            sc->hf_width, sc->hf_height,
+                            loc_or(sc->heightfield_loc, sc->loc), d))
+        goto fail;
+    if (!load_painted(s, d) || !lower_materials(s, d) || d->nerrors > errors)
+        goto fail;
+
+    free(paths);
+    free(dir);
+    free(root);
+    return true;
+fail:
+    free(paths);
+    free(dir);
+    free(root);
+    splat_scene_free(s);
+    return false;
+}
+
+void splat_scene_free(splat_scene *s)
+{
+    if (s->painted && s->desc) {
+        for (int i = 0; i < s->desc->npainted; i++)
+            free(s->painted[i]);
+    }
+    free(s->painted);
+    splat_terrain_free(&s->terrain);
+    ir_free(&s->ir);
+    if (s->prog) sg_free(s->prog);
+    free(s->path);
+    memset(s, 0, sizeof *s);
+}
