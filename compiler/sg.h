@@ -58,12 +58,15 @@ typedef struct sg_diag {
     sg_severity  severity;
     sg_error_id  id;
     char        *msg;
+    char        *src_line;  /* the source line at loc (for the caret), or NULL */
 } sg_diag;
 
 typedef struct sg_diags {
     sg_diag *items;
     int      n, cap;
     int      nerrors;
+    int      ndropped;  /* diagnostics counted but not stored (too many) */
+    struct sg_sources *sources; /* source texts for carets (diag.c)      */
 } sg_diags;
 
 void sg_diags_init(sg_diags *d);
@@ -74,6 +77,10 @@ void sg_note(sg_diags *d, sg_loc loc, const char *fmt, ...)
     __attribute__((format(printf, 3, 4)));
 /* GCC style: "file:line:col: error: msg", the source line, a caret. */
 void sg_diags_print(const sg_diags *d, FILE *out);
+/* Make `text` the source of `path` for the caret lines of later
+ * diagnostics at `path` (copied; sg_load does this for every file). */
+void sg_diags_add_source(sg_diags *d, const char *path, const char *text,
+                         size_t len);
 
 /* ---- programs ---------------------------------------------------------- */
 

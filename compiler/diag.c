@@ -1,0 +1,248 @@
+/* diag.c — diagnostics: a list of user errors with stable ids (sg.h's
+ * SG_ERRORS), printed GCC style with the source line and a caret:
+ *
+ *   graphs/cliff.sg:12:22: error: unknown node type 'rampp'
+ *      12 |     node m  : rampp { x = s.out }
+ *         |               ^
+ *
+ * Each diagnostic copies its file name and source line, so it stays
+ * printable after the program that produced it is freed.  At most
+ * SG_MAX_STORED_DIAGS are stored; later ones are only counted, so garbage
+ * input cannot make the list (or the printout) grow without bound. */
+#include "sg_internal.h"
+
+#include <stdarg.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* Widest source excerpt printed under a diagnostic. */
+#define EXCERPT_MAX 160
+
+static const char *const formats[SG_E_COUNT] = {
+#define X(id, fmt) fmt,
+    SG_ERRORS(X)
+#undef X
+};
+
+typedef struct source {
+    char   *path;
+    char   *text;
+    size_t  len;
+    size_t *lines;      /* start offset of each line, built on first use */
+    int     nlines;
+} source;
+
+struct sg_sources {
+    source *items;
+    int     n, cap;
+};
+
+void sg_diags_init(sg_diags *d)
+{
+    memset(d, 0, sizeof *d);
+}
+
+void sg_diags_free(sg_diags *d)
+{
+    for (int i = 0; i < d->n; i++) {
+        free(d->items[i].msg);
+        free(d->items[i].src_line);
+        free((char *)d->items[i].loc.file);
+    }
+    free(d->items);
+    if (d->sources) {
+        for (int i = 0; i < d->sources->n; i++) {
+            free(d->sources->items[i].path);
+            free(d->sources->items[i].text);
+            free(d->sources->items[i].lines);
+        }
+        free(d->sources->items);
+        free(d->sources);
+    }
+    memset(d, 0, sizeof *d);
+}
+
+static char *xstrdup(const char *s)
+{
+    if (!s)
+        return NULL;
+    size_t n = strlen(s);
+    char *r = malloc(n + 1);
+    if (!r)
+        abort();
+    memcpy(r, s, n + 1);
+    return r;
+}
+
+void sg_diags_add_source(sg_diags *d, const char *path, const char *text,
+                         size_t len)
+{
+    if (!d->sources) {
+        d->sources = calloc(1, sizeof *d->sources);
+        if (!d->sources)
+            abort();
+    }
+    struct sg_sources *s = d->sources;
+    if (s->n == s->cap) {
+        s->cap = s->cap ? s->cap * 2 : 8;
+        s->items = realloc(s->items, (size_t)s->cap * sizeof *s->items);
+        if (!s->items)
+            abort();
+    }
+    source *src = &s->items[s->n++];
+    src->path = xstrdup(path);
+    src->text = malloc(len + 1);
+    if (!src->text)
+        abort();
+    memcpy(src->text, text, len);
+    src->text[len] = 0;
+    src->len = len;
+    src->lines = NULL;
+    src->nlines = 0;
+}
+
+/* The text of line `line` of `file` (not NUL-terminated), or NULL. */
+static const char *find_line(sg_diags *d, const char *file, int line, size_t *n)
+{
+    if (!d->sources || !file || line < 1)
+        return NULL;
+    source *src = NULL;
+    for (int i = d->sources->n - 1; i >= 0; i--)   /* latest wins */
+        if (!strcmp(d->sources->items[i].path, file)) {
+            src = &d->sources->items[i];
+            break;
+        }
+    if (!src)
+        return NULL;
+    if (!src->lines) {
+        int cap = 64;
+        src->lines = malloc((size_t)cap * sizeof *src->lines);
+        if (!src->lines)
+            abort();
+        src->lines[src->nlines++] = 0;
+        for (size_t i = 0; i < src->len; i++)
+            if (src->text[i] == '\n') {
+                if (src->nlines == cap) {
+                    cap *= 2;
+                    src->lines = realloc(src->lines, (size_t)cap * sizeof *src->lines);
+                    if (!src->lines)
+                        abort();
+                }
+                src->lines[src->nlines++] = i + 1;
+            }
+    }
+    if (line > src->nlines)
+        return NULL;
+    size_t start = src->lines[line - 1];
+    size_t end = line < src->nlines ? src->lines[line] - 1 : src->len;
+    if (end > start && src->text[end - 1] == '\r')
+        end--;
+    *n = end - start;
+    return src->text + start;
+}
+
+static void add(sg_diags *d, sg_loc loc, sg_severity sev, sg_error_id id,
+                const char *fmt, va_list ap)
+{
+    if (sev == SG_ERROR)
+        d->nerrors++;
+    if (d->n >= SG_MAX_STORED_DIAGS) {
+        d->ndropped++;
+        return;
+    }
+    if (d->n == d->cap) {
+        d->cap = d->cap ? d->cap * 2 : 16;
+        d->items = realloc(d->items, (size_t)d->cap * sizeof *d->items);
+        if (!d->items)
+            abort();
+    }
+    va_list ap2;
+    va_copy(ap2, ap);
+    int len = vsnprintf(NULL, 0, fmt, ap);
+    char *msg = malloc((size_t)(len > 0 ? len : 0) + 1);
+    if (!msg)
+        abort();
+    vsnprintf(msg, (size_t)(len > 0 ? len : 0) + 1, fmt, ap2);
+    va_end(ap2);
+
+    sg_diag *g = &d->items[d->n++];
+    g->loc = loc;
+    g->loc.file = xstrdup(loc.file);
+    g->severity = sev;
+    g->id = id;
+    g->msg = msg;
+    g->src_line = NULL;
+    size_t n;
+    const char *line = find_line(d, loc.file, loc.line, &n);
+    if (line) {
+        g->src_line = malloc(n + 1);
+        if (!g->src_line)
+            abort();
+        memcpy(g->src_line, line, n);
+        g->src_line[n] = 0;
+    }
+}
+
+void sg_error(sg_diags *d, sg_loc loc, sg_error_id id, ...)
+{
+    va_list ap;
+    va_start(ap, id);
+    add(d, loc, SG_ERROR, id, formats[id], ap);
+    va_end(ap);
+}
+
+void sg_note(sg_diags *d, sg_loc loc, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    add(d, loc, SG_NOTE, SG_E_INTERNAL, fmt, ap);
+    va_end(ap);
+}
+
+/* The line, shortened to a window around the caret, with non-printable
+ * bytes shown as '?', then the caret line. */
+static void print_excerpt(FILE *out, int lineno, const char *line, int col)
+{
+    int n = (int)strlen(line);
+    int c = col > 0 ? col - 1 : 0;
+    if (c > n)
+        c = n;
+    int from = 0, to = n;
+    if (n > EXCERPT_MAX) {
+        from = c - EXCERPT_MAX / 2;
+        if (from < 0)
+            from = 0;
+        to = from + EXCERPT_MAX;
+        if (to > n)
+            to = n;
+    }
+    fprintf(out, "%5d | %s", lineno, from ? "..." : "");
+    for (int i = from; i < to; i++) {
+        unsigned char ch = (unsigned char)line[i];
+        fputc(ch == '\t' || (ch >= 32 && ch < 127) ? ch : '?', out);
+    }
+    fprintf(out, "%s\n      | %s", to < n ? "..." : "", from ? "   " : "");
+    for (int i = from; i < c; i++)
+        fputc(line[i] == '\t' ? '\t' : ' ', out);
+    fputs("^\n", out);
+}
+
+void sg_diags_print(const sg_diags *d, FILE *out)
+{
+    static const char *const sev[] = { "error", "warning", "note" };
+    for (int i = 0; i < d->n; i++) {
+        const sg_diag *g = &d->items[i];
+        if (g->loc.file && g->loc.line > 0)
+            fprintf(out, "%s:%d:%d: ", g->loc.file, g->loc.line, g->loc.col);
+        else if (g->loc.file)
+            fprintf(out, "%s: ", g->loc.file);
+        else
+            fputs("splatc: ", out);
+        fprintf(out, "%s: %s\n", sev[g->severity], g->msg);
+        if (g->src_line)
+            print_excerpt(out, g->loc.line, g->src_line, g->loc.col);
+    }
+    if (d->ndropped)
+        fprintf(out, "splatc: note: %d more diagnostic%s not shown\n",
+                d->ndropped, d->ndropped == 1 ? "" : "s");
+}

@@ -1,0 +1,1090 @@
+/* parse.c — the .sg parser (tokens -> AST) and program loading (files,
+ * imports, then resolve).
+ *
+ * Recursive descent over the token array, one function per rule with the
+ * rule above it.  Newlines are not tokens, but they guide error recovery:
+ * after a syntax error the parser skips to the next line (or the `}` that
+ * closes the block) and goes on, so one run reports several errors.  A
+ * top-level keyword at the start of a line inside a block means the block
+ * was never closed: UNTERMINATED, pointing at its `{`.
+ *
+ * Imports are loaded depth first after the importing file is parsed; a
+ * file reached twice (diamond) is parsed once; a file reached while it is
+ * still being loaded is an import cycle. */
+#include "sg_internal.h"
+
+#include <errno.h>
+#include <limits.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+typedef struct parser {
+    sg_program *p;
+    sg_arena   *a;
+    sg_file    *f;
+    int         fi;
+    sg_diags   *d;
+    int         pos;          /* current token                          */
+    sg_import **imports;
+    int        *nimports;
+    int         capimports;
+} parser;
+
+static sg_token *cur(parser *ps) { return &ps->f->toks[ps->pos]; }
+static sg_token *peek_at(parser *ps, int k)
+{
+    int i = ps->pos + k;
+    return &ps->f->toks[i < ps->f->ntoks ? i : ps->f->ntoks - 1];
+}
+static sg_token *next(parser *ps)
+{
+    sg_token *t = cur(ps);
+    if (t->kind != SG_TK_EOF)
+        ps->pos++;
+    return t;
+}
+
+static sg_loc loc_of(parser *ps, const sg_token *t)
+{
+    return (sg_loc){ ps->f->path, t->line, t->col };
+}
+
+static bool is_kw(const sg_token *t, const char *kw)
+{
+    return t->kind == SG_TK_IDENT && (int)strlen(kw) == t->len &&
+           !memcmp(t->start, kw, (size_t)t->len);
+}
+
+/* First token of its line? */
+static bool line_start(parser *ps, const sg_token *t)
+{
+    int i = (int)(t - ps->f->toks);
+    return i == 0 || ps->f->toks[i - 1].line < t->line;
+}
+
+static bool top_keyword(const sg_token *t)
+{
+    return is_kw(t, "import") || is_kw(t, "texture") || is_kw(t, "shader") ||
+           is_kw(t, "material") || is_kw(t, "scene");
+}
+
+static char *tok_text(parser *ps, const sg_token *t)
+{
+    return sg_strndup(ps->a, t->start, (size_t)t->len);
+}
+
+/* "expected <what>, found <current token>" at the current token. */
+static void expected(parser *ps, const char *what)
+{
+    char buf[96];
+    sg_token *t = cur(ps);
+    sg_error(ps->d, loc_of(ps, t), SG_E_SYNTAX, what,
+             sg_tok_describe(t, buf, sizeof buf));
+}
+
+static bool accept(parser *ps, sg_tok_kind k)
+{
+    if (cur(ps)->kind != k)
+        return false;
+    next(ps);
+    return true;
+}
+
+static bool expect(parser *ps, sg_tok_kind k, const char *what)
+{
+    if (accept(ps, k))
+        return true;
+    expected(ps, what);
+    return false;
+}
+
+/* Skip the rest of a bad statement: up to the next line or the `}` that
+ * closes the enclosing block (not consumed); nested braces are skipped. */
+static void sync_statement(parser *ps, int line)
+{
+    int depth = 0;
+    for (;;) {
+        sg_token *t = cur(ps);
+        if (t->kind == SG_TK_EOF)
+            return;
+        if (depth == 0 && (t->kind == SG_TK_RBRACE || t->line > line))
+            return;
+        if (t->kind == SG_TK_LBRACE)
+            depth++;
+        else if (t->kind == SG_TK_RBRACE)
+            depth--;
+        next(ps);
+    }
+}
+
+static ir_type type_name(const sg_token *t)
+{
+    static const char *const names[] = { "float", "vec2", "vec3", "vec4", "texture" };
+    static const ir_type types[] = { IR_T_FLOAT, IR_T_VEC2, IR_T_VEC3, IR_T_VEC4, IR_T_TEX };
+    for (int i = 0; i < 5; i++)
+        if (is_kw(t, names[i]))
+            return types[i];
+    return IR_T_ERROR;
+}
+
+/* path = IDENT { "." IDENT } */
+static bool parse_path(parser *ps, sg_value *v)
+{
+    sg_token *t = cur(ps);
+    if (t->kind != SG_TK_IDENT) {
+        expected(ps, "a name");
+        return false;
+    }
+    v->kind = SG_V_PATH;
+    v->loc = loc_of(ps, t);
+    int cap = 0;
+    for (;;) {
+        char **slot = SG_PUSH(ps->a, v->parts, v->nparts, cap);
+        *slot = tok_text(ps, next(ps));
+        if (cur(ps)->kind != SG_TK_DOT)
+            return true;
+        next(ps);
+        if (cur(ps)->kind != SG_TK_IDENT) {
+            expected(ps, "a name after '.'");
+            return false;
+        }
+    }
+}
+
+/* value = NUMBER
+ *       | ("vec2" | "vec3" | "vec4") "(" NUMBER { "," NUMBER } ")"
+ *       | STRING
+ *       | path */
+static bool parse_value(parser *ps, sg_value *v)
+{
+    sg_token *t = cur(ps);
+    memset(v, 0, sizeof *v);
+    v->loc = loc_of(ps, t);
+    if (t->kind == SG_TK_NUMBER) {
+        next(ps);
+        v->kind = SG_V_NUMBER;
+        v->num[0] = t->num;
+        v->width = 1;
+        return true;
+    }
+    if (t->kind == SG_TK_STRING) {
+        next(ps);
+        v->kind = SG_V_STRING;
+        v->str = t->str;
+        return true;
+    }
+    ir_type vt = type_name(t);
+    if (vt >= IR_T_VEC2 && vt <= IR_T_VEC4 && peek_at(ps, 1)->kind == SG_TK_LPAREN) {
+        int w = ir_type_width(vt);
+        next(ps);
+        sg_token *open = next(ps);
+        int n = 0;
+        do {
+            if (cur(ps)->kind != SG_TK_NUMBER) {
+                expected(ps, "a number");
+                return false;
+            }
+            double x = next(ps)->num;
+            if (n < 4)
+                v->num[n] = x;
+            n++;
+        } while (accept(ps, SG_TK_COMMA));
+        if (cur(ps)->kind != SG_TK_RPAREN) {
+            if (cur(ps)->kind == SG_TK_EOF || cur(ps)->line > open->line)
+                sg_error(ps->d, loc_of(ps, open), SG_E_UNTERMINATED, "'('", open->line);
+            else
+                expected(ps, "',' or ')'");
+            return false;
+        }
+        next(ps);
+        if (n == 1) {
+            for (int i = 1; i < w; i++)
+                v->num[i] = v->num[0];
+        } else if (n != w) {
+            char msg[96];
+            snprintf(msg, sizeof msg, "%.*s needs %d components, found %d",
+                     t->len, t->start, w, n);
+            sg_error(ps->d, v->loc, SG_E_BAD_VALUE, msg);
+            return false;
+        }
+        v->kind = SG_V_VEC;
+        v->width = w;
+        return true;
+    }
+    if (t->kind == SG_TK_IDENT)
+        return parse_path(ps, v);
+    expected(ps, "a value (number, vecN(...), string or name)");
+    return false;
+}
+
+/* bindings = "{" { IDENT "=" value [","] } "}"
+ * `what` names the block for UNTERMINATED ("'{' of node 'd'").  Each
+ * binding goes through `add`; a bad one is skipped up to the next ',',
+ * line or '}'. */
+typedef void (*binding_fn)(parser *ps, void *user, sg_token *key, sg_value *v);
+
+static void parse_bindings(parser *ps, const char *what, binding_fn add, void *user)
+{
+    sg_token *open = cur(ps);
+    if (!expect(ps, SG_TK_LBRACE, "'{'"))
+        return;
+    for (;;) {
+        sg_token *t = cur(ps);
+        if (t->kind == SG_TK_RBRACE) {
+            next(ps);
+            return;
+        }
+        if (t->kind == SG_TK_EOF || (top_keyword(t) && line_start(ps, t))) {
+            sg_error(ps->d, loc_of(ps, open), SG_E_UNTERMINATED, what, open->line);
+            return;
+        }
+        int line = t->line;
+        sg_value v;
+        bool ok = false;
+        if (t->kind != SG_TK_IDENT) {
+            expected(ps, "a port name or '}'");
+        } else {
+            next(ps);
+            if (expect(ps, SG_TK_EQ, "'='") && parse_value(ps, &v)) {
+                add(ps, user, t, &v);
+                ok = true;
+            }
+        }
+        if (ok) {
+            accept(ps, SG_TK_COMMA);
+            continue;
+        }
+        /* skip to ',' / '}' / next line */
+        while (cur(ps)->kind != SG_TK_EOF && cur(ps)->kind != SG_TK_RBRACE &&
+               cur(ps)->kind != SG_TK_COMMA && cur(ps)->line == line)
+            next(ps);
+        accept(ps, SG_TK_COMMA);
+    }
+}
+
+/* ---- declarations inside shaders and materials -------------------------- */
+
+static void add_node_binding(parser *ps, void *user, sg_token *key, sg_value *v)
+{
+    sg_node *n = user;
+    sg_binding *b = SG_PUSH(ps->a, n->args, n->nargs, n->capargs);
+    b->port = tok_text(ps, key);
+    b->loc = loc_of(ps, key);
+    b->val = *v;
+    b->slot = -1;
+}
+
+/* node = "node" IDENT ":" path [ bindings ] */
+static bool parse_node(parser *ps, sg_shader *s)
+{
+    next(ps);
+    sg_token *name = cur(ps);
+    if (!expect(ps, SG_TK_IDENT, "a node name"))
+        return false;
+    if (!expect(ps, SG_TK_COLON, "':' and a node type"))
+        return false;
+    sg_value type;
+    memset(&type, 0, sizeof type);
+    if (!parse_path(ps, &type))
+        return false;
+    sg_node *n = SG_PUSH(ps->a, s->nodes, s->nnodes, s->capnodes);
+    n->name = tok_text(ps, name);
+    n->loc = loc_of(ps, name);
+    n->type_loc = type.loc;
+    size_t len = 0;
+    for (int i = 0; i < type.nparts; i++)
+        len += strlen(type.parts[i]) + 1;
+    n->type = sg_alloc(ps->a, len);
+    for (int i = 0; i < type.nparts; i++) {
+        if (i)
+            strcat(n->type, ".");
+        strcat(n->type, type.parts[i]);
+    }
+    if (cur(ps)->kind == SG_TK_LBRACE) {
+        char what[160];
+        snprintf(what, sizeof what, "'{' of node '%s'", n->name);
+        parse_bindings(ps, sg_strdup(ps->a, what), add_node_binding, n);
+    }
+    return true;
+}
+
+/* in = "in" TYPE IDENT [ "=" value ] */
+static bool parse_in(parser *ps, sg_shader *s)
+{
+    next(ps);
+    ir_type t = type_name(cur(ps));
+    if (t == IR_T_ERROR) {
+        expected(ps, "a type (float, vec2, vec3, vec4 or texture)");
+        return false;
+    }
+    next(ps);
+    sg_token *name = cur(ps);
+    if (!expect(ps, SG_TK_IDENT, "an input name"))
+        return false;
+    sg_port port = { .name = tok_text(ps, name), .loc = loc_of(ps, name), .type = t };
+    if (accept(ps, SG_TK_EQ)) {
+        if (!parse_value(ps, &port.value))
+            return false;
+        port.has_value = true;
+    }
+    *SG_PUSH(ps->a, s->ins, s->nins, s->capins) = port;
+    return true;
+}
+
+/* out = "out" [ TYPE ] IDENT "=" value */
+static bool parse_out(parser *ps, sg_shader *s)
+{
+    next(ps);
+    ir_type t = IR_T_ERROR;
+    if (type_name(cur(ps)) != IR_T_ERROR && peek_at(ps, 1)->kind == SG_TK_IDENT) {
+        t = type_name(cur(ps));
+        next(ps);
+    } else if (!s->is_material) {
+        expected(ps, "an output type (float, vec2, vec3, vec4 or texture)");
+        return false;
+    }
+    sg_token *name = cur(ps);
+    if (!expect(ps, SG_TK_IDENT, "an output name"))
+        return false;
+    sg_port port = { .name = tok_text(ps, name), .loc = loc_of(ps, name), .type = t,
+                     .output = -1 };
+    if (!expect(ps, SG_TK_EQ, "'='") || !parse_value(ps, &port.value))
+        return false;
+    port.has_value = true;
+    *SG_PUSH(ps->a, s->outs, s->nouts, s->capouts) = port;
+    return true;
+}
+
+static bool parse_number(parser *ps, double *x)
+{
+    if (cur(ps)->kind != SG_TK_NUMBER) {
+        expected(ps, "a number");
+        return false;
+    }
+    *x = next(ps)->num;
+    return true;
+}
+
+/* param = "param" TYPE IDENT "=" value [ "range" NUMBER NUMBER ] */
+static bool parse_param(parser *ps, sg_shader *s)
+{
+    next(ps);
+    ir_type t = type_name(cur(ps));
+    if (t == IR_T_ERROR || t == IR_T_TEX) {
+        expected(ps, "a param type (float, vec2, vec3 or vec4)");
+        return false;
+    }
+    next(ps);
+    sg_token *name = cur(ps);
+    if (!expect(ps, SG_TK_IDENT, "a param name"))
+        return false;
+    sg_port port = { .name = tok_text(ps, name), .loc = loc_of(ps, name), .type = t };
+    if (!expect(ps, SG_TK_EQ, "'=' and a default value") || !parse_value(ps, &port.value))
+        return false;
+    port.has_value = true;
+    if (is_kw(cur(ps), "range")) {
+        next(ps);
+        if (!parse_number(ps, &port.lo) || !parse_number(ps, &port.hi))
+            return false;
+        port.has_range = true;
+    }
+    *SG_PUSH(ps->a, s->params, s->nparams, s->capparams) = port;
+    return true;
+}
+
+/* A block `{ statement* }` whose statements `stmt` parses; returns when the
+ * block is closed (or found unterminated). */
+typedef bool (*stmt_fn)(parser *ps, void *user);
+
+static void parse_block(parser *ps, const char *what, stmt_fn stmt, void *user)
+{
+    sg_token *open = cur(ps);
+    if (!expect(ps, SG_TK_LBRACE, "'{'"))
+        return;
+    for (;;) {
+        sg_token *t = cur(ps);
+        if (t->kind == SG_TK_RBRACE) {
+            next(ps);
+            return;
+        }
+        if (t->kind == SG_TK_EOF || (top_keyword(t) && line_start(ps, t))) {
+            sg_error(ps->d, loc_of(ps, open), SG_E_UNTERMINATED, what, open->line);
+            return;
+        }
+        int line = t->line;
+        int before = ps->pos;
+        if (!stmt(ps, user)) {
+            sync_statement(ps, line);
+            if (ps->pos == before)
+                next(ps);           /* always make progress */
+        }
+    }
+}
+
+/* shader_stmt   = in | out | node
+ * material_stmt = param | out | node */
+static bool shader_stmt(parser *ps, void *user)
+{
+    sg_shader *s = user;
+    sg_token *t = cur(ps);
+    if (is_kw(t, "node"))
+        return parse_node(ps, s);
+    if (is_kw(t, "out"))
+        return parse_out(ps, s);
+    if (!s->is_material && is_kw(t, "in"))
+        return parse_in(ps, s);
+    if (s->is_material && is_kw(t, "param"))
+        return parse_param(ps, s);
+    expected(ps, s->is_material ? "'param', 'node', 'out' or '}'"
+                                : "'in', 'node', 'out' or '}'");
+    return false;
+}
+
+/* shader   = "shader" IDENT "{" { shader_stmt } "}"
+ * material = "material" IDENT "{" { material_stmt } "}" */
+static bool parse_shader(parser *ps, bool material)
+{
+    next(ps);
+    sg_token *name = cur(ps);
+    if (!expect(ps, SG_TK_IDENT, material ? "a material name" : "a shader name"))
+        return false;
+    sg_shader *s = sg_alloc(ps->a, sizeof *s);
+    s->name = tok_text(ps, name);
+    s->loc = loc_of(ps, name);
+    s->is_material = material;
+    s->file = ps->fi;
+    sg_program *p = ps->p;
+    *SG_PUSH(ps->a, p->shaders, p->nshaders, p->capshaders) = s;
+    if (material)
+        *SG_PUSH(ps->a, p->materials, p->nmaterials, p->capmaterials) = p->nshaders - 1;
+    char what[160];
+    snprintf(what, sizeof what, "block of %s '%s'", material ? "material" : "shader", s->name);
+    parse_block(ps, sg_strdup(ps->a, what), shader_stmt, s);
+    return true;
+}
+
+/* ---- textures ------------------------------------------------------------ */
+
+void sg_texdecl_defaults(sg_texdecl *t)
+{
+    t->filter = IR_FILTER_LINEAR;
+    t->mip = IR_FILTER_LINEAR;
+    t->wrap = IR_WRAP_REPEAT;
+    t->srgb = false;
+}
+
+static bool word_is(const sg_value *v, const char *w)
+{
+    return v->kind == SG_V_PATH && v->nparts == 1 && !strcmp(v->parts[0], w);
+}
+
+static void bad_setting(parser *ps, const sg_value *v, const char *key, const char *allowed)
+{
+    char msg[200];
+    snprintf(msg, sizeof msg, "'%s' must be %s", key, allowed);
+    sg_error(ps->d, v->loc, SG_E_BAD_VALUE, msg);
+}
+
+static void add_texture_setting(parser *ps, void *user, sg_token *key, sg_value *v)
+{
+    sg_texdecl *t = user;
+    if (is_kw(key, "file")) {
+        if (v->kind != SG_V_STRING)
+            bad_setting(ps, v, "file", "a string");
+        else {
+            char *path = sg_path_join(ps->f->dir, v->str);
+            t->file = sg_strdup(ps->a, path);
+            free(path);
+        }
+    } else if (is_kw(key, "filter") || is_kw(key, "mip")) {
+        ir_filter *f = is_kw(key, "mip") ? &t->mip : &t->filter;
+        if (word_is(v, "linear"))
+            *f = IR_FILTER_LINEAR;
+        else if (word_is(v, "nearest"))
+            *f = IR_FILTER_NEAREST;
+        else
+            bad_setting(ps, v, is_kw(key, "mip") ? "mip" : "filter", "linear or nearest");
+    } else if (is_kw(key, "wrap")) {
+        if (word_is(v, "repeat"))
+            t->wrap = IR_WRAP_REPEAT;
+        else if (word_is(v, "clamp"))
+            t->wrap = IR_WRAP_CLAMP;
+        else if (word_is(v, "mirror"))
+            t->wrap = IR_WRAP_MIRROR;
+        else
+            bad_setting(ps, v, "wrap", "repeat, clamp or mirror");
+    } else if (is_kw(key, "srgb")) {
+        if (word_is(v, "true"))
+            t->srgb = true;
+        else if (word_is(v, "false"))
+            t->srgb = false;
+        else
+            bad_setting(ps, v, "srgb", "true or false");
+    } else {
+        char msg[160];
+        snprintf(msg, sizeof msg, "unknown texture setting '%.*s' "
+                 "(expected file, filter, mip, wrap or srgb)", key->len, key->start);
+        sg_error(ps->d, loc_of(ps, key), SG_E_BAD_VALUE, msg);
+    }
+}
+
+/* texture = "texture" IDENT "{" { ("file" | "filter" | "mip" | "wrap" |
+ *           "srgb") "=" value [","] } "}" */
+static bool parse_texture(parser *ps)
+{
+    next(ps);
+    sg_token *name = cur(ps);
+    if (!expect(ps, SG_TK_IDENT, "a texture name"))
+        return false;
+    sg_texdecl *t = sg_alloc(ps->a, sizeof *t);
+    t->name = tok_text(ps, name);
+    t->loc = loc_of(ps, name);
+    sg_texdecl_defaults(t);
+    char what[160];
+    snprintf(what, sizeof what, "block of texture '%s'", t->name);
+    parse_bindings(ps, sg_strdup(ps->a, what), add_texture_setting, t);
+    if (!t->file) {
+        char msg[160];
+        snprintf(msg, sizeof msg, "texture '%s' needs a file = \"...\"", t->name);
+        sg_error(ps->d, t->loc, SG_E_BAD_VALUE, msg);
+        t->file = "";
+    }
+    sg_program *p = ps->p;
+    *SG_PUSH(ps->a, p->textures, p->ntextures, p->captextures) = t;
+    return true;
+}
+
+/* import = "import" STRING */
+static bool parse_import(parser *ps)
+{
+    next(ps);
+    sg_token *t = cur(ps);
+    if (!expect(ps, SG_TK_STRING, "a file name in quotes"))
+        return false;
+    sg_import *im = SG_PUSH(ps->a, *ps->imports, *ps->nimports, ps->capimports);
+    im->path = t->str;
+    im->loc = loc_of(ps, t);
+    return true;
+}
+
+/* ---- scenes -------------------------------------------------------------- */
+
+typedef struct scene_parse {
+    sg_scene *sc;
+    int cap_materials, cap_painted, cap_cameras;
+    bool has_hf_size;
+    bool has[8];
+} scene_parse;
+
+enum { HAS_HF, HAS_SIZE, HAS_MAXH, HAS_MATERIALS };
+
+static void scene_error(parser *ps, sg_loc loc, const char *fmt, const char *a)
+{
+    char msg[256];
+    snprintf(msg, sizeof msg, fmt, a);
+    sg_error(ps->d, loc, SG_E_SCENE, msg);
+}
+
+static bool parse_numbers(parser *ps, double *out, int n)
+{
+    for (int i = 0; i < n; i++)
+        if (!parse_number(ps, &out[i]))
+            return false;
+    return true;
+}
+
+static char *scene_path(parser *ps, const char *rel)
+{
+    char *path = sg_path_join(ps->f->dir, rel);
+    char *r = sg_strdup(ps->a, path);
+    free(path);
+    return r;
+}
+
+/* destruction = "destruction" "{" { ("origin" NUM NUM | "size" NUM NUM |
+ *               "cell" NUM) [","] } "}"
+ * camera = "camera" IDENT "{" { ("position" | "look") "=" NUM NUM NUM
+ *          [","] } "}"
+ * Both use this statement function on their own little block. */
+typedef struct sub_block { scene_parse *sp; sg_scene_camera *cam; } sub_block;
+
+static bool sub_stmt(parser *ps, void *user)
+{
+    sub_block *b = user;
+    sg_scene *sc = b->sp->sc;
+    sg_token *key = cur(ps);
+    if (key->kind != SG_TK_IDENT) {
+        expected(ps, b->cam ? "'position', 'look' or '}'" : "'origin', 'size', 'cell' or '}'");
+        return false;
+    }
+    bool ok;
+    if (b->cam && (is_kw(key, "position") || is_kw(key, "look"))) {
+        next(ps);
+        ok = expect(ps, SG_TK_EQ, "'='") &&
+             parse_numbers(ps, is_kw(key, "look") ? b->cam->look : b->cam->position, 3);
+    } else if (!b->cam && (is_kw(key, "origin") || is_kw(key, "size"))) {
+        next(ps);
+        ok = expect(ps, SG_TK_EQ, "'='") &&
+             parse_numbers(ps, is_kw(key, "origin") ? sc->destruction_origin
+                                                    : sc->destruction_size, 2);
+    } else if (!b->cam && is_kw(key, "cell")) {
+        next(ps);
+        ok = expect(ps, SG_TK_EQ, "'='") && parse_number(ps, &sc->destruction_cell);
+        if (ok && !(sc->destruction_cell > 0))
+            scene_error(ps, loc_of(ps, key), "destruction cell must be positive%s", "");
+    } else {
+        expected(ps, b->cam ? "'position', 'look' or '}'" : "'origin', 'size', 'cell' or '}'");
+        return false;
+    }
+    if (ok)
+        accept(ps, SG_TK_COMMA);
+    return ok;
+}
+
+/* scene_stmt = "heightfield" "=" STRING | "heightfield_size" "=" NUM NUM
+ *            | "size" "=" NUM NUM | "max_height" "=" NUM
+ *            | "height_offset" "=" NUM | "cell" "=" NUM
+ *            | "materials" "=" "[" IDENT { "," IDENT } "]"
+ *            | "compositor" "=" IDENT | "painted" IDENT "=" STRING
+ *            | destruction | camera */
+static bool scene_stmt(parser *ps, void *user)
+{
+    scene_parse *sp = user;
+    sg_scene *sc = sp->sc;
+    sg_token *key = cur(ps);
+    sg_loc kloc = loc_of(ps, key);
+    if (key->kind != SG_TK_IDENT) {
+        expected(ps, "a scene setting or '}'");
+        return false;
+    }
+    if (is_kw(key, "destruction")) {
+        next(ps);
+        sub_block b = { sp, NULL };
+        sc->has_destruction = true;
+        parse_block(ps, "block of destruction", sub_stmt, &b);
+        return true;
+    }
+    if (is_kw(key, "camera")) {
+        next(ps);
+        sg_token *name = cur(ps);
+        if (!expect(ps, SG_TK_IDENT, "a camera name"))
+            return false;
+        sg_scene_camera *cam = SG_PUSH(ps->a, sc->cameras, sc->ncameras, sp->cap_cameras);
+        cam->name = tok_text(ps, name);
+        cam->loc = loc_of(ps, name);
+        sub_block b = { sp, cam };
+        parse_block(ps, "block of camera", sub_stmt, &b);
+        return true;
+    }
+    if (is_kw(key, "painted")) {
+        next(ps);
+        sg_token *name = cur(ps);
+        if (!expect(ps, SG_TK_IDENT, "a painted mask name") ||
+            !expect(ps, SG_TK_EQ, "'='"))
+            return false;
+        sg_token *file = cur(ps);
+        if (!expect(ps, SG_TK_STRING, "a file name in quotes"))
+            return false;
+        sg_scene_painted *pm = SG_PUSH(ps->a, sc->painted, sc->npainted, sp->cap_painted);
+        pm->name = tok_text(ps, name);
+        pm->file = scene_path(ps, file->str);
+        pm->loc = loc_of(ps, name);
+        return true;
+    }
+    next(ps);
+    if (!expect(ps, SG_TK_EQ, "'='"))
+        return false;
+    if (is_kw(key, "heightfield")) {
+        sg_token *file = cur(ps);
+        if (!expect(ps, SG_TK_STRING, "a file name in quotes"))
+            return false;
+        sc->heightfield = scene_path(ps, file->str);
+        sc->heightfield_loc = loc_of(ps, file);
+        const char *dot = strrchr(file->str, '.');
+        if (dot && !strcmp(dot, ".png"))
+            sc->hf_format = SG_HF_PNG;
+        else if (dot && (!strcmp(dot, ".r16") || !strcmp(dot, ".raw")))
+            sc->hf_format = SG_HF_R16;
+        else
+            scene_error(ps, sc->heightfield_loc,
+                        "heightfield '%s' must be a .png, .r16 or .raw file", file->str);
+        sp->has[HAS_HF] = true;
+        return true;
+    }
+    if (is_kw(key, "heightfield_size")) {
+        double wh[2];
+        if (!parse_numbers(ps, wh, 2))
+            return false;
+        if (!(wh[0] >= 1 && wh[1] >= 1 && wh[0] <= INT_MAX && wh[1] <= INT_MAX) ||
+            wh[0] != (int)wh[0] || wh[1] != (int)wh[1])
+            scene_error(ps, kloc, "heightfield_size must be two positive whole numbers%s", "");
+        else {
+            sc->hf_width = (int)wh[0];
+            sc->hf_height = (int)wh[1];
+        }
+        sp->has_hf_size = true;
+        return true;
+    }
+    if (is_kw(key, "size")) {
+        if (!parse_numbers(ps, sc->size, 2))
+            return false;
+        sc->size_loc = kloc;
+        if (!(sc->size[0] > 0 && sc->size[1] > 0))
+            scene_error(ps, kloc, "world size must be positive (x and z metres)%s", "");
+        sp->has[HAS_SIZE] = true;
+        return true;
+    }
+    if (is_kw(key, "max_height")) {
+        if (!parse_number(ps, &sc->max_height))
+            return false;
+        sc->max_height_loc = kloc;
+        if (sc->max_height < 0)
+            scene_error(ps, kloc, "max_height must not be negative%s", "");
+        sp->has[HAS_MAXH] = true;
+        return true;
+    }
+    if (is_kw(key, "height_offset"))
+        return parse_number(ps, &sc->height_offset);
+    if (is_kw(key, "cell")) {
+        double c;
+        if (!parse_number(ps, &c))
+            return false;
+        sc->cell_texels_loc = kloc;
+        if (!(c >= 1 && c <= 65536 && c == (int)c))
+            scene_error(ps, kloc, "cell must be a whole number of texels (1..65536)%s", "");
+        else
+            sc->cell_texels = (int)c;
+        return true;
+    }
+    if (is_kw(key, "compositor")) {
+        sg_token *name = cur(ps);
+        if (!expect(ps, SG_TK_IDENT, "a compositor shader name"))
+            return false;
+        sc->compositor = tok_text(ps, name);
+        sc->compositor_loc = loc_of(ps, name);
+        return true;
+    }
+    if (is_kw(key, "materials")) {
+        sg_token *open = cur(ps);
+        if (!expect(ps, SG_TK_LBRACK, "'['"))
+            return false;
+        int cap_locs = 0;
+        sp->has[HAS_MATERIALS] = true;
+        if (accept(ps, SG_TK_RBRACK))
+            return true;
+        do {
+            sg_token *m = cur(ps);
+            if (!expect(ps, SG_TK_IDENT, "a material name"))
+                return false;
+            int n = sc->nmaterials;
+            *SG_PUSH(ps->a, sc->materials, sc->nmaterials, sp->cap_materials) = tok_text(ps, m);
+            *SG_PUSH(ps->a, sc->material_locs, n, cap_locs) = loc_of(ps, m);
+        } while (accept(ps, SG_TK_COMMA));
+        if (cur(ps)->kind != SG_TK_RBRACK) {
+            if (cur(ps)->kind == SG_TK_EOF)
+                sg_error(ps->d, loc_of(ps, open), SG_E_UNTERMINATED, "'['", open->line);
+            else
+                expected(ps, "',' or ']'");
+            return false;
+        }
+        next(ps);
+        return true;
+    }
+    char buf[96];
+    sg_error(ps->d, kloc, SG_E_SYNTAX,
+             "a scene setting (heightfield, heightfield_size, size, max_height, "
+             "height_offset, materials, compositor, painted, destruction, cell, camera)",
+             sg_tok_describe(key, buf, sizeof buf));
+    return false;
+}
+
+/* scene = "scene" IDENT "{" { scene_stmt } "}" */
+static bool parse_scene(parser *ps)
+{
+    next(ps);
+    sg_token *name = cur(ps);
+    if (!expect(ps, SG_TK_IDENT, "a scene name"))
+        return false;
+    sg_scene *sc = sg_alloc(ps->a, sizeof *sc);
+    sc->name = tok_text(ps, name);
+    sc->loc = loc_of(ps, name);
+    sc->compositor = "linear_alpha";
+    sc->compositor_loc = sc->loc;
+    sc->cell_texels = 32;
+    sc->cell_texels_loc = sc->loc;
+    sc->destruction_cell = 16;
+    scene_parse sp = { .sc = sc };
+    char what[160];
+    snprintf(what, sizeof what, "block of scene '%s'", sc->name);
+    parse_block(ps, sg_strdup(ps->a, what), scene_stmt, &sp);
+
+    static const char *const need[] = { "heightfield", "size", "max_height", "materials" };
+    for (int i = 0; i < 4; i++)
+        if (!sp.has[i])
+            scene_error(ps, sc->loc, "scene needs '%s = ...'", need[i]);
+    if (sp.has[HAS_MATERIALS] && sc->nmaterials == 0)
+        scene_error(ps, sc->loc, "scene needs at least one material%s", "");
+    if (sp.has[HAS_HF] && sc->hf_format == SG_HF_R16 && !sp.has_hf_size)
+        scene_error(ps, sc->heightfield_loc,
+                    "raw heightfield '%s' needs heightfield_size = WIDTH HEIGHT",
+                    sc->heightfield);
+    if (ps->fi == 0) {
+        if (ps->p->scene) {
+            sg_error(ps->d, sc->loc, SG_E_DUPLICATE, "scene", sc->name,
+                     ps->p->scene->loc.file, ps->p->scene->loc.line, ps->p->scene->loc.col);
+        } else {
+            ps->p->scene = sc;
+        }
+    }
+    return true;
+}
+
+/* file = { import | texture | shader | material | scene } */
+void sg_parse(sg_program *p, int file, sg_import **imports, int *nimports, sg_diags *d)
+{
+    parser ps = { p, &p->arena, p->files[file], file, d, 0, imports, nimports, 0 };
+    if (cur(&ps)->kind == SG_TK_EOF && d->nerrors == 0) {
+        expected(&ps, "a declaration (import, texture, shader, material or scene)");
+        return;
+    }
+    while (cur(&ps)->kind != SG_TK_EOF) {
+        sg_token *t = cur(&ps);
+        int line = t->line, before = ps.pos;
+        bool ok;
+        if (is_kw(t, "import"))
+            ok = parse_import(&ps);
+        else if (is_kw(t, "texture"))
+            ok = parse_texture(&ps);
+        else if (is_kw(t, "shader"))
+            ok = parse_shader(&ps, false);
+        else if (is_kw(t, "material"))
+            ok = parse_shader(&ps, true);
+        else if (is_kw(t, "scene"))
+            ok = parse_scene(&ps);
+        else {
+            expected(&ps, "'import', 'texture', 'shader', 'material' or 'scene'");
+            ok = false;
+        }
+        if (!ok) {
+            /* skip to a top-level keyword that starts a line */
+            do
+                next(&ps);
+            while (cur(&ps)->kind != SG_TK_EOF &&
+                   !(top_keyword(cur(&ps)) && line_start(&ps, cur(&ps)) &&
+                     cur(&ps)->line > line));
+        }
+        if (ps.pos == before)
+            next(&ps);
+    }
+}
+
+/* ---- loading ------------------------------------------------------------- */
+
+typedef struct loader {
+    sg_program *p;
+    sg_diags   *d;
+    sg_map      keys;        /* file key -> index                          */
+    int        *stack;       /* files being loaded (import cycle check)    */
+    int         depth;
+} loader;
+
+static char *read_all(const char *path, size_t *len, const char **err)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f) {
+        *err = strerror(errno);
+        return NULL;
+    }
+    size_t cap = 4096, n = 0;
+    char *buf = malloc(cap + 1);
+    if (!buf)
+        abort();
+    for (;;) {
+        size_t got = fread(buf + n, 1, cap - n, f);
+        n += got;
+        if (n < cap) {
+            if (ferror(f)) {
+                *err = strerror(errno ? errno : EIO);
+                fclose(f);
+                free(buf);
+                return NULL;
+            }
+            break;
+        }
+        cap *= 2;
+        buf = realloc(buf, cap + 1);
+        if (!buf)
+            abort();
+    }
+    fclose(f);
+    buf[n] = 0;
+    *len = n;
+    return buf;
+}
+
+/* Lex, parse and load the imports of `path` (text given, or read). */
+static int load_file(loader *l, const char *path, const char *text, size_t len,
+                     sg_loc from, bool is_import)
+{
+    sg_program *p = l->p;
+    char *rp = realpath(path, NULL);
+    const char *key = rp ? rp : path;
+    int known = sg_map_get(&l->keys, key);
+    if (known >= 0) {
+        free(rp);
+        for (int i = 0; i < l->depth; i++)
+            if (l->stack[i] == known) {
+                /* the cycle: stack[i] -> … -> top -> known */
+                size_t n = 1;
+                for (int j = i; j < l->depth; j++)
+                    n += strlen(p->files[l->stack[j]]->path) + 4;
+                n += strlen(p->files[known]->path);
+                char *msg = malloc(n);
+                if (!msg)
+                    abort();
+                msg[0] = 0;
+                for (int j = i; j < l->depth; j++) {
+                    strcat(msg, p->files[l->stack[j]]->path);
+                    strcat(msg, " -> ");
+                }
+                strcat(msg, p->files[known]->path);
+                sg_error(l->d, from, SG_E_IMPORT_CYCLE, msg);
+                free(msg);
+                break;
+            }
+        return known;
+    }
+    if (l->depth >= SG_MAX_DEPTH) {
+        free(rp);
+        sg_error(l->d, from, SG_E_TOO_DEEP, SG_MAX_DEPTH);
+        return -1;
+    }
+    char *owned = NULL;
+    if (!text) {
+        const char *err = NULL;
+        owned = read_all(path, &len, &err);
+        if (!owned) {
+            free(rp);
+            if (is_import)
+                sg_error(l->d, from, SG_E_MISSING_IMPORT, path, err);
+            else
+                sg_error(l->d, from, SG_E_IO, path, err);
+            return -1;
+        }
+        text = owned;
+    }
+    sg_file *f = sg_alloc(&p->arena, sizeof *f);
+    f->path = sg_strdup(&p->arena, path);
+    char *dir = sg_path_dir(path);
+    f->dir = sg_strdup(&p->arena, dir);
+    free(dir);
+    f->key = sg_strdup(&p->arena, key);
+    free(rp);
+    f->text = sg_alloc(&p->arena, len + 1);
+    memcpy(f->text, text, len);
+    f->len = len;
+    free(owned);
+    int fi = p->nfiles;
+    *SG_PUSH(&p->arena, p->files, p->nfiles, p->capfiles) = f;
+    sg_map_put(&l->keys, f->key, fi);
+    sg_diags_add_source(l->d, f->path, f->text, f->len);
+
+    sg_lex(&p->arena, f, l->d);
+    sg_import *imports = NULL;
+    int nimports = 0;
+    sg_parse(p, fi, &imports, &nimports, l->d);
+
+    l->stack[l->depth++] = fi;
+    for (int i = 0; i < nimports; i++) {
+        /* relative to the importing file, then the search paths */
+        char *cand = sg_path_join(f->dir, imports[i].path);
+        bool found = access(cand, R_OK) == 0;
+        for (int s = 0; !found && s < p->nsearch; s++) {
+            free(cand);
+            cand = sg_path_join(p->search[s], imports[i].path);
+            found = access(cand, R_OK) == 0;
+        }
+        if (!found) {
+            free(cand);
+            sg_error(l->d, imports[i].loc, SG_E_MISSING_IMPORT, imports[i].path,
+                     p->nsearch ? "not found next to the importing file or in the search paths"
+                                : "not found next to the importing file");
+            continue;
+        }
+        load_file(l, cand, NULL, 0, imports[i].loc, true);
+        free(cand);
+    }
+    l->depth--;
+    return fi;
+}
+
+static sg_program *load(const char *path, const char *text, size_t len,
+                        const char *const *search_paths, sg_diags *d)
+{
+    sg_program *p = calloc(1, sizeof *p);
+    if (!p)
+        return NULL;
+    int nsearch = 0;
+    while (search_paths && search_paths[nsearch])
+        nsearch++;
+    p->search = sg_alloc(&p->arena, (size_t)(nsearch + 1) * sizeof *p->search);
+    for (int i = 0; i < nsearch; i++)
+        p->search[i] = sg_strdup(&p->arena, search_paths[i]);
+    p->nsearch = nsearch;
+
+    int errors0 = d->nerrors;
+    loader l = { p, d, { 0 }, NULL, 0 };
+    l.stack = malloc(SG_MAX_DEPTH * sizeof *l.stack);
+    if (!l.stack)
+        abort();
+    load_file(&l, path, text, len, (sg_loc){ path, 0, 0 }, false);
+    free(l.stack);
+    sg_map_free(&l.keys);
+    if (p->nfiles)
+        sg_resolve(p, d);
+    p->load_errors = d->nerrors - errors0;   /* this load's errors only */
+    return p;
+}
+
+sg_program *sg_load(const char *path, const char *const *search_paths, sg_diags *d)
+{
+    return load(path, NULL, 0, search_paths, d);
+}
+
+sg_program *sg_load_string(const char *name, const char *text,
+                           const char *const *search_paths, sg_diags *d)
+{
+    return load(name, text, strlen(text), search_paths, d);
+}
+
+void sg_free(sg_program *p)
+{
+    if (!p)
+        return;
+    for (int i = 0; i < p->nshaders; i++)
+        free(p->shaders[i]->order);
+    sg_map_free(&p->globals);
+    sg_arena_free(&p->arena);
+    free(p);
+}
+
+int sg_file_count(const sg_program *p) { return p->nfiles; }
+const char *sg_file_path(const sg_program *p, int i) { return p->files[i]->path; }
+int sg_material_count(const sg_program *p) { return p->nmaterials; }
+const char *sg_material_name(const sg_program *p, int i)
+{
+    return p->shaders[p->materials[i]]->name;
+}
+sg_loc sg_material_loc(const sg_program *p, int i)
+{
+    return p->shaders[p->materials[i]]->loc;
+}
+int sg_material_find(const sg_program *p, const char *name)
+{
+    for (int i = 0; i < p->nmaterials; i++)
+        if (!strcmp(p->shaders[p->materials[i]]->name, name))
+            return i;
+    return -1;
+}
+const sg_scene *sg_program_scene(const sg_program *p) { return p->scene; }
