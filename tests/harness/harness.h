@@ -110,4 +110,37 @@ bool harness_eval_ir(harness *h, const harness_ir_desc *d, float *out,
  * too.  NULL with *err on failure. */
 char *harness_ir_shader(const harness_ir_desc *d, char **err);
 
+/* ---- the reference and its fp32 sensitivity (harness_ref.c) ------------- */
+
+/* Why a value cannot be compared with the device's (harness_refval.flags). */
+enum {
+    HARNESS_REF_NONFINITE = 1, /* NaN or Inf in the value or on its way     */
+    HARNESS_REF_RANGE     = 2, /* a value on the way beyond 1e18 or below
+                                  1e-18 in magnitude: fp32 overflows or
+                                  loses precision where double does not    */
+    HARNESS_REF_UNDEFINED = 4, /* GLSL leaves the result undefined
+                                  (smoothstep e0 >= e1, clamp lo > hi,
+                                  pow of x < 0)                            */
+    HARNESS_REF_MISMATCH  = 8, /* the walk disagrees with ir_eval: a bug
+                                  of the harness, tests assert none       */
+};
+
+typedef struct harness_refval {
+    double   value[4];   /* ir_eval's value (double)                        */
+    double   spread[4];  /* how far fp32 rounding may move it: the largest
+                            deviation over `samples` evaluations with every
+                            node's result perturbed by its op's fp32 error
+                            bound (harness_ref.c lists them)             */
+    unsigned flags;      /* HARNESS_REF_*                                   */
+} harness_refval;
+
+/* The reference value of `root` at `env` and its sensitivity to fp32
+ * rounding (a Monte-Carlo rounding analysis: each sample perturbs every
+ * node by +-its bound, signs drawn from `seed`; sample 0 uses all +, sample
+ * 1 all -).  A value whose spread is large is ill-conditioned in fp32 —
+ * a discontinuity (floor, step, less, mod) within rounding distance, or
+ * cancellation amplified — and no fp32 implementation can be held to it. */
+void harness_reference(const ir *ir, ir_ref root, const ir_env *env,
+                       int samples, uint64_t seed, harness_refval *out);
+
 #endif

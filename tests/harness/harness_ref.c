@@ -1,0 +1,279 @@
+/* harness_ref.c — the CPU reference of a root and its sensitivity to fp32
+ * rounding (harness.h, harness_reference).
+ *
+ * How: the DAG under the root is walked in id order (ids are topological),
+ * each node evaluated with the op table's own eval function (the semantics
+ * written once in ir_ops.c; the leaves read the environment exactly as
+ * ir_eval does, which the walk checks).  The walk runs once exactly, then
+ * `samples` times with every node's result moved by +-b, where b is the
+ * fp32 error bound of that op at the exact operands (below); the spread is
+ * the largest deviation of the root.  A discontinuity within rounding
+ * distance shows as a jump, cancellation followed by amplification as a
+ * large spread: both are ill-conditioned points that no fp32 evaluation can
+ * be held to.
+ *
+ * Error bounds per op, u = 2^-24 (fp32 unit roundoff); after the Vulkan
+ * spec's "Precision and Operation of SPIR-V Instructions", generously:
+ *   exact in fp32 (0):  neg abs floor min max clamp saturate step less
+ *                       select splat swizzle construct; inputs, params,
+ *                       painted (the harness passes them as fp32)
+ *   const               u|v|        (the GLSL literal is rounded to fp32)
+ *   add sub mul         u|r|        (correctly rounded; fma contraction
+ *                                    moves a product by at most u|ab|)
+ *   div sqrt            3u|r|       (2.5 ulp; sqrt via inversesqrt)
+ *   fract               u           (x - floor(x) rounds only for x < 0)
+ *   mod                 4u(|x|+|y|)   and ill-conditioned when x/y is within
+ *                                     8u(1+|x/y|) of an integer (floor may flip)
+ *   exp2                (3+2|x|)u|r|
+ *   pow                 (8 + 16|y|(1+|log2 x|))u|r|  (exp2(y*log2(x)))
+ *   sin cos             32u + 8u|x|  (absolute; 2^-19 near 0, range
+ *                                     reduction error growing with |x|)
+ *   mix                 2u(|a|+|b|)(1+|t|) + u|r|  (a+t(b-a) or a(1-t)+bt)
+ *   smoothstep          1.5 e_t + 4u, e_t = (2u(|x|+|e0|) + u|e1-e0|)/|e1-e0|
+ *   dot                 (n+1)u sum|a_i b_i|
+ *   length              4u|r|
+ *   normalize           6u per component
+ *   cross               2u(|a_j b_k| + |a_k b_j|)
+ *   sample              0 with the default (constant) texture, 2^-8 with a
+ *                       sampler (8-bit bilinear weights)
+ */
+#include "harness.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define U (1.0 / 16777216.0)   /* 2^-24 */
+
+/* splitmix64: the sign of sample s at node id, component c. */
+static double sign_of(uint64_t seed, int s, uint32_t id, int c)
+{
+    if (s == 0)
+        return 1.0;
+    if (s == 1)
+        return -1.0;
+    uint64_t z = seed + 0x9e3779b97f4a7c15ull * ((uint64_t)s * 1000003u + id * 4u + (uint64_t)c + 1);
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+    z ^= z >> 31;
+    return (z & 1) ? 1.0 : -1.0;
+}
+
+static void leaf_input(const ir_env *env, uint32_t which, double *out)
+{
+    switch (which) {
+    case IR_IN_HEIGHT:        out[0] = env->height; break;
+    case IR_IN_SLOPE:         out[0] = env->slope; break;
+    case IR_IN_NORMAL:        memcpy(out, env->normal, sizeof env->normal); break;
+    case IR_IN_POSITION:      memcpy(out, env->position, sizeof env->position); break;
+    case IR_IN_UV:            memcpy(out, env->uv, sizeof env->uv); break;
+    case IR_IN_VIEW_DISTANCE: out[0] = env->view_distance; break;
+    case IR_IN_DESTRUCTION:   out[0] = env->destruction; break;
+    default: break;
+    }
+}
+
+/* Evaluate node `id` from operand values `vals` (4 per node). */
+static void eval_node(const ir *ir, uint32_t id, const ir_env *env,
+                      const double (*vals)[4], double out[4])
+{
+    const ir_node *n = &ir->nodes[id];
+    memset(out, 0, 4 * sizeof(double));
+    switch (n->op) {
+    case IR_OP_CONST:
+        memcpy(out, n->val, sizeof n->val);
+        return;
+    case IR_OP_INPUT:
+        leaf_input(env, n->imm, out);
+        return;
+    case IR_OP_PARAM:
+        memcpy(out, env->params ? env->params + 4 * n->imm : ir->params[n->imm].def,
+               4 * sizeof(double));
+        return;
+    case IR_OP_TEXTURE:
+        out[0] = n->imm;
+        return;
+    case IR_OP_PAINTED:
+        out[0] = env->painted ? env->painted[n->imm] : 0.0;
+        return;
+    case IR_OP_SAMPLE: {
+        const double *uv = vals[n->arg[1].id];
+        int tex = (int)ir->nodes[n->arg[0].id].imm;
+        if (env->sample) {
+            env->sample(env->sample_user, tex, uv[0], uv[1], out);
+        } else {
+            out[0] = out[1] = out[2] = 0.5;
+            out[3] = 1.0;
+        }
+        return;
+    }
+    default: {
+        const ir_opinfo *info = ir_opinfo_get((ir_op)n->op);
+        double a[16];
+        ir_type at[4];
+        for (int i = 0; i < n->nargs; i++) {
+            memcpy(&a[4 * i], vals[n->arg[i].id], 4 * sizeof(double));
+            at[i] = (ir_type)ir->nodes[n->arg[i].id].type;
+        }
+        if (info->eval)
+            info->eval(n, at, a, out);
+        return;
+    }
+    }
+}
+
+/* The fp32 error bound of node `id`'s component c (see the table above),
+ * from exact operand values; sets *ill when rounding may flip a
+ * discontinuity inside the op, *undef when GLSL leaves it undefined. */
+static double bound(const ir *ir, uint32_t id, const ir_env *env,
+                    const double (*v)[4], int c, bool *ill, bool *undef)
+{
+    const ir_node *n = &ir->nodes[id];
+    const double *a = n->nargs > 0 ? v[n->arg[0].id] : NULL;
+    const double *b = n->nargs > 1 ? v[n->arg[1].id] : NULL;
+    const double *t = n->nargs > 2 ? v[n->arg[2].id] : NULL;
+    double r = fabs(v[id][c]);
+    int w = n->nargs > 0 ? ir_type_width(ir_typeof(ir, n->arg[0])) : 0;
+    switch (n->op) {
+    case IR_OP_CONST:
+        return U * r;
+    case IR_OP_ADD: case IR_OP_SUB: case IR_OP_MUL:
+        return U * r;
+    case IR_OP_DIV: case IR_OP_SQRT:
+        return 3 * U * r;
+    case IR_OP_FRACT:
+        return U;
+    case IR_OP_MOD: {
+        double x = a[c], y = b[c], q = x / y;
+        double f = q - floor(q);
+        double near = 8 * U * (1 + fabs(q));
+        if (f < near || 1 - f < near)
+            *ill = true;
+        return 4 * U * (fabs(x) + fabs(y));
+    }
+    case IR_OP_EXP2:
+        return (3 + 2 * fabs(a[c])) * U * r;
+    case IR_OP_POW:
+        if (a[c] < 0 || (a[c] == 0 && b[c] <= 0))
+            *undef = true;
+        return (8 + 16 * fabs(b[c]) * (1 + fabs(log2(fabs(a[c]) + 1e-300)))) * U * r;
+    case IR_OP_SIN: case IR_OP_COS:
+        return 32 * U + 8 * U * fabs(a[c]);
+    case IR_OP_MIX:
+        return 2 * U * (fabs(a[c]) + fabs(b[c])) * (1 + fabs(t[c])) + U * r;
+    case IR_OP_CLAMP:
+        if (b[c] > t[c])
+            *undef = true;
+        return 0;
+    case IR_OP_SMOOTHSTEP: {
+        double e0 = a[c], e1 = b[c], x = t[c];
+        if (e0 >= e1) {
+            *undef = true;
+            return 0;
+        }
+        double et = (2 * U * (fabs(x) + fabs(e0)) + U * fabs(e1 - e0)) / fabs(e1 - e0);
+        return 1.5 * et + 4 * U;
+    }
+    case IR_OP_DOT: {
+        double s = 0;
+        for (int i = 0; i < w; i++)
+            s += fabs(a[i] * b[i]);
+        return (w + 1) * U * s;
+    }
+    case IR_OP_LENGTH:
+        return 4 * U * r;
+    case IR_OP_NORMALIZE:
+        return 6 * U;
+    case IR_OP_CROSS: {
+        int j = (c + 1) % 3, k = (c + 2) % 3;
+        return 2 * U * (fabs(a[j] * b[k]) + fabs(a[k] * b[j]));
+    }
+    case IR_OP_SAMPLE:
+        return env->sample ? 1.0 / 256 : 0;
+    default:   /* exact in fp32 */
+        return 0;
+    }
+}
+
+static bool same(double x, double y)
+{
+    return x == y || (isnan(x) && isnan(y));
+}
+
+void harness_reference(const ir *ir, ir_ref root, const ir_env *env,
+                       int samples, uint64_t seed, harness_refval *out)
+{
+    memset(out, 0, sizeof *out);
+    if (!ir_ref_ok(root))
+        return;
+    const uint32_t n = root.id + 1;
+    double (*exact)[4] = calloc(n, sizeof *exact);
+    double (*bnd)[4] = calloc(n, sizeof *bnd);
+    double (*noisy)[4] = calloc(n, sizeof *noisy);
+    uint8_t *need = calloc(n, 1);
+    if (!exact || !bnd || !noisy || !need) {
+        out->flags = HARNESS_REF_NONFINITE;   /* no memory: compare nothing */
+        for (int c = 0; c < 4; c++)
+            out->spread[c] = INFINITY;
+        goto done;
+    }
+    need[root.id] = 1;
+    for (uint32_t id = root.id; id > 0; id--)
+        if (need[id])
+            for (int i = 0; i < ir->nodes[id].nargs; i++)
+                need[ir->nodes[id].arg[i].id] = 1;
+
+    bool ill = false, undef = false;
+    for (uint32_t id = 1; id < n; id++) {
+        if (!need[id])
+            continue;
+        eval_node(ir, id, env, (const double (*)[4])exact, exact[id]);
+        int w = ir_type_width(ir_typeof(ir, (ir_ref){id}));
+        for (int c = 0; c < w; c++) {
+            double x = exact[id][c];
+            if (!isfinite(x))
+                out->flags |= HARNESS_REF_NONFINITE;
+            else if (fabs(x) > 1e18 || (x != 0 && fabs(x) < 1e-18))
+                out->flags |= HARNESS_REF_RANGE;
+            bnd[id][c] = bound(ir, id, env, (const double (*)[4])exact, c, &ill, &undef);
+        }
+    }
+    if (undef)
+        out->flags |= HARNESS_REF_UNDEFINED;
+
+    /* The walk must agree with ir_eval bit for bit (it mirrors its leaves). */
+    double ref[4];
+    ir_eval(ir, root, env, ref);
+    const int rw = ir_type_width(ir_typeof(ir, root));
+    for (int c = 0; c < 4; c++) {
+        out->value[c] = ref[c];
+        if (c < rw && !same(ref[c], exact[root.id][c]))
+            out->flags |= HARNESS_REF_MISMATCH;
+    }
+
+    for (int s = 0; s < samples; s++) {
+        for (uint32_t id = 1; id < n; id++) {
+            if (!need[id])
+                continue;
+            eval_node(ir, id, env, (const double (*)[4])noisy, noisy[id]);
+            int w = ir_type_width(ir_typeof(ir, (ir_ref){id}));
+            for (int c = 0; c < w; c++)
+                noisy[id][c] += sign_of(seed, s, id, c) * bnd[id][c];
+        }
+        for (int c = 0; c < rw; c++) {
+            double d = fabs(noisy[root.id][c] - exact[root.id][c]);
+            if (isnan(d))
+                d = INFINITY;
+            if (d > out->spread[c])
+                out->spread[c] = d;
+        }
+    }
+    if (ill)
+        for (int c = 0; c < rw; c++)
+            out->spread[c] = INFINITY;
+done:
+    free(exact);
+    free(bnd);
+    free(noisy);
+    free(need);
+}

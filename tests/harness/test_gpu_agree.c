@@ -1,0 +1,262 @@
+/* test_gpu_agree.c — the GLSL back end agrees with the CPU reference.
+ *
+ * Random well-typed IR graphs (random_graph.h) are emitted by the
+ * compiler's GLSL emitter into a compute shader (harness_eval_ir) and run
+ * on the Vulkan device (lavapipe here, a GPU elsewhere) over random inputs;
+ * each value is compared with ir_eval's double-precision value.
+ *
+ * Tolerance, and why: the device computes in fp32, whose rounding differs
+ * per op (Vulkan spec precision table: most ops 0.5-3 ulp, exp2/pow/sin/cos
+ * far looser), and a random graph can amplify rounding without bound
+ * (cancellation before a division, a floor or step right at its jump).  So
+ * each value's fp32 sensitivity is estimated with harness_reference (every
+ * node perturbed by its op's fp32 error bound, 16 samples; bounds listed in
+ * harness_ref.c) and:
+ *   - values that are NaN/Inf in double, pass through NaN/Inf, or leave
+ *     fp32's comfortable range (|v| > 1e18 or < 1e-18) on the way, or that
+ *     GLSL leaves undefined (smoothstep e0 >= e1, clamp lo > hi, pow x < 0)
+ *     are excluded — GLSL gives no NaN/Inf guarantees;
+ *   - ill-conditioned values, spread > 1e-3 * max(1, |ref|), are excluded;
+ *   - every other value must satisfy
+ *         |gpu - ref| <= 2^-20 * max(1, |ref|) + 4 * spread
+ *     (a floor of a few fp32 ulps, plus 4x the modelled rounding spread).
+ * Each exclusion is counted and reported, and at least half of all values
+ * must be compared, so the test cannot pass by excluding everything.  A
+ * control compares each root's device values with another root's reference
+ * and must fail nearly everywhere, so the tolerance is not vacuous.
+ */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "harness.h"
+#include "random_graph.h"
+
+enum {
+    BATCHES = 12,      /* one compute shader each                       */
+    ROOTS = 16,        /* random graphs per batch (one IR, shared leaves) */
+    POINTS = 1024,     /* random inputs per batch                       */
+    SAMPLES = 16,      /* rounding-perturbation samples per value       */
+    DEPTH = 5,         /* ops deep                                      */
+};
+
+#define FLOOR_TOL (1.0 / 1048576.0)   /* 2^-20 */
+#define ILL_COND  1e-3
+
+static harness *H;
+
+typedef struct batch {
+    ir      ir;
+    ir_ref  roots[ROOTS];
+    ir_env  env[POINTS];
+    double *params, *painted;
+    float  *gpu;            /* POINTS * ROOTS * 4 */
+    char   *glsl;
+} batch;
+
+static void batch_build(batch *b, uint64_t seed)
+{
+    rg_rng r = { seed };
+    ir_init(&b->ir);
+    rg_setup(&b->ir);
+    for (int k = 0; k < ROOTS; k++) {
+        b->roots[k] = rg_expr(&b->ir, &r, rg_type(&r), DEPTH);
+        char name[16];
+        snprintf(name, sizeof name, "g%d", k);
+        ir_set_root(&b->ir, name, b->roots[k]);
+    }
+    b->params = calloc((size_t)POINTS * 4 * (size_t)b->ir.nparams, sizeof(double));
+    b->painted = calloc((size_t)POINTS * (size_t)b->ir.npainted + 1, sizeof(double));
+    b->gpu = calloc((size_t)POINTS * ROOTS * 4, sizeof(float));
+    assert_non_null(b->params);
+    assert_non_null(b->painted);
+    assert_non_null(b->gpu);
+    for (int p = 0; p < POINTS; p++)
+        rg_env(&b->ir, &r, &b->env[p], b->params + (size_t)p * 4 * (size_t)b->ir.nparams,
+               b->painted + (size_t)p * (size_t)b->ir.npainted);
+}
+
+static void batch_run(batch *b)
+{
+    char *err = NULL;
+    harness_ir_desc d = {
+        .ir = &b->ir, .roots = b->roots, .nroots = ROOTS,
+        .points = b->env, .npoints = POINTS,
+    };
+    bool ok = harness_eval_ir(H, &d, b->gpu, &b->glsl, &err);
+    if (!ok) {
+        fprintf(stderr, "harness_eval_ir: %s\n", err ? err : "?");
+        if (b->glsl)
+            fprintf(stderr, "---- generated shader ----\n%s\n", b->glsl);
+    }
+    free(err);
+    assert_true(ok);
+}
+
+static void batch_free(batch *b)
+{
+    ir_free(&b->ir);
+    free(b->params);
+    free(b->painted);
+    free(b->gpu);
+    free(b->glsl);
+}
+
+typedef struct stats {
+    long values, compared, failed;
+    long nonfinite, range, undefined, ill, mismatch;
+    double max_abs, max_rel, max_ratio;
+} stats;
+
+/* Compare root k's device values with the reference of root `refk`. */
+static void compare(const batch *b, int k, int refk, uint64_t seed, stats *s,
+                    bool report)
+{
+    ir_ref root = b->roots[refk];
+    int w = ir_type_width(ir_typeof(&b->ir, root));
+    for (int p = 0; p < POINTS; p++) {
+        harness_refval rv;
+        harness_reference(&b->ir, root, &b->env[p], SAMPLES, seed + (uint64_t)p, &rv);
+        for (int c = 0; c < w; c++) {
+            s->values++;
+            if (rv.flags & HARNESS_REF_MISMATCH) {
+                s->mismatch++;
+                continue;
+            }
+            if (rv.flags & HARNESS_REF_NONFINITE) { s->nonfinite++; continue; }
+            if (rv.flags & HARNESS_REF_RANGE)     { s->range++; continue; }
+            if (rv.flags & HARNESS_REF_UNDEFINED) { s->undefined++; continue; }
+            double ref = rv.value[c];
+            double scale = fmax(1.0, fabs(ref));
+            if (!(rv.spread[c] <= ILL_COND * scale)) {
+                s->ill++;
+                continue;
+            }
+            s->compared++;
+            double gpu = b->gpu[((size_t)p * ROOTS + (size_t)k) * 4 + (size_t)c];
+            double err = fabs(gpu - ref);
+            if (isnan(err))
+                err = INFINITY;
+            double tol = FLOOR_TOL * scale + 4 * rv.spread[c];
+            if (err > s->max_abs)
+                s->max_abs = err;
+            if (err / scale > s->max_rel)
+                s->max_rel = err / scale;
+            if (err / tol > s->max_ratio)
+                s->max_ratio = err / tol;
+            if (err > tol) {
+                if (report && s->failed < 10)
+                    fprintf(stderr, "  graph g%d point %d component %d: gpu %.9g, "
+                            "reference %.17g, |error| %.3g > tolerance %.3g "
+                            "(spread %.3g)\n", k, p, c, gpu, ref, err, tol,
+                            rv.spread[c]);
+                s->failed++;
+            }
+        }
+    }
+}
+
+static void test_random_graphs_agree(void **state)
+{
+    stats total = {0};
+    bool shown = false;
+    for (int i = 0; i < BATCHES; i++) {
+        batch *b = calloc(1, sizeof *b);
+        assert_non_null(b);
+        batch_build(b, 0x5eed0000u + (uint64_t)i);
+        batch_run(b);
+        stats s = {0};
+        for (int k = 0; k < ROOTS; k++)
+            compare(b, k, k, 77u * (uint64_t)i, &s, true);
+        printf("batch %2d: %6ld values, %6ld compared, max |err| %.3g, "
+               "max err/tol %.3g, %ld failed\n", i, s.values, s.compared,
+               s.max_abs, s.max_ratio, s.failed);
+        if (s.failed && !shown) {
+            fprintf(stderr, "---- shader of batch %d ----\n%s\n", i, b->glsl);
+            shown = true;
+        }
+        total.values += s.values;
+        total.compared += s.compared;
+        total.failed += s.failed;
+        total.nonfinite += s.nonfinite;
+        total.range += s.range;
+        total.undefined += s.undefined;
+        total.ill += s.ill;
+        total.mismatch += s.mismatch;
+        total.max_abs = fmax(total.max_abs, s.max_abs);
+        total.max_rel = fmax(total.max_rel, s.max_rel);
+        total.max_ratio = fmax(total.max_ratio, s.max_ratio);
+        batch_free(b);
+        free(b);
+    }
+    printf("device %s: %d graphs, %ld values\n", harness_device_name(H),
+           BATCHES * ROOTS, total.values);
+    printf("  compared              %8ld (%.1f%%)\n", total.compared,
+           100.0 * (double)total.compared / (double)total.values);
+    printf("  excluded: NaN/Inf     %8ld\n", total.nonfinite);
+    printf("  excluded: fp32 range  %8ld\n", total.range);
+    printf("  excluded: undefined   %8ld\n", total.undefined);
+    printf("  excluded: ill-cond.   %8ld\n", total.ill);
+    printf("  max |gpu - ref|       %.3g (max relative to max(1,|ref|): %.3g)\n",
+           total.max_abs, total.max_rel);
+    printf("  max error/tolerance   %.3g\n", total.max_ratio);
+    printf("  failed                %8ld\n", total.failed);
+    assert_int_equal(total.mismatch, 0);
+    assert_true(2 * total.compared >= total.values);
+    assert_int_equal(total.failed, 0);
+}
+
+/* Control: another graph's reference must not pass for this graph. */
+static void test_tolerance_is_not_vacuous(void **state)
+{
+    batch *b = calloc(1, sizeof *b);
+    assert_non_null(b);
+    batch_build(b, 0x5eed0000u);
+    batch_run(b);
+    stats s = {0};
+    for (int k = 0; k < ROOTS; k++) {
+        /* the next root of the same type */
+        ir_type t = ir_typeof(&b->ir, b->roots[k]);
+        for (int j = 1; j < ROOTS; j++) {
+            int other = (k + j) % ROOTS;
+            if (ir_typeof(&b->ir, b->roots[other]) == t &&
+                !ir_ref_eq(b->roots[other], b->roots[k])) {
+                compare(b, k, other, 1, &s, false);
+                break;
+            }
+        }
+    }
+    printf("control: %ld of %ld compared values fail against another graph\n",
+           s.failed, s.compared);
+    assert_true(s.compared > 0);
+    assert_true(s.failed * 10 >= s.compared * 9);
+    batch_free(b);
+    free(b);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_random_graphs_agree),
+        cmocka_unit_test(test_tolerance_is_not_vacuous),
+    };
+    char *err = NULL;
+    H = harness_create(NULL, &err);
+    if (!H) {
+        fprintf(stderr, "harness_create: %s\n", err ? err : "?");
+        free(err);
+        return 1;
+    }
+    int failed = cmocka_run_group_tests(tests, NULL, NULL);
+    int messages = harness_destroy(H);
+    if (messages)
+        fprintf(stderr, "FAILED: %d Vulkan validation message(s)\n", messages);
+    return failed || messages ? 1 : 0;
+}
