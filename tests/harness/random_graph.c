@@ -112,10 +112,28 @@ ir_ref rg_expr(ir *ir, rg_rng *r, ir_type t, int depth)
     case 2: case 3: case 4: {
         ir_op op = binary[rg_int(r, COUNT(binary))];
         ir_ref a = rg_expr(ir, r, t, d);
+        /* Materials raise non-negative bases (pow(saturate(x), k)); half
+         * the time do the same, so fewer values are NaN. */
+        if (op == IR_OP_POW && rg_int(r, 2))
+            a = ir_op1(ir, IR_OP_ABS, a);
         return ir_op2(ir, op, a, rg_expr(ir, r, t, d));
     }
     case 5: {
         ir_op op = ternary[rg_int(r, COUNT(ternary))];
+        if ((op == IR_OP_CLAMP || op == IR_OP_SMOOTHSTEP) && rg_int(r, 4)) {
+            /* Mostly ordered constant edges, as ramps have (unordered
+             * edges are undefined in GLSL and cannot be compared). */
+            double lo[4], hi[4];
+            for (int c = 0; c < w; c++) {
+                double u = rg_uniform(r, -4, 4), v = rg_uniform(r, -4, 4);
+                lo[c] = fmin(u, v);
+                hi[c] = fmax(u, v) + 0.125;
+            }
+            ir_ref x = rg_expr(ir, r, t, d);
+            ir_ref e0 = ir_const(ir, t, lo), e1 = ir_const(ir, t, hi);
+            return op == IR_OP_CLAMP ? ir_op3(ir, op, x, e0, e1)
+                                     : ir_op3(ir, op, e0, e1, x);
+        }
         ir_ref a = rg_expr(ir, r, t, d);
         ir_ref b = rg_expr(ir, r, t, d);
         return ir_op3(ir, op, a, b, rg_expr(ir, r, t, d));
