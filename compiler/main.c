@@ -1,0 +1,808 @@
+/* main.c — the splatc command line.
+ *
+ *   splatc check FILE...                       parse and type-check
+ *   splatc glsl  FILE -m MAT [-o OUT.frag]     fragment shader of one material
+ *   splatc spirv FILE -m MAT -o OUT.spv        the same, compiled and validated
+ *   splatc dot   FILE [-m MAT] [-o OUT.dot]    Graphviz of the graphs
+ *   splatc dump  FILE -m MAT [--after PASS]    the IR in .sg form
+ *   splatc eval  FILE -m MAT [--output NAME] [--interval] --at KEY=V,...
+ *   splatc build SCENE.sg -o PACK ...          (cli_build.c)
+ *   splatc texgen --out DIR ...                (cli_texgen.c)
+ *
+ * Exit status: 0 success, 1 input errors (diagnostics on stderr), 2 usage.
+ * Files are written atomically (OUT.tmp-XXXXXX, then rename): on an error
+ * nothing is written.  Imports are searched next to the importing file,
+ * then in -I folders, $SPLATC_PATH (':'-separated), the current folder and
+ * the nearest folder above the input file that has a nodes/ folder (the
+ * repository root for files inside it). */
+#include "ir.h"
+#include "scene.h"
+#include "sg.h"
+#include "shader.h"
+#include "spv.h"
+#include "texgen.h"
+
+#include <errno.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+enum { EXIT_OK = 0, EXIT_INPUT = 1, EXIT_USAGE = 2 };
+
+static const char usage_text[] =
+    "usage: splatc COMMAND [options]\n"
+    "commands:\n"
+    "  check FILE...                      parse and type-check graph files\n"
+    "  glsl  FILE -m MATERIAL [-o OUT]    Vulkan GLSL 450 fragment shader of a material\n"
+    "  spirv FILE -m MATERIAL -o OUT.spv  the same compiled to SPIR-V and validated\n"
+    "  dot   FILE [-m MATERIAL] [-o OUT]  Graphviz DOT of the graphs (dot -Tsvg draws it)\n"
+    "  dump  FILE -m MATERIAL [--after PASS]\n"
+    "                                     the material's IR in .sg form, after the whole\n"
+    "                                     pipeline or after PASS (lower = no pass)\n"
+    "  eval  FILE -m MATERIAL [--output NAME] --at KEY=V,...\n"
+    "                                     CPU reference value (double precision);\n"
+    "                                     keys: height=H slope=S normal=X,Y,Z position=X,Z\n"
+    "                                     uv=U,V distance=D destruction=D painted.NAME=V\n"
+    "                                     PARAM=V...  (unset: 0, normal 0,1,0, defaults)\n"
+    "        --interval                   the same keys take LO:HI ranges; prints sound\n"
+    "                                     bounds (unset: slope 0:1, normal -1:1,0:1,-1:1,\n"
+    "                                     uv 0:1, distance 0:inf, others unbounded)\n"
+    "  build SCENE.sg -o PACKDIR ...      compile a scene into a shader pack (build --help)\n"
+    "  texgen --out DIR ...               write the example textures (texgen --help)\n"
+    "options:\n"
+    "  -I DIR       also search DIR for imports (repeatable)\n"
+    "  --help       this text\n"
+    "  --version    the compiler version\n"
+    "exit status: 0 ok, 1 errors in the input, 2 usage errors\n";
+
+static int usage_error(const char *fmt, const char *arg)
+{
+    fputs("splatc: ", stderr);
+    fprintf(stderr, fmt, arg);
+    fputs("\n(splatc --help for usage)\n", stderr);
+    return EXIT_USAGE;
+}
+
+/* ---- options shared by the commands ---------------------------------------- */
+
+typedef struct options {
+    const char **files;  int nfiles;
+    const char  *material;
+    const char  *out;
+    const char  *after;
+    const char  *output;
+    const char  *at;
+    bool         interval;
+    const char **include; int ninclude;
+} options;
+
+/* Parse argv[1..]; `allowed` lists the options this command takes. */
+static int parse_options(int argc, char **argv, const char *allowed, options *o)
+{
+    memset(o, 0, sizeof *o);
+    o->files = calloc((size_t)argc + 1, sizeof *o->files);
+    o->include = calloc((size_t)argc + 1, sizeof *o->include);
+    if (!o->files || !o->include)
+        return EXIT_USAGE;
+    for (int i = 1; i < argc; i++) {
+        const char *a = argv[i];
+        const char *val = i + 1 < argc ? argv[i + 1] : NULL;
+        const char **slot = NULL;
+        if (!strcmp(a, "-m") && strstr(allowed, "m"))
+            slot = &o->material;
+        else if (!strcmp(a, "-o") && strstr(allowed, "o"))
+            slot = &o->out;
+        else if (!strcmp(a, "--after") && strstr(allowed, "A"))
+            slot = &o->after;
+        else if (!strcmp(a, "--output") && strstr(allowed, "O"))
+            slot = &o->output;
+        else if (!strcmp(a, "--at") && strstr(allowed, "@"))
+            slot = &o->at;
+        else if (!strcmp(a, "-I")) {
+            if (!val)
+                return usage_error("option '%s' needs a value", a);
+            o->include[o->ninclude++] = val;
+            i++;
+            continue;
+        } else if (!strcmp(a, "--interval") && strstr(allowed, "@")) {
+            o->interval = true;
+            continue;
+        } else if (a[0] == '-' && a[1]) {
+            return usage_error("unknown option '%s' for this command", a);
+        } else {
+            o->files[o->nfiles++] = a;
+            continue;
+        }
+        if (!val)
+            return usage_error("option '%s' needs a value", a);
+        if (*slot)
+            return usage_error("option '%s' given twice", a);
+        *slot = val;
+        i++;
+    }
+    return EXIT_OK;
+}
+
+static void options_free(options *o)
+{
+    free(o->files);
+    free(o->include);
+}
+
+/* ---- loading ---------------------------------------------------------------- */
+
+typedef struct search {
+    char **paths;   /* NULL-terminated */
+    int    n;
+} search;
+
+static void search_add(search *s, const char *path)
+{
+    char **p = realloc(s->paths, (size_t)(s->n + 2) * sizeof *p);
+    if (!p)
+        abort();
+    s->paths = p;
+    s->paths[s->n] = strdup(path);
+    if (!s->paths[s->n])
+        abort();
+    s->paths[++s->n] = NULL;
+}
+
+static void search_free(search *s)
+{
+    for (int i = 0; i < s->n; i++)
+        free(s->paths[i]);
+    free(s->paths);
+}
+
+static bool is_dir(const char *path)
+{
+    struct stat st;
+    return stat(path, &st) == 0 && S_ISDIR(st.st_mode);
+}
+
+static void search_init(search *s, const options *o, const char *file)
+{
+    memset(s, 0, sizeof *s);
+    for (int i = 0; i < o->ninclude; i++)
+        search_add(s, o->include[i]);
+    const char *env = getenv("SPLATC_PATH");
+    if (env && *env) {
+        char *copy = strdup(env);
+        if (!copy)
+            abort();
+        char *save = NULL;
+        for (char *t = strtok_r(copy, ":", &save); t; t = strtok_r(NULL, ":", &save))
+            search_add(s, t);
+        free(copy);
+    }
+    search_add(s, ".");
+    /* the nearest folder above the file with a nodes/ folder */
+    char *dir = strdup(file);
+    if (!dir)
+        abort();
+    for (;;) {
+        char *slash = strrchr(dir, '/');
+        if (!slash)
+            break;
+        *slash = 0;
+        size_t n = strlen(dir) + 8;
+        char *nodes = malloc(n);
+        if (!nodes)
+            abort();
+        snprintf(nodes, n, "%s/nodes", *dir ? dir : "");
+        bool found = is_dir(nodes);
+        free(nodes);
+        if (found) {
+            search_add(s, *dir ? dir : "/");
+            break;
+        }
+    }
+    free(dir);
+}
+
+/* Load and check one file; diagnostics to stderr.  NULL on errors. */
+static sg_program *load(const char *file, const options *o, sg_diags *d)
+{
+    search s;
+    search_init(&s, o, file);
+    sg_program *p = sg_load(file, (const char *const *)s.paths, d);
+    search_free(&s);
+    sg_diags_print(d, stderr);
+    if (!p || d->nerrors) {
+        sg_free(p);
+        return NULL;
+    }
+    return p;
+}
+
+/* Load FILE and lower material -m into `ir`.  Returns an exit status. */
+static int load_material(const options *o, const char *cmd, ir *ir, sg_program **pp)
+{
+    if (o->nfiles != 1)
+        return usage_error("%s needs exactly one FILE", cmd);
+    if (!o->material)
+        return usage_error("%s needs -m MATERIAL", cmd);
+    sg_diags d;
+    sg_diags_init(&d);
+    sg_program *p = load(o->files[0], o, &d);
+    if (!p) {
+        sg_diags_free(&d);
+        return EXIT_INPUT;
+    }
+    if (sg_material_find(p, o->material) < 0) {
+        fprintf(stderr, "%s: error: no material '%s' (", o->files[0], o->material);
+        if (!sg_material_count(p))
+            fputs("the file declares none", stderr);
+        for (int i = 0; i < sg_material_count(p); i++)
+            fprintf(stderr, "%s%s", i ? ", " : "materials: ", sg_material_name(p, i));
+        fputs(")\n", stderr);
+        sg_free(p);
+        sg_diags_free(&d);
+        return EXIT_INPUT;
+    }
+    bool ok = sg_lower_material(p, o->material, ir, &d);
+    sg_diags_print(&d, stderr);
+    sg_diags_free(&d);
+    if (!ok) {
+        sg_free(p);
+        return EXIT_INPUT;
+    }
+    *pp = p;
+    return EXIT_OK;
+}
+
+/* ---- output ------------------------------------------------------------------ */
+
+/* mkstemp makes 0600 files; give outputs the usual 0666 & ~umask. */
+static int chmod_default(const char *path)
+{
+    mode_t mask = umask(0);
+    umask(mask);
+    return chmod(path, 0666 & ~mask);
+}
+
+/* Write `len` bytes to `path` atomically, or to stdout if path is NULL. */
+static int write_output(const char *path, const void *data, size_t len)
+{
+    if (!path) {
+        if (fwrite(data, 1, len, stdout) != len || fflush(stdout)) {
+            fprintf(stderr, "splatc: error: cannot write to standard output\n");
+            return EXIT_INPUT;
+        }
+        return EXIT_OK;
+    }
+    size_t n = strlen(path) + 16;
+    char *tmp = malloc(n);
+    if (!tmp)
+        abort();
+    snprintf(tmp, n, "%s.tmp-XXXXXX", path);
+    int fd = mkstemp(tmp);
+    if (fd < 0) {
+        fprintf(stderr, "splatc: error: cannot write '%s': %s\n", path, strerror(errno));
+        free(tmp);
+        return EXIT_INPUT;
+    }
+    const char *s = data;
+    size_t done = 0;
+    while (done < len) {
+        ssize_t w = write(fd, s + done, len - done);
+        if (w < 0 && errno == EINTR)
+            continue;
+        if (w <= 0)
+            break;
+        done += (size_t)w;
+    }
+    int err = done == len ? 0 : errno;
+    if (close(fd) && !err)
+        err = errno;
+    if (!err && chmod_default(tmp))
+        err = errno;
+    if (!err && rename(tmp, path))
+        err = errno;
+    if (err) {
+        unlink(tmp);
+        fprintf(stderr, "splatc: error: cannot write '%s': %s\n", path, strerror(err));
+        free(tmp);
+        return EXIT_INPUT;
+    }
+    free(tmp);
+    return EXIT_OK;
+}
+
+/* ---- check ------------------------------------------------------------------- */
+
+static int cmd_check(int argc, char **argv)
+{
+    options o;
+    int st = parse_options(argc, argv, "", &o);
+    if (st == EXIT_OK && o.nfiles == 0)
+        st = usage_error("%s needs at least one FILE", "check");
+    for (int i = 0; st != EXIT_USAGE && i < o.nfiles; i++) {
+        sg_diags d;
+        sg_diags_init(&d);
+        sg_program *p = load(o.files[i], &o, &d);
+        if (!p)
+            st = EXIT_INPUT;
+        sg_free(p);
+        sg_diags_free(&d);
+    }
+    options_free(&o);
+    return st;
+}
+
+/* ---- glsl / spirv -------------------------------------------------------------- */
+
+static int material_glsl(const options *o, const char *cmd, ir_buf *glsl)
+{
+    ir ir;
+    ir_init(&ir);
+    sg_program *p = NULL;
+    int st = load_material(o, cmd, &ir, &p);
+    if (st == EXIT_OK) {
+        ir_optimize(&ir, NULL);
+        glsl_material_shader(&ir, o->material, glsl);
+    }
+    sg_free(p);
+    ir_free(&ir);
+    return st;
+}
+
+static int cmd_glsl(int argc, char **argv)
+{
+    options o;
+    int st = parse_options(argc, argv, "mo", &o);
+    ir_buf glsl = { 0 };
+    if (st == EXIT_OK)
+        st = material_glsl(&o, "glsl", &glsl);
+    if (st == EXIT_OK)
+        st = write_output(o.out, glsl.s, glsl.len);
+    ir_buf_free(&glsl);
+    options_free(&o);
+    return st;
+}
+
+static int cmd_spirv(int argc, char **argv)
+{
+    options o;
+    int st = parse_options(argc, argv, "mo", &o);
+    if (st == EXIT_OK && !o.out)
+        st = usage_error("%s needs -o OUT.spv", "spirv");
+    ir_buf glsl = { 0 };
+    if (st == EXIT_OK)
+        st = material_glsl(&o, "spirv", &glsl);
+    if (st == EXIT_OK) {
+        uint32_t *words = NULL;
+        size_t nwords = 0;
+        char *log = NULL;
+        bool ok = spv_compile(glsl.s, SPV_STAGE_FRAGMENT, o.material, &words, &nwords, &log) &&
+                  spv_validate(words, nwords, &log);
+        if (!ok) {
+            /* generated code that does not compile is a compiler bug */
+            fprintf(stderr, "splatc: %s\n", log ? log : "internal compiler error");
+            st = EXIT_INPUT;
+        } else if (!spv_write_file(o.out, words, nwords)) {
+            fprintf(stderr, "splatc: error: cannot write '%s': %s\n", o.out, strerror(errno));
+            st = EXIT_INPUT;
+        }
+        free(words);
+        free(log);
+    }
+    ir_buf_free(&glsl);
+    options_free(&o);
+    return st;
+}
+
+/* ---- dot / dump ------------------------------------------------------------------ */
+
+/* Run `emit` into a memory stream, then write it out atomically. */
+static int emit_to(const char *path, void (*emit)(void *user, FILE *f), void *user)
+{
+    char *buf = NULL;
+    size_t len = 0;
+    FILE *f = open_memstream(&buf, &len);
+    if (!f)
+        abort();
+    emit(user, f);
+    fclose(f);
+    int st = write_output(path, buf, len);
+    free(buf);
+    return st;
+}
+
+typedef struct dot_job { sg_program *p; const char *material; } dot_job;
+static void emit_dot(void *user, FILE *f)
+{
+    dot_job *j = user;
+    sg_write_dot(j->p, j->material, f);
+}
+
+static int cmd_dot(int argc, char **argv)
+{
+    options o;
+    int st = parse_options(argc, argv, "mo", &o);
+    if (st == EXIT_OK && o.nfiles != 1)
+        st = usage_error("%s needs exactly one FILE", "dot");
+    if (st == EXIT_OK) {
+        sg_diags d;
+        sg_diags_init(&d);
+        sg_program *p = load(o.files[0], &o, &d);
+        if (!p) {
+            st = EXIT_INPUT;
+        } else if (o.material && sg_material_find(p, o.material) < 0) {
+            fprintf(stderr, "%s: error: no material '%s'\n", o.files[0], o.material);
+            st = EXIT_INPUT;
+        } else {
+            dot_job j = { p, o.material };
+            st = emit_to(o.out, emit_dot, &j);
+        }
+        sg_free(p);
+        sg_diags_free(&d);
+    }
+    options_free(&o);
+    return st;
+}
+
+static void emit_dump(void *user, FILE *f)
+{
+    ir_dump(user, f);
+}
+
+static int cmd_dump(int argc, char **argv)
+{
+    options o;
+    int st = parse_options(argc, argv, "moA", &o);
+    if (st == EXIT_OK && o.after && strcmp(o.after, "lower")) {
+        bool known = false;
+        for (const ir_pass *ps = ir_passes; ps->name; ps++)
+            known |= !strcmp(ps->name, o.after);
+        if (!known) {
+            fprintf(stderr, "splatc: unknown pass '%s'; passes: lower", o.after);
+            for (const ir_pass *ps = ir_passes; ps->name; ps++)
+                fprintf(stderr, " %s", ps->name);
+            fputc('\n', stderr);
+            st = EXIT_USAGE;
+        }
+    }
+    ir ir;
+    ir_init(&ir);
+    sg_program *p = NULL;
+    if (st == EXIT_OK)
+        st = load_material(&o, "dump", &ir, &p);
+    if (st == EXIT_OK) {
+        if (!o.after || strcmp(o.after, "lower"))
+            ir_optimize(&ir, o.after);
+        st = emit_to(o.out, emit_dump, &ir);
+    }
+    sg_free(p);
+    ir_free(&ir);
+    options_free(&o);
+    return st;
+}
+
+/* ---- eval ---------------------------------------------------------------------- */
+
+/* One `KEY=V,V,...` item of --at, values as intervals (a plain V is V:V). */
+typedef struct at_item {
+    char  *key;
+    ir_iv  v[4];
+    int    n;
+} at_item;
+
+static bool parse_bound(const char *s, double *x)
+{
+    char *end;
+    if (!strcmp(s, "inf") || !strcmp(s, "+inf")) {
+        *x = INFINITY;
+        return true;
+    }
+    if (!strcmp(s, "-inf")) {
+        *x = -INFINITY;
+        return true;
+    }
+    errno = 0;
+    *x = strtod(s, &end);
+    return *s && !*end && !errno && isfinite(*x);
+}
+
+/* "height=1,normal=0,1,0,slope=0:0.5" -> items.  A value without '=' adds
+ * a component to the previous key. */
+static bool parse_at(const char *spec, bool ranges, at_item **items, int *n)
+{
+    char *copy = strdup(spec);
+    if (!copy)
+        abort();
+    *items = NULL;
+    *n = 0;
+    bool ok = true;
+    char *save = NULL;
+    for (char *t = strtok_r(copy, ",", &save); t && ok; t = strtok_r(NULL, ",", &save)) {
+        char *eq = strchr(t, '=');
+        if (eq) {
+            *items = realloc(*items, (size_t)(*n + 1) * sizeof **items);
+            if (!*items)
+                abort();
+            at_item *it = &(*items)[(*n)++];
+            *eq = 0;
+            it->key = strdup(t);
+            it->n = 0;
+            t = eq + 1;
+        } else if (*n == 0) {
+            ok = false;
+            break;
+        }
+        at_item *it = &(*items)[*n - 1];
+        if (it->n == 4) {
+            ok = false;
+            break;
+        }
+        char *colon = strchr(t, ':');
+        if (colon && !ranges) {
+            ok = false;
+            break;
+        }
+        if (colon) {
+            *colon = 0;
+            ok = parse_bound(t, &it->v[it->n].lo) && parse_bound(colon + 1, &it->v[it->n].hi) &&
+                 it->v[it->n].lo <= it->v[it->n].hi;
+        } else {
+            ok = parse_bound(t, &it->v[it->n].lo);
+            it->v[it->n].hi = it->v[it->n].lo;
+        }
+        it->n++;
+    }
+    free(copy);
+    return ok;
+}
+
+/* Shortest text that reads back as the same double. */
+static void print_double(FILE *f, double x)
+{
+    char buf[40];
+    for (int prec = 15; prec <= 17; prec++) {
+        snprintf(buf, sizeof buf, "%.*g", prec, x);
+        if (strtod(buf, NULL) == x || isnan(x))
+            break;
+    }
+    fputs(buf, f);
+}
+
+typedef struct eval_inputs {
+    ir_env   env;
+    ir_ienv  ienv;
+    double  *params;    /* 4 per param */
+    ir_iv   *iparams;
+    double  *painted;
+    ir_iv   *ipainted;
+} eval_inputs;
+
+static int set_inputs(const ir *ir, const char *material, const at_item *items, int n,
+                      eval_inputs *in)
+{
+    memset(in, 0, sizeof *in);
+    ir_env *e = &in->env;
+    ir_ienv *ie = &in->ienv;
+    e->normal[1] = 1;
+    const ir_iv all = { -INFINITY, INFINITY }, unit = { 0, 1 }, sym = { -1, 1 };
+    ie->height = all;
+    ie->slope = unit;
+    ie->normal[0] = sym;
+    ie->normal[1] = unit;
+    ie->normal[2] = sym;
+    for (int c = 0; c < 3; c++)
+        ie->position[c] = all;
+    ie->uv[0] = ie->uv[1] = unit;
+    ie->view_distance = (ir_iv){ 0, INFINITY };
+    ie->destruction = unit;
+    in->params = calloc((size_t)ir->nparams * 4 + 1, sizeof *in->params);
+    in->iparams = calloc((size_t)ir->nparams + 1, sizeof *in->iparams);
+    in->painted = calloc((size_t)ir->npainted + 1, sizeof *in->painted);
+    in->ipainted = calloc((size_t)ir->npainted + 1, sizeof *in->ipainted);
+    if (!in->params || !in->iparams || !in->painted || !in->ipainted)
+        abort();
+    for (int i = 0; i < ir->nparams; i++) {
+        memcpy(&in->params[4 * i], ir->params[i].def, sizeof ir->params[i].def);
+        in->iparams[i] = (ir_iv){ ir->params[i].lo, ir->params[i].hi };
+    }
+    for (int i = 0; i < ir->npainted; i++)
+        in->ipainted[i] = unit;
+    bool have_height = false, have_pos = false;
+    for (int i = 0; i < n; i++) {
+        const at_item *it = &items[i];
+        const char *k = it->key;
+        int want = -1;
+        ir_iv *iv[4] = { 0 };
+        double *dv[4] = { 0 };
+        if (!strcmp(k, "height")) {
+            want = 1; iv[0] = &ie->height; dv[0] = &e->height; have_height = true;
+        } else if (!strcmp(k, "slope")) {
+            want = 1; iv[0] = &ie->slope; dv[0] = &e->slope;
+        } else if (!strcmp(k, "normal")) {
+            want = 3;
+            for (int c = 0; c < 3; c++) { iv[c] = &ie->normal[c]; dv[c] = &e->normal[c]; }
+        } else if (!strcmp(k, "position")) {
+            /* X,Z (y is the height) or X,Y,Z */
+            want = it->n == 3 ? 3 : 2;
+            int map[3] = { 0, 2, 1 };
+            if (want == 3) { map[1] = 1; map[2] = 2; }
+            for (int c = 0; c < want; c++) {
+                iv[c] = &ie->position[map[c]];
+                dv[c] = &e->position[map[c]];
+            }
+            have_pos = want == 3;
+        } else if (!strcmp(k, "uv")) {
+            want = 2;
+            for (int c = 0; c < 2; c++) { iv[c] = &ie->uv[c]; dv[c] = &e->uv[c]; }
+        } else if (!strcmp(k, "distance")) {
+            want = 1; iv[0] = &ie->view_distance; dv[0] = &e->view_distance;
+        } else if (!strcmp(k, "destruction")) {
+            want = 1; iv[0] = &ie->destruction; dv[0] = &e->destruction;
+        } else if (!strncmp(k, "painted.", 8)) {
+            for (int j = 0; j < ir->npainted; j++)
+                if (!strcmp(ir->painted[j].name, k + 8)) {
+                    want = 1; iv[0] = &in->ipainted[j]; dv[0] = &in->painted[j];
+                }
+            if (want < 0) {
+                fprintf(stderr, "splatc: error: material '%s' reads no painted mask '%s'\n",
+                        material, k + 8);
+                return EXIT_INPUT;
+            }
+        } else {
+            /* a param: "wetness" or "cliff.wetness" */
+            size_t qn = strlen(material) + strlen(k) + 2;
+            char *q = malloc(qn);
+            if (!q)
+                abort();
+            snprintf(q, qn, "%s.%s", material, k);
+            for (int j = 0; j < ir->nparams; j++)
+                if (!strcmp(ir->params[j].name, q) || !strcmp(ir->params[j].name, k)) {
+                    want = ir_type_width(ir->params[j].type);
+                    for (int c = 0; c < want; c++) {
+                        dv[c] = &in->params[4 * j + c];
+                        iv[c] = c == 0 ? &in->iparams[j] : NULL;
+                    }
+                }
+            free(q);
+            if (want < 0) {
+                fprintf(stderr, "splatc: error: unknown --at key '%s' (not an input or a "
+                        "param of '%s')\n", k, material);
+                return EXIT_USAGE;
+            }
+        }
+        if (it->n != want) {
+            fprintf(stderr, "splatc: error: --at %s takes %d value%s, found %d\n", k, want,
+                    want == 1 ? "" : "s", it->n);
+            return EXIT_USAGE;
+        }
+        for (int c = 0; c < want; c++) {
+            *dv[c] = it->v[c].lo;
+            if (iv[c])
+                *iv[c] = it->v[c];
+        }
+    }
+    if (!have_pos) {              /* position.y follows the height */
+        e->position[1] = e->height;
+        if (have_height)
+            ie->position[1] = ie->height;
+    }
+    e->params = in->params;
+    e->painted = in->painted;
+    ie->params = in->iparams;
+    ie->painted = in->ipainted;
+    return EXIT_OK;
+}
+
+static int cmd_eval(int argc, char **argv)
+{
+    options o;
+    int st = parse_options(argc, argv, "mO@", &o);
+    if (st == EXIT_OK && !o.at)
+        st = usage_error("%s needs --at KEY=V,...", "eval");
+    at_item *items = NULL;
+    int nitems = 0;
+    if (st == EXIT_OK && !parse_at(o.at, o.interval, &items, &nitems))
+        st = usage_error(o.interval ? "bad --at '%s' (expected KEY=V or KEY=LO:HI, "
+                                      "comma-separated)"
+                                    : "bad --at '%s' (expected KEY=V,..., comma-separated)",
+                         o.at);
+    if (st == EXIT_OK && o.output) {
+        bool known = false;
+        for (int k = 0; k < SG_OUT_COUNT; k++)
+            known |= !strcmp(o.output, sg_output_names[k]);
+        if (!known)
+            st = usage_error("unknown --output '%s' (mask, albedo, normal, roughness, height)",
+                             o.output);
+    }
+    ir ir;
+    ir_init(&ir);
+    sg_program *p = NULL;
+    eval_inputs in = { 0 };
+    if (st == EXIT_OK)
+        st = load_material(&o, "eval", &ir, &p);
+    if (st == EXIT_OK)
+        st = set_inputs(&ir, o.material, items, nitems, &in);
+    for (int k = 0; st == EXIT_OK && k < SG_OUT_COUNT; k++) {
+        if (o.output && strcmp(o.output, sg_output_names[k]))
+            continue;
+        char root[512];
+        snprintf(root, sizeof root, "%s.%s", o.material, sg_output_names[k]);
+        ir_ref r = ir_find_root(&ir, root);
+        int w = ir_type_width(ir_typeof(&ir, r));
+        if (!o.output)
+            printf("%s = ", sg_output_names[k]);
+        if (o.interval) {
+            ir_iv b[4];
+            ir_interval(&ir, r, &in.ienv, b);
+            for (int c = 0; c < w; c++) {
+                printf("%s[", c ? " " : "");
+                print_double(stdout, b[c].lo);
+                fputs(", ", stdout);
+                print_double(stdout, b[c].hi);
+                fputs("]", stdout);
+            }
+        } else {
+            double v[4];
+            ir_eval(&ir, r, &in.env, v);
+            for (int c = 0; c < w; c++) {
+                if (c)
+                    fputc(' ', stdout);
+                print_double(stdout, v[c]);
+            }
+        }
+        fputc('\n', stdout);
+    }
+    for (int i = 0; i < nitems; i++)
+        free(items[i].key);
+    free(items);
+    free(in.params);
+    free(in.iparams);
+    free(in.painted);
+    free(in.ipainted);
+    sg_free(p);
+    ir_free(&ir);
+    options_free(&o);
+    return st;
+}
+
+/* ---- dispatch ------------------------------------------------------------------- */
+
+typedef int (*command_fn)(int argc, char **argv);
+
+/* Every subcommand gets argv starting at its own name. */
+static const struct { const char *name; command_fn run; } commands[] = {
+    { "check",  cmd_check },
+    { "glsl",   cmd_glsl },
+    { "spirv",  cmd_spirv },
+    { "dot",    cmd_dot },
+    { "dump",   cmd_dump },
+    { "eval",   cmd_eval },
+    { "build",  splat_cli_build },
+    { "texgen", splat_cli_texgen },
+};
+
+int main(int argc, char **argv)
+{
+    if (argc < 2)
+        return usage_error("%s", "no command given");
+    const char *cmd = argv[1];
+    if (!strcmp(cmd, "--help") || !strcmp(cmd, "-h") || !strcmp(cmd, "help")) {
+        fputs(usage_text, stdout);
+        return EXIT_OK;
+    }
+    if (!strcmp(cmd, "--version")) {
+        printf("splatc %s\n", SPLATC_VERSION);
+        return EXIT_OK;
+    }
+    for (size_t i = 0; i < sizeof commands / sizeof commands[0]; i++)
+        if (!strcmp(cmd, commands[i].name)) {
+            for (int j = 2; j < argc; j++)
+                if (!strcmp(argv[j], "--help") && strcmp(cmd, "build") && strcmp(cmd, "texgen")) {
+                    fputs(usage_text, stdout);
+                    return EXIT_OK;
+                }
+            return commands[i].run(argc - 1, argv + 1);
+        }
+    return usage_error("unknown command '%s'", cmd);
+}
