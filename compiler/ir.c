@@ -201,6 +201,19 @@ static void canonicalise(ir_node *n)
     }
 }
 
+ir_ref ir_lookup(const ir *ir, const ir_node *given)
+{
+    ir_node n = *given;
+    canonicalise(&n);
+    if (!can_cse(&n))
+        return IR_NONE;
+    uint32_t mask = ir->captable - 1;
+    for (uint32_t i = (uint32_t)node_hash(&n) & mask; ir->table[i]; i = (i + 1) & mask)
+        if (node_equal(&ir->nodes[ir->table[i]], &n))
+            return (ir_ref){ir->table[i]};
+    return IR_NONE;
+}
+
 ir_ref ir_node_add(ir *ir, const ir_node *given)
 {
     ir_node n = *given;
@@ -209,13 +222,9 @@ ir_ref ir_node_add(ir *ir, const ir_node *given)
     for (int i = 0; i < n.nargs; i++)
         assert(n.arg[i].id > 0 && n.arg[i].id < ir->nnodes);
     canonicalise(&n);
-
-    if (can_cse(&n)) {
-        uint32_t mask = ir->captable - 1;
-        for (uint32_t i = (uint32_t)node_hash(&n) & mask; ir->table[i]; i = (i + 1) & mask)
-            if (node_equal(&ir->nodes[ir->table[i]], &n))
-                return (ir_ref){ir->table[i]};
-    }
+    ir_ref found = ir_lookup(ir, &n);
+    if (ir_ref_ok(found))
+        return found;
     GROW(ir->nodes, ir->nnodes, ir->capnodes);
     uint32_t id = ir->nnodes++;
     ir->nodes[id] = n;

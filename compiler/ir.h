@@ -239,6 +239,8 @@ ir_ref ir_swizzle(ir *ir, ir_ref a, const char *comps); /* "xyz", "rgb", "r"  */
 ir_ref ir_construct(ir *ir, ir_type t, const ir_ref *args, int nargs);
 /* Any node, given fully (used by passes that rebuild). */
 ir_ref ir_node_add(ir *ir, const ir_node *n);
+/* The existing node equal to `n` (after canonicalising it), or IR_NONE. */
+ir_ref ir_lookup(const ir *ir, const ir_node *n);
 
 /* Tables.  add_* interns: same key returns the same index. */
 int  ir_add_param(ir *ir, const ir_param *p);     /* key: name            */
@@ -263,6 +265,15 @@ void           ir_import_end(ir_import_map *m);
 bool opt_fold(ir *ir);   /* constant folding and algebraic identities */
 bool opt_dce(ir *ir);    /* drop nodes no root reaches                */
 bool opt_dedup(ir *ir);  /* merge textures with equal file + sampler  */
+
+/* The passes' shared step (opt.c): rebuild `ir` from its roots.  Each
+ * node a root reaches is visited in id order with its operands already
+ * renamed into the new node array; `fn` returns its replacement there
+ * (ir_node_add(dst, n) keeps it; NULL fn keeps every node).  Unreached
+ * nodes disappear; tables are kept.  Returns whether the node array or a
+ * root changed. */
+typedef ir_ref (*ir_rewrite_fn)(ir *dst, const ir_node *n, void *user);
+bool ir_rebuild(ir *ir, ir_rewrite_fn fn, void *user);
 
 typedef bool (*ir_pass_fn)(ir *ir);
 typedef struct ir_pass { const char *name; ir_pass_fn run; } ir_pass;
