@@ -263,14 +263,19 @@ static bool lower_materials(splat_scene *s, sg_diags *d)
             ok = false;
             continue;
         }
-        /* Painted masks first named by this material are not the scene's. */
+        /* Painted masks first named by this material are not the scene's:
+         * the error at the stack entry, a note at the material. */
         for (int k = before; k < s->ir.npainted; k++) {
-            int m = sg_material_find(s->prog, sc->materials[i]);
-            sg_loc loc = m >= 0 ? sg_material_loc(s->prog, m) : sc->loc;
+            sg_loc loc = sc->material_locs ? loc_or(sc->material_locs[i], sc->loc)
+                                           : sc->loc;
             scene_error(d, loc, "material '%s' reads painted mask '%s', which "
                         "scene '%s' does not declare (painted %s = \"FILE.png\")",
                         sc->materials[i], s->ir.painted[k].name, sc->name,
                         s->ir.painted[k].name);
+            int m = sg_material_find(s->prog, sc->materials[i]);
+            if (m >= 0)
+                sg_note(d, sg_material_loc(s->prog, m), "material '%s' is "
+                        "defined here", sc->materials[i]);
             ok = false;
         }
     }

@@ -1,0 +1,221 @@
+/* test_scene.c — loading scenes (compiler/scene.c) and analysing real scene
+ * files.  Run from the repository root (CTest does).
+ *
+ * Error fixtures: every tests/scene/bad_*.sg opens with
+ *     # error: LINE:COL ID TEXT
+ * and loading it must fail with its first error of id SG_E_<ID> at that
+ * line and column of the fixture itself (scene errors carry the scene
+ * file's locations), its message containing TEXT, and the scene freed. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include <dirent.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <stb_image.h>
+
+#include "scene.h"
+
+static const char *const error_names[] = {
+#define X(id, fmt) #id,
+    SG_ERRORS(X)
+#undef X
+};
+
+static int cmp_str(const void *a, const void *b)
+{
+    return strcmp(*(const char *const *)a, *(const char *const *)b);
+}
+
+static void check_error_fixture(const char *path)
+{
+    FILE *f = fopen(path, "r");
+    assert_non_null(f);
+    char first[256] = "";
+    assert_non_null(fgets(first, sizeof first, f));
+    fclose(f);
+    int line = 0, col = 0, used = 0;
+    char id[64] = "";
+    if (sscanf(first, "# error: %d:%d %63s %n", &line, &col, id, &used) != 3) {
+        print_error("%s: first line must be '# error: LINE:COL ID TEXT'\n", path);
+        fail();
+    }
+    char *text = first + used;
+    text[strcspn(text, "\n")] = 0;
+
+    sg_diags d;
+    sg_diags_init(&d);
+    splat_scene s;
+    bool ok = splat_scene_load(&s, path, NULL, &d);
+    if (ok || d.nerrors == 0) {
+        print_error("%s: loaded without errors\n", path);
+        fail();
+    }
+    const sg_diag *e = NULL;
+    for (int i = 0; i < d.n && !e; i++)
+        if (d.items[i].severity == SG_ERROR) e = &d.items[i];
+    assert_non_null(e);
+    if (strcmp(e->loc.file, path) != 0 || e->loc.line != line || e->loc.col != col ||
+        strcmp(error_names[e->id], id) != 0 || !strstr(e->msg, text)) {
+        print_error("%s: want %d:%d %s '%s'\n", path, line, col, id, text);
+        sg_diags_print(&d, stderr);
+        fail();
+    }
+    /* Left freed. */
+    assert_null(s.prog);
+    assert_null(s.terrain.texels);
+    assert_int_equal(s.ir.nnodes, 0);
+    sg_diags_free(&d);
+}
+
+static void test_error_fixtures(void **state)
+{
+    DIR *dir = opendir("tests/scene");
+    assert_non_null(dir);
+    char *names[64];
+    int n = 0;
+    struct dirent *ent;
+    while ((ent = readdir(dir)) != NULL) {
+        size_t len = strlen(ent->d_name);
+        if (strncmp(ent->d_name, "bad_", 4) == 0 && len > 3 &&
+            strcmp(ent->d_name + len - 3, ".sg") == 0) {
+            assert_true(n < 64);
+            names[n] = malloc(len + 16);
+            snprintf(names[n], len + 16, "tests/scene/%s", ent->d_name);
+            n++;
+        }
+    }
+    closedir(dir);
+    qsort(names, (size_t)n, sizeof *names, cmp_str);
+    assert_true(n >= 10);
+    for (int i = 0; i < n; i++) {
+        check_error_fixture(names[i]);
+        free(names[i]);
+    }
+}
+
+static void load_ok(splat_scene *s, const char *path, const char *const *search)
+{
+    sg_diags d;
+    sg_diags_init(&d);
+    bool ok = splat_scene_load(s, path, search, &d);
+    if (!ok) sg_diags_print(&d, stderr);
+    assert_true(ok);
+    assert_int_equal(d.nerrors, 0);
+    sg_diags_free(&d);
+}
+
+/* ok.sg: the fields, rasters and lowered materials; then its analysis.
+ * hf16.png rises 1000 per texel east with a jump of 30000 at x = 8;
+ * mask.png is 255 on x < 8.  Cells are 4 texels wide. */
+static void test_ok_scene(void **state)
+{
+    splat_scene s;
+    const char *const search[] = { ".", NULL };
+    load_ok(&s, "tests/scene/ok.sg", search);
+    assert_int_equal(s.nmaterials, 3);
+    assert_string_equal(s.desc->materials[2], "steep");
+    assert_int_equal(s.terrain.width, 16);
+    assert_int_equal(s.terrain.height, 16);
+    assert_true(s.terrain.size[0] == 64 && s.terrain.size[1] == 32);
+    assert_true(s.terrain.max_height == 50 && s.terrain.height_offset == -10);
+    assert_int_equal(s.terrain.texels[3 * 16 + 9], 9 * 1000 + 3 * 10 + 30000);
+    /* Painted: the scene's mask 0 is the IR's painted 0. */
+    assert_int_equal(s.ir.npainted, 1);
+    assert_string_equal(s.ir.painted[0].name, "west");
+    assert_int_equal(s.painted[0][5 * 16 + 7], 255);
+    assert_int_equal(s.painted[0][5 * 16 + 8], 0);
+    /* Every material has all five outputs. */
+    for (int m = 0; m < 3; m++)
+        for (int o = 0; o < SG_OUT_COUNT; o++) {
+            char root[128];
+            snprintf(root, sizeof root, "%s.%s", s.desc->materials[m], sg_output_names[o]);
+            assert_true(ir_ref_ok(ir_find_root(&s.ir, root)));
+        }
+
+    sg_diags d;
+    sg_diags_init(&d);
+    splat_analysis a;
+    assert_true(splat_analyze(&s, &a, &d));
+    assert_int_equal(a.cells_x, 4);
+    assert_int_equal(a.cells_z, 4);
+    /* Columns: 0 all painted (west_paint opaque, base dropped); 1 and 2
+     * see the cliff and the mask's edge; 3 is bare ramp. */
+    const int col_sizes[4] = { 1, 3, 3, 1 };
+    const int col_top[4] = { 1, 2, 2, 0 };
+    for (int z = 0; z < 4; z++)
+        for (int x = 0; x < 4; x++) {
+            const splat_combo *c = &a.combos[a.levels[0].ids[z * 4 + x]];
+            assert_int_equal(c->nmaterials, col_sizes[x]);
+            assert_int_equal(c->materials[0], col_top[x]);
+        }
+    splat_analysis_free(&a);
+    sg_diags_free(&d);
+    splat_scene_free(&s);
+    assert_null(s.prog);
+}
+
+/* The raw R16 copy loads to the same texels as the PNG. */
+static void test_raw_matches_png(void **state)
+{
+    splat_scene s;
+    load_ok(&s, "tests/scene/ok_raw.sg", NULL);
+    int w, h, c;
+    stbi_us *png = stbi_load_16("tests/scene/hf16.png", &w, &h, &c, 1);
+    assert_non_null(png);
+    assert_int_equal(s.terrain.width, w);
+    assert_int_equal(s.terrain.height, h);
+    assert_memory_equal(s.terrain.texels, png, sizeof(uint16_t) * w * h);
+    stbi_image_free(png);
+    splat_scene_free(&s);
+}
+
+/* The quickstart: found from the repository root without search paths
+ * (imports of graphs/ and nodes/ resolve through the project root). */
+static void test_minimal_example(void **state)
+{
+    splat_scene s;
+    load_ok(&s, "examples/minimal/scene.sg", NULL);
+    assert_int_equal(s.nmaterials, 3);
+    assert_int_equal(s.terrain.width, 257);
+    assert_int_equal(s.terrain.height, 257);
+    assert_int_equal(s.desc->npainted, 1);
+    sg_diags d;
+    sg_diags_init(&d);
+    splat_analysis a, b;
+    assert_true(splat_analyze(&s, &a, &d));
+    assert_true(splat_analyze(&s, &b, &d));
+    assert_int_equal(a.cells_x, 9);
+    assert_int_equal(a.nlevels, 5);
+    /* Not every cell needs every material, and the same scene gives the
+     * same ids. */
+    assert_true(a.ncombos >= 2);
+    int smallest = 3;
+    for (int i = 0; i < a.ncombos; i++)
+        if (a.combos[i].nmaterials < smallest) smallest = a.combos[i].nmaterials;
+    assert_true(smallest < 3);
+    assert_int_equal(a.ncombos, b.ncombos);
+    for (int L = 0; L < a.nlevels; L++)
+        assert_memory_equal(a.levels[L].ids, b.levels[L].ids,
+                            sizeof(uint16_t) * a.levels[L].width * a.levels[L].height);
+    splat_analysis_free(&a);
+    splat_analysis_free(&b);
+    sg_diags_free(&d);
+    splat_scene_free(&s);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_error_fixtures),
+        cmocka_unit_test(test_ok_scene),
+        cmocka_unit_test(test_raw_matches_png),
+        cmocka_unit_test(test_minimal_example),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
