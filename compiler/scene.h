@@ -98,4 +98,143 @@ bool splat_analyze(const splat_scene *s, splat_analysis *a, sg_diags *d);
 void splat_analysis_free(splat_analysis *a);
 void splat_analysis_report(const splat_scene *s, const splat_analysis *a, FILE *out);
 
+/* ---- compose.c: composite shaders (DESIGN §6) -------------------------- */
+
+/* The material-set resources every shader of a pack shares (abi.h, set 1):
+ * one uniform slot per param of the source ir (in its order), one binding
+ * per distinct texture (file + sampler state, in order of first use), one
+ * painted layer per name.  The strings stay owned by the caller. */
+typedef struct splat_layout {
+    const ir      *src;        /* every material lowered: "<name>.mask", …    */
+    sg_program    *prog;       /* holds the compositor; NULL: built-in alpha  */
+    const char    *compositor; /* shader name; NULL = "linear_alpha"          */
+    const char   **materials;  /* names, bottom (0) first                     */
+    int            nmaterials;
+    const char   **painted;    /* painted mask names, layer order             */
+    int            npainted;
+    int           *texture_of; /* src texture index -> layout texture index   */
+    int           *textures;   /* layout texture -> its first src texture     */
+    int            ntextures;
+    int            nparams;    /* = src->nparams; slot i = src param i        */
+} splat_layout;
+
+/* `materials` and `painted` arrays are copied (not the strings). */
+bool splat_layout_init(splat_layout *L, const ir *src, sg_program *prog,
+                       const char *compositor,
+                       const char *const *materials, int nmaterials,
+                       const char *const *painted, int npainted, sg_diags *d);
+bool splat_layout_from_scene(splat_layout *L, const splat_scene *s, sg_diags *d);
+void splat_layout_free(splat_layout *L);
+/* Index of the layout texture equal (file + sampler state) to `t`, or -1. */
+int  splat_layout_texture(const splat_layout *L, const ir_texture *t);
+
+typedef struct splat_compose_desc {
+    const int *materials;  /* scene material indices, top first; the last is
+                              the bottom layer: opaque wherever the
+                              combination is used, so its mask is taken as 1 */
+    int        nmaterials;
+    bool       reference;  /* one material alone: a multi-pass reference pass
+                              (mask 1 only for scene material 0)             */
+} splat_compose_desc;
+
+typedef struct splat_layer {
+    int    material;       /* scene material index                          */
+    ir_ref T;              /* coverage left before this layer               */
+    ir_ref mask;           /* the mask the compositor sees (clamped 0..1)   */
+    ir_ref weight;         /* compositor weight                             */
+    ir_ref T_next;         /* coverage left after it (NONE for the last)    */
+    ir_ref view_mask;      /* its own mask, clamped, for SPLAT_VIEW_MASK    */
+    ir_ref out[SG_OUT_COUNT];   /* mask (= .mask) and the surface outputs  */
+} splat_layer;
+
+/* One composite: the combination's materials imported into one ir (shared
+ * subtrees are one node, duplicate textures merged, params by name), the
+ * compositor inlined once per layer, then optimised.  Roots:
+ *   "layer<j>.{T,mask,weight,T_next,view_mask,albedo,normal,roughness,height}"
+ *   "composite.{albedo,normal,roughness,height}" = sum_j weight_j * s_j
+ *   (the normal not yet normalised), for the CPU reference. */
+typedef struct splat_composite {
+    ir           ir;
+    splat_layer *layers;      /* top first                                   */
+    int          nlayers;
+    bool         reference;
+    int         *textures;    /* layout textures used, ascending             */
+    int          ntextures;
+    int         *params;      /* layout params used, ascending               */
+    int          nparams;
+} splat_composite;
+
+bool splat_compose(const splat_layout *L, const splat_compose_desc *desc,
+                   splat_composite *c, sg_diags *d);
+void splat_composite_free(splat_composite *c);
+
+typedef struct splat_glsl_desc {
+    const char *title;        /* first header comment line                   */
+    bool        flat;         /* no dynamic branches (benchmark variant)     */
+    bool        no_mask_view; /* leave out the SPLAT_VIEW_MASK branch        */
+} splat_glsl_desc;
+
+/* The complete Vulkan GLSL 450 fragment shader of `c`: for a composite,
+ * front-to-back with every value placed in the innermost region that
+ * dominates its uses (`if (T > 0.0)` per layer, nested; the surface under
+ * `if (w > 0.0)`); for a reference, one pass under SPLAT_MULTIPASS. */
+void splat_composite_glsl(const splat_layout *L, const splat_composite *c,
+                          const splat_glsl_desc *desc, ir_buf *out);
+
+/* ---- cache.c: content-addressed SPIR-V cache --------------------------- */
+
+#define SPLAT_KEY_CHARS 32   /* hex digits of a shader key (XXH3-128)       */
+
+/* The key of a shader: XXH3-128 of the compiler version, ABI version, stage
+ * (spv_stage) and GLSL text, as 32 hex digits. */
+void  splat_shader_key(const char *glsl, int stage, char key[SPLAT_KEY_CHARS + 1]);
+
+typedef struct splat_cache {
+    char *dir;                /* entries live under here; NULL = disabled    */
+} splat_cache;
+
+/* $SPLATC_CACHE, else $XDG_CACHE_HOME/splatc, else ~/.cache/splatc
+ * (malloc'd), or NULL when none can be named. */
+char *splat_cache_default_dir(void);
+/* Open (creating folders) the cache under `dir` (NULL: the default).
+ * False, with the cache disabled, if it cannot be created. */
+bool  splat_cache_open(splat_cache *c, const char *dir);
+void  splat_cache_close(splat_cache *c);
+/* A hit gives a malloc'd module (a damaged entry is a miss). */
+bool  splat_cache_get(const splat_cache *c, const char *key, uint32_t **words,
+                      size_t *nwords);
+/* Store atomically (temporary file + rename). */
+bool  splat_cache_put(const splat_cache *c, const char *key,
+                      const uint32_t *words, size_t nwords);
+
+/* ---- pack.c: `splatc build`, the shader pack (PACK.md) ----------------- */
+
+typedef struct splat_build_desc {
+    const char        *scene;        /* scene.sg                              */
+    const char        *out;          /* PACKDIR                               */
+    const char *const *search_paths; /* for imports (NULL-terminated) or NULL */
+    int                jobs;         /* glslang threads; 0 = 1                */
+    const char        *cache_dir;    /* NULL = splat_cache_default_dir()      */
+    bool               no_cache;
+    bool               flat;         /* also write branch-free composites     */
+    FILE              *report;       /* non-NULL: the analysis report here    */
+} splat_build_desc;
+
+typedef struct splat_build_stats {
+    double load, analysis, compose, glslang, validate, write; /* seconds     */
+    int    combos, combos_cached, combos_compiled;  /* composite shaders     */
+    int    shaders, shaders_cached, shaders_compiled; /* every module         */
+} splat_build_stats;
+
+/* Load, analyse, compose every combination, compile (cache first, then
+ * glslang on `jobs` threads), validate, and write the pack into
+ * OUT.tmp-XXXXXX, then swap it into place.  On any error (diagnostics in
+ * `d`) an existing pack at `out` is left untouched. */
+bool splat_build(const splat_build_desc *desc, splat_build_stats *stats,
+                 sg_diags *d);
+
+/* ---- cli_build.c: `splatc build` (argv[0] is "build") ------------------ */
+
+int  splat_cli_build(int argc, char **argv);
+
 #endif

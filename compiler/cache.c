@@ -1,0 +1,171 @@
+/* cache.c — the content-addressed SPIR-V cache of `splatc build`.
+ *
+ * A shader's SPIR-V depends only on its GLSL text, its stage and the
+ * compiler that turned one into the other, so the key is the XXH3-128 hash
+ * of exactly those: "splatc <version>", the ABI version, the stage and the
+ * GLSL (which already names every binding and param slot).  Editing one
+ * material changes the GLSL of the composites that contain it and of no
+ * other, so only those miss.
+ *
+ * Layout: DIR/spv1/ab/abcdef….spv (two-hex-digit fan-out).  Entries are
+ * written through spv_write_file (temporary file + rename), so a reader —
+ * another `splatc build` running at the same time — never sees half an
+ * entry; a damaged entry (wrong size or magic) reads as a miss.
+ */
+#include "scene.h"
+
+#include <errno.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <xxhash.h>
+
+#include "abi.h"
+#include "spv.h"
+
+#ifndef SPLATC_VERSION
+#define SPLATC_VERSION "0"
+#endif
+
+#define SPIRV_MAGIC 0x07230203u
+
+void splat_shader_key(const char *glsl, int stage, char key[SPLAT_KEY_CHARS + 1])
+{
+    XXH3_state_t *st = XXH3_createState();
+    if (!st)
+        abort();
+    XXH3_128bits_reset(st);
+    char head[96];
+    int n = snprintf(head, sizeof head, "splatc %s\nabi %d\nstage %d\n",
+                     SPLATC_VERSION, SPLAT_ABI_VERSION, stage);
+    XXH3_128bits_update(st, head, (size_t)n);
+    XXH3_128bits_update(st, glsl, strlen(glsl));
+    XXH128_hash_t h = XXH3_128bits_digest(st);
+    XXH3_freeState(st);
+    snprintf(key, SPLAT_KEY_CHARS + 1, "%016llx%016llx",
+             (unsigned long long)h.high64, (unsigned long long)h.low64);
+}
+
+/* mkdir -p; true if the folder exists afterwards. */
+static bool make_dirs(const char *path)
+{
+    char *p = strdup(path);
+    if (!p)
+        return false;
+    for (char *s = p + 1; *s; s++) {
+        if (*s != '/')
+            continue;
+        *s = 0;
+        if (mkdir(p, 0777) != 0 && errno != EEXIST) {
+            free(p);
+            return false;
+        }
+        *s = '/';
+    }
+    bool ok = mkdir(p, 0777) == 0 || errno == EEXIST;
+    struct stat sb;
+    ok = ok && stat(p, &sb) == 0 && S_ISDIR(sb.st_mode);
+    free(p);
+    return ok;
+}
+
+static char *join(const char *a, const char *b)
+{
+    size_t n = strlen(a) + strlen(b) + 2;
+    char *s = malloc(n);
+    if (!s)
+        abort();
+    snprintf(s, n, "%s/%s", a, b);
+    return s;
+}
+
+char *splat_cache_default_dir(void)
+{
+    const char *env = getenv("SPLATC_CACHE");
+    if (env && *env)
+        return strdup(env);
+    env = getenv("XDG_CACHE_HOME");
+    if (env && *env)
+        return join(env, "splatc");
+    env = getenv("HOME");
+    if (env && *env)
+        return join(env, ".cache/splatc");
+    return NULL;
+}
+
+bool splat_cache_open(splat_cache *c, const char *dir)
+{
+    memset(c, 0, sizeof *c);
+    char *base = dir ? strdup(dir) : splat_cache_default_dir();
+    if (!base)
+        return false;
+    c->dir = join(base, "spv1");
+    free(base);
+    if (!make_dirs(c->dir)) {
+        splat_cache_close(c);
+        return false;
+    }
+    return true;
+}
+
+void splat_cache_close(splat_cache *c)
+{
+    free(c->dir);
+    c->dir = NULL;
+}
+
+static char *entry_path(const splat_cache *c, const char *key, bool make_fanout)
+{
+    char sub[3] = {key[0], key[1], 0};
+    char *fan = join(c->dir, sub);
+    if (make_fanout)
+        make_dirs(fan);
+    char file[SPLAT_KEY_CHARS + 8];
+    snprintf(file, sizeof file, "%s.spv", key);
+    char *path = join(fan, file);
+    free(fan);
+    return path;
+}
+
+bool splat_cache_get(const splat_cache *c, const char *key, uint32_t **words,
+                     size_t *nwords)
+{
+    *words = NULL;
+    *nwords = 0;
+    if (!c->dir)
+        return false;
+    char *path = entry_path(c, key, false);
+    FILE *f = fopen(path, "rb");
+    free(path);
+    if (!f)
+        return false;
+    bool ok = false;
+    long size = -1;
+    if (fseek(f, 0, SEEK_END) == 0)
+        size = ftell(f);
+    if (size >= 20 && size % 4 == 0 && fseek(f, 0, SEEK_SET) == 0) {
+        uint32_t *w = malloc((size_t)size);
+        if (!w)
+            abort();
+        if (fread(w, 1, (size_t)size, f) == (size_t)size && w[0] == SPIRV_MAGIC) {
+            *words = w;
+            *nwords = (size_t)size / 4;
+            ok = true;
+        } else {
+            free(w);
+        }
+    }
+    fclose(f);
+    return ok;
+}
+
+bool splat_cache_put(const splat_cache *c, const char *key, const uint32_t *words,
+                     size_t nwords)
+{
+    if (!c->dir)
+        return false;
+    char *path = entry_path(c, key, true);
+    bool ok = spv_write_file(path, words, nwords);
+    free(path);
+    return ok;
+}

@@ -1,0 +1,178 @@
+/* cli_build.c — `splatc build SCENE.sg -o PACKDIR [-j N] [--stats]
+ * [--cache DIR | --no-cache] [--flat] [-I DIR]...`: the command-line face
+ * of splat_build (pack.c).  Exit status 0 on success, 1 on input errors,
+ * 2 on usage errors. */
+#include "scene.h"
+
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+static const char usage[] =
+    "usage: splatc build SCENE.sg -o PACKDIR [options]\n"
+    "  -o PACKDIR     the shader pack folder to write (replaced only on success)\n"
+    "  -j N           compile shaders on N threads (default 1)\n"
+    "  --stats        print the analysis report, per-phase times and cache hits\n"
+    "  --cache DIR    SPIR-V cache folder (default $SPLATC_CACHE, else\n"
+    "                 $XDG_CACHE_HOME/splatc, else ~/.cache/splatc)\n"
+    "  --no-cache     neither read nor write the cache\n"
+    "  --flat         also write each composite without dynamic branches\n"
+    "  -I DIR         search DIR for imports (repeatable)\n";
+
+/* Import search path, as the other subcommands have it (main.c): -I
+ * folders, $SPLATC_PATH (':'-separated), the current folder, and the
+ * nearest folder above the scene that has a nodes/ folder. */
+typedef struct paths {
+    char **v;
+    int    n, cap;
+} paths;
+
+static void paths_add(paths *p, const char *dir)
+{
+    if (p->n + 2 > p->cap) {
+        p->cap = p->cap ? 2 * p->cap : 8;
+        p->v = realloc(p->v, (size_t)p->cap * sizeof *p->v);
+        if (!p->v)
+            abort();
+    }
+    p->v[p->n] = strdup(dir);
+    if (!p->v[p->n])
+        abort();
+    p->v[++p->n] = NULL;
+}
+
+static void paths_free(paths *p)
+{
+    for (int i = 0; i < p->n; i++)
+        free(p->v[i]);
+    free(p->v);
+}
+
+static void paths_defaults(paths *p, const char *scene)
+{
+    const char *env = getenv("SPLATC_PATH");
+    if (env && *env) {
+        char *copy = strdup(env);
+        if (!copy)
+            abort();
+        char *save = NULL;
+        for (char *t = strtok_r(copy, ":", &save); t; t = strtok_r(NULL, ":", &save))
+            paths_add(p, t);
+        free(copy);
+    }
+    paths_add(p, ".");
+    char *dir = strdup(scene);
+    if (!dir)
+        abort();
+    for (char *slash; (slash = strrchr(dir, '/'));) {
+        *slash = 0;
+        size_t n = strlen(dir) + 8;
+        char *nodes = malloc(n);
+        if (!nodes)
+            abort();
+        snprintf(nodes, n, "%s/nodes", dir);
+        struct stat st;
+        bool found = stat(nodes, &st) == 0 && S_ISDIR(st.st_mode);
+        free(nodes);
+        if (found) {
+            paths_add(p, *dir ? dir : "/");
+            break;
+        }
+    }
+    free(dir);
+}
+
+static void print_stats(const splat_build_stats *st, FILE *out)
+{
+    static const char *const names[] = {"load", "analysis", "compose+codegen",
+                                        "glslang", "validation", "write"};
+    double t[] = {st->load, st->analysis, st->compose, st->glslang, st->validate,
+                  st->write};
+    double total = 0;
+    fprintf(out, "phase             seconds\n");
+    for (int i = 0; i < 6; i++) {
+        fprintf(out, "%-16s %8.3f\n", names[i], t[i]);
+        total += t[i];
+    }
+    fprintf(out, "%-16s %8.3f\n", "total", total);
+    fprintf(out, "combinations: %d (%d from cache, %d compiled)\n", st->combos,
+            st->combos_cached, st->combos_compiled);
+    fprintf(out, "shaders: %d (%d from cache, %d compiled)\n", st->shaders,
+            st->shaders_cached, st->shaders_compiled);
+}
+
+int splat_cli_build(int argc, char **argv)
+{
+    splat_build_desc desc = {.jobs = 1};
+    bool stats = false;
+    paths search = {0};
+    int status = 2;
+    for (int i = 1; i < argc; i++) {
+        const char *a = argv[i];
+        const char *next = i + 1 < argc ? argv[i + 1] : NULL;
+        if (strcmp(a, "-h") == 0 || strcmp(a, "--help") == 0) {
+            fputs(usage, stdout);
+            status = 0;
+            goto done;
+        } else if (strcmp(a, "-o") == 0 && next) {
+            desc.out = next;
+            i++;
+        } else if (strcmp(a, "-j") == 0 && next) {
+            char *end;
+            long n = strtol(next, &end, 10);
+            if (*end || n < 1 || n > 256) {
+                fprintf(stderr, "splatc build: -j expects a thread count 1..256, found '%s'\n",
+                        next);
+                goto done;
+            }
+            desc.jobs = (int)n;
+            i++;
+        } else if (strcmp(a, "--stats") == 0) {
+            stats = true;
+        } else if (strcmp(a, "--cache") == 0 && next) {
+            desc.cache_dir = next;
+            i++;
+        } else if (strcmp(a, "--no-cache") == 0) {
+            desc.no_cache = true;
+        } else if (strcmp(a, "--flat") == 0) {
+            desc.flat = true;
+        } else if (strcmp(a, "-I") == 0 && next) {
+            paths_add(&search, next);
+            i++;
+        } else if (a[0] == '-') {
+            fprintf(stderr, "splatc build: unknown or incomplete option '%s'\n%s", a, usage);
+            goto done;
+        } else if (!desc.scene) {
+            desc.scene = a;
+        } else {
+            fprintf(stderr, "splatc build: one scene at a time, found '%s' after '%s'\n",
+                    a, desc.scene);
+            goto done;
+        }
+    }
+    if (!desc.scene || !desc.out) {
+        fprintf(stderr, "splatc build: %s\n%s",
+                !desc.scene ? "no scene file given" : "no output folder (-o PACKDIR)", usage);
+        goto done;
+    }
+    if (desc.no_cache && desc.cache_dir) {
+        fprintf(stderr, "splatc build: --cache and --no-cache exclude each other\n");
+        goto done;
+    }
+    paths_defaults(&search, desc.scene);
+    desc.search_paths = (const char *const *)search.v;
+    desc.report = stats ? stdout : NULL;
+
+    sg_diags d;
+    sg_diags_init(&d);
+    splat_build_stats st;
+    bool ok = splat_build(&desc, &st, &d);
+    sg_diags_print(&d, stderr);
+    sg_diags_free(&d);
+    if (ok && stats)
+        print_stats(&st, stdout);
+    status = ok ? 0 : 1;
+done:
+    paths_free(&search);
+    return status;
+}

@@ -1,0 +1,865 @@
+/* compose.c — the compositor: one composite IR per material combination and
+ * its GLSL, with every value scheduled into the region that needs it
+ * (DESIGN §6, seed 000 §5.3).
+ *
+ * Building: the combination's materials (top first) are imported into one
+ * ir, so whatever two materials share — the terrain normal, a texture
+ * sampled at the same uv — is one node; the compositor shader
+ * (nodes/compositors.sg, `linear_alpha` by default) is inlined once per
+ * layer with T (coverage left), m (the clamped mask) and h (the height):
+ *
+ *     T_0 = 1;  w_j, T_j+1 = compositor(T_j, m_j, h_j)
+ *     composite.albedo = sum_j w_j * albedo_j     (same for the others)
+ *
+ * The bottom layer's mask is 1: the analysis ends every combination at a
+ * material that is opaque wherever the combination is used.
+ *
+ * Scheduling: a region tree mirrors the GLSL blocks,
+ *
+ *     main                        (root)
+ *       G_0  if (T_0 > 0.0) {     mask, weight and T_next of layer 0
+ *         W_0  if (w_0 > 0.0) {   its surface, S += w_0 * s_0
+ *         G_1  if (T_1 > 0.0) {   layer 1 ...
+ *
+ * Each value is used at known regions (a mask in its G, a surface output in
+ * its W, a T in its guard's parent); every other node is placed at the
+ * lowest common ancestor of its users' regions, users before operands
+ * (operands have smaller ids).  Emission walks the tree and, on entering a
+ * region, emits the values placed there in id order; the emitter's scopes
+ * make sure a value emitted inside a block is not reused outside it.  So
+ * the terrain normal that two masks need sits in the outer guard, while a
+ * texture only one surface reads stays inside that surface's `if`.
+ *
+ * Example (grass below cliff): the composite of [cliff, grass] reads
+ *     float v4 = ...cliff mask...;            // G_0 (T_0 = 1: a plain block)
+ *     if (v4 > 0.0) { v9 = texture(u_tex_1, ...); s_albedo += v4 * v9.rgb; }
+ *     float v5 = 1.0 - v4;
+ *     if (v5 > 0.0) { ...grass surface...; s_albedo += v5 * ...; }
+ */
+#include "scene.h"
+
+#include <assert.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "abi.h"
+
+#ifndef SPLATC_VERSION
+#define SPLATC_VERSION "0"
+#endif
+
+static void *xcalloc(size_t n, size_t size)
+{
+    void *p = calloc(n ? n : 1, size);
+    if (!p)
+        abort();  /* out of memory: nothing sensible to report */
+    return p;
+}
+
+static char *xstrdup(const char *s)
+{
+    char *p = strdup(s);
+    if (!p)
+        abort();
+    return p;
+}
+
+/* ---- layout --------------------------------------------------------------- */
+
+static bool texture_same(const ir_texture *a, const ir_texture *b)
+{
+    return strcmp(a->file, b->file) == 0 && a->filter == b->filter &&
+           a->mip == b->mip && a->wrap == b->wrap && a->srgb == b->srgb;
+}
+
+int splat_layout_texture(const splat_layout *L, const ir_texture *t)
+{
+    for (int i = 0; i < L->ntextures; i++)
+        if (texture_same(&L->src->textures[L->textures[i]], t))
+            return i;
+    return -1;
+}
+
+bool splat_layout_init(splat_layout *L, const ir *src, sg_program *prog,
+                       const char *compositor,
+                       const char *const *materials, int nmaterials,
+                       const char *const *painted, int npainted, sg_diags *d)
+{
+    memset(L, 0, sizeof *L);
+    L->src = src;
+    L->prog = prog;
+    L->compositor = compositor;
+    L->materials = xcalloc((size_t)nmaterials, sizeof *L->materials);
+    memcpy(L->materials, materials, (size_t)nmaterials * sizeof *materials);
+    L->nmaterials = nmaterials;
+    L->painted = xcalloc((size_t)npainted, sizeof *L->painted);
+    if (npainted)
+        memcpy(L->painted, painted, (size_t)npainted * sizeof *painted);
+    L->npainted = npainted;
+    L->nparams = src->nparams;
+    L->texture_of = xcalloc((size_t)src->ntextures, sizeof *L->texture_of);
+    L->textures = xcalloc((size_t)src->ntextures, sizeof *L->textures);
+    for (int i = 0; i < src->ntextures; i++) {
+        int t = splat_layout_texture(L, &src->textures[i]);
+        if (t < 0) {
+            t = L->ntextures++;
+            L->textures[t] = i;
+        }
+        L->texture_of[i] = t;
+    }
+    for (int i = 0; i < nmaterials; i++) {
+        char name[512];
+        snprintf(name, sizeof name, "%s.mask", materials[i]);
+        if (!ir_ref_ok(ir_find_root(src, name))) {
+            sg_error(d, (sg_loc){0}, SG_E_INTERNAL, "material not lowered");
+            splat_layout_free(L);
+            return false;
+        }
+    }
+    return true;
+}
+
+bool splat_layout_from_scene(splat_layout *L, const splat_scene *s, sg_diags *d)
+{
+    const sg_scene *sc = s->desc;
+    const char **painted = xcalloc((size_t)sc->npainted, sizeof *painted);
+    for (int i = 0; i < sc->npainted; i++)
+        painted[i] = sc->painted[i].name;
+    bool ok = splat_layout_init(L, &s->ir, s->prog, sc->compositor,
+                                (const char *const *)sc->materials, sc->nmaterials,
+                                painted, sc->npainted, d);
+    free(painted);
+    return ok;
+}
+
+void splat_layout_free(splat_layout *L)
+{
+    free(L->materials);
+    free(L->painted);
+    free(L->texture_of);
+    free(L->textures);
+    memset(L, 0, sizeof *L);
+}
+
+/* ---- building the composite IR -------------------------------------------- */
+
+static void set_root(ir *ir, int layer, const char *what, ir_ref r)
+{
+    char name[64];
+    if (layer < 0)
+        snprintf(name, sizeof name, "composite.%s", what);
+    else
+        snprintf(name, sizeof name, "layer%d.%s", layer, what);
+    if (ir_ref_ok(r))
+        ir_set_root(ir, name, r);
+}
+
+static ir_ref get_root(const ir *ir, int layer, const char *what)
+{
+    char name[64];
+    snprintf(name, sizeof name, "layer%d.%s", layer, what);
+    return ir_find_root(ir, name);
+}
+
+/* w = T * m, T_next = T - w: the linear alpha compositor, used when no
+ * program holds a compositor shader (tests building IR directly). */
+static void builtin_alpha(ir *ir, ir_ref T, ir_ref m, ir_ref *w, ir_ref *T_next)
+{
+    *w = ir_op2(ir, IR_OP_MUL, T, m);
+    *T_next = ir_op2(ir, IR_OP_SUB, T, *w);
+}
+
+static bool lower_compositor(const splat_layout *L, ir *ir, ir_ref T, ir_ref m,
+                             ir_ref h, ir_ref *w, ir_ref *T_next, sg_diags *d)
+{
+    if (!L->prog) {
+        builtin_alpha(ir, T, m, w, T_next);
+        return true;
+    }
+    static const char *const in_names[] = {"T", "m", "h"};
+    static const char *const out_names[] = {"weight", "T_next"};
+    ir_ref in_vals[3] = {T, m, h};
+    ir_ref outs[2];
+    const char *name = L->compositor ? L->compositor : "linear_alpha";
+    if (!sg_lower_shader(L->prog, name, ir, in_names, in_vals, 3, out_names,
+                         outs, 2, d))
+        return false;
+    *w = outs[0];
+    *T_next = outs[1];
+    return true;
+}
+
+static void collect_used(const splat_layout *L, splat_composite *c, sg_diags *d)
+{
+    const ir *ir = &c->ir;
+    bool *tex = xcalloc((size_t)L->ntextures, sizeof *tex);
+    bool *par = xcalloc((size_t)L->nparams, sizeof *par);
+    for (uint32_t i = 1; i < ir->nnodes; i++) {
+        const ir_node *n = &ir->nodes[i];
+        if (n->op == IR_OP_TEXTURE) {
+            int t = splat_layout_texture(L, &ir->textures[n->imm]);
+            assert(t >= 0 && "composite texture missing from the layout");
+            tex[t] = true;
+        } else if (n->op == IR_OP_PARAM) {
+            for (int p = 0; p < L->src->nparams; p++)
+                if (strcmp(L->src->params[p].name, ir->params[n->imm].name) == 0)
+                    par[p] = true;
+        } else if (n->op == IR_OP_PAINTED) {
+            bool found = false;
+            for (int p = 0; p < L->npainted; p++)
+                found |= strcmp(L->painted[p], ir->painted[n->imm].name) == 0;
+            if (!found)
+                sg_error(d, (sg_loc){0}, SG_E_SCENE, "unknown painted mask");
+        }
+    }
+    c->textures = xcalloc((size_t)L->ntextures, sizeof *c->textures);
+    for (int t = 0; t < L->ntextures; t++)
+        if (tex[t])
+            c->textures[c->ntextures++] = t;
+    c->params = xcalloc((size_t)L->nparams, sizeof *c->params);
+    for (int p = 0; p < L->nparams; p++)
+        if (par[p])
+            c->params[c->nparams++] = p;
+    free(tex);
+    free(par);
+}
+
+static const char *const layer_fields[] = {"T", "mask", "weight", "T_next", "view_mask"};
+
+bool splat_compose(const splat_layout *L, const splat_compose_desc *desc,
+                   splat_composite *c, sg_diags *d)
+{
+    memset(c, 0, sizeof *c);
+    ir_init(&c->ir);
+    int n = desc->nmaterials;
+    assert(n >= 1 && (!desc->reference || n == 1));
+    c->reference = desc->reference;
+    c->nlayers = n;
+    c->layers = xcalloc((size_t)n, sizeof *c->layers);
+
+    ir *dst = &c->ir;
+    int errors = d->nerrors;
+    ir_import_map *map = ir_import_begin(dst, L->src);
+    ir_ref one = ir_constf(dst, 1.0);
+    ir_ref T = one;
+    ir_ref acc[SG_OUT_COUNT] = {{0}};
+    for (int j = 0; j < n; j++) {
+        int k = desc->materials[j];
+        assert(k >= 0 && k < L->nmaterials);
+        ir_ref s[SG_OUT_COUNT];
+        for (int o = 0; o < SG_OUT_COUNT; o++) {
+            char name[512];
+            snprintf(name, sizeof name, "%s.%s", L->materials[k], sg_output_names[o]);
+            ir_ref r = ir_find_root(L->src, name);
+            if (!ir_ref_ok(r)) {
+                sg_error(d, (sg_loc){0}, SG_E_INTERNAL, "material output not lowered");
+                ir_import_end(map);
+                splat_composite_free(c);
+                return false;
+            }
+            s[o] = ir_import(map, r);
+        }
+        ir_ref view_mask = k == 0 ? one : ir_op1(dst, IR_OP_SATURATE, s[SG_OUT_MASK]);
+        bool bottom = desc->reference ? k == 0 : j == n - 1;
+        ir_ref m = bottom ? one : view_mask;
+        ir_ref w, T_next = IR_NONE;
+        if (desc->reference) {
+            w = m;
+        } else {
+            if (!lower_compositor(L, dst, T, m, s[SG_OUT_HEIGHT], &w, &T_next, d))
+                break;
+            if (j == n - 1)
+                T_next = IR_NONE;  /* nothing below the bottom layer */
+        }
+        ir_ref f[] = {T, m, w, T_next, view_mask};
+        for (int i = 0; i < 5; i++)
+            set_root(dst, j, layer_fields[i], f[i]);
+        for (int o = 1; o < SG_OUT_COUNT; o++) {
+            set_root(dst, j, sg_output_names[o], s[o]);
+            ir_ref ws = ir_splat(dst, w, ir_typeof(dst, s[o]));
+            ir_ref term = ir_op2(dst, IR_OP_MUL, ws, s[o]);
+            acc[o] = ir_ref_ok(acc[o]) ? ir_op2(dst, IR_OP_ADD, acc[o], term) : term;
+        }
+        T = T_next;
+    }
+    ir_import_end(map);
+    if (d->nerrors > errors) {
+        splat_composite_free(c);
+        return false;
+    }
+    for (int o = 1; o < SG_OUT_COUNT; o++)
+        set_root(dst, -1, sg_output_names[o], acc[o]);
+
+    ir_optimize(dst, NULL);
+
+    for (int j = 0; j < n; j++) {
+        splat_layer *l = &c->layers[j];
+        l->material = desc->materials[j];
+        l->T = get_root(dst, j, "T");
+        l->mask = get_root(dst, j, "mask");
+        l->weight = get_root(dst, j, "weight");
+        l->T_next = get_root(dst, j, "T_next");
+        l->view_mask = get_root(dst, j, "view_mask");
+        l->out[SG_OUT_MASK] = l->mask;
+        for (int o = 1; o < SG_OUT_COUNT; o++)
+            l->out[o] = get_root(dst, j, sg_output_names[o]);
+    }
+    collect_used(L, c, d);
+    if (d->nerrors > errors) {
+        splat_composite_free(c);
+        return false;
+    }
+    return true;
+}
+
+void splat_composite_free(splat_composite *c)
+{
+    ir_free(&c->ir);
+    free(c->layers);
+    free(c->textures);
+    free(c->params);
+    memset(c, 0, sizeof *c);
+}
+
+/* ---- scheduling: regions and placement ------------------------------------ */
+
+typedef struct region {
+    int parent, depth;
+} region;
+
+typedef struct sched {
+    const ir *ir;
+    region   *regions;
+    int       nregions;
+    int      *place;       /* per node: region, or -1 if not needed */
+    int      *guard;       /* per layer: G_j                        */
+    int      *surface;     /* per layer: W_j                        */
+} sched;
+
+static int region_new(sched *s, int parent)
+{
+    int r = s->nregions++;
+    s->regions[r].parent = parent;
+    s->regions[r].depth = parent < 0 ? 0 : s->regions[parent].depth + 1;
+    return r;
+}
+
+static int lca(const sched *s, int a, int b)
+{
+    while (s->regions[a].depth > s->regions[b].depth)
+        a = s->regions[a].parent;
+    while (s->regions[b].depth > s->regions[a].depth)
+        b = s->regions[b].parent;
+    while (a != b) {
+        a = s->regions[a].parent;
+        b = s->regions[b].parent;
+    }
+    return a;
+}
+
+static void use_at(sched *s, ir_ref r, int region)
+{
+    if (!ir_ref_ok(r))
+        return;
+    int *p = &s->place[r.id];
+    *p = *p < 0 ? region : lca(s, *p, region);
+}
+
+/* Regions and uses of a composite; `flat` puts everything at the root. */
+static void schedule(sched *s, const ir *ir, const splat_layer *layers, int n,
+                     bool flat)
+{
+    s->ir = ir;
+    s->regions = xcalloc((size_t)(2 * n + 1), sizeof *s->regions);
+    s->guard = xcalloc((size_t)n, sizeof *s->guard);
+    s->surface = xcalloc((size_t)n, sizeof *s->surface);
+    s->place = xcalloc(ir->nnodes, sizeof *s->place);
+    for (uint32_t i = 0; i < ir->nnodes; i++)
+        s->place[i] = -1;
+    int root = region_new(s, -1);
+    int outer = root;
+    for (int j = 0; j < n; j++) {
+        s->guard[j] = flat ? root : region_new(s, outer);
+        s->surface[j] = flat ? root : region_new(s, s->guard[j]);
+        outer = s->guard[j];
+    }
+    for (int j = 0; j < n; j++) {
+        const splat_layer *l = &layers[j];
+        int parent = s->regions[s->guard[j]].parent;
+        use_at(s, l->T, parent < 0 ? root : parent);
+        use_at(s, l->mask, s->guard[j]);
+        use_at(s, l->weight, s->guard[j]);
+        use_at(s, l->T_next, s->guard[j]);
+        use_at(s, l->weight, s->surface[j]);
+        for (int o = 1; o < SG_OUT_COUNT; o++)
+            use_at(s, l->out[o], s->surface[j]);
+    }
+    /* Users before operands: operands always have smaller ids. */
+    for (uint32_t i = ir->nnodes; i-- > 1;) {
+        if (s->place[i] < 0)
+            continue;
+        const ir_node *nd = &ir->nodes[i];
+        for (int a = 0; a < nd->nargs; a++)
+            use_at(s, nd->arg[a], s->place[i]);
+    }
+}
+
+static void sched_free(sched *s)
+{
+    free(s->regions);
+    free(s->guard);
+    free(s->surface);
+    free(s->place);
+}
+
+/* ---- GLSL ----------------------------------------------------------------- */
+
+/* The emitter writes leaves in place at every use, which would call
+ * splat_normal() (four texture reads) once per use.  So GLSL is written
+ * from a copy of the composite in which every terrain input but the uv
+ * becomes a PARAM leaf named "in_<input>" and painted masks read as
+ * "in_painted<L>"; those are declared by us, once, at the region the
+ * scheduler places them in. */
+typedef struct emit {
+    const splat_layout    *L;
+    const splat_composite *c;
+    ir                     ir;       /* the copy GLSL is written from       */
+    splat_layer           *layers;   /* c->layers, in the copy's ids         */
+    int                   *input_of; /* per param of the copy: input or -1  */
+    glsl_emitter          *e;
+    ir_buf                *out;
+    sched                  s;
+    char                   indent[256];
+} emit;
+
+static const char *const input_var[IR_IN_COUNT] = {
+    [IR_IN_HEIGHT] = "in_height", [IR_IN_SLOPE] = "in_slope",
+    [IR_IN_NORMAL] = "in_normal", [IR_IN_POSITION] = "in_position",
+    [IR_IN_VIEW_DISTANCE] = "in_view_distance",
+    [IR_IN_DESTRUCTION] = "in_destruction"};
+static const char *const input_call[IR_IN_COUNT] = {
+    [IR_IN_HEIGHT] = "splat_height()", [IR_IN_SLOPE] = "splat_slope()",
+    [IR_IN_NORMAL] = "splat_normal()", [IR_IN_POSITION] = "splat_position()",
+    [IR_IN_VIEW_DISTANCE] = "splat_view_distance()",
+    [IR_IN_DESTRUCTION] = "splat_destruction()"};
+
+static ir_ref map_ref(const uint32_t *map, ir_ref r)
+{
+    return (ir_ref){r.id ? map[r.id] : 0};
+}
+
+/* Build em->ir from the composite (same order, so operands stay first). */
+static void emission_copy(emit *em)
+{
+    const ir *src = &em->c->ir;
+    ir *dst = &em->ir;
+    ir_init(dst);
+    uint32_t *map = xcalloc(src->nnodes, sizeof *map);
+    for (int i = 0; i < src->nparams; i++)
+        ir_add_param(dst, &src->params[i]);
+    for (int i = 0; i < src->ntextures; i++)
+        ir_add_texture(dst, &src->textures[i]);
+    for (int i = 0; i < src->npainted; i++)
+        ir_add_painted(dst, src->painted[i].name);
+    int input_param[IR_IN_COUNT];
+    for (int i = 0; i < IR_IN_COUNT; i++)
+        input_param[i] = -1;
+    for (uint32_t id = 1; id < src->nnodes; id++) {
+        ir_node n = src->nodes[id];
+        for (int a = 0; a < n.nargs; a++)
+            n.arg[a].id = map[n.arg[a].id];
+        if (n.op == IR_OP_INPUT && input_var[n.imm]) {
+            if (input_param[n.imm] < 0) {
+                ir_param p = {.name = (char *)input_var[n.imm], .type = (ir_type)n.type};
+                input_param[n.imm] = ir_add_param(dst, &p);
+            }
+            n.op = IR_OP_PARAM;
+            n.imm = (uint32_t)input_param[n.imm];
+        }
+        map[id] = ir_node_add(dst, &n).id;
+    }
+    em->input_of = xcalloc((size_t)dst->nparams, sizeof *em->input_of);
+    for (int i = 0; i < dst->nparams; i++)
+        em->input_of[i] = -1;
+    for (int k = 0; k < IR_IN_COUNT; k++)
+        if (input_param[k] >= 0)
+            em->input_of[input_param[k]] = k;
+    em->layers = xcalloc((size_t)em->c->nlayers, sizeof *em->layers);
+    for (int j = 0; j < em->c->nlayers; j++) {
+        const splat_layer *l = &em->c->layers[j];
+        splat_layer *m = &em->layers[j];
+        m->material = l->material;
+        m->T = map_ref(map, l->T);
+        m->mask = map_ref(map, l->mask);
+        m->weight = map_ref(map, l->weight);
+        m->T_next = map_ref(map, l->T_next);
+        m->view_mask = map_ref(map, l->view_mask);
+        for (int o = 0; o < SG_OUT_COUNT; o++)
+            m->out[o] = map_ref(map, l->out[o]);
+    }
+    free(map);
+}
+
+static void emission_free(emit *em)
+{
+    ir_free(&em->ir);
+    free(em->layers);
+    free(em->input_of);
+}
+
+/* Declare a leaf we name ourselves (an input or a painted mask). */
+static void declare_leaf(emit *em, uint32_t id, const char *ind)
+{
+    const ir_node *n = &em->ir.nodes[id];
+    if (n->op == IR_OP_PARAM && em->input_of[n->imm] >= 0) {
+        int k = em->input_of[n->imm];
+        ir_buf_printf(em->out, "%s%s %s = %s;\n", ind, ir_type_name((ir_type)n->type),
+                      input_var[k], input_call[k]);
+    } else if (n->op == IR_OP_PAINTED) {
+        int layer = 0;
+        for (int p = 0; p < em->L->npainted; p++)
+            if (strcmp(em->L->painted[p], em->ir.painted[n->imm].name) == 0)
+                layer = p;
+        ir_buf_printf(em->out, "%sfloat in_painted%d = splat_painted(%d);\n", ind, layer,
+                      layer);
+    }
+}
+
+static const char *indent_at(emit *em, int depth)
+{
+    int n = depth * 4;
+    if (n > (int)sizeof em->indent - 1)
+        n = (int)sizeof em->indent - 1;  /* deeper nesting: only less indent */
+    memset(em->indent, ' ', (size_t)n);
+    em->indent[n] = 0;
+    return em->indent;
+}
+
+/* The value's GLSL, copied (the emitter's string may not outlive a call). */
+static char *value(emit *em, ir_ref r, int depth)
+{
+    char ind[256];
+    snprintf(ind, sizeof ind, "%s", indent_at(em, depth));
+    return xstrdup(glsl_value(em->e, r, ind));
+}
+
+/* Emit every value placed at `region`, operands first (id order). */
+static void emit_placed(emit *em, int region, int depth)
+{
+    const ir *ir = &em->ir;
+    char ind[256];
+    snprintf(ind, sizeof ind, "%s", indent_at(em, depth));
+    for (uint32_t i = 1; i < ir->nnodes; i++) {
+        if (em->s.place[i] != region || ir->nodes[i].type == IR_T_TEX)
+            continue;
+        declare_leaf(em, i, ind);
+        glsl_value(em->e, (ir_ref){i}, ind);
+    }
+}
+
+/* Whether `r` is a constant, and its value. */
+static bool is_const(const ir *ir, ir_ref r, double *v)
+{
+    const ir_node *n = ir_get(ir, r);
+    if (n->op != IR_OP_CONST)
+        return false;
+    *v = n->val[0];
+    return true;
+}
+
+/* Open a block guarded by `cond > 0.0`: a plain block if it is a positive
+ * constant; false (nothing opened) if it is a constant <= 0. */
+static bool open_guard(emit *em, ir_ref cond, int depth)
+{
+    double v;
+    if (is_const(&em->ir, cond, &v)) {
+        if (!(v > 0.0))
+            return false;
+        ir_buf_printf(em->out, "%s{\n", indent_at(em, depth));
+    } else {
+        char *x = value(em, cond, depth);
+        ir_buf_printf(em->out, "%sif (%s > 0.0) {\n", indent_at(em, depth), x);
+        free(x);
+    }
+    glsl_scope_push(em->e);
+    return true;
+}
+
+static void close_block(emit *em, int depth)
+{
+    glsl_scope_pop(em->e);
+    ir_buf_printf(em->out, "%s}\n", indent_at(em, depth));
+}
+
+static const char *const acc_names[SG_OUT_COUNT] = {
+    NULL, "s_albedo", "s_normal", "s_roughness", "s_height"};
+
+static void emit_accumulate(emit *em, const splat_layer *l, int depth)
+{
+    double wv;
+    bool unit = is_const(&em->ir, l->weight, &wv) && wv == 1.0;
+    char *w = value(em, l->weight, depth);
+    for (int o = 1; o < SG_OUT_COUNT; o++) {
+        char *x = value(em, l->out[o], depth);
+        if (unit)
+            ir_buf_printf(em->out, "%s%s += %s;\n", indent_at(em, depth), acc_names[o], x);
+        else
+            ir_buf_printf(em->out, "%s%s += %s * %s;\n", indent_at(em, depth),
+                          acc_names[o], w, x);
+        free(x);
+    }
+    free(w);
+}
+
+/* Layer j: we are inside G_j's block (at `depth`). */
+static void emit_layer(emit *em, int j, bool flat, int depth)
+{
+    const splat_layer *l = &em->layers[j];
+    if (!flat)  /* flat: everything was placed at the root, emitted already */
+        emit_placed(em, em->s.guard[j], depth);
+    if (flat) {
+        emit_accumulate(em, l, depth);
+    } else if (ir_ref_eq(l->weight, l->T)) {  /* opaque: w = T, already > 0 */
+        ir_buf_printf(em->out, "%s{\n", indent_at(em, depth));
+        glsl_scope_push(em->e);
+        emit_placed(em, em->s.surface[j], depth + 1);
+        emit_accumulate(em, l, depth + 1);
+        close_block(em, depth);
+    } else if (open_guard(em, l->weight, depth)) {
+        emit_placed(em, em->s.surface[j], depth + 1);
+        emit_accumulate(em, l, depth + 1);
+        close_block(em, depth);
+    }
+    if (j + 1 >= em->c->nlayers)
+        return;
+    if (flat) {
+        emit_layer(em, j + 1, flat, depth);
+    } else if (open_guard(em, l->T_next, depth)) {
+        emit_layer(em, j + 1, flat, depth + 1);
+        close_block(em, depth);
+    }
+}
+
+/* Emit what `roots` need at the current point (one straight-line block):
+ * our own leaves declared first, then every value, operands first. */
+static void emit_subtree(emit *em, const ir_ref *roots, int nroots, int depth)
+{
+    const ir *ir = &em->ir;
+    uint8_t *reach = xcalloc(ir->nnodes, 1);
+    for (int i = 0; i < nroots; i++)
+        reach[roots[i].id] = 1;
+    for (uint32_t id = ir->nnodes; id-- > 1;)
+        if (reach[id])
+            for (int a = 0; a < ir->nodes[id].nargs; a++)
+                reach[ir->nodes[id].arg[a].id] = 1;
+    char ind[256];
+    snprintf(ind, sizeof ind, "%s", indent_at(em, depth));
+    for (uint32_t id = 1; id < ir->nnodes; id++)
+        if (reach[id] && ir->nodes[id].type != IR_T_TEX) {
+            declare_leaf(em, id, ind);
+            glsl_value(em->e, (ir_ref){id}, ind);
+        }
+    free(reach);
+}
+
+static void emit_mask_view(emit *em)
+{
+    ir_buf *o = em->out;
+    ir_buf_printf(o, "    if (u_frame.view.x == %uu) {\n", (unsigned)SPLAT_VIEW_MASK);
+    ir_buf_printf(o, "        float mv = 0.0;\n");
+    ir_buf_printf(o, "        switch (u_frame.view.y) {\n");
+    for (int j = 0; j < em->c->nlayers; j++) {
+        const splat_layer *l = &em->layers[j];
+        ir_buf_printf(o, "        case %du: {  /* %s */\n", l->material,
+                      em->L->materials[l->material]);
+        glsl_scope_push(em->e);
+        emit_subtree(em, &l->view_mask, 1, 3);
+        char *x = value(em, l->view_mask, 3);
+        ir_buf_printf(o, "            mv = %s;\n", x);
+        free(x);
+        glsl_scope_pop(em->e);
+        ir_buf_printf(o, "        } break;\n");
+    }
+    ir_buf_printf(o, "        default: break;\n");
+    ir_buf_printf(o, "        }\n");
+    ir_buf_printf(o, "        o_color = vec4(vec3(mv), 1.0);\n");
+    ir_buf_printf(o, "        return;\n");
+    ir_buf_printf(o, "    }\n");
+}
+
+static const char *basename_of(const char *path)
+{
+    const char *s = strrchr(path, '/');
+    return s ? s + 1 : path;
+}
+
+static const char *filter_name(ir_filter f)
+{
+    return f == IR_FILTER_NEAREST ? "nearest" : "linear";
+}
+
+static const char *wrap_name(ir_wrap w)
+{
+    return w == IR_WRAP_CLAMP ? "clamp" : w == IR_WRAP_MIRROR ? "mirror" : "repeat";
+}
+
+static const char *const swizzle_of_type[IR_T_COUNT] = {
+    [IR_T_FLOAT] = ".x", [IR_T_VEC2] = ".xy", [IR_T_VEC3] = ".xyz", [IR_T_VEC4] = ""};
+
+/* Header comment and the set-1 declarations this shader uses. */
+static void emit_header(emit *em, const splat_glsl_desc *desc)
+{
+    const splat_layout *L = em->L;
+    const splat_composite *c = em->c;
+    ir_buf *o = em->out;
+    ir_buf_printf(o, "#version 450\n");
+    ir_buf_printf(o, "/* %s — generated by splatc %s (ABI %d); do not edit.\n",
+                  desc->title ? desc->title : "splatc shader", SPLATC_VERSION,
+                  SPLAT_ABI_VERSION);
+    ir_buf_printf(o, " * %s, top first:", c->reference ? "material" : "layers");
+    for (int j = 0; j < c->nlayers; j++)
+        ir_buf_printf(o, "%s %s (%d)", j ? "," : "",
+                      L->materials[c->layers[j].material], c->layers[j].material);
+    ir_buf_printf(o, "\n * set %d binding %d: splat_params, %d vec4 slot%s",
+                  SPLAT_SET_MATERIAL, SPLAT_BIND_PARAMS, L->nparams > 0 ? L->nparams : 1,
+                  L->nparams > 1 ? "s" : "");
+    ir_buf_printf(o, "%s\n", c->nparams ? "; used here:" : "");
+    for (int i = 0; i < c->nparams; i++)
+        ir_buf_printf(o, " *   slot %d: %s %s\n", c->params[i],
+                      ir_type_name(L->src->params[c->params[i]].type),
+                      L->src->params[c->params[i]].name);
+    for (int i = 0; i < c->ntextures; i++) {
+        const ir_texture *t = &L->src->textures[L->textures[c->textures[i]]];
+        ir_buf_printf(o, " * set %d binding %d: u_tex_%d = %s (%s, mip %s, %s%s)\n",
+                      SPLAT_SET_MATERIAL, SPLAT_BIND_TEXTURE0 + c->textures[i],
+                      c->textures[i], basename_of(t->file), filter_name(t->filter),
+                      filter_name(t->mip), wrap_name(t->wrap), t->srgb ? ", sRGB" : "");
+    }
+    ir_buf_printf(o, " */\n");
+    if (c->reference)
+        ir_buf_printf(o, "#define SPLAT_MULTIPASS 1\n");
+    ir_buf_printf(o, "%s", SPLAT_GLSL_PRELUDE);
+    ir_buf_printf(o, "layout(set = %d, binding = %d, std140) uniform splat_params_block {\n"
+                     "    vec4 slot[%d];\n} u_params;\n",
+                  SPLAT_SET_MATERIAL, SPLAT_BIND_PARAMS, L->nparams > 0 ? L->nparams : 1);
+    for (int i = 0; i < c->ntextures; i++)
+        ir_buf_printf(o, "layout(set = %d, binding = %d) uniform sampler2D u_tex_%d;\n",
+                      SPLAT_SET_MATERIAL, SPLAT_BIND_TEXTURE0 + c->textures[i],
+                      c->textures[i]);
+}
+
+/* How the composite's param/texture/painted tables read in GLSL. */
+typedef struct names {
+    char      **param, **texture, **painted;
+    int         nparam, ntexture, npainted;
+    glsl_names  g;
+} names;
+
+static void names_init(names *nm, const splat_layout *L, const ir *ir,
+                       const int *input_of)
+{
+    nm->nparam = ir->nparams;
+    nm->param = xcalloc((size_t)ir->nparams, sizeof *nm->param);
+    for (int i = 0; i < ir->nparams; i++) {
+        if (input_of[i] >= 0) {
+            nm->param[i] = xstrdup(input_var[input_of[i]]);
+            continue;
+        }
+        int slot = 0;
+        for (int p = 0; p < L->src->nparams; p++)
+            if (strcmp(L->src->params[p].name, ir->params[i].name) == 0)
+                slot = p;
+        char buf[64];
+        snprintf(buf, sizeof buf, "u_params.slot[%d]%s", slot,
+                 swizzle_of_type[ir->params[i].type]);
+        nm->param[i] = xstrdup(buf);
+    }
+    nm->ntexture = ir->ntextures;
+    nm->texture = xcalloc((size_t)ir->ntextures, sizeof *nm->texture);
+    for (int i = 0; i < ir->ntextures; i++) {
+        char buf[32];
+        snprintf(buf, sizeof buf, "u_tex_%d", splat_layout_texture(L, &ir->textures[i]));
+        nm->texture[i] = xstrdup(buf);
+    }
+    nm->npainted = ir->npainted;
+    nm->painted = xcalloc((size_t)ir->npainted, sizeof *nm->painted);
+    for (int i = 0; i < ir->npainted; i++) {
+        int layer = 0;
+        for (int p = 0; p < L->npainted; p++)
+            if (strcmp(L->painted[p], ir->painted[i].name) == 0)
+                layer = p;
+        char buf[40];
+        snprintf(buf, sizeof buf, "in_painted%d", layer);
+        nm->painted[i] = xstrdup(buf);
+    }
+    nm->g.param = (const char *const *)nm->param;
+    nm->g.texture = (const char *const *)nm->texture;
+    nm->g.painted = (const char *const *)nm->painted;
+}
+
+static void names_free(names *nm)
+{
+    for (int i = 0; i < nm->nparam; i++)
+        free(nm->param[i]);
+    for (int i = 0; i < nm->ntexture; i++)
+        free(nm->texture[i]);
+    for (int i = 0; i < nm->npainted; i++)
+        free(nm->painted[i]);
+    free(nm->param);
+    free(nm->texture);
+    free(nm->painted);
+}
+
+static void emit_reference(emit *em)
+{
+    const splat_layer *l = &em->layers[0];
+    emit_subtree(em, l->out, SG_OUT_COUNT, 1);
+    char *x[SG_OUT_COUNT];
+    for (int o = 1; o < SG_OUT_COUNT; o++)
+        x[o] = value(em, l->out[o], 1);
+    char *m = value(em, l->mask, 1);
+    ir_buf_printf(em->out, "    splat_finish(%s, %s, %s, %s, %s);\n",
+                  x[SG_OUT_ALBEDO], x[SG_OUT_NORMAL], x[SG_OUT_ROUGHNESS],
+                  x[SG_OUT_HEIGHT], m);
+    free(m);
+    for (int o = 1; o < SG_OUT_COUNT; o++)
+        free(x[o]);
+}
+
+void splat_composite_glsl(const splat_layout *L, const splat_composite *c,
+                          const splat_glsl_desc *desc, ir_buf *out)
+{
+    emit em = {.L = L, .c = c, .out = out};
+    emission_copy(&em);
+    names nm;
+    names_init(&nm, L, &em.ir, em.input_of);
+    emit_header(&em, desc);
+    em.e = glsl_emitter_new(&em.ir, &nm.g, out);
+    ir_buf_printf(out, "void main() {\n");
+    if (c->reference) {
+        emit_reference(&em);
+    } else {
+        if (!desc->no_mask_view)
+            emit_mask_view(&em);
+        for (int o = 1; o < SG_OUT_COUNT; o++)
+            ir_buf_printf(out, "    %s %s = %s;\n",
+                          o == SG_OUT_ALBEDO || o == SG_OUT_NORMAL ? "vec3" : "float",
+                          acc_names[o],
+                          o == SG_OUT_ALBEDO || o == SG_OUT_NORMAL ? "vec3(0.0)" : "0.0");
+        schedule(&em.s, &em.ir, em.layers, c->nlayers, desc->flat);
+        emit_placed(&em, 0, 1);
+        if (desc->flat) {
+            emit_layer(&em, 0, true, 1);
+        } else if (open_guard(&em, em.layers[0].T, 1)) {
+            emit_layer(&em, 0, false, 2);
+            close_block(&em, 1);
+        }
+        sched_free(&em.s);
+        ir_buf_printf(out, "    splat_finish(s_albedo, normalize(s_normal), s_roughness, "
+                           "s_height, 1.0);\n");
+    }
+    ir_buf_printf(out, "}\n");
+    glsl_emitter_free(em.e);
+    names_free(&nm);
+    emission_free(&em);
+}
