@@ -1,5 +1,6 @@
 /* abi.c — the shared GLSL text of the shader ABI (see abi.h). */
 #include "abi.h"
+#include "sparse.h"
 
 #include <math.h>
 
@@ -74,7 +75,14 @@ const char SPLAT_GLSL_VERTEX[] =
 
 const char SPLAT_GLSL_PRELUDE[] =
     SPLAT_GLSL_COMMON
+    /* painted masks: dense layers, or the sparse quad-tree (sparse.h) */
+    "#ifdef SPLAT_PAINTED_SPARSE\n"
+    "layout(set = 0, binding = 2) uniform sampler2D u_painted_atlas;\n"
+    "layout(set = 0, binding = 5) uniform usampler2DArray u_painted_index;\n"
+    "layout(set = 0, binding = 6) uniform usampler2DArray u_painted_level;\n"
+    "#else\n"
     "layout(set = 0, binding = 2) uniform sampler2DArray u_painted;\n"
+    "#endif\n"
     "layout(set = 0, binding = 3) uniform sampler2D u_destruction_atlas;\n"
     "layout(set = 0, binding = 4) uniform sampler2D u_destruction_index;\n"
     "layout(location = 0) in vec3 v_rel;\n"
@@ -106,9 +114,16 @@ const char SPLAT_GLSL_PRELUDE[] =
     "vec3 splat_position() { return vec3(v_local.x, splat_height(), v_local.z); }\n"
     "vec2 splat_uv() { return v_uv; }\n"
     "float splat_view_distance() { return length(v_rel); }\n"
+    "#ifdef SPLAT_PAINTED_SPARSE\n"
+    SPARSE_GLSL_FUNCTIONS
+    "float splat_painted(int layer) {\n"
+    "    return splat_sparse_painted(v_uv, u_frame.texel.xy, layer);\n"
+    "}\n"
+    "#else\n"
     "float splat_painted(int layer) {\n"
     "    return texture(u_painted, vec3(v_uv, float(layer))).r;\n"
     "}\n"
+    "#endif\n"
     "float splat_destruction() {\n"
     "    if (u_frame.destruction.w <= 0.0) return 0.0;\n"
     "    vec2 p = (v_local.xz - u_frame.destruction.xy) / u_frame.destruction.z;\n"

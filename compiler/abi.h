@@ -12,6 +12,15 @@
  *   binding 1  uniform block   splat_frame (camera, lights, terrain)
  *   binding 2  sampler2DArray  painted masks, R8_UNORM, one layer per mask,
  *                              linear, clamp (dense until the sparse atlas)
+ *              With SPLAT_PAINTED_SPARSE defined before the prelude, the
+ *              painted masks are the sparse quad-tree of sparse.h instead:
+ *   binding 2  sampler2D       painted atlas, R8_UNORM or BC4_UNORM_BLOCK,
+ *                              linear, clamp, one mip level
+ *   binding 5  usampler2DArray painted index, RGBA16_UINT, one layer per
+ *                              4 masks (mask m: layer m/4, channel m%4)
+ *   binding 6  usampler2DArray painted levels, RGBA8_UINT, same shape
+ *              and splat_painted(layer) samples them (sparse_sample on the
+ *              CPU); the masks must be heightfield-sized (u_frame.texel.xy).
  *   binding 3  sampler2D       destruction atlas, R8_UNORM, linear, clamp
  *   binding 4  sampler2D       destruction indirection, RGBA8_UNORM, nearest:
  *                              .rg * 255 = tile x, y in the atlas; .a = 1 if
@@ -48,6 +57,8 @@ enum {
     SPLAT_BIND_PAINTED = 2,
     SPLAT_BIND_DESTRUCTION_ATLAS = 3,
     SPLAT_BIND_DESTRUCTION_INDEX = 4,
+    SPLAT_BIND_PAINTED_INDEX = 5,  /* only with SPLAT_PAINTED_SPARSE */
+    SPLAT_BIND_PAINTED_LEVEL = 6,  /* only with SPLAT_PAINTED_SPARSE */
 
     SPLAT_BIND_PARAMS = 0,
     SPLAT_BIND_TEXTURE0 = 1,   /* texture i at binding 1 + i */

@@ -19,6 +19,7 @@
 
 #include <stb_image_write.h>
 
+#include "abi.h"
 #include "sparse.h"
 #include "spv.h"
 
@@ -705,6 +706,39 @@ static void test_glsl_compiles(void **state)
     free(words);
 }
 
+/* The ABI prelude compiles as a fragment shader with the dense painted
+ * masks (default) and with SPLAT_PAINTED_SPARSE, where splat_painted()
+ * reads the sparse textures at bindings 2, 5 and 6. */
+static void test_abi_prelude_sparse(void **state)
+{
+    for (int sparse = 0; sparse < 2; sparse++) {
+        size_t n = strlen(SPLAT_GLSL_PRELUDE) + 512;
+        char *src = malloc(n);
+        snprintf(src, n, "#version 450\n%s%s"
+                 "void main() {\n"
+                 "    float m = splat_painted(0) + splat_painted(5);\n"
+                 "    splat_finish(vec3(m), splat_normal(), 0.8, 0.5, 1.0);\n"
+                 "}\n", sparse ? "#define SPLAT_PAINTED_SPARSE 1\n" : "",
+                 SPLAT_GLSL_PRELUDE);
+        uint32_t *words;
+        size_t nw;
+        char *log = NULL;
+        bool ok = spv_compile(src, SPV_STAGE_FRAGMENT, "prelude", &words, &nw, &log);
+        if (!ok) fprintf(stderr, "%s\n", log);
+        assert_true(ok);
+        free(log);
+        log = NULL;
+        ok = spv_validate(words, nw, &log);
+        if (!ok) fprintf(stderr, "%s\n", log);
+        assert_true(ok);
+        free(log);
+        free(words);
+        free(src);
+    }
+    assert_int_equal(SPLAT_BIND_PAINTED_INDEX, 5);
+    assert_int_equal(SPLAT_BIND_PAINTED_LEVEL, 6);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -720,6 +754,7 @@ int main(void)
         cmocka_unit_test(test_figure_fields),
         cmocka_unit_test(test_figure_destruction),
         cmocka_unit_test(test_glsl_compiles),
+        cmocka_unit_test(test_abi_prelude_sparse),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
