@@ -1,0 +1,464 @@
+/* pipelines.c — descriptor set layouts exactly as compiler/abi.h fixes
+ * them, one graphics pipeline per combination over the pack's shared
+ * vertex shader, the multi-pass reference pipelines (one blended pass per
+ * material and a resolve pass that lights the blended surface with the
+ * ABI's splat_light), the über-shader pipeline, and a pipeline cache kept
+ * on disk between runs. */
+#include "splatrt.h"
+
+#include <errno.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+/* The resolve pass of the multi-pass reference: a fullscreen triangle that
+ * reads the three blended targets and applies the same lighting as the
+ * single-pass shaders (splat_finish), so both give the same image. */
+static const char resolve_vert[] =
+    "#version 450\n"
+    "layout(location = 0) out vec3 v_rel;\n"
+    "layout(location = 1) out vec2 v_uv;\n"
+    "layout(location = 2) out vec3 v_local;\n"
+    "void main() {\n"
+    "    vec2 p = vec2((gl_VertexIndex << 1) & 2, gl_VertexIndex & 2);\n"
+    "    gl_Position = vec4(p * 2.0 - 1.0, 0.0, 1.0);\n"
+    "    v_rel = vec3(0.0); v_uv = p; v_local = vec3(0.0);\n"
+    "}\n";
+
+static const char resolve_frag_main[] =
+    "layout(set = 2, binding = 0) uniform sampler2D r_albedo;\n"
+    "layout(set = 2, binding = 1) uniform sampler2D r_normal;\n"
+    "layout(set = 2, binding = 2) uniform sampler2D r_misc;\n"
+    "void main() {\n"
+    "    ivec2 p = ivec2(gl_FragCoord.xy);\n"
+    "    vec4 a = texelFetch(r_albedo, p, 0);\n"
+    "    if (a.a <= 0.0) discard;          /* no terrain: keep the clear colour */\n"
+    "    vec4 n = texelFetch(r_normal, p, 0);\n"
+    "    vec4 m = texelFetch(r_misc, p, 0);\n"
+    "    vec3 nn = normalize(n.xyz);\n"
+    "    vec3 c;\n"
+    "    if (u_frame.view.x == 6u) c = a.rgb;\n"
+    "    else if (u_frame.view.x == 3u) c = nn * 0.5 + 0.5;\n"
+    "    else c = splat_light(a.rgb, nn, m.r, m.b);\n"
+    "    o_color = vec4(c, 1.0);\n"
+    "}\n";
+
+/* ---- pipeline cache on disk ---------------------------------------------- */
+
+static char *default_cache_path(void)
+{
+    const char *env = getenv("SPLAT_PIPELINE_CACHE");
+    if (env && *env)
+        return strdup(env);
+    const char *xdg = getenv("XDG_CACHE_HOME"), *home = getenv("HOME");
+    char dir[1024];
+    if (xdg && *xdg)
+        snprintf(dir, sizeof dir, "%s/splatc", xdg);
+    else if (home && *home)
+        snprintf(dir, sizeof dir, "%s/.cache/splatc", home);
+    else
+        return NULL;
+    /* Create the folder and its parent; failure only disables saving. */
+    char *slash = strrchr(dir, '/');
+    if (slash) {
+        *slash = '\0';
+        mkdir(dir, 0755);
+        *slash = '/';
+    }
+    if (mkdir(dir, 0755) != 0 && errno != EEXIST)
+        return NULL;
+    size_t n = strlen(dir) + 32;
+    char *path = malloc(n);
+    if (path)
+        snprintf(path, n, "%s/pipelines.bin", dir);
+    return path;
+}
+
+/* Cache data is only handed to the driver if its header names this device. */
+static bool cache_matches(const rt_device *d, const uint8_t *data, size_t n)
+{
+    if (n < 32)
+        return false;
+    uint32_t len, version, vendor, device;
+    memcpy(&len, data, 4);
+    memcpy(&version, data + 4, 4);
+    memcpy(&vendor, data + 8, 4);
+    memcpy(&device, data + 12, 4);
+    return len >= 32 && version == VK_PIPELINE_CACHE_HEADER_VERSION_ONE &&
+           vendor == d->props.vendorID && device == d->props.deviceID &&
+           !memcmp(data + 16, d->props.pipelineCacheUUID, VK_UUID_SIZE);
+}
+
+static bool open_cache(rt_device *d, rt_pipelines *pl, const char *path, rt_error *e)
+{
+    pl->cache_path = path ? strdup(path) : default_cache_path();
+    uint8_t *data = NULL;
+    size_t n = 0;
+    FILE *f = pl->cache_path ? fopen(pl->cache_path, "rb") : NULL;
+    if (f) {
+        if (fseek(f, 0, SEEK_END) == 0) {
+            long len = ftell(f);
+            if (len > 0 && fseek(f, 0, SEEK_SET) == 0 && (data = malloc((size_t)len))) {
+                n = fread(data, 1, (size_t)len, f);
+                if (n != (size_t)len)
+                    n = 0;
+            }
+        }
+        fclose(f);
+    }
+    VkPipelineCacheCreateInfo ci = {
+        .sType = VK_STRUCTURE_TYPE_PIPELINE_CACHE_CREATE_INFO,
+        .initialDataSize = cache_matches(d, data, n) ? n : 0,
+        .pInitialData = data,
+    };
+    VkResult r = vkCreatePipelineCache(d->dev, &ci, NULL, &pl->cache);
+    free(data);
+    if (r != VK_SUCCESS)
+        return rt_fail(e, RT_E_VULKAN, "vkCreatePipelineCache", rt_vk_result_name(r));
+    return true;
+}
+
+static void save_cache(rt_device *d, rt_pipelines *pl)
+{
+    size_t n = 0;
+    if (!pl->cache_path || vkGetPipelineCacheData(d->dev, pl->cache, &n, NULL) != VK_SUCCESS || !n)
+        return;
+    uint8_t *data = malloc(n);
+    if (!data)
+        return;
+    if (vkGetPipelineCacheData(d->dev, pl->cache, &n, data) == VK_SUCCESS) {
+        /* Written beside and renamed: readers never see half a file. */
+        size_t len = strlen(pl->cache_path) + 16;
+        char *tmp = malloc(len);
+        if (tmp) {
+            snprintf(tmp, len, "%s.tmp%d", pl->cache_path, (int)(n & 0xffff));
+            FILE *f = fopen(tmp, "wb");
+            if (f) {
+                bool ok = fwrite(data, 1, n, f) == n;
+                ok = fclose(f) == 0 && ok;
+                if (!ok || rename(tmp, pl->cache_path) != 0)
+                    remove(tmp);
+            }
+            free(tmp);
+        }
+    }
+    free(data);
+}
+
+/* ---- layouts ------------------------------------------------------------- */
+
+static bool make_set_layout(rt_device *d, const VkDescriptorSetLayoutBinding *b,
+                            uint32_t n, VkDescriptorSetLayout *out, rt_error *e)
+{
+    VkDescriptorSetLayoutCreateInfo ci = {
+        .sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO,
+        .bindingCount = n,
+        .pBindings = b,
+    };
+    RT_VK(e, vkCreateDescriptorSetLayout(d->dev, &ci, NULL, out));
+    return true;
+}
+
+static bool make_layouts(rt_device *d, int ntextures, rt_pipelines *pl, rt_error *e)
+{
+    const VkShaderStageFlags vf = VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT;
+    const VkShaderStageFlags fs = VK_SHADER_STAGE_FRAGMENT_BIT;
+    const VkDescriptorType smp = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
+    VkDescriptorSetLayoutBinding terrain[] = {
+        { SPLAT_BIND_HEIGHTFIELD, smp, 1, vf, NULL },
+        { SPLAT_BIND_FRAME, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 1, vf, NULL },
+        { SPLAT_BIND_PAINTED, smp, 1, fs, NULL },
+        { SPLAT_BIND_DESTRUCTION_ATLAS, smp, 1, fs, NULL },
+        { SPLAT_BIND_DESTRUCTION_INDEX, smp, 1, fs, NULL },
+    };
+    if (!make_set_layout(d, terrain, 5, &pl->set_terrain, e))
+        return false;
+    VkDescriptorSetLayoutBinding *mat = calloc((size_t)ntextures + 1, sizeof *mat);
+    if (!mat)
+        return rt_fail(e, RT_E_VULKAN, "layout", "out of memory");
+    mat[0] = (VkDescriptorSetLayoutBinding){ SPLAT_BIND_PARAMS, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 1, fs, NULL };
+    for (int i = 0; i < ntextures; i++)
+        mat[i + 1] = (VkDescriptorSetLayoutBinding){ (uint32_t)(SPLAT_BIND_TEXTURE0 + i), smp, 1, fs, NULL };
+    bool ok = make_set_layout(d, mat, (uint32_t)ntextures + 1, &pl->set_material, e);
+    free(mat);
+    VkDescriptorSetLayoutBinding res[] = {
+        { 0, smp, 1, fs, NULL }, { 1, smp, 1, fs, NULL }, { 2, smp, 1, fs, NULL },
+    };
+    if (!ok || !make_set_layout(d, res, 3, &pl->set_resolve, e))
+        return false;
+    VkPushConstantRange push = { vf, 0, sizeof(splat_push) };
+    VkDescriptorSetLayout sets[3] = { pl->set_terrain, pl->set_material, pl->set_resolve };
+    VkPipelineLayoutCreateInfo li = {
+        .sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO,
+        .setLayoutCount = 2,
+        .pSetLayouts = sets,
+        .pushConstantRangeCount = 1,
+        .pPushConstantRanges = &push,
+    };
+    RT_VK(e, vkCreatePipelineLayout(d->dev, &li, NULL, &pl->layout));
+    li.setLayoutCount = 3;
+    RT_VK(e, vkCreatePipelineLayout(d->dev, &li, NULL, &pl->resolve_layout));
+    return true;
+}
+
+/* ---- pipelines ----------------------------------------------------------- */
+
+static bool make_module(rt_device *d, const uint32_t *words, size_t n,
+                        VkShaderModule *m, rt_error *e)
+{
+    VkShaderModuleCreateInfo ci = {
+        .sType = VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO,
+        .codeSize = n * 4,
+        .pCode = words,
+    };
+    RT_VK(e, vkCreateShaderModule(d->dev, &ci, NULL, m));
+    return true;
+}
+
+typedef enum kind {
+    K_OPAQUE,       /* composites, über: depth test + write                  */
+    K_BASE,         /* multi-pass bottom material: 3 targets, depth write     */
+    K_BLEND,        /* multi-pass upper materials: blend, depth EQUAL         */
+    K_RESOLVE,      /* fullscreen, no depth, no vertex input                  */
+} kind;
+
+static bool make_pipeline(rt_device *d, rt_pipelines *pl, VkShaderModule vs,
+                          VkShaderModule fs, VkRenderPass pass, kind k,
+                          bool wire, VkPipeline *out, rt_error *e)
+{
+    VkPipelineShaderStageCreateInfo stages[2] = {
+        { .sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO,
+          .stage = VK_SHADER_STAGE_VERTEX_BIT, .module = vs, .pName = "main" },
+        { .sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO,
+          .stage = VK_SHADER_STAGE_FRAGMENT_BIT, .module = fs, .pName = "main" },
+    };
+    VkVertexInputBindingDescription vb = { 0, 8, VK_VERTEX_INPUT_RATE_VERTEX };
+    VkVertexInputAttributeDescription va = { 0, 0, VK_FORMAT_R32G32_SFLOAT, 0 };
+    VkPipelineVertexInputStateCreateInfo vi = {
+        .sType = VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO,
+        .vertexBindingDescriptionCount = k == K_RESOLVE ? 0 : 1,
+        .pVertexBindingDescriptions = &vb,
+        .vertexAttributeDescriptionCount = k == K_RESOLVE ? 0 : 1,
+        .pVertexAttributeDescriptions = &va,
+    };
+    VkPipelineInputAssemblyStateCreateInfo ia = {
+        .sType = VK_STRUCTURE_TYPE_PIPELINE_INPUT_ASSEMBLY_STATE_CREATE_INFO,
+        .topology = VK_PRIMITIVE_TOPOLOGY_TRIANGLE_LIST,
+    };
+    VkPipelineViewportStateCreateInfo vp = {
+        .sType = VK_STRUCTURE_TYPE_PIPELINE_VIEWPORT_STATE_CREATE_INFO,
+        .viewportCount = 1,
+        .scissorCount = 1,
+    };
+    VkPipelineRasterizationStateCreateInfo rs = {
+        .sType = VK_STRUCTURE_TYPE_PIPELINE_RASTERIZATION_STATE_CREATE_INFO,
+        .polygonMode = wire ? VK_POLYGON_MODE_LINE : VK_POLYGON_MODE_FILL,
+        .cullMode = VK_CULL_MODE_NONE,   /* terrain seen from below shows too */
+        .frontFace = VK_FRONT_FACE_COUNTER_CLOCKWISE,
+        .lineWidth = 1.0f,
+    };
+    VkPipelineMultisampleStateCreateInfo ms = {
+        .sType = VK_STRUCTURE_TYPE_PIPELINE_MULTISAMPLE_STATE_CREATE_INFO,
+        .rasterizationSamples = VK_SAMPLE_COUNT_1_BIT,
+    };
+    /* Reversed Z (1 at the near plane, 0 at infinity): greater is nearer. */
+    VkPipelineDepthStencilStateCreateInfo ds = {
+        .sType = VK_STRUCTURE_TYPE_PIPELINE_DEPTH_STENCIL_STATE_CREATE_INFO,
+        .depthTestEnable = k != K_RESOLVE,
+        .depthWriteEnable = k == K_OPAQUE || k == K_BASE,
+        .depthCompareOp = k == K_BLEND ? VK_COMPARE_OP_EQUAL : VK_COMPARE_OP_GREATER_OR_EQUAL,
+    };
+    const VkColorComponentFlags all = VK_COLOR_COMPONENT_R_BIT | VK_COLOR_COMPONENT_G_BIT |
+                                      VK_COLOR_COMPONENT_B_BIT | VK_COLOR_COMPONENT_A_BIT;
+    VkPipelineColorBlendAttachmentState att[3];
+    for (int i = 0; i < 3; i++)
+        att[i] = (VkPipelineColorBlendAttachmentState){
+            .blendEnable = k == K_BLEND,   /* the base pass writes, mask 1 */
+            .srcColorBlendFactor = VK_BLEND_FACTOR_SRC_ALPHA,
+            .dstColorBlendFactor = VK_BLEND_FACTOR_ONE_MINUS_SRC_ALPHA,
+            .colorBlendOp = VK_BLEND_OP_ADD,
+            .srcAlphaBlendFactor = VK_BLEND_FACTOR_ONE,
+            .dstAlphaBlendFactor = VK_BLEND_FACTOR_ONE_MINUS_SRC_ALPHA,
+            .alphaBlendOp = VK_BLEND_OP_ADD,
+            .colorWriteMask = all,
+        };
+    VkPipelineColorBlendStateCreateInfo cb = {
+        .sType = VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO,
+        .attachmentCount = (k == K_BASE || k == K_BLEND) ? 3 : 1,
+        .pAttachments = att,
+    };
+    VkDynamicState dyn[2] = { VK_DYNAMIC_STATE_VIEWPORT, VK_DYNAMIC_STATE_SCISSOR };
+    VkPipelineDynamicStateCreateInfo dy = {
+        .sType = VK_STRUCTURE_TYPE_PIPELINE_DYNAMIC_STATE_CREATE_INFO,
+        .dynamicStateCount = 2,
+        .pDynamicStates = dyn,
+    };
+    VkGraphicsPipelineCreateInfo ci = {
+        .sType = VK_STRUCTURE_TYPE_GRAPHICS_PIPELINE_CREATE_INFO,
+        .stageCount = 2,
+        .pStages = stages,
+        .pVertexInputState = &vi,
+        .pInputAssemblyState = &ia,
+        .pViewportState = &vp,
+        .pRasterizationState = &rs,
+        .pMultisampleState = &ms,
+        .pDepthStencilState = &ds,
+        .pColorBlendState = &cb,
+        .pDynamicState = &dy,
+        .layout = k == K_RESOLVE ? pl->resolve_layout : pl->layout,
+        .renderPass = pass,
+    };
+    RT_VK(e, vkCreateGraphicsPipelines(d->dev, pl->cache, 1, &ci, NULL, out));
+    return true;
+}
+
+/* A pipeline from a pack module over the shared vertex shader. */
+static bool pack_pipeline(rt_device *d, rt_pipelines *pl, const rt_spirv *fs,
+                          VkRenderPass pass, kind k, bool wire, VkPipeline *out,
+                          rt_error *e)
+{
+    VkShaderModule m;
+    if (!make_module(d, fs->words, fs->nwords, &m, e))
+        return false;
+    bool ok = make_pipeline(d, pl, pl->vertex, m, pass, k, wire, out, e);
+    vkDestroyShaderModule(d->dev, m, NULL);
+    return ok;
+}
+
+bool rt_pipelines_combos(rt_device *d, const rt_pack *p, const rt_passes *rp,
+                         rt_pipelines *pl, VkPipeline **out, rt_error *e)
+{
+    VkPipeline *ps = calloc((size_t)p->ncombos, sizeof *ps);
+    if (!ps)
+        return rt_fail(e, RT_E_VULKAN, "pipelines", "out of memory");
+    for (int i = 0; i < p->ncombos; i++) {
+        if (!pack_pipeline(d, pl, &p->combos[i].spirv, rp->main, K_OPAQUE, false, &ps[i], e)) {
+            for (int k = 0; k < i; k++)
+                vkDestroyPipeline(d->dev, ps[k], NULL);
+            free(ps);
+            return false;
+        }
+    }
+    *out = ps;
+    return true;
+}
+
+bool rt_pipelines_wire(rt_device *d, const rt_pack *p, const rt_passes *rp,
+                       rt_pipelines *pl, rt_error *e)
+{
+    if (pl->combo_wire)
+        return true;
+    if (!d->wireframe)
+        return rt_fail(e, RT_E_NO_FORMAT, "draw wireframe (no fillModeNonSolid)");
+    pl->combo_wire = calloc((size_t)pl->ncombos, sizeof *pl->combo_wire);
+    if (!pl->combo_wire)
+        return rt_fail(e, RT_E_VULKAN, "pipelines", "out of memory");
+    for (int i = 0; i < pl->ncombos; i++)
+        if (!pack_pipeline(d, pl, &p->combos[i].spirv, rp->main, K_OPAQUE, true,
+                           &pl->combo_wire[i], e))
+            return false;
+    return true;
+}
+
+static bool resolve_pipeline(rt_device *d, rt_pipelines *pl, VkRenderPass pass, rt_error *e)
+{
+    size_t n = strlen(SPLAT_GLSL_PRELUDE) + strlen(resolve_frag_main) + 32;
+    char *src = malloc(n);
+    if (!src)
+        return rt_fail(e, RT_E_VULKAN, "resolve", "out of memory");
+    snprintf(src, n, "#version 450\n%s%s", SPLAT_GLSL_PRELUDE, resolve_frag_main);
+    uint32_t *vw = NULL, *fw = NULL;
+    size_t vn = 0, fn = 0;
+    bool ok = rt_glsl_compile(resolve_vert, VK_SHADER_STAGE_VERTEX_BIT, "resolve.vert", &vw, &vn, e) &&
+              rt_glsl_compile(src, VK_SHADER_STAGE_FRAGMENT_BIT, "resolve.frag", &fw, &fn, e);
+    free(src);
+    VkShaderModule vm = VK_NULL_HANDLE, fm = VK_NULL_HANDLE;
+    ok = ok && make_module(d, vw, vn, &vm, e) && make_module(d, fw, fn, &fm, e) &&
+         make_pipeline(d, pl, vm, fm, pass, K_RESOLVE, false, &pl->resolve, e);
+    if (vm)
+        vkDestroyShaderModule(d->dev, vm, NULL);
+    if (fm)
+        vkDestroyShaderModule(d->dev, fm, NULL);
+    free(vw);
+    free(fw);
+    return ok;
+}
+
+bool rt_pipelines_create(rt_device *d, const rt_pack *p, const rt_passes *rp,
+                         rt_reference ref, const char *cache_path,
+                         int ntextures, rt_pipelines *pl, rt_error *e)
+{
+    memset(pl, 0, sizeof *pl);
+    if (!make_layouts(d, ntextures, pl, e) || !open_cache(d, pl, cache_path, e) ||
+        !make_module(d, p->vertex.words, p->vertex.nwords, &pl->vertex, e))
+        return false;
+    if (!rt_pipelines_combos(d, p, rp, pl, &pl->combo, e))
+        return false;
+    pl->ncombos = p->ncombos;
+    if (ref == RT_REF_MULTIPASS) {
+        for (int i = 0; i < p->nmaterials; i++)
+            if (!p->materials[i].reference.words) {
+                char what[256];
+                snprintf(what, sizeof what, "materials[%d] (%s) has no reference shader",
+                         i, p->materials[i].name);
+                return rt_fail(e, RT_E_PACK_FIELD, p->dir, what);
+            }
+        pl->ref = calloc((size_t)p->nmaterials, sizeof *pl->ref);
+        if (!pl->ref)
+            return rt_fail(e, RT_E_VULKAN, "pipelines", "out of memory");
+        pl->nref = p->nmaterials;
+        for (int i = 0; i < p->nmaterials; i++)
+            if (!pack_pipeline(d, pl, &p->materials[i].reference, rp->multi,
+                               i == 0 ? K_BASE : K_BLEND, false, &pl->ref[i], e))
+                return false;
+        if (!resolve_pipeline(d, pl, rp->resolve, e))
+            return false;
+    }
+    if (ref == RT_REF_UBER) {
+        if (!p->uber.words)
+            return rt_fail(e, RT_E_PACK_FIELD, p->dir, "the pack has no uber shader");
+        if (!pack_pipeline(d, pl, &p->uber, rp->main, K_OPAQUE, false, &pl->uber, e))
+            return false;
+    }
+    return true;
+}
+
+void rt_pipelines_destroy(rt_device *d, rt_pipelines *pl)
+{
+    if (!d->dev)
+        return;
+    if (pl->cache) {
+        save_cache(d, pl);
+        vkDestroyPipelineCache(d->dev, pl->cache, NULL);
+    }
+    for (int i = 0; i < pl->ncombos; i++) {
+        if (pl->combo && pl->combo[i])
+            vkDestroyPipeline(d->dev, pl->combo[i], NULL);
+        if (pl->combo_wire && pl->combo_wire[i])
+            vkDestroyPipeline(d->dev, pl->combo_wire[i], NULL);
+    }
+    for (int i = 0; i < pl->nref; i++)
+        if (pl->ref[i])
+            vkDestroyPipeline(d->dev, pl->ref[i], NULL);
+    if (pl->uber)
+        vkDestroyPipeline(d->dev, pl->uber, NULL);
+    if (pl->resolve)
+        vkDestroyPipeline(d->dev, pl->resolve, NULL);
+    if (pl->vertex)
+        vkDestroyShaderModule(d->dev, pl->vertex, NULL);
+    if (pl->layout)
+        vkDestroyPipelineLayout(d->dev, pl->layout, NULL);
+    if (pl->resolve_layout)
+        vkDestroyPipelineLayout(d->dev, pl->resolve_layout, NULL);
+    if (pl->set_terrain)
+        vkDestroyDescriptorSetLayout(d->dev, pl->set_terrain, NULL);
+    if (pl->set_material)
+        vkDestroyDescriptorSetLayout(d->dev, pl->set_material, NULL);
+    if (pl->set_resolve)
+        vkDestroyDescriptorSetLayout(d->dev, pl->set_resolve, NULL);
+    free(pl->combo);
+    free(pl->combo_wire);
+    free(pl->ref);
+    free(pl->cache_path);
+    memset(pl, 0, sizeof *pl);
+}

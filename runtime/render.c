@@ -1,0 +1,858 @@
+/* render.c — offscreen frames: RGBA32F colour + D32 depth (reversed Z),
+ * the quadtree selection per frame, patches grouped by combination and
+ * drawn with one pipeline bind per group, camera-relative patch corners
+ * computed in double and pushed as floats, GPU time from timestamp
+ * queries.  The reference modes draw the same patches with the multi-pass
+ * alpha-blended material passes (+ a resolve pass) or the über-shader.
+ *
+ * Nothing in the frame loop allocates or uploads textures: the per-frame
+ * work is the selection (preallocated arrays), a counting sort by
+ * combination, a uniform write into mapped memory and one command buffer. */
+#include "splatrt.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+struct rt_renderer {
+    rt_device        *d;
+    const rt_pack    *p;
+    rt_render_desc    desc;
+    rt_terrain_gpu    terrain;
+    rt_bounds         bounds;
+    rt_quadtree       qt;
+    const uint16_t  **combo_ids;       /* per level, into the pack          */
+    int               ncombos;
+    rt_buffer         vbuf, ibuf;
+    uint32_t          perm_first[RT_PERMS], perm_count[RT_PERMS];
+    rt_buffer         frame_ubo, params_ubo, readback;
+    rt_image         *tex;
+    VkSampler        *tex_smp;
+    int               ntex;
+    rt_image          color, depth, mp[3];
+    rt_passes         rp;
+    VkFramebuffer     fb_main, fb_multi, fb_resolve;
+    rt_pipelines      pl;
+    VkDescriptorPool  dpool;
+    VkDescriptorSet   set0, set1, set2;
+    VkCommandBuffer   cb;
+    VkFence           fence;
+    VkQueryPool       qpool;
+    bool              timestamps;
+    rt_patch         *sorted;          /* patches grouped by combination    */
+    int              *counts;          /* ncombos + 1                       */
+    splat_view        view;
+    int               view_material;
+    bool              wireframe;
+    double            lod_distance;
+};
+
+static double now_ms(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec * 1e-6;
+}
+
+/* ---- render passes -------------------------------------------------------- */
+
+static bool make_pass(rt_device *d, uint32_t ncolor, bool depth, VkImageLayout color_final,
+                      VkRenderPass *out, rt_error *e)
+{
+    VkAttachmentDescription att[4];
+    VkAttachmentReference cref[3], dref = { ncolor, VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL };
+    for (uint32_t i = 0; i < ncolor; i++) {
+        att[i] = (VkAttachmentDescription){
+            .format = VK_FORMAT_R32G32B32A32_SFLOAT,
+            .samples = VK_SAMPLE_COUNT_1_BIT,
+            .loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR,
+            .storeOp = VK_ATTACHMENT_STORE_OP_STORE,
+            .stencilLoadOp = VK_ATTACHMENT_LOAD_OP_DONT_CARE,
+            .stencilStoreOp = VK_ATTACHMENT_STORE_OP_DONT_CARE,
+            .initialLayout = VK_IMAGE_LAYOUT_UNDEFINED,
+            .finalLayout = color_final,
+        };
+        cref[i] = (VkAttachmentReference){ i, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL };
+    }
+    if (depth)
+        att[ncolor] = (VkAttachmentDescription){
+            .format = VK_FORMAT_D32_SFLOAT,
+            .samples = VK_SAMPLE_COUNT_1_BIT,
+            .loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR,
+            .storeOp = VK_ATTACHMENT_STORE_OP_DONT_CARE,
+            .stencilLoadOp = VK_ATTACHMENT_LOAD_OP_DONT_CARE,
+            .stencilStoreOp = VK_ATTACHMENT_STORE_OP_DONT_CARE,
+            .initialLayout = VK_IMAGE_LAYOUT_UNDEFINED,
+            .finalLayout = VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL,
+        };
+    VkSubpassDescription sub = {
+        .pipelineBindPoint = VK_PIPELINE_BIND_POINT_GRAPHICS,
+        .colorAttachmentCount = ncolor,
+        .pColorAttachments = cref,
+        .pDepthStencilAttachment = depth ? &dref : NULL,
+    };
+    /* Earlier reads (copies, resolve, viewer) finish before we write again;
+     * our writes are visible to whatever reads the targets next. */
+    VkSubpassDependency dep[2] = {
+        { VK_SUBPASS_EXTERNAL, 0,
+          VK_PIPELINE_STAGE_TRANSFER_BIT | VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT |
+          VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT | VK_PIPELINE_STAGE_LATE_FRAGMENT_TESTS_BIT,
+          VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT | VK_PIPELINE_STAGE_EARLY_FRAGMENT_TESTS_BIT,
+          VK_ACCESS_TRANSFER_READ_BIT | VK_ACCESS_SHADER_READ_BIT |
+          VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT | VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT,
+          VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT | VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT |
+          VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_READ_BIT, 0 },
+        { 0, VK_SUBPASS_EXTERNAL,
+          VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT,
+          VK_PIPELINE_STAGE_TRANSFER_BIT | VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT,
+          VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT,
+          VK_ACCESS_TRANSFER_READ_BIT | VK_ACCESS_SHADER_READ_BIT, 0 },
+    };
+    VkRenderPassCreateInfo ci = {
+        .sType = VK_STRUCTURE_TYPE_RENDER_PASS_CREATE_INFO,
+        .attachmentCount = ncolor + (depth ? 1 : 0),
+        .pAttachments = att,
+        .subpassCount = 1,
+        .pSubpasses = &sub,
+        .dependencyCount = 2,
+        .pDependencies = dep,
+    };
+    RT_VK(e, vkCreateRenderPass(d->dev, &ci, NULL, out));
+    return true;
+}
+
+static bool make_fb(rt_device *d, VkRenderPass pass, const VkImageView *views, uint32_t n,
+                    int w, int h, VkFramebuffer *out, rt_error *e)
+{
+    VkFramebufferCreateInfo ci = {
+        .sType = VK_STRUCTURE_TYPE_FRAMEBUFFER_CREATE_INFO,
+        .renderPass = pass,
+        .attachmentCount = n,
+        .pAttachments = views,
+        .width = (uint32_t)w,
+        .height = (uint32_t)h,
+        .layers = 1,
+    };
+    RT_VK(e, vkCreateFramebuffer(d->dev, &ci, NULL, out));
+    return true;
+}
+
+static bool make_targets(rt_renderer *r, rt_error *e)
+{
+    rt_device *d = r->d;
+    int w = r->desc.width, h = r->desc.height;
+    const VkFormat cf = VK_FORMAT_R32G32B32A32_SFLOAT;
+    VkFormatFeatureFlags need = VK_FORMAT_FEATURE_COLOR_ATTACHMENT_BIT;
+    if (r->desc.reference == RT_REF_MULTIPASS)
+        need |= VK_FORMAT_FEATURE_COLOR_ATTACHMENT_BLEND_BIT;
+    if (!rt_format_supports(d, cf, need))
+        return rt_fail(e, RT_E_NO_FORMAT, "render (and blend) to R32G32B32A32_SFLOAT");
+    if (!rt_format_supports(d, VK_FORMAT_D32_SFLOAT, VK_FORMAT_FEATURE_DEPTH_STENCIL_ATTACHMENT_BIT))
+        return rt_fail(e, RT_E_NO_FORMAT, "use D32_SFLOAT depth");
+    if (!rt_image_create(d, (uint32_t)w, (uint32_t)h, 1, false, 1, cf,
+                         VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT |
+                         VK_IMAGE_USAGE_SAMPLED_BIT, VK_IMAGE_ASPECT_COLOR_BIT, &r->color, e) ||
+        !rt_image_create(d, (uint32_t)w, (uint32_t)h, 1, false, 1, VK_FORMAT_D32_SFLOAT,
+                         VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT, VK_IMAGE_ASPECT_DEPTH_BIT,
+                         &r->depth, e))
+        return false;
+    if (!make_pass(d, 1, true, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, &r->rp.main, e))
+        return false;
+    VkImageView mv[2] = { r->color.view, r->depth.view };
+    if (!make_fb(d, r->rp.main, mv, 2, w, h, &r->fb_main, e))
+        return false;
+    if (r->desc.reference != RT_REF_MULTIPASS)
+        return true;
+    for (int i = 0; i < 3; i++)
+        if (!rt_image_create(d, (uint32_t)w, (uint32_t)h, 1, false, 1, cf,
+                             VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_SAMPLED_BIT,
+                             VK_IMAGE_ASPECT_COLOR_BIT, &r->mp[i], e))
+            return false;
+    if (!make_pass(d, 3, true, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, &r->rp.multi, e) ||
+        !make_pass(d, 1, false, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, &r->rp.resolve, e))
+        return false;
+    VkImageView tv[4] = { r->mp[0].view, r->mp[1].view, r->mp[2].view, r->depth.view };
+    return make_fb(d, r->rp.multi, tv, 4, w, h, &r->fb_multi, e) &&
+           make_fb(d, r->rp.resolve, &r->color.view, 1, w, h, &r->fb_resolve, e);
+}
+
+/* ---- geometry, textures, descriptors --------------------------------------- */
+
+static bool make_geometry(rt_renderer *r, rt_error *e)
+{
+    rt_device *d = r->d;
+    const size_t nv = SPLAT_GRID * SPLAT_GRID;
+    uint32_t total = 0;
+    for (int i = 0; i < RT_PERMS; i++) {
+        r->perm_first[i] = total;
+        r->perm_count[i] = rt_grid_indices(r->desc.no_stitch ? 0 : i, NULL);
+        total += r->perm_count[i];
+    }
+    if (!rt_buffer_create(d, nv * 8, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT, true, &r->vbuf, e) ||
+        !rt_buffer_create(d, total * 2u, VK_BUFFER_USAGE_INDEX_BUFFER_BIT, true, &r->ibuf, e))
+        return false;
+    rt_grid_vertices(r->vbuf.map);
+    for (int i = 0; i < RT_PERMS; i++)
+        rt_grid_indices(r->desc.no_stitch ? 0 : i, (uint16_t *)r->ibuf.map + r->perm_first[i]);
+    return true;
+}
+
+static bool make_textures(rt_renderer *r, rt_error *e)
+{
+    rt_device *d = r->d;
+    const rt_pack *p = r->p;
+    r->ntex = p->ntextures;
+    r->tex = calloc((size_t)r->ntex + 1, sizeof *r->tex);
+    r->tex_smp = calloc((size_t)r->ntex + 1, sizeof *r->tex_smp);
+    if (!r->tex || !r->tex_smp)
+        return rt_fail(e, RT_E_VULKAN, "textures", "out of memory");
+    for (int i = 0; i < r->ntex; i++) {
+        const rt_pack_texture *t = &p->textures[i];
+        VkFormat f = t->srgb ? VK_FORMAT_R8G8B8A8_SRGB : VK_FORMAT_R8G8B8A8_UNORM;
+        uint32_t mips = 1;
+        if (rt_format_supports(d, f, VK_FORMAT_FEATURE_BLIT_SRC_BIT | VK_FORMAT_FEATURE_BLIT_DST_BIT |
+                                     VK_FORMAT_FEATURE_SAMPLED_IMAGE_FILTER_LINEAR_BIT))
+            for (int s = t->width > t->height ? t->width : t->height; s > 1; s /= 2)
+                mips++;
+        if (!rt_image_create(d, (uint32_t)t->width, (uint32_t)t->height, 1, false, mips, f,
+                             VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT |
+                             VK_IMAGE_USAGE_TRANSFER_SRC_BIT, VK_IMAGE_ASPECT_COLOR_BIT, &r->tex[i], e) ||
+            !rt_image_upload(d, &r->tex[i], t->rgba, (size_t)t->width * (size_t)t->height * 4, e))
+            return false;
+        VkFilter filt = t->linear ? VK_FILTER_LINEAR : VK_FILTER_NEAREST;
+        VkSamplerCreateInfo ci = {
+            .sType = VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO,
+            .magFilter = filt,
+            .minFilter = filt,
+            .mipmapMode = t->mip_linear ? VK_SAMPLER_MIPMAP_MODE_LINEAR : VK_SAMPLER_MIPMAP_MODE_NEAREST,
+            .addressModeU = t->wrap,
+            .addressModeV = t->wrap,
+            .addressModeW = t->wrap,
+            .maxLod = (float)mips,
+        };
+        RT_VK(e, vkCreateSampler(d->dev, &ci, NULL, &r->tex_smp[i]));
+    }
+    return true;
+}
+
+static bool make_descriptors(rt_renderer *r, rt_error *e)
+{
+    rt_device *d = r->d;
+    const rt_pack *p = r->p;
+    if (!rt_buffer_create(d, sizeof(splat_frame), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, true,
+                          &r->frame_ubo, e) ||
+        !rt_buffer_create(d, p->params_size, VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, true,
+                          &r->params_ubo, e))
+        return false;
+    memset(r->params_ubo.map, 0, p->params_size);
+    for (int i = 0; i < p->nparams; i++)
+        memcpy((uint8_t *)r->params_ubo.map + p->params[i].offset, p->params[i].value, 16);
+
+    VkDescriptorPoolSize sizes[2] = {
+        { VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 2 },
+        { VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 4 + (uint32_t)r->ntex + 3 },
+    };
+    VkDescriptorPoolCreateInfo pci = {
+        .sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO,
+        .maxSets = 3,
+        .poolSizeCount = 2,
+        .pPoolSizes = sizes,
+    };
+    RT_VK(e, vkCreateDescriptorPool(d->dev, &pci, NULL, &r->dpool));
+    VkDescriptorSetLayout layouts[3] = { r->pl.set_terrain, r->pl.set_material, r->pl.set_resolve };
+    VkDescriptorSet sets[3];
+    VkDescriptorSetAllocateInfo ai = {
+        .sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO,
+        .descriptorPool = r->dpool,
+        .descriptorSetCount = r->desc.reference == RT_REF_MULTIPASS ? 3 : 2,
+        .pSetLayouts = layouts,
+    };
+    RT_VK(e, vkAllocateDescriptorSets(d->dev, &ai, sets));
+    r->set0 = sets[0];
+    r->set1 = sets[1];
+    r->set2 = r->desc.reference == RT_REF_MULTIPASS ? sets[2] : VK_NULL_HANDLE;
+
+    const VkImageLayout ro = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
+    const rt_terrain_gpu *t = &r->terrain;
+    int n = 0;
+    VkDescriptorImageInfo img[8 + 3];
+    VkDescriptorImageInfo *timg = calloc((size_t)r->ntex + 1, sizeof *timg);
+    VkWriteDescriptorSet *w = calloc((size_t)r->ntex + 16, sizeof *w);
+    if (!timg || !w) {
+        free(timg);
+        free(w);
+        return rt_fail(e, RT_E_VULKAN, "descriptors", "out of memory");
+    }
+    VkDescriptorBufferInfo fb = { r->frame_ubo.buf, 0, sizeof(splat_frame) };
+    VkDescriptorBufferInfo pb = { r->params_ubo.buf, 0, p->params_size };
+    img[0] = (VkDescriptorImageInfo){ t->linear_clamp, t->height.view, ro };
+    img[1] = (VkDescriptorImageInfo){ t->linear_clamp, t->painted.view, ro };
+    img[2] = (VkDescriptorImageInfo){ t->linear_clamp, t->destr_atlas.view, ro };
+    img[3] = (VkDescriptorImageInfo){ t->nearest_clamp, t->destr_index.view, ro };
+#define W(set_, b_, type_, img_, buf_) \
+    w[n++] = (VkWriteDescriptorSet){ .sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, \
+        .dstSet = set_, .dstBinding = b_, .descriptorCount = 1, .descriptorType = type_, \
+        .pImageInfo = img_, .pBufferInfo = buf_ }
+    const VkDescriptorType smp = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
+    const VkDescriptorType ubo = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER;
+    W(r->set0, SPLAT_BIND_HEIGHTFIELD, smp, &img[0], NULL);
+    W(r->set0, SPLAT_BIND_FRAME, ubo, NULL, &fb);
+    W(r->set0, SPLAT_BIND_PAINTED, smp, &img[1], NULL);
+    W(r->set0, SPLAT_BIND_DESTRUCTION_ATLAS, smp, &img[2], NULL);
+    W(r->set0, SPLAT_BIND_DESTRUCTION_INDEX, smp, &img[3], NULL);
+    W(r->set1, SPLAT_BIND_PARAMS, ubo, NULL, &pb);
+    for (int i = 0; i < r->ntex; i++) {
+        timg[i] = (VkDescriptorImageInfo){ r->tex_smp[i], r->tex[i].view, ro };
+        W(r->set1, (uint32_t)(SPLAT_BIND_TEXTURE0 + i), smp, &timg[i], NULL);
+    }
+    if (r->set2)
+        for (uint32_t i = 0; i < 3; i++) {
+            img[4 + i] = (VkDescriptorImageInfo){ t->nearest_clamp, r->mp[i].view, ro };
+            W(r->set2, i, smp, &img[4 + i], NULL);
+        }
+#undef W
+    vkUpdateDescriptorSets(d->dev, (uint32_t)n, w, 0, NULL);
+    free(timg);
+    free(w);
+    return true;
+}
+
+static bool make_commands(rt_renderer *r, rt_error *e)
+{
+    rt_device *d = r->d;
+    VkCommandBufferAllocateInfo ai = {
+        .sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO,
+        .commandPool = d->pool,
+        .level = VK_COMMAND_BUFFER_LEVEL_PRIMARY,
+        .commandBufferCount = 1,
+    };
+    RT_VK(e, vkAllocateCommandBuffers(d->dev, &ai, &r->cb));
+    VkFenceCreateInfo fi = { .sType = VK_STRUCTURE_TYPE_FENCE_CREATE_INFO };
+    RT_VK(e, vkCreateFence(d->dev, &fi, NULL, &r->fence));
+    uint32_t n = 0;
+    vkGetPhysicalDeviceQueueFamilyProperties(d->phys, &n, NULL);
+    VkQueueFamilyProperties *qf = calloc(n ? n : 1, sizeof *qf);
+    if (qf) {
+        vkGetPhysicalDeviceQueueFamilyProperties(d->phys, &n, qf);
+        r->timestamps = qf[d->queue_family].timestampValidBits > 0 &&
+                        d->props.limits.timestampPeriod > 0;
+        free(qf);
+    }
+    if (r->timestamps) {
+        VkQueryPoolCreateInfo qi = {
+            .sType = VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO,
+            .queryType = VK_QUERY_TYPE_TIMESTAMP,
+            .queryCount = 2,
+        };
+        RT_VK(e, vkCreateQueryPool(d->dev, &qi, NULL, &r->qpool));
+    }
+    return rt_buffer_create(d, (VkDeviceSize)r->desc.width * (VkDeviceSize)r->desc.height * 16,
+                            VK_BUFFER_USAGE_TRANSFER_DST_BIT, true, &r->readback, e);
+}
+
+/* ---- public ---------------------------------------------------------------- */
+
+bool rt_renderer_create(rt_device *d, const rt_pack *p, const rt_render_desc *desc,
+                        rt_renderer **out, rt_error *e)
+{
+    *out = NULL;
+    rt_renderer *r = calloc(1, sizeof *r);
+    if (!r)
+        return rt_fail(e, RT_E_VULKAN, "renderer", "out of memory");
+    r->d = d;
+    r->p = p;
+    r->desc = *desc;
+    if (r->desc.width <= 0)
+        r->desc.width = 1280;
+    if (r->desc.height <= 0)
+        r->desc.height = 720;
+    if (r->desc.lod_pixels <= 0)
+        r->desc.lod_pixels = 3.0;
+    if (r->desc.clear[3] == 0 && r->desc.clear[0] == 0 && r->desc.clear[1] == 0 && r->desc.clear[2] == 0) {
+        static const float sky[4] = { 0.55f, 0.65f, 0.80f, 1.0f };
+        memcpy(r->desc.clear, sky, sizeof sky);
+    }
+    r->ncombos = p->ncombos;
+    r->combo_ids = calloc((size_t)p->nlevels, sizeof *r->combo_ids);
+    r->sorted = malloc(sizeof *r->sorted * (size_t)(p->levels[0].width * p->levels[0].height));
+    r->counts = calloc((size_t)p->ncombos + 1, sizeof *r->counts);
+    if (!r->combo_ids || !r->sorted || !r->counts ||
+        !rt_bounds_build(&r->bounds, p->heights, p->hf_width, p->hf_height, p->cell_texels,
+                         p->max_height, p->height_offset) ||
+        !rt_quadtree_init(&r->qt, &r->bounds, p->cell_texels, p->hf_width, p->hf_height, p->size)) {
+        rt_renderer_destroy(r);
+        return rt_fail(e, RT_E_VULKAN, "renderer", "out of memory");
+    }
+    for (int L = 0; L < p->nlevels; L++)
+        r->combo_ids[L] = p->levels[L].ids;
+    r->qt.combo_ids = r->combo_ids;
+    /* Split while a grid step would cover more than lod_pixels pixels. */
+    double k = r->desc.height / (2.0 * tan(M_PI / 6.0));
+    r->lod_distance = k / ((SPLAT_GRID - 1) * r->desc.lod_pixels);
+
+    if (!rt_terrain_upload(d, p, &r->terrain, e) || !make_targets(r, e) ||
+        !rt_pipelines_create(d, p, &r->rp, r->desc.reference, r->desc.pipeline_cache,
+                             p->ntextures, &r->pl, e) ||
+        !make_geometry(r, e) || !make_textures(r, e) || !make_descriptors(r, e) ||
+        !make_commands(r, e)) {
+        rt_renderer_destroy(r);
+        return false;
+    }
+    *out = r;
+    return true;
+}
+
+void rt_renderer_destroy(rt_renderer *r)
+{
+    if (!r)
+        return;
+    rt_device *d = r->d;
+    if (d->dev) {
+        vkDeviceWaitIdle(d->dev);
+        rt_pipelines_destroy(d, &r->pl);
+        if (r->fence)
+            vkDestroyFence(d->dev, r->fence, NULL);
+        if (r->qpool)
+            vkDestroyQueryPool(d->dev, r->qpool, NULL);
+        if (r->cb)
+            vkFreeCommandBuffers(d->dev, d->pool, 1, &r->cb);
+        if (r->dpool)
+            vkDestroyDescriptorPool(d->dev, r->dpool, NULL);
+        VkFramebuffer fbs[3] = { r->fb_main, r->fb_multi, r->fb_resolve };
+        for (int i = 0; i < 3; i++)
+            if (fbs[i])
+                vkDestroyFramebuffer(d->dev, fbs[i], NULL);
+        VkRenderPass rps[3] = { r->rp.main, r->rp.multi, r->rp.resolve };
+        for (int i = 0; i < 3; i++)
+            if (rps[i])
+                vkDestroyRenderPass(d->dev, rps[i], NULL);
+        for (int i = 0; i < r->ntex; i++) {
+            rt_image_destroy(d, &r->tex[i]);
+            if (r->tex_smp[i])
+                vkDestroySampler(d->dev, r->tex_smp[i], NULL);
+        }
+        rt_image_destroy(d, &r->color);
+        rt_image_destroy(d, &r->depth);
+        for (int i = 0; i < 3; i++)
+            rt_image_destroy(d, &r->mp[i]);
+        rt_buffer_destroy(d, &r->vbuf);
+        rt_buffer_destroy(d, &r->ibuf);
+        rt_buffer_destroy(d, &r->frame_ubo);
+        rt_buffer_destroy(d, &r->params_ubo);
+        rt_buffer_destroy(d, &r->readback);
+        rt_terrain_destroy(d, &r->terrain);
+    }
+    rt_quadtree_free(&r->qt);
+    rt_bounds_free(&r->bounds);
+    free(r->tex);
+    free(r->tex_smp);
+    free(r->combo_ids);
+    free(r->sorted);
+    free(r->counts);
+    free(r);
+}
+
+void rt_default_camera(const rt_pack *p, rt_camera *c)
+{
+    memset(c, 0, sizeof *c);
+    double sx = p->size[0], sz = p->size[1], ext = sx > sz ? sx : sz;
+    double top = p->height_offset + p->max_height;
+    /* From the south-west (x small, z large: row 0 is north), above the
+     * highest point, looking at the centre. */
+    c->position[0] = -0.15 * sx;
+    c->position[1] = top + 0.45 * ext;
+    c->position[2] = 1.15 * sz;
+    c->look[0] = 0.5 * sx;
+    c->look[1] = p->height_offset + 0.3 * p->max_height;
+    c->look[2] = 0.5 * sz;
+}
+
+void rt_renderer_set_view(rt_renderer *r, splat_view view, int material)
+{
+    r->view = view;
+    r->view_material = material;
+}
+
+void rt_renderer_set_wireframe(rt_renderer *r, bool on)
+{
+    rt_error e = { 0 };
+    if (on && !rt_pipelines_wire(r->d, r->p, &r->rp, &r->pl, &e)) {
+        fprintf(stderr, "splatrt: %s\n", e.msg ? e.msg : "wireframe unavailable");
+        rt_error_clear(&e);
+        on = false;
+    }
+    r->wireframe = on;
+}
+
+bool rt_renderer_set_param(rt_renderer *r, const char *name, const float value[4], rt_error *e)
+{
+    for (int i = 0; i < r->p->nparams; i++)
+        if (!strcmp(r->p->params[i].name, name)) {
+            memcpy((uint8_t *)r->params_ubo.map + r->p->params[i].offset, value, 16);
+            return true;
+        }
+    char what[256];
+    snprintf(what, sizeof what, "no param named '%s'", name);
+    return rt_fail(e, RT_E_PACK_FIELD, r->p->dir, what);
+}
+
+const rt_image *rt_renderer_target(const rt_renderer *r) { return &r->color; }
+
+/* Camera-relative view-projection: rotation only (positions reach the GPU
+ * relative to the camera), perspective with reversed infinite Z and
+ * Vulkan's downward y.  Column-major. */
+static void camera_matrix(const rt_camera *c, double aspect, float m[16])
+{
+    double f[3], len = 0;
+    for (int i = 0; i < 3; i++) {
+        f[i] = c->look[i] - c->position[i];
+        len += f[i] * f[i];
+    }
+    len = sqrt(len);
+    if (len <= 0) {
+        f[0] = 0; f[1] = 0; f[2] = -1; len = 1;
+    }
+    for (int i = 0; i < 3; i++)
+        f[i] /= len;
+    double up[3] = { 0, 1, 0 };
+    if (fabs(f[1]) > 0.999) {
+        up[1] = 0;
+        up[2] = -1;
+    }
+    double s[3] = { f[1] * up[2] - f[2] * up[1], f[2] * up[0] - f[0] * up[2], f[0] * up[1] - f[1] * up[0] };
+    double sl = sqrt(s[0] * s[0] + s[1] * s[1] + s[2] * s[2]);
+    for (int i = 0; i < 3; i++)
+        s[i] /= sl;
+    double u[3] = { s[1] * f[2] - s[2] * f[1], s[2] * f[0] - s[0] * f[2], s[0] * f[1] - s[1] * f[0] };
+    double fovy = c->fovy > 0 ? c->fovy : M_PI / 3.0;
+    double znear = c->znear > 0 ? c->znear : 0.25;
+    double t = 1.0 / tan(fovy / 2.0);
+    /* rows of view: s, u, -f; clip = P * view */
+    double v[3][3] = { { s[0], s[1], s[2] }, { u[0], u[1], u[2] }, { -f[0], -f[1], -f[2] } };
+    memset(m, 0, 16 * sizeof *m);
+    for (int col = 0; col < 3; col++) {
+        m[col * 4 + 0] = (float)(t / aspect * v[0][col]);
+        m[col * 4 + 1] = (float)(-t * v[1][col]);
+        m[col * 4 + 2] = 0.0f;
+        m[col * 4 + 3] = (float)(-v[2][col]);
+    }
+    m[3 * 4 + 2] = (float)znear;
+}
+
+static void fill_frame(rt_renderer *r, const rt_camera *c, splat_frame *fr)
+{
+    const rt_pack *p = r->p;
+    memset(fr, 0, sizeof *fr);
+    camera_matrix(c, (double)r->desc.width / r->desc.height, fr->view_proj);
+    for (int i = 0; i < 3; i++)
+        fr->camera[i] = (float)c->position[i];
+    double sun[3] = { -0.45, 0.7, 0.55 }, sl = sqrt(0.45 * 0.45 + 0.7 * 0.7 + 0.55 * 0.55);
+    for (int i = 0; i < 3; i++)
+        fr->sun_dir[i] = (float)(sun[i] / sl);
+    fr->sun_color[0] = 2.9f; fr->sun_color[1] = 2.75f; fr->sun_color[2] = 2.5f;
+    fr->sky_color[0] = 0.35f; fr->sky_color[1] = 0.45f; fr->sky_color[2] = 0.62f;
+    double ext = p->size[0] > p->size[1] ? p->size[0] : p->size[1];
+    memcpy(fr->fog, r->desc.clear, 3 * sizeof(float));
+    fr->fog[3] = (float)(0.25 / ext);
+    fr->terrain[0] = (float)p->size[0];
+    fr->terrain[1] = (float)p->size[1];
+    fr->terrain[2] = (float)p->max_height;
+    fr->terrain[3] = (float)p->height_offset;
+    fr->texel[0] = (float)p->hf_width;
+    fr->texel[1] = (float)p->hf_height;
+    fr->texel[2] = 1.0f / (float)p->hf_width;
+    fr->texel[3] = 1.0f / (float)p->hf_height;
+    fr->destruction_atlas[0] = 64.0f;
+    fr->destruction_atlas[1] = 1.0f;
+    fr->destruction_atlas[2] = 1.0f;
+    fr->view[0] = (uint32_t)r->view;
+    fr->view[1] = (uint32_t)(r->view_material > 0 ? r->view_material : 0);
+}
+
+static void push_patch(rt_renderer *r, VkCommandBuffer cb, VkPipelineLayout layout,
+                       const rt_camera *c, const rt_patch *pt)
+{
+    const rt_pack *p = r->p;
+    double x0, z0, sx, sz;
+    rt_node_rect(&r->qt, pt->level, pt->x, pt->z, &x0, &z0, &sx, &sz);
+    splat_push push;
+    /* corner minus camera in double: precise near the viewer in any world */
+    push.patch_xz[0] = (float)(x0 - c->position[0]);
+    push.patch_xz[1] = (float)(z0 - c->position[2]);
+    push.patch_xz[2] = (float)sx;
+    push.patch_xz[3] = (float)sz;
+    push.patch_uv[0] = (float)(x0 / p->size[0]);
+    push.patch_uv[1] = (float)(z0 / p->size[1]);
+    push.patch_uv[2] = (float)(sx / p->size[0]);
+    push.patch_uv[3] = (float)(sz / p->size[1]);
+    push.info[0] = pt->level;
+    push.info[1] = pt->combo;
+    push.info[2] = (uint32_t)p->nmaterials;
+    push.info[3] = 0;
+    vkCmdPushConstants(cb, layout, VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT,
+                       0, sizeof push, &push);
+}
+
+static void draw_patches(rt_renderer *r, VkCommandBuffer cb, const rt_camera *c,
+                         const rt_patch *pts, int n)
+{
+    for (int i = 0; i < n; i++) {
+        push_patch(r, cb, r->pl.layout, c, &pts[i]);
+        vkCmdDrawIndexed(cb, r->perm_count[pts[i].perm], 1, r->perm_first[pts[i].perm], 0, 0);
+    }
+}
+
+bool rt_renderer_frame(rt_renderer *r, const rt_camera *c, rt_frame_stats *st, rt_error *e)
+{
+    rt_device *d = r->d;
+    double t0 = now_ms();
+    splat_frame *fr = r->frame_ubo.map;
+    fill_frame(r, c, fr);
+
+    rt_select_desc sd = { .lod_distance = r->lod_distance, .cull = true };
+    memcpy(sd.camera, c->position, sizeof sd.camera);
+    memcpy(sd.view_proj, fr->view_proj, sizeof sd.view_proj);
+    double ts = now_ms();
+    rt_quadtree_select(&r->qt, &sd);
+    double select_ms = now_ms() - ts;
+
+    /* Counting sort by combination: one pipeline bind per group. */
+    int n = r->qt.npatches;
+    memset(r->counts, 0, sizeof *r->counts * (size_t)(r->ncombos + 1));
+    for (int i = 0; i < n; i++)
+        r->counts[r->qt.patches[i].combo + 1]++;
+    int in_view = 0;
+    for (int k = 0; k < r->ncombos; k++) {
+        in_view += r->counts[k + 1] > 0;
+        r->counts[k + 1] += r->counts[k];
+    }
+    for (int i = 0; i < n; i++)
+        r->sorted[r->counts[r->qt.patches[i].combo]++] = r->qt.patches[i];
+    /* counts[k] now ends group k; group k starts at counts[k-1] (0 for k=0) */
+
+    VkCommandBuffer cb = r->cb;
+    RT_VK(e, vkResetCommandBuffer(cb, 0));
+    VkCommandBufferBeginInfo bi = {
+        .sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO,
+        .flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT,
+    };
+    RT_VK(e, vkBeginCommandBuffer(cb, &bi));
+    if (r->timestamps) {
+        vkCmdResetQueryPool(cb, r->qpool, 0, 2);
+        vkCmdWriteTimestamp(cb, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, r->qpool, 0);
+    }
+    VkViewport vp = { 0, 0, (float)r->desc.width, (float)r->desc.height, 0, 1 };
+    VkRect2D area = { { 0, 0 }, { (uint32_t)r->desc.width, (uint32_t)r->desc.height } };
+    VkDeviceSize zero = 0;
+    int binds = 0;
+    VkClearValue clears[4];
+    VkDescriptorSet sets[3] = { r->set0, r->set1, r->set2 };
+
+    if (r->desc.reference == RT_REF_MULTIPASS) {
+        for (int i = 0; i < 3; i++)
+            clears[i].color = (VkClearColorValue){ { 0, 0, 0, 0 } };
+        clears[3].depthStencil = (VkClearDepthStencilValue){ 0.0f, 0 };
+        VkRenderPassBeginInfo rb = {
+            .sType = VK_STRUCTURE_TYPE_RENDER_PASS_BEGIN_INFO,
+            .renderPass = r->rp.multi, .framebuffer = r->fb_multi,
+            .renderArea = area, .clearValueCount = 4, .pClearValues = clears,
+        };
+        vkCmdBeginRenderPass(cb, &rb, VK_SUBPASS_CONTENTS_INLINE);
+        vkCmdSetViewport(cb, 0, 1, &vp);
+        vkCmdSetScissor(cb, 0, 1, &area);
+        vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_GRAPHICS, r->pl.layout, 0, 2, sets, 0, NULL);
+        vkCmdBindVertexBuffers(cb, 0, 1, &r->vbuf.buf, &zero);
+        vkCmdBindIndexBuffer(cb, r->ibuf.buf, 0, VK_INDEX_TYPE_UINT16);
+        /* bottom to top, each material over every patch */
+        for (int m = 0; m < r->pl.nref; m++) {
+            vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_GRAPHICS, r->pl.ref[m]);
+            binds++;
+            draw_patches(r, cb, c, r->sorted, n);
+        }
+        vkCmdEndRenderPass(cb);
+        clears[0].color = (VkClearColorValue){ { r->desc.clear[0], r->desc.clear[1], r->desc.clear[2], 1 } };
+        rb.renderPass = r->rp.resolve;
+        rb.framebuffer = r->fb_resolve;
+        rb.clearValueCount = 1;
+        vkCmdBeginRenderPass(cb, &rb, VK_SUBPASS_CONTENTS_INLINE);
+        vkCmdSetViewport(cb, 0, 1, &vp);
+        vkCmdSetScissor(cb, 0, 1, &area);
+        vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_GRAPHICS, r->pl.resolve);
+        binds++;
+        vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_GRAPHICS, r->pl.resolve_layout, 0, 3, sets, 0, NULL);
+        splat_push none;
+        memset(&none, 0, sizeof none);
+        vkCmdPushConstants(cb, r->pl.resolve_layout, VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT,
+                           0, sizeof none, &none);
+        vkCmdDraw(cb, 3, 1, 0, 0);
+        vkCmdEndRenderPass(cb);
+    } else {
+        clears[0].color = (VkClearColorValue){ { r->desc.clear[0], r->desc.clear[1], r->desc.clear[2], 1 } };
+        clears[1].depthStencil = (VkClearDepthStencilValue){ 0.0f, 0 };
+        VkRenderPassBeginInfo rb = {
+            .sType = VK_STRUCTURE_TYPE_RENDER_PASS_BEGIN_INFO,
+            .renderPass = r->rp.main, .framebuffer = r->fb_main,
+            .renderArea = area, .clearValueCount = 2, .pClearValues = clears,
+        };
+        vkCmdBeginRenderPass(cb, &rb, VK_SUBPASS_CONTENTS_INLINE);
+        vkCmdSetViewport(cb, 0, 1, &vp);
+        vkCmdSetScissor(cb, 0, 1, &area);
+        vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_GRAPHICS, r->pl.layout, 0, 2, sets, 0, NULL);
+        vkCmdBindVertexBuffers(cb, 0, 1, &r->vbuf.buf, &zero);
+        vkCmdBindIndexBuffer(cb, r->ibuf.buf, 0, VK_INDEX_TYPE_UINT16);
+        if (r->desc.reference == RT_REF_UBER) {
+            if (n > 0) {
+                vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_GRAPHICS, r->pl.uber);
+                binds++;
+            }
+            draw_patches(r, cb, c, r->sorted, n);
+        } else {
+            VkPipeline *ps = r->wireframe && r->pl.combo_wire ? r->pl.combo_wire : r->pl.combo;
+            int start = 0;
+            for (int k = 0; k < r->ncombos; k++) {
+                int end = r->counts[k];
+                if (end > start) {
+                    vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_GRAPHICS, ps[k]);
+                    binds++;
+                    draw_patches(r, cb, c, r->sorted + start, end - start);
+                }
+                start = end;
+            }
+        }
+        vkCmdEndRenderPass(cb);
+    }
+    if (r->timestamps)
+        vkCmdWriteTimestamp(cb, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, r->qpool, 1);
+    RT_VK(e, vkEndCommandBuffer(cb));
+    VkSubmitInfo si = {
+        .sType = VK_STRUCTURE_TYPE_SUBMIT_INFO,
+        .commandBufferCount = 1,
+        .pCommandBuffers = &cb,
+    };
+    double cpu_ms = now_ms() - t0;
+    RT_VK(e, vkQueueSubmit(d->queue, 1, &si, r->fence));
+    RT_VK(e, vkWaitForFences(d->dev, 1, &r->fence, VK_TRUE, UINT64_MAX));
+    RT_VK(e, vkResetFences(d->dev, 1, &r->fence));
+
+    if (st) {
+        memset(st, 0, sizeof *st);
+        st->patches = n;
+        st->culled = r->qt.nculled;
+        st->pipelines = binds;
+        st->combos_in_view = in_view;
+        st->select_ms = select_ms;
+        st->cpu_ms = cpu_ms;
+        st->gpu_ms = -1;
+        if (r->timestamps) {
+            uint64_t q[2];
+            RT_VK(e, vkGetQueryPoolResults(d->dev, r->qpool, 0, 2, sizeof q, q, sizeof q[0],
+                                           VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT));
+            st->gpu_ms = (double)(q[1] - q[0]) * d->props.limits.timestampPeriod * 1e-6;
+        }
+    }
+    return true;
+}
+
+bool rt_renderer_read(rt_renderer *r, float *rgba, rt_error *e)
+{
+    VkCommandBuffer cb;
+    if (!rt_oneshot_begin(r->d, &cb, e))
+        return false;
+    VkBufferImageCopy copy = {
+        .imageSubresource = { VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1 },
+        .imageExtent = { (uint32_t)r->desc.width, (uint32_t)r->desc.height, 1 },
+    };
+    vkCmdCopyImageToBuffer(cb, r->color.img, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+                           r->readback.buf, 1, &copy);
+    VkBufferMemoryBarrier b = {
+        .sType = VK_STRUCTURE_TYPE_BUFFER_MEMORY_BARRIER,
+        .srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT,
+        .dstAccessMask = VK_ACCESS_HOST_READ_BIT,
+        .srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED,
+        .dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED,
+        .buffer = r->readback.buf,
+        .size = VK_WHOLE_SIZE,
+    };
+    vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0,
+                         0, NULL, 1, &b, 0, NULL);
+    if (!rt_oneshot_end(r->d, cb, e))
+        return false;
+    memcpy(rgba, r->readback.map, (size_t)r->desc.width * (size_t)r->desc.height * 16);
+    return true;
+}
+
+bool rt_renderer_swap_pack(rt_renderer *r, const rt_pack *p, rt_error *e)
+{
+    const rt_pack *o = r->p;
+    if (p->hf_width != o->hf_width || p->hf_height != o->hf_height ||
+        p->cell_texels != o->cell_texels || p->ntextures != o->ntextures ||
+        p->params_size > o->params_size || p->nlevels != o->nlevels)
+        return rt_fail(e, RT_E_RELOAD, "the new pack changes the terrain or its resources; restart splatview");
+    VkPipeline *ps;
+    if (!rt_pipelines_combos(r->d, p, &r->rp, &r->pl, &ps, e))
+        return false;
+    int *counts = calloc((size_t)p->ncombos + 1, sizeof *counts);
+    if (!counts) {
+        for (int i = 0; i < p->ncombos; i++)
+            vkDestroyPipeline(r->d->dev, ps[i], NULL);
+        free(ps);
+        return rt_fail(e, RT_E_RELOAD, "out of memory");
+    }
+    vkDeviceWaitIdle(r->d->dev);
+    for (int i = 0; i < r->pl.ncombos; i++) {
+        vkDestroyPipeline(r->d->dev, r->pl.combo[i], NULL);
+        if (r->pl.combo_wire)
+            vkDestroyPipeline(r->d->dev, r->pl.combo_wire[i], NULL);
+    }
+    free(r->pl.combo);
+    free(r->pl.combo_wire);
+    r->pl.combo_wire = NULL;
+    r->pl.combo = ps;
+    r->pl.ncombos = p->ncombos;
+    free(r->counts);
+    r->counts = counts;
+    r->ncombos = p->ncombos;
+    for (int L = 0; L < p->nlevels; L++)
+        r->combo_ids[L] = p->levels[L].ids;
+    memset(r->params_ubo.map, 0, o->params_size);
+    for (int i = 0; i < p->nparams; i++)
+        memcpy((uint8_t *)r->params_ubo.map + p->params[i].offset, p->params[i].value, 16);
+    r->p = p;
+    if (r->wireframe)
+        rt_renderer_set_wireframe(r, true);
+    return true;
+}
+
+const char *rt_view_name(splat_view v)
+{
+    static const char *const names[SPLAT_VIEW_COUNT] = {
+        "final", "combos", "lod", "normal", "slope", "mask", "albedo",
+    };
+    return (unsigned)v < SPLAT_VIEW_COUNT ? names[v] : "?";
+}
+
+bool rt_parse_view(const char *s, const rt_pack *p, splat_view *view, int *material, rt_error *e)
+{
+    *material = 0;
+    if (!strncmp(s, "mask:", 5)) {
+        int m = rt_pack_material_find(p, s + 5);
+        if (m < 0) {
+            char what[256];
+            snprintf(what, sizeof what, "--view %s: the pack has no material '%s'", s, s + 5);
+            return rt_fail(e, RT_E_PACK_FIELD, p->dir, what);
+        }
+        *view = SPLAT_VIEW_MASK;
+        *material = m;
+        return true;
+    }
+    for (int v = 0; v < SPLAT_VIEW_COUNT; v++)
+        if (v != SPLAT_VIEW_MASK && !strcmp(s, rt_view_name((splat_view)v))) {
+            *view = (splat_view)v;
+            return true;
+        }
+    char what[256];
+    snprintf(what, sizeof what,
+             "unknown view '%s' (final, combos, lod, normal, slope, albedo, mask:MATERIAL)", s);
+    return rt_fail(e, RT_E_PACK_FIELD, "--view", what);
+}

@@ -1,0 +1,445 @@
+/* splatrt.h — libsplatrt, the Vulkan terrain runtime: a shader pack
+ * (compiler/PACK.md) turned into pictures (DESIGN §8, seed 000 §5.4).
+ *
+ * Everything public is prefixed rt_.  Library code never exits: a failing
+ * call returns false and fills an rt_error (id + message).
+ *
+ * Sections, one per source file: errors + device.c, glsl.c, image.c,
+ * pack.c, terrain.c, quadtree.c, pipelines.c, render.c, viewer.c.
+ */
+#ifndef SPLAT_RT_H
+#define SPLAT_RT_H
+
+#include <stdbool.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <stdio.h>
+
+#include <vulkan/vulkan.h>
+
+#include "abi.h"
+
+/* ---- errors (device.c) -------------------------------------------------
+ * X(id, format): one list so tests and callers can switch on the id. */
+#define RT_ERRORS(X)                                                        \
+    X(VULKAN,       "%s failed: %s")                                        \
+    X(NO_DEVICE,    "no usable Vulkan device: %s")                          \
+    X(NO_FORMAT,    "the device cannot %s")                                 \
+    X(IO,           "cannot %s '%s': %s")                                   \
+    X(PACK_JSON,    "%s:%d:%d: error: %s")                                  \
+    X(PACK_FIELD,   "%s: error: %s")                                        \
+    X(PACK_FILE,    "%s: error: %s names '%s', which %s")                   \
+    X(PACK_SPIRV,   "%s: error: corrupt SPIR-V: %s")                        \
+    X(PACK_COMBO,   "%s: error: combination id %d out of range (the pack has %d) at %s") \
+    X(PACK_VERSION, "%s: error: %s")                                        \
+    X(SHADER,       "shader '%s' does not compile:\n%s")                    \
+    X(WINDOW,       "window: %s")                                           \
+    X(RELOAD,       "reload: %s")
+
+typedef enum rt_error_id {
+    RT_OK = 0,
+#define X(id, fmt) RT_E_##id,
+    RT_ERRORS(X)
+#undef X
+    RT_E_COUNT
+} rt_error_id;
+
+typedef struct rt_error {
+    rt_error_id id;
+    char       *msg;   /* formatted message, owned; NULL when id == RT_OK */
+} rt_error;
+
+/* Record an error (printf arguments for the id's format); returns false so
+ * that `return rt_fail(e, RT_E_IO, ...)` reads naturally.  `e` may be NULL. */
+bool        rt_fail(rt_error *e, rt_error_id id, ...);
+void        rt_error_clear(rt_error *e);
+const char *rt_vk_result_name(VkResult r);
+
+/* Check a VkResult at run time (never only inside assert). */
+#define RT_VK(e, call)                                                      \
+    do {                                                                    \
+        VkResult rt_vk_r_ = (call);                                         \
+        if (rt_vk_r_ != VK_SUCCESS)                                         \
+            return rt_fail((e), RT_E_VULKAN, #call, rt_vk_result_name(rt_vk_r_)); \
+    } while (0)
+
+/* ---- device.c: instance, device, memory -------------------------------- */
+
+typedef struct rt_device_desc {
+    bool         validate;      /* validation layer + messenger; default: env
+                                   SPLAT_VALIDATE=1                        */
+    const char  *select;        /* device index or name substring; default:
+                                   env SPLAT_DEVICE; else discrete GPU first */
+    const char *const *instance_exts;  /* extra instance extensions (GLFW) */
+    uint32_t     ninstance_exts;
+    bool         swapchain;     /* enable VK_KHR_swapchain                  */
+} rt_device_desc;
+
+typedef struct rt_device {
+    VkInstance               instance;
+    VkDebugUtilsMessengerEXT messenger;
+    VkPhysicalDevice         phys;
+    VkPhysicalDeviceProperties props;
+    VkPhysicalDeviceMemoryProperties mem;
+    VkDevice                 dev;
+    VkQueue                  queue;
+    uint32_t                 queue_family;
+    VkCommandPool            pool;       /* resettable command buffers      */
+    bool                     wireframe;  /* fillModeNonSolid enabled        */
+    bool                     validating;
+    int                      messages;   /* validation warnings + errors    */
+} rt_device;
+
+bool rt_device_create(rt_device *d, const rt_device_desc *desc, rt_error *e);
+void rt_device_destroy(rt_device *d);
+/* Validation messages counted so far (0 when not validating). */
+int  rt_device_messages(const rt_device *d);
+
+typedef struct rt_buffer {
+    VkBuffer       buf;
+    VkDeviceMemory mem;
+    VkDeviceSize   size;
+    void          *map;      /* persistently mapped when host visible       */
+} rt_buffer;
+
+typedef struct rt_image {
+    VkImage        img;
+    VkDeviceMemory mem;
+    VkImageView    view;
+    VkFormat       format;
+    uint32_t       width, height, layers, mips;
+} rt_image;
+
+bool rt_buffer_create(rt_device *d, VkDeviceSize size, VkBufferUsageFlags usage,
+                      bool host_visible, rt_buffer *b, rt_error *e);
+void rt_buffer_destroy(rt_device *d, rt_buffer *b);
+/* A 2D image with a view of every layer and mip (a 2D_ARRAY view when
+ * `array`, even for one layer). */
+bool rt_image_create(rt_device *d, uint32_t w, uint32_t h, uint32_t layers,
+                     bool array, uint32_t mips, VkFormat fmt, VkImageUsageFlags usage,
+                     VkImageAspectFlags aspect, rt_image *img, rt_error *e);
+void rt_image_destroy(rt_device *d, rt_image *img);
+/* Upload tightly packed texels into mip 0 of every layer, then either build
+ * the mip chain by blits (mips > 1) and leave the image in
+ * SHADER_READ_ONLY_OPTIMAL.  Blocks until done (load time only). */
+bool rt_image_upload(rt_device *d, rt_image *img, const void *data,
+                     size_t bytes, rt_error *e);
+/* One-time command buffer helpers (load time only). */
+bool rt_oneshot_begin(rt_device *d, VkCommandBuffer *cb, rt_error *e);
+bool rt_oneshot_end(rt_device *d, VkCommandBuffer cb, rt_error *e);
+bool rt_format_supports(rt_device *d, VkFormat f, VkFormatFeatureFlags need);
+
+/* ---- glsl.c: GLSL -> SPIR-V for the runtime's own shaders -------------- */
+
+/* stage: VK_SHADER_STAGE_VERTEX_BIT or _FRAGMENT_BIT.  *words is malloc'd. */
+bool rt_glsl_compile(const char *glsl, VkShaderStageFlagBits stage,
+                     const char *name, uint32_t **words, size_t *nwords,
+                     rt_error *e);
+/* SPIRV-Tools validation for Vulkan 1.2; message in e on failure. */
+bool rt_spirv_validate(const uint32_t *words, size_t nwords, const char *name,
+                       rt_error *e);
+
+/* ---- image.c: writing pictures ---------------------------------------- */
+
+/* How float colours become 8-bit PNG pixels. */
+typedef enum rt_tonemap {
+    RT_TONEMAP_FILMIC,   /* lit colour: exposure, x/(1+x), sRGB encode      */
+    RT_TONEMAP_SRGB,     /* linear colour (albedo): clamp, sRGB encode      */
+    RT_TONEMAP_NONE,     /* display values (debug views): clamp only        */
+} rt_tonemap;
+
+void rt_tonemap_rgba8(const float *rgba, int w, int h, rt_tonemap tm,
+                      uint8_t *out);
+bool rt_write_png(const char *path, const uint8_t *rgba8, int w, int h,
+                  rt_error *e);
+/* The raw float image: PFM ("PF\n<w> <h>\n-1.0\n", little-endian floats,
+ * bottom row first) is RGB only, so the runtime writes its own tiny format:
+ *   bytes 0..7   "SPLATF32"
+ *   bytes 8..15  uint32 width, uint32 height (little-endian)
+ *   then         width*height*4 little-endian float32, RGBA, top row first
+ * rt_read_float reads it back (tests, benchmarks). */
+bool rt_write_float(const char *path, const float *rgba, int w, int h,
+                    rt_error *e);
+bool rt_read_float(const char *path, float **rgba, int *w, int *h, rt_error *e);
+
+/* ---- pack.c: reading a shader pack ------------------------------------ */
+
+typedef struct rt_spirv {
+    char     *path;       /* relative to the pack                          */
+    uint32_t *words;
+    size_t    nwords;
+} rt_spirv;
+
+typedef struct rt_pack_camera {
+    char  *name;
+    double position[3], look[3];
+} rt_pack_camera;
+
+typedef struct rt_pack_material {
+    char    *name;
+    char    *source;      /* graph file, relative to the scene (hot reload) */
+    rt_spirv reference;   /* SPLAT_MULTIPASS pass; words NULL if absent     */
+} rt_pack_material;
+
+typedef struct rt_pack_param {
+    char  *name;
+    float  value[4];      /* default                                       */
+    uint32_t offset;      /* bytes into the params block                    */
+} rt_pack_param;
+
+typedef struct rt_pack_texture {
+    char    *file;
+    uint32_t binding;
+    bool     linear, mip_linear, srgb;
+    VkSamplerAddressMode wrap;
+    uint8_t *rgba;        /* decoded RGBA8                                 */
+    int      width, height;
+} rt_pack_texture;
+
+typedef struct rt_pack_combo {
+    int     *materials;   /* scene indices, top first                       */
+    int      nmaterials;
+    rt_spirv spirv;
+} rt_pack_combo;
+
+typedef struct rt_pack_level {
+    int       width, height;
+    uint16_t *ids;        /* combination per node, row-major                */
+} rt_pack_level;
+
+typedef struct rt_pack {
+    char            *dir;
+    char            *name;
+    int              hf_width, hf_height;
+    uint16_t        *heights;        /* hf_width * hf_height               */
+    double           size[2], max_height, height_offset;
+    int              cell_texels;
+    rt_pack_camera  *cameras;   int ncameras;
+    rt_pack_material *materials; int nmaterials;
+    rt_pack_param   *params;    int nparams;
+    uint32_t         params_size;
+    rt_pack_texture *textures;  int ntextures;
+    int              npainted;
+    uint8_t         *painted;        /* npainted * W * H, NULL if none     */
+    rt_pack_combo   *combos;    int ncombos;
+    rt_spirv         uber;           /* words NULL if absent               */
+    rt_spirv         vertex;
+    rt_pack_level   *levels;    int nlevels;
+    char            *scene_path;     /* scene.sg if the manifest names one  */
+} rt_pack;
+
+/* Read and check a pack: every file it names exists and has the right
+ * size, every SPIR-V module validates, every combination id in combos.bin
+ * is in range.  Errors name the pack file and what is wrong. */
+bool rt_pack_load(rt_pack *p, const char *dir, rt_error *e);
+void rt_pack_free(rt_pack *p);
+int  rt_pack_material_find(const rt_pack *p, const char *name);   /* -1 */
+int  rt_pack_camera_find(const rt_pack *p, const char *name);     /* -1 */
+
+/* ---- terrain.c: heightfield on the GPU, node height bounds ------------ */
+
+/* Min/max height (metres) of every quadtree node, from the texels its
+ * vertices can sample (bilinear between texel centres, one texel border). */
+typedef struct rt_bounds {
+    int     nlevels;
+    int    *width, *height;   /* nodes per level                            */
+    float **hmin, **hmax;     /* per level, row-major                       */
+} rt_bounds;
+
+bool rt_bounds_build(rt_bounds *b, const uint16_t *texels, int w, int h,
+                     int cell_texels, double max_height, double offset);
+void rt_bounds_free(rt_bounds *b);
+/* Level grid of PACK.md: cells, then halve (rounding up) until 1x1. */
+int  rt_level_count(int cells_x, int cells_z);
+
+/* GPU resources of the terrain descriptor set (set 0) but the frame UBO. */
+typedef struct rt_terrain_gpu {
+    rt_image  height;       /* R16_UNORM                                    */
+    rt_image  painted;      /* R8_UNORM array, >= 1 layer                   */
+    rt_image  destr_atlas;  /* R8_UNORM 1x1 until issue 5                   */
+    rt_image  destr_index;  /* RGBA8 1x1, a = 0: nothing destroyed          */
+    VkSampler linear_clamp, nearest_clamp;
+} rt_terrain_gpu;
+
+bool rt_terrain_upload(rt_device *d, const rt_pack *p, rt_terrain_gpu *t,
+                       rt_error *e);
+void rt_terrain_destroy(rt_device *d, rt_terrain_gpu *t);
+
+/* ---- quadtree.c: restricted quadtree LOD, culling, stitching ---------- */
+
+/* Edges of a patch: N = z min, E = x max, S = z max, W = x min. */
+enum { RT_EDGE_N = 1, RT_EDGE_E = 2, RT_EDGE_S = 4, RT_EDGE_W = 8 };
+#define RT_PERMS 9   /* none, N, E, S, W, NE, ES, SW, WN (seed 000 Fig. 18) */
+
+/* The index-buffer permutation drawn for a set of coarser edges, and the
+ * coarser edges of a permutation. */
+int      rt_perm_of_edges(unsigned edges);   /* -1 for opposite edges       */
+unsigned rt_edges_of_perm(int perm);
+/* Vertices of the shared grid: SPLAT_GRID^2 vec2 in 0..1, x fastest. */
+void     rt_grid_vertices(float *xy);
+/* Triangle list of one permutation over the grid: odd vertices of the
+ * coarser edges are folded onto their even neighbours (an edge collapse),
+ * so those edges use only every other vertex, and the triangles that
+ * became degenerate are dropped.  Returns the index count; `out` may be
+ * NULL to ask for it (at most 6 * (SPLAT_GRID-1)^2). */
+uint32_t rt_grid_indices(int perm, uint16_t *out);
+
+typedef struct rt_patch {
+    uint8_t  level, perm;
+    uint16_t combo;
+    int      x, z;            /* node at `level`                            */
+} rt_patch;
+
+typedef struct rt_select_desc {
+    double camera[3];          /* terrain-local metres                       */
+    float  view_proj[16];      /* camera-relative world -> clip             */
+    double lod_distance;       /* split while distance < this * node size   */
+    bool   cull;               /* frustum culling (default on by caller)   */
+    int    max_level_bias;     /* tests: 0                                   */
+} rt_select_desc;
+
+typedef struct rt_quadtree {
+    int        nlevels;
+    int       *width, *height;    /* nodes per level                         */
+    int        cell_texels, hf_width, hf_height;
+    double     size[2];           /* terrain metres                          */
+    const rt_bounds *bounds;
+    const uint16_t *const *combo_ids; /* per level (pack); NULL: all 0     */
+    uint8_t  **split;             /* per level scratch, reused every frame   */
+    rt_patch  *patches;           /* the selection (drawn patches)           */
+    int        npatches, cap;
+    int        nculled;           /* leaves dropped by the frustum           */
+} rt_quadtree;
+
+bool rt_quadtree_init(rt_quadtree *q, const rt_bounds *b, int cell_texels,
+                      int hf_width, int hf_height, const double size[2]);
+void rt_quadtree_free(rt_quadtree *q);
+/* Select the patches for a camera: split by distance, restrict so that edge
+ * neighbours differ by at most one level, cull, pick each patch's
+ * permutation.  No allocation after init. */
+void rt_quadtree_select(rt_quadtree *q, const rt_select_desc *s);
+/* World rectangle of a node (metres; may overhang the terrain). */
+void rt_node_rect(const rt_quadtree *q, int level, int x, int z,
+                  double *x0, double *z0, double *sx, double *sz);
+
+/* ---- pipelines.c: layouts, pipelines, the on-disk pipeline cache ------ */
+
+typedef enum rt_reference {
+    RT_REF_NONE = 0,      /* per-combination composites                     */
+    RT_REF_MULTIPASS,     /* one blended pass per material + resolve        */
+    RT_REF_UBER,          /* every patch with the über-shader               */
+} rt_reference;
+
+typedef struct rt_pipelines {
+    VkDescriptorSetLayout set_terrain;   /* set 0 (abi.h)                    */
+    VkDescriptorSetLayout set_material;  /* set 1: params + textures         */
+    VkDescriptorSetLayout set_resolve;   /* set 2 of the resolve pass        */
+    VkPipelineLayout      layout;        /* sets 0, 1 + splat_push           */
+    VkPipelineLayout      resolve_layout;/* sets 0, 1, 2 + splat_push        */
+    VkPipelineCache       cache;
+    char                 *cache_path;    /* NULL: not saved                  */
+    VkShaderModule        vertex;
+    VkPipeline           *combo;         /* one per combination              */
+    VkPipeline           *combo_wire;    /* line fill, made on first use     */
+    int                   ncombos;
+    VkPipeline           *ref;           /* multi-pass: one per material     */
+    int                   nref;
+    VkPipeline            uber, resolve;
+} rt_pipelines;
+
+/* Render passes the pipelines are made for (render.c creates them). */
+typedef struct rt_passes {
+    VkRenderPass main;       /* RGBA32F colour + D32 depth                   */
+    VkRenderPass multi;      /* three RGBA32F blend targets + D32 depth      */
+    VkRenderPass resolve;    /* RGBA32F colour                               */
+} rt_passes;
+
+/* Layouts, the pipeline cache and the pipelines `ref` needs: always the
+ * combinations; the per-material passes and the resolve pass for
+ * RT_REF_MULTIPASS; the über-shader for RT_REF_UBER. */
+bool rt_pipelines_create(rt_device *d, const rt_pack *p, const rt_passes *rp,
+                         rt_reference ref, const char *cache_path,
+                         int ntextures, rt_pipelines *pl, rt_error *e);
+/* The combination pipelines of `p` only (hot reload: built beside the old
+ * ones with the same layouts). */
+bool rt_pipelines_combos(rt_device *d, const rt_pack *p, const rt_passes *rp,
+                         rt_pipelines *pl, VkPipeline **out, rt_error *e);
+bool rt_pipelines_wire(rt_device *d, const rt_pack *p, const rt_passes *rp,
+                       rt_pipelines *pl, rt_error *e);
+/* Saves the cache (if it has a path) and destroys everything. */
+void rt_pipelines_destroy(rt_device *d, rt_pipelines *pl);
+
+/* ---- render.c: drawing ------------------------------------------------- */
+
+
+typedef struct rt_camera {
+    double position[3];   /* terrain-local metres                           */
+    double look[3];       /* a point looked at                              */
+    double fovy;          /* radians; default 60 degrees                    */
+    double znear;         /* metres; default 0.25                           */
+} rt_camera;
+
+typedef struct rt_render_desc {
+    int          width, height;
+    rt_reference reference;
+    float        clear[4];          /* background (linear); default sky       */
+    const char  *pipeline_cache;    /* file; NULL: $XDG_CACHE_HOME/splatc/…   */
+    bool         no_stitch;         /* tests: draw every patch unstitched     */
+    double       lod_pixels;        /* screen error per grid step; default 3  */
+} rt_render_desc;
+
+typedef struct rt_frame_stats {
+    int    patches, culled, pipelines, combos_in_view;
+    double gpu_ms;            /* timestamps; < 0 if unsupported              */
+    double select_ms;         /* CPU quadtree selection + culling            */
+    double cpu_ms;            /* whole CPU side of the frame                 */
+} rt_frame_stats;
+
+typedef struct rt_renderer rt_renderer;
+
+bool rt_renderer_create(rt_device *d, const rt_pack *p,
+                        const rt_render_desc *desc, rt_renderer **out,
+                        rt_error *e);
+void rt_renderer_destroy(rt_renderer *r);
+/* A camera looking at the whole terrain from the south-west, above it. */
+void rt_default_camera(const rt_pack *p, rt_camera *c);
+/* Debug view and the material of the MASK view. */
+void rt_renderer_set_view(rt_renderer *r, splat_view view, int material);
+void rt_renderer_set_wireframe(rt_renderer *r, bool on);
+bool rt_renderer_set_param(rt_renderer *r, const char *name,
+                           const float value[4], rt_error *e);
+/* Render one frame offscreen and wait for it. */
+bool rt_renderer_frame(rt_renderer *r, const rt_camera *c,
+                       rt_frame_stats *st, rt_error *e);
+/* The last frame's colour as RGBA32F, top row first (w * h * 4 floats). */
+bool rt_renderer_read(rt_renderer *r, float *rgba, rt_error *e);
+/* The offscreen colour image (SHADER_READ_ONLY_OPTIMAL after a frame). */
+const rt_image *rt_renderer_target(const rt_renderer *r);
+/* Replace the combination pipelines with those of a new pack of the same
+ * terrain (hot reload); on failure the old ones stay. */
+bool rt_renderer_swap_pack(rt_renderer *r, const rt_pack *p, rt_error *e);
+const char *rt_view_name(splat_view v);
+bool rt_parse_view(const char *s, const rt_pack *p, splat_view *view,
+                   int *material, rt_error *e);
+
+/* ---- viewer.c: the GLFW window ---------------------------------------- */
+
+typedef struct rt_viewer_desc {
+    const char *pack_dir;
+    const char *scene;        /* scene.sg to watch for hot reload; NULL: the
+                                 manifest's scene.source, if any           */
+    int         width, height;
+    const char *script;       /* "frames=30;screenshot=out.png;quit" or NULL  */
+    rt_render_desc render;
+    bool        have_camera;  /* camera below is set; else preset/default   */
+    rt_camera   camera;
+    const char *preset;       /* manifest camera name or NULL               */
+    splat_view  view;
+    const char *view_name;    /* --view text, parsed against the pack       */
+} rt_viewer_desc;
+
+/* Runs until the window closes or the script quits; returns the exit
+ * status (0 ok). */
+int rt_viewer_run(const rt_viewer_desc *desc);
+
+#endif

@@ -1,0 +1,371 @@
+/* splatview — render a shader pack: headless to PNG (and raw floats), or in
+ * a GLFW window with a fly camera and hot reload.  See usage() below. */
+#include "splatrt.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+static void usage(FILE *f)
+{
+    fprintf(f,
+        "usage: splatview PACK [options]\n"
+        "  --headless -o OUT.png     render offscreen and write a PNG\n"
+        "  --size WxH                image or window size (default 1280x720)\n"
+        "  --camera x,y,z --look x,y,z   camera in terrain-local metres\n"
+        "  --camera-preset NAME      a camera of the manifest's scene.cameras\n"
+        "  --view V                  final|combos|lod|normal|slope|albedo|mask:MATERIAL\n"
+        "  --frames N                render N frames (stats over them)\n"
+        "  --stats                   patches, pipelines, GPU and CPU times, device\n"
+        "  --reference multipass|uber   the multi-pass alpha reference or the uber-shader\n"
+        "  --float-out FILE          also write the RGBA32F image (SPLATF32 format)\n"
+        "  --param NAME=v[,v,v,v]    set a material param\n"
+        "  --lod-pixels P            screen error per grid step (default 3)\n"
+        "  --clear r,g,b             background colour (linear)\n"
+        "  --pipeline-cache FILE     pipeline cache file\n"
+        "  --scene FILE              scene.sg to watch for hot reload (viewer)\n"
+        "  --script S                viewer script: \"frames=30;screenshot=out.png;quit\"\n"
+        "  --no-stitch               draw patches without stitching (tests)\n"
+        "environment: SPLAT_DEVICE=<index|name>, SPLAT_VALIDATE=1\n");
+}
+
+static bool parse_vec(const char *s, double *v, int n)
+{
+    char *end;
+    for (int i = 0; i < n; i++) {
+        v[i] = strtod(s, &end);
+        if (end == s || !isfinite(v[i]))
+            return false;
+        s = end;
+        if (i + 1 < n) {
+            if (*s != ',')
+                return false;
+            s++;
+        }
+    }
+    return *s == '\0';
+}
+
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* median and the 10th..90th percentile spread of n samples (sorted here) */
+static void summary(double *v, int n, double *med, double *lo, double *hi)
+{
+    qsort(v, (size_t)n, sizeof *v, cmp_double);
+    *med = n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+    *lo = v[(int)floor(0.1 * (n - 1))];
+    *hi = v[(int)ceil(0.9 * (n - 1))];
+}
+
+typedef struct opts {
+    const char *pack, *out, *float_out, *preset, *view, *cache, *scene, *script;
+    bool headless, stats, have_camera, have_look, no_stitch;
+    int width, height, frames;
+    double camera[3], look[3], lod_pixels;
+    float clear[4];
+    rt_reference ref;
+    const char *params[64];
+    int nparams;
+} opts;
+
+static int parse_args(int argc, char **argv, opts *o)
+{
+    memset(o, 0, sizeof *o);
+    o->frames = 1;
+    for (int i = 1; i < argc; i++) {
+        const char *a = argv[i];
+        const char *v = i + 1 < argc ? argv[i + 1] : NULL;
+#define NEED() do { if (!v) { fprintf(stderr, "splatview: %s needs a value\n", a); return 2; } i++; } while (0)
+        if (!strcmp(a, "--help") || !strcmp(a, "-h")) {
+            usage(stdout);
+            exit(0);
+        } else if (!strcmp(a, "--headless")) {
+            o->headless = true;
+        } else if (!strcmp(a, "--stats")) {
+            o->stats = true;
+        } else if (!strcmp(a, "--no-stitch")) {
+            o->no_stitch = true;
+        } else if (!strcmp(a, "-o")) {
+            NEED(); o->out = v;
+        } else if (!strcmp(a, "--float-out")) {
+            NEED(); o->float_out = v;
+        } else if (!strcmp(a, "--size")) {
+            NEED();
+            if (sscanf(v, "%dx%d", &o->width, &o->height) != 2 || o->width <= 0 ||
+                o->height <= 0 || o->width > 16384 || o->height > 16384) {
+                fprintf(stderr, "splatview: --size expects WxH, found '%s'\n", v);
+                return 2;
+            }
+        } else if (!strcmp(a, "--camera")) {
+            NEED();
+            if (!parse_vec(v, o->camera, 3)) {
+                fprintf(stderr, "splatview: --camera expects x,y,z, found '%s'\n", v);
+                return 2;
+            }
+            o->have_camera = true;
+        } else if (!strcmp(a, "--look")) {
+            NEED();
+            if (!parse_vec(v, o->look, 3)) {
+                fprintf(stderr, "splatview: --look expects x,y,z, found '%s'\n", v);
+                return 2;
+            }
+            o->have_look = true;
+        } else if (!strcmp(a, "--clear")) {
+            NEED();
+            double c[3];
+            if (!parse_vec(v, c, 3)) {
+                fprintf(stderr, "splatview: --clear expects r,g,b, found '%s'\n", v);
+                return 2;
+            }
+            for (int k = 0; k < 3; k++)
+                o->clear[k] = (float)c[k];
+            o->clear[3] = 1.0f;
+        } else if (!strcmp(a, "--camera-preset")) {
+            NEED(); o->preset = v;
+        } else if (!strcmp(a, "--view")) {
+            NEED(); o->view = v;
+        } else if (!strcmp(a, "--frames")) {
+            NEED();
+            o->frames = atoi(v);
+            if (o->frames < 1) {
+                fprintf(stderr, "splatview: --frames expects a positive count, found '%s'\n", v);
+                return 2;
+            }
+        } else if (!strcmp(a, "--lod-pixels")) {
+            NEED();
+            o->lod_pixels = atof(v);
+            if (!(o->lod_pixels > 0)) {
+                fprintf(stderr, "splatview: --lod-pixels expects a positive number\n");
+                return 2;
+            }
+        } else if (!strcmp(a, "--reference")) {
+            NEED();
+            if (!strcmp(v, "multipass"))
+                o->ref = RT_REF_MULTIPASS;
+            else if (!strcmp(v, "uber"))
+                o->ref = RT_REF_UBER;
+            else {
+                fprintf(stderr, "splatview: --reference expects multipass or uber, found '%s'\n", v);
+                return 2;
+            }
+        } else if (!strcmp(a, "--param")) {
+            NEED();
+            if (o->nparams == 64) {
+                fprintf(stderr, "splatview: more than 64 --param options\n");
+                return 2;
+            }
+            o->params[o->nparams++] = v;
+        } else if (!strcmp(a, "--pipeline-cache")) {
+            NEED(); o->cache = v;
+        } else if (!strcmp(a, "--scene")) {
+            NEED(); o->scene = v;
+        } else if (!strcmp(a, "--script")) {
+            NEED(); o->script = v;
+        } else if (a[0] == '-') {
+            fprintf(stderr, "splatview: unknown option '%s' (see --help)\n", a);
+            return 2;
+        } else if (!o->pack) {
+            o->pack = a;
+        } else {
+            fprintf(stderr, "splatview: more than one pack given ('%s')\n", a);
+            return 2;
+        }
+#undef NEED
+    }
+    if (!o->pack) {
+        usage(stderr);
+        return 2;
+    }
+    if (o->have_camera != o->have_look) {
+        fprintf(stderr, "splatview: --camera and --look go together\n");
+        return 2;
+    }
+    if (o->headless && !o->out && !o->float_out && !o->stats) {
+        fprintf(stderr, "splatview: --headless needs -o OUT.png, --float-out or --stats\n");
+        return 2;
+    }
+    return 0;
+}
+
+static bool pick_camera(const opts *o, const rt_pack *p, rt_camera *cam)
+{
+    rt_default_camera(p, cam);
+    if (o->preset) {
+        int c = rt_pack_camera_find(p, o->preset);
+        if (c < 0) {
+            fprintf(stderr, "splatview: the pack has no camera preset '%s'", o->preset);
+            for (int i = 0; i < p->ncameras; i++)
+                fprintf(stderr, "%s'%s'", i ? ", " : " (it has ", p->cameras[i].name);
+            fprintf(stderr, "%s\n", p->ncameras ? ")" : "");
+            return false;
+        }
+        memcpy(cam->position, p->cameras[c].position, sizeof cam->position);
+        memcpy(cam->look, p->cameras[c].look, sizeof cam->look);
+    }
+    if (o->have_camera) {
+        memcpy(cam->position, o->camera, sizeof cam->position);
+        memcpy(cam->look, o->look, sizeof cam->look);
+    }
+    return true;
+}
+
+static bool apply_params(const opts *o, rt_renderer *r, rt_error *e)
+{
+    for (int i = 0; i < o->nparams; i++) {
+        char name[256];
+        const char *eq = strchr(o->params[i], '=');
+        size_t n = eq ? (size_t)(eq - o->params[i]) : 0;
+        if (!eq || n == 0 || n >= sizeof name)
+            return rt_fail(e, RT_E_PACK_FIELD, "--param", "expects NAME=v[,v,v,v]");
+        memcpy(name, o->params[i], n);
+        name[n] = '\0';
+        float v[4] = { 0, 0, 0, 0 };
+        char *s = (char *)eq + 1, *end;
+        for (int k = 0; k < 4 && *s; k++) {
+            v[k] = strtof(s, &end);
+            if (end == s)
+                return rt_fail(e, RT_E_PACK_FIELD, "--param", "expects numbers after '='");
+            s = *end == ',' ? end + 1 : end;
+        }
+        if (!rt_renderer_set_param(r, name, v, e))
+            return false;
+    }
+    return true;
+}
+
+static rt_tonemap tonemap_for(splat_view v)
+{
+    return v == SPLAT_VIEW_FINAL ? RT_TONEMAP_FILMIC
+         : v == SPLAT_VIEW_ALBEDO ? RT_TONEMAP_SRGB : RT_TONEMAP_NONE;
+}
+
+static int headless(const opts *o)
+{
+    rt_error e = { 0 };
+    rt_pack pack;
+    rt_device dev;
+    rt_renderer *r = NULL;
+    int status = 1;
+    float *rgba = NULL;
+    uint8_t *png = NULL;
+    double *gpu = NULL, *sel = NULL, *cpu = NULL;
+    bool have_dev = false;
+
+    if (!rt_pack_load(&pack, o->pack, &e)) {
+        fprintf(stderr, "splatview: %s\n", e.msg);
+        rt_error_clear(&e);
+        return 1;
+    }
+    splat_view view = SPLAT_VIEW_FINAL;
+    int material = 0;
+    rt_camera cam;
+    if ((o->view && !rt_parse_view(o->view, &pack, &view, &material, &e)) ||
+        !pick_camera(o, &pack, &cam))
+        goto done;
+    if (!rt_device_create(&dev, NULL, &e))
+        goto done;
+    have_dev = true;
+    rt_render_desc rd = {
+        .width = o->width, .height = o->height, .reference = o->ref,
+        .pipeline_cache = o->cache, .no_stitch = o->no_stitch, .lod_pixels = o->lod_pixels,
+    };
+    memcpy(rd.clear, o->clear, sizeof rd.clear);
+    if (!rt_renderer_create(&dev, &pack, &rd, &r, &e) || !apply_params(o, r, &e))
+        goto done;
+    rt_renderer_set_view(r, view, material);
+    int W = o->width > 0 ? o->width : 1280, H = o->height > 0 ? o->height : 720;
+    gpu = calloc((size_t)o->frames, sizeof *gpu);
+    sel = calloc((size_t)o->frames, sizeof *sel);
+    cpu = calloc((size_t)o->frames, sizeof *cpu);
+    if (!gpu || !sel || !cpu)
+        goto done;
+    rt_frame_stats st = { 0 };
+    for (int f = 0; f < o->frames; f++) {
+        if (!rt_renderer_frame(r, &cam, &st, &e))
+            goto done;
+        gpu[f] = st.gpu_ms;
+        sel[f] = st.select_ms;
+        cpu[f] = st.cpu_ms;
+    }
+    if (o->out || o->float_out) {
+        rgba = malloc((size_t)W * (size_t)H * 16);
+        png = malloc((size_t)W * (size_t)H * 4);
+        if (!rgba || !png || !rt_renderer_read(r, rgba, &e))
+            goto done;
+        if (o->float_out && !rt_write_float(o->float_out, rgba, W, H, &e))
+            goto done;
+        if (o->out) {
+            rt_tonemap_rgba8(rgba, W, H, tonemap_for(view), png);
+            if (!rt_write_png(o->out, png, W, H, &e))
+                goto done;
+        }
+    }
+    if (o->stats) {
+        double gm, gl, gh, sm, sl, sh, cm, cl, ch;
+        summary(gpu, o->frames, &gm, &gl, &gh);
+        summary(sel, o->frames, &sm, &sl, &sh);
+        summary(cpu, o->frames, &cm, &cl, &ch);
+        printf("device: %s\n", dev.props.deviceName);
+        printf("size: %dx%d  view: %s  reference: %s  frames: %d\n", W, H, rt_view_name(view),
+               o->ref == RT_REF_MULTIPASS ? "multipass" : o->ref == RT_REF_UBER ? "uber" : "none",
+               o->frames);
+        printf("patches drawn: %d  culled: %d\n", st.patches, st.culled);
+        printf("pipelines bound: %d\n", st.pipelines);
+        printf("combinations in view: %d of %d\n", st.combos_in_view, pack.ncombos);
+        if (gm >= 0)
+            printf("gpu ms/frame: median %.3f  p10 %.3f  p90 %.3f\n", gm, gl, gh);
+        else
+            printf("gpu ms/frame: n/a (no timestamp support)\n");
+        printf("quadtree cpu ms/frame: median %.4f  p10 %.4f  p90 %.4f\n", sm, sl, sh);
+        printf("cpu ms/frame (record): median %.3f  p10 %.3f  p90 %.3f\n", cm, cl, ch);
+    }
+    status = 0;
+done:
+    if (e.msg)
+        fprintf(stderr, "splatview: %s\n", e.msg);
+    rt_error_clear(&e);
+    rt_renderer_destroy(r);
+    if (have_dev) {
+        rt_device_destroy(&dev);
+        if (dev.validating && dev.messages) {
+            fprintf(stderr, "splatview: %d validation message(s)\n", dev.messages);
+            status = status ? status : 3;
+        }
+    }
+    rt_pack_free(&pack);
+    free(rgba);
+    free(png);
+    free(gpu);
+    free(sel);
+    free(cpu);
+    return status;
+}
+
+int main(int argc, char **argv)
+{
+    opts o;
+    int rc = parse_args(argc, argv, &o);
+    if (rc)
+        return rc;
+    if (o.headless)
+        return headless(&o);
+    rt_viewer_desc vd = {
+        .pack_dir = o.pack, .scene = o.scene, .width = o.width ? o.width : 1280,
+        .height = o.height ? o.height : 720, .script = o.script,
+        .render = { .reference = o.ref, .pipeline_cache = o.cache, .lod_pixels = o.lod_pixels },
+        .view = SPLAT_VIEW_FINAL,
+    };
+    memcpy(vd.render.clear, o.clear, sizeof o.clear);
+    vd.have_camera = o.have_camera || o.preset;
+    if (o.have_camera) {
+        memcpy(vd.camera.position, o.camera, sizeof o.camera);
+        memcpy(vd.camera.look, o.look, sizeof o.look);
+    }
+    vd.preset = o.preset;
+    vd.view_name = o.view;
+    return rt_viewer_run(&vd);
+}

@@ -1,0 +1,127 @@
+/* imgcheck — small picture checks for the render tests.
+ *
+ *   imgcheck nonuniform IMG.png          exit 1 if every pixel is the same
+ *   imgcheck colors IMG.png [r,g,b]      print the distinct colours
+ *                                        (without the given background)
+ *   imgcheck count IMG.png r,g,b         print pixels of exactly that colour
+ *   imgcheck diff A.f32 B.f32 TOL        max |A - B| over RGB; exit 1 if > TOL
+ *   imgcheck finite A.f32                exit 1 on any NaN or Inf
+ */
+#include "splatrt.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <stb_image.h>
+
+static uint8_t *load(const char *path, int *w, int *h)
+{
+    int ch;
+    uint8_t *px = stbi_load(path, w, h, &ch, 4);
+    if (!px)
+        fprintf(stderr, "imgcheck: cannot read %s\n", path);
+    return px;
+}
+
+static int cmp_u32(const void *a, const void *b)
+{
+    uint32_t x = *(const uint32_t *)a, y = *(const uint32_t *)b;
+    return (x > y) - (x < y);
+}
+
+static bool parse_rgb(const char *s, uint32_t *rgb)
+{
+    int r, g, b;
+    if (sscanf(s, "%d,%d,%d", &r, &g, &b) != 3)
+        return false;
+    *rgb = (uint32_t)r | (uint32_t)g << 8 | (uint32_t)b << 16;
+    return true;
+}
+
+int main(int argc, char **argv)
+{
+    if (argc < 3) {
+        fprintf(stderr, "usage: see imgcheck.c\n");
+        return 2;
+    }
+    const char *cmd = argv[1];
+    if (!strcmp(cmd, "diff") || !strcmp(cmd, "finite")) {
+        rt_error e = { 0 };
+        float *a = NULL, *b = NULL;
+        int w, h, w2, h2;
+        if (!rt_read_float(argv[2], &a, &w, &h, &e) ||
+            (argc > 3 && !rt_read_float(argv[3], &b, &w2, &h2, &e))) {
+            fprintf(stderr, "imgcheck: %s\n", e.msg);
+            return 2;
+        }
+        size_t n = (size_t)w * h, bad = 0;
+        if (!strcmp(cmd, "finite")) {
+            for (size_t i = 0; i < n * 4; i++)
+                bad += !isfinite(a[i]);
+            printf("non-finite values: %zu\n", bad);
+            return bad ? 1 : 0;
+        }
+        if (argc != 5 || w != w2 || h != h2) {
+            fprintf(stderr, "imgcheck: diff needs two images of one size and a tolerance\n");
+            return 2;
+        }
+        double tol = atof(argv[4]), worst = 0, sum = 0;
+        size_t at = 0;
+        for (size_t i = 0; i < n; i++)
+            for (int c = 0; c < 3; c++) {
+                double d = fabs((double)a[i * 4 + c] - (double)b[i * 4 + c]);
+                if (!(d <= worst)) {
+                    worst = d;
+                    at = i;
+                }
+                sum += d;
+                bad += d > tol;
+            }
+        printf("max abs diff %.3g at (%zu, %zu), mean %.3g, %zu values over %.3g\n", worst,
+               at % (size_t)w, at / (size_t)w, sum / (double)(n * 3), bad, tol);
+        free(a);
+        free(b);
+        return worst <= tol ? 0 : 1;
+    }
+    int w, h;
+    uint8_t *px = load(argv[2], &w, &h);
+    if (!px)
+        return 2;
+    size_t n = (size_t)w * h;
+    uint32_t *c = malloc(n * sizeof *c);
+    for (size_t i = 0; i < n; i++)
+        c[i] = (uint32_t)px[4 * i] | (uint32_t)px[4 * i + 1] << 8 | (uint32_t)px[4 * i + 2] << 16;
+    int rc = 0;
+    if (!strcmp(cmd, "nonuniform")) {
+        size_t differ = 0;
+        for (size_t i = 0; i < n; i++)
+            differ += c[i] != c[0];
+        printf("pixels unlike the first: %zu of %zu\n", differ, n);
+        rc = differ > n / 100 ? 0 : 1;
+    } else if (!strcmp(cmd, "colors")) {
+        uint32_t bg = 0xffffffffu;
+        if (argc > 3 && !parse_rgb(argv[3], &bg))
+            return 2;
+        qsort(c, n, sizeof *c, cmp_u32);
+        size_t distinct = 0;
+        for (size_t i = 0; i < n; i++)
+            if ((i == 0 || c[i] != c[i - 1]) && c[i] != bg)
+                distinct++;
+        printf("%zu\n", distinct);
+    } else if (!strcmp(cmd, "count") && argc > 3) {
+        uint32_t want;
+        if (!parse_rgb(argv[3], &want))
+            return 2;
+        size_t k = 0;
+        for (size_t i = 0; i < n; i++)
+            k += c[i] == want;
+        printf("%zu\n", k);
+    } else {
+        fprintf(stderr, "imgcheck: unknown command '%s'\n", cmd);
+        rc = 2;
+    }
+    free(c);
+    stbi_image_free(px);
+    return rc;
+}

@@ -1,0 +1,119 @@
+#!/bin/sh
+# Render test cases: run.sh CASE SPLATVIEW IMGCHECK PACK OUTDIR
+# Every splatview run has SPLAT_VALIDATE=1; splatview itself exits non-zero
+# (3) when the validation layer said anything.
+set -u
+case_=$1 SV=$2 IC=$3 PACK=$4 OUT=$5/$1
+mkdir -p "$OUT"
+export SPLAT_VALIDATE=1
+export SPLAT_PIPELINE_CACHE="$OUT/pipelines.bin"
+fail() { echo "FAIL: $*"; exit 1; }
+run() { echo "+ splatview $*"; "$SV" "$@" || fail "splatview $* (exit $?)"; }
+
+case $case_ in
+final)
+    run "$PACK" --headless --size 320x200 -o "$OUT/final.png"
+    "$IC" nonuniform "$OUT/final.png" || fail "final view is uniform"
+    run "$PACK" --headless --size 320x200 --camera-preset ridge -o "$OUT/ridge.png"
+    "$IC" nonuniform "$OUT/ridge.png" || fail "ridge view is uniform"
+    ;;
+combos)
+    # as many colours as combinations in view (flat colours, background excluded)
+    run "$PACK" --headless --size 320x200 --view combos --clear 0,0,0 --stats -o "$OUT/combos.png" > "$OUT/stats.txt"
+    cat "$OUT/stats.txt"
+    want=$(sed -n 's/^combinations in view: \([0-9]*\) of.*/\1/p' "$OUT/stats.txt")
+    got=$("$IC" colors "$OUT/combos.png" 0,0,0)
+    echo "combinations in view: $want, colours: $got"
+    [ -n "$want" ] && [ "$want" -ge 2 ] || fail "fewer than 2 combinations in view"
+    [ "$got" = "$want" ] || fail "$got colours for $want combinations"
+    ;;
+views)
+    for v in lod normal slope albedo mask:rock mask:snow; do
+        f=$(echo "$v" | tr : _)
+        run "$PACK" --headless --size 160x100 --view "$v" -o "$OUT/$f.png"
+        "$IC" nonuniform "$OUT/$f.png" || fail "view $v is uniform"
+    done
+    "$SV" "$PACK" --headless --size 16x16 --view mask:nothing -o "$OUT/x.png" 2> "$OUT/err.txt" &&
+        fail "an unknown material in --view was accepted"
+    grep -q "no material 'nothing'" "$OUT/err.txt" || fail "unclear error: $(cat "$OUT/err.txt")"
+    ;;
+reference_multipass)
+    # composite vs multi-pass alpha blending: <= 1/255 per channel everywhere
+    for cam in overview ridge; do
+        run "$PACK" --headless --size 320x200 --camera-preset $cam --float-out "$OUT/c_$cam.f32"
+        run "$PACK" --headless --size 320x200 --camera-preset $cam --reference multipass --float-out "$OUT/m_$cam.f32"
+        "$IC" diff "$OUT/c_$cam.f32" "$OUT/m_$cam.f32" 0.00392 || fail "multipass differs ($cam)"
+    done
+    ;;
+reference_uber)
+    # uber vs per-combination: identical within float rounding
+    for cam in overview ridge; do
+        run "$PACK" --headless --size 320x200 --camera-preset $cam --float-out "$OUT/c_$cam.f32"
+        run "$PACK" --headless --size 320x200 --camera-preset $cam --reference uber --float-out "$OUT/u_$cam.f32"
+        "$IC" diff "$OUT/c_$cam.f32" "$OUT/u_$cam.f32" 1e-5 || fail "uber differs ($cam)"
+    done
+    ;;
+cracks)
+    # a steep view over rugged terrain full of LOD transitions: no magenta
+    # background shows through; without stitching it does (the test can fail)
+    args="--headless --size 400x300 --view albedo --clear 1,0,1 --lod-pixels 4 --camera 1024,700,800 --look 1024,0,600"
+    run "$PACK" $args --stats -o "$OUT/stitched.png"
+    holes=$("$IC" count "$OUT/stitched.png" 255,0,255)
+    run "$PACK" $args --no-stitch -o "$OUT/unstitched.png"
+    cracks=$("$IC" count "$OUT/unstitched.png" 255,0,255)
+    echo "background pixels: stitched $holes, unstitched $cracks"
+    [ "$holes" = 0 ] || fail "$holes background pixels through the terrain"
+    [ "$cracks" -gt 0 ] || fail "the unstitched render shows no cracks: the view tests nothing"
+    ;;
+stats)
+    run "$PACK" --headless --size 320x200 --frames 5 --stats > "$OUT/stats.txt"
+    cat "$OUT/stats.txt"
+    for key in "device:" "patches drawn:" "pipelines bound:" "gpu ms/frame:" "quadtree cpu ms/frame:"; do
+        grep -q "^$key" "$OUT/stats.txt" || fail "--stats lacks '$key'"
+    done
+    ;;
+bad_packs)
+    expect_error() {   # name, expected message part
+        "$SV" "$OUT/$1" --headless --size 32x32 -o "$OUT/$1.png" > "$OUT/$1.log" 2>&1
+        rc=$?
+        cat "$OUT/$1.log"
+        [ $rc = 1 ] || fail "$1: exit $rc, expected 1"
+        grep -q "$2" "$OUT/$1.log" || fail "$1: message lacks '$2'"
+        grep -qi "validation" "$OUT/$1.log" && fail "$1: validation message"
+        [ -e "$OUT/$1.png" ] && fail "$1: wrote a picture"
+        return 0
+    }
+    fresh() { rm -rf "$OUT/$1"; cp -r "$PACK" "$OUT/$1"; }
+    fresh no_manifest; rm "$OUT/no_manifest/manifest.json"
+    expect_error no_manifest "cannot read '.*manifest.json'"
+    fresh bad_json; printf '{"format": "splatc-pack",\n  "version": 1,,\n' > "$OUT/bad_json/manifest.json"
+    expect_error bad_json "manifest.json:2:"
+    fresh corrupt_spirv; head -c 64 /dev/urandom > "$OUT/corrupt_spirv/shaders/0001.spv"
+    expect_error corrupt_spirv "0001.spv: error: corrupt SPIR-V"
+    fresh bad_spirv_body; { head -c 20 "$PACK/shaders/0000.spv"; head -c 400 /dev/zero; } > "$OUT/bad_spirv_body/shaders/0000.spv"
+    expect_error bad_spirv_body "corrupt SPIR-V"
+    fresh missing_file; rm "$OUT/missing_file/shaders/0000.spv"
+    expect_error missing_file "names 'shaders/0000.spv', which cannot be read"
+    fresh short_heightfield; head -c 1000 "$PACK/heightfield.r16" > "$OUT/short_heightfield/heightfield.r16"
+    expect_error short_heightfield "heightfield.r16', which has 1000 bytes"
+    fresh combo_range; printf '\377\177' | dd of="$OUT/combo_range/combos.bin" bs=1 seek=2 conv=notrunc 2>/dev/null
+    expect_error combo_range "combination id 32767 out of range"
+    fresh bad_version; sed -i 's/"abi": 1/"abi": 99/' "$OUT/bad_version/manifest.json"
+    expect_error bad_version "abi 99"
+    ;;
+viewer)
+    command -v xvfb-run > /dev/null || { echo "SKIP: no xvfb-run"; exit 0; }
+    rm -f "$OUT/shot.png"
+    xvfb-run -a -s "-screen 0 640x480x24" "$SV" "$PACK" --size 320x200 \
+        --script "frames=10;view=combos;frames=5;screenshot=$OUT/shot.png;key=Q" \
+        > "$OUT/viewer.log" 2>&1
+    rc=$?
+    cat "$OUT/viewer.log"
+    [ $rc = 0 ] || fail "viewer exit $rc"
+    "$IC" nonuniform "$OUT/shot.png" || fail "viewer screenshot is uniform"
+    ;;
+*)
+    fail "unknown case $case_"
+    ;;
+esac
+echo "PASS: $case_"

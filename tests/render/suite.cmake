@@ -1,0 +1,25 @@
+# Render tests (label "render"): headless splatview on lavapipe with
+# SPLAT_VALIDATE=1 over a fixture pack written by make_fixture (until
+# `splatc build` writes real packs), checked by imgcheck.  run.sh holds the
+# cases; each is one CTest.
+if(TARGET splatrt AND TARGET splatview)
+  set(RENDER_DIR ${CMAKE_CURRENT_LIST_DIR})
+  add_executable(make_fixture ${RENDER_DIR}/make_fixture.c)
+  target_link_libraries(make_fixture splatrt)
+  add_executable(imgcheck ${RENDER_DIR}/imgcheck.c)
+  target_link_libraries(imgcheck splatrt)
+
+  set(RENDER_OUT ${CMAKE_BINARY_DIR}/tests/render)
+  add_test(NAME render.fixture COMMAND make_fixture ${RENDER_OUT}/fixture)
+  set_tests_properties(render.fixture PROPERTIES LABELS render FIXTURES_SETUP render_pack)
+
+  set(RENDER_CASES final combos views reference_multipass reference_uber cracks
+      bad_packs stats viewer)
+  foreach(case ${RENDER_CASES})
+    add_test(NAME render.${case}
+      COMMAND sh ${RENDER_DIR}/run.sh ${case} $<TARGET_FILE:splatview>
+              $<TARGET_FILE:imgcheck> ${RENDER_OUT}/fixture ${RENDER_OUT}/out)
+    set_tests_properties(render.${case} PROPERTIES LABELS render
+      FIXTURES_REQUIRED render_pack ENVIRONMENT "SPLAT_VALIDATE=1" TIMEOUT 300)
+  endforeach()
+endif()
