@@ -307,7 +307,7 @@ static void check_op(checker *c, sg_node *n)
     const ir_opinfo *info = ir_opinfo_get((ir_op)n->op);
     int nargs = info->nargs;
     sg_binding *slot[4] = { 0 };
-    bool bad = false;
+    bool bad = false, unknown = false;
     for (int i = 0; i < n->nargs; i++) {
         sg_binding *b = &n->args[i];
         int k = -1;
@@ -316,7 +316,7 @@ static void check_op(checker *c, sg_node *n)
                 k = j;
         if (k < 0) {
             sg_error(c->d, b->loc, SG_E_UNKNOWN_PORT, n->type, "input", b->port);
-            bad = true;
+            bad = unknown = true;
             continue;
         }
         if (slot[k]) {
@@ -330,7 +330,7 @@ static void check_op(checker *c, sg_node *n)
             bad = true;
     }
     for (int j = 0; j < nargs; j++)
-        if (!slot[j]) {
+        if (!slot[j] && !unknown) {   /* a misspelt port is reported once */
             sg_error(c->d, n->loc, SG_E_MISSING_INPUT, n->name, info->ports[j]);
             bad = true;
         }
@@ -346,24 +346,32 @@ static void check_op(checker *c, sg_node *n)
         n->out_type = r;
         return;
     }
-    /* Which operand is wrong?  The last one that has a type making the
-     * rule succeed. */
+    /* Which operand is wrong?  The last one that some other type would
+     * make acceptable, trying the other operands' types first. */
     char what[200], buf[100];
-    for (int j = nargs - 1; j >= 0; j--)
-        for (ir_type t = IR_T_FLOAT; t < IR_T_COUNT; t++) {
-            if (t == args[j])
+    for (int j = nargs - 1; j >= 0; j--) {
+        ir_type cand[4 + IR_T_COUNT];
+        int ncand = 0;
+        for (int k = 0; k < nargs; k++)
+            if (k != j)
+                cand[ncand++] = args[k];
+        for (int t = IR_T_FLOAT; t < IR_T_COUNT; t++)
+            cand[ncand++] = (ir_type)t;
+        for (int k = 0; k < ncand; k++) {
+            if (cand[k] == args[j])
                 continue;
             ir_type try[4];
             memcpy(try, args, sizeof try);
-            try[j] = t;
+            try[j] = cand[k];
             if (op_result(info, try, nargs, NULL) != IR_T_ERROR) {
                 snprintf(what, sizeof what, "port '%s' of '%s' (%s)", info->ports[j],
                          n->name, n->type);
                 sg_error(c->d, slot[j]->val.loc, SG_E_TYPE_MISMATCH, what,
-                         ir_type_name(t), ir_type_name(args[j]));
+                         ir_type_name(cand[k]), ir_type_name(args[j]));
                 return;
             }
         }
+    }
     snprintf(what, sizeof what, "'%s' (%s)", n->name, n->type);
     sg_error(c->d, n->loc, SG_E_TYPE_MISMATCH, what, "operands it accepts",
              type_list(args, nargs, buf, sizeof buf));
@@ -387,6 +395,7 @@ static void check_instance(checker *c, sg_node *n)
 {
     sg_shader *callee = c->p->shaders[n->shader];
     sg_binding **slot = calloc((size_t)callee->nins + 1, sizeof *slot);
+    bool unknown = false;
     if (!slot)
         abort();
     for (int i = 0; i < n->nargs; i++) {
@@ -397,6 +406,7 @@ static void check_instance(checker *c, sg_node *n)
                 k = j;
         if (k < 0) {
             sg_error(c->d, b->loc, SG_E_UNKNOWN_PORT, n->type, "input", b->port);
+            unknown = true;
             continue;
         }
         if (slot[k]) {
@@ -415,7 +425,7 @@ static void check_instance(checker *c, sg_node *n)
         }
     }
     for (int j = 0; j < callee->nins; j++)
-        if (!slot[j] && !callee->ins[j].has_value)
+        if (!slot[j] && !callee->ins[j].has_value && !unknown)
             sg_error(c->d, n->loc, SG_E_MISSING_INPUT, n->name, callee->ins[j].name);
     free(slot);
 }
