@@ -40,7 +40,11 @@ void   splat_terrain_normal(const splat_terrain *t, double u, double v, double n
 
 /* Sound ranges of the terrain inputs over a rectangle of texels
  * [x0, x1) x [z0, z1): every fragment whose uv falls in that rectangle
- * has its height, slope, normal and position inside the returned bounds. */
+ * has its height, slope, normal and position inside the returned bounds
+ * (widened for the GPU's filtering and float error: terrain.c).  Also sets
+ * view_distance to [0, inf] and destruction to [0, 0]; the analysis makes
+ * it [0, 1] where the destructible area reaches.  Leaves params and
+ * painted alone. */
 void splat_terrain_ranges(const splat_terrain *t, int x0, int z0, int x1, int z1,
                           ir_ienv *out);
 /* Widen `env` (from splat_terrain_ranges) for an area whose heights change
@@ -64,7 +68,11 @@ typedef struct splat_scene {
 
 /* Parse and check the scene file and its imports, load the heightfield and
  * the rasters, lower every material.  All errors carry the scene file's
- * locations.  On failure the scene is left freed. */
+ * locations.  On failure the scene is left freed.  Imports are searched
+ * next to the importing file, in the scene's folder, then `search_paths`
+ * (NULL-terminated); with NULL, the nearest folder at or above the
+ * scene's that holds nodes/ (the project root), then ".".  s->ir.painted[i]
+ * is the scene's painted mask i. */
 bool splat_scene_load(splat_scene *s, const char *path,
                       const char *const *search_paths, sg_diags *d);
 void splat_scene_free(splat_scene *s);
