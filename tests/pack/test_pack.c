@@ -1,0 +1,402 @@
+/* test_pack.c — `splatc build` end to end on examples/minimal: the pack's
+ * manifest and grid, every shader through glslangValidator and spirv-val,
+ * byte-identical rebuilds, incremental rebuilds through the cache, and bad
+ * scenes that must leave an existing pack untouched.
+ *
+ * Usage: test_pack SPLATC (run from the repository root). */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include <dirent.h>
+#include <glob.h>
+#include <jansson.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+static const char *splatc;   /* the CLI under test                         */
+static char tmp[64];         /* scratch folder of this run                 */
+
+/* Run a shell command; its stdout + stderr into *out (if non-NULL). */
+static int run(char **out, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+static int run(char **out, const char *fmt, ...)
+{
+    char cmd[4096];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(cmd, sizeof cmd, fmt, ap);
+    va_end(ap);
+    char full[4200];
+    snprintf(full, sizeof full, "(%s) 2>&1", cmd);
+    FILE *p = popen(full, "r");
+    assert_non_null(p);
+    size_t cap = 4096, n = 0;
+    char *buf = malloc(cap);
+    size_t got;
+    while ((got = fread(buf + n, 1, cap - n - 1, p)) > 0) {
+        n += got;
+        if (n + 1 == cap)
+            buf = realloc(buf, cap *= 2);
+    }
+    buf[n] = 0;
+    int st = pclose(p);
+    if (out)
+        *out = buf;
+    else
+        free(buf);
+    return WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+}
+
+/* Build `scene` into `pack` with the given extra options; the output. */
+static char *build(int expect, const char *scene, const char *pack, const char *opts)
+{
+    char *out;
+    int rc = run(&out, "'%s' build '%s' -o '%s' %s", splatc, scene, pack, opts);
+    if (rc != expect)
+        fail_msg("splatc build %s -> %s: exit %d, expected %d\n%s", scene, pack, rc, expect,
+                 out);
+    return out;
+}
+
+/* "combinations: N (A from cache, B compiled)" of --stats. */
+static void stats_line(const char *out, const char *what, int *n, int *cached, int *compiled)
+{
+    char key[32];
+    snprintf(key, sizeof key, "\n%s: ", what);
+    const char *p = strstr(out, "phase ");  /* after the analysis report */
+    p = p ? strstr(p, key) : NULL;
+    if (!p)
+        fail_msg("no '%s' line in:\n%s", what, out);
+    assert_int_equal(sscanf(p + strlen(key), "%d (%d from cache, %d compiled)", n, cached,
+                            compiled), 3);
+}
+
+static json_t *load_manifest(const char *pack)
+{
+    char path[256];
+    snprintf(path, sizeof path, "%s/manifest.json", pack);
+    json_error_t err;
+    json_t *m = json_load_file(path, JSON_STRICT, &err);
+    if (!m)
+        fail_msg("%s:%d: %s", path, err.line, err.text);
+    return m;
+}
+
+static long file_size(const char *pack, const char *name)
+{
+    char path[512];
+    snprintf(path, sizeof path, "%s/%s", pack, name);
+    struct stat sb;
+    return stat(path, &sb) == 0 ? (long)sb.st_size : -1;
+}
+
+static int geti(json_t *o, const char *key)
+{
+    json_t *v = json_object_get(o, key);
+    assert_true(json_is_integer(v));
+    return (int)json_integer_value(v);
+}
+
+/* ---- tests ------------------------------------------------------------------ */
+
+static char pack_a[128];
+
+static void test_manifest_and_grid(void **state)
+{
+    snprintf(pack_a, sizeof pack_a, "%s/a", tmp);
+    char opts[256];
+    snprintf(opts, sizeof opts, "--cache '%s/cache' -j 2 --stats", tmp);
+    free(build(0, "examples/minimal/scene.sg", pack_a, opts));
+    json_t *m = load_manifest(pack_a);
+    assert_string_equal(json_string_value(json_object_get(m, "format")), "splatc-pack");
+    json_t *scene = json_object_get(m, "scene");
+    json_t *hf = json_object_get(scene, "heightfield");
+    int W = geti(hf, "width"), H = geti(hf, "height");
+    assert_int_equal(file_size(pack_a, "heightfield.r16"), 2L * W * H);
+    int cell = geti(scene, "cell_texels");
+    assert_true(cell > 0);
+
+    int nmat = (int)json_array_size(json_object_get(m, "materials"));
+    json_t *combos = json_object_get(m, "combinations");
+    int ncombos = (int)json_array_size(combos);
+    assert_true(ncombos >= 2);
+    for (int i = 0; i < ncombos; i++) {
+        json_t *c = json_array_get(combos, i);
+        assert_int_equal(geti(c, "id"), i);
+        json_t *mats = json_object_get(c, "materials");
+        assert_true(json_array_size(mats) >= 1);
+        for (size_t k = 0; k < json_array_size(mats); k++) {
+            json_int_t mi = json_integer_value(json_array_get(mats, k));
+            assert_true(mi >= 0 && mi < nmat);
+        }
+        assert_true(file_size(pack_a, json_string_value(json_object_get(c, "glsl"))) > 0);
+        assert_true(file_size(pack_a, json_string_value(json_object_get(c, "spirv"))) > 0);
+    }
+
+    /* the leaf grid covers the heightfield; each level halves (rounding up)
+     * down to one node; combos.bin holds exactly the levels; ids in range */
+    json_t *qt = json_object_get(m, "quadtree");
+    json_t *levels = json_object_get(qt, "levels");
+    int nl = (int)json_array_size(levels);
+    assert_true(nl >= 1);
+    json_t *l0 = json_array_get(levels, 0);
+    int w0 = geti(l0, "width"), h0 = geti(l0, "height");
+    assert_true((long)w0 * cell >= W && (long)(w0 - 1) * cell < W);
+    assert_true((long)h0 * cell >= H && (long)(h0 - 1) * cell < H);
+    long total = 0;
+    int pw = 0, ph = 0;
+    for (int l = 0; l < nl; l++) {
+        json_t *lv = json_array_get(levels, l);
+        int w = geti(lv, "width"), h = geti(lv, "height");
+        if (l > 0) {
+            assert_int_equal(w, (pw + 1) / 2);
+            assert_int_equal(h, (ph + 1) / 2);
+        }
+        assert_int_equal(geti(lv, "offset"), total);
+        total += 2L * w * h;
+        pw = w;
+        ph = h;
+    }
+    assert_int_equal(pw, 1);
+    assert_int_equal(ph, 1);
+    char path[256];
+    snprintf(path, sizeof path, "%s/%s", pack_a,
+             json_string_value(json_object_get(qt, "file")));
+    FILE *f = fopen(path, "rb");
+    assert_non_null(f);
+    uint8_t *ids = malloc((size_t)total);
+    assert_int_equal(fread(ids, 1, (size_t)total + 1, f), (size_t)total);
+    fclose(f);
+    for (long i = 0; i < total; i += 2)
+        assert_true(ids[i] + 256 * ids[i + 1] < ncombos);
+    free(ids);
+    json_decref(m);
+}
+
+static void test_shaders_validate(void **state)
+{
+    char pattern[256];
+    glob_t g;
+    snprintf(pattern, sizeof pattern, "%s/shaders/*.spv", pack_a);
+    assert_int_equal(glob(pattern, 0, NULL, &g), 0);
+    assert_true(g.gl_pathc >= 5);  /* composites, refs, uber, vertex */
+    for (size_t i = 0; i < g.gl_pathc; i++) {
+        char *out;
+        if (run(&out, "spirv-val --target-env vulkan1.2 '%s'", g.gl_pathv[i]) != 0)
+            fail_msg("spirv-val %s:\n%s", g.gl_pathv[i], out);
+        free(out);
+    }
+    globfree(&g);
+    snprintf(pattern, sizeof pattern, "%s/shaders/*.frag", pack_a);
+    assert_int_equal(glob(pattern, 0, NULL, &g), 0);
+    snprintf(pattern, sizeof pattern, "%s/shaders/*.vert", pack_a);
+    assert_int_equal(glob(pattern, GLOB_APPEND, NULL, &g), 0);
+    for (size_t i = 0; i < g.gl_pathc; i++) {
+        char *out;
+        if (run(&out, "glslangValidator -V --target-env vulkan1.2 -o /dev/null '%s'",
+                g.gl_pathv[i]) != 0)
+            fail_msg("glslangValidator %s:\n%s", g.gl_pathv[i], out);
+        free(out);
+    }
+    globfree(&g);
+}
+
+/* Same inputs, same bytes: with a cold cache, without one, and again. */
+static void test_byte_identical(void **state)
+{
+    char b[160], c[160], opts[256];
+    snprintf(b, sizeof b, "%s/b", tmp);
+    snprintf(c, sizeof c, "%s/c", tmp);
+    snprintf(opts, sizeof opts, "--cache '%s/cache-b'", tmp);
+    free(build(0, "examples/minimal/scene.sg", b, opts));
+    free(build(0, "examples/minimal/scene.sg", c, "--no-cache -j 2"));
+    char *out;
+    if (run(&out, "diff -r '%s' '%s' && diff -r '%s' '%s'", pack_a, b, pack_a, c) != 0)
+        fail_msg("packs differ:\n%s", out);
+    free(out);
+    /* rebuilding over an existing pack replaces it with the same bytes */
+    free(build(0, "examples/minimal/scene.sg", b, opts));
+    assert_int_equal(run(NULL, "diff -r '%s' '%s'", pack_a, b), 0);
+}
+
+static void replace_in_file(const char *path, const char *from, const char *to)
+{
+    FILE *f = fopen(path, "rb");
+    assert_non_null(f);
+    char *text = calloc(1, 1 << 20);
+    size_t n = fread(text, 1, (1 << 20) - 1, f);
+    fclose(f);
+    char *at = strstr(text, from);
+    assert_non_null(at);
+    assert_null(strstr(at + 1, from));  /* exactly one place */
+    f = fopen(path, "wb");
+    assert_non_null(f);
+    fwrite(text, 1, (size_t)(at - text), f);
+    fputs(to, f);
+    fputs(at + strlen(from), f);
+    fclose(f);
+    (void)n;
+    free(text);
+}
+
+/* Touching a graph recompiles nothing; editing one material recompiles
+ * exactly the combinations that contain it (plus its reference pass and
+ * the über-shader), and gives the pack a cold build gives. */
+static void test_incremental(void **state)
+{
+    char root[160], scene[256], pack[200], cold[200], opts[256];
+    snprintf(root, sizeof root, "%s/tree", tmp);
+    assert_int_equal(run(NULL, "mkdir -p '%s/examples' && cp -r nodes graphs '%s/' && "
+                               "cp -r examples/minimal '%s/examples/'", root, root, root), 0);
+    snprintf(scene, sizeof scene, "%s/examples/minimal/scene.sg", root);
+    snprintf(pack, sizeof pack, "%s/inc", tmp);
+    snprintf(cold, sizeof cold, "%s/inc-cold", tmp);
+    snprintf(opts, sizeof opts, "--cache '%s/cache-inc' --stats", tmp);
+
+    char *out = build(0, scene, pack, opts);
+    int n, cached, compiled;
+    stats_line(out, "combinations", &n, &cached, &compiled);
+    assert_int_equal(cached, 0);
+    assert_int_equal(compiled, n);
+    free(out);
+
+    assert_int_equal(run(NULL, "touch '%s' '%s/graphs/grass.sg'", scene, root), 0);
+    out = build(0, scene, pack, opts);
+    stats_line(out, "combinations", &n, &cached, &compiled);
+    assert_int_equal(compiled, 0);
+    assert_int_equal(cached, n);
+    int ns, scached, scompiled;
+    stats_line(out, "shaders", &ns, &scached, &scompiled);
+    assert_int_equal(scompiled, 0);
+    free(out);
+
+    /* which combinations hold the rock material */
+    json_t *m = load_manifest(pack);
+    json_t *mats = json_object_get(m, "materials");
+    int rock = -1;
+    for (size_t i = 0; i < json_array_size(mats); i++)
+        if (!strcmp(json_string_value(json_object_get(json_array_get(mats, i), "name")),
+                    "rock"))
+            rock = (int)i;
+    assert_true(rock >= 0);
+    json_t *combos = json_object_get(m, "combinations");
+    int with_rock = 0;
+    for (size_t i = 0; i < json_array_size(combos); i++) {
+        json_t *cm = json_object_get(json_array_get(combos, i), "materials");
+        for (size_t k = 0; k < json_array_size(cm); k++)
+            with_rock += json_integer_value(json_array_get(cm, k)) == rock;
+    }
+    json_decref(m);
+    assert_true(with_rock >= 1 && with_rock < n);
+
+    replace_in_file(scene, "out roughness = 0.8", "out roughness = 0.7");
+    out = build(0, scene, pack, opts);
+    stats_line(out, "combinations", &n, &cached, &compiled);
+    assert_int_equal(compiled, with_rock);
+    assert_int_equal(cached, n - with_rock);
+    stats_line(out, "shaders", &ns, &scached, &scompiled);
+    assert_int_equal(scompiled, with_rock + 2);  /* + rock's reference, über */
+    free(out);
+
+    free(build(0, scene, cold, "--no-cache"));
+    if (run(&out, "diff -r '%s' '%s'", pack, cold) != 0)
+        fail_msg("cached and cold packs differ:\n%s", out);
+    free(out);
+}
+
+/* Each bad scene: exit 1, a file:line:col error, the pack untouched and no
+ * temporary folder left behind. */
+static void test_bad_scenes_leave_pack(void **state)
+{
+    char snap[160];
+    snprintf(snap, sizeof snap, "%s/a-snapshot", tmp);
+    assert_int_equal(run(NULL, "cp -r '%s' '%s'", pack_a, snap), 0);
+
+    /* a negative world size, next to the fixtures it imports */
+    char neg[160];
+    snprintf(neg, sizeof neg, "tests/scene/bad_size.sg");
+    char negative[200];
+    snprintf(negative, sizeof negative, "%s/bad_negative_size.sg", tmp);
+    char cwd[512];
+    assert_non_null(getcwd(cwd, sizeof cwd));
+    assert_int_equal(run(NULL, "sed -e 's#size = 0 32#size = 64 -32#' "
+                               "-e 's#import \"materials.sg\"#import \"%s/tests/scene/materials.sg\"#' "
+                               "-e 's#\"hf16.png\"#\"%s/tests/scene/hf16.png\"#' '%s' > '%s'",
+                         cwd, cwd, neg, negative), 0);
+
+    const char *bad[] = {
+        "tests/scene/bad_missing_heightfield.sg", "tests/scene/bad_raw_size.sg",
+        "tests/scene/bad_rgb_heightfield.sg",     "tests/scene/bad_painted_size.sg",
+        "tests/scene/bad_unknown_material.sg",    "tests/scene/bad_empty_stack.sg",
+        "tests/scene/bad_size.sg",                negative,
+    };
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+        char *out = build(1, bad[i], pack_a, "--no-cache");
+        /* "FILE:LINE:COL: error:" naming the scene file */
+        char want[300];
+        snprintf(want, sizeof want, "%s:", bad[i]);
+        const char *at = strstr(out, want);
+        if (!at)
+            fail_msg("%s: no located error in:\n%s", bad[i], out);
+        int line = 0, col = 0;
+        if (sscanf(at + strlen(want), "%d:%d: error:", &line, &col) != 2 || line < 1 || col < 1)
+            fail_msg("%s: not file:line:col: error:\n%s", bad[i], out);
+        free(out);
+        if (run(&out, "diff -r '%s' '%s'", snap, pack_a) != 0)
+            fail_msg("%s changed the pack:\n%s", bad[i], out);
+        free(out);
+    }
+    char pattern[200];
+    glob_t g;
+    snprintf(pattern, sizeof pattern, "%s.tmp-*", pack_a);
+    assert_int_equal(glob(pattern, 0, NULL, &g), GLOB_NOMATCH);
+
+    /* a folder that is not a pack is never replaced */
+    char other[160];
+    snprintf(other, sizeof other, "%s/not-a-pack", tmp);
+    assert_int_equal(run(NULL, "mkdir -p '%s' && echo keep > '%s/notes.txt'", other, other), 0);
+    char *out = build(1, "examples/minimal/scene.sg", other, "--no-cache");
+    assert_non_null(strstr(out, "not a shader pack"));
+    free(out);
+    assert_int_equal(file_size(other, "notes.txt"), 5);
+}
+
+static void test_usage_errors(void **state)
+{
+    assert_int_equal(run(NULL, "'%s' build", splatc), 2);
+    assert_int_equal(run(NULL, "'%s' build examples/minimal/scene.sg", splatc), 2);
+    assert_int_equal(run(NULL, "'%s' build examples/minimal/scene.sg -o x -j 0", splatc), 2);
+    assert_int_equal(run(NULL, "'%s' build --help", splatc), 0);
+}
+
+int main(int argc, char **argv)
+{
+    if (argc < 2) {
+        fprintf(stderr, "usage: test_pack SPLATC\n");
+        return 2;
+    }
+    splatc = argv[1];
+    snprintf(tmp, sizeof tmp, "/tmp/splatc-pack-XXXXXX");
+    if (!mkdtemp(tmp))
+        return 1;
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_manifest_and_grid),
+        cmocka_unit_test(test_shaders_validate),
+        cmocka_unit_test(test_byte_identical),
+        cmocka_unit_test(test_incremental),
+        cmocka_unit_test(test_bad_scenes_leave_pack),
+        cmocka_unit_test(test_usage_errors),
+    };
+    int failed = cmocka_run_group_tests(tests, NULL, NULL);
+    if (!failed)
+        run(NULL, "rm -rf '%s'", tmp);
+    else
+        fprintf(stderr, "test_pack: scratch files kept in %s\n", tmp);
+    return failed;
+}
