@@ -403,10 +403,21 @@ static void compute_bounds(sparse_masks *s, const sparse_desc *d)
     size_t ncell = (size_t)s->cells_x * s->cells_z;
     s->lo = xcalloc(ncell * (size_t)(d->nmasks ? d->nmasks : 1), sizeof *s->lo);
     s->hi = xcalloc(ncell * (size_t)(d->nmasks ? d->nmasks : 1), sizeof *s->hi);
-    float *dec = xcalloc((size_t)s->atlas_width * s->atlas_height, sizeof *dec);
-    for (int az = 0; az < s->atlas_height; az++)
-        for (int ax = 0; ax < s->atlas_width; ax++)
-            dec[(size_t)az * s->atlas_width + ax] = atlas_texel(s, ax, az);
+    /* the atlas as the GPU reads it, decoded once */
+    size_t aw = (size_t)s->atlas_width, ah = (size_t)s->atlas_height;
+    float *dec = xcalloc(aw * ah, sizeof *dec);
+    if (s->format == SPARSE_R8) {
+        for (size_t i = 0; i < aw * ah; i++)
+            dec[i] = s->atlas[i] / 255.0f;
+    } else {
+        for (size_t bz = 0; bz < ah / 4; bz++)
+            for (size_t bx = 0; bx < aw / 4; bx++) {
+                float block[16];
+                sparse_bc4_decode(s->atlas + (bz * (aw / 4) + bx) * 8, block);
+                for (int j = 0; j < 4; j++)
+                    memcpy(dec + (bz * 4 + j) * aw + bx * 4, block + 4 * j, 4 * sizeof *dec);
+            }
+    }
     for (int m = 0; m < d->nmasks; m++) {
         raster r = { d->width, d->height, d->masks[m].texels };
         for (int cz = 0; cz < s->cells_z; cz++)

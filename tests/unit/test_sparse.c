@@ -739,6 +739,68 @@ static void test_abi_prelude_sparse(void **state)
     assert_int_equal(SPLAT_BIND_PAINTED_LEVEL, 6);
 }
 
+/* Issue 5's target on the example content: the painted masks of
+ * examples/colorado in at most 15 % of their dense size (BC4), and the
+ * reduced-level option (everything but the centre quarter of the map at
+ * levels <= 2, whatever the error) at most half of that, with its error. */
+static void test_colorado_masks(void **state)
+{
+    const char *names[] = { "field_wheat", "field_plowed", "field_fallow", "road" };
+    int w = 2401, h = 1201;
+    uint8_t *t[4];
+    sparse_mask_desc md[4];
+    sparse_error err;
+    char path[256];
+    snprintf(path, sizeof path, "examples/colorado/masks/%s.png", names[0]);
+    if (access(path, R_OK) != 0) {
+        printf("examples/colorado not here: skipped\n");
+        skip();
+    }
+    for (int i = 0; i < 4; i++) {
+        snprintf(path, sizeof path, "examples/colorado/masks/%s.png", names[i]);
+        bool ok = sparse_load_raster(path, w, h, &t[i], &err);
+        if (!ok) fprintf(stderr, "%s\n", err.msg);
+        assert_true(ok);
+        md[i] = (sparse_mask_desc){ .name = names[i], .texels = t[i] };
+    }
+    sparse_desc d = { .width = w, .height = h, .masks = md, .nmasks = 4, .format = SPARSE_BC4 };
+    sparse_masks s;
+    sparse_stats full, red;
+    assert_true(sparse_build(&s, &d, &err));
+    printf("\ncolorado painted masks, BC4, full resolution:\n");
+    sparse_print_stats(&s, stdout);
+    sparse_get_stats(&s, &full);
+    sparse_free(&s);
+    /* the far area (all but the centre quarter of the map) at level <= L,
+     * whatever the error: the reduced-level option with its error */
+    double frac[3] = { full.fraction, 0, 0 };
+    for (int L = 1; L <= 2; L++) {
+        for (int i = 0; i < 4; i++) {
+            md[i].max_level = L;
+            md[i].max_error = 1.0;
+            memcpy(md[i].near, (int[4]){ w / 4, h / 4, 3 * w / 4, 3 * h / 4 }, sizeof md[i].near);
+        }
+        assert_true(sparse_build(&s, &d, &err));
+        printf("colorado, BC4, levels <= %d outside the centre quarter:\n", L);
+        sparse_print_stats(&s, stdout);
+        sparse_get_stats(&s, &red);
+        double e = 0.0;
+        for (int i = 0; i < 4; i++) e = fmax(e, s.info[i].reduce_error);
+        frac[L] = red.fraction;
+        printf("  -> %.2f %% of dense (%.2f x full resolution), reduced-level max "
+               "error %.3f\n", 100 * red.fraction, red.fraction / full.fraction, e);
+        assert_true(e > 0.0 && e <= 1.0);
+        sparse_free(&s);
+    }
+    printf("colorado: %.2f %% of dense at full resolution (target <= 15 %%); reduced "
+           "levels %.2f %% (level 1), %.2f %% (level 2; target <= half)\n",
+           100 * frac[0], 100 * frac[1], 100 * frac[2]);
+    assert_true(frac[0] <= 0.15);
+    assert_true(frac[1] < frac[0]);
+    assert_true(frac[2] <= 0.5 * frac[0]);
+    for (int i = 0; i < 4; i++) free(t[i]);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -753,6 +815,7 @@ int main(void)
         cmocka_unit_test(test_bad_rasters),
         cmocka_unit_test(test_figure_fields),
         cmocka_unit_test(test_figure_destruction),
+        cmocka_unit_test(test_colorado_masks),
         cmocka_unit_test(test_glsl_compiles),
         cmocka_unit_test(test_abi_prelude_sparse),
     };
