@@ -32,7 +32,8 @@
  *
  * Cost: each cell's terrain and painted ranges are O(its footprint), so the
  * whole analysis is linear in texels; masks are bounded once per cell and
- * material (not per texel).
+ * material (not per texel), on an ir holding only the masks, and only down
+ * to the cell's first opaque material.
  */
 #include "scene.h"
 
@@ -205,22 +206,46 @@ bool splat_analyze(const splat_scene *s, splat_analysis *a, sg_diags *d)
     combo_set cs = { .a = a, .words = (n + 63) / 64 };
     if (cs.words == 0) cs.words = 1;
     ir_ref *masks = calloc((size_t)(n ? n : 1), sizeof *masks);
-    ir_iv *painted = calloc((size_t)(s->ir.npainted ? s->ir.npainted : 1),
-                            sizeof *painted);
     uint64_t *bits = NULL;
-    bool ok = masks && painted;
+    ir_iv *painted = NULL;
+    int *painted_src = NULL;    /* mask ir's painted k -> scene raster, -1 */
+    bool ok = masks != NULL;
     if (!ok) sg_error(d, sc->loc, SG_E_TOO_LARGE, "out of memory in the analysis");
 
+    /* The masks alone, imported into a small ir of their own: the interval
+     * evaluator's cost per call grows with the ir below the root, and the
+     * scene's ir is mostly surfaces (albedo, normal …) the analysis never
+     * reads. */
+    ir mir;
+    ir_init(&mir);
+    ir_import_map *map = ok ? ir_import_begin(&mir, &s->ir) : NULL;
     for (int m = 1; ok && m < n; m++) {
         char name[512];
         snprintf(name, sizeof name, "%s.mask", sc->materials[m]);
-        masks[m] = ir_find_root(&s->ir, name);
-        if (!ir_ref_ok(masks[m])) {
+        ir_ref root = ir_find_root(&s->ir, name);
+        if (!ir_ref_ok(root)) {
             char msg[600];
             snprintf(msg, sizeof msg, "material '%s' has no mask root", sc->materials[m]);
             sg_error(d, sc->loc, SG_E_INTERNAL, msg);
             ok = false;
+            break;
         }
+        masks[m] = ir_import(map, root);
+    }
+    if (map) ir_import_end(map);
+    if (ok) {
+        size_t np = (size_t)(mir.npainted ? mir.npainted : 1);
+        painted = calloc(np, sizeof *painted);
+        painted_src = calloc(np, sizeof *painted_src);
+        ok = painted && painted_src;
+        if (!ok) sg_error(d, sc->loc, SG_E_TOO_LARGE, "out of memory in the analysis");
+    }
+    for (int k = 0; ok && k < mir.npainted; k++) {
+        painted_src[k] = -1;
+        for (int j = 0; j < sc->npainted; j++)
+            if (s->painted && s->painted[j] &&
+                strcmp(mir.painted[k].name, sc->painted[j].name) == 0)
+                painted_src[k] = j;
     }
 
     /* Levels: 0 = cells, each next one halves the sides (rounding up). */
@@ -268,12 +293,12 @@ bool splat_analyze(const splat_scene *s, splat_analysis *a, sg_diags *d)
                 env.destruction = (ir_iv){ 0.0, 1.0 };
                 splat_terrain_any_shape(t, &env);
             }
-            for (int k = 0; k < s->ir.npainted; k++) {
-                if (k < sc->npainted && s->painted && s->painted[k])
-                    painted[k] = painted_range(s->painted[k], t->width, t->height,
-                                               x0, z0, x1, z1);
+            for (int k = 0; k < mir.npainted; k++) {
+                if (painted_src[k] >= 0)
+                    painted[k] = painted_range(s->painted[painted_src[k]], t->width,
+                                               t->height, x0, z0, x1, z1);
                 else
-                    painted[k] = (ir_iv){ 0.0, 1.0 };
+                    painted[k] = (ir_iv){ 0.0, 1.0 };   /* no raster: any */
             }
             env.painted = painted;
             env.params = NULL;      /* every param over its [lo, hi] */
@@ -282,7 +307,7 @@ bool splat_analyze(const splat_scene *s, splat_analysis *a, sg_diags *d)
             int m = n - 1;
             for (; m > 0; m--) {
                 ir_iv out[4];
-                ir_interval(&s->ir, masks[m], &env, out);
+                ir_interval(&mir, masks[m], &env, out);
                 bool present = !(out[0].hi <= 0.0);     /* NaN: present */
                 bool opaque = out[0].lo >= 1.0;
                 if (present) cell[m / 64] |= 1ull << (m % 64);
@@ -341,7 +366,9 @@ bool splat_analyze(const splat_scene *s, splat_analysis *a, sg_diags *d)
 
     free(bits);
     free(painted);
+    free(painted_src);
     free(masks);
+    ir_free(&mir);
     free(cs.keys);
     free(cs.slots);
     a->seconds = now_seconds() - t0;
