@@ -20,7 +20,7 @@ const ir_pass ir_passes[] = {
     {NULL, NULL},
 };
 
-bool ir_rebuild(ir *ir, ir_rewrite_fn fn, void *user)
+static bool rebuild_once(ir *ir, ir_rewrite_fn fn, void *user, bool *dead_left)
 {
     uint32_t n = ir->nnodes;
     uint8_t *reach = calloc(n, 1);
@@ -64,8 +64,37 @@ bool ir_rebuild(ir *ir, ir_rewrite_fn fn, void *user)
     free(ir->nodes);
     free(ir->table);
     *ir = dst;
+
+    /* A rewrite may leave nodes behind that nothing uses any more (the
+     * operands of a folded constant): report them for a second sweep. */
+    free(reach);
+    reach = calloc(ir->nnodes, 1);
+    if (!reach) {
+        fprintf(stderr, "splatc: out of memory\n");
+        abort();
+    }
+    for (int i = 0; i < ir->nroots; i++)
+        reach[ir->roots[i].ref.id] = 1;
+    *dead_left = false;
+    for (uint32_t id = ir->nnodes - 1; id > 0; id--) {
+        if (!reach[id]) {
+            *dead_left = true;
+            continue;
+        }
+        for (int i = 0; i < ir->nodes[id].nargs; i++)
+            reach[ir->nodes[id].arg[i].id] = 1;
+    }
     free(reach);
     free(map);
+    return changed;
+}
+
+bool ir_rebuild(ir *ir, ir_rewrite_fn fn, void *user)
+{
+    bool dead;
+    bool changed = rebuild_once(ir, fn, user, &dead);
+    if (dead)
+        changed |= rebuild_once(ir, NULL, NULL, &dead);
     return changed;
 }
 

@@ -21,7 +21,7 @@
 #include "random_ir.h"
 
 #ifndef GRAPHS
-#define GRAPHS 400
+#define GRAPHS 1000
 #endif
 enum { BOXES = 12, POINTS = 40, DEPTH = 6 };
 
