@@ -5,8 +5,9 @@
  * (terrain.c says why soundly), the painted masks are bounded by the min and
  * max of their texels in the bilinear footprint (the cell plus a one-texel
  * ring), the destruction mask is [0, 1] where the destructible area reaches
- * the cell (and there heights and slopes may change: splat_terrain_any_shape)
- * and 0 elsewhere.  Then, from the top of the stack down, ir_interval bounds
+ * the cell and 0 elsewhere; where the area comes within two texels of the
+ * cell, craters may change the heights the cell's filters read, so height,
+ * normal and slope take every value they can (splat_terrain_any_shape).  Then, from the top of the stack down, ir_interval bounds
  * each material's "<name>.mask": the material is present if the upper bound
  * is above 0, opaque if the lower bound is at least 1; the cell's
  * combination is the present materials down to the first opaque one (the
@@ -175,17 +176,18 @@ static ir_iv painted_range(const uint8_t *px, int w, int h,
     return r;
 }
 
-/* Whether the destructible area can reach positions in env's x/z range.
- * The runtime's indirection grid covers whole cells, as many per side as
- * the longer side needs, so the reachable area is rounded up to that. */
-static bool destruction_reaches(const sg_scene *sc, const ir_ienv *env)
+/* Whether the destructible area, grown by `mx`, `mz` metres, meets env's
+ * x/z range.  The runtime's indirection grid covers whole cells, as many
+ * per side as the longer side needs, so the area is rounded up to that. */
+static bool destruction_reaches(const sg_scene *sc, const ir_ienv *env,
+                                double mx, double mz)
 {
     double cell = sc->destruction_cell;
     double side = fmax(sc->destruction_size[0], sc->destruction_size[1]);
     double extent = ceil(side / cell) * cell;
     double ox = sc->destruction_origin[0], oz = sc->destruction_origin[1];
-    return env->position[0].hi >= ox && env->position[0].lo <= ox + extent &&
-           env->position[2].hi >= oz && env->position[2].lo <= oz + extent;
+    return env->position[0].hi >= ox - mx && env->position[0].lo <= ox + extent + mx &&
+           env->position[2].hi >= oz - mz && env->position[2].lo <= oz + extent + mz;
 }
 
 /* ---- the analysis ------------------------------------------------------- */
@@ -280,6 +282,8 @@ bool splat_analyze(const splat_scene *s, splat_analysis *a, sg_diags *d)
         if (!ok) sg_error(d, sc->loc, SG_E_TOO_LARGE, "out of memory in the analysis");
     }
 
+    double texel_x = t->size[0] / t->width, texel_z = t->size[1] / t->height;
+
     /* Level 0: the cells. */
     for (int cz = 0; ok && cz < a->cells_z; cz++) {
         for (int cx = 0; ok && cx < a->cells_x; cx++) {
@@ -289,9 +293,14 @@ bool splat_analyze(const splat_scene *s, splat_analysis *a, sg_diags *d)
             ir_ienv env;
             memset(&env, 0, sizeof env);
             splat_terrain_ranges(t, x0, z0, x1, z1, &env);
-            if (sc->has_destruction && destruction_reaches(sc, &env)) {
-                env.destruction = (ir_iv){ 0.0, 1.0 };
-                splat_terrain_any_shape(t, &env);
+            /* The mask is read where the area is; craters lower texels in
+             * it, which the cell's filters read from up to two texels
+             * (footprint ring + cross taps) outside the cell. */
+            if (sc->has_destruction) {
+                if (destruction_reaches(sc, &env, 0, 0))
+                    env.destruction = (ir_iv){ 0.0, 1.0 };
+                if (destruction_reaches(sc, &env, 2 * texel_x, 2 * texel_z))
+                    splat_terrain_any_shape(t, &env);
             }
             for (int k = 0; k < mir.npainted; k++) {
                 if (painted_src[k] >= 0)

@@ -320,21 +320,33 @@ static void test_destruction_area(void **state)
     f->desc.has_destruction = true;
     f->desc.destruction_origin[0] = 40;    /* metres: texels are 1 m */
     f->desc.destruction_origin[1] = 0;
-    f->desc.destruction_size[0] = 8;
-    f->desc.destruction_size[1] = 8;
-    f->desc.destruction_cell = 4;
+    f->desc.destruction_size[0] = 6;       /* x 40..46, z 0..6 */
+    f->desc.destruction_size[1] = 6;
+    f->desc.destruction_cell = 2;
     ir *ir = &f->s.ir;
     set_mask(f, "cliff", ramp(ir, ir_input(ir, IR_IN_SLOPE), 0.5, 0.6));
     set_mask(f, "burnt", ir_input(ir, IR_IN_DESTRUCTION));
     splat_analysis a;
     analyze(f, &a);
-    /* Cell (2, 0) covers x 32..48 m and z 0..16 m: reached.  Craters may
-     * make cliffs there too, so cliff is kept although the ground is flat. */
-    const int flat[] = { 0, -1 }, reached[] = { 2, 1, 0, -1 };
+    /* Cell (2, 0) covers x 32..48 m and z 0..16 m: the area is inside.
+     * Craters may make cliffs there, so cliff is kept on flat ground. */
+    const int flat[] = { 0, -1 }, reached[] = { 2, 1, 0, -1 }, near[] = { 1, 0, -1 };
     assert_true(combo_is(combo_at(&a, 0, 2, 0), reached));
+    /* Cell (3, 0) starts at x = 48, two texels from the area: no
+     * destruction mask there, but its filters read texels craters lower. */
+    assert_true(combo_is(combo_at(&a, 0, 3, 0), near));
     assert_true(combo_is(combo_at(&a, 0, 0, 0), flat));
-    assert_true(combo_is(combo_at(&a, 0, 0, 1), flat));
+    assert_true(combo_is(combo_at(&a, 0, 1, 0), flat));
     assert_true(combo_is(combo_at(&a, 0, 2, 1), flat));
+    assert_true(combo_is(combo_at(&a, 0, 3, 1), flat));
+    splat_analysis_free(&a);
+
+    /* Three texels away is out of the filters' reach. */
+    f->desc.destruction_size[0] = f->desc.destruction_size[1] = 5;
+    f->desc.destruction_cell = 5;          /* x 40..45 */
+    analyze(f, &a);
+    assert_true(combo_is(combo_at(&a, 0, 3, 0), flat));
+    assert_true(combo_is(combo_at(&a, 0, 2, 0), reached));
     splat_analysis_free(&a);
     fixture_free(f);
 }
