@@ -142,12 +142,10 @@ static void lex_string(lexer *l)
             p++;
         p++;
     }
-    if (p >= l->end || *p != '"') {
+    bool closed = p < l->end && *p == '"';
+    if (!closed)   /* report, then read it as closed at the end of the line */
         sg_error(l->d, here(l, start), SG_E_UNTERMINATED, "string", l->line);
-        l->s = p;               /* the newline (or EOF) is lexed next */
-        return;
-    }
-    sg_token *t = emit(l, SG_TK_STRING, start, (int)(p + 1 - start));
+    sg_token *t = emit(l, SG_TK_STRING, start, (int)(p + closed - start));
     char *out = sg_alloc(l->arena, (size_t)(p - l->s) + 1);
     int o = 0;
     for (const char *q = l->s; q < p; q++) {
@@ -157,7 +155,7 @@ static void lex_string(lexer *l)
     }
     out[o] = 0;
     t->str = out;
-    l->s = p + 1;
+    l->s = p + closed;      /* an unclosed string leaves the newline next */
 }
 
 static bool starts_token(const char *p)

@@ -224,20 +224,30 @@ static bool parse_value(parser *ps, sg_value *v)
  * line or '}'. */
 typedef void (*binding_fn)(parser *ps, void *user, sg_token *key, sg_value *v);
 
-static void parse_bindings(parser *ps, const char *what, binding_fn add, void *user)
+/* A statement keyword starting a line (not a binding `out = …`)? */
+static bool starts_statement(parser *ps, const sg_token *t)
+{
+    return line_start(ps, t) && peek_at(ps, 1)->kind != SG_TK_EQ &&
+           (is_kw(t, "node") || is_kw(t, "out") || is_kw(t, "in") || is_kw(t, "param"));
+}
+
+/* Returns false if the list had errors (some bindings may be missing). */
+static bool parse_bindings(parser *ps, const char *what, binding_fn add, void *user)
 {
     sg_token *open = cur(ps);
+    bool clean = true;
     if (!expect(ps, SG_TK_LBRACE, "'{'"))
-        return;
+        return false;
     for (;;) {
         sg_token *t = cur(ps);
         if (t->kind == SG_TK_RBRACE) {
             next(ps);
-            return;
+            return clean;
         }
-        if (t->kind == SG_TK_EOF || (top_keyword(t) && line_start(ps, t))) {
+        if (t->kind == SG_TK_EOF || (top_keyword(t) && line_start(ps, t)) ||
+            (t->line > open->line && starts_statement(ps, t))) {
             sg_error(ps->d, loc_of(ps, open), SG_E_UNTERMINATED, what, open->line);
-            return;
+            return false;
         }
         int line = t->line;
         sg_value v;
@@ -255,6 +265,7 @@ static void parse_bindings(parser *ps, const char *what, binding_fn add, void *u
             accept(ps, SG_TK_COMMA);
             continue;
         }
+        clean = false;
         /* skip to ',' / '}' / next line */
         while (cur(ps)->kind != SG_TK_EOF && cur(ps)->kind != SG_TK_RBRACE &&
                cur(ps)->kind != SG_TK_COMMA && cur(ps)->line == line)
@@ -304,7 +315,7 @@ static bool parse_node(parser *ps, sg_shader *s)
     if (cur(ps)->kind == SG_TK_LBRACE) {
         char what[160];
         snprintf(what, sizeof what, "'{' of node '%s'", n->name);
-        parse_bindings(ps, sg_strdup(ps->a, what), add_node_binding, n);
+        n->incomplete = !parse_bindings(ps, sg_strdup(ps->a, what), add_node_binding, n);
     }
     return true;
 }

@@ -330,8 +330,9 @@ static void check_op(checker *c, sg_node *n)
             bad = true;
     }
     for (int j = 0; j < nargs; j++)
-        if (!slot[j] && !unknown) {   /* a misspelt port is reported once */
-            sg_error(c->d, n->loc, SG_E_MISSING_INPUT, n->name, info->ports[j]);
+        if (!slot[j]) {
+            if (!unknown && !n->incomplete)    /* otherwise already reported */
+                sg_error(c->d, n->loc, SG_E_MISSING_INPUT, n->name, info->ports[j]);
             bad = true;
         }
     if (bad)
@@ -425,7 +426,7 @@ static void check_instance(checker *c, sg_node *n)
         }
     }
     for (int j = 0; j < callee->nins; j++)
-        if (!slot[j] && !callee->ins[j].has_value && !unknown)
+        if (!slot[j] && !callee->ins[j].has_value && !unknown && !n->incomplete)
             sg_error(c->d, n->loc, SG_E_MISSING_INPUT, n->name, callee->ins[j].name);
     free(slot);
 }
@@ -453,7 +454,7 @@ static void check_painted(checker *c, sg_node *n)
                      "a painted mask name in quotes", ir_type_name(b->val.type));
         }
     }
-    if (!have)
+    if (!have && !n->incomplete)
         sg_error(c->d, n->loc, SG_E_MISSING_INPUT, n->name, "mask");
 }
 

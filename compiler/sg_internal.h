@@ -154,6 +154,8 @@ typedef struct sg_node {
     sg_loc      type_loc;
     sg_binding *args;
     int         nargs, capargs;
+    bool        incomplete; /* its `{ … }` had syntax errors: do not
+                               report the inputs they lost as missing   */
     /* resolved */
     sg_node_kind kind;
     int          op;        /* ir_op, or ir_input for SG_NODE_INPUT       */
