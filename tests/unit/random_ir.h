@@ -102,7 +102,7 @@ static inline bool random_ir_allowed(const random_ir_opts *o, ir_op op)
     return !o || !(o->exclude >> op & 1);
 }
 
-static ir_ref random_ir_expr(ir *ir, random_ir_rng *r, ir_type t, int depth,
+static inline ir_ref random_ir_expr(ir *ir, random_ir_rng *r, ir_type t, int depth,
                              const random_ir_opts *o);
 
 static inline ir_ref random_ir_leaf(ir *ir, random_ir_rng *r, ir_type t,
@@ -153,7 +153,7 @@ static inline ir_type random_ir_type(random_ir_rng *r, int min_width)
 
 /* A random expression of type t (float..vec4) with at most `depth` levels
  * of ops above the leaves. */
-static ir_ref random_ir_expr(ir *ir, random_ir_rng *r, ir_type t, int depth,
+static inline ir_ref random_ir_expr(ir *ir, random_ir_rng *r, ir_type t, int depth,
                              const random_ir_opts *o)
 {
     int w = ir_type_width(t);
