@@ -22,6 +22,7 @@
  */
 #include "sparse.h"
 
+#include <assert.h>
 #include <errno.h>
 #include <math.h>
 #include <stdarg.h>
@@ -301,6 +302,7 @@ static void slot_origin(const sparse_masks *s, int slot, int *ox, int *oz)
 
 double sparse_sample(const sparse_masks *s, int mask, double u, double v)
 {
+    assert(mask >= 0 && mask < s->nmasks);
     /* the GLSL's float arithmetic, step by step */
     float tx = (float)u * (float)s->width, tz = (float)v * (float)s->height;
     int cx = clampi((int)floorf(tx * (1.0f / 32.0f)), 0, s->cells_x - 1);
@@ -455,6 +457,7 @@ static void compute_bounds(sparse_masks *s, const sparse_desc *d)
 void sparse_range(const sparse_masks *s, int mask, int x0, int z0, int x1,
                   int z1, double *lo, double *hi)
 {
+    assert(mask >= 0 && mask < s->nmasks && x0 < x1 && z0 < z1);
     int cx0 = clampi(x0 / SPARSE_TILE, 0, s->cells_x - 1);
     int cz0 = clampi(z0 / SPARSE_TILE, 0, s->cells_z - 1);
     int cx1 = clampi((x1 - 1) / SPARSE_TILE, 0, s->cells_x - 1);
