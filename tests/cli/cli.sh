@@ -1,0 +1,177 @@
+#!/bin/sh
+# cli.sh SPLATC CASE — command-line tests of splatc, run from the repository
+# root by CTest (tests/cli/suite.cmake), one CASE per test:
+#   graphs     every material of graphs/*.sg through `splatc glsl` +
+#              glslangValidator -V + spirv-val, and `splatc spirv` + spirv-val;
+#              outputs byte-identical across runs
+#   status     exit codes 0 / 1 / 2, nothing written on error
+#   eval       `splatc eval` values and --interval bounds
+#   tools      dot, dump --after, check of several files
+#   malformed  empty file, binary garbage, truncated files, 10 MB inputs,
+#              10000-deep instance nesting: exit 1 with a diagnostic, no crash
+#              or hang
+set -u
+SPLATC=$1
+CASE=$2
+TMP=$(mktemp -d "${TMPDIR:-/tmp}/splatc_cli.XXXXXX")
+trap 'rm -rf "$TMP"' EXIT
+fails=0
+
+fail() { echo "FAIL: $*"; fails=$((fails + 1)); }
+
+# run EXPECTED_STATUS CMD... : status must match; stderr kept in $TMP/err
+run() {
+    want=$1; shift
+    timeout 120 "$@" >"$TMP/out" 2>"$TMP/err"
+    got=$?
+    if [ "$got" != "$want" ]; then
+        fail "'$*' exited $got, expected $want"; sed 's/^/    /' "$TMP/err" | head -20
+    fi
+}
+
+# diag FILE: splatc check FILE must exit 1 with a file:line:col diagnostic
+diag() {
+    run 1 "$SPLATC" check "$1"
+    grep -q "error: " "$TMP/err" || fail "no diagnostic for $1"
+}
+
+materials() { sed -n 's/^material[ \t]*\([A-Za-z_][A-Za-z0-9_]*\).*/\1/p' "$1"; }
+
+case $CASE in
+graphs)
+    n=0
+    for g in graphs/*.sg; do
+        for m in $(materials "$g"); do
+            n=$((n + 1))
+            run 0 "$SPLATC" glsl "$g" -m "$m" -o "$TMP/$m.frag"
+            run 0 glslangValidator -V -S frag "$TMP/$m.frag" -o "$TMP/$m.gv.spv"
+            run 0 spirv-val --target-env vulkan1.2 "$TMP/$m.gv.spv"
+            run 0 "$SPLATC" spirv "$g" -m "$m" -o "$TMP/$m.spv"
+            run 0 spirv-val --target-env vulkan1.2 "$TMP/$m.spv"
+            run 0 "$SPLATC" glsl "$g" -m "$m" -o "$TMP/$m.2.frag"
+            cmp -s "$TMP/$m.frag" "$TMP/$m.2.frag" || fail "glsl of $m differs between runs"
+            run 0 "$SPLATC" spirv "$g" -m "$m" -o "$TMP/$m.2.spv"
+            cmp -s "$TMP/$m.spv" "$TMP/$m.2.spv" || fail "spirv of $m differs between runs"
+            grep -q "^#version 450" "$TMP/$m.frag" || fail "$m.frag has no #version 450"
+        done
+    done
+    [ "$n" -ge 3 ] || fail "only $n materials in graphs/"
+    echo "$n materials compiled and validated"
+    ;;
+status)
+    run 0 "$SPLATC" --version
+    grep -q "^splatc " "$TMP/out" || fail "--version prints no version"
+    run 0 "$SPLATC" --help
+    grep -q "usage" "$TMP/out" || fail "--help prints no usage"
+    run 0 "$SPLATC" check graphs/cliff.sg
+    run 2 "$SPLATC"
+    run 2 "$SPLATC" frobnicate
+    run 2 "$SPLATC" check
+    run 2 "$SPLATC" glsl graphs/cliff.sg
+    run 2 "$SPLATC" spirv graphs/cliff.sg -m cliff
+    run 2 "$SPLATC" glsl graphs/cliff.sg -m cliff --bogus
+    run 2 "$SPLATC" dump graphs/cliff.sg -m cliff --after nonsense
+    run 2 "$SPLATC" eval graphs/cliff.sg -m cliff --at slope
+    run 1 "$SPLATC" glsl graphs/cliff.sg -m no_such_material
+    run 1 "$SPLATC" check no/such/file.sg
+    grep -q "cannot read 'no/such/file.sg'" "$TMP/err" || fail "no IO diagnostic"
+    # errors are file:line:col with the source line and a caret
+    run 1 "$SPLATC" check tests/golden/unknown_node.sg
+    grep -q "^tests/golden/unknown_node.sg:5:14: error: unknown node type 'rampp'" "$TMP/err" ||
+        fail "unknown_node diagnostic"
+    grep -q "^ *| *\^" "$TMP/err" || fail "no caret line"
+    # nothing is written on error, and no temporary file is left behind
+    run 1 "$SPLATC" glsl tests/golden/type_mismatch.sg -m m -o "$TMP/bad.frag"
+    [ ! -e "$TMP/bad.frag" ] || fail "output written despite errors"
+    run 1 "$SPLATC" spirv tests/golden/type_mismatch.sg -m m -o "$TMP/bad.spv"
+    [ ! -e "$TMP/bad.spv" ] || fail "spirv written despite errors"
+    echo "old" > "$TMP/keep.frag"
+    run 1 "$SPLATC" glsl tests/golden/cycle.sg -m m -o "$TMP/keep.frag"
+    [ "$(cat "$TMP/keep.frag")" = old ] || fail "existing output replaced on error"
+    run 0 "$SPLATC" glsl graphs/cliff.sg -m cliff -o "$TMP/good.frag"
+    ls "$TMP" | grep -q "tmp-" && fail "temporary files left in $TMP"
+    ;;
+eval)
+    # the cliff mask: 0 on flat ground, 1 on steep ground (overlay keeps both)
+    run 0 "$SPLATC" eval graphs/cliff.sg -m cliff --output mask --at slope=0.1
+    [ "$(cat "$TMP/out")" = 0 ] || fail "cliff mask on flat ground: $(cat "$TMP/out")"
+    run 0 "$SPLATC" eval graphs/cliff.sg -m cliff --output mask --at slope=0.9
+    [ "$(cat "$TMP/out")" = 1 ] || fail "cliff mask on steep ground: $(cat "$TMP/out")"
+    # a param changes the value: roughness = mix(0.85, 0.3, wetness)
+    run 0 "$SPLATC" eval graphs/cliff.sg -m cliff --output roughness --at slope=0.5
+    [ "$(cat "$TMP/out")" = 0.74 ] || fail "roughness at the default wetness: $(cat "$TMP/out")"
+    run 0 "$SPLATC" eval graphs/cliff.sg -m cliff --output roughness --at slope=0.5,wetness=0
+    [ "$(cat "$TMP/out")" = 0.85 ] || fail "roughness at wetness 0: $(cat "$TMP/out")"
+    run 0 "$SPLATC" eval graphs/cliff.sg -m cliff --at height=100,slope=0.5,normal=0,0.5,0.86,position=3,4
+    grep -q "^normal = 0 0.5 0.86$" "$TMP/out" || fail "normal output: $(cat "$TMP/out")"
+    [ "$(wc -l < "$TMP/out")" = 5 ] || fail "eval prints 5 outputs"
+    # intervals: the mask is exactly 1 over a steep band, exactly 0 over a
+    # flat one, and the bounds over all slopes contain 0 and 1 (sound)
+    run 0 "$SPLATC" eval graphs/cliff.sg -m cliff --interval --output mask --at slope=0.6:0.9
+    [ "$(cat "$TMP/out")" = "[1, 1]" ] || fail "interval steep: $(cat "$TMP/out")"
+    run 0 "$SPLATC" eval graphs/cliff.sg -m cliff --interval --output mask --at slope=0:0.3
+    [ "$(cat "$TMP/out")" = "[0, 0]" ] || fail "interval flat: $(cat "$TMP/out")"
+    run 0 "$SPLATC" eval graphs/cliff.sg -m cliff --interval --output mask --at slope=0:1
+    tr -d '[],' < "$TMP/out" | awk '{ exit !($1 <= 0 && $2 >= 1) }' ||
+        fail "interval all: $(cat "$TMP/out")"
+    run 2 "$SPLATC" eval graphs/cliff.sg -m cliff --at slope=0:1
+    run 2 "$SPLATC" eval graphs/cliff.sg -m cliff --at nothing=1
+    ;;
+tools)
+    run 0 "$SPLATC" check graphs/cliff.sg graphs/grass.sg nodes/masks.sg nodes/compositors.sg
+    run 1 "$SPLATC" check graphs/cliff.sg tests/golden/cycle.sg
+    grep -q "cycle: a -> c -> b -> a" "$TMP/err" || fail "cycle path not shown"
+    run 0 "$SPLATC" dot graphs/cliff.sg -m cliff -o "$TMP/c.dot"
+    grep -q "^digraph" "$TMP/c.dot" || fail "dot output"
+    grep -q "cluster_overlay" "$TMP/c.dot" || fail "dot lacks the instanced shader"
+    if command -v dot >/dev/null; then run 0 dot -Tsvg "$TMP/c.dot" -o "$TMP/c.svg"; fi
+    run 0 "$SPLATC" dump graphs/cliff.sg -m cliff --after lower
+    grep -q "^out cliff.mask = " "$TMP/out" || fail "dump has no roots"
+    lowered=$(wc -l < "$TMP/out")
+    run 0 "$SPLATC" dump graphs/cliff.sg -m cliff
+    [ "$(wc -l < "$TMP/out")" -lt "$lowered" ] || fail "optimised dump not smaller"
+    ;;
+malformed)
+    : > "$TMP/empty.sg"
+    diag "$TMP/empty.sg"
+    awk 'BEGIN { srand(7); for (i = 0; i < 200000; i++) printf "%c", 1 + int(rand() * 255) }' \
+        > "$TMP/garbage.sg"
+    diag "$TMP/garbage.sg"
+    # truncated: every graph without its closing brace, and cut at many points
+    for g in graphs/*.sg nodes/*.sg; do
+        size=$(wc -c < "$g")
+        last=$(grep -b -o '}' "$g" | tail -1 | cut -d: -f1)
+        head -c "$last" "$g" > "$TMP/trunc.sg"
+        diag "$TMP/trunc.sg"
+        for pct in 7 19 33 48 61 77 89 97; do
+            head -c $((size * pct / 100)) "$g" > "$TMP/cut.sg"
+            timeout 60 "$SPLATC" check "$TMP/cut.sg" > /dev/null 2>&1
+            st=$?
+            [ $st -le 1 ] || fail "$g cut at $pct%: exit $st"
+        done
+    done
+    # 10 MB: a material of 200 000 nodes with one error at the very end,
+    # and 10 MB of garbage
+    awk 'BEGIN { print "material big {"; print "  node n0 : terrain.slope";
+                 for (i = 1; i < 200000; i++) printf "  node n%d : abs { x = n%d.out }  # padding padding\n", i, i - 1;
+                 print "  out mask = n199999.oops"; print "}" }' > "$TMP/big.sg"
+    [ "$(wc -c < "$TMP/big.sg")" -ge 10000000 ] || fail "big.sg is not 10 MB"
+    diag "$TMP/big.sg"
+    grep -q "big.sg:200002:" "$TMP/err" || fail "error in the 10 MB file not located"
+    awk 'BEGIN { srand(3); for (i = 0; i < 10000000; i++) printf "%c", 32 + int(rand() * 95) }' \
+        > "$TMP/biggarbage.sg"
+    diag "$TMP/biggarbage.sg"
+    # 10000 levels of instances
+    awk 'BEGIN { for (i = 0; i < 10000; i++)
+                   printf "shader s%d { in float x node n : s%d { x = x } out float out = n.out }\n", i, i + 1;
+                 print "shader s10000 { in float x out float out = x }";
+                 print "material m { node n : s0 { x = 1.0 } out mask = n.out }" }' > "$TMP/deep.sg"
+    diag "$TMP/deep.sg"
+    grep -q "nesting deeper than" "$TMP/err" || fail "deep nesting not TOO_DEEP"
+    run 1 "$SPLATC" glsl "$TMP/deep.sg" -m m
+    ;;
+*)
+    echo "unknown case $CASE"; exit 2 ;;
+esac
+[ $fails -eq 0 ] || { echo "$fails failure(s)"; exit 1; }
+echo "ok"
