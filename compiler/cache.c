@@ -7,10 +7,14 @@
  * material changes the GLSL of the composites that contain it and of no
  * other, so only those miss.
  *
- * Layout: DIR/spv1/ab/abcdef….spv (two-hex-digit fan-out).  Entries are
- * written through spv_write_file (temporary file + rename), so a reader —
- * another `splatc build` running at the same time — never sees half an
- * entry; a damaged entry (wrong size or magic) reads as a miss.
+ * Layout: DIR/spv1/ab/abcdef….spv (two-hex-digit fan-out).  An entry is
+ * the module followed by a 4-word trailer (ENTRY_MAGIC, the module's word
+ * count, its XXH3-64 as two words).  Only validated modules are stored and
+ * the trailer proves an entry is the one stored, so a hit needs no new
+ * spirv-val run (which would cost more than the whole warm build).
+ * Entries are written through spv_write_file (temporary file + rename),
+ * so a reader — another `splatc build` running at the same time — never
+ * sees half an entry; a damaged entry reads as a miss.
  */
 #include "scene.h"
 
@@ -28,6 +32,8 @@
 #endif
 
 #define SPIRV_MAGIC 0x07230203u
+#define ENTRY_MAGIC 0x434c5053u   /* "SPLC" */
+#define TRAILER 4                  /* words after the module               */
 
 void splat_shader_key(const char *glsl, int stage, char key[SPLAT_KEY_CHARS + 1])
 {
@@ -143,14 +149,20 @@ bool splat_cache_get(const splat_cache *c, const char *key, uint32_t **words,
     long size = -1;
     if (fseek(f, 0, SEEK_END) == 0)
         size = ftell(f);
-    if (size >= 20 && size % 4 == 0 && fseek(f, 0, SEEK_SET) == 0) {
+    if (size >= 4 * (5 + TRAILER) && size % 4 == 0 && fseek(f, 0, SEEK_SET) == 0) {
         uint32_t *w = malloc((size_t)size);
         if (!w)
             abort();
+        size_t n = (size_t)size / 4 - TRAILER;
         if (fread(w, 1, (size_t)size, f) == (size_t)size && w[0] == SPIRV_MAGIC) {
+            uint64_t h = XXH3_64bits(w, 4 * n);
+            const uint32_t *t = w + n;
+            ok = t[0] == ENTRY_MAGIC && t[1] == (uint32_t)n && t[2] == (uint32_t)h &&
+                 t[3] == (uint32_t)(h >> 32);
+        }
+        if (ok) {
             *words = w;
-            *nwords = (size_t)size / 4;
-            ok = true;
+            *nwords = n;
         } else {
             free(w);
         }
@@ -164,8 +176,18 @@ bool splat_cache_put(const splat_cache *c, const char *key, const uint32_t *word
 {
     if (!c->dir)
         return false;
+    uint32_t *w = malloc(4 * (nwords + TRAILER));
+    if (!w)
+        abort();
+    memcpy(w, words, 4 * nwords);
+    uint64_t h = XXH3_64bits(words, 4 * nwords);
+    w[nwords] = ENTRY_MAGIC;
+    w[nwords + 1] = (uint32_t)nwords;
+    w[nwords + 2] = (uint32_t)h;
+    w[nwords + 3] = (uint32_t)(h >> 32);
     char *path = entry_path(c, key, true);
-    bool ok = spv_write_file(path, words, nwords);
+    bool ok = spv_write_file(path, w, nwords + TRAILER);
     free(path);
+    free(w);
     return ok;
 }

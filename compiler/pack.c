@@ -8,8 +8,9 @@
  *             a reference pass per material and the vertex shader: GLSL,
  *             then each shader's key (cache.c)
  *   glslang   cache lookups first; only misses are compiled, on N threads
- *   validate  spv_validate on every module (a cache entry that fails is
- *             recompiled), new modules stored in the cache
+ *   validate  spv_validate on every newly compiled module, which is then
+ *             stored in the cache (only validated modules are; a hit was
+ *             validated when it was stored, and its entry is checksummed)
  *   write     everything into OUT.tmp-XXXXXX, then swapped into place
  *
  * Determinism: every file is a function of the inputs only (no times, no
@@ -184,15 +185,6 @@ static void validate_job(build *b, job *j)
     if (spv_validate(j->words, j->nwords, &log)) {
         free(log);
         return;
-    }
-    if (j->cached) {  /* a damaged cache entry: compile afresh */
-        free(log);
-        free(j->words);
-        j->words = NULL;
-        j->cached = false;
-        compile_job(b, j);
-        if (j->words && spv_validate(j->words, j->nwords, &log))
-            return;
     }
     free(j->log);
     j->log = log;
@@ -828,7 +820,7 @@ bool splat_build(const splat_build_desc *desc, splat_build_stats *st, sg_diags *
 
     t = now();
     for (int i = 0; i < b.njobs; i++)
-        pending[i] = true;
+        pending[i] = !b.jobs[i].cached;
     run_pool(&b, validate_job, pending, desc->jobs);
     for (int i = 0; i < b.njobs; i++) {
         job *j = &b.jobs[i];
