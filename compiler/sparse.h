@@ -44,6 +44,12 @@
  *   e == 0 -> 0.0, e == 0xFFFF -> 1.0, otherwise
  *   q    = clamp(t / 2^L - 32 * (cell >> L), 0, 32)
  *   value = bilinear(atlas, texel coords slot_origin + 2 + q)
+ *
+ * Against Listing 3: the index is an integer slot (texelFetch, exact at
+ * any atlas size) with two reserved constants instead of a normalised
+ * XZ index; the level texture holds L, not the scale 2^L; slots carry
+ * the padding the listing leaves out; the cell comes from the raster
+ * position, so the indirection texel is one 32-texel tile everywhere.
  */
 #ifndef SPLAT_SPARSE_H
 #define SPLAT_SPARSE_H
