@@ -2,6 +2,7 @@
  * as `T vN = …;`, with the op table's GLSL forms.  Trivial leaves
  * (constants, inputs, params, painted masks, samplers) are written in
  * place.  Values emitted inside a scope are forgotten when it is popped.
+ * The ir must not grow while an emitter on it lives (asserted).
  */
 #include "ir.h"
 
@@ -75,6 +76,7 @@ void glsl_literal(ir_buf *b, ir_type t, const double *v)
 
 struct glsl_emitter {
     const ir  *ir;
+    uint32_t   nnodes;    /* ir->nnodes when created: the ir must not grow */
     glsl_names names;
     ir_buf    *out;
     char     **expr;      /* per node: its GLSL expression once known      */
@@ -91,6 +93,7 @@ glsl_emitter *glsl_emitter_new(const ir *ir, const glsl_names *names, ir_buf *ou
 {
     glsl_emitter *e = xalloc(sizeof *e);
     e->ir = ir;
+    e->nnodes = ir->nnodes;
     if (names)
         e->names = *names;
     e->out = out;
@@ -107,7 +110,7 @@ void glsl_emitter_free(glsl_emitter *e)
 {
     if (!e)
         return;
-    for (uint32_t i = 0; i < e->ir->nnodes; i++)
+    for (uint32_t i = 0; i < e->nnodes; i++)
         free(e->expr[i]);
     free(e->expr);
     free(e->level);
@@ -243,7 +246,7 @@ static int cmp_id(const void *x, const void *y)
 const char *glsl_value(glsl_emitter *e, ir_ref r, const char *indent)
 {
     const ir *ir = e->ir;
-    assert(ir_ref_ok(r) && r.id < ir->nnodes);
+    assert(ir_ref_ok(r) && r.id < e->nnodes && ir->nnodes == e->nnodes);
     if (e->expr[r.id])
         return e->expr[r.id];
     /* Collect what is not yet visible (depth first), then emit it in id
