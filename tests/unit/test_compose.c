@@ -191,17 +191,17 @@ static void eval_root(const ir *ir, const char *name, ir_env *e, double out[4])
 
 /* Multi-pass alpha (back to front, S = mix(S, s_i, m_i)) and front to back
  * (T = 1; w = T m; S += w s; T -= w) over `mats` (top first). */
-static void reference(const ir *src, const int *mats, int n, ir_env *e, int out,
-                      double b2f[4], double f2b[4])
+static void reference(const ir *src, const char *const *names, const int *mats, int n,
+                      ir_env *e, int out, double b2f[4], double f2b[4])
 {
     double m[8], s[8][4];
     for (int j = 0; j < n; j++) {
         char root[64];
-        snprintf(root, sizeof root, "%s.mask", mat_names[mats[j]]);
+        snprintf(root, sizeof root, "%s.mask", names[mats[j]]);
         double mv[4];
         eval_root(src, root, e, mv);
         m[j] = j == n - 1 ? 1.0 : fmin(fmax(mv[0], 0.0), 1.0);
-        snprintf(root, sizeof root, "%s.%s", mat_names[mats[j]], sg_output_names[out]);
+        snprintf(root, sizeof root, "%s.%s", names[mats[j]], sg_output_names[out]);
         eval_root(src, root, e, s[j]);
     }
     for (int c = 0; c < 4; c++) {
@@ -218,17 +218,23 @@ static void reference(const ir *src, const int *mats, int n, ir_env *e, int out,
     }
 }
 
-static void check_exact(fixture *f, const int *mats, int n)
+static void check_exact_with(const splat_layout *L, const int *mats, int n)
 {
     splat_composite c;
-    compose(f, mats, n, false, &c);
+    sg_diags d;
+    sg_diags_init(&d);
+    splat_compose_desc desc = {.materials = mats, .nmaterials = n};
+    bool ok = splat_compose(L, &desc, &c, &d);
+    sg_diags_print(&d, stderr);
+    sg_diags_free(&d);
+    assert_true(ok);
     srand(1234);
     int partial = 0;  /* samples where the top mask is strictly inside (0, 1) */
     for (int i = 0; i < 2000; i++) {
         ir_env e = random_env();
         for (int o = SG_OUT_ALBEDO; o < SG_OUT_COUNT; o++) {
             double b2f[4], f2b[4], got[4];
-            reference(&f->src, mats, n, &e, o, b2f, f2b);
+            reference(L->src, (const char *const *)L->materials, mats, n, &e, o, b2f, f2b);
             char root[64];
             snprintf(root, sizeof root, "composite.%s", sg_output_names[o]);
             eval_root(&c.ir, root, &e, got);
@@ -245,6 +251,11 @@ static void check_exact(fixture *f, const int *mats, int n)
     }
     assert_true(partial > 100);  /* the samples really blend */
     splat_composite_free(&c);
+}
+
+static void check_exact(fixture *f, const int *mats, int n)
+{
+    check_exact_with(&f->L, mats, n);
 }
 
 static void test_exact_against_multipass(void **state)
@@ -467,6 +478,89 @@ static void test_deterministic(void **state)
     splat_composite_free(&b);
 }
 
+/* ---- the same from graph text, with nodes/compositors.sg -------------------- */
+
+static const char GRAPH[] =
+    "import \"nodes/compositors.sg\"\n"
+    "import \"nodes/masks.sg\"\n"
+    "texture rock { file = \"graphs/textures/rock.png\" }\n"
+    "material base {\n"
+    "    node c : sample { tex = rock, uv = terrain.uv }\n"
+    "    out albedo = c.rgb\n"
+    "}\n"
+    "material cliff {\n"
+    "    node m : slope_ramp { lo = 0.2, hi = 0.6 }\n"
+    "    node c : sample { tex = rock, uv = terrain.uv }\n"
+    "    node a : mul { a = c.rgb, b = 0.5 }\n"
+    "    out mask = m.out\n"
+    "    out albedo = a.out\n"
+    "    out roughness = 0.4\n"
+    "}\n"
+    "material snow {\n"
+    "    param float level = 120\n"
+    "    node d : sub { a = terrain.height, b = level }\n"
+    "    node k : mul { a = d.out, b = 0.01 }\n"
+    "    node s : saturate { x = k.out }\n"
+    "    out mask = s.out\n"
+    "    out albedo = vec3(0.95, 0.95, 1.0)\n"
+    "    out roughness = 0.3\n"
+    "    out height = 0.8\n"
+    "}\n";
+
+static void test_graph_compositor(void **state)
+{
+    static const char *const names[] = {"base", "cliff", "snow"};
+    static const char *const search[] = {".", NULL};
+    sg_diags d;
+    sg_diags_init(&d);
+    sg_program *p = sg_load_string("test.sg", GRAPH, search, &d);
+    assert_non_null(p);
+    ir src;
+    ir_init(&src);
+    for (int i = 0; i < 3; i++)
+        assert_true(sg_lower_material(p, names[i], &src, &d));
+    sg_diags_print(&d, stderr);
+    assert_int_equal(d.nerrors, 0);
+
+    splat_layout graph, builtin;
+    assert_true(splat_layout_init(&graph, &src, p, "linear_alpha", names, 3, NULL, 0, &d));
+    assert_true(splat_layout_init(&builtin, &src, NULL, NULL, names, 3, NULL, 0, &d));
+    static const int mats[] = {2, 1, 0};
+    check_exact_with(&graph, mats, 3);
+
+    /* the graph's linear_alpha is the built-in w = T m, T' = T - w: the
+     * same composite, to the byte */
+    splat_composite a, b;
+    splat_compose_desc desc = {.materials = mats, .nmaterials = 3};
+    assert_true(splat_compose(&graph, &desc, &a, &d));
+    assert_true(splat_compose(&builtin, &desc, &b, &d));
+    ir_buf ga = {0}, gb = {0};
+    splat_glsl_desc gd = {.title = "t"};
+    splat_composite_glsl(&graph, &a, &gd, &ga);
+    splat_composite_glsl(&builtin, &b, &gd, &gb);
+    assert_string_equal(ga.s, gb.s);
+    compiles(ga.s, "graph composite");
+
+    /* an unknown compositor is an error, not a crash */
+    splat_layout bad;
+    assert_true(splat_layout_init(&bad, &src, p, "no_such_compositor", names, 3, NULL, 0, &d));
+    splat_composite c;
+    int before = d.nerrors;
+    assert_false(splat_compose(&bad, &desc, &c, &d));
+    assert_true(d.nerrors > before);
+
+    ir_buf_free(&ga);
+    ir_buf_free(&gb);
+    splat_composite_free(&a);
+    splat_composite_free(&b);
+    splat_layout_free(&bad);
+    splat_layout_free(&graph);
+    splat_layout_free(&builtin);
+    ir_free(&src);
+    sg_free(p);
+    sg_diags_free(&d);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -475,6 +569,7 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_placement, setup, teardown),
         cmocka_unit_test_setup_teardown(test_variants_compile, setup, teardown),
         cmocka_unit_test_setup_teardown(test_deterministic, setup, teardown),
+        cmocka_unit_test(test_graph_compositor),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
