@@ -24,8 +24,9 @@
  *    SUBTEXEL_EPS adds margin for the float uv + texel offset): widens gx,
  *    gz by SUBTEXEL_EPS * (largest difference of neighbouring texels);
  *  - texel conversion and filtering arithmetic: UNORM16_EPS (one 16-bit
- *    step) on gx, gz; FLOAT_EPS on the normalised normal, slope, heights
- *    (relative) and positions.
+ *    step) on gx, gz and on heights that vary; FLOAT_EPS on the normalised
+ *    normal and slope, and times the magnitudes involved on heights
+ *    (max_height + |offset|) and positions (the world size).
  * Painted masks (analysis.c) are convex combinations of 8-bit texels and
  * are not widened when constant, so an all-0 / all-1 area stays exact.
  */
@@ -274,12 +275,6 @@ static void gradient_scale(const splat_terrain *t, double *kx, double *kz)
     *kz = t->max_height / (t->size[1] / t->height);
 }
 
-/* Widen [lo, hi] by a relative float error (zero stays exactly zero). */
-static ir_iv widen_rel(double lo, double hi)
-{
-    return iv(lo - fabs(lo) * FLOAT_EPS, hi + fabs(hi) * FLOAT_EPS);
-}
-
 void splat_terrain_ranges(const splat_terrain *t, int x0, int z0, int x1, int z1,
                           ir_ienv *out)
 {
@@ -328,7 +323,9 @@ void splat_terrain_ranges(const splat_terrain *t, int x0, int z0, int x1, int z1
         lo -= UNORM16_EPS * fabs(maxh);
         hi += UNORM16_EPS * fabs(maxh);
     }
-    out->height = widen_rel(lo, hi);       /* scale and offset in float */
+    /* texel * max_height + offset in float: the error scales with both. */
+    double eh = FLOAT_EPS * (fabs(maxh) + fabs(off));
+    out->height = iv(lo - eh, hi + eh);
 
     double kx, kz;
     gradient_scale(t, &kx, &kz);
@@ -365,7 +362,8 @@ void splat_terrain_any_shape(const splat_terrain *t, ir_ienv *env)
     normal_bounds(A, B, env->normal, &env->slope);
     double floor_h = t->max_height >= 0 ? t->height_offset
                                         : t->height_offset + t->max_height;
-    if (floor_h < env->height.lo)
-        env->height.lo = floor_h - fabs(floor_h) * FLOAT_EPS;
+    double eh = FLOAT_EPS * (fabs(t->max_height) + fabs(t->height_offset));
+    if (floor_h - eh < env->height.lo)
+        env->height.lo = floor_h - eh;
     env->position[1] = env->height;
 }
