@@ -5,8 +5,9 @@
  * double-precision reference at many random points of the region (a NaN
  * value only inside [-inf, +inf]); and the optimiser must not change any
  * value (folding evaluates with the same op table).  The GPU third of the
- * check (emitted GLSL on lavapipe) lives in the Vulkan harness, which
- * reuses random_ir.h.
+ * check (emitted GLSL on lavapipe against this reference) is
+ * tests/harness/test_gpu_agree.c; random_ir.h is header-only so that
+ * harness (or any other test) can draw the same graphs.
  */
 #include <setjmp.h>
 #include <stdarg.h>
