@@ -420,7 +420,7 @@ static char **texture_names(build *b)
     return names;
 }
 
-static json_t *manifest(build *b, char **tex_names)
+static json_t *manifest(build *b, char **tex_names, const char *dir)
 {
     const splat_scene *s = &b->scene;
     const sg_scene *sc = s->desc;
@@ -434,6 +434,10 @@ static json_t *manifest(build *b, char **tex_names)
 
     json_t *scene = json_object();
     json_object_set_new(scene, "name", json_string(sc->name ? sc->name : ""));
+    /* relative to the pack folder (`dir` is its sibling: same answer) */
+    char *scene_src = relative_to(dir, b->desc->scene);
+    json_object_set_new(scene, "source", json_string(scene_src));
+    free(scene_src);
     json_t *hf = json_object();
     json_object_set_new(hf, "file", json_string("heightfield.r16"));
     json_object_set_new(hf, "width", json_integer(s->terrain.width));
@@ -639,7 +643,7 @@ static bool write_contents(build *b, const char *dir)
                            tex_names[i]);
     }
     if (ok) {
-        json_t *m = manifest(b, tex_names);
+        json_t *m = manifest(b, tex_names, dir);
         char *text = json_dumps(m, JSON_INDENT(2) | JSON_PRESERVE_ORDER |
                                        JSON_REAL_PRECISION(15));
         json_decref(m);
