@@ -95,6 +95,11 @@ static void print_stats(const splat_build_stats *st, FILE *out)
         total += t[i];
     }
     fprintf(out, "%-16s %8.3f\n", "total", total);
+    if (st->up_to_date) {
+        fprintf(out, "pack up to date: same input bytes, nothing rebuilt\n");
+        fprintf(out, "combinations: %d (0 compiled)\n", st->combos);
+        return;
+    }
     fprintf(out, "combinations: %d (%d from cache, %d compiled)\n", st->combos,
             st->combos_cached, st->combos_compiled);
     fprintf(out, "shaders: %d (%d from cache, %d compiled)\n", st->shaders,

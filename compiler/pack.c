@@ -13,6 +13,12 @@
  *             validated when it was stored, and its entry is checksummed)
  *   write     everything into OUT.tmp-XXXXXX, then swapped into place
  *
+ * Nothing changed: right after loading, the bytes of every input (the
+ * graph files the program read, the heightfield, the painted rasters, the
+ * texture files) are hashed with the compiler version and options; the
+ * manifest records that "inputs" key, and when the existing pack carries
+ * the same key and has all its shader files, the build stops there.
+ *
  * Determinism: every file is a function of the inputs only (no times, no
  * absolute paths: material sources are written relative to the scene's
  * folder); manifest keys in a fixed order, reals with 15 significant
@@ -34,6 +40,8 @@
 #include <sys/stat.h>
 #include <time.h>
 #include <unistd.h>
+
+#include <xxhash.h>
 
 #include "abi.h"
 #include "spv.h"
@@ -107,6 +115,7 @@ typedef struct build {
     job           *jobs;
     int            njobs, capjobs;
     splat_cache    cache;
+    char           inputs[SPLAT_KEY_CHARS + 1]; /* key of every input file */
     sg_diags      *d;
     sg_loc         loc;       /* the scene file, for errors without a line */
 } build;
@@ -431,6 +440,7 @@ static json_t *manifest(build *b, char **tex_names, const char *dir)
     json_object_set_new(m, "version", json_integer(1));
     json_object_set_new(m, "abi", json_integer(SPLAT_ABI_VERSION));
     json_object_set_new(m, "compiler", json_string("splatc " SPLATC_VERSION));
+    json_object_set_new(m, "inputs", json_string(b->inputs));
 
     json_t *scene = json_object();
     json_object_set_new(scene, "name", json_string(sc->name ? sc->name : ""));
@@ -742,6 +752,101 @@ static bool write_pack(build *b)
     return ok;
 }
 
+/* ---- nothing changed? ---------------------------------------------------- */
+
+static bool hash_file(XXH3_state_t *st, const char *path)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return false;
+    char buf[1 << 16];
+    size_t n, total = 0;
+    while ((n = fread(buf, 1, sizeof buf, f)) > 0) {
+        XXH3_128bits_update(st, buf, n);
+        total += n;
+    }
+    bool ok = !ferror(f);
+    fclose(f);
+    /* the length separates one file from the next */
+    XXH3_128bits_update(st, &total, sizeof total);
+    return ok;
+}
+
+/* The key of everything the pack is made from (contents, not names or
+ * times, so a moved or touched scene is still up to date).  False if a
+ * file cannot be read (then there is no shortcut). */
+static bool inputs_key(build *b)
+{
+    const splat_scene *s = &b->scene;
+    XXH3_state_t *st = XXH3_createState();
+    if (!st)
+        abort();
+    XXH3_128bits_reset(st);
+    char head[128];
+    int n = snprintf(head, sizeof head, "splatc %s\nabi %d\nflat %d\n", SPLATC_VERSION,
+                     SPLAT_ABI_VERSION, b->desc->flat);
+    XXH3_128bits_update(st, head, (size_t)n);
+    bool ok = true;
+    for (int i = 0; ok && i < sg_file_count(s->prog); i++)
+        ok = hash_file(st, sg_file_path(s->prog, i));
+    ok = ok && hash_file(st, s->desc->heightfield);
+    for (int i = 0; ok && i < s->desc->npainted; i++)
+        ok = hash_file(st, s->desc->painted[i].file);
+    for (int i = 0; ok && i < s->ir.ntextures; i++)
+        ok = hash_file(st, s->ir.textures[i].file);
+    XXH128_hash_t h = XXH3_128bits_digest(st);
+    XXH3_freeState(st);
+    snprintf(b->inputs, sizeof b->inputs, "%016llx%016llx", (unsigned long long)h.high64,
+             (unsigned long long)h.low64);
+    if (!ok)
+        b->inputs[0] = 0;  /* recorded as "": never up to date */
+    return ok;
+}
+
+static bool has_files(const char *pack, json_t *shader)
+{
+    const char *keys[] = {"glsl", "spirv"};
+    for (int i = 0; i < 2; i++) {
+        const char *rel = json_string_value(json_object_get(shader, keys[i]));
+        if (!rel)
+            return false;
+        char *path = xasprintf("%s/%s", pack, rel);
+        bool ok = access(path, R_OK) == 0;
+        free(path);
+        if (!ok)
+            return false;
+    }
+    return true;
+}
+
+/* Does the pack at desc->out already hold what this build would write?
+ * On yes, *ncombos is its combination count. */
+static bool up_to_date(build *b, int *ncombos)
+{
+    char *mf = xasprintf("%s/manifest.json", b->desc->out);
+    json_t *m = json_load_file(mf, 0, NULL);
+    free(mf);
+    if (!m)
+        return false;
+    const char *key = json_string_value(json_object_get(m, "inputs"));
+    bool ok = key && strcmp(key, b->inputs) == 0;
+    json_t *combos = json_object_get(m, "combinations");
+    ok = ok && json_is_array(combos);
+    for (size_t i = 0; ok && i < json_array_size(combos); i++) {
+        json_t *c = json_array_get(combos, i);
+        ok = has_files(b->desc->out, c) &&
+             (!b->desc->flat || has_files(b->desc->out, json_object_get(c, "flat")));
+    }
+    json_t *mats = json_object_get(m, "materials");
+    for (size_t i = 0; ok && i < json_array_size(mats); i++)
+        ok = has_files(b->desc->out, json_object_get(json_array_get(mats, i), "reference"));
+    ok = ok && has_files(b->desc->out, json_object_get(m, "uber")) &&
+         has_files(b->desc->out, json_object_get(m, "vertex"));
+    *ncombos = ok ? (int)json_array_size(combos) : 0;
+    json_decref(m);
+    return ok;
+}
+
 /* ---- the pipeline --------------------------------------------------------- */
 
 static void build_free(build *b)
@@ -794,6 +899,12 @@ bool splat_build(const splat_build_desc *desc, splat_build_stats *st, sg_diags *
     st->load = now() - t;
     if (!b.scene_ok || d->nerrors > errors)
         goto out;
+    if (inputs_key(&b) && up_to_date(&b, &st->combos)) {
+        st->up_to_date = true;
+        st->load = now() - t;
+        goto out;
+    }
+    st->load = now() - t;
 
     t = now();
     b.analysis_ok = splat_analyze(&b.scene, &b.analysis, d);

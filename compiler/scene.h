@@ -232,12 +232,16 @@ typedef struct splat_build_stats {
     double load, analysis, compose, glslang, validate, write; /* seconds     */
     int    combos, combos_cached, combos_compiled;  /* composite shaders     */
     int    shaders, shaders_cached, shaders_compiled; /* every module         */
+    bool   up_to_date;       /* the pack already held this build's output:
+                                nothing after `load` ran (combos = its count) */
 } splat_build_stats;
 
 /* Load, analyse, compose every combination, compile (cache first, then
  * glslang on `jobs` threads), validate, and write the pack into
- * OUT.tmp-XXXXXX, then swap it into place.  On any error (diagnostics in
- * `d`) an existing pack at `out` is left untouched. */
+ * OUT.tmp-XXXXXX, then swap it into place.  When the pack at `out` was
+ * built from the same input bytes, stop after loading (stats->up_to_date).
+ * On any error (diagnostics in `d`) an existing pack at `out` is left
+ * untouched. */
 bool splat_build(const splat_build_desc *desc, splat_build_stats *stats,
                  sg_diags *d);
 

@@ -266,8 +266,17 @@ static void test_incremental(void **state)
     assert_int_equal(compiled, n);
     free(out);
 
+    /* touched, not changed: the pack is up to date, nothing is rebuilt */
     assert_int_equal(run(NULL, "touch '%s' '%s/graphs/grass.sg'", scene, root), 0);
     out = build(0, scene, pack, opts);
+    if (!strstr(out, "pack up to date"))
+        fail_msg("touched scene rebuilt:\n%s", out);
+    free(out);
+
+    /* a new pack from the same cache: every shader from the cache */
+    char pack2[200];
+    snprintf(pack2, sizeof pack2, "%s/inc2", tmp);
+    out = build(0, scene, pack2, opts);
     stats_line(out, "combinations", &n, &cached, &compiled);
     assert_int_equal(compiled, 0);
     assert_int_equal(cached, n);
@@ -275,6 +284,7 @@ static void test_incremental(void **state)
     stats_line(out, "shaders", &ns, &scached, &scompiled);
     assert_int_equal(scompiled, 0);
     free(out);
+    assert_int_equal(run(NULL, "diff -r '%s' '%s'", pack, pack2), 0);
 
     /* which combinations hold the rock material */
     json_t *m = load_manifest(pack);
@@ -308,6 +318,29 @@ static void test_incremental(void **state)
     if (run(&out, "diff -r '%s' '%s'", pack, cold) != 0)
         fail_msg("cached and cold packs differ:\n%s", out);
     free(out);
+
+    /* a damaged cache entry (combination 0's) is a miss, compiled afresh */
+    m = load_manifest(pack);
+    const char *key = json_string_value(
+        json_object_get(json_array_get(json_object_get(m, "combinations"), 0), "hash"));
+    assert_non_null(key);
+    char entry[400];
+    snprintf(entry, sizeof entry, "%s/cache-inc/spv1/%.2s/%s.spv", tmp, key, key);
+    json_decref(m);
+    FILE *f = fopen(entry, "r+b");
+    assert_non_null(f);
+    fseek(f, 40, SEEK_SET);
+    int byte = fgetc(f);
+    fseek(f, 40, SEEK_SET);
+    fputc(byte ^ 0x40, f);
+    fclose(f);
+    char pack3[200];
+    snprintf(pack3, sizeof pack3, "%s/inc3", tmp);
+    out = build(0, scene, pack3, opts);
+    stats_line(out, "combinations", &n, &cached, &compiled);
+    assert_int_equal(compiled, 1);
+    free(out);
+    assert_int_equal(run(NULL, "diff -r '%s' '%s'", pack, pack3), 0);
 }
 
 /* Each bad scene: exit 1, a file:line:col error, the pack untouched and no
