@@ -27,8 +27,9 @@ void rt_tonemap_rgba8(const float *rgba, int w, int h, rt_tonemap tm,
                 v = 0.0f;
             if (c < 3) {
                 if (tm == RT_TONEMAP_FILMIC) {
-                    v = v < 0.0f ? 0.0f : v * 1.6f;       /* exposure */
-                    v = srgb_encode(v / (1.0f + v));
+                    /* exposure, then Narkowicz's fit of the ACES curve */
+                    v = v < 0.0f ? 0.0f : v * 0.8f;
+                    v = srgb_encode(v * (2.51f * v + 0.03f) / (v * (2.43f * v + 0.59f) + 0.14f));
                 } else if (tm == RT_TONEMAP_SRGB) {
                     v = srgb_encode(v);
                 }

@@ -325,38 +325,42 @@ static bool pack_pipeline(rt_device *d, rt_pipelines *pl, const rt_spirv *fs,
     return ok;
 }
 
-bool rt_pipelines_combos(rt_device *d, const rt_pack *p, const rt_passes *rp,
-                         rt_pipelines *pl, VkPipeline **out, rt_error *e)
+bool rt_pipelines_combo(rt_device *d, const rt_pack *p, const rt_passes *rp,
+                        rt_pipelines *pl, int id, bool wire, VkPipeline *out,
+                        rt_error *e)
 {
-    VkPipeline *ps = calloc((size_t)p->ncombos, sizeof *ps);
-    if (!ps)
-        return rt_fail(e, RT_E_VULKAN, "pipelines", "out of memory");
-    for (int i = 0; i < p->ncombos; i++) {
-        if (!pack_pipeline(d, pl, &p->combos[i].spirv, rp->main, K_OPAQUE, false, &ps[i], e)) {
-            for (int k = 0; k < i; k++)
-                vkDestroyPipeline(d->dev, ps[k], NULL);
-            free(ps);
-            return false;
-        }
-    }
-    *out = ps;
+    if (wire && !d->wireframe)
+        return rt_fail(e, RT_E_NO_FORMAT, "draw wireframe (no fillModeNonSolid)");
+    VkPipeline *slot = wire ? &pl->combo_wire[id] : &pl->combo[id];
+    if (!*slot && !pack_pipeline(d, pl, &p->combos[id].spirv, rp->main, K_OPAQUE, wire, slot, e))
+        return false;
+    *out = *slot;
     return true;
 }
 
-bool rt_pipelines_wire(rt_device *d, const rt_pack *p, const rt_passes *rp,
-                       rt_pipelines *pl, rt_error *e)
+static void destroy_combos(rt_device *d, rt_pipelines *pl)
 {
-    if (pl->combo_wire)
-        return true;
-    if (!d->wireframe)
-        return rt_fail(e, RT_E_NO_FORMAT, "draw wireframe (no fillModeNonSolid)");
-    pl->combo_wire = calloc((size_t)pl->ncombos, sizeof *pl->combo_wire);
-    if (!pl->combo_wire)
+    for (int i = 0; i < pl->ncombos; i++) {
+        if (pl->combo && pl->combo[i])
+            vkDestroyPipeline(d->dev, pl->combo[i], NULL);
+        if (pl->combo_wire && pl->combo_wire[i])
+            vkDestroyPipeline(d->dev, pl->combo_wire[i], NULL);
+    }
+    free(pl->combo);
+    free(pl->combo_wire);
+    pl->combo = pl->combo_wire = NULL;
+    pl->ncombos = 0;
+}
+
+bool rt_pipelines_reset_combos(rt_device *d, const rt_pack *p, rt_pipelines *pl,
+                               rt_error *e)
+{
+    destroy_combos(d, pl);
+    pl->combo = calloc((size_t)p->ncombos, sizeof *pl->combo);
+    pl->combo_wire = calloc((size_t)p->ncombos, sizeof *pl->combo_wire);
+    if (!pl->combo || !pl->combo_wire)
         return rt_fail(e, RT_E_VULKAN, "pipelines", "out of memory");
-    for (int i = 0; i < pl->ncombos; i++)
-        if (!pack_pipeline(d, pl, &p->combos[i].spirv, rp->main, K_OPAQUE, true,
-                           &pl->combo_wire[i], e))
-            return false;
+    pl->ncombos = p->ncombos;
     return true;
 }
 
@@ -392,9 +396,8 @@ bool rt_pipelines_create(rt_device *d, const rt_pack *p, const rt_passes *rp,
     if (!make_layouts(d, ntextures, pl, e) || !open_cache(d, pl, cache_path, e) ||
         !make_module(d, p->vertex.words, p->vertex.nwords, &pl->vertex, e))
         return false;
-    if (!rt_pipelines_combos(d, p, rp, pl, &pl->combo, e))
+    if (!rt_pipelines_reset_combos(d, p, pl, e))
         return false;
-    pl->ncombos = p->ncombos;
     if (ref == RT_REF_MULTIPASS) {
         for (int i = 0; i < p->nmaterials; i++)
             if (!p->materials[i].reference.words) {
@@ -431,12 +434,7 @@ void rt_pipelines_destroy(rt_device *d, rt_pipelines *pl)
         save_cache(d, pl);
         vkDestroyPipelineCache(d->dev, pl->cache, NULL);
     }
-    for (int i = 0; i < pl->ncombos; i++) {
-        if (pl->combo && pl->combo[i])
-            vkDestroyPipeline(d->dev, pl->combo[i], NULL);
-        if (pl->combo_wire && pl->combo_wire[i])
-            vkDestroyPipeline(d->dev, pl->combo_wire[i], NULL);
-    }
+    destroy_combos(d, pl);
     for (int i = 0; i < pl->nref; i++)
         if (pl->ref[i])
             vkDestroyPipeline(d->dev, pl->ref[i], NULL);
@@ -456,8 +454,6 @@ void rt_pipelines_destroy(rt_device *d, rt_pipelines *pl)
         vkDestroyDescriptorSetLayout(d->dev, pl->set_material, NULL);
     if (pl->set_resolve)
         vkDestroyDescriptorSetLayout(d->dev, pl->set_resolve, NULL);
-    free(pl->combo);
-    free(pl->combo_wire);
     free(pl->ref);
     free(pl->cache_path);
     memset(pl, 0, sizeof *pl);

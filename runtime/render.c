@@ -476,10 +476,8 @@ void rt_renderer_set_view(rt_renderer *r, splat_view view, int material)
 
 void rt_renderer_set_wireframe(rt_renderer *r, bool on)
 {
-    rt_error e = { 0 };
-    if (on && !rt_pipelines_wire(r->d, r->p, &r->rp, &r->pl, &e)) {
-        fprintf(stderr, "splatrt: %s\n", e.msg ? e.msg : "wireframe unavailable");
-        rt_error_clear(&e);
+    if (on && !r->d->wireframe) {
+        fprintf(stderr, "splatrt: wireframe unavailable (no fillModeNonSolid)\n");
         on = false;
     }
     r->wireframe = on;
@@ -708,12 +706,16 @@ bool rt_renderer_frame(rt_renderer *r, const rt_camera *c, rt_frame_stats *st, r
             }
             draw_patches(r, cb, c, r->sorted, n);
         } else {
-            VkPipeline *ps = r->wireframe && r->pl.combo_wire ? r->pl.combo_wire : r->pl.combo;
             int start = 0;
             for (int k = 0; k < r->ncombos; k++) {
                 int end = r->counts[k];
                 if (end > start) {
-                    vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_GRAPHICS, ps[k]);
+                    VkPipeline pipe;
+                    if (!rt_pipelines_combo(d, r->p, &r->rp, &r->pl, k, r->wireframe, &pipe, e)) {
+                        vkEndCommandBuffer(cb);
+                        return false;
+                    }
+                    vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_GRAPHICS, pipe);
                     binds++;
                     draw_patches(r, cb, c, r->sorted + start, end - start);
                 }
@@ -789,27 +791,14 @@ bool rt_renderer_swap_pack(rt_renderer *r, const rt_pack *p, rt_error *e)
         p->cell_texels != o->cell_texels || p->ntextures != o->ntextures ||
         p->params_size > o->params_size || p->nlevels != o->nlevels)
         return rt_fail(e, RT_E_RELOAD, "the new pack changes the terrain or its resources; restart splatview");
-    VkPipeline *ps;
-    if (!rt_pipelines_combos(r->d, p, &r->rp, &r->pl, &ps, e))
-        return false;
     int *counts = calloc((size_t)p->ncombos + 1, sizeof *counts);
-    if (!counts) {
-        for (int i = 0; i < p->ncombos; i++)
-            vkDestroyPipeline(r->d->dev, ps[i], NULL);
-        free(ps);
+    if (!counts)
         return rt_fail(e, RT_E_RELOAD, "out of memory");
-    }
     vkDeviceWaitIdle(r->d->dev);
-    for (int i = 0; i < r->pl.ncombos; i++) {
-        vkDestroyPipeline(r->d->dev, r->pl.combo[i], NULL);
-        if (r->pl.combo_wire)
-            vkDestroyPipeline(r->d->dev, r->pl.combo_wire[i], NULL);
+    if (!rt_pipelines_reset_combos(r->d, p, &r->pl, e)) {
+        free(counts);
+        return false;
     }
-    free(r->pl.combo);
-    free(r->pl.combo_wire);
-    r->pl.combo_wire = NULL;
-    r->pl.combo = ps;
-    r->pl.ncombos = p->ncombos;
     free(r->counts);
     r->counts = counts;
     r->ncombos = p->ncombos;
@@ -819,8 +808,6 @@ bool rt_renderer_swap_pack(rt_renderer *r, const rt_pack *p, rt_error *e)
     for (int i = 0; i < p->nparams; i++)
         memcpy((uint8_t *)r->params_ubo.map + p->params[i].offset, p->params[i].value, 16);
     r->p = p;
-    if (r->wireframe)
-        rt_renderer_set_wireframe(r, true);
     return true;
 }
 

@@ -143,7 +143,7 @@ bool rt_spirv_validate(const uint32_t *words, size_t nwords, const char *name,
 
 /* How float colours become 8-bit PNG pixels. */
 typedef enum rt_tonemap {
-    RT_TONEMAP_FILMIC,   /* lit colour: exposure, x/(1+x), sRGB encode      */
+    RT_TONEMAP_FILMIC,   /* lit colour: exposure 0.8, ACES fit, sRGB encode */
     RT_TONEMAP_SRGB,     /* linear colour (albedo): clamp, sRGB encode      */
     RT_TONEMAP_NONE,     /* display values (debug views): clamp only        */
 } rt_tonemap;
@@ -354,18 +354,23 @@ typedef struct rt_passes {
     VkRenderPass resolve;    /* RGBA32F colour                               */
 } rt_passes;
 
-/* Layouts, the pipeline cache and the pipelines `ref` needs: always the
- * combinations; the per-material passes and the resolve pass for
- * RT_REF_MULTIPASS; the über-shader for RT_REF_UBER. */
+/* Layouts, the pipeline cache and the pipelines `ref` needs: the
+ * per-material passes and the resolve pass for RT_REF_MULTIPASS, the
+ * über-shader for RT_REF_UBER.  Combination pipelines are made on first
+ * use (rt_pipelines_combo): a view of colorado needs 20 of its 166, and
+ * lavapipe compiles each in tens of milliseconds. */
 bool rt_pipelines_create(rt_device *d, const rt_pack *p, const rt_passes *rp,
                          rt_reference ref, const char *cache_path,
                          int ntextures, rt_pipelines *pl, rt_error *e);
-/* The combination pipelines of `p` only (hot reload: built beside the old
- * ones with the same layouts). */
-bool rt_pipelines_combos(rt_device *d, const rt_pack *p, const rt_passes *rp,
-                         rt_pipelines *pl, VkPipeline **out, rt_error *e);
-bool rt_pipelines_wire(rt_device *d, const rt_pack *p, const rt_passes *rp,
-                       rt_pipelines *pl, rt_error *e);
+/* The pipeline of combination `id` (filled or wireframe), made now if it
+ * does not exist yet. */
+bool rt_pipelines_combo(rt_device *d, const rt_pack *p, const rt_passes *rp,
+                        rt_pipelines *pl, int id, bool wire, VkPipeline *out,
+                        rt_error *e);
+/* Drop every combination pipeline (hot reload: the next frames make those
+ * of the new pack); the array is resized to p->ncombos. */
+bool rt_pipelines_reset_combos(rt_device *d, const rt_pack *p, rt_pipelines *pl,
+                               rt_error *e);
 /* Saves the cache (if it has a path) and destroys everything. */
 void rt_pipelines_destroy(rt_device *d, rt_pipelines *pl);
 

@@ -112,6 +112,23 @@ viewer)
     [ $rc = 0 ] || fail "viewer exit $rc"
     "$IC" nonuniform "$OUT/shot.png" || fail "viewer screenshot is uniform"
     ;;
+real)
+    # a pack written by splatc build: pictures, combination colours, and the
+    # exactness of the composites against both references
+    run "$PACK" --headless --size 320x200 -o "$OUT/default.png"
+    "$IC" nonuniform "$OUT/default.png" || fail "default view is uniform"
+    run "$PACK" --headless --size 320x200 --view combos --clear 0,0,0 --stats -o "$OUT/combos.png" > "$OUT/stats.txt"
+    want=$(sed -n 's/^combinations in view: \([0-9]*\) of.*/\1/p' "$OUT/stats.txt")
+    got=$("$IC" colors "$OUT/combos.png" 0,0,0)
+    echo "combinations in view: $want, colours: $got"
+    [ "$got" = "$want" ] || fail "$got colours for $want combinations"
+    run "$PACK" --headless --size 320x200 --float-out "$OUT/c.f32"
+    run "$PACK" --headless --size 320x200 --reference multipass --float-out "$OUT/m.f32"
+    run "$PACK" --headless --size 320x200 --reference uber --float-out "$OUT/u.f32"
+    "$IC" finite "$OUT/c.f32" || fail "NaN or Inf in the composite render"
+    "$IC" diff "$OUT/c.f32" "$OUT/m.f32" 0.00392 || fail "multipass differs"
+    "$IC" diff "$OUT/c.f32" "$OUT/u.f32" 1e-5 || fail "uber differs"
+    ;;
 *)
     fail "unknown case $case_"
     ;;

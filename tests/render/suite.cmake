@@ -10,6 +10,7 @@ if(TARGET splatrt AND TARGET splatview)
   target_link_libraries(imgcheck splatrt)
 
   set(RENDER_OUT ${CMAKE_BINARY_DIR}/tests/render)
+  file(MAKE_DIRECTORY ${RENDER_OUT})
   add_test(NAME render.fixture COMMAND make_fixture ${RENDER_OUT}/fixture)
   set_tests_properties(render.fixture PROPERTIES LABELS render FIXTURES_SETUP render_pack)
 
@@ -22,4 +23,17 @@ if(TARGET splatrt AND TARGET splatview)
     set_tests_properties(render.${case} PROPERTIES LABELS render
       FIXTURES_REQUIRED render_pack ENVIRONMENT "SPLAT_VALIDATE=1" TIMEOUT 300)
   endforeach()
+
+  # The same checks on a real pack: examples/minimal through `splatc build`.
+  if(TARGET splatc_cli)
+    add_test(NAME render.pack_minimal
+      COMMAND $<TARGET_FILE:splatc_cli> build ${PROJECT_SOURCE_DIR}/examples/minimal/scene.sg
+              -o ${RENDER_OUT}/minimal --no-cache)
+    set_tests_properties(render.pack_minimal PROPERTIES LABELS render FIXTURES_SETUP minimal_pack)
+    add_test(NAME render.real_minimal
+      COMMAND sh ${RENDER_DIR}/run.sh real $<TARGET_FILE:splatview>
+              $<TARGET_FILE:imgcheck> ${RENDER_OUT}/minimal ${RENDER_OUT}/out)
+    set_tests_properties(render.real_minimal PROPERTIES LABELS render
+      FIXTURES_REQUIRED minimal_pack ENVIRONMENT "SPLAT_VALIDATE=1" TIMEOUT 300)
+  endif()
 endif()
