@@ -118,6 +118,7 @@ typedef struct build {
     char           inputs[SPLAT_KEY_CHARS + 1]; /* key of every input file */
     sg_diags      *d;
     sg_loc         loc;       /* the scene file, for errors without a line */
+    char          *out;       /* desc->out without trailing slashes        */
 } build;
 
 static job *job_add(build *b, job_kind kind, int index, char *file, int stage)
@@ -712,7 +713,7 @@ static bool replaceable(build *b, const char *path, bool *exists)
 
 static bool write_pack(build *b)
 {
-    const char *out = b->desc->out;
+    const char *out = b->out;
     bool exists;
     if (!replaceable(b, out, &exists))
         return false;
@@ -823,7 +824,7 @@ static bool has_files(const char *pack, json_t *shader)
  * On yes, *ncombos is its combination count. */
 static bool up_to_date(build *b, int *ncombos)
 {
-    char *mf = xasprintf("%s/manifest.json", b->desc->out);
+    char *mf = xasprintf("%s/manifest.json", b->out);
     json_t *m = json_load_file(mf, 0, NULL);
     free(mf);
     if (!m)
@@ -834,14 +835,14 @@ static bool up_to_date(build *b, int *ncombos)
     ok = ok && json_is_array(combos);
     for (size_t i = 0; ok && i < json_array_size(combos); i++) {
         json_t *c = json_array_get(combos, i);
-        ok = has_files(b->desc->out, c) &&
-             (!b->desc->flat || has_files(b->desc->out, json_object_get(c, "flat")));
+        ok = has_files(b->out, c) &&
+             (!b->desc->flat || has_files(b->out, json_object_get(c, "flat")));
     }
     json_t *mats = json_object_get(m, "materials");
     for (size_t i = 0; ok && i < json_array_size(mats); i++)
-        ok = has_files(b->desc->out, json_object_get(json_array_get(mats, i), "reference"));
-    ok = ok && has_files(b->desc->out, json_object_get(m, "uber")) &&
-         has_files(b->desc->out, json_object_get(m, "vertex"));
+        ok = has_files(b->out, json_object_get(json_array_get(mats, i), "reference"));
+    ok = ok && has_files(b->out, json_object_get(m, "uber")) &&
+         has_files(b->out, json_object_get(m, "vertex"));
     *ncombos = ok ? (int)json_array_size(combos) : 0;
     json_decref(m);
     return ok;
@@ -871,6 +872,7 @@ static void build_free(build *b)
     if (b->scene_ok)
         splat_scene_free(&b->scene);
     splat_cache_close(&b->cache);
+    free(b->out);
 }
 
 /* glslang's message already says "internal compiler error: …". */
@@ -888,6 +890,12 @@ static void report_job_error(build *b, const job *j)
 bool splat_build(const splat_build_desc *desc, splat_build_stats *st, sg_diags *d)
 {
     build b = {.desc = desc, .d = d, .loc = {.file = desc->scene}};
+    /* "pack/" would put the temporary folder inside the old pack */
+    b.out = strdup(desc->out);
+    if (!b.out)
+        abort();
+    for (size_t n = strlen(b.out); n > 1 && b.out[n - 1] == '/'; n--)
+        b.out[n - 1] = 0;
     splat_build_stats dummy;
     if (!st)
         st = &dummy;
