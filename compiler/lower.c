@@ -107,8 +107,10 @@ static void memo_insert(lowerer *L, int shader, const ir_ref *ins, int nin,
     e->outs = malloc(((size_t)nout + 1) * sizeof *outs);
     if (!e->ins || !e->outs)
         abort();
-    memcpy(e->ins, ins, (size_t)nin * sizeof *ins);
-    memcpy(e->outs, outs, (size_t)nout * sizeof *outs);
+    if (nin)
+        memcpy(e->ins, ins, (size_t)nin * sizeof *ins);
+    if (nout)
+        memcpy(e->outs, outs, (size_t)nout * sizeof *outs);
     L->nmemo++;
 }
 
@@ -277,7 +279,8 @@ static bool inline_shader(lowerer *L, int si, const ir_ref *ins, ir_ref *outs,
     }
     memo_entry *m = memo_find(L, si, ins, s->nins);
     if (m) {
-        memcpy(outs, m->outs, (size_t)s->nouts * sizeof *outs);
+        if (s->nouts)
+            memcpy(outs, m->outs, (size_t)s->nouts * sizeof *outs);
         return true;
     }
     int *off = malloc(((size_t)s->nnodes + 1) * sizeof *off);

@@ -17,6 +17,7 @@
 #include <limits.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 typedef struct parser {
@@ -905,6 +906,13 @@ static char *read_all(const char *path, size_t *len, const char **err)
     FILE *f = fopen(path, "rb");
     if (!f) {
         *err = strerror(errno);
+        return NULL;
+    }
+    /* only regular files: an import of /dev/zero or a FIFO must not hang */
+    struct stat st;
+    if (fstat(fileno(f), &st) || !S_ISREG(st.st_mode)) {
+        *err = "not a regular file";
+        fclose(f);
         return NULL;
     }
     size_t cap = 4096, n = 0;

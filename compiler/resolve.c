@@ -674,7 +674,9 @@ static void check_shader(checker *c, sg_shader *s)
             n->args[j].splat = IR_T_ERROR;
             if (n->kind == SG_NODE_PAINTED && v->kind == SG_V_STRING)
                 continue;
-            if (resolve_path(c, v, true) && v->ref == SG_REF_NODE)
+            resolve_path(c, v, true);
+            /* an edge even if the path was bad after naming a node */
+            if (v->kind == SG_V_PATH && v->ref == SG_REF_NODE)
                 nedges++;
         }
     }
