@@ -27,6 +27,10 @@ run() {
     if [ "$got" != "$want" ]; then
         fail "'$*' exited $got, expected $want"; sed 's/^/    /' "$TMP/err" | head -20
     fi
+    # sanitizer builds exit 1 on a report: look for one too
+    if grep -q "Sanitizer" "$TMP/err"; then
+        fail "'$*': sanitizer report"; grep -A5 Sanitizer "$TMP/err" | head -20
+    fi
 }
 
 # diag FILE: splatc check FILE must exit 1 with a file:line:col diagnostic
