@@ -155,7 +155,8 @@ static char *normalise(char *path)
     if (!comp || !out)
         abort();
     int nc = 0, keep_up = 0;   /* leading ".." components we must keep */
-    for (char *s = strtok(path, "/"); s; s = strtok(NULL, "/")) {
+    char *save = NULL;   /* strtok_r: loading may run on several threads */
+    for (char *s = strtok_r(path, "/", &save); s; s = strtok_r(NULL, "/", &save)) {
         if (!strcmp(s, "."))
             continue;
         if (!strcmp(s, "..")) {
