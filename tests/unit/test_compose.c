@@ -13,6 +13,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "abi.h"
 #include "scene.h"
 #include "spv.h"
 
@@ -462,6 +463,35 @@ static void test_variants_compile(void **state)
     }
 }
 
+/* SPLAT_VIEW_MASK: a case per layer's scene material showing its own
+ * clamped mask (1 for material 0), nothing for materials not in it. */
+static void test_mask_view(void **state)
+{
+    fixture *f = *state;
+    static const int mats[] = {SNOW, BASE};
+    splat_composite c;
+    compose(f, mats, 2, false, &c);
+    char *g = glsl_of(f, &c, false);
+    char want[64];
+    snprintf(want, sizeof want, "u_frame.view.x == %du", SPLAT_VIEW_MASK);
+    assert_non_null(strstr(g, want));
+    assert_non_null(strstr(g, "case 2u:"));  /* snow */
+    assert_non_null(strstr(g, "case 0u:"));  /* base */
+    assert_null(strstr(g, "case 1u:"));      /* cliff is not in it */
+    free(g);
+    srand(99);
+    for (int i = 0; i < 500; i++) {
+        ir_env e = random_env();
+        double top[4], bottom[4], mask[4];
+        eval_root(&c.ir, "layer0.view_mask", &e, top);
+        eval_root(&c.ir, "layer1.view_mask", &e, bottom);
+        eval_root(&f->src, "snow.mask", &e, mask);
+        assert_true(fabs(top[0] - fmin(fmax(mask[0], 0.0), 1.0)) <= 1e-12);
+        assert_true(bottom[0] == 1.0);
+    }
+    splat_composite_free(&c);
+}
+
 /* Same inputs, same text. */
 static void test_deterministic(void **state)
 {
@@ -569,6 +599,7 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_placement, setup, teardown),
         cmocka_unit_test_setup_teardown(test_variants_compile, setup, teardown),
         cmocka_unit_test_setup_teardown(test_deterministic, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_mask_view, setup, teardown),
         cmocka_unit_test(test_graph_compositor),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
