@@ -1,9 +1,890 @@
-/* viewer.c — the GLFW window (being written). */
+/* viewer.c — splatview's window: the renderer's RGBA32F frame tone-mapped
+ * into a GLFW/Vulkan swapchain, a fly camera, debug views on number keys,
+ * wireframe, frame time in the title, and hot reload of the scene's graph
+ * files through libsplatc (splat_build in process, then the combination
+ * pipelines swapped; compile errors go to the console and the title, the
+ * old pipelines stay).
+ *
+ * Keys: W/A/S/D move, Space/Ctrl up/down, mouse with the right button
+ * held looks around, wheel changes speed, 1 final, 2 combinations, 3 LOD,
+ * 4 normal, 5 slope, 6 albedo, 7 mask (again: next material), F wireframe,
+ * R rebuild now, Q/Escape quit.
+ *
+ * --script runs without a person: "frames=N" renders N frames,
+ * "view=NAME", "key=K" acts as if K was pressed, "screenshot=FILE" writes
+ * the swapchain image as the window shows it, "wait_reload=SECONDS" renders
+ * until a hot reload succeeded (compile errors on the way are shown and
+ * survived; the time running out fails the script), "quit" ends. */
 #include "splatrt.h"
+#include "scene.h"
+
+#define GLFW_INCLUDE_VULKAN
+#include <GLFW/glfw3.h>
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <time.h>
+
+static const char tonemap_vert[] =
+    "#version 450\n"
+    "void main() {\n"
+    "    vec2 p = vec2((gl_VertexIndex << 1) & 2, gl_VertexIndex & 2);\n"
+    "    gl_Position = vec4(p * 2.0 - 1.0, 0.0, 1.0);\n"
+    "}\n";
+
+/* The same curves as rt_tonemap_rgba8 (image.c). */
+static const char tonemap_frag[] =
+    "#version 450\n"
+    "layout(set = 0, binding = 0) uniform sampler2D u_src;\n"
+    "layout(push_constant) uniform pc { uint mode; } u_pc;\n"
+    "layout(location = 0) out vec4 o_color;\n"
+    "float srgb(float c) {\n"
+    "    c = clamp(c, 0.0, 1.0);\n"
+    "    return c <= 0.0031308 ? 12.92 * c : 1.055 * pow(c, 1.0 / 2.4) - 0.055;\n"
+    "}\n"
+    "void main() {\n"
+    "    vec3 c = texelFetch(u_src, ivec2(gl_FragCoord.xy), 0).rgb;\n"
+    "    if (u_pc.mode == 0u) {\n"
+    "        c = max(c, vec3(0.0)) * 0.8;\n"
+    "        c = c * (2.51 * c + 0.03) / (c * (2.43 * c + 0.59) + 0.14);\n"
+    "    }\n"
+    "    if (u_pc.mode != 2u) c = vec3(srgb(c.r), srgb(c.g), srgb(c.b));\n"
+    "    o_color = vec4(clamp(c, 0.0, 1.0), 1.0);\n"
+    "}\n";
+
+typedef struct watch {
+    char   **files;
+    double  *mtimes;
+    int      n;
+} watch;
+
+typedef struct viewer {
+    const rt_viewer_desc *desc;
+    GLFWwindow    *win;
+    rt_device      dev;
+    rt_pack       *pack;         /* the renderer points at it: heap, swapped whole */
+    rt_renderer   *r;
+    VkSurfaceKHR   surface;
+    VkSwapchainKHR swapchain;
+    VkFormat       format;
+    VkExtent2D     extent;
+    uint32_t       nimages;
+    VkImage       *images;
+    VkImageView   *views;
+    VkFramebuffer *fbs;
+    VkRenderPass   pass;
+    VkDescriptorSetLayout set_layout;
+    VkPipelineLayout layout;
+    VkPipeline     pipeline;
+    VkDescriptorPool dpool;
+    VkDescriptorSet set;
+    VkSampler      sampler;
+    VkCommandBuffer cb;
+    VkSemaphore    acquired, rendered;
+    VkFence        fence;
+    rt_buffer      shot;
+    /* camera and state */
+    rt_camera      cam;
+    double         yaw, pitch, speed;
+    splat_view     view;
+    int            material;
+    bool           wire, quit, dragging;
+    double         mx, my;
+    /* hot reload */
+    watch          w;
+    const char    *scene;
+    int            reloads, reload_errors;
+    double         last_check;
+    char           status[256];
+    int            status_code;
+} viewer;
+
+static double now_s(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + (double)ts.tv_nsec * 1e-9;
+}
+
+/* ---- camera ----------------------------------------------------------------- */
+
+static void camera_from_angles(viewer *v)
+{
+    double f[3] = { cos(v->pitch) * sin(v->yaw), sin(v->pitch), -cos(v->pitch) * cos(v->yaw) };
+    for (int i = 0; i < 3; i++)
+        v->cam.look[i] = v->cam.position[i] + f[i] * 100.0;
+}
+
+static void angles_from_camera(viewer *v)
+{
+    double f[3], len = 0;
+    for (int i = 0; i < 3; i++) {
+        f[i] = v->cam.look[i] - v->cam.position[i];
+        len += f[i] * f[i];
+    }
+    len = sqrt(len);
+    if (len <= 0)
+        return;
+    v->pitch = asin(f[1] / len);
+    v->yaw = atan2(f[0], -f[2]);
+}
+
+static void move_camera(viewer *v, double dt)
+{
+    GLFWwindow *w = v->win;
+    double f[3] = { sin(v->yaw), 0, -cos(v->yaw) }, r[3] = { cos(v->yaw), 0, sin(v->yaw) };
+    double d[3] = { 0, 0, 0 };
+    if (glfwGetKey(w, GLFW_KEY_W) == GLFW_PRESS) for (int i = 0; i < 3; i++) d[i] += f[i];
+    if (glfwGetKey(w, GLFW_KEY_S) == GLFW_PRESS) for (int i = 0; i < 3; i++) d[i] -= f[i];
+    if (glfwGetKey(w, GLFW_KEY_D) == GLFW_PRESS) for (int i = 0; i < 3; i++) d[i] += r[i];
+    if (glfwGetKey(w, GLFW_KEY_A) == GLFW_PRESS) for (int i = 0; i < 3; i++) d[i] -= r[i];
+    if (glfwGetKey(w, GLFW_KEY_SPACE) == GLFW_PRESS) d[1] += 1;
+    if (glfwGetKey(w, GLFW_KEY_LEFT_CONTROL) == GLFW_PRESS) d[1] -= 1;
+    for (int i = 0; i < 3; i++)
+        v->cam.position[i] += d[i] * v->speed * dt;
+    camera_from_angles(v);
+}
+
+/* ---- keys (also from the script) -------------------------------------------- */
+
+static void key_action(viewer *v, int key)
+{
+    static const splat_view views[] = { SPLAT_VIEW_FINAL, SPLAT_VIEW_COMBOS, SPLAT_VIEW_LOD,
+                                        SPLAT_VIEW_NORMAL, SPLAT_VIEW_SLOPE, SPLAT_VIEW_ALBEDO };
+    if (key >= GLFW_KEY_1 && key <= GLFW_KEY_6) {
+        v->view = views[key - GLFW_KEY_1];
+    } else if (key == GLFW_KEY_7) {
+        if (v->view == SPLAT_VIEW_MASK)
+            v->material = (v->material + 1) % v->pack->nmaterials;
+        v->view = SPLAT_VIEW_MASK;
+    } else if (key == GLFW_KEY_F) {
+        v->wire = !v->wire;
+        rt_renderer_set_wireframe(v->r, v->wire);
+    } else if (key == GLFW_KEY_R) {
+        v->last_check = -1e9;   /* check the files on the next frame */
+        for (int i = 0; i < v->w.n; i++)
+            v->w.mtimes[i] = -1;
+    } else if (key == GLFW_KEY_Q || key == GLFW_KEY_ESCAPE) {
+        v->quit = true;
+    }
+    rt_renderer_set_view(v->r, v->view, v->material);
+}
+
+static void on_key(GLFWwindow *w, int key, int sc, int action, int mods)
+{
+    if (action == GLFW_PRESS)
+        key_action(glfwGetWindowUserPointer(w), key);
+}
+
+static void on_scroll(GLFWwindow *w, double dx, double dy)
+{
+    viewer *v = glfwGetWindowUserPointer(w);
+    v->speed *= pow(1.25, dy);
+}
+
+static void on_button(GLFWwindow *w, int button, int action, int mods)
+{
+    viewer *v = glfwGetWindowUserPointer(w);
+    if (button == GLFW_MOUSE_BUTTON_RIGHT) {
+        v->dragging = action == GLFW_PRESS;
+        glfwGetCursorPos(w, &v->mx, &v->my);
+    }
+}
+
+static void on_cursor(GLFWwindow *w, double x, double y)
+{
+    viewer *v = glfwGetWindowUserPointer(w);
+    if (!v->dragging)
+        return;
+    v->yaw += (x - v->mx) * 0.004;
+    v->pitch -= (y - v->my) * 0.004;
+    v->pitch = fmax(-1.55, fmin(1.55, v->pitch));
+    v->mx = x;
+    v->my = y;
+    camera_from_angles(v);
+}
+
+/* ---- hot reload ---------------------------------------------------------------- */
+
+static double mtime(const char *path)
+{
+    struct stat st;
+    if (stat(path, &st) != 0)
+        return -2;
+    return (double)st.st_mtim.tv_sec + (double)st.st_mtim.tv_nsec * 1e-9;
+}
+
+static void watch_free(watch *w)
+{
+    for (int i = 0; i < w->n; i++)
+        free(w->files[i]);
+    free(w->files);
+    free(w->mtimes);
+    memset(w, 0, sizeof *w);
+}
+
+/* Import search paths as `splatc build` has them: ".", then the nearest
+ * folder above the scene that holds nodes/. */
+static void search_paths(const char *scene, char *buf, size_t n, const char *paths[3])
+{
+    paths[0] = ".";
+    paths[1] = NULL;
+    paths[2] = NULL;
+    snprintf(buf, n, "%s", scene);
+    for (char *slash; (slash = strrchr(buf, '/'));) {
+        *slash = '\0';
+        char nodes[1200];
+        snprintf(nodes, sizeof nodes, "%s/nodes", *buf ? buf : "/");
+        struct stat st;
+        if (stat(nodes, &st) == 0 && S_ISDIR(st.st_mode)) {
+            paths[1] = *buf ? buf : "/";
+            return;
+        }
+    }
+}
+
+/* The files the scene reads (scene.sg and every import), with mtimes. */
+static void watch_scene(viewer *v)
+{
+    watch_free(&v->w);
+    char buf[1024];
+    const char *paths[3];
+    search_paths(v->scene, buf, sizeof buf, paths);
+    sg_diags d;
+    sg_diags_init(&d);
+    sg_program *prog = sg_load(v->scene, paths, &d);
+    int n = prog ? sg_file_count(prog) : 0;
+    v->w.files = calloc((size_t)n + 1, sizeof *v->w.files);
+    v->w.mtimes = calloc((size_t)n + 1, sizeof *v->w.mtimes);
+    if (v->w.files && v->w.mtimes) {
+        if (n == 0) {   /* even a scene that does not parse is watched */
+            v->w.files[0] = strdup(v->scene);
+            v->w.mtimes[0] = mtime(v->scene);
+            v->w.n = 1;
+        }
+        for (int i = 0; i < n; i++) {
+            v->w.files[i] = strdup(sg_file_path(prog, i));
+            v->w.mtimes[i] = mtime(v->w.files[i]);
+        }
+        if (n)
+            v->w.n = n;
+    }
+    if (prog)
+        sg_free(prog);
+    sg_diags_free(&d);
+}
+
+/* Rebuild the pack in process and swap pipelines; errors leave the old
+ * pack drawing and are shown in the console and the title. */
+static void reload(viewer *v)
+{
+    char buf[1024];
+    const char *paths[3];
+    search_paths(v->scene, buf, sizeof buf, paths);
+    sg_diags d;
+    sg_diags_init(&d);
+    splat_build_desc bd = { .scene = v->scene, .out = v->desc->pack_dir, .search_paths = paths,
+                            .jobs = 2 };
+    splat_build_stats bs;
+    double t0 = now_s();
+    bool ok = splat_build(&bd, &bs, &d);
+    if (!ok || d.nerrors) {
+        fprintf(stderr, "splatview: hot reload: the scene does not compile:\n");
+        sg_diags_print(&d, stderr);
+        snprintf(v->status, sizeof v->status, "COMPILE ERROR (see console)");
+        v->reload_errors++;
+        sg_diags_free(&d);
+        return;
+    }
+    sg_diags_free(&d);
+    rt_error e = { 0 };
+    rt_pack *np = calloc(1, sizeof *np);
+    if (!np || !rt_pack_load(np, v->desc->pack_dir, &e) ||
+        !rt_renderer_swap_pack(v->r, np, &e)) {
+        fprintf(stderr, "splatview: hot reload: %s\n", e.msg ? e.msg : "out of memory");
+        snprintf(v->status, sizeof v->status, "RELOAD FAILED (see console)");
+        rt_error_clear(&e);
+        if (np && np->dir)
+            rt_pack_free(np);
+        free(np);
+        v->reload_errors++;
+        return;
+    }
+    rt_pack_free(v->pack);
+    free(v->pack);
+    v->pack = np;
+    v->reloads++;
+    snprintf(v->status, sizeof v->status, "reloaded in %.0f ms (%d compiled)",
+             (now_s() - t0) * 1e3, bs.shaders_compiled);
+    fprintf(stderr, "splatview: %s\n", v->status);
+}
+
+static void check_files(viewer *v)
+{
+    double t = now_s();
+    if (!v->scene || t - v->last_check < 0.25)
+        return;
+    v->last_check = t;
+    bool changed = false;
+    for (int i = 0; i < v->w.n; i++)
+        if (mtime(v->w.files[i]) != v->w.mtimes[i])
+            changed = true;
+    if (!changed)
+        return;
+    reload(v);
+    watch_scene(v);   /* imports may have changed too */
+}
+
+/* ---- swapchain and the tone-map pass ------------------------------------------ */
+
+static bool make_swapchain(viewer *v, rt_error *e)
+{
+    rt_device *d = &v->dev;
+    VkSurfaceCapabilitiesKHR caps;
+    RT_VK(e, vkGetPhysicalDeviceSurfaceCapabilitiesKHR(d->phys, v->surface, &caps));
+    uint32_t n = 0;
+    RT_VK(e, vkGetPhysicalDeviceSurfaceFormatsKHR(d->phys, v->surface, &n, NULL));
+    VkSurfaceFormatKHR *fmts = calloc(n ? n : 1, sizeof *fmts);
+    if (!fmts)
+        return rt_fail(e, RT_E_WINDOW, "out of memory");
+    vkGetPhysicalDeviceSurfaceFormatsKHR(d->phys, v->surface, &n, fmts);
+    VkSurfaceFormatKHR f = fmts[0];
+    for (uint32_t i = 0; i < n; i++)   /* UNORM: the shader encodes sRGB */
+        if (fmts[i].format == VK_FORMAT_B8G8R8A8_UNORM || fmts[i].format == VK_FORMAT_R8G8B8A8_UNORM)
+            f = fmts[i];
+    free(fmts);
+    if (f.format != VK_FORMAT_B8G8R8A8_UNORM && f.format != VK_FORMAT_R8G8B8A8_UNORM)
+        return rt_fail(e, RT_E_WINDOW, "the surface offers no 8-bit UNORM format");
+    v->format = f.format;
+    v->extent = caps.currentExtent;
+    if (v->extent.width == UINT32_MAX) {
+        v->extent.width = (uint32_t)v->desc->width;
+        v->extent.height = (uint32_t)v->desc->height;
+    }
+    if (!(caps.supportedUsageFlags & VK_IMAGE_USAGE_TRANSFER_SRC_BIT))
+        return rt_fail(e, RT_E_WINDOW, "swapchain images cannot be copied (screenshots)");
+    VkSwapchainCreateInfoKHR ci = {
+        .sType = VK_STRUCTURE_TYPE_SWAPCHAIN_CREATE_INFO_KHR,
+        .surface = v->surface,
+        .minImageCount = caps.minImageCount + 1 <= caps.maxImageCount || caps.maxImageCount == 0
+                             ? caps.minImageCount + 1 : caps.minImageCount,
+        .imageFormat = f.format,
+        .imageColorSpace = f.colorSpace,
+        .imageExtent = v->extent,
+        .imageArrayLayers = 1,
+        .imageUsage = VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT,
+        .imageSharingMode = VK_SHARING_MODE_EXCLUSIVE,
+        .preTransform = caps.currentTransform,
+        .compositeAlpha = VK_COMPOSITE_ALPHA_OPAQUE_BIT_KHR,
+        .presentMode = VK_PRESENT_MODE_FIFO_KHR,
+        .clipped = VK_TRUE,
+    };
+    RT_VK(e, vkCreateSwapchainKHR(d->dev, &ci, NULL, &v->swapchain));
+    RT_VK(e, vkGetSwapchainImagesKHR(d->dev, v->swapchain, &v->nimages, NULL));
+    v->images = calloc(v->nimages, sizeof *v->images);
+    v->views = calloc(v->nimages, sizeof *v->views);
+    v->fbs = calloc(v->nimages, sizeof *v->fbs);
+    if (!v->images || !v->views || !v->fbs)
+        return rt_fail(e, RT_E_WINDOW, "out of memory");
+    RT_VK(e, vkGetSwapchainImagesKHR(d->dev, v->swapchain, &v->nimages, v->images));
+
+    VkAttachmentDescription att = {
+        .format = v->format,
+        .samples = VK_SAMPLE_COUNT_1_BIT,
+        .loadOp = VK_ATTACHMENT_LOAD_OP_DONT_CARE,
+        .storeOp = VK_ATTACHMENT_STORE_OP_STORE,
+        .stencilLoadOp = VK_ATTACHMENT_LOAD_OP_DONT_CARE,
+        .stencilStoreOp = VK_ATTACHMENT_STORE_OP_DONT_CARE,
+        .initialLayout = VK_IMAGE_LAYOUT_UNDEFINED,
+        .finalLayout = VK_IMAGE_LAYOUT_PRESENT_SRC_KHR,
+    };
+    VkAttachmentReference ref = { 0, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL };
+    VkSubpassDescription sub = {
+        .pipelineBindPoint = VK_PIPELINE_BIND_POINT_GRAPHICS,
+        .colorAttachmentCount = 1,
+        .pColorAttachments = &ref,
+    };
+    VkSubpassDependency dep = {
+        VK_SUBPASS_EXTERNAL, 0, VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT,
+        VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT, 0, VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT, 0,
+    };
+    VkRenderPassCreateInfo rp = {
+        .sType = VK_STRUCTURE_TYPE_RENDER_PASS_CREATE_INFO,
+        .attachmentCount = 1, .pAttachments = &att,
+        .subpassCount = 1, .pSubpasses = &sub,
+        .dependencyCount = 1, .pDependencies = &dep,
+    };
+    RT_VK(e, vkCreateRenderPass(d->dev, &rp, NULL, &v->pass));
+    for (uint32_t i = 0; i < v->nimages; i++) {
+        VkImageViewCreateInfo vi = {
+            .sType = VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO,
+            .image = v->images[i],
+            .viewType = VK_IMAGE_VIEW_TYPE_2D,
+            .format = v->format,
+            .subresourceRange = { VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1 },
+        };
+        RT_VK(e, vkCreateImageView(d->dev, &vi, NULL, &v->views[i]));
+        VkFramebufferCreateInfo fi = {
+            .sType = VK_STRUCTURE_TYPE_FRAMEBUFFER_CREATE_INFO,
+            .renderPass = v->pass, .attachmentCount = 1, .pAttachments = &v->views[i],
+            .width = v->extent.width, .height = v->extent.height, .layers = 1,
+        };
+        RT_VK(e, vkCreateFramebuffer(d->dev, &fi, NULL, &v->fbs[i]));
+    }
+    return rt_buffer_create(d, (VkDeviceSize)v->extent.width * v->extent.height * 4,
+                            VK_BUFFER_USAGE_TRANSFER_DST_BIT, true, &v->shot, e);
+}
+
+static bool make_tonemap(viewer *v, rt_error *e)
+{
+    rt_device *d = &v->dev;
+    VkDescriptorSetLayoutBinding b = { 0, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1,
+                                       VK_SHADER_STAGE_FRAGMENT_BIT, NULL };
+    VkDescriptorSetLayoutCreateInfo li = {
+        .sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO, .bindingCount = 1, .pBindings = &b,
+    };
+    RT_VK(e, vkCreateDescriptorSetLayout(d->dev, &li, NULL, &v->set_layout));
+    VkPushConstantRange pr = { VK_SHADER_STAGE_FRAGMENT_BIT, 0, 4 };
+    VkPipelineLayoutCreateInfo pli = {
+        .sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO,
+        .setLayoutCount = 1, .pSetLayouts = &v->set_layout,
+        .pushConstantRangeCount = 1, .pPushConstantRanges = &pr,
+    };
+    RT_VK(e, vkCreatePipelineLayout(d->dev, &pli, NULL, &v->layout));
+    VkSamplerCreateInfo si = {
+        .sType = VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO,
+        .magFilter = VK_FILTER_NEAREST, .minFilter = VK_FILTER_NEAREST,
+        .addressModeU = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE,
+        .addressModeV = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE,
+        .addressModeW = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE,
+    };
+    RT_VK(e, vkCreateSampler(d->dev, &si, NULL, &v->sampler));
+    VkDescriptorPoolSize ps = { VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1 };
+    VkDescriptorPoolCreateInfo pci = {
+        .sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO, .maxSets = 1,
+        .poolSizeCount = 1, .pPoolSizes = &ps,
+    };
+    RT_VK(e, vkCreateDescriptorPool(d->dev, &pci, NULL, &v->dpool));
+    VkDescriptorSetAllocateInfo ai = {
+        .sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO,
+        .descriptorPool = v->dpool, .descriptorSetCount = 1, .pSetLayouts = &v->set_layout,
+    };
+    RT_VK(e, vkAllocateDescriptorSets(d->dev, &ai, &v->set));
+    VkDescriptorImageInfo ii = { v->sampler, rt_renderer_target(v->r)->view,
+                                 VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL };
+    VkWriteDescriptorSet w = {
+        .sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = v->set, .dstBinding = 0,
+        .descriptorCount = 1, .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+        .pImageInfo = &ii,
+    };
+    vkUpdateDescriptorSets(d->dev, 1, &w, 0, NULL);
+
+    uint32_t *vw = NULL, *fw = NULL;
+    size_t vn = 0, fn = 0;
+    VkShaderModule vm = VK_NULL_HANDLE, fm = VK_NULL_HANDLE;
+    bool ok = rt_glsl_compile(tonemap_vert, VK_SHADER_STAGE_VERTEX_BIT, "tonemap.vert", &vw, &vn, e) &&
+              rt_glsl_compile(tonemap_frag, VK_SHADER_STAGE_FRAGMENT_BIT, "tonemap.frag", &fw, &fn, e);
+    if (ok) {
+        VkShaderModuleCreateInfo mi = { .sType = VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO,
+                                        .codeSize = vn * 4, .pCode = vw };
+        ok = vkCreateShaderModule(d->dev, &mi, NULL, &vm) == VK_SUCCESS;
+        mi.codeSize = fn * 4;
+        mi.pCode = fw;
+        ok = ok && vkCreateShaderModule(d->dev, &mi, NULL, &fm) == VK_SUCCESS;
+        if (!ok)
+            rt_fail(e, RT_E_VULKAN, "vkCreateShaderModule", "tone map");
+    }
+    free(vw);
+    free(fw);
+    if (ok) {
+        VkPipelineShaderStageCreateInfo st[2] = {
+            { .sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO,
+              .stage = VK_SHADER_STAGE_VERTEX_BIT, .module = vm, .pName = "main" },
+            { .sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO,
+              .stage = VK_SHADER_STAGE_FRAGMENT_BIT, .module = fm, .pName = "main" },
+        };
+        VkPipelineVertexInputStateCreateInfo vi = { .sType = VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO };
+        VkPipelineInputAssemblyStateCreateInfo ia = {
+            .sType = VK_STRUCTURE_TYPE_PIPELINE_INPUT_ASSEMBLY_STATE_CREATE_INFO,
+            .topology = VK_PRIMITIVE_TOPOLOGY_TRIANGLE_LIST,
+        };
+        VkViewport vp = { 0, 0, (float)v->extent.width, (float)v->extent.height, 0, 1 };
+        VkRect2D sc = { { 0, 0 }, v->extent };
+        VkPipelineViewportStateCreateInfo vps = {
+            .sType = VK_STRUCTURE_TYPE_PIPELINE_VIEWPORT_STATE_CREATE_INFO,
+            .viewportCount = 1, .pViewports = &vp, .scissorCount = 1, .pScissors = &sc,
+        };
+        VkPipelineRasterizationStateCreateInfo rs = {
+            .sType = VK_STRUCTURE_TYPE_PIPELINE_RASTERIZATION_STATE_CREATE_INFO,
+            .polygonMode = VK_POLYGON_MODE_FILL, .cullMode = VK_CULL_MODE_NONE, .lineWidth = 1.0f,
+        };
+        VkPipelineMultisampleStateCreateInfo ms = {
+            .sType = VK_STRUCTURE_TYPE_PIPELINE_MULTISAMPLE_STATE_CREATE_INFO,
+            .rasterizationSamples = VK_SAMPLE_COUNT_1_BIT,
+        };
+        VkPipelineColorBlendAttachmentState cba = { .colorWriteMask = 0xf };
+        VkPipelineColorBlendStateCreateInfo cb = {
+            .sType = VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO,
+            .attachmentCount = 1, .pAttachments = &cba,
+        };
+        VkGraphicsPipelineCreateInfo gi = {
+            .sType = VK_STRUCTURE_TYPE_GRAPHICS_PIPELINE_CREATE_INFO,
+            .stageCount = 2, .pStages = st, .pVertexInputState = &vi, .pInputAssemblyState = &ia,
+            .pViewportState = &vps, .pRasterizationState = &rs, .pMultisampleState = &ms,
+            .pColorBlendState = &cb, .layout = v->layout, .renderPass = v->pass,
+        };
+        VkResult r = vkCreateGraphicsPipelines(d->dev, VK_NULL_HANDLE, 1, &gi, NULL, &v->pipeline);
+        if (r != VK_SUCCESS)
+            ok = rt_fail(e, RT_E_VULKAN, "vkCreateGraphicsPipelines(tone map)", rt_vk_result_name(r));
+    }
+    if (vm)
+        vkDestroyShaderModule(d->dev, vm, NULL);
+    if (fm)
+        vkDestroyShaderModule(d->dev, fm, NULL);
+    if (!ok)
+        return false;
+    VkCommandBufferAllocateInfo cai = {
+        .sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO,
+        .commandPool = d->pool, .level = VK_COMMAND_BUFFER_LEVEL_PRIMARY, .commandBufferCount = 1,
+    };
+    RT_VK(e, vkAllocateCommandBuffers(d->dev, &cai, &v->cb));
+    VkSemaphoreCreateInfo sci = { .sType = VK_STRUCTURE_TYPE_SEMAPHORE_CREATE_INFO };
+    RT_VK(e, vkCreateSemaphore(d->dev, &sci, NULL, &v->acquired));
+    RT_VK(e, vkCreateSemaphore(d->dev, &sci, NULL, &v->rendered));
+    VkFenceCreateInfo fci = { .sType = VK_STRUCTURE_TYPE_FENCE_CREATE_INFO };
+    RT_VK(e, vkCreateFence(d->dev, &fci, NULL, &v->fence));
+    return true;
+}
+
+static void image_barrier(VkCommandBuffer cb, VkImage img, VkImageLayout from, VkImageLayout to,
+                          VkAccessFlags sa, VkAccessFlags da, VkPipelineStageFlags ss,
+                          VkPipelineStageFlags ds)
+{
+    VkImageMemoryBarrier b = {
+        .sType = VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER,
+        .srcAccessMask = sa, .dstAccessMask = da, .oldLayout = from, .newLayout = to,
+        .srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED, .dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED,
+        .image = img, .subresourceRange = { VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1 },
+    };
+    vkCmdPipelineBarrier(cb, ss, ds, 0, 0, NULL, 0, NULL, 1, &b);
+}
+
+/* Tone-map the renderer's frame into the next swapchain image, present it;
+ * with `shot`, also copy it out and write a PNG. */
+static bool present(viewer *v, const char *shot, rt_error *e)
+{
+    rt_device *d = &v->dev;
+    uint32_t idx;
+    VkResult r = vkAcquireNextImageKHR(d->dev, v->swapchain, UINT64_MAX, v->acquired, VK_NULL_HANDLE, &idx);
+    if (r != VK_SUCCESS && r != VK_SUBOPTIMAL_KHR)
+        return rt_fail(e, RT_E_VULKAN, "vkAcquireNextImageKHR", rt_vk_result_name(r));
+    VkCommandBuffer cb = v->cb;
+    RT_VK(e, vkResetCommandBuffer(cb, 0));
+    VkCommandBufferBeginInfo bi = { .sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO,
+                                    .flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT };
+    RT_VK(e, vkBeginCommandBuffer(cb, &bi));
+    image_barrier(cb, rt_renderer_target(v->r)->img, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+                  VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT,
+                  VK_ACCESS_SHADER_READ_BIT, VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT,
+                  VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT);
+    VkRenderPassBeginInfo rb = {
+        .sType = VK_STRUCTURE_TYPE_RENDER_PASS_BEGIN_INFO, .renderPass = v->pass,
+        .framebuffer = v->fbs[idx], .renderArea = { { 0, 0 }, v->extent },
+    };
+    vkCmdBeginRenderPass(cb, &rb, VK_SUBPASS_CONTENTS_INLINE);
+    vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_GRAPHICS, v->pipeline);
+    vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_GRAPHICS, v->layout, 0, 1, &v->set, 0, NULL);
+    uint32_t mode = v->view == SPLAT_VIEW_FINAL ? 0 : v->view == SPLAT_VIEW_ALBEDO ? 1 : 2;
+    vkCmdPushConstants(cb, v->layout, VK_SHADER_STAGE_FRAGMENT_BIT, 0, 4, &mode);
+    vkCmdDraw(cb, 3, 1, 0, 0);
+    vkCmdEndRenderPass(cb);
+    if (shot) {
+        image_barrier(cb, v->images[idx], VK_IMAGE_LAYOUT_PRESENT_SRC_KHR,
+                      VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT,
+                      VK_ACCESS_TRANSFER_READ_BIT, VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT,
+                      VK_PIPELINE_STAGE_TRANSFER_BIT);
+        VkBufferImageCopy copy = {
+            .imageSubresource = { VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1 },
+            .imageExtent = { v->extent.width, v->extent.height, 1 },
+        };
+        vkCmdCopyImageToBuffer(cb, v->images[idx], VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+                               v->shot.buf, 1, &copy);
+        image_barrier(cb, v->images[idx], VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+                      VK_IMAGE_LAYOUT_PRESENT_SRC_KHR, VK_ACCESS_TRANSFER_READ_BIT, 0,
+                      VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT);
+    }
+    RT_VK(e, vkEndCommandBuffer(cb));
+    VkPipelineStageFlags wait = VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT;
+    VkSubmitInfo si = {
+        .sType = VK_STRUCTURE_TYPE_SUBMIT_INFO,
+        .waitSemaphoreCount = 1, .pWaitSemaphores = &v->acquired, .pWaitDstStageMask = &wait,
+        .commandBufferCount = 1, .pCommandBuffers = &cb,
+        .signalSemaphoreCount = 1, .pSignalSemaphores = &v->rendered,
+    };
+    RT_VK(e, vkQueueSubmit(d->queue, 1, &si, v->fence));
+    VkPresentInfoKHR pi = {
+        .sType = VK_STRUCTURE_TYPE_PRESENT_INFO_KHR,
+        .waitSemaphoreCount = 1, .pWaitSemaphores = &v->rendered,
+        .swapchainCount = 1, .pSwapchains = &v->swapchain, .pImageIndices = &idx,
+    };
+    r = vkQueuePresentKHR(d->queue, &pi);
+    if (r != VK_SUCCESS && r != VK_SUBOPTIMAL_KHR)
+        return rt_fail(e, RT_E_VULKAN, "vkQueuePresentKHR", rt_vk_result_name(r));
+    RT_VK(e, vkWaitForFences(d->dev, 1, &v->fence, VK_TRUE, UINT64_MAX));
+    RT_VK(e, vkResetFences(d->dev, 1, &v->fence));
+    if (shot) {
+        size_t n = (size_t)v->extent.width * v->extent.height;
+        uint8_t *px = malloc(n * 4);
+        if (!px)
+            return rt_fail(e, RT_E_WINDOW, "out of memory");
+        memcpy(px, v->shot.map, n * 4);
+        if (v->format == VK_FORMAT_B8G8R8A8_UNORM)
+            for (size_t i = 0; i < n; i++) {
+                uint8_t t = px[4 * i];
+                px[4 * i] = px[4 * i + 2];
+                px[4 * i + 2] = t;
+            }
+        bool ok = rt_write_png(shot, px, (int)v->extent.width, (int)v->extent.height, e);
+        free(px);
+        if (!ok)
+            return false;
+        fprintf(stderr, "splatview: screenshot %s\n", shot);
+    }
+    return true;
+}
+
+/* ---- the loop ------------------------------------------------------------------ */
+
+static bool frame(viewer *v, const char *shot, double *last, rt_error *e)
+{
+    double t = now_s(), dt = t - *last;
+    *last = t;
+    glfwPollEvents();
+    move_camera(v, dt > 0.25 ? 0.25 : dt);
+    check_files(v);
+    rt_frame_stats st;
+    if (!rt_renderer_frame(v->r, &v->cam, &st, e) || !present(v, shot, e))
+        return false;
+    static double shown;
+    if (t - shown > 0.25) {
+        shown = t;
+        char title[512];
+        snprintf(title, sizeof title,
+                 "splatview %s | %s%s | %.1f ms/frame (gpu %.1f) | %d patches, %d pipelines | %s",
+                 v->pack->name, rt_view_name(v->view), v->wire ? " wire" : "", dt * 1e3,
+                 st.gpu_ms, st.patches, st.pipelines, v->status);
+        glfwSetWindowTitle(v->win, title);
+    }
+    return true;
+}
+
+/* One script step: "name=value" or "name". */
+static bool script_step(viewer *v, const char *step, double *last, rt_error *e)
+{
+    char key[64] = "", val[1024] = "";
+    const char *eq = strchr(step, '=');
+    size_t kn = eq ? (size_t)(eq - step) : strlen(step);
+    if (kn >= sizeof key)
+        return rt_fail(e, RT_E_WINDOW, "script step name too long");
+    memcpy(key, step, kn);
+    if (eq)
+        snprintf(val, sizeof val, "%s", eq + 1);
+    if (!strcmp(key, "frames")) {
+        int n = atoi(val);
+        for (int i = 0; i < n && !v->quit; i++)
+            if (!frame(v, NULL, last, e))
+                return false;
+    } else if (!strcmp(key, "screenshot")) {
+        return frame(v, val, last, e);
+    } else if (!strcmp(key, "view")) {
+        splat_view view;
+        int m;
+        if (!rt_parse_view(val, v->pack, &view, &m, e))
+            return false;
+        v->view = view;
+        v->material = m;
+        rt_renderer_set_view(v->r, view, m);
+    } else if (!strcmp(key, "key")) {
+        int k = !strcmp(val, "ESC") ? GLFW_KEY_ESCAPE : val[0] >= 'a' && val[0] <= 'z' ? val[0] - 32 : val[0];
+        key_action(v, k);
+    } else if (!strcmp(key, "wait_reload")) {
+        /* compile errors on the way are shown and survived; only a
+         * successful reload ends the wait */
+        int before = v->reloads;
+        double until = now_s() + atof(val);
+        while (v->reloads == before && now_s() < until && !v->quit)
+            if (!frame(v, NULL, last, e))
+                return false;
+        if (v->reloads == before)
+            return rt_fail(e, RT_E_RELOAD, "no reload within the time given");
+    } else if (!strcmp(key, "quit")) {
+        v->quit = true;
+    } else if (key[0]) {
+        char what[128];
+        snprintf(what, sizeof what, "unknown script step '%s'", key);
+        return rt_fail(e, RT_E_WINDOW, what);
+    }
+    return true;
+}
+
+static bool run_script(viewer *v, const char *script, double *last, rt_error *e)
+{
+    char *s = strdup(script), *save = NULL;
+    if (!s)
+        return rt_fail(e, RT_E_WINDOW, "out of memory");
+    bool ok = true;
+    for (char *t = strtok_r(s, ";", &save); t && ok && !v->quit; t = strtok_r(NULL, ";", &save))
+        ok = script_step(v, t, last, e);
+    free(s);
+    v->quit = true;   /* a script always ends the viewer */
+    return ok;
+}
+
+static void teardown(viewer *v)
+{
+    rt_device *d = &v->dev;
+    if (d->dev) {
+        vkDeviceWaitIdle(d->dev);
+        rt_renderer_destroy(v->r);
+        v->r = NULL;
+        if (v->pipeline) vkDestroyPipeline(d->dev, v->pipeline, NULL);
+        if (v->layout) vkDestroyPipelineLayout(d->dev, v->layout, NULL);
+        if (v->set_layout) vkDestroyDescriptorSetLayout(d->dev, v->set_layout, NULL);
+        if (v->dpool) vkDestroyDescriptorPool(d->dev, v->dpool, NULL);
+        if (v->sampler) vkDestroySampler(d->dev, v->sampler, NULL);
+        if (v->acquired) vkDestroySemaphore(d->dev, v->acquired, NULL);
+        if (v->rendered) vkDestroySemaphore(d->dev, v->rendered, NULL);
+        if (v->fence) vkDestroyFence(d->dev, v->fence, NULL);
+        for (uint32_t i = 0; i < v->nimages; i++) {
+            if (v->fbs && v->fbs[i]) vkDestroyFramebuffer(d->dev, v->fbs[i], NULL);
+            if (v->views && v->views[i]) vkDestroyImageView(d->dev, v->views[i], NULL);
+        }
+        if (v->pass) vkDestroyRenderPass(d->dev, v->pass, NULL);
+        if (v->swapchain) vkDestroySwapchainKHR(d->dev, v->swapchain, NULL);
+        rt_buffer_destroy(d, &v->shot);
+    }
+    if (v->surface)
+        vkDestroySurfaceKHR(d->instance, v->surface, NULL);
+    free(v->images);
+    free(v->views);
+    free(v->fbs);
+    rt_device_destroy(d);
+    if (v->win)
+        glfwDestroyWindow(v->win);
+    glfwTerminate();
+    if (v->pack)
+        rt_pack_free(v->pack);
+    free(v->pack);
+    watch_free(&v->w);
+}
 
 int rt_viewer_run(const rt_viewer_desc *desc)
 {
-    (void)desc;
-    fprintf(stderr, "splatview: the window viewer is not built yet; use --headless\n");
-    return 1;
+    viewer vw;
+    viewer *v = &vw;
+    memset(v, 0, sizeof *v);
+    v->desc = desc;
+    v->speed = 50.0;
+    rt_error e = { 0 };
+    int status = 1;
+    v->pack = calloc(1, sizeof *v->pack);
+    if (!v->pack || !rt_pack_load(v->pack, desc->pack_dir, &e)) {
+        fprintf(stderr, "splatview: %s\n", e.msg ? e.msg : "out of memory");
+        rt_error_clear(&e);
+        free(v->pack);
+        return 1;
+    }
+    if (desc->view_name && !rt_parse_view(desc->view_name, v->pack, &v->view, &v->material, &e))
+        goto done;
+    rt_default_camera(v->pack, &v->cam);
+    if (desc->preset) {
+        int c = rt_pack_camera_find(v->pack, desc->preset);
+        if (c < 0) {
+            rt_fail(&e, RT_E_WINDOW, "the pack has no such camera preset");
+            goto done;
+        }
+        memcpy(v->cam.position, v->pack->cameras[c].position, sizeof v->cam.position);
+        memcpy(v->cam.look, v->pack->cameras[c].look, sizeof v->cam.look);
+    }
+    if (desc->have_camera && !desc->preset)
+        v->cam = desc->camera;
+    angles_from_camera(v);
+    camera_from_angles(v);
+    double ext = v->pack->size[0] > v->pack->size[1] ? v->pack->size[0] : v->pack->size[1];
+    v->speed = ext / 20.0;
+
+    if (!glfwInit()) {
+        rt_fail(&e, RT_E_WINDOW, "glfwInit failed (no display?)");
+        goto done;
+    }
+    if (!glfwVulkanSupported()) {
+        rt_fail(&e, RT_E_WINDOW, "GLFW finds no Vulkan loader");
+        goto done;
+    }
+    glfwWindowHint(GLFW_CLIENT_API, GLFW_NO_API);
+    glfwWindowHint(GLFW_RESIZABLE, GLFW_FALSE);   /* fixed-size targets */
+    v->win = glfwCreateWindow(desc->width, desc->height, "splatview", NULL, NULL);
+    if (!v->win) {
+        rt_fail(&e, RT_E_WINDOW, "cannot open a window");
+        goto done;
+    }
+    glfwSetWindowUserPointer(v->win, v);
+    uint32_t next = 0;
+    const char **exts = glfwGetRequiredInstanceExtensions(&next);
+    rt_device_desc dd = { .instance_exts = exts, .ninstance_exts = next, .swapchain = true };
+    if (!rt_device_create(&v->dev, &dd, &e))
+        goto done;
+    VkResult vr = glfwCreateWindowSurface(v->dev.instance, v->win, NULL, &v->surface);
+    if (vr != VK_SUCCESS) {
+        rt_fail(&e, RT_E_VULKAN, "glfwCreateWindowSurface", rt_vk_result_name(vr));
+        goto done;
+    }
+    VkBool32 can_present = VK_FALSE;
+    vkGetPhysicalDeviceSurfaceSupportKHR(v->dev.phys, v->dev.queue_family, v->surface, &can_present);
+    if (!can_present) {
+        rt_fail(&e, RT_E_WINDOW, "the chosen device's graphics queue cannot present to the window");
+        goto done;
+    }
+    if (!make_swapchain(v, &e))
+        goto done;
+    rt_render_desc rd = desc->render;
+    rd.width = (int)v->extent.width;
+    rd.height = (int)v->extent.height;
+    if (!rt_renderer_create(&v->dev, v->pack, &rd, &v->r, &e) || !make_tonemap(v, &e))
+        goto done;
+    rt_renderer_set_view(v->r, v->view, v->material);
+    v->scene = desc->scene;
+    if (v->scene) {
+        watch_scene(v);
+        snprintf(v->status, sizeof v->status, "watching %d files", v->w.n);
+    } else {
+        snprintf(v->status, sizeof v->status, "no --scene: hot reload off");
+    }
+    glfwSetKeyCallback(v->win, on_key);
+    glfwSetScrollCallback(v->win, on_scroll);
+    glfwSetMouseButtonCallback(v->win, on_button);
+    glfwSetCursorPosCallback(v->win, on_cursor);
+
+    double last = now_s();
+    if (desc->script) {
+        if (!run_script(v, desc->script, &last, &e))
+            goto done;
+    } else {
+        while (!v->quit && !glfwWindowShouldClose(v->win))
+            if (!frame(v, NULL, &last, &e))
+                goto done;
+    }
+    status = 0;
+done:
+    if (e.msg)
+        fprintf(stderr, "splatview: %s\n", e.msg);
+    rt_error_clear(&e);
+    teardown(v);
+    if (v->dev.validating && v->dev.messages) {
+        fprintf(stderr, "splatview: %d validation message(s)\n", v->dev.messages);
+        status = status ? status : 3;
+    }
+    return status;
 }

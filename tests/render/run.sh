@@ -104,13 +104,45 @@ bad_packs)
 viewer)
     command -v xvfb-run > /dev/null || { echo "SKIP: no xvfb-run"; exit 0; }
     rm -f "$OUT/shot.png"
+    rm -f "$OUT/after.png"
     xvfb-run -a -s "-screen 0 640x480x24" "$SV" "$PACK" --size 320x200 \
-        --script "frames=10;view=combos;frames=5;screenshot=$OUT/shot.png;key=Q" \
+        --script "frames=10;view=combos;frames=5;screenshot=$OUT/shot.png;key=Q;screenshot=$OUT/after.png" \
         > "$OUT/viewer.log" 2>&1
     rc=$?
     cat "$OUT/viewer.log"
     [ $rc = 0 ] || fail "viewer exit $rc"
     "$IC" nonuniform "$OUT/shot.png" || fail "viewer screenshot is uniform"
+    [ -e "$OUT/after.png" ] && fail "the viewer went on after the Q key"
+    ;;
+hot_reload)
+    # edit a material of a copy of examples/minimal while the viewer runs:
+    # first a syntax error (shown, survived), then a new colour (reloaded)
+    command -v xvfb-run > /dev/null || { echo "SKIP: no xvfb-run"; exit 0; }
+    ROOT=$(cd "$(dirname "$0")/../.." && pwd)
+    rm -rf "$OUT/src" "$OUT/pack" "$OUT"/*.png
+    mkdir -p "$OUT/src/examples"
+    cp -r "$ROOT/examples/minimal" "$OUT/src/examples/" && cp -r "$ROOT/graphs" "$ROOT/nodes" "$OUT/src/"
+    SCENE="$OUT/src/examples/minimal/scene.sg"
+    "$SPLATC" build "$SCENE" -o "$OUT/pack" --no-cache > /dev/null || fail "splatc build"
+    xvfb-run -a -s "-screen 0 640x480x24" "$SV" "$OUT/pack" --scene "$SCENE" --size 320x200 \
+        --camera-preset overview \
+        --script "frames=3;screenshot=$OUT/a.png;wait_reload=150;frames=2;screenshot=$OUT/b.png;quit" \
+        > "$OUT/viewer.log" 2>&1 &
+    pid=$!
+    i=0
+    while [ ! -e "$OUT/a.png" ] && [ $i -lt 120 ]; do sleep 0.5; i=$((i + 1)); done
+    [ -e "$OUT/a.png" ] || { kill $pid; fail "no first screenshot"; }
+    sleep 1
+    sed -i 's/node rows : mul {/node rows : mul {{/' "$SCENE"
+    sleep 2
+    sed -i 's/node rows : mul {{/node rows : mul {/; s/vec3(0.55, 0.47, 0.22)/vec3(0.9, 0.05, 0.05)/; s/a = 0.8, b = 1.0/a = 0.2, b = 1.0/' "$SCENE"
+    wait $pid
+    rc=$?
+    cat "$OUT/viewer.log"
+    [ $rc = 0 ] || fail "viewer exit $rc"
+    grep -q "does not compile" "$OUT/viewer.log" || fail "the syntax error was not reported"
+    grep -q "reloaded" "$OUT/viewer.log" || fail "no reload"
+    cmp -s "$OUT/a.png" "$OUT/b.png" && fail "the picture did not change after the edit"
     ;;
 real)
     # a pack written by splatc build: pictures, combination colours, and the

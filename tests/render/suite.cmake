@@ -35,5 +35,10 @@ if(TARGET splatrt AND TARGET splatview)
               $<TARGET_FILE:imgcheck> ${RENDER_OUT}/minimal ${RENDER_OUT}/out)
     set_tests_properties(render.real_minimal PROPERTIES LABELS render
       FIXTURES_REQUIRED minimal_pack ENVIRONMENT "SPLAT_VALIDATE=1" TIMEOUT 300)
+    add_test(NAME render.hot_reload
+      COMMAND sh ${RENDER_DIR}/run.sh hot_reload $<TARGET_FILE:splatview>
+              $<TARGET_FILE:imgcheck> ${RENDER_OUT}/minimal ${RENDER_OUT}/out)
+    set_tests_properties(render.hot_reload PROPERTIES LABELS render TIMEOUT 300
+      ENVIRONMENT "SPLAT_VALIDATE=1;SPLATC=$<TARGET_FILE:splatc_cli>")
   endif()
 endif()
