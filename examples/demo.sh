@@ -1,30 +1,26 @@
 #!/bin/sh
-# make demo: compile the colorado scene into a shader pack and render it
-# headless (lavapipe on a machine without a GPU).  Usage: demo.sh BUILD_DIR
-set -e
-build=${1:-build}
-out=out
-mkdir -p "$out"
-splatc="$build/compiler/splatc"
-splatview="$build/runtime/splatview"
-jobs=$(nproc 2>/dev/null || echo 2)
-
-echo "== splatc build examples/colorado/scene.sg -> $out/colorado.pack"
-"$splatc" build examples/colorado/scene.sg -o "$out/colorado.pack" -j "$jobs" --stats \
-    | grep -E '^(cells|combinations|largest|naive|total|analysis time)' || true
-
-camera=${SPLAT_DEMO_CAMERA:-blanca}
-echo "== splatview --headless (camera preset '$camera')"
-"$splatview" "$out/colorado.pack" --headless --size 1280x720 --camera-preset "$camera" \
-    -o "$out/demo.png" --stats | grep -E '^(device|patches|pipelines|combinations|gpu)'
-"$splatview" "$out/colorado.pack" --headless --size 1280x720 --camera-preset "$camera" \
-    --view combos -o "$out/demo_combos.png"
-
-cat <<MSG
-
-Pictures:
-  $out/demo.png         the colorado scene, lit
-  $out/demo_combos.png  one colour per material combination (seed 000 Fig. 14)
-Open the viewer (needs a display):
-  $splatview $out/colorado.pack --scene examples/colorado/scene.sg
-MSG
+# demo.sh BUILD — what `make demo` runs after building: compile the colorado
+# scene into a shader pack and render it headless (lavapipe where there is no
+# GPU): the lit picture and the combinations view beside it (seed 000 Fig. 14).
+set -eu
+BUILD=${1:-build}
+SPLATC="$BUILD/compiler/splatc"
+VIEW="$BUILD/runtime/splatview"
+CAMERA=${SPLAT_DEMO_CAMERA:-blanca}
+SIZE=${SPLAT_DEMO_SIZE:-1280x720}
+for tool in "$SPLATC" "$VIEW"; do
+    if [ ! -x "$tool" ]; then
+        echo "demo: $tool is missing: build first (make build)" >&2
+        exit 1
+    fi
+done
+mkdir -p out
+JOBS=$(nproc 2>/dev/null || echo 2)
+"$SPLATC" build examples/colorado/scene.sg -o out/colorado.pack -j "$JOBS" --stats
+"$VIEW" out/colorado.pack --headless -o out/demo.png --size "$SIZE" --camera-preset "$CAMERA"
+"$VIEW" out/colorado.pack --headless -o out/demo_combos.png --size "$SIZE" \
+    --camera-preset "$CAMERA" --view combos
+echo
+echo "pictures:  out/demo.png  out/demo_combos.png  (camera preset '$CAMERA')"
+echo "viewer:    $VIEW out/colorado.pack --camera-preset $CAMERA"
+echo "other presets: overview blanca spanish_peaks pivots trinidad (SPLAT_DEMO_CAMERA=...)"
