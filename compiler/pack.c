@@ -753,6 +753,52 @@ static bool write_pack(build *b)
     return ok;
 }
 
+/* ---- the report: what each composite costs against the über-shader ----- */
+
+/* Instructions in a SPIR-V module (each one's first word holds its length). */
+static int spirv_instructions(const uint32_t *w, size_t n)
+{
+    int count = 0;
+    for (size_t i = 5; i < n; count++) {
+        size_t len = w[i] >> 16;
+        if (len == 0)
+            break;  /* malformed: validation has said so already */
+        i += len;
+    }
+    return count;
+}
+
+static void report_shaders(build *b, FILE *out)
+{
+    const job *uber = NULL;
+    for (int i = 0; i < b->njobs; i++)
+        if (b->jobs[i].kind == JOB_UBER)
+            uber = &b->jobs[i];
+    if (!uber || !uber->words)
+        return;
+    int ui = spirv_instructions(uber->words, uber->nwords);
+    fprintf(out, "shaders: SPIR-V instructions and resources per composite\n"
+                 "  (the über-shader: %d instructions, %d textures, %d params)\n"
+                 "  id  layers  instructions  of über  textures  params\n",
+            ui, b->layout.ntextures, b->layout.nparams);
+    double sum = 0;
+    int n = 0;
+    for (int i = 0; i < b->njobs; i++) {
+        const job *j = &b->jobs[i];
+        if (j->kind != JOB_COMBO || !j->words)
+            continue;
+        int ci = spirv_instructions(j->words, j->nwords);
+        const combo_info *c = &b->combos[j->index];
+        fprintf(out, "%4d  %6d  %12d  %6.0f%%  %4d/%-3d  %3d/%d\n", j->index,
+                b->analysis.combos[j->index].nmaterials, ci, 100.0 * ci / ui, c->ntextures,
+                b->layout.ntextures, c->nparams, b->layout.nparams);
+        sum += (double)ci / ui;
+        n++;
+    }
+    if (n)
+        fprintf(out, "mean composite size: %.0f%% of the über-shader\n", 100.0 * sum / n);
+}
+
 /* ---- nothing changed? ---------------------------------------------------- */
 
 static bool hash_file(XXH3_state_t *st, const char *path)
@@ -968,6 +1014,8 @@ bool splat_build(const splat_build_desc *desc, splat_build_stats *st, sg_diags *
     st->validate = now() - t;
     if (d->nerrors > errors)
         goto out;
+    if (desc->report)
+        report_shaders(&b, desc->report);
 
     t = now();
     write_pack(&b);
