@@ -225,7 +225,8 @@ typedef struct rt_pack {
     rt_spirv         uber;           /* words NULL if absent               */
     rt_spirv         vertex;
     rt_pack_level   *levels;    int nlevels;
-    char            *scene_path;     /* scene.sg if the manifest names one  */
+    char            *scene_path;     /* scene.source: scene.sg relative to
+                                        the pack (hot reload), or NULL      */
 } rt_pack;
 
 /* Read and check a pack: every file it names exists and has the right

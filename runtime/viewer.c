@@ -855,12 +855,20 @@ int rt_viewer_run(const rt_viewer_desc *desc)
     if (!rt_renderer_create(&v->dev, v->pack, &rd, &v->r, &e) || !make_tonemap(v, &e))
         goto done;
     rt_renderer_set_view(v->r, v->view, v->material);
+    /* the scene to watch: --scene, else the manifest's scene.source */
+    char scene_buf[2048];
     v->scene = desc->scene;
+    if (!v->scene && v->pack->scene_path) {
+        snprintf(scene_buf, sizeof scene_buf, "%s/%s", desc->pack_dir, v->pack->scene_path);
+        struct stat st;
+        if (stat(scene_buf, &st) == 0)
+            v->scene = scene_buf;
+    }
     if (v->scene) {
         watch_scene(v);
         snprintf(v->status, sizeof v->status, "watching %d files", v->w.n);
     } else {
-        snprintf(v->status, sizeof v->status, "no --scene: hot reload off");
+        snprintf(v->status, sizeof v->status, "no scene source: hot reload off");
     }
     glfwSetKeyCallback(v->win, on_key);
     glfwSetScrollCallback(v->win, on_scroll);

@@ -124,7 +124,8 @@ hot_reload)
     cp -r "$ROOT/examples/minimal" "$OUT/src/examples/" && cp -r "$ROOT/graphs" "$ROOT/nodes" "$OUT/src/"
     SCENE="$OUT/src/examples/minimal/scene.sg"
     "$SPLATC" build "$SCENE" -o "$OUT/pack" --no-cache > /dev/null || fail "splatc build"
-    xvfb-run -a -s "-screen 0 640x480x24" "$SV" "$OUT/pack" --scene "$SCENE" --size 320x200 \
+    # no --scene: the viewer finds the scene through the manifest's scene.source
+    xvfb-run -a -s "-screen 0 640x480x24" "$SV" "$OUT/pack" --size 320x200 \
         --camera-preset overview \
         --script "frames=3;screenshot=$OUT/a.png;wait_reload=150;frames=2;screenshot=$OUT/b.png;quit" \
         > "$OUT/viewer.log" 2>&1 &
