@@ -143,18 +143,32 @@ typedef struct pool {
     build          *b;
     void          (*fn)(build *b, job *j);
     bool           *pending;
+    int            *order;    /* job indices, largest GLSL first: the long
+                                 compiles start early, the short ones fill
+                                 the tail                                  */
     int             next;
     pthread_mutex_t lock;
 } pool;
+
+static const build *sort_build;  /* qsort has no context argument */
+
+static int by_size_desc(const void *a, const void *b)
+{
+    const job *x = &sort_build->jobs[*(const int *)a];
+    const job *y = &sort_build->jobs[*(const int *)b];
+    if (x->glsl.len != y->glsl.len)
+        return x->glsl.len < y->glsl.len ? 1 : -1;
+    return *(const int *)a - *(const int *)b;
+}
 
 static void *pool_worker(void *arg)
 {
     pool *p = arg;
     for (;;) {
         pthread_mutex_lock(&p->lock);
-        while (p->next < p->b->njobs && !p->pending[p->next])
+        while (p->next < p->b->njobs && !p->pending[p->order[p->next]])
             p->next++;
-        int i = p->next < p->b->njobs ? p->next++ : -1;
+        int i = p->next < p->b->njobs ? p->order[p->next++] : -1;
         pthread_mutex_unlock(&p->lock);
         if (i < 0)
             return NULL;
@@ -165,6 +179,11 @@ static void *pool_worker(void *arg)
 static void run_pool(build *b, void (*fn)(build *, job *), bool *pending, int threads)
 {
     pool p = {.b = b, .fn = fn, .pending = pending};
+    p.order = xcalloc((size_t)b->njobs, sizeof *p.order);
+    for (int i = 0; i < b->njobs; i++)
+        p.order[i] = i;
+    sort_build = b;  /* single-threaded here */
+    qsort(p.order, (size_t)b->njobs, sizeof *p.order, by_size_desc);
     pthread_mutex_init(&p.lock, NULL);
     if (threads < 1)
         threads = 1;
@@ -179,6 +198,7 @@ static void run_pool(build *b, void (*fn)(build *, job *), bool *pending, int th
     for (int i = 1; i <= started; i++)
         pthread_join(t[i], NULL);
     free(t);
+    free(p.order);
     pthread_mutex_destroy(&p.lock);
 }
 
