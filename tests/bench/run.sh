@@ -1,0 +1,333 @@
+#!/bin/sh
+# run.sh — the speed–accuracy benchmark of issue 7 (`make bench`,
+# `make bench-smoke`, CTest bench.smoke).
+#
+#   sh tests/bench/run.sh BUILD_DIR [--smoke] [--out DIR] [--quick]
+#
+# Writes into DIR (default out/bench): compile.csv (per scene: phases of
+# `splatc build --stats`, cold and warm, peak memory), scale_hf.csv
+# (analysis vs heightfield texels 1x/4x/16x), scale_mat.csv (compile phases
+# vs material count 4/8/15/30), render.csv (splatbench: GPU/CPU ms per frame
+# and error vs the reference of the same frames, one row per variant),
+# sparse.txt / quadtree.txt (figures printed by the sparse and quadtree
+# tests), summary.md (ratios and targets, met or missed) and, when gnuplot
+# is installed, PNG plots.  Every CSV row names the Vulkan device.
+#
+# Runs from a build folder carried to another machine: only BUILD_DIR's
+# compiler/splatc, runtime/splatview and tests/splatbench are needed (plus
+# the repository's examples, graphs and nodes); the caller sets the Vulkan
+# loader up (VK_DRIVER_FILES / VK_ICD_FILENAMES, LD_LIBRARY_PATH).
+# --smoke: examples/minimal only, tiny frames, a minute at most.
+# --quick: the full set of comparisons with fewer frames (a fast GPU run).
+set -eu
+
+if [ $# -lt 1 ]; then
+    echo "usage: sh tests/bench/run.sh BUILD_DIR [--smoke] [--quick] [--out DIR]" >&2
+    exit 2
+fi
+B=$(cd "$1" && pwd)
+shift
+MODE=full
+OUT=out/bench
+while [ $# -gt 0 ]; do
+    case $1 in
+    --smoke) MODE=smoke ;;
+    --quick) MODE=quick ;;
+    --out) OUT=$2; shift ;;
+    *) echo "run.sh: unknown option '$1'" >&2; exit 2 ;;
+    esac
+    shift
+done
+REPO=$(cd "$(dirname "$0")/../.." && pwd)
+SPLATC=$B/compiler/splatc
+BENCH=$B/tests/splatbench
+for t in "$SPLATC" "$BENCH"; do
+    [ -x "$t" ] || { echo "run.sh: $t is not built (cmake --build $B)" >&2; exit 1; }
+done
+mkdir -p "$OUT"
+OUT=$(cd "$OUT" && pwd)
+W=$OUT/work
+rm -rf "$W" "$OUT"/*.csv "$OUT"/*.png "$OUT"/*.dat "$OUT"/summary.md
+mkdir -p "$W"
+cd "$REPO"
+START=$(date +%s)
+log() { echo "[bench $(( $(date +%s) - START ))s] $*"; }
+
+# Peak memory of a command (KB) through GNU time when it is installed.
+TIME=""
+if [ -x /usr/bin/time ] && /usr/bin/time -f %M true >/dev/null 2>&1; then TIME=/usr/bin/time; fi
+
+case $MODE in
+smoke) FRAMES=2; WARM=1; SIZES=320x180; PATHS=ground; SCENES=minimal ;;
+quick) FRAMES=3; WARM=1; SIZES="1280x720 1920x1080"; PATHS="ground topdown grazing"; SCENES="minimal colorado" ;;
+*)     FRAMES=4; WARM=1; SIZES="1280x720 1920x1080"; PATHS="ground topdown grazing"; SCENES="minimal colorado" ;;
+esac
+
+# ---- mirrors: a scene variant lives in ROOT/examples/NAME with the
+# example's files linked, ROOT/nodes linked and ROOT/graphs a folder of
+# links, so a variant may replace one graph file (imports search the
+# nearest folder above the scene that has nodes/).
+mirror() {  # ROOT
+    mkdir -p "$1/graphs" "$1/examples"
+    [ -e "$1/nodes" ] || ln -s "$REPO/nodes" "$1/nodes"
+    for f in "$REPO"/graphs/*; do
+        [ -e "$1/graphs/$(basename "$f")" ] || ln -s "$f" "$1/graphs/"
+    done
+}
+mirror_scene() {  # ROOT EXAMPLE NAME  -> ROOT/examples/NAME (scene.sg not linked)
+    d=$1/examples/$3
+    mkdir -p "$d"
+    for f in "$REPO/examples/$2"/*; do
+        [ "$(basename "$f")" = scene.sg ] || ln -sf "$f" "$d/"
+    done
+    echo "$d"
+}
+
+# ---- splatc build with --stats into a CSV row ------------------------------
+# build_row LABEL SCENE PACK CACHEARGS...  (appends to $CSV; prints the pack)
+COMPILE_HEAD="device,scene,label,texels,materials,combinations,load_s,analysis_s,codegen_s,glslang_s,validation_s,write_s,total_s,wall_s,peak_mb,per_combo_ms,analysis_ns_per_texel"
+build_row() {
+    label=$1; scene=$2; pack=$3; shift 3
+    st=$W/stats.txt
+    t0=$(date +%s.%N)
+    if [ -n "$TIME" ]; then
+        $TIME -f "PEAKKB %M" -o "$W/time.txt" "$SPLATC" build "$scene" -o "$pack" -j 2 --stats "$@" > "$st"
+    else
+        "$SPLATC" build "$scene" -o "$pack" -j 2 --stats "$@" > "$st"; echo "PEAKKB NA" > "$W/time.txt"
+    fi
+    t1=$(date +%s.%N)
+    awk -v dev="$DEVICE" -v label="$label" -v name="$(basename "$(dirname "$scene")")" \
+        -v wall="$(echo "$t1 $t0" | awk '{printf "%.3f", $1 - $2}')" \
+        -v peak="$(awk '{print $2}' "$W/time.txt")" '
+        /^scene /{ m = $3; split($0, a, "heightfield "); split(a[2], b, " "); tex = b[1] * b[3] }
+        /^load /{ load = $2 } /^analysis /{ an = $2 } /^compose\+codegen/{ cg = $2 }
+        /^glslang /{ gl = $2 } /^validation /{ va = $2 } /^write /{ wr = $2 } /^total /{ tot = $2 }
+        /^combinations: [0-9]+ \(/{ nc = $2 }
+        /^analysis time:/{ anms = $3 }
+        END {
+            pk = peak == "NA" ? "NA" : sprintf("%.1f", peak / 1024)
+            # a pack that is up to date prints no scene line: texels unknown
+            printf "\"%s\",%s,%s,%s,%s,%d,%s,%s,%s,%s,%s,%s,%s,%s,%s,%.2f,%s\n", dev, name, label,
+                   tex ? tex : "", tex ? m : "", nc, load, an, cg, gl, va, wr, tot, wall, pk,
+                   nc ? 1000 * (cg + gl + va) / nc : 0,
+                   tex && anms != "" ? sprintf("%.2f", anms * 1e6 / tex) : ""
+        }' "$st" >> "$CSV"
+}
+
+# The device name: one tiny render of the minimal pack.
+log "device"
+"$SPLATC" build examples/minimal/scene.sg -o "$W/minimal" --flat --cache "$W/cache" >/dev/null
+DEVICE=$("$BENCH" render --pack "$W/minimal" --variant c=composite --size 64x36 --frames 1 \
+         --warmup 0 | awk -F'"' 'NR == 2 { print $2 }')
+[ -n "$DEVICE" ] || { echo "run.sh: no Vulkan device answers" >&2; exit 1; }
+log "device: $DEVICE"
+
+# ---- (a) compile figures: every scene cold (empty cache) and warm --------
+CSV=$OUT/compile.csv
+echo "$COMPILE_HEAD" > "$CSV"
+case $MODE in smoke) CSCENES=minimal ;; *) CSCENES="minimal colorado billingsley" ;; esac
+for s in $CSCENES; do
+    log "compile $s (cold, warm)"
+    rm -rf "$W/cache-$s" "$W/pack-$s"
+    build_row cold "examples/$s/scene.sg" "$W/pack-$s" --cache "$W/cache-$s"
+    build_row warm "examples/$s/scene.sg" "$W/pack-$s" --cache "$W/cache-$s"
+    # the packs the renders use: with the flat variants (branching benchmark)
+    "$SPLATC" build "examples/$s/scene.sg" -o "$W/$s" -j 2 --flat --cache "$W/cache-$s" >/dev/null
+done
+
+# ---- (a) scaling with heightfield texels: 1x, 4x, 16x ---------------------
+CSV=$OUT/scale_hf.csv
+echo "$COMPILE_HEAD" > "$CSV"
+case $MODE in smoke) HS=minimal; KS="1 2" ;; *) HS=colorado; KS="1 2 4" ;; esac
+R=$W/mirror-hf
+mirror "$R"
+hf=$(awk -F'"' '/^[ \t]*heightfield[ \t]*=/{ print $2; exit }' "examples/$HS/scene.sg")
+for k in $KS; do
+    log "scale heightfield $HS x$((k * k))"
+    d=$(mirror_scene "$R" "$HS" "${HS}_x$((k * k))")
+    if [ "$k" = 1 ]; then
+        cp "examples/$HS/scene.sg" "$d/scene.sg"
+    else
+        "$BENCH" upscale "examples/$HS/$hf" "$k" "$d/hf.r16" > "$W/upscale.txt"
+        size=$(awk '{ print $2, $4 }' "$W/upscale.txt")
+        sed_masks=""
+        for m in $(awk -F'"' '/^[ \t]*painted[ \t]/{ print $2 }' "examples/$HS/scene.sg"); do
+            mkdir -p "$d/$(dirname "$m").scaled"
+            "$BENCH" upscale "examples/$HS/$m" "$k" "$d/$(dirname "$m").scaled/$(basename "$m")" >/dev/null
+            sed_masks="$sed_masks -e s|\"$m\"|\"$(dirname "$m").scaled/$(basename "$m")\"|"
+        done
+        # shellcheck disable=SC2086
+        sed -e "s|heightfield *= *\"$hf\"|heightfield = \"hf.r16\"\n    heightfield_size = $size|" \
+            -e "s|^\([ \t]*cell\) *= *\([0-9]*\)|\1 = \2|" $sed_masks \
+            "examples/$HS/scene.sg" > "$d/scene.sg"
+    fi
+    build_row "x$((k * k))" "$d/scene.sg" "$W/pack-hf" --cache "$W/cache-$HS"
+done
+rm -rf "$W/pack-hf"
+
+# ---- (a) scaling with the material count: 4, 8, 15, 30 (colorado's stack;
+# 30 = the 15 twice, the copies renamed) -------------------------------------
+CSV=$OUT/scale_mat.csv
+echo "$COMPILE_HEAD" > "$CSV"
+if [ "$MODE" != smoke ]; then
+    R=$W/mirror-mat
+    mirror "$R"
+    stack=$(awk '/materials *=/,/\]/' examples/colorado/scene.sg | tr -d '[],' | sed 's/materials *=//' | tr -s ' \n' ' ')
+    for g in $stack; do   # renamed copies: material NAME -> NAME_b
+        sed "s/^material $g\b/material ${g}_b/" "graphs/$g.sg" > "$R/graphs/${g}_b.sg"
+    done
+    for n in 4 8 15 30; do
+        log "scale materials $n"
+        d=$(mirror_scene "$R" colorado "colorado_m$n")
+        list=$(echo $stack $(for g in $stack; do echo "${g}_b"; done) | tr ' ' '\n' | head -n $n | tr '\n' ' ')
+        imports=$(for g in $list; do echo "import \"graphs/$g.sg\""; done)
+        awk -v imports="$imports" -v list="$(echo $list | sed 's/ /, /g')" '
+            /^import "graphs\//{ next }
+            /^import "nodes\/compositors.sg"/{ print; print imports; next }
+            /materials *=/{ skip = 1; print "    materials = [" list "]" }
+            skip { if (/\]/) skip = 0; next }
+            { print }' examples/colorado/scene.sg > "$d/scene.sg"
+        build_row "m$n" "$d/scene.sg" "$W/pack-mat" --no-cache
+    done
+    rm -rf "$W/pack-mat"
+fi
+
+# ---- compositor and knob packs ------------------------------------------------
+# compositor variants: the scene with another `compositor =`
+comp_pack() {  # SCENE COMPOSITOR -> pack dir
+    R=$W/mirror-comp
+    mirror "$R"
+    d=$(mirror_scene "$R" "$1" "$1_$2")
+    sed -e "s/compositor *= *[a-z_]*/compositor = $2/" \
+        -e 's|^import "nodes/compositors.sg"|import "nodes/compositors.sg"\nimport "nodes/compositors_extra.sg"\nimport "nodes/stochastic.sg"|' \
+        "examples/$1/scene.sg" > "$d/scene.sg"
+    "$SPLATC" build "$d/scene.sg" -o "$W/$1_$2" -j 2 --cache "$W/cache-$1" >/dev/null
+    echo "$W/$1_$2"
+}
+# graph knob variants: one graph file with a node type replaced
+knob_pack() {  # SCENE LABEL GRAPH FROM TO -> pack dir
+    R=$W/mirror-knob-$2
+    mirror "$R"
+    rm -f "$R/graphs/$3.sg"
+    sed "s/: *$4 /: $5 /" "graphs/$3.sg" > "$R/graphs/$3.sg"
+    d=$(mirror_scene "$R" "$1" "$1")
+    cp "examples/$1/scene.sg" "$d/scene.sg"
+    "$SPLATC" build "$d/scene.sg" -o "$W/$1_knob_$2" -j 2 --cache "$W/cache-$1" >/dev/null
+    echo "$W/$1_knob_$2"
+}
+
+# ---- (b)-(d) renders --------------------------------------------------------------
+CSV=$OUT/render.csv
+rm -f "$CSV"
+render() {  # GROUP SCENE PATH SIZE VARIANT... (first variant = reference)
+    group=$1; scene=$2; path=$3; size=$4; shift 4
+    log "render $group $scene $path $size"
+    args=""
+    for v in "$@"; do args="$args --variant $v"; done
+    preset=""
+    [ "$scene" = colorado ] && [ "$path" = ground ] && preset="--start-preset trinidad"
+    [ "$scene" = billingsley ] && [ "$path" = ground ] && preset="--start-preset ground"
+    mkdir -p "$W/img/$group-$scene-$path-$size"
+    # shellcheck disable=SC2086
+    "$BENCH" render --pack "$W/$scene" $args --path "$path" $preset --size "$size" \
+        --frames "$FRAMES" --warmup "$WARM" --scene "$scene" \
+        --save "$W/img/$group-$scene-$path-$size" > "$W/render.txt"
+    awk -v g="$group" -F, 'NR > 1 { print g "," $0 }' "$W/render.txt" >> "$CSV.body"
+}
+rm -f "$CSV.body"
+for s in $SCENES; do
+    for size in $SIZES; do
+        for p in $PATHS; do
+            # 1080p: the ground path only (lavapipe time)
+            [ "$size" = 1920x1080 ] && [ "$p" != ground ] && [ "$MODE" = full ] && continue
+            render main "$s" "$p" "$size" ref=multipass composite=composite uber=uber flat=flat
+        done
+    done
+done
+if [ "$MODE" = smoke ]; then
+    stoch=$(comp_pack minimal stochastic_select)
+    render knobs minimal ground 320x180 composite=composite fp16=fp16 sobel=sobel \
+        "stochastic=composite,pack=$stoch" lod6=composite,lod=6
+else
+    # (c) compositors, against the alpha composite of the same frames
+    for s in minimal colorado; do
+        hb=$(comp_pack "$s" height_blend)
+        st=$(comp_pack "$s" stochastic_select)
+        for p in ground topdown; do
+            render compositor "$s" "$p" 1280x720 linear_alpha=composite \
+                "height_blend=composite,pack=$hb" "stochastic=composite,pack=$st"
+        done
+    done
+    # Billingsley's max-height selection (his scene: masks + linear_alpha)
+    # against its multi-pass reference, and stochastic selection on it
+    st=$(comp_pack billingsley stochastic_select)
+    render compositor billingsley ground 1280x720 ref=multipass max_height=composite \
+        "stochastic=composite,pack=$st"
+    # (d) knobs: arithmetic precision, normal filter, LOD threshold
+    for p in ground topdown; do
+        render knob_precision colorado "$p" 1280x720 fp32=composite fp16=fp16
+        render knob_normal colorado "$p" 1280x720 cross=composite sobel=sobel
+        render knob_lod colorado "$p" 1280x720 lod1=composite,lod=1 lod2=composite,lod=2 \
+            lod3=composite,lod=3 lod6=composite,lod=6 lod12=composite,lod=12
+    done
+    # fBm octaves (forest_floor: texture fBm 2/4/6/8) and texture fBm vs ALU
+    # gradient fBm at 4 octaves, against 8 texture octaves
+    f2=$(knob_pack colorado tfbm2 forest_floor texture_fbm4 texture_fbm2)
+    f6=$(knob_pack colorado tfbm6 forest_floor texture_fbm4 texture_fbm6)
+    f8=$(knob_pack colorado tfbm8 forest_floor texture_fbm4 texture_fbm8)
+    ga=$(knob_pack colorado alu4 forest_floor texture_fbm4 gradient_fbm4)
+    m8=$(knob_pack colorado mud8 mud gradient_fbm2 gradient_fbm8)
+    m4=$(knob_pack colorado mud4 mud gradient_fbm2 gradient_fbm4)
+    for p in topdown ground; do
+        render knob_fbm colorado "$p" 1280x720 "tfbm8=composite,pack=$f8" \
+            "tfbm6=composite,pack=$f6" tfbm4=composite "tfbm2=composite,pack=$f2" \
+            "alu_gfbm4=composite,pack=$ga"
+        render knob_alu_octaves colorado "$p" 1280x720 "mud_gfbm8=composite,pack=$m8" \
+            "mud_gfbm4=composite,pack=$m4" mud_gfbm2=composite
+    done
+fi
+{ echo "group,$(sed -n 1p "$W/render.txt")"; cat "$CSV.body"; } > "$CSV"
+rm -f "$CSV.body"
+
+# ---- figures printed by tests: sparse masks, quadtree selection -----------------
+: > "$OUT/sparse.txt"
+: > "$OUT/quadtree.txt"
+if [ "$MODE" != smoke ]; then
+    if [ -x "$B/tests/gpu_sparse" ]; then
+        log "sparse mask accuracy (gpu_sparse)"
+        "$B/tests/gpu_sparse" > "$OUT/sparse.txt" 2>&1 || echo "gpu_sparse failed" >> "$OUT/sparse.txt"
+    fi
+    if [ -x "$B/tests/test_quadtree" ]; then
+        log "quadtree selection (test_quadtree)"
+        "$B/tests/test_quadtree" > "$OUT/quadtree.txt" 2>&1 || echo "test_quadtree failed" >> "$OUT/quadtree.txt"
+    fi
+fi
+
+# ---- summary and plots --------------------------------------------------------------
+log "summary"
+sh "$REPO/tests/bench/summary.sh" "$OUT" "$MODE" > "$OUT/summary.md"
+# plot data: one file per knob/compositor group and view (label, GPU ms,
+# mean error) with its Pareto front; the ratio bars; the scaling curves
+awk -F, -v dir="$OUT" 'NR > 1 && $1 != "main" {
+        f = dir "/knob_" $1 "_" $3 "_" $4 ".dat"
+        print $7, $12, $20 > f
+    }' "$OUT/render.csv"
+for f in "$OUT"/knob_*.dat; do
+    [ -e "$f" ] || continue
+    sort -g -k2 "$f" | awk 'NR == 1 || $3 < best { print; best = $3 }' > "$OUT/pareto_${f##*/knob_}"
+done
+awk -F, 'NR > 1 && $1 == "main" { k = $3 "-" $4 "-" $5 "x" $6; t[k, $8] = $12; keys[k] = 1 }
+    END { for (k in keys) if (t[k, "composite"] > 0)
+        printf "%s %.3f %.3f %.3f\n", k, t[k, "multipass"] / t[k, "composite"],
+               t[k, "flat"] / t[k, "composite"], t[k, "uber"] / t[k, "composite"] }' \
+    "$OUT/render.csv" | sort > "$OUT/ratios.dat"
+awk -F, 'NR > 1 { print $4, $17, $8 * 10 }' "$OUT/scale_hf.csv" > "$OUT/scale_hf.dat"
+awk -F, 'NR > 1 { print $5, $6, $9, $10, $13 }' "$OUT/scale_mat.csv" > "$OUT/scale_mat.dat"
+if command -v gnuplot >/dev/null 2>&1; then
+    log "plots"
+    (cd "$OUT" && gnuplot "$REPO/tests/bench/plots.gp") || echo "run.sh: gnuplot failed (plots skipped)"
+else
+    log "gnuplot not installed: plots skipped"
+fi
+log "done: $OUT/summary.md"
+cat "$OUT/summary.md"

@@ -1,0 +1,717 @@
+/* splatbench — speed and accuracy of shader-pack variants, side by side on
+ * the same frames of a fixed camera path (issue 7, DESIGN §9).
+ *
+ *   splatbench render --variant LABEL=KIND[,pack=DIR][,lod=P] ... [options]
+ *       Renders every variant on every frame of a camera path, frames
+ *       interleaved (frame f of every variant, then frame f + 1), so a
+ *       change of machine load hits all variants alike.  Per variant: GPU
+ *       ms per frame from timestamp queries (median, p10, p90), CPU ms per
+ *       frame, and the error of its lit RGBA32F image against the reference
+ *       variant's image of the same frame (max and mean absolute error over
+ *       RGB, PSNR with peak 1, count of NaN/Inf values).  One CSV row per
+ *       variant.  KIND:
+ *         composite   per-combination composites (the pack's shaders)
+ *         multipass   the multi-pass alpha-blended reference (seed 000 §5.3)
+ *         uber        the über-shader for every patch
+ *         flat        composites without dynamic branches (pack built --flat)
+ *         fp16        composites recompiled with `precision mediump float`
+ *         sobel       composites recompiled with a 3x3 Sobel normal filter
+ *                     in place of Listing 1's 4-tap cross
+ *       pack=DIR renders another pack of the same terrain (compositors, fBm
+ *       knobs); lod=P sets the LOD error threshold in pixels per grid step.
+ *   splatbench upscale IN.png K OUT
+ *       K times the texels per side, bilinear: a 16-bit PNG becomes raw
+ *       little-endian R16 (OUT), an 8-bit one an 8-bit PNG (nearest).
+ *   splatbench compare A.f32 B.f32
+ *       max/mean abs error and PSNR of two --float-out images.
+ *
+ * Exit status: 0 ok, 1 a failure (message on stderr), 2 usage. */
+#include "splatrt.h"
+
+#include <errno.h>
+#include <jansson.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/resource.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <stb/stb_image.h>
+#include <stb/stb_image_write.h>
+
+/* ---- small helpers ------------------------------------------------------- */
+
+static void *xcalloc(size_t n, size_t size)
+{
+    void *p = calloc(n ? n : 1, size);
+    if (!p) {
+        fprintf(stderr, "splatbench: out of memory\n");
+        abort();
+    }
+    return p;
+}
+
+static char *read_text(const char *path)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return NULL;
+    fseek(f, 0, SEEK_END);
+    long n = ftell(f);
+    fseek(f, 0, SEEK_SET);
+    char *s = xcalloc((size_t)n + 1, 1);
+    if (n > 0 && fread(s, 1, (size_t)n, f) != (size_t)n) {
+        free(s);
+        s = NULL;
+    }
+    fclose(f);
+    return s;
+}
+
+static bool read_words(const char *path, uint32_t **words, size_t *n)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return false;
+    fseek(f, 0, SEEK_END);
+    long bytes = ftell(f);
+    fseek(f, 0, SEEK_SET);
+    bool ok = bytes > 0 && bytes % 4 == 0;
+    if (ok) {
+        *words = xcalloc((size_t)bytes / 4, 4);
+        *n = (size_t)bytes / 4;
+        ok = fread(*words, 4, *n, f) == *n;
+    }
+    fclose(f);
+    return ok;
+}
+
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* median, 10th and 90th percentile of n samples (sorted in place) */
+static void percentiles(double *v, int n, double *med, double *p10, double *p90)
+{
+    qsort(v, (size_t)n, sizeof *v, cmp_double);
+    *med = n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+    *p10 = v[(int)floor(0.1 * (n - 1))];
+    *p90 = v[(int)ceil(0.9 * (n - 1))];
+}
+
+/* resident set size now, MB (lavapipe's "GPU" memory is host memory) */
+static double rss_mb(void)
+{
+    FILE *f = fopen("/proc/self/statm", "r");
+    long pages = 0, res = 0;
+    if (f) {
+        if (fscanf(f, "%ld %ld", &pages, &res) != 2)
+            res = 0;
+        fclose(f);
+    }
+    return (double)res * (double)sysconf(_SC_PAGESIZE) / (1024.0 * 1024.0);
+}
+
+/* ---- image error ---------------------------------------------------------- */
+
+typedef struct err_acc {
+    double max_abs, sum_abs, sum_sq;
+    long   n, nonfinite;
+} err_acc;
+
+/* RGB of `img` against `ref` (w*h RGBA floats).  A NaN/Inf in img counts
+ * as nonfinite and as an error of 1 (so it cannot hide in the mean). */
+static void err_add(err_acc *a, const float *img, const float *ref, size_t npx)
+{
+    for (size_t i = 0; i < npx; i++)
+        for (int c = 0; c < 3; c++) {
+            float v = img[4 * i + c], r = ref[4 * i + c];
+            double d;
+            if (!isfinite(v) || !isfinite(r)) {
+                a->nonfinite++;
+                d = 1.0;
+            } else {
+                d = fabs((double)v - (double)r);
+            }
+            a->max_abs = d > a->max_abs ? d : a->max_abs;
+            a->sum_abs += d;
+            a->sum_sq += d * d;
+            a->n++;
+        }
+}
+
+static double err_psnr(const err_acc *a)
+{
+    double mse = a->n ? a->sum_sq / (double)a->n : 0;
+    return mse > 0 ? 10.0 * log10(1.0 / mse) : 999.0;
+}
+
+/* ---- variants -------------------------------------------------------------- */
+
+typedef enum kind { K_COMPOSITE, K_MULTIPASS, K_UBER, K_FLAT, K_FP16, K_SOBEL } kind;
+static const char *const kind_names[] = {"composite", "multipass", "uber", "flat", "fp16", "sobel"};
+
+typedef struct variant {
+    char        *label;
+    kind         k;
+    const char  *pack_dir;
+    double       lod;
+    rt_pack     *base;      /* loaded pack (shared by variants of one dir)  */
+    rt_pack      view;      /* shallow copy with this variant's combos      */
+    rt_pack_combo *combos;  /* owned when the shaders differ, else NULL     */
+    rt_renderer *r;
+    double      *gpu, *cpu, *sel;
+    int          patches, pipelines;
+    err_acc      err;
+    double       rss_delta;
+} variant;
+
+/* The 3x3 Sobel filter replacing the prelude's splat_normal_at (abi.c):
+ * x and z differences of the three rows/columns weighted 1 2 1, over 4. */
+static const char sobel_normal[] =
+    "vec3 splat_normal_at(vec2 uv) {\n"
+    "    vec2 t = u_frame.texel.zw;\n"
+    "    float h00 = texture(u_height, uv + vec2(-t.x, -t.y)).r;\n"
+    "    float h10 = texture(u_height, uv + vec2(0.0, -t.y)).r;\n"
+    "    float h20 = texture(u_height, uv + vec2(t.x, -t.y)).r;\n"
+    "    float h01 = texture(u_height, uv + vec2(-t.x, 0.0)).r;\n"
+    "    float h21 = texture(u_height, uv + vec2(t.x, 0.0)).r;\n"
+    "    float h02 = texture(u_height, uv + vec2(-t.x, t.y)).r;\n"
+    "    float h12 = texture(u_height, uv + vec2(0.0, t.y)).r;\n"
+    "    float h22 = texture(u_height, uv + vec2(t.x, t.y)).r;\n"
+    "    float dx = u_frame.terrain.x * t.x;\n"
+    "    float dz = u_frame.terrain.y * t.y;\n"
+    "    float gx = ((h00 + 2.0 * h01 + h02) - (h20 + 2.0 * h21 + h22)) * 0.25;\n"
+    "    float gz = ((h00 + 2.0 * h10 + h20) - (h02 + 2.0 * h12 + h22)) * 0.25;\n"
+    "    vec3 n = vec3(gx * u_frame.terrain.z / dx, 2.0, gz * u_frame.terrain.z / dz);\n"
+    "    return normalize(n);\n"
+    "}\n";
+
+/* GLSL of a combination with the variant's change; NULL if the text does
+ * not have the expected shape (message on stderr). */
+static char *transform_glsl(const char *src, kind k, const char *name)
+{
+    const char *at, *end;
+    const char *insert;
+    if (k == K_FP16) {
+        /* Every float of the shader at mediump (RelaxedPrecision in SPIR-V:
+         * drivers may use fp16 arithmetic; exact fp32 ones ignore it). */
+        at = strstr(src, "#version 450\n");
+        if (!at) {
+            fprintf(stderr, "splatbench: %s: no '#version 450' line\n", name);
+            return NULL;
+        }
+        at += strlen("#version 450\n");
+        end = at;
+        insert = "precision mediump float;\n";
+    } else {
+        at = strstr(src, "vec3 splat_normal_at(vec2 uv) {\n");
+        end = at ? strstr(at, "\n}\n") : NULL;
+        if (!end) {
+            fprintf(stderr, "splatbench: %s: no splat_normal_at() to replace\n", name);
+            return NULL;
+        }
+        end += 3;
+        insert = sobel_normal;
+    }
+    size_t a = (size_t)(at - src), b = strlen(end), c = strlen(insert);
+    char *out = xcalloc(a + b + c + 1, 1);
+    memcpy(out, src, a);
+    memcpy(out + a, insert, c);
+    memcpy(out + a + c, end, b);
+    return out;
+}
+
+/* The combination shaders a variant draws with: the pack's own, the flat
+ * ones of the manifest, or recompiled GLSL. */
+static bool variant_shaders(variant *v)
+{
+    v->view = *v->base;
+    if (v->k != K_FLAT && v->k != K_FP16 && v->k != K_SOBEL)
+        return true;
+    char path[4096];
+    snprintf(path, sizeof path, "%s/manifest.json", v->pack_dir);
+    json_error_t jerr;
+    json_t *m = json_load_file(path, 0, &jerr);
+    json_t *combos = m ? json_object_get(m, "combinations") : NULL;
+    if (!json_is_array(combos) || (int)json_array_size(combos) != v->base->ncombos) {
+        fprintf(stderr, "splatbench: %s: no combinations list matching the pack\n", path);
+        json_decref(m);
+        return false;
+    }
+    v->combos = xcalloc((size_t)v->base->ncombos, sizeof *v->combos);
+    bool ok = true;
+    for (int i = 0; i < v->base->ncombos && ok; i++) {
+        json_t *c = json_array_get(combos, (size_t)i);
+        v->combos[i] = v->base->combos[i];
+        v->combos[i].spirv.words = NULL;
+        if (v->k == K_FLAT) {
+            const char *spv = json_string_value(json_object_get(json_object_get(c, "flat"), "spirv"));
+            if (!spv) {
+                fprintf(stderr, "splatbench: %s: combination %d has no flat shader "
+                        "(build the pack with splatc build --flat)\n", path, i);
+                ok = false;
+                break;
+            }
+            snprintf(path, sizeof path, "%s/%s", v->pack_dir, spv);
+            if (!read_words(path, &v->combos[i].spirv.words, &v->combos[i].spirv.nwords)) {
+                fprintf(stderr, "splatbench: cannot read '%s'\n", path);
+                ok = false;
+            }
+        } else {
+            const char *glsl = json_string_value(json_object_get(c, "glsl"));
+            snprintf(path, sizeof path, "%s/%s", v->pack_dir, glsl ? glsl : "?");
+            char *src = glsl ? read_text(path) : NULL;
+            char *text = src ? transform_glsl(src, v->k, path) : NULL;
+            rt_error e = {0};
+            if (!text || !rt_glsl_compile(text, VK_SHADER_STAGE_FRAGMENT_BIT, path,
+                                          &v->combos[i].spirv.words,
+                                          &v->combos[i].spirv.nwords, &e)) {
+                fprintf(stderr, "splatbench: %s: %s\n", path, e.msg ? e.msg : "unreadable");
+                ok = false;
+            }
+            rt_error_clear(&e);
+            free(src);
+            free(text);
+        }
+    }
+    json_decref(m);
+    v->view.combos = v->combos;
+    return ok;
+}
+
+static void variant_free(variant *v)
+{
+    rt_renderer_destroy(v->r);
+    if (v->combos)
+        for (int i = 0; i < v->base->ncombos; i++)
+            free(v->combos[i].spirv.words);
+    free(v->combos);
+    free(v->label);
+    free(v->gpu);
+    free(v->cpu);
+    free(v->sel);
+}
+
+/* LABEL=KIND[,pack=DIR][,lod=P] */
+static bool parse_variant(const char *s, const char *default_pack, variant *v)
+{
+    memset(v, 0, sizeof *v);
+    const char *eq = strchr(s, '=');
+    if (!eq || eq == s)
+        return false;
+    v->label = strndup(s, (size_t)(eq - s));
+    v->pack_dir = default_pack;
+    char *rest = strdup(eq + 1), *save = NULL;
+    bool ok = true, have_kind = false;
+    for (char *t = strtok_r(rest, ",", &save); t && ok; t = strtok_r(NULL, ",", &save)) {
+        if (!strncmp(t, "pack=", 5)) {
+            v->pack_dir = strdup(t + 5);   /* lives as long as the process */
+        } else if (!strncmp(t, "lod=", 4)) {
+            v->lod = atof(t + 4);
+            ok = v->lod > 0;
+        } else {
+            ok = false;
+            for (int k = 0; k < (int)(sizeof kind_names / sizeof *kind_names); k++)
+                if (!strcmp(t, kind_names[k])) {
+                    v->k = (kind)k;
+                    ok = have_kind = true;
+                }
+        }
+    }
+    free(rest);
+    return ok && have_kind && v->pack_dir;
+}
+
+/* ---- camera paths ------------------------------------------------------------ */
+
+/* Terrain height (metres) at terrain-local x, z: bilinear between texel
+ * centres, clamped to the edge (PACK.md "Coordinates"). */
+static double ground(const rt_pack *p, double x, double z)
+{
+    double u = x / p->size[0] * p->hf_width - 0.5, v = z / p->size[1] * p->hf_height - 0.5;
+    u = fmin(fmax(u, 0), p->hf_width - 1);
+    v = fmin(fmax(v, 0), p->hf_height - 1);
+    int i = (int)u, j = (int)v;
+    int i1 = i + 1 < p->hf_width ? i + 1 : i, j1 = j + 1 < p->hf_height ? j + 1 : j;
+    double fu = u - i, fv = v - j;
+#define H(a, b) (p->heights[(size_t)(b) * (size_t)p->hf_width + (size_t)(a)] / 65535.0)
+    double h = (H(i, j) * (1 - fu) + H(i1, j) * fu) * (1 - fv) +
+               (H(i, j1) * (1 - fu) + H(i1, j1) * fu) * fv;
+#undef H
+    return h * p->max_height + p->height_offset;
+}
+
+typedef struct path_desc {
+    const char *name;          /* ground | topdown | grazing                */
+    const char *preset;        /* ground: start at this camera preset       */
+} path_desc;
+
+/* Camera of frame f of n.  ground: 2 m above the terrain, looking 150 m
+ * ahead along a straight line (seed 002 §3.2), 1.5 % of the terrain per
+ * path; topdown: straight down from above the highest point, covering
+ * about half the terrain, drifting east; grazing: 40 m above a corner,
+ * looking across the terrain at about 1-3 degrees below the horizon. */
+static bool path_camera(const rt_pack *p, const path_desc *pd, int f, int n, rt_camera *c)
+{
+    memset(c, 0, sizeof *c);
+    double sx = p->size[0], sz = p->size[1], smax = fmax(sx, sz);
+    double t = n > 1 ? (double)f / (n - 1) : 0;
+    double top = p->max_height + p->height_offset;
+    if (!strcmp(pd->name, "ground")) {
+        double x0 = 0.3 * sx, z0 = 0.3 * sz, dx = 0.7071, dz = 0.7071;
+        if (pd->preset) {
+            int k = rt_pack_camera_find(p, pd->preset);
+            if (k < 0) {
+                fprintf(stderr, "splatbench: no camera preset '%s'\n", pd->preset);
+                return false;
+            }
+            x0 = p->cameras[k].position[0];
+            z0 = p->cameras[k].position[2];
+            dx = p->cameras[k].look[0] - x0;
+            dz = p->cameras[k].look[2] - z0;
+            double l = hypot(dx, dz);
+            if (l <= 0)
+                dx = 1, dz = 0, l = 1;
+            dx /= l, dz /= l;
+        }
+        double x = x0 + dx * 0.015 * smax * t, z = z0 + dz * 0.015 * smax * t;
+        double ahead = fmin(150.0, 0.1 * smax);
+        double lx = x + dx * ahead, lz = z + dz * ahead;
+        c->position[0] = x, c->position[1] = ground(p, x, z) + 2.0, c->position[2] = z;
+        c->look[0] = lx, c->look[1] = ground(p, lx, lz) + 1.0, c->look[2] = lz;
+    } else if (!strcmp(pd->name, "topdown")) {
+        double x = 0.5 * sx + 0.05 * sx * (t - 0.5), z = 0.5 * sz;
+        c->position[0] = x, c->position[1] = top + 0.5 * smax, c->position[2] = z;
+        /* slightly off vertical so the view's up vector is defined */
+        c->look[0] = x, c->look[1] = p->height_offset, c->look[2] = z + 0.001 * smax;
+    } else if (!strcmp(pd->name, "grazing")) {
+        double x = 0.05 * sx + 0.02 * sx * t, z = 0.05 * sz + 0.02 * sz * t;
+        double lx = 0.7 * sx, lz = 0.7 * sz;
+        c->position[0] = x, c->position[1] = ground(p, x, z) + 40.0, c->position[2] = z;
+        c->look[0] = lx, c->look[1] = ground(p, lx, lz), c->look[2] = lz;
+        if (c->look[1] > c->position[1] - 1.0)
+            c->look[1] = c->position[1] - 0.02 * hypot(lx - x, lz - z);
+    } else {
+        fprintf(stderr, "splatbench: unknown path '%s' (ground, topdown, grazing)\n", pd->name);
+        return false;
+    }
+    return true;
+}
+
+/* ---- render ---------------------------------------------------------------- */
+
+static int cmd_render(int argc, char **argv)
+{
+    const char *pack_dir = NULL, *csv = NULL, *scene = NULL, *save = NULL, *ref_label = NULL;
+    path_desc pd = {.name = "ground"};
+    int width = 1280, height = 720, frames = 5, warmup = 1;
+    char **specs = xcalloc((size_t)argc, sizeof *specs);
+    int nspecs = 0;
+    for (int i = 2; i < argc; i++) {
+        const char *a = argv[i], *next = i + 1 < argc ? argv[i + 1] : NULL;
+        if (!next) {
+            fprintf(stderr, "splatbench render: %s needs a value\n", a);
+            return 2;
+        }
+        i++;
+        if (!strcmp(a, "--pack")) pack_dir = next;
+        else if (!strcmp(a, "--variant")) specs[nspecs++] = (char *)next;
+        else if (!strcmp(a, "--ref")) ref_label = next;
+        else if (!strcmp(a, "--path")) pd.name = next;
+        else if (!strcmp(a, "--start-preset")) pd.preset = next;
+        else if (!strcmp(a, "--csv")) csv = next;
+        else if (!strcmp(a, "--scene")) scene = next;
+        else if (!strcmp(a, "--save")) save = next;
+        else if (!strcmp(a, "--frames")) frames = atoi(next);
+        else if (!strcmp(a, "--warmup")) warmup = atoi(next);
+        else if (!strcmp(a, "--size")) {
+            if (sscanf(next, "%dx%d", &width, &height) != 2 || width <= 0 || height <= 0) {
+                fprintf(stderr, "splatbench render: --size expects WxH\n");
+                return 2;
+            }
+        } else {
+            fprintf(stderr, "splatbench render: unknown option '%s'\n", a);
+            return 2;
+        }
+    }
+    if (nspecs == 0 || frames < 1 || warmup < 0) {
+        fprintf(stderr, "splatbench render: needs --variant LABEL=KIND... and --frames >= 1\n");
+        return 2;
+    }
+    variant *v = xcalloc((size_t)nspecs, sizeof *v);
+    for (int i = 0; i < nspecs; i++)
+        if (!parse_variant(specs[i], pack_dir, &v[i])) {
+            fprintf(stderr, "splatbench render: bad variant '%s' (LABEL=KIND[,pack=DIR][,lod=P];"
+                    " KIND composite|multipass|uber|flat|fp16|sobel; a pack from --pack or pack=)\n",
+                    specs[i]);
+            return 2;
+        }
+    int ref = 0;
+    if (ref_label) {
+        ref = -1;
+        for (int i = 0; i < nspecs; i++)
+            if (!strcmp(v[i].label, ref_label))
+                ref = i;
+        if (ref < 0) {
+            fprintf(stderr, "splatbench render: --ref '%s' is not a variant\n", ref_label);
+            return 2;
+        }
+    }
+
+    int status = 1;
+    rt_error e = {0};
+    rt_device dev;
+    bool have_dev = false;
+    rt_pack *packs = xcalloc((size_t)nspecs, sizeof *packs);
+    const char **pack_dirs = xcalloc((size_t)nspecs, sizeof *pack_dirs);
+    int npacks = 0;
+    size_t npx = (size_t)width * (size_t)height;
+    float *img = xcalloc(npx * 4, sizeof *img), *refimg = xcalloc(npx * 4, sizeof *refimg);
+
+    /* every distinct pack once */
+    for (int i = 0; i < nspecs; i++) {
+        int k = 0;
+        while (k < npacks && strcmp(pack_dirs[k], v[i].pack_dir))
+            k++;
+        if (k == npacks) {
+            if (!rt_pack_load(&packs[k], v[i].pack_dir, &e))
+                goto done;
+            pack_dirs[npacks++] = v[i].pack_dir;
+        }
+        v[i].base = &packs[k];
+        if (packs[k].hf_width != packs[0].hf_width || packs[k].hf_height != packs[0].hf_height) {
+            fprintf(stderr, "splatbench: pack '%s' has another terrain than '%s'\n",
+                    v[i].pack_dir, pack_dirs[0]);
+            goto done;
+        }
+        if (!variant_shaders(&v[i]))
+            goto done;
+    }
+    if (!rt_device_create(&dev, NULL, &e))
+        goto done;
+    have_dev = true;
+    char cache[4096];
+    if (save)
+        snprintf(cache, sizeof cache, "%s/pipeline-cache.bin", save);
+    for (int i = 0; i < nspecs; i++) {
+        rt_render_desc rd = {
+            .width = width, .height = height, .lod_pixels = v[i].lod,
+            .reference = v[i].k == K_MULTIPASS ? RT_REF_MULTIPASS
+                       : v[i].k == K_UBER ? RT_REF_UBER : RT_REF_NONE,
+            .pipeline_cache = save ? cache : NULL,
+        };
+        double before = rss_mb();
+        if (!rt_renderer_create(&dev, &v[i].view, &rd, &v[i].r, &e))
+            goto done;
+        v[i].gpu = xcalloc((size_t)frames, sizeof(double));
+        v[i].cpu = xcalloc((size_t)frames, sizeof(double));
+        v[i].sel = xcalloc((size_t)frames, sizeof(double));
+        /* warm-up frames: pipelines are made (and JIT-compiled) on first use */
+        rt_camera cam;
+        rt_frame_stats st;
+        for (int w = 0; w < warmup; w++) {
+            if (!path_camera(&v[i].view, &pd, 0, frames, &cam))
+                goto done;
+            if (!rt_renderer_frame(v[i].r, &cam, &st, &e))
+                goto done;
+        }
+        v[i].rss_delta = rss_mb() - before;
+    }
+    for (int f = 0; f < frames; f++) {
+        rt_camera cam;
+        if (!path_camera(&packs[0], &pd, f, frames, &cam))
+            goto done;
+        /* the reference first, so the others compare against this frame */
+        for (int o = 0; o < nspecs; o++) {
+            int i = o == 0 ? ref : o == ref ? 0 : o;
+            rt_frame_stats st;
+            if (!rt_renderer_frame(v[i].r, &cam, &st, &e))
+                goto done;
+            v[i].gpu[f] = st.gpu_ms;
+            v[i].cpu[f] = st.cpu_ms;
+            v[i].sel[f] = st.select_ms;
+            v[i].patches = st.patches;
+            v[i].pipelines = st.pipelines;
+            if (!rt_renderer_read(v[i].r, i == ref ? refimg : img, &e))
+                goto done;
+            err_add(&v[i].err, i == ref ? refimg : img, refimg, npx);
+            if (save && f == frames - 1) {
+                char path[4096];
+                snprintf(path, sizeof path, "%s/%s.f32", save, v[i].label);
+                if (!rt_write_float(path, i == ref ? refimg : img, width, height, &e))
+                    goto done;
+            }
+        }
+    }
+
+    FILE *out = stdout;
+    bool header = true;
+    if (csv) {
+        struct stat sb;
+        header = stat(csv, &sb) != 0 || sb.st_size == 0;
+        out = fopen(csv, "a");
+        if (!out) {
+            fprintf(stderr, "splatbench: cannot write '%s': %s\n", csv, strerror(errno));
+            goto done;
+        }
+    }
+    if (header)
+        fprintf(out, "device,scene,path,width,height,variant,kind,pack,lod_pixels,frames,"
+                     "gpu_med_ms,gpu_p10_ms,gpu_p90_ms,cpu_med_ms,select_med_ms,patches,"
+                     "pipelines,max_abs,mean_abs,psnr_db,nonfinite,rss_delta_mb,reference\n");
+    /* the device name in CSV: its commas become ';' */
+    char devname[VK_MAX_PHYSICAL_DEVICE_NAME_SIZE];
+    snprintf(devname, sizeof devname, "%s", dev.props.deviceName);
+    for (char *c = devname; *c; c++)
+        if (*c == ',' || *c == '"')
+            *c = ';';
+    for (int i = 0; i < nspecs; i++) {
+        double gm, g10, g90, cm, c10, c90, sm, s10, s90;
+        percentiles(v[i].gpu, frames, &gm, &g10, &g90);
+        percentiles(v[i].cpu, frames, &cm, &c10, &c90);
+        percentiles(v[i].sel, frames, &sm, &s10, &s90);
+        const char *pk = strrchr(v[i].pack_dir, '/');
+        fprintf(out, "\"%s\",%s,%s,%d,%d,%s,%s,%s,%g,%d,%.3f,%.3f,%.3f,%.3f,%.4f,%d,%d,"
+                     "%.6g,%.6g,%.2f,%ld,%.1f,%s\n",
+                devname, scene ? scene : v[i].base->name, pd.name, width, height,
+                v[i].label, kind_names[v[i].k], pk ? pk + 1 : v[i].pack_dir,
+                v[i].lod > 0 ? v[i].lod : 3.0, frames, gm, g10, g90, cm, sm,
+                v[i].patches, v[i].pipelines, v[i].err.max_abs,
+                v[i].err.n ? v[i].err.sum_abs / (double)v[i].err.n : 0.0,
+                err_psnr(&v[i].err), v[i].err.nonfinite, v[i].rss_delta, v[ref].label);
+    }
+    if (csv)
+        fclose(out);
+    status = 0;
+done:
+    if (e.msg)
+        fprintf(stderr, "splatbench: %s\n", e.msg);
+    rt_error_clear(&e);
+    for (int i = 0; i < nspecs; i++)
+        variant_free(&v[i]);
+    if (have_dev) {
+        if (dev.validating && dev.messages) {
+            fprintf(stderr, "splatbench: %d validation message(s)\n", dev.messages);
+            status = status ? status : 3;
+        }
+        rt_device_destroy(&dev);
+    }
+    for (int k = 0; k < npacks; k++)
+        rt_pack_free(&packs[k]);
+    free(packs);
+    free(pack_dirs);
+    free(v);
+    free(specs);
+    free(img);
+    free(refimg);
+    return status;
+}
+
+/* ---- upscale ---------------------------------------------------------------- */
+
+static int cmd_upscale(int argc, char **argv)
+{
+    if (argc != 5 || atoi(argv[3]) < 1) {
+        fprintf(stderr, "usage: splatbench upscale IN.png K OUT\n");
+        return 2;
+    }
+    const char *in = argv[2], *outp = argv[4];
+    int k = atoi(argv[3]), w, h, ch;
+    bool sixteen = stbi_is_16_bit(in);
+    void *px = sixteen ? (void *)stbi_load_16(in, &w, &h, &ch, 1) : (void *)stbi_load(in, &w, &h, &ch, 1);
+    if (!px) {
+        fprintf(stderr, "splatbench: cannot read '%s': %s\n", in, stbi_failure_reason());
+        return 1;
+    }
+    /* texel centres stay aligned: output texel i samples input (i + 0.5)/k - 0.5 */
+    size_t W = (size_t)w * (size_t)k, H = (size_t)h * (size_t)k;
+    int status = 0;
+    if (sixteen) {
+        const uint16_t *s = px;
+        uint16_t *o = xcalloc(W * H, 2);
+        for (size_t j = 0; j < H; j++) {
+            double v = fmin(fmax((j + 0.5) / k - 0.5, 0), h - 1);
+            int j0 = (int)v, j1 = j0 + 1 < h ? j0 + 1 : j0;
+            double fv = v - j0;
+            for (size_t i = 0; i < W; i++) {
+                double u = fmin(fmax((i + 0.5) / k - 0.5, 0), w - 1);
+                int i0 = (int)u, i1 = i0 + 1 < w ? i0 + 1 : i0;
+                double fu = u - i0;
+                double a = s[(size_t)j0 * w + i0] * (1 - fu) + s[(size_t)j0 * w + i1] * fu;
+                double b = s[(size_t)j1 * w + i0] * (1 - fu) + s[(size_t)j1 * w + i1] * fu;
+                o[j * W + i] = (uint16_t)lround(a * (1 - fv) + b * fv);   /* little-endian host */
+            }
+        }
+        FILE *f = fopen(outp, "wb");
+        if (!f || fwrite(o, 2, W * H, f) != W * H) {
+            fprintf(stderr, "splatbench: cannot write '%s'\n", outp);
+            status = 1;
+        }
+        if (f)
+            fclose(f);
+        free(o);
+    } else {
+        const uint8_t *s = px;
+        uint8_t *o = xcalloc(W * H, 1);
+        for (size_t j = 0; j < H; j++)
+            for (size_t i = 0; i < W; i++)
+                o[j * W + i] = s[(j / (size_t)k) * (size_t)w + i / (size_t)k];
+        stbi_write_png_compression_level = 1;
+        if (!stbi_write_png(outp, (int)W, (int)H, 1, o, (int)W)) {
+            fprintf(stderr, "splatbench: cannot write '%s'\n", outp);
+            status = 1;
+        }
+        free(o);
+    }
+    stbi_image_free(px);
+    printf("%s: %zu x %zu\n", outp, W, H);
+    return status;
+}
+
+/* ---- compare ------------------------------------------------------------------ */
+
+static int cmd_compare(int argc, char **argv)
+{
+    if (argc != 4) {
+        fprintf(stderr, "usage: splatbench compare A.f32 B.f32\n");
+        return 2;
+    }
+    float *a = NULL, *b = NULL;
+    int wa, ha, wb, hb;
+    rt_error e = {0};
+    int status = 1;
+    if (!rt_read_float(argv[2], &a, &wa, &ha, &e) || !rt_read_float(argv[3], &b, &wb, &hb, &e))
+        goto done;
+    if (wa != wb || ha != hb) {
+        fprintf(stderr, "splatbench: images differ in size (%dx%d, %dx%d)\n", wa, ha, wb, hb);
+        goto done;
+    }
+    err_acc acc = {0};
+    err_add(&acc, a, b, (size_t)wa * (size_t)ha);
+    printf("max_abs %.6g mean_abs %.6g psnr_db %.2f nonfinite %ld\n", acc.max_abs,
+           acc.n ? acc.sum_abs / (double)acc.n : 0.0, err_psnr(&acc), acc.nonfinite);
+    status = 0;
+done:
+    if (e.msg)
+        fprintf(stderr, "splatbench: %s\n", e.msg);
+    rt_error_clear(&e);
+    free(a);
+    free(b);
+    return status;
+}
+
+int main(int argc, char **argv)
+{
+    if (argc >= 2 && !strcmp(argv[1], "render"))
+        return cmd_render(argc, argv);
+    if (argc >= 2 && !strcmp(argv[1], "upscale"))
+        return cmd_upscale(argc, argv);
+    if (argc >= 2 && !strcmp(argv[1], "compare"))
+        return cmd_compare(argc, argv);
+    fprintf(stderr, "usage: splatbench render|upscale|compare ... (see tests/bench/splatbench.c)\n");
+    return 2;
+}
