@@ -105,10 +105,11 @@ static void eval3(const char *file, const ir_env *env, const char *value,
     free(text);
 }
 
-/* Interval of the mask over a region. */
-static ir_iv intervalf(const char *file, const ir_ienv *env, const char *node)
+/* Interval of `value` as the mask over a region. */
+static ir_iv intervalv(const char *file, const ir_ienv *env, const char *value,
+                       const char *node)
 {
-    char *text = material(file, "mask", "n.out", node);
+    char *text = material(file, "mask", value, node);
     lowered l;
     lower(&l, text);
     ir_iv out[4];
@@ -116,6 +117,11 @@ static ir_iv intervalf(const char *file, const ir_ienv *env, const char *node)
     unlower(&l);
     free(text);
     return out[0];
+}
+
+static ir_iv intervalf(const char *file, const ir_ienv *env, const char *node)
+{
+    return intervalv(file, env, "n.out", node);
 }
 
 static ir_ienv wide_ienv(void)
@@ -524,6 +530,25 @@ static void test_alu_fbm(void **state)
     assert_true(u >= 0 && u <= 1);
 }
 
+static void test_noise_intervals(void **state)
+{
+    /* over a wide region the bounds are the noises' stated ranges (not the
+     * much wider ones interval arithmetic gives for the blends) */
+    ir_ienv e = wide_ienv();
+    const char *f = "noise.sg";
+    ir_iv r = intervalv(f, &e, "n.out", "value_noise { p = terrain.position.xz }");
+    assert_true(r.lo == 0 && r.hi == 1);
+    r = intervalv(f, &e, "n.out", "gradient_noise { p = terrain.position.xz }");
+    assert_true(r.lo == -0.7072 && r.hi == 0.7072);
+    r = intervalv(f, &e, "n.unorm", "gradient_fbm4 { p = terrain.position.xz }");
+    assert_true(r.lo >= 0 && r.hi <= 1);
+    r = intervalv(f, &e, "n.out", "value_fbm6 { p = terrain.position.xz }");
+    assert_true(r.lo >= 0 && r.hi <= 1 + 1e-12);
+    /* tri-planar stays finite when the normal is unknown */
+    r = intervalv("projection.sg", &e, "n.out.r", "triplanar { tex = \"textures/rock.png\" }");
+    assert_true(isfinite(r.lo) && isfinite(r.hi));
+}
+
 /* A smooth, non-periodic "texture" for texture fBm: red = f(u, v). */
 static double tex_f(double u, double v) { return 0.5 + 0.4 * sin(3.1 * u + 1.7 * v); }
 static void sample_f(void *user, int tex, double u, double v, double rgba[4])
@@ -741,6 +766,7 @@ int main(void)
         cmocka_unit_test(test_alu_noise),
         cmocka_unit_test(test_alu_fbm),
         cmocka_unit_test(test_texture_fbm),
+        cmocka_unit_test(test_noise_intervals),
         cmocka_unit_test(test_compositors),
         cmocka_unit_test(test_billingsley),
     };
