@@ -406,7 +406,7 @@ bool rt_pipelines_create(rt_device *d, const rt_pack *p, const rt_passes *rp,
                          i, p->materials[i].name);
                 return rt_fail(e, RT_E_PACK_FIELD, p->dir, what);
             }
-        pl->ref = calloc((size_t)p->nmaterials, sizeof *pl->ref);
+        pl->ref = calloc((size_t)p->nmaterials + 1, sizeof *pl->ref);
         if (!pl->ref)
             return rt_fail(e, RT_E_VULKAN, "pipelines", "out of memory");
         pl->nref = p->nmaterials;

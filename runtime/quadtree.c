@@ -252,8 +252,13 @@ static void emit(frame *f, int L, int x, int z)
     }
     size_t i = (size_t)z * (size_t)q->width[L] + (size_t)x;
     if (q->split[L][i]) {
+        /* nearest child first: patches come out roughly front to back
+         * (the counting sort by combination keeps that order within a
+         * group), so early depth testing skips hidden fragments */
+        int fx = f->s->camera[0] >= 0.5 * (lo[0] + hi[0]) ? 1 : 0;
+        int fz = f->s->camera[2] >= 0.5 * (lo[2] + hi[2]) ? 1 : 0;
         for (int c = 0; c < 4; c++) {
-            int cx = 2 * x + (c & 1), cz = 2 * z + (c >> 1);
+            int cx = 2 * x + ((c & 1) ^ fx), cz = 2 * z + ((c >> 1) ^ fz);
             if (cx < q->width[L - 1] && cz < q->height[L - 1])
                 emit(f, L - 1, cx, cz);
         }
