@@ -712,7 +712,8 @@ bool rt_renderer_frame(rt_renderer *r, const rt_camera *c, rt_frame_stats *st, r
                 if (end > start) {
                     VkPipeline pipe;
                     if (!rt_pipelines_combo(d, r->p, &r->rp, &r->pl, k, r->wireframe, &pipe, e)) {
-                        vkEndCommandBuffer(cb);
+                        vkCmdEndRenderPass(cb);
+                        vkEndCommandBuffer(cb);   /* reset by the next frame */
                         return false;
                     }
                     vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_GRAPHICS, pipe);

@@ -419,7 +419,7 @@ bool rt_renderer_frame(rt_renderer *r, const rt_camera *c,
                        rt_frame_stats *st, rt_error *e);
 /* The last frame's colour as RGBA32F, top row first (w * h * 4 floats). */
 bool rt_renderer_read(rt_renderer *r, float *rgba, rt_error *e);
-/* The offscreen colour image (SHADER_READ_ONLY_OPTIMAL after a frame). */
+/* The offscreen colour image (TRANSFER_SRC_OPTIMAL after a frame). */
 const rt_image *rt_renderer_target(const rt_renderer *r);
 /* Replace the combination pipelines with those of a new pack of the same
  * terrain (hot reload); on failure the old ones stay. */
