@@ -77,6 +77,15 @@ typedef struct harness_dispatch {
 
 bool harness_run(harness *h, const harness_dispatch *d, char **err);
 
+/* The CPU twin of the device's sampler for `im` (harness_ref.c): Vulkan's
+ * texel addressing (u * width - 0.5), its wrap mode, nearest or bilinear,
+ * in double.  Usable as an ir_sample_fn over an array of images (`user`
+ * points at the first, `texture` indexes it): harness_sample_images. */
+void harness_image_sample(const harness_image *im, double u, double v,
+                          double rgba[4]);
+void harness_sample_images(void *user, int texture, double u, double v,
+                           double rgba[4]);
+
 /* ---- IR evaluation ------------------------------------------------------ */
 
 /* Evaluate IR roots at many points on the device.
@@ -115,9 +124,9 @@ char *harness_ir_shader(const harness_ir_desc *d, char **err);
 /* Why a value cannot be compared with the device's (harness_refval.flags). */
 enum {
     HARNESS_REF_NONFINITE = 1, /* NaN or Inf in the value or on its way     */
-    HARNESS_REF_RANGE     = 2, /* a value on the way beyond 1e18 or below
-                                  1e-18 in magnitude: fp32 overflows or
-                                  loses precision where double does not    */
+    HARNESS_REF_RANGE     = 2, /* a value on the way beyond 1e30 or below
+                                  1e-30 in magnitude: fp32 overflows or
+                                  flushes where double does not            */
     HARNESS_REF_UNDEFINED = 4, /* GLSL leaves the result undefined
                                   (smoothstep e0 >= e1, clamp lo > hi,
                                   pow of x < 0)                            */
@@ -128,19 +137,34 @@ enum {
 typedef struct harness_refval {
     double   value[4];   /* ir_eval's value (double)                        */
     double   spread[4];  /* how far fp32 rounding may move it: the largest
-                            deviation over `samples` evaluations with every
-                            node's result perturbed by its op's fp32 error
-                            bound (harness_ref.c lists them)             */
-    unsigned flags;      /* HARNESS_REF_*                                   */
+                            deviation over the samples, every node's result
+                            perturbed by its op's fp32 error bound (listed
+                            in harness_ref.c); INFINITY when flagged      */
+    unsigned flags[4];   /* HARNESS_REF_*, per component                    */
 } harness_refval;
 
+typedef struct harness_ref_opts {
+    int      samples;     /* rounding-perturbation samples (0: 16)          */
+    uint64_t seed;        /* their signs                                    */
+    double   texel_step;  /* largest difference between neighbouring texels
+                             of the textures env->sample reads (0: 1)      */
+    int      texels;      /* their largest size in texels (0: 4096)         */
+} harness_ref_opts;
+
 /* The reference value of `root` at `env` and its sensitivity to fp32
- * rounding (a Monte-Carlo rounding analysis: each sample perturbs every
- * node by +-its bound, signs drawn from `seed`; sample 0 uses all +, sample
- * 1 all -).  A value whose spread is large is ill-conditioned in fp32 —
- * a discontinuity (floor, step, less, mod) within rounding distance, or
- * cancellation amplified — and no fp32 implementation can be held to it. */
+ * rounding: a Monte-Carlo rounding analysis — each sample perturbs every
+ * node by +-its bound (sample 0 all +, sample 1 all -, then random signs).
+ * A value whose spread is large is ill-conditioned in fp32 — a
+ * discontinuity (floor, step, less, mod) within rounding distance, or
+ * cancellation amplified — and no fp32 implementation can be held to it.
+ * Nodes that are NaN/Inf, out of range or undefined in GLSL on the way flag
+ * a component only when they matter to it: replacing their values with
+ * garbage (NaN, +-Inf, 0, 1.2345e7) changes it.  `opts` may be NULL. */
 void harness_reference(const ir *ir, ir_ref root, const ir_env *env,
-                       int samples, uint64_t seed, harness_refval *out);
+                       const harness_ref_opts *opts, harness_refval *out);
+
+/* Largest difference between neighbouring texels (any channel, across the
+ * wrap), for harness_ref_opts.texel_step. */
+double harness_image_max_step(const harness_image *im);
 
 #endif

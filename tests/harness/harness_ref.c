@@ -34,8 +34,12 @@
  *   length              4u|r|
  *   normalize           6u per component
  *   cross               2u(|a_j b_k| + |a_k b_j|)
- *   sample              0 with the default (constant) texture, 2^-8 with a
- *                       sampler (8-bit bilinear weights)
+ *   sample              (undefined where uv is NaN, Inf or beyond 1e9)
+ *                       0 with the default (constant) texture; with a
+ *                       sampler step (2^-8 + 4u size (1 + max(|u|, |v|))):
+ *                       8-bit sub-texel weights (lavapipe; Vulkan allows
+ *                       4) and the texel coordinate's fp32 rounding, each
+ *                       times the largest neighbouring-texel difference
  */
 #include "harness.h"
 
@@ -126,7 +130,8 @@ static void eval_node(const ir *ir, uint32_t id, const ir_env *env,
  * from exact operand values; sets *ill when rounding may flip a
  * discontinuity inside the op, *undef when GLSL leaves it undefined. */
 static double bound(const ir *ir, uint32_t id, const ir_env *env,
-                    const double (*v)[4], int c, bool *ill, bool *undef)
+                    const harness_ref_opts *o, const double (*v)[4], int c,
+                    bool *ill, bool *undef)
 {
     const ir_node *n = &ir->nodes[id];
     const double *a = n->nargs > 0 ? v[n->arg[0].id] : NULL;
@@ -189,10 +194,70 @@ static double bound(const ir *ir, uint32_t id, const ir_env *env,
         return 2 * U * (fabs(a[j] * b[k]) + fabs(a[k] * b[j]));
     }
     case IR_OP_SAMPLE:
-        return env->sample ? 1.0 / 256 : 0;
+        /* NaN, Inf or huge coordinates: which texel is read is undefined */
+        if (!isfinite(b[0]) || !isfinite(b[1]) || fmax(fabs(b[0]), fabs(b[1])) > 1e9)
+            *undef = true;
+        if (!env->sample)
+            return 0;
+        return o->texel_step * (1.0 / 256 + 4 * U * o->texels *
+                                (1 + fmax(fabs(b[0]), fabs(b[1]))));
     default:   /* exact in fp32 */
         return 0;
     }
+}
+
+/* ---- the sampler's CPU twin -------------------------------------------- */
+
+static int wrap_texel(int i, int n, ir_wrap w)
+{
+    switch (w) {
+    case IR_WRAP_CLAMP:
+        return i < 0 ? 0 : i >= n ? n - 1 : i;
+    case IR_WRAP_MIRROR: {
+        int m = ((i % (2 * n)) + 2 * n) % (2 * n);
+        return m < n ? m : 2 * n - 1 - m;
+    }
+    default:
+        return ((i % n) + n) % n;
+    }
+}
+
+static const float *texel(const harness_image *im, int x, int y)
+{
+    x = wrap_texel(x, im->width, im->wrap);
+    y = wrap_texel(y, im->height, im->wrap);
+    return im->rgba + ((size_t)y * (size_t)im->width + (size_t)x) * 4;
+}
+
+void harness_image_sample(const harness_image *im, double u, double v, double rgba[4])
+{
+    if (!isfinite(u) || !isfinite(v) || fabs(u) > 1e9 || fabs(v) > 1e9) {
+        for (int c = 0; c < 4; c++)     /* some texel, as a device would */
+            rgba[c] = im->rgba[c];
+        return;
+    }
+    double x = u * im->width, y = v * im->height;
+    if (im->filter == IR_FILTER_NEAREST) {
+        const float *t = texel(im, (int)floor(x), (int)floor(y));
+        for (int c = 0; c < 4; c++)
+            rgba[c] = t[c];
+        return;
+    }
+    x -= 0.5;
+    y -= 0.5;
+    double fx = floor(x), fy = floor(y);
+    double a = x - fx, b = y - fy;
+    int i = (int)fx, j = (int)fy;
+    const float *t00 = texel(im, i, j), *t10 = texel(im, i + 1, j);
+    const float *t01 = texel(im, i, j + 1), *t11 = texel(im, i + 1, j + 1);
+    for (int c = 0; c < 4; c++)
+        rgba[c] = (1 - a) * (1 - b) * t00[c] + a * (1 - b) * t10[c] +
+                  (1 - a) * b * t01[c] + a * b * t11[c];
+}
+
+void harness_sample_images(void *user, int texture, double u, double v, double rgba[4])
+{
+    harness_image_sample((const harness_image *)user + texture, u, v, rgba);
 }
 
 static bool same(double x, double y)
@@ -200,21 +265,65 @@ static bool same(double x, double y)
     return x == y || (isnan(x) && isnan(y));
 }
 
-void harness_reference(const ir *ir, ir_ref root, const ir_env *env,
-                       int samples, uint64_t seed, harness_refval *out)
+/* Evaluate the nodes under the root (need[]) into vals, in id order.
+ * Components with poison[id][c] & mask take the value `garbage` instead;
+ * with bounds, every component moves by its bound times the sample's sign. */
+static void walk(const ir *ir, uint32_t n, const uint8_t *need, const ir_env *env,
+                 const uint8_t (*poison)[4], unsigned mask, double garbage,
+                 const double (*bnd)[4], uint64_t seed, int sample, double (*vals)[4])
 {
+    for (uint32_t id = 1; id < n; id++) {
+        if (!need[id])
+            continue;
+        eval_node(ir, id, env, (const double (*)[4])vals, vals[id]);
+        int w = ir_type_width(ir_typeof(ir, (ir_ref){id}));
+        for (int c = 0; c < w; c++) {
+            if (poison[id][c] & mask)
+                vals[id][c] = garbage;
+            else if (bnd)
+                vals[id][c] += sign_of(seed, sample, id, c) * bnd[id][c];
+        }
+    }
+}
+
+double harness_image_max_step(const harness_image *im)
+{
+    double m = 0;
+    for (int y = 0; y < im->height; y++)
+        for (int x = 0; x < im->width; x++) {
+            const float *t = texel(im, x, y), *r = texel(im, x + 1, y),
+                        *d = texel(im, x, y + 1);
+            for (int c = 0; c < 4; c++)
+                m = fmax(m, fmax(fabs((double)r[c] - t[c]), fabs((double)d[c] - t[c])));
+        }
+    return m;
+}
+
+void harness_reference(const ir *ir, ir_ref root, const ir_env *env,
+                       const harness_ref_opts *opts, harness_refval *out)
+{
+    harness_ref_opts o = opts ? *opts : (harness_ref_opts){0};
+    if (o.samples <= 0)
+        o.samples = 16;
+    if (o.texel_step <= 0)
+        o.texel_step = 1;
+    if (o.texels <= 0)
+        o.texels = 4096;
     memset(out, 0, sizeof *out);
+    for (int c = 0; c < 4; c++)
+        out->spread[c] = INFINITY;      /* until shown otherwise */
     if (!ir_ref_ok(root))
         return;
     const uint32_t n = root.id + 1;
+    const int rw = ir_type_width(ir_typeof(ir, root));
     double (*exact)[4] = calloc(n, sizeof *exact);
     double (*bnd)[4] = calloc(n, sizeof *bnd);
-    double (*noisy)[4] = calloc(n, sizeof *noisy);
+    double (*other)[4] = calloc(n, sizeof *other);
     uint8_t *need = calloc(n, 1);
-    if (!exact || !bnd || !noisy || !need) {
-        out->flags = HARNESS_REF_NONFINITE;   /* no memory: compare nothing */
-        for (int c = 0; c < 4; c++)
-            out->spread[c] = INFINITY;
+    uint8_t (*poison)[4] = calloc(n, sizeof *poison);
+    if (!exact || !bnd || !other || !need || !poison) {
+        for (int c = 0; c < 4; c++)           /* no memory: compare nothing */
+            out->flags[c] = HARNESS_REF_NONFINITE;
         goto done;
     }
     need[root.id] = 1;
@@ -223,7 +332,11 @@ void harness_reference(const ir *ir, ir_ref root, const ir_env *env,
             for (int i = 0; i < ir->nodes[id].nargs; i++)
                 need[ir->nodes[id].arg[i].id] = 1;
 
-    bool ill = false, undef = false;
+    /* Exact values, error bounds, and the nodes whose fp32 value is not
+     * held to the reference ("poisoned"): NaN/Inf, out of comfortable fp32
+     * range, or undefined in GLSL. */
+    bool ill = false;
+    unsigned kinds = 0;
     for (uint32_t id = 1; id < n; id++) {
         if (!need[id])
             continue;
@@ -231,49 +344,64 @@ void harness_reference(const ir *ir, ir_ref root, const ir_env *env,
         int w = ir_type_width(ir_typeof(ir, (ir_ref){id}));
         for (int c = 0; c < w; c++) {
             double x = exact[id][c];
+            bool undef = false;
             if (!isfinite(x))
-                out->flags |= HARNESS_REF_NONFINITE;
-            else if (fabs(x) > 1e18 || (x != 0 && fabs(x) < 1e-18))
-                out->flags |= HARNESS_REF_RANGE;
-            bnd[id][c] = bound(ir, id, env, (const double (*)[4])exact, c, &ill, &undef);
+                poison[id][c] |= HARNESS_REF_NONFINITE;
+            else if (fabs(x) > 1e30 || (x != 0 && fabs(x) < 1e-30))
+                poison[id][c] |= HARNESS_REF_RANGE;
+            bnd[id][c] = bound(ir, id, env, &o, (const double (*)[4])exact, c, &ill, &undef);
+            if (undef)
+                poison[id][c] |= HARNESS_REF_UNDEFINED;
+            kinds |= poison[id][c];
         }
     }
-    if (undef)
-        out->flags |= HARNESS_REF_UNDEFINED;
 
     /* The walk must agree with ir_eval bit for bit (it mirrors its leaves). */
     double ref[4];
     ir_eval(ir, root, env, ref);
-    const int rw = ir_type_width(ir_typeof(ir, root));
     for (int c = 0; c < 4; c++) {
         out->value[c] = ref[c];
         if (c < rw && !same(ref[c], exact[root.id][c]))
-            out->flags |= HARNESS_REF_MISMATCH;
+            out->flags[c] |= HARNESS_REF_MISMATCH;
+        if (c < rw && !isfinite(ref[c]))
+            out->flags[c] |= HARNESS_REF_NONFINITE;
     }
 
-    for (int s = 0; s < samples; s++) {
-        for (uint32_t id = 1; id < n; id++) {
-            if (!need[id])
-                continue;
-            eval_node(ir, id, env, (const double (*)[4])noisy, noisy[id]);
-            int w = ir_type_width(ir_typeof(ir, (ir_ref){id}));
-            for (int c = 0; c < w; c++)
-                noisy[id][c] += sign_of(seed, s, id, c) * bnd[id][c];
+    /* A poisoned node matters to a component when replacing its value
+     * changes it (a select that does not pick it, a step far from it: no). */
+    static const double garbage[] = { NAN, INFINITY, -INFINITY, 0.0, 1.2345e7 };
+    for (unsigned kind = 1; kind <= HARNESS_REF_UNDEFINED; kind <<= 1) {
+        if (!(kinds & kind))
+            continue;
+        for (size_t g = 0; g < sizeof garbage / sizeof garbage[0]; g++) {
+            walk(ir, n, need, env, (const uint8_t (*)[4])poison, kind, garbage[g],
+                 NULL, 0, 0, other);
+            for (int c = 0; c < rw; c++)
+                if (!same(other[root.id][c], exact[root.id][c]))
+                    out->flags[c] |= kind;
         }
+    }
+
+    if (ill)
+        goto done;
+    for (int c = 0; c < rw; c++)
+        out->spread[c] = out->flags[c] ? INFINITY : 0.0;
+    for (int s = 0; s < o.samples; s++) {
+        /* poisoned nodes that do not matter keep their exact values */
+        walk(ir, n, need, env, (const uint8_t (*)[4])poison, 0, 0.0,
+             (const double (*)[4])bnd, o.seed, s, other);
         for (int c = 0; c < rw; c++) {
-            double d = fabs(noisy[root.id][c] - exact[root.id][c]);
+            double d = fabs(other[root.id][c] - exact[root.id][c]);
             if (isnan(d))
                 d = INFINITY;
             if (d > out->spread[c])
                 out->spread[c] = d;
         }
     }
-    if (ill)
-        for (int c = 0; c < rw; c++)
-            out->spread[c] = INFINITY;
 done:
     free(exact);
     free(bnd);
-    free(noisy);
+    free(other);
     free(need);
+    free(poison);
 }
