@@ -2,14 +2,10 @@
 # Included by tests/CMakeLists.txt.
 set(HARNESS_DIR ${CMAKE_CURRENT_LIST_DIR})
 
-set(HARNESS_SOURCES ${HARNESS_DIR}/harness.c ${HARNESS_DIR}/harness_ref.c)
-# harness_ir.c drives the compiler's GLSL emitter; until compiler/glsl.c
-# exists the harness is dispatch-only (the glob over compiler/*.c re-runs
-# CMake when it appears).
-if(EXISTS ${PROJECT_SOURCE_DIR}/compiler/glsl.c)
-  list(APPEND HARNESS_SOURCES ${HARNESS_DIR}/harness_ir.c)
-endif()
-add_library(splat_harness STATIC ${HARNESS_SOURCES})
+# harness.c: device and dispatch; harness_ir.c: IR through the compiler's
+# GLSL emitter; harness_ref.c: the CPU reference with its fp32 sensitivity.
+add_library(splat_harness STATIC ${HARNESS_DIR}/harness.c
+            ${HARNESS_DIR}/harness_ir.c ${HARNESS_DIR}/harness_ref.c)
 target_include_directories(splat_harness PUBLIC ${HARNESS_DIR})
 target_link_libraries(splat_harness PUBLIC splatc Vulkan::Vulkan m)
 
@@ -22,8 +18,6 @@ function(splat_gpu_test name)
 endfunction()
 
 splat_gpu_test(test_harness)
-if(EXISTS ${PROJECT_SOURCE_DIR}/compiler/glsl.c)
-  splat_gpu_test(test_gpu_agree)
-  # random_ir.h: the IR's random graph generator, shared with the CPU test
-  target_include_directories(test_gpu_agree PRIVATE ${PROJECT_SOURCE_DIR}/tests/unit)
-endif()
+splat_gpu_test(test_gpu_agree)
+# random_ir.h: the IR's random graph generator, shared with the CPU test
+target_include_directories(test_gpu_agree PRIVATE ${PROJECT_SOURCE_DIR}/tests/unit)

@@ -187,6 +187,76 @@ static void test_errors_are_messages(void **state)
     free(w);
 }
 
+/* harness_eval_ir hands every input, param and painted mask to the emitted
+ * code exactly (fp32 values pass through unchanged), and binds textures. */
+static void test_eval_ir_plumbing(void **state)
+{
+    ir g;
+    ir_init(&g);
+    ir_param pf = { .name = "m.f", .type = IR_T_FLOAT, .def = { 0.25 } };
+    ir_param pv = { .name = "m.v", .type = IR_T_VEC3, .def = { 1, 2, 3 } };
+    ir_add_param(&g, &pf);
+    ir_add_param(&g, &pv);
+    for (int k = 0; k < 5; k++) {           /* 5 masks: two record slots */
+        char name[8];
+        snprintf(name, sizeof name, "p%d", k);
+        ir_add_painted(&g, name);
+    }
+    ir_texture tex = { .file = "t.png", .filter = IR_FILTER_NEAREST, .wrap = IR_WRAP_CLAMP };
+    ir_add_texture(&g, &tex);
+    ir_ref roots[] = {
+        ir_input(&g, IR_IN_HEIGHT), ir_input(&g, IR_IN_SLOPE),
+        ir_input(&g, IR_IN_NORMAL), ir_input(&g, IR_IN_POSITION),
+        ir_input(&g, IR_IN_UV), ir_input(&g, IR_IN_VIEW_DISTANCE),
+        ir_input(&g, IR_IN_DESTRUCTION), ir_param_ref(&g, 0), ir_param_ref(&g, 1),
+        ir_painted_ref(&g, 0), ir_painted_ref(&g, 4),
+        ir_op2(&g, IR_OP_SAMPLE, ir_texture_ref(&g, 0), ir_input(&g, IR_IN_UV)),
+    };
+    enum { R = sizeof roots / sizeof roots[0], P = 3 };
+    double params[P][8], painted[P][5];
+    ir_env env[P];
+    for (int p = 0; p < P; p++) {
+        env[p] = (ir_env){
+            .height = 100.5 + p, .slope = 0.125 * p,
+            .normal = { 0.25, 0.5 + p, -0.75 }, .position = { 10, 20 + p, 30 },
+            .uv = { 0.25 + 0.5 * (p & 1), 0.25 }, .view_distance = 1000 + p,
+            .destruction = 0.5 * p, .params = params[p], .painted = painted[p],
+        };
+        for (int i = 0; i < 8; i++)
+            params[p][i] = i + 0.5 * p;
+        for (int k = 0; k < 5; k++)
+            painted[p][k] = 0.125 * k + 0.0625 * p;
+    }
+    const float texels[] = { 0.5f, 1, 0, 1,  0.25f, 0, 1, 1 };   /* 2x1 */
+    harness_image im = { 2, 1, texels, IR_FILTER_NEAREST, IR_WRAP_CLAMP };
+    float out[P * R * 4];
+    char *err = NULL, *glsl = NULL;
+    harness_ir_desc d = { .ir = &g, .roots = roots, .nroots = R, .points = env,
+                          .npoints = P, .images = &im };
+    bool ok = harness_eval_ir(H, &d, out, &glsl, &err);
+    if (!ok)
+        fprintf(stderr, "%s\n%s\n", err ? err : "", glsl ? glsl : "");
+    assert_true(ok);
+    assert_non_null(strstr(glsl, "splat_height()"));
+    for (int p = 0; p < P; p++)
+        for (int r = 0; r < R; r++) {
+            double want[4];
+            ir_env e = env[p];
+            e.sample = harness_sample_images;
+            e.sample_user = &im;
+            ir_eval(&g, roots[r], &e, want);
+            int w = ir_type_width(ir_typeof(&g, roots[r]));
+            for (int c = 0; c < 4; c++)
+                if (out[(p * R + r) * 4 + c] != (c < w ? (float)want[c] : 0.0f)) {
+                    fprintf(stderr, "point %d root %d component %d: %g, want %g\n",
+                            p, r, c, out[(p * R + r) * 4 + c], want[c]);
+                    fail();
+                }
+        }
+    free(glsl);
+    ir_free(&g);
+}
+
 static void test_device_choice(void **state)
 {
     char *err = NULL;
@@ -204,6 +274,7 @@ int main(void)
         cmocka_unit_test(test_push_constants),
         cmocka_unit_test(test_images_and_samplers),
         cmocka_unit_test(test_errors_are_messages),
+        cmocka_unit_test(test_eval_ir_plumbing),
         cmocka_unit_test(test_device_choice),
     };
     char *err = NULL;
