@@ -4,7 +4,9 @@
  * cell: splat_terrain_ranges bounds height, slope, normal, position and uv
  * (terrain.c says why soundly), the painted masks are bounded by the min and
  * max of their texels in the bilinear footprint (the cell plus a one-texel
- * ring), the destruction mask is [0, 1] where the destructible area reaches
+ * ring) or, when the scene carries the sparse masks the pack stores, by
+ * sparse_range (the exact bounds of the stored tiles the cell reads, sound
+ * for BC4 and reduced levels too), the destruction mask is [0, 1] where the destructible area reaches
  * the cell and 0 elsewhere; where the area comes within two texels of the
  * cell, craters may change the heights the cell's filters read, so height,
  * normal and slope take every value they can (splat_terrain_any_shape).  Then, from the top of the stack down, ir_interval bounds
@@ -223,7 +225,11 @@ static void block_combo(const block_ctx *bc, int x0, int z0, int x1, int z1,
             splat_terrain_any_shape(t, &env);
     }
     for (int k = 0; k < bc->mir->npainted; k++) {
-        if (bc->painted_src[k] >= 0)
+        if (bc->painted_src[k] >= 0 && s->sparse) {
+            double lo, hi;
+            sparse_range(s->sparse, bc->painted_src[k], x0, z0, x1, z1, &lo, &hi);
+            bc->painted[k] = (ir_iv){ lo, hi };
+        } else if (bc->painted_src[k] >= 0)
             bc->painted[k] = painted_range(s->painted[bc->painted_src[k]], t->width,
                                            t->height, x0, z0, x1, z1);
         else

@@ -1,5 +1,6 @@
 /* cli_build.c — `splatc build SCENE.sg -o PACKDIR [-j N] [--stats]
- * [--cache DIR | --no-cache] [--flat] [-I DIR]...`: the command-line face
+ * [--cache DIR | --no-cache] [--flat] [--painted bc4|r8|dense] [-I DIR]...`:
+ * the command-line face
  * of splat_build (pack.c).  Exit status 0 on success, 1 on input errors,
  * 2 on usage errors. */
 #include "scene.h"
@@ -12,11 +13,14 @@ static const char usage[] =
     "usage: splatc build SCENE.sg -o PACKDIR [options]\n"
     "  -o PACKDIR     the shader pack folder to write (replaced only on success)\n"
     "  -j N           compile shaders on N threads (default 1)\n"
-    "  --stats        print the analysis report, per-phase times and cache hits\n"
+    "  --stats        print the analysis report, per-phase times, cache hits\n"
+    "                 and the painted masks' bytes next to their dense size\n"
     "  --cache DIR    SPIR-V cache folder (default $SPLATC_CACHE, else\n"
     "                 $XDG_CACHE_HOME/splatc, else ~/.cache/splatc)\n"
     "  --no-cache     neither read nor write the cache\n"
     "  --flat         also write each composite without dynamic branches\n"
+    "  --painted F    painted mask storage: bc4 (default: sparse quad-tree,\n"
+    "                 BC4 atlas), r8 (sparse, R8 atlas) or dense (painted.r8)\n"
     "  -I DIR         search DIR for imports (repeatable)\n";
 
 /* Import search path, as the other subcommands have it (main.c): -I
@@ -141,6 +145,13 @@ int splat_cli_build(int argc, char **argv)
             desc.no_cache = true;
         } else if (strcmp(a, "--flat") == 0) {
             desc.flat = true;
+        } else if (strcmp(a, "--painted") == 0 && next) {
+            if (!splat_painted_format_parse(next, &desc.painted)) {
+                fprintf(stderr, "splatc build: --painted expects bc4, r8 or dense, found '%s'\n",
+                        next);
+                goto done;
+            }
+            i++;
         } else if (strcmp(a, "-I") == 0 && next) {
             paths_add(&search, next);
             i++;

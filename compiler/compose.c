@@ -738,6 +738,8 @@ static void emit_header(emit *em, const splat_glsl_desc *desc)
     ir_buf_printf(o, " */\n");
     if (c->reference)
         ir_buf_printf(o, "#define SPLAT_MULTIPASS 1\n");
+    if (desc->painted_sparse)
+        ir_buf_printf(o, "#define SPLAT_PAINTED_SPARSE 1\n");
     ir_buf_printf(o, "%s", SPLAT_GLSL_PRELUDE);
     ir_buf_printf(o, "layout(set = %d, binding = %d, std140) uniform splat_params_block {\n"
                      "    vec4 slot[%d];\n} u_params;\n",

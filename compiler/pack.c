@@ -3,7 +3,9 @@
  * The pipeline, one phase after the other (each timed for --stats):
  *
  *   load      splat_scene_load: parse, check, heightfield, rasters, lower
- *   analysis  splat_analyze: the combinations and the quadtree grids
+ *   analysis  splat_painted_build: the painted masks as the pack stores
+ *             them (sparse BC4 / R8, unless --painted dense), then
+ *             splat_analyze on them: the combinations and quadtree grids
  *   compose   a composite per combination (+ flat variants), the über-shader,
  *             a reference pass per material and the vertex shader: GLSL,
  *             then each shader's key (cache.c)
@@ -109,6 +111,8 @@ typedef struct build {
     bool           scene_ok;
     splat_analysis analysis;
     bool           analysis_ok;
+    sparse_masks   sparse;    /* painted masks as stored (not dense)      */
+    bool           sparse_ok;
     splat_layout   layout;
     bool           layout_ok;
     combo_info    *combos;
@@ -248,7 +252,8 @@ static bool add_composite(build *b, job_kind kind, int index, const int *materia
             file = xasprintf(k == JOB_FLAT ? "shaders/flat_%04d" : "shaders/%04d", index);
         }
         job *j = job_add(b, k, index, file, SPV_STAGE_FRAGMENT);
-        splat_glsl_desc gd = {.title = title, .flat = k == JOB_FLAT};
+        splat_glsl_desc gd = {.title = title, .flat = k == JOB_FLAT,
+                              .painted_sparse = b->sparse_ok};
         splat_composite_glsl(&b->layout, &c, &gd, &j->glsl);
     }
     if (info) {
@@ -556,6 +561,11 @@ static json_t *manifest(build *b, char **tex_names, const char *dir)
         json_array_append_new(painted, o);
     }
     json_object_set_new(m, "painted", painted);
+    /* how they are stored: dense layers or the sparse quad-tree */
+    json_object_set_new(m, "painted_format",
+                        json_string(splat_painted_format_name(b->desc->painted)));
+    json_object_set_new(m, "painted_file",
+                        json_string(b->sparse_ok ? "painted.sparse" : "painted.r8"));
 
     json_t *combos = json_array();
     for (int i = 0; i < a->ncombos; i++) {
@@ -606,6 +616,19 @@ static json_t *manifest(build *b, char **tex_names, const char *dir)
     return m;
 }
 
+static bool write_sparse(build *b, const char *dir)
+{
+    char *path = xasprintf("%s/painted.sparse", dir);
+    FILE *f = fopen(path, "wb");
+    bool ok = f && sparse_write(&b->sparse, f);
+    if (f && fclose(f) != 0)
+        ok = false;
+    if (!ok)
+        write_error(b, path);
+    free(path);
+    return ok;
+}
+
 static bool write_contents(build *b, const char *dir)
 {
     const splat_scene *s = &b->scene;
@@ -631,13 +654,17 @@ static bool write_contents(build *b, const char *dir)
     ok = write_file(b, dir, "heightfield.r16", hf, 2 * ntex);
     free(hf);
 
-    int np = s->desc->npainted;
-    uint8_t *painted = xcalloc(ntex * (size_t)np, 1);
-    for (int i = 0; i < np; i++)
-        if (s->painted && s->painted[i])
-            memcpy(painted + ntex * (size_t)i, s->painted[i], ntex);
-    ok = ok && write_file(b, dir, "painted.r8", painted, ntex * (size_t)np);
-    free(painted);
+    if (b->sparse_ok) {
+        ok = ok && write_sparse(b, dir);
+    } else {
+        int np = s->desc->npainted;
+        uint8_t *painted = xcalloc(ntex * (size_t)np, 1);
+        for (int i = 0; i < np; i++)
+            if (s->painted && s->painted[i])
+                memcpy(painted + ntex * (size_t)i, s->painted[i], ntex);
+        ok = ok && write_file(b, dir, "painted.r8", painted, ntex * (size_t)np);
+        free(painted);
+    }
 
     size_t total = 0;
     for (int l = 0; l < a->nlevels; l++)
@@ -819,6 +846,20 @@ static void report_shaders(build *b, FILE *out)
         fprintf(out, "mean composite size: %.0f%% of the über-shader\n", 100.0 * sum / n);
 }
 
+/* The painted masks' bytes in the pack next to their dense 8-bit size. */
+static void report_painted(build *b, FILE *out)
+{
+    const splat_scene *s = &b->scene;
+    if (b->sparse_ok) {
+        sparse_print_stats(&b->sparse, out);
+        return;
+    }
+    size_t dense = (size_t)s->desc->npainted * (size_t)s->terrain.width *
+                   (size_t)s->terrain.height;
+    fprintf(out, "painted masks: %d stored dense (painted.r8): %zu B\n",
+            s->desc->npainted, dense);
+}
+
 /* ---- nothing changed? ---------------------------------------------------- */
 
 static bool hash_file(XXH3_state_t *st, const char *path)
@@ -850,8 +891,9 @@ static bool inputs_key(build *b)
         abort();
     XXH3_128bits_reset(st);
     char head[128];
-    int n = snprintf(head, sizeof head, "splatc %s\nabi %d\nflat %d\n", SPLATC_VERSION,
-                     SPLAT_ABI_VERSION, b->desc->flat);
+    int n = snprintf(head, sizeof head, "splatc %s\nabi %d\nflat %d\npainted %s\n",
+                     SPLATC_VERSION, SPLAT_ABI_VERSION, b->desc->flat,
+                     splat_painted_format_name(b->desc->painted));
     XXH3_128bits_update(st, head, (size_t)n);
     bool ok = true;
     for (int i = 0; ok && i < sg_file_count(s->prog); i++)
@@ -935,6 +977,8 @@ static void build_free(build *b)
         splat_layout_free(&b->layout);
     if (b->analysis_ok)
         splat_analysis_free(&b->analysis);
+    if (b->sparse_ok)
+        sparse_free(&b->sparse);
     if (b->scene_ok)
         splat_scene_free(&b->scene);
     splat_cache_close(&b->cache);
@@ -981,12 +1025,20 @@ bool splat_build(const splat_build_desc *desc, splat_build_stats *st, sg_diags *
     st->load = now() - t;
 
     t = now();
+    if (desc->painted != SPLAT_PAINTED_DENSE) {
+        b.sparse_ok = splat_painted_build(&b.scene, desc->painted, &b.sparse, d);
+        if (!b.sparse_ok)
+            goto out;
+        b.scene.sparse = &b.sparse;
+    }
     b.analysis_ok = splat_analyze(&b.scene, &b.analysis, d);
     st->analysis = now() - t;
     if (!b.analysis_ok || d->nerrors > errors)
         goto out;
-    if (desc->report)
+    if (desc->report) {
         splat_analysis_report(&b.scene, &b.analysis, desc->report);
+        report_painted(&b, desc->report);
+    }
 
     t = now();
     b.layout_ok = splat_layout_from_scene(&b.layout, &b.scene, d);

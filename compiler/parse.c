@@ -614,6 +614,47 @@ static char *scene_path(parser *ps, const char *rel)
     return r;
 }
 
+/* painted_opts = "{" { ("max_level" "=" NUM | "max_error" "=" NUM |
+ *                "near" "=" NUM NUM NUM NUM) [","] } "}" */
+static bool painted_stmt(parser *ps, void *user)
+{
+    sg_scene_painted *pm = user;
+    sg_token *key = cur(ps);
+    sg_loc kloc = loc_of(ps, key);
+    const char *keys = "'max_level', 'max_error', 'near' or '}'";
+    if (key->kind != SG_TK_IDENT) {
+        expected(ps, keys);
+        return false;
+    }
+    bool ok;
+    if (is_kw(key, "max_level")) {
+        next(ps);
+        double v;
+        ok = expect(ps, SG_TK_EQ, "'='") && parse_number(ps, &v);
+        if (ok && !(v >= 0 && v <= 7 && v == (int)v))
+            scene_error(ps, kloc, "max_level must be a whole number 0..7%s", "");
+        else if (ok)
+            pm->max_level = (int)v;
+    } else if (is_kw(key, "max_error")) {
+        next(ps);
+        ok = expect(ps, SG_TK_EQ, "'='") && parse_number(ps, &pm->max_error);
+        if (ok && !(pm->max_error >= 0 && pm->max_error <= 1))
+            scene_error(ps, kloc, "max_error must be between 0 and 1%s", "");
+    } else if (is_kw(key, "near")) {
+        next(ps);
+        ok = expect(ps, SG_TK_EQ, "'='") && parse_numbers(ps, pm->near, 4);
+        if (ok && !(pm->near[2] > pm->near[0] && pm->near[3] > pm->near[1]))
+            scene_error(ps, kloc, "near must be x0 z0 x1 z1 with x1 > x0 and z1 > z0%s", "");
+        pm->has_near = ok;
+    } else {
+        expected(ps, keys);
+        return false;
+    }
+    if (ok)
+        accept(ps, SG_TK_COMMA);
+    return ok;
+}
+
 /* destruction = "destruction" "{" { ("origin" NUM NUM | "size" NUM NUM |
  *               "cell" NUM) [","] } "}"
  * camera = "camera" IDENT "{" { ("position" | "look") "=" NUM NUM NUM
@@ -658,7 +699,8 @@ static bool sub_stmt(parser *ps, void *user)
  *            | "size" "=" NUM NUM | "max_height" "=" NUM
  *            | "height_offset" "=" NUM | "cell" "=" NUM
  *            | "materials" "=" "[" IDENT { "," IDENT } "]"
- *            | "compositor" "=" IDENT | "painted" IDENT "=" STRING
+ *            | "compositor" "=" IDENT
+ *            | "painted" IDENT "=" STRING [painted_opts]
  *            | destruction | camera */
 static bool scene_stmt(parser *ps, void *user)
 {
@@ -702,6 +744,9 @@ static bool scene_stmt(parser *ps, void *user)
         pm->name = tok_text(ps, name);
         pm->file = scene_path(ps, file->str);
         pm->loc = loc_of(ps, name);
+        pm->max_error = 1.0;
+        if (cur(ps)->kind == SG_TK_LBRACE)
+            parse_block(ps, "block of painted mask options", painted_stmt, pm);
         return true;
     }
     next(ps);

@@ -4,7 +4,7 @@
  * combination into one composite shader (DESIGN §6), and the shader pack
  * (compiler/PACK.md).
  *
- * Sections: terrain.c, scene.c, analysis.c, compose.c, pack.c.
+ * Sections: terrain.c, scene.c, painted.c, analysis.c, compose.c, pack.c.
  */
 #ifndef SPLAT_SCENE_H
 #define SPLAT_SCENE_H
@@ -14,6 +14,7 @@
 
 #include "ir.h"
 #include "sg.h"
+#include "sparse.h"
 
 /* ---- terrain.c: heightfield and terrain parameters --------------------- */
 
@@ -61,6 +62,10 @@ typedef struct splat_scene {
     const sg_scene *desc;      /* owned by prog                               */
     splat_terrain  terrain;
     uint8_t      **painted;    /* desc->npainted dense rasters, W*H bytes      */
+    /* The painted masks as the pack stores them (painted.c), or NULL: the
+     * analysis then bounds the dense rasters.  Not owned by the scene:
+     * whoever built it (pack.c) frees it. */
+    const sparse_masks *sparse;
     int            nmaterials; /* desc->nmaterials, bottom (0) first          */
     /* Every material lowered into one shared ir: roots "<name>.mask", … */
     ir             ir;
@@ -76,6 +81,23 @@ typedef struct splat_scene {
 bool splat_scene_load(splat_scene *s, const char *path,
                       const char *const *search_paths, sg_diags *d);
 void splat_scene_free(splat_scene *s);
+
+/* ---- painted.c: how a pack stores the painted masks -------------------- */
+
+typedef enum splat_painted_format {
+    SPLAT_PAINTED_BC4 = 0,     /* default: sparse quad-tree, BC4 atlas      */
+    SPLAT_PAINTED_R8,          /* sparse quad-tree, R8 atlas (exact)        */
+    SPLAT_PAINTED_DENSE,       /* painted.r8: one W*H layer per mask        */
+} splat_painted_format;
+
+const char *splat_painted_format_name(splat_painted_format f);  /* "bc4" … */
+bool splat_painted_format_parse(const char *s, splat_painted_format *f);
+
+/* The scene's painted rasters as sparse masks in format `f` (BC4 or R8),
+ * with each mask's options from the scene file (max_level, max_error,
+ * near in metres -> texels).  Errors at the scene's painted entries. */
+bool splat_painted_build(const splat_scene *s, splat_painted_format f,
+                         sparse_masks *out, sg_diags *d);
 
 /* ---- analysis.c: combinations ------------------------------------------ */
 
@@ -180,6 +202,9 @@ typedef struct splat_glsl_desc {
     const char *title;        /* first header comment line                   */
     bool        flat;         /* no dynamic branches (benchmark variant)     */
     bool        no_mask_view; /* leave out the SPLAT_VIEW_MASK branch        */
+    bool        painted_sparse; /* #define SPLAT_PAINTED_SPARSE before the
+                                 prelude: painted masks read the sparse
+                                 quad-tree (abi.h bindings 2, 5, 6)         */
 } splat_glsl_desc;
 
 /* The complete Vulkan GLSL 450 fragment shader of `c`: for a composite,
@@ -225,6 +250,7 @@ typedef struct splat_build_desc {
     const char        *cache_dir;    /* NULL = splat_cache_default_dir()      */
     bool               no_cache;
     bool               flat;         /* also write branch-free composites     */
+    splat_painted_format painted;    /* painted mask storage; default BC4     */
     FILE              *report;       /* non-NULL: the analysis report here    */
 } splat_build_desc;
 

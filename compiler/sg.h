@@ -153,6 +153,14 @@ typedef struct sg_scene_painted {
     char  *name;       /* the name materials use: painted { mask = "fields" } */
     char  *file;       /* 8-bit greyscale PNG, same size as the heightfield  */
     sg_loc loc;
+    /* Sparse storage options (sparse.h), from an optional block after the
+     * file: painted NAME = "FILE" { max_level = 2, max_error = 0.05,
+     * near = x0 z0 x1 z1 }.  Defaults: max_level 0 (full resolution),
+     * max_error 1 (no limit once max_level allows), no near rectangle. */
+    int    max_level;  /* coarsest quad-tree level, 0..7                    */
+    double max_error;  /* largest reduction error allowed, 0..1             */
+    bool   has_near;
+    double near[4];    /* terrain-local metres x0 z0 x1 z1 kept at level 0   */
 } sg_scene_painted;
 
 typedef struct sg_scene_camera {
