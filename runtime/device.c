@@ -261,6 +261,8 @@ bool rt_device_create(rt_device *d, const rt_device_desc *desc, rt_error *e)
     vkGetPhysicalDeviceFeatures(d->phys, &have);
     want.fillModeNonSolid = have.fillModeNonSolid;
     d->wireframe = have.fillModeNonSolid;
+    want.textureCompressionBC = have.textureCompressionBC;   /* sparse masks */
+    d->bc = have.textureCompressionBC;
 
     float prio = 1.0f;
     VkDeviceQueueCreateInfo qci = {

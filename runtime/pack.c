@@ -283,6 +283,17 @@ static bool read_scene(reader *r, json_t *root)
         p->heights[i] = (uint16_t)(raw[2 * i] | raw[2 * i + 1] << 8);
     free(raw);
 
+    /* the destructible area (destruction.c), or null */
+    json_t *dd = get(r, scene, "destruction", "scene", false);
+    if (dd && !json_is_null(dd)) {
+        if (!get_vec(r, dd, "origin", "scene.destruction", 2, p->destr_origin) ||
+            !get_vec(r, dd, "size", "scene.destruction", 2, p->destr_size) ||
+            !get_number(r, dd, "cell_size", "scene.destruction", &p->destr_cell))
+            return false;
+        if (!(p->destr_cell > 0) || !(p->destr_size[0] > 0) || !(p->destr_size[1] > 0))
+            return field_fail(r, "scene.destruction:", "needs a positive size and cell_size");
+        p->has_destruction = true;
+    }
     json_t *cams = get_array(r, scene, "cameras", "scene", false);
     if (cams) {
         p->ncameras = (int)json_array_size(cams);
@@ -426,6 +437,13 @@ static bool read_painted(reader *r, json_t *root)
     if (!pa || json_array_size(pa) == 0)
         return !r->e->msg;
     p->npainted = (int)json_array_size(pa);
+    /* sparse quad-tree (painted.c) unless painted_format says dense */
+    json_t *fmt = get(r, root, "painted_format", "manifest", false);
+    if (fmt && strcmp(json_string_value(fmt) ? json_string_value(fmt) : "", "dense")) {
+        const char *file;
+        return get_string(r, root, "painted_file", "manifest", &file) &&
+               rt_painted_read(p, file, r->e);
+    }
     size_t bytes = (size_t)p->npainted * (size_t)p->hf_width * (size_t)p->hf_height;
     p->painted = pack_file(r, "painted", "painted.r8", bytes, NULL);
     return p->painted != NULL;
@@ -645,6 +663,9 @@ void rt_pack_free(rt_pack *p)
     free(p->combos);
     free(p->levels);
     free(p->painted);
+    if (p->sparse)
+        sparse_free(p->sparse);
+    free(p->sparse);
     free(p->heights);
     free(p->name);
     free(p->scene_path);

@@ -170,8 +170,10 @@ static bool make_layouts(rt_device *d, int ntextures, rt_pipelines *pl, rt_error
         { SPLAT_BIND_PAINTED, smp, 1, fs, NULL },
         { SPLAT_BIND_DESTRUCTION_ATLAS, smp, 1, fs, NULL },
         { SPLAT_BIND_DESTRUCTION_INDEX, smp, 1, fs, NULL },
+        { SPLAT_BIND_PAINTED_INDEX, smp, 1, fs, NULL },   /* sparse masks */
+        { SPLAT_BIND_PAINTED_LEVEL, smp, 1, fs, NULL },
     };
-    if (!make_set_layout(d, terrain, 5, &pl->set_terrain, e))
+    if (!make_set_layout(d, terrain, 7, &pl->set_terrain, e))
         return false;
     VkDescriptorSetLayoutBinding *mat = calloc((size_t)ntextures + 1, sizeof *mat);
     if (!mat)

@@ -251,7 +251,7 @@ static bool make_descriptors(rt_renderer *r, rt_error *e)
 
     VkDescriptorPoolSize sizes[2] = {
         { VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 2 },
-        { VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 4 + (uint32_t)r->ntex + 3 },
+        { VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 6 + (uint32_t)r->ntex + 3 },
     };
     VkDescriptorPoolCreateInfo pci = {
         .sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO,
@@ -276,7 +276,7 @@ static bool make_descriptors(rt_renderer *r, rt_error *e)
     const VkImageLayout ro = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
     const rt_terrain_gpu *t = &r->terrain;
     int n = 0;
-    VkDescriptorImageInfo img[8 + 3];
+    VkDescriptorImageInfo img[10 + 3];
     VkDescriptorImageInfo *timg = calloc((size_t)r->ntex + 1, sizeof *timg);
     VkWriteDescriptorSet *w = calloc((size_t)r->ntex + 16, sizeof *w);
     if (!timg || !w) {
@@ -301,6 +301,10 @@ static bool make_descriptors(rt_renderer *r, rt_error *e)
     W(r->set0, SPLAT_BIND_PAINTED, smp, &img[1], NULL);
     W(r->set0, SPLAT_BIND_DESTRUCTION_ATLAS, smp, &img[2], NULL);
     W(r->set0, SPLAT_BIND_DESTRUCTION_INDEX, smp, &img[3], NULL);
+    img[7] = (VkDescriptorImageInfo){ t->nearest_clamp, t->painted_index.view, ro };
+    img[8] = (VkDescriptorImageInfo){ t->nearest_clamp, t->painted_level.view, ro };
+    W(r->set0, SPLAT_BIND_PAINTED_INDEX, smp, &img[7], NULL);
+    W(r->set0, SPLAT_BIND_PAINTED_LEVEL, smp, &img[8], NULL);
     W(r->set1, SPLAT_BIND_PARAMS, ubo, NULL, &pb);
     for (int i = 0; i < r->ntex; i++) {
         timg[i] = (VkDescriptorImageInfo){ r->tex_smp[i], r->tex[i].view, ro };

@@ -5,7 +5,8 @@
  * call returns false and fills an rt_error (id + message).
  *
  * Sections, one per source file: errors + device.c, glsl.c, image.c,
- * pack.c, terrain.c, quadtree.c, pipelines.c, render.c, viewer.c.
+ * pack.c, painted.c, terrain.c, quadtree.c, pipelines.c, render.c,
+ * destruction.c, viewer.c.
  */
 #ifndef SPLAT_RT_H
 #define SPLAT_RT_H
@@ -18,6 +19,7 @@
 #include <vulkan/vulkan.h>
 
 #include "abi.h"
+#include "sparse.h"
 
 /* ---- errors (device.c) -------------------------------------------------
  * X(id, format): one list so tests and callers can switch on the id. */
@@ -86,6 +88,7 @@ typedef struct rt_device {
     uint32_t                 queue_family;
     VkCommandPool            pool;       /* resettable command buffers      */
     bool                     wireframe;  /* fillModeNonSolid enabled        */
+    bool                     bc;         /* textureCompressionBC enabled    */
     bool                     validating;
     int                      messages;   /* validation warnings + errors    */
 } rt_device;
@@ -220,7 +223,12 @@ typedef struct rt_pack {
     uint32_t         params_size;
     rt_pack_texture *textures;  int ntextures;
     int              npainted;
-    uint8_t         *painted;        /* npainted * W * H, NULL if none     */
+    uint8_t         *painted;        /* npainted * W * H, NULL if none or
+                                        sparse                             */
+    sparse_masks    *sparse;         /* painted.sparse (painted_format bc4
+                                        or r8), NULL: dense painted         */
+    bool             has_destruction; /* scene.destruction is not null      */
+    double           destr_origin[2], destr_size[2], destr_cell; /* metres */
     rt_pack_combo   *combos;    int ncombos;
     rt_spirv         uber;           /* words NULL if absent               */
     rt_spirv         vertex;
@@ -236,6 +244,19 @@ bool rt_pack_load(rt_pack *p, const char *dir, rt_error *e);
 void rt_pack_free(rt_pack *p);
 int  rt_pack_material_find(const rt_pack *p, const char *name);   /* -1 */
 int  rt_pack_camera_find(const rt_pack *p, const char *name);     /* -1 */
+
+/* ---- painted.c: the sparse painted masks ------------------------------ */
+
+/* Read `file` (painted.sparse, relative to the pack) into p->sparse and
+ * check it against the manifest (heightfield size, mask count). */
+bool rt_painted_read(rt_pack *p, const char *file, rt_error *e);
+/* Upload p->sparse: atlas (BC4_UNORM_BLOCK, or R8_UNORM decoded on the
+ * CPU when the device lacks BC textures), index RGBA16UI and level
+ * RGBA8UI 2D arrays. */
+bool rt_painted_upload(rt_device *d, const rt_pack *p, rt_image *atlas,
+                       rt_image *index, rt_image *level, rt_error *e);
+/* Print the bytes of each mask representation next to dense. */
+void rt_painted_print_stats(const rt_pack *p, FILE *out);
 
 /* ---- terrain.c: heightfield on the GPU, node height bounds ------------ */
 
@@ -256,7 +277,9 @@ int  rt_level_count(int cells_x, int cells_z);
 /* GPU resources of the terrain descriptor set (set 0) but the frame UBO. */
 typedef struct rt_terrain_gpu {
     rt_image  height;       /* R16_UNORM                                    */
-    rt_image  painted;      /* R8_UNORM array, >= 1 layer                   */
+    rt_image  painted;      /* R8_UNORM array, >= 1 layer; sparse: the atlas */
+    rt_image  painted_index; /* RGBA16UI array (1x1 when dense)              */
+    rt_image  painted_level; /* RGBA8UI array (1x1 when dense)               */
     rt_image  destr_atlas;  /* R8_UNORM 1x1 until issue 5                   */
     rt_image  destr_index;  /* RGBA8 1x1, a = 0: nothing destroyed          */
     VkSampler linear_clamp, nearest_clamp;

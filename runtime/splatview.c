@@ -322,6 +322,7 @@ static int headless(const opts *o)
             printf("gpu ms/frame: n/a (no timestamp support)\n");
         printf("quadtree cpu ms/frame: median %.4f  p10 %.4f  p90 %.4f\n", sm, sl, sh);
         printf("cpu ms/frame (record): median %.3f  p10 %.3f  p90 %.3f\n", cm, cl, ch);
+        rt_painted_print_stats(&pack, stdout);
     }
     status = 0;
 done:

@@ -139,13 +139,27 @@ bool rt_terrain_upload(rt_device *d, const rt_pack *p, rt_terrain_gpu *t,
         !rt_image_upload(d, &t->height, p->heights, (size_t)W * H * 2, e))
         return false;
 
-    /* Painted masks: one layer each; one zero layer when the scene has none. */
+    /* Painted masks: the sparse quad-tree (painted.c), or dense: one layer
+     * each, one zero layer when the scene has none (index and level then
+     * 1x1 placeholders for bindings 5 and 6). */
+    uint8_t zero8[8] = { 0 };
+    if (p->sparse) {
+        if (!rt_painted_upload(d, p, &t->painted, &t->painted_index, &t->painted_level, e))
+            return false;
+    } else if (!rt_image_create(d, 1, 1, 1, true, 1, VK_FORMAT_R16G16B16A16_UINT, use,
+                                VK_IMAGE_ASPECT_COLOR_BIT, &t->painted_index, e) ||
+               !rt_image_upload(d, &t->painted_index, zero8, 8, e) ||
+               !rt_image_create(d, 1, 1, 1, true, 1, VK_FORMAT_R8G8B8A8_UINT, use,
+                                VK_IMAGE_ASPECT_COLOR_BIT, &t->painted_level, e) ||
+               !rt_image_upload(d, &t->painted_level, zero8, 4, e))
+        return false;
     uint32_t layers = p->npainted > 0 ? (uint32_t)p->npainted : 1;
     size_t pbytes = p->npainted > 0 ? (size_t)layers * W * H : 1;
     uint8_t zero4[4] = { 0, 0, 0, 0 };
-    if (!rt_image_create(d, p->npainted > 0 ? W : 1, p->npainted > 0 ? H : 1, layers, true, 1,
+    if (!p->sparse &&
+        (!rt_image_create(d, p->npainted > 0 ? W : 1, p->npainted > 0 ? H : 1, layers, true, 1,
                          VK_FORMAT_R8_UNORM, use, VK_IMAGE_ASPECT_COLOR_BIT, &t->painted, e) ||
-        !rt_image_upload(d, &t->painted, p->npainted > 0 ? p->painted : zero4, pbytes, e))
+         !rt_image_upload(d, &t->painted, p->npainted > 0 ? p->painted : zero4, pbytes, e)))
         return false;
     /* Destruction: nothing destroyed (index alpha 0) until issue 5 fills it. */
     if (!rt_image_create(d, 1, 1, 1, false, 1, VK_FORMAT_R8_UNORM, use,
@@ -163,6 +177,8 @@ void rt_terrain_destroy(rt_device *d, rt_terrain_gpu *t)
 {
     rt_image_destroy(d, &t->height);
     rt_image_destroy(d, &t->painted);
+    rt_image_destroy(d, &t->painted_index);
+    rt_image_destroy(d, &t->painted_level);
     rt_image_destroy(d, &t->destr_atlas);
     rt_image_destroy(d, &t->destr_index);
     if (t->linear_clamp)
