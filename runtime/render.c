@@ -20,6 +20,7 @@ struct rt_renderer {
     const rt_pack    *p;
     rt_render_desc    desc;
     rt_terrain_gpu    terrain;
+    rt_destruction   *destr;           /* NULL: no destructible area        */
     rt_bounds         bounds;
     rt_quadtree       qt;
     const uint16_t  **combo_ids;       /* per level, into the pack          */
@@ -290,6 +291,8 @@ static bool make_descriptors(rt_renderer *r, rt_error *e)
     img[1] = (VkDescriptorImageInfo){ t->linear_clamp, t->painted.view, ro };
     img[2] = (VkDescriptorImageInfo){ t->linear_clamp, t->destr_atlas.view, ro };
     img[3] = (VkDescriptorImageInfo){ t->nearest_clamp, t->destr_index.view, ro };
+    if (r->destr)
+        rt_destruction_views(r->destr, &img[2].imageView, &img[3].imageView);
 #define W(set_, b_, type_, img_, buf_) \
     w[n++] = (VkWriteDescriptorSet){ .sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, \
         .dstSet = set_, .dstBinding = b_, .descriptorCount = 1, .descriptorType = type_, \
@@ -395,7 +398,10 @@ bool rt_renderer_create(rt_device *d, const rt_pack *p, const rt_render_desc *de
     double k = r->desc.height / (2.0 * tan(M_PI / 6.0));
     r->lod_distance = k / ((SPLAT_GRID - 1) * r->desc.lod_pixels);
 
-    if (!rt_terrain_upload(d, p, &r->terrain, e) || !make_targets(r, e) ||
+    if (!rt_terrain_upload(d, p, &r->terrain, e) ||
+        !rt_destruction_create(d, p, r->desc.destruction_pool, &r->terrain.height, &r->bounds,
+                               &r->destr, e) ||
+        !make_targets(r, e) ||
         !rt_pipelines_create(d, p, &r->rp, r->desc.reference, r->desc.pipeline_cache,
                              p->ntextures, &r->pl, e) ||
         !make_geometry(r, e) || !make_textures(r, e) || !make_descriptors(r, e) ||
@@ -445,6 +451,7 @@ void rt_renderer_destroy(rt_renderer *r)
         rt_buffer_destroy(d, &r->frame_ubo);
         rt_buffer_destroy(d, &r->params_ubo);
         rt_buffer_destroy(d, &r->readback);
+        rt_destruction_destroy(r->destr);
         rt_terrain_destroy(d, &r->terrain);
     }
     rt_quadtree_free(&r->qt);
@@ -568,6 +575,8 @@ static void fill_frame(rt_renderer *r, const rt_camera *c, splat_frame *fr)
     fr->destruction_atlas[0] = 64.0f;
     fr->destruction_atlas[1] = 1.0f;
     fr->destruction_atlas[2] = 1.0f;
+    if (r->destr)
+        rt_destruction_frame(r->destr, fr);
     fr->view[0] = (uint32_t)r->view;
     fr->view[1] = (uint32_t)(r->view_material > 0 ? r->view_material : 0);
 }
@@ -814,6 +823,36 @@ bool rt_renderer_swap_pack(rt_renderer *r, const rt_pack *p, rt_error *e)
         memcpy((uint8_t *)r->params_ubo.map + p->params[i].offset, p->params[i].value, 16);
     r->p = p;
     return true;
+}
+
+bool rt_renderer_crater(rt_renderer *r, const rt_crater *c, rt_crater_stats *st, rt_error *e)
+{
+    if (!r->destr) {
+        if (st) {
+            memset(st, 0, sizeof *st);
+            st->result = RT_CRATER_OUTSIDE;
+        }
+        return true;
+    }
+    return rt_destruction_crater(r->destr, c, st, e);
+}
+
+rt_destruction *rt_renderer_destruction(rt_renderer *r) { return r->destr; }
+
+const uint16_t *rt_renderer_heights(const rt_renderer *r)
+{
+    return r->destr ? rt_destruction_heights(r->destr) : r->p->heights;
+}
+
+bool rt_renderer_pick(const rt_renderer *r, const double o[3], const double dir[3],
+                      double hit[3])
+{
+    return rt_heightfield_pick(rt_renderer_heights(r), r->p, o, dir, hit);
+}
+
+bool rt_renderer_read_heights(rt_renderer *r, uint16_t *out, rt_error *e)
+{
+    return rt_destruction_wait(r->destr, e) && rt_read_r16(r->d, &r->terrain.height, out, e);
 }
 
 const char *rt_view_name(splat_view v)

@@ -415,6 +415,7 @@ typedef struct rt_render_desc {
     const char  *pipeline_cache;    /* file; NULL: $XDG_CACHE_HOME/splatc/…   */
     bool         no_stitch;         /* tests: draw every patch unstitched     */
     double       lod_pixels;        /* screen error per grid step; default 3  */
+    int          destruction_pool;  /* destruction tiles; 0: RT_DESTR_POOL_DEFAULT */
 } rt_render_desc;
 
 typedef struct rt_frame_stats {
@@ -448,8 +449,86 @@ const rt_image *rt_renderer_target(const rt_renderer *r);
  * terrain (hot reload); on failure the old ones stay. */
 bool rt_renderer_swap_pack(rt_renderer *r, const rt_pack *p, rt_error *e);
 const char *rt_view_name(splat_view v);
+/* Craters (destruction.c) on the renderer's terrain: a pack without a
+ * destructible area answers RT_CRATER_OUTSIDE. */
+typedef struct rt_crater rt_crater;
+typedef struct rt_crater_stats rt_crater_stats;
+typedef struct rt_destruction rt_destruction;
+bool rt_renderer_crater(rt_renderer *r, const rt_crater *c, rt_crater_stats *st,
+                        rt_error *e);
+/* NULL when the pack has no destructible area. */
+rt_destruction *rt_renderer_destruction(rt_renderer *r);
+/* The heightfield as the renderer has it now (craters included). */
+const uint16_t *rt_renderer_heights(const rt_renderer *r);
+/* Where the ray from `o` along `dir` first meets the terrain (CPU march
+ * on the current heightfield); false if it misses. */
+bool rt_renderer_pick(const rt_renderer *r, const double o[3], const double dir[3],
+                      double hit[3]);
+/* The GPU heightfield read back (tests): W*H texels. */
+bool rt_renderer_read_heights(rt_renderer *r, uint16_t *out, rt_error *e);
 bool rt_parse_view(const char *s, const rt_pack *p, splat_view *view,
                    int *material, rt_error *e);
+
+/* ---- destruction.c: the destruction mask (seed 000 §5.2.5) -------------
+ * Fixed-grid indirection over the destructible area, 64x64 R8 tiles from a
+ * fixed pool, crater decals rendered into them, heightfield and node bounds
+ * updated in the same event (destruction.c explains).  Pool exhausted: the
+ * crater is refused as a whole (warning on stderr, nothing changes). */
+
+enum { RT_DESTR_TILE = 64, RT_DESTR_POOL_DEFAULT = 256 };
+
+struct rt_crater {
+    double x, z;       /* centre, terrain-local metres                      */
+    double radius;     /* metres                                            */
+    double depth;      /* metres lowered at the centre (0: mask only)       */
+    double strength;   /* mask at the centre, 0..1; 0 means 1               */
+};
+
+typedef enum rt_crater_result {
+    RT_CRATER_DONE = 0,
+    RT_CRATER_OUTSIDE,   /* misses the destructible area (or none)          */
+    RT_CRATER_REFUSED,   /* the tile pool has too few free tiles            */
+} rt_crater_result;
+
+struct rt_crater_stats {
+    rt_crater_result result;
+    int    cells;        /* grid cells the disc meets                       */
+    int    tiles_new;    /* tiles allocated by this crater                  */
+    int    tiles_used, pool;
+    int    texels;       /* heightfield texels lowered                      */
+    int    upload[4];    /* x, z, w, h of the uploaded texel rectangle      */
+    double cpu_ms;       /* the event on the CPU (record + submit), without
+                            wait_ms                                         */
+    double wait_ms;      /* waiting for the event four back to finish       */
+};
+
+/* Memory of a destruction mask configuration (the slides' figures). */
+typedef struct rt_destruction_figures {
+    int    side_px, cells, tile_px, tiles;
+    double dense_bytes, indirection_bytes, tile_bytes, sparse_bytes;
+} rt_destruction_figures;
+
+void rt_destruction_memory(double area_m, double px_per_m, double cell_m,
+                           double coverage, rt_destruction_figures *f);
+/* *out stays NULL when the pack has no destructible area.  `height` and
+ * `bounds` are the renderer's; they are updated by craters. */
+bool rt_destruction_create(rt_device *d, const rt_pack *p, int pool_tiles,
+                           rt_image *height, rt_bounds *bounds, rt_destruction **out,
+                           rt_error *e);
+void rt_destruction_destroy(rt_destruction *ds);
+void rt_destruction_frame(const rt_destruction *ds, splat_frame *fr);
+void rt_destruction_views(const rt_destruction *ds, VkImageView *atlas, VkImageView *index);
+const uint16_t *rt_destruction_heights(const rt_destruction *ds);
+bool rt_destruction_crater(rt_destruction *ds, const rt_crater *c, rt_crater_stats *st,
+                           rt_error *e);
+/* Wait until the last crater's commands are done. */
+bool rt_destruction_wait(rt_destruction *ds, rt_error *e);
+void rt_destruction_print_stats(const rt_destruction *ds, FILE *out);
+/* Helpers shared with the renderer and tests. */
+bool   rt_read_r16(rt_device *d, const rt_image *img, uint16_t *out, rt_error *e);
+double rt_height_at(const uint16_t *heights, const rt_pack *p, double x, double z);
+bool   rt_heightfield_pick(const uint16_t *heights, const rt_pack *p, const double o[3],
+                           const double dir[3], double hit[3]);
 
 /* ---- viewer.c: the GLFW window ---------------------------------------- */
 

@@ -26,6 +26,12 @@ static void usage(FILE *f)
         "  --scene FILE              scene.sg to watch for hot reload (viewer)\n"
         "  --script S                viewer script: \"frames=30;screenshot=out.png;quit\"\n"
         "  --no-stitch               draw patches without stitching (tests)\n"
+        "  --crater x,z,r[,depth]    a crater before the frames (metres; repeatable;\n"
+        "                            depth defaults to r/4)\n"
+        "  --crater-at-view R        a crater of radius R where the view's centre ray\n"
+        "                            meets the terrain\n"
+        "  --destruction-pool N      destruction mask tiles (default 256); when full,\n"
+        "                            a crater needing more is refused with a warning\n"
         "environment: SPLAT_DEVICE=<index|name>, SPLAT_VALIDATE=1\n");
 }
 
@@ -70,7 +76,36 @@ typedef struct opts {
     rt_reference ref;
     const char *params[64];
     int nparams;
+    rt_crater craters[64];      /* --crater, applied in order before frames */
+    int ncraters;
+    double crater_at_view;      /* --crater-at-view RADIUS (0: none)        */
+    int destruction_pool;       /* --destruction-pool N                      */
 } opts;
+
+/* "x,z,radius[,depth]" in metres; depth defaults to radius / 4. */
+static bool parse_crater(const char *s, rt_crater *c)
+{
+    double v[4] = { 0, 0, 0, -1 };
+    int n = 0;
+    char *end;
+    while (n < 4) {
+        v[n] = strtod(s, &end);
+        if (end == s)
+            return false;
+        n++;
+        if (*end != ',')
+            break;
+        s = end + 1;
+    }
+    if (*end || n < 3 || !(v[2] > 0))
+        return false;
+    memset(c, 0, sizeof *c);
+    c->x = v[0];
+    c->z = v[1];
+    c->radius = v[2];
+    c->depth = n == 4 ? v[3] : v[2] / 4;
+    return true;
+}
 
 static int parse_args(int argc, char **argv, opts *o)
 {
@@ -165,6 +200,31 @@ static int parse_args(int argc, char **argv, opts *o)
             NEED(); o->scene = v;
         } else if (!strcmp(a, "--script")) {
             NEED(); o->script = v;
+        } else if (!strcmp(a, "--crater")) {
+            NEED();
+            if (o->ncraters == 64 || !parse_crater(v, &o->craters[o->ncraters])) {
+                fprintf(stderr, "splatview: --crater expects x,z,radius[,depth] in metres "
+                        "(radius > 0, at most 64), found '%s'\n", v);
+                return 2;
+            }
+            o->ncraters++;
+        } else if (!strcmp(a, "--crater-at-view")) {
+            NEED();
+            char *end;
+            o->crater_at_view = strtod(v, &end);
+            if (*end || !(o->crater_at_view > 0)) {
+                fprintf(stderr, "splatview: --crater-at-view expects a radius in metres, found '%s'\n", v);
+                return 2;
+            }
+        } else if (!strcmp(a, "--destruction-pool")) {
+            NEED();
+            char *end;
+            long n = strtol(v, &end, 10);
+            if (*end || n < 1 || n > 65025) {
+                fprintf(stderr, "splatview: --destruction-pool expects 1..65025 tiles, found '%s'\n", v);
+                return 2;
+            }
+            o->destruction_pool = (int)n;
         } else if (a[0] == '-') {
             fprintf(stderr, "splatview: unknown option '%s' (see --help)\n", a);
             return 2;
@@ -237,6 +297,42 @@ static bool apply_params(const opts *o, rt_renderer *r, rt_error *e)
     return true;
 }
 
+/* --crater in order, then --crater-at-view: where the view's centre ray
+ * meets the terrain.  Each event is reported on stdout. */
+static bool apply_craters(const opts *o, rt_renderer *r, const rt_camera *cam, rt_error *e)
+{
+    static const char *const results[] = { "done", "outside the destructible area",
+                                           "refused (tile pool exhausted)" };
+    int n = o->ncraters + (o->crater_at_view > 0);
+    for (int i = 0; i < n; i++) {
+        rt_crater c;
+        if (i < o->ncraters) {
+            c = o->craters[i];
+        } else {
+            double dir[3], hit[3];
+            for (int k = 0; k < 3; k++)
+                dir[k] = cam->look[k] - cam->position[k];
+            if (!rt_renderer_pick(r, cam->position, dir, hit)) {
+                printf("crater at view: the view's centre ray misses the terrain\n");
+                continue;
+            }
+            memset(&c, 0, sizeof c);
+            c.x = hit[0];
+            c.z = hit[2];
+            c.radius = o->crater_at_view;
+            c.depth = c.radius / 4;
+        }
+        rt_crater_stats st;
+        if (!rt_renderer_crater(r, &c, &st, e))
+            return false;
+        printf("crater (%.2f, %.2f) r %.2f depth %.2f: %s, %d cells, %d new tiles "
+               "(%d of %d used), %d texels lowered in a %dx%d upload, %.3f ms cpu\n",
+               c.x, c.z, c.radius, c.depth, results[st.result], st.cells, st.tiles_new,
+               st.tiles_used, st.pool, st.texels, st.upload[2], st.upload[3], st.cpu_ms);
+    }
+    return true;
+}
+
 static rt_tonemap tonemap_for(splat_view v)
 {
     return v == SPLAT_VIEW_FINAL ? RT_TONEMAP_FILMIC
@@ -272,9 +368,11 @@ static int headless(const opts *o)
     rt_render_desc rd = {
         .width = o->width, .height = o->height, .reference = o->ref,
         .pipeline_cache = o->cache, .no_stitch = o->no_stitch, .lod_pixels = o->lod_pixels,
+        .destruction_pool = o->destruction_pool,
     };
     memcpy(rd.clear, o->clear, sizeof rd.clear);
-    if (!rt_renderer_create(&dev, &pack, &rd, &r, &e) || !apply_params(o, r, &e))
+    if (!rt_renderer_create(&dev, &pack, &rd, &r, &e) || !apply_params(o, r, &e) ||
+        !apply_craters(o, r, &cam, &e))
         goto done;
     rt_renderer_set_view(r, view, material);
     int W = o->width > 0 ? o->width : 1280, H = o->height > 0 ? o->height : 720;
@@ -323,6 +421,8 @@ static int headless(const opts *o)
         printf("quadtree cpu ms/frame: median %.4f  p10 %.4f  p90 %.4f\n", sm, sl, sh);
         printf("cpu ms/frame (record): median %.3f  p10 %.3f  p90 %.3f\n", cm, cl, ch);
         rt_painted_print_stats(&pack, stdout);
+        if (rt_renderer_destruction(r))
+            rt_destruction_print_stats(rt_renderer_destruction(r), stdout);
     }
     status = 0;
 done:

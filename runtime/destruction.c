@@ -1,0 +1,882 @@
+/* destruction.c — the dynamic destruction mask (seed 000 §5.2.5, slides 003
+ * "Destruction mask"): craters change the material and the geometry at run
+ * time.
+ *
+ * The mask.  A fixed grid of n x n cells (cell_size metres, 16 by default)
+ * starts at the scene's destructible area's origin; n is what the longer
+ * side of the area needs (the analysis assumes exactly this grid).  The
+ * indirection texture (RGBA8, n x n, set 0 binding 4) holds per cell
+ * .rg = the tile's column and row in the atlas (/255), .a = 1 when the cell
+ * has a tile.  The atlas (R8, binding 3) is a square of cols x cols tiles of
+ * RT_DESTR_TILE^2 texels; only `pool` of its slots are used, handed out on
+ * demand from a free list.  A cell without a tile reads 0 (untouched).
+ *
+ * A crater event (rt_destruction_crater), all in one command buffer that
+ * is submitted without waiting (the next frame is ordered after it on the
+ * queue; events rotate over a ring of command buffers and staging buffers,
+ * so an event waits only when the one four events back still runs):
+ *   1. the cells the crater's disc meets get tiles (new ones cleared to 0);
+ *      if the pool has fewer free tiles than needed the crater is REFUSED:
+ *      a warning, nothing changes (mask and geometry stay consistent);
+ *   2. the indirection texels that changed are uploaded (their rectangle);
+ *   3. the decal is rendered into each affected tile, the viewport set to
+ *      the tile: a radial gradient broken up by value noise, strength at
+ *      the centre, exactly 0 from the radius on, combined with MAX blending
+ *      so overlapping craters keep the stronger mark;
+ *   4. the heightfield texels whose centres lie inside the disc (and inside
+ *      the grid: the analysis widened only the area and two texels around
+ *      it) are lowered by depth * (1 - d^2)^2 (d = distance / radius), on
+ *      the CPU copy, and only their texel rectangle is uploaded — never the
+ *      whole texture;
+ *   5. the quadtree min/max heights of the leaves reading those texels and
+ *      of their ancestors are recomputed.
+ *
+ * Memory (slides: 2048 m at 4 px/m is 64 MB dense): rt_destruction_memory
+ * gives the figures for any configuration. */
+#include "splatrt.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+enum { RT_DESTR_RING = 4 };
+
+struct rt_destruction {
+    rt_device *d;
+    int        n;              /* cells per side                           */
+    double     origin[2], cell; /* metres                                   */
+    int        cols;           /* tiles per atlas row (and column)          */
+    int        pool, used;     /* tiles available / allocated               */
+    int       *free_tiles;     /* stack of free tile slots                  */
+    int        nfree;
+    int       *cell_tile;      /* n*n: slot or -1                           */
+    uint8_t   *index;          /* n*n RGBA8, the indirection on the CPU     */
+    rt_image   atlas, indir;
+    rt_image  *height;         /* the terrain's R16 heightfield image       */
+    rt_bounds *bounds;
+    uint16_t  *heights;        /* CPU copy, lowered by craters              */
+    int        hw, hh, cell_texels;
+    double     size[2], max_height, offset;
+    VkRenderPass     pass;
+    VkFramebuffer    fb;
+    VkPipelineLayout layout;
+    VkPipeline       pipe;
+    /* RT_DESTR_RING events in flight, each with its command buffer, fence
+     * and staging memory; an event waits only when the oldest is still
+     * running (reported as wait_ms, not part of the event's cpu_ms) */
+    VkCommandBuffer  cb[RT_DESTR_RING];
+    VkFence          fence[RT_DESTR_RING];
+    bool             pending[RT_DESTR_RING];
+    rt_buffer        staging[RT_DESTR_RING];
+    int              slot;     /* the ring entry the next event uses        */
+    int             *touched;  /* scratch: cells of the current crater      */
+    VkClearRect     *clears;   /* scratch: rects of its new tiles           */
+    int              craters, refused;
+    double           last_ms, max_ms, total_ms;
+};
+
+/* Push constants of the decal pipeline. */
+typedef struct decal_push {
+    float crater[4];  /* xy: centre in cell units from the cell's corner,
+                         z: radius (cells), w: strength at the centre      */
+    float world[4];   /* xy: cell corner - area origin (m), z: cell (m)    */
+} decal_push;
+
+static const char decal_vert[] =
+    "#version 450\n"
+    "layout(location = 0) out vec2 v_cell;\n"
+    "void main() {\n"
+    "    vec2 c = vec2(gl_VertexIndex & 1, (gl_VertexIndex >> 1) & 1);\n"
+    "    v_cell = c;                          /* the whole tile */\n"
+    "    gl_Position = vec4(c * 2.0 - 1.0, 0.0, 1.0);\n"
+    "}\n";
+
+static const char decal_frag[] =
+    "#version 450\n"
+    "layout(push_constant, std430) uniform decal_push {\n"
+    "    vec4 crater;\n"
+    "    vec4 world;\n"
+    "} u;\n"
+    "layout(location = 0) in vec2 v_cell;\n"
+    "layout(location = 0) out vec4 o_mask;\n"
+    "float hash(vec2 p) {\n"
+    "    vec3 q = fract(vec3(p.xyx) * 0.1031);\n"
+    "    q += dot(q, q.yzx + 33.33);\n"
+    "    return fract((q.x + q.y) * q.z);\n"
+    "}\n"
+    "float vnoise(vec2 p) {\n"
+    "    vec2 i = floor(p), f = fract(p);\n"
+    "    f = f * f * (3.0 - 2.0 * f);\n"
+    "    return mix(mix(hash(i), hash(i + vec2(1, 0)), f.x),\n"
+    "               mix(hash(i + vec2(0, 1)), hash(i + vec2(1, 1)), f.x), f.y);\n"
+    "}\n"
+    "void main() {\n"
+    "    float d = length(v_cell - u.crater.xy) / u.crater.z;\n"
+    "    float edge = max(1.0 - d, 0.0);\n"
+    "    vec2 w = u.world.xy + v_cell * u.world.z;\n"
+    "    float n = 0.65 * vnoise(w * 0.6) + 0.35 * vnoise(w * 1.9);\n"
+    "    o_mask = vec4(u.crater.w * clamp(edge * 4.0 * (0.5 + n), 0.0, 1.0));\n"
+    "}\n";
+
+static double now_ms(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec * 1e-6;
+}
+
+/* ---- memory figures --------------------------------------------------------- */
+
+void rt_destruction_memory(double area_m, double px_per_m, double cell_m,
+                           double coverage, rt_destruction_figures *f)
+{
+    memset(f, 0, sizeof *f);
+    f->side_px = (int)ceil(area_m * px_per_m);
+    f->cells = (int)ceil(area_m / cell_m);
+    f->tile_px = (int)ceil(cell_m * px_per_m);
+    f->dense_bytes = (double)f->side_px * f->side_px;
+    f->indirection_bytes = 2.0 * f->cells * f->cells;  /* RG88 as the slides */
+    f->tiles = (int)ceil(coverage * f->cells * f->cells);
+    f->tile_bytes = (double)f->tiles * f->tile_px * f->tile_px;
+    f->sparse_bytes = f->indirection_bytes + f->tile_bytes;
+}
+
+/* ---- creation ---------------------------------------------------------------- */
+
+static bool make_pipeline(rt_destruction *ds, rt_error *e)
+{
+    VkDevice dev = ds->d->dev;
+    VkAttachmentDescription att = {
+        .format = VK_FORMAT_R8_UNORM,
+        .samples = VK_SAMPLE_COUNT_1_BIT,
+        .loadOp = VK_ATTACHMENT_LOAD_OP_LOAD,
+        .storeOp = VK_ATTACHMENT_STORE_OP_STORE,
+        .stencilLoadOp = VK_ATTACHMENT_LOAD_OP_DONT_CARE,
+        .stencilStoreOp = VK_ATTACHMENT_STORE_OP_DONT_CARE,
+        .initialLayout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+        .finalLayout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+    };
+    VkAttachmentReference ref = { 0, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL };
+    VkSubpassDescription sub = {
+        .pipelineBindPoint = VK_PIPELINE_BIND_POINT_GRAPHICS,
+        .colorAttachmentCount = 1,
+        .pColorAttachments = &ref,
+    };
+    /* Earlier frames' reads of the atlas finish before the decals write;
+     * the decals are visible to the fragment shaders of later frames. */
+    VkSubpassDependency dep[2] = {
+        { VK_SUBPASS_EXTERNAL, 0, VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT,
+          VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT, VK_ACCESS_SHADER_READ_BIT,
+          VK_ACCESS_COLOR_ATTACHMENT_READ_BIT | VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT, 0 },
+        { 0, VK_SUBPASS_EXTERNAL, VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT,
+          VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT, VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT,
+          VK_ACCESS_SHADER_READ_BIT, 0 },
+    };
+    VkRenderPassCreateInfo rci = {
+        .sType = VK_STRUCTURE_TYPE_RENDER_PASS_CREATE_INFO,
+        .attachmentCount = 1, .pAttachments = &att,
+        .subpassCount = 1, .pSubpasses = &sub,
+        .dependencyCount = 2, .pDependencies = dep,
+    };
+    RT_VK(e, vkCreateRenderPass(dev, &rci, NULL, &ds->pass));
+    VkFramebufferCreateInfo fci = {
+        .sType = VK_STRUCTURE_TYPE_FRAMEBUFFER_CREATE_INFO,
+        .renderPass = ds->pass,
+        .attachmentCount = 1, .pAttachments = &ds->atlas.view,
+        .width = ds->atlas.width, .height = ds->atlas.height, .layers = 1,
+    };
+    RT_VK(e, vkCreateFramebuffer(dev, &fci, NULL, &ds->fb));
+    VkPushConstantRange push = { VK_SHADER_STAGE_FRAGMENT_BIT, 0, sizeof(decal_push) };
+    VkPipelineLayoutCreateInfo lci = {
+        .sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO,
+        .pushConstantRangeCount = 1, .pPushConstantRanges = &push,
+    };
+    RT_VK(e, vkCreatePipelineLayout(dev, &lci, NULL, &ds->layout));
+
+    uint32_t *vw = NULL, *fw = NULL;
+    size_t vn = 0, fn = 0;
+    VkShaderModule vm = VK_NULL_HANDLE, fm = VK_NULL_HANDLE;
+    bool ok = rt_glsl_compile(decal_vert, VK_SHADER_STAGE_VERTEX_BIT, "decal.vert", &vw, &vn, e) &&
+              rt_glsl_compile(decal_frag, VK_SHADER_STAGE_FRAGMENT_BIT, "decal.frag", &fw, &fn, e);
+    VkResult vr = VK_SUCCESS;
+    if (ok) {
+        VkShaderModuleCreateInfo mci = { .sType = VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO,
+                                         .codeSize = vn * 4, .pCode = vw };
+        vr = vkCreateShaderModule(dev, &mci, NULL, &vm);
+        mci.codeSize = fn * 4;
+        mci.pCode = fw;
+        if (vr == VK_SUCCESS)
+            vr = vkCreateShaderModule(dev, &mci, NULL, &fm);
+    }
+    if (ok && vr == VK_SUCCESS) {
+        VkPipelineShaderStageCreateInfo st[2] = {
+            { .sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO,
+              .stage = VK_SHADER_STAGE_VERTEX_BIT, .module = vm, .pName = "main" },
+            { .sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO,
+              .stage = VK_SHADER_STAGE_FRAGMENT_BIT, .module = fm, .pName = "main" },
+        };
+        VkPipelineVertexInputStateCreateInfo vi = {
+            .sType = VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO };
+        VkPipelineInputAssemblyStateCreateInfo ia = {
+            .sType = VK_STRUCTURE_TYPE_PIPELINE_INPUT_ASSEMBLY_STATE_CREATE_INFO,
+            .topology = VK_PRIMITIVE_TOPOLOGY_TRIANGLE_STRIP };
+        VkPipelineViewportStateCreateInfo vp = {
+            .sType = VK_STRUCTURE_TYPE_PIPELINE_VIEWPORT_STATE_CREATE_INFO,
+            .viewportCount = 1, .scissorCount = 1 };
+        VkPipelineRasterizationStateCreateInfo rs = {
+            .sType = VK_STRUCTURE_TYPE_PIPELINE_RASTERIZATION_STATE_CREATE_INFO,
+            .polygonMode = VK_POLYGON_MODE_FILL, .cullMode = VK_CULL_MODE_NONE,
+            .lineWidth = 1.0f };
+        VkPipelineMultisampleStateCreateInfo ms = {
+            .sType = VK_STRUCTURE_TYPE_PIPELINE_MULTISAMPLE_STATE_CREATE_INFO,
+            .rasterizationSamples = VK_SAMPLE_COUNT_1_BIT };
+        /* MAX: overlapping craters keep the stronger mark */
+        VkPipelineColorBlendAttachmentState blend = {
+            .blendEnable = VK_TRUE,
+            .srcColorBlendFactor = VK_BLEND_FACTOR_ONE, .dstColorBlendFactor = VK_BLEND_FACTOR_ONE,
+            .colorBlendOp = VK_BLEND_OP_MAX,
+            .srcAlphaBlendFactor = VK_BLEND_FACTOR_ONE, .dstAlphaBlendFactor = VK_BLEND_FACTOR_ONE,
+            .alphaBlendOp = VK_BLEND_OP_MAX,
+            .colorWriteMask = VK_COLOR_COMPONENT_R_BIT,
+        };
+        VkPipelineColorBlendStateCreateInfo cb = {
+            .sType = VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO,
+            .attachmentCount = 1, .pAttachments = &blend };
+        VkDynamicState dyn[2] = { VK_DYNAMIC_STATE_VIEWPORT, VK_DYNAMIC_STATE_SCISSOR };
+        VkPipelineDynamicStateCreateInfo ds_ = {
+            .sType = VK_STRUCTURE_TYPE_PIPELINE_DYNAMIC_STATE_CREATE_INFO,
+            .dynamicStateCount = 2, .pDynamicStates = dyn };
+        VkGraphicsPipelineCreateInfo pci = {
+            .sType = VK_STRUCTURE_TYPE_GRAPHICS_PIPELINE_CREATE_INFO,
+            .stageCount = 2, .pStages = st,
+            .pVertexInputState = &vi, .pInputAssemblyState = &ia, .pViewportState = &vp,
+            .pRasterizationState = &rs, .pMultisampleState = &ms, .pColorBlendState = &cb,
+            .pDynamicState = &ds_, .layout = ds->layout, .renderPass = ds->pass,
+        };
+        vr = vkCreateGraphicsPipelines(dev, VK_NULL_HANDLE, 1, &pci, NULL, &ds->pipe);
+    }
+    if (vm)
+        vkDestroyShaderModule(dev, vm, NULL);
+    if (fm)
+        vkDestroyShaderModule(dev, fm, NULL);
+    free(vw);
+    free(fw);
+    if (!ok)
+        return false;
+    if (vr != VK_SUCCESS)
+        return rt_fail(e, RT_E_VULKAN, "decal pipeline", rt_vk_result_name(vr));
+    return true;
+}
+
+bool rt_destruction_create(rt_device *d, const rt_pack *p, int pool_tiles,
+                           rt_image *height, rt_bounds *bounds, rt_destruction **out,
+                           rt_error *e)
+{
+    *out = NULL;
+    if (!p->has_destruction)
+        return true;
+    rt_destruction *ds = calloc(1, sizeof *ds);
+    if (!ds)
+        return rt_fail(e, RT_E_VULKAN, "destruction", "out of memory");
+    ds->d = d;
+    ds->cell = p->destr_cell;
+    ds->origin[0] = p->destr_origin[0];
+    ds->origin[1] = p->destr_origin[1];
+    double side = p->destr_size[0] > p->destr_size[1] ? p->destr_size[0] : p->destr_size[1];
+    ds->n = (int)ceil(side / ds->cell);
+    ds->pool = pool_tiles > 0 ? pool_tiles : RT_DESTR_POOL_DEFAULT;
+    /* square atlas (the ABI has one atlas size); a tile's column and row
+     * are 8-bit in the indirection texture */
+    uint32_t maxdim = d->props.limits.maxImageDimension2D;
+    ds->cols = (int)ceil(sqrt((double)ds->pool));
+    int max_cols = (int)(maxdim / RT_DESTR_TILE) < 255 ? (int)(maxdim / RT_DESTR_TILE) : 255;
+    if (ds->cols > max_cols) {
+        ds->cols = max_cols;
+        ds->pool = max_cols * max_cols;
+        fprintf(stderr, "splatrt: warning: destruction pool limited to %d tiles\n", ds->pool);
+    }
+    ds->height = height;
+    ds->bounds = bounds;
+    ds->hw = p->hf_width;
+    ds->hh = p->hf_height;
+    ds->cell_texels = p->cell_texels;
+    ds->size[0] = p->size[0];
+    ds->size[1] = p->size[1];
+    ds->max_height = p->max_height;
+    ds->offset = p->height_offset;
+    size_t ncell = (size_t)ds->n * (size_t)ds->n;
+    size_t texels = (size_t)ds->hw * (size_t)ds->hh;
+    ds->free_tiles = malloc((size_t)ds->pool * sizeof *ds->free_tiles);
+    ds->cell_tile = malloc(ncell * sizeof *ds->cell_tile);
+    ds->index = calloc(ncell, 4);
+    ds->heights = malloc(texels * 2);
+    ds->touched = malloc(ncell * sizeof *ds->touched);
+    ds->clears = malloc(ncell * sizeof *ds->clears);
+    if (!ds->free_tiles || !ds->cell_tile || !ds->index || !ds->heights || !ds->touched ||
+        !ds->clears) {
+        rt_destruction_destroy(ds);
+        return rt_fail(e, RT_E_VULKAN, "destruction", "out of memory");
+    }
+    for (int i = 0; i < ds->pool; i++)
+        ds->free_tiles[i] = ds->pool - 1 - i;   /* slot 0 is handed out first */
+    ds->nfree = ds->pool;
+    for (size_t i = 0; i < ncell; i++)
+        ds->cell_tile[i] = -1;
+    memcpy(ds->heights, p->heights, texels * 2);
+
+    /* Staging for one event: the whole indirection and the heightfield
+     * texels under the grid (a crater never writes outside it). */
+    int tx0, tz0, tx1, tz1;
+    tx0 = (int)floor(ds->origin[0] / ds->size[0] * ds->hw) - 1;
+    tz0 = (int)floor(ds->origin[1] / ds->size[1] * ds->hh) - 1;
+    tx1 = (int)ceil((ds->origin[0] + ds->n * ds->cell) / ds->size[0] * ds->hw) + 1;
+    tz1 = (int)ceil((ds->origin[1] + ds->n * ds->cell) / ds->size[1] * ds->hh) + 1;
+    tx0 = tx0 < 0 ? 0 : tx0;
+    tz0 = tz0 < 0 ? 0 : tz0;
+    tx1 = tx1 > ds->hw ? ds->hw : tx1;
+    tz1 = tz1 > ds->hh ? ds->hh : tz1;
+    size_t hbytes = tx1 > tx0 && tz1 > tz0 ? (size_t)(tx1 - tx0) * (size_t)(tz1 - tz0) * 2 : 0;
+    VkDeviceSize sbytes = (VkDeviceSize)(ncell * 4 + hbytes + 16);
+
+    const VkImageUsageFlags use = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT;
+    uint32_t aside = (uint32_t)(ds->cols * RT_DESTR_TILE);
+    uint8_t *zero = calloc((size_t)aside * aside > ncell * 4 ? (size_t)aside * aside : ncell * 4, 1);
+    if (!zero) {
+        rt_destruction_destroy(ds);
+        return rt_fail(e, RT_E_VULKAN, "destruction", "out of memory");
+    }
+    if (!rt_format_supports(d, VK_FORMAT_R8_UNORM, VK_FORMAT_FEATURE_COLOR_ATTACHMENT_BLEND_BIT |
+                                                   VK_FORMAT_FEATURE_SAMPLED_IMAGE_FILTER_LINEAR_BIT)) {
+        free(zero);
+        rt_destruction_destroy(ds);
+        return rt_fail(e, RT_E_NO_FORMAT, "render with blending into R8_UNORM (destruction mask)");
+    }
+    VkCommandBufferAllocateInfo ai = {
+        .sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO,
+        .commandPool = d->pool, .level = VK_COMMAND_BUFFER_LEVEL_PRIMARY,
+        .commandBufferCount = 1,
+    };
+    VkFenceCreateInfo fi = { .sType = VK_STRUCTURE_TYPE_FENCE_CREATE_INFO };
+    bool ok = rt_image_create(d, aside, aside, 1, false, 1, VK_FORMAT_R8_UNORM,
+                              use | VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT,
+                              VK_IMAGE_ASPECT_COLOR_BIT, &ds->atlas, e) &&
+              rt_image_upload(d, &ds->atlas, zero, (size_t)aside * aside, e) &&
+              rt_image_create(d, (uint32_t)ds->n, (uint32_t)ds->n, 1, false, 1,
+                              VK_FORMAT_R8G8B8A8_UNORM, use, VK_IMAGE_ASPECT_COLOR_BIT,
+                              &ds->indir, e) &&
+              rt_image_upload(d, &ds->indir, zero, ncell * 4, e) &&
+              make_pipeline(ds, e);
+    free(zero);
+    ai.commandBufferCount = RT_DESTR_RING;
+    if (ok) {
+        VkResult r = vkAllocateCommandBuffers(d->dev, &ai, ds->cb);
+        for (int i = 0; r == VK_SUCCESS && i < RT_DESTR_RING; i++)
+            r = vkCreateFence(d->dev, &fi, NULL, &ds->fence[i]);
+        if (r != VK_SUCCESS)
+            ok = rt_fail(e, RT_E_VULKAN, "destruction commands", rt_vk_result_name(r));
+    }
+    for (int i = 0; ok && i < RT_DESTR_RING; i++)
+        ok = rt_buffer_create(d, sbytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, true,
+                              &ds->staging[i], e);
+    if (!ok) {
+        rt_destruction_destroy(ds);
+        return false;
+    }
+    *out = ds;
+    return true;
+}
+
+void rt_destruction_destroy(rt_destruction *ds)
+{
+    if (!ds)
+        return;
+    rt_device *d = ds->d;
+    if (d && d->dev) {
+        for (int i = 0; i < RT_DESTR_RING; i++) {
+            if (ds->pending[i])
+                vkWaitForFences(d->dev, 1, &ds->fence[i], VK_TRUE, UINT64_MAX);
+            if (ds->fence[i])
+                vkDestroyFence(d->dev, ds->fence[i], NULL);
+            if (ds->cb[i])
+                vkFreeCommandBuffers(d->dev, d->pool, 1, &ds->cb[i]);
+            rt_buffer_destroy(d, &ds->staging[i]);
+        }
+        if (ds->pipe)
+            vkDestroyPipeline(d->dev, ds->pipe, NULL);
+        if (ds->layout)
+            vkDestroyPipelineLayout(d->dev, ds->layout, NULL);
+        if (ds->fb)
+            vkDestroyFramebuffer(d->dev, ds->fb, NULL);
+        if (ds->pass)
+            vkDestroyRenderPass(d->dev, ds->pass, NULL);
+        rt_image_destroy(d, &ds->atlas);
+        rt_image_destroy(d, &ds->indir);
+    }
+    free(ds->free_tiles);
+    free(ds->cell_tile);
+    free(ds->index);
+    free(ds->heights);
+    free(ds->touched);
+    free(ds->clears);
+    free(ds);
+}
+
+void rt_destruction_frame(const rt_destruction *ds, splat_frame *fr)
+{
+    fr->destruction[0] = (float)ds->origin[0];
+    fr->destruction[1] = (float)ds->origin[1];
+    fr->destruction[2] = (float)ds->cell;
+    fr->destruction[3] = (float)ds->n;
+    fr->destruction_atlas[0] = (float)RT_DESTR_TILE;
+    fr->destruction_atlas[1] = (float)ds->atlas.width;
+    fr->destruction_atlas[2] = (float)ds->cols;
+    fr->destruction_atlas[3] = 0.0f;
+}
+
+void rt_destruction_views(const rt_destruction *ds, VkImageView *atlas, VkImageView *index)
+{
+    *atlas = ds->atlas.view;
+    *index = ds->indir.view;
+}
+
+const uint16_t *rt_destruction_heights(const rt_destruction *ds) { return ds->heights; }
+
+/* ---- a crater ------------------------------------------------------------------ */
+
+static void image_barrier(VkCommandBuffer cb, VkImage img, VkImageLayout from, VkImageLayout to,
+                          VkAccessFlags sa, VkAccessFlags da, VkPipelineStageFlags ss,
+                          VkPipelineStageFlags dst)
+{
+    VkImageMemoryBarrier b = {
+        .sType = VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER,
+        .srcAccessMask = sa, .dstAccessMask = da, .oldLayout = from, .newLayout = to,
+        .srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED,
+        .dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED,
+        .image = img, .subresourceRange = { VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1 },
+    };
+    vkCmdPipelineBarrier(cb, ss, dst, 0, 0, NULL, 0, NULL, 1, &b);
+}
+
+/* Copy `rows` x `bytes_per_row` bytes from staging offset `off` into the
+ * rectangle (x, y, w, h) of `img` (SHADER_READ_ONLY before and after). */
+static void upload_rect(rt_destruction *ds, VkImage img, VkDeviceSize off, int x, int y,
+                        int w, int h)
+{
+    VkCommandBuffer cb = ds->cb[ds->slot];
+    const VkPipelineStageFlags shaders = VK_PIPELINE_STAGE_VERTEX_SHADER_BIT |
+                                         VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT;
+    image_barrier(cb, img, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+                  VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_ACCESS_SHADER_READ_BIT,
+                  VK_ACCESS_TRANSFER_WRITE_BIT, shaders, VK_PIPELINE_STAGE_TRANSFER_BIT);
+    VkBufferImageCopy copy = {
+        .bufferOffset = off,
+        .bufferRowLength = (uint32_t)w,
+        .imageSubresource = { VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1 },
+        .imageOffset = { x, y, 0 },
+        .imageExtent = { (uint32_t)w, (uint32_t)h, 1 },
+    };
+    vkCmdCopyBufferToImage(cb, ds->staging[ds->slot].buf, img, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1,
+                           &copy);
+    image_barrier(cb, img, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+                  VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, VK_ACCESS_TRANSFER_WRITE_BIT,
+                  VK_ACCESS_SHADER_READ_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, shaders);
+}
+
+/* Min/max of the texels leaf (x, z) can show (terrain.c's rule). */
+static void leaf_bounds(rt_destruction *ds, int x, int z)
+{
+    int T = ds->cell_texels, w = ds->hw, h = ds->hh;
+    int x0 = x * T - 1, x1 = (x + 1) * T, z0 = z * T - 1, z1 = (z + 1) * T;
+    x0 = x0 < 0 ? 0 : x0;
+    z0 = z0 < 0 ? 0 : z0;
+    x1 = x1 >= w ? w - 1 : x1;
+    z1 = z1 >= h ? h - 1 : z1;
+    unsigned lo = 65535, hi = 0;
+    for (int tz = z0; tz <= z1; tz++)
+        for (int tx = x0; tx <= x1; tx++) {
+            unsigned v = ds->heights[(size_t)tz * (size_t)w + (size_t)tx];
+            lo = v < lo ? v : lo;
+            hi = v > hi ? v : hi;
+        }
+    rt_bounds *b = ds->bounds;
+    size_t i = (size_t)z * (size_t)b->width[0] + (size_t)x;
+    b->hmin[0][i] = (float)(lo / 65535.0 * ds->max_height + ds->offset);
+    b->hmax[0][i] = (float)(hi / 65535.0 * ds->max_height + ds->offset);
+}
+
+/* Leaves reading texels [tx0, tx1] x [tz0, tz1], then their ancestors. */
+static void update_bounds(rt_destruction *ds, int tx0, int tz0, int tx1, int tz1)
+{
+    rt_bounds *b = ds->bounds;
+    int T = ds->cell_texels;
+    int lx0 = tx0 / T - 1, lx1 = (tx1 + 1) / T, lz0 = tz0 / T - 1, lz1 = (tz1 + 1) / T;
+    lx0 = lx0 < 0 ? 0 : lx0;
+    lz0 = lz0 < 0 ? 0 : lz0;
+    lx1 = lx1 >= b->width[0] ? b->width[0] - 1 : lx1;
+    lz1 = lz1 >= b->height[0] ? b->height[0] - 1 : lz1;
+    for (int z = lz0; z <= lz1; z++)
+        for (int x = lx0; x <= lx1; x++)
+            leaf_bounds(ds, x, z);
+    for (int L = 1; L < b->nlevels; L++) {
+        lx0 /= 2; lx1 /= 2; lz0 /= 2; lz1 /= 2;
+        int pw = b->width[L - 1], ph = b->height[L - 1];
+        for (int z = lz0; z <= lz1; z++)
+            for (int x = lx0; x <= lx1; x++) {
+                float lo = 1e30f, hi = -1e30f;
+                for (int c = 0; c < 4; c++) {
+                    int qx = 2 * x + (c & 1), qz = 2 * z + (c >> 1);
+                    if (qx >= pw || qz >= ph)
+                        continue;
+                    size_t j = (size_t)qz * (size_t)pw + (size_t)qx;
+                    lo = b->hmin[L - 1][j] < lo ? b->hmin[L - 1][j] : lo;
+                    hi = b->hmax[L - 1][j] > hi ? b->hmax[L - 1][j] : hi;
+                }
+                size_t i = (size_t)z * (size_t)b->width[L] + (size_t)x;
+                b->hmin[L][i] = lo;
+                b->hmax[L][i] = hi;
+            }
+    }
+}
+
+bool rt_destruction_crater(rt_destruction *ds, const rt_crater *c, rt_crater_stats *st,
+                           rt_error *e)
+{
+    double t0 = now_ms();
+    rt_crater_stats local;
+    if (!st)
+        st = &local;
+    memset(st, 0, sizeof *st);
+    st->pool = ds->pool;
+    st->tiles_used = ds->used;
+    double r = c->radius;
+    if (!(r > 0) || !isfinite(r) || !isfinite(c->x) || !isfinite(c->z)) {
+        st->result = RT_CRATER_OUTSIDE;
+        return true;
+    }
+    double depth = c->depth > 0 ? c->depth : 0.0;
+    double strength = c->strength > 0 ? (c->strength < 1 ? c->strength : 1.0) : 1.0;
+
+    /* 1. the cells the disc meets */
+    int n = ds->n, ntouched = 0, nnew = 0;
+    double lx = (c->x - ds->origin[0]) / ds->cell, lz = (c->z - ds->origin[1]) / ds->cell;
+    double rc = r / ds->cell;
+    int cx0 = (int)floor(lx - rc), cx1 = (int)floor(lx + rc);
+    int cz0 = (int)floor(lz - rc), cz1 = (int)floor(lz + rc);
+    cx0 = cx0 < 0 ? 0 : cx0;
+    cz0 = cz0 < 0 ? 0 : cz0;
+    cx1 = cx1 >= n ? n - 1 : cx1;
+    cz1 = cz1 >= n ? n - 1 : cz1;
+    for (int z = cz0; z <= cz1; z++)
+        for (int x = cx0; x <= cx1; x++) {
+            double qx = lx < x ? x : lx > x + 1 ? x + 1 : lx;   /* nearest point */
+            double qz = lz < z ? z : lz > z + 1 ? z + 1 : lz;
+            if ((qx - lx) * (qx - lx) + (qz - lz) * (qz - lz) >= rc * rc)
+                continue;
+            ds->touched[ntouched++] = z * n + x;
+            nnew += ds->cell_tile[z * n + x] < 0;
+        }
+    if (ntouched == 0) {
+        st->result = RT_CRATER_OUTSIDE;
+        st->cpu_ms = now_ms() - t0;
+        return true;
+    }
+    if (nnew > ds->nfree) {
+        /* Documented behaviour: refuse the whole crater, change nothing. */
+        fprintf(stderr, "splatrt: warning: destruction tile pool exhausted (%d of %d tiles "
+                "used, this crater needs %d more): crater at (%.1f, %.1f) m refused\n",
+                ds->used, ds->pool, nnew, c->x, c->z);
+        ds->refused++;
+        st->result = RT_CRATER_REFUSED;
+        st->cells = ntouched;
+        st->cpu_ms = now_ms() - t0;
+        return true;
+    }
+    int k = ds->slot;
+    if (ds->pending[k]) {   /* the oldest event still runs: its memory */
+        double tw = now_ms();
+        RT_VK(e, vkWaitForFences(ds->d->dev, 1, &ds->fence[k], VK_TRUE, UINT64_MAX));
+        RT_VK(e, vkResetFences(ds->d->dev, 1, &ds->fence[k]));
+        ds->pending[k] = false;
+        st->wait_ms = now_ms() - tw;
+    }
+
+    /* 2. tiles and the indirection rectangle */
+    int ix0 = n, iz0 = n, ix1 = -1, iz1 = -1, nclear = 0;
+    for (int i = 0; i < ntouched; i++) {
+        int cell = ds->touched[i];
+        if (ds->cell_tile[cell] >= 0)
+            continue;
+        int slot = ds->free_tiles[--ds->nfree];
+        ds->cell_tile[cell] = slot;
+        ds->used++;
+        int tx = slot % ds->cols, tz = slot / ds->cols;
+        uint8_t *px = ds->index + (size_t)cell * 4;
+        px[0] = (uint8_t)tx;
+        px[1] = (uint8_t)tz;
+        px[2] = 0;
+        px[3] = 255;
+        int x = cell % n, z = cell / n;
+        ix0 = x < ix0 ? x : ix0;
+        ix1 = x > ix1 ? x : ix1;
+        iz0 = z < iz0 ? z : iz0;
+        iz1 = z > iz1 ? z : iz1;
+        ds->clears[nclear++] = (VkClearRect){
+            { { tx * RT_DESTR_TILE, tz * RT_DESTR_TILE }, { RT_DESTR_TILE, RT_DESTR_TILE } }, 0, 1 };
+    }
+    uint8_t *staging = ds->staging[k].map;
+    VkDeviceSize off = 0, index_off = 0;
+    if (ix1 >= 0) {
+        int w = ix1 - ix0 + 1;
+        for (int z = iz0; z <= iz1; z++)
+            memcpy(staging + off + (size_t)(z - iz0) * (size_t)w * 4,
+                   ds->index + ((size_t)z * (size_t)n + (size_t)ix0) * 4, (size_t)w * 4);
+        off += (VkDeviceSize)w * (VkDeviceSize)(iz1 - iz0 + 1) * 4;
+    }
+
+    /* 4. heights: texel centres inside the disc and inside the grid */
+    double gx0 = ds->origin[0], gz0 = ds->origin[1], ext = n * ds->cell;
+    double dx = ds->size[0] / ds->hw, dz = ds->size[1] / ds->hh;
+    double ax0 = fmax(c->x - r, gx0), ax1 = fmin(c->x + r, gx0 + ext);
+    double az0 = fmax(c->z - r, gz0), az1 = fmin(c->z + r, gz0 + ext);
+    int tx0 = (int)ceil(ax0 / dx - 0.5), tx1 = (int)floor(ax1 / dx - 0.5);
+    int tz0 = (int)ceil(az0 / dz - 0.5), tz1 = (int)floor(az1 / dz - 0.5);
+    tx0 = tx0 < 0 ? 0 : tx0;
+    tz0 = tz0 < 0 ? 0 : tz0;
+    tx1 = tx1 >= ds->hw ? ds->hw - 1 : tx1;
+    tz1 = tz1 >= ds->hh ? ds->hh - 1 : tz1;
+    double units = depth / (ds->max_height > 0 ? ds->max_height : 1.0) * 65535.0;
+    int hx0 = ds->hw, hz0 = ds->hh, hx1 = -1, hz1 = -1;
+    for (int z = tz0; depth > 0 && z <= tz1; z++)
+        for (int x = tx0; x <= tx1; x++) {
+            double wx = (x + 0.5) * dx, wz = (z + 0.5) * dz;
+            if (wx < gx0 || wx > gx0 + ext || wz < gz0 || wz > gz0 + ext)
+                continue;
+            double d2 = ((wx - c->x) * (wx - c->x) + (wz - c->z) * (wz - c->z)) / (r * r);
+            if (d2 >= 1.0)
+                continue;
+            double k = (1.0 - d2) * (1.0 - d2);
+            uint16_t *h = &ds->heights[(size_t)z * (size_t)ds->hw + (size_t)x];
+            double v = *h - units * k;
+            uint16_t nv = (uint16_t)(v <= 0 ? 0 : lrint(v));
+            if (nv == *h)
+                continue;
+            *h = nv;
+            st->texels++;
+            hx0 = x < hx0 ? x : hx0;
+            hx1 = x > hx1 ? x : hx1;
+            hz0 = z < hz0 ? z : hz0;
+            hz1 = z > hz1 ? z : hz1;
+        }
+    VkDeviceSize height_off = (off + 3) & ~(VkDeviceSize)3;
+    if (hx1 >= 0) {
+        int w = hx1 - hx0 + 1;
+        for (int z = hz0; z <= hz1; z++)
+            memcpy(staging + height_off + (size_t)(z - hz0) * (size_t)w * 2,
+                   ds->heights + (size_t)z * (size_t)ds->hw + (size_t)hx0, (size_t)w * 2);
+        st->upload[0] = hx0;
+        st->upload[1] = hz0;
+        st->upload[2] = w;
+        st->upload[3] = hz1 - hz0 + 1;
+    }
+
+    /* record: uploads, then the decals */
+    VkCommandBuffer cb = ds->cb[k];
+    RT_VK(e, vkResetCommandBuffer(cb, 0));
+    VkCommandBufferBeginInfo bi = { .sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO,
+                                    .flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT };
+    RT_VK(e, vkBeginCommandBuffer(cb, &bi));
+    if (ix1 >= 0)
+        upload_rect(ds, ds->indir.img, index_off, ix0, iz0, ix1 - ix0 + 1, iz1 - iz0 + 1);
+    if (hx1 >= 0)
+        upload_rect(ds, ds->height->img, height_off, hx0, hz0, hx1 - hx0 + 1, hz1 - hz0 + 1);
+    VkRenderPassBeginInfo rb = {
+        .sType = VK_STRUCTURE_TYPE_RENDER_PASS_BEGIN_INFO,
+        .renderPass = ds->pass, .framebuffer = ds->fb,
+        .renderArea = { { 0, 0 }, { ds->atlas.width, ds->atlas.height } },
+    };
+    vkCmdBeginRenderPass(cb, &rb, VK_SUBPASS_CONTENTS_INLINE);
+    if (nclear > 0) {
+        VkClearAttachment ca = { VK_IMAGE_ASPECT_COLOR_BIT, 0, { .color = { { 0, 0, 0, 0 } } } };
+        vkCmdClearAttachments(cb, 1, &ca, (uint32_t)nclear, ds->clears);
+    }
+    vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_GRAPHICS, ds->pipe);
+    for (int i = 0; i < ntouched; i++) {
+        int cell = ds->touched[i], x = cell % n, z = cell / n;
+        int slot = ds->cell_tile[cell];
+        float tx = (float)(slot % ds->cols * RT_DESTR_TILE);
+        float tz = (float)(slot / ds->cols * RT_DESTR_TILE);
+        VkViewport vp = { tx, tz, RT_DESTR_TILE, RT_DESTR_TILE, 0, 1 };
+        VkRect2D sc = { { (int32_t)tx, (int32_t)tz }, { RT_DESTR_TILE, RT_DESTR_TILE } };
+        vkCmdSetViewport(cb, 0, 1, &vp);
+        vkCmdSetScissor(cb, 0, 1, &sc);
+        decal_push push = {
+            { (float)(lx - x), (float)(lz - z), (float)rc, (float)strength },
+            { (float)(x * ds->cell), (float)(z * ds->cell), (float)ds->cell, 0.0f },
+        };
+        vkCmdPushConstants(cb, ds->layout, VK_SHADER_STAGE_FRAGMENT_BIT, 0, sizeof push, &push);
+        vkCmdDraw(cb, 4, 1, 0, 0);
+    }
+    vkCmdEndRenderPass(cb);
+    RT_VK(e, vkEndCommandBuffer(cb));
+    VkSubmitInfo si = { .sType = VK_STRUCTURE_TYPE_SUBMIT_INFO,
+                        .commandBufferCount = 1, .pCommandBuffers = &cb };
+    RT_VK(e, vkQueueSubmit(ds->d->queue, 1, &si, ds->fence[k]));
+    ds->pending[k] = true;
+    ds->slot = (k + 1) % RT_DESTR_RING;
+
+    /* 5. node bounds */
+    if (hx1 >= 0)
+        update_bounds(ds, hx0, hz0, hx1, hz1);
+
+    st->result = RT_CRATER_DONE;
+    st->cells = ntouched;
+    st->tiles_new = nclear;
+    st->tiles_used = ds->used;
+    st->cpu_ms = now_ms() - t0 - st->wait_ms;
+    ds->craters++;
+    ds->last_ms = st->cpu_ms;
+    ds->max_ms = st->cpu_ms > ds->max_ms ? st->cpu_ms : ds->max_ms;
+    ds->total_ms += st->cpu_ms;
+    return true;
+}
+
+/* ---- reading back, picking, reporting -------------------------------------- */
+
+bool rt_destruction_wait(rt_destruction *ds, rt_error *e)
+{
+    for (int i = 0; ds && i < RT_DESTR_RING; i++)
+        if (ds->pending[i]) {
+            RT_VK(e, vkWaitForFences(ds->d->dev, 1, &ds->fence[i], VK_TRUE, UINT64_MAX));
+            RT_VK(e, vkResetFences(ds->d->dev, 1, &ds->fence[i]));
+            ds->pending[i] = false;
+        }
+    return true;
+}
+
+bool rt_read_r16(rt_device *d, const rt_image *img, uint16_t *out, rt_error *e)
+{
+    size_t bytes = (size_t)img->width * img->height * 2;
+    rt_buffer buf;
+    if (!rt_buffer_create(d, bytes, VK_BUFFER_USAGE_TRANSFER_DST_BIT, true, &buf, e))
+        return false;
+    VkCommandBuffer cb;
+    if (!rt_oneshot_begin(d, &cb, e)) {
+        rt_buffer_destroy(d, &buf);
+        return false;
+    }
+    const VkPipelineStageFlags shaders = VK_PIPELINE_STAGE_VERTEX_SHADER_BIT |
+                                         VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT;
+    image_barrier(cb, img->img, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+                  VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_ACCESS_SHADER_READ_BIT |
+                  VK_ACCESS_TRANSFER_WRITE_BIT, VK_ACCESS_TRANSFER_READ_BIT,
+                  shaders | VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT);
+    VkBufferImageCopy copy = {
+        .imageSubresource = { VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1 },
+        .imageExtent = { img->width, img->height, 1 },
+    };
+    vkCmdCopyImageToBuffer(cb, img->img, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, buf.buf, 1, &copy);
+    image_barrier(cb, img->img, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+                  VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, VK_ACCESS_TRANSFER_READ_BIT,
+                  VK_ACCESS_SHADER_READ_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, shaders);
+    VkBufferMemoryBarrier hb = {
+        .sType = VK_STRUCTURE_TYPE_BUFFER_MEMORY_BARRIER,
+        .srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT, .dstAccessMask = VK_ACCESS_HOST_READ_BIT,
+        .srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED,
+        .dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED,
+        .buffer = buf.buf, .size = VK_WHOLE_SIZE,
+    };
+    vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_HOST_BIT, 0, 0,
+                         NULL, 1, &hb, 0, NULL);
+    bool ok = rt_oneshot_end(d, cb, e);
+    if (ok)
+        memcpy(out, buf.map, bytes);
+    rt_buffer_destroy(d, &buf);
+    return ok;
+}
+
+/* Bilinear height (metres) at terrain-local (x, z), clamp to edge. */
+static double height_at(const uint16_t *h, const rt_pack *p, double x, double z)
+{
+    double tx = x / p->size[0] * p->hf_width - 0.5, tz = z / p->size[1] * p->hf_height - 0.5;
+    int x0 = (int)floor(tx), z0 = (int)floor(tz);
+    double fx = tx - x0, fz = tz - z0;
+    double v[4];
+    for (int k = 0; k < 4; k++) {
+        int xi = x0 + (k & 1), zi = z0 + (k >> 1);
+        xi = xi < 0 ? 0 : xi >= p->hf_width ? p->hf_width - 1 : xi;
+        zi = zi < 0 ? 0 : zi >= p->hf_height ? p->hf_height - 1 : zi;
+        v[k] = h[(size_t)zi * (size_t)p->hf_width + (size_t)xi];
+    }
+    double s = (v[0] * (1 - fx) + v[1] * fx) * (1 - fz) + (v[2] * (1 - fx) + v[3] * fx) * fz;
+    return s / 65535.0 * p->max_height + p->height_offset;
+}
+
+double rt_height_at(const uint16_t *heights, const rt_pack *p, double x, double z)
+{
+    return height_at(heights, p, x, z);
+}
+
+bool rt_heightfield_pick(const uint16_t *heights, const rt_pack *p, const double o[3],
+                         const double dir[3], double hit[3])
+{
+    double len = sqrt(dir[0] * dir[0] + dir[1] * dir[1] + dir[2] * dir[2]);
+    if (!(len > 0))
+        return false;
+    double d[3] = { dir[0] / len, dir[1] / len, dir[2] / len };
+    double step = 0.5 * fmin(p->size[0] / p->hf_width, p->size[1] / p->hf_height);
+    double far = 4.0 * (p->size[0] + p->size[1] + p->max_height + fabs(p->height_offset));
+    double prev = 0;
+    for (double t = 0; t <= far; t += step) {
+        double x = o[0] + d[0] * t, y = o[1] + d[1] * t, z = o[2] + d[2] * t;
+        bool inside = x >= 0 && z >= 0 && x <= p->size[0] && z <= p->size[1];
+        if (inside && y <= height_at(heights, p, x, z)) {
+            double a = prev, b = t;   /* refine between the last two steps */
+            for (int i = 0; i < 40; i++) {
+                double m = 0.5 * (a + b);
+                double mx = o[0] + d[0] * m, mz = o[2] + d[2] * m;
+                if (o[1] + d[1] * m <= height_at(heights, p, mx, mz))
+                    b = m;
+                else
+                    a = m;
+            }
+            hit[0] = o[0] + d[0] * b;
+            hit[2] = o[2] + d[2] * b;
+            hit[1] = height_at(heights, p, hit[0], hit[2]);
+            return true;
+        }
+        prev = t;
+        /* bigger steps high above the terrain */
+        double above = y - (p->height_offset + p->max_height);
+        if (above > step)
+            t += above * 0.5;
+    }
+    return false;
+}
+
+void rt_destruction_print_stats(const rt_destruction *ds, FILE *out)
+{
+    double dens = RT_DESTR_TILE / ds->cell;
+    fprintf(out, "destruction: %d x %d cells of %g m from (%g, %g) m, %.2f px/m; "
+            "indirection RGBA8 %d B; atlas %ux%u R8 = %u B, pool %d tiles of %dx%d, "
+            "%d used\n", ds->n, ds->n, ds->cell, ds->origin[0], ds->origin[1], dens,
+            ds->n * ds->n * 4, ds->atlas.width, ds->atlas.height,
+            ds->atlas.width * ds->atlas.height, ds->pool, RT_DESTR_TILE, RT_DESTR_TILE,
+            ds->used);
+    if (ds->craters || ds->refused)
+        fprintf(out, "crater events: %d (%d refused), cpu ms/event: last %.3f  max %.3f  "
+                "mean %.3f\n", ds->craters, ds->refused, ds->last_ms, ds->max_ms,
+                ds->craters ? ds->total_ms / ds->craters : 0.0);
+    /* this scene's area, and the slides' configuration (seed 003) */
+    double side = ds->n * ds->cell;
+    rt_destruction_figures f;
+    rt_destruction_memory(side, dens, ds->cell, 0.10, &f);
+    fprintf(out, "destruction memory, this area at 10%% coverage: dense 8-bit %.0f B, "
+            "sparse %.0f B (%d tiles + RG88 indirection) = %.1f %%\n", f.dense_bytes,
+            f.sparse_bytes, f.tiles, 100.0 * f.sparse_bytes / f.dense_bytes);
+    rt_destruction_memory(2048, 4, 16, 0.10, &f);
+    fprintf(out, "destruction memory, slides' configuration (2048 m, 4 px/m, 16 m cells, "
+            "%dx%d RG88 indirection, %dx%d L8 tiles, 10%% scattered): dense %.1f MB, "
+            "sparse %.2f MB = %.1f %%\n", f.cells, f.cells, f.tile_px, f.tile_px,
+            f.dense_bytes / 1e6, f.sparse_bytes / 1e6, 100.0 * f.sparse_bytes / f.dense_bytes);
+}
