@@ -269,6 +269,32 @@ static bool make_pipeline(rt_destruction *ds, rt_error *e)
     return true;
 }
 
+/* One decal of strength 0 (MAX blend: no change) at load time, so that
+ * drivers that compile pipeline variants on first use (lavapipe's JIT) do
+ * it now rather than in the first crater event. */
+static bool warm_up(rt_destruction *ds, rt_error *e)
+{
+    VkCommandBuffer cb;
+    if (!rt_oneshot_begin(ds->d, &cb, e))
+        return false;
+    VkRenderPassBeginInfo rb = {
+        .sType = VK_STRUCTURE_TYPE_RENDER_PASS_BEGIN_INFO,
+        .renderPass = ds->pass, .framebuffer = ds->fb,
+        .renderArea = { { 0, 0 }, { ds->atlas.width, ds->atlas.height } },
+    };
+    vkCmdBeginRenderPass(cb, &rb, VK_SUBPASS_CONTENTS_INLINE);
+    vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_GRAPHICS, ds->pipe);
+    VkViewport vp = { 0, 0, RT_DESTR_TILE, RT_DESTR_TILE, 0, 1 };
+    VkRect2D sc = { { 0, 0 }, { RT_DESTR_TILE, RT_DESTR_TILE } };
+    vkCmdSetViewport(cb, 0, 1, &vp);
+    vkCmdSetScissor(cb, 0, 1, &sc);
+    decal_push push = { { 0.5f, 0.5f, 0.5f, 0.0f }, { 0, 0, 1, 0 } };
+    vkCmdPushConstants(cb, ds->layout, VK_SHADER_STAGE_FRAGMENT_BIT, 0, sizeof push, &push);
+    vkCmdDraw(cb, 4, 1, 0, 0);
+    vkCmdEndRenderPass(cb);
+    return rt_oneshot_end(ds->d, cb, e);
+}
+
 bool rt_destruction_create(rt_device *d, const rt_pack *p, int pool_tiles,
                            rt_image *height, rt_bounds *bounds, rt_destruction **out,
                            rt_error *e)
@@ -379,6 +405,7 @@ bool rt_destruction_create(rt_device *d, const rt_pack *p, int pool_tiles,
     for (int i = 0; ok && i < RT_DESTR_RING; i++)
         ok = rt_buffer_create(d, sbytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, true,
                               &ds->staging[i], e);
+    ok = ok && warm_up(ds, e);
     if (!ok) {
         rt_destruction_destroy(ds);
         return false;
