@@ -881,6 +881,53 @@ bool rt_heightfield_pick(const uint16_t *heights, const rt_pack *p, const double
     return false;
 }
 
+/* The direction through normalised window position (nx, ny) in -1..1
+ * (y down) of render.c's camera: rows s (right), u (up), f (forward). */
+static void camera_ray(const rt_camera *c, double aspect, double nx, double ny, double dir[3])
+{
+    double f[3], len = 0;
+    for (int i = 0; i < 3; i++) {
+        f[i] = c->look[i] - c->position[i];
+        len += f[i] * f[i];
+    }
+    len = len > 0 ? sqrt(len) : 1;
+    for (int i = 0; i < 3; i++)
+        f[i] /= len;
+    double up[3] = { 0, 1, 0 };
+    if (fabs(f[1]) > 0.999) {
+        up[1] = 0;
+        up[2] = -1;
+    }
+    double s[3] = { f[1] * up[2] - f[2] * up[1], f[2] * up[0] - f[0] * up[2],
+                    f[0] * up[1] - f[1] * up[0] };
+    double sl = sqrt(s[0] * s[0] + s[1] * s[1] + s[2] * s[2]);
+    for (int i = 0; i < 3; i++)
+        s[i] /= sl;
+    double u[3] = { s[1] * f[2] - s[2] * f[1], s[2] * f[0] - s[0] * f[2],
+                    s[0] * f[1] - s[1] * f[0] };
+    double fovy = c->fovy > 0 ? c->fovy : M_PI / 3.0;
+    double t = tan(fovy / 2.0);
+    for (int i = 0; i < 3; i++)
+        dir[i] = f[i] + s[i] * nx * t * aspect - u[i] * ny * t;
+}
+
+bool rt_renderer_crater_at_pixel(rt_renderer *r, const rt_camera *c, double px, double py,
+                                 int w, int h, double radius, rt_crater_stats *st,
+                                 rt_error *e)
+{
+    double dir[3], hit[3];
+    camera_ray(c, (double)w / h, (px + 0.5) / w * 2 - 1, (py + 0.5) / h * 2 - 1, dir);
+    if (!rt_renderer_pick(r, c->position, dir, hit)) {
+        if (st) {
+            memset(st, 0, sizeof *st);
+            st->result = RT_CRATER_OUTSIDE;
+        }
+        return true;
+    }
+    rt_crater cr = { .x = hit[0], .z = hit[2], .radius = radius, .depth = radius / 4 };
+    return rt_renderer_crater(r, &cr, st, e);
+}
+
 void rt_destruction_print_stats(const rt_destruction *ds, FILE *out)
 {
     double dens = RT_DESTR_TILE / ds->cell;

@@ -464,6 +464,11 @@ const uint16_t *rt_renderer_heights(const rt_renderer *r);
  * on the current heightfield); false if it misses. */
 bool rt_renderer_pick(const rt_renderer *r, const double o[3], const double dir[3],
                       double hit[3]);
+/* A crater of `radius` m (depth radius / 4) where the ray through pixel
+ * (px, py) of a w x h view of camera c meets the terrain (viewer clicks). */
+bool rt_renderer_crater_at_pixel(rt_renderer *r, const rt_camera *c, double px, double py,
+                                 int w, int h, double radius, rt_crater_stats *st,
+                                 rt_error *e);
 /* The GPU heightfield read back (tests): W*H texels. */
 bool rt_renderer_read_heights(rt_renderer *r, uint16_t *out, rt_error *e);
 bool rt_parse_view(const char *s, const rt_pack *p, splat_view *view,

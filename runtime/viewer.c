@@ -8,7 +8,7 @@
  * Keys: W/A/S/D move, Space/Ctrl up/down, mouse with the right button
  * held looks around, wheel changes speed, 1 final, 2 combinations, 3 LOD,
  * 4 normal, 5 slope, 6 albedo, 7 mask (again: next material), F wireframe,
- * R rebuild now, Q/Escape quit.
+ * R rebuild now, Q/Escape quit, left click: a crater there (destruction.c).
  *
  * --script runs without a person: "frames=N" renders N frames,
  * "view=NAME", "key=K" acts as if K was pressed, "screenshot=FILE" writes
@@ -184,9 +184,33 @@ static void on_scroll(GLFWwindow *w, double dx, double dy)
     v->speed *= pow(1.25, dy);
 }
 
+/* A crater (1.5 destruction cells wide) where window pixel (x, y) shows
+ * the terrain. */
+static void click_crater(viewer *v, double x, double y)
+{
+    int ww, wh;
+    glfwGetWindowSize(v->win, &ww, &wh);
+    rt_crater_stats st;
+    rt_error e = { 0 };
+    double radius = v->pack->has_destruction ? 1.5 * v->pack->destr_cell : 1.0;
+    if (!rt_renderer_crater_at_pixel(v->r, &v->cam, x, y, ww, wh, radius, &st, &e))
+        fprintf(stderr, "splatview: crater: %s\n", e.msg);
+    else
+        printf("crater: %s, %d new tiles (%d of %d used), %.3f ms cpu\n",
+               st.result == RT_CRATER_DONE ? "done" : st.result == RT_CRATER_REFUSED
+               ? "refused (tile pool exhausted)" : "outside the destructible area",
+               st.tiles_new, st.tiles_used, st.pool, st.cpu_ms);
+    rt_error_clear(&e);
+}
+
 static void on_button(GLFWwindow *w, int button, int action, int mods)
 {
     viewer *v = glfwGetWindowUserPointer(w);
+    if (button == GLFW_MOUSE_BUTTON_LEFT && action == GLFW_PRESS) {
+        double x, y;
+        glfwGetCursorPos(w, &x, &y);
+        click_crater(v, x, y);
+    }
     if (button == GLFW_MOUSE_BUTTON_RIGHT) {
         v->dragging = action == GLFW_PRESS;
         glfwGetCursorPos(w, &v->mx, &v->my);
@@ -719,6 +743,11 @@ static bool script_step(viewer *v, const char *step, double *last, rt_error *e)
                 return false;
         if (v->reloads == before)
             return rt_fail(e, RT_E_RELOAD, "no reload within the time given");
+    } else if (!strcmp(key, "click")) {   /* click=X,Y: a left click there */
+        double x = 0, y = 0;
+        if (sscanf(val, "%lf,%lf", &x, &y) != 2)
+            return rt_fail(e, RT_E_WINDOW, "click expects X,Y (window pixels)");
+        click_crater(v, x, y);
     } else if (!strcmp(key, "quit")) {
         v->quit = true;
     } else if (key[0]) {

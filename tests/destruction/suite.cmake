@@ -15,3 +15,12 @@ if(TARGET splatrt AND TARGET splatc_cli)
   set_tests_properties(destruction.craters PROPERTIES LABELS render TIMEOUT 300
     FIXTURES_REQUIRED destruction_pack ENVIRONMENT "SPLAT_VALIDATE=1")
 endif()
+# imgcheck comes from tests/render (included after this suite)
+if(TARGET splatview AND TARGET splatc_cli)
+  add_test(NAME destruction.viewer_click
+    COMMAND sh ${CMAKE_CURRENT_LIST_DIR}/viewer_click.sh $<TARGET_FILE:splatview>
+            $<TARGET_FILE:imgcheck> ${CMAKE_BINARY_DIR}/tests/destruction/pack
+            ${CMAKE_BINARY_DIR}/tests/destruction/viewer)
+  set_tests_properties(destruction.viewer_click PROPERTIES LABELS render TIMEOUT 300
+    FIXTURES_REQUIRED destruction_pack ENVIRONMENT "SPLAT_VALIDATE=1")
+endif()
