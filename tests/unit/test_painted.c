@@ -1,0 +1,244 @@
+/* test_painted.c — the scene's painted masks as the pack stores them
+ * (compiler/painted.c over sparse.h):
+ *   - the per-mask options of the scene file reach the sparse build
+ *     (tests/painted/colorado_levels.sg: colorado with max_level = 1);
+ *   - colorado's masks stored sparse (BC4) take at most 15 % of their dense
+ *     8-bit bytes, constant cells cost no atlas slot, and the reduced-level
+ *     option at most halves that again (the figures and the reduction error
+ *     are printed);
+ *   - the analysis over the sparse masks is sound for what the GPU samples:
+ *     at random points of every leaf cell, every material the CPU reference
+ *     shows with the painted values of sparse_sample (BC4 decoded, reduced
+ *     levels) is in the cell's combination. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "scene.h"
+
+static void load_ok(splat_scene *s, const char *path)
+{
+    sg_diags d;
+    sg_diags_init(&d);
+    bool ok = splat_scene_load(s, path, NULL, &d);
+    if (!ok)
+        sg_diags_print(&d, stderr);
+    assert_true(ok);
+    sg_diags_free(&d);
+}
+
+static void build_ok(const splat_scene *s, splat_painted_format f, sparse_masks *out)
+{
+    sg_diags d;
+    sg_diags_init(&d);
+    bool ok = splat_painted_build(s, f, out, &d);
+    if (!ok)
+        sg_diags_print(&d, stderr);
+    assert_true(ok);
+    sg_diags_free(&d);
+}
+
+static void test_format_names(void **state)
+{
+    (void)state;
+    splat_painted_format f = SPLAT_PAINTED_DENSE;
+    assert_true(splat_painted_format_parse("bc4", &f));
+    assert_int_equal(f, SPLAT_PAINTED_BC4);
+    assert_true(splat_painted_format_parse("r8", &f));
+    assert_int_equal(f, SPLAT_PAINTED_R8);
+    assert_true(splat_painted_format_parse("dense", &f));
+    assert_int_equal(f, SPLAT_PAINTED_DENSE);
+    assert_false(splat_painted_format_parse("bc7", &f));
+    assert_string_equal(splat_painted_format_name(SPLAT_PAINTED_R8), "r8");
+}
+
+/* Colorado: options parsed, fractions and the constant cells. */
+static void test_colorado_sizes(void **state)
+{
+    (void)state;
+    splat_scene full, lv;
+    load_ok(&full, "examples/colorado/scene.sg");
+    load_ok(&lv, "tests/painted/colorado_levels.sg");
+    assert_int_equal(full.desc->npainted, 4);
+    assert_int_equal(lv.desc->npainted, 4);
+    for (int i = 0; i < 4; i++) {
+        assert_int_equal(full.desc->painted[i].max_level, 0);
+        assert_true(full.desc->painted[i].max_error == 1.0);
+        assert_false(full.desc->painted[i].has_near);
+        assert_int_equal(lv.desc->painted[i].max_level, 1);
+    }
+    sparse_masks a, b, r8;
+    build_ok(&full, SPLAT_PAINTED_BC4, &a);
+    build_ok(&full, SPLAT_PAINTED_R8, &r8);
+    build_ok(&lv, SPLAT_PAINTED_BC4, &b);
+    sparse_stats sa, sb, sr;
+    sparse_get_stats(&a, &sa);
+    sparse_get_stats(&b, &sb);
+    sparse_get_stats(&r8, &sr);
+    sparse_print_stats(&a, stdout);
+    sparse_print_stats(&b, stdout);
+    double err = 0;
+    for (int m = 0; m < b.nmasks; m++)
+        err = fmax(err, b.info[m].reduce_error);
+    printf("colorado painted masks: dense %zu B; sparse BC4 %zu B (%.2f %%), R8 %zu B "
+           "(%.2f %%), BC4 with levels <= 1 %zu B (%.2f %%, max reduction error %.3f)\n",
+           sa.dense_bytes, sa.total_bytes, 100 * sa.fraction, sr.total_bytes,
+           100 * sr.fraction, sb.total_bytes, 100 * sb.fraction, err);
+    assert_true(sa.fraction <= 0.15);
+    assert_true(sb.total_bytes * 2 <= sa.total_bytes);
+    assert_true(sb.reduced_cells > 0 && err > 0);
+    /* constant cells are index constants, never slots: the atlas holds at
+     * most one slot per stored cell */
+    size_t ncell = (size_t)a.cells_x * a.cells_z;
+    int consts = 0, stored = 0;
+    for (int m = 0; m < a.nmasks; m++)
+        for (size_t c = 0; c < ncell; c++) {
+            uint16_t e = a.index[((size_t)(m / 4) * ncell + c) * 4 + (size_t)(m % 4)];
+            consts += e == SPARSE_CONST0 || e == SPARSE_CONST1;
+            stored += e != SPARSE_CONST0 && e != SPARSE_CONST1;
+        }
+    assert_int_equal(consts, sa.const_cells);
+    assert_int_equal(stored, sa.stored_cells);
+    assert_true(consts > 0 && a.nslots <= stored);
+    assert_true(sa.atlas_bytes == (size_t)a.atlas_width * a.atlas_height / 2);
+    assert_true((size_t)a.nslots * SPARSE_SLOT * SPARSE_SLOT <=
+                (size_t)a.atlas_width * a.atlas_height);
+    sparse_free(&a);
+    sparse_free(&b);
+    sparse_free(&r8);
+    splat_scene_free(&full);
+    splat_scene_free(&lv);
+}
+
+/* ---- soundness at points, painted values as the GPU samples them -------- */
+
+static uint64_t rng = 0x9e3779b97f4a7c15ull;
+static double rnd01(void)
+{
+    rng ^= rng << 13;
+    rng ^= rng >> 7;
+    rng ^= rng << 17;
+    return (double)(uint32_t)(rng >> 16) / 4294967296.0;
+}
+
+static void any_texture(void *user, int texture, double u, double v, double rgba[4])
+{
+    (void)user;
+    uint32_t h = (uint32_t)texture * 0x9e3779b9u ^ (uint32_t)(int64_t)floor(u * 512) * 0x85ebca6bu ^
+                 (uint32_t)(int64_t)floor(v * 512) * 0xc2b2ae35u;
+    for (int c = 0; c < 4; c++) {
+        h ^= h >> 15;
+        h *= 0x2c1b3c6du;
+        h ^= h >> 12;
+        rgba[c] = (h & 0xffff) / 65535.0;
+    }
+}
+
+static bool combo_has(const splat_combo *c, int m)
+{
+    for (int i = 0; i < c->nmaterials; i++)
+        if (c->materials[i] == m)
+            return true;
+    return false;
+}
+
+static void test_analysis_sound_over_sparse(void **state)
+{
+    (void)state;
+    splat_scene s;
+    load_ok(&s, "tests/painted/colorado_levels.sg");
+    sparse_masks sp;
+    build_ok(&s, SPLAT_PAINTED_BC4, &sp);
+    s.sparse = &sp;
+    sg_diags d;
+    sg_diags_init(&d);
+    splat_analysis a;
+    assert_true(splat_analyze(&s, &a, &d));
+    sg_diags_free(&d);
+
+    const splat_terrain *t = &s.terrain;
+    int n = s.nmaterials;
+    ir_ref *masks = calloc((size_t)n, sizeof *masks);
+    double *params = calloc((size_t)s.ir.nparams * 4 + 4, sizeof *params);
+    double *painted = calloc((size_t)s.ir.npainted + 1, sizeof *painted);
+    assert_true(masks && params && painted);
+    for (int m = 0; m < n; m++) {
+        char root[256];
+        snprintf(root, sizeof root, "%s.mask", s.desc->materials[m]);
+        masks[m] = ir_find_root(&s.ir, root);
+        assert_true(ir_ref_ok(masks[m]));
+    }
+    int T = a.cell_texels, checked = 0;
+    for (int cz = 0; cz < a.cells_z; cz++)
+        for (int cx = 0; cx < a.cells_x; cx++) {
+            const splat_combo *c = &a.combos[a.levels[0].ids[cz * a.cells_x + cx]];
+            int x1 = (cx + 1) * T < t->width ? (cx + 1) * T : t->width;
+            int z1 = (cz + 1) * T < t->height ? (cz + 1) * T : t->height;
+            for (int k = 0; k < 12; k++) {
+                double u = (cx * T + rnd01() * (x1 - cx * T)) / t->width;
+                double v = (cz * T + rnd01() * (z1 - cz * T)) / t->height;
+                ir_env env;
+                memset(&env, 0, sizeof env);
+                env.height = splat_terrain_height(t, u, v);
+                splat_terrain_normal(t, u, v, env.normal);
+                env.slope = 1 - env.normal[1];
+                env.uv[0] = u;
+                env.uv[1] = v;
+                env.position[0] = u * t->size[0];
+                env.position[1] = env.height;
+                env.position[2] = v * t->size[1];
+                env.view_distance = rnd01() * 5000;
+                for (int p = 0; p < s.ir.nparams; p++) {
+                    const ir_param *ip = &s.ir.params[p];
+                    for (int q = 0; q < 4; q++)
+                        params[4 * p + q] = ip->lo == ip->hi ? ip->def[q]
+                                          : ip->lo + rnd01() * (ip->hi - ip->lo);
+                }
+                env.params = params;
+                /* the scene's painted mask i is the ir's painted i */
+                for (int p = 0; p < s.ir.npainted; p++)
+                    painted[p] = sparse_sample(&sp, p, u, v);
+                env.painted = painted;
+                env.sample = any_texture;
+                double cover = 1;
+                for (int m = n - 1; m >= 0 && cover > 0; m--) {
+                    double mask[4] = { 1 };
+                    if (m > 0)
+                        ir_eval(&s.ir, masks[m], &env, mask);
+                    double w = cover * mask[0];
+                    if (w > 0 && !combo_has(c, m)) {
+                        print_error("cell (%d, %d): '%s' visible (w = %g) at uv (%.9f, %.9f) "
+                                    "but not in the combination\n", cx, cz,
+                                    s.desc->materials[m], w, u, v);
+                        fail();
+                    }
+                    cover -= w;
+                }
+                checked++;
+            }
+        }
+    printf("%d points in %d cells: every visible material in its cell's combination "
+           "(%d combinations)\n", checked, a.cells_x * a.cells_z, a.ncombos);
+    free(masks);
+    free(params);
+    free(painted);
+    splat_analysis_free(&a);
+    sparse_free(&sp);
+    splat_scene_free(&s);
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_format_names),
+        cmocka_unit_test(test_colorado_sizes),
+        cmocka_unit_test(test_analysis_sound_over_sparse),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}
