@@ -15,6 +15,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+static void fill_info(sparse_masks *s);
+
 bool rt_painted_read(rt_pack *p, const char *file, rt_error *e)
 {
     size_t n = strlen(p->dir) + strlen(file) + 2;
@@ -53,7 +55,37 @@ bool rt_painted_read(rt_pack *p, const char *file, rt_error *e)
         return false;
     }
     free(path);
+    fill_info(p->sparse);
     return true;
+}
+
+/* The per-mask figures sparse_read does not store, recounted from the
+ * index and level data for --stats (the reduction error is not in the
+ * file: NaN, printed as "nan"). */
+static void fill_info(sparse_masks *s)
+{
+    s->info = calloc((size_t)(s->nmasks ? s->nmasks : 1), sizeof *s->info);
+    if (!s->info)
+        return;
+    size_t ncell = (size_t)s->cells_x * s->cells_z;
+    for (int m = 0; m < s->nmasks; m++) {
+        sparse_mask_info *in = &s->info[m];
+        char name[32];
+        snprintf(name, sizeof name, "mask %d", m);
+        in->name = strdup(name);
+        in->reduce_error = NAN;
+        for (size_t c = 0; c < ncell; c++) {
+            size_t at = ((size_t)(m / 4) * ncell + c) * 4 + (size_t)(m % 4);
+            uint16_t e = s->index[at];
+            in->const0 += e == SPARSE_CONST0;
+            in->const1 += e == SPARSE_CONST1;
+            if (e == SPARSE_CONST0 || e == SPARSE_CONST1)
+                continue;
+            in->stored++;
+            in->reduced += s->level[at] > 0;
+            in->max_level = s->level[at] > in->max_level ? s->level[at] : in->max_level;
+        }
+    }
 }
 
 /* The BC4 atlas as R8 bytes (devices without BC textures). */
