@@ -148,14 +148,15 @@ static bool pick_device(harness *h, const char *want, char **err)
             continue;
         uint32_t nq = 0;
         vkGetPhysicalDeviceQueueFamilyProperties(devs[i], &nq, NULL);
-        VkQueueFamilyProperties q[16];
-        if (nq > 16)
-            nq = 16;
-        vkGetPhysicalDeviceQueueFamilyProperties(devs[i], &nq, q);
+        VkQueueFamilyProperties *q = calloc(nq ? nq : 1, sizeof *q);
         uint32_t fam = UINT32_MAX;
-        for (uint32_t k = 0; k < nq && fam == UINT32_MAX; k++)
-            if (q[k].queueFlags & VK_QUEUE_COMPUTE_BIT)
-                fam = k;
+        if (q) {
+            vkGetPhysicalDeviceQueueFamilyProperties(devs[i], &nq, q);
+            for (uint32_t k = 0; k < nq && fam == UINT32_MAX; k++)
+                if (q[k].queueFlags & VK_QUEUE_COMPUTE_BIT)
+                    fam = k;
+            free(q);
+        }
         int rank = device_rank(&p, want);
         if (fam != UINT32_MAX && rank > best) {
             best = rank;
