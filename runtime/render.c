@@ -377,7 +377,7 @@ bool rt_renderer_create(rt_device *d, const rt_pack *p, const rt_render_desc *de
     if (r->desc.lod_pixels <= 0)
         r->desc.lod_pixels = 3.0;
     if (r->desc.clear[3] == 0 && r->desc.clear[0] == 0 && r->desc.clear[1] == 0 && r->desc.clear[2] == 0) {
-        static const float sky[4] = { 0.55f, 0.65f, 0.80f, 1.0f };
+        static const float sky[4] = { 0.35f, 0.52f, 0.85f, 1.0f };
         memcpy(r->desc.clear, sky, sizeof sky);
     }
     r->ncombos = p->ncombos;
@@ -556,14 +556,21 @@ static void fill_frame(rt_renderer *r, const rt_camera *c, splat_frame *fr)
     camera_matrix(c, (double)r->desc.width / r->desc.height, fr->view_proj);
     for (int i = 0; i < 3; i++)
         fr->camera[i] = (float)c->position[i];
-    double sun[3] = { -0.45, 0.7, 0.55 }, sl = sqrt(0.45 * 0.45 + 0.7 * 0.7 + 0.55 * 0.55);
+    /* Default lighting: a low morning sun from the south-east (about 20 deg
+     * up) so even gentle relief reads as light and shade; warm sun, blue
+     * sky ambient (sun : sky about 5 : 1 on flat ground); fog in the
+     * background colour with a density scaled to the scene's extent, so
+     * any scene fades to about 78 % fog at its far side whatever its size
+     * (colorado: 8 % at 10 km). */
+    double sun[3] = { 0.55, 0.36, 0.75 };
+    double sl = sqrt(sun[0] * sun[0] + sun[1] * sun[1] + sun[2] * sun[2]);
     for (int i = 0; i < 3; i++)
         fr->sun_dir[i] = (float)(sun[i] / sl);
-    fr->sun_color[0] = 2.9f; fr->sun_color[1] = 2.75f; fr->sun_color[2] = 2.5f;
-    fr->sky_color[0] = 0.35f; fr->sky_color[1] = 0.45f; fr->sky_color[2] = 0.62f;
+    fr->sun_color[0] = 2.9f; fr->sun_color[1] = 2.7f; fr->sun_color[2] = 2.35f;
+    fr->sky_color[0] = 0.16f; fr->sky_color[1] = 0.22f; fr->sky_color[2] = 0.34f;
     double ext = p->size[0] > p->size[1] ? p->size[0] : p->size[1];
     memcpy(fr->fog, r->desc.clear, 3 * sizeof(float));
-    fr->fog[3] = (float)(0.25 / ext);
+    fr->fog[3] = (float)(1.5 / ext);
     fr->terrain[0] = (float)p->size[0];
     fr->terrain[1] = (float)p->size[1];
     fr->terrain[2] = (float)p->max_height;
