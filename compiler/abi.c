@@ -114,6 +114,12 @@ const char SPLAT_GLSL_PRELUDE[] =
     "vec3 splat_position() { return vec3(v_local.x, splat_height(), v_local.z); }\n"
     "vec2 splat_uv() { return v_uv; }\n"
     "float splat_view_distance() { return length(v_rel); }\n"
+    /* v_rel = surface - camera (terrain-local axes), so surface -> camera
+     * is its negation; the camera exactly on the surface reads straight up */
+    "vec3 splat_view_direction() {\n"
+    "    float l = length(v_rel);\n"
+    "    return l > 0.0 ? -v_rel / l : vec3(0.0, 1.0, 0.0);\n"
+    "}\n"
     "#ifdef SPLAT_PAINTED_SPARSE\n"
     SPARSE_GLSL_FUNCTIONS
     "float splat_painted(int layer) {\n"

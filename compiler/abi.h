@@ -111,6 +111,7 @@ typedef struct splat_push {
  *   constants, varyings, fragment outputs and these functions:
  *     float splat_height()   vec3 splat_normal()   float splat_slope()
  *     vec3 splat_position()  vec2 splat_uv()        float splat_view_distance()
+ *     vec3 splat_view_direction() (unit, surface -> camera, terrain-local)
  *     float splat_destruction()   float splat_painted(int layer)
  *     float splat_height_at(vec2 uv)  vec3 splat_normal_at(vec2 uv)
  *     void splat_finish(vec3 albedo, vec3 normal, float roughness,

@@ -152,6 +152,7 @@ static const char *const input_glsl[IR_IN_COUNT] = {
     [IR_IN_UV] = "splat_uv()",
     [IR_IN_VIEW_DISTANCE] = "splat_view_distance()",
     [IR_IN_DESTRUCTION] = "splat_destruction()",
+    [IR_IN_VIEW_DIRECTION] = "splat_view_direction()",
 };
 
 static char *leaf_expr(glsl_emitter *e, const ir_node *n)

@@ -52,7 +52,8 @@ ir_type     ir_type_from_name(const char *s); /* IR_T_ERROR if unknown       */
     X(POSITION,      "terrain.position", IR_T_VEC3)  /* terrain-local m   */ \
     X(UV,            "terrain.uv",       IR_T_VEC2)  /* heightfield 0..1  */ \
     X(VIEW_DISTANCE, "view.distance",    IR_T_FLOAT) /* metres to camera  */ \
-    X(DESTRUCTION,   "terrain.destruction", IR_T_FLOAT) /* 0 = untouched */
+    X(DESTRUCTION,   "terrain.destruction", IR_T_FLOAT) /* 0 = untouched */ \
+    X(VIEW_DIRECTION, "view.direction",  IR_T_VEC3)  /* unit, to camera   */
 
 /* The type is `enum ir_input` (alias ir_input_kind): the plain name
  * `ir_input` is the builder function below. */
@@ -313,6 +314,9 @@ typedef struct ir_env {
     const double *params;          /* 4 doubles per param; NULL = defaults */
     const double *painted;         /* 1 double per painted mask; NULL = 0 */
     ir_sample_fn sample; void *sample_user;
+    double view_direction[3];      /* unit vector from the point to the
+                                      camera, terrain-local; (0, 0, 0)
+                                      reads as (0, 1, 0), straight down  */
 } ir_env;
 
 /* Double-precision reference value of `r` (w = ir_type_width components). */
@@ -321,7 +325,9 @@ void ir_eval(const ir *ir, ir_ref r, const ir_env *env, double out[4]);
 typedef struct ir_iv { double lo, hi; } ir_iv;
 
 /* Input regions for the interval evaluator: every input lies in its
- * interval (component-wise for vectors). */
+ * interval (component-wise for vectors).  view.direction has no field: the
+ * camera is not part of a terrain region, so its bounds are always
+ * [-1, 1] per component (a unit vector). */
 typedef struct ir_ienv {
     ir_iv height, slope, normal[3], position[3], uv[2];
     ir_iv view_distance, destruction;

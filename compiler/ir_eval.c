@@ -21,6 +21,14 @@ static void eval_input(const ir_env *env, uint32_t which, double *out)
     case IR_IN_UV:            memcpy(out, env->uv, sizeof env->uv); break;
     case IR_IN_VIEW_DISTANCE: out[0] = env->view_distance; break;
     case IR_IN_DESTRUCTION:   out[0] = env->destruction; break;
+    case IR_IN_VIEW_DIRECTION: {
+        const double *d = env->view_direction;
+        bool zero = d[0] == 0.0 && d[1] == 0.0 && d[2] == 0.0;
+        out[0] = d[0];
+        out[1] = zero ? 1.0 : d[1];   /* unset: looking straight down */
+        out[2] = d[2];
+        break;
+    }
     default:                  assert(!"unknown input");
     }
 }

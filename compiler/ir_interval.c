@@ -27,6 +27,10 @@ static void input_bounds(const ir_ienv *env, uint32_t which, ir_iv *out)
     case IR_IN_UV:            memcpy(out, env->uv, sizeof env->uv); break;
     case IR_IN_VIEW_DISTANCE: out[0] = env->view_distance; break;
     case IR_IN_DESTRUCTION:   out[0] = env->destruction; break;
+    case IR_IN_VIEW_DIRECTION:     /* any camera: a unit vector */
+        for (int c = 0; c < 3; c++)
+            out[c] = (ir_iv){-1.0, 1.0};
+        break;
     default:                  assert(!"unknown input");
     }
 }

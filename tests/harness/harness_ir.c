@@ -6,9 +6,9 @@
  * heightfield:
  *
  *   rec[0]                 height, slope, view distance, destruction
- *   rec[1]                 normal.xyz
- *   rec[2]                 position.xyz
- *   rec[3]                 uv.xy
+ *   rec[1]                 normal.xyz, view direction.x
+ *   rec[2]                 position.xyz, view direction.y
+ *   rec[3]                 uv.xy, view direction.z
  *   rec[4 + i]             param i (its first ir_type_width components)
  *   rec[4 + P + k / 4][k % 4]  painted mask k        (P = number of params)
  *
@@ -53,7 +53,10 @@ static const char INPUTS[] =
     "float splat_destruction() { return h_in.rec[h_base].w; }\n"
     "vec3 splat_normal() { return h_in.rec[h_base + 1u].xyz; }\n"
     "vec3 splat_position() { return h_in.rec[h_base + 2u].xyz; }\n"
-    "vec2 splat_uv() { return h_in.rec[h_base + 3u].xy; }\n";
+    "vec2 splat_uv() { return h_in.rec[h_base + 3u].xy; }\n"
+    "vec3 splat_view_direction() {\n"
+    "    return vec3(h_in.rec[h_base + 1u].w, h_in.rec[h_base + 2u].w, h_in.rec[h_base + 3u].z);\n"
+    "}\n";
 
 char *harness_ir_shader(const harness_ir_desc *d, char **err)
 {
@@ -170,6 +173,12 @@ static float *pack_points(const harness_ir_desc *d, size_t *bytes)
         }
         r[12] = (float)env->uv[0];
         r[13] = (float)env->uv[1];
+        /* view direction as ir_eval reads it: unset (0, 0, 0) is straight up */
+        const double *vd = env->view_direction;
+        bool unset = vd[0] == 0.0 && vd[1] == 0.0 && vd[2] == 0.0;
+        r[7] = (float)vd[0];
+        r[11] = (float)(unset ? 1.0 : vd[1]);
+        r[14] = (float)vd[2];
         for (int i = 0; i < ir->nparams; i++)
             for (int c = 0; c < 4; c++)
                 r[(4 + i) * 4 + c] = (float)(env->params ? env->params[4 * i + c]

@@ -73,6 +73,13 @@ static void leaf_input(const ir_env *env, uint32_t which, double *out)
     case IR_IN_UV:            memcpy(out, env->uv, sizeof env->uv); break;
     case IR_IN_VIEW_DISTANCE: out[0] = env->view_distance; break;
     case IR_IN_DESTRUCTION:   out[0] = env->destruction; break;
+    case IR_IN_VIEW_DIRECTION: {  /* as ir_eval: unset (0, 0, 0) is straight up */
+        const double *d = env->view_direction;
+        memcpy(out, d, 3 * sizeof *d);
+        if (d[0] == 0.0 && d[1] == 0.0 && d[2] == 0.0)
+            out[1] = 1.0;
+        break;
+    }
     default: break;
     }
 }

@@ -208,7 +208,8 @@ static void test_eval_ir_plumbing(void **state)
         ir_input(&g, IR_IN_HEIGHT), ir_input(&g, IR_IN_SLOPE),
         ir_input(&g, IR_IN_NORMAL), ir_input(&g, IR_IN_POSITION),
         ir_input(&g, IR_IN_UV), ir_input(&g, IR_IN_VIEW_DISTANCE),
-        ir_input(&g, IR_IN_DESTRUCTION), ir_param_ref(&g, 0), ir_param_ref(&g, 1),
+        ir_input(&g, IR_IN_DESTRUCTION), ir_input(&g, IR_IN_VIEW_DIRECTION),
+        ir_param_ref(&g, 0), ir_param_ref(&g, 1),
         ir_painted_ref(&g, 0), ir_painted_ref(&g, 4),
         ir_op2(&g, IR_OP_SAMPLE, ir_texture_ref(&g, 0), ir_input(&g, IR_IN_UV)),
     };
@@ -221,6 +222,8 @@ static void test_eval_ir_plumbing(void **state)
             .normal = { 0.25, 0.5 + p, -0.75 }, .position = { 10, 20 + p, 30 },
             .uv = { 0.25 + 0.5 * (p & 1), 0.25 }, .view_distance = 1000 + p,
             .destruction = 0.5 * p, .params = params[p], .painted = painted[p],
+            /* point 0 leaves it unset: reads (0, 1, 0) on both sides */
+            .view_direction = { 0.6 * p, 0, p ? -0.8 : 0 },
         };
         for (int i = 0; i < 8; i++)
             params[p][i] = i + 0.5 * p;
