@@ -455,6 +455,32 @@ static char **texture_names(build *b)
     return names;
 }
 
+/* A texture's stored mip files (texgen.h's contract): "X.mipK.ext" beside
+ * "X.ext" for K = 1, 2, … while they exist.  mip_path(path, k) is that name
+ * for any path (source or pack); mip_count(src) how many the source has. */
+static char *mip_path(const char *path, int k)
+{
+    const char *slash = strrchr(path, '/');
+    const char *dot = strrchr(path, '.');
+    if (!dot || (slash && dot < slash))
+        return xasprintf("%s.mip%d", path, k);
+    return xasprintf("%.*s.mip%d%s", (int)(dot - path), path, k, dot);
+}
+
+static int mip_count(const char *src)
+{
+    int k = 0;
+    for (;;) {
+        char *p = mip_path(src, k + 1);
+        struct stat st;
+        bool there = stat(p, &st) == 0 && S_ISREG(st.st_mode);
+        free(p);
+        if (!there || k >= 32)
+            return k;
+        k++;
+    }
+}
+
 static json_t *manifest(build *b, char **tex_names, const char *dir)
 {
     const splat_scene *s = &b->scene;
@@ -549,6 +575,9 @@ static json_t *manifest(build *b, char **tex_names, const char *dir)
         json_object_set_new(o, "mip", json_string(filter_str(t->mip)));
         json_object_set_new(o, "wrap", json_string(wrap_str(t->wrap)));
         json_object_set_new(o, "srgb", json_boolean(t->srgb));
+        int mips = mip_count(t->file);
+        if (mips > 0)
+            json_object_set_new(o, "mips", json_integer(mips));
         json_array_append_new(texs, o);
     }
     json_object_set_new(m, "textures", texs);
@@ -696,9 +725,15 @@ static bool write_contents(build *b, const char *dir)
         bool first = true;
         for (int k = 0; k < i; k++)
             first &= strcmp(tex_names[k], tex_names[i]) != 0;
+        const char *src = b->layout.src->textures[b->layout.textures[i]].file;
         if (first)
-            ok = copy_file(b, b->layout.src->textures[b->layout.textures[i]].file, dir,
-                           tex_names[i]);
+            ok = copy_file(b, src, dir, tex_names[i]);
+        for (int k = 1, n = first ? mip_count(src) : 0; ok && k <= n; k++) {
+            char *from = mip_path(src, k), *to = mip_path(tex_names[i], k);
+            ok = copy_file(b, from, dir, to);
+            free(from);
+            free(to);
+        }
     }
     if (ok) {
         json_t *m = manifest(b, tex_names, dir);
@@ -901,8 +936,14 @@ static bool inputs_key(build *b)
     ok = ok && hash_file(st, s->desc->heightfield);
     for (int i = 0; ok && i < s->desc->npainted; i++)
         ok = hash_file(st, s->desc->painted[i].file);
-    for (int i = 0; ok && i < s->ir.ntextures; i++)
+    for (int i = 0; ok && i < s->ir.ntextures; i++) {
         ok = hash_file(st, s->ir.textures[i].file);
+        for (int k = 1, n = mip_count(s->ir.textures[i].file); ok && k <= n; k++) {
+            char *m = mip_path(s->ir.textures[i].file, k);
+            ok = hash_file(st, m);
+            free(m);
+        }
+    }
     XXH128_hash_t h = XXH3_128bits_digest(st);
     XXH3_freeState(st);
     snprintf(b->inputs, sizeof b->inputs, "%016llx%016llx", (unsigned long long)h.high64,

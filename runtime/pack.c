@@ -379,6 +379,61 @@ static bool read_params(reader *r, json_t *root)
     return true;
 }
 
+/* "X.mipK.ext" beside "X.ext" (texgen.h's contract, as the pack writer
+ * names them). */
+static char *mip_name(const char *file, int k)
+{
+    const char *slash = strrchr(file, '/'), *dot = strrchr(file, '.');
+    size_t stem = dot && (!slash || dot > slash) ? (size_t)(dot - file) : strlen(file);
+    const char *ext = file + stem;
+    size_t n = strlen(file) + 16;
+    char *s = malloc(n);
+    if (s)
+        snprintf(s, n, "%.*s.mip%d%s", (int)stem, file, k, ext);
+    return s;
+}
+
+/* The stored mip levels of texture `tx` (manifest "mips": how many files);
+ * each must have the size of its level. */
+static bool read_mips(reader *r, json_t *t, const char *where, rt_pack_texture *tx)
+{
+    int n;
+    if (!get_int(r, t, "mips", where, 1, 31, &n))
+        return false;
+    tx->mips = calloc((size_t)n, sizeof *tx->mips);
+    if (!tx->mips)
+        return rt_fail(r->e, RT_E_VULKAN, "textures", "out of memory");
+    tx->nmips = n;
+    for (int k = 1; k <= n; k++) {
+        char *file = mip_name(tx->file, k), field[96];
+        if (!file)
+            return rt_fail(r->e, RT_E_VULKAN, "textures", "out of memory");
+        snprintf(field, sizeof field, "%s.mips[%d]", where, k);
+        size_t bytes;
+        uint8_t *data = pack_file(r, field, file, 0, &bytes);
+        int w = 0, h = 0, ch;
+        if (data)
+            tx->mips[k - 1] = stbi_load_from_memory(data, (int)bytes, &w, &h, &ch, 4);
+        free(data);
+        int ww = tx->width >> k > 0 ? tx->width >> k : 1;
+        int wh = tx->height >> k > 0 ? tx->height >> k : 1;
+        bool ok = data && tx->mips[k - 1];
+        if (data && !ok)
+            rt_fail(r->e, RT_E_PACK_FILE, r->manifest, field, file,
+                    "is not an image stb_image can read");
+        else if (ok && (w != ww || h != wh)) {
+            char msg[96];
+            snprintf(msg, sizeof msg, "is %dx%d, its level needs %dx%d", w, h, ww, wh);
+            rt_fail(r->e, RT_E_PACK_FILE, r->manifest, field, file, msg);
+            ok = false;
+        }
+        free(file);
+        if (!ok)
+            return false;
+    }
+    return true;
+}
+
 static bool read_textures(reader *r, json_t *root)
 {
     rt_pack *p = r->p;
@@ -426,6 +481,8 @@ static bool read_textures(reader *r, json_t *root)
         if (!tx->rgba)
             return rt_fail(r->e, RT_E_PACK_FILE, r->manifest, field, file,
                            "is not an image stb_image can read");
+        if (get(r, t, "mips", where, false) && !read_mips(r, t, where, tx))
+            return false;
     }
     return true;
 }
@@ -647,6 +704,9 @@ void rt_pack_free(rt_pack *p)
     for (int i = 0; i < p->ntextures && p->textures; i++) {
         free(p->textures[i].file);
         stbi_image_free(p->textures[i].rgba);
+        for (int k = 0; k < p->textures[i].nmips && p->textures[i].mips; k++)
+            stbi_image_free(p->textures[i].mips[k]);
+        free(p->textures[i].mips);
     }
     for (int i = 0; i < p->ncombos && p->combos; i++) {
         free(p->combos[i].materials);

@@ -212,14 +212,33 @@ static bool make_textures(rt_renderer *r, rt_error *e)
         const rt_pack_texture *t = &p->textures[i];
         VkFormat f = t->srgb ? VK_FORMAT_R8G8B8A8_SRGB : VK_FORMAT_R8G8B8A8_UNORM;
         uint32_t mips = 1;
-        if (rt_format_supports(d, f, VK_FORMAT_FEATURE_BLIT_SRC_BIT | VK_FORMAT_FEATURE_BLIT_DST_BIT |
-                                     VK_FORMAT_FEATURE_SAMPLED_IMAGE_FILTER_LINEAR_BIT))
+        if (t->nmips > 0) {
+            /* the pack's own levels (e.g. nearest-neighbour reduced noise) */
+            mips = 1 + (uint32_t)t->nmips;
+        } else if (rt_format_supports(d, f, VK_FORMAT_FEATURE_BLIT_SRC_BIT |
+                                            VK_FORMAT_FEATURE_BLIT_DST_BIT |
+                                            VK_FORMAT_FEATURE_SAMPLED_IMAGE_FILTER_LINEAR_BIT)) {
             for (int s = t->width > t->height ? t->width : t->height; s > 1; s /= 2)
                 mips++;
+        }
         if (!rt_image_create(d, (uint32_t)t->width, (uint32_t)t->height, 1, false, mips, f,
                              VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT |
-                             VK_IMAGE_USAGE_TRANSFER_SRC_BIT, VK_IMAGE_ASPECT_COLOR_BIT, &r->tex[i], e) ||
-            !rt_image_upload(d, &r->tex[i], t->rgba, (size_t)t->width * (size_t)t->height * 4, e))
+                             VK_IMAGE_USAGE_TRANSFER_SRC_BIT, VK_IMAGE_ASPECT_COLOR_BIT, &r->tex[i], e))
+            return false;
+        bool up;
+        if (t->nmips > 0) {
+            const uint8_t **levels = calloc(mips, sizeof *levels);
+            if (!levels)
+                return rt_fail(e, RT_E_VULKAN, "textures", "out of memory");
+            levels[0] = t->rgba;
+            for (int k = 0; k < t->nmips; k++)
+                levels[1 + k] = t->mips[k];
+            up = rt_image_upload_levels(d, &r->tex[i], levels, e);
+            free(levels);
+        } else {
+            up = rt_image_upload(d, &r->tex[i], t->rgba, (size_t)t->width * (size_t)t->height * 4, e);
+        }
+        if (!up)
             return false;
         VkFilter filt = t->linear ? VK_FILTER_LINEAR : VK_FILTER_NEAREST;
         VkSamplerCreateInfo ci = {

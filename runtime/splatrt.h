@@ -127,6 +127,11 @@ void rt_image_destroy(rt_device *d, rt_image *img);
  * SHADER_READ_ONLY_OPTIMAL.  Blocks until done (load time only). */
 bool rt_image_upload(rt_device *d, rt_image *img, const void *data,
                      size_t bytes, rt_error *e);
+/* Upload every mip level of a one-layer RGBA8 image from `levels[m]`
+ * (tightly packed, max(1, w >> m) x max(1, h >> m)) instead of blitting:
+ * for mips that must not be box-filtered.  Leaves SHADER_READ_ONLY. */
+bool rt_image_upload_levels(rt_device *d, rt_image *img, const uint8_t *const *levels,
+                            rt_error *e);
 /* One-time command buffer helpers (load time only). */
 bool rt_oneshot_begin(rt_device *d, VkCommandBuffer *cb, rt_error *e);
 bool rt_oneshot_end(rt_device *d, VkCommandBuffer cb, rt_error *e);
@@ -197,6 +202,10 @@ typedef struct rt_pack_texture {
     VkSamplerAddressMode wrap;
     uint8_t *rgba;        /* decoded RGBA8                                 */
     int      width, height;
+    uint8_t **mips;       /* stored levels 1..nmips (manifest "mips", files
+                             "X.mipK.png"; level k is max(1, w >> k) x
+                             max(1, h >> k)); NULL: the runtime blits them */
+    int      nmips;
 } rt_pack_texture;
 
 typedef struct rt_pack_combo {
