@@ -6,7 +6,7 @@ set -eu
 BUILD=${1:-build}
 SPLATC="$BUILD/compiler/splatc"
 VIEW="$BUILD/runtime/splatview"
-CAMERA=${SPLAT_DEMO_CAMERA:-blanca}
+CAMERA=${SPLAT_DEMO_CAMERA:-valley}
 SIZE=${SPLAT_DEMO_SIZE:-1280x720}
 for tool in "$SPLATC" "$VIEW"; do
     if [ ! -x "$tool" ]; then
@@ -23,4 +23,4 @@ JOBS=$(nproc 2>/dev/null || echo 2)
 echo
 echo "pictures:  out/demo.png  out/demo_combos.png  (camera preset '$CAMERA')"
 echo "viewer:    $VIEW out/colorado.pack --camera-preset $CAMERA"
-echo "other presets: overview blanca spanish_peaks pivots trinidad (SPLAT_DEMO_CAMERA=...)"
+echo "other presets: valley overview blanca spanish_peaks pivots trinidad (SPLAT_DEMO_CAMERA=...)"
