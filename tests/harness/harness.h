@@ -114,7 +114,8 @@ bool harness_eval_ir(harness *h, const harness_ir_desc *d, float *out,
 /* The compute shader harness_eval_ir runs (malloc'd).  Its prelude
  * defines the ABI prelude's input functions (splat_height(),
  * splat_slope(), splat_normal(), splat_position(), splat_uv(),
- * splat_view_distance(), splat_destruction()) over the per-point record
+ * splat_view_distance(), splat_view_direction(), splat_destruction()) over
+ * the per-point record
  * in the input buffer; params and painted values read from the record
  * too.  NULL with *err on failure. */
 char *harness_ir_shader(const harness_ir_desc *d, char **err);
