@@ -45,10 +45,12 @@ static const char usage_text[] =
     "                                     CPU reference value (double precision);\n"
     "                                     keys: height=H slope=S normal=X,Y,Z position=X,Z\n"
     "                                     uv=U,V distance=D destruction=D painted.NAME=V\n"
-    "                                     PARAM=V...  (unset: 0, normal 0,1,0, defaults)\n"
+    "                                     direction=X,Y,Z (unit, to the camera) PARAM=V...\n"
+    "                                     (unset: 0, normal and direction 0,1,0, defaults)\n"
     "        --interval                   the same keys take LO:HI ranges; prints sound\n"
     "                                     bounds (unset: slope 0:1, normal -1:1,0:1,-1:1,\n"
-    "                                     uv 0:1, distance 0:inf, others unbounded)\n"
+    "                                     uv 0:1, distance 0:inf, others unbounded;\n"
+    "                                     direction is always -1:1)\n"
     "  build SCENE.sg -o PACKDIR ...      compile a scene into a shader pack (build --help)\n"
     "  texgen --out DIR ...               write the example textures (texgen --help)\n"
     "options:\n"
@@ -609,6 +611,7 @@ static int set_inputs(const ir *ir, const char *material, const at_item *items, 
     for (int i = 0; i < ir->npainted; i++)
         in->ipainted[i] = unit;
     bool have_height = false, have_pos = false;
+    ir_iv direction_any[3];   /* view.direction's bounds are always [-1, 1] */
     for (int i = 0; i < n; i++) {
         const at_item *it = &items[i];
         const char *k = it->key;
@@ -639,6 +642,9 @@ static int set_inputs(const ir *ir, const char *material, const at_item *items, 
             want = 1; iv[0] = &ie->view_distance; dv[0] = &e->view_distance;
         } else if (!strcmp(k, "destruction")) {
             want = 1; iv[0] = &ie->destruction; dv[0] = &e->destruction;
+        } else if (!strcmp(k, "direction")) {
+            want = 3;
+            for (int c = 0; c < 3; c++) { iv[c] = &direction_any[c]; dv[c] = &e->view_direction[c]; }
         } else if (!strncmp(k, "painted.", 8)) {
             for (int j = 0; j < ir->npainted; j++)
                 if (!strcmp(ir->painted[j].name, k + 8)) {
