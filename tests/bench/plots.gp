@@ -9,6 +9,7 @@
 set terminal pngcairo size 900,600 noenhanced font ",10"
 set datafile separator whitespace
 set grid
+set key outside right top
 
 do for [f in system("ls knob_*.dat 2>/dev/null")] {
     base = f[1:strlen(f) - 4]

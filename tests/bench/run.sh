@@ -2,7 +2,8 @@
 # run.sh — the speed–accuracy benchmark of issue 7 (`make bench`,
 # `make bench-smoke`, CTest bench.smoke).
 #
-#   sh tests/bench/run.sh BUILD_DIR [--smoke] [--out DIR] [--quick]
+#   sh tests/bench/run.sh BUILD_DIR [--smoke] [--quick] [--out DIR]
+#                         [--frames N] [--keep-work]
 #
 # Writes into DIR (default out/bench): compile.csv (per scene: phases of
 # `splatc build --stats`, cold and warm, peak memory), scale_hf.csv
@@ -19,6 +20,9 @@
 # loader up (VK_DRIVER_FILES / VK_ICD_FILENAMES, LD_LIBRARY_PATH).
 # --smoke: examples/minimal only, tiny frames, a minute at most.
 # --quick: the full set of comparisons with fewer frames (a fast GPU run).
+# --frames N: frames per camera path (medians over them; default 4, smoke 2).
+# --keep-work: keep OUT/work (packs, scene mirrors, the last frame of every
+# variant as RGBA32F); by default the images are deleted at the end.
 set -eu
 
 if [ $# -lt 1 ]; then
@@ -29,11 +33,15 @@ B=$(cd "$1" && pwd)
 shift
 MODE=full
 OUT=out/bench
+NFRAMES=""
+KEEP=no
 while [ $# -gt 0 ]; do
     case $1 in
     --smoke) MODE=smoke ;;
     --quick) MODE=quick ;;
     --out) OUT=$2; shift ;;
+    --frames) NFRAMES=$2; shift ;;
+    --keep-work) KEEP=yes ;;
     *) echo "run.sh: unknown option '$1'" >&2; exit 2 ;;
     esac
     shift
@@ -62,6 +70,7 @@ smoke) FRAMES=2; WARM=1; SIZES=320x180; PATHS=ground; SCENES=minimal ;;
 quick) FRAMES=3; WARM=1; SIZES="1280x720 1920x1080"; PATHS="ground topdown grazing"; SCENES="minimal colorado" ;;
 *)     FRAMES=4; WARM=1; SIZES="1280x720 1920x1080"; PATHS="ground topdown grazing"; SCENES="minimal colorado" ;;
 esac
+[ -n "$NFRAMES" ] && FRAMES=$NFRAMES
 
 # ---- mirrors: a scene variant lives in ROOT/examples/NAME with the
 # example's files linked, ROOT/nodes linked and ROOT/graphs a folder of
@@ -205,14 +214,22 @@ comp_pack() {  # SCENE COMPOSITOR -> pack dir
     echo "$W/$1_$2"
 }
 # graph knob variants: one graph file with a node type replaced
-knob_pack() {  # SCENE LABEL GRAPH FROM TO -> pack dir
+KNOB_BUILD_ARGS=""
+knob_pack() {  # SCENE LABEL GRAPH FROM TO [SCENE-SED] -> pack dir
     R=$W/mirror-knob-$2
     mirror "$R"
-    rm -f "$R/graphs/$3.sg"
-    sed "s/: *$4 /: $5 /" "graphs/$3.sg" > "$R/graphs/$3.sg"
+    if [ -n "$3" ]; then
+        rm -f "$R/graphs/$3.sg"
+        sed "s/: *$4 /: $5 /" "graphs/$3.sg" > "$R/graphs/$3.sg"
+    fi
     d=$(mirror_scene "$R" "$1" "$1")
-    cp "examples/$1/scene.sg" "$d/scene.sg"
-    "$SPLATC" build "$d/scene.sg" -o "$W/$1_knob_$2" -j 2 --cache "$W/cache-$1" >/dev/null
+    sed -e "${6:-}" "examples/$1/scene.sg" > "$d/scene.sg"
+    # -I first: imports search -I folders before the current folder (REPO)
+    "$SPLATC" build "$d/scene.sg" -o "$W/$1_knob_$2" -j 2 --cache "$W/cache-$1" -I "$R" $KNOB_BUILD_ARGS >/dev/null
+    # the variant must differ from the scene's own pack, or the knob is void
+    if cmp -s "$W/$1_knob_$2/manifest.json" "$W/$1/manifest.json"; then
+        echo "run.sh: warning: knob $2 did not change $1's pack" >&2
+    fi
     echo "$W/$1_knob_$2"
 }
 
@@ -225,7 +242,7 @@ render() {  # GROUP SCENE PATH SIZE VARIANT... (first variant = reference)
     args=""
     for v in "$@"; do args="$args --variant $v"; done
     preset=""
-    [ "$scene" = colorado ] && [ "$path" = ground ] && preset="--start-preset trinidad"
+    [ "$scene" = colorado ] && [ "$path" = ground ] && preset="--start-preset ${PRESET:-trinidad}"
     [ "$scene" = billingsley ] && [ "$path" = ground ] && preset="--start-preset ground"
     mkdir -p "$W/img/$group-$scene-$path-$size"
     # shellcheck disable=SC2086
@@ -263,15 +280,15 @@ else
     st=$(comp_pack billingsley stochastic_select)
     render compositor billingsley ground 1280x720 ref=multipass max_height=composite \
         "stochastic=composite,pack=$st"
-    # (d) knobs: arithmetic precision, normal filter, LOD threshold
-    for p in ground topdown; do
-        render knob_precision colorado "$p" 1280x720 fp32=composite fp16=fp16
-        render knob_normal colorado "$p" 1280x720 cross=composite sobel=sobel
-        render knob_lod colorado "$p" 1280x720 lod1=composite,lod=1 lod2=composite,lod=2 \
-            lod3=composite,lod=3 lod6=composite,lod=6 lod12=composite,lod=12
-    done
+    # (d) knobs: arithmetic precision, normal filter, LOD threshold (the
+    # ground path; LOD against the finest threshold measured)
+    render knob_precision colorado ground 1280x720 fp32=composite fp16=fp16
+    render knob_normal colorado ground 1280x720 cross=composite sobel=sobel
+    render knob_lod colorado ground 1280x720 lod1=composite,lod=1 lod2=composite,lod=2 \
+        lod3=composite,lod=3 lod6=composite,lod=6 lod12=composite,lod=12
     # fBm octaves (forest_floor: texture fBm 2/4/6/8) and texture fBm vs ALU
-    # gradient fBm at 4 octaves, against 8 texture octaves
+    # gradient fBm at 4 octaves, against 8 texture octaves; mud's ALU
+    # gradient fBm 2/4/8 against 8
     f2=$(knob_pack colorado tfbm2 forest_floor texture_fbm4 texture_fbm2)
     f6=$(knob_pack colorado tfbm6 forest_floor texture_fbm4 texture_fbm6)
     f8=$(knob_pack colorado tfbm8 forest_floor texture_fbm4 texture_fbm8)
@@ -282,9 +299,24 @@ else
         render knob_fbm colorado "$p" 1280x720 "tfbm8=composite,pack=$f8" \
             "tfbm6=composite,pack=$f6" tfbm4=composite "tfbm2=composite,pack=$f2" \
             "alu_gfbm4=composite,pack=$ga"
-        render knob_alu_octaves colorado "$p" 1280x720 "mud_gfbm8=composite,pack=$m8" \
-            "mud_gfbm4=composite,pack=$m4" mud_gfbm2=composite
     done
+    render knob_alu_octaves colorado ground 1280x720 "mud_gfbm8=composite,pack=$m8" \
+        "mud_gfbm4=composite,pack=$m4" mud_gfbm2=composite
+    # steep parallax step counts (rock: 8 steps) on a ground path at Blanca
+    p4=$(knob_pack colorado par4 rock parallax8 parallax4)
+    p16=$(knob_pack colorado par16 rock parallax8 parallax16)
+    PRESET=blanca render knob_parallax colorado ground 1280x720 "parallax16=composite,pack=$p16" \
+        parallax8=composite "parallax4=composite,pack=$p4"
+    # painted masks: dense raster (the reference) vs sparse R8, BC4 (the
+    # default) and BC4 with every mask limited to quad-tree level 2
+    KNOB_BUILD_ARGS="--painted dense"
+    pd=$(knob_pack colorado dense "" "" "")
+    KNOB_BUILD_ARGS="--painted r8"
+    pr=$(knob_pack colorado r8 "" "" "")
+    KNOB_BUILD_ARGS=""
+    pl=$(knob_pack colorado lvl2 "" "" "" 's|^\([ \t]*painted [a-z_]* *= *"[^"]*"\)[ \t]*$|\1 { max_level = 2 }|')
+    render knob_painted colorado ground 1280x720 "dense=composite,pack=$pd" \
+        "sparse_r8=composite,pack=$pr" sparse_bc4=composite "bc4_level2=composite,pack=$pl"
 fi
 { echo "group,$(sed -n 1p "$W/render.txt")"; cat "$CSV.body"; } > "$CSV"
 rm -f "$CSV.body"
@@ -329,5 +361,6 @@ if command -v gnuplot >/dev/null 2>&1; then
 else
     log "gnuplot not installed: plots skipped"
 fi
+[ "$KEEP" = yes ] || rm -rf "$W/img"
 log "done: $OUT/summary.md"
 cat "$OUT/summary.md"

@@ -106,7 +106,6 @@ if [ -s "$O/sparse.txt" ]; then
 fi
 echo "## Not measured"
 echo
-echo "- Steep parallax step counts: no parallax node exists yet (graphs/rock.sg notes it)."
-echo "- Sparse-mask R8 vs BC4 vs reduced levels in full renders: packs still carry dense painted.r8, so the knob is measured on the sparse sampler alone (gpu_sparse figures above), not in scene renders or time."
+echo "- Painted masks and parallax are measured in scene renders (groups knob_painted, knob_parallax) only in full/quick mode; smoke mode measures neither."
 echo "- Analytic normals on an analytic heightfield: only the cross vs Sobel difference is measured."
 echo "- GPU memory per variant: rss_delta_mb in render.csv is the host RSS growth when the variant's renderer is made (lavapipe's device memory is host memory; on a discrete GPU it misses device allocations)."

@@ -386,7 +386,10 @@ static int cmd_gen(const char *dir)
             fprintf(stderr, "extreme: cannot write %s\n", path);
             return 1;
         }
-        uint8_t *m = calloc((size_t)g->w * (size_t)g->h, 1);
+        size_t npx = (size_t)(unsigned)g->w * (unsigned)g->h;
+        uint8_t *m = calloc(npx, 1);
+        if (!m)
+            return 1;
         for (int i = 0; i < g->w * g->h; i++)
             m[i] = g->mask ? (!strcmp(g->mask, "one") ? 255 : 0) : (i % g->w < g->w / 2 ? 255 : 0);
         snprintf(path, sizeof path, "%s/%s/paint.png", dir, g->name);
