@@ -15,7 +15,7 @@ if(TARGET splatrt AND TARGET splatview AND TARGET splatc_cli AND EXISTS ${EXTREM
   add_test(NAME extreme.normals COMMAND extreme normals WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
   add_test(NAME extreme.renders
     COMMAND sh ${CMAKE_CURRENT_LIST_DIR}/run.sh $<TARGET_FILE:extreme>
-            $<TARGET_FILE:splatc_cli> $<TARGET_FILE:splatview> ${CMAKE_BINARY_DIR}/tests/extreme
+            $<TARGET_FILE:splatc_cli> $<TARGET_FILE:splatview> ${CMAKE_BINARY_DIR}/tests/extreme_out
     WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
   set_tests_properties(extreme.nodes extreme.normals extreme.renders PROPERTIES
     LABELS extreme TIMEOUT 600 ENVIRONMENT SPLAT_VALIDATE=1)
