@@ -95,6 +95,11 @@ const char SPLAT_GLSL_PRELUDE[] =
     "#else\n"
     "layout(location = 0) out vec4 o_color;\n"
     "#endif\n"
+    /* the view: fixed at pipeline creation, or read per frame (abi.h) */
+    "layout(constant_id = 0) const uint splat_spec_view = 0xffffffffu;\n"
+    "uint splat_view() {\n"
+    "    return splat_spec_view == 0xffffffffu ? u_frame.view.x : splat_spec_view;\n"
+    "}\n"
     /* Listing 1 (seed 000), with the texel aspect in metres. */
     "vec3 splat_normal_at(vec2 uv) {\n"
     "    vec2 t = u_frame.texel.zw;\n"
@@ -154,7 +159,7 @@ const char SPLAT_GLSL_PRELUDE[] =
     "#else\n"
     "    vec3 n = normalize(normal);\n"
     "    vec3 c;\n"
-    "    switch (u_frame.view.x) {\n"
+    "    switch (splat_view()) {\n"
     "    case 1u: c = splat_combo_color(u_push.info.y); break;\n"
     "    case 2u: c = splat_combo_color(u_push.info.x + 1000u); break;\n"
     "    case 3u: c = n * 0.5 + 0.5; break;\n"

@@ -66,7 +66,19 @@ enum {
     SPLAT_GRID = 33,           /* vertices per patch side */
 };
 
-/* Debug views (splat_frame.view.x). */
+/* Specialization constant of every fragment shader that includes the
+ * prelude: constant_id SPLAT_SPEC_VIEW, a uint, default
+ * SPLAT_SPEC_VIEW_DYNAMIC.  splat_view() returns it, or u_frame.view.x when
+ * it is left at the default.  A pipeline specialised to SPLAT_VIEW_FINAL
+ * carries no debug-view code at all (lavapipe executes both sides of every
+ * branch, so the dead MASK-view block alone cost ~40% of a frame); one left
+ * dynamic serves every debug view. */
+enum {
+    SPLAT_SPEC_VIEW = 0,
+};
+#define SPLAT_SPEC_VIEW_DYNAMIC 0xffffffffu
+
+/* Debug views (splat_view(): splat_frame.view.x or the spec constant). */
 typedef enum splat_view {
     SPLAT_VIEW_FINAL = 0,  /* lit colour                                 */
     SPLAT_VIEW_COMBOS,     /* colour per combination id (seed 000 Fig. 14) */
@@ -116,6 +128,7 @@ typedef struct splat_push {
  *     float splat_height_at(vec2 uv)  vec3 splat_normal_at(vec2 uv)
  *     void splat_finish(vec3 albedo, vec3 normal, float roughness,
  *                       float height, float coverage)
+ *     uint splat_view()   the debug view (SPLAT_SPEC_VIEW above)
  *   splat_finish writes the outputs for the current view (single pass) or
  *   the three blend targets (SPLAT_MULTIPASS).
  * SPLAT_GLSL_LIGHTING: vec3 splat_light(vec3 albedo, vec3 n, float rough,

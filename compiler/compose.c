@@ -665,7 +665,7 @@ static void emit_subtree(emit *em, const ir_ref *roots, int nroots, int depth)
 static void emit_mask_view(emit *em)
 {
     ir_buf *o = em->out;
-    ir_buf_printf(o, "    if (u_frame.view.x == %uu) {\n", (unsigned)SPLAT_VIEW_MASK);
+    ir_buf_printf(o, "    if (splat_view() == %uu) {\n", (unsigned)SPLAT_VIEW_MASK);
     ir_buf_printf(o, "        float mv = 0.0;\n");
     ir_buf_printf(o, "        switch (u_frame.view.y) {\n");
     for (int j = 0; j < em->c->nlayers; j++) {

@@ -226,13 +226,20 @@ typedef enum kind {
 
 static bool make_pipeline(rt_device *d, rt_pipelines *pl, VkShaderModule vs,
                           VkShaderModule fs, VkRenderPass pass, kind k,
-                          bool wire, VkPipeline *out, rt_error *e)
+                          unsigned variant, VkPipeline *out, rt_error *e)
 {
+    /* Not RT_VARIANT_DEBUG: the fragment shader specialised to the final
+     * view (abi.h SPLAT_SPEC_VIEW), so the driver drops the debug views'
+     * code.  Shaders without the constant ignore it. */
+    static const uint32_t final_view = SPLAT_VIEW_FINAL;
+    static const VkSpecializationMapEntry view_entry = { SPLAT_SPEC_VIEW, 0, sizeof final_view };
+    static const VkSpecializationInfo final_spec = { 1, &view_entry, sizeof final_view, &final_view };
     VkPipelineShaderStageCreateInfo stages[2] = {
         { .sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO,
           .stage = VK_SHADER_STAGE_VERTEX_BIT, .module = vs, .pName = "main" },
         { .sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO,
-          .stage = VK_SHADER_STAGE_FRAGMENT_BIT, .module = fs, .pName = "main" },
+          .stage = VK_SHADER_STAGE_FRAGMENT_BIT, .module = fs, .pName = "main",
+          .pSpecializationInfo = (variant & RT_VARIANT_DEBUG) ? NULL : &final_spec },
     };
     VkVertexInputBindingDescription vb = { 0, 8, VK_VERTEX_INPUT_RATE_VERTEX };
     VkVertexInputAttributeDescription va = { 0, 0, VK_FORMAT_R32G32_SFLOAT, 0 };
@@ -254,9 +261,12 @@ static bool make_pipeline(rt_device *d, rt_pipelines *pl, VkShaderModule vs,
     };
     VkPipelineRasterizationStateCreateInfo rs = {
         .sType = VK_STRUCTURE_TYPE_PIPELINE_RASTERIZATION_STATE_CREATE_INFO,
-        .polygonMode = wire ? VK_POLYGON_MODE_LINE : VK_POLYGON_MODE_FILL,
-        .cullMode = VK_CULL_MODE_NONE,   /* terrain seen from below shows too */
-        .frontFace = VK_FRONT_FACE_COUNTER_CLOCKWISE,
+        .polygonMode = (variant & RT_VARIANT_WIRE) ? VK_POLYGON_MODE_LINE : VK_POLYGON_MODE_FILL,
+        /* Without RT_VARIANT_CULL terrain seen from below shows too.  The
+         * grid's triangles are clockwise on screen seen from above (the
+         * projection flips y). */
+        .cullMode = (variant & RT_VARIANT_CULL) ? VK_CULL_MODE_BACK_BIT : VK_CULL_MODE_NONE,
+        .frontFace = VK_FRONT_FACE_CLOCKWISE,
         .lineWidth = 1.0f,
     };
     VkPipelineMultisampleStateCreateInfo ms = {
@@ -316,25 +326,53 @@ static bool make_pipeline(rt_device *d, rt_pipelines *pl, VkShaderModule vs,
 
 /* A pipeline from a pack module over the shared vertex shader. */
 static bool pack_pipeline(rt_device *d, rt_pipelines *pl, const rt_spirv *fs,
-                          VkRenderPass pass, kind k, bool wire, VkPipeline *out,
+                          VkRenderPass pass, kind k, unsigned variant, VkPipeline *out,
                           rt_error *e)
 {
     VkShaderModule m;
     if (!make_module(d, fs->words, fs->nwords, &m, e))
         return false;
-    bool ok = make_pipeline(d, pl, pl->vertex, m, pass, k, wire, out, e);
+    bool ok = make_pipeline(d, pl, pl->vertex, m, pass, k, variant, out, e);
     vkDestroyShaderModule(d->dev, m, NULL);
     return ok;
 }
 
 bool rt_pipelines_combo(rt_device *d, const rt_pack *p, const rt_passes *rp,
-                        rt_pipelines *pl, int id, bool wire, VkPipeline *out,
+                        rt_pipelines *pl, int id, unsigned variant, VkPipeline *out,
                         rt_error *e)
 {
-    if (wire && !d->wireframe)
+    if ((variant & RT_VARIANT_WIRE) && !d->wireframe)
         return rt_fail(e, RT_E_NO_FORMAT, "draw wireframe (no fillModeNonSolid)");
-    VkPipeline *slot = wire ? &pl->combo_wire[id] : &pl->combo[id];
-    if (!*slot && !pack_pipeline(d, pl, &p->combos[id].spirv, rp->main, K_OPAQUE, wire, slot, e))
+    VkPipeline *slot = &pl->combo[(size_t)id * RT_VARIANTS + (variant % RT_VARIANTS)];
+    if (!*slot && !pack_pipeline(d, pl, &p->combos[id].spirv, rp->main, K_OPAQUE, variant, slot, e))
+        return false;
+    *out = *slot;
+    return true;
+}
+
+bool rt_pipelines_uber(rt_device *d, const rt_pack *p, const rt_passes *rp,
+                       rt_pipelines *pl, unsigned variant, VkPipeline *out,
+                       rt_error *e)
+{
+    if ((variant & RT_VARIANT_WIRE) && !d->wireframe)
+        return rt_fail(e, RT_E_NO_FORMAT, "draw wireframe (no fillModeNonSolid)");
+    if (!p->uber.words)
+        return rt_fail(e, RT_E_PACK_FIELD, p->dir, "the pack has no uber shader");
+    VkPipeline *slot = &pl->uber[variant % RT_VARIANTS];
+    if (!*slot && !pack_pipeline(d, pl, &p->uber, rp->main, K_OPAQUE, variant, slot, e))
+        return false;
+    *out = *slot;
+    return true;
+}
+
+bool rt_pipelines_ref(rt_device *d, const rt_pack *p, const rt_passes *rp,
+                      rt_pipelines *pl, int m, bool cull, VkPipeline *out,
+                      rt_error *e)
+{
+    VkPipeline *slot = &pl->ref[2 * m + cull];
+    if (!*slot && !pack_pipeline(d, pl, &p->materials[m].reference, rp->multi,
+                                 m == 0 ? K_BASE : K_BLEND, cull ? RT_VARIANT_CULL : 0,
+                                 slot, e))
         return false;
     *out = *slot;
     return true;
@@ -342,15 +380,11 @@ bool rt_pipelines_combo(rt_device *d, const rt_pack *p, const rt_passes *rp,
 
 static void destroy_combos(rt_device *d, rt_pipelines *pl)
 {
-    for (int i = 0; i < pl->ncombos; i++) {
-        if (pl->combo && pl->combo[i])
+    for (size_t i = 0; pl->combo && i < (size_t)pl->ncombos * RT_VARIANTS; i++)
+        if (pl->combo[i])
             vkDestroyPipeline(d->dev, pl->combo[i], NULL);
-        if (pl->combo_wire && pl->combo_wire[i])
-            vkDestroyPipeline(d->dev, pl->combo_wire[i], NULL);
-    }
     free(pl->combo);
-    free(pl->combo_wire);
-    pl->combo = pl->combo_wire = NULL;
+    pl->combo = NULL;
     pl->ncombos = 0;
 }
 
@@ -358,9 +392,8 @@ bool rt_pipelines_reset_combos(rt_device *d, const rt_pack *p, rt_pipelines *pl,
                                rt_error *e)
 {
     destroy_combos(d, pl);
-    pl->combo = calloc((size_t)p->ncombos, sizeof *pl->combo);
-    pl->combo_wire = calloc((size_t)p->ncombos, sizeof *pl->combo_wire);
-    if (!pl->combo || !pl->combo_wire)
+    pl->combo = calloc((size_t)p->ncombos * RT_VARIANTS + 1, sizeof *pl->combo);
+    if (!pl->combo)
         return rt_fail(e, RT_E_VULKAN, "pipelines", "out of memory");
     pl->ncombos = p->ncombos;
     return true;
@@ -380,7 +413,7 @@ static bool resolve_pipeline(rt_device *d, rt_pipelines *pl, VkRenderPass pass, 
     free(src);
     VkShaderModule vm = VK_NULL_HANDLE, fm = VK_NULL_HANDLE;
     ok = ok && make_module(d, vw, vn, &vm, e) && make_module(d, fw, fn, &fm, e) &&
-         make_pipeline(d, pl, vm, fm, pass, K_RESOLVE, false, &pl->resolve, e);
+         make_pipeline(d, pl, vm, fm, pass, K_RESOLVE, RT_VARIANT_DEBUG, &pl->resolve, e);
     if (vm)
         vkDestroyShaderModule(d->dev, vm, NULL);
     if (fm)
@@ -408,23 +441,15 @@ bool rt_pipelines_create(rt_device *d, const rt_pack *p, const rt_passes *rp,
                          i, p->materials[i].name);
                 return rt_fail(e, RT_E_PACK_FIELD, p->dir, what);
             }
-        pl->ref = calloc((size_t)p->nmaterials + 1, sizeof *pl->ref);
+        pl->ref = calloc(2 * (size_t)p->nmaterials + 1, sizeof *pl->ref);
         if (!pl->ref)
             return rt_fail(e, RT_E_VULKAN, "pipelines", "out of memory");
         pl->nref = p->nmaterials;
-        for (int i = 0; i < p->nmaterials; i++)
-            if (!pack_pipeline(d, pl, &p->materials[i].reference, rp->multi,
-                               i == 0 ? K_BASE : K_BLEND, false, &pl->ref[i], e))
-                return false;
         if (!resolve_pipeline(d, pl, rp->resolve, e))
             return false;
     }
-    if (ref == RT_REF_UBER) {
-        if (!p->uber.words)
-            return rt_fail(e, RT_E_PACK_FIELD, p->dir, "the pack has no uber shader");
-        if (!pack_pipeline(d, pl, &p->uber, rp->main, K_OPAQUE, false, &pl->uber, e))
-            return false;
-    }
+    if (ref == RT_REF_UBER && !p->uber.words)
+        return rt_fail(e, RT_E_PACK_FIELD, p->dir, "the pack has no uber shader");
     return true;
 }
 
@@ -437,11 +462,12 @@ void rt_pipelines_destroy(rt_device *d, rt_pipelines *pl)
         vkDestroyPipelineCache(d->dev, pl->cache, NULL);
     }
     destroy_combos(d, pl);
-    for (int i = 0; i < pl->nref; i++)
+    for (int i = 0; i < 2 * pl->nref; i++)
         if (pl->ref[i])
             vkDestroyPipeline(d->dev, pl->ref[i], NULL);
-    if (pl->uber)
-        vkDestroyPipeline(d->dev, pl->uber, NULL);
+    for (int i = 0; i < RT_VARIANTS; i++)
+        if (pl->uber[i])
+            vkDestroyPipeline(d->dev, pl->uber[i], NULL);
     if (pl->resolve)
         vkDestroyPipeline(d->dev, pl->resolve, NULL);
     if (pl->vertex)

@@ -363,6 +363,20 @@ typedef enum rt_reference {
     RT_REF_UBER,          /* every patch with the über-shader               */
 } rt_reference;
 
+/* Variants of a pipeline, as bits; each is made on first use. */
+enum {
+    RT_VARIANT_WIRE  = 1,  /* line fill                                     */
+    RT_VARIANT_DEBUG = 2,  /* any debug view, read from u_frame each frame;
+                              without it the fragment shader is specialised
+                              to SPLAT_VIEW_FINAL (abi.h SPLAT_SPEC_VIEW) and
+                              carries no debug-view code                    */
+    RT_VARIANT_CULL  = 4,  /* back faces culled: only while the camera is
+                              above the terrain (render.c), where it hides
+                              nothing visible (a few ridge pixels change
+                              where depth rounding let a back face win)     */
+    RT_VARIANTS      = 8,
+};
+
 typedef struct rt_pipelines {
     VkDescriptorSetLayout set_terrain;   /* set 0 (abi.h)                    */
     VkDescriptorSetLayout set_material;  /* set 1: params + textures         */
@@ -372,12 +386,13 @@ typedef struct rt_pipelines {
     VkPipelineCache       cache;
     char                 *cache_path;    /* NULL: not saved                  */
     VkShaderModule        vertex;
-    VkPipeline           *combo;         /* one per combination              */
-    VkPipeline           *combo_wire;    /* line fill, made on first use     */
+    VkPipeline           *combo;         /* RT_VARIANTS per combination      */
     int                   ncombos;
-    VkPipeline           *ref;           /* multi-pass: one per material     */
+    VkPipeline           *ref;           /* multi-pass: 2 per material
+                                            (RT_VARIANT_CULL or not)         */
     int                   nref;
-    VkPipeline            uber, resolve;
+    VkPipeline            uber[RT_VARIANTS];
+    VkPipeline            resolve;
 } rt_pipelines;
 
 /* Render passes the pipelines are made for (render.c creates them). */
@@ -387,19 +402,28 @@ typedef struct rt_passes {
     VkRenderPass resolve;    /* RGBA32F colour                               */
 } rt_passes;
 
-/* Layouts, the pipeline cache and the pipelines `ref` needs: the
- * per-material passes and the resolve pass for RT_REF_MULTIPASS, the
- * über-shader for RT_REF_UBER.  Combination pipelines are made on first
- * use (rt_pipelines_combo): a view of colorado needs 20 of its 166, and
- * lavapipe compiles each in tens of milliseconds. */
+/* Layouts, the pipeline cache and the resolve pass for RT_REF_MULTIPASS;
+ * checks that the shaders `ref` needs are in the pack.  Combination,
+ * über-shader and reference pipelines are made on first use
+ * (rt_pipelines_combo/uber/ref): a view of colorado needs 20 of its 166,
+ * and lavapipe compiles each in tens of milliseconds or more. */
 bool rt_pipelines_create(rt_device *d, const rt_pack *p, const rt_passes *rp,
                          rt_reference ref, const char *cache_path,
                          int ntextures, rt_pipelines *pl, rt_error *e);
-/* The pipeline of combination `id` (filled or wireframe), made now if it
- * does not exist yet. */
+/* The pipeline of combination `id` in `variant` (RT_VARIANT_* bits), made
+ * now if it does not exist yet. */
 bool rt_pipelines_combo(rt_device *d, const rt_pack *p, const rt_passes *rp,
-                        rt_pipelines *pl, int id, bool wire, VkPipeline *out,
+                        rt_pipelines *pl, int id, unsigned variant, VkPipeline *out,
                         rt_error *e);
+/* The über-shader's pipeline in `variant`, made on first use. */
+bool rt_pipelines_uber(rt_device *d, const rt_pack *p, const rt_passes *rp,
+                       rt_pipelines *pl, unsigned variant, VkPipeline *out,
+                       rt_error *e);
+/* The multi-pass reference pass of scene material `m` (blended above
+ * material 0), back faces culled or not, made on first use. */
+bool rt_pipelines_ref(rt_device *d, const rt_pack *p, const rt_passes *rp,
+                      rt_pipelines *pl, int m, bool cull, VkPipeline *out,
+                      rt_error *e);
 /* Drop every combination pipeline (hot reload: the next frames make those
  * of the new pack); the array is resized to p->ncombos. */
 bool rt_pipelines_reset_combos(rt_device *d, const rt_pack *p, rt_pipelines *pl,
@@ -423,12 +447,14 @@ typedef struct rt_render_desc {
     float        clear[4];          /* background (linear); default sky       */
     const char  *pipeline_cache;    /* file; NULL: $XDG_CACHE_HOME/splatc/…   */
     bool         no_stitch;         /* tests: draw every patch unstitched     */
+    bool         no_cull;           /* tests: never cull back faces           */
     double       lod_pixels;        /* screen error per grid step; default 3  */
     int          destruction_pool;  /* destruction tiles; 0: RT_DESTR_POOL_DEFAULT */
 } rt_render_desc;
 
 typedef struct rt_frame_stats {
     int    patches, culled, pipelines, combos_in_view;
+    bool   backfaces_culled;  /* the camera was above the terrain            */
     double gpu_ms;            /* timestamps; < 0 if unsupported              */
     double select_ms;         /* CPU quadtree selection + culling            */
     double cpu_ms;            /* whole CPU side of the frame                 */

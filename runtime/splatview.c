@@ -26,6 +26,7 @@ static void usage(FILE *f)
         "  --scene FILE              scene.sg to watch for hot reload (viewer)\n"
         "  --script S                viewer script: \"frames=30;screenshot=out.png;quit\"\n"
         "  --no-stitch               draw patches without stitching (tests)\n"
+        "  --no-cull                 never cull back faces (tests)\n"
         "  --crater x,z,r[,depth]    a crater before the frames (metres; repeatable;\n"
         "                            depth defaults to r/4)\n"
         "  --crater-at-view R        a crater of radius R where the view's centre ray\n"
@@ -69,7 +70,7 @@ static void summary(double *v, int n, double *med, double *lo, double *hi)
 
 typedef struct opts {
     const char *pack, *out, *float_out, *preset, *view, *cache, *scene, *script;
-    bool headless, stats, have_camera, have_look, no_stitch;
+    bool headless, stats, have_camera, have_look, no_stitch, no_cull;
     int width, height, frames;
     double camera[3], look[3], lod_pixels;
     float clear[4];
@@ -124,6 +125,8 @@ static int parse_args(int argc, char **argv, opts *o)
             o->stats = true;
         } else if (!strcmp(a, "--no-stitch")) {
             o->no_stitch = true;
+        } else if (!strcmp(a, "--no-cull")) {
+            o->no_cull = true;
         } else if (!strcmp(a, "-o")) {
             NEED(); o->out = v;
         } else if (!strcmp(a, "--float-out")) {
@@ -367,7 +370,8 @@ static int headless(const opts *o)
     have_dev = true;
     rt_render_desc rd = {
         .width = o->width, .height = o->height, .reference = o->ref,
-        .pipeline_cache = o->cache, .no_stitch = o->no_stitch, .lod_pixels = o->lod_pixels,
+        .pipeline_cache = o->cache, .no_stitch = o->no_stitch,
+        .no_cull = o->no_cull, .lod_pixels = o->lod_pixels,
         .destruction_pool = o->destruction_pool,
     };
     memcpy(rd.clear, o->clear, sizeof rd.clear);
@@ -412,6 +416,7 @@ static int headless(const opts *o)
                o->ref == RT_REF_MULTIPASS ? "multipass" : o->ref == RT_REF_UBER ? "uber" : "none",
                o->frames);
         printf("patches drawn: %d  culled: %d\n", st.patches, st.culled);
+        printf("back faces culled: %s\n", st.backfaces_culled ? "yes" : "no");
         printf("pipelines bound: %d\n", st.pipelines);
         printf("combinations in view: %d of %d\n", st.combos_in_view, pack.ncombos);
         if (gm >= 0)

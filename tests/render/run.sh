@@ -161,6 +161,16 @@ real)
     "$IC" finite "$OUT/c.f32" || fail "NaN or Inf in the composite render"
     "$IC" diff "$OUT/c.f32" "$OUT/m.f32" 0.00392 || fail "multipass differs"
     "$IC" diff "$OUT/c.f32" "$OUT/u.f32" 1e-5 || fail "uber differs"
+    # back faces culled (camera above the terrain, inside it) and not: the
+    # same pixels; the default camera (outside the terrain) culls nothing
+    grep -q "^back faces culled: no" "$OUT/stats.txt" || fail "outside camera culled"
+    cam="--camera 300,300,250 --look 800,20,700"
+    run "$PACK" --headless --size 320x200 $cam --stats --float-out "$OUT/cu.f32" > "$OUT/cull.txt"
+    grep -q "^back faces culled: yes" "$OUT/cull.txt" || fail "camera above: back faces not culled"
+    run "$PACK" --headless --size 320x200 $cam --no-cull --stats --float-out "$OUT/nc.f32" > "$OUT/nocull.txt"
+    grep -q "^back faces culled: no" "$OUT/nocull.txt" || fail "--no-cull culled"
+    "$IC" nonuniform "$OUT/cu.f32" 2>/dev/null || true
+    "$IC" diff "$OUT/cu.f32" "$OUT/nc.f32" 1e-6 || fail "culling back faces changed the picture"
     ;;
 *)
     fail "unknown case $case_"

@@ -473,7 +473,7 @@ static void test_mask_view(void **state)
     compose(f, mats, 2, false, &c);
     char *g = glsl_of(f, &c, false);
     char want[64];
-    snprintf(want, sizeof want, "u_frame.view.x == %du", SPLAT_VIEW_MASK);
+    snprintf(want, sizeof want, "splat_view() == %du", SPLAT_VIEW_MASK);
     const char *body = strstr(g, "void main()");  /* not the prelude's switch */
     assert_non_null(body);
     assert_non_null(strstr(body, want));
