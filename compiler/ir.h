@@ -295,8 +295,12 @@ bool ir_validate(const ir *ir, FILE *out);
 
 /* ---- dump (ir_dump.c) -------------------------------------------------- */
 
-/* The IR in .sg form: one `node nN : op { port = nM.out, … }` per node in
- * id order, params and textures as declarations, roots as `out` lines. */
+/* The IR in .sg form, text that reads back in (sg_load_string) and lowers
+ * to the same IR: a `material` block per material's roots ("M.mask" …)
+ * with its params, `texture` declarations, one `node nN : op { port =
+ * nM.out, … }` line per op, terrain input and painted mask in id order,
+ * constants as literals, swizzles and splats on the operand, roots as `out`
+ * lines; other roots in a `shader dump` block (ir_dump.c says more). */
 void ir_dump(const ir *ir, FILE *out);
 
 /* ---- evaluators (ir_eval.c, ir_interval.c) ----------------------------- */

@@ -452,6 +452,88 @@ static void emit_dump(void *user, FILE *f)
     ir_dump(user, f);
 }
 
+/* `path` made absolute (against the current folder) with "." and ".."
+ * resolved lexically; malloc'd. */
+static char *absolute_path(const char *path)
+{
+    char cwd[4096];
+    if (path[0] != '/' && !getcwd(cwd, sizeof cwd))
+        return strdup(path);
+    size_t n = strlen(path) + (path[0] == '/' ? 0 : strlen(cwd)) + 2;
+    char *joined = malloc(n), *out = malloc(n + 1);
+    if (!joined || !out)
+        abort();
+    snprintf(joined, n, "%s%s%s", path[0] == '/' ? "" : cwd, path[0] == '/' ? "" : "/", path);
+    size_t len = 0;
+    char *save = NULL;
+    for (char *c = strtok_r(joined, "/", &save); c; c = strtok_r(NULL, "/", &save)) {
+        if (!strcmp(c, "."))
+            continue;
+        if (!strcmp(c, "..")) {
+            while (len > 0 && out[len - 1] != '/')
+                len--;
+            if (len > 0)
+                len--;
+            continue;
+        }
+        out[len++] = '/';
+        memcpy(out + len, c, strlen(c));
+        len += strlen(c);
+    }
+    out[len] = 0;
+    if (!len)
+        strcpy(out, "/");
+    free(joined);
+    return out;
+}
+
+/* `to` relative to the folder `from` (both absolute, normalised). */
+static char *relative_path(const char *from, const char *to)
+{
+    size_t common = 0;
+    for (size_t i = 0;; i++) {
+        bool end_f = from[i] == 0 || from[i] == '/', end_t = to[i] == 0 || to[i] == '/';
+        if (end_f && end_t)
+            common = i;
+        if (!from[i] || !to[i] || from[i] != to[i])
+            break;
+    }
+    int ups = 0;
+    for (const char *c = from + common; *c; c++)
+        ups += *c == '/';
+    if (!strcmp(from, "/"))
+        ups = 0;
+    const char *rest = to + common + (to[common] == '/');
+    char *r = malloc((size_t)ups * 3 + strlen(rest) + 2);
+    if (!r)
+        abort();
+    r[0] = 0;
+    for (int i = 0; i < ups; i++)
+        strcat(r, "../");
+    strcat(r, *rest ? rest : ".");
+    return r;
+}
+
+/* Texture files are relative to the current folder in the IR; a dump
+ * written to OUT names them relative to OUT's folder, as graph files do,
+ * so the dump reads back from wherever it is. */
+static void textures_relative_to(ir *ir, const char *out)
+{
+    char *abs_out = absolute_path(out);
+    char *slash = strrchr(abs_out, '/');
+    if (slash == abs_out)
+        slash[1] = 0;
+    else if (slash)
+        *slash = 0;
+    for (int i = 0; i < ir->ntextures; i++) {
+        char *abs_tex = absolute_path(ir->textures[i].file);
+        free(ir->textures[i].file);
+        ir->textures[i].file = relative_path(abs_out, abs_tex);
+        free(abs_tex);
+    }
+    free(abs_out);
+}
+
 static int cmd_dump(int argc, char **argv)
 {
     options o;
@@ -476,6 +558,8 @@ static int cmd_dump(int argc, char **argv)
     if (st == EXIT_OK) {
         if (!o.after || strcmp(o.after, "lower"))
             ir_optimize(&ir, o.after);
+        if (o.out)
+            textures_relative_to(&ir, o.out);
         st = emit_to(o.out, emit_dump, &ir);
     }
     sg_free(p);

@@ -239,12 +239,21 @@ static void test_dump(void **state)
     ir_ref s = ir_input(&ir, IR_IN_SLOPE);
     ir_ref m = ir_op3(&ir, IR_OP_MIX, s, ir_constf(&ir, 0.5), w);
     ir_set_root(&ir, "cliff.mask", m);
+    /* a root that is no material output goes into a shader block */
+    ir_ref pos = ir_input(&ir, IR_IN_POSITION);
+    ir_set_root(&ir, "r", ir_op2(&ir, IR_OP_MUL, ir_constf(&ir, 2), ir_swizzle(&ir, pos, "z")));
     char *a = dump_text(&ir), *b = dump_text(&ir);
     assert_string_equal(a, b);                                   /* deterministic */
-    assert_non_null(strstr(a, "param float cliff.wetness = 0.2 [0.0, 1.0]\n"));
-    assert_non_null(strstr(a, "node n2 : terrain.slope  # float\n"));
-    assert_non_null(strstr(a, "node n4 : mix { a = n2.out, b = 0.5, t = n1.out }  # float\n"));
-    assert_non_null(strstr(a, "out cliff.mask = n4.out\n"));
+    assert_non_null(strstr(a, "\nmaterial cliff {\n"
+                              "    param float wetness = 0.2 range 0.0 1.0\n"
+                              "    node n1 : terrain.slope  # float\n"
+                              "    node n2 : mix { a = n1.out, b = 0.5, t = wetness }  # float\n"
+                              "    out mask = n2.out\n}\n"));
+    /* node operands of a commutative op first, whatever their ids */
+    assert_non_null(strstr(a, "\nshader dump {\n"
+                              "    node n3 : terrain.position  # vec3\n"
+                              "    node n4 : mul { a = n3.out.z, b = 2.0 }  # float\n"
+                              "    out float r = n4.out\n}\n"));
     free(a);
     free(b);
     ir_free(&ir);
