@@ -872,11 +872,20 @@ static const struct { const char *name; command_fn run; } commands[] = {
     { "texgen", splat_cli_texgen },
 };
 
+/* General options may come before the command (`splatc -I DIR check F`):
+ * they are moved behind the command's name, where every command that reads
+ * graph files takes them (texgen reads none and ignores them). */
 int main(int argc, char **argv)
 {
-    if (argc < 2)
+    int first = 1;
+    while (first < argc && !strcmp(argv[first], "-I")) {
+        if (first + 1 >= argc)
+            return usage_error("option '%s' needs a value", argv[first]);
+        first += 2;
+    }
+    if (first >= argc)
         return usage_error("%s", "no command given");
-    const char *cmd = argv[1];
+    const char *cmd = argv[first];
     if (!strcmp(cmd, "--help") || !strcmp(cmd, "-h") || !strcmp(cmd, "help")) {
         fputs(usage_text, stdout);
         return EXIT_OK;
@@ -887,12 +896,25 @@ int main(int argc, char **argv)
     }
     for (size_t i = 0; i < sizeof commands / sizeof commands[0]; i++)
         if (!strcmp(cmd, commands[i].name)) {
-            for (int j = 2; j < argc; j++)
+            for (int j = first + 1; j < argc; j++)
                 if (!strcmp(argv[j], "--help") && strcmp(cmd, "build") && strcmp(cmd, "texgen")) {
                     fputs(usage_text, stdout);
                     return EXIT_OK;
                 }
-            return commands[i].run(argc - 1, argv + 1);
+            /* argv for the command: its name, the general options, the rest */
+            bool keep = strcmp(cmd, "texgen") != 0;
+            char **av = calloc((size_t)argc + 1, sizeof *av);
+            if (!av)
+                return EXIT_USAGE;
+            int n = 0;
+            av[n++] = argv[first];
+            for (int j = 1; keep && j < first; j++)
+                av[n++] = argv[j];
+            for (int j = first + 1; j < argc; j++)
+                av[n++] = argv[j];
+            int st = commands[i].run(n, av);
+            free(av);
+            return st;
         }
     return usage_error("unknown command '%s'", cmd);
 }

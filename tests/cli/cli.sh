@@ -79,6 +79,18 @@ status)
     run 1 "$SPLATC" glsl graphs/cliff.sg -m no_such_material
     run 1 "$SPLATC" check no/such/file.sg
     grep -q "cannot read 'no/such/file.sg'" "$TMP/err" || fail "no IO diagnostic"
+    # general options (-I) before the command as well as after it
+    mkdir -p "$TMP/lib" "$TMP/g"
+    printf 'shader half {\n    in float x\n    node m : mul { a = x, b = 0.5 }\n    out float out = m.out\n}\n' > "$TMP/lib/half.sg"
+    printf 'import "half.sg"\nmaterial h {\n    node s : terrain.slope\n    node k : half { x = s.out }\n    out mask = k.out\n}\n' > "$TMP/g/h.sg"
+    run 1 "$SPLATC" check "$TMP/g/h.sg"
+    run 0 "$SPLATC" -I "$TMP/lib" check "$TMP/g/h.sg"
+    run 0 "$SPLATC" check -I "$TMP/lib" "$TMP/g/h.sg"
+    run 0 "$SPLATC" -I "$TMP/lib" eval "$TMP/g/h.sg" -m h --output mask --at slope=0.5
+    [ "$(cat "$TMP/out")" = 0.25 ] || fail "-I before eval: $(cat "$TMP/out")"
+    run 2 "$SPLATC" -I "$TMP/lib"
+    run 2 "$SPLATC" -I
+    run 2 "$SPLATC" -I "$TMP/lib" frobnicate
     # errors are file:line:col with the source line and a caret
     run 1 "$SPLATC" check tests/golden/unknown_node.sg
     grep -q "^tests/golden/unknown_node.sg:5:14: error: unknown node type 'rampp'" "$TMP/err" ||
