@@ -223,7 +223,14 @@ bool spv_compile(const char *glsl, int stage, const char *name,
         map_glslang_log(&m, name, glsl, glslang_program_get_info_log(prog));
         goto done;
     }
-    glslang_program_SPIRV_generate(prog, st);
+    /* glslang_program_SPIRV_generate would also run SPIRV-Tools' validator
+     * (its default options set validate), and only as messages: callers
+     * validate once with spv_validate, which fails on an invalid module. */
+    glslang_spv_options_t spv_opts = {
+        .disable_optimizer = true,
+        .validate = false,
+    };
+    glslang_program_SPIRV_generate_with_options(prog, st, &spv_opts);
     size_t n = glslang_program_SPIRV_get_size(prog);
     const char *spv_msgs = glslang_program_SPIRV_get_messages(prog);
     if (n == 0) {

@@ -42,7 +42,9 @@ typedef enum spv_stage {
 /* Compile a complete GLSL 450 shader (with its #version line) for `stage`
  * (an spv_stage).  `name` names the shader in messages (a material or
  * combination).  On success *words / *nwords receive a malloc'd SPIR-V
- * module (caller frees); on failure they are NULL / 0 and *log says why. */
+ * module (caller frees); on failure they are NULL / 0 and *log says why.
+ * The module is not validated here (glslang's own validation is off):
+ * callers that keep it run spv_validate once. */
 bool spv_compile(const char *glsl, int stage, const char *name,
                  uint32_t **words, size_t *nwords, char **log);
 
