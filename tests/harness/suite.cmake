@@ -4,8 +4,10 @@ function(splat_gpu_test name)
   add_executable(${name} ${HARNESS_DIR}/${name}.c ${ARGN})
   target_link_libraries(${name} splat_harness PkgConfig::CMOCKA)
   add_test(NAME gpu.${name} COMMAND ${name} WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
-  # lavapipe on two shared cores: allow for a slow machine.
-  set_tests_properties(gpu.${name} PROPERTIES LABELS gpu TIMEOUT 600)
+  # lavapipe on two shared cores: allow for a slow machine.  Validation on
+  # whoever runs the test (ctest alone, not only make test).
+  set_tests_properties(gpu.${name} PROPERTIES LABELS gpu TIMEOUT 600
+    ENVIRONMENT "SPLAT_VALIDATE=1")
 endfunction()
 
 splat_gpu_test(test_harness)
