@@ -19,7 +19,9 @@
  * graph files the program read, the heightfield, the painted rasters, the
  * texture files) are hashed with the compiler version and options; the
  * manifest records that "inputs" key, and when the existing pack carries
- * the same key and has all its shader files, the build stops there.
+ * the same key and has all its shader files, the build stops there (with
+ * --stats it still runs the analysis for the report and reads the shader
+ * figures back from the pack).
  *
  * Determinism: every file is a function of the inputs only (no times, no
  * absolute paths: material sources are written relative to the scene's
@@ -850,6 +852,30 @@ static int spirv_instructions(const uint32_t *w, size_t n)
     return count;
 }
 
+/* One composite's line of the report. */
+typedef struct shader_row {
+    int id, layers, instructions, ntextures, nparams;
+} shader_row;
+
+static void print_shader_report(FILE *out, int uber, int ntextures, int nparams,
+                                const shader_row *rows, int n)
+{
+    fprintf(out, "shaders: SPIR-V instructions and resources per composite\n"
+                 "  (the über-shader: %d instructions, %d textures, %d params)\n"
+                 "  id  layers  instructions  of über  textures  params\n",
+            uber, ntextures, nparams);
+    double sum = 0;
+    for (int i = 0; i < n; i++) {
+        const shader_row *r = &rows[i];
+        fprintf(out, "%4d  %6d  %12d  %6.0f%%  %4d/%-3d  %3d/%d\n", r->id, r->layers,
+                r->instructions, 100.0 * r->instructions / uber, r->ntextures, ntextures,
+                r->nparams, nparams);
+        sum += (double)r->instructions / uber;
+    }
+    if (n)
+        fprintf(out, "mean composite size: %.0f%% of the über-shader\n", 100.0 * sum / n);
+}
+
 static void report_shaders(build *b, FILE *out)
 {
     const job *uber = NULL;
@@ -858,27 +884,80 @@ static void report_shaders(build *b, FILE *out)
             uber = &b->jobs[i];
     if (!uber || !uber->words)
         return;
-    int ui = spirv_instructions(uber->words, uber->nwords);
-    fprintf(out, "shaders: SPIR-V instructions and resources per composite\n"
-                 "  (the über-shader: %d instructions, %d textures, %d params)\n"
-                 "  id  layers  instructions  of über  textures  params\n",
-            ui, b->layout.ntextures, b->layout.nparams);
-    double sum = 0;
+    shader_row *rows = xcalloc((size_t)b->njobs + 1, sizeof *rows);
     int n = 0;
     for (int i = 0; i < b->njobs; i++) {
         const job *j = &b->jobs[i];
         if (j->kind != JOB_COMBO || !j->words)
             continue;
-        int ci = spirv_instructions(j->words, j->nwords);
         const combo_info *c = &b->combos[j->index];
-        fprintf(out, "%4d  %6d  %12d  %6.0f%%  %4d/%-3d  %3d/%d\n", j->index,
-                b->analysis.combos[j->index].nmaterials, ci, 100.0 * ci / ui, c->ntextures,
-                b->layout.ntextures, c->nparams, b->layout.nparams);
-        sum += (double)ci / ui;
-        n++;
+        rows[n++] = (shader_row){j->index, b->analysis.combos[j->index].nmaterials,
+                                 spirv_instructions(j->words, j->nwords), c->ntextures,
+                                 c->nparams};
     }
-    if (n)
-        fprintf(out, "mean composite size: %.0f%% of the über-shader\n", 100.0 * sum / n);
+    print_shader_report(out, spirv_instructions(uber->words, uber->nwords),
+                        b->layout.ntextures, b->layout.nparams, rows, n);
+    free(rows);
+}
+
+/* SPIR-V instructions of the pack's shader file `rel`, or -1. */
+static int pack_spirv_instructions(const build *b, const char *rel)
+{
+    if (!rel)
+        return -1;
+    char *path = xasprintf("%s/%s", b->out, rel);
+    FILE *f = fopen(path, "rb");
+    free(path);
+    if (!f)
+        return -1;
+    uint32_t *w = NULL;
+    size_t n = 0, cap = 0, got;
+    do {
+        if (n == cap) {
+            cap = cap ? 2 * cap : 4096;
+            w = realloc(w, cap * sizeof *w);
+            if (!w)
+                abort();
+        }
+        got = fread(w + n, sizeof *w, cap - n, f);
+        n += got;
+    } while (got > 0);
+    fclose(f);
+    int count = spirv_instructions(w, n);
+    free(w);
+    return count;
+}
+
+/* The same report for a pack that is up to date, from its manifest and
+ * SPIR-V files (nothing is composed or compiled). */
+static void report_shaders_from_pack(build *b, FILE *out)
+{
+    char *mf = xasprintf("%s/manifest.json", b->out);
+    json_t *m = json_load_file(mf, 0, NULL);
+    free(mf);
+    if (!m)
+        return;
+    json_t *combos = json_object_get(m, "combinations");
+    int uber = pack_spirv_instructions(
+        b, json_string_value(json_object_get(json_object_get(m, "uber"), "spirv")));
+    size_t nc = json_array_size(combos);
+    shader_row *rows = xcalloc(nc + 1, sizeof *rows);
+    int n = 0;
+    for (size_t i = 0; i < nc && uber > 0; i++) {
+        json_t *c = json_array_get(combos, i);
+        int k = pack_spirv_instructions(b, json_string_value(json_object_get(c, "spirv")));
+        if (k < 0)
+            continue;
+        rows[n++] = (shader_row){(int)json_integer_value(json_object_get(c, "id")),
+                                 (int)json_array_size(json_object_get(c, "materials")), k,
+                                 (int)json_array_size(json_object_get(c, "textures")),
+                                 (int)json_array_size(json_object_get(c, "params"))};
+    }
+    if (uber > 0)
+        print_shader_report(out, uber, (int)json_array_size(json_object_get(m, "textures")),
+                            (int)json_array_size(json_object_get(m, "params")), rows, n);
+    free(rows);
+    json_decref(m);
 }
 
 /* The painted masks' bytes in the pack next to their dense 8-bit size. */
@@ -1038,6 +1117,20 @@ static void report_job_error(build *b, const job *j)
     free(m);
 }
 
+/* The painted masks as the pack stores them (sparse unless --painted
+ * dense), then the analysis over them. */
+static bool analyse(build *b)
+{
+    if (b->desc->painted != SPLAT_PAINTED_DENSE) {
+        b->sparse_ok = splat_painted_build(&b->scene, b->desc->painted, &b->sparse, b->d);
+        if (!b->sparse_ok)
+            return false;
+        b->scene.sparse = &b->sparse;
+    }
+    b->analysis_ok = splat_analyze(&b->scene, &b->analysis, b->d);
+    return b->analysis_ok;
+}
+
 bool splat_build(const splat_build_desc *desc, splat_build_stats *st, sg_diags *d)
 {
     build b = {.desc = desc, .d = d, .loc = {.file = desc->scene}};
@@ -1061,18 +1154,24 @@ bool splat_build(const splat_build_desc *desc, splat_build_stats *st, sg_diags *
     if (inputs_key(&b) && up_to_date(&b, &st->combos)) {
         st->up_to_date = true;
         st->load = now() - t;
+        /* nothing to rebuild; the report still wants the (cheap) analysis
+         * and the shaders' figures, read back from the pack */
+        if (desc->report) {
+            t = now();
+            bool ok = analyse(&b);
+            st->analysis = now() - t;
+            if (ok && d->nerrors == errors) {
+                splat_analysis_report(&b.scene, &b.analysis, desc->report);
+                report_painted(&b, desc->report);
+                report_shaders_from_pack(&b, desc->report);
+            }
+        }
         goto out;
     }
     st->load = now() - t;
 
     t = now();
-    if (desc->painted != SPLAT_PAINTED_DENSE) {
-        b.sparse_ok = splat_painted_build(&b.scene, desc->painted, &b.sparse, d);
-        if (!b.sparse_ok)
-            goto out;
-        b.scene.sparse = &b.sparse;
-    }
-    b.analysis_ok = splat_analyze(&b.scene, &b.analysis, d);
+    b.analysis_ok = analyse(&b);
     st->analysis = now() - t;
     if (!b.analysis_ok || d->nerrors > errors)
         goto out;
