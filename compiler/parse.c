@@ -587,6 +587,7 @@ typedef struct scene_parse {
     int cap_materials, cap_painted, cap_cameras;
     bool has_hf_size;
     bool has[8];
+    sg_loc materials_loc;   /* the `materials` setting, for an empty stack */
 } scene_parse;
 
 enum { HAS_HF, HAS_SIZE, HAS_MAXH, HAS_MATERIALS };
@@ -823,6 +824,7 @@ static bool scene_stmt(parser *ps, void *user)
         return true;
     }
     if (is_kw(key, "materials")) {
+        sp->materials_loc = kloc;
         sg_token *open = cur(ps);
         if (!expect(ps, SG_TK_LBRACK, "'['"))
             return false;
@@ -881,7 +883,8 @@ static bool parse_scene(parser *ps)
         if (!sp.has[i])
             scene_error(ps, sc->loc, "scene needs '%s = ...'", need[i]);
     if (sp.has[HAS_MATERIALS] && sc->nmaterials == 0)
-        scene_error(ps, sc->loc, "scene needs at least one material%s", "");
+        scene_error(ps, sp.materials_loc, "scene needs at least one material "
+                    "(materials = [BOTTOM, …, TOP])%s", "");
     if (sp.has[HAS_HF] && sc->hf_format == SG_HF_R16 && !sp.has_hf_size)
         scene_error(ps, sc->heightfield_loc,
                     "raw heightfield '%s' needs heightfield_size = WIDTH HEIGHT",
