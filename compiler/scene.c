@@ -216,7 +216,11 @@ static uint8_t *load_mask(const char *name, const char *file, int w, int h,
     int lw, lh, lc;
     uint8_t *px = stbi_load(file, &lw, &lh, &lc, 1);
     if (!px) {
-        sg_error(d, loc, SG_E_IO, file, stbi_failure_reason());
+        /* the header read, the data did not */
+        char why[160];
+        snprintf(why, sizeof why, "truncated or corrupt PNG (stb_image: %s)",
+                 stbi_failure_reason());
+        sg_error(d, loc, SG_E_IO, file, why);
         return NULL;
     }
     /* Own the pixels with malloc so splat_scene_free needs no stb. */

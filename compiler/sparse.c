@@ -707,8 +707,13 @@ bool sparse_load_raster(const char *path, int width, int height,
     }
     uint8_t *t = stbi_load_from_file(f, &w, &h, &comp, 1);
     fclose(f);
-    if (!t)
-        return fail(err, SPARSE_E_IO, path, stbi_failure_reason());
+    if (!t) {
+        /* the header read, the data did not */
+        char why[160];
+        snprintf(why, sizeof why, "truncated or corrupt PNG (stb_image: %s)",
+                 stbi_failure_reason());
+        return fail(err, SPARSE_E_IO, path, why);
+    }
     /* copy into a malloc'd buffer the caller frees with free() */
     *texels = xcalloc((size_t)w * h, 1);
     memcpy(*texels, t, (size_t)w * h);

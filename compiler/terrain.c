@@ -91,7 +91,13 @@ static bool load_png(splat_terrain *t, const char *path, sg_loc loc, sg_diags *d
     t->height = h;
     return true;
 fail:
-    sg_error(d, loc, SG_E_IO, path, stbi_failure_reason());
+    {
+        /* the header read, the data did not */
+        char why[160];
+        snprintf(why, sizeof why, "truncated or corrupt PNG (stb_image: %s)",
+                 stbi_failure_reason());
+        sg_error(d, loc, SG_E_IO, path, why);
+    }
     free(t->texels);
     t->texels = NULL;
     return false;

@@ -5,7 +5,9 @@
  * writes hf16.png (16 x 16, 16-bit grey: a ramp east with a 1-texel cliff at
  * x = 8), hf.r16 (the same texels, raw little-endian), hf_rgb.png (16 x 16
  * 8-bit RGB: not a heightfield), mask.png (16 x 16 8-bit grey: the west half
- * painted) and mask8x8.png (8 x 8: the wrong size for the heightfield).
+ * painted) and mask8x8.png (8 x 8: the wrong size for the heightfield),
+ * and hf_truncated.png, mask_truncated.png: hf16.png and mask.png cut 30
+ * bytes short (a valid header, the image data cut off).
  */
 #include <stdint.h>
 #include <stdio.h>
@@ -16,6 +18,29 @@
 #include "texgen.h"
 
 enum { N = 16 };
+
+/* OUTDIR/to = OUTDIR/from without its last `drop` bytes. */
+static int truncated_copy(const char *dir, const char *from, const char *to, long drop)
+{
+    char path[4096];
+    unsigned char buf[1 << 16];
+    snprintf(path, sizeof path, "%s/%s", dir, from);
+    FILE *f = fopen(path, "rb");
+    size_t n = f ? fread(buf, 1, sizeof buf, f) : 0;
+    if (f)
+        fclose(f);
+    if ((long)n <= drop) {
+        fprintf(stderr, "%s: cannot read\n", path);
+        return 0;
+    }
+    snprintf(path, sizeof path, "%s/%s", dir, to);
+    f = fopen(path, "wb");
+    if (!f || fwrite(buf, 1, n - (size_t)drop, f) != n - (size_t)drop || fclose(f) != 0) {
+        fprintf(stderr, "%s: cannot write\n", path);
+        return 0;
+    }
+    return 1;
+}
 
 int main(int argc, char **argv)
 {
@@ -60,5 +85,10 @@ int main(int argc, char **argv)
             return 1;
         }
     }
+    const char *cut[][2] = { { "hf16.png", "hf_truncated.png" },
+                             { "mask.png", "mask_truncated.png" } };
+    for (int i = 0; i < 2; i++)
+        if (!truncated_copy(argv[1], cut[i][0], cut[i][1], 30))
+            return 1;
     return 0;
 }

@@ -27,7 +27,7 @@ add_test(NAME scene.rasters_reproducible
 '$<TARGET_FILE:scene_gen_fixtures>' '${SCENE_OUT}/fixtures' && \
 cmp '${SCENE_OUT}/minimal/heightfield.png' examples/minimal/heightfield.png && \
 cmp '${SCENE_OUT}/minimal/fields.png' examples/minimal/fields.png && \
-for f in hf16.png hf.r16 hf_rgb.png mask.png mask8x8.png; do \
+for f in hf16.png hf.r16 hf_rgb.png mask.png mask8x8.png hf_truncated.png mask_truncated.png; do \
   cmp '${SCENE_OUT}/fixtures/'$f tests/scene/$f || exit 1; done"
   WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
 set_tests_properties(scene.rasters_reproducible PROPERTIES LABELS unit)
