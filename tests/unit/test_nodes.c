@@ -586,6 +586,174 @@ static void test_texture_fbm(void **state)
     NEAR(evalf(f, &e, "n.out", "texture_fbm6 { tex = \"textures/noise.png\", uv = vec2(0.1, 0.2) }"), 0.3);
 }
 
+/* ---- masks.sg: multiply and linear_blend ------------------------------------ */
+
+static void test_mask_products(void **state)
+{
+    ir_env e = flat_env();
+    const char *f = "masks.sg";
+    NEAR(evalf(f, &e, "n.out", "multiply { a = 0.6, b = 0.5 }"), 0.3);
+    NEAR(evalf(f, &e, "n.out", "multiply { a = 0.25, b = 0.8 }"), 0.2);
+    /* the ends: 0 cuts everything, 1 leaves the other mask alone */
+    NEAR(evalf(f, &e, "n.out", "multiply { a = 0.0, b = 0.9 }"), 0.0);
+    NEAR(evalf(f, &e, "n.out", "multiply { a = 1.0, b = 0.9 }"), 0.9);
+    NEAR(evalf(f, &e, "n.out", "multiply { a = 1.0, b = 1.0 }"), 1.0);
+    /* a wire too: slope 0.4 cut by 0.5 */
+    e.slope = 0.4;
+    NEAR(evalf(f, &e, "n.out", "multiply { a = terrain.slope, b = 0.5 }"), 0.2);
+
+    /* linear_blend = a + (b - a) t, t = 0.5 by default */
+    e = flat_env();
+    NEAR(evalf(f, &e, "n.out", "linear_blend { a = 0.2, b = 0.6 }"), 0.4);
+    NEAR(evalf(f, &e, "n.out", "linear_blend { a = 0.2, b = 0.6, t = 0.25 }"), 0.3);
+    NEAR(evalf(f, &e, "n.out", "linear_blend { a = 0.2, b = 0.6, t = 0.0 }"), 0.2);
+    NEAR(evalf(f, &e, "n.out", "linear_blend { a = 0.2, b = 0.6, t = 1.0 }"), 0.6);
+    NEAR(evalf(f, &e, "n.out", "linear_blend { a = 0.0, b = 1.0, t = 0.7 }"), 0.7);
+    NEAR(evalf(f, &e, "n.out", "linear_blend { a = 1.0, b = 0.0, t = 0.7 }"), 0.3);
+}
+
+/* ---- stochastic.sg ------------------------------------------------------------ */
+
+/* pow2_cell by its definition: cell_min * 2^k, k = #{j = 1..15 : r >= 2^j}. */
+static double pow2_cell(double footprint, double cell_min)
+{
+    double r = footprint / cell_min;
+    int k = 0;
+    for (int j = 1; j <= 15; j++)
+        k += r >= ldexp(1, j);
+    return cell_min * ldexp(1, k);
+}
+
+/* world_hash by hand: q = floor(p / cell); two chained hash_perm lookups
+ * over (x, z), (y, x), (z, y), u = fract(h2 + h3 / 289). */
+static double world_hash(const double p[3], double cell)
+{
+    double qx = floor(p[0] / cell), qy = floor(p[1] / cell), qz = floor(p[2] / cell);
+    double h1 = hash_perm(qx, qz);
+    double h2 = hash_perm(qy + 289 * h1, qx + 289 * h1);
+    double h3 = hash_perm(qz + 289 * h2, qy + 289 * h2);
+    double s = h2 + h3 / 289;
+    return s - floor(s);
+}
+
+static void test_stochastic(void **state)
+{
+    ir_env e = flat_env();
+    const char *f = "stochastic.sg";
+    /* pow2_cell: the cell stays cell_min below twice it, then doubles at
+     * every power of two of footprint / cell_min, up to 2^15 */
+    const char *pc = "pow2_cell { footprint = %.17g, cell_min = 0.05 }";
+    NEAR(evalf(f, &e, "n.out", pc, 0.0), 0.05);
+    NEAR(evalf(f, &e, "n.out", pc, 0.0999), 0.05);
+    NEAR(evalf(f, &e, "n.out", pc, 0.1), 0.1);
+    NEAR(evalf(f, &e, "n.out", pc, 0.15), 0.1);
+    NEAR(evalf(f, &e, "n.out", pc, 0.2), 0.2);
+    NEAR(evalf(f, &e, "n.out", pc, 3.3), 3.2);           /* r = 66: 2^6 */
+    NEAR(evalf(f, &e, "n.out", pc, 0.05 * 32768), 0.05 * 32768);
+    NEAR(evalf(f, &e, "n.out", pc, 1e9), 0.05 * 32768);  /* capped at 2^15 */
+    for (double fp = 0.01; fp < 3000; fp *= 2.7) {
+        double c = evalf(f, &e, "n.out", pc, fp);
+        NEAR(c, pow2_cell(fp, 0.05));
+        assert_true(c <= fmax(fp, 0.05) && (c == 0.05 || 2 * c > fp));
+    }
+
+    /* world_hash: hand-computed, in [0, 1), constant inside a cell */
+    const double pts[][3] = {{0, 0, 0}, {3.5, 120.25, -7.75}, {1000.2, 2000.7, 3000.9},
+                             {-50.0, 0.5, 12.0}};
+    for (size_t k = 0; k < sizeof pts / sizeof pts[0]; k++) {
+        memcpy(e.position, pts[k], sizeof e.position);
+        double u = evalf(f, &e, "n.out", "world_hash { cell = 2.0 }");
+        NEAR(u, world_hash(pts[k], 2.0));
+        assert_true(u >= 0 && u < 1);
+        double inside[3] = {2 * floor(pts[k][0] / 2) + 1.9, 2 * floor(pts[k][1] / 2) + 0.1,
+                            2 * floor(pts[k][2] / 2) + 1.0};
+        memcpy(e.position, inside, sizeof e.position);
+        NEAR(evalf(f, &e, "n.out", "world_hash { cell = 2.0 }"), u);
+    }
+    e.position[0] = 0.5; e.position[1] = 0.5; e.position[2] = 0.5;
+    double u0 = evalf(f, &e, "n.out", "world_hash { cell = 1.0 }");
+    e.position[0] = 1.5;                                  /* the next cell along x */
+    assert_true(fabs(evalf(f, &e, "n.out", "world_hash { cell = 1.0 }") - u0) > 1e-6);
+
+    /* stochastic_select: u from the cell of distance * pixel_angle; the
+     * layer is drawn when u lies in [T - T m, T) */
+    e = flat_env();
+    const double pos[3] = {412.3, 95.1, 77.7};
+    memcpy(e.position, pos, sizeof e.position);
+    e.view_distance = 100.0;
+    double u = world_hash(pos, pow2_cell(100.0 * 0.0016, 0.05));
+    assert_true(u > 0.01 && u < 0.99);
+    const char *ss = "stochastic_select { T = %.17g, m = %.17g }";
+    /* m = 0: never drawn, coverage unchanged; m = 1 at the top: always */
+    NEAR(evalf(f, &e, "n.weight", ss, 1.0, 0.0), 0.0);
+    NEAR(evalf(f, &e, "n.T_next", ss, 1.0, 0.0), 1.0);
+    NEAR(evalf(f, &e, "n.weight", ss, 1.0, 1.0), 1.0);
+    NEAR(evalf(f, &e, "n.T_next", ss, 1.0, 1.0), 0.0);
+    /* T = 1: drawn iff u >= 1 - m */
+    double m_hit = 1 - u + 0.005, m_miss = 1 - u - 0.005;
+    NEAR(evalf(f, &e, "n.weight", ss, 1.0, m_hit), 1.0);
+    NEAR(evalf(f, &e, "n.T_next", ss, 1.0, m_hit), 0.0);
+    NEAR(evalf(f, &e, "n.weight", ss, 1.0, m_miss), 0.0);
+    NEAR(evalf(f, &e, "n.T_next", ss, 1.0, m_miss), 1.0 - m_miss);
+    /* a layer further down, reached with T <= u: never drawn */
+    double T = u * 0.9;
+    NEAR(evalf(f, &e, "n.weight", ss, T, 1.0), 0.0);
+    NEAR(evalf(f, &e, "n.T_next", ss, T, 0.5), T - T * 0.5);
+    /* T above u: drawn iff u >= T (1 - m) */
+    T = fmin(1.0, u + 0.2);
+    NEAR(evalf(f, &e, "n.weight", ss, T, 1 - u / T + 0.01), 1.0);
+    NEAR(evalf(f, &e, "n.weight", ss, T, 1 - u / T - 0.01), 0.0);
+}
+
+/* ---- noise.sg: the longer fBms ---------------------------------------------- */
+
+static void test_fbm_octaves(void **state)
+{
+    ir_env e = flat_env();
+    const char *f = "noise.sg";
+    const double x = -1.7, y = 4.2;
+    for (int n = 6; n <= 8; n += 2) {
+        double px = x, py = y, sum = 0, norm = 0, amp = 1;
+        for (int k = 0; k < n; k++) {
+            sum += amp * gradient_noise(px, py);
+            norm += amp;
+            amp *= 0.5;
+            px = px * 2 + 17.31;
+            py = py * 2 + 9.77;
+        }
+        double g = evalf(f, &e, "n.out", "gradient_fbm%d { p = vec2(%g, %g) }", n, x, y);
+        NEAR(g, sum / norm);
+        assert_true(fabs(g) <= 0.7072);
+        double un = evalf(f, &e, "n.unorm", "gradient_fbm%d { p = vec2(%g, %g) }", n, x, y);
+        NEAR(un, fmin(1, fmax(0, 0.5 + 0.7071067811865476 * sum / norm)));
+        /* lacunarity and gain are inputs: gain 0 leaves the first octave */
+        NEAR(evalf(f, &e, "n.out", "gradient_fbm%d { p = vec2(%g, %g), gain = 0.0 }", n, x, y),
+             gradient_noise(x, y));
+    }
+    /* at a lattice point the first octave is 0 (gradient noise vanishes
+     * there); the later ones, shifted off the lattice, are not */
+    double px = 3, py = 5, sum = 0, norm = 0, amp = 1;
+    for (int k = 0; k < 8; k++) {
+        sum += amp * gradient_noise(px, py);
+        norm += amp;
+        amp *= 0.5;
+        px = px * 2 + 17.31;
+        py = py * 2 + 9.77;
+    }
+    NEAR(evalf(f, &e, "n.out", "gradient_fbm8 { p = vec2(3.0, 5.0) }"), sum / norm);
+
+    /* texture fBm 4 and 8 at the ends of their range: all-0 and all-1
+     * textures give 0 and 1 exactly (normalised sums) */
+    e.sample = sample_const;
+    for (int n = 4; n <= 8; n += 4)
+        for (int v = 0; v <= 1; v++) {
+            map_rgb[0] = v;
+            NEAR(evalf(f, &e, "n.out", "texture_fbm%d { tex = \"textures/noise.png\", uv = vec2(0.4, 0.9) }", n),
+                 (double)v);
+        }
+}
+
+
 /* ---- compositors ------------------------------------------------------------- */
 
 static void test_compositors(void **state)
@@ -767,6 +935,9 @@ int main(void)
         cmocka_unit_test(test_alu_fbm),
         cmocka_unit_test(test_texture_fbm),
         cmocka_unit_test(test_noise_intervals),
+        cmocka_unit_test(test_mask_products),
+        cmocka_unit_test(test_stochastic),
+        cmocka_unit_test(test_fbm_octaves),
         cmocka_unit_test(test_compositors),
         cmocka_unit_test(test_billingsley),
     };
