@@ -486,16 +486,31 @@ void rt_renderer_destroy(rt_renderer *r)
 void rt_default_camera(const rt_pack *p, rt_camera *c)
 {
     memset(c, 0, sizeof *c);
+    /* The scene's own overview: its preset named "overview", else its first
+     * preset (the scene's author knows where the terrain is worth seeing). */
+    int k = rt_pack_camera_find(p, "overview");
+    if (k < 0 && p->ncameras > 0)
+        k = 0;
+    if (k >= 0) {
+        memcpy(c->position, p->cameras[k].position, sizeof c->position);
+        memcpy(c->look, p->cameras[k].look, sizeof c->look);
+        return;
+    }
+    /* Else from the south (z large: row 0 is north), 30 degrees down onto
+     * the centre from a quarter of the extent: the distance fog (density
+     * 1.5 / extent, frame_ubo below) hides about 30 % there and less in
+     * front, where a camera seeing the whole terrain would see mostly fog.
+     * Never below the highest point. */
     double sx = p->size[0], sz = p->size[1], ext = sx > sz ? sx : sz;
-    double top = p->height_offset + p->max_height;
-    /* From the south-west (x small, z large: row 0 is north), above the
-     * highest point, looking at the centre. */
-    c->position[0] = -0.15 * sx;
-    c->position[1] = top + 0.45 * ext;
-    c->position[2] = 1.15 * sz;
+    double top = p->height_offset + p->max_height, d = 0.25 * ext;
     c->look[0] = 0.5 * sx;
-    c->look[1] = p->height_offset + 0.3 * p->max_height;
+    c->look[1] = p->height_offset + 0.5 * p->max_height;
     c->look[2] = 0.5 * sz;
+    c->position[0] = c->look[0];
+    c->position[1] = c->look[1] + 0.5 * d;            /* sin 30 */
+    c->position[2] = c->look[2] + 0.8660254037844386 * d;
+    if (c->position[1] < top + 0.02 * ext)
+        c->position[1] = top + 0.02 * ext;
 }
 
 void rt_renderer_set_view(rt_renderer *r, splat_view view, int material)

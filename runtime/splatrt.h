@@ -466,7 +466,9 @@ bool rt_renderer_create(rt_device *d, const rt_pack *p,
                         const rt_render_desc *desc, rt_renderer **out,
                         rt_error *e);
 void rt_renderer_destroy(rt_renderer *r);
-/* A camera looking at the whole terrain from the south-west, above it. */
+/* The default camera: the pack's preset named "overview", else its first
+ * preset, else a view from the south down onto the centre, close enough
+ * that the distance fog stays light there. */
 void rt_default_camera(const rt_pack *p, rt_camera *c);
 /* Debug view and the material of the MASK view. */
 void rt_renderer_set_view(rt_renderer *r, splat_view view, int material);

@@ -14,6 +14,7 @@ static void usage(FILE *f)
         "  --size WxH                image or window size (default 1280x720)\n"
         "  --camera x,y,z --look x,y,z   camera in terrain-local metres\n"
         "  --camera-preset NAME      a camera of the manifest's scene.cameras\n"
+        "                            (default: the preset 'overview', else the first)\n"
         "  --view V                  final|combos|lod|normal|slope|albedo|mask:MATERIAL\n"
         "  --frames N                render N frames (stats over them)\n"
         "  --stats                   patches, pipelines, GPU and CPU times, device\n"
