@@ -6,6 +6,9 @@
  *   imgcheck count IMG.png r,g,b         print pixels of exactly that colour
  *   imgcheck diff A.f32 B.f32 TOL        max |A - B| over RGB; exit 1 if > TOL
  *   imgcheck finite A.f32                exit 1 on any NaN or Inf
+ *   imgcheck near A.f32 r,g,b TOL MAX    the share of pixels whose RGB is
+ *                                        within TOL of (r, g, b) (floats);
+ *                                        exit 1 if it is over MAX (0..1)
  */
 #include "splatrt.h"
 
@@ -46,6 +49,34 @@ int main(int argc, char **argv)
         return 2;
     }
     const char *cmd = argv[1];
+    if (!strcmp(cmd, "near")) {
+        rt_error e = { 0 };
+        float *a = NULL;
+        int w, h;
+        double ref[3], tol, max;
+        if (argc != 6 || sscanf(argv[3], "%lf,%lf,%lf", &ref[0], &ref[1], &ref[2]) != 3) {
+            fprintf(stderr, "imgcheck: near A.f32 r,g,b TOL MAX\n");
+            return 2;
+        }
+        tol = atof(argv[4]);
+        max = atof(argv[5]);
+        if (!rt_read_float(argv[2], &a, &w, &h, &e)) {
+            fprintf(stderr, "imgcheck: %s\n", e.msg);
+            return 2;
+        }
+        size_t n = (size_t)w * h, k = 0;
+        for (size_t i = 0; i < n; i++) {
+            bool close = true;
+            for (int c = 0; c < 3; c++)
+                close = close && fabs((double)a[i * 4 + c] - ref[c]) <= tol;
+            k += close;
+        }
+        double share = n ? (double)k / (double)n : 0;
+        printf("pixels within %g of (%g, %g, %g): %zu of %zu (%.1f %%)\n", tol, ref[0], ref[1],
+               ref[2], k, n, 100 * share);
+        free(a);
+        return share <= max ? 0 : 1;
+    }
     if (!strcmp(cmd, "diff") || !strcmp(cmd, "finite")) {
         rt_error e = { 0 };
         float *a = NULL, *b = NULL;

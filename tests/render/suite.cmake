@@ -40,5 +40,28 @@ if(TARGET splatrt AND TARGET splatview)
               $<TARGET_FILE:imgcheck> ${RENDER_OUT}/minimal ${RENDER_OUT}/out)
     set_tests_properties(render.hot_reload PROPERTIES LABELS render TIMEOUT 300
       ENVIRONMENT "SPLAT_VALIDATE=1;SPLATC=$<TARGET_FILE:splatc_cli>")
+
+    # The example scenes rendered (examples.sh): colorado and billingsley,
+    # and billingsley without presets (nocam.sg) for the computed default
+    # camera.  Their packs are built first, with a SPIR-V cache in the
+    # build tree so reruns are quick.
+    set(EXAMPLE_SCENES
+      colorado examples/colorado/scene.sg
+      billingsley examples/billingsley/scene.sg
+      nocam tests/render/nocam.sg)
+    while(EXAMPLE_SCENES)
+      list(POP_FRONT EXAMPLE_SCENES ex scene)
+      add_test(NAME render.pack_${ex}
+        COMMAND $<TARGET_FILE:splatc_cli> build ${scene} -o ${RENDER_OUT}/${ex} -j 2
+                --cache ${RENDER_OUT}/spv_cache
+        WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
+      set_tests_properties(render.pack_${ex} PROPERTIES LABELS render TIMEOUT 600
+        FIXTURES_SETUP ${ex}_pack)
+      add_test(NAME render.example_${ex}
+        COMMAND sh ${RENDER_DIR}/examples.sh ${ex} $<TARGET_FILE:splatview>
+                $<TARGET_FILE:imgcheck> ${RENDER_OUT}/${ex} ${RENDER_OUT}/out)
+      set_tests_properties(render.example_${ex} PROPERTIES LABELS render TIMEOUT 600
+        FIXTURES_REQUIRED ${ex}_pack ENVIRONMENT "SPLAT_VALIDATE=1")
+    endwhile()
   endif()
 endif()

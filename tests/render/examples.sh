@@ -1,0 +1,72 @@
+#!/bin/sh
+# The example scenes rendered (suite.cmake builds their packs first):
+#   examples.sh CASE SPLATVIEW IMGCHECK PACK OUTDIR
+# CASE colorado | billingsley | nocam.  Small pictures (320x180) to keep
+# lavapipe fast.  Every splatview run has SPLAT_VALIDATE=1 and splatview
+# exits non-zero (3) when the validation layer said anything, so each run
+# also checks for zero validation messages.
+#   every case: the default camera's picture is non-empty, non-uniform and
+#     finite, and at most MAX_FOG of it is fog or sky (pixels within 0.1 of
+#     the fog colour, which is the clear colour: the old default camera
+#     showed 76 % on colorado, 79 % on billingsley);
+#   colorado, billingsley: the default camera is the preset 'overview'; the
+#     combinations view shows one colour per combination in view;
+#   colorado: composite vs the multi-pass reference within 1/255 at the
+#     preset 'valley';
+#   nocam: a scene without presets gets the computed view (light fog).
+set -u
+case_=$1 SV=$2 IC=$3 PACK=$4 OUT=$5/example_$1
+mkdir -p "$OUT"
+export SPLAT_VALIDATE=1
+export SPLAT_PIPELINE_CACHE="$OUT/pipelines.bin"
+fail() { echo "FAIL: $*"; exit 1; }
+run() { echo "+ splatview $*"; "$SV" "$@" || fail "splatview $* (exit $?)"; }
+SIZE="--size 320x180"
+FOG=0.5,0.6,0.8            # --clear: the sky and the fog colour
+
+default_view() {           # MAX_FOG
+    run "$PACK" --headless $SIZE --clear $FOG -o "$OUT/default.png" --float-out "$OUT/default.f32"
+    [ -s "$OUT/default.png" ] || fail "empty picture"
+    "$IC" nonuniform "$OUT/default.png" || fail "the default view is uniform"
+    "$IC" finite "$OUT/default.f32" || fail "NaN or Inf in the default view"
+    "$IC" near "$OUT/default.f32" $FOG 0.1 "$1" || fail "the default view is mostly fog or sky"
+}
+
+is_overview() {
+    run "$PACK" --headless $SIZE --clear $FOG --camera-preset overview --float-out "$OUT/overview.f32"
+    "$IC" diff "$OUT/default.f32" "$OUT/overview.f32" 0 || fail "the default camera is not 'overview'"
+}
+
+combos() {                 # MIN: combinations that must be in view
+    run "$PACK" --headless $SIZE --view combos --clear 0,0,0 --stats -o "$OUT/combos.png" > "$OUT/stats.txt"
+    cat "$OUT/stats.txt"
+    want=$(sed -n 's/^combinations in view: \([0-9]*\) of.*/\1/p' "$OUT/stats.txt")
+    got=$("$IC" colors "$OUT/combos.png" 0,0,0)
+    echo "combinations in view: $want, colours: $got"
+    [ -n "$want" ] && [ "$want" -ge "$1" ] || fail "fewer than $1 combinations in view"
+    [ "$got" = "$want" ] || fail "$got colours for $want combinations"
+}
+
+case $case_ in
+colorado)
+    default_view 0.65
+    is_overview
+    combos 2
+    cam="--camera-preset valley"
+    run "$PACK" --headless $SIZE $cam --float-out "$OUT/c.f32"
+    run "$PACK" --headless $SIZE $cam --reference multipass --float-out "$OUT/m.f32"
+    "$IC" diff "$OUT/c.f32" "$OUT/m.f32" 0.00392 || fail "composite and multipass differ by more than 1/255"
+    ;;
+billingsley)
+    default_view 0.75
+    is_overview
+    combos 1                   # every material everywhere: one combination
+    ;;
+nocam)
+    default_view 0.4
+    ;;
+*)
+    fail "unknown case $case_"
+    ;;
+esac
+echo "ok"
