@@ -26,6 +26,8 @@ do for [f in system("ls knob_*.dat 2>/dev/null")] {
 
 if (system("test -s ratios.dat && echo y") eq "y") {
     set output "ratios.png"
+    set key inside top right
+    unset xlabel
     set title "GPU time ratios, measured side by side on the same frames (higher = composite wins)"
     set style data histograms
     set style histogram clustered gap 1
@@ -39,20 +41,22 @@ if (system("test -s ratios.dat && echo y") eq "y") {
          "" using 4 title "uber / composite (target 1.3)", \
          4 with lines dt 2 lc rgb "black" notitle, 1.7 with lines dt 3 lc rgb "black" notitle, \
          1.3 with lines dt 4 lc rgb "black" notitle
-    unset style
     set style data points
+    set style fill empty
     set xtics norotate
     set yrange [*:*]
+    set key outside right top
 }
 
 set output "compile_scaling.png"
+set key inside top left
 set multiplot layout 1,2 title "splatc build scaling"
 set title "analysis vs heightfield texels"
 set xlabel "texels (millions)"
-set ylabel "ns per texel / analysis ms"
+set ylabel "ns per texel; analysis time / 10 ms"
 set logscale x
 plot "scale_hf.dat" using ($1/1e6):2 with linespoints lw 2 title "analysis ns/texel", \
-     "" using ($1/1e6):3 with linespoints lw 2 axes x1y1 title "analysis ms / 100"
+     "" using ($1/1e6):3 with linespoints lw 2 title "analysis time (10 ms units)"
 unset logscale x
 set title "compile phases vs material count (no cache)"
 set xlabel "materials"

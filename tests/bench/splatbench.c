@@ -19,6 +19,8 @@
  *                     in place of Listing 1's 4-tap cross
  *       pack=DIR renders another pack of the same terrain (compositors, fBm
  *       knobs); lod=P sets the LOD error threshold in pixels per grid step.
+ *       Paths (--path): ground (2 m above the terrain looking 150 m ahead,
+ *       from --start-preset NAME or --start x,z,dx,dz), topdown, grazing.
  *   splatbench upscale IN.png K OUT
  *       K times the texels per side, bilinear: a 16-bit PNG becomes raw
  *       little-endian R16 (OUT), an 8-bit one an 8-bit PNG (nearest).
@@ -348,6 +350,8 @@ static double ground(const rt_pack *p, double x, double z)
 typedef struct path_desc {
     const char *name;          /* ground | topdown | grazing                */
     const char *preset;        /* ground: start at this camera preset       */
+    bool        have_start;    /* ground: start here instead (--start)      */
+    double      start[4];      /* x, z, direction x, z                      */
 } path_desc;
 
 /* Camera of frame f of n.  ground: 2 m above the terrain, looking 150 m
@@ -363,7 +367,11 @@ static bool path_camera(const rt_pack *p, const path_desc *pd, int f, int n, rt_
     double top = p->max_height + p->height_offset;
     if (!strcmp(pd->name, "ground")) {
         double x0 = 0.3 * sx, z0 = 0.3 * sz, dx = 0.7071, dz = 0.7071;
-        if (pd->preset) {
+        if (pd->have_start) {
+            x0 = pd->start[0], z0 = pd->start[1];
+            double l = hypot(pd->start[2], pd->start[3]);
+            dx = l > 0 ? pd->start[2] / l : 1, dz = l > 0 ? pd->start[3] / l : 0;
+        } else if (pd->preset) {
             int k = rt_pack_camera_find(p, pd->preset);
             if (k < 0) {
                 fprintf(stderr, "splatbench: no camera preset '%s'\n", pd->preset);
@@ -423,6 +431,14 @@ static int cmd_render(int argc, char **argv)
         else if (!strcmp(a, "--ref")) ref_label = next;
         else if (!strcmp(a, "--path")) pd.name = next;
         else if (!strcmp(a, "--start-preset")) pd.preset = next;
+        else if (!strcmp(a, "--start")) {
+            if (sscanf(next, "%lf,%lf,%lf,%lf", &pd.start[0], &pd.start[1], &pd.start[2],
+                       &pd.start[3]) != 4) {
+                fprintf(stderr, "splatbench render: --start expects x,z,dx,dz\n");
+                return 2;
+            }
+            pd.have_start = true;
+        }
         else if (!strcmp(a, "--csv")) csv = next;
         else if (!strcmp(a, "--scene")) scene = next;
         else if (!strcmp(a, "--save")) save = next;

@@ -37,13 +37,19 @@ awk -F, '
     FILENAME ~ /compile.csv/ && $2 == "colorado" && $3 == "warm" {
         printf "| issue 3: colorado rebuild with nothing changed < 0.3 s | %.2f s wall (%.1fx the target) | %s |\n", $14, $14 / 0.3, verdict($14 < 0.3)
     }
+    # repeated builds of one size: the smallest analysis time counts
     FILENAME ~ /scale_hf.csv/ && FNR > 1 && $17 != "" {
         sc = $2; sub(/_x[0-9]+$/, "", sc)
-        n++; v = $17 + 0; lab = lab sprintf("%s%s %.1f ns", n > 1 ? ", " : "", $3, v)
-        if (n == 1 || v < lo) lo = v
-        if (n == 1 || v > hi) hi = v
+        if (!($3 in best)) { order[++n] = $3; best[$3] = $17 + 0 }
+        else if ($17 + 0 < best[$3]) best[$3] = $17 + 0
     }
     END {
+        for (i = 1; i <= n; i++) {
+            v = best[order[i]]
+            lab = lab sprintf("%s%s %.1f ns", i > 1 ? ", " : "", order[i], v)
+            if (i == 1 || v < lo) lo = v
+            if (i == 1 || v > hi) hi = v
+        }
         if (!cold) print "| issue 3: colorado cold/warm build, peak memory | not measured in this mode | not measured |"
         if (n >= 3) printf "| issue 3: analysis cost per texel flat within 30 %% over 1x/4x/16x (%s) | %s; max/min %.2f | %s |\n", sc, lab, hi / lo, verdict(hi / lo <= 1.3)
         else printf "| issue 3: analysis per texel over 1x/4x/16x | %s (fewer than 3 sizes) | not measured |\n", n ? lab : "none"
@@ -106,6 +112,7 @@ if [ -s "$O/sparse.txt" ]; then
 fi
 echo "## Not measured"
 echo
-echo "- Painted masks and parallax are measured in scene renders (groups knob_painted, knob_parallax) only in full/quick mode; smoke mode measures neither."
+echo "- Smoke mode measures no compositors but stochastic, and no painted-storage, parallax, fBm or colorado figures: see a full run."
+echo "- fp16: the shaders are recompiled with precision mediump (RelaxedPrecision in SPIR-V); a driver may still compute in fp32 (lavapipe does), then time and error equal fp32."
 echo "- Analytic normals on an analytic heightfield: only the cross vs Sobel difference is measured."
 echo "- GPU memory per variant: rss_delta_mb in render.csv is the host RSS growth when the variant's renderer is made (lavapipe's device memory is host memory; on a discrete GPU it misses device allocations)."
