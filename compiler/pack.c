@@ -254,8 +254,12 @@ static bool add_composite(build *b, job_kind kind, int index, const int *materia
             file = xasprintf(k == JOB_FLAT ? "shaders/flat_%04d" : "shaders/%04d", index);
         }
         job *j = job_add(b, k, index, file, SPV_STAGE_FRAGMENT);
+        /* The MASK debug view recomputes every layer's mask: only the
+         * über-shader carries it (the runtime draws that view with it),
+         * which keeps each composite about half as long for glslang. */
         splat_glsl_desc gd = {.title = title, .flat = k == JOB_FLAT,
-                              .painted_sparse = b->sparse_ok};
+                              .painted_sparse = b->sparse_ok,
+                              .no_mask_view = k != JOB_UBER};
         splat_composite_glsl(&b->layout, &c, &gd, &j->glsl);
     }
     if (info) {

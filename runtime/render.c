@@ -798,7 +798,9 @@ bool rt_renderer_frame(rt_renderer *r, const rt_camera *c, rt_frame_stats *st, r
         vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_GRAPHICS, r->pl.layout, 0, 2, sets, 0, NULL);
         vkCmdBindVertexBuffers(cb, 0, 1, &r->vbuf.buf, &zero);
         vkCmdBindIndexBuffer(cb, r->ibuf.buf, 0, VK_INDEX_TYPE_UINT16);
-        if (r->desc.reference == RT_REF_UBER) {
+        /* Composites carry no MASK view (compiler/pack.c): the über-shader
+         * draws it, with every material's mask. */
+        if (r->desc.reference == RT_REF_UBER || r->view == SPLAT_VIEW_MASK) {
             if (n > 0) {
                 VkPipeline pipe;
                 if (!rt_pipelines_uber(d, r->p, &r->rp, &r->pl, variant, &pipe, e)) {
