@@ -10,8 +10,9 @@
  * GPU-twin difference beyond the device's filtering precision, or on a
  * seam.
  *
- * A minimal compute path of its own: the shared harness (tests/harness)
- * binds RGBA32F sampler2Ds only, and this test needs integer arrays and
+ * The device, buffers and images are libsplatrt's (runtime/device.c); the
+ * compute pipeline is its own: the shared harness (tests/harness) binds
+ * RGBA32F sampler2Ds only, and this test needs integer arrays and
  * compressed textures.
  *
  * Measured (ctest -R gpu.sparse; on the H100 the same binary through the
@@ -38,9 +39,8 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include <vulkan/vulkan.h>
-
 #include "sparse.h"
+#include "splatrt.h"
 #include "spv.h"
 
 #define VK(call)                                                              \
@@ -53,261 +53,36 @@
         }                                                                     \
     } while (0)
 
-/* ---- device --------------------------------------------------------------- */
+/* ---- device: libsplatrt's (runtime/device.c) -------------------------------- */
 
-typedef struct gpu {
-    VkInstance instance;
-    VkDebugUtilsMessengerEXT messenger;
-    VkPhysicalDevice phys;
-    VkDevice dev;
-    VkQueue queue;
-    uint32_t family;
-    VkCommandPool pool;
-    VkPhysicalDeviceMemoryProperties mem;
-    char name[256];
-    uint32_t subtexel_bits;
-} gpu;
-
-static int validation_messages;
-
-static VKAPI_ATTR VkBool32 VKAPI_CALL on_message(
-    VkDebugUtilsMessageSeverityFlagBitsEXT sev, VkDebugUtilsMessageTypeFlagsEXT type,
-    const VkDebugUtilsMessengerCallbackDataEXT *data, void *user)
+/* A runtime call that failed: print its message and stop. */
+static void check(bool ok, rt_error *e)
 {
-    if (sev & (VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT |
-               VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT)) {
-        fprintf(stderr, "validation: %s\n", data->pMessage);
-        validation_messages++;
-    }
-    return VK_FALSE;
-}
-
-static void gpu_create(gpu *g)
-{
-    memset(g, 0, sizeof *g);
-    const char *env = getenv("SPLAT_VALIDATE");
-    bool validate = env && env[0] == '1';
-    const char *layers[] = { "VK_LAYER_KHRONOS_validation" };
-    const char *exts[] = { VK_EXT_DEBUG_UTILS_EXTENSION_NAME };
-    VkApplicationInfo app = { .sType = VK_STRUCTURE_TYPE_APPLICATION_INFO,
-                              .pApplicationName = "gpu_sparse",
-                              .apiVersion = VK_API_VERSION_1_2 };
-    VkInstanceCreateInfo ici = { .sType = VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO,
-                                 .pApplicationInfo = &app,
-                                 .enabledLayerCount = validate ? 1 : 0,
-                                 .ppEnabledLayerNames = layers,
-                                 .enabledExtensionCount = validate ? 1 : 0,
-                                 .ppEnabledExtensionNames = exts };
-    VK(vkCreateInstance(&ici, NULL, &g->instance));
-    if (validate) {
-        VkDebugUtilsMessengerCreateInfoEXT mci = {
-            .sType = VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT,
-            .messageSeverity = VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT |
-                               VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT,
-            .messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT |
-                           VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |
-                           VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT,
-            .pfnUserCallback = on_message };
-        PFN_vkCreateDebugUtilsMessengerEXT create = (PFN_vkCreateDebugUtilsMessengerEXT)
-            vkGetInstanceProcAddr(g->instance, "vkCreateDebugUtilsMessengerEXT");
-        if (create)
-            VK(create(g->instance, &mci, NULL, &g->messenger));
-    }
-    uint32_t n = 0;
-    VK(vkEnumeratePhysicalDevices(g->instance, &n, NULL));
-    if (n == 0) {
-        fprintf(stderr, "no Vulkan device\n");
+    if (!ok) {
+        fprintf(stderr, "%s\n", e->msg ? e->msg : "splatrt call failed");
         exit(1);
     }
-    VkPhysicalDevice *devs = calloc(n, sizeof *devs);
-    VK(vkEnumeratePhysicalDevices(g->instance, &n, devs));
-    const char *want = getenv("SPLAT_DEVICE");
-    g->phys = devs[0];
-    for (uint32_t i = 0; i < n; i++) {
-        VkPhysicalDeviceProperties p;
-        vkGetPhysicalDeviceProperties(devs[i], &p);
-        if ((want && strstr(p.deviceName, want)) ||
-            (!want && p.deviceType == VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU)) {
-            g->phys = devs[i];
-            break;
-        }
-    }
-    free(devs);
-    VkPhysicalDeviceProperties props;
-    vkGetPhysicalDeviceProperties(g->phys, &props);
-    snprintf(g->name, sizeof g->name, "%s", props.deviceName);
-    g->subtexel_bits = props.limits.subTexelPrecisionBits;
-    vkGetPhysicalDeviceMemoryProperties(g->phys, &g->mem);
-    VkPhysicalDeviceFeatures feats;
-    vkGetPhysicalDeviceFeatures(g->phys, &feats);
-
-    uint32_t nq = 0;
-    vkGetPhysicalDeviceQueueFamilyProperties(g->phys, &nq, NULL);
-    VkQueueFamilyProperties *qf = calloc(nq, sizeof *qf);
-    vkGetPhysicalDeviceQueueFamilyProperties(g->phys, &nq, qf);
-    g->family = UINT32_MAX;
-    for (uint32_t i = 0; i < nq && g->family == UINT32_MAX; i++)
-        if (qf[i].queueFlags & VK_QUEUE_COMPUTE_BIT)
-            g->family = i;
-    free(qf);
-    if (g->family == UINT32_MAX) {
-        fprintf(stderr, "no compute queue\n");
-        exit(1);
-    }
-    float prio = 1.0f;
-    VkDeviceQueueCreateInfo qci = { .sType = VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO,
-                                    .queueFamilyIndex = g->family, .queueCount = 1,
-                                    .pQueuePriorities = &prio };
-    VkPhysicalDeviceFeatures enable = { .textureCompressionBC = feats.textureCompressionBC };
-    VkDeviceCreateInfo dci = { .sType = VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO,
-                               .queueCreateInfoCount = 1, .pQueueCreateInfos = &qci,
-                               .pEnabledFeatures = &enable };
-    VK(vkCreateDevice(g->phys, &dci, NULL, &g->dev));
-    vkGetDeviceQueue(g->dev, g->family, 0, &g->queue);
-    VkCommandPoolCreateInfo pci = { .sType = VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO,
-                                    .flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT,
-                                    .queueFamilyIndex = g->family };
-    VK(vkCreateCommandPool(g->dev, &pci, NULL, &g->pool));
 }
 
-static void gpu_destroy(gpu *g)
+static rt_buffer buffer_new(rt_device *g, size_t size, VkBufferUsageFlags usage)
 {
-    vkDestroyCommandPool(g->dev, g->pool, NULL);
-    vkDestroyDevice(g->dev, NULL);
-    if (g->messenger) {
-        PFN_vkDestroyDebugUtilsMessengerEXT destroy = (PFN_vkDestroyDebugUtilsMessengerEXT)
-            vkGetInstanceProcAddr(g->instance, "vkDestroyDebugUtilsMessengerEXT");
-        if (destroy)
-            destroy(g->instance, g->messenger, NULL);
-    }
-    vkDestroyInstance(g->instance, NULL);
-}
-
-static VkDeviceMemory alloc_mem(gpu *g, VkMemoryRequirements req, VkMemoryPropertyFlags want)
-{
-    for (uint32_t i = 0; i < g->mem.memoryTypeCount; i++)
-        if ((req.memoryTypeBits & (1u << i)) &&
-            (g->mem.memoryTypes[i].propertyFlags & want) == want) {
-            VkMemoryAllocateInfo mai = { .sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO,
-                                         .allocationSize = req.size, .memoryTypeIndex = i };
-            VkDeviceMemory m;
-            VK(vkAllocateMemory(g->dev, &mai, NULL, &m));
-            return m;
-        }
-    fprintf(stderr, "no suitable memory type\n");
-    exit(1);
-}
-
-typedef struct buffer { VkBuffer buf; VkDeviceMemory mem; void *map; size_t size; } buffer;
-
-static buffer buffer_new(gpu *g, size_t size, VkBufferUsageFlags usage)
-{
-    buffer b = { .size = size };
-    VkBufferCreateInfo bci = { .sType = VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO,
-                               .size = size, .usage = usage };
-    VK(vkCreateBuffer(g->dev, &bci, NULL, &b.buf));
-    VkMemoryRequirements req;
-    vkGetBufferMemoryRequirements(g->dev, b.buf, &req);
-    b.mem = alloc_mem(g, req, VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT |
-                              VK_MEMORY_PROPERTY_HOST_COHERENT_BIT);
-    VK(vkBindBufferMemory(g->dev, b.buf, b.mem, 0));
-    VK(vkMapMemory(g->dev, b.mem, 0, size, 0, &b.map));
+    rt_buffer b;
+    rt_error e = { 0 };
+    check(rt_buffer_create(g, size, usage, true, &b, &e), &e);
     return b;
 }
 
-static void buffer_free(gpu *g, buffer *b)
-{
-    vkUnmapMemory(g->dev, b->mem);
-    vkDestroyBuffer(g->dev, b->buf, NULL);
-    vkFreeMemory(g->dev, b->mem, NULL);
-}
-
-typedef struct image { VkImage img; VkDeviceMemory mem; VkImageView view; } image;
-
-static VkCommandBuffer begin(gpu *g)
-{
-    VkCommandBufferAllocateInfo cai = { .sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO,
-                                        .commandPool = g->pool,
-                                        .level = VK_COMMAND_BUFFER_LEVEL_PRIMARY,
-                                        .commandBufferCount = 1 };
-    VkCommandBuffer cb;
-    VK(vkAllocateCommandBuffers(g->dev, &cai, &cb));
-    VkCommandBufferBeginInfo bi = { .sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO,
-                                    .flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT };
-    VK(vkBeginCommandBuffer(cb, &bi));
-    return cb;
-}
-
-static void submit(gpu *g, VkCommandBuffer cb)
-{
-    VK(vkEndCommandBuffer(cb));
-    VkSubmitInfo si = { .sType = VK_STRUCTURE_TYPE_SUBMIT_INFO,
-                        .commandBufferCount = 1, .pCommandBuffers = &cb };
-    VK(vkQueueSubmit(g->queue, 1, &si, VK_NULL_HANDLE));
-    VK(vkQueueWaitIdle(g->queue));
-    vkFreeCommandBuffers(g->dev, g->pool, 1, &cb);
-}
-
-static void barrier(VkCommandBuffer cb, VkImage img, uint32_t layers, VkImageLayout from,
-                    VkImageLayout to, VkAccessFlags src, VkAccessFlags dst,
-                    VkPipelineStageFlags s0, VkPipelineStageFlags s1)
-{
-    VkImageMemoryBarrier b = {
-        .sType = VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER, .srcAccessMask = src,
-        .dstAccessMask = dst, .oldLayout = from, .newLayout = to,
-        .srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED,
-        .dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED, .image = img,
-        .subresourceRange = { VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, layers } };
-    vkCmdPipelineBarrier(cb, s0, s1, 0, 0, NULL, 0, NULL, 1, &b);
-}
-
 /* A sampled image (2D or 2D array) filled from `data` (tightly packed). */
-static image image_new(gpu *g, VkFormat fmt, int w, int h, int layers, bool array,
-                       const void *data, size_t bytes)
+static rt_image image_new(rt_device *g, VkFormat fmt, int w, int h, int layers, bool array,
+                          const void *data, size_t bytes)
 {
-    image im;
-    VkImageCreateInfo ici = {
-        .sType = VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO, .imageType = VK_IMAGE_TYPE_2D,
-        .format = fmt, .extent = { (uint32_t)w, (uint32_t)h, 1 }, .mipLevels = 1,
-        .arrayLayers = (uint32_t)layers, .samples = VK_SAMPLE_COUNT_1_BIT,
-        .tiling = VK_IMAGE_TILING_OPTIMAL,
-        .usage = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT,
-        .initialLayout = VK_IMAGE_LAYOUT_UNDEFINED };
-    VK(vkCreateImage(g->dev, &ici, NULL, &im.img));
-    VkMemoryRequirements req;
-    vkGetImageMemoryRequirements(g->dev, im.img, &req);
-    im.mem = alloc_mem(g, req, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT);
-    VK(vkBindImageMemory(g->dev, im.img, im.mem, 0));
-    buffer staging = buffer_new(g, bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT);
-    memcpy(staging.map, data, bytes);
-    VkCommandBuffer cb = begin(g);
-    barrier(cb, im.img, (uint32_t)layers, VK_IMAGE_LAYOUT_UNDEFINED,
-            VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 0, VK_ACCESS_TRANSFER_WRITE_BIT,
-            VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT);
-    VkBufferImageCopy copy = {
-        .imageSubresource = { VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, (uint32_t)layers },
-        .imageExtent = { (uint32_t)w, (uint32_t)h, 1 } };
-    vkCmdCopyBufferToImage(cb, staging.buf, im.img, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &copy);
-    barrier(cb, im.img, (uint32_t)layers, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
-            VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, VK_ACCESS_TRANSFER_WRITE_BIT,
-            VK_ACCESS_SHADER_READ_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
-            VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT);
-    submit(g, cb);
-    buffer_free(g, &staging);
-    VkImageViewCreateInfo vci = {
-        .sType = VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO, .image = im.img,
-        .viewType = array ? VK_IMAGE_VIEW_TYPE_2D_ARRAY : VK_IMAGE_VIEW_TYPE_2D,
-        .format = fmt,
-        .subresourceRange = { VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, (uint32_t)layers } };
-    VK(vkCreateImageView(g->dev, &vci, NULL, &im.view));
+    rt_image im;
+    rt_error e = { 0 };
+    check(rt_image_create(g, (uint32_t)w, (uint32_t)h, (uint32_t)layers, array, 1, fmt,
+                          VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT,
+                          VK_IMAGE_ASPECT_COLOR_BIT, &im, &e), &e);
+    check(rt_image_upload(g, &im, data, bytes, &e), &e);
     return im;
-}
-
-static void image_free(gpu *g, image *im)
-{
-    vkDestroyImageView(g->dev, im->view, NULL);
-    vkDestroyImage(g->dev, im->img, NULL);
-    vkFreeMemory(g->dev, im->mem, NULL);
 }
 
 /* ---- the sampling shader ---------------------------------------------------- */
@@ -330,15 +105,15 @@ static const char shader_src[] =
     "}\n";
 
 /* Sample every point (u, v, mask) on the device. */
-static void gpu_sample(gpu *g, const sparse_masks *s, const float *pts, int n, float *out)
+static void gpu_sample(rt_device *g, const sparse_masks *s, const float *pts, int n, float *out)
 {
     VkFormat afmt = s->format == SPARSE_BC4 ? VK_FORMAT_BC4_UNORM_BLOCK : VK_FORMAT_R8_UNORM;
-    image atlas = image_new(g, afmt, s->atlas_width, s->atlas_height, 1, false,
+    rt_image atlas = image_new(g, afmt, s->atlas_width, s->atlas_height, 1, false,
                             s->atlas, s->atlas_bytes);
     size_t ncell = (size_t)s->cells_x * s->cells_z * 4 * s->layers;
-    image index = image_new(g, VK_FORMAT_R16G16B16A16_UINT, s->cells_x, s->cells_z,
+    rt_image index = image_new(g, VK_FORMAT_R16G16B16A16_UINT, s->cells_x, s->cells_z,
                             s->layers, true, s->index, ncell * 2);
-    image level = image_new(g, VK_FORMAT_R8G8B8A8_UINT, s->cells_x, s->cells_z,
+    rt_image level = image_new(g, VK_FORMAT_R8G8B8A8_UINT, s->cells_x, s->cells_z,
                             s->layers, true, s->level, ncell);
     VkSamplerCreateInfo sci = {
         .sType = VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO, .magFilter = VK_FILTER_LINEAR,
@@ -350,8 +125,8 @@ static void gpu_sample(gpu *g, const sparse_masks *s, const float *pts, int n, f
     VK(vkCreateSampler(g->dev, &sci, NULL, &linear));
     sci.magFilter = sci.minFilter = VK_FILTER_NEAREST;
     VK(vkCreateSampler(g->dev, &sci, NULL, &nearest));
-    buffer in = buffer_new(g, (size_t)n * 16, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
-    buffer res = buffer_new(g, (size_t)n * 4, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+    rt_buffer in = buffer_new(g, (size_t)n * 16, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
+    rt_buffer res = buffer_new(g, (size_t)n * 4, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT);
     memcpy(in.map, pts, (size_t)n * 16);
 
     VkDescriptorSetLayoutBinding b[5];
@@ -419,7 +194,9 @@ static void gpu_sample(gpu *g, const sparse_masks *s, const float *pts, int n, f
 
     struct { float size[2]; uint32_t n, pad; } push = {
         { (float)s->width, (float)s->height }, (uint32_t)n, 0 };
-    VkCommandBuffer cb = begin(g);
+    VkCommandBuffer cb;
+    rt_error e = { 0 };
+    check(rt_oneshot_begin(g, &cb, &e), &e);
     vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, pipe);
     vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, pl, 0, 1, &ds, 0, NULL);
     vkCmdPushConstants(cb, pl, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof push, &push);
@@ -429,7 +206,7 @@ static void gpu_sample(gpu *g, const sparse_masks *s, const float *pts, int n, f
                            .dstAccessMask = VK_ACCESS_HOST_READ_BIT };
     vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_HOST_BIT,
                          0, 1, &mb, 0, NULL, 0, NULL);
-    submit(g, cb);
+    check(rt_oneshot_end(g, cb, &e), &e);
     memcpy(out, res.map, (size_t)n * 4);
 
     vkDestroyPipeline(g->dev, pipe, NULL);
@@ -439,11 +216,11 @@ static void gpu_sample(gpu *g, const sparse_masks *s, const float *pts, int n, f
     vkDestroyDescriptorSetLayout(g->dev, dsl, NULL);
     vkDestroySampler(g->dev, linear, NULL);
     vkDestroySampler(g->dev, nearest, NULL);
-    buffer_free(g, &in);
-    buffer_free(g, &res);
-    image_free(g, &atlas);
-    image_free(g, &index);
-    image_free(g, &level);
+    rt_buffer_destroy(g, &in);
+    rt_buffer_destroy(g, &res);
+    rt_image_destroy(g, &atlas);
+    rt_image_destroy(g, &index);
+    rt_image_destroy(g, &level);
 }
 
 /* ---- content and the checks ----------------------------------------------- */
@@ -491,7 +268,7 @@ static uint8_t *gen(int w, int h, int kind, uint32_t seed)
 
 typedef struct result { double gpu_ref, gpu_twin, twin_ref, seam; } result;
 
-static result run_option(gpu *g, const char *name, sparse_format fmt, int max_level,
+static result run_option(rt_device *g, const char *name, sparse_format fmt, int max_level,
                          double max_error, int w, int h, uint8_t *const *rasters, int nm)
 {
     sparse_mask_desc md[8];
@@ -559,13 +336,15 @@ static result run_option(gpu *g, const char *name, sparse_format fmt, int max_le
 
 int main(void)
 {
-    gpu g;
-    gpu_create(&g);
+    rt_device g;
+    rt_error e = { 0 };
+    check(rt_device_create(&g, NULL, &e), &e);
     int w = 300, h = 203, nm = 5;
     uint8_t *r[5] = { gen(w, h, 0, 1), gen(w, h, 1, 2), gen(w, h, 2, 3), NULL, NULL };
     r[3] = r[0];
     r[4] = gen(w, h, 0, 4);
-    printf("device: %s (subTexelPrecisionBits %u)\n", g.name, g.subtexel_bits);
+    printf("device: %s (subTexelPrecisionBits %u)\n", g.props.deviceName,
+           g.props.limits.subTexelPrecisionBits);
     printf("%-22s %8s %10s %10s %10s %10s %10s\n", "option", "points", "gpu-ref",
            "gpu-twin", "twin-ref", "seam", "size");
     /* The GPU weights bilinear filtering with subTexelPrecisionBits bits:
@@ -573,12 +352,13 @@ int main(void)
      * value by that times the texel difference (<= 1) in each of the two
      * axes; a device may also keep the filtered value of an 8-bit texture
      * at 8 bits (llvmpipe does), off by up to 1/255 more. */
-    double filt = 2.0 * ldexp(1.0, -(int)g.subtexel_bits) + 1.0 / 255.0 + 1e-5;
+    double filt = 2.0 * ldexp(1.0, -(int)g.props.limits.subTexelPrecisionBits) + 1.0 / 255.0 + 1e-5;
     result r8 = run_option(&g, "R8", SPARSE_R8, 0, 0, w, h, r, nm);
     result bc4 = run_option(&g, "BC4", SPARSE_BC4, 0, 0, w, h, r, nm);
     result red = run_option(&g, "R8, levels <= 2 (0.05)", SPARSE_R8, 2, 0.05, w, h, r, nm);
     result redbc = run_option(&g, "BC4, levels <= 2 (1.0)", SPARSE_BC4, 2, 1.0, w, h, r, nm);
-    printf("filtering precision bound %.5f; validation messages: %d\n", filt, validation_messages);
+    printf("filtering precision bound %.5f; validation messages: %d\n", filt,
+           rt_device_messages(&g));
     int fails = 0;
 #define CHECK(c) do { if (!(c)) { fprintf(stderr, "FAILED: %s\n", #c); fails++; } } while (0)
     CHECK(r8.gpu_twin <= filt);
@@ -589,9 +369,9 @@ int main(void)
     CHECK(red.gpu_twin <= filt);
     CHECK(red.twin_ref <= 0.05 + 1e-4);
     CHECK(redbc.gpu_twin <= filt + 0.5 / 255.0);
-    CHECK(validation_messages == 0);
+    CHECK(rt_device_messages(&g) == 0);
     for (int i = 0; i < 5; i++)
         if (i != 3) free(r[i]);
-    gpu_destroy(&g);
+    rt_device_destroy(&g);
     return fails ? 1 : 0;
 }
