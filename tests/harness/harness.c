@@ -11,45 +11,18 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include <vulkan/vulkan.h>
-
+#include "splatrt.h"
 #include "spv.h"
 
 struct harness {
-    VkInstance               instance;
-    VkDebugUtilsMessengerEXT messenger;
-    VkPhysicalDevice         phys;
-    VkPhysicalDeviceProperties props;
-    VkPhysicalDeviceMemoryProperties mem;
-    VkDevice                 device;
-    uint32_t                 family;
-    VkQueue                  queue;
-    VkCommandPool            pool;
-    VkCommandBuffer          cmd;
-    VkFence                  fence;
-    bool                     validate;
-    int                      messages;    /* validation warnings + errors */
+    rt_device       rt;         /* instance, device, queue, pool, messenger:
+                                   libsplatrt's (runtime/device.c)       */
+    VkCommandBuffer cmd;
+    VkFence         fence;
+    bool            validate;
 };
 
 /* ---- errors ------------------------------------------------------------ */
-
-static const char *vk_result_name(VkResult r)
-{
-    switch (r) {
-#define R(x) case x: return #x;
-    R(VK_SUCCESS) R(VK_NOT_READY) R(VK_TIMEOUT) R(VK_INCOMPLETE)
-    R(VK_ERROR_OUT_OF_HOST_MEMORY) R(VK_ERROR_OUT_OF_DEVICE_MEMORY)
-    R(VK_ERROR_INITIALIZATION_FAILED) R(VK_ERROR_DEVICE_LOST)
-    R(VK_ERROR_MEMORY_MAP_FAILED) R(VK_ERROR_LAYER_NOT_PRESENT)
-    R(VK_ERROR_EXTENSION_NOT_PRESENT) R(VK_ERROR_FEATURE_NOT_PRESENT)
-    R(VK_ERROR_INCOMPATIBLE_DRIVER) R(VK_ERROR_TOO_MANY_OBJECTS)
-    R(VK_ERROR_FORMAT_NOT_SUPPORTED) R(VK_ERROR_FRAGMENTED_POOL)
-    R(VK_ERROR_OUT_OF_POOL_MEMORY) R(VK_ERROR_INVALID_SHADER_NV)
-    R(VK_ERROR_UNKNOWN)
-#undef R
-    default: return "VkResult(?)";
-    }
-}
 
 __attribute__((format(printf, 2, 3)))
 static void set_err(char **err, const char *fmt, ...)
@@ -74,112 +47,16 @@ static void set_err(char **err, const char *fmt, ...)
         VkResult vk_r_ = (call);                                          \
         if (vk_r_ != VK_SUCCESS) {                                        \
             set_err(err, "%s:%d: %s: %s", __FILE__, __LINE__, #call,      \
-                    vk_result_name(vk_r_));                               \
+                    rt_vk_result_name(vk_r_));                               \
             goto fail;                                                    \
         }                                                                 \
     } while (0)
 
 /* ---- instance and device ------------------------------------------------ */
 
-static VKAPI_ATTR VkBool32 VKAPI_CALL
-on_message(VkDebugUtilsMessageSeverityFlagBitsEXT severity,
-           VkDebugUtilsMessageTypeFlagsEXT type,
-           const VkDebugUtilsMessengerCallbackDataEXT *data, void *user)
-{
-    harness *h = user;
-    if (severity & (VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT |
-                    VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT)) {
-        h->messages++;
-        fprintf(stderr, "vulkan validation: %s\n",
-                data && data->pMessage ? data->pMessage : "(no message)");
-    }
-    return VK_FALSE;
-}
-
-static bool has_layer(const char *name)
-{
-    uint32_t n = 0;
-    if (vkEnumerateInstanceLayerProperties(&n, NULL) != VK_SUCCESS)
-        return false;
-    VkLayerProperties *l = calloc(n ? n : 1, sizeof *l);
-    bool found = false;
-    if (l && vkEnumerateInstanceLayerProperties(&n, l) == VK_SUCCESS)
-        for (uint32_t i = 0; i < n && !found; i++)
-            found = strcmp(l[i].layerName, name) == 0;
-    free(l);
-    return found;
-}
-
-/* Rank a device: a name match wins; otherwise discrete > integrated >
- * virtual > CPU (lavapipe) > other. */
-static int device_rank(const VkPhysicalDeviceProperties *p, const char *want)
-{
-    if (want && *want)
-        return strstr(p->deviceName, want) ? 100 : -1;
-    switch (p->deviceType) {
-    case VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU:   return 5;
-    case VK_PHYSICAL_DEVICE_TYPE_INTEGRATED_GPU: return 4;
-    case VK_PHYSICAL_DEVICE_TYPE_VIRTUAL_GPU:    return 3;
-    case VK_PHYSICAL_DEVICE_TYPE_CPU:            return 2;
-    default:                                     return 1;
-    }
-}
-
-static bool pick_device(harness *h, const char *want, char **err)
-{
-    uint32_t n = 0;
-    VkPhysicalDevice *devs = NULL;
-    VK(vkEnumeratePhysicalDevices(h->instance, &n, NULL));
-    if (n == 0) {
-        set_err(err, "no Vulkan device (is mesa-vulkan-drivers installed?)");
-        return false;
-    }
-    devs = calloc(n, sizeof *devs);
-    if (!devs) {
-        set_err(err, "out of memory");
-        return false;
-    }
-    VK(vkEnumeratePhysicalDevices(h->instance, &n, devs));
-    int best = -1;
-    for (uint32_t i = 0; i < n; i++) {
-        VkPhysicalDeviceProperties p;
-        vkGetPhysicalDeviceProperties(devs[i], &p);
-        if (p.apiVersion < VK_API_VERSION_1_2)
-            continue;
-        uint32_t nq = 0;
-        vkGetPhysicalDeviceQueueFamilyProperties(devs[i], &nq, NULL);
-        VkQueueFamilyProperties *q = calloc(nq ? nq : 1, sizeof *q);
-        uint32_t fam = UINT32_MAX;
-        if (q) {
-            vkGetPhysicalDeviceQueueFamilyProperties(devs[i], &nq, q);
-            for (uint32_t k = 0; k < nq && fam == UINT32_MAX; k++)
-                if (q[k].queueFlags & VK_QUEUE_COMPUTE_BIT)
-                    fam = k;
-            free(q);
-        }
-        int rank = device_rank(&p, want);
-        if (fam != UINT32_MAX && rank > best) {
-            best = rank;
-            h->phys = devs[i];
-            h->props = p;
-            h->family = fam;
-        }
-    }
-    free(devs);
-    if (best < 0) {
-        if (want && *want)
-            set_err(err, "no Vulkan 1.2 device with compute named like '%s'", want);
-        else
-            set_err(err, "no Vulkan 1.2 device with a compute queue");
-        return false;
-    }
-    vkGetPhysicalDeviceMemoryProperties(h->phys, &h->mem);
-    return true;
-fail:
-    free(devs);
-    return false;
-}
-
+/* The device is libsplatrt's (rt_device_create: validation layer and
+ * messenger, SPLAT_DEVICE, discrete GPU first); here only the harness's
+ * stricter rule that asked-for validation must be there. */
 harness *harness_create(const harness_desc *desc, char **err)
 {
     harness_desc dd = desc ? *desc : (harness_desc){0};
@@ -194,83 +71,31 @@ harness *harness_create(const harness_desc *desc, char **err)
     h->validate = dd.validate || (env && strcmp(env, "1") == 0);
     if (!dd.device)
         dd.device = getenv("SPLAT_DEVICE");
-
-    const char *layers[] = { "VK_LAYER_KHRONOS_validation" };
-    const char *exts[] = { VK_EXT_DEBUG_UTILS_EXTENSION_NAME };
-    if (h->validate && !has_layer(layers[0])) {
-        set_err(err, "validation requested (SPLAT_VALIDATE=1) but %s is not "
-                "installed (Debian: vulkan-validationlayers)", layers[0]);
+    rt_device_desc rd = { .validate = h->validate, .select = dd.device };
+    rt_error e = { 0 };
+    if (!rt_device_create(&h->rt, &rd, &e)) {
+        if (e.id == RT_E_NO_DEVICE && dd.device && *dd.device)
+            set_err(err, "no Vulkan 1.2 device named like '%s'", dd.device);
+        else
+            set_err(err, "%s", e.msg ? e.msg : "rt_device_create failed");
+        rt_error_clear(&e);
         goto fail;
     }
-    VkApplicationInfo app = {
-        .sType = VK_STRUCTURE_TYPE_APPLICATION_INFO,
-        .pApplicationName = "splat-harness",
-        .pEngineName = "splatc",
-        .apiVersion = VK_API_VERSION_1_2,
-    };
-    VkDebugUtilsMessengerCreateInfoEXT mci = {
-        .sType = VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT,
-        .messageSeverity = VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT |
-                           VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT,
-        .messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT |
-                       VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |
-                       VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT,
-        .pfnUserCallback = on_message,
-        .pUserData = h,
-    };
-    VkInstanceCreateInfo ici = {
-        .sType = VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO,
-        /* chained so instance creation and destruction are covered too */
-        .pNext = h->validate ? &mci : NULL,
-        .pApplicationInfo = &app,
-        .enabledLayerCount = h->validate ? 1 : 0,
-        .ppEnabledLayerNames = layers,
-        .enabledExtensionCount = h->validate ? 1 : 0,
-        .ppEnabledExtensionNames = exts,
-    };
-    VK(vkCreateInstance(&ici, NULL, &h->instance));
-    if (h->validate) {
-        PFN_vkCreateDebugUtilsMessengerEXT create =
-            (PFN_vkCreateDebugUtilsMessengerEXT)vkGetInstanceProcAddr(
-                h->instance, "vkCreateDebugUtilsMessengerEXT");
-        if (!create) {
-            set_err(err, "vkCreateDebugUtilsMessengerEXT not found");
-            goto fail;
-        }
-        VK(create(h->instance, &mci, NULL, &h->messenger));
-    }
-    if (!pick_device(h, dd.device, err))
+    if (h->validate && !h->rt.validating) {
+        set_err(err, "validation requested (SPLAT_VALIDATE=1) but "
+                "VK_LAYER_KHRONOS_validation is not installed (Debian: "
+                "vulkan-validationlayers)");
         goto fail;
-
-    float prio = 1.0f;
-    VkDeviceQueueCreateInfo qci = {
-        .sType = VK_STRUCTURE_TYPE_DEVICE_QUEUE_CREATE_INFO,
-        .queueFamilyIndex = h->family,
-        .queueCount = 1,
-        .pQueuePriorities = &prio,
-    };
-    VkDeviceCreateInfo dci = {
-        .sType = VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO,
-        .queueCreateInfoCount = 1,
-        .pQueueCreateInfos = &qci,
-    };
-    VK(vkCreateDevice(h->phys, &dci, NULL, &h->device));
-    vkGetDeviceQueue(h->device, h->family, 0, &h->queue);
-    VkCommandPoolCreateInfo pci = {
-        .sType = VK_STRUCTURE_TYPE_COMMAND_POOL_CREATE_INFO,
-        .flags = VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT,
-        .queueFamilyIndex = h->family,
-    };
-    VK(vkCreateCommandPool(h->device, &pci, NULL, &h->pool));
+    }
     VkCommandBufferAllocateInfo cai = {
         .sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO,
-        .commandPool = h->pool,
+        .commandPool = h->rt.pool,
         .level = VK_COMMAND_BUFFER_LEVEL_PRIMARY,
         .commandBufferCount = 1,
     };
-    VK(vkAllocateCommandBuffers(h->device, &cai, &h->cmd));
+    VK(vkAllocateCommandBuffers(h->rt.dev, &cai, &h->cmd));
     VkFenceCreateInfo fci = { .sType = VK_STRUCTURE_TYPE_FENCE_CREATE_INFO };
-    VK(vkCreateFence(h->device, &fci, NULL, &h->fence));
+    VK(vkCreateFence(h->rt.dev, &fci, NULL, &h->fence));
     return h;
 fail:
     harness_destroy(h);
@@ -281,31 +106,20 @@ int harness_destroy(harness *h)
 {
     if (!h)
         return 0;
-    if (h->device) {
-        vkDeviceWaitIdle(h->device);
+    if (h->rt.dev) {
+        vkDeviceWaitIdle(h->rt.dev);
         if (h->fence)
-            vkDestroyFence(h->device, h->fence, NULL);
-        if (h->pool)
-            vkDestroyCommandPool(h->device, h->pool, NULL);
-        vkDestroyDevice(h->device, NULL);
+            vkDestroyFence(h->rt.dev, h->fence, NULL);
     }
-    if (h->messenger) {
-        PFN_vkDestroyDebugUtilsMessengerEXT destroy =
-            (PFN_vkDestroyDebugUtilsMessengerEXT)vkGetInstanceProcAddr(
-                h->instance, "vkDestroyDebugUtilsMessengerEXT");
-        if (destroy)
-            destroy(h->instance, h->messenger, NULL);
-    }
-    if (h->instance)
-        vkDestroyInstance(h->instance, NULL);
-    int n = h->messages;
+    rt_device_destroy(&h->rt);      /* the command buffer goes with its pool */
+    int n = rt_device_messages(&h->rt);
     free(h);
     return n;
 }
 
-const char *harness_device_name(const harness *h) { return h->props.deviceName; }
+const char *harness_device_name(const harness *h) { return h->rt.props.deviceName; }
 bool harness_validating(const harness *h) { return h->validate; }
-int harness_validation_count(const harness *h) { return h->messages; }
+int harness_validation_count(const harness *h) { return rt_device_messages(&h->rt); }
 
 /* ---- resources of one run ----------------------------------------------- */
 
@@ -326,9 +140,9 @@ typedef struct himage {
 static bool find_memory(const harness *h, uint32_t bits, VkMemoryPropertyFlags want,
                         uint32_t *type)
 {
-    for (uint32_t i = 0; i < h->mem.memoryTypeCount; i++)
+    for (uint32_t i = 0; i < h->rt.mem.memoryTypeCount; i++)
         if ((bits & (1u << i)) &&
-            (h->mem.memoryTypes[i].propertyFlags & want) == want) {
+            (h->rt.mem.memoryTypes[i].propertyFlags & want) == want) {
             *type = i;
             return true;
         }
@@ -349,7 +163,7 @@ static bool alloc_memory(harness *h, VkMemoryRequirements req,
         .allocationSize = req.size,
         .memoryTypeIndex = type,
     };
-    VK(vkAllocateMemory(h->device, &mai, NULL, mem));
+    VK(vkAllocateMemory(h->rt.dev, &mai, NULL, mem));
     return true;
 fail:
     return false;
@@ -365,14 +179,14 @@ static bool buffer_create(harness *h, VkDeviceSize size, VkBufferUsageFlags usag
         .usage = usage,
         .sharingMode = VK_SHARING_MODE_EXCLUSIVE,
     };
-    VK(vkCreateBuffer(h->device, &bci, NULL, &b->buf));
+    VK(vkCreateBuffer(h->rt.dev, &bci, NULL, &b->buf));
     VkMemoryRequirements req;
-    vkGetBufferMemoryRequirements(h->device, b->buf, &req);
+    vkGetBufferMemoryRequirements(h->rt.dev, b->buf, &req);
     if (!alloc_memory(h, req, VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT |
                               VK_MEMORY_PROPERTY_HOST_COHERENT_BIT, &b->mem, err))
         return false;
-    VK(vkBindBufferMemory(h->device, b->buf, b->mem, 0));
-    VK(vkMapMemory(h->device, b->mem, 0, VK_WHOLE_SIZE, 0, &b->map));
+    VK(vkBindBufferMemory(h->rt.dev, b->buf, b->mem, 0));
+    VK(vkMapMemory(h->rt.dev, b->mem, 0, VK_WHOLE_SIZE, 0, &b->map));
     memset(b->map, 0, size);
     b->size = size;
     return true;
@@ -383,9 +197,9 @@ fail:
 static void buffer_destroy(harness *h, hbuffer *b)
 {
     if (b->buf)
-        vkDestroyBuffer(h->device, b->buf, NULL);
+        vkDestroyBuffer(h->rt.dev, b->buf, NULL);
     if (b->mem)
-        vkFreeMemory(h->device, b->mem, NULL);   /* unmaps */
+        vkFreeMemory(h->rt.dev, b->mem, NULL);   /* unmaps */
     memset(b, 0, sizeof *b);
 }
 
@@ -405,13 +219,13 @@ static bool image_create(harness *h, const harness_image *src, himage *im,
 {
     const VkFormat fmt = VK_FORMAT_R32G32B32A32_SFLOAT;
     VkFormatProperties fp;
-    vkGetPhysicalDeviceFormatProperties(h->phys, fmt, &fp);
+    vkGetPhysicalDeviceFormatProperties(h->rt.phys, fmt, &fp);
     VkFormatFeatureFlags need = VK_FORMAT_FEATURE_SAMPLED_IMAGE_BIT;
     if (src->filter == IR_FILTER_LINEAR)
         need |= VK_FORMAT_FEATURE_SAMPLED_IMAGE_FILTER_LINEAR_BIT;
     if ((fp.optimalTilingFeatures & need) != need) {
         set_err(err, "%s cannot sample RGBA32F images with this filter",
-                h->props.deviceName);
+                h->rt.props.deviceName);
         return false;
     }
     VkImageCreateInfo ici = {
@@ -427,12 +241,12 @@ static bool image_create(harness *h, const harness_image *src, himage *im,
         .sharingMode = VK_SHARING_MODE_EXCLUSIVE,
         .initialLayout = VK_IMAGE_LAYOUT_UNDEFINED,
     };
-    VK(vkCreateImage(h->device, &ici, NULL, &im->img));
+    VK(vkCreateImage(h->rt.dev, &ici, NULL, &im->img));
     VkMemoryRequirements req;
-    vkGetImageMemoryRequirements(h->device, im->img, &req);
+    vkGetImageMemoryRequirements(h->rt.dev, im->img, &req);
     if (!alloc_memory(h, req, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT, &im->mem, err))
         return false;
-    VK(vkBindImageMemory(h->device, im->img, im->mem, 0));
+    VK(vkBindImageMemory(h->rt.dev, im->img, im->mem, 0));
     VkImageViewCreateInfo vci = {
         .sType = VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO,
         .image = im->img,
@@ -440,7 +254,7 @@ static bool image_create(harness *h, const harness_image *src, himage *im,
         .format = fmt,
         .subresourceRange = { VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1 },
     };
-    VK(vkCreateImageView(h->device, &vci, NULL, &im->view));
+    VK(vkCreateImageView(h->rt.dev, &vci, NULL, &im->view));
     VkFilter f = src->filter == IR_FILTER_NEAREST ? VK_FILTER_NEAREST : VK_FILTER_LINEAR;
     VkSamplerAddressMode am = address_mode(src->wrap);
     VkSamplerCreateInfo sci = {
@@ -453,7 +267,7 @@ static bool image_create(harness *h, const harness_image *src, himage *im,
         .addressModeW = am,
         .maxLod = 0.0f,
     };
-    VK(vkCreateSampler(h->device, &sci, NULL, &im->sampler));
+    VK(vkCreateSampler(h->rt.dev, &sci, NULL, &im->sampler));
     return true;
 fail:
     return false;
@@ -462,13 +276,13 @@ fail:
 static void image_destroy(harness *h, himage *im)
 {
     if (im->sampler)
-        vkDestroySampler(h->device, im->sampler, NULL);
+        vkDestroySampler(h->rt.dev, im->sampler, NULL);
     if (im->view)
-        vkDestroyImageView(h->device, im->view, NULL);
+        vkDestroyImageView(h->rt.dev, im->view, NULL);
     if (im->img)
-        vkDestroyImage(h->device, im->img, NULL);
+        vkDestroyImage(h->rt.dev, im->img, NULL);
     if (im->mem)
-        vkFreeMemory(h->device, im->mem, NULL);
+        vkFreeMemory(h->rt.dev, im->mem, NULL);
     memset(im, 0, sizeof *im);
 }
 
@@ -571,7 +385,7 @@ bool harness_run(harness *h, const harness_dispatch *d, char **err)
         .codeSize = d->nwords * sizeof(uint32_t),
         .pCode = d->spv,
     };
-    VK(vkCreateShaderModule(h->device, &smci, NULL, &module));
+    VK(vkCreateShaderModule(h->rt.dev, &smci, NULL, &module));
     for (uint32_t b = 0; b < nbind; b++)
         binds[b] = (VkDescriptorSetLayoutBinding){
             .binding = b,
@@ -585,7 +399,7 @@ bool harness_run(harness *h, const harness_dispatch *d, char **err)
         .bindingCount = nbind,
         .pBindings = binds,
     };
-    VK(vkCreateDescriptorSetLayout(h->device, &dslci, NULL, &dsl));
+    VK(vkCreateDescriptorSetLayout(h->rt.dev, &dslci, NULL, &dsl));
     VkPushConstantRange pcr = {
         .stageFlags = VK_SHADER_STAGE_COMPUTE_BIT,
         .offset = 0,
@@ -598,7 +412,7 @@ bool harness_run(harness *h, const harness_dispatch *d, char **err)
         .pushConstantRangeCount = d->push_bytes ? 1 : 0,
         .pPushConstantRanges = &pcr,
     };
-    VK(vkCreatePipelineLayout(h->device, &plci, NULL, &layout));
+    VK(vkCreatePipelineLayout(h->rt.dev, &plci, NULL, &layout));
     VkComputePipelineCreateInfo cpci = {
         .sType = VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO,
         .stage = {
@@ -609,7 +423,7 @@ bool harness_run(harness *h, const harness_dispatch *d, char **err)
         },
         .layout = layout,
     };
-    VK(vkCreateComputePipelines(h->device, VK_NULL_HANDLE, 1, &cpci, NULL, &pipeline));
+    VK(vkCreateComputePipelines(h->rt.dev, VK_NULL_HANDLE, 1, &cpci, NULL, &pipeline));
 
     /* Descriptors. */
     VkDescriptorPoolSize sizes[2] = {
@@ -622,14 +436,14 @@ bool harness_run(harness *h, const harness_dispatch *d, char **err)
         .poolSizeCount = nimg ? 2 : 1,
         .pPoolSizes = sizes,
     };
-    VK(vkCreateDescriptorPool(h->device, &dpci, NULL, &dpool));
+    VK(vkCreateDescriptorPool(h->rt.dev, &dpci, NULL, &dpool));
     VkDescriptorSetAllocateInfo dsai = {
         .sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO,
         .descriptorPool = dpool,
         .descriptorSetCount = 1,
         .pSetLayouts = &dsl,
     };
-    VK(vkAllocateDescriptorSets(h->device, &dsai, &set));
+    VK(vkAllocateDescriptorSets(h->rt.dev, &dsai, &set));
     VkDescriptorBufferInfo binfo[2] = {
         { in.buf, 0, VK_WHOLE_SIZE },
         { out.buf, 0, VK_WHOLE_SIZE },
@@ -652,7 +466,7 @@ bool harness_run(harness *h, const harness_dispatch *d, char **err)
             writes[b].pImageInfo = &iinfo[b - 2];
         }
     }
-    vkUpdateDescriptorSets(h->device, nbind, writes, 0, NULL);
+    vkUpdateDescriptorSets(h->rt.dev, nbind, writes, 0, NULL);
 
     /* Record: upload images, dispatch, make the output visible to the host. */
     VK(vkResetCommandBuffer(h->cmd, 0));
@@ -700,26 +514,26 @@ bool harness_run(harness *h, const harness_dispatch *d, char **err)
         .commandBufferCount = 1,
         .pCommandBuffers = &h->cmd,
     };
-    VK(vkResetFences(h->device, 1, &h->fence));
-    VK(vkQueueSubmit(h->queue, 1, &si, h->fence));
+    VK(vkResetFences(h->rt.dev, 1, &h->fence));
+    VK(vkQueueSubmit(h->rt.queue, 1, &si, h->fence));
     /* 60 s: lavapipe on two busy cores is slow, but never that slow. */
-    VK(vkWaitForFences(h->device, 1, &h->fence, VK_TRUE, 60ull * 1000000000ull));
+    VK(vkWaitForFences(h->rt.dev, 1, &h->fence, VK_TRUE, 60ull * 1000000000ull));
     memcpy(d->output, out.map, d->output_bytes);
     ok = true;
 
 fail:
-    if (h->device)
-        vkQueueWaitIdle(h->queue);
+    if (h->rt.dev)
+        vkQueueWaitIdle(h->rt.queue);
     if (pipeline)
-        vkDestroyPipeline(h->device, pipeline, NULL);
+        vkDestroyPipeline(h->rt.dev, pipeline, NULL);
     if (layout)
-        vkDestroyPipelineLayout(h->device, layout, NULL);
+        vkDestroyPipelineLayout(h->rt.dev, layout, NULL);
     if (dpool)
-        vkDestroyDescriptorPool(h->device, dpool, NULL);
+        vkDestroyDescriptorPool(h->rt.dev, dpool, NULL);
     if (dsl)
-        vkDestroyDescriptorSetLayout(h->device, dsl, NULL);
+        vkDestroyDescriptorSetLayout(h->rt.dev, dsl, NULL);
     if (module)
-        vkDestroyShaderModule(h->device, module, NULL);
+        vkDestroyShaderModule(h->rt.dev, module, NULL);
     for (int i = 0; images && staging && i < nimg; i++) {
         image_destroy(h, &images[i]);
         buffer_destroy(h, &staging[i]);

@@ -31,9 +31,10 @@ typedef struct harness harness;
 typedef struct harness_desc {
     bool        validate;  /* validation layer + messenger; also turned on
                               by SPLAT_VALIDATE=1 in the environment       */
-    const char *device;    /* substring of the device name to pick; NULL:
-                              $SPLAT_DEVICE, else the first discrete GPU,
-                              else the first integrated, else any         */
+    const char *device;    /* device index or name substring (any case) to
+                              pick; NULL: $SPLAT_DEVICE, else the first
+                              discrete GPU, else integrated, else any
+                              (rt_device_desc.select)                     */
 } harness_desc;
 
 /* NULL on failure with *err (malloc'd, caller frees) saying why. */
