@@ -22,7 +22,7 @@
 # --quick: the full set of comparisons with fewer frames (a fast GPU run).
 # --frames N: frames per camera path (medians over them; default 4, smoke 2).
 # --keep-work: keep OUT/work (packs, scene mirrors, the last frame of every
-# variant as RGBA32F); by default the images are deleted at the end.
+# variant as RGBA32F); by default it is deleted at the end.
 set -eu
 
 if [ $# -lt 1 ]; then
@@ -173,6 +173,7 @@ for k in $KS; do
     # three builds each: the machine is shared, the smallest analysis time
     # of the three is the one least disturbed (summary.sh takes it)
     for rep in 1 2 3; do
+        rm -rf "$W/pack-hf"   # an up-to-date pack would skip the analysis
         build_row "x$((k * k))" "$d/scene.sg" "$W/pack-hf" --cache "$W/cache-$HS"
         [ "$MODE" = smoke ] && break
     done
@@ -255,7 +256,7 @@ render() {  # GROUP SCENE PATH SIZE VARIANT... (first variant = reference)
     preset=""
     [ "$scene" = colorado ] && [ "$path" = ground ] && preset="--start-preset ${PRESET:-trinidad}"
     [ "$scene" = billingsley ] && [ "$path" = ground ] && preset="--start-preset ground"
-    [ -n "${START:-}" ] && preset="--start $START"
+    [ -n "${GROUND_START:-}" ] && preset="--start $GROUND_START"
     mkdir -p "$W/img/$group-$scene-$path-$size"
     # shellcheck disable=SC2086
     "$BENCH" render --pack "$W/$scene" $args --path "$path" $preset --size "$size" \
@@ -322,8 +323,10 @@ else
     # flank of Blanca Peak (parallax fades out beyond 300 m)
     p4=$(knob_pack colorado par4 rock "s/: *parallax8 /: parallax4 /")
     p16=$(knob_pack colorado par16 rock "s/: *parallax8 /: parallax16 /")
-    START=45000,47087,1,0 render knob_parallax colorado ground 1280x720 "parallax16=composite,pack=$p16" \
+    GROUND_START=45000,47087,1,0
+    render knob_parallax colorado ground 1280x720 "parallax16=composite,pack=$p16" \
         parallax8=composite "parallax4=composite,pack=$p4"
+    GROUND_START=""
     # painted masks: dense raster (the reference) vs sparse R8, BC4 (the
     # default) and BC4 with every mask limited to quad-tree level 2
     KNOB_BUILD_ARGS="--painted dense"
@@ -378,6 +381,7 @@ if command -v gnuplot >/dev/null 2>&1; then
 else
     log "gnuplot not installed: plots skipped"
 fi
-[ "$KEEP" = yes ] || rm -rf "$W/img"
+# the work folder holds packs and images (hundreds of MB): gone unless kept
+[ "$KEEP" = yes ] || rm -rf "$W"
 log "done: $OUT/summary.md"
 cat "$OUT/summary.md"
