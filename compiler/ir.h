@@ -325,6 +325,11 @@ typedef struct ir_env {
 
 /* Double-precision reference value of `r` (w = ir_type_width components). */
 void ir_eval(const ir *ir, ir_ref r, const ir_env *env, double out[4]);
+/* One step of ir_eval: node `id`'s value at `env` (not NULL) into
+ * vals[id], from its operands' values already in `vals` (4 per node,
+ * indexed by id).  For walks that inspect or perturb every node's value
+ * (the harness's fp32 sensitivity analysis, tests/harness/harness_ref.c). */
+void ir_eval_node(const ir *ir, uint32_t id, const ir_env *env, double (*vals)[4]);
 
 typedef struct ir_iv { double lo, hi; } ir_iv;
 

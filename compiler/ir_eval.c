@@ -33,8 +33,7 @@ static void eval_input(const ir_env *env, uint32_t which, double *out)
     }
 }
 
-/* Evaluate node `id` whose operands are already in `vals` (4 per node). */
-static void eval_node(const ir *ir, uint32_t id, const ir_env *env, double (*vals)[4])
+void ir_eval_node(const ir *ir, uint32_t id, const ir_env *env, double (*vals)[4])
 {
     const ir_node *n = &ir->nodes[id];
     double *out = vals[id];
@@ -105,7 +104,7 @@ void ir_eval(const ir *ir, ir_ref r, const ir_env *env, double out[4])
                 need[ir->nodes[id].arg[i].id] = 1;
     for (uint32_t id = 1; id <= r.id; id++)
         if (need[id])
-            eval_node(ir, id, env, vals);
+            ir_eval_node(ir, id, env, vals);
     memcpy(out, vals[r.id], 4 * sizeof(double));
     free(vals);
     free(need);

@@ -2,9 +2,9 @@
  * rounding (harness.h, harness_reference).
  *
  * How: the DAG under the root is walked in id order (ids are topological),
- * each node evaluated with the op table's own eval function (the semantics
- * written once in ir_ops.c; the leaves read the environment exactly as
- * ir_eval does, which the walk checks).  The walk runs once exactly, then
+ * each node evaluated by ir_eval's own step (ir_eval_node: the op table's
+ * eval functions of ir_ops.c, the leaves read from the environment; the
+ * walk checks that it agrees with ir_eval).  The walk runs once exactly, then
  * `samples` times with every node's result moved by +-b, where b is the
  * fp32 error bound of that op at the exact operands (below); the spread is
  * the largest deviation of the root.  A discontinuity within rounding
@@ -61,76 +61,6 @@ static double sign_of(uint64_t seed, int s, uint32_t id, int c)
     z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
     z ^= z >> 31;
     return (z & 1) ? 1.0 : -1.0;
-}
-
-static void leaf_input(const ir_env *env, uint32_t which, double *out)
-{
-    switch (which) {
-    case IR_IN_HEIGHT:        out[0] = env->height; break;
-    case IR_IN_SLOPE:         out[0] = env->slope; break;
-    case IR_IN_NORMAL:        memcpy(out, env->normal, sizeof env->normal); break;
-    case IR_IN_POSITION:      memcpy(out, env->position, sizeof env->position); break;
-    case IR_IN_UV:            memcpy(out, env->uv, sizeof env->uv); break;
-    case IR_IN_VIEW_DISTANCE: out[0] = env->view_distance; break;
-    case IR_IN_DESTRUCTION:   out[0] = env->destruction; break;
-    case IR_IN_VIEW_DIRECTION: {  /* as ir_eval: unset (0, 0, 0) is straight up */
-        const double *d = env->view_direction;
-        memcpy(out, d, 3 * sizeof *d);
-        if (d[0] == 0.0 && d[1] == 0.0 && d[2] == 0.0)
-            out[1] = 1.0;
-        break;
-    }
-    default: break;
-    }
-}
-
-/* Evaluate node `id` from operand values `vals` (4 per node). */
-static void eval_node(const ir *ir, uint32_t id, const ir_env *env,
-                      const double (*vals)[4], double out[4])
-{
-    const ir_node *n = &ir->nodes[id];
-    memset(out, 0, 4 * sizeof(double));
-    switch (n->op) {
-    case IR_OP_CONST:
-        memcpy(out, n->val, sizeof n->val);
-        return;
-    case IR_OP_INPUT:
-        leaf_input(env, n->imm, out);
-        return;
-    case IR_OP_PARAM:
-        memcpy(out, env->params ? env->params + 4 * n->imm : ir->params[n->imm].def,
-               4 * sizeof(double));
-        return;
-    case IR_OP_TEXTURE:
-        out[0] = n->imm;
-        return;
-    case IR_OP_PAINTED:
-        out[0] = env->painted ? env->painted[n->imm] : 0.0;
-        return;
-    case IR_OP_SAMPLE: {
-        const double *uv = vals[n->arg[1].id];
-        int tex = (int)ir->nodes[n->arg[0].id].imm;
-        if (env->sample) {
-            env->sample(env->sample_user, tex, uv[0], uv[1], out);
-        } else {
-            out[0] = out[1] = out[2] = 0.5;
-            out[3] = 1.0;
-        }
-        return;
-    }
-    default: {
-        const ir_opinfo *info = ir_opinfo_get((ir_op)n->op);
-        double a[16];
-        ir_type at[4];
-        for (int i = 0; i < n->nargs; i++) {
-            memcpy(&a[4 * i], vals[n->arg[i].id], 4 * sizeof(double));
-            at[i] = (ir_type)ir->nodes[n->arg[i].id].type;
-        }
-        if (info->eval)
-            info->eval(n, at, a, out);
-        return;
-    }
-    }
 }
 
 /* The fp32 error bound of node `id`'s component c (see the table above),
@@ -282,7 +212,7 @@ static void walk(const ir *ir, uint32_t n, const uint8_t *need, const ir_env *en
     for (uint32_t id = 1; id < n; id++) {
         if (!need[id])
             continue;
-        eval_node(ir, id, env, (const double (*)[4])vals, vals[id]);
+        ir_eval_node(ir, id, env, vals);
         int w = ir_type_width(ir_typeof(ir, (ir_ref){id}));
         for (int c = 0; c < w; c++) {
             if (poison[id][c] & mask)
@@ -347,7 +277,7 @@ void harness_reference(const ir *ir, ir_ref root, const ir_env *env,
     for (uint32_t id = 1; id < n; id++) {
         if (!need[id])
             continue;
-        eval_node(ir, id, env, (const double (*)[4])exact, exact[id]);
+        ir_eval_node(ir, id, env, exact);
         int w = ir_type_width(ir_typeof(ir, (ir_ref){id}));
         for (int c = 0; c < w; c++) {
             double x = exact[id][c];
