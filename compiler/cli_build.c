@@ -23,9 +23,9 @@ static const char usage[] =
     "                 BC4 atlas), r8 (sparse, R8 atlas) or dense (painted.r8)\n"
     "  -I DIR         search DIR for imports (repeatable)\n";
 
-/* Import search path, as the other subcommands have it (main.c): -I
- * folders, $SPLATC_PATH (':'-separated), the current folder, and the
- * nearest folder above the scene that has a nodes/ folder. */
+/* Import search path of every subcommand (splat_search_path; main.c has
+ * it from there): -I folders, $SPLATC_PATH (':'-separated), the current
+ * folder, and the nearest folder above the scene that has a nodes/ folder. */
 typedef struct paths {
     char **v;
     int    n, cap;
@@ -84,6 +84,22 @@ static void paths_defaults(paths *p, const char *scene)
         }
     }
     free(dir);
+}
+
+char **splat_search_path(const char *const *include, int ninclude, const char *file)
+{
+    paths p = {0};
+    for (int i = 0; i < ninclude; i++)
+        paths_add(&p, include[i]);
+    paths_defaults(&p, file);
+    return p.v;
+}
+
+void splat_search_path_free(char **v)
+{
+    for (int i = 0; v && v[i]; i++)
+        free(v[i]);
+    free(v);
 }
 
 static void print_stats(const splat_build_stats *st, FILE *out)

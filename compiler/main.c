@@ -135,83 +135,12 @@ static void options_free(options *o)
 
 /* ---- loading ---------------------------------------------------------------- */
 
-typedef struct search {
-    char **paths;   /* NULL-terminated */
-    int    n;
-} search;
-
-static void search_add(search *s, const char *path)
-{
-    char **p = realloc(s->paths, (size_t)(s->n + 2) * sizeof *p);
-    if (!p)
-        abort();
-    s->paths = p;
-    s->paths[s->n] = strdup(path);
-    if (!s->paths[s->n])
-        abort();
-    s->paths[++s->n] = NULL;
-}
-
-static void search_free(search *s)
-{
-    for (int i = 0; i < s->n; i++)
-        free(s->paths[i]);
-    free(s->paths);
-}
-
-static bool is_dir(const char *path)
-{
-    struct stat st;
-    return stat(path, &st) == 0 && S_ISDIR(st.st_mode);
-}
-
-static void search_init(search *s, const options *o, const char *file)
-{
-    memset(s, 0, sizeof *s);
-    for (int i = 0; i < o->ninclude; i++)
-        search_add(s, o->include[i]);
-    const char *env = getenv("SPLATC_PATH");
-    if (env && *env) {
-        char *copy = strdup(env);
-        if (!copy)
-            abort();
-        char *save = NULL;
-        for (char *t = strtok_r(copy, ":", &save); t; t = strtok_r(NULL, ":", &save))
-            search_add(s, t);
-        free(copy);
-    }
-    search_add(s, ".");
-    /* the nearest folder above the file with a nodes/ folder */
-    char *dir = strdup(file);
-    if (!dir)
-        abort();
-    for (;;) {
-        char *slash = strrchr(dir, '/');
-        if (!slash)
-            break;
-        *slash = 0;
-        size_t n = strlen(dir) + 8;
-        char *nodes = malloc(n);
-        if (!nodes)
-            abort();
-        snprintf(nodes, n, "%s/nodes", *dir ? dir : "");
-        bool found = is_dir(nodes);
-        free(nodes);
-        if (found) {
-            search_add(s, *dir ? dir : "/");
-            break;
-        }
-    }
-    free(dir);
-}
-
 /* Load and check one file; diagnostics to stderr.  NULL on errors. */
 static sg_program *load(const char *file, const options *o, sg_diags *d)
 {
-    search s;
-    search_init(&s, o, file);
-    sg_program *p = sg_load(file, (const char *const *)s.paths, d);
-    search_free(&s);
+    char **paths = splat_search_path(o->include, o->ninclude, file);
+    sg_program *p = sg_load(file, (const char *const *)paths, d);
+    splat_search_path_free(paths);
     sg_diags_print(d, stderr);
     if (!p || d->nerrors) {
         sg_free(p);

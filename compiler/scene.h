@@ -274,5 +274,11 @@ bool splat_build(const splat_build_desc *desc, splat_build_stats *stats,
 /* ---- cli_build.c: `splatc build` (argv[0] is "build") ------------------ */
 
 int  splat_cli_build(int argc, char **argv);
+/* The import search path of every splatc command: the `include` folders
+ * (-I) in order, $SPLATC_PATH (':'-separated), the current folder, and the
+ * nearest folder above `file` that has a nodes/ folder.  NULL-terminated,
+ * malloc'd: free with splat_search_path_free. */
+char **splat_search_path(const char *const *include, int ninclude, const char *file);
+void   splat_search_path_free(char **paths);
 
 #endif
