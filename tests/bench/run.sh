@@ -260,7 +260,7 @@ render() {  # GROUP SCENE PATH SIZE VARIANT... (first variant = reference)
     mkdir -p "$W/img/$group-$scene-$path-$size"
     # shellcheck disable=SC2086
     "$BENCH" render --pack "$W/$scene" $args --path "$path" $preset --size "$size" \
-        --frames "$FRAMES" --warmup "$WARM" --scene "$scene" \
+        --frames "$FRAMES" --warmup "$WARM" --scene "$scene" --view "${VIEW:-final}" \
         --save "$W/img/$group-$scene-$path-$size" > "$W/render.txt"
     awk -v g="$group" -F, 'NR > 1 { print g "," $0 }' "$W/render.txt" >> "$CSV.body"
 }
@@ -297,6 +297,25 @@ else
     # ground path; LOD against the finest threshold measured)
     render knob_precision colorado ground 1280x720 fp32=composite fp16=fp16
     render knob_normal colorado ground 1280x720 cross=composite sobel=sobel
+    # normal filters against the exact normal: minimal's scene over an
+    # analytic heightfield (splatbench analytic-hf), in the normal view and lit
+    R=$W/mirror-analytic
+    mirror "$R"
+    d=$(mirror_scene "$R" minimal minimal)
+    "$BENCH" analytic-hf 257 257 "$d/hf.r16"
+    sed 's|heightfield *= *"heightfield.png"|heightfield = "hf.r16"\n    heightfield_size = 257 257|' \
+        examples/minimal/scene.sg > "$d/scene.sg"
+    "$SPLATC" build "$d/scene.sg" -o "$W/minimal_analytic" -j 2 --cache "$W/cache-minimal" >/dev/null
+    for p in ground topdown; do
+        VIEW=normal
+        render knob_normal_exact_nview minimal "$p" 1280x720 \
+            "analytic=analytic,pack=$W/minimal_analytic" "cross=composite,pack=$W/minimal_analytic" \
+            "sobel=sobel,pack=$W/minimal_analytic"
+        VIEW=final
+        render knob_normal_exact minimal "$p" 1280x720 \
+            "analytic=analytic,pack=$W/minimal_analytic" "cross=composite,pack=$W/minimal_analytic" \
+            "sobel=sobel,pack=$W/minimal_analytic"
+    done
     render knob_lod colorado ground 1280x720 lod1=composite,lod=1 lod2=composite,lod=2 \
         lod3=composite,lod=3 lod6=composite,lod=6 lod12=composite,lod=12
     # fBm octaves (forest_floor: texture fBm 2/4/6/8) and texture fBm vs ALU

@@ -17,6 +17,9 @@
  *         fp16        composites recompiled with `precision mediump float`
  *         sobel       composites recompiled with a 3x3 Sobel normal filter
  *                     in place of Listing 1's 4-tap cross
+ *         analytic    composites recompiled with the exact normal of the
+ *                     function `splatbench analytic-hf` samples (only for
+ *                     a pack built on such a heightfield)
  *       pack=DIR renders another pack of the same terrain (compositors, fBm
  *       knobs); lod=P sets the LOD error threshold in pixels per grid step.
  *       Paths (--path): ground (2 m above the terrain looking 150 m ahead,
@@ -24,6 +27,9 @@
  *   splatbench upscale IN.png K OUT
  *       K times the texels per side, bilinear: a 16-bit PNG becomes raw
  *       little-endian R16 (OUT), an 8-bit one an 8-bit PNG (nearest).
+ *   splatbench analytic-hf W H OUT.r16
+ *       a W x H raw R16 heightfield sampling analytic_height() at texel
+ *       centres (the reference of the normal-filter knob).
  *   splatbench compare A.f32 B.f32
  *       max/mean abs error and PSNR of two --float-out images.
  *
@@ -153,8 +159,9 @@ static double err_psnr(const err_acc *a)
 
 /* ---- variants -------------------------------------------------------------- */
 
-typedef enum kind { K_COMPOSITE, K_MULTIPASS, K_UBER, K_FLAT, K_FP16, K_SOBEL } kind;
-static const char *const kind_names[] = {"composite", "multipass", "uber", "flat", "fp16", "sobel"};
+typedef enum kind { K_COMPOSITE, K_MULTIPASS, K_UBER, K_FLAT, K_FP16, K_SOBEL, K_ANALYTIC } kind;
+static const char *const kind_names[] = {"composite", "multipass", "uber", "flat", "fp16", "sobel",
+                                         "analytic"};
 
 typedef struct variant {
     char        *label;
@@ -192,6 +199,26 @@ static const char sobel_normal[] =
     "    return normalize(n);\n"
     "}\n";
 
+/* The analytic heightfield: normalised height at heightfield uv (u, v),
+ * within 0.1 .. 0.9, and its exact normal in GLSL (terrain.x, .y: size in
+ * metres, .z: max height), written from the same formula. */
+static double analytic_height(double u, double v)
+{
+    const double tau = 6.283185307179586;
+    return 0.5 + 0.25 * sin(tau * 3 * u) * cos(tau * 2 * v) + 0.15 * sin(tau * 7 * (u + v));
+}
+
+static const char analytic_normal[] =
+    "vec3 splat_normal_at(vec2 uv) {\n"
+    "    const float TAU = 6.283185307179586;\n"
+    "    float c7 = 0.15 * TAU * 7.0 * cos(TAU * 7.0 * (uv.x + uv.y));\n"
+    "    float du = 0.25 * TAU * 3.0 * cos(TAU * 3.0 * uv.x) * cos(TAU * 2.0 * uv.y) + c7;\n"
+    "    float dv = -0.25 * TAU * 2.0 * sin(TAU * 3.0 * uv.x) * sin(TAU * 2.0 * uv.y) + c7;\n"
+    "    vec3 n = vec3(-du * u_frame.terrain.z / u_frame.terrain.x, 1.0,\n"
+    "                  -dv * u_frame.terrain.z / u_frame.terrain.y);\n"
+    "    return normalize(n);\n"
+    "}\n";
+
 /* GLSL of a combination with the variant's change; NULL if the text does
  * not have the expected shape (message on stderr). */
 static char *transform_glsl(const char *src, kind k, const char *name)
@@ -217,7 +244,7 @@ static char *transform_glsl(const char *src, kind k, const char *name)
             return NULL;
         }
         end += 3;
-        insert = sobel_normal;
+        insert = k == K_SOBEL ? sobel_normal : analytic_normal;
     }
     size_t a = (size_t)(at - src), b = strlen(end), c = strlen(insert);
     char *out = xcalloc(a + b + c + 1, 1);
@@ -232,7 +259,7 @@ static char *transform_glsl(const char *src, kind k, const char *name)
 static bool variant_shaders(variant *v)
 {
     v->view = *v->base;
-    if (v->k != K_FLAT && v->k != K_FP16 && v->k != K_SOBEL)
+    if (v->k != K_FLAT && v->k != K_FP16 && v->k != K_SOBEL && v->k != K_ANALYTIC)
         return true;
     char path[4096];
     snprintf(path, sizeof path, "%s/manifest.json", v->pack_dir);
@@ -415,6 +442,7 @@ static bool path_camera(const rt_pack *p, const path_desc *pd, int f, int n, rt_
 static int cmd_render(int argc, char **argv)
 {
     const char *pack_dir = NULL, *csv = NULL, *scene = NULL, *save = NULL, *ref_label = NULL;
+    const char *view_name = "final";
     path_desc pd = {.name = "ground"};
     int width = 1280, height = 720, frames = 5, warmup = 1;
     char **specs = xcalloc((size_t)argc, sizeof *specs);
@@ -440,6 +468,7 @@ static int cmd_render(int argc, char **argv)
             pd.have_start = true;
         }
         else if (!strcmp(a, "--csv")) csv = next;
+        else if (!strcmp(a, "--view")) view_name = next;
         else if (!strcmp(a, "--scene")) scene = next;
         else if (!strcmp(a, "--save")) save = next;
         else if (!strcmp(a, "--frames")) frames = atoi(next);
@@ -462,7 +491,8 @@ static int cmd_render(int argc, char **argv)
     for (int i = 0; i < nspecs; i++)
         if (!parse_variant(specs[i], pack_dir, &v[i])) {
             fprintf(stderr, "splatbench render: bad variant '%s' (LABEL=KIND[,pack=DIR][,lod=P];"
-                    " KIND composite|multipass|uber|flat|fp16|sobel; a pack from --pack or pack=)\n",
+                    " KIND composite|multipass|uber|flat|fp16|sobel|analytic; a pack from --pack"
+                    " or pack=)\n",
                     specs[i]);
             return 2;
         }
@@ -523,6 +553,11 @@ static int cmd_render(int argc, char **argv)
         double before = rss_mb();
         if (!rt_renderer_create(&dev, &v[i].view, &rd, &v[i].r, &e))
             goto done;
+        splat_view view;
+        int material = 0;
+        if (!rt_parse_view(view_name, &v[i].view, &view, &material, &e))
+            goto done;
+        rt_renderer_set_view(v[i].r, view, material);
         v[i].gpu = xcalloc((size_t)frames, sizeof(double));
         v[i].cpu = xcalloc((size_t)frames, sizeof(double));
         v[i].sel = xcalloc((size_t)frames, sizeof(double));
@@ -578,7 +613,7 @@ static int cmd_render(int argc, char **argv)
     if (header)
         fprintf(out, "device,scene,path,width,height,variant,kind,pack,lod_pixels,frames,"
                      "gpu_med_ms,gpu_p10_ms,gpu_p90_ms,cpu_med_ms,select_med_ms,patches,"
-                     "pipelines,max_abs,mean_abs,psnr_db,nonfinite,rss_delta_mb,reference\n");
+                     "pipelines,max_abs,mean_abs,psnr_db,nonfinite,rss_delta_mb,reference,view\n");
     /* the device name in CSV: its commas become ';' */
     char devname[VK_MAX_PHYSICAL_DEVICE_NAME_SIZE];
     snprintf(devname, sizeof devname, "%s", dev.props.deviceName);
@@ -592,13 +627,14 @@ static int cmd_render(int argc, char **argv)
         percentiles(v[i].sel, frames, &sm, &s10, &s90);
         const char *pk = strrchr(v[i].pack_dir, '/');
         fprintf(out, "\"%s\",%s,%s,%d,%d,%s,%s,%s,%g,%d,%.3f,%.3f,%.3f,%.3f,%.4f,%d,%d,"
-                     "%.6g,%.6g,%.2f,%ld,%.1f,%s\n",
+                     "%.6g,%.6g,%.2f,%ld,%.1f,%s,%s\n",
                 devname, scene ? scene : v[i].base->name, pd.name, width, height,
                 v[i].label, kind_names[v[i].k], pk ? pk + 1 : v[i].pack_dir,
                 v[i].lod > 0 ? v[i].lod : 3.0, frames, gm, g10, g90, cm, sm,
                 v[i].patches, v[i].pipelines, v[i].err.max_abs,
                 v[i].err.n ? v[i].err.sum_abs / (double)v[i].err.n : 0.0,
-                err_psnr(&v[i].err), v[i].err.nonfinite, v[i].rss_delta, v[ref].label);
+                err_psnr(&v[i].err), v[i].err.nonfinite, v[i].rss_delta, v[ref].label,
+                view_name);
     }
     if (csv)
         fclose(out);
@@ -688,6 +724,34 @@ static int cmd_upscale(int argc, char **argv)
     return status;
 }
 
+/* ---- analytic-hf ----------------------------------------------------------- */
+
+static int cmd_analytic_hf(int argc, char **argv)
+{
+    int w = argc == 5 ? atoi(argv[2]) : 0, h = argc == 5 ? atoi(argv[3]) : 0;
+    if (w < 1 || h < 1) {
+        fprintf(stderr, "usage: splatbench analytic-hf W H OUT.r16\n");
+        return 2;
+    }
+    FILE *f = fopen(argv[4], "wb");
+    if (!f) {
+        fprintf(stderr, "splatbench: cannot write '%s'\n", argv[4]);
+        return 1;
+    }
+    bool ok = true;
+    for (int j = 0; j < h; j++)
+        for (int i = 0; i < w; i++) {
+            long q = lround(analytic_height((i + 0.5) / w, (j + 0.5) / h) * 65535.0);
+            uint8_t b[2] = {(uint8_t)(q & 255), (uint8_t)(q >> 8)};
+            ok = ok && fwrite(b, 1, 2, f) == 2;
+        }
+    if (fclose(f) != 0 || !ok) {
+        fprintf(stderr, "splatbench: cannot write '%s'\n", argv[4]);
+        return 1;
+    }
+    return 0;
+}
+
 /* ---- compare ------------------------------------------------------------------ */
 
 static int cmd_compare(int argc, char **argv)
@@ -728,6 +792,8 @@ int main(int argc, char **argv)
         return cmd_upscale(argc, argv);
     if (argc >= 2 && !strcmp(argv[1], "compare"))
         return cmd_compare(argc, argv);
+    if (argc >= 2 && !strcmp(argv[1], "analytic-hf"))
+        return cmd_analytic_hf(argc, argv);
     fprintf(stderr, "usage: splatbench render|upscale|compare ... (see tests/bench/splatbench.c)\n");
     return 2;
 }

@@ -114,5 +114,5 @@ echo "## Not measured"
 echo
 echo "- Smoke mode measures no compositors but stochastic, and no painted-storage, parallax, fBm or colorado figures: see a full run."
 echo "- fp16: the shaders are recompiled with precision mediump (RelaxedPrecision in SPIR-V); a driver may still compute in fp32 (lavapipe does), then time and error equal fp32."
-echo "- Analytic normals on an analytic heightfield: only the cross vs Sobel difference is measured."
+echo "- Normal filters against exact normals: on minimal over an analytic heightfield only (groups knob_normal_exact*); colorado has no exact normal, so there cross vs Sobel is a difference, not an error."
 echo "- GPU memory per variant: rss_delta_mb in render.csv is the host RSS growth when the variant's renderer is made (lavapipe's device memory is host memory; on a discrete GPU it misses device allocations)."
