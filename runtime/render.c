@@ -690,6 +690,30 @@ static void draw_patches(rt_renderer *r, VkCommandBuffer cb, const rt_camera *c,
     }
 }
 
+/* Begin the pass `rb` over the whole target and bind what every terrain
+ * draw reads: sets 0 and 1, the grid's vertex and index buffers. */
+static void begin_terrain_pass(rt_renderer *r, VkCommandBuffer cb,
+                               const VkRenderPassBeginInfo *rb, const VkViewport *vp,
+                               const VkDescriptorSet *sets)
+{
+    VkDeviceSize zero = 0;
+    vkCmdBeginRenderPass(cb, rb, VK_SUBPASS_CONTENTS_INLINE);
+    vkCmdSetViewport(cb, 0, 1, vp);
+    vkCmdSetScissor(cb, 0, 1, &rb->renderArea);
+    vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_GRAPHICS, r->pl.layout, 0, 2, sets, 0, NULL);
+    vkCmdBindVertexBuffers(cb, 0, 1, &r->vbuf.buf, &zero);
+    vkCmdBindIndexBuffer(cb, r->ibuf.buf, 0, VK_INDEX_TYPE_UINT16);
+}
+
+/* A pipeline could not be made mid-pass: end the pass and the command
+ * buffer (reset by the next frame).  Returns false for the caller. */
+static bool abandon_frame(VkCommandBuffer cb)
+{
+    vkCmdEndRenderPass(cb);
+    vkEndCommandBuffer(cb);
+    return false;
+}
+
 bool rt_renderer_frame(rt_renderer *r, const rt_camera *c, rt_frame_stats *st, rt_error *e)
 {
     rt_device *d = r->d;
@@ -731,7 +755,6 @@ bool rt_renderer_frame(rt_renderer *r, const rt_camera *c, rt_frame_stats *st, r
     }
     VkViewport vp = { 0, 0, (float)r->desc.width, (float)r->desc.height, 0, 1 };
     VkRect2D area = { { 0, 0 }, { (uint32_t)r->desc.width, (uint32_t)r->desc.height } };
-    VkDeviceSize zero = 0;
     int binds = 0;
     bool cull = !r->desc.no_cull && camera_above_terrain(r, c);
     unsigned variant = (r->wireframe ? RT_VARIANT_WIRE : 0) |
@@ -749,20 +772,12 @@ bool rt_renderer_frame(rt_renderer *r, const rt_camera *c, rt_frame_stats *st, r
             .renderPass = r->rp.multi, .framebuffer = r->fb_multi,
             .renderArea = area, .clearValueCount = 4, .pClearValues = clears,
         };
-        vkCmdBeginRenderPass(cb, &rb, VK_SUBPASS_CONTENTS_INLINE);
-        vkCmdSetViewport(cb, 0, 1, &vp);
-        vkCmdSetScissor(cb, 0, 1, &area);
-        vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_GRAPHICS, r->pl.layout, 0, 2, sets, 0, NULL);
-        vkCmdBindVertexBuffers(cb, 0, 1, &r->vbuf.buf, &zero);
-        vkCmdBindIndexBuffer(cb, r->ibuf.buf, 0, VK_INDEX_TYPE_UINT16);
+        begin_terrain_pass(r, cb, &rb, &vp, sets);
         /* bottom to top, each material over every patch */
         for (int m = 0; m < r->pl.nref; m++) {
             VkPipeline pipe;
-            if (!rt_pipelines_ref(d, r->p, &r->rp, &r->pl, m, cull, &pipe, e)) {
-                vkCmdEndRenderPass(cb);
-                vkEndCommandBuffer(cb);   /* reset by the next frame */
-                return false;
-            }
+            if (!rt_pipelines_ref(d, r->p, &r->rp, &r->pl, m, cull, &pipe, e))
+                return abandon_frame(cb);
             vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_GRAPHICS, pipe);
             binds++;
             draw_patches(r, cb, c, r->sorted, n);
@@ -792,22 +807,14 @@ bool rt_renderer_frame(rt_renderer *r, const rt_camera *c, rt_frame_stats *st, r
             .renderPass = r->rp.main, .framebuffer = r->fb_main,
             .renderArea = area, .clearValueCount = 2, .pClearValues = clears,
         };
-        vkCmdBeginRenderPass(cb, &rb, VK_SUBPASS_CONTENTS_INLINE);
-        vkCmdSetViewport(cb, 0, 1, &vp);
-        vkCmdSetScissor(cb, 0, 1, &area);
-        vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_GRAPHICS, r->pl.layout, 0, 2, sets, 0, NULL);
-        vkCmdBindVertexBuffers(cb, 0, 1, &r->vbuf.buf, &zero);
-        vkCmdBindIndexBuffer(cb, r->ibuf.buf, 0, VK_INDEX_TYPE_UINT16);
+        begin_terrain_pass(r, cb, &rb, &vp, sets);
         /* Composites carry no MASK view (compiler/pack.c): the über-shader
          * draws it, with every material's mask. */
         if (r->desc.reference == RT_REF_UBER || r->view == SPLAT_VIEW_MASK) {
             if (n > 0) {
                 VkPipeline pipe;
-                if (!rt_pipelines_uber(d, r->p, &r->rp, &r->pl, variant, &pipe, e)) {
-                    vkCmdEndRenderPass(cb);
-                    vkEndCommandBuffer(cb);   /* reset by the next frame */
-                    return false;
-                }
+                if (!rt_pipelines_uber(d, r->p, &r->rp, &r->pl, variant, &pipe, e))
+                    return abandon_frame(cb);
                 vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_GRAPHICS, pipe);
                 binds++;
             }
@@ -818,11 +825,8 @@ bool rt_renderer_frame(rt_renderer *r, const rt_camera *c, rt_frame_stats *st, r
                 int end = r->counts[k];
                 if (end > start) {
                     VkPipeline pipe;
-                    if (!rt_pipelines_combo(d, r->p, &r->rp, &r->pl, k, variant, &pipe, e)) {
-                        vkCmdEndRenderPass(cb);
-                        vkEndCommandBuffer(cb);   /* reset by the next frame */
-                        return false;
-                    }
+                    if (!rt_pipelines_combo(d, r->p, &r->rp, &r->pl, k, variant, &pipe, e))
+                        return abandon_frame(cb);
                     vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_GRAPHICS, pipe);
                     binds++;
                     draw_patches(r, cb, c, r->sorted + start, end - start);
