@@ -4,7 +4,7 @@
 # that a fresh run reproduces the committed bytes.
 
 add_executable(test_scene ${CMAKE_CURRENT_LIST_DIR}/test_scene.c)
-target_link_libraries(test_scene splatc PkgConfig::CMOCKA)
+target_link_libraries(test_scene splatc splat_unit_helpers PkgConfig::CMOCKA)
 add_test(NAME scene.test_scene COMMAND test_scene WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
 set_tests_properties(scene.test_scene PROPERTIES LABELS unit)
 

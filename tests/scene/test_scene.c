@@ -20,6 +20,7 @@
 
 #include <stb_image.h>
 
+#include "points.h"
 #include "scene.h"
 
 static const char *const error_names[] = {
@@ -27,13 +28,6 @@ static const char *const error_names[] = {
     SG_ERRORS(X)
 #undef X
 };
-
-static bool combo_has(const splat_combo *c, int m)
-{
-    for (int i = 0; i < c->nmaterials; i++)
-        if (c->materials[i] == m) return true;
-    return false;
-}
 
 static int cmp_str(const void *a, const void *b)
 {
@@ -110,108 +104,21 @@ static void test_error_fixtures(void **state)
 /* ---- soundness at points ------------------------------------------------- */
 
 static uint64_t rng = 0x853c49e6748fea9bull;
-static uint32_t rnd(void)
-{
-    rng ^= rng << 13;
-    rng ^= rng >> 7;
-    rng ^= rng << 17;
-    return (uint32_t)(rng >> 16);
-}
-static double rnd01(void) { return rnd() / 4294967296.0; }
 
-/* Arbitrary texture content: a hash of (texture, texel) in [0, 1]. */
-static void any_texture(void *user, int texture, double u, double v, double rgba[4])
+static double raster_painted(void *user, int p, double u, double v)
 {
-    uint32_t h = (uint32_t)texture * 0x9e3779b9u ^ (uint32_t)(int64_t)floor(u * 512) * 0x85ebca6bu ^
-                 (uint32_t)(int64_t)floor(v * 512) * 0xc2b2ae35u;
-    for (int c = 0; c < 4; c++) {
-        h ^= h >> 15;
-        h *= 0x2c1b3c6du;
-        h ^= h >> 12;
-        rgba[c] = (h & 0xffff) / 65535.0;
-    }
-}
-
-static double raster_bilinear(const uint8_t *px, int w, int h, double u, double v)
-{
-    double x = u * w - 0.5, z = v * h - 0.5;
-    int ix = (int)floor(x), iz = (int)floor(z);
-    double ax = x - ix, az = z - iz;
-#define P(i, j) (px[(size_t)((j) < 0 ? 0 : (j) >= h ? h - 1 : (j)) * w + \
-                    ((i) < 0 ? 0 : (i) >= w ? w - 1 : (i))] / 255.0)
-    double a = P(ix, iz) + (P(ix + 1, iz) - P(ix, iz)) * ax;
-    double b = P(ix, iz + 1) + (P(ix + 1, iz + 1) - P(ix, iz + 1)) * ax;
-#undef P
-    return a + (b - a) * az;
+    const splat_scene *s = user;
+    return points_raster_bilinear(s->painted[p], s->terrain.width, s->terrain.height, u, v);
 }
 
 /* At random points of every leaf cell (and random params and texture
  * content), every material the CPU reference makes visible (front to back:
- * w = T * mask > 0 until T reaches 0) is in the cell's combination. */
+ * w = T * mask > 0 until T reaches 0) is in the cell's combination; painted
+ * values bilinear in the scene's rasters. */
 static void check_points_sound(const splat_scene *s, const splat_analysis *a,
                                int samples)
 {
-    const splat_terrain *t = &s->terrain;
-    int n = s->nmaterials;
-    ir_ref *masks = calloc((size_t)n, sizeof *masks);
-    double *params = calloc((size_t)s->ir.nparams * 4 + 4, sizeof *params);
-    double *painted = calloc((size_t)s->ir.npainted + 1, sizeof *painted);
-    assert_true(masks && params && painted);
-    for (int m = 0; m < n; m++) {
-        char root[256];
-        snprintf(root, sizeof root, "%s.mask", s->desc->materials[m]);
-        masks[m] = ir_find_root(&s->ir, root);
-        assert_true(ir_ref_ok(masks[m]));
-    }
-    int T = a->cell_texels;
-    for (int cz = 0; cz < a->cells_z; cz++)
-        for (int cx = 0; cx < a->cells_x; cx++) {
-            const splat_combo *c = &a->combos[a->levels[0].ids[cz * a->cells_x + cx]];
-            int x1 = (cx + 1) * T < t->width ? (cx + 1) * T : t->width;
-            int z1 = (cz + 1) * T < t->height ? (cz + 1) * T : t->height;
-            for (int k = 0; k < samples; k++) {
-                double u = (cx * T + rnd01() * (x1 - cx * T)) / t->width;
-                double v = (cz * T + rnd01() * (z1 - cz * T)) / t->height;
-                ir_env env;
-                memset(&env, 0, sizeof env);
-                env.height = splat_terrain_height(t, u, v);
-                splat_terrain_normal(t, u, v, env.normal);
-                env.slope = 1 - env.normal[1];
-                env.uv[0] = u;
-                env.uv[1] = v;
-                env.position[0] = u * t->size[0];
-                env.position[1] = env.height;
-                env.position[2] = v * t->size[1];
-                env.view_distance = rnd01() * 5000;
-                for (int p = 0; p < s->ir.nparams; p++) {
-                    const ir_param *ip = &s->ir.params[p];
-                    for (int q = 0; q < 4; q++)
-                        params[4 * p + q] = ip->lo == ip->hi ? ip->def[q]
-                                          : ip->lo + rnd01() * (ip->hi - ip->lo);
-                }
-                env.params = params;
-                for (int p = 0; p < s->ir.npainted; p++)
-                    painted[p] = raster_bilinear(s->painted[p], t->width, t->height, u, v);
-                env.painted = painted;
-                env.sample = any_texture;
-                double cover = 1;
-                for (int m = n - 1; m >= 0 && cover > 0; m--) {
-                    double mask[4] = { 1 };
-                    if (m > 0) ir_eval(&s->ir, masks[m], &env, mask);
-                    double w = cover * mask[0];
-                    if (w > 0 && !combo_has(c, m)) {
-                        print_error("cell (%d, %d): '%s' visible (w = %g) at uv "
-                                    "(%.9f, %.9f) but not in the combination\n", cx, cz,
-                                    s->desc->materials[m], w, u, v);
-                        fail();
-                    }
-                    cover -= w;
-                }
-            }
-        }
-    free(masks);
-    free(params);
-    free(painted);
+    points_check_sound(s, a, samples, &rng, raster_painted, (void *)s);
 }
 
 static void load_ok(splat_scene *s, const char *path, const char *const *search)

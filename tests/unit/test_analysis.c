@@ -18,6 +18,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "points.h"
 #include "scene.h"
 
 /* ---- fixtures ------------------------------------------------------------ */
@@ -404,27 +405,8 @@ static void test_deterministic_first_occurrence_ids(void **state)
 /* ---- randomised soundness ------------------------------------------------ */
 
 static uint64_t rng = 0x2545f4914f6cdd1dull;
-static uint32_t rnd(void)
-{
-    rng ^= rng << 13;
-    rng ^= rng >> 7;
-    rng ^= rng << 17;
-    return (uint32_t)(rng >> 16);
-}
-static double rnd01(void) { return rnd() / 4294967296.0; }
-
-static double painted_bilinear(const uint8_t *px, int w, int h, double u, double v)
-{
-    double x = u * w - 0.5, z = v * h - 0.5;
-    int ix = (int)floor(x), iz = (int)floor(z);
-    double ax = x - ix, az = z - iz;
-#define P(i, j) (px[(size_t)((j) < 0 ? 0 : (j) >= h ? h - 1 : (j)) * w + \
-                    ((i) < 0 ? 0 : (i) >= w ? w - 1 : (i))] / 255.0)
-    double a = P(ix, iz) + (P(ix + 1, iz) - P(ix, iz)) * ax;
-    double b = P(ix, iz + 1) + (P(ix + 1, iz + 1) - P(ix, iz + 1)) * ax;
-#undef P
-    return a + (b - a) * az;
-}
+static uint32_t rnd(void) { return points_rnd(&rng); }
+static double rnd01(void) { return points_rnd01(&rng); }
 
 /* At random points of every cell, the materials whose CPU-reference mask
  * makes them visible (top down: w > 0 until the first mask of 1) are all
@@ -475,16 +457,8 @@ static void test_random_points_inside_cell_combination(void **state)
             for (int s = 0; s < 60; s++) {
                 double u = (cx * 8 + rnd01() * 8) / 96, v = (cz * 8 + rnd01() * 8) / 64;
                 ir_env env;
-                memset(&env, 0, sizeof env);
-                env.height = splat_terrain_height(t, u, v);
-                splat_terrain_normal(t, u, v, env.normal);
-                env.slope = 1 - env.normal[1];
-                env.uv[0] = u;
-                env.uv[1] = v;
-                env.position[0] = u * t->size[0];
-                env.position[1] = env.height;
-                env.position[2] = v * t->size[1];
-                double p = painted_bilinear(px, 96, 64, u, v);
+                points_env(t, u, v, &env);
+                double p = points_raster_bilinear(px, 96, 64, u, v);
                 env.painted = &p;
                 double T = 1;
                 for (int m = 4; m >= 0 && T > 0; m--) {

@@ -20,6 +20,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "points.h"
 #include "scene.h"
 
 static void load_ok(splat_scene *s, const char *path)
@@ -119,33 +120,10 @@ static void test_colorado_sizes(void **state)
 /* ---- soundness at points, painted values as the GPU samples them -------- */
 
 static uint64_t rng = 0x9e3779b97f4a7c15ull;
-static double rnd01(void)
-{
-    rng ^= rng << 13;
-    rng ^= rng >> 7;
-    rng ^= rng << 17;
-    return (double)(uint32_t)(rng >> 16) / 4294967296.0;
-}
 
-static void any_texture(void *user, int texture, double u, double v, double rgba[4])
+static double sparse_painted(void *user, int p, double u, double v)
 {
-    (void)user;
-    uint32_t h = (uint32_t)texture * 0x9e3779b9u ^ (uint32_t)(int64_t)floor(u * 512) * 0x85ebca6bu ^
-                 (uint32_t)(int64_t)floor(v * 512) * 0xc2b2ae35u;
-    for (int c = 0; c < 4; c++) {
-        h ^= h >> 15;
-        h *= 0x2c1b3c6du;
-        h ^= h >> 12;
-        rgba[c] = (h & 0xffff) / 65535.0;
-    }
-}
-
-static bool combo_has(const splat_combo *c, int m)
-{
-    for (int i = 0; i < c->nmaterials; i++)
-        if (c->materials[i] == m)
-            return true;
-    return false;
+    return sparse_sample(user, p, u, v);
 }
 
 static void test_analysis_sound_over_sparse(void **state)
@@ -162,72 +140,10 @@ static void test_analysis_sound_over_sparse(void **state)
     assert_true(splat_analyze(&s, &a, &d));
     sg_diags_free(&d);
 
-    const splat_terrain *t = &s.terrain;
-    int n = s.nmaterials;
-    ir_ref *masks = calloc((size_t)n, sizeof *masks);
-    double *params = calloc((size_t)s.ir.nparams * 4 + 4, sizeof *params);
-    double *painted = calloc((size_t)s.ir.npainted + 1, sizeof *painted);
-    assert_true(masks && params && painted);
-    for (int m = 0; m < n; m++) {
-        char root[256];
-        snprintf(root, sizeof root, "%s.mask", s.desc->materials[m]);
-        masks[m] = ir_find_root(&s.ir, root);
-        assert_true(ir_ref_ok(masks[m]));
-    }
-    int T = a.cell_texels, checked = 0;
-    for (int cz = 0; cz < a.cells_z; cz++)
-        for (int cx = 0; cx < a.cells_x; cx++) {
-            const splat_combo *c = &a.combos[a.levels[0].ids[cz * a.cells_x + cx]];
-            int x1 = (cx + 1) * T < t->width ? (cx + 1) * T : t->width;
-            int z1 = (cz + 1) * T < t->height ? (cz + 1) * T : t->height;
-            for (int k = 0; k < 12; k++) {
-                double u = (cx * T + rnd01() * (x1 - cx * T)) / t->width;
-                double v = (cz * T + rnd01() * (z1 - cz * T)) / t->height;
-                ir_env env;
-                memset(&env, 0, sizeof env);
-                env.height = splat_terrain_height(t, u, v);
-                splat_terrain_normal(t, u, v, env.normal);
-                env.slope = 1 - env.normal[1];
-                env.uv[0] = u;
-                env.uv[1] = v;
-                env.position[0] = u * t->size[0];
-                env.position[1] = env.height;
-                env.position[2] = v * t->size[1];
-                env.view_distance = rnd01() * 5000;
-                for (int p = 0; p < s.ir.nparams; p++) {
-                    const ir_param *ip = &s.ir.params[p];
-                    for (int q = 0; q < 4; q++)
-                        params[4 * p + q] = ip->lo == ip->hi ? ip->def[q]
-                                          : ip->lo + rnd01() * (ip->hi - ip->lo);
-                }
-                env.params = params;
-                /* the scene's painted mask i is the ir's painted i */
-                for (int p = 0; p < s.ir.npainted; p++)
-                    painted[p] = sparse_sample(&sp, p, u, v);
-                env.painted = painted;
-                env.sample = any_texture;
-                double cover = 1;
-                for (int m = n - 1; m >= 0 && cover > 0; m--) {
-                    double mask[4] = { 1 };
-                    if (m > 0)
-                        ir_eval(&s.ir, masks[m], &env, mask);
-                    double w = cover * mask[0];
-                    if (w > 0 && !combo_has(c, m)) {
-                        print_error("cell (%d, %d): '%s' visible (w = %g) at uv (%.9f, %.9f) "
-                                    "but not in the combination\n", cx, cz,
-                                    s.desc->materials[m], w, u, v);
-                        fail();
-                    }
-                    cover -= w;
-                }
-                checked++;
-            }
-        }
+    /* the scene's painted mask i is the ir's painted i */
+    int checked = points_check_sound(&s, &a, 12, &rng, sparse_painted, &sp);
     printf("%d points in %d cells: every visible material in its cell's combination "
            "(%d combinations)\n", checked, a.cells_x * a.cells_z, a.ncombos);
-    free(masks);
-    free(params);
-    free(painted);
     splat_analysis_free(&a);
     sparse_free(&sp);
     splat_scene_free(&s);
