@@ -17,6 +17,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "lowered.h"
 #include "sg.h"
 
 static const char *const search[] = {".", NULL};
@@ -30,28 +31,6 @@ static ir_env flat_env(void)
     memset(&e, 0, sizeof e);
     e.normal[1] = 1;
     return e;
-}
-
-typedef struct lowered { sg_program *p; ir ir; } lowered;
-
-/* Lower material `t` of `text`; fails the test on any diagnostic. */
-static void lower(lowered *l, const char *text)
-{
-    sg_diags d;
-    sg_diags_init(&d);
-    l->p = sg_load_string("test.sg", text, search, &d);
-    ir_init(&l->ir);
-    if (!l->p || d.nerrors || !sg_lower_material(l->p, "t", &l->ir, &d) || d.nerrors) {
-        sg_diags_print(&d, stderr);
-        fail_msg("cannot lower:\n%s", text);
-    }
-    sg_diags_free(&d);
-}
-
-static void unlower(lowered *l)
-{
-    ir_free(&l->ir);
-    sg_free(l->p);
 }
 
 /* The material text: `import "nodes/FILE"`, node n of type NODE, and the
@@ -85,10 +64,10 @@ static double evalf(const char *file, const ir_env *env, const char *value,
     va_end(ap);
     char *text = material(file, "mask", value, node);
     lowered l;
-    lower(&l, text);
+    lowered_load(&l, text);
     double out[4];
     ir_eval(&l.ir, ir_find_root(&l.ir, "t.mask"), env, out);
-    unlower(&l);
+    lowered_free(&l);
     free(text);
     return out[0];
 }
@@ -99,9 +78,9 @@ static void eval3(const char *file, const ir_env *env, const char *value,
 {
     char *text = material(file, "albedo", value, node);
     lowered l;
-    lower(&l, text);
+    lowered_load(&l, text);
     ir_eval(&l.ir, ir_find_root(&l.ir, "t.albedo"), env, out);
-    unlower(&l);
+    lowered_free(&l);
     free(text);
 }
 
@@ -111,10 +90,10 @@ static ir_iv intervalv(const char *file, const ir_ienv *env, const char *value,
 {
     char *text = material(file, "mask", value, node);
     lowered l;
-    lower(&l, text);
+    lowered_load(&l, text);
     ir_iv out[4];
     ir_interval(&l.ir, ir_find_root(&l.ir, "t.mask"), env, out);
-    unlower(&l);
+    lowered_free(&l);
     free(text);
     return out[0];
 }

@@ -19,6 +19,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "lowered.h"
 #include "sg.h"
 
 static const char *const search[] = {".", NULL};
@@ -28,8 +29,6 @@ static const char *const search[] = {".", NULL};
         if (!(fabs(a_ - b_) <= 1e-12 * (1 + fabs(b_))))                       \
             fail_msg("%s = %.17g, expected %.17g", #a, a_, b_);               \
     } while (0)
-
-typedef struct lowered { sg_program *p; ir ir; } lowered;
 
 /* Material t with node `px` as given; its mask is `mx`, its height `my`. */
 static void lower(lowered *l, const char *node, const char *mx, const char *my)
@@ -42,21 +41,7 @@ static void lower(lowered *l, const char *node, const char *mx, const char *my)
              "    out mask = %s\n"
              "    out height = %s\n"
              "}\n", node, mx, my);
-    sg_diags d;
-    sg_diags_init(&d);
-    l->p = sg_load_string("test.sg", text, search, &d);
-    ir_init(&l->ir);
-    if (!l->p || d.nerrors || !sg_lower_material(l->p, "t", &l->ir, &d) || d.nerrors) {
-        sg_diags_print(&d, stderr);
-        fail_msg("cannot lower:\n%s", text);
-    }
-    sg_diags_free(&d);
-}
-
-static void unlower(lowered *l)
-{
-    ir_free(&l->ir);
-    sg_free(l->p);
+    lowered_load(l, text);
 }
 
 /* ---- height textures (.r is the relief; every channel the same) --------- */
@@ -112,7 +97,7 @@ static void eval_uv(int n, height_fn h, const double uv0[2], const double off[2]
     ir_eval(&l.ir, ir_find_root(&l.ir, "t.height"), &e, y);
     out[0] = x[0];
     out[1] = y[0];
-    unlower(&l);
+    lowered_free(&l);
 }
 
 /* ---- tests --------------------------------------------------------------- */
@@ -193,7 +178,7 @@ static void test_intervals(void **state)
     NEAR(x[0].hi, 0.7);
     NEAR(y[0].lo, 0.35);
     NEAR(y[0].hi, 0.7);
-    unlower(&l);
+    lowered_free(&l);
 
     /* parallax_offset over any camera: finite, at most 4 * depth / scale */
     lower(&l, "parallax_offset { scale = 2.0, depth = 0.5, fade = 100.0 }",
@@ -205,7 +190,7 @@ static void test_intervals(void **state)
     NEAR(x[0].hi, 1.0);
     NEAR(y[0].lo, -1.0);
     NEAR(y[0].hi, 1.0);
-    unlower(&l);
+    lowered_free(&l);
 }
 
 /* offset = -V.xz / max(V.y, 0.25) * depth * saturate(1 - dist / fade) / scale */
@@ -244,7 +229,7 @@ static void test_offset(void **state)
     e.view_direction[2] = sqrt(0.99);
     ir_eval(&l.ir, ry, &e, y);
     NEAR(y[0], -sqrt(0.99) / 0.25 * 0.5 / 2.0);
-    unlower(&l);
+    lowered_free(&l);
 }
 
 /* The rock material uses it: its albedo depends on the view direction. */
