@@ -547,22 +547,9 @@ static void update_bounds(rt_destruction *ds, int tx0, int tz0, int tx1, int tz1
             leaf_bounds(ds, x, z);
     for (int L = 1; L < b->nlevels; L++) {
         lx0 /= 2; lx1 /= 2; lz0 /= 2; lz1 /= 2;
-        int pw = b->width[L - 1], ph = b->height[L - 1];
         for (int z = lz0; z <= lz1; z++)
-            for (int x = lx0; x <= lx1; x++) {
-                float lo = 1e30f, hi = -1e30f;
-                for (int c = 0; c < 4; c++) {
-                    int qx = 2 * x + (c & 1), qz = 2 * z + (c >> 1);
-                    if (qx >= pw || qz >= ph)
-                        continue;
-                    size_t j = (size_t)qz * (size_t)pw + (size_t)qx;
-                    lo = b->hmin[L - 1][j] < lo ? b->hmin[L - 1][j] : lo;
-                    hi = b->hmax[L - 1][j] > hi ? b->hmax[L - 1][j] : hi;
-                }
-                size_t i = (size_t)z * (size_t)b->width[L] + (size_t)x;
-                b->hmin[L][i] = lo;
-                b->hmax[L][i] = hi;
-            }
+            for (int x = lx0; x <= lx1; x++)
+                rt_bounds_merge(b, L, x, z);
     }
 }
 

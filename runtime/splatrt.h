@@ -280,6 +280,9 @@ typedef struct rt_bounds {
 bool rt_bounds_build(rt_bounds *b, const uint16_t *texels, int w, int h,
                      int cell_texels, double max_height, double offset);
 void rt_bounds_free(rt_bounds *b);
+/* Node (x, z) of level L >= 1: the min and max of its (up to 4) children
+ * on level L - 1 (the build, and destruction's update after a crater). */
+void rt_bounds_merge(rt_bounds *b, int L, int x, int z);
 /* Level grid of PACK.md: cells, then halve (rounding up) until 1x1. */
 int  rt_level_count(int cells_x, int cells_z);
 

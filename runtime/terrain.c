@@ -71,26 +71,28 @@ bool rt_bounds_build(rt_bounds *b, const uint16_t *texels, int w, int h,
             b->hmax[0][i] = (float)(hi / 65535.0 * max_height + offset);
         }
     }
-    for (int L = 1; L < b->nlevels; L++) {
-        int pw = b->width[L - 1], ph = b->height[L - 1];
-        for (int z = 0; z < b->height[L]; z++) {
-            for (int x = 0; x < b->width[L]; x++) {
-                float lo = 1e30f, hi = -1e30f;
-                for (int c = 0; c < 4; c++) {
-                    int qx = 2 * x + (c & 1), qz = 2 * z + (c >> 1);
-                    if (qx >= pw || qz >= ph)
-                        continue;
-                    size_t j = (size_t)qz * (size_t)pw + (size_t)qx;
-                    lo = b->hmin[L - 1][j] < lo ? b->hmin[L - 1][j] : lo;
-                    hi = b->hmax[L - 1][j] > hi ? b->hmax[L - 1][j] : hi;
-                }
-                size_t i = (size_t)z * (size_t)b->width[L] + (size_t)x;
-                b->hmin[L][i] = lo;
-                b->hmax[L][i] = hi;
-            }
-        }
-    }
+    for (int L = 1; L < b->nlevels; L++)
+        for (int z = 0; z < b->height[L]; z++)
+            for (int x = 0; x < b->width[L]; x++)
+                rt_bounds_merge(b, L, x, z);
     return true;
+}
+
+void rt_bounds_merge(rt_bounds *b, int L, int x, int z)
+{
+    int pw = b->width[L - 1], ph = b->height[L - 1];
+    float lo = 1e30f, hi = -1e30f;
+    for (int c = 0; c < 4; c++) {
+        int qx = 2 * x + (c & 1), qz = 2 * z + (c >> 1);
+        if (qx >= pw || qz >= ph)
+            continue;
+        size_t j = (size_t)qz * (size_t)pw + (size_t)qx;
+        lo = b->hmin[L - 1][j] < lo ? b->hmin[L - 1][j] : lo;
+        hi = b->hmax[L - 1][j] > hi ? b->hmax[L - 1][j] : hi;
+    }
+    size_t i = (size_t)z * (size_t)b->width[L] + (size_t)x;
+    b->hmin[L][i] = lo;
+    b->hmax[L][i] = hi;
 }
 
 void rt_bounds_free(rt_bounds *b)
