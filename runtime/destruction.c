@@ -510,28 +510,6 @@ static void upload_rect(rt_destruction *ds, VkImage img, VkDeviceSize off, int x
                   VK_ACCESS_SHADER_READ_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, shaders);
 }
 
-/* Min/max of the texels leaf (x, z) can show (terrain.c's rule). */
-static void leaf_bounds(rt_destruction *ds, int x, int z)
-{
-    int T = ds->cell_texels, w = ds->hw, h = ds->hh;
-    int x0 = x * T - 1, x1 = (x + 1) * T, z0 = z * T - 1, z1 = (z + 1) * T;
-    x0 = x0 < 0 ? 0 : x0;
-    z0 = z0 < 0 ? 0 : z0;
-    x1 = x1 >= w ? w - 1 : x1;
-    z1 = z1 >= h ? h - 1 : z1;
-    unsigned lo = 65535, hi = 0;
-    for (int tz = z0; tz <= z1; tz++)
-        for (int tx = x0; tx <= x1; tx++) {
-            unsigned v = ds->heights[(size_t)tz * (size_t)w + (size_t)tx];
-            lo = v < lo ? v : lo;
-            hi = v > hi ? v : hi;
-        }
-    rt_bounds *b = ds->bounds;
-    size_t i = (size_t)z * (size_t)b->width[0] + (size_t)x;
-    b->hmin[0][i] = (float)(lo / 65535.0 * ds->max_height + ds->offset);
-    b->hmax[0][i] = (float)(hi / 65535.0 * ds->max_height + ds->offset);
-}
-
 /* Leaves reading texels [tx0, tx1] x [tz0, tz1], then their ancestors. */
 static void update_bounds(rt_destruction *ds, int tx0, int tz0, int tx1, int tz1)
 {
@@ -544,7 +522,8 @@ static void update_bounds(rt_destruction *ds, int tx0, int tz0, int tx1, int tz1
     lz1 = lz1 >= b->height[0] ? b->height[0] - 1 : lz1;
     for (int z = lz0; z <= lz1; z++)
         for (int x = lx0; x <= lx1; x++)
-            leaf_bounds(ds, x, z);
+            rt_bounds_leaf(b, ds->heights, ds->hw, ds->hh, T, ds->max_height, ds->offset,
+                           x, z);
     for (int L = 1; L < b->nlevels; L++) {
         lx0 /= 2; lx1 /= 2; lz0 /= 2; lz1 /= 2;
         for (int z = lz0; z <= lz1; z++)

@@ -280,6 +280,10 @@ typedef struct rt_bounds {
 bool rt_bounds_build(rt_bounds *b, const uint16_t *texels, int w, int h,
                      int cell_texels, double max_height, double offset);
 void rt_bounds_free(rt_bounds *b);
+/* Leaf (x, z): the min and max height (metres) of the texels it can show,
+ * its cell plus one texel around (the build, and destruction's update). */
+void rt_bounds_leaf(rt_bounds *b, const uint16_t *texels, int w, int h, int cell_texels,
+                    double max_height, double offset, int x, int z);
 /* Node (x, z) of level L >= 1: the min and max of its (up to 4) children
  * on level L - 1 (the build, and destruction's update after a crater). */
 void rt_bounds_merge(rt_bounds *b, int L, int x, int z);

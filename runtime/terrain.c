@@ -51,31 +51,35 @@ bool rt_bounds_build(rt_bounds *b, const uint16_t *texels, int w, int h,
     }
     /* Leaves from the texels.  Row minima/maxima first would be faster; a
      * 4096^2 field still takes only a few milliseconds at load. */
-    for (int z = 0; z < b->height[0]; z++) {
-        for (int x = 0; x < b->width[0]; x++) {
-            int x0 = x * cell_texels - 1, x1 = (x + 1) * cell_texels;
-            int z0 = z * cell_texels - 1, z1 = (z + 1) * cell_texels;
-            x0 = x0 < 0 ? 0 : x0;
-            z0 = z0 < 0 ? 0 : z0;
-            x1 = x1 >= w ? w - 1 : x1;
-            z1 = z1 >= h ? h - 1 : z1;
-            unsigned lo = 65535, hi = 0;
-            for (int tz = z0; tz <= z1; tz++)
-                for (int tx = x0; tx <= x1; tx++) {
-                    unsigned v = texels[(size_t)tz * (size_t)w + (size_t)tx];
-                    lo = v < lo ? v : lo;
-                    hi = v > hi ? v : hi;
-                }
-            size_t i = (size_t)z * (size_t)b->width[0] + (size_t)x;
-            b->hmin[0][i] = (float)(lo / 65535.0 * max_height + offset);
-            b->hmax[0][i] = (float)(hi / 65535.0 * max_height + offset);
-        }
-    }
+    for (int z = 0; z < b->height[0]; z++)
+        for (int x = 0; x < b->width[0]; x++)
+            rt_bounds_leaf(b, texels, w, h, cell_texels, max_height, offset, x, z);
     for (int L = 1; L < b->nlevels; L++)
         for (int z = 0; z < b->height[L]; z++)
             for (int x = 0; x < b->width[L]; x++)
                 rt_bounds_merge(b, L, x, z);
     return true;
+}
+
+void rt_bounds_leaf(rt_bounds *b, const uint16_t *texels, int w, int h, int cell_texels,
+                    double max_height, double offset, int x, int z)
+{
+    int x0 = x * cell_texels - 1, x1 = (x + 1) * cell_texels;
+    int z0 = z * cell_texels - 1, z1 = (z + 1) * cell_texels;
+    x0 = x0 < 0 ? 0 : x0;
+    z0 = z0 < 0 ? 0 : z0;
+    x1 = x1 >= w ? w - 1 : x1;
+    z1 = z1 >= h ? h - 1 : z1;
+    unsigned lo = 65535, hi = 0;
+    for (int tz = z0; tz <= z1; tz++)
+        for (int tx = x0; tx <= x1; tx++) {
+            unsigned v = texels[(size_t)tz * (size_t)w + (size_t)tx];
+            lo = v < lo ? v : lo;
+            hi = v > hi ? v : hi;
+        }
+    size_t i = (size_t)z * (size_t)b->width[0] + (size_t)x;
+    b->hmin[0][i] = (float)(lo / 65535.0 * max_height + offset);
+    b->hmax[0][i] = (float)(hi / 65535.0 * max_height + offset);
 }
 
 void rt_bounds_merge(rt_bounds *b, int L, int x, int z)
