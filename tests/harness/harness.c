@@ -52,6 +52,14 @@ static void set_err(char **err, const char *fmt, ...)
         }                                                                 \
     } while (0)
 
+/* A failed runtime call's message into *err; returns false. */
+static bool rt_err(char **err, rt_error *e)
+{
+    set_err(err, "%s", e->msg ? e->msg : "splatrt call failed");
+    rt_error_clear(e);
+    return false;
+}
+
 /* ---- instance and device ------------------------------------------------ */
 
 /* The device is libsplatrt's (rt_device_create: validation layer and
@@ -76,9 +84,7 @@ harness *harness_create(const harness_desc *desc, char **err)
     if (!rt_device_create(&h->rt, &rd, &e)) {
         if (e.id == RT_E_NO_DEVICE && dd.device && *dd.device)
             set_err(err, "no Vulkan 1.2 device named like '%s'", dd.device);
-        else
-            set_err(err, "%s", e.msg ? e.msg : "rt_device_create failed");
-        rt_error_clear(&e);
+        rt_err(err, &e);    /* keeps the first message */
         goto fail;
     }
     if (h->validate && !h->rt.validating) {
@@ -123,84 +129,22 @@ int harness_validation_count(const harness *h) { return rt_device_messages(&h->r
 
 /* ---- resources of one run ----------------------------------------------- */
 
-typedef struct hbuffer {
-    VkBuffer       buf;
-    VkDeviceMemory mem;
-    void          *map;
-    VkDeviceSize   size;
-} hbuffer;
-
+/* Buffers and images are libsplatrt's (rt_buffer, rt_image); an image
+ * here also carries its sampler. */
 typedef struct himage {
-    VkImage        img;
-    VkDeviceMemory mem;
-    VkImageView    view;
-    VkSampler      sampler;
+    rt_image  im;
+    VkSampler sampler;
 } himage;
-
-static bool find_memory(const harness *h, uint32_t bits, VkMemoryPropertyFlags want,
-                        uint32_t *type)
-{
-    for (uint32_t i = 0; i < h->rt.mem.memoryTypeCount; i++)
-        if ((bits & (1u << i)) &&
-            (h->rt.mem.memoryTypes[i].propertyFlags & want) == want) {
-            *type = i;
-            return true;
-        }
-    return false;
-}
-
-static bool alloc_memory(harness *h, VkMemoryRequirements req,
-                         VkMemoryPropertyFlags want, VkDeviceMemory *mem,
-                         char **err)
-{
-    uint32_t type;
-    if (!find_memory(h, req.memoryTypeBits, want, &type)) {
-        set_err(err, "no Vulkan memory type with properties 0x%x", (unsigned)want);
-        return false;
-    }
-    VkMemoryAllocateInfo mai = {
-        .sType = VK_STRUCTURE_TYPE_MEMORY_ALLOCATE_INFO,
-        .allocationSize = req.size,
-        .memoryTypeIndex = type,
-    };
-    VK(vkAllocateMemory(h->rt.dev, &mai, NULL, mem));
-    return true;
-fail:
-    return false;
-}
 
 /* A host-visible, coherent buffer, mapped, zero-filled. */
 static bool buffer_create(harness *h, VkDeviceSize size, VkBufferUsageFlags usage,
-                          hbuffer *b, char **err)
+                          rt_buffer *b, char **err)
 {
-    VkBufferCreateInfo bci = {
-        .sType = VK_STRUCTURE_TYPE_BUFFER_CREATE_INFO,
-        .size = size,
-        .usage = usage,
-        .sharingMode = VK_SHARING_MODE_EXCLUSIVE,
-    };
-    VK(vkCreateBuffer(h->rt.dev, &bci, NULL, &b->buf));
-    VkMemoryRequirements req;
-    vkGetBufferMemoryRequirements(h->rt.dev, b->buf, &req);
-    if (!alloc_memory(h, req, VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT |
-                              VK_MEMORY_PROPERTY_HOST_COHERENT_BIT, &b->mem, err))
-        return false;
-    VK(vkBindBufferMemory(h->rt.dev, b->buf, b->mem, 0));
-    VK(vkMapMemory(h->rt.dev, b->mem, 0, VK_WHOLE_SIZE, 0, &b->map));
+    rt_error e = { 0 };
+    if (!rt_buffer_create(&h->rt, size, usage, true, b, &e))
+        return rt_err(err, &e);
     memset(b->map, 0, size);
-    b->size = size;
     return true;
-fail:
-    return false;
-}
-
-static void buffer_destroy(harness *h, hbuffer *b)
-{
-    if (b->buf)
-        vkDestroyBuffer(h->rt.dev, b->buf, NULL);
-    if (b->mem)
-        vkFreeMemory(h->rt.dev, b->mem, NULL);   /* unmaps */
-    memset(b, 0, sizeof *b);
 }
 
 static VkSamplerAddressMode address_mode(ir_wrap w)
@@ -218,43 +162,19 @@ static bool image_create(harness *h, const harness_image *src, himage *im,
                          char **err)
 {
     const VkFormat fmt = VK_FORMAT_R32G32B32A32_SFLOAT;
-    VkFormatProperties fp;
-    vkGetPhysicalDeviceFormatProperties(h->rt.phys, fmt, &fp);
     VkFormatFeatureFlags need = VK_FORMAT_FEATURE_SAMPLED_IMAGE_BIT;
     if (src->filter == IR_FILTER_LINEAR)
         need |= VK_FORMAT_FEATURE_SAMPLED_IMAGE_FILTER_LINEAR_BIT;
-    if ((fp.optimalTilingFeatures & need) != need) {
+    if (!rt_format_supports(&h->rt, fmt, need)) {
         set_err(err, "%s cannot sample RGBA32F images with this filter",
                 h->rt.props.deviceName);
         return false;
     }
-    VkImageCreateInfo ici = {
-        .sType = VK_STRUCTURE_TYPE_IMAGE_CREATE_INFO,
-        .imageType = VK_IMAGE_TYPE_2D,
-        .format = fmt,
-        .extent = { (uint32_t)src->width, (uint32_t)src->height, 1 },
-        .mipLevels = 1,
-        .arrayLayers = 1,
-        .samples = VK_SAMPLE_COUNT_1_BIT,
-        .tiling = VK_IMAGE_TILING_OPTIMAL,
-        .usage = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT,
-        .sharingMode = VK_SHARING_MODE_EXCLUSIVE,
-        .initialLayout = VK_IMAGE_LAYOUT_UNDEFINED,
-    };
-    VK(vkCreateImage(h->rt.dev, &ici, NULL, &im->img));
-    VkMemoryRequirements req;
-    vkGetImageMemoryRequirements(h->rt.dev, im->img, &req);
-    if (!alloc_memory(h, req, VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT, &im->mem, err))
-        return false;
-    VK(vkBindImageMemory(h->rt.dev, im->img, im->mem, 0));
-    VkImageViewCreateInfo vci = {
-        .sType = VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO,
-        .image = im->img,
-        .viewType = VK_IMAGE_VIEW_TYPE_2D,
-        .format = fmt,
-        .subresourceRange = { VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1 },
-    };
-    VK(vkCreateImageView(h->rt.dev, &vci, NULL, &im->view));
+    rt_error e = { 0 };
+    if (!rt_image_create(&h->rt, (uint32_t)src->width, (uint32_t)src->height, 1, false, 1,
+                         fmt, VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT,
+                         VK_IMAGE_ASPECT_COLOR_BIT, &im->im, &e))
+        return rt_err(err, &e);
     VkFilter f = src->filter == IR_FILTER_NEAREST ? VK_FILTER_NEAREST : VK_FILTER_LINEAR;
     VkSamplerAddressMode am = address_mode(src->wrap);
     VkSamplerCreateInfo sci = {
@@ -277,13 +197,8 @@ static void image_destroy(harness *h, himage *im)
 {
     if (im->sampler)
         vkDestroySampler(h->rt.dev, im->sampler, NULL);
-    if (im->view)
-        vkDestroyImageView(h->rt.dev, im->view, NULL);
-    if (im->img)
-        vkDestroyImage(h->rt.dev, im->img, NULL);
-    if (im->mem)
-        vkFreeMemory(h->rt.dev, im->mem, NULL);
-    memset(im, 0, sizeof *im);
+    rt_image_destroy(&h->rt, &im->im);
+    im->sampler = VK_NULL_HANDLE;
 }
 
 static void image_barrier(VkCommandBuffer cmd, VkImage img, VkImageLayout from,
@@ -348,8 +263,8 @@ bool harness_run(harness *h, const harness_dispatch *d, char **err)
     const int nimg = d->nimages;
     const uint32_t nbind = 2 + (uint32_t)nimg;
     bool ok = false;
-    hbuffer in = {0}, out = {0};
-    hbuffer *staging = calloc((size_t)nimg + 1, sizeof *staging);
+    rt_buffer in = {0}, out = {0};
+    rt_buffer *staging = calloc((size_t)nimg + 1, sizeof *staging);
     himage *images = calloc((size_t)nimg + 1, sizeof *images);
     VkDescriptorSetLayoutBinding *binds = calloc(nbind, sizeof *binds);
     VkDescriptorImageInfo *iinfo = calloc((size_t)nimg + 1, sizeof *iinfo);
@@ -460,7 +375,7 @@ bool harness_run(harness *h, const harness_dispatch *d, char **err)
             writes[b].pBufferInfo = &binfo[b];
         } else {
             iinfo[b - 2] = (VkDescriptorImageInfo){
-                images[b - 2].sampler, images[b - 2].view,
+                images[b - 2].sampler, images[b - 2].im.view,
                 VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
             };
             writes[b].pImageInfo = &iinfo[b - 2];
@@ -476,7 +391,7 @@ bool harness_run(harness *h, const harness_dispatch *d, char **err)
     };
     VK(vkBeginCommandBuffer(h->cmd, &cbbi));
     for (int i = 0; i < nimg; i++) {
-        image_barrier(h->cmd, images[i].img, VK_IMAGE_LAYOUT_UNDEFINED,
+        image_barrier(h->cmd, images[i].im.img, VK_IMAGE_LAYOUT_UNDEFINED,
                       VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 0,
                       VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT,
                       VK_PIPELINE_STAGE_TRANSFER_BIT);
@@ -485,9 +400,9 @@ bool harness_run(harness *h, const harness_dispatch *d, char **err)
             .imageExtent = { (uint32_t)d->images[i].width,
                              (uint32_t)d->images[i].height, 1 },
         };
-        vkCmdCopyBufferToImage(h->cmd, staging[i].buf, images[i].img,
+        vkCmdCopyBufferToImage(h->cmd, staging[i].buf, images[i].im.img,
                                VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
-        image_barrier(h->cmd, images[i].img, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+        image_barrier(h->cmd, images[i].im.img, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
                       VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
                       VK_ACCESS_TRANSFER_WRITE_BIT, VK_ACCESS_SHADER_READ_BIT,
                       VK_PIPELINE_STAGE_TRANSFER_BIT,
@@ -536,10 +451,10 @@ fail:
         vkDestroyShaderModule(h->rt.dev, module, NULL);
     for (int i = 0; images && staging && i < nimg; i++) {
         image_destroy(h, &images[i]);
-        buffer_destroy(h, &staging[i]);
+        rt_buffer_destroy(&h->rt, &staging[i]);
     }
-    buffer_destroy(h, &in);
-    buffer_destroy(h, &out);
+    rt_buffer_destroy(&h->rt, &in);
+    rt_buffer_destroy(&h->rt, &out);
     free(staging);
     free(images);
     free(binds);
