@@ -30,12 +30,12 @@ echo "|---|---|---|"
 awk -F, '
     function verdict(ok) { return ok ? "MET" : "**MISSED**" }
     FILENAME ~ /compile.csv/ && $2 == "colorado" && $3 == "cold" {
-        printf "| issue 3: colorado build from an empty cache < 2 s (-j 2) | %.2f s wall (%.1fx the target) | %s |\n", $14, $14 / 2, verdict($14 < 2)
+        printf "| issue 3: colorado build from an empty cache < 2 s (-j 2) | %.2f s wall (%.2fx the target) | %s |\n", $14, $14 / 2, verdict($14 < 2)
         if ($15 != "NA") printf "| issue 3: peak memory < 500 MB | %.0f MB | %s |\n", $15, verdict($15 < 500)
         cold = 1
     }
     FILENAME ~ /compile.csv/ && $2 == "colorado" && $3 == "warm" {
-        printf "| issue 3: colorado rebuild with nothing changed < 0.3 s | %.2f s wall (%.1fx the target) | %s |\n", $14, $14 / 0.3, verdict($14 < 0.3)
+        printf "| issue 3: colorado rebuild with nothing changed < 0.3 s | %.2f s wall (%.2fx the target) | %s |\n", $14, $14 / 0.3, verdict($14 < 0.3)
     }
     # repeated builds of one size: the smallest analysis time counts
     FILENAME ~ /scale_hf.csv/ && FNR > 1 && $17 != "" {
