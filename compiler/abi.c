@@ -100,6 +100,20 @@ const char SPLAT_GLSL_PRELUDE[] =
     "uint splat_view() {\n"
     "    return splat_spec_view == 0xffffffffu ? u_frame.view.x : splat_spec_view;\n"
     "}\n"
+    /* A composite's branch condition, made uniform over each 2x2 quad:
+     * true for all four pixels if it holds for any.  Textures sampled
+     * inside the branch take implicit derivatives, which are undefined
+     * when only part of a quad runs it (NVIDIA then picks wrong mip levels
+     * at material borders).  Fine derivatives of a 0/1 flag are the OR
+     * with the horizontal, then the vertical neighbour; the caller is in
+     * quad-uniform control flow by induction.  Pixels with weight 0 that
+     * run the branch add 0 * surface. */
+    "bool splat_quad_any(bool c) {\n"
+    "    float f = c ? 1.0 : 0.0;\n"
+    "    f = max(f, abs(dFdxFine(f)));\n"
+    "    f = max(f, abs(dFdyFine(f)));\n"
+    "    return f > 0.0;\n"
+    "}\n"
     /* Listing 1 (seed 000), with the texel aspect in metres. */
     "vec3 splat_normal_at(vec2 uv) {\n"
     "    vec2 t = u_frame.texel.zw;\n"

@@ -578,7 +578,9 @@ static bool open_guard(emit *em, ir_ref cond, int depth)
         ir_buf_printf(em->out, "%s{\n", indent_at(em, depth));
     } else {
         char *x = value(em, cond, depth);
-        ir_buf_printf(em->out, "%sif (%s > 0.0) {\n", indent_at(em, depth), x);
+        /* quad-uniform, so implicit texture derivatives stay defined */
+        ir_buf_printf(em->out, "%sif (splat_quad_any(%s > 0.0)) {\n",
+                      indent_at(em, depth), x);
         free(x);
     }
     glsl_scope_push(em->e);

@@ -376,7 +376,7 @@ static void test_placement(void **state)
     assert_non_null(hdr);
     char *h = strndup(hdr, hl);
     assert_non_null(strstr(h, "if ("));
-    assert_non_null(strstr(h, "> 0.0) {"));
+    assert_non_null(strstr(h, "> 0.0)) {"));
     char *block = strndup(hdr, (size_t)(body + end - hdr));
     assert_non_null(strstr(block, "s_albedo +="));
     free(block);
