@@ -471,20 +471,6 @@ const uint16_t *rt_destruction_heights(const rt_destruction *ds) { return ds->he
 
 /* ---- a crater ------------------------------------------------------------------ */
 
-static void image_barrier(VkCommandBuffer cb, VkImage img, VkImageLayout from, VkImageLayout to,
-                          VkAccessFlags sa, VkAccessFlags da, VkPipelineStageFlags ss,
-                          VkPipelineStageFlags dst)
-{
-    VkImageMemoryBarrier b = {
-        .sType = VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER,
-        .srcAccessMask = sa, .dstAccessMask = da, .oldLayout = from, .newLayout = to,
-        .srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED,
-        .dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED,
-        .image = img, .subresourceRange = { VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1 },
-    };
-    vkCmdPipelineBarrier(cb, ss, dst, 0, 0, NULL, 0, NULL, 1, &b);
-}
-
 /* Copy `rows` x `bytes_per_row` bytes from staging offset `off` into the
  * rectangle (x, y, w, h) of `img` (SHADER_READ_ONLY before and after). */
 static void upload_rect(rt_destruction *ds, VkImage img, VkDeviceSize off, int x, int y,
@@ -493,7 +479,7 @@ static void upload_rect(rt_destruction *ds, VkImage img, VkDeviceSize off, int x
     VkCommandBuffer cb = ds->cb[ds->slot];
     const VkPipelineStageFlags shaders = VK_PIPELINE_STAGE_VERTEX_SHADER_BIT |
                                          VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT;
-    image_barrier(cb, img, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+    rt_cmd_image_barrier(cb, img, 0, 1, 1, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
                   VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_ACCESS_SHADER_READ_BIT,
                   VK_ACCESS_TRANSFER_WRITE_BIT, shaders, VK_PIPELINE_STAGE_TRANSFER_BIT);
     VkBufferImageCopy copy = {
@@ -505,7 +491,7 @@ static void upload_rect(rt_destruction *ds, VkImage img, VkDeviceSize off, int x
     };
     vkCmdCopyBufferToImage(cb, ds->staging[ds->slot].buf, img, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1,
                            &copy);
-    image_barrier(cb, img, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+    rt_cmd_image_barrier(cb, img, 0, 1, 1, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
                   VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, VK_ACCESS_TRANSFER_WRITE_BIT,
                   VK_ACCESS_SHADER_READ_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, shaders);
 }
@@ -760,7 +746,7 @@ bool rt_read_r16(rt_device *d, const rt_image *img, uint16_t *out, rt_error *e)
     }
     const VkPipelineStageFlags shaders = VK_PIPELINE_STAGE_VERTEX_SHADER_BIT |
                                          VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT;
-    image_barrier(cb, img->img, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+    rt_cmd_image_barrier(cb, img->img, 0, 1, 1, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
                   VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_ACCESS_SHADER_READ_BIT |
                   VK_ACCESS_TRANSFER_WRITE_BIT, VK_ACCESS_TRANSFER_READ_BIT,
                   shaders | VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT);
@@ -769,7 +755,7 @@ bool rt_read_r16(rt_device *d, const rt_image *img, uint16_t *out, rt_error *e)
         .imageExtent = { img->width, img->height, 1 },
     };
     vkCmdCopyImageToBuffer(cb, img->img, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, buf.buf, 1, &copy);
-    image_barrier(cb, img->img, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+    rt_cmd_image_barrier(cb, img->img, 0, 1, 1, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
                   VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, VK_ACCESS_TRANSFER_READ_BIT,
                   VK_ACCESS_SHADER_READ_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, shaders);
     VkBufferMemoryBarrier hb = {

@@ -474,10 +474,10 @@ bool rt_oneshot_end(rt_device *d, VkCommandBuffer cb, rt_error *e)
     return true;
 }
 
-static void barrier(VkCommandBuffer cb, VkImage img, uint32_t mip, uint32_t nmips,
-                    uint32_t layers, VkImageLayout from, VkImageLayout to,
-                    VkAccessFlags src_access, VkAccessFlags dst_access,
-                    VkPipelineStageFlags src, VkPipelineStageFlags dst)
+void rt_cmd_image_barrier(VkCommandBuffer cb, VkImage img, uint32_t mip, uint32_t nmips,
+                          uint32_t layers, VkImageLayout from, VkImageLayout to,
+                          VkAccessFlags src_access, VkAccessFlags dst_access,
+                          VkPipelineStageFlags src, VkPipelineStageFlags dst)
 {
     VkImageMemoryBarrier b = {
         .sType = VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER,
@@ -505,7 +505,7 @@ bool rt_image_upload(rt_device *d, rt_image *img, const void *data,
         rt_buffer_destroy(d, &staging);
         return false;
     }
-    barrier(cb, img->img, 0, img->mips, img->layers, VK_IMAGE_LAYOUT_UNDEFINED,
+    rt_cmd_image_barrier(cb, img->img, 0, img->mips, img->layers, VK_IMAGE_LAYOUT_UNDEFINED,
             VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 0, VK_ACCESS_TRANSFER_WRITE_BIT,
             VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT);
     VkBufferImageCopy copy = {
@@ -517,7 +517,7 @@ bool rt_image_upload(rt_device *d, rt_image *img, const void *data,
     /* Mip chain by successive blits: mip i-1 -> mip i. */
     int32_t w = (int32_t)img->width, h = (int32_t)img->height;
     for (uint32_t m = 1; m < img->mips; m++) {
-        barrier(cb, img->img, m - 1, 1, img->layers, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+        rt_cmd_image_barrier(cb, img->img, m - 1, 1, img->layers, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
                 VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_ACCESS_TRANSFER_WRITE_BIT,
                 VK_ACCESS_TRANSFER_READ_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
                 VK_PIPELINE_STAGE_TRANSFER_BIT);
@@ -530,14 +530,14 @@ bool rt_image_upload(rt_device *d, rt_image *img, const void *data,
         };
         vkCmdBlitImage(cb, img->img, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, img->img,
                        VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &blit, VK_FILTER_LINEAR);
-        barrier(cb, img->img, m - 1, 1, img->layers, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+        rt_cmd_image_barrier(cb, img->img, m - 1, 1, img->layers, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
                 VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, VK_ACCESS_TRANSFER_READ_BIT,
                 VK_ACCESS_SHADER_READ_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
                 VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT);
         w = nw;
         h = nh;
     }
-    barrier(cb, img->img, img->mips - 1, 1, img->layers, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+    rt_cmd_image_barrier(cb, img->img, img->mips - 1, 1, img->layers, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
             VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, VK_ACCESS_TRANSFER_WRITE_BIT,
             VK_ACCESS_SHADER_READ_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
             VK_PIPELINE_STAGE_VERTEX_SHADER_BIT | VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT);
@@ -579,12 +579,12 @@ bool rt_image_upload_levels(rt_device *d, rt_image *img, const uint8_t *const *l
     VkCommandBuffer cb;
     bool ok = rt_oneshot_begin(d, &cb, e);
     if (ok) {
-        barrier(cb, img->img, 0, img->mips, 1, VK_IMAGE_LAYOUT_UNDEFINED,
+        rt_cmd_image_barrier(cb, img->img, 0, img->mips, 1, VK_IMAGE_LAYOUT_UNDEFINED,
                 VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 0, VK_ACCESS_TRANSFER_WRITE_BIT,
                 VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT);
         vkCmdCopyBufferToImage(cb, staging.buf, img->img, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
                                img->mips, regions);
-        barrier(cb, img->img, 0, img->mips, 1, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+        rt_cmd_image_barrier(cb, img->img, 0, img->mips, 1, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
                 VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, VK_ACCESS_TRANSFER_WRITE_BIT,
                 VK_ACCESS_SHADER_READ_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
                 VK_PIPELINE_STAGE_VERTEX_SHADER_BIT | VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT);

@@ -135,6 +135,12 @@ bool rt_image_upload_levels(rt_device *d, rt_image *img, const uint8_t *const *l
 /* One-time command buffer helpers (load time only). */
 bool rt_oneshot_begin(rt_device *d, VkCommandBuffer *cb, rt_error *e);
 bool rt_oneshot_end(rt_device *d, VkCommandBuffer cb, rt_error *e);
+/* Record a layout transition of mips [mip, mip + nmips) of the first
+ * `layers` layers of a colour image. */
+void rt_cmd_image_barrier(VkCommandBuffer cb, VkImage img, uint32_t mip, uint32_t nmips,
+                          uint32_t layers, VkImageLayout from, VkImageLayout to,
+                          VkAccessFlags src_access, VkAccessFlags dst_access,
+                          VkPipelineStageFlags src, VkPipelineStageFlags dst);
 bool rt_format_supports(rt_device *d, VkFormat f, VkFormatFeatureFlags need);
 
 /* ---- glsl.c: GLSL -> SPIR-V for the runtime's own shaders -------------- */

@@ -582,19 +582,6 @@ static bool make_tonemap(viewer *v, rt_error *e)
     return true;
 }
 
-static void image_barrier(VkCommandBuffer cb, VkImage img, VkImageLayout from, VkImageLayout to,
-                          VkAccessFlags sa, VkAccessFlags da, VkPipelineStageFlags ss,
-                          VkPipelineStageFlags ds)
-{
-    VkImageMemoryBarrier b = {
-        .sType = VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER,
-        .srcAccessMask = sa, .dstAccessMask = da, .oldLayout = from, .newLayout = to,
-        .srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED, .dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED,
-        .image = img, .subresourceRange = { VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1 },
-    };
-    vkCmdPipelineBarrier(cb, ss, ds, 0, 0, NULL, 0, NULL, 1, &b);
-}
-
 /* Tone-map the renderer's frame into the next swapchain image, present it;
  * with `shot`, also copy it out and write a PNG. */
 static bool present(viewer *v, const char *shot, rt_error *e)
@@ -609,7 +596,7 @@ static bool present(viewer *v, const char *shot, rt_error *e)
     VkCommandBufferBeginInfo bi = { .sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO,
                                     .flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT };
     RT_VK(e, vkBeginCommandBuffer(cb, &bi));
-    image_barrier(cb, rt_renderer_target(v->r)->img, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+    rt_cmd_image_barrier(cb, rt_renderer_target(v->r)->img, 0, 1, 1, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
                   VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT,
                   VK_ACCESS_SHADER_READ_BIT, VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT,
                   VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT);
@@ -625,7 +612,7 @@ static bool present(viewer *v, const char *shot, rt_error *e)
     vkCmdDraw(cb, 3, 1, 0, 0);
     vkCmdEndRenderPass(cb);
     if (shot) {
-        image_barrier(cb, v->images[idx], VK_IMAGE_LAYOUT_PRESENT_SRC_KHR,
+        rt_cmd_image_barrier(cb, v->images[idx], 0, 1, 1, VK_IMAGE_LAYOUT_PRESENT_SRC_KHR,
                       VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT,
                       VK_ACCESS_TRANSFER_READ_BIT, VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT,
                       VK_PIPELINE_STAGE_TRANSFER_BIT);
@@ -635,7 +622,7 @@ static bool present(viewer *v, const char *shot, rt_error *e)
         };
         vkCmdCopyImageToBuffer(cb, v->images[idx], VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
                                v->shot.buf, 1, &copy);
-        image_barrier(cb, v->images[idx], VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+        rt_cmd_image_barrier(cb, v->images[idx], 0, 1, 1, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
                       VK_IMAGE_LAYOUT_PRESENT_SRC_KHR, VK_ACCESS_TRANSFER_READ_BIT, 0,
                       VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT);
     }

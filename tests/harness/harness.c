@@ -201,25 +201,6 @@ static void image_destroy(harness *h, himage *im)
     im->sampler = VK_NULL_HANDLE;
 }
 
-static void image_barrier(VkCommandBuffer cmd, VkImage img, VkImageLayout from,
-                          VkImageLayout to, VkAccessFlags src_access,
-                          VkAccessFlags dst_access, VkPipelineStageFlags src,
-                          VkPipelineStageFlags dst)
-{
-    VkImageMemoryBarrier b = {
-        .sType = VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER,
-        .srcAccessMask = src_access,
-        .dstAccessMask = dst_access,
-        .oldLayout = from,
-        .newLayout = to,
-        .srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED,
-        .dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED,
-        .image = img,
-        .subresourceRange = { VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1 },
-    };
-    vkCmdPipelineBarrier(cmd, src, dst, 0, 0, NULL, 0, NULL, 1, &b);
-}
-
 /* ---- the run ------------------------------------------------------------- */
 
 static bool check_dispatch(const harness_dispatch *d, char **err)
@@ -391,7 +372,7 @@ bool harness_run(harness *h, const harness_dispatch *d, char **err)
     };
     VK(vkBeginCommandBuffer(h->cmd, &cbbi));
     for (int i = 0; i < nimg; i++) {
-        image_barrier(h->cmd, images[i].im.img, VK_IMAGE_LAYOUT_UNDEFINED,
+        rt_cmd_image_barrier(h->cmd, images[i].im.img, 0, 1, 1, VK_IMAGE_LAYOUT_UNDEFINED,
                       VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 0,
                       VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT,
                       VK_PIPELINE_STAGE_TRANSFER_BIT);
@@ -402,7 +383,7 @@ bool harness_run(harness *h, const harness_dispatch *d, char **err)
         };
         vkCmdCopyBufferToImage(h->cmd, staging[i].buf, images[i].im.img,
                                VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, &region);
-        image_barrier(h->cmd, images[i].im.img, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+        rt_cmd_image_barrier(h->cmd, images[i].im.img, 0, 1, 1, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
                       VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
                       VK_ACCESS_TRANSFER_WRITE_BIT, VK_ACCESS_SHADER_READ_BIT,
                       VK_PIPELINE_STAGE_TRANSFER_BIT,
