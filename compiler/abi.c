@@ -4,6 +4,99 @@
 
 #include <math.h>
 
+#define SPLAT_STR_(x) #x
+#define SPLAT_STR(x) SPLAT_STR_(x)
+
+
+/* The prelude's own textures have one mip level: texture() where the
+ * stage has implicit derivatives, level 0 where it has none (compute;
+ * the vertex stage has none either, but its level is 0 already). */
+#define SPLAT_GLSL_TEXTURE0                                                 \
+    "#ifdef SPLAT_COMPUTE\n"                                                \
+    "#define splat_texture0(s, p) textureLod(s, p, 0.0)\n"                  \
+    "#else\n"                                                               \
+    "#define splat_texture0(s, p) texture(s, p)\n"                          \
+    "#endif\n"
+
+/* ---- compute stage (abi.h "compute stage"): declarations and main --------- */
+
+/* Bindings 7-10 and the globals that stand for the fragment varyings. */
+#define COMPUTE_DECLS                                                       \
+    "layout(local_size_x = 8, local_size_y = 8) in;\n"                      \
+    "layout(set = 0, binding = 7) uniform sampler2D u_depth;\n"             \
+    "layout(set = 0, binding = 8, rgba32f) uniform writeonly image2D u_out;\n" \
+    "layout(set = 0, binding = 9, std430) readonly buffer splat_tiles_block {\n" \
+    "    uint tiles[];\n"                                                   \
+    "} u_tiles;\n"                                                          \
+    "#ifdef SPLAT_COUNT\n"                                                  \
+    "layout(set = 0, binding = 10, std430) buffer splat_counters_block {\n" \
+    "    uint pixels;\n"                                                    \
+    "    uint layers_evaluated;\n"                                          \
+    "    uint layers_needed;\n"                                             \
+    "    uint samples;\n"                                                   \
+    "} u_counters;\n"                                                       \
+    "#endif\n"                                                              \
+    "vec3 v_rel;      /* camera-relative position (m), from depth */\n"     \
+    "vec2 v_uv;       /* heightfield uv */\n"                               \
+    "vec3 v_local;    /* terrain-local position (m) */\n"                   \
+    "vec4 o_color;    /* what main() stores into u_out */\n"                \
+    "ivec2 splat_pixel;\n"                                                  \
+    "vec3 splat_nrm;  /* the terrain normal (Listing 1) at v_uv */\n"      \
+    "vec3 splat_dpdx; /* position one pixel right, minus the position */\n" \
+    "vec3 splat_dpdy; /* position one pixel down, minus the position */\n"  \
+    "uint splat_n_evaluated = 0u, splat_n_needed = 0u, splat_n_samples = 0u;\n"
+
+/* After splat_finish: depth reconstruction, FC5's position derivatives,
+ * the real main() around the composite's (renamed splat_main).
+ *
+ * Derivatives (Moore 2018, "Shading Pass Derivatives"): the plane through
+ * the pixel's position with the terrain normal (Listing 1), intersected
+ * with the ray from the camera (the origin of camera-relative space)
+ * through the centre of the pixel to the right / below; the difference to
+ * the position is what a fragment quad's dFdx / dFdy of the position
+ * would be on that plane.  A ray that misses the plane (grazing, or
+ * parallel) takes the far cap t = 1e4: the coarsest mips, as a quad would
+ * pick next to a silhouette. */
+#define COMPUTE_MAIN                                                        \
+    "vec3 splat_unproject(vec2 px, float depth) {\n"                        \
+    "    vec2 ndc = px / u_frame.screen.xy * 2.0 - 1.0;\n"                   \
+    "    vec4 p = u_frame.inv_view_proj * vec4(ndc, depth, 1.0);\n"         \
+    "    return p.xyz / p.w;\n"                                             \
+    "}\n"                                                                   \
+    "vec3 splat_plane_step(vec3 n, vec2 px, float depth) {\n"               \
+    "    vec3 q = splat_unproject(px, depth);\n"                            \
+    "    float t = dot(n, v_rel) / dot(n, q);\n"                            \
+    "    t = t > 0.0 ? min(t, 1e4) : 1e4;\n"                                \
+    "    return q * t - v_rel;\n"                                           \
+    "}\n"                                                                   \
+    "bool splat_begin() {\n"                                                \
+    "    uint t = u_tiles.tiles[u_push.info.w + gl_WorkGroupID.x];\n"       \
+    "    splat_pixel = ivec2(uvec2(t & 0xffffu, t >> 16u) * 8u + gl_LocalInvocationID.xy);\n" \
+    "    if (any(greaterThanEqual(splat_pixel, ivec2(u_frame.screen.xy)))) return false;\n" \
+    "    float d = texelFetch(u_depth, splat_pixel, 0).r;\n"                \
+    "    if (d == u_frame.screen.z) return false;\n"                        \
+    "    vec2 c = vec2(splat_pixel) + 0.5;\n"                               \
+    "    v_rel = splat_unproject(c, d);\n"                                  \
+    "    v_local = v_rel + u_frame.camera.xyz;\n"                           \
+    "    v_uv = v_local.xz / u_frame.terrain.xy;\n"                         \
+    "    splat_nrm = splat_normal_at(v_uv);\n"                              \
+    "    splat_dpdx = splat_plane_step(splat_nrm, c + vec2(1.0, 0.0), d);\n" \
+    "    splat_dpdy = splat_plane_step(splat_nrm, c + vec2(0.0, 1.0), d);\n" \
+    "    return true;\n"                                                    \
+    "}\n"                                                                   \
+    "void splat_main();\n"                                                  \
+    "void main() {\n"                                                       \
+    "    if (!splat_begin()) return;\n"                                     \
+    "    splat_main();\n"                                                   \
+    "#ifdef SPLAT_COUNT\n"                                                  \
+    "    atomicAdd(u_counters.pixels, 1u);\n"                               \
+    "    atomicAdd(u_counters.layers_evaluated, splat_n_evaluated);\n"      \
+    "    atomicAdd(u_counters.layers_needed, splat_n_needed);\n"            \
+    "    atomicAdd(u_counters.samples, splat_n_samples);\n"                 \
+    "#endif\n"                                                              \
+    "    imageStore(u_out, splat_pixel, o_color);\n"                        \
+    "}\n"                                                                   \
+    "#define main splat_main\n"
 
 /* Declarations common to the vertex and fragment stages. */
 #define SPLAT_GLSL_COMMON                                                   \
@@ -20,14 +113,18 @@
     "    vec4 destruction;\n"                                               \
     "    vec4 destruction_atlas;\n"                                         \
     "    uvec4 view;\n"                                                     \
+    "    mat4 inv_view_proj;\n"                                             \
+    "    vec4 screen;\n"                                                    \
+    "    vec4 world[" SPLAT_STR(SPLAT_WORLD_SITES) "];\n"                   \
     "} u_frame;\n"                                                          \
     "layout(push_constant, std430) uniform splat_push_block {\n"            \
     "    vec4 patch_xz;\n"                                                  \
     "    vec4 patch_uv;\n"                                                  \
     "    uvec4 info;\n"                                                     \
     "} u_push;\n"                                                           \
+    SPLAT_GLSL_TEXTURE0                                                     \
     "float splat_height_at(vec2 uv) {\n"                                    \
-    "    return texture(u_height, uv).r * u_frame.terrain.z + u_frame.terrain.w;\n" \
+    "    return splat_texture0(u_height, uv).r * u_frame.terrain.z + u_frame.terrain.w;\n" \
     "}\n"
 
 #define COMBO_COLOR_TEXT \
@@ -56,6 +153,8 @@ const char SPLAT_GLSL_LIGHTING[] = LIGHTING_TEXT;
 const char SPLAT_GLSL_VERTEX[] =
     "#version 450\n"
     SPLAT_GLSL_COMMON
+    "layout(set = 0, binding = 12) uniform sampler2D u_holes;\n"
+    "out gl_PerVertex { vec4 gl_Position; float gl_ClipDistance[1]; };\n"
     "layout(location = 0) in vec2 a_grid;\n"
     "layout(location = 0) out vec3 v_rel;\n"
     "layout(location = 1) out vec2 v_uv;\n"
@@ -71,9 +170,15 @@ const char SPLAT_GLSL_VERTEX[] =
     "    v_uv = uv;\n"
     "    v_local = vec3(uv.x * u_frame.terrain.x, h, uv.y * u_frame.terrain.y);\n"
     "    gl_Position = u_frame.view_proj * vec4(rel, 1.0);\n"
+    /* terrain holes: cut along the 0.5 contour (abi.h, binding 12) */
+    "    gl_ClipDistance[0] = 0.5 - textureLod(u_holes, uv, 0.0).r;\n"
     "}\n";
 
 const char SPLAT_GLSL_PRELUDE[] =
+    /* the counting variant's branches are subgroup-uniform (abi.h) */
+    "#if defined(SPLAT_COMPUTE) && defined(SPLAT_COUNT)\n"
+    "#extension GL_KHR_shader_subgroup_vote : require\n"
+    "#endif\n"
     SPLAT_GLSL_COMMON
     /* painted masks: dense layers, or the sparse quad-tree (sparse.h) */
     "#ifdef SPLAT_PAINTED_SPARSE\n"
@@ -85,10 +190,15 @@ const char SPLAT_GLSL_PRELUDE[] =
     "#endif\n"
     "layout(set = 0, binding = 3) uniform sampler2D u_destruction_atlas;\n"
     "layout(set = 0, binding = 4) uniform sampler2D u_destruction_index;\n"
+    "#ifdef SPLAT_COMPUTE\n"
+    COMPUTE_DECLS
+    "#else\n"
     "layout(location = 0) in vec3 v_rel;\n"
     "layout(location = 1) in vec2 v_uv;\n"
     "layout(location = 2) in vec3 v_local;\n"
-    "#ifdef SPLAT_MULTIPASS\n"
+    "#endif\n"
+    "#if defined(SPLAT_COMPUTE)\n"
+    "#elif defined(SPLAT_MULTIPASS)\n"
     "layout(location = 0) out vec4 o_albedo;   /* rgb albedo, a mask */\n"
     "layout(location = 1) out vec4 o_normal;   /* xyz normal, a mask */\n"
     "layout(location = 2) out vec4 o_misc;     /* roughness, height, distance */\n"
@@ -96,9 +206,11 @@ const char SPLAT_GLSL_PRELUDE[] =
     "layout(location = 0) out vec4 o_color;\n"
     "#endif\n"
     /* the view: fixed at pipeline creation, or read per frame (abi.h) */
-    "layout(constant_id = 0) const uint splat_spec_view = 0xffffffffu;\n"
+    "layout(constant_id = " SPLAT_STR(SPLAT_SPEC_VIEW) ") const uint splat_spec_view = "
+    SPLAT_STR(SPLAT_SPEC_VIEW_DYNAMIC) ";\n"
     "uint splat_view() {\n"
-    "    return splat_spec_view == 0xffffffffu ? u_frame.view.x : splat_spec_view;\n"
+    "    return splat_spec_view == " SPLAT_STR(SPLAT_SPEC_VIEW_DYNAMIC)
+    " ? u_frame.view.x : splat_spec_view;\n"
     "}\n"
     /* A composite's branch condition, made uniform over each 2x2 quad:
      * true for all four pixels if it holds for any.  Textures sampled
@@ -108,19 +220,25 @@ const char SPLAT_GLSL_PRELUDE[] =
      * with the horizontal, then the vertical neighbour; the caller is in
      * quad-uniform control flow by induction.  Pixels with weight 0 that
      * run the branch add 0 * surface. */
+    "#if defined(SPLAT_COMPUTE) && defined(SPLAT_COUNT)\n"
+    "bool splat_quad_any(bool c) { return subgroupAny(c); }\n"
+    "#elif defined(SPLAT_COMPUTE)\n"
+    "bool splat_quad_any(bool c) { return c; }\n"
+    "#else\n"
     "bool splat_quad_any(bool c) {\n"
     "    float f = c ? 1.0 : 0.0;\n"
     "    f = max(f, abs(dFdxFine(f)));\n"
     "    f = max(f, abs(dFdyFine(f)));\n"
     "    return f > 0.0;\n"
     "}\n"
-    /* Listing 1 (seed 000), with the texel aspect in metres. */
+    "#endif\n"
+    /* Listing 1 (Andersson 2007), with the texel aspect in metres. */
     "vec3 splat_normal_at(vec2 uv) {\n"
     "    vec2 t = u_frame.texel.zw;\n"
-    "    float hd = texture(u_height, uv + vec2(0.0, -t.y)).r;\n"
-    "    float hl = texture(u_height, uv + vec2(-t.x, 0.0)).r;\n"
-    "    float hr = texture(u_height, uv + vec2(t.x, 0.0)).r;\n"
-    "    float hu = texture(u_height, uv + vec2(0.0, t.y)).r;\n"
+    "    float hd = splat_texture0(u_height, uv + vec2(0.0, -t.y)).r;\n"
+    "    float hl = splat_texture0(u_height, uv + vec2(-t.x, 0.0)).r;\n"
+    "    float hr = splat_texture0(u_height, uv + vec2(t.x, 0.0)).r;\n"
+    "    float hu = splat_texture0(u_height, uv + vec2(0.0, t.y)).r;\n"
     "    float dx = u_frame.terrain.x * t.x;\n"
     "    float dz = u_frame.terrain.y * t.y;\n"
     "    vec3 n = vec3((hl - hr) * u_frame.terrain.z / dx, 2.0,\n"
@@ -128,10 +246,16 @@ const char SPLAT_GLSL_PRELUDE[] =
     "    return normalize(n);\n"
     "}\n"
     "float splat_height() { return splat_height_at(v_uv); }\n"
+    /* compute: splat_begin computed it already (for the derivatives) */
+    "#ifdef SPLAT_COMPUTE\n"
+    "vec3 splat_normal() { return splat_nrm; }\n"
+    "#else\n"
     "vec3 splat_normal() { return splat_normal_at(v_uv); }\n"
+    "#endif\n"
     "float splat_slope() { return 1.0 - splat_normal().y; }\n"
     "vec3 splat_position() { return vec3(v_local.x, splat_height(), v_local.z); }\n"
     "vec2 splat_uv() { return v_uv; }\n"
+    "vec3 splat_offset() { return v_rel; }\n"
     "float splat_view_distance() { return length(v_rel); }\n"
     /* v_rel = surface - camera (terrain-local axes), so surface -> camera
      * is its negation; the camera exactly on the surface reads straight up */
@@ -139,6 +263,55 @@ const char SPLAT_GLSL_PRELUDE[] =
     "    float l = length(v_rel);\n"
     "    return l > 0.0 ? -v_rel / l : vec3(0.0, 1.0, 0.0);\n"
     "}\n"
+    /* Screen-space derivatives of the inputs (d/dx: axis 0, d/dy: 1), the
+     * leaves ir_differentiate writes.  All follow from the position's:
+     * FC5's plane step in compute, the quad's dFdx / dFdy in fragments.
+     * normal, slope, destruction and painted masks have derivative 0 (the
+     * pass writes constants for them). */
+    "#ifdef SPLAT_COMPUTE\n"
+    "vec3 splat_d_rel(int a) { return a == 0 ? splat_dpdx : splat_dpdy; }\n"
+    "#else\n"
+    "vec3 splat_d_rel(int a) { return a == 0 ? dFdx(v_rel) : dFdy(v_rel); }\n"
+    "#endif\n"
+    "vec3 splat_d_position(int a) { return splat_d_rel(a); }\n"
+    "float splat_d_height(int a) { return splat_d_rel(a).y; }\n"
+    "vec2 splat_d_uv(int a) { return splat_d_rel(a).xz / u_frame.terrain.xy; }\n"
+    "float splat_d_view_distance(int a) {\n"
+    "    float l = length(v_rel);\n"
+    "    return l > 0.0 ? dot(v_rel, splat_d_rel(a)) / l : 0.0;\n"
+    "}\n"
+    "vec3 splat_d_view_direction(int a) {\n"
+    "    float l = length(v_rel);\n"
+    "    if (!(l > 0.0)) return vec3(0.0);\n"
+    "    vec3 r = v_rel / l, d = splat_d_rel(a);\n"
+    "    return (r * dot(r, d) - d) / l;\n"
+    "}\n"
+    /* The counting variant's hooks (abi.h); nothing elsewhere. */
+    "#if defined(SPLAT_COMPUTE) && defined(SPLAT_COUNT)\n"
+    "void splat_count_layer(float w) {\n"
+    "    splat_n_evaluated += 1u;\n"
+    "    if (w > 0.0) splat_n_needed += 1u;\n"
+    "}\n"
+    "void splat_count_samples(uint n) { splat_n_samples += n; }\n"
+    "#else\n"
+    "void splat_count_layer(float w) {}\n"
+    "void splat_count_samples(uint n) {}\n"
+    "#endif\n"
+    /* The cost view (shader complexity): texture samples of this pixel as
+     * a heat colour, 0 black, 4 blue, 8 green, 16 yellow, 32 red, 64 and
+     * more white; only the counting variant counts (0 elsewhere). */
+    "vec3 splat_heat(float x) {\n"
+    "    float t = clamp(log2(1.0 + x) / 6.0, 0.0, 1.0) * 5.0;\n"
+    "    vec3 k[6] = vec3[6](vec3(0.0), vec3(0.0, 0.2, 1.0), vec3(0.0, 0.9, 0.2),\n"
+    "                        vec3(1.0, 0.9, 0.0), vec3(1.0, 0.1, 0.0), vec3(1.0));\n"
+    "    int i = min(int(t), 4);\n"
+    "    return mix(k[i], k[i + 1], t - float(i));\n"
+    "}\n"
+    "#if defined(SPLAT_COMPUTE) && defined(SPLAT_COUNT)\n"
+    "vec3 splat_cost_color() { return splat_heat(float(splat_n_samples)); }\n"
+    "#else\n"
+    "vec3 splat_cost_color() { return splat_heat(0.0); }\n"
+    "#endif\n"
     "#ifdef SPLAT_PAINTED_SPARSE\n"
     SPARSE_GLSL_FUNCTIONS
     "float splat_painted(int layer) {\n"
@@ -146,7 +319,7 @@ const char SPLAT_GLSL_PRELUDE[] =
     "}\n"
     "#else\n"
     "float splat_painted(int layer) {\n"
-    "    return texture(u_painted, vec3(v_uv, float(layer))).r;\n"
+    "    return splat_texture0(u_painted, vec3(v_uv, float(layer))).r;\n"
     "}\n"
     "#endif\n"
     "float splat_destruction() {\n"
@@ -159,7 +332,7 @@ const char SPLAT_GLSL_PRELUDE[] =
     "    float tile = u_frame.destruction_atlas.x;\n"
     "    vec2 inner = clamp(fract(p) * tile, vec2(0.5), vec2(tile - 0.5));\n"
     "    vec2 px = floor(e.rg * 255.0 + 0.5) * tile + inner;\n"
-    "    return texture(u_destruction_atlas, px / u_frame.destruction_atlas.y).r;\n"
+    "    return splat_texture0(u_destruction_atlas, px / u_frame.destruction_atlas.y).r;\n"
     "}\n"
     LIGHTING_TEXT
     COMBO_COLOR_TEXT
@@ -174,16 +347,15 @@ const char SPLAT_GLSL_PRELUDE[] =
     "    vec3 n = normalize(normal);\n"
     "    vec3 c;\n"
     "    switch (splat_view()) {\n"
-    "    case 1u: c = splat_combo_color(u_push.info.y); break;\n"
-    "    case 2u: c = splat_combo_color(u_push.info.x + 1000u); break;\n"
-    "    case 3u: c = n * 0.5 + 0.5; break;\n"
-    "    case 4u: c = vec3(splat_slope()); break;\n"
-    "    case 6u: c = albedo; break;\n"
+    SPLAT_VIEWS(SPLAT_VIEW_CASE_FORWARD)   /* abi.h */
     "    default: c = splat_light(albedo, n, rough, dist); break;\n"
     "    }\n"
     "    o_color = vec4(c, 1.0);\n"
     "#endif\n"
-    "}\n";
+    "}\n"
+    "#ifdef SPLAT_COMPUTE\n"
+    COMPUTE_MAIN
+    "#endif\n";
 
 void splat_normal_filter(double hl, double hr, double hd, double hu,
                          double maxh, double dx, double dz, double n[3])

@@ -21,6 +21,18 @@
  *   binding 6  usampler2DArray painted levels, RGBA8_UINT, same shape
  *              and splat_painted(layer) samples them (sparse_sample on the
  *              CPU); the masks must be heightfield-sized (u_frame.texel.xy).
+ *   binding 12 sampler2D       holes (vertex stage), R8_UNORM, heightfield-
+ *                              sized, linear, clamp: 1 where the terrain is
+ *                              cut (a 1x1 texel of 0 when it has none).  The
+ *                              shared vertex shader writes gl_ClipDistance[0]
+ *                              = 0.5 - holes(uv) (base level, bilinear), so
+ *                              the terrain is cut along the 0.5 contour of the
+ *                              hole texels -- at their edges on grids of one
+ *                              quad per texel or finer, coarser further away
+ *                              -- and a clipped pixel is never rasterised:
+ *                              no fragment shading, its depth left clear
+ *                              (any pass using the shared vertex shader,
+ *                              depth-only ones included, sees the hole).
  *   binding 3  sampler2D       destruction atlas, R8_UNORM, linear, clamp
  *   binding 4  sampler2D       destruction indirection, RGBA8_UNORM, nearest:
  *                              .rg * 255 = tile x, y in the atlas; .a = 1 if
@@ -40,6 +52,57 @@
  * RGBA32F colour; a multi-pass reference pass (compiled with
  * SPLAT_MULTIPASS defined) writes three targets blended with
  * SRC_ALPHA / ONE_MINUS_SRC_ALPHA that the resolve pass lights.
+ *
+ * ---- compute stage (screen-space shading) ----------------
+ * The compute variant of a composite (or of the über-shader) is the same
+ * GLSL with `#define SPLAT_COMPUTE 1` before the prelude (pack: *.comp).
+ * The prelude hides the stage:
+ *   layout(local_size_x = 8, local_size_y = 8) in;  one workgroup = one
+ *   8x8 pixel tile.  Set 0 gains (compute only):
+ *   binding 7  sampler2D  u_depth: the geometry pass's depth (D32_SFLOAT,
+ *              read with texelFetch, level 0; any sampler)
+ *   binding 8  image2D    u_out: rgba32f storage image, the lit colour
+ *              (written only for terrain pixels; the runtime writes sky and
+ *              fog for empty pixels before the dispatches)
+ *   binding 9  buffer     splat_tiles_block { uint tiles[]; } (std430,
+ *              readonly): entry = tile_x | tile_y << 16, in tiles (pixel =
+ *              tile * 8 + gl_LocalInvocationID.xy)
+ *   binding 10 buffer     splat_counters_block (SPLAT_COUNT only, below)
+ *   Push constants: struct splat_push; patch_xz / patch_uv are unused,
+ *   info.x unused, info.y = combination id (the COMBOS view), info.z =
+ *   scene material count, info.w = index of this combination's first tile
+ *   in tiles[]: workgroup g shades tiles[info.w + g.x].
+ *   main(): the prelude defines the real main(), which reads the tile and
+ *   pixel, returns for pixels outside u_frame.screen.xy or whose depth is
+ *   u_frame.screen.z (empty / sky), reconstructs the camera-relative
+ *   position from depth with u_frame.inv_view_proj (NDC x, y = pixel
+ *   centre * 2 / size - 1, Vulkan's downward y; z = depth), sets the
+ *   globals that stand for the fragment varyings (v_rel, v_uv from the
+ *   position's xz / terrain size, v_local = v_rel + camera), calls the
+ *   composite's main (renamed splat_main by a #define), and imageStores
+ *   the colour splat_finish left.  Height, slope and normal then come from
+ *   the heightfield (Listing 1) through the same functions as in the
+ *   fragment stage.  splat_quad_any(c) is c (no quads: explicit gradients).
+ *   Textures of the prelude (heightfield, painted, destruction: one mip
+ *   level each) read through splat_texture0(s, uv): texture() in the
+ *   fragment stage, textureLod(s, uv, 0.0) in compute.  New prelude code
+ *   that samples must use it (compute has no implicit derivatives).
+ *
+ * Counting variant (SPLAT_COUNT, compute only): not stored in the pack.
+ *   The runtime compiles it on first use from the pack's compute GLSL with
+ *   `#define SPLAT_COUNT 1` inserted after the #version line (glslang, as
+ *   runtime/glsl.c does for its own shaders).  It adds binding 10 and
+ *   atomically adds, per terrain pixel, the fields of splat_counters
+ *   below.  Its dynamic branches are subgroup-uniform (splat_quad_any is
+ *   subgroupAny, GL_KHR_shader_subgroup_vote): a layer counts as evaluated
+ *   for every pixel of a subgroup in which any pixel needs it (weight > 0),
+ *   which is what the SIMD hardware pays; the picture is the same (a pixel
+ *   of weight 0 adds 0 * surface).  "samples" counts the material texture
+ *   samples (SAMPLE_GRAD, including the extra ones of noise-warped uvs) of
+ *   the blocks the pixel ran, not the prelude's heightfield and painted
+ *   reads.  The cost view's row (SPLAT_VIEWS) writes splat_cost_color():
+ *   those samples as a heat colour (splat_heat: 0 black, 4 blue, 8 green,
+ *   16 yellow, 32 red, 64+ white), black outside the counting variant.
  */
 #ifndef SPLAT_ABI_H
 #define SPLAT_ABI_H
@@ -59,12 +122,46 @@ enum {
     SPLAT_BIND_DESTRUCTION_INDEX = 4,
     SPLAT_BIND_PAINTED_INDEX = 5,  /* only with SPLAT_PAINTED_SPARSE */
     SPLAT_BIND_PAINTED_LEVEL = 6,  /* only with SPLAT_PAINTED_SPARSE */
+    SPLAT_BIND_HOLES = 12,         /* vertex stage: terrain holes         */
+
+    SPLAT_BIND_DEPTH = 7,          /* compute only */
+    SPLAT_BIND_OUT = 8,            /* compute only: rgba32f storage image */
+    SPLAT_BIND_TILES = 9,          /* compute only: uint tiles[]          */
+    SPLAT_BIND_COUNTERS = 10,      /* compute, SPLAT_COUNT only           */
+    SPLAT_BIND_SHADOW = 11,        /* heightfield shadows (lighting)      */
+
+    SPLAT_TILE = 8,                /* compute: pixels per tile side = local size */
 
     SPLAT_BIND_PARAMS = 0,
     SPLAT_BIND_TEXTURE0 = 1,   /* texture i at binding 1 + i */
 
     SPLAT_GRID = 33,           /* vertices per patch side */
 };
+
+/* Pack limits (compiler/PACK.md "Limits"): what every pack promises and
+ * both sides check — splatc build refuses a scene beyond them with a
+ * located error, the runtime's loader refuses a pack beyond them, and at
+ * renderer creation each size is also checked against the device's own
+ * limits (maxImageDimension2D, maxImageArrayLayers, ...). */
+enum {
+    SPLAT_MAX_HEIGHTFIELD = 16384,  /* texels per heightfield side           */
+    SPLAT_MAX_TEXTURE = 16384,      /* texels per side of a texture          */
+    SPLAT_MAX_CELLS = 4096,         /* leaf cells per side (heightfield side
+                                       / cell); combos.bin <= 45 MB         */
+    SPLAT_MAX_PAINTED = 256,        /* painted masks (Vulkan's minimum
+                                       maxImageArrayLayers: a dense pack's
+                                       layers fit every device)             */
+    SPLAT_MAX_DESTRUCTION_CELLS = 1024, /* destruction grid cells per side  */
+    SPLAT_MAX_TEXTURES = 64,        /* textures of a scene (set 1 bindings)  */
+};
+
+/* Periodic sites of terrain.position (compiler/precision.c): at most this
+ * many per pack, each a vec4 of splat_frame.world. */
+#define SPLAT_WORLD_SITES 16
+
+/* combos.bin id of a quadtree node that is all hole (PACK.md): it has no
+ * combination and is not drawn. */
+#define SPLAT_COMBO_HOLE 0xFFFFu
 
 /* Specialization constant of every fragment shader that includes the
  * prelude: constant_id SPLAT_SPEC_VIEW, a uint, default
@@ -73,22 +170,67 @@ enum {
  * carries no debug-view code at all (lavapipe executes both sides of every
  * branch, so the dead MASK-view block alone cost ~40% of a frame); one left
  * dynamic serves every debug view. */
-enum {
-    SPLAT_SPEC_VIEW = 0,
-};
+#define SPLAT_SPEC_VIEW         0
 #define SPLAT_SPEC_VIEW_DYNAMIC 0xffffffffu
+/* A macro's value as a GLSL literal string (the prelude pastes these). */
+#define SPLAT_STR_(x) #x
+#define SPLAT_STR(x)  SPLAT_STR_(x)
 
-/* Debug views (splat_view(): splat_frame.view.x or the spec constant). */
+/* Debug views (splat_view(): splat_frame.view.x or the spec constant):
+ * one row each.  The prelude's colour switch (abi.c), the multipass
+ * resolve (runtime pipelines.c), the runtime's name/key/tone-map tables
+ * and the CLI lists are all generated from these rows.
+ *
+ *   X(id, num, name, key, tonemap, where, glsl)
+ *     num      its value in splat_frame.view.x (ABI: never renumber; the
+ *              next row takes the next number, rows stay in number order)
+ *     name     the --view name
+ *     key      the viewer's key that selects it
+ *     tonemap  how a screenshot encodes it: FILMIC, SRGB or NONE (rt_tonemap)
+ *     where    ALL: the single-pass prelude and the multipass resolve show
+ *              it; FORWARD: the single-pass prelude only (the resolve
+ *              shows the lit colour); COMPOSITE: the composite writes it
+ *              itself before splat_finish (compose.c)
+ *     glsl     its colour (vec3) from splat_finish's albedo, n (unit
+ *              normal), rough and dist; in the resolve only those four
+ *              are available
+ *
+ * A new view: a row here (and its colour's inputs, if new, in abi.c). */
+#define SPLAT_VIEWS(X)                                                              \
+    X(FINAL,  0, "final",  '1', FILMIC, ALL,       "splat_light(albedo, n, rough, dist)") \
+    X(COMBOS, 1, "combos", '2', NONE,   FORWARD,   "splat_combo_color(u_push.info.y)") \
+    X(LOD,    2, "lod",    '3', NONE,   FORWARD,   "splat_combo_color(u_push.info.x + 1000u)") \
+    X(NORMAL, 3, "normal", '4', NONE,   ALL,       "n * 0.5 + 0.5")                    \
+    X(SLOPE,  4, "slope",  '5', NONE,   FORWARD,   "vec3(splat_slope())")              \
+    X(MASK,   5, "mask",   '7', NONE,   COMPOSITE, "vec3(0.0)") /* material view.y */  \
+    X(ALBEDO, 6, "albedo", '6', SRGB,   ALL,       "albedo")
+
 typedef enum splat_view {
-    SPLAT_VIEW_FINAL = 0,  /* lit colour                                 */
-    SPLAT_VIEW_COMBOS,     /* colour per combination id (seed 000 Fig. 14) */
-    SPLAT_VIEW_LOD,        /* colour per quadtree level                  */
-    SPLAT_VIEW_NORMAL,     /* world normal * 0.5 + 0.5                   */
-    SPLAT_VIEW_SLOPE,      /* slope as grey                              */
-    SPLAT_VIEW_MASK,       /* mask of scene material view.y, as grey     */
-    SPLAT_VIEW_ALBEDO,     /* composited albedo, unlit                   */
-    SPLAT_VIEW_COUNT
+#define X(id, num, ...) SPLAT_VIEW_##id = num,
+    SPLAT_VIEWS(X)
+#undef X
+#define X(...) +1
+    SPLAT_VIEW_COUNT = 0 SPLAT_VIEWS(X)
+#undef X
 } splat_view;
+/* Rows numbered 0, 1, … in order (the runtime's tables index by number). */
+#define X(id, num, ...) _Static_assert(SPLAT_VIEW_##id < SPLAT_VIEW_COUNT, "view " #id);
+SPLAT_VIEWS(X)
+#undef X
+
+/* GLSL `case` lines of a switch on the view setting `c`, for the rows
+ * whose `where` is in the given set (used by abi.c and pipelines.c). */
+#define SPLAT_VIEW_CASE_(num, glsl) "    case " #num "u: c = " glsl "; break;\n"
+#define SPLAT_VIEW_IN_FORWARD_ALL(num, glsl)       SPLAT_VIEW_CASE_(num, glsl)
+#define SPLAT_VIEW_IN_FORWARD_FORWARD(num, glsl)   SPLAT_VIEW_CASE_(num, glsl)
+#define SPLAT_VIEW_IN_FORWARD_COMPOSITE(num, glsl)
+#define SPLAT_VIEW_IN_RESOLVE_ALL(num, glsl)       SPLAT_VIEW_CASE_(num, glsl)
+#define SPLAT_VIEW_IN_RESOLVE_FORWARD(num, glsl)
+#define SPLAT_VIEW_IN_RESOLVE_COMPOSITE(num, glsl)
+#define SPLAT_VIEW_CASE_FORWARD(id, num, name, key, tm, where, glsl) \
+    SPLAT_VIEW_IN_FORWARD_##where(num, glsl)
+#define SPLAT_VIEW_CASE_RESOLVE(id, num, name, key, tm, where, glsl) \
+    SPLAT_VIEW_IN_RESOLVE_##where(num, glsl)
 
 /* Per-frame uniform block, set 0 binding 1. */
 typedef struct splat_frame {
@@ -107,7 +249,27 @@ typedef struct splat_frame {
     float destruction_atlas[4]; /* x: tile size (px), y: atlas size (px),
                                    z: tiles per atlas row, w: 0            */
     uint32_t view[4];        /* x: splat_view, y: material for MASK view   */
+    /* Appended members (std140: vec4 / mat4 only; new ones go last). */
+    float inv_view_proj[16]; /* clip -> camera-relative world (inverse of
+                                view_proj; compute: depth reconstruction) */
+    float screen[4];         /* x: width, y: height (px), z: depth value of
+                                empty / sky pixels (0 with reversed Z), w: 0 */
+    /* Site k of the pack's "world_sites" (PACK.md, precision.c): xy =
+     * floor(c / S), zw = c / S - xy, with c the camera's two position
+     * components of the site and S its scale (c * S for a product),
+     * computed in double on the CPU every frame. */
+    float world[4 * SPLAT_WORLD_SITES];
 } splat_frame;
+
+/* Counters of the counting variant (SPLAT_COUNT), set 0 binding 10, std430;
+ * every field is a uint atomically added to, summed over the frame's
+ * terrain pixels.  The runtime zeroes it before the dispatches. */
+typedef struct splat_counters {
+    uint32_t pixels;           /* terrain pixels shaded                       */
+    uint32_t layers_evaluated; /* layers whose surface block ran              */
+    uint32_t layers_needed;    /* layers whose weight is > 0 at the pixel     */
+    uint32_t samples;          /* material texture samples taken              */
+} splat_counters;
 
 /* Push constants, vertex + fragment. */
 typedef struct splat_push {
@@ -123,6 +285,8 @@ typedef struct splat_push {
  *   constants, varyings, fragment outputs and these functions:
  *     float splat_height()   vec3 splat_normal()   float splat_slope()
  *     vec3 splat_position()  vec2 splat_uv()        float splat_view_distance()
+ *     vec3 splat_offset()  surface - camera, terrain-local metres (precise
+ *                          at any distance: precision.c builds on it)
  *     vec3 splat_view_direction() (unit, surface -> camera, terrain-local)
  *     float splat_destruction()   float splat_painted(int layer)
  *     float splat_height_at(vec2 uv)  vec3 splat_normal_at(vec2 uv)
@@ -141,7 +305,7 @@ extern const char SPLAT_GLSL_LIGHTING[];
 extern const char SPLAT_GLSL_VERTEX[];
 extern const char SPLAT_GLSL_COMBO_COLOR[];
 
-/* The normal filter of seed 000 Listing 1, honouring texel aspect, on the
+/* The normal filter of Andersson 2007 Listing 1, honouring texel aspect, on the
  * CPU.  `h` returns the normalised height (0..1) at a texel, clamped to the
  * edges; the result is what splat_normal_at() computes at texel centres:
  *   n = normalize((hl - hr) * maxh / dx, 2, (hd - hu) * maxh / dz)

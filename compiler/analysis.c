@@ -1,4 +1,4 @@
-/* analysis.c — the material combinations a scene really has (DESIGN §7).
+/* analysis.c — the material combinations a scene really has (compiler/DESIGN.md §7).
  *
  * Leaf cells are cell_texels x cell_texels heightfield texels.  For each
  * cell: splat_terrain_ranges bounds height, slope, normal, position and uv
@@ -30,6 +30,14 @@
  *     leaf A: {cliff}            leaf B: {dirt, grass}
  *     parent: {cliff, dirt, grass}
  *
+ * Holes (scene.h, terrain.holes): a cell whose texels and one-texel ring
+ * are all hole is drawn nowhere (the vertex shader clips every vertex that
+ * samples only holes, abi.c), so it gets no combination: id
+ * SPLAT_COMBO_HOLE, and a node all of whose children are holes is one too
+ * (the runtime does not draw them).  A cell partly hole is bounded as
+ * usual: its hole texels hold heights filled in from their neighbours
+ * (terrain.c), which the filters near the hole's edge really read.
+ *
  * Combination ids follow first occurrence: level 0 row-major, then each
  * higher level, so the same scene always gives the same ids.
  *
@@ -39,19 +47,15 @@
  * to the cell's first opaque material.
  */
 #include "scene.h"
+#include "util.h"
+
+#include "abi.h"
 
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <time.h>
-
-static double now_seconds(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + ts.tv_nsec * 1e-9;
-}
 
 /* ---- combination table -------------------------------------------------- */
 
@@ -140,9 +144,9 @@ static int intern_checked(combo_set *cs, const uint64_t *bits, int nmaterials,
     int id = set_intern(cs, bits, nmaterials);
     if (id < 0) {
         sg_error(d, sc->loc, SG_E_TOO_LARGE, "out of memory in the analysis");
-    } else if (id > UINT16_MAX) {
+    } else if (id >= (int)SPLAT_COMBO_HOLE) {
         sg_error(d, sc->loc, SG_E_TOO_LARGE,
-                 "the scene has more than 65536 material combinations");
+                 "the scene has more than 65535 material combinations");
         id = -1;
     }
     return id;
@@ -250,11 +254,37 @@ static void block_combo(const block_ctx *bc, int x0, int z0, int x1, int z1,
     if (s->nmaterials > 0) bits[0] |= 1ull;     /* the base: mask 1 */
 }
 
+static sg_loc loc_hole(const sg_scene *sc)
+{
+    if (sc->holes_loc.line > 0) return sc->holes_loc;
+    return sc->heightfield_loc.line > 0 ? sc->heightfield_loc : sc->loc;
+}
+
+/* Whether texels [x0, x1) x [z0, z1) and their one-texel ring are all
+ * holes: then every vertex a patch over them has, at any level, samples
+ * holes only (abi.c's clip distance is negative there), so nothing of the
+ * cell is drawn and it needs no combination. */
+static bool all_hole(const splat_terrain *t, int x0, int z0, int x1, int z1)
+{
+    if (!t->holes) return false;
+    for (int j = z0 - 1; j <= z1; j++)
+        for (int i = x0 - 1; i <= x1; i++)
+            if (!splat_terrain_hole(t, i, j)) return false;
+    return true;
+}
+
+static bool bits_empty(const uint64_t *bits, int words)
+{
+    for (int w = 0; w < words; w++)
+        if (bits[w]) return false;
+    return true;
+}
+
 /* ---- the analysis ------------------------------------------------------- */
 
 bool splat_analyze(const splat_scene *s, splat_analysis *a, sg_diags *d)
 {
-    double t0 = now_seconds();
+    double t0 = splat_now();
     memset(a, 0, sizeof *a);
     const sg_scene *sc = s->desc;
     const splat_terrain *t = &s->terrain;
@@ -353,6 +383,11 @@ bool splat_analyze(const splat_scene *s, splat_analysis *a, sg_diags *d)
             int x1 = x0 + T < t->width ? x0 + T : t->width;
             int z1 = z0 + T < t->height ? z0 + T : t->height;
             uint64_t *cell = bits + ((size_t)cz * a->cells_x + cx) * cs.words;
+            if (all_hole(t, x0, z0, x1, z1)) {     /* no members: a hole */
+                a->levels[0].ids[(size_t)cz * a->cells_x + cx] = SPLAT_COMBO_HOLE;
+                a->hole_cells++;
+                continue;
+            }
             block_combo(&bc, x0, z0, x1, z1, cell);
             int id = intern_checked(&cs, cell, n, sc, d);
             if (id < 0) {
@@ -388,6 +423,10 @@ bool splat_analyze(const splat_scene *s, splat_analysis *a, sg_diags *d)
                         for (int w = 0; w < cs.words; w++) node[w] |= child[w];
                     }
                 }
+                if (bits_empty(node, cs.words)) {    /* every child a hole */
+                    lv->ids[(size_t)z * lv->width + x] = SPLAT_COMBO_HOLE;
+                    continue;
+                }
                 int id = intern_checked(&cs, node, n, sc, d);
                 if (id < 0) {
                     ok = false;
@@ -403,6 +442,11 @@ bool splat_analyze(const splat_scene *s, splat_analysis *a, sg_diags *d)
     for (int i = 0; i < a->ncombos; i++)
         if (a->combos[i].nmaterials > a->largest)
             a->largest = a->combos[i].nmaterials;
+    if (ok && a->ncombos == 0) {
+        sg_error(d, loc_hole(sc), SG_E_SCENE, "the whole terrain is a hole "
+                 "(holes mask and nodata cover every texel)");
+        ok = false;
+    }
 
     free(bits);
     free(painted);
@@ -411,7 +455,7 @@ bool splat_analyze(const splat_scene *s, splat_analysis *a, sg_diags *d)
     ir_free(&mir);
     free(cs.keys);
     free(cs.slots);
-    a->seconds = now_seconds() - t0;
+    a->seconds = splat_now() - t0;
     if (!ok) splat_analysis_free(a);
     return ok;
 }
@@ -442,6 +486,8 @@ void splat_analysis_report(const splat_scene *s, const splat_analysis *a, FILE *
     fprintf(out, "combinations: %d in leaf cells, %d with quadtree nodes "
             "(naive all subsets: %.0f)\n", leaf, a->ncombos, a->naive_subsets);
     fprintf(out, "largest combination: %d materials\n", a->largest);
+    if (s->terrain.holes)
+        fprintf(out, "holes: %d cells entirely hole (no combination)\n", a->hole_cells);
     fprintf(out, "  id  cells  nodes  materials (top first)\n");
     for (int i = 0; i < a->ncombos; i++) {
         const splat_combo *c = &a->combos[i];

@@ -17,6 +17,7 @@
  * sees half an entry; a damaged entry reads as a miss.
  */
 #include "scene.h"
+#include "util.h"
 
 #include <errno.h>
 #include <stdlib.h>
@@ -78,9 +79,7 @@ static bool make_dirs(const char *path)
 static char *join(const char *a, const char *b)
 {
     size_t n = strlen(a) + strlen(b) + 2;
-    char *s = malloc(n);
-    if (!s)
-        abort();
+    char *s = xmalloc(n);
     snprintf(s, n, "%s/%s", a, b);
     return s;
 }
@@ -150,9 +149,7 @@ bool splat_cache_get(const splat_cache *c, const char *key, uint32_t **words,
     if (fseek(f, 0, SEEK_END) == 0)
         size = ftell(f);
     if (size >= 4 * (5 + TRAILER) && size % 4 == 0 && fseek(f, 0, SEEK_SET) == 0) {
-        uint32_t *w = malloc((size_t)size);
-        if (!w)
-            abort();
+        uint32_t *w = xmalloc((size_t)size);
         size_t n = (size_t)size / 4 - TRAILER;
         if (fread(w, 1, (size_t)size, f) == (size_t)size && w[0] == SPIRV_MAGIC) {
             uint64_t h = XXH3_64bits(w, 4 * n);
@@ -176,9 +173,7 @@ bool splat_cache_put(const splat_cache *c, const char *key, const uint32_t *word
 {
     if (!c->dir)
         return false;
-    uint32_t *w = malloc(4 * (nwords + TRAILER));
-    if (!w)
-        abort();
+    uint32_t *w = xmalloc(4 * (nwords + TRAILER));
     memcpy(w, words, 4 * nwords);
     uint64_t h = XXH3_64bits(words, 4 * nwords);
     w[nwords] = ENTRY_MAGIC;

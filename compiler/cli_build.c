@@ -1,9 +1,11 @@
 /* cli_build.c — `splatc build SCENE.sg -o PACKDIR [-j N] [--stats]
- * [--cache DIR | --no-cache] [--flat] [--painted bc4|r8|dense] [-I DIR]...`:
+ * [--cache DIR | --no-cache] [--flat] [--compute-spirv] [--painted bc4|r8|dense]
+ * [-I DIR]... [--depfile FILE] [--json]`:
  * the command-line face
- * of splat_build (pack.c).  Exit status 0 on success, 1 on input errors,
+ * of splat_build (build.c).  Exit status 0 on success, 1 on input errors,
  * 2 on usage errors. */
 #include "scene.h"
+#include "util.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -19,88 +21,15 @@ static const char usage[] =
     "                 $XDG_CACHE_HOME/splatc, else ~/.cache/splatc)\n"
     "  --no-cache     neither read nor write the cache\n"
     "  --flat         also write each composite without dynamic branches\n"
+    "  --compute-spirv  also compile the compute variants to SPIR-V (default:\n"
+    "                 their GLSL only; the runtime compiles them on first use)\n"
     "  --painted F    painted mask storage: bc4 (default: sparse quad-tree,\n"
     "                 BC4 atlas), r8 (sparse, R8 atlas) or dense (painted.r8)\n"
-    "  -I DIR         search DIR for imports (repeatable)\n";
-
-/* Import search path of every subcommand (splat_search_path; main.c has
- * it from there): -I folders, $SPLATC_PATH (':'-separated), the current
- * folder, and the nearest folder above the scene that has a nodes/ folder. */
-typedef struct paths {
-    char **v;
-    int    n, cap;
-} paths;
-
-static void paths_add(paths *p, const char *dir)
-{
-    if (p->n + 2 > p->cap) {
-        p->cap = p->cap ? 2 * p->cap : 8;
-        p->v = realloc(p->v, (size_t)p->cap * sizeof *p->v);
-        if (!p->v)
-            abort();
-    }
-    p->v[p->n] = strdup(dir);
-    if (!p->v[p->n])
-        abort();
-    p->v[++p->n] = NULL;
-}
-
-static void paths_free(paths *p)
-{
-    for (int i = 0; i < p->n; i++)
-        free(p->v[i]);
-    free(p->v);
-}
-
-static void paths_defaults(paths *p, const char *scene)
-{
-    const char *env = getenv("SPLATC_PATH");
-    if (env && *env) {
-        char *copy = strdup(env);
-        if (!copy)
-            abort();
-        char *save = NULL;
-        for (char *t = strtok_r(copy, ":", &save); t; t = strtok_r(NULL, ":", &save))
-            paths_add(p, t);
-        free(copy);
-    }
-    paths_add(p, ".");
-    char *dir = strdup(scene);
-    if (!dir)
-        abort();
-    for (char *slash; (slash = strrchr(dir, '/'));) {
-        *slash = 0;
-        size_t n = strlen(dir) + 8;
-        char *nodes = malloc(n);
-        if (!nodes)
-            abort();
-        snprintf(nodes, n, "%s/nodes", dir);
-        struct stat st;
-        bool found = stat(nodes, &st) == 0 && S_ISDIR(st.st_mode);
-        free(nodes);
-        if (found) {
-            paths_add(p, *dir ? dir : "/");
-            break;
-        }
-    }
-    free(dir);
-}
-
-char **splat_search_path(const char *const *include, int ninclude, const char *file)
-{
-    paths p = {0};
-    for (int i = 0; i < ninclude; i++)
-        paths_add(&p, include[i]);
-    paths_defaults(&p, file);
-    return p.v;
-}
-
-void splat_search_path_free(char **v)
-{
-    for (int i = 0; v && v[i]; i++)
-        free(v[i]);
-    free(v);
-}
+    "  -I DIR         search DIR for imports (repeatable; then $SPLATC_PATH,\n"
+    "                 '.', the project root, the installed nodes)\n"
+    "  --depfile FILE write a Make/Ninja depfile: PACKDIR/manifest.json and\n"
+    "                 every file the pack was made from\n"
+    "  --json         diagnostics as JSON Lines on stderr (for editors)\n";
 
 static void print_stats(const splat_build_stats *st, FILE *out)
 {
@@ -129,8 +58,10 @@ static void print_stats(const splat_build_stats *st, FILE *out)
 int splat_cli_build(int argc, char **argv)
 {
     splat_build_desc desc = {.jobs = 1};
-    bool stats = false;
-    paths search = {0};
+    bool stats = false, json = false;
+    const char **include = xcalloc((size_t)argc + 1, sizeof *include);
+    int ninclude = 0;
+    char **search = NULL;
     int status = 2;
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
@@ -161,6 +92,8 @@ int splat_cli_build(int argc, char **argv)
             desc.no_cache = true;
         } else if (strcmp(a, "--flat") == 0) {
             desc.flat = true;
+        } else if (strcmp(a, "--compute-spirv") == 0) {
+            desc.compute_spirv = true;
         } else if (strcmp(a, "--painted") == 0 && next) {
             if (!splat_painted_format_parse(next, &desc.painted)) {
                 fprintf(stderr, "splatc build: --painted expects bc4, r8 or dense, found '%s'\n",
@@ -169,8 +102,13 @@ int splat_cli_build(int argc, char **argv)
             }
             i++;
         } else if (strcmp(a, "-I") == 0 && next) {
-            paths_add(&search, next);
+            include[ninclude++] = next;
             i++;
+        } else if (strcmp(a, "--depfile") == 0 && next) {
+            desc.depfile = next;
+            i++;
+        } else if (strcmp(a, "--json") == 0) {
+            json = true;
         } else if (a[0] == '-') {
             fprintf(stderr, "splatc build: unknown or incomplete option '%s'\n%s", a, usage);
             goto done;
@@ -191,20 +129,24 @@ int splat_cli_build(int argc, char **argv)
         fprintf(stderr, "splatc build: --cache and --no-cache exclude each other\n");
         goto done;
     }
-    paths_defaults(&search, desc.scene);
-    desc.search_paths = (const char *const *)search.v;
+    search = splat_search_path(include, ninclude, desc.scene);
+    desc.search_paths = (const char *const *)search;
     desc.report = stats ? stdout : NULL;
 
     sg_diags d;
     sg_diags_init(&d);
     splat_build_stats st;
     bool ok = splat_build(&desc, &st, &d);
-    sg_diags_print(&d, stderr);
+    if (json)
+        sg_diags_print_json(&d, stderr);
+    else
+        sg_diags_print(&d, stderr);
     sg_diags_free(&d);
     if (ok && stats)
         print_stats(&st, stdout);
     status = ok ? 0 : 1;
 done:
-    paths_free(&search);
+    splat_search_path_free(search);
+    free(include);
     return status;
 }

@@ -10,6 +10,7 @@
  * SG_MAX_STORED_DIAGS are stored; later ones are only counted, so garbage
  * input cannot make the list (or the printout) grow without bound. */
 #include "sg_internal.h"
+#include "util.h"
 
 #include <stdarg.h>
 #include <stdlib.h>
@@ -62,38 +63,20 @@ void sg_diags_free(sg_diags *d)
     memset(d, 0, sizeof *d);
 }
 
-static char *xstrdup(const char *s)
-{
-    if (!s)
-        return NULL;
-    size_t n = strlen(s);
-    char *r = malloc(n + 1);
-    if (!r)
-        abort();
-    memcpy(r, s, n + 1);
-    return r;
-}
-
 void sg_diags_add_source(sg_diags *d, const char *path, const char *text,
                          size_t len)
 {
     if (!d->sources) {
-        d->sources = calloc(1, sizeof *d->sources);
-        if (!d->sources)
-            abort();
+        d->sources = xcalloc(1, sizeof *d->sources);
     }
     struct sg_sources *s = d->sources;
     if (s->n == s->cap) {
         s->cap = s->cap ? s->cap * 2 : 8;
-        s->items = realloc(s->items, (size_t)s->cap * sizeof *s->items);
-        if (!s->items)
-            abort();
+        s->items = xrealloc(s->items, (size_t)s->cap * sizeof *s->items);
     }
     source *src = &s->items[s->n++];
     src->path = xstrdup(path);
-    src->text = malloc(len + 1);
-    if (!src->text)
-        abort();
+    src->text = xmalloc(len + 1);
     memcpy(src->text, text, len);
     src->text[len] = 0;
     src->len = len;
@@ -116,17 +99,13 @@ static const char *find_line(sg_diags *d, const char *file, int line, size_t *n)
         return NULL;
     if (!src->lines) {
         int cap = 64;
-        src->lines = malloc((size_t)cap * sizeof *src->lines);
-        if (!src->lines)
-            abort();
+        src->lines = xmalloc((size_t)cap * sizeof *src->lines);
         src->lines[src->nlines++] = 0;
         for (size_t i = 0; i < src->len; i++)
             if (src->text[i] == '\n') {
                 if (src->nlines == cap) {
                     cap *= 2;
-                    src->lines = realloc(src->lines, (size_t)cap * sizeof *src->lines);
-                    if (!src->lines)
-                        abort();
+                    src->lines = xrealloc(src->lines, (size_t)cap * sizeof *src->lines);
                 }
                 src->lines[src->nlines++] = i + 1;
             }
@@ -152,22 +131,18 @@ static void add(sg_diags *d, sg_loc loc, sg_severity sev, sg_error_id id,
     }
     if (d->n == d->cap) {
         d->cap = d->cap ? d->cap * 2 : 16;
-        d->items = realloc(d->items, (size_t)d->cap * sizeof *d->items);
-        if (!d->items)
-            abort();
+        d->items = xrealloc(d->items, (size_t)d->cap * sizeof *d->items);
     }
     va_list ap2;
     va_copy(ap2, ap);
     int len = vsnprintf(NULL, 0, fmt, ap);
-    char *msg = malloc((size_t)(len > 0 ? len : 0) + 1);
-    if (!msg)
-        abort();
+    char *msg = xmalloc((size_t)(len > 0 ? len : 0) + 1);
     vsnprintf(msg, (size_t)(len > 0 ? len : 0) + 1, fmt, ap2);
     va_end(ap2);
 
     sg_diag *g = &d->items[d->n++];
     g->loc = loc;
-    g->loc.file = xstrdup(loc.file);
+    g->loc.file = loc.file ? xstrdup(loc.file) : NULL;
     g->severity = sev;
     g->id = id;
     g->msg = msg;
@@ -175,9 +150,7 @@ static void add(sg_diags *d, sg_loc loc, sg_severity sev, sg_error_id id,
     size_t n;
     const char *line = find_line(d, loc.file, loc.line, &n);
     if (line) {
-        g->src_line = malloc(n + 1);
-        if (!g->src_line)
-            abort();
+        g->src_line = xmalloc(n + 1);
         memcpy(g->src_line, line, n);
         g->src_line[n] = 0;
     }
@@ -188,6 +161,14 @@ void sg_error(sg_diags *d, sg_loc loc, sg_error_id id, ...)
     va_list ap;
     va_start(ap, id);
     add(d, loc, SG_ERROR, id, formats[id], ap);
+    va_end(ap);
+}
+
+void sg_warning(sg_diags *d, sg_loc loc, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    add(d, loc, SG_WARNING, SG_E_INTERNAL, fmt, ap);
     va_end(ap);
 }
 
@@ -225,6 +206,57 @@ static void print_excerpt(FILE *out, int lineno, const char *line, int col)
     for (int i = from; i < c; i++)
         fputc(line[i] == '\t' ? '\t' : ' ', out);
     fputs("^\n", out);
+}
+
+static const char *const names[SG_E_COUNT] = {
+#define X(id, fmt) #id,
+    SG_ERRORS(X)
+#undef X
+};
+
+const char *sg_error_name(sg_error_id id)
+{
+    return (unsigned)id < SG_E_COUNT ? names[id] : "?";
+}
+
+/* A JSON string: quotes, backslashes and control characters escaped. */
+static void json_string(FILE *out, const char *s)
+{
+    if (!s) {
+        fputs("null", out);
+        return;
+    }
+    fputc('"', out);
+    for (const unsigned char *p = (const unsigned char *)s; *p; p++) {
+        if (*p == '"' || *p == '\\')
+            fprintf(out, "\\%c", *p);
+        else if (*p == '\n')
+            fputs("\\n", out);
+        else if (*p < 0x20)
+            fprintf(out, "\\u%04x", *p);
+        else
+            fputc(*p, out);
+    }
+    fputc('"', out);
+}
+
+void sg_diags_print_json(const sg_diags *d, FILE *out)
+{
+    static const char *const sev[] = { "error", "warning", "note" };
+    for (int i = 0; i < d->n; i++) {
+        const sg_diag *g = &d->items[i];
+        fputs("{\"file\": ", out);
+        json_string(out, g->loc.file);
+        fprintf(out, ", \"line\": %d, \"column\": %d, \"severity\": \"%s\", \"id\": ",
+                g->loc.line > 0 ? g->loc.line : 0, g->loc.line > 0 ? g->loc.col : 0,
+                sev[g->severity]);
+        json_string(out, g->severity == SG_NOTE ? NULL : sg_error_name(g->id));
+        fputs(", \"message\": ", out);
+        json_string(out, g->msg);
+        fputs("}\n", out);
+    }
+    if (d->ndropped)
+        fprintf(out, "{\"dropped\": %d}\n", d->ndropped);
 }
 
 void sg_diags_print(const sg_diags *d, FILE *out)

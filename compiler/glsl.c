@@ -142,18 +142,18 @@ void glsl_scope_pop(glsl_emitter *e)
     }
 }
 
-static bool is_leaf(const ir_node *n) { return n->op <= IR_OP_PAINTED; }
+int glsl_scope_count(const glsl_emitter *e, ir_op op)
+{
+    int from = e->nscopes ? e->scope_mark[e->nscopes - 1] : 0, n = 0;
+    for (int i = from; i < e->nemitted; i++)
+        n += e->ir->nodes[e->emitted[i]].op == op;
+    return n;
+}
 
-static const char *const input_glsl[IR_IN_COUNT] = {
-    [IR_IN_HEIGHT] = "splat_height()",
-    [IR_IN_SLOPE] = "splat_slope()",
-    [IR_IN_NORMAL] = "splat_normal()",
-    [IR_IN_POSITION] = "splat_position()",
-    [IR_IN_UV] = "splat_uv()",
-    [IR_IN_VIEW_DISTANCE] = "splat_view_distance()",
-    [IR_IN_DESTRUCTION] = "splat_destruction()",
-    [IR_IN_VIEW_DIRECTION] = "splat_view_direction()",
-};
+static bool is_leaf(const ir_node *n)
+{
+    return n->op <= IR_OP_PAINTED || n->op == IR_OP_DINPUT;
+}
 
 static char *leaf_expr(glsl_emitter *e, const ir_node *n)
 {
@@ -169,7 +169,7 @@ static char *leaf_expr(glsl_emitter *e, const ir_node *n)
         break;
     }
     case IR_OP_INPUT:
-        ir_buf_printf(&b, "%s", input_glsl[n->imm]);
+        ir_buf_printf(&b, "%s", ir_input_get((ir_input_kind)n->imm)->glsl);
         break;
     case IR_OP_PARAM:
         assert(e->names.param && e->names.param[n->imm]);
@@ -179,6 +179,12 @@ static char *leaf_expr(glsl_emitter *e, const ir_node *n)
         assert(e->names.texture && e->names.texture[n->imm]);
         ir_buf_printf(&b, "%s", e->names.texture[n->imm]);
         break;
+    case IR_OP_DINPUT: {   /* the input row's derivative accessor (abi.c) */
+        const char *d = ir_input_get((ir_input_kind)IR_DINPUT_INPUT(n->imm))->dglsl;
+        assert(d);
+        ir_buf_printf(&b, "%s(%d)", d, IR_DINPUT_AXIS(n->imm));
+        break;
+    }
     case IR_OP_PAINTED:
         assert(e->names.painted && e->names.painted[n->imm]);
         ir_buf_printf(&b, "%s", e->names.painted[n->imm]);
@@ -190,6 +196,11 @@ static char *leaf_expr(glsl_emitter *e, const ir_node *n)
 /* The right-hand side of node n (operands already have expressions). */
 static void op_expr(glsl_emitter *e, const ir_node *n, ir_buf *b)
 {
+    uint32_t id = (uint32_t)(n - e->ir->nodes);
+    if (e->names.override && e->names.override[id]) {
+        ir_buf_printf(b, "%s", e->names.override[id]);
+        return;
+    }
     const char *a[4] = {0};
     for (int i = 0; i < n->nargs; i++)
         a[i] = e->expr[n->arg[i].id];
@@ -265,6 +276,8 @@ const char *glsl_value(glsl_emitter *e, ir_ref r, const char *indent)
             continue;
         }
         todo[ntodo++] = id;
+        if (e->names.override && e->names.override[id])
+            continue;     /* written whole: its operands are not read */
         for (int i = 0; i < n->nargs; i++) {
             uint32_t a = n->arg[i].id;
             if (!e->expr[a] && !e->seen[a]) {

@@ -7,28 +7,12 @@
  * then looks it up with the can_cse / node_hash / node_equal triple below.
  */
 #include "ir.h"
+#include "util.h"
 
 #include <assert.h>
 #include <stdarg.h>
 #include <stdlib.h>
 #include <string.h>
-
-/* Allocation failure is not a user error we can report; stop loudly. */
-static void *xrealloc(void *p, size_t n)
-{
-    void *q = realloc(p, n ? n : 1);
-    if (!q) {
-        fprintf(stderr, "splatc: out of memory\n");
-        abort();
-    }
-    return q;
-}
-
-static char *xstrdup(const char *s)
-{
-    size_t n = strlen(s) + 1;
-    return memcpy(xrealloc(NULL, n), s, n);
-}
 
 #define GROW(ptr, n, cap)                                                  \
     do {                                                                   \
@@ -253,16 +237,10 @@ ir_ref ir_constf(ir *ir, double v)
     return ir_const(ir, IR_T_FLOAT, &v);
 }
 
-static const ir_type input_types[IR_IN_COUNT] = {
-#define X(id, name, type) type,
-    IR_INPUTS(X)
-#undef X
-};
-
 ir_ref ir_input(ir *ir, ir_input_kind which)
 {
     assert((unsigned)which < IR_IN_COUNT);
-    ir_node n = {.op = IR_OP_INPUT, .type = (uint8_t)input_types[which], .imm = which};
+    ir_node n = {.op = IR_OP_INPUT, .type = (uint8_t)ir_input_get(which)->type, .imm = which};
     return ir_node_add(ir, &n);
 }
 
@@ -390,6 +368,12 @@ int ir_add_texture(ir *ir, const ir_texture *t)
     *q = *t;
     q->file = xstrdup(t->file);
     return ir->ntextures++;
+}
+
+bool ir_texture_same(const ir_texture *a, const ir_texture *b)
+{
+    return strcmp(a->file, b->file) == 0 && a->filter == b->filter && a->mip == b->mip &&
+           a->wrap == b->wrap && a->srgb == b->srgb;
 }
 
 int ir_add_painted(ir *ir, const char *name)
@@ -528,4 +512,13 @@ void ir_buf_free(ir_buf *b)
     free(b->s);
     b->s = NULL;
     b->len = b->cap = 0;
+}
+
+void ir_clone(ir *dst, const ir *src)
+{
+    ir_init(dst);
+    ir_import_map *m = ir_import_begin(dst, src);
+    for (int i = 0; i < src->nroots; i++)
+        ir_set_root(dst, src->roots[i].name, ir_import(m, src->roots[i].ref));
+    ir_import_end(m);
 }

@@ -9,13 +9,16 @@
  * order before hashing.
  *
  * Each op's semantics live once, in the op table (ir_ops.c): its .sg name and
- * port names, its type rule, its GLSL form, its double-precision evaluation
- * and its interval evaluation.  The three back ends (GLSL emitter, CPU
- * reference, interval evaluator) all read that table.
+ * port names, its type rule, its GLSL form, its double-precision evaluation,
+ * its interval evaluation and its derivative rule.  The back ends (GLSL
+ * emitter, CPU reference, interval evaluator, forward-mode differentiation)
+ * all read that table.
  *
  * Sections below: types, ops, the ir and its builder (ir.c), passes
- * (opt_*.c, driven by ir_optimize in opt.c), validator (ir_validate.c),
- * dump (ir_dump.c), evaluators (ir_eval.c, ir_interval.c), GLSL (glsl.c).
+ * (opt_*.c, driven by ir_optimize in opt.c), derivatives
+ * (ir_differentiate.c: texture gradients for the compute stage), validator
+ * (ir_validate.c), dump (ir_dump.c), evaluators (ir_eval.c, ir_interval.c),
+ * GLSL (glsl.c).
  */
 #ifndef SPLAT_IR_H
 #define SPLAT_IR_H
@@ -44,80 +47,224 @@ ir_type     ir_type_from_name(const char *s); /* IR_T_ERROR if unknown       */
 
 /* ---- ops --------------------------------------------------------------- */
 
-/* Terrain and view inputs (OP_INPUT's imm). */
-#define IR_INPUTS(X)                                                      \
-    X(HEIGHT,        "terrain.height",   IR_T_FLOAT) /* metres, + offset  */ \
-    X(SLOPE,         "terrain.slope",    IR_T_FLOAT) /* 1 - normal.y      */ \
-    X(NORMAL,        "terrain.normal",   IR_T_VEC3)  /* world, Listing 1  */ \
-    X(POSITION,      "terrain.position", IR_T_VEC3)  /* terrain-local m   */ \
-    X(UV,            "terrain.uv",       IR_T_VEC2)  /* heightfield 0..1  */ \
-    X(VIEW_DISTANCE, "view.distance",    IR_T_FLOAT) /* metres to camera  */ \
-    X(DESTRUCTION,   "terrain.destruction", IR_T_FLOAT) /* 0 = untouched */ \
-    X(VIEW_DIRECTION, "view.direction",  IR_T_VEC3)  /* unit, to camera   */
+/* Terrain and view inputs (OP_INPUT's imm): one row per input, every fact
+ * about it in its row.  ir_input_get (ir_ops.c) returns a row as an
+ * ir_input_info; the front end, the evaluators, the GLSL emitter, the
+ * compositor and `splatc eval --at` all loop over it.
+ *
+ *   X(id, sg_name, type, glsl, key, ev, iv, domain, hoist, dglsl)
+ *     sg_name  what a graph writes ("terrain.height")
+ *     glsl     the ABI prelude's accessor (abi.h)
+ *     key      the `splatc eval --at KEY=…` name
+ *     ev       the ir_env field holding its value (ir_eval)
+ *     iv       IV(field): the ir_ienv field holding its bounds
+ *              (ir_interval); IV_NONE: bounded by its domain alone
+ *     domain   bounds of every value it can take: what `splatc eval`
+ *              and a terrain region assume until told more
+ *              (IR_DOM_* in ir_ops.c, per component)
+ *     hoist    composites read it once into a local (its accessor costs
+ *              more than a register read; compose.c)
+ *     dglsl    its screen-space derivative rule (ir_differentiate.c): the
+ *              prelude's splat_d_<input>(axis) accessor the DINPUT leaf
+ *              reads (abi.c), or NULL: taken as 0 (normal and slope would
+ *              need the heightfield's second derivatives; destruction is
+ *              piecewise)
+ *
+ * A new input: a row here, its ir_env (and ir_ienv) field below, its
+ * accessor in the ABI prelude (abi.c), and in terrain.c if a region
+ * bounds it tighter than its domain. */
+#define IR_INPUTS(X)                                                              \
+    X(HEIGHT,         "terrain.height",      IR_T_FLOAT, "splat_height()",        \
+      "height",       height,         IV(height),        ALL,    1,               \
+      "splat_d_height")                                                /* m        */ \
+    X(SLOPE,          "terrain.slope",       IR_T_FLOAT, "splat_slope()",         \
+      "slope",        slope,          IV(slope),         UNIT,   1,               \
+      NULL)                                                            /* 1-n.y    */ \
+    X(NORMAL,         "terrain.normal",      IR_T_VEC3,  "splat_normal()",        \
+      "normal",       normal,         IV(normal),        NORMAL, 1,               \
+      NULL)                                                            /* world    */ \
+    X(POSITION,       "terrain.position",    IR_T_VEC3,  "splat_position()",      \
+      "position",     position,       IV(position),      ALL,    1,               \
+      "splat_d_position")                                              /* local m  */ \
+    X(UV,             "terrain.uv",          IR_T_VEC2,  "splat_uv()",            \
+      "uv",           uv,             IV(uv),            UNIT,   0,               \
+      "splat_d_uv")                                                    /* 0..1     */ \
+    X(VIEW_DISTANCE,  "view.distance",       IR_T_FLOAT, "splat_view_distance()", \
+      "distance",     view_distance,  IV(view_distance), DIST,   1,               \
+      "splat_d_view_distance")                                         /* m        */ \
+    X(DESTRUCTION,    "terrain.destruction", IR_T_FLOAT, "splat_destruction()",   \
+      "destruction",  destruction,    IV(destruction),   UNIT,   1,               \
+      NULL)                                                            /* 0 = none */ \
+    X(VIEW_DIRECTION, "view.direction",      IR_T_VEC3,  "splat_view_direction()",\
+      "direction",    view_direction, IV_NONE,           SIGNED, 0,               \
+      "splat_d_view_direction")                                        /* unit     */
 
 /* The type is `enum ir_input` (alias ir_input_kind): the plain name
  * `ir_input` is the builder function below. */
 typedef enum ir_input {
-#define X(id, name, type) IR_IN_##id,
+#define X(id, ...) IR_IN_##id,
     IR_INPUTS(X)
 #undef X
     IR_IN_COUNT
 } ir_input_kind;
 
-/* The op list.  X(id, sg_name, nargs, flags).  The table in ir_ops.c gives
- * each op its ports, type rule, GLSL, eval and interval functions.
- * Ops whose sg_name is NULL are not nodes an artist writes directly. */
-#define IR_OPS(X)                                                          \
-    /* leaves */                                                           \
-    X(CONST,     NULL,         0, 0)  /* val[0..w-1]                    */ \
-    X(INPUT,     NULL,         0, 0)  /* imm = ir_input                 */ \
-    X(PARAM,     NULL,         0, 0)  /* imm = index into ir.params     */ \
-    X(TEXTURE,   NULL,         0, 0)  /* imm = index into ir.textures   */ \
-    X(PAINTED,   NULL,         0, 0)  /* imm = index into ir.painted    */ \
-    /* shape */                                                            \
-    X(SPLAT,     NULL,         1, 0)  /* float -> vecN (type says N)    */ \
-    X(SWIZZLE,   NULL,         1, 0)  /* imm = IR_SWZ(n, c0, c1, c2, c3) */\
-    X(CONSTRUCT, NULL,         4, 0)  /* vecN from floats (nargs = N)   */ \
-    /* texture */                                                          \
-    X(SAMPLE,    "sample",     2, 0)  /* (tex, uv) -> vec4              */ \
-    /* componentwise arithmetic: operands of one type (lowering splats) */ \
-    X(ADD,       "add",        2, IR_COMMUTATIVE | IR_COMPONENTWISE)       \
-    X(SUB,       "sub",        2, IR_COMPONENTWISE)                        \
-    X(MUL,       "mul",        2, IR_COMMUTATIVE | IR_COMPONENTWISE)       \
-    X(DIV,       "div",        2, IR_COMPONENTWISE)                        \
-    X(NEG,       "neg",        1, IR_COMPONENTWISE)                        \
-    X(MIN,       "min",        2, IR_COMMUTATIVE | IR_COMPONENTWISE)       \
-    X(MAX,       "max",        2, IR_COMMUTATIVE | IR_COMPONENTWISE)       \
-    X(ABS,       "abs",        1, IR_COMPONENTWISE)                        \
-    X(FLOOR,     "floor",      1, IR_COMPONENTWISE)                        \
-    X(FRACT,     "fract",      1, IR_COMPONENTWISE)                        \
-    X(MOD,       "mod",        2, IR_COMPONENTWISE)                        \
-    X(SQRT,      "sqrt",       1, IR_COMPONENTWISE)                        \
-    X(POW,       "pow",        2, IR_COMPONENTWISE)                        \
-    X(EXP2,      "exp2",       1, IR_COMPONENTWISE)                        \
-    X(SIN,       "sin",        1, IR_COMPONENTWISE)                        \
-    X(COS,       "cos",        1, IR_COMPONENTWISE)                        \
-    X(MIX,       "mix",        3, IR_COMPONENTWISE)  /* a, b, t         */ \
-    X(CLAMP,     "clamp",      3, IR_COMPONENTWISE)  /* x, lo, hi       */ \
-    X(SATURATE,  "saturate",   1, IR_COMPONENTWISE)                        \
-    X(STEP,      "step",       2, IR_COMPONENTWISE)  /* edge, x         */ \
-    X(SMOOTHSTEP,"smoothstep", 3, IR_COMPONENTWISE)  /* e0, e1, x       */ \
-    X(LESS,      "less",       2, IR_COMPONENTWISE)  /* a < b ? 1 : 0   */ \
-    X(SELECT,    "select",     3, IR_COMPONENTWISE)  /* c != 0 ? a : b  */ \
-    /* vector */                                                           \
-    X(DOT,       "dot",        2, IR_COMMUTATIVE)                          \
-    X(LENGTH,    "length",     1, 0)                                       \
-    X(NORMALIZE, "normalize",  1, 0)                                       \
-    X(CROSS,     "cross",      2, 0)
+/* fp32 error classes: how far a GPU's fp32 result of an op may lie from
+ * the double reference (u = 2^-24).  The GPU-agreement harness
+ * (tests/harness/harness_ref.c) turns each class into a bound; it switches
+ * on the class without a default, so a new class that it does not know is
+ * a compile error there, and every op row must name one. */
+#define IR_FP32_CLASSES(X)                                                       \
+    X(EXACT)      /* exact in fp32 (neg abs floor min max splat …)          */ \
+    X(LITERAL)    /* u|v|: a constant rounded to fp32                       */ \
+    X(ROUNDED)    /* u|r|: correctly rounded (add sub mul)                  */ \
+    X(ULP3)       /* 3u|r|: div, sqrt (2.5 ulp)                             */ \
+    X(FRACT)      /* u                                                      */ \
+    X(MOD)        /* 4u(|x|+|y|), ill-conditioned near integer x/y          */ \
+    X(EXP2)       /* (3+2|x|)u|r|                                           */ \
+    X(POW)        /* (8+16|y|(1+|log2 x|))u|r|, undefined x<0               */ \
+    X(TRIG)       /* 32u + 8u|x| absolute                                   */ \
+    X(MIX)        /* 2u(|a|+|b|)(1+|t|) + u|r|                              */ \
+    X(CLAMP)      /* exact; undefined when lo > hi                          */ \
+    X(SMOOTHSTEP) /* 1.5 e_t + 4u; undefined when e0 >= e1                  */ \
+    X(DOT)        /* (n+1)u sum|a_i b_i|                                    */ \
+    X(LENGTH)     /* 4u|r|                                                  */ \
+    X(NORMALIZE)  /* 6u per component                                       */ \
+    X(CROSS)      /* 2u(|a_j b_k| + |a_k b_j|)                              */ \
+    X(SAMPLE)     /* sub-texel weights and coordinate rounding              */
 
-enum { IR_COMMUTATIVE = 1, IR_COMPONENTWISE = 2 };
+typedef enum ir_fp32_class {
+#define X(id) IR_FP32_##id,
+    IR_FP32_CLASSES(X)
+#undef X
+    IR_FP32_COUNT
+} ir_fp32_class;
+
+/* Finiteness: when an op's result is provably neither NaN nor inf
+ * (opt_fold may then fold x * 0 to 0).  IR_FIN_ARGS(mask): when the
+ * operands in `mask` (bit i = operand i) are; IR_FIN_DATA: decided by the
+ * leaf's data (a constant's value, a param's range, a texture's range). */
+enum { IR_FIN_NO = 0, IR_FIN_YES = 1, IR_FIN_DATA = 2, IR_FIN_ARGS_BIT = 0x100 };
+#define IR_FIN_ARGS(mask) (IR_FIN_ARGS_BIT | (mask))
+
+/* THE op table: one row per op, every fact about the op in its row.
+ *
+ *   X(id, sg_name, nargs, flags, ports, glsl, type, sem, fin, fp32, cost,
+ *     deriv)
+ *     sg_name  .sg node type; NULL for ops an artist does not write
+ *     nargs    operand count (4 for CONSTRUCT means "up to 4")
+ *     flags    IR_COMMUTATIVE | IR_COMPONENTWISE | IR_NAN_PROPAGATES
+ *     ports    input port names in operand order: P1 ("x"), P2 ("a",
+ *              "b"), PORTS(...), NOPORTS
+ *     glsl     GLSL form, $i = operand i ("mix($0, $1, $2)")
+ *     type     type rule (ty_* in ir_ops.c): result type or IR_T_ERROR
+ *     sem      double-precision value and sound interval, written side by
+ *              side in ir_ops.c: CW(f) = scalar e_f/i_f applied per
+ *              component; NODE(f) = e_f/i_f on the whole node; ENV = the
+ *              evaluator's environment supplies it (leaves, SAMPLE)
+ *     fin      IR_FIN_*: when the result is provably finite (opt_fold)
+ *     fp32     IR_FP32_* error class (the GPU-agreement harness)
+ *     cost     op cost units per component (below)
+ *     deriv    forward-mode derivative rule (ir_differentiate.c): D(f) =
+ *              d_f in ir_ops.c, building the derivative as IR from the
+ *              operands and theirs; D0: always 0 (constants, floor, step…)
+ *
+ * A row is positional: a row missing a column does not compile.  To add a
+ * column (e.g. the forward-mode derivative): add a parameter at the END of
+ * the list above and in every row, a field at the end of ir_opinfo, and
+ * its expansion in ir_ops.c's ROW macro (marked "new columns here").
+ *
+ * Cost units (ir_node_cost, ir_cost): an estimate of ALU work, 1 = one
+ * fp32 add/mul/compare on one component; transcendental ops cost more,
+ * a texture sample 4 per component (16 for its vec4).  A node costs
+ * `cost` times the widest of its result and operands (so a vec3 add is 3,
+ * dot(vec3, vec3) is 3 x 2).  Leaves, swizzles, splats and constructs are
+ * free (register moves).  The screen-space path picks the cheapest
+ * covering combination by it; shading LOD will rank materials by it.
+ * Relative, not cycles: keep new rows consistent with the old ones.
+ *
+ * A new op touches this row and its e_/i_ functions in ir_ops.c (and
+ * glsl.c only if its GLSL form is not a template).
+ */
+#define IR_OPS(X)                                                                           \
+    /* leaves: values come from the environment (ir_env, glsl_names)  */                    \
+    X(CONST,     NULL,  0, 0, NOPORTS, "<literal>",         ty_leaf, ENV, IR_FIN_DATA, LITERAL, 0, D0) \
+    X(INPUT,     NULL,  0, 0, NOPORTS, "splat_<input>()",   ty_leaf, ENV, IR_FIN_YES,  EXACT, 0, D(input))   \
+    X(PARAM,     NULL,  0, 0, NOPORTS, "<names.param[i]>",  ty_leaf, ENV, IR_FIN_DATA, EXACT, 0, D0)   \
+    X(TEXTURE,   NULL,  0, 0, NOPORTS, "<names.texture[i]>",ty_leaf, ENV, IR_FIN_NO,   EXACT, 0, D0)   \
+    X(PAINTED,   NULL,  0, 0, NOPORTS, "<names.painted[i]>",ty_leaf, ENV, IR_FIN_YES,  EXACT, 0, D0)   \
+    /* shape: SPLAT float -> vecN (type says N); SWIZZLE imm = IR_SWZ; */                   \
+    /* CONSTRUCT vecN from floats/vectors (nargs = operands)           */                   \
+    X(SPLAT,     NULL,  1, 0, P1, "vecN($0)",       ty_splat,     NODE(splat),     IR_FIN_ARGS(1), EXACT, 0, D(linear)) \
+    X(SWIZZLE,   NULL,  1, 0, P1, "$0.<xyzw>",      ty_swizzle,   NODE(swizzle),   IR_FIN_ARGS(1), EXACT, 0, D(linear)) \
+    X(CONSTRUCT, NULL,  4, 0, PORTS("x", "y", "z", "w"), "vecN($0, ...)", ty_construct, NODE(construct), \
+      IR_FIN_NO, EXACT, 0, D(linear))                                                                  \
+    /* texture: (tex, uv) -> vec4 */                                                        \
+    X(SAMPLE,    "sample", 2, 0, PORTS("tex", "uv"), "texture($0, $1)", ty_sample, ENV,     \
+      IR_FIN_DATA, SAMPLE, 4, D(sample))                                                               \
+    /* componentwise arithmetic: operands of one type (lowering splats) */                  \
+    X(ADD,   "add",   2, IR_COMMUTATIVE | IR_CWN, P2, "$0 + $1",     ty_same, CW(add),   IR_FIN_NO, ROUNDED, 1, D(add)) \
+    X(SUB,   "sub",   2, IR_CWN,                  P2, "$0 - $1",     ty_same, CW(sub),   IR_FIN_NO, ROUNDED, 1, D(sub)) \
+    X(MUL,   "mul",   2, IR_COMMUTATIVE | IR_CWN, P2, "$0 * $1",     ty_same, CW(mul),   IR_FIN_NO, ROUNDED, 1, D(mul)) \
+    X(DIV,   "div",   2, IR_CWN,                  P2, "$0 / $1",     ty_same, CW(div),   IR_FIN_NO, ULP3, 4, D(div))    \
+    X(NEG,   "neg",   1, IR_CWN,                  P1, "-($0)",       ty_same, CW(neg),   IR_FIN_NO, EXACT, 1, D(linear))   \
+    X(MIN,   "min",   2, IR_COMMUTATIVE | IR_COMPONENTWISE, P2, "min($0, $1)", ty_same, CW(min), IR_FIN_NO, EXACT, 1, D(min)) \
+    X(MAX,   "max",   2, IR_COMMUTATIVE | IR_COMPONENTWISE, P2, "max($0, $1)", ty_same, CW(max), IR_FIN_NO, EXACT, 1, D(max)) \
+    X(ABS,   "abs",   1, IR_CWN,                  P1, "abs($0)",     ty_same, CW(abs),   IR_FIN_NO, EXACT, 1, D(abs))   \
+    X(FLOOR, "floor", 1, IR_CWN,                  P1, "floor($0)",   ty_same, CW(floor), IR_FIN_NO, EXACT, 1, D0)   \
+    X(FRACT, "fract", 1, IR_CWN,                  P1, "fract($0)",   ty_same, CW(fract), IR_FIN_NO, FRACT, 2, D(fract))   \
+    X(MOD,   "mod",   2, IR_CWN, PORTS("x", "y"), "mod($0, $1)",     ty_same, CW(mod),   IR_FIN_NO, MOD, 6, D(mod))     \
+    X(SQRT,  "sqrt",  1, IR_CWN,                  P1, "sqrt($0)",    ty_same, CW(sqrt),  IR_FIN_NO, ULP3, 4, D(sqrt))    \
+    X(POW,   "pow",   2, IR_CWN, PORTS("x", "y"), "pow($0, $1)",     ty_same, CW(pow),   IR_FIN_NO, POW, 9, D(pow))     \
+    X(EXP2,  "exp2",  1, IR_CWN,                  P1, "exp2($0)",    ty_same, CW(exp2),  IR_FIN_NO, EXP2, 4, D(exp2))    \
+    X(SIN,   "sin",   1, IR_CWN,                  P1, "sin($0)",     ty_same, CW(sin),   IR_FIN_NO, TRIG, 8, D(sin))    \
+    X(COS,   "cos",   1, IR_CWN,                  P1, "cos($0)",     ty_same, CW(cos),   IR_FIN_NO, TRIG, 8, D(cos))    \
+    X(MIX,   "mix",   3, IR_CWN, PORTS("a", "b", "t"), "mix($0, $1, $2)", ty_same, CW(mix), IR_FIN_NO, MIX, 3, D(mix)) \
+    X(CLAMP, "clamp", 3, IR_COMPONENTWISE, PORTS("x", "lo", "hi"), "clamp($0, $1, $2)", ty_same, CW(clamp), \
+      IR_FIN_ARGS(6), CLAMP, 2, D(clamp))                                                             \
+    X(SATURATE, "saturate", 1, IR_COMPONENTWISE, P1, "clamp($0, 0.0, 1.0)", ty_same, CW(saturate), \
+      IR_FIN_YES, EXACT, 1, D(saturate))                                                                 \
+    X(STEP,  "step",  2, IR_COMPONENTWISE, PORTS("edge", "x"), "step($0, $1)", ty_same, CW(step), \
+      IR_FIN_YES, EXACT, 1, D0)                                                                 \
+    X(SMOOTHSTEP, "smoothstep", 3, IR_COMPONENTWISE, PORTS("e0", "e1", "x"),                \
+      "smoothstep($0, $1, $2)", ty_same, CW(smoothstep), IR_FIN_YES, SMOOTHSTEP, 8, D(smoothstep))         \
+    /* float forms; the emitter writes lessThan / a bvec mix for vectors */                 \
+    X(LESS,  "less",  2, IR_COMPONENTWISE, P2, "float($0 < $1)", ty_same, CW(less),          \
+      IR_FIN_YES, EXACT, 1, D0)                                    /* a < b ? 1 : 0  */         \
+    X(SELECT, "select", 3, IR_COMPONENTWISE, PORTS("c", "a", "b"), "($0 != 0.0 ? $1 : $2)", \
+      ty_same, CW(select), IR_FIN_NO, EXACT, 1, D(select))                /* c != 0 ? a : b */         \
+    /* vector */                                                                            \
+    X(DOT,       "dot",       2, IR_COMMUTATIVE, P2, "dot($0, $1)",   ty_dot,    NODE(dot),       \
+      IR_FIN_NO, DOT, 2, D(dot))                                                                    \
+    X(LENGTH,    "length",    1, 0, P1, "length($0)",    ty_length, NODE(length),    IR_FIN_NO, LENGTH, 3, D(length))    \
+    X(NORMALIZE, "normalize", 1, 0, P1, "normalize($0)", ty_same,   NODE(normalize), IR_FIN_NO, NORMALIZE, 4, D(normalize)) \
+    X(CROSS,     "cross",     2, 0, P2, "cross($0, $1)", ty_cross,  NODE(cross),     IR_FIN_NO, CROSS, 2, D(cross)) \
+    /* derivatives (ir_differentiate.c; not written in .sg).  Kept last:  */                 \
+    /* random graph generators draw SPLAT..CROSS.  DINPUT: imm =          */                 \
+    /* IR_DINPUT_IMM(input, axis), the input row's dglsl accessor;        */                 \
+    /* SAMPLE_GRAD (tex, uv, duv/dx, duv/dy): the reference samples as    */                 \
+    /* SAMPLE does (level 0); LOG2: pow's rule (never drawn by the harness) */               \
+    X(DINPUT,    NULL,  0, 0, NOPORTS, "splat_d_<input>(axis)", ty_leaf, ENV, IR_FIN_NO, EXACT, 0, D0) \
+    X(SAMPLE_GRAD, NULL, 4, 0, PORTS("tex", "uv", "ddx", "ddy"), "textureGrad($0, $1, $2, $3)", \
+      ty_sample_grad, ENV, IR_FIN_DATA, SAMPLE, 4, D(sample))                               \
+    X(LOG2,      NULL,  1, IR_CWN, P1, "log2($0)", ty_same, CW(log2), IR_FIN_NO, ULP3, 4, D(log2))
+
+/* IR_NAN_PROPAGATES: a NaN operand component gives a NaN result component
+ * (the interval code short-circuits such operands to [-inf, inf]). */
+enum { IR_COMMUTATIVE = 1, IR_COMPONENTWISE = 2, IR_NAN_PROPAGATES = 4 };
+#define IR_CWN (IR_COMPONENTWISE | IR_NAN_PROPAGATES)
 
 typedef enum ir_op {
-#define X(id, name, nargs, flags) IR_OP_##id,
+#define X(id, ...) IR_OP_##id,
     IR_OPS(X)
 #undef X
     IR_OP_COUNT
 } ir_op;
+
+/* DINPUT immediates: the screen-space derivative of terrain input `input`
+ * along axis 0 (d/dx, one pixel right) or 1 (d/dy, one pixel down). */
+#define IR_DINPUT_IMM(input, axis) ((uint32_t)(input) | (uint32_t)(axis) << 8)
+#define IR_DINPUT_INPUT(imm)       ((int)((imm) & 255))
+#define IR_DINPUT_AXIS(imm)        ((int)((imm) >> 8))
 
 /* Swizzle immediates: n components, each 0..3 (x y z w). */
 #define IR_SWZ(n, a, b, c, d) \
@@ -127,12 +274,15 @@ typedef enum ir_op {
 
 typedef struct ir_iv ir_iv;    /* an interval, defined with the evaluators */
 struct ir_node;
+struct ir_ref;
+typedef struct ir_dctx ir_dctx;  /* a differentiation in progress (below) */
 
+/* One row of IR_OPS, as the back ends read it. */
 typedef struct ir_opinfo {
     const char *name;          /* .sg node type, NULL for internal ops   */
     const char *ports[4];      /* input port names, in arg order          */
     int         nargs;         /* 4 for CONSTRUCT means "up to 4"         */
-    unsigned    flags;         /* IR_COMMUTATIVE | IR_COMPONENTWISE       */
+    unsigned    flags;         /* IR_COMMUTATIVE | IR_COMPONENTWISE | …   */
     const char *glsl;          /* GLSL form: "mix($0, $1, $2)"            */
     /* Result type for operand types, or IR_T_ERROR.  The front end's type
      * checker calls this too, so the two cannot disagree. */
@@ -146,6 +296,19 @@ typedef struct ir_opinfo {
                       const double *a, double out[4]);
     void      (*interval)(const struct ir_node *n, const ir_type *atype,
                           const ir_iv *a, ir_iv *out);
+    /* Componentwise ops (CW rows): the scalar functions `eval` and
+     * `interval` apply per component; NULL otherwise. */
+    double    (*scalar_eval)(const double *x);
+    ir_iv     (*scalar_interval)(const ir_iv *x);
+    unsigned      finite;      /* IR_FIN_*                                */
+    ir_fp32_class fp32;        /* fp32 error class                        */
+    int           cost;        /* cost units per component (see IR_OPS)   */
+    /* Forward-mode derivative rule (ir_differentiate.c): the derivative of
+     * node `self` (a copy in `n`) along the context's screen axis, built
+     * in the context's ir from its operands and their derivatives d[i]
+     * (IR_NONE: zero); IR_NONE for a zero derivative.  NULL: always 0. */
+    struct ir_ref (*deriv)(struct ir_dctx *c, const struct ir_node *n,
+                           struct ir_ref self, const struct ir_ref *d);
 } ir_opinfo;
 
 const ir_opinfo *ir_opinfo_get(ir_op op);
@@ -178,11 +341,28 @@ typedef struct ir_param {
                           is sound over it.  lo == hi == def[0] if fixed */
 } ir_param;
 
-typedef enum ir_filter { IR_FILTER_LINEAR, IR_FILTER_NEAREST } ir_filter;
-typedef enum ir_wrap { IR_WRAP_REPEAT, IR_WRAP_CLAMP, IR_WRAP_MIRROR } ir_wrap;
+/* Sampler state and its names, one table each: graph files, dumps, the
+ * pack manifest and generated comments all spell them so. */
+#define IR_FILTERS(X) X(LINEAR, "linear") X(NEAREST, "nearest")
+#define IR_WRAPS(X)   X(REPEAT, "repeat") X(CLAMP, "clamp") X(MIRROR, "mirror")
+typedef enum ir_filter {
+#define X(id, name) IR_FILTER_##id,
+    IR_FILTERS(X)
+#undef X
+} ir_filter;
+typedef enum ir_wrap {
+#define X(id, name) IR_WRAP_##id,
+    IR_WRAPS(X)
+#undef X
+} ir_wrap;
+const char *ir_filter_name(ir_filter f);
+const char *ir_wrap_name(ir_wrap w);
+int         ir_filter_by_name(const char *name);   /* -1 if unknown */
+int         ir_wrap_by_name(const char *name);     /* -1 if unknown */
 
 /* A texture resource: a file and its sampler state.  Two with the same
- * file and state are the same resource (opt_dedup merges them). */
+ * file and state are the same resource (ir_texture_same: opt_dedup merges
+ * them, the pack layout binds them once). */
 typedef struct ir_texture {
     char     *file;     /* path as resolved by the front end (relative to
                            the graph file that named it)                   */
@@ -248,8 +428,17 @@ int  ir_add_param(ir *ir, const ir_param *p);     /* key: name            */
 int  ir_add_texture(ir *ir, const ir_texture *t); /* appends (no interning:
                                                      opt_dedup merges)    */
 int  ir_add_painted(ir *ir, const char *name);    /* key: name            */
+/* The texture identity: same file and sampler state (filter, mip, wrap,
+ * sRGB).  The value bounds follow from the file. */
+bool ir_texture_same(const ir_texture *a, const ir_texture *b);
 void ir_set_root(ir *ir, const char *name, ir_ref r); /* add or replace   */
 ir_ref ir_find_root(const ir *ir, const char *name);  /* IR_NONE if absent */
+
+/* Cost (IR_OPS' cost column, in its units): of node `r` alone, and of
+ * every node under `roots` counted once (a shared subtree is paid once,
+ * as the emitter writes it once). */
+int  ir_node_cost(const ir *ir, ir_ref r);
+long ir_cost(const ir *ir, const ir_ref *roots, int nroots);
 
 /* Copy the subgraph under `r` of `src` into `dst` (params, textures and
  * painted masks re-interned), returning its ref in dst.  Composites are
@@ -258,6 +447,8 @@ typedef struct ir_import_map ir_import_map;  /* opaque memo, per src */
 ir_import_map *ir_import_begin(ir *dst, const ir *src);
 ir_ref         ir_import(ir_import_map *m, ir_ref r);
 void           ir_import_end(ir_import_map *m);
+/* A fresh `dst` holding `src`'s roots (and what they reach), same names. */
+void           ir_clone(ir *dst, const ir *src);
 
 /* ---- passes (opt_*.c) -------------------------------------------------- */
 
@@ -284,6 +475,34 @@ extern const ir_pass ir_passes[];   /* in pipeline order, NULL-terminated */
  * after that pass's first run (for `splatc dump --after`).  Validates after
  * every pass when built with SPLAT_VALIDATE_IR (debug builds). */
 void ir_optimize(ir *ir, const char *stop_after);
+
+/* ---- derivatives (ir_differentiate.c) ---------------------------------- */
+
+/* The pass: every SAMPLE(tex, uv) becomes SAMPLE_GRAD(tex, uv, duv/dx,
+ * duv/dy), the gradients built as IR by forward-mode differentiation with
+ * the op table's rules (IR_OPS' deriv column) from DINPUT leaves.  For
+ * shaders without implicit derivatives (the compute stage).  Returns
+ * progress.  Run ir_optimize after it to fold the zeros away. */
+bool   ir_differentiate(ir *ir);
+/* The derivative of `r` along `axis` (0: d/dx, 1: d/dy) as a node of `ir`
+ * (a constant 0 if it is zero), built the same way (for tests). */
+ir_ref ir_derivative(ir *ir, ir_ref r, int axis);
+
+/* What the rules build with: the ir, the axis, and arithmetic that reads
+ * IR_NONE as zero and splats a float operand to the other's width. */
+struct ir_dctx {
+    ir       *ir;
+    int       axis;
+    uint32_t *memo[2];  /* per axis, per node: derivative id + 1, or 0      */
+    uint32_t  cap;      /* entries of each memo                            */
+};
+ir_ref ir_d_add(ir_dctx *c, ir_ref a, ir_ref b);   /* a + b, NONE = 0     */
+ir_ref ir_d_sub(ir_dctx *c, ir_ref a, ir_ref b);   /* a - b               */
+ir_ref ir_d_mul(ir_dctx *c, ir_ref a, ir_ref b);   /* a * b (NONE if
+                                                       either is NONE)    */
+ir_ref ir_d_div(ir_dctx *c, ir_ref a, ir_ref b);   /* a / b (NONE if a is) */
+ir_ref ir_d_num(ir_dctx *c, ir_type t, double v);   /* constant v of type t */
+ir_ref ir_d_zero(ir_dctx *c, ir_ref d, ir_type t);  /* d, or 0 if NONE     */
 
 /* ---- validator (ir_validate.c) ----------------------------------------- */
 
@@ -321,6 +540,9 @@ typedef struct ir_env {
     double view_direction[3];      /* unit vector from the point to the
                                       camera, terrain-local; (0, 0, 0)
                                       reads as (0, 1, 0), straight down  */
+    double d_input[2][IR_IN_COUNT][4]; /* DINPUT leaves: screen-space
+                                      derivative of each input, per axis
+                                      (d/dx, d/dy); 0 when unset          */
 } ir_env;
 
 /* Double-precision reference value of `r` (w = ir_type_width components). */
@@ -343,6 +565,32 @@ typedef struct ir_ienv {
     const ir_iv *params;           /* 1 per param; NULL = [lo, hi] of each */
     const ir_iv *painted;          /* 1 per painted mask; NULL = [0, 1]    */
 } ir_ienv;
+
+/* One row of IR_INPUTS, as the evaluators, the emitter and the CLI read
+ * it.  The env slots are byte offsets of the input's first component. */
+typedef struct ir_input_info {
+    const char *name;          /* "terrain.height"                        */
+    const char *glsl;          /* "splat_height()"                        */
+    const char *key;           /* `splatc eval --at` key: "height"        */
+    ir_type     type;
+    size_t      env_off;       /* offsetof(ir_env, field)                 */
+    long        ienv_off;      /* offsetof(ir_ienv, field), -1: none      */
+    ir_iv       domain[4];     /* every value it can take, per component  */
+    bool        hoist;         /* composites read it once into a local    */
+    const char *local;         /* that local's name: "in_" + ev field     */
+    const char *dglsl;         /* derivative accessor "splat_d_height"
+                                  (takes the axis), NULL: derivative 0    */
+} ir_input_info;
+
+const ir_input_info *ir_input_get(ir_input_kind which);
+/* The input whose .sg name is `name`, or -1. */
+int     ir_input_by_name(const char *name);
+/* The input's value slots in `env` (width doubles) and bounds slots in
+ * `ienv` (width intervals; NULL where it has none: IV_NONE). */
+double *ir_env_slot(ir_env *env, ir_input_kind which);
+ir_iv  *ir_ienv_slot(ir_ienv *ienv, ir_input_kind which);
+/* Every input of `ienv` set to its domain (params and painted untouched). */
+void    ir_ienv_domain(ir_ienv *ienv);
 
 /* Sound bounds: for every input point in the region, ir_eval's value lies
  * in out[c] for each component c.  NaN-producing cases widen to
@@ -372,6 +620,10 @@ typedef struct glsl_names {
     const char *const *param;
     const char *const *texture;
     const char *const *painted;
+    /* NULL, or per node id: a complete GLSL expression emitted for that
+     * node instead of its op, its operands left unread (precision.c's
+     * camera-relative rewrites). */
+    const char *const *override;
 } glsl_names;
 
 typedef struct glsl_emitter glsl_emitter;
@@ -383,6 +635,10 @@ void          glsl_emitter_free(glsl_emitter *e);
 const char   *glsl_value(glsl_emitter *e, ir_ref r, const char *indent);
 void          glsl_scope_push(glsl_emitter *e);
 void          glsl_scope_pop(glsl_emitter *e);
+/* Values of op `op` emitted in the innermost open scope itself (the whole
+ * shader's outermost level when none is open): e.g. the texture samples a
+ * block takes, for the counting variant. */
+int           glsl_scope_count(const glsl_emitter *e, ir_op op);
 
 /* GLSL literal for a constant of type t ("vec3(0.5, 0.5, 0.5)"), exact
  * enough to round-trip a float. */

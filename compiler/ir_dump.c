@@ -42,17 +42,12 @@
  * same IR always gives the same text.
  */
 #include "ir.h"
+#include "util.h"
 
 #include <math.h>
 #include <stdarg.h>
 #include <stdlib.h>
 #include <string.h>
-
-static const char *const input_names[IR_IN_COUNT] = {
-#define X(id, name, type) name,
-    IR_INPUTS(X)
-#undef X
-};
 
 /* The standard material outputs (sg.h's SG_OUTPUTS; the IR does not
  * depend on the front end, so the names are repeated here). */
@@ -74,9 +69,7 @@ static void tx_printf(text *t, const char *fmt, ...)
         abort();
     if (t->len + (size_t)n + 1 > t->cap) {
         t->cap = (t->len + (size_t)n + 1) * 2;
-        t->s = realloc(t->s, t->cap);
-        if (!t->s)
-            abort();
+        t->s = xrealloc(t->s, t->cap);
     }
     va_start(ap, fmt);
     vsnprintf(t->s + t->len, t->cap - t->len, fmt, ap);
@@ -216,7 +209,10 @@ static void dump_node(text *t, const dumper *D, uint32_t id)
     const ir_opinfo *info = ir_opinfo_get((ir_op)n->op);
     tx_printf(t, "    node n%u : ", D->number[id]);
     if (n->op == IR_OP_INPUT) {
-        tx_printf(t, "%s", input_names[n->imm]);
+        tx_printf(t, "%s", ir_input_get((ir_input_kind)n->imm)->name);
+    } else if (n->op == IR_OP_DINPUT) {   /* for reading: no .sg form */
+        tx_printf(t, "%s.d%c", ir_input_get((ir_input_kind)IR_DINPUT_INPUT(n->imm))->name,
+                  "xy"[IR_DINPUT_AXIS(n->imm)]);
     } else if (n->op == IR_OP_PAINTED) {
         tx_printf(t, "painted { mask = \"%s\" }", D->ir->painted[n->imm].name);
     } else {
@@ -237,7 +233,11 @@ static void dump_node(text *t, const dumper *D, uint32_t id)
                 order[1] = 0;
             }
         }
-        tx_printf(t, "%s {", info->name ? info->name : "construct");
+        /* the derivative pass's ops have no .sg form: named for reading */
+        tx_printf(t, "%s {", info->name                       ? info->name
+                             : n->op == IR_OP_SAMPLE_GRAD ? "sample_grad"
+                             : n->op == IR_OP_LOG2        ? "log2"
+                                                          : "construct");
         for (int i = 0; i < n->nargs; i++) {
             const char *port = n->op == IR_OP_CONSTRUCT ? construct_ports[i] : info->ports[i];
             tx_printf(t, "%s %s = %s", i ? "," : "", port, arg[order[i]]);
@@ -341,8 +341,6 @@ static void dump_block(text *t, dumper *D, const char *name, size_t namelen,
 
 void ir_dump(const ir *ir, FILE *out)
 {
-    static const char *const filter_names[] = {"linear", "nearest"};
-    static const char *const wrap_names[] = {"repeat", "clamp", "mirror"};
     dumper D = {.ir = ir};
     int nroots = ir->nroots;
     D.number = calloc((size_t)ir->nnodes + 1, sizeof *D.number);
@@ -384,8 +382,8 @@ void ir_dump(const ir *ir, FILE *out)
                 continue;
             const ir_texture *tx = &ir->textures[i];
             tx_printf(&t, "texture t%d { file = \"%s\", filter = %s, mip = %s, wrap = %s, srgb = %s }",
-                      k, tx->file, filter_names[tx->filter], filter_names[tx->mip],
-                      wrap_names[tx->wrap], tx->srgb ? "true" : "false");
+                      k, tx->file, ir_filter_name(tx->filter), ir_filter_name(tx->mip),
+                      ir_wrap_name(tx->wrap), tx->srgb ? "true" : "false");
             if (tx->lo != 0 || tx->hi != 1) {
                 tx_printf(&t, "  # value range ");
                 tx_num(&t, tx->lo);

@@ -11,26 +11,15 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* An input's value: its ir_env slot (IR_INPUTS' ev column). */
 static void eval_input(const ir_env *env, uint32_t which, double *out)
 {
-    switch (which) {
-    case IR_IN_HEIGHT:        out[0] = env->height; break;
-    case IR_IN_SLOPE:         out[0] = env->slope; break;
-    case IR_IN_NORMAL:        memcpy(out, env->normal, sizeof env->normal); break;
-    case IR_IN_POSITION:      memcpy(out, env->position, sizeof env->position); break;
-    case IR_IN_UV:            memcpy(out, env->uv, sizeof env->uv); break;
-    case IR_IN_VIEW_DISTANCE: out[0] = env->view_distance; break;
-    case IR_IN_DESTRUCTION:   out[0] = env->destruction; break;
-    case IR_IN_VIEW_DIRECTION: {
-        const double *d = env->view_direction;
-        bool zero = d[0] == 0.0 && d[1] == 0.0 && d[2] == 0.0;
-        out[0] = d[0];
-        out[1] = zero ? 1.0 : d[1];   /* unset: looking straight down */
-        out[2] = d[2];
-        break;
-    }
-    default:                  assert(!"unknown input");
-    }
+    assert(which < IR_IN_COUNT);
+    const ir_input_info *in = ir_input_get((ir_input_kind)which);
+    const double *v = (const double *)((const char *)env + in->env_off);
+    memcpy(out, v, (size_t)ir_type_width(in->type) * sizeof *v);
+    if (which == IR_IN_VIEW_DIRECTION && out[0] == 0.0 && out[1] == 0.0 && out[2] == 0.0)
+        out[1] = 1.0;                 /* unset: looking straight down */
 }
 
 void ir_eval_node(const ir *ir, uint32_t id, const ir_env *env, double (*vals)[4])
@@ -55,7 +44,12 @@ void ir_eval_node(const ir *ir, uint32_t id, const ir_env *env, double (*vals)[4
     case IR_OP_PAINTED:
         out[0] = env->painted ? env->painted[n->imm] : 0.0;
         return;
-    case IR_OP_SAMPLE: {
+    case IR_OP_DINPUT:
+        memcpy(out, env->d_input[IR_DINPUT_AXIS(n->imm)][IR_DINPUT_INPUT(n->imm)],
+               4 * sizeof(double));
+        return;
+    case IR_OP_SAMPLE:        /* the gradients do not change level 0 */
+    case IR_OP_SAMPLE_GRAD: {
         const double *uv = vals[n->arg[1].id];
         int tex = (int)ir->nodes[n->arg[0].id].imm;
         if (env->sample) {

@@ -17,22 +17,17 @@
 #include <stdlib.h>
 #include <string.h>
 
+/* An input's bounds: its ir_ienv slot, or its domain where it has none
+ * (IR_INPUTS' iv and domain columns: view.direction, any camera). */
 static void input_bounds(const ir_ienv *env, uint32_t which, ir_iv *out)
 {
-    switch (which) {
-    case IR_IN_HEIGHT:        out[0] = env->height; break;
-    case IR_IN_SLOPE:         out[0] = env->slope; break;
-    case IR_IN_NORMAL:        memcpy(out, env->normal, sizeof env->normal); break;
-    case IR_IN_POSITION:      memcpy(out, env->position, sizeof env->position); break;
-    case IR_IN_UV:            memcpy(out, env->uv, sizeof env->uv); break;
-    case IR_IN_VIEW_DISTANCE: out[0] = env->view_distance; break;
-    case IR_IN_DESTRUCTION:   out[0] = env->destruction; break;
-    case IR_IN_VIEW_DIRECTION:     /* any camera: a unit vector */
-        for (int c = 0; c < 3; c++)
-            out[c] = (ir_iv){-1.0, 1.0};
-        break;
-    default:                  assert(!"unknown input");
-    }
+    assert(which < IR_IN_COUNT);
+    const ir_input_info *in = ir_input_get((ir_input_kind)which);
+    int w = ir_type_width(in->type);
+    if (in->ienv_off < 0)
+        memcpy(out, in->domain, (size_t)w * sizeof *out);
+    else
+        memcpy(out, (const char *)env + in->ienv_off, (size_t)w * sizeof *out);
 }
 
 static void param_bounds(const ir *ir, const ir_ienv *env, uint32_t i, ir_iv *out)
@@ -72,7 +67,12 @@ static void bound_node(const ir *ir, uint32_t id, const ir_ienv *env, ir_iv (*va
     case IR_OP_PAINTED:
         out[0] = env->painted ? env->painted[n->imm] : (ir_iv){0, 1};
         return;
-    case IR_OP_SAMPLE: {
+    case IR_OP_DINPUT:        /* unbounded: the region has no derivatives */
+        for (int c = 0; c < 4; c++)
+            out[c] = (ir_iv){-INFINITY, INFINITY};
+        return;
+    case IR_OP_SAMPLE:
+    case IR_OP_SAMPLE_GRAD: {
         const ir_texture *t = &ir->textures[ir->nodes[n->arg[0].id].imm];
         for (int c = 0; c < 4; c++)
             out[c] = (ir_iv){t->lo, t->hi};

@@ -1,7 +1,9 @@
-/* ir_ops.c — THE op table: for every op of IR_OPS its .sg ports, type rule,
- * GLSL form, double-precision evaluation and interval evaluation, written
- * once, side by side.  ir_eval, ir_interval, opt_fold and the GLSL emitter
- * all read this table, so the three back ends cannot drift apart.
+/* ir_ops.c — the op and input tables: IR_OPS and IR_INPUTS (ir.h) expanded
+ * into rows, and the functions their rows name: each op's type rule,
+ * double-precision evaluation and interval evaluation, written once, side
+ * by side.  ir_eval, ir_interval, opt_fold, the GLSL emitter, the front
+ * end's type checker and the GPU-agreement harness all read these tables,
+ * so the back ends cannot drift apart.
  *
  * Semantics (the CPU reference; GLSL agrees up to float precision):
  *   min/max/clamp/saturate ignore a NaN operand (IEEE minNum/maxNum, what
@@ -22,11 +24,13 @@
  * a NaN operand returns full when an operand is full.
  */
 #include "ir.h"
+#include "util.h"
 
 #include <assert.h>
 #include <float.h>
 #include <math.h>
-#include <pthread.h>
+#include <stddef.h>
+#include <stdlib.h>
 #include <string.h>
 
 /* ---- type rules --------------------------------------------------------- */
@@ -70,6 +74,13 @@ static ir_type ty_construct(const ir_type *a, int n)
 static ir_type ty_sample(const ir_type *a, int n)
 {
     return n == 2 && a[0] == IR_T_TEX && a[1] == IR_T_VEC2 ? IR_T_VEC4 : IR_T_ERROR;
+}
+
+static ir_type ty_sample_grad(const ir_type *a, int n)
+{
+    return n == 4 && a[0] == IR_T_TEX && a[1] == IR_T_VEC2 && a[2] == IR_T_VEC2 &&
+                   a[3] == IR_T_VEC2
+               ? IR_T_VEC4 : IR_T_ERROR;
 }
 
 static ir_type ty_dot(const ir_type *a, int n)
@@ -326,6 +337,17 @@ static ir_iv periodic_bounds(ir_iv a, double (*f)(double), double peak)
     return iv(fmax(r.lo, -1), fmin(r.hi, 1));
 }
 
+/* log2: NaN below 0, -inf at 0 (the derivative pass's pow rule) */
+static double e_log2(const double *x) { return log2(x[0]); }
+static ir_iv  i_log2(const ir_iv *x)
+{
+    if (x[0].lo < 0)
+        return FULL;
+    if (x[0].lo == x[0].hi)
+        return iv_point(log2(x[0].lo));
+    return widen(iv(log2(x[0].lo), log2(x[0].hi)), 2, 0);   /* libm */
+}
+
 static double e_sin(const double *x) { return sin(x[0]); }
 static ir_iv  i_sin(const ir_iv *x)  { return periodic_bounds(x[0], sin, M_PI / 2); }
 
@@ -419,53 +441,21 @@ static ir_iv  i_select(const ir_iv *x)
     return hull(x[1], x[2]);                   /* a NaN condition selects a */
 }
 
-/* The componentwise ops, applied to each component. */
-typedef struct scalar_op {
-    double (*eval)(const double *x);   /* x[i]: operand i's component        */
-    ir_iv  (*iv)(const ir_iv *x);
-    bool   nan_in_nan_out;             /* a NaN operand gives a NaN result    */
-} scalar_op;
-
-static const scalar_op scalar_ops[IR_OP_COUNT] = {
-    [IR_OP_ADD]        = {e_add, i_add, true},
-    [IR_OP_SUB]        = {e_sub, i_sub, true},
-    [IR_OP_MUL]        = {e_mul, i_mul, true},
-    [IR_OP_DIV]        = {e_div, i_div, true},
-    [IR_OP_NEG]        = {e_neg, i_neg, true},
-    [IR_OP_MIN]        = {e_min, i_min, false},
-    [IR_OP_MAX]        = {e_max, i_max, false},
-    [IR_OP_ABS]        = {e_abs, i_abs, true},
-    [IR_OP_FLOOR]      = {e_floor, i_floor, true},
-    [IR_OP_FRACT]      = {e_fract, i_fract, true},
-    [IR_OP_MOD]        = {e_mod, i_mod, true},
-    [IR_OP_SQRT]       = {e_sqrt, i_sqrt, true},
-    [IR_OP_POW]        = {e_pow, i_pow, true},
-    [IR_OP_EXP2]       = {e_exp2, i_exp2, true},
-    [IR_OP_SIN]        = {e_sin, i_sin, true},
-    [IR_OP_COS]        = {e_cos, i_cos, true},
-    [IR_OP_MIX]        = {e_mix, i_mix, true},
-    [IR_OP_CLAMP]      = {e_clamp, i_clamp, false},
-    [IR_OP_SATURATE]   = {e_saturate, i_saturate, false},
-    [IR_OP_STEP]       = {e_step, i_step, false},
-    [IR_OP_SMOOTHSTEP] = {e_smoothstep, i_smoothstep, false},
-    [IR_OP_LESS]       = {e_less, i_less, false},
-    [IR_OP_SELECT]     = {e_select, i_select, false},
-};
-
 static void cw_eval(const ir_node *n, const ir_type *atype, const double *a, double out[4])
 {
-    const scalar_op *s = &scalar_ops[n->op];
+    const ir_opinfo *s = ir_opinfo_get((ir_op)n->op);
     for (int c = 0; c < ir_type_width((ir_type)n->type); c++) {
         double x[4];
         for (int i = 0; i < n->nargs; i++)
             x[i] = a[4 * i + c];
-        out[c] = s->eval(x);
+        out[c] = s->scalar_eval(x);
     }
 }
 
 static void cw_interval(const ir_node *n, const ir_type *atype, const ir_iv *a, ir_iv *out)
 {
-    const scalar_op *s = &scalar_ops[n->op];
+    const ir_opinfo *s = ir_opinfo_get((ir_op)n->op);
+    bool nan_in_nan_out = s->flags & IR_NAN_PROPAGATES;
     for (int c = 0; c < ir_type_width((ir_type)n->type); c++) {
         ir_iv x[4];
         bool nan = false;
@@ -473,7 +463,7 @@ static void cw_interval(const ir_node *n, const ir_type *atype, const ir_iv *a, 
             x[i] = a[4 * i + c];
             nan = nan || iv_full(x[i]);
         }
-        out[c] = nan && s->nan_in_nan_out ? FULL : s->iv(x);
+        out[c] = nan && nan_in_nan_out ? FULL : s->scalar_interval(x);
     }
 }
 
@@ -633,89 +623,397 @@ static void i_cross(const ir_node *n, const ir_type *atype, const ir_iv *a, ir_i
     out[2] = iv_sub(iv_mul(x[0], y[1]), iv_mul(x[1], y[0]));
 }
 
-/* ---- the table ---------------------------------------------------------- */
+/* ---- derivative rules (ir_differentiate.c) ------------------------------ */
 
-/* Name, arity and flags come from IR_OPS in ir.h (one source of truth);
- * the rest of each row is written here: ROW(id, ports, glsl, type rule,
- * eval, interval). */
-#define X(id, name, nargs, flags) enum { NARGS_##id = nargs, FLAGS_##id = flags };
-IR_OPS(X)
-#undef X
-#define X(id, name, nargs, flags) [IR_OP_##id] = name,
-static const char *const op_names[IR_OP_COUNT] = {IR_OPS(X)};
-#undef X
+/* Each returns the derivative of `self` (= *n) along c->axis from its
+ * operands n->arg[i] and their derivatives d[i] (IR_NONE = 0), or IR_NONE.
+ * They follow the double semantics above: min/max/abs/clamp/saturate take
+ * the derivative of the operand they return, step/less/floor are 0, a
+ * select differentiates the side it takes. */
 
-#define CW cw_eval, cw_interval
-#define P1 PORTS("x")
-#define P2 PORTS("a", "b")
-#define PORTS(...) {__VA_ARGS__}
+#define A(i) (n->arg[i])
+#define T    ((ir_type)n->type)
 
-static const ir_opinfo op_rows[IR_OP_COUNT] = {
-    /* leaves: the evaluators and the emitter read them from their env */
-    [IR_OP_CONST]     = {NULL, {0}, NARGS_CONST, FLAGS_CONST, "<literal>", ty_leaf},
-    [IR_OP_INPUT]     = {NULL, {0}, NARGS_INPUT, FLAGS_INPUT, "splat_<input>()", ty_leaf},
-    [IR_OP_PARAM]     = {NULL, {0}, NARGS_PARAM, FLAGS_PARAM, "<names.param[i]>", ty_leaf},
-    [IR_OP_TEXTURE]   = {NULL, {0}, NARGS_TEXTURE, FLAGS_TEXTURE, "<names.texture[i]>", ty_leaf},
-    [IR_OP_PAINTED]   = {NULL, {0}, NARGS_PAINTED, FLAGS_PAINTED, "<names.painted[i]>", ty_leaf},
-#define ROW(id, ports, ...) [IR_OP_##id] = {NULL, ports, NARGS_##id, FLAGS_##id, __VA_ARGS__}
-    ROW(SPLAT,      P1, "vecN($0)", ty_splat, e_splat, i_splat),
-    ROW(SWIZZLE,    P1, "$0.<xyzw>", ty_swizzle, e_swizzle, i_swizzle),
-    ROW(CONSTRUCT,  PORTS("x", "y", "z", "w"), "vecN($0, ...)", ty_construct, e_construct, i_construct),
-    ROW(SAMPLE,     PORTS("tex", "uv"), "texture($0, $1)", ty_sample),
-    ROW(ADD,        P2, "$0 + $1", ty_same, CW),
-    ROW(SUB,        P2, "$0 - $1", ty_same, CW),
-    ROW(MUL,        P2, "$0 * $1", ty_same, CW),
-    ROW(DIV,        P2, "$0 / $1", ty_same, CW),
-    ROW(NEG,        P1, "-($0)", ty_same, CW),
-    ROW(MIN,        P2, "min($0, $1)", ty_same, CW),
-    ROW(MAX,        P2, "max($0, $1)", ty_same, CW),
-    ROW(ABS,        P1, "abs($0)", ty_same, CW),
-    ROW(FLOOR,      P1, "floor($0)", ty_same, CW),
-    ROW(FRACT,      P1, "fract($0)", ty_same, CW),
-    ROW(MOD,        PORTS("x", "y"), "mod($0, $1)", ty_same, CW),
-    ROW(SQRT,       P1, "sqrt($0)", ty_same, CW),
-    ROW(POW,        PORTS("x", "y"), "pow($0, $1)", ty_same, CW),
-    ROW(EXP2,       P1, "exp2($0)", ty_same, CW),
-    ROW(SIN,        P1, "sin($0)", ty_same, CW),
-    ROW(COS,        P1, "cos($0)", ty_same, CW),
-    ROW(MIX,        PORTS("a", "b", "t"), "mix($0, $1, $2)", ty_same, CW),
-    ROW(CLAMP,      PORTS("x", "lo", "hi"), "clamp($0, $1, $2)", ty_same, CW),
-    ROW(SATURATE,   P1, "clamp($0, 0.0, 1.0)", ty_same, CW),
-    ROW(STEP,       PORTS("edge", "x"), "step($0, $1)", ty_same, CW),
-    ROW(SMOOTHSTEP, PORTS("e0", "e1", "x"), "smoothstep($0, $1, $2)", ty_same, CW),
-    /* float forms; the emitter writes lessThan / a bvec mix for vectors */
-    ROW(LESS,       P2, "float($0 < $1)", ty_same, CW),
-    ROW(SELECT,     PORTS("c", "a", "b"), "($0 != 0.0 ? $1 : $2)", ty_same, CW),
-    ROW(DOT,        P2, "dot($0, $1)", ty_dot, e_dot, i_dot),
-    ROW(LENGTH,     P1, "length($0)", ty_length, e_length, i_length),
-    ROW(NORMALIZE,  P1, "normalize($0)", ty_same, e_normalize, i_normalize),
-    ROW(CROSS,      P2, "cross($0, $1)", ty_cross, e_cross, i_cross),
-#undef ROW
-};
-
-static ir_opinfo op_table[IR_OP_COUNT];
-static pthread_once_t op_table_once = PTHREAD_ONCE_INIT;
-
-static void op_table_init(void)
+/* An input moves where its row has a derivative accessor (IR_INPUTS'
+ * dglsl column); normal, slope and destruction are taken as 0. */
+static ir_ref d_input(ir_dctx *c, const ir_node *n, ir_ref self, const ir_ref *d)
 {
-    for (int op = 0; op < IR_OP_COUNT; op++) {
-        op_table[op] = op_rows[op];
-        op_table[op].name = op_names[op];
-        assert(op_table[op].type && op_table[op].glsl);
-    }
+    if (!ir_input_get((ir_input_kind)n->imm)->dglsl)
+        return IR_NONE;
+    ir_node l = {.op = IR_OP_DINPUT, .type = n->type, .imm = IR_DINPUT_IMM(n->imm, c->axis)};
+    return ir_node_add(c->ir, &l);
 }
+
+/* The op itself over the derivatives (linear ops: splat, swizzle,
+ * construct, neg; zeros written out where some operand moves). */
+static ir_ref d_linear(ir_dctx *c, const ir_node *n, ir_ref self, const ir_ref *d)
+{
+    ir_node m = *n;
+    for (int i = 0; i < n->nargs; i++)
+        m.arg[i] = ir_d_zero(c, d[i], ir_typeof(c->ir, n->arg[i]));
+    return ir_node_add(c->ir, &m);
+}
+
+static ir_ref d_add(ir_dctx *c, const ir_node *n, ir_ref self, const ir_ref *d)
+{
+    return ir_d_add(c, d[0], d[1]);
+}
+
+static ir_ref d_sub(ir_dctx *c, const ir_node *n, ir_ref self, const ir_ref *d)
+{
+    return ir_d_sub(c, d[0], d[1]);
+}
+
+static ir_ref d_mul(ir_dctx *c, const ir_node *n, ir_ref self, const ir_ref *d)
+{
+    return ir_d_add(c, ir_d_mul(c, d[0], A(1)), ir_d_mul(c, A(0), d[1]));
+}
+
+/* (a / b)' = (a' - q b') / b */
+static ir_ref d_div(ir_dctx *c, const ir_node *n, ir_ref self, const ir_ref *d)
+{
+    return ir_d_div(c, ir_d_sub(c, d[0], ir_d_mul(c, self, d[1])), A(1));
+}
+
+/* select(cond, a', b') with zeros written out; NONE if both are zero */
+static ir_ref pick(ir_dctx *c, ir_ref cond, ir_ref da, ir_ref db, ir_type t)
+{
+    if (!ir_ref_ok(da) && !ir_ref_ok(db))
+        return IR_NONE;
+    return ir_op3(c->ir, IR_OP_SELECT, cond, ir_d_zero(c, da, t), ir_d_zero(c, db, t));
+}
+
+/* fmin(a, b) is a where a < b, else b; fmax(a, b) a where b < a */
+static ir_ref min_rule(ir_dctx *c, ir_ref a, ir_ref b, ir_ref da, ir_ref db, ir_type t)
+{
+    return pick(c, ir_op2(c->ir, IR_OP_LESS, a, b), da, db, t);
+}
+
+static ir_ref max_rule(ir_dctx *c, ir_ref a, ir_ref b, ir_ref da, ir_ref db, ir_type t)
+{
+    return pick(c, ir_op2(c->ir, IR_OP_LESS, b, a), da, db, t);
+}
+
+static ir_ref d_min(ir_dctx *c, const ir_node *n, ir_ref self, const ir_ref *d)
+{
+    return min_rule(c, A(0), A(1), d[0], d[1], T);
+}
+
+static ir_ref d_max(ir_dctx *c, const ir_node *n, ir_ref self, const ir_ref *d)
+{
+    return max_rule(c, A(0), A(1), d[0], d[1], T);
+}
+
+static ir_ref d_abs(ir_dctx *c, const ir_node *n, ir_ref self, const ir_ref *d)
+{
+    ir_ref neg = ir_op2(c->ir, IR_OP_LESS, A(0), ir_d_num(c, T, 0.0));
+    return pick(c, neg, ir_op1(c->ir, IR_OP_NEG, d[0]), d[0], T);
+}
+
+static ir_ref d_fract(ir_dctx *c, const ir_node *n, ir_ref self, const ir_ref *d)
+{
+    return d[0];
+}
+
+/* mod(x, y) = x - y floor(x / y) */
+static ir_ref d_mod(ir_dctx *c, const ir_node *n, ir_ref self, const ir_ref *d)
+{
+    ir_ref k = ir_op1(c->ir, IR_OP_FLOOR, ir_op2(c->ir, IR_OP_DIV, A(0), A(1)));
+    return ir_d_sub(c, d[0], ir_d_mul(c, k, d[1]));
+}
+
+/* `e` where the operand's derivative d is not 0, else 0: for rules whose
+ * partial is infinite where it does not move (sqrt(0), pow(0, 0.5)'s,
+ * log2(0), length(0)): a clamped sqrt(saturate(x)) must read 0, not 0 * inf. */
+static ir_ref guarded(ir_dctx *c, ir_ref cond, ir_ref e)
+{
+    if (!ir_ref_ok(e))
+        return e;
+    ir_type t = ir_typeof(c->ir, e);
+    if (ir_typeof(c->ir, cond) != t)
+        cond = ir_splat(c->ir, cond, t);
+    return ir_op3(c->ir, IR_OP_SELECT, cond, e, ir_d_num(c, t, 0.0));
+}
+
+static ir_ref d_sqrt(ir_dctx *c, const ir_node *n, ir_ref self, const ir_ref *d)
+{
+    return guarded(c, d[0], ir_d_div(c, ir_d_mul(c, d[0], ir_d_num(c, T, 0.5)), self));
+}
+
+/* pow(x, y)' = y pow(x, y - 1) x' + pow(x, y) ln(x) y' */
+static ir_ref d_pow(ir_dctx *c, const ir_node *n, ir_ref self, const ir_ref *d)
+{
+    ir_ref dx = IR_NONE, dy = IR_NONE;
+    if (ir_ref_ok(d[0])) {
+        ir_ref ym1 = ir_op2(c->ir, IR_OP_SUB, A(1), ir_d_num(c, T, 1.0));
+        ir_ref k = ir_op2(c->ir, IR_OP_MUL, A(1), ir_op2(c->ir, IR_OP_POW, A(0), ym1));
+        dx = guarded(c, d[0], ir_d_mul(c, k, d[0]));
+    }
+    if (ir_ref_ok(d[1])) {
+        ir_ref ln = ir_op2(c->ir, IR_OP_MUL, ir_op1(c->ir, IR_OP_LOG2, A(0)),
+                           ir_d_num(c, T, M_LN2));
+        /* 0 where the power is 0 (x = 0: 0 * ln 0) */
+        dy = guarded(c, self, guarded(c, d[1], ir_d_mul(c, ir_op2(c->ir, IR_OP_MUL, self, ln),
+                                                        d[1])));
+    }
+    return ir_d_add(c, dx, dy);
+}
+
+static ir_ref d_exp2(ir_dctx *c, const ir_node *n, ir_ref self, const ir_ref *d)
+{
+    return ir_d_mul(c, ir_op2(c->ir, IR_OP_MUL, self, ir_d_num(c, T, M_LN2)), d[0]);
+}
+
+static ir_ref d_log2(ir_dctx *c, const ir_node *n, ir_ref self, const ir_ref *d)
+{
+    return guarded(c, d[0],
+                   ir_d_div(c, d[0], ir_op2(c->ir, IR_OP_MUL, A(0), ir_d_num(c, T, M_LN2))));
+}
+
+static ir_ref d_sin(ir_dctx *c, const ir_node *n, ir_ref self, const ir_ref *d)
+{
+    return ir_d_mul(c, ir_op1(c->ir, IR_OP_COS, A(0)), d[0]);
+}
+
+static ir_ref d_cos(ir_dctx *c, const ir_node *n, ir_ref self, const ir_ref *d)
+{
+    return ir_d_mul(c, ir_op1(c->ir, IR_OP_NEG, ir_op1(c->ir, IR_OP_SIN, A(0))), d[0]);
+}
+
+/* mix(a, b, t)' = mix(a', b', t) + (b - a) t' */
+static ir_ref d_mix(ir_dctx *c, const ir_node *n, ir_ref self, const ir_ref *d)
+{
+    ir_ref ab = IR_NONE;
+    if (ir_ref_ok(d[0]) || ir_ref_ok(d[1]))
+        ab = ir_op3(c->ir, IR_OP_MIX, ir_d_zero(c, d[0], T), ir_d_zero(c, d[1], T), A(2));
+    return ir_d_add(c, ab, ir_d_mul(c, ir_op2(c->ir, IR_OP_SUB, A(1), A(0)), d[2]));
+}
+
+/* clamp(x, lo, hi) = fmin(fmax(x, lo), hi) */
+static ir_ref d_clamp(ir_dctx *c, const ir_node *n, ir_ref self, const ir_ref *d)
+{
+    ir_ref m = ir_op2(c->ir, IR_OP_MAX, A(0), A(1));
+    ir_ref dm = max_rule(c, A(0), A(1), d[0], d[1], T);
+    return min_rule(c, m, A(2), dm, d[2], T);
+}
+
+/* x' inside [0, 1], 0 outside */
+static ir_ref d_saturate(ir_dctx *c, const ir_node *n, ir_ref self, const ir_ref *d)
+{
+    ir_ref zero = ir_d_num(c, T, 0.0), one = ir_d_num(c, T, 1.0);
+    ir_ref inner = pick(c, ir_op2(c->ir, IR_OP_LESS, one, A(0)), zero, d[0], T);
+    return pick(c, ir_op2(c->ir, IR_OP_LESS, A(0), zero), zero, inner, T);
+}
+
+/* t = clamp((x - e0) / (e1 - e0), 0, 1), t^2 (3 - 2t)' = 6 t (1 - t) q'
+ * with q the unclamped ratio (6 t (1 - t) is 0 where the clamp holds) */
+static ir_ref d_smoothstep(ir_dctx *c, const ir_node *n, ir_ref self, const ir_ref *d)
+{
+    ir *ir = c->ir;
+    ir_ref num = ir_op2(ir, IR_OP_SUB, A(2), A(0)), den = ir_op2(ir, IR_OP_SUB, A(1), A(0));
+    ir_ref q = ir_op2(ir, IR_OP_DIV, num, den);
+    ir_ref dq = ir_d_div(c, ir_d_sub(c, ir_d_sub(c, d[2], d[0]),
+                                     ir_d_mul(c, q, ir_d_sub(c, d[1], d[0]))), den);
+    ir_ref t = ir_op1(ir, IR_OP_SATURATE, q);
+    ir_ref k = ir_op2(ir, IR_OP_MUL, ir_d_num(c, T, 6.0),
+                      ir_op2(ir, IR_OP_MUL, t, ir_op2(ir, IR_OP_SUB, ir_d_num(c, T, 1.0), t)));
+    return guarded(c, k, ir_d_mul(c, k, dq));   /* clamped: 0, even if e0 == e1 */
+}
+
+static ir_ref d_select(ir_dctx *c, const ir_node *n, ir_ref self, const ir_ref *d)
+{
+    return pick(c, A(0), d[1], d[2], T);
+}
+
+static ir_ref d_dot(ir_dctx *c, const ir_node *n, ir_ref self, const ir_ref *d)
+{
+    ir_ref a = ir_ref_ok(d[0]) ? ir_op2(c->ir, IR_OP_DOT, d[0], A(1)) : IR_NONE;
+    ir_ref b = ir_ref_ok(d[1]) ? ir_op2(c->ir, IR_OP_DOT, A(0), d[1]) : IR_NONE;
+    return ir_d_add(c, a, b);
+}
+
+/* |a|' = (a . a') / |a| */
+static ir_ref d_length(ir_dctx *c, const ir_node *n, ir_ref self, const ir_ref *d)
+{
+    return guarded(c, ir_op2(c->ir, IR_OP_DOT, d[0], d[0]),
+                   ir_d_div(c, ir_op2(c->ir, IR_OP_DOT, A(0), d[0]), self));
+}
+
+/* (a / |a|)' = (a' - u (u . a')) / |a|, u = the result */
+static ir_ref d_normalize(ir_dctx *c, const ir_node *n, ir_ref self, const ir_ref *d)
+{
+    ir_ref along = ir_d_mul(c, self, ir_op2(c->ir, IR_OP_DOT, self, d[0]));
+    return ir_d_div(c, ir_d_sub(c, d[0], along), ir_op1(c->ir, IR_OP_LENGTH, A(0)));
+}
+
+static ir_ref d_cross(ir_dctx *c, const ir_node *n, ir_ref self, const ir_ref *d)
+{
+    ir_ref a = ir_ref_ok(d[0]) ? ir_op2(c->ir, IR_OP_CROSS, d[0], A(1)) : IR_NONE;
+    ir_ref b = ir_ref_ok(d[1]) ? ir_op2(c->ir, IR_OP_CROSS, A(0), d[1]) : IR_NONE;
+    return ir_d_add(c, a, b);
+}
+
+/* A texture-space finite difference over the uv's step to the next pixel
+ * (what a quad's dFdx of the sampled value is): sample(uv + uv') -
+ * sample(uv), the extra sample taking the same gradients (SAMPLE_GRAD). */
+static ir_ref d_sample(ir_dctx *c, const ir_node *n, ir_ref self, const ir_ref *d)
+{
+    if (!ir_ref_ok(d[1]))
+        return IR_NONE;
+    ir_node m = *n;
+    m.arg[1] = ir_op2(c->ir, IR_OP_ADD, A(1), d[1]);
+    return ir_op2(c->ir, IR_OP_SUB, ir_node_add(c->ir, &m), self);
+}
+
+#undef A
+#undef T
+
+/* ---- sampler names ------------------------------------------------------- */
+
+static const char *const filter_names[] = {
+#define X(id, name) name,
+    IR_FILTERS(X)
+#undef X
+};
+static const char *const wrap_names[] = {
+#define X(id, name) name,
+    IR_WRAPS(X)
+#undef X
+};
+enum { NFILTERS = sizeof filter_names / sizeof *filter_names,
+       NWRAPS = sizeof wrap_names / sizeof *wrap_names };
+
+const char *ir_filter_name(ir_filter f) { return (unsigned)f < NFILTERS ? filter_names[f] : "?"; }
+const char *ir_wrap_name(ir_wrap w) { return (unsigned)w < NWRAPS ? wrap_names[w] : "?"; }
+
+int ir_filter_by_name(const char *name)
+{
+    for (int i = 0; i < NFILTERS; i++)
+        if (!strcmp(filter_names[i], name))
+            return i;
+    return -1;
+}
+
+int ir_wrap_by_name(const char *name)
+{
+    for (int i = 0; i < NWRAPS; i++)
+        if (!strcmp(wrap_names[i], name))
+            return i;
+    return -1;
+}
+
+/* ---- the tables ---------------------------------------------------------- */
+
+/* IR_OPS (ir.h) expanded into ir_opinfo rows.  The columns' shorthands: */
+#define NOPORTS {0}
+#define P1 {"x"}
+#define P2 {"a", "b"}
+#define PORTS(...) {__VA_ARGS__}
+#define ENV NULL, NULL, NULL, NULL
+#define CW(f) cw_eval, cw_interval, e_##f, i_##f
+#define NODE(f) e_##f, i_##f, NULL, NULL
+#define D(f) d_##f
+#define D0 NULL
+
+static const ir_opinfo op_table[IR_OP_COUNT] = {
+#define X(id, name, nargs, flags, ports, glsl, type, sem, fin, fp32, cost, deriv) \
+    [IR_OP_##id] = {name, ports, nargs, flags, glsl, type, sem, fin, IR_FP32_##fp32, cost, \
+                    deriv /* new columns here */},
+    IR_OPS(X)
+#undef X
+};
 
 const ir_opinfo *ir_opinfo_get(ir_op op)
 {
     assert((unsigned)op < IR_OP_COUNT);
-    pthread_once(&op_table_once, op_table_init);
     return &op_table[op];
+}
+
+int ir_node_cost(const ir *ir, ir_ref r)
+{
+    const ir_node *n = ir_get(ir, r);
+    int w = ir_type_width((ir_type)n->type);
+    for (int i = 0; i < n->nargs; i++) {
+        int aw = ir_type_width(ir_typeof(ir, n->arg[i]));
+        w = aw > w ? aw : w;
+    }
+    return op_table[n->op].cost * w;
+}
+
+long ir_cost(const ir *ir, const ir_ref *roots, int nroots)
+{
+    /* Ids are topological: mark what the roots reach, top down. */
+    bool *live = xcalloc(ir->nnodes, sizeof *live);
+    for (int i = 0; i < nroots; i++)
+        live[roots[i].id] = ir_ref_ok(roots[i]);
+    long total = 0;
+    for (uint32_t id = ir->nnodes; id-- > 1;) {
+        if (!live[id])
+            continue;
+        const ir_node *n = &ir->nodes[id];
+        for (int a = 0; a < n->nargs; a++)
+            live[n->arg[a].id] = true;
+        total += ir_node_cost(ir, (ir_ref){id});
+    }
+    free(live);
+    return total;
+}
+
+/* The domains named by IR_INPUTS' domain column, per component. */
+#define DOM_ALL    {{-INFINITY, INFINITY}, {-INFINITY, INFINITY}, {-INFINITY, INFINITY}}
+#define DOM_UNIT   {{0, 1}, {0, 1}, {0, 1}}
+#define DOM_SIGNED {{-1, 1}, {-1, 1}, {-1, 1}}
+#define DOM_NORMAL {{-1, 1}, {0, 1}, {-1, 1}}   /* an up-facing unit normal */
+#define DOM_DIST   {{0, INFINITY}}
+#define IV(field) (long)offsetof(ir_ienv, field)
+#define IV_NONE   -1L
+
+static const ir_input_info input_table[IR_IN_COUNT] = {
+#define X(id, name, type, glsl, key, ev, iv, domain, hoist, dglsl) \
+    [IR_IN_##id] = {name, glsl, key, type, offsetof(ir_env, ev), iv, DOM_##domain, hoist, \
+                    "in_" #ev, dglsl},
+    IR_INPUTS(X)
+#undef X
+};
+
+const ir_input_info *ir_input_get(ir_input_kind which)
+{
+    assert((unsigned)which < IR_IN_COUNT);
+    return &input_table[which];
+}
+
+int ir_input_by_name(const char *name)
+{
+    for (int i = 0; i < IR_IN_COUNT; i++)
+        if (!strcmp(input_table[i].name, name))
+            return i;
+    return -1;
+}
+
+double *ir_env_slot(ir_env *env, ir_input_kind which)
+{
+    return (double *)((char *)env + ir_input_get(which)->env_off);
+}
+
+ir_iv *ir_ienv_slot(ir_ienv *ienv, ir_input_kind which)
+{
+    long off = ir_input_get(which)->ienv_off;
+    return off < 0 ? NULL : (ir_iv *)((char *)ienv + off);
+}
+
+void ir_ienv_domain(ir_ienv *ienv)
+{
+    for (int k = 0; k < IR_IN_COUNT; k++) {
+        ir_iv *slot = ir_ienv_slot(ienv, (ir_input_kind)k);
+        for (int c = 0; slot && c < ir_type_width(input_table[k].type); c++)
+            slot[c] = input_table[k].domain[c];
+    }
 }
 
 int ir_op_by_name(const char *name)
 {
     for (int op = 0; op < IR_OP_COUNT; op++)
-        if (op_names[op] && strcmp(op_names[op], name) == 0)
+        if (op_table[op].name && strcmp(op_table[op].name, name) == 0)
             return op;
     return -1;
 }

@@ -33,12 +33,6 @@ static void fail(vstate *st, const char *cond, const char *file, int line)
             fail((st), #cond, __FILE__, __LINE__);          \
     } while (0)
 
-static const ir_type input_type[IR_IN_COUNT] = {
-#define X(id, name, type) type,
-    IR_INPUTS(X)
-#undef X
-};
-
 static void validate_leaf(vstate *st, const ir *ir, const ir_node *n)
 {
     ir_type t = (ir_type)n->type;
@@ -51,7 +45,7 @@ static void validate_leaf(vstate *st, const ir *ir, const ir_node *n)
     case IR_OP_INPUT:
         VALIDATE(st, n->imm < IR_IN_COUNT);
         if (n->imm < IR_IN_COUNT)
-            VALIDATE(st, t == input_type[n->imm]);
+            VALIDATE(st, t == ir_input_get((ir_input_kind)n->imm)->type);
         break;
     case IR_OP_PARAM:
         VALIDATE(st, (int)n->imm < ir->nparams);
@@ -66,6 +60,13 @@ static void validate_leaf(vstate *st, const ir *ir, const ir_node *n)
         VALIDATE(st, (int)n->imm < ir->npainted);
         VALIDATE(st, t == IR_T_FLOAT);
         break;
+    case IR_OP_DINPUT: {
+        int in = IR_DINPUT_INPUT(n->imm);
+        VALIDATE(st, in < IR_IN_COUNT && IR_DINPUT_AXIS(n->imm) < 2);
+        if (in < IR_IN_COUNT)
+            VALIDATE(st, t == ir_input_get((ir_input_kind)in)->type);
+        break;
+    }
     }
 }
 
@@ -105,7 +106,7 @@ static void validate_op(vstate *st, const ir *ir, uint32_t id, const ir_node *n)
     }
     if (info->flags & IR_COMMUTATIVE)
         VALIDATE(st, n->arg[0].id <= n->arg[1].id);
-    if (n->op == IR_OP_SAMPLE)
+    if (n->op == IR_OP_SAMPLE || n->op == IR_OP_SAMPLE_GRAD)
         VALIDATE(st, ir_get(ir, n->arg[0])->op == IR_OP_TEXTURE);
     for (int c = 0; c < 4; c++)
         VALIDATE(st, n->val[c] == 0.0);
@@ -128,7 +129,7 @@ bool ir_validate(const ir *ir, FILE *out)
         VALIDATE(&st, n->pad == 0);
         for (int i = n->nargs; i < 4; i++)
             VALIDATE(&st, n->arg[i].id == 0);
-        if (n->op <= IR_OP_PAINTED) {
+        if (n->op <= IR_OP_PAINTED || n->op == IR_OP_DINPUT) {
             VALIDATE(&st, n->nargs == 0);
             validate_leaf(&st, ir, n);
         } else {

@@ -11,6 +11,7 @@
  * BAD_LITERAL each rather than a confusing run of tokens.  A run of
  * unexpected bytes (binary garbage) is one BAD_CHAR.  Linear time. */
 #include "sg_internal.h"
+#include "util.h"
 
 #include <ctype.h>
 #include <errno.h>
@@ -86,9 +87,7 @@ static const char *bad_number(const char *s, int n, double *val)
         buf[n] = 0;
         text = buf;
     } else {
-        heap = malloc((size_t)n + 1);
-        if (!heap)
-            abort();
+        heap = xmalloc((size_t)n + 1);
         memcpy(heap, s, (size_t)n);
         heap[n] = 0;
         text = heap;

@@ -25,6 +25,7 @@
  *     node n5 : saturate { x = n4.out }    out m.mask = n5.out
  */
 #include "sg_internal.h"
+#include "util.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -83,9 +84,7 @@ static void memo_insert(lowerer *L, int shader, const ir_ref *ins, int nin,
         memo_entry *old = L->memo;
         uint32_t oldcap = L->capmemo;
         L->capmemo = oldcap ? oldcap * 2 : 64;
-        L->memo = malloc(L->capmemo * sizeof *L->memo);
-        if (!L->memo)
-            abort();
+        L->memo = xmalloc(L->capmemo * sizeof *L->memo);
         for (uint32_t i = 0; i < L->capmemo; i++)
             L->memo[i].shader = -1;
         for (uint32_t i = 0; i < oldcap; i++)
@@ -136,9 +135,7 @@ static void lowerer_init(lowerer *L, sg_program *p, ir *ir, sg_diags *d)
     L->p = p;
     L->ir = ir;
     L->d = d;
-    L->tex_ids = malloc(((size_t)p->ntextures + 1) * sizeof *L->tex_ids);
-    if (!L->tex_ids)
-        abort();
+    L->tex_ids = xmalloc(((size_t)p->ntextures + 1) * sizeof *L->tex_ids);
     for (int i = 0; i < p->ntextures; i++)
         L->tex_ids[i] = -1;
 }
@@ -162,7 +159,7 @@ static ir_ref texture_ref(lowerer *L, const sg_texdecl *t)
  * state, the file relative to the graph file that names it. */
 static ir_ref inline_texture(lowerer *L, const sg_shader *s, const char *file)
 {
-    char *path = sg_path_join(L->p->files[s->file]->dir, file);
+    char *path = splat_path_join(L->p->files[s->file]->dir, file);
     int idx = sg_map_get(&L->inline_tex, path);
     if (idx >= 0) {
         free(path);
@@ -174,9 +171,7 @@ static ir_ref inline_texture(lowerer *L, const sg_shader *s, const char *file)
     ir_ref r = texture_ref(L, &t);
     if (L->ninline_keys == L->capinline_keys) {
         L->capinline_keys = L->capinline_keys ? 2 * L->capinline_keys : 8;
-        L->inline_keys = realloc(L->inline_keys, (size_t)L->capinline_keys * sizeof *L->inline_keys);
-        if (!L->inline_keys)
-            abort();
+        L->inline_keys = xrealloc(L->inline_keys, (size_t)L->capinline_keys * sizeof *L->inline_keys);
     }
     L->inline_keys[L->ninline_keys++] = path;
     sg_map_put(&L->inline_tex, path, (int)ir_get(L->ir, r)->imm);
@@ -283,18 +278,14 @@ static bool inline_shader(lowerer *L, int si, const ir_ref *ins, ir_ref *outs,
             memcpy(outs, m->outs, (size_t)s->nouts * sizeof *outs);
         return true;
     }
-    int *off = malloc(((size_t)s->nnodes + 1) * sizeof *off);
-    if (!off)
-        abort();
+    int *off = xmalloc(((size_t)s->nnodes + 1) * sizeof *off);
     int total = 0;
     for (int i = 0; i < s->nnodes; i++) {
         off[i] = total;
         const sg_node *n = &s->nodes[i];
         total += n->kind == SG_NODE_INSTANCE ? L->p->shaders[n->shader]->nouts : 1;
     }
-    ir_ref *vals = calloc((size_t)total + 1, sizeof *vals);
-    if (!vals)
-        abort();
+    ir_ref *vals = xcalloc((size_t)total + 1, sizeof *vals);
     frame f = { s, ins, vals, off };
     bool ok = true;
     for (int k = 0; k < s->norder && ok; k++) {
@@ -318,9 +309,7 @@ static bool inline_shader(lowerer *L, int si, const ir_ref *ins, ir_ref *outs,
         }
         case SG_NODE_INSTANCE: {
             const sg_shader *callee = L->p->shaders[n->shader];
-            ir_ref *cin = malloc(((size_t)callee->nins + 1) * sizeof *cin);
-            if (!cin)
-                abort();
+            ir_ref *cin = xmalloc(((size_t)callee->nins + 1) * sizeof *cin);
             instance_inputs(L, &f, n, cin);
             ok = inline_shader(L, n->shader, cin, out, depth + 1, n->loc);
             free(cin);
@@ -377,15 +366,11 @@ bool sg_lower_material(sg_program *p, const char *name, ir *out, sg_diags *d)
 
     lowerer L;
     lowerer_init(&L, p, out, d);
-    L.param_ids = malloc(((size_t)s->nparams + 1) * sizeof *L.param_ids);
-    if (!L.param_ids)
-        abort();
+    L.param_ids = xmalloc(((size_t)s->nparams + 1) * sizeof *L.param_ids);
     for (int i = 0; i < s->nparams; i++) {
         const sg_port *pp = &s->params[i];
         size_t n = strlen(name) + strlen(pp->name) + 2;
-        char *qname = malloc(n);
-        if (!qname)
-            abort();
+        char *qname = xmalloc(n);
         snprintf(qname, n, "%s.%s", name, pp->name);
         ir_param param = { .name = qname, .type = pp->type };
         int w = ir_type_width(pp->type);
@@ -397,9 +382,7 @@ bool sg_lower_material(sg_program *p, const char *name, ir *out, sg_diags *d)
         free(qname);
     }
     ir_ref outs_ref[SG_OUT_COUNT];
-    ir_ref *vals = malloc(((size_t)s->nouts + 1) * sizeof *vals);
-    if (!vals)
-        abort();
+    ir_ref *vals = xmalloc(((size_t)s->nouts + 1) * sizeof *vals);
     bool ok = inline_shader(&L, si, NULL, vals, 1, s->loc);
     if (ok) {
         double grey[4] = { 0.5, 0.5, 0.5, 0 };
@@ -412,9 +395,7 @@ bool sg_lower_material(sg_program *p, const char *name, ir *out, sg_diags *d)
             outs_ref[s->outs[i].output] = vals[i];
         for (int k = 0; k < SG_OUT_COUNT; k++) {
             size_t n = strlen(name) + strlen(sg_output_names[k]) + 2;
-            char *rname = malloc(n);
-            if (!rname)
-                abort();
+            char *rname = xmalloc(n);
             snprintf(rname, n, "%s.%s", name, sg_output_names[k]);
             ir_set_root(out, rname, outs_ref[k]);
             free(rname);
@@ -477,9 +458,7 @@ bool sg_lower_shader(sg_program *p, const char *name, ir *out,
             }
             ins[j] = coerce(&L, lower_value(&L, &cf, &s->ins[j].value), s->ins[j].type);
         }
-    int *out_idx = malloc(((size_t)nout + 1) * sizeof *out_idx);
-    if (!out_idx)
-        abort();
+    int *out_idx = xmalloc(((size_t)nout + 1) * sizeof *out_idx);
     for (int i = 0; i < nout; i++) {
         out_idx[i] = -1;
         for (int j = 0; j < s->nouts; j++)

@@ -1,8 +1,9 @@
 /* main.c — the splatc command line.
  *
  *   splatc check FILE...                       parse and type-check
- *   splatc glsl  FILE -m MAT [-o OUT.frag]     fragment shader of one material
- *   splatc spirv FILE -m MAT -o OUT.spv        the same, compiled and validated
+ *   splatc glsl  FILE -m MAT [-o OUT.frag] [--stage fragment|compute]
+ *                                              shader of one material
+ *   splatc spirv FILE -m MAT -o OUT.spv [--stage …]  the same, compiled and validated
  *   splatc dot   FILE [-m MAT] [-o OUT.dot]    Graphviz of the graphs
  *   splatc dump  FILE -m MAT [--after PASS]    the IR in .sg form
  *   splatc eval  FILE -m MAT [--output NAME] [--interval] --at KEY=V,...
@@ -21,6 +22,7 @@
 #include "shader.h"
 #include "spv.h"
 #include "texgen.h"
+#include "util.h"
 
 #include <errno.h>
 #include <math.h>
@@ -37,6 +39,8 @@ static const char usage_text[] =
     "  check FILE...                      parse and type-check graph files\n"
     "  glsl  FILE -m MATERIAL [-o OUT]    Vulkan GLSL 450 fragment shader of a material\n"
     "  spirv FILE -m MATERIAL -o OUT.spv  the same compiled to SPIR-V and validated\n"
+    "        --stage fragment|compute     (glsl, spirv) the fragment shader (default) or\n"
+    "                                     the compute variant (screen-space shading)\n"
     "  dot   FILE [-m MATERIAL] [-o OUT]  Graphviz DOT of the graphs (dot -Tsvg draws it)\n"
     "  dump  FILE -m MATERIAL [--after PASS]\n"
     "                                     the material's IR in .sg form, after the whole\n"
@@ -76,6 +80,7 @@ typedef struct options {
     const char  *after;
     const char  *output;
     const char  *at;
+    const char  *stage;   /* --stage fragment|compute (glsl, spirv) */
     bool         interval;
     const char **include; int ninclude;
 } options;
@@ -102,6 +107,8 @@ static int parse_options(int argc, char **argv, const char *allowed, options *o)
             slot = &o->output;
         else if (!strcmp(a, "--at") && strstr(allowed, "@"))
             slot = &o->at;
+        else if (!strcmp(a, "--stage") && strstr(allowed, "S"))
+            slot = &o->stage;
         else if (!strcmp(a, "-I")) {
             if (!val)
                 return usage_error("option '%s' needs a value", a);
@@ -187,14 +194,6 @@ static int load_material(const options *o, const char *cmd, ir *ir, sg_program *
 
 /* ---- output ------------------------------------------------------------------ */
 
-/* mkstemp makes 0600 files; give outputs the usual 0666 & ~umask. */
-static int chmod_default(const char *path)
-{
-    mode_t mask = umask(0);
-    umask(mask);
-    return chmod(path, 0666 & ~mask);
-}
-
 /* Write `len` bytes to `path` atomically, or to stdout if path is NULL. */
 static int write_output(const char *path, const void *data, size_t len)
 {
@@ -205,41 +204,10 @@ static int write_output(const char *path, const void *data, size_t len)
         }
         return EXIT_OK;
     }
-    size_t n = strlen(path) + 16;
-    char *tmp = malloc(n);
-    if (!tmp)
-        abort();
-    snprintf(tmp, n, "%s.tmp-XXXXXX", path);
-    int fd = mkstemp(tmp);
-    if (fd < 0) {
+    if (!splat_write_atomic(path, data, len)) {
         fprintf(stderr, "splatc: error: cannot write '%s': %s\n", path, strerror(errno));
-        free(tmp);
         return EXIT_INPUT;
     }
-    const char *s = data;
-    size_t done = 0;
-    while (done < len) {
-        ssize_t w = write(fd, s + done, len - done);
-        if (w < 0 && errno == EINTR)
-            continue;
-        if (w <= 0)
-            break;
-        done += (size_t)w;
-    }
-    int err = done == len ? 0 : errno;
-    if (close(fd) && !err)
-        err = errno;
-    if (!err && chmod_default(tmp))
-        err = errno;
-    if (!err && rename(tmp, path))
-        err = errno;
-    if (err) {
-        unlink(tmp);
-        fprintf(stderr, "splatc: error: cannot write '%s': %s\n", path, strerror(err));
-        free(tmp);
-        return EXIT_INPUT;
-    }
-    free(tmp);
     return EXIT_OK;
 }
 
@@ -266,15 +234,27 @@ static int cmd_check(int argc, char **argv)
 
 /* ---- glsl / spirv -------------------------------------------------------------- */
 
+/* --stage: false for fragment (the default), true for compute; -1 if bad. */
+static int stage_compute(const options *o)
+{
+    if (!o->stage || !strcmp(o->stage, "fragment"))
+        return 0;
+    if (!strcmp(o->stage, "compute"))
+        return 1;
+    return -1;
+}
+
 static int material_glsl(const options *o, const char *cmd, ir_buf *glsl)
 {
+    if (stage_compute(o) < 0)
+        return usage_error("--stage takes 'fragment' or 'compute', not '%s'", o->stage);
     ir ir;
     ir_init(&ir);
     sg_program *p = NULL;
     int st = load_material(o, cmd, &ir, &p);
     if (st == EXIT_OK) {
         ir_optimize(&ir, NULL);
-        glsl_material_shader(&ir, o->material, glsl);
+        glsl_material_shader_stage(&ir, o->material, stage_compute(o) == 1, glsl);
     }
     sg_free(p);
     ir_free(&ir);
@@ -284,7 +264,7 @@ static int material_glsl(const options *o, const char *cmd, ir_buf *glsl)
 static int cmd_glsl(int argc, char **argv)
 {
     options o;
-    int st = parse_options(argc, argv, "mo", &o);
+    int st = parse_options(argc, argv, "moS", &o);
     ir_buf glsl = { 0 };
     if (st == EXIT_OK)
         st = material_glsl(&o, "glsl", &glsl);
@@ -298,7 +278,7 @@ static int cmd_glsl(int argc, char **argv)
 static int cmd_spirv(int argc, char **argv)
 {
     options o;
-    int st = parse_options(argc, argv, "mo", &o);
+    int st = parse_options(argc, argv, "moS", &o);
     if (st == EXIT_OK && !o.out)
         st = usage_error("%s needs -o OUT.spv", "spirv");
     ir_buf glsl = { 0 };
@@ -308,7 +288,8 @@ static int cmd_spirv(int argc, char **argv)
         uint32_t *words = NULL;
         size_t nwords = 0;
         char *log = NULL;
-        bool ok = spv_compile(glsl.s, SPV_STAGE_FRAGMENT, o.material, &words, &nwords, &log) &&
+        int stage = stage_compute(&o) == 1 ? SPV_STAGE_COMPUTE : SPV_STAGE_FRAGMENT;
+        bool ok = spv_compile(glsl.s, stage, o.material, &words, &nwords, &log) &&
                   spv_validate(words, nwords, &log);
         if (!ok) {
             /* generated code that does not compile is a compiler bug */
@@ -381,83 +362,21 @@ static void emit_dump(void *user, FILE *f)
     ir_dump(user, f);
 }
 
-/* `path` made absolute (against the current folder) with "." and ".."
- * resolved lexically; malloc'd. */
-static char *absolute_path(const char *path)
-{
-    char cwd[4096];
-    if (path[0] != '/' && !getcwd(cwd, sizeof cwd))
-        return strdup(path);
-    size_t n = strlen(path) + (path[0] == '/' ? 0 : strlen(cwd)) + 2;
-    char *joined = malloc(n), *out = malloc(n + 1);
-    if (!joined || !out)
-        abort();
-    snprintf(joined, n, "%s%s%s", path[0] == '/' ? "" : cwd, path[0] == '/' ? "" : "/", path);
-    size_t len = 0;
-    char *save = NULL;
-    for (char *c = strtok_r(joined, "/", &save); c; c = strtok_r(NULL, "/", &save)) {
-        if (!strcmp(c, "."))
-            continue;
-        if (!strcmp(c, "..")) {
-            while (len > 0 && out[len - 1] != '/')
-                len--;
-            if (len > 0)
-                len--;
-            continue;
-        }
-        out[len++] = '/';
-        memcpy(out + len, c, strlen(c));
-        len += strlen(c);
-    }
-    out[len] = 0;
-    if (!len)
-        strcpy(out, "/");
-    free(joined);
-    return out;
-}
-
-/* `to` relative to the folder `from` (both absolute, normalised). */
-static char *relative_path(const char *from, const char *to)
-{
-    size_t common = 0;
-    for (size_t i = 0;; i++) {
-        bool end_f = from[i] == 0 || from[i] == '/', end_t = to[i] == 0 || to[i] == '/';
-        if (end_f && end_t)
-            common = i;
-        if (!from[i] || !to[i] || from[i] != to[i])
-            break;
-    }
-    int ups = 0;
-    for (const char *c = from + common; *c; c++)
-        ups += *c == '/';
-    if (!strcmp(from, "/"))
-        ups = 0;
-    const char *rest = to + common + (to[common] == '/');
-    char *r = malloc((size_t)ups * 3 + strlen(rest) + 2);
-    if (!r)
-        abort();
-    r[0] = 0;
-    for (int i = 0; i < ups; i++)
-        strcat(r, "../");
-    strcat(r, *rest ? rest : ".");
-    return r;
-}
-
 /* Texture files are relative to the current folder in the IR; a dump
  * written to OUT names them relative to OUT's folder, as graph files do,
  * so the dump reads back from wherever it is. */
 static void textures_relative_to(ir *ir, const char *out)
 {
-    char *abs_out = absolute_path(out);
+    char *abs_out = splat_path_absolute(out);
     char *slash = strrchr(abs_out, '/');
     if (slash == abs_out)
         slash[1] = 0;
     else if (slash)
         *slash = 0;
     for (int i = 0; i < ir->ntextures; i++) {
-        char *abs_tex = absolute_path(ir->textures[i].file);
+        char *abs_tex = splat_path_absolute(ir->textures[i].file);
         free(ir->textures[i].file);
-        ir->textures[i].file = relative_path(abs_out, abs_tex);
+        ir->textures[i].file = splat_path_relative(abs_out, abs_tex);
         free(abs_tex);
     }
     free(abs_out);
@@ -526,9 +445,7 @@ static bool parse_bound(const char *s, double *x)
  * a component to the previous key. */
 static bool parse_at(const char *spec, bool ranges, at_item **items, int *n)
 {
-    char *copy = strdup(spec);
-    if (!copy)
-        abort();
+    char *copy = xstrdup(spec);
     *items = NULL;
     *n = 0;
     bool ok = true;
@@ -599,18 +516,9 @@ static int set_inputs(const ir *ir, const char *material, const at_item *items, 
     memset(in, 0, sizeof *in);
     ir_env *e = &in->env;
     ir_ienv *ie = &in->ienv;
-    e->normal[1] = 1;
-    const ir_iv all = { -INFINITY, INFINITY }, unit = { 0, 1 }, sym = { -1, 1 };
-    ie->height = all;
-    ie->slope = unit;
-    ie->normal[0] = sym;
-    ie->normal[1] = unit;
-    ie->normal[2] = sym;
-    for (int c = 0; c < 3; c++)
-        ie->position[c] = all;
-    ie->uv[0] = ie->uv[1] = unit;
-    ie->view_distance = (ir_iv){ 0, INFINITY };
-    ie->destruction = unit;
+    e->normal[1] = 1;                 /* flat ground until told */
+    ir_ienv_domain(ie);               /* every input anywhere in its domain */
+    const ir_iv unit = { 0, 1 };
     in->params = calloc((size_t)ir->nparams * 4 + 1, sizeof *in->params);
     in->iparams = calloc((size_t)ir->nparams + 1, sizeof *in->iparams);
     in->painted = calloc((size_t)ir->npainted + 1, sizeof *in->painted);
@@ -624,21 +532,26 @@ static int set_inputs(const ir *ir, const char *material, const at_item *items, 
     for (int i = 0; i < ir->npainted; i++)
         in->ipainted[i] = unit;
     bool have_height = false, have_pos = false;
-    ir_iv direction_any[3];   /* view.direction's bounds are always [-1, 1] */
     for (int i = 0; i < n; i++) {
         const at_item *it = &items[i];
         const char *k = it->key;
         int want = -1;
-        ir_iv *iv[4] = { 0 };
+        ir_iv *iv[4] = { 0 };     /* NULL: no bounds slot (view.direction) */
         double *dv[4] = { 0 };
-        if (!strcmp(k, "height")) {
-            want = 1; iv[0] = &ie->height; dv[0] = &e->height; have_height = true;
-        } else if (!strcmp(k, "slope")) {
-            want = 1; iv[0] = &ie->slope; dv[0] = &e->slope;
-        } else if (!strcmp(k, "normal")) {
-            want = 3;
-            for (int c = 0; c < 3; c++) { iv[c] = &ie->normal[c]; dv[c] = &e->normal[c]; }
-        } else if (!strcmp(k, "position")) {
+        int input = -1;
+        for (int j = 0; j < IR_IN_COUNT; j++)
+            if (!strcmp(k, ir_input_get((ir_input_kind)j)->key))
+                input = j;
+        if (input >= 0 && input != IR_IN_POSITION) {
+            double *d = ir_env_slot(e, (ir_input_kind)input);
+            ir_iv *s = ir_ienv_slot(ie, (ir_input_kind)input);
+            want = ir_type_width(ir_input_get((ir_input_kind)input)->type);
+            for (int c = 0; c < want; c++) {
+                dv[c] = d + c;
+                iv[c] = s ? s + c : NULL;
+            }
+            have_height = have_height || input == IR_IN_HEIGHT;
+        } else if (input == IR_IN_POSITION) {
             /* X,Z (y is the height) or X,Y,Z */
             want = it->n == 3 ? 3 : 2;
             int map[3] = { 0, 2, 1 };
@@ -648,16 +561,6 @@ static int set_inputs(const ir *ir, const char *material, const at_item *items, 
                 dv[c] = &e->position[map[c]];
             }
             have_pos = want == 3;
-        } else if (!strcmp(k, "uv")) {
-            want = 2;
-            for (int c = 0; c < 2; c++) { iv[c] = &ie->uv[c]; dv[c] = &e->uv[c]; }
-        } else if (!strcmp(k, "distance")) {
-            want = 1; iv[0] = &ie->view_distance; dv[0] = &e->view_distance;
-        } else if (!strcmp(k, "destruction")) {
-            want = 1; iv[0] = &ie->destruction; dv[0] = &e->destruction;
-        } else if (!strcmp(k, "direction")) {
-            want = 3;
-            for (int c = 0; c < 3; c++) { iv[c] = &direction_any[c]; dv[c] = &e->view_direction[c]; }
         } else if (!strncmp(k, "painted.", 8)) {
             for (int j = 0; j < ir->npainted; j++)
                 if (!strcmp(ir->painted[j].name, k + 8)) {
@@ -671,9 +574,7 @@ static int set_inputs(const ir *ir, const char *material, const at_item *items, 
         } else {
             /* a param: "wetness" or "cliff.wetness" */
             size_t qn = strlen(material) + strlen(k) + 2;
-            char *q = malloc(qn);
-            if (!q)
-                abort();
+            char *q = xmalloc(qn);
             snprintf(q, qn, "%s.%s", material, k);
             for (int j = 0; j < ir->nparams; j++)
                 if (!strcmp(ir->params[j].name, q) || !strcmp(ir->params[j].name, k)) {

@@ -22,12 +22,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-static bool same_resource(const ir_texture *a, const ir_texture *b)
-{
-    return strcmp(a->file, b->file) == 0 && a->filter == b->filter && a->mip == b->mip &&
-           a->wrap == b->wrap && a->srgb == b->srgb;
-}
-
 static ir_ref retarget(ir *dst, const ir_node *n, void *user)
 {
     const int *to = user;
@@ -49,7 +43,7 @@ bool opt_dedup(ir *ir)
     for (int i = 0; i < n; i++) {
         to[i] = i;
         for (int j = 0; j < i; j++)
-            if (to[j] == j && same_resource(&ir->textures[j], &ir->textures[i])) {
+            if (to[j] == j && ir_texture_same(&ir->textures[j], &ir->textures[i])) {
                 to[i] = j;
                 ir_texture *keep = &ir->textures[j];
                 keep->lo = fmin(keep->lo, ir->textures[i].lo);

@@ -6,10 +6,12 @@
  *     never change a value) — unless the result is not a finite float, which
  *     stays an expression so the GPU computes it its own way;
  *   - x + 0, x - 0, x * 1, x / 1, min(x, x), max(x, x), -(-x) by x
+ *     (and x - x by 0 where x is provably finite, below)
  *     (exact for every x, NaN and inf included; x + 0 turns -0 into +0,
  *     which no output can tell apart);
  *   - x * 0 by 0 only where x is provably finite (a NaN or inf x would
- *     give NaN): saturate/clamp/step/smoothstep/less/sin/cos results,
+ *     give NaN): the op table's finiteness column (IR_FIN_*) says which —
+ *     saturate/step/smoothstep/less results, clamps with finite bounds,
  *     inputs, painted masks, params with a finite range, texture samples
  *     of a finite range, and finite constants.  Everything else keeps it;
  *   - saturate(saturate(x)) by saturate(x); select(c, a, b) with a
@@ -27,6 +29,7 @@
  */
 #include "ir.h"
 
+#include <assert.h>
 #include <float.h>
 #include <math.h>
 #include <string.h>
@@ -49,38 +52,39 @@ static bool is_const_all(const ir *ir, ir_ref r, double v)
 
 static bool finite_iv(double lo, double hi) { return isfinite(lo) && isfinite(hi); }
 
-/* Conservative: true only where the value can be neither NaN nor inf. */
+/* Conservative: true only where the value can be neither NaN nor inf.
+ * The op table's finiteness column says when (IR_FIN_*); only the leaves
+ * whose data decides (IR_FIN_DATA) are looked at here. */
 static bool provably_finite(const ir *ir, ir_ref r)
 {
     const ir_node *n = N(ir, r);
+    unsigned fin = ir_opinfo_get((ir_op)n->op)->finite;
+    if (fin & IR_FIN_ARGS_BIT) {
+        for (int i = 0; i < n->nargs; i++)
+            if ((fin >> i & 1) && !provably_finite(ir, n->arg[i]))
+                return false;
+        return true;
+    }
+    if (fin != IR_FIN_DATA)
+        return fin == IR_FIN_YES;
     switch (n->op) {
     case IR_OP_CONST:
         for (int c = 0; c < 4; c++)
             if (!isfinite(n->val[c]))
                 return false;
         return true;
-    case IR_OP_INPUT:        /* the ABI's inputs are finite by construction */
-    case IR_OP_PAINTED:
-    case IR_OP_SATURATE:
-    case IR_OP_STEP:
-    case IR_OP_SMOOTHSTEP:
-    case IR_OP_LESS:
-        return true;
     case IR_OP_PARAM: {
         const ir_param *p = &ir->params[n->imm];
         return finite_iv(p->lo, p->hi) && finite_iv(p->def[0], p->def[3]) &&
                finite_iv(p->def[1], p->def[2]);
     }
-    case IR_OP_SAMPLE: {
+    case IR_OP_SAMPLE:
+    case IR_OP_SAMPLE_GRAD: {
         const ir_texture *t = &ir->textures[N(ir, n->arg[0])->imm];
         return finite_iv(t->lo, t->hi);
     }
-    case IR_OP_CLAMP:
-        return provably_finite(ir, n->arg[1]) && provably_finite(ir, n->arg[2]);
-    case IR_OP_SPLAT:
-    case IR_OP_SWIZZLE:
-        return provably_finite(ir, n->arg[0]);
     default:
+        assert(!"IR_FIN_DATA for an op whose data is not looked at");
         return false;
     }
 }
@@ -153,7 +157,12 @@ static ir_ref fold_identity(ir *dst, const ir_node *n)
         if (is_const_all(dst, a, 0.0)) return b;
         return IR_NONE;
     case IR_OP_SUB:
-        return is_const_all(dst, b, 0.0) ? a : IR_NONE;
+        if (is_const_all(dst, b, 0.0)) return a;
+        if (ir_ref_eq(a, b) && provably_finite(dst, a)) {   /* x - x: 0 unless inf/NaN */
+            double zero[4] = {0};
+            return ir_const(dst, (ir_type)n->type, zero);
+        }
+        return IR_NONE;
     case IR_OP_MUL:
         if (is_const_all(dst, b, 1.0)) return a;
         if (is_const_all(dst, a, 1.0)) return b;

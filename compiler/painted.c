@@ -10,6 +10,7 @@
  *                         .near = texels under those metres }
  */
 #include "scene.h"
+#include "util.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -48,9 +49,7 @@ bool splat_painted_build(const splat_scene *s, splat_painted_format f,
     const sg_scene *sc = s->desc;
     const splat_terrain *t = &s->terrain;
     int n = sc->npainted;
-    sparse_mask_desc *md = calloc((size_t)(n ? n : 1), sizeof *md);
-    if (!md)
-        abort();
+    sparse_mask_desc *md = xcalloc((size_t)(n ? n : 1), sizeof *md);
     for (int i = 0; i < n; i++) {
         const sg_scene_painted *pm = &sc->painted[i];
         md[i].name = pm->name;

@@ -12,6 +12,7 @@
  * file reached twice (diamond) is parsed once; a file reached while it is
  * still being loaded is an import cycle. */
 #include "sg_internal.h"
+#include "util.h"
 
 #include <errno.h>
 #include <limits.h>
@@ -491,6 +492,12 @@ static bool word_is(const sg_value *v, const char *w)
     return v->kind == SG_V_PATH && v->nparts == 1 && !strcmp(v->parts[0], w);
 }
 
+/* A bare word's text ("nearest"), or "" for any other value. */
+static const char *word_of(const sg_value *v)
+{
+    return v->kind == SG_V_PATH && v->nparts == 1 ? v->parts[0] : "";
+}
+
 static void bad_setting(parser *ps, const sg_value *v, const char *key, const char *allowed)
 {
     char msg[200];
@@ -505,25 +512,21 @@ static void add_texture_setting(parser *ps, void *user, sg_token *key, sg_value 
         if (v->kind != SG_V_STRING)
             bad_setting(ps, v, "file", "a string");
         else {
-            char *path = sg_path_join(ps->f->dir, v->str);
+            char *path = splat_path_join(ps->f->dir, v->str);
             t->file = sg_strdup(ps->a, path);
             free(path);
         }
     } else if (is_kw(key, "filter") || is_kw(key, "mip")) {
         ir_filter *f = is_kw(key, "mip") ? &t->mip : &t->filter;
-        if (word_is(v, "linear"))
-            *f = IR_FILTER_LINEAR;
-        else if (word_is(v, "nearest"))
-            *f = IR_FILTER_NEAREST;
+        int k = ir_filter_by_name(word_of(v));
+        if (k >= 0)
+            *f = (ir_filter)k;
         else
             bad_setting(ps, v, is_kw(key, "mip") ? "mip" : "filter", "linear or nearest");
     } else if (is_kw(key, "wrap")) {
-        if (word_is(v, "repeat"))
-            t->wrap = IR_WRAP_REPEAT;
-        else if (word_is(v, "clamp"))
-            t->wrap = IR_WRAP_CLAMP;
-        else if (word_is(v, "mirror"))
-            t->wrap = IR_WRAP_MIRROR;
+        int k = ir_wrap_by_name(word_of(v));
+        if (k >= 0)
+            t->wrap = (ir_wrap)k;
         else
             bad_setting(ps, v, "wrap", "repeat, clamp or mirror");
     } else if (is_kw(key, "srgb")) {
@@ -609,7 +612,7 @@ static bool parse_numbers(parser *ps, double *out, int n)
 
 static char *scene_path(parser *ps, const char *rel)
 {
-    char *path = sg_path_join(ps->f->dir, rel);
+    char *path = splat_path_join(ps->f->dir, rel);
     char *r = sg_strdup(ps->a, path);
     free(path);
     return r;
@@ -717,6 +720,7 @@ static bool scene_stmt(parser *ps, void *user)
         next(ps);
         sub_block b = { sp, NULL };
         sc->has_destruction = true;
+        sc->destruction_loc = kloc;
         parse_block(ps, "block of destruction", sub_stmt, &b);
         return true;
     }
@@ -741,6 +745,21 @@ static bool scene_stmt(parser *ps, void *user)
         sg_token *file = cur(ps);
         if (!expect(ps, SG_TK_STRING, "a file name in quotes"))
             return false;
+        if (is_kw(name, "holes")) {
+            /* the terrain's holes: a mask of its own, not a painted layer */
+            if (sc->holes)
+                sg_error(ps->d, loc_of(ps, name), SG_E_DUPLICATE, "painted mask",
+                         "holes", sc->holes_loc.file, sc->holes_loc.line,
+                         sc->holes_loc.col);
+            sc->holes = scene_path(ps, file->str);
+            sc->holes_loc = loc_of(ps, name);
+            if (cur(ps)->kind == SG_TK_LBRACE) {
+                scene_error(ps, loc_of(ps, cur(ps)), "the holes mask takes no "
+                            "options (it is not stored as a painted layer)%s", "");
+                return false;
+            }
+            return true;
+        }
         sg_scene_painted *pm = SG_PUSH(ps->a, sc->painted, sc->npainted, sp->cap_painted);
         pm->name = tok_text(ps, name);
         pm->file = scene_path(ps, file->str);
@@ -765,8 +784,7 @@ static bool scene_stmt(parser *ps, void *user)
         else if (dot && (!strcmp(dot, ".r16") || !strcmp(dot, ".raw")))
             sc->hf_format = SG_HF_R16;
         else
-            scene_error(ps, sc->heightfield_loc,
-                        "heightfield '%s' must be a .png, .r16 or .raw file", file->str);
+            sc->hf_format = SG_HF_GDAL;   /* .tif, .hgt, .asc, …: raster.c */
         sp->has[HAS_HF] = true;
         return true;
     }
@@ -802,8 +820,10 @@ static bool scene_stmt(parser *ps, void *user)
         sp->has[HAS_MAXH] = true;
         return true;
     }
-    if (is_kw(key, "height_offset"))
+    if (is_kw(key, "height_offset")) {
+        sc->height_offset_loc = kloc;
         return parse_number(ps, &sc->height_offset);
+    }
     if (is_kw(key, "cell")) {
         double c;
         if (!parse_number(ps, &c))
@@ -879,9 +899,18 @@ static bool parse_scene(parser *ps)
     parse_block(ps, sg_strdup(ps->a, what), scene_stmt, &sp);
 
     static const char *const need[] = { "heightfield", "size", "max_height", "materials" };
+    bool gdal = sp.has[HAS_HF] && sc->hf_format == SG_HF_GDAL;
     for (int i = 0; i < 4; i++)
-        if (!sp.has[i])
+        if (!sp.has[i] && !(gdal && (i == HAS_SIZE || i == HAS_MAXH)))
             scene_error(ps, sc->loc, "scene needs '%s = ...'", need[i]);
+    /* A GDAL raster's heights are used as stored (raster.c). */
+    if (gdal && sc->max_height_loc.line > 0)
+        scene_error(ps, sc->max_height_loc, "max_height comes from the heights "
+                    "stored in '%s' (a GDAL raster); remove it", sc->heightfield);
+    if (gdal && sc->height_offset_loc.line > 0)
+        scene_error(ps, sc->height_offset_loc, "height_offset comes from the "
+                    "heights stored in '%s' (a GDAL raster); remove it",
+                    sc->heightfield);
     if (sp.has[HAS_MATERIALS] && sc->nmaterials == 0)
         scene_error(ps, sp.materials_loc, "scene needs at least one material "
                     "(materials = [BOTTOM, …, TOP])%s", "");
@@ -964,9 +993,7 @@ static char *read_all(const char *path, size_t *len, const char **err)
         return NULL;
     }
     size_t cap = 4096, n = 0;
-    char *buf = malloc(cap + 1);
-    if (!buf)
-        abort();
+    char *buf = xmalloc(cap + 1);
     for (;;) {
         size_t got = fread(buf + n, 1, cap - n, f);
         n += got;
@@ -980,9 +1007,7 @@ static char *read_all(const char *path, size_t *len, const char **err)
             break;
         }
         cap *= 2;
-        buf = realloc(buf, cap + 1);
-        if (!buf)
-            abort();
+        buf = xrealloc(buf, cap + 1);
     }
     fclose(f);
     buf[n] = 0;
@@ -1007,9 +1032,7 @@ static int load_file(loader *l, const char *path, const char *text, size_t len,
                 for (int j = i; j < l->depth; j++)
                     n += strlen(p->files[l->stack[j]]->path) + 4;
                 n += strlen(p->files[known]->path);
-                char *msg = malloc(n);
-                if (!msg)
-                    abort();
+                char *msg = xmalloc(n);
                 msg[0] = 0;
                 for (int j = i; j < l->depth; j++) {
                     strcat(msg, p->files[l->stack[j]]->path);
@@ -1043,7 +1066,7 @@ static int load_file(loader *l, const char *path, const char *text, size_t len,
     }
     sg_file *f = sg_alloc(&p->arena, sizeof *f);
     f->path = sg_strdup(&p->arena, path);
-    char *dir = sg_path_dir(path);
+    char *dir = splat_path_dir(path);
     f->dir = sg_strdup(&p->arena, dir);
     free(dir);
     f->key = sg_strdup(&p->arena, key);
@@ -1065,11 +1088,11 @@ static int load_file(loader *l, const char *path, const char *text, size_t len,
     l->stack[l->depth++] = fi;
     for (int i = 0; i < nimports; i++) {
         /* relative to the importing file, then the search paths */
-        char *cand = sg_path_join(f->dir, imports[i].path);
+        char *cand = splat_path_join(f->dir, imports[i].path);
         bool found = access(cand, R_OK) == 0;
         for (int s = 0; !found && s < p->nsearch; s++) {
             free(cand);
-            cand = sg_path_join(p->search[s], imports[i].path);
+            cand = splat_path_join(p->search[s], imports[i].path);
             found = access(cand, R_OK) == 0;
         }
         if (!found) {
@@ -1102,9 +1125,7 @@ static sg_program *load(const char *path, const char *text, size_t len,
 
     int errors0 = d->nerrors;
     loader l = { p, d, { 0 }, NULL, 0 };
-    l.stack = malloc(SG_MAX_DEPTH * sizeof *l.stack);
-    if (!l.stack)
-        abort();
+    l.stack = xmalloc(SG_MAX_DEPTH * sizeof *l.stack);
     load_file(&l, path, text, len, (sg_loc){ path, 0, 0 }, false);
     free(l.stack);
     sg_map_free(&l.keys);

@@ -23,6 +23,7 @@
  * `n.out` resolves to (SG_REF_NODE, node n, output 0), r depends on n and
  * d, and r's type is div's rule applied to (float, float) = float. */
 #include "sg_internal.h"
+#include "util.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -38,26 +39,6 @@ static const ir_type output_types[SG_OUT_COUNT] = {
     SG_OUTPUTS(X)
 #undef X
 };
-
-static const char *const input_names[IR_IN_COUNT] = {
-#define X(id, name, type) name,
-    IR_INPUTS(X)
-#undef X
-};
-
-static const ir_type input_types[IR_IN_COUNT] = {
-#define X(id, name, type) type,
-    IR_INPUTS(X)
-#undef X
-};
-
-int sg_input_by_name(const char *name)
-{
-    for (int i = 0; i < IR_IN_COUNT; i++)
-        if (!strcmp(input_names[i], name))
-            return i;
-    return -1;
-}
 
 int sg_shader_find(const sg_program *p, const char *name)
 {
@@ -226,14 +207,14 @@ static bool resolve_path(checker *c, sg_value *v, bool allow_locals)
         v->type = IR_T_TEX;
     } else if ((!strcmp(first, "terrain") || !strcmp(first, "view")) && v->nparts >= 2) {
         snprintf(buf, sizeof buf, "%s.%s", first, v->parts[1]);
-        int in = sg_input_by_name(buf);
+        int in = ir_input_by_name(buf);
         if (in < 0) {
             sg_error(c->d, v->loc, SG_E_UNKNOWN_NAME, buf);
             return false;
         }
         v->ref = SG_REF_INPUT;
         v->index = in;
-        v->type = input_types[in];
+        v->type = ir_input_get((ir_input_kind)in)->type;
         rest = 2;
     } else {
         if (!allow_locals && sg_map_get(&c->locals, first) >= 0) {
@@ -528,9 +509,7 @@ static void report_cycle(void *user, const int *path, int len)
     for (int i = 0; i < len; i++)
         n += strlen(cc->name(cc->names, path[i])) + 4;
     n += strlen(cc->name(cc->names, path[0]));
-    char *msg = malloc(n);
-    if (!msg)
-        abort();
+    char *msg = xmalloc(n);
     msg[0] = 0;
     for (int i = 0; i < len; i++) {
         strcat(msg, cc->name(cc->names, path[i]));
@@ -586,11 +565,11 @@ static void declare_locals(checker *c, sg_shader *s)
 
 static void resolve_node_type(checker *c, sg_node *n)
 {
-    int in = sg_input_by_name(n->type);
+    int in = ir_input_by_name(n->type);
     if (in >= 0) {
         n->kind = SG_NODE_INPUT;
         n->op = in;
-        n->out_type = input_types[in];
+        n->out_type = ir_input_get((ir_input_kind)in)->type;
         if (n->nargs)
             sg_error(c->d, n->args[0].loc, SG_E_UNKNOWN_PORT, n->type, "input", n->args[0].port);
         return;
@@ -680,9 +659,7 @@ static void check_shader(checker *c, sg_shader *s)
                 nedges++;
         }
     }
-    g.adj = malloc(((size_t)nedges + 1) * sizeof *g.adj);
-    if (!g.adj)
-        abort();
+    g.adj = xmalloc(((size_t)nedges + 1) * sizeof *g.adj);
     for (int i = 0, e = 0; i < s->nnodes; i++) {
         g.start[i] = e;
         for (int j = 0; j < s->nodes[i].nargs; j++) {
@@ -802,9 +779,7 @@ static void check_nesting(checker *c)
     for (int i = 0; i < p->nshaders; i++)
         for (int j = 0; j < p->shaders[i]->nnodes; j++)
             nedges += p->shaders[i]->nodes[j].kind == SG_NODE_INSTANCE;
-    g.adj = malloc(((size_t)nedges + 1) * sizeof *g.adj);
-    if (!g.adj)
-        abort();
+    g.adj = xmalloc(((size_t)nedges + 1) * sizeof *g.adj);
     for (int i = 0, e = 0; i < p->nshaders; i++) {
         g.start[i] = e;
         for (int j = 0; j < p->shaders[i]->nnodes; j++)
@@ -814,9 +789,7 @@ static void check_nesting(checker *c)
     }
     cycle_ctx cc = { c, shader_name, p, shader_loc };
     int *order = dfs_order(&g, report_cycle, &cc);
-    int *done = calloc((size_t)p->nshaders + 1, sizeof *done);
-    if (!done)
-        abort();
+    int *done = xcalloc((size_t)p->nshaders + 1, sizeof *done);
     for (int k = 0; k < p->nshaders; k++) {
         int v = order[k];
         int depth = 0;

@@ -14,11 +14,12 @@
  * IR, the analysis and the pack's painted layers.
  *
  * Imports are searched relative to the importing file, then the scene's
- * folder, then the caller's search paths; without any, the nearest folder
- * at or above the scene's that has a `nodes/` folder (the project root, so
- * `import "graphs/grass.sg"` works from examples/NAME/scene.sg), then ".".
+ * folder, then the caller's search paths; without any, splat_search_path's
+ * (search.c: $SPLATC_PATH, ".", the project root, the installed nodes).
  */
 #include "scene.h"
+#include "abi.h"
+#include "util.h"
 
 #include <errno.h>
 #include <math.h>
@@ -29,70 +30,6 @@
 #include <sys/stat.h>
 
 #include <stb_image.h>
-
-/* ---- search paths ------------------------------------------------------- */
-
-static char *xstrdup(const char *s)
-{
-    size_t n = strlen(s) + 1;
-    char *p = malloc(n);
-    if (p) memcpy(p, s, n);
-    return p;
-}
-
-static char *dir_of(const char *path)
-{
-    const char *slash = strrchr(path, '/');
-    if (!slash) return xstrdup(".");
-    if (slash == path) return xstrdup("/");
-    size_t n = (size_t)(slash - path);
-    char *d = malloc(n + 1);
-    if (!d) return NULL;
-    memcpy(d, path, n);
-    d[n] = 0;
-    return d;
-}
-
-static bool is_dir(const char *dir, const char *sub)
-{
-    size_t n = strlen(dir) + strlen(sub) + 2;
-    char *p = malloc(n);
-    if (!p) return false;
-    snprintf(p, n, "%s/%s", dir, sub);
-    struct stat st;
-    bool ok = stat(p, &st) == 0 && S_ISDIR(st.st_mode);
-    free(p);
-    return ok;
-}
-
-/* The parent of a folder path, kept relative where it was relative:
- * "a/b" -> "a" -> "." -> ".." -> "../.."; NULL above "/". */
-static char *parent_dir(const char *dir)
-{
-    if (strcmp(dir, "/") == 0) return NULL;
-    if (strcmp(dir, ".") == 0) return xstrdup("..");
-    size_t n = strlen(dir);
-    if (n >= 2 && strcmp(dir + n - 2, "..") == 0 && (n == 2 || dir[n - 3] == '/')) {
-        char *p = malloc(n + 4);
-        if (p) snprintf(p, n + 4, "%s/..", dir);
-        return p;
-    }
-    return dir_of(dir);
-}
-
-/* The nearest folder at or above `dir` holding a nodes/ folder, or NULL. */
-static char *project_root(const char *dir)
-{
-    char *d = xstrdup(dir);
-    for (int depth = 0; d && depth < 32; depth++) {
-        if (is_dir(d, "nodes")) return d;
-        char *up = parent_dir(d);
-        free(d);
-        d = up;
-    }
-    free(d);
-    return NULL;
-}
 
 /* ---- checks ------------------------------------------------------------- */
 
@@ -116,14 +53,30 @@ static void scene_error(sg_diags *d, sg_loc loc, const char *fmt, ...)
 
 static bool is_pow2(int v) { return v > 0 && (v & (v - 1)) == 0; }
 
+/* Leaf cells per side within the pack limit (abi.h): for a raw
+ * heightfield from its declared size, before it is read; for a PNG once
+ * its size is known. */
+static bool cells_fit(const sg_scene *sc, int w, int h, sg_diags *d)
+{
+    int side = w > h ? w : h, cell = sc->cell_texels > 0 ? sc->cell_texels : 32;
+    if ((side + cell - 1) / cell <= SPLAT_MAX_CELLS)
+        return true;
+    scene_error(d, loc_or(sc->cell_texels_loc, sc->loc), "a cell of %d texels gives %d leaf "
+                "cells per side over the %d x %d heightfield, over the pack limit of %d",
+                cell, (side + cell - 1) / cell, w, h, SPLAT_MAX_CELLS);
+    return false;
+}
+
 /* Every scene field that can be checked without reading files. */
 static void check_scene(sg_program *p, const sg_scene *sc, sg_diags *d)
 {
     if (!sc->heightfield)
         scene_error(d, sc->loc, "scene '%s' has no heightfield "
                     "(heightfield = \"FILE.png\")", sc->name);
-    if (!(sc->size[0] > 0) || !(sc->size[1] > 0) || !isfinite(sc->size[0]) ||
-        !isfinite(sc->size[1]))
+    bool gdal = sc->hf_format == SG_HF_GDAL;   /* size may come from the file */
+    if ((!gdal || sc->size_loc.line > 0) &&
+        (!(sc->size[0] > 0) || !(sc->size[1] > 0) || !isfinite(sc->size[0]) ||
+         !isfinite(sc->size[1])))
         scene_error(d, loc_or(sc->size_loc, sc->loc), "world size must be two "
                     "positive lengths in metres, found %g %g",
                     sc->size[0], sc->size[1]);
@@ -170,6 +123,30 @@ static void check_scene(sg_program *p, const sg_scene *sc, sg_diags *d)
             }
         }
     }
+    if (sc->hf_format == SG_HF_R16 && sc->hf_width > 0 && sc->hf_height > 0)
+        cells_fit(sc, sc->hf_width, sc->hf_height, d);
+    if (sc->npainted > SPLAT_MAX_PAINTED)
+        scene_error(d, loc_or(sc->painted[SPLAT_MAX_PAINTED].loc, sc->loc), "scene '%s' "
+                    "declares %d painted masks, over the pack limit of %d", sc->name,
+                    sc->npainted, SPLAT_MAX_PAINTED);
+    if (sc->has_destruction) {
+        sg_loc dloc = loc_or(sc->destruction_loc, sc->loc);
+        double side = fmax(sc->destruction_size[0], sc->destruction_size[1]);
+        double cells = ceil(side / sc->destruction_cell);
+        if (sc->destruction_cell > 0 && side > 0 && !(cells <= SPLAT_MAX_DESTRUCTION_CELLS))
+            scene_error(d, dloc, "the destructible area is %.0f cells of %g m per side, over "
+                        "the pack limit of %d (a larger cell or a smaller area)", cells,
+                        sc->destruction_cell, SPLAT_MAX_DESTRUCTION_CELLS);
+        /* (a GDAL heightfield's size is known once it is read) */
+        if ((!gdal || sc->size_loc.line > 0) &&
+            !(sc->destruction_origin[0] >= 0 && sc->destruction_origin[1] >= 0 &&
+              sc->destruction_origin[0] + sc->destruction_size[0] <= sc->size[0] &&
+              sc->destruction_origin[1] + sc->destruction_size[1] <= sc->size[1]))
+            scene_error(d, dloc, "the destructible area (origin %g %g, size %g %g) must lie "
+                        "inside the terrain (0 0 to %g %g)", sc->destruction_origin[0],
+                        sc->destruction_origin[1], sc->destruction_size[0],
+                        sc->destruction_size[1], sc->size[0], sc->size[1]);
+    }
     if (sc->has_destruction) {
         if (!(sc->destruction_size[0] > 0) || !(sc->destruction_size[1] > 0) ||
             !isfinite(sc->destruction_size[0]) || !isfinite(sc->destruction_size[1]) ||
@@ -187,10 +164,30 @@ static void check_scene(sg_program *p, const sg_scene *sc, sg_diags *d)
 
 /* ---- rasters ------------------------------------------------------------ */
 
-/* An 8-bit greyscale raster of exactly w x h texels, or NULL (error at loc). */
+static bool is_png(const char *file)
+{
+    const char *dot = strrchr(file, '.');
+    return dot && strcmp(dot, ".png") == 0;
+}
+
+/* An 8-bit greyscale raster of exactly w x h texels, or NULL (error at loc):
+ * a PNG through stb_image, anything else through GDAL (raster.c). */
 static uint8_t *load_mask(const char *name, const char *file, int w, int h,
                           sg_loc loc, sg_diags *d)
 {
+    if (!is_png(file)) {
+        char what[160];
+        snprintf(what, sizeof what, "painted mask '%s'", name);
+        int fw = 0, fh = 0;
+        uint8_t *px = splat_raster_mask(what, file, &fw, &fh, loc, d);
+        if (px && (fw != w || fh != h)) {
+            scene_error(d, loc, "painted mask '%s' ('%s') is %d x %d texels; the "
+                        "heightfield is %d x %d", name, file, fw, fh, w, h);
+            free(px);
+            px = NULL;
+        }
+        return px;
+    }
     int fw, fh, comp;
     if (!stbi_info(file, &fw, &fh, &comp)) {
         FILE *f = fopen(file, "rb");
@@ -213,6 +210,8 @@ static uint8_t *load_mask(const char *name, const char *file, int w, int h,
                     "heightfield is %d x %d", name, file, fw, fh, w, h);
         return NULL;
     }
+    if (!splat_raster_check_size("painted mask", file, fw, fh, loc, d))
+        return NULL;
     int lw, lh, lc;
     uint8_t *px = stbi_load(file, &lw, &lh, &lc, 1);
     if (!px) {
@@ -230,6 +229,29 @@ static uint8_t *load_mask(const char *name, const char *file, int w, int h,
     else sg_error(d, loc, SG_E_TOO_LARGE, "painted mask does not fit in memory");
     stbi_image_free(px);
     return out;
+}
+
+/* The holes mask (texels > 127) joins GDAL's nodata in s->terrain.holes;
+ * then the hole texels get heights from their neighbours. */
+static bool load_holes(splat_scene *s, sg_diags *d)
+{
+    const sg_scene *sc = s->desc;
+    splat_terrain *t = &s->terrain;
+    sg_loc loc = loc_or(sc->holes_loc, sc->loc);
+    if (sc->holes) {
+        uint8_t *m = load_mask("holes", sc->holes, t->width, t->height, loc, d);
+        if (!m) return false;
+        size_t n = (size_t)t->width * (size_t)t->height;
+        for (size_t i = 0; i < n; i++)
+            m[i] = m[i] > 127 || (t->holes && t->holes[i]);
+        free(t->holes);
+        t->holes = m;
+    }
+    if (!splat_terrain_fill_holes(t)) {
+        sg_error(d, loc, SG_E_TOO_LARGE, "the terrain's holes do not fit in memory");
+        return false;
+    }
+    return true;
 }
 
 static bool load_painted(splat_scene *s, sg_diags *d)
@@ -295,25 +317,9 @@ bool splat_scene_load(splat_scene *s, const char *path,
     ir_init(&s->ir);
     int errors = d->nerrors;
     s->path = xstrdup(path);
-    char *dir = dir_of(path);
-    char *root = search_paths ? NULL : project_root(dir ? dir : ".");
-    int nsearch = 0;
-    while (search_paths && search_paths[nsearch]) nsearch++;
-    const char **paths = calloc((size_t)nsearch + 4, sizeof *paths);
-    if (!s->path || !dir || !paths) {
-        sg_error(d, (sg_loc){ path, 0, 0 }, SG_E_TOO_LARGE, "out of memory");
-        goto fail;
-    }
-    int np = 0;
-    paths[np++] = dir;
-    for (int i = 0; i < nsearch; i++) paths[np++] = search_paths[i];
-    if (!search_paths) {
-        if (root) paths[np++] = root;
-        paths[np++] = ".";
-    }
-    paths[np] = NULL;
+    char **paths = splat_import_path(path, search_paths);
 
-    s->prog = sg_load(path, paths, d);
+    s->prog = sg_load(path, (const char *const *)paths, d);
     if (!s->prog) {
         sg_error(d, (sg_loc){ path, 0, 0 }, SG_E_TOO_LARGE, "out of memory");
         goto fail;
@@ -330,25 +336,29 @@ bool splat_scene_load(splat_scene *s, const char *path,
     check_scene(s->prog, sc, d);
     if (d->nerrors > errors) goto fail;
 
-    s->terrain.size[0] = sc->size[0];
-    s->terrain.size[1] = sc->size[1];
+    /* 0: a GDAL raster's size comes from its geotransform */
+    s->terrain.size[0] = sc->size_loc.line > 0 ? sc->size[0] : 0;
+    s->terrain.size[1] = sc->size_loc.line > 0 ? sc->size[1] : 0;
     s->terrain.max_height = sc->max_height;
     s->terrain.height_offset = sc->height_offset;
     if (!splat_terrain_load(&s->terrain, sc->heightfield, sc->hf_format,
                             sc->hf_width, sc->hf_height,
                             loc_or(sc->heightfield_loc, sc->loc), d))
         goto fail;
-    if (!load_painted(s, d) || !lower_materials(s, d) || d->nerrors > errors)
+    if (sc->hf_format != SG_HF_R16 &&
+        !cells_fit(sc, s->terrain.width, s->terrain.height, d))
+        goto fail;
+    if (!load_holes(s, d) || !load_painted(s, d) || !lower_materials(s, d) ||
+        d->nerrors > errors)
+        goto fail;
+    if (!splat_compositor_check(s->prog, sc->compositor ? sc->compositor : "linear_alpha",
+                                loc_or(sc->compositor_loc, sc->loc), d))
         goto fail;
 
-    free(paths);
-    free(dir);
-    free(root);
+    splat_search_path_free(paths);
     return true;
 fail:
-    free(paths);
-    free(dir);
-    free(root);
+    splat_search_path_free(paths);
     splat_scene_free(s);
     return false;
 }

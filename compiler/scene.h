@@ -1,10 +1,10 @@
 /* scene.h — scenes: the heightfield and rasters on the CPU, terrain
  * parameters per cell, the interval analysis that finds the material
- * combinations a scene really has (DESIGN §7), the compositor that turns a
- * combination into one composite shader (DESIGN §6), and the shader pack
+ * combinations a scene really has (compiler/DESIGN.md §7), the compositor that turns a
+ * combination into one composite shader (compiler/DESIGN.md §6), and the shader pack
  * (compiler/PACK.md).
  *
- * Sections: terrain.c, scene.c, painted.c, analysis.c, compose.c, pack.c.
+ * Sections: terrain.c, scene.c, painted.c, analysis.c, compose.c, build.c (build.h).
  */
 #ifndef SPLAT_SCENE_H
 #define SPLAT_SCENE_H
@@ -12,6 +12,7 @@
 #include <stdbool.h>
 #include <stdint.h>
 
+#include "abi.h"
 #include "ir.h"
 #include "sg.h"
 #include "sparse.h"
@@ -24,13 +25,45 @@ typedef struct splat_terrain {
     double    size[2];         /* world metres, x and z                    */
     double    max_height;      /* metres for normalised height 1           */
     double    height_offset;   /* metres added to every height             */
+    /* 1 where the terrain is cut (GDAL nodata, the scene's holes mask), or
+     * NULL when it has no holes; hole texels hold heights filled in from
+     * their neighbours (splat_terrain_fill_holes), so every filter and
+     * bound that reads them sees plausible heights. */
+    uint8_t  *holes;
+    double    origin[2];       /* a GDAL raster's corner in its CRS units
+                                  (east, north); 0 0 for PNG and raw       */
 } splat_terrain;
+
+/* Every raster loader (PNG, raw, GDAL; heightfields and masks) checks its
+ * size against the pack limit (abi.h SPLAT_MAX_HEIGHTFIELD a side) here,
+ * before allocating. */
+bool splat_raster_check_size(const char *what, const char *path, long long w,
+                             long long h, sg_loc loc, sg_diags *d);
 
 /* Load 16-bit PNG, 8-bit PNG (scaled to 16 bits) or raw little-endian R16
  * (width and height given).  Errors at `loc`. */
 bool splat_terrain_load(splat_terrain *t, const char *path, sg_hf_format fmt,
                         int raw_width, int raw_height, sg_loc loc, sg_diags *d);
 void splat_terrain_free(splat_terrain *t);
+/* Give every hole texel the mean of its already known 4-neighbours,
+ * breadth first from the valid texels (deterministic, O(texels)).  False
+ * only when out of memory. */
+bool splat_terrain_fill_holes(splat_terrain *t);
+/* 1 if texel (x, z) is a hole (clamped to the edges), else 0. */
+int  splat_terrain_hole(const splat_terrain *t, int x, int z);
+
+/* ---- raster.c: rasters through libgdal --------------------------------- */
+
+/* Any raster GDAL reads (band 1): width, height, texels, size (unless
+ * `size_given`: then t->size is kept), origin, max_height and
+ * height_offset from the file, nodata as t->holes (not yet filled).
+ * Conversions are reported as notes at `loc`. */
+bool splat_raster_heightfield(splat_terrain *t, const char *path, bool size_given,
+                              sg_loc loc, sg_diags *d);
+/* An 8-bit mask (band 1) of any size, malloc'd; `what` names it in
+ * errors ("painted mask 'road'").  NULL on error. */
+uint8_t *splat_raster_mask(const char *what, const char *path, int *w, int *h,
+                           sg_loc loc, sg_diags *d);
 
 /* Normalised height (0..1) of texel (x, z), clamped to the edges. */
 double splat_terrain_texel(const splat_terrain *t, int x, int z);
@@ -42,8 +75,9 @@ void   splat_terrain_normal(const splat_terrain *t, double u, double v, double n
 /* Sound ranges of the terrain inputs over a rectangle of texels
  * [x0, x1) x [z0, z1): every fragment whose uv falls in that rectangle
  * has its height, slope, normal and position inside the returned bounds
- * (widened for the GPU's filtering and float error: terrain.c).  Also sets
- * view_distance to [0, inf] and destruction to [0, 0]; the analysis makes
+ * (widened for the GPU's filtering and float error: terrain.c).  Inputs
+ * the heightfield does not bound get their domain (IR_INPUTS:
+ * view_distance [0, inf]), except destruction: [0, 0]; the analysis makes
  * it [0, 1] where the destructible area reaches.  Leaves params and
  * painted alone. */
 void splat_terrain_ranges(const splat_terrain *t, int x0, int z0, int x1, int z1,
@@ -64,7 +98,7 @@ typedef struct splat_scene {
     uint8_t      **painted;    /* desc->npainted dense rasters, W*H bytes      */
     /* The painted masks as the pack stores them (painted.c), or NULL: the
      * analysis then bounds the dense rasters.  Not owned by the scene:
-     * whoever built it (pack.c) frees it. */
+     * whoever built it (build.c) frees it. */
     const sparse_masks *sparse;
     int            nmaterials; /* desc->nmaterials, bottom (0) first          */
     /* Every material lowered into one shared ir: roots "<name>.mask", … */
@@ -120,6 +154,10 @@ typedef struct splat_analysis {
     splat_level *levels;       /* 0 = leaf cells, up to a single root node   */
     int          nlevels;
     int          largest;      /* most materials in one combination          */
+    int          hole_cells;   /* leaf cells entirely hole (with their one-
+                                  texel ring): id SPLAT_COMBO_HOLE (abi.h),
+                                  no combination; nodes all of whose
+                                  children are holes are holes too         */
     double       naive_subsets; /* 2^(n-1): every subset above the base       */
     double       seconds;      /* wall time of the analysis                  */
 } splat_analysis;
@@ -128,7 +166,18 @@ bool splat_analyze(const splat_scene *s, splat_analysis *a, sg_diags *d);
 void splat_analysis_free(splat_analysis *a);
 void splat_analysis_report(const splat_scene *s, const splat_analysis *a, FILE *out);
 
-/* ---- compose.c: composite shaders (DESIGN §6) -------------------------- */
+/* ---- precision.c: shading far from the origin -------------------------- */
+
+/* A periodic site: terrain.position.AB / S (or * S), S a constant or a
+ * float param; see precision.c. */
+typedef struct splat_site {
+    uint32_t swz;        /* IR_SWZ of the two position components         */
+    bool     mul;        /* position * S; else position / S               */
+    int      param;      /* layout param slot of S (a float), or -1       */
+    double   value[2];   /* constant S per component (param: unused)      */
+} splat_site;
+
+/* ---- compose.c: composite shaders (compiler/DESIGN.md §6) -------------- */
 
 /* The material-set resources every shader of a pack shares (abi.h, set 1):
  * one uniform slot per param of the source ir (in its order), one binding
@@ -146,7 +195,25 @@ typedef struct splat_layout {
     int           *textures;   /* layout texture -> its first src texture     */
     int            ntextures;
     int            nparams;    /* = src->nparams; slot i = src param i        */
+    /* every material's precise sites, u_frame.world[k] (precision.c) */
+    splat_site     sites[SPLAT_WORLD_SITES];
+    int            nsites;
 } splat_layout;
+
+/* precision.c.  Find the layout's sites (splat_layout_init calls it). */
+bool   splat_sites_find(splat_layout *L);
+/* glsl_names.override for `ir` (a composite's emission copy; param_of:
+ * its params -> layout slots, -1 for none; input_of: the terrain input a
+ * param stands for, -1 for none): the camera-relative forms of the uses
+ * of L's sites; free with splat_sites_overrides_free. */
+char **splat_sites_overrides(const splat_layout *L, const ir *ir,
+                             const int *param_of, const int *input_of,
+                             const glsl_names *names);
+void   splat_sites_overrides_free(const ir *ir, char **ov);
+/* A warning per material whose terrain.position uses stay absolute fp32,
+ * with the distance at which their error passes a quarter texel. */
+struct splat_scene;
+void   splat_sites_warn(const struct splat_scene *s, sg_diags *d);
 
 /* `materials` and `painted` arrays are copied (not the strings). */
 bool splat_layout_init(splat_layout *L, const ir *src, sg_program *prog,
@@ -154,6 +221,13 @@ bool splat_layout_init(splat_layout *L, const ir *src, sg_program *prog,
                        const char *const *materials, int nmaterials,
                        const char *const *painted, int npainted, sg_diags *d);
 bool splat_layout_from_scene(splat_layout *L, const splat_scene *s, sg_diags *d);
+/* Compositor shader `name` of `prog` keeps its soundness contract (DESIGN
+ * §6): weight 0 where m = 0, T_next 0 where m = 1, over T in [0, 1] —
+ * proved with the interval evaluator, or a COMPOSITOR_CONTRACT error at
+ * `at` where it proves the contract broken (compose.c says how; slack it
+ * can neither prove nor refute passes).  splat_scene_load checks the
+ * scene's compositor. */
+bool splat_compositor_check(sg_program *prog, const char *name, sg_loc at, sg_diags *d);
 void splat_layout_free(splat_layout *L);
 /* Index of the layout texture equal (file + sampler state) to `t`, or -1. */
 int  splat_layout_texture(const splat_layout *L, const ir_texture *t);
@@ -198,6 +272,12 @@ bool splat_compose(const splat_layout *L, const splat_compose_desc *desc,
                    splat_composite *c, sg_diags *d);
 void splat_composite_free(splat_composite *c);
 
+/* Estimated per-pixel cost of shading with `c` when every layer runs
+ * (the most a pixel pays): ir_cost over all its values, in the op table's
+ * cost units (ir.h IR_OPS).  The manifest's "cost": the runtime picks the
+ * cheapest combination covering a tile. */
+double splat_composite_cost(const splat_composite *c);
+
 typedef struct splat_glsl_desc {
     const char *title;        /* first header comment line                   */
     bool        flat;         /* no dynamic branches (benchmark variant)     */
@@ -205,6 +285,8 @@ typedef struct splat_glsl_desc {
     bool        painted_sparse; /* #define SPLAT_PAINTED_SPARSE before the
                                  prelude: painted masks read the sparse
                                  quad-tree (abi.h bindings 2, 5, 6)         */
+    bool        compute;      /* the compute variant: #define SPLAT_COMPUTE
+                                 before the prelude (abi.h "compute stage") */
 } splat_glsl_desc;
 
 /* The complete Vulkan GLSL 450 fragment shader of `c`: for a composite,
@@ -240,7 +322,7 @@ bool  splat_cache_get(const splat_cache *c, const char *key, uint32_t **words,
 bool  splat_cache_put(const splat_cache *c, const char *key,
                       const uint32_t *words, size_t nwords);
 
-/* ---- pack.c: `splatc build`, the shader pack (PACK.md) ----------------- */
+/* ---- build.c: `splatc build`, the shader pack (PACK.md) ---------------- */
 
 typedef struct splat_build_desc {
     const char        *scene;        /* scene.sg                              */
@@ -250,8 +332,12 @@ typedef struct splat_build_desc {
     const char        *cache_dir;    /* NULL = splat_cache_default_dir()      */
     bool               no_cache;
     bool               flat;         /* also write branch-free composites     */
+    bool               compute_spirv; /* also compile the compute variants
+                                        (default: their GLSL only; PACK.md) */
     splat_painted_format painted;    /* painted mask storage; default BC4     */
     FILE              *report;       /* non-NULL: the analysis report here    */
+    const char        *depfile;      /* non-NULL: write a Make/Ninja depfile
+                                        of every input here (build.c)     */
 } splat_build_desc;
 
 typedef struct splat_build_stats {
@@ -274,11 +360,22 @@ bool splat_build(const splat_build_desc *desc, splat_build_stats *stats,
 /* ---- cli_build.c: `splatc build` (argv[0] is "build") ------------------ */
 
 int  splat_cli_build(int argc, char **argv);
-/* The import search path of every splatc command: the `include` folders
- * (-I) in order, $SPLATC_PATH (':'-separated), the current folder, and the
- * nearest folder above `file` that has a nodes/ folder.  NULL-terminated,
- * malloc'd: free with splat_search_path_free. */
+/* ---- search.c: where imports are found ---------------------------------- */
+
+/* The import search path, the one every entry point uses (splatc's
+ * commands, splat_scene_load without one, the viewer's hot reload): the
+ * `include` folders (-I) in order, $SPLATC_PATH (':'-separated), the
+ * current folder, the nearest folder at or above `file`'s that has a
+ * nodes/ folder, and the installed node library (splat_data_dir).
+ * NULL-terminated, malloc'd: free with splat_search_path_free. */
 char **splat_search_path(const char *const *include, int ninclude, const char *file);
+/* What a scene's imports are resolved against: the scene's folder, then
+ * `search` (NULL: splat_search_path's defaults).  Free with
+ * splat_search_path_free. */
+char **splat_import_path(const char *scene, const char *const *search);
 void   splat_search_path_free(char **paths);
+/* The installed data folder, PREFIX/share/splatc when this program runs
+ * from PREFIX/bin and the folder holds nodes/; else NULL.  malloc'd. */
+char  *splat_data_dir(void);
 
 #endif

@@ -24,6 +24,9 @@ typedef struct sg_loc {
  * X(id, format) — format is printf-style. */
 #define SG_ERRORS(X)                                                        \
     X(IO,            "cannot read '%s': %s")                                \
+    X(WRITE,         "cannot write '%s': %s")                               \
+    X(COMPOSITOR_CONTRACT, "compositor '%s' breaks its contract: %s must be 0 where m = %d " \
+                     "for every T in [0, 1], but at T = %g, h = %g it lies in [%g, %g]") \
     X(SYNTAX,        "expected %s, found %s")                               \
     X(UNTERMINATED,  "unterminated %s (opened at line %d)")                 \
     X(BAD_LITERAL,   "bad literal '%s': %s")                                \
@@ -75,8 +78,18 @@ void sg_diags_free(sg_diags *d);
 void sg_error(sg_diags *d, sg_loc loc, sg_error_id id, ...);
 void sg_note(sg_diags *d, sg_loc loc, const char *fmt, ...)
     __attribute__((format(printf, 3, 4)));
+/* A warning: printed like an error, but the input is accepted. */
+void sg_warning(sg_diags *d, sg_loc loc, const char *fmt, ...)
+    __attribute__((format(printf, 3, 4)));
 /* GCC style: "file:line:col: error: msg", the source line, a caret. */
 void sg_diags_print(const sg_diags *d, FILE *out);
+/* The same diagnostics for editors, one JSON object per line (JSON Lines):
+ * {"file": …, "line": N, "column": N, "severity": "error", "id":
+ * "UNKNOWN_NODE", "message": …}; file is null and line/column 0 where
+ * unknown; a last {"dropped": N} line if some were not stored. */
+void sg_diags_print_json(const sg_diags *d, FILE *out);
+/* The id's name as in SG_ERRORS ("UNKNOWN_NODE"). */
+const char *sg_error_name(sg_error_id id);
 /* Make `text` the source of `path` for the caret lines of later
  * diagnostics at `path` (copied; sg_load does this for every file). */
 void sg_diags_add_source(sg_diags *d, const char *path, const char *text,
@@ -147,11 +160,17 @@ void sg_write_dot(const sg_program *p, const char *material, FILE *out);
 
 /* A `scene` block (one per scene.sg).  Paths are resolved relative to the
  * scene file.  Every field keeps its location for later errors. */
-typedef enum sg_hf_format { SG_HF_PNG, SG_HF_R16 } sg_hf_format;
+typedef enum sg_hf_format {
+    SG_HF_PNG,      /* .png: 16-bit (or 8-bit) greyscale, through stb_image   */
+    SG_HF_R16,      /* .r16 / .raw: little-endian 16-bit, heightfield_size    */
+    SG_HF_GDAL,     /* anything else (.tif, .hgt, .asc, …): through libgdal;
+                       size, origin and heights come from the file (raster.c) */
+} sg_hf_format;
 
 typedef struct sg_scene_painted {
     char  *name;       /* the name materials use: painted { mask = "fields" } */
-    char  *file;       /* 8-bit greyscale PNG, same size as the heightfield  */
+    char  *file;       /* 8-bit greyscale PNG (or any raster GDAL reads),
+                          same size as the heightfield                      */
     sg_loc loc;
     /* Sparse storage options (sparse.h), from an optional block after the
      * file: painted NAME = "FILE" { max_level = 2, max_error = 0.05,
@@ -173,15 +192,22 @@ typedef struct sg_scene {
     char  *name;
     sg_loc loc;
     char  *heightfield;      sg_loc heightfield_loc;
-    sg_hf_format hf_format;  /* from the extension: .png or .r16/.raw      */
+    sg_hf_format hf_format;  /* from the extension: .png, .r16/.raw, else GDAL */
     int    hf_width, hf_height; /* required for raw R16, 0 otherwise       */
+    /* size and max_height: required for PNG and raw heightfields; for a
+     * GDAL one size is optional (default: the geotransform's) and
+     * max_height / height_offset are not allowed (the file's heights are
+     * used as stored).  A location with line 0 means "not given". */
     double size[2];          sg_loc size_loc;      /* x, z metres          */
     double max_height;       sg_loc max_height_loc;
-    double height_offset;                          /* default 0            */
+    double height_offset;    sg_loc height_offset_loc; /* default 0        */
+    /* `painted holes = "FILE"`: texels > 127 cut the terrain (terrain.c);
+     * not a painted layer.  NULL if none. */
+    char  *holes;            sg_loc holes_loc;
     char **materials;        sg_loc *material_locs; int nmaterials; /* bottom first */
     char  *compositor;       sg_loc compositor_loc; /* default "linear_alpha" */
     sg_scene_painted *painted; int npainted;
-    bool   has_destruction;
+    bool   has_destruction;  sg_loc destruction_loc; /* the block's keyword */
     double destruction_origin[2], destruction_size[2];
     double destruction_cell;                       /* default 16 m         */
     int    cell_texels;      sg_loc cell_texels_loc; /* default 32         */

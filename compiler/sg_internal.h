@@ -15,6 +15,7 @@
 
 #include "ir.h"
 #include "sg.h"
+#include "util.h"    /* paths: splat_path_join, splat_path_dir */
 
 /* Deepest nesting of instance shaders (and of imports).  Deeper graphs are
  * TOO_DEEP errors, never a stack overflow. */
@@ -50,10 +51,6 @@ int  sg_map_get(const sg_map *m, const char *key);
 /* Insert if absent; returns the existing value, or -1 if inserted. */
 int  sg_map_put(sg_map *m, const char *key, int val);
 
-/* Lexical path arithmetic ("a/b/../c" -> "a/c"), malloc'd results. */
-char *sg_path_join(const char *dir, const char *rel);  /* normalised     */
-char *sg_path_dir(const char *path);                   /* "." if none    */
-
 /* ---- lex.c ------------------------------------------------------------- */
 
 typedef enum sg_tok_kind {
@@ -79,7 +76,7 @@ typedef struct sg_token {
 /* One source file: its text and tokens. */
 typedef struct sg_file {
     char     *path;      /* as resolved (relative to the CWD, as given) */
-    char     *dir;       /* sg_path_dir(path)                            */
+    char     *dir;       /* splat_path_dir(path)                         */
     char     *key;       /* realpath for import dedup, else path         */
     char     *text;      /* NUL-terminated copy                          */
     size_t    len;
@@ -238,7 +235,5 @@ int  sg_shader_find(const sg_program *p, const char *name);
 /* Type of node output `index` of node n in shader s (IR_T_ERROR if bad). */
 ir_type sg_node_output_type(const sg_program *p, const sg_shader *s,
                             const sg_node *n, int index);
-/* Terrain input named `name` ("terrain.slope"), or -1. */
-int  sg_input_by_name(const char *name);
 
 #endif

@@ -1,8 +1,7 @@
 /* sg_util.c — the front end's small utilities: an arena for everything
- * with the program's lifetime, a string -> int map, and lexical path
- * arithmetic (paths stay relative as given, so outputs do not depend on
- * where the repository lives). */
+ * with the program's lifetime and a string -> int map (paths: util.h). */
 #include "sg_internal.h"
+#include "util.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -23,9 +22,7 @@ void *sg_alloc(sg_arena *a, size_t n)
         size_t cap = 64 * 1024;
         if (n > cap / 4)
             cap = n;               /* big requests get a block of their own */
-        b = malloc(sizeof *b + cap);
-        if (!b)
-            abort();               /* out of memory: nothing sane to do */
+        b = xmalloc(sizeof *b + cap);               /* out of memory: nothing sane to do */
         b->used = 0;
         b->cap = cap;
         if (n == cap && a->head) { /* keep filling the current block */
@@ -143,82 +140,3 @@ int sg_map_put(sg_map *m, const char *key, int val)
     return -1;
 }
 
-/* ---- paths ------------------------------------------------------------- */
-
-/* Normalise in place: drop "." and empty components, fold "x/..". */
-static char *normalise(char *path)
-{
-    bool abs = path[0] == '/';
-    size_t n = strlen(path);
-    char **comp = malloc((n / 2 + 2) * sizeof *comp);
-    char *out = malloc(n + 3);
-    if (!comp || !out)
-        abort();
-    int nc = 0, keep_up = 0;   /* leading ".." components we must keep */
-    char *save = NULL;   /* strtok_r: loading may run on several threads */
-    for (char *s = strtok_r(path, "/", &save); s; s = strtok_r(NULL, "/", &save)) {
-        if (!strcmp(s, "."))
-            continue;
-        if (!strcmp(s, "..")) {
-            if (nc > keep_up) {
-                nc--;
-                continue;
-            }
-            if (abs)
-                continue;      /* "/.." is "/" */
-            keep_up++;
-        }
-        comp[nc++] = s;
-    }
-    size_t o = 0;
-    if (abs)
-        out[o++] = '/';
-    for (int i = 0; i < nc; i++) {
-        size_t l = strlen(comp[i]);
-        if (i)
-            out[o++] = '/';
-        memcpy(out + o, comp[i], l);
-        o += l;
-    }
-    if (o == 0)
-        out[o++] = '.';
-    out[o] = 0;
-    free(comp);
-    free(path);
-    return out;
-}
-
-char *sg_path_join(const char *dir, const char *rel)
-{
-    size_t ld = strlen(dir), lr = strlen(rel);
-    char *s = malloc(ld + lr + 2);
-    if (!s)
-        abort();
-    if (rel[0] == '/' || !ld || !strcmp(dir, ".")) {
-        memcpy(s, rel, lr + 1);
-    } else {
-        memcpy(s, dir, ld);
-        s[ld] = '/';
-        memcpy(s + ld + 1, rel, lr + 1);
-    }
-    return normalise(s);
-}
-
-char *sg_path_dir(const char *path)
-{
-    const char *slash = strrchr(path, '/');
-    if (!slash) {
-        char *s = malloc(2);
-        if (!s)
-            abort();
-        strcpy(s, ".");
-        return s;
-    }
-    size_t n = slash == path ? 1 : (size_t)(slash - path);
-    char *s = malloc(n + 1);
-    if (!s)
-        abort();
-    memcpy(s, path, n);
-    s[n] = 0;
-    return s;
-}

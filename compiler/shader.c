@@ -112,8 +112,6 @@ static void comment_text(ir_buf *out, const char *s)
 
 void glsl_describe_resources(const ir *ir, const glsl_resources *res, ir_buf *out)
 {
-    static const char *const filters[] = {"linear", "nearest"};
-    static const char *const wraps[] = {"repeat", "clamp", "mirror"};
     ir_buf_printf(out, " * set 0: the terrain set of the ABI prelude (abi.h)\n");
     if (ir->nparams > 0)
         ir_buf_printf(out, " * set %d, binding %d: uniform block splat_params (std140, "
@@ -133,8 +131,8 @@ void glsl_describe_resources(const ir *ir, const glsl_resources *res, ir_buf *ou
         ir_buf_printf(out, " * set %d, binding %d: sampler2D %s  \"", SPLAT_SET_MATERIAL,
                       SPLAT_BIND_TEXTURE0 + i, res->texture[i]);
         comment_text(out, t->file);
-        ir_buf_printf(out, "\" (%s, mip %s, %s, %s)\n", filters[t->filter], filters[t->mip],
-                      wraps[t->wrap], t->srgb ? "sRGB" : "linear data");
+        ir_buf_printf(out, "\" (%s, mip %s, %s, %s)\n", ir_filter_name(t->filter), ir_filter_name(t->mip),
+                      ir_wrap_name(t->wrap), t->srgb ? "sRGB" : "linear data");
     }
     for (int i = 0; i < ir->npainted; i++) {
         ir_buf_printf(out, " * painted mask \"");
@@ -144,6 +142,31 @@ void glsl_describe_resources(const ir *ir, const glsl_resources *res, ir_buf *ou
 }
 
 void glsl_material_shader(const ir *ir, const char *material, ir_buf *out)
+{
+    glsl_material_shader_stage(ir, material, false, out);
+}
+
+static void material_shader(const ir *ir, const char *material, bool compute,
+                            ir_buf *out);
+
+void glsl_material_shader_stage(const ir *ir, const char *material, bool compute,
+                                ir_buf *out)
+{
+    if (!compute) {
+        material_shader(ir, material, false, out);
+        return;
+    }
+    /* no quads in compute: explicit gradients (ir_differentiate) */
+    struct ir d;
+    ir_clone(&d, ir);
+    if (ir_differentiate(&d))
+        ir_optimize(&d, NULL);
+    material_shader(&d, material, true, out);
+    ir_free(&d);
+}
+
+static void material_shader(const ir *ir, const char *material, bool compute,
+                            ir_buf *out)
 {
     /* The material outputs, in splat_finish's argument order after mask. */
     static const struct { const char *name; ir_type type; const char *def; } outs[] = {
@@ -159,12 +182,15 @@ void glsl_material_shader(const ir *ir, const char *material, ir_buf *out)
     glsl_resources res;
     glsl_declare_resources(ir, NULL, &decl, &res);
 
-    ir_buf_printf(out, "#version 450\n/* splatc: fragment shader for material '");
+    ir_buf_printf(out, "#version 450\n/* splatc: %s shader for material '",
+                  compute ? "compute" : "fragment");
     comment_text(out, material);
     ir_buf_printf(out, "'.\n *\n * Resources:\n");
     glsl_describe_resources(ir, &res, out);
     ir_buf_printf(out, " *\n * main() computes the material's outputs (mask, albedo, normal, "
                   "roughness,\n * height) and hands them to splat_finish().\n */\n");
+    if (compute)
+        ir_buf_printf(out, "#define SPLAT_COMPUTE 1\n");
     ir_buf_printf(out, "%s", SPLAT_GLSL_PRELUDE);
     ir_buf_printf(out, "%s", decl.s ? decl.s : "");
     ir_buf_printf(out, "\nvoid main() {\n");

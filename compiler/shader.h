@@ -39,5 +39,9 @@ void glsl_describe_resources(const ir *ir, const glsl_resources *res, ir_buf *ou
  * terrain: #version, a header comment with the bindings, the ABI prelude,
  * the resources, and main() ending in splat_finish(). */
 void glsl_material_shader(const ir *ir, const char *material, ir_buf *out);
+/* The same for either stage: `compute` writes the compute variant (abi.h
+ * "compute stage": #define SPLAT_COMPUTE before the prelude). */
+void glsl_material_shader_stage(const ir *ir, const char *material, bool compute,
+                                ir_buf *out);
 
 #endif

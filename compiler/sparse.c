@@ -21,6 +21,7 @@
  *   atlas 1 x 1 slots = 36 x 36 texels.
  */
 #include "sparse.h"
+#include "util.h"
 
 #include <assert.h>
 #include <errno.h>
@@ -57,14 +58,6 @@ static bool fail(sparse_error *err, sparse_error_id id, ...)
 static int clampi(int v, int lo, int hi)
 {
     return v < lo ? lo : v > hi ? hi : v;
-}
-
-static void *xcalloc(size_t n, size_t size)
-{
-    void *p = calloc(n ? n : 1, size);
-    if (!p)
-        abort();  /* out of memory: not a user error */
-    return p;
 }
 
 /* ---- rasters and bilinear sampling ------------------------------------- */
@@ -776,29 +769,25 @@ bool sparse_write(const sparse_masks *s, FILE *f)
            write_floats(s->lo, ncell, f) && write_floats(s->hi, ncell, f);
 }
 
-static bool read_floats(float *v, size_t n, FILE *f)
-{
-    uint8_t b[4];
-    for (size_t i = 0; i < n; i++) {
-        if (fread(b, 1, 4, f) != 4)
-            return false;
-        uint32_t u = get_u32(b);
-        memcpy(&v[i], &u, 4);
-    }
-    return true;
-}
-
-bool sparse_read(sparse_masks *s, FILE *f, const char *name, sparse_error *err)
+/* The header's words, checked, then the file's size against what they
+ * describe, before anything is allocated: a forged header can neither
+ * make the reader allocate more than the file holds nor read past it. */
+bool sparse_read(sparse_masks *s, const uint8_t *data, size_t size, const char *name,
+                 sparse_error *err)
 {
     memset(s, 0, sizeof *s);
-    uint8_t hdr[8 + 4 * FILE_HEADER_WORDS];
-    if (fread(hdr, 1, sizeof hdr, f) != sizeof hdr || memcmp(hdr, file_magic, 8) != 0)
+    enum { HDR = 8 + 4 * FILE_HEADER_WORDS };
+    if (size < HDR || memcmp(data, file_magic, 8) != 0)
         return fail(err, SPARSE_E_BAD_FILE, name, "bad header");
     uint32_t w[FILE_HEADER_WORDS];
     for (int i = 0; i < FILE_HEADER_WORDS; i++)
-        w[i] = get_u32(hdr + 8 + 4 * i);
+        w[i] = get_u32(data + 8 + 4 * i);
     if (w[0] != FILE_VERSION)
         return fail(err, SPARSE_E_BAD_FILE, name, "unsupported version");
+    /* every word bounded before any arithmetic on it */
+    for (int i = 1; i < FILE_HEADER_WORDS; i++)
+        if (w[i] > 65536)
+            return fail(err, SPARSE_E_BAD_FILE, name, "inconsistent header (a field over 65536)");
     s->width = (int)w[1];
     s->height = (int)w[2];
     s->nmasks = (int)w[3];
@@ -810,12 +799,11 @@ bool sparse_read(sparse_masks *s, FILE *f, const char *name, sparse_error *err)
     s->atlas_cols = (int)w[9];
     s->atlas_rows = (int)w[10];
     /* the header must describe a consistent, reasonably sized object */
-    if (s->width <= 0 || s->height <= 0 || s->width > 65536 || s->height > 65536 ||
-        s->nmasks < 0 || s->nmasks > 4096 ||
+    if (s->width <= 0 || s->height <= 0 || s->nmasks > 4096 ||
         (s->format != SPARSE_R8 && s->format != SPARSE_BC4) ||
         s->cells_x != (s->width + 31) / 32 || s->cells_z != (s->height + 31) / 32 ||
         s->layers != ((s->nmasks + 3) / 4 > 0 ? (s->nmasks + 3) / 4 : 1) ||
-        s->nslots < 0 || s->nslots > SPARSE_MAX_SLOTS || s->atlas_cols <= 0 ||
+        s->nslots > SPARSE_MAX_SLOTS || s->atlas_cols <= 0 ||
         s->atlas_cols > 256 || s->atlas_rows <= 0 || s->atlas_rows > 256 ||
         s->atlas_cols * s->atlas_rows < s->nslots) {
         memset(s, 0, sizeof *s);
@@ -827,26 +815,43 @@ bool sparse_read(sparse_masks *s, FILE *f, const char *name, sparse_error *err)
                      (s->format == SPARSE_BC4 ? 2 : 1);
     size_t n = (size_t)s->cells_x * s->cells_z * 4 * s->layers;
     size_t ncell = (size_t)s->cells_x * s->cells_z * s->nmasks;
-    s->index = xcalloc(n, sizeof *s->index);
-    s->level = xcalloc(n, 1);
-    s->atlas = xcalloc(s->atlas_bytes, 1);
-    s->lo = xcalloc(ncell, sizeof *s->lo);
-    s->hi = xcalloc(ncell, sizeof *s->hi);
+    /* all sizes < 2^48 here (each factor <= 65536 or a small constant) */
+    size_t want = HDR + n * 2 + n + s->atlas_bytes + ncell * 8;
+    if (size != want) {
+        char what[160];
+        snprintf(what, sizeof what, "%s: the header describes %zu bytes, the file has %zu",
+                 size < want ? "truncated" : "trailing bytes", want, size);
+        memset(s, 0, sizeof *s);
+        return fail(err, SPARSE_E_BAD_FILE, name, what);
+    }
+    s->index = calloc(n ? n : 1, sizeof *s->index);
+    s->level = calloc(n ? n : 1, 1);
+    s->atlas = calloc(s->atlas_bytes ? s->atlas_bytes : 1, 1);
+    s->lo = calloc(ncell ? ncell : 1, sizeof *s->lo);
+    s->hi = calloc(ncell ? ncell : 1, sizeof *s->hi);
+    if (!s->index || !s->level || !s->atlas || !s->lo || !s->hi) {
+        sparse_free(s);
+        return fail(err, SPARSE_E_BAD_FILE, name, "does not fit in memory");
+    }
+    const uint8_t *at = data + HDR;
     bool ok = true;
-    for (size_t i = 0; i < n && ok; i++) {
-        uint8_t b[2];
-        ok = fread(b, 1, 2, f) == 2;
-        s->index[i] = (uint16_t)(b[0] | b[1] << 8);
+    for (size_t i = 0; i < n; i++, at += 2) {
+        s->index[i] = (uint16_t)(at[0] | at[1] << 8);
         ok = ok && (s->index[i] == SPARSE_CONST1 || s->index[i] <= (unsigned)s->nslots);
     }
-    ok = ok && fread(s->level, 1, n, f) == n;
-    for (size_t i = 0; i < n && ok; i++)
-        ok = s->level[i] <= SPARSE_MAX_LEVEL;
-    ok = ok && fread(s->atlas, 1, s->atlas_bytes, f) == s->atlas_bytes;
-    ok = ok && read_floats(s->lo, ncell, f) && read_floats(s->hi, ncell, f);
+    memcpy(s->level, at, n);
+    at += n;
+    for (size_t i = 0; i < n; i++)
+        ok = ok && s->level[i] <= SPARSE_MAX_LEVEL;
+    memcpy(s->atlas, at, s->atlas_bytes);
+    at += s->atlas_bytes;
+    for (size_t i = 0; i < 2 * ncell; i++, at += 4) {
+        uint32_t u = get_u32(at);
+        memcpy(i < ncell ? &s->lo[i] : &s->hi[i - ncell], &u, 4);
+    }
     if (!ok) {
         sparse_free(s);
-        return fail(err, SPARSE_E_BAD_FILE, name, "truncated or out-of-range data");
+        return fail(err, SPARSE_E_BAD_FILE, name, "index or level out of range");
     }
     return true;
 }

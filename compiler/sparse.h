@@ -1,4 +1,4 @@
-/* sparse.h — painted masks as sparse quad-tree textures (seed 000 §5.2.4,
+/* sparse.h — painted masks as sparse quad-tree textures (Andersson 2007 §5.2.4,
  * Listing 3; slides 003 "Static sparse mask textures").
  *
  * A painted mask is an 8-bit raster of the heightfield's size (W x H
@@ -194,9 +194,12 @@ bool sparse_load_raster(const char *path, int width, int height,
 /* The pack file "painted.sparse" (little-endian): "SPLATSPM", u32 version
  * (1), u32 width, height, nmasks, format, cells_x, cells_z, layers, nslots,
  * atlas_cols, atlas_rows; then index (u16), level, atlas bytes, and the
- * per-cell bounds lo, hi (float32). */
+ * per-cell bounds lo, hi (float32).  sparse_read parses a file's `size`
+ * bytes: the header is checked for consistency and against `size` before
+ * anything is allocated; any mismatch is SPARSE_E_BAD_FILE. */
 bool sparse_write(const sparse_masks *s, FILE *f);
-bool sparse_read(sparse_masks *s, FILE *f, const char *name, sparse_error *err);
+bool sparse_read(sparse_masks *s, const uint8_t *data, size_t size, const char *name,
+                 sparse_error *err);
 
 /* BC4 (bc4.c): encode one 4x4 block of bytes (row-major) with stb_dxt;
  * decode a block to 16 values in 0..1 with the BC4_UNORM palette. */

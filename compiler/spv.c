@@ -1,6 +1,7 @@
 /* spv.c — GLSL to SPIR-V through glslang's C API, validation through
  * SPIRV-Tools, atomic writes (see spv.h).  spv_optimize is in spv_opt.cpp. */
 #include "spv.h"
+#include "util.h"
 
 #include <errno.h>
 #include <pthread.h>
@@ -302,30 +303,5 @@ bool spv_validate(const uint32_t *words, size_t nwords, char **log)
 
 bool spv_write_file(const char *path, const uint32_t *words, size_t nwords)
 {
-    static atomic_uint counter;
-    unsigned k = atomic_fetch_add(&counter, 1u);
-    size_t len = strlen(path) + 64;
-    char *tmp = malloc(len);
-    if (!tmp) {
-        errno = ENOMEM;
-        return false;
-    }
-    /* "*.tmp-*" is in .gitignore; pid + counter keep threads apart. */
-    snprintf(tmp, len, "%s.tmp-%ld-%u", path, (long)getpid(), k);
-    FILE *f = fopen(tmp, "wb");
-    if (!f) {
-        free(tmp);
-        return false;
-    }
-    bool ok = fwrite(words, sizeof *words, nwords, f) == nwords;
-    ok = (fclose(f) == 0) && ok;
-    if (ok && rename(tmp, path) != 0)
-        ok = false;
-    if (!ok) {
-        int e = errno;
-        remove(tmp);
-        errno = e ? e : EIO;
-    }
-    free(tmp);
-    return ok;
+    return splat_write_atomic(path, words, nwords * sizeof *words);
 }

@@ -61,6 +61,8 @@ static bool load_png(splat_terrain *t, const char *path, sg_loc loc, sg_diags *d
         }
         return false;
     }
+    if (!splat_raster_check_size("heightfield", path, w, h, loc, d))
+        return false;
     if (comp != 1) {
         char msg[256];
         snprintf(msg, sizeof msg, "heightfield '%s' has %d channels; expected a "
@@ -113,6 +115,8 @@ static bool load_r16(splat_terrain *t, const char *path, int w, int h,
         sg_error(d, loc, SG_E_SCENE, msg);
         return false;
     }
+    if (!splat_raster_check_size("heightfield", path, w, h, loc, d))
+        return false;
     FILE *f = fopen(path, "rb");
     if (!f) {
         sg_error(d, loc, SG_E_IO, path, strerror(errno));
@@ -165,9 +169,14 @@ static bool load_r16(splat_terrain *t, const char *path, int w, int h,
 bool splat_terrain_load(splat_terrain *t, const char *path, sg_hf_format fmt,
                         int raw_width, int raw_height, sg_loc loc, sg_diags *d)
 {
-    /* Keep the caller's size / max_height / offset; reset the raster. */
+    /* Keep the caller's size / max_height / offset; reset the raster.  A
+     * GDAL raster brings its own (size only where the caller's is 0). */
     t->texels = NULL;
+    t->holes = NULL;
     t->width = t->height = 0;
+    if (fmt == SG_HF_GDAL)
+        return splat_raster_heightfield(t, path, t->size[0] > 0 && t->size[1] > 0,
+                                        loc, d);
     if (fmt == SG_HF_R16)
         return load_r16(t, path, raw_width, raw_height, loc, d);
     return load_png(t, path, loc, d);
@@ -176,8 +185,82 @@ bool splat_terrain_load(splat_terrain *t, const char *path, sg_hf_format fmt,
 void splat_terrain_free(splat_terrain *t)
 {
     free(t->texels);
+    free(t->holes);
     t->texels = NULL;
+    t->holes = NULL;
     t->width = t->height = 0;
+}
+
+int splat_terrain_hole(const splat_terrain *t, int x, int z)
+{
+    if (!t->holes) return 0;
+    x = x < 0 ? 0 : x >= t->width ? t->width - 1 : x;
+    z = z < 0 ? 0 : z >= t->height ? t->height - 1 : z;
+    return t->holes[(size_t)z * (size_t)t->width + (size_t)x] != 0;
+}
+
+/* Breadth first from the known texels: each round, every hole texel next
+ * to a known one takes the rounded mean of its known 4-neighbours (all
+ * computed before any is written, so the order within a round does not
+ * matter), then counts as known. */
+bool splat_terrain_fill_holes(splat_terrain *t)
+{
+    if (!t->holes) return true;
+    size_t W = (size_t)t->width, H = (size_t)t->height, n = W * H, nholes = 0;
+    for (size_t i = 0; i < n; i++)
+        nholes += t->holes[i] != 0;
+    if (nholes == 0) return true;
+    /* state: 0 known, 1 unknown hole, 2 unknown hole in the next round */
+    uint8_t *state = malloc(n);
+    uint32_t *cur = malloc(nholes * sizeof *cur), *nxt = malloc(nholes * sizeof *nxt);
+    uint16_t *val = malloc(nholes * sizeof *val);
+    if (!state || !cur || !nxt || !val) {
+        free(state); free(cur); free(nxt); free(val);
+        return false;
+    }
+    for (size_t i = 0; i < n; i++)
+        state[i] = t->holes[i] ? 1 : 0;
+    size_t ncur = 0;
+    for (size_t z = 0; z < H; z++)
+        for (size_t x = 0; x < W; x++) {
+            size_t i = z * W + x;
+            if (state[i] != 1) continue;
+            if ((x > 0 && !state[i - 1]) || (x + 1 < W && !state[i + 1]) ||
+                (z > 0 && !state[i - W]) || (z + 1 < H && !state[i + W])) {
+                state[i] = 2;
+                cur[ncur++] = (uint32_t)i;
+            }
+        }
+    while (ncur > 0) {
+        for (size_t k = 0; k < ncur; k++) {
+            size_t i = cur[k], x = i % W, z = i / W;
+            uint32_t sum = 0, cnt = 0;
+            if (x > 0 && !state[i - 1]) { sum += t->texels[i - 1]; cnt++; }
+            if (x + 1 < W && !state[i + 1]) { sum += t->texels[i + 1]; cnt++; }
+            if (z > 0 && !state[i - W]) { sum += t->texels[i - W]; cnt++; }
+            if (z + 1 < H && !state[i + W]) { sum += t->texels[i + W]; cnt++; }
+            val[k] = (uint16_t)((sum + cnt / 2) / cnt);
+        }
+        for (size_t k = 0; k < ncur; k++) {
+            t->texels[cur[k]] = val[k];
+            state[cur[k]] = 0;
+        }
+        size_t nn = 0;
+        for (size_t k = 0; k < ncur; k++) {
+            size_t i = cur[k], x = i % W, z = i / W;
+            size_t nb[4] = { x > 0 ? i - 1 : i, x + 1 < W ? i + 1 : i,
+                             z > 0 ? i - W : i, z + 1 < H ? i + W : i };
+            for (int j = 0; j < 4; j++)
+                if (state[nb[j]] == 1) {
+                    state[nb[j]] = 2;
+                    nxt[nn++] = (uint32_t)nb[j];
+                }
+        }
+        uint32_t *tmp = cur; cur = nxt; nxt = tmp;
+        ncur = nn;
+    }
+    free(state); free(cur); free(nxt); free(val);
+    return true;
 }
 
 /* ---- sampling: the CPU twins of abi.c ----------------------------------- */
@@ -284,6 +367,7 @@ static void gradient_scale(const splat_terrain *t, double *kx, double *kz)
 void splat_terrain_ranges(const splat_terrain *t, int x0, int z0, int x1, int z1,
                           ir_ienv *out)
 {
+    ir_ienv_domain(out);   /* inputs the heightfield does not bound below */
     x0 = clampi(x0, 0, t->width - 1);
     z0 = clampi(z0, 0, t->height - 1);
     x1 = clampi(x1, x0 + 1, t->width);
@@ -352,8 +436,7 @@ void splat_terrain_ranges(const splat_terrain *t, int x0, int z0, int x1, int z1
     out->position[0] = iv(u0 * t->size[0] - ex, u1 * t->size[0] + ex);
     out->position[1] = out->height;
     out->position[2] = iv(v0 * t->size[1] - ez, v1 * t->size[1] + ez);
-    out->view_distance = iv(0.0, INFINITY);
-    out->destruction = iv(0.0, 0.0);
+    out->destruction = iv(0.0, 0.0);    /* scene.h: undamaged at build time */
 }
 
 void splat_terrain_any_shape(const splat_terrain *t, ir_ienv *env)

@@ -6,6 +6,7 @@
  * pixels depend only on (size, seed).  See texgen.h for the mip contract.
  */
 #include "texgen.h"
+#include "util.h"
 
 #include <errno.h>
 #include <math.h>
@@ -391,39 +392,12 @@ static void png_sink(void *ctx, void *data, int size)
     membuf_put(ctx, data, (size_t)size);
 }
 
-/* Write `n` bytes to `path` atomically: a temp file beside it, renamed. */
+/* Write `n` bytes to `path` atomically (util.h). */
 static bool write_atomic(const char *path, const void *data, size_t n, char **err)
 {
-    size_t len = strlen(path);
-    char *tmp = malloc(len + 16);
-    if (!tmp)
-        return fail(err, "%s: out of memory", path);
-    memcpy(tmp, path, len);
-    memcpy(tmp + len, ".tmp-XXXXXX", 12);
-    int fd = mkstemp(tmp);
-    if (fd < 0) {
-        bool r = fail(err, "cannot write '%s': %s", path, strerror(errno));
-        free(tmp);
-        return r;
-    }
-    /* mkstemp creates 0600; texture files are ordinary readable files. */
-    mode_t mask = umask(0);
-    umask(mask);
-    fchmod(fd, 0666 & ~mask);
-    FILE *f = fdopen(fd, "wb");
-    bool ok = f && fwrite(data, 1, n, f) == n;
-    if (f)
-        ok = (fclose(f) == 0) && ok;
-    else
-        close(fd);
-    if (ok)
-        ok = rename(tmp, path) == 0;
-    if (!ok) {
-        fail(err, "cannot write '%s': %s", path, strerror(errno));
-        unlink(tmp);
-    }
-    free(tmp);
-    return ok;
+    if (splat_write_atomic(path, data, n))
+        return true;
+    return fail(err, "cannot write '%s': %s", path, strerror(errno));
 }
 
 bool texgen_write_png(const char *path, const texgen_image *img, char **err)
@@ -576,9 +550,9 @@ static const struct example {
 } examples[] = {
     {"noise", "gradient noise, 8 cells, one octave: the octave source of texture fBm",
      EX_PERLIN, 1, 8, 1, TEXGEN_REDUCE_BOX},
-    {"perlin", "RGBA, four independent fBm channels (16 cells, 2 octaves; seed 002's Perlin texture)",
+    {"perlin", "RGBA, four independent fBm channels (16 cells, 2 octaves; Billingsley 2009's Perlin texture)",
      EX_PERLIN, 4, 16, 2, TEXGEN_REDUCE_BOX},
-    {"uniform", "white noise with nearest-neighbour mips (seed 002 section 2.2)",
+    {"uniform", "white noise with nearest-neighbour mips (Billingsley 2009 §2.2)",
      EX_UNIFORM, 1, 0, 0, TEXGEN_REDUCE_NEAREST},
 #define X(id, name, about) {name, about, EX_DETAIL, TEXGEN_##id, 0, 0, TEXGEN_REDUCE_BOX},
     TEXGEN_DETAILS(X)

@@ -16,7 +16,7 @@
  * mips itself by box filtering (2×2 average, what vkCmdBlitImage with a
  * linear filter gives), which is what texgen_reduce TEXGEN_REDUCE_BOX
  * computes.  Today only the uniform-noise texture needs the files: its mips
- * are nearest-neighbour reductions (seed 002 §2.2: averaging white noise
+ * are nearest-neighbour reductions (Billingsley 2009 §2.2: averaging white noise
  * flattens its peaks, so a material that is "highest" on a few texels
  * vanishes in the distance; picking one texel per 2×2 block keeps the
  * value distribution of the level above).

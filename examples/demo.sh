@@ -1,7 +1,7 @@
 #!/bin/sh
 # demo.sh BUILD — what `make demo` runs after building: compile the colorado
 # scene into a shader pack and render it headless (lavapipe where there is no
-# GPU): the lit picture and the combinations view beside it (seed 000 Fig. 14).
+# GPU): the lit picture and the combinations view beside it (Andersson 2007 Fig. 14).
 set -eu
 BUILD=${1:-build}
 SPLATC="$BUILD/compiler/splatc"

@@ -1,4 +1,4 @@
-/* destruction.c — the dynamic destruction mask (seed 000 §5.2.5, slides 003
+/* destruction.c — the dynamic destruction mask (Andersson 2007 §5.2.5, slides 003
  * "Destruction mask"): craters change the material and the geometry at run
  * time.
  *
@@ -34,6 +34,7 @@
  * Memory (slides: 2048 m at 4 px/m is 64 MB dense): rt_destruction_memory
  * gives the figures for any configuration. */
 #include "splatrt.h"
+#include "util.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -118,13 +119,6 @@ static const char decal_frag[] =
     "    float n = 0.65 * vnoise(w * 0.6) + 0.35 * vnoise(w * 1.9);\n"
     "    o_mask = vec4(u.crater.w * clamp(edge * 4.0 * (0.5 + n), 0.0, 1.0));\n"
     "}\n";
-
-static double now_ms(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec * 1e-6;
-}
 
 /* ---- memory figures --------------------------------------------------------- */
 
@@ -521,7 +515,7 @@ static void update_bounds(rt_destruction *ds, int tx0, int tz0, int tx1, int tz1
 bool rt_destruction_crater(rt_destruction *ds, const rt_crater *c, rt_crater_stats *st,
                            rt_error *e)
 {
-    double t0 = now_ms();
+    double t0 = 1e3 * splat_now();
     rt_crater_stats local;
     if (!st)
         st = &local;
@@ -557,7 +551,7 @@ bool rt_destruction_crater(rt_destruction *ds, const rt_crater *c, rt_crater_sta
         }
     if (ntouched == 0) {
         st->result = RT_CRATER_OUTSIDE;
-        st->cpu_ms = now_ms() - t0;
+        st->cpu_ms = 1e3 * splat_now() - t0;
         return true;
     }
     if (nnew > ds->nfree) {
@@ -568,16 +562,16 @@ bool rt_destruction_crater(rt_destruction *ds, const rt_crater *c, rt_crater_sta
         ds->refused++;
         st->result = RT_CRATER_REFUSED;
         st->cells = ntouched;
-        st->cpu_ms = now_ms() - t0;
+        st->cpu_ms = 1e3 * splat_now() - t0;
         return true;
     }
     int k = ds->slot;
     if (ds->pending[k]) {   /* the oldest event still runs: its memory */
-        double tw = now_ms();
+        double tw = 1e3 * splat_now();
         RT_VK(e, vkWaitForFences(ds->d->dev, 1, &ds->fence[k], VK_TRUE, UINT64_MAX));
         RT_VK(e, vkResetFences(ds->d->dev, 1, &ds->fence[k]));
         ds->pending[k] = false;
-        st->wait_ms = now_ms() - tw;
+        st->wait_ms = 1e3 * splat_now() - tw;
     }
 
     /* 2. tiles and the indirection rectangle */
@@ -712,7 +706,7 @@ bool rt_destruction_crater(rt_destruction *ds, const rt_crater *c, rt_crater_sta
     st->cells = ntouched;
     st->tiles_new = nclear;
     st->tiles_used = ds->used;
-    st->cpu_ms = now_ms() - t0 - st->wait_ms;
+    st->cpu_ms = 1e3 * splat_now() - t0 - st->wait_ms;
     ds->craters++;
     ds->last_ms = st->cpu_ms;
     ds->max_ms = st->cpu_ms > ds->max_ms ? st->cpu_ms : ds->max_ms;
@@ -893,7 +887,7 @@ void rt_destruction_print_stats(const rt_destruction *ds, FILE *out)
         fprintf(out, "crater events: %d (%d refused), cpu ms/event: last %.3f  max %.3f  "
                 "mean %.3f\n", ds->craters, ds->refused, ds->last_ms, ds->max_ms,
                 ds->craters ? ds->total_ms / ds->craters : 0.0);
-    /* this scene's area, and the slides' configuration (seed 003) */
+    /* this scene's area, and the slides' configuration (Andersson 2007 (slides)) */
     double side = ds->n * ds->cell;
     rt_destruction_figures f;
     rt_destruction_memory(side, dens, ds->cell, 0.10, &f);

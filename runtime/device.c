@@ -4,8 +4,10 @@
  * the first discrete GPU, then integrated, virtual, and last the CPU
  * (lavapipe).  SPLAT_VALIDATE=1 turns on VK_LAYER_KHRONOS_validation and a
  * debug messenger that prints and counts every warning and error, so tests
- * can demand zero. */
+ * can demand zero; asked for and not installed is an error
+ * (RT_E_NO_VALIDATION), never a silent run without it. */
 #include "splatrt.h"
+#include "ir.h"
 
 #include <ctype.h>
 #include <stdarg.h>
@@ -105,10 +107,8 @@ static bool create_instance(rt_device *d, const rt_device_desc *desc, rt_error *
     const char *env = getenv("SPLAT_VALIDATE");
     bool validate = desc->validate || (env && !strcmp(env, "1"));
     const char *layer = "VK_LAYER_KHRONOS_validation";
-    if (validate && !has_layer(layer)) {
-        fprintf(stderr, "splatrt: warning: SPLAT_VALIDATE=1 but %s is not installed\n", layer);
-        validate = false;
-    }
+    if (validate && !has_layer(layer))
+        return rt_fail(e, RT_E_NO_VALIDATION, layer);
     const char *exts[16];
     uint32_t next = 0;
     for (uint32_t i = 0; i < desc->ninstance_exts && next < 15; i++)
@@ -264,6 +264,12 @@ bool rt_device_create(rt_device *d, const rt_device_desc *desc, rt_error *e)
     d->wireframe = have.fillModeNonSolid;
     want.textureCompressionBC = have.textureCompressionBC;   /* sparse masks */
     d->bc = have.textureCompressionBC;
+    /* the shared vertex shader cuts terrain holes with a clip distance */
+    if (!have.shaderClipDistance) {
+        rt_device_destroy(d);
+        return rt_fail(e, RT_E_NO_FORMAT, "write clip distances (shaderClipDistance: terrain holes)");
+    }
+    want.shaderClipDistance = VK_TRUE;
 
     float prio = 1.0f;
     VkDeviceQueueCreateInfo qci = {
@@ -472,6 +478,16 @@ bool rt_oneshot_end(rt_device *d, VkCommandBuffer cb, rt_error *e)
     if (r != VK_SUCCESS)
         return rt_fail(e, RT_E_VULKAN, "one-time submit", rt_vk_result_name(r));
     return true;
+}
+
+VkSamplerAddressMode rt_sampler_wrap(int ir_wrap)
+{
+    switch ((enum ir_wrap)ir_wrap) {
+    case IR_WRAP_CLAMP:  return VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE;
+    case IR_WRAP_MIRROR: return VK_SAMPLER_ADDRESS_MODE_MIRRORED_REPEAT;
+    case IR_WRAP_REPEAT: break;
+    }
+    return VK_SAMPLER_ADDRESS_MODE_REPEAT;
 }
 
 void rt_cmd_image_barrier(VkCommandBuffer cb, VkImage img, uint32_t mip, uint32_t nmips,

@@ -4,10 +4,15 @@
  * combination id in combos.bin (in range).  A bad pack is a message that
  * names the file and the field, never a crash or a validation error. */
 #include "splatrt.h"
+#include "ir.h"
 
 #include <errno.h>
+#include <fcntl.h>
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include <jansson.h>
 #include <stb_image.h>
@@ -16,9 +21,16 @@ typedef struct reader {
     const char *manifest;   /* path, for messages */
     rt_pack    *p;
     rt_error   *e;
+    int         dirfd;      /* the pack folder: every file opened under it */
 } reader;
 
-static char *dup(const char *s)
+/* Files bigger than these are refused before they are read. */
+#define MAX_MANIFEST ((size_t)64 << 20)
+#define MAX_SPIRV    ((size_t)64 << 20)
+#define MAX_IMAGE    ((size_t)1 << 30)
+#define MAX_BINARY   ((size_t)1 << 31)
+
+static char *xstrdup(const char *s)
 {
     size_t n = strlen(s) + 1;
     char *d = malloc(n);
@@ -36,39 +48,121 @@ static char *join(const char *dir, const char *rel)
     return s;
 }
 
-/* Read a whole file; NULL with errno set on failure. */
-static uint8_t *slurp(const char *path, size_t *size)
+/* ---- pack files: untrusted input ----------------------------------------
+ * Every file of a pack is opened here, relative to the pack folder, one
+ * path component at a time with O_NOFOLLOW: no absolute path, no "..", no
+ * symbolic link anywhere on the way (a link out of the pack, or to
+ * /dev/zero, is never followed), and only a regular file at the end (a
+ * FIFO would block a reader forever, a device never ends).  The size comes
+ * from fstat before a byte is read, and reads stop at that size. */
+
+int rt_pack_open_file(int dirfd, const char *rel, char *why, size_t nwhy)
 {
-    FILE *f = fopen(path, "rb");
-    if (!f)
-        return NULL;
-    uint8_t *buf = NULL;
-    size_t n = 0, cap = 0;
-    for (;;) {
-        if (n == cap) {
-            cap = cap ? cap * 2 : 65536;
-            uint8_t *nb = realloc(buf, cap);
-            if (!nb) {
-                free(buf);
-                fclose(f);
-                errno = ENOMEM;
-                return NULL;
-            }
-            buf = nb;
-        }
-        size_t got = fread(buf + n, 1, cap - n, f);
-        n += got;
-        if (got == 0)
+    if (!rel[0] || rel[0] == '/') {
+        snprintf(why, nwhy, "is outside the pack (an absolute or empty path)");
+        return -1;
+    }
+    size_t len = strlen(rel);
+    char *path = malloc(len + 1);
+    if (!path) {
+        snprintf(why, nwhy, "cannot be opened (out of memory)");
+        return -1;
+    }
+    memcpy(path, rel, len + 1);
+    int cur = dirfd, fd = -1;
+    char *save = NULL;
+    for (char *c = strtok_r(path, "/", &save); c; c = strtok_r(NULL, "/", &save)) {
+        bool last = save == NULL || *save == '\0';
+        if (!strcmp(c, "..")) {
+            snprintf(why, nwhy, "is outside the pack (\"..\")");
             break;
+        }
+        struct stat st;
+        if (fstatat(cur, c, &st, AT_SYMLINK_NOFOLLOW) != 0) {
+            snprintf(why, nwhy, "cannot be read (%s)", strerror(errno));
+            break;
+        }
+        if (S_ISLNK(st.st_mode)) {
+            snprintf(why, nwhy, "is%s a symbolic link (a pack holds only regular files)",
+                     last ? "" : " inside");
+            break;
+        }
+        if (!last && !S_ISDIR(st.st_mode)) {
+            snprintf(why, nwhy, "cannot be read ('%s' is not a folder)", c);
+            break;
+        }
+        if (last && !S_ISREG(st.st_mode)) {
+            snprintf(why, nwhy, "is not a regular file (%s)",
+                     S_ISFIFO(st.st_mode) ? "a FIFO" : S_ISDIR(st.st_mode) ? "a folder"
+                     : S_ISCHR(st.st_mode) || S_ISBLK(st.st_mode) ? "a device" : "a socket");
+            break;
+        }
+        int next = openat(cur, c, O_RDONLY | O_NOFOLLOW | O_CLOEXEC | O_NOCTTY |
+                                      (last ? O_NONBLOCK : O_DIRECTORY));
+        struct stat st2;
+        if (next >= 0 && (fstat(next, &st2) != 0 || st2.st_dev != st.st_dev ||
+                          st2.st_ino != st.st_ino)) {
+            close(next);   /* replaced between the look and the open */
+            next = -1;
+            errno = ESTALE;
+        }
+        if (next < 0) {
+            snprintf(why, nwhy, "cannot be read (%s)", strerror(errno));
+            break;
+        }
+        if (cur != dirfd)
+            close(cur);
+        cur = next;
+        if (last) {
+            fd = cur;
+            cur = dirfd;
+        }
     }
-    bool err = ferror(f);
-    fclose(f);
-    if (err) {
-        free(buf);
-        errno = EIO;
+    if (cur != dirfd)
+        close(cur);
+    free(path);
+    if (fd >= 0)
+        fcntl(fd, F_SETFL, 0);   /* a regular file: blocking reads again */
+    return fd;
+}
+
+uint8_t *rt_pack_read_file(int dirfd, const char *rel, size_t max, size_t *n, char *why,
+                           size_t nwhy)
+{
+    int fd = rt_pack_open_file(dirfd, rel, why, nwhy);
+    if (fd < 0)
         return NULL;
+    struct stat st;
+    uint8_t *buf = NULL;
+    if (fstat(fd, &st) != 0) {
+        snprintf(why, nwhy, "cannot be read (%s)", strerror(errno));
+    } else if ((uint64_t)st.st_size > max) {
+        snprintf(why, nwhy, "has %llu bytes, more than the %zu it may have",
+                 (unsigned long long)st.st_size, max);
+    } else if (!(buf = malloc((size_t)st.st_size + 1))) {
+        snprintf(why, nwhy, "does not fit in memory (%llu bytes)",
+                 (unsigned long long)st.st_size);
+    } else {
+        size_t size = (size_t)st.st_size, got = 0;
+        while (got < size) {
+            ssize_t r = read(fd, buf + got, size - got);
+            if (r < 0 && errno == EINTR)
+                continue;
+            if (r <= 0) {
+                snprintf(why, nwhy, "cannot be read (%s)",
+                         r < 0 ? strerror(errno) : "it shrank while being read");
+                free(buf);
+                buf = NULL;
+                break;
+            }
+            got += (size_t)r;
+        }
+        if (buf) {
+            buf[size] = 0;   /* text files end in a NUL */
+            *n = size;
+        }
     }
-    *size = n;
+    close(fd);
     return buf;
 }
 
@@ -176,26 +270,19 @@ static bool get_vec(reader *r, json_t *obj, const char *key, const char *where,
     return true;
 }
 
-/* A file of the pack: present, of the expected size if size > 0. */
+/* A file of the pack (rt_pack_read_file): of exactly `want` bytes if want
+ * > 0, else at most `max`. */
 static uint8_t *pack_file(reader *r, const char *field, const char *rel,
-                          size_t want, size_t *got)
+                          size_t want, size_t max, size_t *got)
 {
-    if (strstr(rel, "..") || rel[0] == '/') {
-        rt_fail(r->e, RT_E_PACK_FILE, r->manifest, field, rel, "is outside the pack");
-        return NULL;
-    }
-    char *path = join(r->p->dir, rel);
+    char why[256];
     size_t n = 0;
-    uint8_t *data = path ? slurp(path, &n) : NULL;
-    free(path);
+    uint8_t *data = rt_pack_read_file(r->dirfd, rel, want ? want : max, &n, why, sizeof why);
     if (!data) {
-        char why[160];
-        snprintf(why, sizeof why, "cannot be read (%s)", strerror(errno));
         rt_fail(r->e, RT_E_PACK_FILE, r->manifest, field, rel, why);
         return NULL;
     }
     if (want && n != want) {
-        char why[160];
         snprintf(why, sizeof why, "has %zu bytes, expected %zu", n, want);
         rt_fail(r->e, RT_E_PACK_FILE, r->manifest, field, rel, why);
         free(data);
@@ -215,10 +302,10 @@ static bool read_spirv(reader *r, json_t *obj, const char *where, rt_spirv *out)
     char field[256];
     snprintf(field, sizeof field, "%s.spirv", where);
     size_t n = 0;
-    uint8_t *data = pack_file(r, field, rel, 0, &n);
+    uint8_t *data = pack_file(r, field, rel, 0, MAX_SPIRV, &n);
     if (!data)
         return false;
-    out->path = dup(rel);
+    out->path = xstrdup(rel);
     if (n % 4) {
         free(data);
         char path[512];
@@ -244,16 +331,16 @@ static bool read_scene(reader *r, json_t *root)
     json_t *nm = get(r, scene, "name", "scene", false);
     if (json_is_string(nm))
         name = json_string_value(nm);
-    p->name = dup(name);
+    p->name = xstrdup(name);
     json_t *sp = get(r, scene, "source", "scene", false);
     if (json_is_string(sp))
-        p->scene_path = dup(json_string_value(sp));
+        p->scene_path = xstrdup(json_string_value(sp));
 
     json_t *hf = get(r, scene, "heightfield", "scene", true);
     const char *file;
     if (!hf || !get_string(r, hf, "file", "scene.heightfield", &file) ||
-        !get_int(r, hf, "width", "scene.heightfield", 1, 1 << 16, &p->hf_width) ||
-        !get_int(r, hf, "height", "scene.heightfield", 1, 1 << 16, &p->hf_height))
+        !get_int(r, hf, "width", "scene.heightfield", 1, SPLAT_MAX_HEIGHTFIELD, &p->hf_width) ||
+        !get_int(r, hf, "height", "scene.heightfield", 1, SPLAT_MAX_HEIGHTFIELD, &p->hf_height))
         return false;
     double size[2];
     if (!get_vec(r, scene, "size", "scene", 2, size) ||
@@ -267,11 +354,25 @@ static bool read_scene(reader *r, json_t *root)
     if (get(r, scene, "height_offset", "scene", false) &&
         !get_number(r, scene, "height_offset", "scene", &p->height_offset))
         return false;
-    if (!get_int(r, scene, "cell_texels", "scene", 1, 1 << 16, &p->cell_texels))
+    if (!get_int(r, scene, "cell_texels", "scene", 1, 4096, &p->cell_texels))
         return false;
+    if (p->cell_texels & (p->cell_texels - 1))
+        return field_fail(r, "scene.cell_texels:", "must be a power of two");
+    int side = p->hf_width > p->hf_height ? p->hf_width : p->hf_height;
+    int cells = (side + p->cell_texels - 1) / p->cell_texels;
+    if (cells > SPLAT_MAX_CELLS) {
+        char what[160];
+        snprintf(what, sizeof what, "gives %d leaf cells per side, over the pack limit of %d",
+                 cells, SPLAT_MAX_CELLS);
+        return field_fail(r, "scene.cell_texels:", what);
+    }
+    if (!isfinite(p->size[0]) || !isfinite(p->size[1]) || !isfinite(p->max_height) ||
+        !isfinite(p->height_offset) || p->max_height < 0)
+        return field_fail(r, "scene:", "size, max_height and height_offset must be finite "
+                          "(max_height >= 0)");
 
     size_t texels = (size_t)p->hf_width * (size_t)p->hf_height;
-    uint8_t *raw = pack_file(r, "scene.heightfield.file", file, texels * 2, NULL);
+    uint8_t *raw = pack_file(r, "scene.heightfield.file", file, texels * 2, 0, NULL);
     if (!raw)
         return false;
     p->heights = malloc(texels * sizeof *p->heights);
@@ -282,6 +383,15 @@ static bool read_scene(reader *r, json_t *root)
     for (size_t i = 0; i < texels; i++)
         p->heights[i] = (uint16_t)(raw[2 * i] | raw[2 * i + 1] << 8);
     free(raw);
+    /* the terrain's holes (PACK.md), optional: W*H bytes, 0 or 255 */
+    if (get(r, hf, "holes", "scene.heightfield", false)) {
+        const char *hfile;
+        if (!get_string(r, hf, "holes", "scene.heightfield", &hfile))
+            return false;
+        p->holes = pack_file(r, "scene.heightfield.holes", hfile, texels, 0, NULL);
+        if (!p->holes)
+            return false;
+    }
 
     /* the destructible area (destruction.c), or null */
     json_t *dd = get(r, scene, "destruction", "scene", false);
@@ -290,14 +400,26 @@ static bool read_scene(reader *r, json_t *root)
             !get_vec(r, dd, "size", "scene.destruction", 2, p->destr_size) ||
             !get_number(r, dd, "cell_size", "scene.destruction", &p->destr_cell))
             return false;
-        if (!(p->destr_cell > 0) || !(p->destr_size[0] > 0) || !(p->destr_size[1] > 0))
-            return field_fail(r, "scene.destruction:", "needs a positive size and cell_size");
+        if (!(p->destr_cell > 0) || !(p->destr_size[0] > 0) || !(p->destr_size[1] > 0) ||
+            !isfinite(p->destr_origin[0]) || !isfinite(p->destr_origin[1]) ||
+            !isfinite(p->destr_size[0]) || !isfinite(p->destr_size[1]))
+            return field_fail(r, "scene.destruction:", "needs a finite origin, a positive size "
+                              "and a positive cell_size");
+        double side = p->destr_size[0] > p->destr_size[1] ? p->destr_size[0] : p->destr_size[1];
+        if (!(side / p->destr_cell <= SPLAT_MAX_DESTRUCTION_CELLS)) {
+            char what[200];
+            snprintf(what, sizeof what, "size / cell_size is %.0f cells per side, over the "
+                     "pack limit of %d", ceil(side / p->destr_cell), SPLAT_MAX_DESTRUCTION_CELLS);
+            return field_fail(r, "scene.destruction:", what);
+        }
         p->has_destruction = true;
     }
     json_t *cams = get_array(r, scene, "cameras", "scene", false);
     if (cams) {
         p->ncameras = (int)json_array_size(cams);
         p->cameras = calloc((size_t)p->ncameras + 1, sizeof *p->cameras);
+        if (!p->cameras)
+            return false;
         for (int i = 0; i < p->ncameras; i++) {
             json_t *c = json_array_get(cams, (size_t)i);
             char where[64];
@@ -307,7 +429,7 @@ static bool read_scene(reader *r, json_t *root)
                 !get_vec(r, c, "position", where, 3, p->cameras[i].position) ||
                 !get_vec(r, c, "look", where, 3, p->cameras[i].look))
                 return false;
-            p->cameras[i].name = dup(cn);
+            p->cameras[i].name = xstrdup(cn);
         }
     }
     return true;
@@ -323,6 +445,8 @@ static bool read_materials(reader *r, json_t *root)
     if (p->nmaterials == 0)
         return field_fail(r, "materials:", "is empty");
     p->materials = calloc((size_t)p->nmaterials, sizeof *p->materials);
+    if (!p->materials)
+        return false;
     for (int i = 0; i < p->nmaterials; i++) {
         json_t *m = json_array_get(mats, (size_t)i);
         char where[64];
@@ -330,10 +454,10 @@ static bool read_materials(reader *r, json_t *root)
         const char *name;
         if (!get_string(r, m, "name", where, &name))
             return false;
-        p->materials[i].name = dup(name);
+        p->materials[i].name = xstrdup(name);
         json_t *src = get(r, m, "source", where, false);
         if (json_is_string(src))
-            p->materials[i].source = dup(json_string_value(src));
+            p->materials[i].source = xstrdup(json_string_value(src));
         json_t *ref = get(r, m, "reference", where, false);
         if (ref && !json_is_null(ref)) {
             char w2[96];
@@ -358,6 +482,8 @@ static bool read_params(reader *r, json_t *root)
         return !r->e->msg;
     p->nparams = (int)json_array_size(ps);
     p->params = calloc((size_t)p->nparams + 1, sizeof *p->params);
+    if (!p->params)
+        return false;
     for (int i = 0; i < p->nparams; i++) {
         json_t *q = json_array_get(ps, (size_t)i);
         char where[64];
@@ -371,7 +497,7 @@ static bool read_params(reader *r, json_t *root)
             return false;
         if (off % 16)
             return field_fail(r, where, "offset must be a multiple of 16");
-        p->params[i].name = dup(name);
+        p->params[i].name = xstrdup(name);
         p->params[i].offset = (uint32_t)off;
         for (int k = 0; k < 4; k++)
             p->params[i].value[k] = (float)def[k];
@@ -397,9 +523,20 @@ static char *mip_name(const char *file, int k)
  * each must have the size of its level. */
 static bool read_mips(reader *r, json_t *t, const char *where, rt_pack_texture *tx)
 {
-    int n;
+    int n, side = tx->width > tx->height ? tx->width : tx->height, levels = 1;
+    while (side >> levels)
+        levels++;   /* floor(log2(side)) + 1 levels down to 1x1 */
     if (!get_int(r, t, "mips", where, 1, 31, &n))
         return false;
+    if (n + 1 > levels) {
+        char what[160];
+        snprintf(what, sizeof what, "is %d: %d levels with the base, more than the %d "
+                 "(log2(%d) + 1) a %dx%d texture has", n, n + 1, levels, side, tx->width,
+                 tx->height);
+        char w[96];
+        snprintf(w, sizeof w, "%s.mips", where);
+        return field_fail(r, w, what);
+    }
     tx->mips = calloc((size_t)n, sizeof *tx->mips);
     if (!tx->mips)
         return rt_fail(r->e, RT_E_VULKAN, "textures", "out of memory");
@@ -410,15 +547,21 @@ static bool read_mips(reader *r, json_t *t, const char *where, rt_pack_texture *
             return rt_fail(r->e, RT_E_VULKAN, "textures", "out of memory");
         snprintf(field, sizeof field, "%s.mips[%d]", where, k);
         size_t bytes;
-        uint8_t *data = pack_file(r, field, file, 0, &bytes);
+        uint8_t *data = pack_file(r, field, file, 0, MAX_IMAGE, &bytes);
         int w = 0, h = 0, ch;
-        if (data)
+        if (data && stbi_info_from_memory(data, (int)bytes, &w, &h, &ch) &&
+            w == (tx->width >> k > 0 ? tx->width >> k : 1) &&
+            h == (tx->height >> k > 0 ? tx->height >> k : 1))
             tx->mips[k - 1] = stbi_load_from_memory(data, (int)bytes, &w, &h, &ch, 4);
         free(data);
         int ww = tx->width >> k > 0 ? tx->width >> k : 1;
         int wh = tx->height >> k > 0 ? tx->height >> k : 1;
         bool ok = data && tx->mips[k - 1];
-        if (data && !ok)
+        if (data && !ok && (w != ww || h != wh) && w > 0) {
+            char msg[96];
+            snprintf(msg, sizeof msg, "is %dx%d, its level needs %dx%d", w, h, ww, wh);
+            rt_fail(r->e, RT_E_PACK_FILE, r->manifest, field, file, msg);
+        } else if (data && !ok)
             rt_fail(r->e, RT_E_PACK_FILE, r->manifest, field, file,
                     "is not an image stb_image can read");
         else if (ok && (w != ww || h != wh)) {
@@ -441,7 +584,16 @@ static bool read_textures(reader *r, json_t *root)
     if (!ts)
         return !r->e->msg;
     p->ntextures = (int)json_array_size(ts);
+    if (p->ntextures > SPLAT_MAX_TEXTURES) {
+        char what[96];
+        snprintf(what, sizeof what, "has %d entries, over the pack limit of %d", p->ntextures,
+                 SPLAT_MAX_TEXTURES);
+        p->ntextures = 0;
+        return field_fail(r, "textures:", what);
+    }
     p->textures = calloc((size_t)p->ntextures + 1, sizeof *p->textures);
+    if (!p->textures)
+        return false;
     for (int i = 0; i < p->ntextures; i++) {
         json_t *t = json_array_get(ts, (size_t)i);
         rt_pack_texture *tx = &p->textures[i];
@@ -460,22 +612,32 @@ static bool read_textures(reader *r, json_t *root)
             return false;
         if (get(r, t, "wrap", where, false) && !get_string(r, t, "wrap", where, &wrap))
             return false;
-        tx->file = dup(file);
+        tx->file = xstrdup(file);
         tx->binding = (uint32_t)binding;
-        tx->linear = strcmp(filter, "nearest") != 0;
-        tx->mip_linear = strcmp(mip, "nearest") != 0;
-        tx->wrap = !strcmp(wrap, "clamp") ? VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE
-                 : !strcmp(wrap, "mirror") ? VK_SAMPLER_ADDRESS_MODE_MIRRORED_REPEAT
-                 : VK_SAMPLER_ADDRESS_MODE_REPEAT;
+        int f = ir_filter_by_name(filter), mf = ir_filter_by_name(mip), wr = ir_wrap_by_name(wrap);
+        if (f < 0 || mf < 0 || wr < 0)   /* ir.h's sampler names */
+            return field_fail(r, where, "unknown filter, mip or wrap name");
+        tx->linear = f == IR_FILTER_LINEAR;
+        tx->mip_linear = mf == IR_FILTER_LINEAR;
+        tx->wrap = rt_sampler_wrap((ir_wrap)wr);
         json_t *srgb = get(r, t, "srgb", where, false);
         tx->srgb = json_is_true(srgb);
         char field[96];
         snprintf(field, sizeof field, "%s.file", where);
         size_t n;
-        uint8_t *data = pack_file(r, field, file, 0, &n);
+        uint8_t *data = pack_file(r, field, file, 0, MAX_IMAGE, &n);
         if (!data)
             return false;
-        int ch;
+        int ch, w, h;
+        /* the size from the header before anything is decoded */
+        if (stbi_info_from_memory(data, (int)n, &w, &h, &ch) &&
+            (w > SPLAT_MAX_TEXTURE || h > SPLAT_MAX_TEXTURE)) {
+            free(data);
+            char msg[160];
+            snprintf(msg, sizeof msg, "is %dx%d, over the pack limit of %d texels per side", w,
+                     h, SPLAT_MAX_TEXTURE);
+            return rt_fail(r->e, RT_E_PACK_FILE, r->manifest, field, file, msg);
+        }
         tx->rgba = stbi_load_from_memory(data, (int)n, &tx->width, &tx->height, &ch, 4);
         free(data);
         if (!tx->rgba)
@@ -491,19 +653,82 @@ static bool read_painted(reader *r, json_t *root)
 {
     rt_pack *p = r->p;
     json_t *pa = get_array(r, root, "painted", "manifest", false);
-    if (!pa || json_array_size(pa) == 0)
-        return !r->e->msg;
-    p->npainted = (int)json_array_size(pa);
-    /* sparse quad-tree (painted.c) unless painted_format says dense */
-    json_t *fmt = get(r, root, "painted_format", "manifest", false);
-    if (fmt && strcmp(json_string_value(fmt) ? json_string_value(fmt) : "", "dense")) {
-        const char *file;
-        return get_string(r, root, "painted_file", "manifest", &file) &&
-               rt_painted_read(p, file, r->e);
+    if (!pa && r->e->msg)
+        return false;
+    p->npainted = pa ? (int)json_array_size(pa) : 0;
+    if (p->npainted > SPLAT_MAX_PAINTED) {
+        char what[96];
+        snprintf(what, sizeof what, "has %d masks, over the pack limit of %d", p->npainted,
+                 SPLAT_MAX_PAINTED);
+        return field_fail(r, "painted:", what);
+    }
+    /* sparse quad-tree (painted.c) unless painted_format says dense;
+     * absent: dense (PACK.md) */
+    const char *fmt = "dense", *file = "painted.r8";
+    if (get(r, root, "painted_format", "manifest", false) &&
+        !get_string(r, root, "painted_format", "manifest", &fmt))
+        return false;
+    if (strcmp(fmt, "dense") && strcmp(fmt, "bc4") && strcmp(fmt, "r8"))
+        return field_fail(r, "painted_format:", "must be \"dense\", \"bc4\" or \"r8\"");
+    bool dense = !strcmp(fmt, "dense");
+    if ((!dense || get(r, root, "painted_file", "manifest", false)) &&
+        !get_string(r, root, "painted_file", "manifest", &file))
+        return false;
+    if (dense && p->npainted == 0)
+        return true;   /* no masks: one zero layer (terrain.c) */
+    /* a sparse pack's shaders sample the atlas even without masks (the
+     * file then holds none), so it is read and bound the same way */
+    if (!dense) {
+        size_t n = 0;
+        uint8_t *data = pack_file(r, "painted_file", file, 0, MAX_BINARY, &n);
+        bool ok = data && rt_painted_read(p, r->manifest, file, data, n, r->e);
+        free(data);
+        if (ok && (p->sparse->format == SPARSE_BC4) != !strcmp(fmt, "bc4")) {
+            char what[160];
+            snprintf(what, sizeof what, "holds %s masks, the manifest's painted_format is %s",
+                     p->sparse->format == SPARSE_BC4 ? "bc4" : "r8", fmt);
+            ok = rt_fail(r->e, RT_E_PACK_FILE, r->manifest, "painted_file", file, what);
+        }
+        return ok;
     }
     size_t bytes = (size_t)p->npainted * (size_t)p->hf_width * (size_t)p->hf_height;
-    p->painted = pack_file(r, "painted", "painted.r8", bytes, NULL);
+    p->painted = pack_file(r, "painted_file", file, bytes, 0, NULL);
     return p->painted != NULL;
+}
+
+/* The periodic sites of terrain.position (PACK.md), optional. */
+static bool read_sites(reader *r, json_t *root)
+{
+    rt_pack *p = r->p;
+    json_t *ss = get(r, root, "world_sites", "manifest", false);
+    if (!ss)
+        return true;
+    if (!json_is_array(ss) || json_array_size(ss) > SPLAT_WORLD_SITES)
+        return field_fail(r, "world_sites:", "must be an array of at most 16 sites");
+    p->nsites = (int)json_array_size(ss);
+    for (int i = 0; i < p->nsites; i++) {
+        json_t *o = json_array_get(ss, (size_t)i);
+        rt_pack_site *st = &p->sites[i];
+        char where[64];
+        snprintf(where, sizeof where, "world_sites[%d]", i);
+        const char *axes, *op;
+        if (!get_string(r, o, "axes", where, &axes) || !get_string(r, o, "op", where, &op))
+            return false;
+        if (strlen(axes) != 2 || !strchr("xyz", axes[0]) || !strchr("xyz", axes[1]) ||
+            (strcmp(op, "div") && strcmp(op, "mul")))
+            return field_fail(r, where, "axes must be two of x y z, op div or mul");
+        st->axes[0] = (int)(strchr("xyz", axes[0]) - "xyz");
+        st->axes[1] = (int)(strchr("xyz", axes[1]) - "xyz");
+        st->mul = op[0] == 'm';
+        st->param = -1;
+        if (get(r, o, "param", where, false)) {
+            if (!get_int(r, o, "param", where, 0, p->nparams - 1, &st->param))
+                return false;
+        } else if (!get_vec(r, o, "scale", where, 2, st->scale)) {
+            return false;
+        }
+    }
+    return true;
 }
 
 static bool read_combos(reader *r, json_t *root)
@@ -518,6 +743,8 @@ static bool read_combos(reader *r, json_t *root)
     if (p->ncombos > 65535)
         return field_fail(r, "combinations:", "has more than 65535 entries");
     p->combos = calloc((size_t)p->ncombos, sizeof *p->combos);
+    if (!p->combos)
+        return false;
     for (int i = 0; i < p->ncombos; i++) {
         json_t *c = json_array_get(cs, (size_t)i);
         char where[64];
@@ -533,6 +760,8 @@ static bool read_combos(reader *r, json_t *root)
         rt_pack_combo *co = &p->combos[i];
         co->nmaterials = (int)json_array_size(ms);
         co->materials = calloc((size_t)co->nmaterials + 1, sizeof *co->materials);
+        if (!co->materials)
+            return false;
         for (int k = 0; k < co->nmaterials; k++) {
             json_t *m = json_array_get(ms, (size_t)k);
             if (!json_is_integer(m) || json_integer_value(m) < 0 ||
@@ -542,6 +771,41 @@ static bool read_combos(reader *r, json_t *root)
         }
         if (!read_spirv(r, c, where, &co->spirv))
             return false;
+    }
+    return true;
+}
+
+bool rt_combos_parse(const uint8_t *data, size_t n, int cells_x, int cells_z,
+                     const int64_t *offsets, int ncombos, bool holes,
+                     rt_pack_level *levels, const char *path, rt_error *e)
+{
+    int nlevels = rt_level_count(cells_x, cells_z), w = cells_x, h = cells_z;
+    for (int L = 0; L < nlevels; L++) {
+        size_t nodes = (size_t)w * (size_t)h, off = (size_t)offsets[L];
+        if (offsets[L] < 0 || off > n || nodes * 2 > n - off) {
+            char what[200];
+            snprintf(what, sizeof what, "level %d (%dx%d nodes at offset %lld) runs past the "
+                     "end of the file (%zu bytes)", L, w, h, (long long)offsets[L], n);
+            return rt_fail(e, RT_E_PACK_FIELD, path, what);
+        }
+        rt_pack_level *pl = &levels[L];
+        pl->width = w;
+        pl->height = h;
+        pl->ids = malloc(nodes * 2);
+        if (!pl->ids)
+            return rt_fail(e, RT_E_PACK_FIELD, path, "does not fit in memory");
+        for (size_t i = 0; i < nodes; i++) {
+            pl->ids[i] = (uint16_t)(data[off + 2 * i] | data[off + 2 * i + 1] << 8);
+            /* a node all hole (PACK.md) only where the terrain has holes */
+            if (pl->ids[i] >= ncombos && !(pl->ids[i] == SPLAT_COMBO_HOLE && holes)) {
+                char at[160];
+                snprintf(at, sizeof at, "level %d node (%zu, %zu)", L, i % (size_t)w,
+                         i / (size_t)w);
+                return rt_fail(e, RT_E_PACK_COMBO, path, pl->ids[i], ncombos, at);
+            }
+        }
+        w = (w + 1) / 2;
+        h = (h + 1) / 2;
     }
     return true;
 }
@@ -564,15 +828,15 @@ static bool read_quadtree(reader *r, json_t *root)
         snprintf(what, sizeof what, "must have %d levels for %dx%d cells", want, cx, cz);
         return field_fail(r, "quadtree.levels", what);
     }
-    size_t n = 0;
-    uint8_t *data = pack_file(r, "quadtree.file", file, 0, &n);
-    if (!data)
-        return false;
-    p->nlevels = want;
+    int64_t *offsets = calloc((size_t)want, sizeof *offsets);
     p->levels = calloc((size_t)want, sizeof *p->levels);
-    bool ok = true;
+    if (!offsets || !p->levels) {
+        free(offsets);
+        return false;
+    }
+    p->nlevels = want;
     int w = cx, h = cz;
-    for (int L = 0; L < want && ok; L++) {
+    for (int L = 0; L < want; L++) {
         json_t *l = json_array_get(lv, (size_t)L);
         char where[64];
         snprintf(where, sizeof where, "quadtree.levels[%d]", L);
@@ -580,42 +844,62 @@ static bool read_quadtree(reader *r, json_t *root)
         if (!get_int(r, l, "width", where, 1, 1 << 20, &lw) ||
             !get_int(r, l, "height", where, 1, 1 << 20, &lh) ||
             !get_int(r, l, "offset", where, 0, 0x7fffffff, &off)) {
-            ok = false;
-            break;
+            free(offsets);
+            return false;
         }
         if (lw != w || lh != h) {
             char what[96];
             snprintf(what, sizeof what, "must be %dx%d nodes", w, h);
-            ok = field_fail(r, where, what);
-            break;
+            free(offsets);
+            return field_fail(r, where, what);
         }
-        size_t bytes = (size_t)lw * (size_t)lh * 2;
-        if ((size_t)off + bytes > n) {
-            char path[512];
-            snprintf(path, sizeof path, "%s/%s", p->dir, file);
-            ok = rt_fail(r->e, RT_E_PACK_FILE, r->manifest, where, file,
-                         "is too short for this level");
-            break;
-        }
-        rt_pack_level *pl = &p->levels[L];
-        pl->width = lw;
-        pl->height = lh;
-        pl->ids = malloc(bytes);
-        for (size_t i = 0; i < (size_t)lw * (size_t)lh; i++) {
-            pl->ids[i] = (uint16_t)(data[off + 2 * i] | data[off + 2 * i + 1] << 8);
-            if (pl->ids[i] >= p->ncombos) {
-                char at[160], path[512];
-                snprintf(at, sizeof at, "level %d node (%zu, %zu)", L,
-                         i % (size_t)lw, i / (size_t)lw);
-                snprintf(path, sizeof path, "%s/%s", p->dir, file);
-                ok = rt_fail(r->e, RT_E_PACK_COMBO, path, pl->ids[i], p->ncombos, at);
-                break;
-            }
-        }
+        offsets[L] = off;
         w = (w + 1) / 2;
         h = (h + 1) / 2;
     }
+    size_t n = 0;
+    uint8_t *data = pack_file(r, "quadtree.file", file, 0, MAX_BINARY, &n);
+    char path[1024];
+    snprintf(path, sizeof path, "%s/%s", p->dir, file);
+    bool ok = data && rt_combos_parse(data, n, cx, cz, offsets, p->ncombos, p->holes != NULL,
+                                      p->levels, path,
+                                      r->e);
     free(data);
+    free(offsets);
+    return ok;
+}
+
+/* Every shader against the interface of its role (spirv_check.c), so
+ * that no module reaches the driver unchecked. */
+static bool check_one(reader *r, const rt_spirv *s, const rt_interface *in)
+{
+    if (!s->words)
+        return true;
+    char path[1024];
+    snprintf(path, sizeof path, "%s/%s", r->p->dir, s->path);
+    return rt_spirv_check(s->words, s->nwords, path, in, r->e);
+}
+
+static bool check_shaders(reader *r)
+{
+    rt_pack *p = r->p;
+    rt_interface in[RT_ROLE_COUNT];
+    bool ok = true;
+    int made = 0;
+    for (; made < RT_ROLE_COUNT && ok; made++)
+        ok = rt_interface_for(p, (rt_shader_role)made, &in[made]);
+    if (!ok) {
+        made--;
+        rt_fail(r->e, RT_E_PACK_FIELD, r->manifest, "out of memory");
+    }
+    ok = ok && check_one(r, &p->vertex, &in[RT_ROLE_VERTEX]) &&
+         check_one(r, &p->uber, &in[RT_ROLE_COMPOSITE]);
+    for (int i = 0; ok && i < p->ncombos; i++)
+        ok = check_one(r, &p->combos[i].spirv, &in[RT_ROLE_COMPOSITE]);
+    for (int i = 0; ok && i < p->nmaterials; i++)
+        ok = check_one(r, &p->materials[i].reference, &in[RT_ROLE_REFERENCE]);
+    for (int i = 0; i < made; i++)
+        rt_interface_free(&in[i]);
     return ok;
 }
 
@@ -625,21 +909,32 @@ bool rt_pack_load(rt_pack *p, const char *dir, rt_error *e)
     if (!e)
         e = &local;
     memset(p, 0, sizeof *p);
-    p->dir = dup(dir);
+    p->dir = xstrdup(dir);
     char *manifest = join(dir, "manifest.json");
-    reader r = { manifest, p, e };
+    reader r = { manifest, p, e, -1 };
     rt_error_clear(e);
-    json_error_t je;
-    json_t *root = json_load_file(manifest, 0, &je);
+    json_t *root = NULL;
     bool ok = false;
+    if (!p->dir || !manifest)
+        goto done;
+    r.dirfd = open(dir, O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+    if (r.dirfd < 0) {
+        rt_fail(e, RT_E_IO, "open the pack folder", dir, strerror(errno));
+        goto done;
+    }
+    char why[256];
+    size_t mn = 0;
+    char *text = (char *)rt_pack_read_file(r.dirfd, "manifest.json", MAX_MANIFEST, &mn, why,
+                                           sizeof why);
+    if (!text) {
+        rt_fail(e, RT_E_IO, "read", manifest, why);
+        goto done;
+    }
+    json_error_t je;
+    root = json_loadb(text, mn, JSON_REJECT_DUPLICATES, &je);
+    free(text);
     if (!root) {
-        FILE *f = fopen(manifest, "rb");
-        if (!f)
-            rt_fail(e, RT_E_IO, "read", manifest, strerror(errno));
-        else {
-            fclose(f);
-            rt_fail(e, RT_E_PACK_JSON, manifest, je.line, je.column, je.text);
-        }
+        rt_fail(e, RT_E_PACK_JSON, manifest, je.line, je.column, je.text);
         goto done;
     }
     const char *format;
@@ -661,7 +956,8 @@ bool rt_pack_load(rt_pack *p, const char *dir, rt_error *e)
         goto done;
     }
     ok = read_scene(&r, root) && read_materials(&r, root) && read_params(&r, root) &&
-         read_textures(&r, root) && read_painted(&r, root) && read_combos(&r, root) &&
+         read_textures(&r, root) && read_painted(&r, root) && read_sites(&r, root) &&
+         read_combos(&r, root) &&
          read_quadtree(&r, root);
     if (ok) {
         json_t *vx = get(&r, root, "vertex", "manifest", true);
@@ -672,7 +968,10 @@ bool rt_pack_load(rt_pack *p, const char *dir, rt_error *e)
         if (ub && !json_is_null(ub))
             ok = read_spirv(&r, ub, "uber", &p->uber);
     }
+    ok = ok && check_shaders(&r);
 done:
+    if (r.dirfd >= 0)
+        close(r.dirfd);
     json_decref(root);
     free(manifest);
     if (!ok) {
@@ -714,6 +1013,7 @@ void rt_pack_free(rt_pack *p)
     }
     for (int i = 0; i < p->nlevels && p->levels; i++)
         free(p->levels[i].ids);
+    free(p->holes);
     free_spirv(&p->uber);
     free_spirv(&p->vertex);
     free(p->cameras);
@@ -747,4 +1047,66 @@ int rt_pack_camera_find(const rt_pack *p, const char *name)
         if (!strcmp(p->cameras[i].name, name))
             return i;
     return -1;
+}
+
+/* ---- the pack against the device ------------------------------------------ */
+
+static bool limit(const rt_pack *p, const char *what, uint64_t v, const char *name,
+                  uint64_t max, rt_error *e)
+{
+    if (v <= max)
+        return true;
+    char where[1024], lim[128];
+    snprintf(where, sizeof where, "%s/manifest.json", p->dir);
+    snprintf(lim, sizeof lim, "the device's %s", name);
+    return rt_fail(e, RT_E_PACK_LIMIT, where, what, (unsigned long long)v, lim,
+                   (unsigned long long)max);
+}
+
+bool rt_pack_check_device(const rt_pack *p, const rt_device *d, rt_error *e)
+{
+    const VkPhysicalDeviceLimits *L = &d->props.limits;
+    const uint32_t dim = L->maxImageDimension2D, layers = L->maxImageArrayLayers;
+    if (!limit(p, "the heightfield's width", (uint64_t)p->hf_width, "maxImageDimension2D", dim, e) ||
+        !limit(p, "the heightfield's height", (uint64_t)p->hf_height, "maxImageDimension2D", dim, e))
+        return false;
+    for (int i = 0; i < p->ntextures; i++) {
+        char what[256];
+        snprintf(what, sizeof what, "textures[%d] (%s): the larger side", i, p->textures[i].file);
+        int side = p->textures[i].width > p->textures[i].height ? p->textures[i].width
+                                                                : p->textures[i].height;
+        if (!limit(p, what, (uint64_t)side, "maxImageDimension2D", dim, e))
+            return false;
+    }
+    if (p->painted && !limit(p, "the dense painted layer count", (uint64_t)p->npainted,
+                             "maxImageArrayLayers", layers, e))
+        return false;
+    if (p->sparse) {
+        const sparse_masks *s = p->sparse;
+        int side = s->atlas_width > s->atlas_height ? s->atlas_width : s->atlas_height;
+        int cells = s->cells_x > s->cells_z ? s->cells_x : s->cells_z;
+        if (!limit(p, "the painted atlas's larger side", (uint64_t)side, "maxImageDimension2D",
+                   dim, e) ||
+            !limit(p, "the painted index's larger side", (uint64_t)cells, "maxImageDimension2D",
+                   dim, e) ||
+            !limit(p, "the painted index's layer count", (uint64_t)s->layers,
+                   "maxImageArrayLayers", layers, e))
+            return false;
+    }
+    if (p->has_destruction) {
+        double side = p->destr_size[0] > p->destr_size[1] ? p->destr_size[0] : p->destr_size[1];
+        if (!limit(p, "the destruction grid's cells per side", (uint64_t)ceil(side / p->destr_cell),
+                   "maxImageDimension2D", dim, e))
+            return false;
+    }
+    /* fragment stage: set 0's six samplers and set 1's textures */
+    uint64_t samplers = 6 + (uint64_t)p->ntextures;
+    return limit(p, "the fragment stage's sampler count (6 + textures)", samplers,
+                 "maxPerStageDescriptorSamplers", L->maxPerStageDescriptorSamplers, e) &&
+           limit(p, "the fragment stage's sampled image count (6 + textures)", samplers,
+                 "maxPerStageDescriptorSampledImages", L->maxPerStageDescriptorSampledImages, e) &&
+           limit(p, "params_size", p->params_size, "maxUniformBufferRange",
+                 L->maxUniformBufferRange, e) &&
+           limit(p, "the push-constant block (bytes)", sizeof(splat_push),
+                 "maxPushConstantsSize", L->maxPushConstantsSize, e);
 }

@@ -1,5 +1,5 @@
 /* painted.c — the painted masks of a sparse pack (compiler/sparse.h) on the
- * GPU: painted.sparse read with sparse_read and checked against the
+ * GPU: painted.sparse (read by pack.c) parsed with sparse_read and checked against the
  * manifest, then three images for set 0 (abi.h, SPLAT_PAINTED_SPARSE):
  *   binding 2  atlas  BC4_UNORM_BLOCK (R8_UNORM where the device has no BC
  *              textures: the blocks decoded on the CPU, rounded to 8 bits,
@@ -17,29 +17,18 @@
 
 static void fill_info(sparse_masks *s);
 
-bool rt_painted_read(rt_pack *p, const char *file, rt_error *e)
+bool rt_painted_read(rt_pack *p, const char *manifest, const char *file,
+                     const uint8_t *data, size_t n, rt_error *e)
 {
-    size_t n = strlen(p->dir) + strlen(file) + 2;
-    char *path = malloc(n);
-    if (!path)
-        return rt_fail(e, RT_E_PACK_FIELD, p->dir, "out of memory");
-    snprintf(path, n, "%s/%s", p->dir, file);
-    FILE *f = fopen(path, "rb");
-    if (!f) {
-        rt_fail(e, RT_E_IO, "read", path, strerror(errno));
-        free(path);
-        return false;
-    }
     p->sparse = calloc(1, sizeof *p->sparse);
     sparse_error err;
-    bool ok = p->sparse && sparse_read(p->sparse, f, path, &err);
-    fclose(f);
-    if (!ok) {
-        rt_fail(e, RT_E_PACK_FILE, p->dir, "painted_file", file,
-                p->sparse ? err.msg : "does not fit in memory");
+    if (!p->sparse || !sparse_read(p->sparse, data, n, "", &err)) {
+        /* "'' is not a sparse mask file: …" read as "which is not …" */
+        const char *why = !p->sparse ? "does not fit in memory"
+                        : !strncmp(err.msg, "'' ", 3) ? err.msg + 3 : err.msg;
+        rt_fail(e, RT_E_PACK_FILE, manifest, "painted_file", file, why);
         free(p->sparse);
         p->sparse = NULL;
-        free(path);
         return false;
     }
     const sparse_masks *s = p->sparse;
@@ -47,14 +36,12 @@ bool rt_painted_read(rt_pack *p, const char *file, rt_error *e)
         char what[256];
         snprintf(what, sizeof what, "holds %d masks of %dx%d texels, the manifest %d of %dx%d",
                  s->nmasks, s->width, s->height, p->npainted, p->hf_width, p->hf_height);
-        rt_fail(e, RT_E_PACK_FILE, p->dir, "painted_file", file, what);
+        rt_fail(e, RT_E_PACK_FILE, manifest, "painted_file", file, what);
         sparse_free(p->sparse);
         free(p->sparse);
         p->sparse = NULL;
-        free(path);
         return false;
     }
-    free(path);
     fill_info(p->sparse);
     return true;
 }

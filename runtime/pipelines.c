@@ -33,13 +33,15 @@ static const char resolve_frag_main[] =
     "    ivec2 p = ivec2(gl_FragCoord.xy);\n"
     "    vec4 a = texelFetch(r_albedo, p, 0);\n"
     "    if (a.a <= 0.0) discard;          /* no terrain: keep the clear colour */\n"
-    "    vec4 n = texelFetch(r_normal, p, 0);\n"
+    "    vec4 ns = texelFetch(r_normal, p, 0);\n"
     "    vec4 m = texelFetch(r_misc, p, 0);\n"
-    "    vec3 nn = normalize(n.xyz);\n"
-    "    vec3 c;\n"
-    "    if (u_frame.view.x == 6u) c = a.rgb;\n"
-    "    else if (u_frame.view.x == 3u) c = nn * 0.5 + 0.5;\n"
-    "    else c = splat_light(a.rgb, nn, m.r, m.b);\n"
+    "    vec3 nn = normalize(ns.xyz);\n"
+    "    vec3 albedo = a.rgb, n = nn, c;\n"
+    "    float rough = m.r, dist = m.b;\n"
+    "    switch (u_frame.view.x) {\n"
+    SPLAT_VIEWS(SPLAT_VIEW_CASE_RESOLVE)   /* abi.h: the views it can show */
+    "    default: c = splat_light(albedo, n, rough, dist); break;\n"
+    "    }\n"
     "    o_color = vec4(c, 1.0);\n"
     "}\n";
 
@@ -172,8 +174,9 @@ static bool make_layouts(rt_device *d, int ntextures, rt_pipelines *pl, rt_error
         { SPLAT_BIND_DESTRUCTION_INDEX, smp, 1, fs, NULL },
         { SPLAT_BIND_PAINTED_INDEX, smp, 1, fs, NULL },   /* sparse masks */
         { SPLAT_BIND_PAINTED_LEVEL, smp, 1, fs, NULL },
+        { SPLAT_BIND_HOLES, smp, 1, VK_SHADER_STAGE_VERTEX_BIT, NULL },
     };
-    if (!make_set_layout(d, terrain, 7, &pl->set_terrain, e))
+    if (!make_set_layout(d, terrain, 8, &pl->set_terrain, e))
         return false;
     VkDescriptorSetLayoutBinding *mat = calloc((size_t)ntextures + 1, sizeof *mat);
     if (!mat)

@@ -1,4 +1,4 @@
-/* quadtree.c — terrain LOD as seed 000 §5.4.1 describes it: a restricted
+/* quadtree.c — terrain LOD as Andersson 2007 §5.4.1 describes it: a restricted
  * quadtree of 33x33-vertex patches over the heightfield, selected per frame
  * by distance (a screen-space error bound), with edge neighbours at most
  * one level apart and the 9 index-buffer permutations that stitch a patch
@@ -264,6 +264,11 @@ static void emit(frame *f, int L, int x, int z)
         }
         return;
     }
+    /* all hole (PACK.md): nothing of it is drawn */
+    if (q->combo_ids && q->combo_ids[L][i] == SPLAT_COMBO_HOLE) {
+        q->nholes++;
+        return;
+    }
     unsigned edges = 0;
     if (coarser(q, L, x, z - 1)) edges |= RT_EDGE_N;
     if (coarser(q, L, x + 1, z)) edges |= RT_EDGE_E;
@@ -305,5 +310,6 @@ void rt_quadtree_select(rt_quadtree *q, const rt_select_desc *s)
     restrict_levels(q);
     q->npatches = 0;
     q->nculled = 0;
+    q->nholes = 0;
     emit(&f, top, 0, 0);
 }

@@ -9,6 +9,7 @@
  * work is the selection (preallocated arrays), a counting sort by
  * combination, a uniform write into mapped memory and one command buffer. */
 #include "splatrt.h"
+#include "util.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -48,13 +49,6 @@ struct rt_renderer {
     bool              wireframe;
     double            lod_distance;
 };
-
-static double now_ms(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec * 1e-6;
-}
 
 /* ---- render passes -------------------------------------------------------- */
 
@@ -271,7 +265,7 @@ static bool make_descriptors(rt_renderer *r, rt_error *e)
 
     VkDescriptorPoolSize sizes[2] = {
         { VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 2 },
-        { VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 6 + (uint32_t)r->ntex + 3 },
+        { VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 7 + (uint32_t)r->ntex + 3 },
     };
     VkDescriptorPoolCreateInfo pci = {
         .sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO,
@@ -327,6 +321,8 @@ static bool make_descriptors(rt_renderer *r, rt_error *e)
     img[8] = (VkDescriptorImageInfo){ t->nearest_clamp, t->painted_level.view, ro };
     W(r->set0, SPLAT_BIND_PAINTED_INDEX, smp, &img[7], NULL);
     W(r->set0, SPLAT_BIND_PAINTED_LEVEL, smp, &img[8], NULL);
+    img[9] = (VkDescriptorImageInfo){ t->linear_clamp, t->holes.view, ro };
+    W(r->set0, SPLAT_BIND_HOLES, smp, &img[9], NULL);
     W(r->set1, SPLAT_BIND_PARAMS, ubo, NULL, &pb);
     for (int i = 0; i < r->ntex; i++) {
         timg[i] = (VkDescriptorImageInfo){ r->tex_smp[i], r->tex[i].view, ro };
@@ -383,6 +379,8 @@ bool rt_renderer_create(rt_device *d, const rt_pack *p, const rt_render_desc *de
                         rt_renderer **out, rt_error *e)
 {
     *out = NULL;
+    if (!rt_pack_check_device(p, d, e))
+        return false;
     rt_renderer *r = calloc(1, sizeof *r);
     if (!r)
         return rt_fail(e, RT_E_VULKAN, "renderer", "out of memory");
@@ -618,6 +616,22 @@ static void fill_frame(rt_renderer *r, const rt_camera *c, splat_frame *fr)
     fr->destruction_atlas[2] = 1.0f;
     if (r->destr)
         rt_destruction_frame(r->destr, fr);
+    /* precision far from the origin (compiler/precision.c): per site, the
+     * camera's whole cells and fraction in double; the scale as the
+     * shader reads it (float) */
+    for (int k = 0; k < p->nsites; k++) {
+        const rt_pack_site *st = &p->sites[k];
+        for (int a = 0; a < 2; a++) {
+            double s = st->param >= 0
+                ? (double)*(const float *)((const uint8_t *)r->params_ubo.map +
+                                           p->params[st->param].offset)
+                : (double)(float)st->scale[a];
+            double v = st->mul ? c->position[st->axes[a]] * s : c->position[st->axes[a]] / s;
+            double cell = floor(v);
+            fr->world[4 * k + a] = (float)cell;
+            fr->world[4 * k + 2 + a] = (float)(v - cell);
+        }
+    }
     fr->view[0] = (uint32_t)r->view;
     fr->view[1] = (uint32_t)(r->view_material > 0 ? r->view_material : 0);
 }
@@ -717,16 +731,16 @@ static bool abandon_frame(VkCommandBuffer cb)
 bool rt_renderer_frame(rt_renderer *r, const rt_camera *c, rt_frame_stats *st, rt_error *e)
 {
     rt_device *d = r->d;
-    double t0 = now_ms();
+    double t0 = 1e3 * splat_now();
     splat_frame *fr = r->frame_ubo.map;
     fill_frame(r, c, fr);
 
     rt_select_desc sd = { .lod_distance = r->lod_distance, .cull = true };
     memcpy(sd.camera, c->position, sizeof sd.camera);
     memcpy(sd.view_proj, fr->view_proj, sizeof sd.view_proj);
-    double ts = now_ms();
+    double ts = 1e3 * splat_now();
     rt_quadtree_select(&r->qt, &sd);
-    double select_ms = now_ms() - ts;
+    double select_ms = 1e3 * splat_now() - ts;
 
     /* Counting sort by combination: one pipeline bind per group. */
     int n = r->qt.npatches;
@@ -808,7 +822,7 @@ bool rt_renderer_frame(rt_renderer *r, const rt_camera *c, rt_frame_stats *st, r
             .renderArea = area, .clearValueCount = 2, .pClearValues = clears,
         };
         begin_terrain_pass(r, cb, &rb, &vp, sets);
-        /* Composites carry no MASK view (compiler/pack.c): the über-shader
+        /* Composites carry no MASK view (compiler/build_jobs.c): the über-shader
          * draws it, with every material's mask. */
         if (r->desc.reference == RT_REF_UBER || r->view == SPLAT_VIEW_MASK) {
             if (n > 0) {
@@ -844,7 +858,7 @@ bool rt_renderer_frame(rt_renderer *r, const rt_camera *c, rt_frame_stats *st, r
         .commandBufferCount = 1,
         .pCommandBuffers = &cb,
     };
-    double cpu_ms = now_ms() - t0;
+    double cpu_ms = 1e3 * splat_now() - t0;
     RT_VK(e, vkQueueSubmit(d->queue, 1, &si, r->fence));
     RT_VK(e, vkWaitForFences(d->dev, 1, &r->fence, VK_TRUE, UINT64_MAX));
     RT_VK(e, vkResetFences(d->dev, 1, &r->fence));
@@ -897,13 +911,80 @@ bool rt_renderer_read(rt_renderer *r, float *rgba, rt_error *e)
     return true;
 }
 
+static bool same_bytes(const void *a, const void *b, size_t n)
+{
+    return (!a && !b) || (a && b && !memcmp(a, b, n));
+}
+
+/* What of the new pack differs from the data the renderer uploaded at
+ * creation (heights, bounds, textures and samplers, painted masks,
+ * destruction settings, terrain scale), or NULL: only shaders, params and
+ * combination ids may change in a hot reload, never old data under new
+ * shaders. */
+static const char *reload_refused(const rt_pack *o, const rt_pack *p)
+{
+    if (p->hf_width != o->hf_width || p->hf_height != o->hf_height ||
+        p->cell_texels != o->cell_texels || p->nlevels != o->nlevels)
+        return "the heightfield's size or cell changed";
+    if (!same_bytes(p->heights, o->heights, (size_t)p->hf_width * p->hf_height * 2))
+        return "the heightfield's contents changed";
+    if (!p->holes != !o->holes ||
+        (p->holes && !same_bytes(p->holes, o->holes, (size_t)p->hf_width * p->hf_height)))
+        return "the terrain's holes changed";
+    if (p->size[0] != o->size[0] || p->size[1] != o->size[1] ||
+        p->max_height != o->max_height || p->height_offset != o->height_offset)
+        return "the terrain's size, max_height or height_offset changed";
+    if (p->ntextures != o->ntextures)
+        return "the number of textures changed";
+    for (int i = 0; i < p->ntextures; i++) {
+        const rt_pack_texture *a = &o->textures[i], *b = &p->textures[i];
+        bool same = a->width == b->width && a->height == b->height && a->linear == b->linear &&
+                    a->mip_linear == b->mip_linear && a->srgb == b->srgb && a->wrap == b->wrap &&
+                    a->nmips == b->nmips &&
+                    same_bytes(a->rgba, b->rgba, (size_t)a->width * a->height * 4);
+        for (int k = 0; same && k < a->nmips; k++) {
+            size_t w = (size_t)(a->width >> (k + 1) > 0 ? a->width >> (k + 1) : 1);
+            size_t h = (size_t)(a->height >> (k + 1) > 0 ? a->height >> (k + 1) : 1);
+            same = same_bytes(a->mips[k], b->mips[k], w * h * 4);
+        }
+        if (!same)
+            return "a texture (its pixels, mip levels or sampler settings) changed";
+    }
+    if (p->npainted != o->npainted || !p->sparse != !o->sparse)
+        return "the painted masks' count or format changed";
+    if (!same_bytes(p->painted, o->painted, (size_t)p->npainted * p->hf_width * p->hf_height))
+        return "a painted mask changed";
+    if (p->sparse) {
+        const sparse_masks *a = o->sparse, *b = p->sparse;
+        size_t idx = (size_t)a->cells_x * a->cells_z * 4 * a->layers;
+        if (a->format != b->format || a->atlas_cols != b->atlas_cols ||
+            a->atlas_rows != b->atlas_rows || a->cells_x != b->cells_x ||
+            a->cells_z != b->cells_z || a->layers != b->layers ||
+            !same_bytes(a->atlas, b->atlas, a->atlas_bytes) ||
+            !same_bytes(a->index, b->index, idx * 2) || !same_bytes(a->level, b->level, idx))
+            return "a painted mask changed";
+    }
+    if (p->has_destruction != o->has_destruction ||
+        (p->has_destruction &&
+         (p->destr_origin[0] != o->destr_origin[0] || p->destr_origin[1] != o->destr_origin[1] ||
+          p->destr_size[0] != o->destr_size[0] || p->destr_size[1] != o->destr_size[1] ||
+          p->destr_cell != o->destr_cell)))
+        return "the destructible area changed";
+    if (p->params_size > o->params_size)
+        return "the params block grew";
+    return NULL;
+}
+
 bool rt_renderer_swap_pack(rt_renderer *r, const rt_pack *p, rt_error *e)
 {
     const rt_pack *o = r->p;
-    if (p->hf_width != o->hf_width || p->hf_height != o->hf_height ||
-        p->cell_texels != o->cell_texels || p->ntextures != o->ntextures ||
-        p->params_size > o->params_size || p->nlevels != o->nlevels)
-        return rt_fail(e, RT_E_RELOAD, "the new pack changes the terrain or its resources; restart splatview");
+    const char *why = reload_refused(o, p);
+    if (why) {
+        char msg[256];
+        snprintf(msg, sizeof msg, "%s: restart splatview to see it (hot reload swaps shaders and "
+                 "parameters, not the data uploaded at start)", why);
+        return rt_fail(e, RT_E_RELOAD, msg);
+    }
     int *counts = calloc((size_t)p->ncombos + 1, sizeof *counts);
     if (!counts)
         return rt_fail(e, RT_E_RELOAD, "out of memory");
@@ -954,12 +1035,42 @@ bool rt_renderer_read_heights(rt_renderer *r, uint16_t *out, rt_error *e)
     return rt_destruction_wait(r->destr, e) && rt_read_r16(r->d, &r->terrain.height, out, e);
 }
 
+static const struct view_row {
+    const char *name;
+    int         key;
+    rt_tonemap  tonemap;
+} view_rows[SPLAT_VIEW_COUNT] = {
+#define X(id, num, name, key, tm, where, glsl) [num] = { name, key, RT_TONEMAP_##tm },
+    SPLAT_VIEWS(X)
+#undef X
+};
+
 const char *rt_view_name(splat_view v)
 {
-    static const char *const names[SPLAT_VIEW_COUNT] = {
-        "final", "combos", "lod", "normal", "slope", "mask", "albedo",
-    };
-    return (unsigned)v < SPLAT_VIEW_COUNT ? names[v] : "?";
+    return (unsigned)v < SPLAT_VIEW_COUNT ? view_rows[v].name : "?";
+}
+
+rt_tonemap rt_view_tonemap(splat_view v)
+{
+    return (unsigned)v < SPLAT_VIEW_COUNT ? view_rows[v].tonemap : RT_TONEMAP_NONE;
+}
+
+int rt_view_by_key(int key)
+{
+    for (int v = 0; v < SPLAT_VIEW_COUNT; v++)
+        if (view_rows[v].key == key)
+            return v;
+    return -1;
+}
+
+void rt_view_list(char *buf, size_t n)
+{
+    size_t len = 0;
+    if (n)
+        buf[0] = 0;
+    for (int v = 0; v < SPLAT_VIEW_COUNT && len < n; v++)
+        len += (size_t)snprintf(buf + len, n - len, "%s%s%s", v ? "|" : "", view_rows[v].name,
+                                v == SPLAT_VIEW_MASK ? ":MATERIAL" : "");
 }
 
 bool rt_parse_view(const char *s, const rt_pack *p, splat_view *view, int *material, rt_error *e)
@@ -981,8 +1092,8 @@ bool rt_parse_view(const char *s, const rt_pack *p, splat_view *view, int *mater
             *view = (splat_view)v;
             return true;
         }
-    char what[256];
-    snprintf(what, sizeof what,
-             "unknown view '%s' (final, combos, lod, normal, slope, albedo, mask:MATERIAL)", s);
+    char what[512], list[256];
+    rt_view_list(list, sizeof list);
+    snprintf(what, sizeof what, "unknown view '%s' (%s)", s, list);
     return rt_fail(e, RT_E_PACK_FIELD, "--view", what);
 }

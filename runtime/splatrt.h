@@ -1,5 +1,5 @@
 /* splatrt.h — libsplatrt, the Vulkan terrain runtime: a shader pack
- * (compiler/PACK.md) turned into pictures (DESIGN §8, seed 000 §5.4).
+ * (compiler/PACK.md) turned into pictures (compiler/DESIGN.md §8, Andersson 2007 §5.4).
  *
  * Everything public is prefixed rt_.  Library code never exits: a failing
  * call returns false and fills an rt_error (id + message).
@@ -26,6 +26,7 @@
 #define RT_ERRORS(X)                                                        \
     X(VULKAN,       "%s failed: %s")                                        \
     X(NO_DEVICE,    "no usable Vulkan device: %s")                          \
+    X(NO_VALIDATION, "validation requested (SPLAT_VALIDATE=1) but %s is not installed (Debian: vulkan-validationlayers)") \
     X(NO_FORMAT,    "the device cannot %s")                                 \
     X(IO,           "cannot %s '%s': %s")                                   \
     X(PACK_JSON,    "%s:%d:%d: error: %s")                                  \
@@ -34,6 +35,8 @@
     X(PACK_SPIRV,   "%s: error: corrupt SPIR-V: %s")                        \
     X(PACK_COMBO,   "%s: error: combination id %d out of range (the pack has %d) at %s") \
     X(PACK_VERSION, "%s: error: %s")                                        \
+    X(PACK_SHADER,  "%s: error: %s does not fit the runtime: %s")           \
+    X(PACK_LIMIT,   "%s: error: %s is %llu, over %s (%llu)")                \
     X(SHADER,       "shader '%s' does not compile:\n%s")                    \
     X(WINDOW,       "window: %s")                                           \
     X(RELOAD,       "reload: %s")
@@ -69,7 +72,10 @@ const char *rt_vk_result_name(VkResult r);
 
 typedef struct rt_device_desc {
     bool         validate;      /* validation layer + messenger; default: env
-                                   SPLAT_VALIDATE=1                        */
+                                   SPLAT_VALIDATE=1.  Asked for but not
+                                   installed: RT_E_NO_VALIDATION, so a "no
+                                   validation messages" test cannot pass
+                                   without the layer                      */
     const char  *select;        /* device index or name substring; default:
                                    env SPLAT_DEVICE; else discrete GPU first */
     const char *const *instance_exts;  /* extra instance extensions (GLFW) */
@@ -142,6 +148,8 @@ void rt_cmd_image_barrier(VkCommandBuffer cb, VkImage img, uint32_t mip, uint32_
                           VkAccessFlags src_access, VkAccessFlags dst_access,
                           VkPipelineStageFlags src, VkPipelineStageFlags dst);
 bool rt_format_supports(rt_device *d, VkFormat f, VkFormatFeatureFlags need);
+/* The sampler address mode of an ir_wrap (ir.h IR_WRAPS). */
+VkSamplerAddressMode rt_sampler_wrap(int ir_wrap);
 
 /* ---- glsl.c: GLSL -> SPIR-V for the runtime's own shaders -------------- */
 
@@ -175,6 +183,76 @@ bool rt_write_png(const char *path, const uint8_t *rgba8, int w, int h,
 bool rt_write_float(const char *path, const float *rgba, int w, int h,
                     rt_error *e);
 bool rt_read_float(const char *path, float **rgba, int *w, int *h, rt_error *e);
+
+/* ---- spirv_check.c: a pack shader against what it is bound to --------- */
+
+typedef enum rt_res {
+    RT_RES_UNIFORM = 1,       /* uniform block                              */
+    RT_RES_SAMPLED,           /* combined image sampler                     */
+    RT_RES_STORAGE_IMAGE,
+    RT_RES_STORAGE_BUFFER,
+} rt_res;
+
+enum { RT_FLOAT = 1, RT_UINT, RT_INT };             /* image component types */
+enum { RT_IMAGE_2D = 1 };                           /* SpvDim2D              */
+typedef enum rt_painted_when {
+    RT_PAINTED_ANY = 0, RT_PAINTED_DENSE, RT_PAINTED_SPARSE,
+} rt_painted_when;
+
+/* One binding of a pipeline layout, as a shader may declare it. */
+typedef struct rt_binding_rule {
+    uint32_t set, binding;
+    rt_res   kind;
+    uint8_t  dim;             /* images: SpvDim (RT_IMAGE_2D)               */
+    bool     arrayed;         /* images: 2D array                           */
+    uint8_t  comp;            /* images: RT_FLOAT / RT_UINT / RT_INT        */
+    uint32_t bytes;           /* blocks: at most this many bytes declared   */
+    VkShaderStageFlags stages; /* stages the layout makes it visible to     */
+    rt_painted_when painted;  /* packs whose painted format has this row    */
+} rt_binding_rule;
+
+/* The ABI's set-0 rows (compiler/abi.h), one per binding and painted
+ * format: a new set-0 binding (compute passes, shadows) is one more row. */
+extern const rt_binding_rule rt_abi_bindings[];
+extern const int rt_abi_nbindings;
+
+typedef struct rt_varying {
+    uint32_t location;
+    int      components;      /* float vector size                          */
+} rt_varying;
+
+/* What a shader must fit. */
+typedef struct rt_interface {
+    const char *what;               /* "a composite fragment shader"        */
+    VkShaderStageFlagBits stage;    /* entry point "main" of this stage     */
+    const rt_binding_rule *bindings; int nbindings;
+    rt_painted_when painted;        /* the pack's painted format            */
+    uint32_t push_bytes;            /* push-constant block at most          */
+    const uint32_t *spec_ids; int nspec;   /* constant_ids the runtime sets */
+    const rt_varying *inputs; int ninputs;   /* allowed stage inputs        */
+    const rt_varying *outputs; int noutputs; /* allowed stage outputs       */
+    bool     outputs_exact;         /* every listed output written          */
+    int      colour_targets;        /* fragment: float outputs at locations
+                                       below this, instead of `outputs`     */
+} rt_interface;
+
+struct rt_pack;
+
+typedef enum rt_shader_role {
+    RT_ROLE_VERTEX, RT_ROLE_COMPOSITE, RT_ROLE_REFERENCE,
+    RT_ROLE_COMPUTE,      /* the compute variants (*.comp.spv, abi.h)       */
+    RT_ROLE_COUNT,
+} rt_shader_role;
+
+/* The interface of a pack shader role: the ABI rows plus the pack's set 1
+ * (params block of params_size bytes, its textures).  Free with
+ * rt_interface_free; false: out of memory. */
+bool rt_interface_for(const struct rt_pack *p, rt_shader_role role, rt_interface *out);
+void rt_interface_free(rt_interface *in);
+/* Reflect `words` (already through spirv-val) with SPIRV-Cross and check
+ * it against `want`; RT_E_PACK_SHADER naming `path` and the mismatch. */
+bool rt_spirv_check(const uint32_t *words, size_t nwords, const char *path,
+                    const rt_interface *want, rt_error *e);
 
 /* ---- pack.c: reading a shader pack ------------------------------------ */
 
@@ -225,11 +303,23 @@ typedef struct rt_pack_level {
     uint16_t *ids;        /* combination per node, row-major                */
 } rt_pack_level;
 
+/* A periodic site of terrain.position (compiler/precision.c). */
+typedef struct rt_pack_site {
+    int    axes[2];         /* camera components: 0 x, 1 y, 2 z          */
+    bool   mul;             /* position * scale; else / scale            */
+    int    param;           /* params index of the scale, or -1          */
+    double scale[2];        /* constant scale per component              */
+} rt_pack_site;
+
 typedef struct rt_pack {
     char            *dir;
     char            *name;
     int              hf_width, hf_height;
     uint16_t        *heights;        /* hf_width * hf_height               */
+    rt_pack_site     sites[SPLAT_WORLD_SITES];  /* u_frame.world (abi.h)  */
+    int              nsites;
+    uint8_t         *holes;          /* hf_width * hf_height, 255 = cut, or
+                                        NULL: no holes (PACK.md)           */
     double           size[2], max_height, height_offset;
     int              cell_texels;
     rt_pack_camera  *cameras;   int ncameras;
@@ -252,19 +342,46 @@ typedef struct rt_pack {
                                         the pack (hot reload), or NULL      */
 } rt_pack;
 
-/* Read and check a pack: every file it names exists and has the right
- * size, every SPIR-V module validates, every combination id in combos.bin
- * is in range.  Errors name the pack file and what is wrong. */
+/* Read and check a pack, untrusted input: every file it names is a
+ * regular file inside the pack folder (rt_pack_read_file) of the right
+ * size, every size within the pack limits (abi.h), every SPIR-V module
+ * validates and fits the interface of its role (rt_spirv_check), every
+ * combination id in combos.bin is in range.  Errors name the pack file
+ * and what is wrong. */
 bool rt_pack_load(rt_pack *p, const char *dir, rt_error *e);
+/* The runtime's one way into a pack folder: open `rel` below the folder
+ * `dirfd` component by component with O_NOFOLLOW — no absolute path, no
+ * "..", no symbolic link on the way, a regular file at the end (never a
+ * FIFO or device).  Returns the descriptor, or -1 with `why` saying what
+ * is wrong ("is a symbolic link ..."). */
+int      rt_pack_open_file(int dirfd, const char *rel, char *why, size_t nwhy);
+/* rt_pack_open_file, then the whole file if fstat says it has at most
+ * `max` bytes (bounded reads; NUL appended, not counted in *n). */
+uint8_t *rt_pack_read_file(int dirfd, const char *rel, size_t max, size_t *n, char *why,
+                           size_t nwhy);
+/* combos.bin (PACK.md) of `n` bytes: the rt_level_count(cells_x, cells_z)
+ * levels, level L (cells halved L times, rounding up) at offsets[L]; every
+ * level inside the file and every id below ncombos, checked before each
+ * level is allocated (SPLAT_COMBO_HOLE is also accepted when `holes`: the
+ * pack has a holes raster).  Fills levels[0..nlevels); errors name `path`. */
+bool rt_combos_parse(const uint8_t *data, size_t n, int cells_x, int cells_z,
+                     const int64_t *offsets, int ncombos, bool holes,
+                     rt_pack_level *levels, const char *path, rt_error *e);
+/* Each size of the pack against the device's limits (maxImageDimension2D,
+ * maxImageArrayLayers, samplers per stage, uniform range), before any of
+ * it is created; RT_E_PACK_LIMIT naming the limit. */
+bool rt_pack_check_device(const rt_pack *p, const rt_device *d, rt_error *e);
 void rt_pack_free(rt_pack *p);
 int  rt_pack_material_find(const rt_pack *p, const char *name);   /* -1 */
 int  rt_pack_camera_find(const rt_pack *p, const char *name);     /* -1 */
 
 /* ---- painted.c: the sparse painted masks ------------------------------ */
 
-/* Read `file` (painted.sparse, relative to the pack) into p->sparse and
- * check it against the manifest (heightfield size, mask count). */
-bool rt_painted_read(rt_pack *p, const char *file, rt_error *e);
+/* Parse the `n` bytes of `file` (painted.sparse, read by the pack loader)
+ * into p->sparse and check them against the manifest (heightfield size,
+ * mask count); errors name `manifest` and `file`. */
+bool rt_painted_read(rt_pack *p, const char *manifest, const char *file,
+                     const uint8_t *data, size_t n, rt_error *e);
 /* Upload p->sparse: atlas (BC4_UNORM_BLOCK, or R8_UNORM decoded on the
  * CPU when the device lacks BC textures), index RGBA16UI and level
  * RGBA8UI 2D arrays. */
@@ -302,8 +419,9 @@ typedef struct rt_terrain_gpu {
     rt_image  painted;      /* R8_UNORM array, >= 1 layer; sparse: the atlas */
     rt_image  painted_index; /* RGBA16UI array (1x1 when dense)              */
     rt_image  painted_level; /* RGBA8UI array (1x1 when dense)               */
-    rt_image  destr_atlas;  /* R8_UNORM 1x1 until issue 5                   */
+    rt_image  destr_atlas;  /* R8_UNORM destruction mask tiles (destruction.c) */
     rt_image  destr_index;  /* RGBA8 1x1, a = 0: nothing destroyed          */
+    rt_image  holes;        /* R8_UNORM W x H (1x1 of 0: none), binding 12  */
     VkSampler linear_clamp, nearest_clamp;
 } rt_terrain_gpu;
 
@@ -315,7 +433,7 @@ void rt_terrain_destroy(rt_device *d, rt_terrain_gpu *t);
 
 /* Edges of a patch: N = z min, E = x max, S = z max, W = x min. */
 enum { RT_EDGE_N = 1, RT_EDGE_E = 2, RT_EDGE_S = 4, RT_EDGE_W = 8 };
-#define RT_PERMS 9   /* none, N, E, S, W, NE, ES, SW, WN (seed 000 Fig. 18) */
+#define RT_PERMS 9   /* none, N, E, S, W, NE, ES, SW, WN (Andersson 2007 Fig. 18) */
 
 /* The index-buffer permutation drawn for a set of coarser edges, and the
  * coarser edges of a permutation. */
@@ -355,6 +473,7 @@ typedef struct rt_quadtree {
     rt_patch  *patches;           /* the selection (drawn patches)           */
     int        npatches, cap;
     int        nculled;           /* leaves dropped by the frustum           */
+    int        nholes;            /* nodes not drawn: all hole (PACK.md)     */
 } rt_quadtree;
 
 bool rt_quadtree_init(rt_quadtree *q, const rt_bounds *b, int cell_texels,
@@ -496,9 +615,19 @@ bool rt_renderer_read(rt_renderer *r, float *rgba, rt_error *e);
 /* The offscreen colour image (TRANSFER_SRC_OPTIMAL after a frame). */
 const rt_image *rt_renderer_target(const rt_renderer *r);
 /* Replace the combination pipelines with those of a new pack of the same
- * terrain (hot reload); on failure the old ones stay. */
+ * terrain (hot reload); on failure the old ones stay.  Refused
+ * (RT_E_RELOAD naming the input) when the pack's data differ from what was
+ * uploaded: heightfield contents or size, terrain scale, textures (pixels,
+ * mips, samplers), painted masks, the destructible area. */
 bool rt_renderer_swap_pack(rt_renderer *r, const rt_pack *p, rt_error *e);
+/* The debug views' tables (abi.h SPLAT_VIEWS): --view name ("?" if not a
+ * view), how a screenshot of it is tone-mapped, the view the viewer's key
+ * selects (-1: none), and the --view list for help texts
+ * ("final|combos|…|mask:MATERIAL|…") into buf (truncated to n). */
 const char *rt_view_name(splat_view v);
+rt_tonemap  rt_view_tonemap(splat_view v);
+int         rt_view_by_key(int key);
+void        rt_view_list(char *buf, size_t n);
 /* Craters (destruction.c) on the renderer's terrain: a pack without a
  * destructible area answers RT_CRATER_OUTSIDE. */
 typedef struct rt_crater rt_crater;
@@ -524,7 +653,7 @@ bool rt_renderer_read_heights(rt_renderer *r, uint16_t *out, rt_error *e);
 bool rt_parse_view(const char *s, const rt_pack *p, splat_view *view,
                    int *material, rt_error *e);
 
-/* ---- destruction.c: the destruction mask (seed 000 §5.2.5) -------------
+/* ---- destruction.c: the destruction mask (Andersson 2007 §5.2.5) -------------
  * Fixed-grid indirection over the destructible area, 64x64 R8 tiles from a
  * fixed pool, crater decals rendered into them, heightfield and node bounds
  * updated in the same event (destruction.c explains).  Pool exhausted: the
@@ -599,6 +728,8 @@ typedef struct rt_viewer_desc {
     const char *preset;       /* manifest camera name or NULL               */
     splat_view  view;
     const char *view_name;    /* --view text, parsed against the pack       */
+    const char *const *include; /* -I folders for the scene's imports, as   */
+    int         ninclude;       /* splatc has them (splat_search_path)      */
 } rt_viewer_desc;
 
 /* Runs until the window closes or the script quits; returns the exit

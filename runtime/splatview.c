@@ -8,6 +8,8 @@
 
 static void usage(FILE *f)
 {
+    char views[256];
+    rt_view_list(views, sizeof views);
     fprintf(f,
         "usage: splatview PACK [options]\n"
         "  --headless -o OUT.png     render offscreen and write a PNG\n"
@@ -15,7 +17,7 @@ static void usage(FILE *f)
         "  --camera x,y,z --look x,y,z   camera in terrain-local metres\n"
         "  --camera-preset NAME      a camera of the manifest's scene.cameras\n"
         "                            (default: the preset 'overview', else the first)\n"
-        "  --view V                  final|combos|lod|normal|slope|albedo|mask:MATERIAL\n"
+        "  --view V                  %s\n"
         "  --frames N                render N frames (stats over them)\n"
         "  --stats                   patches, pipelines, GPU and CPU times, device\n"
         "  --reference multipass|uber   the multi-pass alpha reference or the uber-shader\n"
@@ -25,6 +27,8 @@ static void usage(FILE *f)
         "  --clear r,g,b             background colour (linear)\n"
         "  --pipeline-cache FILE     pipeline cache file\n"
         "  --scene FILE              scene.sg to watch for hot reload (viewer)\n"
+        "  -I DIR                    search DIR for the scene's imports, as splatc\n"
+        "                            build -I does (repeatable; also $SPLATC_PATH)\n"
         "  --script S                viewer script: \"frames=30;screenshot=out.png;quit\"\n"
         "  --no-stitch               draw patches without stitching (tests)\n"
         "  --no-cull                 never cull back faces (tests)\n"
@@ -34,7 +38,7 @@ static void usage(FILE *f)
         "                            meets the terrain\n"
         "  --destruction-pool N      destruction mask tiles (default 256); when full,\n"
         "                            a crater needing more is refused with a warning\n"
-        "environment: SPLAT_DEVICE=<index|name>, SPLAT_VALIDATE=1\n");
+        "environment: SPLAT_DEVICE=<index|name>, SPLAT_VALIDATE=1\n", views);
 }
 
 static bool parse_vec(const char *s, double *v, int n)
@@ -78,6 +82,8 @@ typedef struct opts {
     rt_reference ref;
     const char *params[64];
     int nparams;
+    const char *include[64];    /* -I DIR: import folders for hot reload    */
+    int ninclude;
     rt_crater craters[64];      /* --crater, applied in order before frames */
     int ncraters;
     double crater_at_view;      /* --crater-at-view RADIUS (0: none)        */
@@ -202,6 +208,13 @@ static int parse_args(int argc, char **argv, opts *o)
             NEED(); o->cache = v;
         } else if (!strcmp(a, "--scene")) {
             NEED(); o->scene = v;
+        } else if (!strcmp(a, "-I")) {
+            NEED();
+            if (o->ninclude == 64) {
+                fprintf(stderr, "splatview: too many -I folders (at most 64)\n");
+                return 2;
+            }
+            o->include[o->ninclude++] = v;
         } else if (!strcmp(a, "--script")) {
             NEED(); o->script = v;
         } else if (!strcmp(a, "--crater")) {
@@ -339,8 +352,7 @@ static bool apply_craters(const opts *o, rt_renderer *r, const rt_camera *cam, r
 
 static rt_tonemap tonemap_for(splat_view v)
 {
-    return v == SPLAT_VIEW_FINAL ? RT_TONEMAP_FILMIC
-         : v == SPLAT_VIEW_ALBEDO ? RT_TONEMAP_SRGB : RT_TONEMAP_NONE;
+    return rt_view_tonemap(v);
 }
 
 static int headless(const opts *o)
@@ -474,5 +486,7 @@ int main(int argc, char **argv)
     }
     vd.preset = o.preset;
     vd.view_name = o.view;
+    vd.include = o.include;
+    vd.ninclude = o.ninclude;
     return rt_viewer_run(&vd);
 }

@@ -169,7 +169,16 @@ bool rt_terrain_upload(rt_device *d, const rt_pack *p, rt_terrain_gpu *t,
                          VK_FORMAT_R8_UNORM, use, VK_IMAGE_ASPECT_COLOR_BIT, &t->painted, e) ||
          !rt_image_upload(d, &t->painted, p->npainted > 0 ? p->painted : zero4, pbytes, e)))
         return false;
-    /* Destruction: nothing destroyed (index alpha 0) until issue 5 fills it. */
+    /* Holes (abi.h binding 12): the pack's, or one texel of 0 (none). */
+    if (!rt_format_supports(d, VK_FORMAT_R8_UNORM, filt))
+        return rt_fail(e, RT_E_NO_FORMAT, "sample R8_UNORM with linear filtering");
+    if (!rt_image_create(d, p->holes ? W : 1, p->holes ? H : 1, 1, false, 1,
+                         VK_FORMAT_R8_UNORM, use, VK_IMAGE_ASPECT_COLOR_BIT, &t->holes, e) ||
+        !rt_image_upload(d, &t->holes, p->holes ? p->holes : zero4,
+                         p->holes ? (size_t)W * H : 1, e))
+        return false;
+    /* Destruction: nothing destroyed (index alpha 0) until a crater fills it
+     * (destruction.c). */
     if (!rt_image_create(d, 1, 1, 1, false, 1, VK_FORMAT_R8_UNORM, use,
                          VK_IMAGE_ASPECT_COLOR_BIT, &t->destr_atlas, e) ||
         !rt_image_upload(d, &t->destr_atlas, zero4, 1, e) ||
@@ -189,6 +198,7 @@ void rt_terrain_destroy(rt_device *d, rt_terrain_gpu *t)
     rt_image_destroy(d, &t->painted_level);
     rt_image_destroy(d, &t->destr_atlas);
     rt_image_destroy(d, &t->destr_index);
+    rt_image_destroy(d, &t->holes);
     if (t->linear_clamp)
         vkDestroySampler(d->dev, t->linear_clamp, NULL);
     if (t->nearest_clamp)

@@ -16,6 +16,7 @@
  * until a hot reload succeeded (compile errors on the way are shown and
  * survived; the time running out fails the script), "quit" ends. */
 #include "splatrt.h"
+#include "util.h"
 #include "scene.h"
 
 #define GLFW_INCLUDE_VULKAN
@@ -101,13 +102,6 @@ typedef struct viewer {
     int            status_code;
 } viewer;
 
-static double now_s(void)
-{
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + (double)ts.tv_nsec * 1e-9;
-}
-
 /* ---- camera ----------------------------------------------------------------- */
 
 static void camera_from_angles(viewer *v)
@@ -151,14 +145,13 @@ static void move_camera(viewer *v, double dt)
 
 static void key_action(viewer *v, int key)
 {
-    static const splat_view views[] = { SPLAT_VIEW_FINAL, SPLAT_VIEW_COMBOS, SPLAT_VIEW_LOD,
-                                        SPLAT_VIEW_NORMAL, SPLAT_VIEW_SLOPE, SPLAT_VIEW_ALBEDO };
-    if (key >= GLFW_KEY_1 && key <= GLFW_KEY_6) {
-        v->view = views[key - GLFW_KEY_1];
-    } else if (key == GLFW_KEY_7) {
+    int view = rt_view_by_key(key);   /* GLFW's digit keys are their ASCII */
+    if (view == SPLAT_VIEW_MASK) {    /* again: the next material's mask */
         if (v->view == SPLAT_VIEW_MASK)
             v->material = (v->material + 1) % v->pack->nmaterials;
         v->view = SPLAT_VIEW_MASK;
+    } else if (view >= 0) {
+        v->view = (splat_view)view;
     } else if (key == GLFW_KEY_F) {
         v->wire = !v->wire;
         rt_renderer_set_wireframe(v->r, v->wire);
@@ -249,36 +242,18 @@ static void watch_free(watch *w)
     memset(w, 0, sizeof *w);
 }
 
-/* Import search paths as `splatc build` has them: ".", then the nearest
- * folder above the scene that holds nodes/. */
-static void search_paths(const char *scene, char *buf, size_t n, const char *paths[3])
-{
-    paths[0] = ".";
-    paths[1] = NULL;
-    paths[2] = NULL;
-    snprintf(buf, n, "%s", scene);
-    for (char *slash; (slash = strrchr(buf, '/'));) {
-        *slash = '\0';
-        char nodes[1200];
-        snprintf(nodes, sizeof nodes, "%s/nodes", *buf ? buf : "/");
-        struct stat st;
-        if (stat(nodes, &st) == 0 && S_ISDIR(st.st_mode)) {
-            paths[1] = *buf ? buf : "/";
-            return;
-        }
-    }
-}
-
 /* The files the scene reads (scene.sg and every import), with mtimes. */
 static void watch_scene(viewer *v)
 {
     watch_free(&v->w);
-    char buf[1024];
-    const char *paths[3];
-    search_paths(v->scene, buf, sizeof buf, paths);
+    /* the paths the build uses, so the watch list is the build's inputs */
+    char **paths = splat_search_path(v->desc->include, v->desc->ninclude, v->scene);
+    char **imports = splat_import_path(v->scene, (const char *const *)paths);
     sg_diags d;
     sg_diags_init(&d);
-    sg_program *prog = sg_load(v->scene, paths, &d);
+    sg_program *prog = sg_load(v->scene, (const char *const *)imports, &d);
+    splat_search_path_free(imports);
+    splat_search_path_free(paths);
     int n = prog ? sg_file_count(prog) : 0;
     v->w.files = calloc((size_t)n + 1, sizeof *v->w.files);
     v->w.mtimes = calloc((size_t)n + 1, sizeof *v->w.mtimes);
@@ -304,16 +279,15 @@ static void watch_scene(viewer *v)
  * pack drawing and are shown in the console and the title. */
 static void reload(viewer *v)
 {
-    char buf[1024];
-    const char *paths[3];
-    search_paths(v->scene, buf, sizeof buf, paths);
+    char **paths = splat_search_path(v->desc->include, v->desc->ninclude, v->scene);
     sg_diags d;
     sg_diags_init(&d);
-    splat_build_desc bd = { .scene = v->scene, .out = v->desc->pack_dir, .search_paths = paths,
-                            .jobs = 2 };
+    splat_build_desc bd = { .scene = v->scene, .out = v->desc->pack_dir,
+                            .search_paths = (const char *const *)paths, .jobs = 2 };
     splat_build_stats bs;
-    double t0 = now_s();
+    double t0 = splat_now();
     bool ok = splat_build(&bd, &bs, &d);
+    splat_search_path_free(paths);
     if (!ok || d.nerrors) {
         fprintf(stderr, "splatview: hot reload: the scene does not compile:\n");
         sg_diags_print(&d, stderr);
@@ -341,13 +315,13 @@ static void reload(viewer *v)
     v->pack = np;
     v->reloads++;
     snprintf(v->status, sizeof v->status, "reloaded in %.0f ms (%d compiled)",
-             (now_s() - t0) * 1e3, bs.shaders_compiled);
+             (splat_now() - t0) * 1e3, bs.shaders_compiled);
     fprintf(stderr, "splatview: %s\n", v->status);
 }
 
 static void check_files(viewer *v)
 {
-    double t = now_s();
+    double t = splat_now();
     if (!v->scene || t - v->last_check < 0.25)
         return;
     v->last_check = t;
@@ -607,7 +581,8 @@ static bool present(viewer *v, const char *shot, rt_error *e)
     vkCmdBeginRenderPass(cb, &rb, VK_SUBPASS_CONTENTS_INLINE);
     vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_GRAPHICS, v->pipeline);
     vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_GRAPHICS, v->layout, 0, 1, &v->set, 0, NULL);
-    uint32_t mode = v->view == SPLAT_VIEW_FINAL ? 0 : v->view == SPLAT_VIEW_ALBEDO ? 1 : 2;
+    _Static_assert(RT_TONEMAP_FILMIC == 0 && RT_TONEMAP_NONE == 2, "the blit's u_pc.mode");
+    uint32_t mode = (uint32_t)rt_view_tonemap(v->view);
     vkCmdPushConstants(cb, v->layout, VK_SHADER_STAGE_FRAGMENT_BIT, 0, 4, &mode);
     vkCmdDraw(cb, 3, 1, 0, 0);
     vkCmdEndRenderPass(cb);
@@ -670,7 +645,7 @@ static bool present(viewer *v, const char *shot, rt_error *e)
 
 static bool frame(viewer *v, const char *shot, double *last, rt_error *e)
 {
-    double t = now_s(), dt = t - *last;
+    double t = splat_now(), dt = t - *last;
     *last = t;
     glfwPollEvents();
     move_camera(v, dt > 0.25 ? 0.25 : dt);
@@ -724,8 +699,8 @@ static bool script_step(viewer *v, const char *step, double *last, rt_error *e)
         /* compile errors on the way are shown and survived; only a
          * successful reload ends the wait */
         int before = v->reloads;
-        double until = now_s() + atof(val);
-        while (v->reloads == before && now_s() < until && !v->quit)
+        double until = splat_now() + atof(val);
+        while (v->reloads == before && splat_now() < until && !v->quit)
             if (!frame(v, NULL, last, e))
                 return false;
         if (v->reloads == before)
@@ -891,7 +866,7 @@ int rt_viewer_run(const rt_viewer_desc *desc)
     glfwSetMouseButtonCallback(v->win, on_button);
     glfwSetCursorPosCallback(v->win, on_cursor);
 
-    double last = now_s();
+    double last = splat_now();
     if (desc->script) {
         if (!run_script(v, desc->script, &last, &e))
             goto done;

@@ -1,4 +1,4 @@
-/* gen_terrain.c — the rasters of the billingsley example (seed 002),
+/* gen_terrain.c — the rasters of the billingsley example (Billingsley 2009),
  * deterministic (no clock, no rand()):
  *
  *   billingsley_gen_terrain OUTDIR

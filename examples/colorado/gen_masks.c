@@ -6,7 +6,7 @@
  *
  * writes four 8-bit greyscale masks of the DEM's size (2401 x 1201):
  *   field_wheat.png, field_plowed.png, field_fallow.png — fields on flat
- *       lowland, like seed 000 Fig. 10's scattered painted fields: centre-
+ *       lowland, like Andersson 2007 Fig. 10's scattered painted fields: centre-
  *       pivot circles in the San Luis Valley (the west), rectangles on the
  *       plains (the east); each field gets one of the three crops;
  *   road.png — roads found as least-cost paths (Dijkstra; cost grows with

@@ -3,7 +3,7 @@
 #   pareto_*.png      speed–accuracy scatter of one knob group with its
 #                     Pareto front (no other variant both faster and closer)
 #   ratios.png        reference / composite, flat / composite, uber /
-#                     composite GPU time ratios with the issue 7 targets
+#                     composite GPU time ratios with the speed targets
 #   compile_scaling.png  analysis cost per texel vs heightfield texels, and
 #                     compile phases vs material count
 set terminal pngcairo size 900,600 noenhanced font ",10"

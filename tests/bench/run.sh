@@ -1,12 +1,13 @@
 #!/bin/sh
-# run.sh — the speed–accuracy benchmark of issue 7 (`make bench`,
+# run.sh — the speed–accuracy benchmark (`make bench`,
 # `make bench-smoke`, CTest bench.smoke).
 #
 #   sh tests/bench/run.sh BUILD_DIR [--smoke] [--quick] [--out DIR]
 #                         [--frames N] [--keep-work]
 #
 # Writes into DIR (default out/bench): compile.csv (per scene: phases of
-# `splatc build --stats`, cold and warm, peak memory), scale_hf.csv
+# `splatc build --stats`, cold and warm, peak memory; colorado_geotiff:
+# the same scene imported from GeoTIFFs through GDAL), scale_hf.csv
 # (analysis vs heightfield texels 1x/4x/16x), scale_mat.csv (compile phases
 # vs material count 4/8/15/30), render.csv (splatbench: GPU/CPU ms per frame
 # and error vs the reference of the same frames, one row per variant),
@@ -150,6 +151,26 @@ for s in $CSCENES; do
     # the packs the renders use: with the flat variants (branching benchmark)
     "$SPLATC" build "examples/$s/scene.sg" -o "$W/$s" -j 2 --flat --cache "$W/cache-$s" >/dev/null
 done
+
+# ---- (a) the GeoTIFF import: colorado's twin (tests/world/colorado_twin.sh)
+# through GDAL, heightfield and masks as GeoTIFFs written by gen_geotiff ----
+GEN=$B/tests/gen_geotiff
+if [ "$MODE" != smoke ] && [ -x "$GEN" ]; then
+    log "compile colorado_geotiff (cold)"
+    T=$W/colorado_geotiff
+    mkdir -p "$T/masks"
+    "$GEN" examples/colorado/trinidad.png "$T/trinidad.tif" 176473.5 111212.6 2962.242 1358.652
+    for m in field_wheat field_plowed field_fallow road; do
+        "$GEN" examples/colorado/masks/$m.png "$T/masks/$m.tif" 176473.5 111212.6
+    done
+    sed -e 's/"trinidad.png"/"trinidad.tif"/' \
+        -e 's/^\( *painted [a-z_]* *= *"masks\/[a-z_]*\)\.png"/\1.tif"/' \
+        -e '/^ *size = /d' -e '/^ *max_height = /d' -e '/^ *height_offset = /d' \
+        examples/colorado/scene.sg > "$T/scene.sg"
+    export SPLATC_PATH="$REPO"
+    build_row cold "$T/scene.sg" "$W/pack-colorado_geotiff" --cache "$W/cache-colorado_geotiff"
+    unset SPLATC_PATH
+fi
 
 # ---- (a) scaling with heightfield texels: 1x, 4x, 16x ---------------------
 CSV=$OUT/scale_hf.csv

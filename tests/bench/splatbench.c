@@ -1,5 +1,5 @@
 /* splatbench — speed and accuracy of shader-pack variants, side by side on
- * the same frames of a fixed camera path (issue 7, DESIGN §9).
+ * the same frames of a fixed camera path (compiler/DESIGN.md §9).
  *
  *   splatbench render --variant LABEL=KIND[,pack=DIR][,lod=P] ... [options]
  *       Renders every variant on every frame of a camera path, frames
@@ -11,7 +11,7 @@
  *       RGB, PSNR with peak 1, count of NaN/Inf values).  One CSV row per
  *       variant.  KIND:
  *         composite   per-combination composites (the pack's shaders)
- *         multipass   the multi-pass alpha-blended reference (seed 000 §5.3)
+ *         multipass   the multi-pass alpha-blended reference (Andersson 2007 §5.3)
  *         uber        the über-shader for every patch
  *         flat        composites without dynamic branches (pack built --flat)
  *         fp16        composites recompiled with `precision mediump float`
@@ -382,7 +382,7 @@ typedef struct path_desc {
 } path_desc;
 
 /* Camera of frame f of n.  ground: 2 m above the terrain, looking 150 m
- * ahead along a straight line (seed 002 §3.2), 1.5 % of the terrain per
+ * ahead along a straight line (Billingsley 2009 §3.2), 1.5 % of the terrain per
  * path; topdown: straight down from above the highest point, covering
  * about half the terrain, drifting east; grazing: 40 m above a corner,
  * looking across the terrain at about 1-3 degrees below the horizon. */

@@ -1,8 +1,8 @@
-# Benchmarks (issue 7): splatbench renders pack variants side by side on
+# Benchmarks: splatbench renders pack variants side by side on
 # fixed camera paths; tests/bench/run.sh drives it (`make bench`, 20 min on
 # lavapipe) and its smoke mode is this suite's one test (label `bench`): a
 # few small frames of examples/minimal through the whole pipeline, so the
-# benchmark cannot rot.  Figures are printed, never asserted (DESIGN §9).
+# benchmark cannot rot.  Figures are printed, never asserted (compiler/DESIGN.md §9).
 if(TARGET splatrt AND TARGET splatview AND TARGET splatc_cli)
   add_executable(splatbench ${CMAKE_CURRENT_LIST_DIR}/splatbench.c)
   target_link_libraries(splatbench splatrt)

@@ -1,7 +1,7 @@
 #!/bin/sh
 # summary.sh OUTDIR MODE — out/bench/summary.md from the CSVs run.sh wrote:
 # ratios A/B of variants rendered side by side on the same frames (medians),
-# and every target of issues 3, 4 and 7 as MET or MISSED with the measured
+# and every build, renderer and benchmark target as MET or MISSED with the measured
 # figure.  A target whose figures are absent is "not measured", never met.
 set -eu
 O=$1
@@ -30,12 +30,12 @@ echo "|---|---|---|"
 awk -F, '
     function verdict(ok) { return ok ? "MET" : "**MISSED**" }
     FILENAME ~ /compile.csv/ && $2 == "colorado" && $3 == "cold" {
-        printf "| issue 3: colorado build from an empty cache < 2 s (-j 2) | %.2f s wall (%.2fx the target) | %s |\n", $14, $14 / 2, verdict($14 < 2)
-        if ($15 != "NA") printf "| issue 3: peak memory < 500 MB | %.0f MB | %s |\n", $15, verdict($15 < 500)
+        printf "| build target: colorado build from an empty cache < 2 s (-j 2) | %.2f s wall (%.2fx the target) | %s |\n", $14, $14 / 2, verdict($14 < 2)
+        if ($15 != "NA") printf "| build target: peak memory < 500 MB | %.0f MB | %s |\n", $15, verdict($15 < 500)
         cold = 1
     }
     FILENAME ~ /compile.csv/ && $2 == "colorado" && $3 == "warm" {
-        printf "| issue 3: colorado rebuild with nothing changed < 0.3 s | %.2f s wall (%.2fx the target) | %s |\n", $14, $14 / 0.3, verdict($14 < 0.3)
+        printf "| build target: colorado rebuild with nothing changed < 0.3 s | %.2f s wall (%.2fx the target) | %s |\n", $14, $14 / 0.3, verdict($14 < 0.3)
     }
     # repeated builds of one size: the smallest analysis time counts
     FILENAME ~ /scale_hf.csv/ && FNR > 1 && $17 != "" {
@@ -50,27 +50,27 @@ awk -F, '
             if (i == 1 || v < lo) lo = v
             if (i == 1 || v > hi) hi = v
         }
-        if (!cold) print "| issue 3: colorado cold/warm build, peak memory | not measured in this mode | not measured |"
-        if (n >= 3) printf "| issue 3: analysis cost per texel flat within 30 %% over 1x/4x/16x (%s) | %s; max/min %.2f | %s |\n", sc, lab, hi / lo, verdict(hi / lo <= 1.3)
-        else printf "| issue 3: analysis per texel over 1x/4x/16x | %s (fewer than 3 sizes) | not measured |\n", n ? lab : "none"
+        if (!cold) print "| build target: colorado cold/warm build, peak memory | not measured in this mode | not measured |"
+        if (n >= 3) printf "| build target: analysis cost per texel flat within 30 %% over 1x/4x/16x (%s) | %s; max/min %.2f | %s |\n", sc, lab, hi / lo, verdict(hi / lo <= 1.3)
+        else printf "| build target: analysis per texel over 1x/4x/16x | %s (fewer than 3 sizes) | not measured |\n", n ? lab : "none"
     }' "$O/compile.csv" "$O/scale_hf.csv"
 # quadtree selection for 4096^2 (printed by test_quadtree)
 q=$(grep -i "4096" "$O/quadtree.txt" 2>/dev/null | grep -o "[0-9.]* *ms" | head -n 1 | tr -d ' ms' || true)
 if [ -n "$q" ]; then
-    awk -v q="$q" 'BEGIN { printf "| issue 4: quadtree selection + culling < 0.2 ms for 4096^2 | %.4f ms (test_quadtree) | %s |\n", q, (q < 0.2 ? "MET" : "**MISSED**") }'
+    awk -v q="$q" 'BEGIN { printf "| renderer target: quadtree selection + culling < 0.2 ms for 4096^2 | %.4f ms (test_quadtree) | %s |\n", q, (q < 0.2 ? "MET" : "**MISSED**") }'
 else
-    echo "| issue 4: quadtree selection < 0.2 ms for 4096^2 | not measured in this mode | not measured |"
+    echo "| renderer target: quadtree selection < 0.2 ms for 4096^2 | not measured in this mode | not measured |"
 fi
 awk -F, -v dev="$dev" '
     NR > 1 && $1 == "main" && $3 == "colorado" && $8 == "composite" {
         if ($5 == 1280) {
             fps = $12 > 0 ? 1000 / $12 : 0
-            printf "| issue 4: colorado 1280x720 >= 10 fps (%s path, GPU median %.1f ms) | %.1f fps | %s |\n", $4, $12, fps, (fps >= 10 ? "MET" : "**MISSED**")
+            printf "| renderer target: colorado 1280x720 >= 10 fps (%s path, GPU median %.1f ms) | %.1f fps | %s |\n", $4, $12, fps, (fps >= 10 ? "MET" : "**MISSED**")
         }
         if ($5 == 1920 && dev !~ /llvmpipe/)
-            printf "| issue 4: colorado 1920x1080 within 2 ms on the GPU (%s path) | %.3f ms | %s |\n", $4, $12, ($12 <= 2 ? "MET" : "**MISSED**")
+            printf "| renderer target: colorado 1920x1080 within 2 ms on the GPU (%s path) | %.3f ms | %s |\n", $4, $12, ($12 <= 2 ? "MET" : "**MISSED**")
     }' "$O/render.csv"
-# issue 7 ratios: reference (multipass), uber and flat over composite, same frames
+# benchmark ratios: reference (multipass), uber and flat over composite, same frames
 awk -F, '
     NR > 1 && $1 == "main" { k = $3 "|" $4 "|" $5 "x" $6; t[k, $8] = $12; e[k, $8] = $19; keys[k] = 1 }
     END {
@@ -79,13 +79,13 @@ awk -F, '
             c = t[k, "composite"]
             if (c <= 0) continue
             r = t[k, "multipass"] / c
-            printf "| issue 7: single pass >= 4x faster than multi-pass, error <= 1/255 (%s %s %s) | %.2fx, max error %.2e (%.2f/255) | %s |\n", a[1], a[2], a[3], r, e[k, "composite"], e[k, "composite"] * 255, (r >= 4 && e[k, "composite"] <= 1 / 255) ? "MET" : "**MISSED**"
+            printf "| benchmark target: single pass >= 4x faster than multi-pass, error <= 1/255 (%s %s %s) | %.2fx, max error %.2e (%.2f/255) | %s |\n", a[1], a[2], a[3], r, e[k, "composite"], e[k, "composite"] * 255, (r >= 4 && e[k, "composite"] <= 1 / 255) ? "MET" : "**MISSED**"
             if (a[1] == "colorado") {
                 r = t[k, "flat"] / c
-                printf "| issue 7: branching >= 1.7x faster than flat on colorado (%s %s) | %.2fx | %s |\n", a[2], a[3], r, (r >= 1.7 ? "MET" : "**MISSED**")
+                printf "| benchmark target: branching >= 1.7x faster than flat on colorado (%s %s) | %.2fx | %s |\n", a[2], a[3], r, (r >= 1.7 ? "MET" : "**MISSED**")
             }
             r = t[k, "uber"] / c
-            printf "| issue 7: per-combination >= 1.3x faster than uber (%s %s %s) | %.2fx, uber error %.2e | %s |\n", a[1], a[2], a[3], r, e[k, "uber"], (r >= 1.3 ? "MET" : "**MISSED**")
+            printf "| benchmark target: per-combination >= 1.3x faster than uber (%s %s %s) | %.2fx, uber error %.2e | %s |\n", a[1], a[2], a[3], r, e[k, "uber"], (r >= 1.3 ? "MET" : "**MISSED**")
         }
     }' "$O/render.csv" | sort
 echo

@@ -7,6 +7,9 @@
 #   status     exit codes 0 / 1 / 2, nothing written on error
 #   eval       `splatc eval` values and --interval bounds
 #   tools      dot, dump --after, check of several files
+#   depfile    `splatc build --depfile`: every input listed (graphs,
+#              imports, rasters, textures, mips), Make-escaped, and make
+#              rebuilds exactly when one of them changes; --json diagnostics
 #   malformed  empty file, binary garbage, truncated files, 10 MB inputs,
 #              10000-deep instance nesting: exit 1 with a diagnostic, no crash
 #              or hang
@@ -150,6 +153,46 @@ tools)
     run 0 "$SPLATC" check "$TMP/cliff_dump.sg"
     run 0 "$SPLATC" dump "$TMP/cliff_dump.sg" -m cliff -o "$TMP/cliff_dump2.sg"
     cmp -s "$TMP/cliff_dump.sg" "$TMP/cliff_dump2.sg" || fail "dump of the dump differs"
+    ;;
+depfile)
+    # a copy of examples/minimal in a folder with a space, and a mip level
+    # for one texture, so escaping and mips are both seen
+    W="$TMP/a b"
+    mkdir -p "$W/examples" && cp -r examples/minimal "$W/examples/" && cp -r graphs nodes "$W/" ||
+        fail "copy"
+    cp "$W/graphs/textures/rock.png" "$W/graphs/textures/rock.mip1.png"
+    ( cd "$W" && timeout 300 "$SPLATC" build examples/minimal/scene.sg -o pack -j 2 \
+          --depfile pack.d > "$TMP/out" 2> "$TMP/err" ) || fail "build --depfile"
+    [ "$(head -1 "$W/pack.d")" = 'pack/manifest.json: \' ] || fail "depfile target: $(head -1 "$W/pack.d")"
+    # the listed files, one a line ("  PATH \" or "  PATH" last)
+    sed -n 's/^  //p' "$W/pack.d" | sed 's/ \\$//' > "$TMP/deps"
+    for f in examples/minimal/scene.sg nodes/compositors.sg nodes/masks.sg graphs/grass.sg \
+             examples/minimal/heightfield.png examples/minimal/fields.png \
+             graphs/textures/rock.png graphs/textures/rock.mip1.png graphs/textures/grass.png; do
+        grep -qxF "$f" "$TMP/deps" || fail "depfile lacks $f"
+    done
+    while read -r f; do [ -f "$W/$f" ] || fail "depfile names a missing file: $f"; done < "$TMP/deps"
+    # make: up to date right after, out of date after an import or a mip changes
+    printf 'include pack.d\npack/manifest.json:\n\t%s build examples/minimal/scene.sg -o pack --depfile pack.d\n' \
+        "$SPLATC" > "$W/Makefile"
+    ( cd "$W" && make -q ) || fail "make says the fresh pack is out of date"
+    sleep 1; touch "$W/nodes/masks.sg"
+    ( cd "$W" && make -q ); [ $? = 1 ] || fail "make misses a changed import"
+    ( cd "$W" && make > /dev/null 2>&1 && make -q ) || fail "make did not bring the pack up to date"
+    sleep 1; touch "$W/graphs/textures/rock.mip1.png"
+    ( cd "$W" && make -q ); [ $? = 1 ] || fail "make misses a changed mip"
+    # a folder with a space is escaped
+    ( cd "$TMP" && timeout 300 "$SPLATC" build "a b/examples/minimal/scene.sg" -o p2 \
+          --depfile p2.d > /dev/null 2>&1 ) || fail "build from a spaced path"
+    grep -qF '  a\ b/examples/minimal/scene.sg' "$TMP/p2.d" || fail "space not escaped"
+    # --json: one JSON object per diagnostic, with its id and location
+    printf 'material m {\n    node x : nosuch { }\n    out mask = x.out\n}\n' > "$TMP/bad.sg"
+    run 1 "$SPLATC" build "$TMP/bad.sg" -o "$TMP/badpack" --json
+    [ -e "$TMP/badpack" ] && fail "a failed build wrote a pack"
+    jq -e 'select(.id == "UNKNOWN_NODE" and .line == 2 and .column == 14)' "$TMP/err" \
+        > /dev/null || { fail "--json: no UNKNOWN_NODE at 2:14"; cat "$TMP/err"; }
+    jq -e -s 'length >= 1 and all(.[]; has("file") and has("severity") and has("message"))' \
+        "$TMP/err" > /dev/null || fail "--json: not JSON Lines of diagnostics"
     ;;
 malformed)
     : > "$TMP/empty.sg"

@@ -71,8 +71,7 @@ static bool render(scene *s, splat_view view, int material, const char *png)
     bool ok = rt_renderer_frame(s->r, &s->cam, NULL, &e) && rt_renderer_read(s->r, s->rgba, &e);
     if (ok && png) {
         uint8_t *px = malloc((size_t)W * H * 4);
-        rt_tonemap_rgba8(s->rgba, W, H, view == SPLAT_VIEW_FINAL ? RT_TONEMAP_FILMIC
-                                                                  : RT_TONEMAP_NONE, px);
+        rt_tonemap_rgba8(s->rgba, W, H, rt_view_tonemap(view), px);
         ok = px && rt_write_png(png, px, W, H, &e);
         free(px);
     }

@@ -1,4 +1,4 @@
-/* extreme.c — numerical stability at the extremes (issue 7 §4).
+/* extreme.c — numerical stability at the extremes (extreme-value stability).
  *
  *   extreme nodes      mask nodes at extreme inputs: ramp with lo == hi,
  *                      overlay and scale_contrast at 0, 1 and outside

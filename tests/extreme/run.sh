@@ -1,5 +1,5 @@
 #!/bin/sh
-# run.sh — extreme-value renders (issue 7 §4): every scene `extreme gen`
+# run.sh — extreme-value renders (extreme-value stability): every scene `extreme gen`
 # writes (max height 0 m / 1 m / 10 km over vertical cliffs and 0|65535
 # checkerboards, flat ground, 1x1 and 2x2 heightfields, a 1e6 m height
 # offset, a 100 km terrain, painted masks all 0 / all 1) is built with

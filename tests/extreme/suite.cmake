@@ -1,4 +1,4 @@
-# Extreme-value tests (issue 7 §4), label `extreme`: mask nodes at extreme
+# Extreme-value tests (extreme-value stability), label `extreme`: mask nodes at extreme
 # inputs on the CPU reference and the device (compute harness), Listing 1's
 # normal filter at extreme heights and scales (double vs fp32), and renders
 # of extreme scenes through splatc build + splatview --float-out (no NaN/Inf,

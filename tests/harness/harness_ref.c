@@ -12,7 +12,8 @@
  * large spread: both are ill-conditioned points that no fp32 evaluation can
  * be held to.
  *
- * Error bounds per op, u = 2^-24 (fp32 unit roundoff); after the Vulkan
+ * Error bounds per op (the op table's fp32 column, IR_FP32_CLASSES in
+ * ir.h, names each op's class), u = 2^-24 (fp32 unit roundoff); after the Vulkan
  * spec's "Precision and Operation of SPIR-V Instructions", generously:
  *   exact in fp32 (0):  neg abs floor min max clamp saturate step less
  *                       select splat swizzle construct; inputs, params,
@@ -76,16 +77,17 @@ static double bound(const ir *ir, uint32_t id, const ir_env *env,
     const double *t = n->nargs > 2 ? v[n->arg[2].id] : NULL;
     double r = fabs(v[id][c]);
     int w = n->nargs > 0 ? ir_type_width(ir_typeof(ir, n->arg[0])) : 0;
-    switch (n->op) {
-    case IR_OP_CONST:
+    /* No default: a class added to IR_FP32_CLASSES without a bound here is
+     * a compile error (-Werror=switch), and every op row names a class. */
+    switch (ir_opinfo_get((ir_op)n->op)->fp32) {
+    case IR_FP32_LITERAL:
+    case IR_FP32_ROUNDED:
         return U * r;
-    case IR_OP_ADD: case IR_OP_SUB: case IR_OP_MUL:
-        return U * r;
-    case IR_OP_DIV: case IR_OP_SQRT:
+    case IR_FP32_ULP3:
         return 3 * U * r;
-    case IR_OP_FRACT:
+    case IR_FP32_FRACT:
         return U;
-    case IR_OP_MOD: {
+    case IR_FP32_MOD: {
         double x = a[c], y = b[c], q = x / y;
         double f = q - floor(q);
         double near = 8 * U * (1 + fabs(q));
@@ -93,21 +95,21 @@ static double bound(const ir *ir, uint32_t id, const ir_env *env,
             *ill = true;
         return 4 * U * (fabs(x) + fabs(y));
     }
-    case IR_OP_EXP2:
+    case IR_FP32_EXP2:
         return (3 + 2 * fabs(a[c])) * U * r;
-    case IR_OP_POW:
+    case IR_FP32_POW:
         if (a[c] < 0 || (a[c] == 0 && b[c] <= 0))
             *undef = true;
         return (8 + 16 * fabs(b[c]) * (1 + fabs(log2(fabs(a[c]) + 1e-300)))) * U * r;
-    case IR_OP_SIN: case IR_OP_COS:
+    case IR_FP32_TRIG:
         return 32 * U + 8 * U * fabs(a[c]);
-    case IR_OP_MIX:
+    case IR_FP32_MIX:
         return 2 * U * (fabs(a[c]) + fabs(b[c])) * (1 + fabs(t[c])) + U * r;
-    case IR_OP_CLAMP:
+    case IR_FP32_CLAMP:
         if (b[c] > t[c])
             *undef = true;
         return 0;
-    case IR_OP_SMOOTHSTEP: {
+    case IR_FP32_SMOOTHSTEP: {
         double e0 = a[c], e1 = b[c], x = t[c];
         if (e0 >= e1) {
             *undef = true;
@@ -116,21 +118,21 @@ static double bound(const ir *ir, uint32_t id, const ir_env *env,
         double et = (2 * U * (fabs(x) + fabs(e0)) + U * fabs(e1 - e0)) / fabs(e1 - e0);
         return 1.5 * et + 4 * U;
     }
-    case IR_OP_DOT: {
+    case IR_FP32_DOT: {
         double s = 0;
         for (int i = 0; i < w; i++)
             s += fabs(a[i] * b[i]);
         return (w + 1) * U * s;
     }
-    case IR_OP_LENGTH:
+    case IR_FP32_LENGTH:
         return 4 * U * r;
-    case IR_OP_NORMALIZE:
+    case IR_FP32_NORMALIZE:
         return 6 * U;
-    case IR_OP_CROSS: {
+    case IR_FP32_CROSS: {
         int j = (c + 1) % 3, k = (c + 2) % 3;
         return 2 * U * (fabs(a[j] * b[k]) + fabs(a[k] * b[j]));
     }
-    case IR_OP_SAMPLE:
+    case IR_FP32_SAMPLE:
         /* NaN, Inf or huge coordinates: which texel is read is undefined */
         if (!isfinite(b[0]) || !isfinite(b[1]) || fmax(fabs(b[0]), fabs(b[1])) > 1e9)
             *undef = true;
@@ -138,9 +140,12 @@ static double bound(const ir *ir, uint32_t id, const ir_env *env,
             return 0;
         return o->texel_step * (1.0 / 256 + 4 * U * o->texels *
                                 (1 + fmax(fabs(b[0]), fabs(b[1]))));
-    default:   /* exact in fp32 */
+    case IR_FP32_EXACT:
         return 0;
+    case IR_FP32_COUNT:
+        break;
     }
+    abort();   /* not a class */
 }
 
 /* ---- the sampler's CPU twin -------------------------------------------- */

@@ -29,9 +29,12 @@
  * Each exclusion is counted and reported.  The generator draws every op
  * with unconstrained operands, so many values are NaN or undefined by
  * construction (pow of negatives, unordered smoothstep edges, sqrt of
- * negatives); still at least a third of all values, and some values of at
- * least 75% of the graphs, must be compared, so the test cannot pass by
- * excluding everything.  A control compares each graph's device values
+ * negatives); still at least 60% of all values (MIN_COMPARED_PCT), and
+ * some values of at least 75% of the graphs, must be compared, so the test
+ * cannot pass by excluding most of them.  Every exclusion is decided on the
+ * CPU reference (seeded draws), so the fraction does not depend on the
+ * device: 65.9% of 500736 values and 153 of 192 graphs are compared; 60%
+ * leaves room for a changed generator, not for a third of the values to go.  A control compares each graph's device values
  * with another graph's reference, which must fail nearly everywhere, so the
  * tolerance is not vacuous.
  */
@@ -51,6 +54,7 @@
 
 enum {
     BATCHES = 12,      /* one compute shader each                       */
+    MIN_COMPARED_PCT = 60, /* values that must be compared (see the top)  */
     ROOTS = 16,        /* random graphs per batch (one IR, shared leaves) */
     POINTS = 1024,     /* random inputs per batch                       */
     REGION = 32,       /* points drawn from one random input region     */
@@ -269,7 +273,7 @@ static void test_random_graphs_agree(void **state)
     printf("  max error/tolerance   %.3g\n", total.max_ratio);
     printf("  failed                %8ld\n", total.failed);
     assert_int_equal(total.mismatch, 0);
-    assert_true(3 * total.compared >= total.values);
+    assert_true(100 * total.compared >= MIN_COMPARED_PCT * total.values);
     assert_true(4 * total.graphs_compared >= 3 * BATCHES * ROOTS);
     assert_int_equal(total.failed, 0);
 }

@@ -1,21 +1,38 @@
 #!/bin/sh
 # check_pack.sh SPLATC SCENE OUT CACHE — build SCENE into OUT (SPIR-V cache in
 # CACHE) and pass every shader of the pack through spirv-val and
-# glslangValidator: the composites, the reference passes, the über-shader and
-# the vertex shader.
+# glslangValidator: the composites, the reference passes, the über-shader,
+# the vertex shader and the compute variants (built with --compute-spirv, so
+# splatc compiles and validates them too) and their counting variants.
+# The checks run two files at a time (colorado has some 500 shaders).
 set -e
 splatc=$1 scene=$2 out=$3 cache=$4
-"$splatc" build "$scene" -o "$out" --cache "$cache" -j 2
-n=0
-for f in "$out"/shaders/*.spv; do
-    spirv-val --target-env vulkan1.2 "$f" || { echo "spirv-val: $f" >&2; exit 1; }
-    n=$((n + 1))
-done
-for f in "$out"/shaders/*.frag "$out"/shaders/*.vert; do
-    if ! glslangValidator -V --target-env vulkan1.2 -o /dev/null "$f" >/dev/null; then
-        glslangValidator -V --target-env vulkan1.2 -o /dev/null "$f" >&2
-        exit 1
-    fi
-done
+"$splatc" build "$scene" -o "$out" --cache "$cache" -j 2 --compute-spirv
+n=$(ls "$out"/shaders/*.spv | wc -l)
+test -n "$(ls "$out"/shaders/*.comp.spv)"
+# each batch exits 255 on the first failure, which stops xargs (and set -e)
+ls "$out"/shaders/*.spv | xargs -P 2 -n 16 sh -c '
+    for f; do
+        spirv-val --target-env vulkan1.2 "$f" || { echo "spirv-val: $f" >&2; exit 255; }
+    done' sh
+ls "$out"/shaders/*.frag "$out"/shaders/*.vert "$out"/shaders/*.comp | xargs -P 2 -n 8 sh -c '
+    for f; do
+        if ! glslangValidator -V --target-env vulkan1.2 -o /dev/null "$f" >/dev/null; then
+            glslangValidator -V --target-env vulkan1.2 -o /dev/null "$f" >&2
+            exit 255
+        fi
+    done' sh
+# the counting variant the runtime compiles from each compute shader (abi.h)
+ls "$out"/shaders/*.comp | xargs -P 2 -n 8 sh -c '
+    v=$(mktemp --suffix=.spv)
+    for f; do
+        if ! glslangValidator -V --target-env vulkan1.2 -DSPLAT_COUNT=1 -o "$v" "$f" >/dev/null ||
+           ! spirv-val --target-env vulkan1.2 "$v"; then
+            glslangValidator -V --target-env vulkan1.2 -DSPLAT_COUNT=1 -o /dev/null "$f" >&2
+            rm -f "$v"
+            exit 255
+        fi
+    done
+    rm -f "$v"' sh
 test -f "$out/manifest.json"
-echo "$scene: $n SPIR-V modules and their GLSL valid"
+echo "$scene: $n SPIR-V modules and their GLSL valid, and the counting variants"

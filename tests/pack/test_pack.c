@@ -158,7 +158,18 @@ static void test_manifest_and_grid(void **state)
         }
         assert_true(file_size(pack_a, json_string_value(json_object_get(c, "glsl"))) > 0);
         assert_true(file_size(pack_a, json_string_value(json_object_get(c, "spirv"))) > 0);
+        /* the compute variant: its GLSL only by default (PACK.md), the
+         * stage's #define before the prelude; a positive cost */
+        json_t *cx = json_object_get(c, "compute");
+        const char *comp = json_string_value(json_object_get(cx, "glsl"));
+        assert_non_null(comp);
+        assert_true(file_size(pack_a, comp) > 0);
+        assert_null(json_object_get(cx, "spirv"));
+        assert_int_equal(strlen(json_string_value(json_object_get(cx, "hash"))), 32);
+        assert_true(json_real_value(json_object_get(c, "cost")) > 0);
     }
+    assert_true(file_size(pack_a, json_string_value(json_object_get(
+                    json_object_get(json_object_get(m, "uber"), "compute"), "glsl"))) > 0);
 
     /* the leaf grid covers the heightfield; each level halves (rounding up)
      * down to one node; combos.bin holds exactly the levels; ids in range */
@@ -217,6 +228,8 @@ static void test_shaders_validate(void **state)
     snprintf(pattern, sizeof pattern, "%s/shaders/*.frag", pack_a);
     assert_int_equal(glob(pattern, 0, NULL, &g), 0);
     snprintf(pattern, sizeof pattern, "%s/shaders/*.vert", pack_a);
+    assert_int_equal(glob(pattern, GLOB_APPEND, NULL, &g), 0);
+    snprintf(pattern, sizeof pattern, "%s/shaders/*.comp", pack_a);
     assert_int_equal(glob(pattern, GLOB_APPEND, NULL, &g), 0);
     for (size_t i = 0; i < g.gl_pathc; i++) {
         char *out;

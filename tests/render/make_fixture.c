@@ -4,7 +4,7 @@
  * GLSL over the ABI prelude (grass at the bottom, rock and snow by height
  * bands), the per-cell analysis done here exactly (height bands are exact
  * on the cell's texel range), the quadtree levels, one composite per
- * combination (front to back, DESIGN §6), the multi-pass reference passes,
+ * combination (front to back, compiler/DESIGN.md §6), the multi-pass reference passes,
  * the über-shader, a texture and a param.
  *
  *   make_fixture OUTDIR
@@ -92,7 +92,7 @@ static bool write_file(const char *dir, const char *rel, const void *data, size_
     return ok;
 }
 
-/* The bottom material's mask is 1 (DESIGN §6). */
+/* The bottom material's mask is 1 (compiler/DESIGN.md §6). */
 static void mask_call(int m, char out[32])
 {
     if (m == 0)
@@ -124,7 +124,7 @@ static char *shader_source(const int *mats, int n, int multipass)
         return s;
     }
     /* the mask view: this combination's masks (absent materials are 0) */
-    PUT("    if (u_frame.view.x == 5u) {\n        float m = 0.0;\n");
+    PUT("    if (u_frame.view.x == %uu) {\n        float m = 0.0;\n", (unsigned)SPLAT_VIEW_MASK);
     for (int k = 0; k < n; k++)
         PUT("        if (u_frame.view.y == %du) m = mask_%d();\n", mats[k], mats[k]);
     PUT("        o_color = vec4(vec3(m), 1.0);\n        return;\n    }\n");

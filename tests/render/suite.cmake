@@ -16,12 +16,18 @@ if(TARGET splatrt AND TARGET splatview)
 
   set(RENDER_CASES final combos views reference_multipass reference_uber cracks
       bad_packs stats viewer)
+  # these also run under ASan + UBSan (`make test-asan`, label asan): the
+  # pack loader on good and bad packs, a frame, the multi-pass reference
+  set(RENDER_ASAN final bad_packs reference_multipass)
   foreach(case ${RENDER_CASES})
     add_test(NAME render.${case}
       COMMAND sh ${RENDER_DIR}/run.sh ${case} $<TARGET_FILE:splatview>
               $<TARGET_FILE:imgcheck> ${RENDER_OUT}/fixture ${RENDER_OUT}/out)
-    set_tests_properties(render.${case} PROPERTIES LABELS render
+    set_tests_properties(render.${case} PROPERTIES LABELS render SKIP_RETURN_CODE 77
       FIXTURES_REQUIRED render_pack ENVIRONMENT "SPLAT_VALIDATE=1" TIMEOUT 300)
+    if(case IN_LIST RENDER_ASAN)
+      set_property(TEST render.${case} APPEND PROPERTY LABELS asan)
+    endif()
   endforeach()
 
   # The same checks on a real pack: examples/minimal through `splatc build`.
@@ -33,13 +39,18 @@ if(TARGET splatrt AND TARGET splatview)
     add_test(NAME render.real_minimal
       COMMAND sh ${RENDER_DIR}/run.sh real $<TARGET_FILE:splatview>
               $<TARGET_FILE:imgcheck> ${RENDER_OUT}/minimal ${RENDER_OUT}/out)
-    set_tests_properties(render.real_minimal PROPERTIES LABELS render
+    set_tests_properties(render.real_minimal PROPERTIES LABELS "render;asan"
       FIXTURES_REQUIRED minimal_pack ENVIRONMENT "SPLAT_VALIDATE=1" TIMEOUT 300)
-    add_test(NAME render.hot_reload
-      COMMAND sh ${RENDER_DIR}/run.sh hot_reload $<TARGET_FILE:splatview>
-              $<TARGET_FILE:imgcheck> ${RENDER_OUT}/minimal ${RENDER_OUT}/out)
-    set_tests_properties(render.hot_reload PROPERTIES LABELS render TIMEOUT 300
-      ENVIRONMENT "SPLAT_VALIDATE=1;SPLATC=$<TARGET_FILE:splatc_cli>")
+    # hot reload of an edited scene; _search: imports found only through
+    # -I or $SPLATC_PATH, as splatc build finds them
+    foreach(case hot_reload hot_reload_search)
+      add_test(NAME render.${case}
+        COMMAND sh ${RENDER_DIR}/run.sh ${case} $<TARGET_FILE:splatview>
+                $<TARGET_FILE:imgcheck> ${RENDER_OUT}/minimal ${RENDER_OUT}/out)
+      set_tests_properties(render.${case} PROPERTIES LABELS render TIMEOUT 300
+        SKIP_RETURN_CODE 77
+        ENVIRONMENT "SPLAT_VALIDATE=1;SPLATC=$<TARGET_FILE:splatc_cli>")
+    endforeach()
 
     # The example scenes rendered (examples.sh): colorado and billingsley,
     # and billingsley without presets (nocam.sg) for the computed default

@@ -101,6 +101,30 @@ static void test_error_fixtures(void **state)
     }
 }
 
+/* Every compositor of the node library keeps the contract
+ * (splat_compositor_check); the broken ones of bad_compositor_*.sg are
+ * errors (test_error_fixtures). */
+static void test_shipped_compositors(void **state)
+{
+    static const char *const files[] = {"nodes/compositors.sg", "nodes/compositors_extra.sg",
+                                        "nodes/stochastic.sg"};
+    static const char *const names[] = {"linear_alpha", "height_blend", "stochastic_select"};
+    const char *search[] = {".", NULL};
+    for (int i = 0; i < 3; i++) {
+        sg_diags d;
+        sg_diags_init(&d);
+        sg_program *p = sg_load(files[i], search, &d);
+        assert_non_null(p);
+        bool ok = splat_compositor_check(p, names[i], (sg_loc){files[i], 1, 1}, &d);
+        if (!ok)
+            sg_diags_print(&d, stderr);
+        assert_true(ok);
+        assert_int_equal(d.nerrors, 0);
+        sg_free(p);
+        sg_diags_free(&d);
+    }
+}
+
 /* ---- soundness at points ------------------------------------------------- */
 
 static uint64_t rng = 0x853c49e6748fea9bull;
@@ -253,6 +277,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_error_fixtures),
+        cmocka_unit_test(test_shipped_compositors),
         cmocka_unit_test(test_ok_scene),
         cmocka_unit_test(test_raw_matches_png),
         cmocka_unit_test(test_minimal_example),

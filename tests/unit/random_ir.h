@@ -160,7 +160,8 @@ static inline ir_ref random_ir_expr(ir *ir, random_ir_rng *r, ir_type t, int dep
     if (depth <= 0 || random_ir_int(r, 6) == 0)
         return random_ir_leaf(ir, r, t, o);
     for (int tries = 0; tries < 100; tries++) {
-        ir_op op = (ir_op)(IR_OP_SPLAT + random_ir_int(r, IR_OP_COUNT - IR_OP_SPLAT));
+        /* SPLAT..CROSS: the derivative pass's ops come after CROSS */
+        ir_op op = (ir_op)(IR_OP_SPLAT + random_ir_int(r, IR_OP_CROSS + 1 - IR_OP_SPLAT));
         if (!random_ir_allowed(o, op))
             continue;
         const ir_opinfo *info = ir_opinfo_get(op);

@@ -99,7 +99,7 @@ static void set_texel(fixture *f, int x, int z, uint16_t v)
     f->s.terrain.texels[(size_t)z * f->s.terrain.width + x] = v;
 }
 
-/* saturate((x - lo) / (hi - lo)): the linear ramp of seed 000. */
+/* saturate((x - lo) / (hi - lo)): the linear ramp of Andersson 2007. */
 static ir_ref ramp(ir *ir, ir_ref x, double lo, double hi)
 {
     ir_ref d = ir_op2(ir, IR_OP_SUB, x, ir_constf(ir, lo));

@@ -13,6 +13,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "abi.h"
 #include "ir.h"
 #include "random_ir.h"
 #include "shader.h"
@@ -24,6 +25,25 @@ static int count(const char *hay, const char *needle)
     for (const char *p = strstr(hay, needle); p; p = strstr(p + 1, needle))
         n++;
     return n;
+}
+
+/* The prelude's view switch has a case for each view of abi.h's table
+ * that the single-pass fragment shows, with the row's colour, and none for
+ * the views a composite writes itself. */
+static void test_prelude_views(void **state)
+{
+    int n = 0;
+#define X(id, num, name, key, tm, where, glsl)                                     \
+    do {                                                                           \
+        const char *line = "case " #num "u: c = " glsl "; break;";               \
+        bool want = strcmp(#where, "COMPOSITE") != 0;                             \
+        assert_int_equal(strstr(SPLAT_GLSL_PRELUDE, line) != NULL, want);          \
+        assert_int_equal(SPLAT_VIEW_##id, num);                                    \
+        assert_int_equal(num, n++);                                                \
+    } while (0);
+    SPLAT_VIEWS(X)
+#undef X
+    assert_int_equal(n, SPLAT_VIEW_COUNT);
 }
 
 static void test_value_once_leaves_inline(void **state)
@@ -226,7 +246,9 @@ static void test_random_graphs_compile(void **state)
         ir_buf_free(&a);
         ir_free(&ir);
     }
-    for (int op = 0; op < IR_OP_COUNT; op++)
+    /* the derivative pass's ops after CROSS are never generated here
+     * (test_differentiate compiles compute variants, which have them) */
+    for (int op = 0; op <= IR_OP_CROSS; op++)
         if (!seen[op]) {
             fprintf(stderr, "op %d never generated\n", op);
             fail();
@@ -237,6 +259,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_value_once_leaves_inline),
+        cmocka_unit_test(test_prelude_views),
         cmocka_unit_test(test_scopes),
         cmocka_unit_test(test_literals),
         cmocka_unit_test(test_material_shader),

@@ -121,30 +121,111 @@ static void test_type_rules(void **state)
     assert_int_equal(rule(IR_OP_ADD, IR_T_TEX, IR_T_TEX, 0, 2), IR_T_ERROR);
 }
 
-static void test_op_table_matches_op_list(void **state)
+/* The op table's rows are complete and their columns agree with each other:
+ * names round-trip, evaluators exist where the semantics column says so,
+ * and the finiteness column matches what the interval evaluator proves. */
+static void test_op_table_rows(void **state)
 {
-#define X(id, NAME, NARGS, FLAGS)                                              \
-    do {                                                                       \
-        const ir_opinfo *i = ir_opinfo_get(IR_OP_##id);                        \
-        assert_int_equal(i->nargs, NARGS);                                     \
-        assert_int_equal(i->flags, FLAGS);                                     \
-        if (NAME) {                                                            \
-            assert_string_equal(i->name, NAME);                               \
-            assert_int_equal(ir_op_by_name(NAME), IR_OP_##id);                 \
-        } else {                                                               \
-            assert_null(i->name);                                              \
-        }                                                                      \
-        assert_non_null(i->type);                                              \
-        assert_non_null(i->glsl);                                              \
-        /* every non-leaf op but SAMPLE has both evaluators */                 \
-        if (IR_OP_##id > IR_OP_PAINTED && IR_OP_##id != IR_OP_SAMPLE)          \
-            assert_true(i->eval && i->interval);                               \
-        for (int p = 0; p < (NARGS); p++)                                      \
-            assert_non_null(i->ports[p]);                                      \
-    } while (0);
-    IR_OPS(X)
-#undef X
+    const ir_iv full = {-INFINITY, INFINITY}, lo = {-2, -1}, hi = {1, 2};
+    for (int op = 0; op < IR_OP_COUNT; op++) {
+        const ir_opinfo *i = ir_opinfo_get((ir_op)op);
+        if (i->name)
+            assert_int_equal(ir_op_by_name(i->name), op);
+        assert_non_null(i->type);
+        assert_non_null(i->glsl);
+        assert_true(i->fp32 >= 0 && i->fp32 < IR_FP32_COUNT);
+        bool leaf = op <= IR_OP_PAINTED || op == IR_OP_DINPUT;
+        bool sample = op == IR_OP_SAMPLE || op == IR_OP_SAMPLE_GRAD;
+        /* every non-leaf op but the samples has both evaluators */
+        if (!leaf && !sample)
+            assert_true(i->eval && i->interval);
+        /* scalar functions exactly for the componentwise ops */
+        bool cw = i->flags & IR_COMPONENTWISE;
+        assert_int_equal(i->scalar_eval != NULL, cw);
+        assert_int_equal(i->scalar_interval != NULL, cw);
+        assert_true(!(i->flags & IR_NAN_PROPAGATES) || cw);
+        for (int p = 0; p < i->nargs; p++)
+            assert_non_null(i->ports[p]);
+        /* cost: leaves and register moves are free, real work is not */
+        bool moves = leaf || op == IR_OP_SPLAT || op == IR_OP_SWIZZLE || op == IR_OP_CONSTRUCT;
+        assert_int_equal(i->cost == 0, moves);
+        assert_true(i->finite == IR_FIN_DATA ? leaf || sample : true);
+        /* a derivative rule wherever the result can move with an operand
+         * (D0 only for leaves that never move and piecewise-constant ops) */
+        bool constant = op == IR_OP_FLOOR || op == IR_OP_STEP || op == IR_OP_LESS;
+        if (!leaf)
+            assert_int_equal(i->deriv != NULL, !constant);
+        if (!cw)
+            continue;
+        /* finiteness vs intervals: operands the column needs finite get a
+         * finite interval (lo <= hi for clamp), the others anything */
+        ir_node n = {.op = (uint8_t)op, .type = IR_T_FLOAT, .nargs = (uint8_t)i->nargs};
+        ir_type at[4] = {IR_T_FLOAT, IR_T_FLOAT, IR_T_FLOAT, IR_T_FLOAT};
+        ir_iv a[16], out[4];
+        for (int k = 0; k < 16; k++)
+            a[k] = full;
+        bool need_args = i->finite & IR_FIN_ARGS_BIT;
+        for (int k = 0; k < i->nargs; k++)
+            if (need_args && (i->finite >> k & 1))
+                a[4 * k] = k == 1 ? lo : hi;
+        i->interval(&n, at, a, out);
+        bool finite = isfinite(out[0].lo) && isfinite(out[0].hi);
+        if (finite != (i->finite != IR_FIN_NO))
+            fail_msg("op %d: finiteness column %#x, interval [%g, %g]", op, i->finite,
+                     out[0].lo, out[0].hi);
+    }
     assert_int_equal(ir_op_by_name("no_such_op"), -1);
+}
+
+/* The input table: names round-trip, env slots are the fields, and
+ * ir_ienv_domain sets what the domain column says. */
+static void test_input_table_rows(void **state)
+{
+    ir_env env;
+    ir_ienv ienv;
+    memset(&ienv, 0, sizeof ienv);
+    ir_ienv_domain(&ienv);
+    for (int k = 0; k < IR_IN_COUNT; k++) {
+        const ir_input_info *in = ir_input_get((ir_input_kind)k);
+        assert_int_equal(ir_input_by_name(in->name), k);
+        int w = ir_type_width(in->type);
+        assert_true(w >= 1 && w <= 3);
+        assert_true(in->env_off + (size_t)w * sizeof(double) <= sizeof env);
+        assert_true(strncmp(in->local, "in_", 3) == 0);
+        for (int c = 0; c < w; c++)
+            assert_true(in->domain[c].lo <= in->domain[c].hi);
+        ir_iv *slot = ir_ienv_slot(&ienv, (ir_input_kind)k);
+        for (int c = 0; slot && c < w; c++)
+            assert_true(slot[c].lo == in->domain[c].lo && slot[c].hi == in->domain[c].hi);
+    }
+    assert_ptr_equal(ir_env_slot(&env, IR_IN_VIEW_DISTANCE), &env.view_distance);
+    assert_ptr_equal(ir_env_slot(&env, IR_IN_NORMAL), env.normal);
+    assert_ptr_equal(ir_ienv_slot(&ienv, IR_IN_UV), ienv.uv);
+    assert_null(ir_ienv_slot(&ienv, IR_IN_VIEW_DIRECTION));
+    assert_true(ienv.slope.lo == 0 && ienv.slope.hi == 1);
+    assert_true(ienv.view_distance.lo == 0 && isinf(ienv.view_distance.hi));
+    assert_int_equal(ir_input_by_name("terrain.nope"), -1);
+}
+
+/* Cost: per component of the widest value, shared subtrees paid once. */
+static void test_cost(void **state)
+{
+    ir ir;
+    ir_init(&ir);
+    ir_ref h = ir_input(&ir, IR_IN_HEIGHT), n = ir_input(&ir, IR_IN_NORMAL);
+    ir_ref add = ir_op2(&ir, IR_OP_ADD, h, h);                       /* 1 x 1 */
+    ir_ref nadd = ir_op2(&ir, IR_OP_ADD, n, n);                      /* 1 x 3 */
+    ir_ref d = ir_op2(&ir, IR_OP_DOT, nadd, n);                      /* 2 x 3 */
+    ir_ref s = ir_op1(&ir, IR_OP_SIN, add);                          /* 8 x 1 */
+    assert_int_equal(ir_node_cost(&ir, h), 0);
+    assert_int_equal(ir_node_cost(&ir, add), 1);
+    assert_int_equal(ir_node_cost(&ir, nadd), 3);
+    assert_int_equal(ir_node_cost(&ir, d), 6);
+    ir_ref roots[3] = {d, s, ir_op2(&ir, IR_OP_MUL, d, s)};          /* + 1 */
+    assert_int_equal(ir_cost(&ir, roots, 1), 9);
+    assert_int_equal(ir_cost(&ir, roots, 2), 9 + 9);
+    assert_int_equal(ir_cost(&ir, roots, 3), 9 + 9 + 1);             /* shared once */
+    ir_free(&ir);
 }
 
 static void test_types(void **state)
@@ -316,7 +397,9 @@ int main(void)
         cmocka_unit_test(test_equal_operands_distinct),
         cmocka_unit_test(test_constants_bitwise),
         cmocka_unit_test(test_type_rules),
-        cmocka_unit_test(test_op_table_matches_op_list),
+        cmocka_unit_test(test_op_table_rows),
+        cmocka_unit_test(test_input_table_rows),
+        cmocka_unit_test(test_cost),
         cmocka_unit_test(test_types),
         cmocka_unit_test(test_shape_builders),
         cmocka_unit_test(test_tables_and_roots),

@@ -1,7 +1,7 @@
 /* test_lower.c — AST -> IR: instance inlining (nested), hash-consing that
  * makes a subtree computed through two instances one node (and one line
  * of GLSL), params / textures / painted masks, material defaults, splats,
- * the node library against seed 000 Listing 2 computed directly, the
+ * the node library against Andersson 2007 Listing 2 computed directly, the
  * compositor through sg_lower_shader, and lowering staying linear. */
 #include <setjmp.h>
 #include <stdarg.h>

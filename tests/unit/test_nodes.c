@@ -759,7 +759,7 @@ static void test_compositors(void **state)
     NEAR(evalf(f, &e, "n.out", "max_height_mask { h = -1.0, below = 1.0 }"), 0.0);
 }
 
-/* ---- Billingsley (seed 002): Eq. 2 with Tables 1 and 2 ---------------------- */
+/* ---- Billingsley (Billingsley 2009): Eq. 2 with Tables 1 and 2 ---------------------- */
 
 /* Table 1 (M1, M2, M3, Offset) and Table 2 (Scaling), dirt sand grass rock. */
 static const double table1[4][4] = {

@@ -1,5 +1,5 @@
 /* test_texgen.c — the texture generator: determinism, tileability, the
- * nearest-neighbour mips of the uniform noise (seed 002 §2.2), histograms,
+ * nearest-neighbour mips of the uniform noise (Billingsley 2009 §2.2), histograms,
  * PNG round trips (8 and 16 bit), and the committed example textures in
  * graphs/textures/ being exactly what the generator makes. */
 #include <setjmp.h>

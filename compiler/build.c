@@ -1,0 +1,344 @@
+/* build.c — `splatc build`: from a scene to a shader pack (compiler/PACK.md).
+ *
+ * The pipeline is splat_build at the bottom, one phase after the other
+ * (each timed for --stats); build.h names the files the phases live in:
+ *
+ *   load      splat_scene_load: parse, check, heightfield, rasters, lower
+ *   analysis  splat_painted_build: the painted masks as the pack stores
+ *             them (sparse BC4 / R8, unless --painted dense), then
+ *             splat_analyze on them: the combinations and quadtree grids
+ *   compose   a composite per combination (+ flat variants), the über-shader,
+ *             a reference pass per material and the vertex shader: GLSL,
+ *             then each shader's key (cache.c)
+ *   glslang   cache lookups first; only misses are compiled, on N threads
+ *   validate  spv_validate on every newly compiled module, which is then
+ *             stored in the cache (only validated modules are; a hit was
+ *             validated when it was stored, and its entry is checksummed)
+ *   write     everything into OUT.tmp-XXXXXX, then swapped into place
+ *
+ * Nothing changed: right after loading, the bytes of every input (the
+ * graph files the program read, the heightfield, the painted rasters, the
+ * texture files) are hashed with the compiler version and options; the
+ * manifest records that "inputs" key, and when the existing pack carries
+ * the same key and has all its shader files, the build stops there (with
+ * --stats it still runs the analysis for the report and reads the shader
+ * figures back from the pack).
+ *
+ * Determinism: every file is a function of the inputs only (no times, no
+ * absolute paths: material sources are written relative to the scene's
+ * folder); manifest keys in a fixed order, reals with 15 significant
+ * digits (JSON_REAL_PRECISION).
+ */
+#include "build.h"
+
+#include <errno.h>
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <jansson.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include <xxhash.h>
+
+#include "abi.h"
+
+#ifndef SPLATC_VERSION
+#define SPLATC_VERSION "0"
+#endif
+
+/* ---- nothing changed? ---------------------------------------------------- */
+
+static bool hash_file(XXH3_state_t *st, const char *path)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return false;
+    char buf[1 << 16];
+    size_t n, total = 0;
+    while ((n = fread(buf, 1, sizeof buf, f)) > 0) {
+        XXH3_128bits_update(st, buf, n);
+        total += n;
+    }
+    bool ok = !ferror(f);
+    fclose(f);
+    /* the length separates one file from the next */
+    XXH3_128bits_update(st, &total, sizeof total);
+    return ok;
+}
+
+/* Every file the pack is made from, in a fixed order: the graph files the
+ * program read (scene and imports), the heightfield, the painted rasters,
+ * each texture and its mips.  NULL-terminated, malloc'd (the key and the
+ * depfile both read this list, so they cannot disagree). */
+static char **input_files(const splat_scene *s)
+{
+    int cap = 8, n = 0;
+    char **v = xcalloc((size_t)cap, sizeof *v);
+#define ADD(path) do {                                                     \
+        if (n + 2 > cap)                                                   \
+            v = xrealloc(v, (size_t)(cap *= 2) * sizeof *v);              \
+        v[n++] = (path);                                                   \
+        v[n] = NULL;                                                       \
+    } while (0)
+    for (int i = 0; i < sg_file_count(s->prog); i++)
+        ADD(xstrdup(sg_file_path(s->prog, i)));
+    ADD(xstrdup(s->desc->heightfield));
+    if (s->desc->holes)
+        ADD(xstrdup(s->desc->holes));
+    for (int i = 0; i < s->desc->npainted; i++)
+        ADD(xstrdup(s->desc->painted[i].file));
+    for (int i = 0; i < s->ir.ntextures; i++) {
+        ADD(xstrdup(s->ir.textures[i].file));
+        for (int k = 1, m = build_mip_count(s->ir.textures[i].file); k <= m; k++)
+            ADD(build_mip_path(s->ir.textures[i].file, k));
+    }
+#undef ADD
+    return v;
+}
+
+static void free_list(char **v)
+{
+    for (int i = 0; v && v[i]; i++)
+        free(v[i]);
+    free(v);
+}
+
+/* The key of everything the pack is made from (contents, not names or
+ * times, so a moved or touched scene is still up to date).  False if a
+ * file cannot be read (then there is no shortcut). */
+static bool inputs_key(build *b)
+{
+    XXH3_state_t *st = XXH3_createState();
+    if (!st)
+        abort();
+    XXH3_128bits_reset(st);
+    char head[128];
+    int n = snprintf(head, sizeof head,
+                     "splatc %s\nabi %d\nflat %d\npainted %s\ncompute-spirv %d\n",
+                     SPLATC_VERSION, SPLAT_ABI_VERSION, b->desc->flat,
+                     splat_painted_format_name(b->desc->painted), b->desc->compute_spirv);
+    XXH3_128bits_update(st, head, (size_t)n);
+    bool ok = true;
+    char **files = input_files(&b->scene);
+    for (int i = 0; ok && files[i]; i++)
+        ok = hash_file(st, files[i]);
+    free_list(files);
+    XXH128_hash_t h = XXH3_128bits_digest(st);
+    XXH3_freeState(st);
+    snprintf(b->inputs, sizeof b->inputs, "%016llx%016llx", (unsigned long long)h.high64,
+             (unsigned long long)h.low64);
+    if (!ok)
+        b->inputs[0] = 0;  /* recorded as "": never up to date */
+    return ok;
+}
+
+/* The shader's files are there: "glsl" and "spirv" (`spirv`: the entry
+ * must name one; else only if it does — a compute variant's GLSL alone). */
+static bool shader_files(const char *pack, json_t *shader, bool spirv)
+{
+    const char *keys[] = {"glsl", "spirv"};
+    for (int i = 0; i < 2; i++) {
+        const char *rel = json_string_value(json_object_get(shader, keys[i]));
+        if (!rel && i == 1 && !spirv && json_is_object(shader))
+            continue;
+        if (!rel)
+            return false;
+        char *path = xasprintf("%s/%s", pack, rel);
+        bool ok = access(path, R_OK) == 0;
+        free(path);
+        if (!ok)
+            return false;
+    }
+    return true;
+}
+
+static bool has_files(const char *pack, json_t *shader)
+{
+    return shader_files(pack, shader, true);
+}
+
+/* Does the pack at desc->out already hold what this build would write?
+ * On yes, *ncombos is its combination count. */
+static bool up_to_date(build *b, int *ncombos)
+{
+    char *mf = xasprintf("%s/manifest.json", b->out);
+    json_t *m = json_load_file(mf, 0, NULL);
+    free(mf);
+    if (!m)
+        return false;
+    const char *key = json_string_value(json_object_get(m, "inputs"));
+    bool ok = key && strcmp(key, b->inputs) == 0;
+    json_t *combos = json_object_get(m, "combinations");
+    ok = ok && json_is_array(combos);
+    for (size_t i = 0; ok && i < json_array_size(combos); i++) {
+        json_t *c = json_array_get(combos, i);
+        ok = has_files(b->out, c) &&
+             shader_files(b->out, json_object_get(c, "compute"), b->desc->compute_spirv) &&
+             (!b->desc->flat || has_files(b->out, json_object_get(c, "flat")));
+    }
+    json_t *mats = json_object_get(m, "materials");
+    for (size_t i = 0; ok && i < json_array_size(mats); i++)
+        ok = has_files(b->out, json_object_get(json_array_get(mats, i), "reference"));
+    ok = ok && has_files(b->out, json_object_get(m, "uber")) &&
+         shader_files(b->out, json_object_get(json_object_get(m, "uber"), "compute"),
+                      b->desc->compute_spirv) &&
+         has_files(b->out, json_object_get(m, "vertex"));
+    *ncombos = ok ? (int)json_array_size(combos) : 0;
+    json_decref(m);
+    return ok;
+}
+
+/* ---- the phases ----------------------------------------------------------- */
+
+static bool load(build *b)
+{
+    b->scene_ok = splat_scene_load(&b->scene, b->desc->scene, b->desc->search_paths, b->d);
+    if (b->scene_ok)   /* here, so an up-to-date build warns the same */
+        splat_sites_warn(&b->scene, b->d);   /* precision.c */
+    return b->scene_ok;
+}
+
+/* The painted masks as the pack stores them (sparse unless --painted
+ * dense), then the analysis over them. */
+static bool analyse(build *b)
+{
+    if (b->desc->painted != SPLAT_PAINTED_DENSE) {
+        b->sparse_ok = splat_painted_build(&b->scene, b->desc->painted, &b->sparse, b->d);
+        if (!b->sparse_ok)
+            return false;
+        b->scene.sparse = &b->sparse;
+    }
+    b->analysis_ok = splat_analyze(&b->scene, &b->analysis, b->d);
+    if (b->analysis_ok && b->desc->report) {
+        splat_analysis_report(&b->scene, &b->analysis, b->desc->report);
+        build_report_painted(b, b->desc->report);
+    }
+    return b->analysis_ok;
+}
+
+static bool layout(build *b)
+{
+    b->layout_ok = splat_layout_from_scene(&b->layout, &b->scene, b->d);
+    return b->layout_ok;
+}
+
+static bool write_out(build *b)
+{
+    if (b->desc->report)
+        build_report_shaders(b, b->desc->report);
+    return build_write_pack(b);
+}
+
+/* A Make/Ninja path: spaces, '#' and '\\' before them escaped, '$' doubled. */
+static void dep_path(ir_buf *o, const char *p)
+{
+    for (; *p; p++) {
+        if (*p == ' ' || *p == '#' || *p == '\\')
+            ir_buf_printf(o, "\\");
+        ir_buf_printf(o, *p == '$' ? "$$" : "%c", *p);
+    }
+}
+
+/* --depfile: "PACKDIR/manifest.json: every input", written atomically
+ * after the pack is (or is found) up to date, so Make and Ninja rebuild
+ * the pack when any file it was made from changes. */
+static bool write_depfile(build *b)
+{
+    if (!b->desc->depfile)
+        return true;
+    ir_buf o = {0};
+    dep_path(&o, b->out);
+    ir_buf_printf(&o, "/manifest.json:");
+    char **files = input_files(&b->scene);
+    for (int i = 0; files[i]; i++) {
+        ir_buf_printf(&o, " \\\n  ");
+        dep_path(&o, files[i]);
+    }
+    free_list(files);
+    ir_buf_printf(&o, "\n");
+    bool ok = splat_write_atomic(b->desc->depfile, o.s, o.len);
+    if (!ok)
+        sg_error(b->d, (sg_loc){.file = b->desc->depfile}, SG_E_WRITE, b->desc->depfile,
+                 strerror(errno));
+    ir_buf_free(&o);
+    return ok;
+}
+
+/* Run phase `fn` unless one before failed, adding its time to *seconds.
+ * A phase fails by returning false or by reporting an error. */
+static void phase(build *b, bool (*fn)(build *), double *seconds)
+{
+    if (b->failed)
+        return;
+    double t = splat_now();
+    b->failed = !fn(b) || b->d->nerrors > b->errors;
+    *seconds += splat_now() - t;
+}
+
+/* Nothing changed: the existing pack is what this build would write.  The
+ * report still wants the (cheap) analysis, and the shaders' figures read
+ * back from the pack. */
+static bool unchanged(build *b)
+{
+    double t = splat_now();
+    bool same = !b->failed && inputs_key(b) && up_to_date(b, &b->st->combos);
+    if (same) {
+        /* Make and Ninja compare times: an input touched but not changed
+         * must still leave the pack newer than it (--depfile's target). */
+        char *mf = xasprintf("%s/manifest.json", b->out);
+        utimensat(AT_FDCWD, mf, NULL, 0);
+        free(mf);
+    }
+    b->st->load += splat_now() - t;
+    if (same && b->desc->report) {
+        phase(b, analyse, &b->st->analysis);
+        if (!b->failed)
+            build_report_shaders_from_pack(b, b->desc->report);
+    }
+    return b->st->up_to_date = same;
+}
+
+/* ---- the pipeline --------------------------------------------------------- */
+
+static bool build_finish(build *b)
+{
+    build_jobs_free(b);
+    if (b->layout_ok)
+        splat_layout_free(&b->layout);
+    if (b->analysis_ok)
+        splat_analysis_free(&b->analysis);
+    if (b->sparse_ok)
+        sparse_free(&b->sparse);
+    if (b->scene_ok)
+        splat_scene_free(&b->scene);
+    free(b->out);
+    return b->d->nerrors == b->errors;
+}
+
+bool splat_build(const splat_build_desc *desc, splat_build_stats *st, sg_diags *d)
+{
+    splat_build_stats ignored;
+    st = st ? st : &ignored;
+    memset(st, 0, sizeof *st);
+    build b = {.desc = desc, .st = st, .d = d, .errors = d->nerrors,
+               .loc = {.file = desc->scene}, .out = xstrdup(desc->out)};
+    /* "pack/" would put the temporary folder inside the old pack */
+    for (size_t n = strlen(b.out); n > 1 && b.out[n - 1] == '/'; n--)
+        b.out[n - 1] = 0;
+
+    phase(&b, load, &st->load);             /* parse, check, lower, rasters */
+    if (unchanged(&b)) {
+        phase(&b, write_depfile, &st->write);
+        return build_finish(&b);
+    }
+    phase(&b, analyse, &st->analysis);      /* painted masks, combinations  */
+    phase(&b, layout, &st->compose);        /* the pack's params, textures  */
+    phase(&b, build_compose, &st->compose); /* GLSL and key per shader      */
+    phase(&b, build_compile, &st->glslang); /* cache, then glslang          */
+    phase(&b, build_validate, &st->validate); /* spirv-val, cache puts      */
+    phase(&b, write_out, &st->write);       /* manifest, files, swap        */
+    phase(&b, write_depfile, &st->write);   /* --depfile: every input       */
+    return build_finish(&b);
+}

@@ -1,0 +1,95 @@
+/* build.h — `splatc build`'s internals, shared by its files (the public
+ * entry point, splat_build, is in scene.h):
+ *
+ *   build.c         the pipeline in one function, its phases, the
+ *                   up-to-date check (the inputs' key)
+ *   build_jobs.c    the shaders to compile: composed per combination,
+ *                   compiled on N threads, validated, cached (cache.c)
+ *   build_report.c  --stats's report: each composite against the über-shader
+ *   pack_write.c    the pack writer: manifest, files, the directory swap
+ */
+#ifndef SPLAT_BUILD_H
+#define SPLAT_BUILD_H
+
+#include "scene.h"
+#include "util.h"
+
+/* ---- shaders to compile (build_jobs.c) ----------------------------------- */
+
+typedef enum job_kind {
+    JOB_COMBO, JOB_FLAT, JOB_UBER, JOB_REF, JOB_VERTEX,
+    JOB_COMBO_COMPUTE, JOB_UBER_COMPUTE,   /* abi.h "compute stage" */
+} job_kind;
+
+typedef struct job {
+    job_kind  kind;
+    int       index;          /* combination or material                   */
+    char     *file;           /* "shaders/0003" (".frag" added for fragment
+                                 shaders, ".spv" for the module)          */
+    ir_buf    glsl;
+    int       stage;          /* spv_stage                                 */
+    char      key[SPLAT_KEY_CHARS + 1];
+    uint32_t *words;
+    size_t    nwords;
+    bool      cached;         /* came from the cache (and validated)      */
+    bool      glsl_only;      /* a compute variant without --compute-spirv:
+                                 GLSL written, not compiled                */
+    const splat_composite *composite; /* its GLSL is written from this, on
+                                 the pool (build_compose), with gdesc      */
+    splat_glsl_desc gdesc;
+    char      title[96];      /* gdesc.title                              */
+    char     *log;            /* compile / validation failure             */
+} job;
+
+typedef struct combo_info {
+    int *textures, ntextures; /* layout textures used                     */
+    int *params, nparams;
+    double cost;              /* splat_composite_cost                     */
+} combo_info;
+
+typedef struct build {
+    const splat_build_desc *desc;
+    splat_build_stats *st;
+    int            errors;    /* d->nerrors when the build started        */
+    bool           failed;    /* a phase failed: the rest are skipped     */
+    splat_scene    scene;
+    bool           scene_ok;
+    splat_analysis analysis;
+    bool           analysis_ok;
+    sparse_masks   sparse;    /* painted masks as stored (not dense)      */
+    bool           sparse_ok;
+    splat_layout   layout;
+    bool           layout_ok;
+    combo_info    *combos;
+    job           *jobs;
+    int            njobs, capjobs;
+    splat_composite **composites; /* the jobs' composites until their GLSL
+                                 is written                               */
+    int            ncomposites;
+    splat_cache    cache;
+    char           inputs[SPLAT_KEY_CHARS + 1]; /* key of every input file */
+    sg_diags      *d;
+    sg_loc         loc;       /* the scene file, for errors without a line */
+    char          *out;       /* desc->out without trailing slashes        */
+} build;
+
+/* Phases: each returns false on failure (with diagnostics in b->d). */
+bool build_compose(build *b);    /* a job per shader, with its GLSL and key */
+bool build_compile(build *b);    /* cache lookups, glslang on the misses    */
+bool build_validate(build *b);   /* spirv-val on the compiled, cache puts   */
+void build_jobs_free(build *b);
+
+/* ---- the pack writer (pack_write.c) -------------------------------------- */
+
+bool build_write_pack(build *b);
+/* A texture's k-th mip file ("rock.mip1.png") and how many it has. */
+char *build_mip_path(const char *path, int k);
+int   build_mip_count(const char *src);
+
+/* ---- the report (build_report.c) ----------------------------------------- */
+
+void build_report_painted(build *b, FILE *out);
+void build_report_shaders(build *b, FILE *out);
+void build_report_shaders_from_pack(build *b, FILE *out);
+
+#endif

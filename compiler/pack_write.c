@@ -1,0 +1,604 @@
+/* pack_write.c — the pack writer (compiler/PACK.md): every file of the
+ * pack into OUT.tmp-XXXXXX (manifest.json with keys in a fixed order and
+ * reals at 15 significant digits, shaders, heightfield, painted masks,
+ * textures and their mips), then swapped into place in one step where the
+ * file system can (renameat2 RENAME_EXCHANGE), else by two renames; an
+ * existing folder is replaced only if it is empty or a pack.
+ */
+#define _GNU_SOURCE 1   /* renameat2 */
+#include "build.h"
+#include "util.h"
+
+#include <errno.h>
+#include <fcntl.h>
+#include <ftw.h>
+#include <jansson.h>
+#include <limits.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <stb_image.h>
+
+#include "abi.h"
+#include "spv.h"
+
+#ifndef SPLATC_VERSION
+#define SPLATC_VERSION "0"
+#endif
+
+/* ---- writing -------------------------------------------------------------- */
+
+static void write_error(build *b, const char *path)
+{
+    sg_error(b->d, b->loc, SG_E_WRITE, path, strerror(errno));
+}
+
+/* Write dir/name through fn(f, user); a failure is reported with the path. */
+static bool write_with(build *b, const char *dir, const char *name,
+                       bool (*fn)(FILE *f, const void *user), const void *user)
+{
+    char *path = xasprintf("%s/%s", dir, name);
+    FILE *f = fopen(path, "wb");
+    bool ok = f && fn(f, user);
+    if (f && fclose(f) != 0)
+        ok = false;
+    if (!ok)
+        write_error(b, path);
+    free(path);
+    return ok;
+}
+
+typedef struct bytes { const void *data; size_t n; } bytes;
+
+static bool put_bytes(FILE *f, const void *user)
+{
+    const bytes *by = user;
+    return fwrite(by->data, 1, by->n, f) == by->n;
+}
+
+static bool write_file(build *b, const char *dir, const char *name, const void *data,
+                       size_t n)
+{
+    bytes by = {data, n};
+    return write_with(b, dir, name, put_bytes, &by);
+}
+
+static bool copy_file(build *b, const char *from, const char *dir, const char *name)
+{
+    FILE *f = fopen(from, "rb");
+    if (!f) {
+        sg_error(b->d, b->loc, SG_E_IO, from, strerror(errno));
+        return false;
+    }
+    size_t cap = 1 << 16, n = 0;
+    char *buf = xmalloc(cap);
+    size_t got;
+    while ((got = fread(buf + n, 1, cap - n, f)) > 0) {
+        n += got;
+        if (n == cap) {
+            cap *= 2;
+            buf = xrealloc(buf, cap);
+        }
+    }
+    bool ok = !ferror(f);
+    fclose(f);
+    if (!ok)
+        sg_error(b->d, b->loc, SG_E_IO, from, strerror(errno));
+    ok = ok && write_file(b, dir, name, buf, n);
+    free(buf);
+    return ok;
+}
+
+/* Little-endian uint16 array. */
+static uint8_t *le16(const uint16_t *v, size_t n)
+{
+    uint8_t *out = xcalloc(n, 2);
+    for (size_t i = 0; i < n; i++) {
+        out[2 * i] = (uint8_t)(v[i] & 0xff);
+        out[2 * i + 1] = (uint8_t)(v[i] >> 8);
+    }
+    return out;
+}
+
+static json_t *jreals(const double *v, int n)
+{
+    json_t *a = json_array();
+    for (int i = 0; i < n; i++)
+        json_array_append_new(a, json_real(v[i]));
+    return a;
+}
+
+static json_t *jints(const int *v, int n)
+{
+    json_t *a = json_array();
+    for (int i = 0; i < n; i++)
+        json_array_append_new(a, json_integer(v[i]));
+    return a;
+}
+
+static json_t *jshader(const char *file, const char *vert_ext)
+{
+    json_t *o = json_object();
+    char buf[128];
+    snprintf(buf, sizeof buf, "%s%s", file, vert_ext ? "" : ".frag");
+    json_object_set_new(o, "glsl", json_string(buf));
+    snprintf(buf, sizeof buf, "%s.spv", file);
+    json_object_set_new(o, "spirv", json_string(buf));
+    return o;
+}
+
+/* A compute variant's manifest entry (PACK.md). */
+static json_t *jcompute(const job *j)
+{
+    json_t *o = json_object();
+    json_object_set_new(o, "glsl", json_string(j->file));
+    if (!j->glsl_only) {
+        char *spv = xasprintf("%s.spv", j->file);
+        json_object_set_new(o, "spirv", json_string(spv));
+        free(spv);
+    }
+    json_object_set_new(o, "hash", json_string(j->key));
+    return o;
+}
+
+/* Pack names of the texture files: textures/<basename>, "-N" added before
+ * the extension when two different files share a basename. */
+static char **texture_names(build *b)
+{
+    const splat_layout *L = &b->layout;
+    char **names = xcalloc((size_t)L->ntextures, sizeof *names);
+    for (int i = 0; i < L->ntextures; i++) {
+        const char *file = L->src->textures[L->textures[i]].file;
+        for (int k = 0; k < i && !names[i]; k++)
+            if (strcmp(L->src->textures[L->textures[k]].file, file) == 0)
+                names[i] = strdup(names[k]);
+        if (names[i])
+            continue;
+        const char *base = strrchr(file, '/') ? strrchr(file, '/') + 1 : file;
+        for (int n = 0; !names[i]; n++) {
+            const char *dot = strrchr(base, '.');
+            int stem = dot ? (int)(dot - base) : (int)strlen(base);
+            char *cand = n ? xasprintf("textures/%.*s-%d%s", stem, base, n, dot ? dot : "")
+                           : xasprintf("textures/%s", base);
+            bool taken = false;
+            for (int k = 0; k < i; k++)
+                taken |= strcmp(names[k], cand) == 0;
+            if (taken)
+                free(cand);
+            else
+                names[i] = cand;
+        }
+    }
+    return names;
+}
+
+/* A texture's stored mip files (texgen.h's contract): "X.mipK.ext" beside
+ * "X.ext" for K = 1, 2, … while they exist.  build_mip_path(path, k) is that name
+ * for any path (source or pack); build_mip_count(src) how many the source has. */
+char *build_mip_path(const char *path, int k)
+{
+    const char *slash = strrchr(path, '/');
+    const char *dot = strrchr(path, '.');
+    if (!dot || (slash && dot < slash))
+        return xasprintf("%s.mip%d", path, k);
+    return xasprintf("%.*s.mip%d%s", (int)(dot - path), path, k, dot);
+}
+
+int build_mip_count(const char *src)
+{
+    /* never more than the texture has below its base (PACK.md "Limits") */
+    int w = 0, h = 0, comp, levels = 0;
+    if (stbi_info(src, &w, &h, &comp))
+        while ((w > h ? w : h) >> (levels + 1))
+            levels++;
+    int k = 0;
+    for (;;) {
+        char *p = build_mip_path(src, k + 1);
+        struct stat st;
+        bool there = stat(p, &st) == 0 && S_ISREG(st.st_mode);
+        free(p);
+        if (!there || k >= levels)
+            return k;
+        k++;
+    }
+}
+
+/* A texture within the pack limit (abi.h): one image on the GPU. */
+static bool texture_fits(build *b, const char *src)
+{
+    int w, h, comp;
+    if (!stbi_info(src, &w, &h, &comp) || (w <= SPLAT_MAX_TEXTURE && h <= SPLAT_MAX_TEXTURE))
+        return true;   /* unreadable images are the runtime's error (it names the file) */
+    char msg[512];
+    snprintf(msg, sizeof msg, "texture '%s' is %d x %d texels, over the pack limit of %d "
+             "per side", src, w, h, SPLAT_MAX_TEXTURE);
+    sg_error(b->d, b->loc, SG_E_TOO_LARGE, msg);
+    return false;
+}
+
+static json_t *manifest(build *b, char **tex_names, const char *dir)
+{
+    const splat_scene *s = &b->scene;
+    const sg_scene *sc = s->desc;
+    const splat_layout *L = &b->layout;
+    const splat_analysis *a = &b->analysis;
+    json_t *m = json_object();
+    json_object_set_new(m, "format", json_string("splatc-pack"));
+    json_object_set_new(m, "version", json_integer(1));
+    json_object_set_new(m, "abi", json_integer(SPLAT_ABI_VERSION));
+    json_object_set_new(m, "compiler", json_string("splatc " SPLATC_VERSION));
+    json_object_set_new(m, "inputs", json_string(b->inputs));
+
+    json_t *scene = json_object();
+    json_object_set_new(scene, "name", json_string(sc->name ? sc->name : ""));
+    /* relative to the pack folder (`dir` is its sibling: same answer) */
+    char *scene_src = splat_path_relative_real(dir, b->desc->scene);
+    json_object_set_new(scene, "source", json_string(scene_src));
+    free(scene_src);
+    json_t *hf = json_object();
+    json_object_set_new(hf, "file", json_string("heightfield.r16"));
+    json_object_set_new(hf, "width", json_integer(s->terrain.width));
+    json_object_set_new(hf, "height", json_integer(s->terrain.height));
+    if (s->terrain.holes)
+        json_object_set_new(hf, "holes", json_string("holes.r8"));
+    json_object_set_new(scene, "heightfield", hf);
+    json_object_set_new(scene, "size", jreals(s->terrain.size, 2));
+    json_object_set_new(scene, "max_height", json_real(s->terrain.max_height));
+    json_object_set_new(scene, "height_offset", json_real(s->terrain.height_offset));
+    json_object_set_new(scene, "cell_texels", json_integer(a->cell_texels));
+    json_t *cams = json_array();
+    for (int i = 0; i < sc->ncameras; i++) {
+        json_t *c = json_object();
+        json_object_set_new(c, "name", json_string(sc->cameras[i].name));
+        json_object_set_new(c, "position", jreals(sc->cameras[i].position, 3));
+        json_object_set_new(c, "look", jreals(sc->cameras[i].look, 3));
+        json_array_append_new(cams, c);
+    }
+    json_object_set_new(scene, "cameras", cams);
+    if (sc->has_destruction) {
+        json_t *dd = json_object();
+        json_object_set_new(dd, "origin", jreals(sc->destruction_origin, 2));
+        json_object_set_new(dd, "size", jreals(sc->destruction_size, 2));
+        json_object_set_new(dd, "cell_size", json_real(sc->destruction_cell));
+        json_object_set_new(scene, "destruction", dd);
+    } else {
+        json_object_set_new(scene, "destruction", json_null());
+    }
+    json_object_set_new(m, "scene", scene);
+
+    char *scene_dir = splat_path_dir(b->desc->scene);
+    json_t *mats = json_array();
+    for (int k = 0; k < L->nmaterials; k++) {
+        json_t *o = json_object();
+        json_object_set_new(o, "name", json_string(L->materials[k]));
+        int pi = sg_material_find(s->prog, L->materials[k]);
+        sg_loc ml = pi >= 0 ? sg_material_loc(s->prog, pi) : (sg_loc){0};
+        char *src = ml.file ? splat_path_relative_real(scene_dir, ml.file) : xstrdup("");
+        json_object_set_new(o, "source", json_string(src));
+        free(src);
+        char file[64];
+        snprintf(file, sizeof file, "shaders/ref_%04d", k);
+        json_object_set_new(o, "reference", jshader(file, NULL));
+        json_array_append_new(mats, o);
+    }
+    free(scene_dir);
+    json_object_set_new(m, "materials", mats);
+
+    static const char *const tnames[IR_T_COUNT] = {
+        [IR_T_FLOAT] = "float", [IR_T_VEC2] = "vec2", [IR_T_VEC3] = "vec3",
+        [IR_T_VEC4] = "vec4"};
+    json_t *params = json_array();
+    for (int i = 0; i < L->nparams; i++) {
+        const ir_param *p = &L->src->params[i];
+        json_t *o = json_object();
+        json_object_set_new(o, "name", json_string(p->name));
+        json_object_set_new(o, "type", json_string(tnames[p->type] ? tnames[p->type] : "float"));
+        json_object_set_new(o, "default", jreals(p->def, 4));
+        json_object_set_new(o, "min", json_real(p->lo));
+        json_object_set_new(o, "max", json_real(p->hi));
+        json_object_set_new(o, "offset", json_integer(16 * i));
+        json_array_append_new(params, o);
+    }
+    json_object_set_new(m, "params", params);
+    json_object_set_new(m, "params_size", json_integer(16 * (L->nparams > 0 ? L->nparams : 1)));
+
+    json_t *texs = json_array();
+    for (int i = 0; i < L->ntextures; i++) {
+        const ir_texture *t = &L->src->textures[L->textures[i]];
+        json_t *o = json_object();
+        json_object_set_new(o, "file", json_string(tex_names[i]));
+        json_object_set_new(o, "binding", json_integer(SPLAT_BIND_TEXTURE0 + i));
+        json_object_set_new(o, "filter", json_string(ir_filter_name(t->filter)));
+        json_object_set_new(o, "mip", json_string(ir_filter_name(t->mip)));
+        json_object_set_new(o, "wrap", json_string(ir_wrap_name(t->wrap)));
+        json_object_set_new(o, "srgb", json_boolean(t->srgb));
+        int mips = build_mip_count(t->file);
+        if (mips > 0)
+            json_object_set_new(o, "mips", json_integer(mips));
+        json_array_append_new(texs, o);
+    }
+    json_object_set_new(m, "textures", texs);
+
+    json_t *painted = json_array();
+    for (int i = 0; i < L->npainted; i++) {
+        json_t *o = json_object();
+        json_object_set_new(o, "name", json_string(L->painted[i]));
+        json_object_set_new(o, "layer", json_integer(i));
+        json_array_append_new(painted, o);
+    }
+    json_object_set_new(m, "painted", painted);
+    /* how they are stored: dense layers or the sparse quad-tree */
+    json_t *sites = json_array();
+    for (int i = 0; i < L->nsites; i++) {
+        const splat_site *st = &L->sites[i];
+        json_t *o = json_object();
+        char ax[3] = { "xyzw"[IR_SWZ_C(st->swz, 0)], "xyzw"[IR_SWZ_C(st->swz, 1)], 0 };
+        json_object_set_new(o, "axes", json_string(ax));
+        json_object_set_new(o, "op", json_string(st->mul ? "mul" : "div"));
+        if (st->param >= 0)
+            json_object_set_new(o, "param", json_integer(st->param));
+        else
+            json_object_set_new(o, "scale", jreals(st->value, 2));
+        json_array_append_new(sites, o);
+    }
+    json_object_set_new(m, "world_sites", sites);
+    json_object_set_new(m, "painted_format",
+                        json_string(splat_painted_format_name(b->desc->painted)));
+    json_object_set_new(m, "painted_file",
+                        json_string(b->sparse_ok ? "painted.sparse" : "painted.r8"));
+
+    json_t *combos = json_array();
+    for (int i = 0; i < a->ncombos; i++) {
+        const job *cj = NULL, *fj = NULL, *xj = NULL;
+        for (int k = 0; k < b->njobs; k++) {
+            if (b->jobs[k].index == i && b->jobs[k].kind == JOB_COMBO)
+                cj = &b->jobs[k];
+            if (b->jobs[k].index == i && b->jobs[k].kind == JOB_FLAT)
+                fj = &b->jobs[k];
+            if (b->jobs[k].index == i && b->jobs[k].kind == JOB_COMBO_COMPUTE)
+                xj = &b->jobs[k];
+        }
+        json_t *o = json_object();
+        json_object_set_new(o, "id", json_integer(i));
+        json_object_set_new(o, "materials", jints(a->combos[i].materials,
+                                                  a->combos[i].nmaterials));
+        char buf[160];
+        snprintf(buf, sizeof buf, "%s.frag", cj->file);
+        json_object_set_new(o, "glsl", json_string(buf));
+        snprintf(buf, sizeof buf, "%s.spv", cj->file);
+        json_object_set_new(o, "spirv", json_string(buf));
+        if (fj)
+            json_object_set_new(o, "flat", jshader(fj->file, NULL));
+        json_object_set_new(o, "textures", jints(b->combos[i].textures, b->combos[i].ntextures));
+        json_object_set_new(o, "params", jints(b->combos[i].params, b->combos[i].nparams));
+        json_object_set_new(o, "cells", json_integer(a->combos[i].ncells));
+        json_object_set_new(o, "nodes", json_integer(a->combos[i].nnodes));
+        json_object_set_new(o, "hash", json_string(cj->key));
+        json_object_set_new(o, "cost", json_real(b->combos[i].cost));
+        json_object_set_new(o, "compute", jcompute(xj));
+        json_array_append_new(combos, o);
+    }
+    json_object_set_new(m, "combinations", combos);
+    json_t *uber = jshader("shaders/uber", NULL);
+    for (int k = 0; k < b->njobs; k++)
+        if (b->jobs[k].kind == JOB_UBER_COMPUTE)
+            json_object_set_new(uber, "compute", jcompute(&b->jobs[k]));
+    json_object_set_new(m, "uber", uber);
+    json_object_set_new(m, "vertex", jshader("shaders/terrain.vert", ""));
+
+    json_t *qt = json_object();
+    json_object_set_new(qt, "file", json_string("combos.bin"));
+    json_t *levels = json_array();
+    size_t offset = 0;
+    for (int l = 0; l < a->nlevels; l++) {
+        json_t *o = json_object();
+        json_object_set_new(o, "level", json_integer(l));
+        json_object_set_new(o, "width", json_integer(a->levels[l].width));
+        json_object_set_new(o, "height", json_integer(a->levels[l].height));
+        json_object_set_new(o, "offset", json_integer((json_int_t)offset));
+        json_array_append_new(levels, o);
+        offset += 2 * (size_t)a->levels[l].width * (size_t)a->levels[l].height;
+    }
+    json_object_set_new(qt, "levels", levels);
+    json_object_set_new(m, "quadtree", qt);
+    return m;
+}
+
+static bool put_sparse(FILE *f, const void *user)
+{
+    return sparse_write(user, f);
+}
+
+static bool write_sparse(build *b, const char *dir)
+{
+    return write_with(b, dir, "painted.sparse", put_sparse, &b->sparse);
+}
+
+static bool write_contents(build *b, const char *dir)
+{
+    const splat_scene *s = &b->scene;
+    const splat_analysis *a = &b->analysis;
+    bool ok = true;
+    char *sub = xasprintf("%s/shaders", dir);
+    if (mkdir(sub, 0777) != 0) {
+        write_error(b, sub);
+        ok = false;
+    }
+    free(sub);
+    sub = xasprintf("%s/textures", dir);
+    if (ok && mkdir(sub, 0777) != 0) {
+        write_error(b, sub);
+        ok = false;
+    }
+    free(sub);
+    if (!ok)
+        return false;
+
+    size_t ntex = (size_t)s->terrain.width * (size_t)s->terrain.height;
+    uint8_t *hf = le16(s->terrain.texels, ntex);
+    ok = write_file(b, dir, "heightfield.r16", hf, 2 * ntex);
+    free(hf);
+    if (ok && s->terrain.holes) {
+        uint8_t *holes = xcalloc(ntex, 1);
+        for (size_t i = 0; i < ntex; i++)
+            holes[i] = s->terrain.holes[i] ? 255 : 0;
+        ok = write_file(b, dir, "holes.r8", holes, ntex);
+        free(holes);
+    }
+
+    if (b->sparse_ok) {
+        ok = ok && write_sparse(b, dir);
+    } else {
+        int np = s->desc->npainted;
+        uint8_t *painted = xcalloc(ntex * (size_t)np, 1);
+        for (int i = 0; i < np; i++)
+            if (s->painted && s->painted[i])
+                memcpy(painted + ntex * (size_t)i, s->painted[i], ntex);
+        ok = ok && write_file(b, dir, "painted.r8", painted, ntex * (size_t)np);
+        free(painted);
+    }
+
+    size_t total = 0;
+    for (int l = 0; l < a->nlevels; l++)
+        total += (size_t)a->levels[l].width * (size_t)a->levels[l].height;
+    uint16_t *ids = xcalloc(total, sizeof *ids);
+    size_t at = 0;
+    for (int l = 0; l < a->nlevels; l++) {
+        size_t n = (size_t)a->levels[l].width * (size_t)a->levels[l].height;
+        memcpy(ids + at, a->levels[l].ids, n * sizeof *ids);
+        at += n;
+    }
+    uint8_t *bytes = le16(ids, total);
+    ok = ok && write_file(b, dir, "combos.bin", bytes, 2 * total);
+    free(bytes);
+    free(ids);
+
+    for (int i = 0; ok && i < b->njobs; i++) {
+        const job *j = &b->jobs[i];
+        char *name = xasprintf("%s%s", j->file, j->stage == SPV_STAGE_FRAGMENT ? ".frag" : "");
+        ok = write_file(b, dir, name, j->glsl.s, j->glsl.len);
+        free(name);
+        if (j->glsl_only)
+            continue;
+        name = xasprintf("%s.spv", j->file);
+        ok = ok && write_file(b, dir, name, j->words, 4 * j->nwords);
+        free(name);
+    }
+
+    char **tex_names = texture_names(b);
+    for (int i = 0; ok && i < b->layout.ntextures; i++) {
+        bool first = true;
+        for (int k = 0; k < i; k++)
+            first &= strcmp(tex_names[k], tex_names[i]) != 0;
+        const char *src = b->layout.src->textures[b->layout.textures[i]].file;
+        if (first)
+            ok = texture_fits(b, src) && copy_file(b, src, dir, tex_names[i]);
+        for (int k = 1, n = first ? build_mip_count(src) : 0; ok && k <= n; k++) {
+            char *from = build_mip_path(src, k), *to = build_mip_path(tex_names[i], k);
+            ok = copy_file(b, from, dir, to);
+            free(from);
+            free(to);
+        }
+    }
+    if (ok) {
+        json_t *m = manifest(b, tex_names, dir);
+        char *text = json_dumps(m, JSON_INDENT(2) | JSON_PRESERVE_ORDER |
+                                       JSON_REAL_PRECISION(15));
+        json_decref(m);
+        if (!text)
+            abort();
+        size_t n = strlen(text);
+        char *withnl = xasprintf("%s\n", text);
+        free(text);
+        ok = write_file(b, dir, "manifest.json", withnl, n + 1);
+        free(withnl);
+    }
+    for (int i = 0; i < b->layout.ntextures; i++)
+        free(tex_names[i]);
+    free(tex_names);
+    return ok;
+}
+
+static int rm_entry(const char *path, const struct stat *sb, int flag, struct FTW *ftw)
+{
+    (void)sb; (void)flag; (void)ftw;
+    remove(path);
+    return 0;
+}
+
+static void remove_tree(const char *path)
+{
+    nftw(path, rm_entry, 16, FTW_DEPTH | FTW_PHYS);
+}
+
+/* May `path` be replaced?  Yes if absent, an empty folder, or a pack. */
+static bool replaceable(build *b, const char *path, bool *exists)
+{
+    struct stat sb;
+    *exists = lstat(path, &sb) == 0;
+    if (!*exists)
+        return true;
+    if (S_ISDIR(sb.st_mode)) {
+        char *mf = xasprintf("%s/manifest.json", path);
+        json_t *m = json_load_file(mf, 0, NULL);
+        free(mf);
+        const char *fmt = m ? json_string_value(json_object_get(m, "format")) : NULL;
+        bool pack = fmt && strcmp(fmt, "splatc-pack") == 0;
+        json_decref(m);
+        if (pack)
+            return true;
+        if (rmdir(path) == 0) {  /* empty: gone, nothing lost */
+            *exists = false;
+            return true;
+        }
+    }
+    char msg[PATH_MAX + 64];
+    snprintf(msg, sizeof msg, "refusing to replace '%s': it is not a shader pack", path);
+    sg_error(b->d, b->loc, SG_E_SCENE, msg);
+    return false;
+}
+
+bool build_write_pack(build *b)
+{
+    const char *out = b->out;
+    bool exists;
+    if (!replaceable(b, out, &exists))
+        return false;
+    char *tmp = xasprintf("%s.tmp-XXXXXX", out);
+    if (!mkdtemp(tmp)) {
+        write_error(b, tmp);
+        free(tmp);
+        return false;
+    }
+    chmod(tmp, 0755);
+    bool ok = write_contents(b, tmp);
+    if (ok && exists) {
+        /* Swap old and new in one step where the file system can. */
+        if (renameat2(AT_FDCWD, tmp, AT_FDCWD, out, RENAME_EXCHANGE) == 0) {
+            remove_tree(tmp);  /* now the old pack */
+        } else {
+            char *old = xasprintf("%s.old-XXXXXX", out);
+            if (!mkdtemp(old) || rmdir(old) != 0 || rename(out, old) != 0) {
+                write_error(b, out);
+                ok = false;
+            } else if (rename(tmp, out) != 0) {
+                write_error(b, out);
+                rename(old, out);  /* put the old pack back */
+                ok = false;
+            } else {
+                remove_tree(old);
+            }
+            free(old);
+        }
+    } else if (ok && rename(tmp, out) != 0) {
+        write_error(b, out);
+        ok = false;
+    }
+    if (!ok)
+        remove_tree(tmp);
+    free(tmp);
+    return ok;
+}

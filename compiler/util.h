@@ -1,0 +1,54 @@
+/* util.h — the compiler's small utilities, one of each: allocation with
+ * one out-of-memory policy, one clock, one set of path helpers, one atomic
+ * file write.  libsplatrt links libsplatc and uses them too.
+ *
+ * Out of memory: the x* functions print "splatc: out of memory" and
+ * abort().  The compiler's data is small next to any machine it runs on,
+ * so running out is a bug or a runaway input that the limits
+ * (diagnostics with an id) should have stopped first; there is nothing
+ * sane to undo.  Library code otherwise never exits (STYLE). */
+#ifndef SPLAT_UTIL_H
+#define SPLAT_UTIL_H
+
+#include <stdbool.h>
+#include <stddef.h>
+
+void *xmalloc(size_t size);
+void *xcalloc(size_t n, size_t size);          /* n == 0 gives a valid block */
+void *xrealloc(void *p, size_t size);
+char *xstrdup(const char *s);
+char *xstrndup(const char *s, size_t n);
+char *xasprintf(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
+void  splat_oom(void) __attribute__((noreturn)); /* the policy itself */
+
+/* Seconds on a monotonic clock (phase timers, --stats, frame times). */
+double splat_now(void);
+
+/* ---- paths: lexical, malloc'd, relative paths stay relative ------------ */
+
+/* dir/rel with "." and empty components dropped and "x/.." folded; rel
+ * as given if absolute or dir is "" or ".". */
+char *splat_path_join(const char *dir, const char *rel);
+/* The folder part: "a/b" -> "a", "b" -> ".", "/b" -> "/". */
+char *splat_path_dir(const char *path);
+/* The parent of a folder, kept relative where it was: "a/b" -> "a" ->
+ * "." -> ".." -> "../.."; NULL above "/". */
+char *splat_path_parent(const char *dir);
+/* Absolute (against the current folder), "." and ".." resolved lexically. */
+char *splat_path_absolute(const char *path);
+/* `to` relative to folder `from` (both absolute and normalised). */
+char *splat_path_relative(const char *from, const char *to);
+/* `path` relative to folder `base` after resolving both (symlinks too),
+ * so the result does not depend on where the tree lives; `path` as given
+ * when either does not resolve. */
+char *splat_path_relative_real(const char *base, const char *path);
+bool  splat_is_dir(const char *path);
+
+/* ---- files ---------------------------------------------------------------- */
+
+/* Write `n` bytes to `path` atomically: a temporary file beside it
+ * (PATH.tmp-XXXXXX, mode 0666 & ~umask), renamed over it; readers never
+ * see half a file, and on failure nothing is left.  False with errno set. */
+bool splat_write_atomic(const char *path, const void *data, size_t n);
+
+#endif

@@ -1,0 +1,195 @@
+/* test_pack_checks — the pack checks that splatview cannot show alone:
+ *   rt_pack_check_device: each size of a real pack against a device's
+ *     limits, with devices made small enough to fail on each one in turn
+ *     (lavapipe's own limits equal the pack limits, so a real device never
+ *     trips them).  No Vulkan call: the check reads props.limits only.
+ *   rt_spirv_check's compute role: every compute variant of a pack built
+ *     with --compute-spirv fits it; its fragment shaders do not, nor does a
+ *     compute variant in a fragment role.
+ *
+ *   test_pack_checks MINIMAL_PACK DESTRUCTION_PACK COMPUTE_PACK
+ *   (all by splatc build)
+ */
+#include <dirent.h>
+#include <stdlib.h>
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <stdint.h>
+#include <cmocka.h>
+
+#include <string.h>
+
+#include "splatrt.h"
+
+static const char *minimal_dir, *destr_dir, *compute_dir;
+
+/* A device with room for everything, then one limit lowered per check. */
+static void roomy(rt_device *d)
+{
+    memset(d, 0, sizeof *d);
+    VkPhysicalDeviceLimits *L = &d->props.limits;
+    L->maxImageDimension2D = 16384;
+    L->maxImageArrayLayers = 2048;
+    L->maxPerStageDescriptorSamplers = 64;
+    L->maxPerStageDescriptorSampledImages = 64;
+    L->maxUniformBufferRange = 65536;
+    L->maxPushConstantsSize = 128;
+}
+
+/* The check fails and its message holds each of the strings. */
+static void refused(const rt_pack *p, const rt_device *d, const char *a, const char *b)
+{
+    rt_error e = { 0 };
+    assert_false(rt_pack_check_device(p, d, &e));
+    assert_int_equal(e.id, RT_E_PACK_LIMIT);
+    printf("  %s\n", e.msg);
+    assert_non_null(strstr(e.msg, "manifest.json: error: "));
+    assert_non_null(strstr(e.msg, a));
+    assert_non_null(strstr(e.msg, b));
+    rt_error_clear(&e);
+}
+
+static void test_minimal(void **state)
+{
+    (void)state;
+    rt_pack p;
+    rt_error e = { 0 };
+    assert_true(rt_pack_load(&p, minimal_dir, &e));
+    assert_non_null(p.sparse);
+    rt_device d;
+    roomy(&d);
+    assert_true(rt_pack_check_device(&p, &d, &e));
+
+    d.props.limits.maxImageDimension2D = 200;   /* the heightfield is 257 */
+    refused(&p, &d, "the heightfield's width is 257",
+            "over the device's maxImageDimension2D (200)");
+    int hw = p.hf_width, hh = p.hf_height;
+    p.hf_width = p.hf_height = 16;               /* textures are 256 */
+    refused(&p, &d, "textures[0] (textures/grass.png): the larger side is 256",
+            "maxImageDimension2D (200)");
+    for (int i = 0; i < p.ntextures; i++)
+        p.textures[i].width = p.textures[i].height = 8;
+    d.props.limits.maxImageDimension2D = (uint32_t)p.sparse->atlas_width - 1;
+    refused(&p, &d, "the painted atlas's larger side", "maxImageDimension2D");
+    for (int i = 0; i < p.ntextures; i++)
+        p.textures[i].width = p.textures[i].height = 256;
+    p.hf_width = hw, p.hf_height = hh;
+
+    roomy(&d);
+    d.props.limits.maxImageArrayLayers = 0;
+    refused(&p, &d, "the painted index's layer count is 1", "maxImageArrayLayers (0)");
+
+    roomy(&d);
+    d.props.limits.maxPerStageDescriptorSamplers = 8;   /* 6 + 3 textures */
+    refused(&p, &d, "sampler count (6 + textures) is 9", "maxPerStageDescriptorSamplers (8)");
+
+    roomy(&d);
+    d.props.limits.maxUniformBufferRange = 16;
+    refused(&p, &d, "params_size is", "maxUniformBufferRange (16)");
+    rt_pack_free(&p);
+}
+
+static void test_dense_and_destruction(void **state)
+{
+    (void)state;
+    rt_pack p;
+    rt_error e = { 0 };
+    assert_true(rt_pack_load(&p, destr_dir, &e));
+    assert_true(p.has_destruction);
+    rt_device d;
+    roomy(&d);
+    assert_true(rt_pack_check_device(&p, &d, &e));
+    int hw = p.hf_width, hh = p.hf_height;
+    p.hf_width = p.hf_height = 8;
+    for (int i = 0; i < p.ntextures; i++)
+        p.textures[i].width = p.textures[i].height = 8;
+    int aw = p.sparse->atlas_width, ah = p.sparse->atlas_height;
+    p.sparse->atlas_width = p.sparse->atlas_height = 8;
+    d.props.limits.maxImageDimension2D = 31;   /* 512 m / 16 m = 32 cells */
+    refused(&p, &d, "the destruction grid's cells per side is 32", "maxImageDimension2D (31)");
+    p.sparse->atlas_width = aw, p.sparse->atlas_height = ah;
+    p.hf_width = hw, p.hf_height = hh;
+
+    /* a dense painted array of 3 layers on a device with 2 */
+    roomy(&d);
+    d.props.limits.maxImageArrayLayers = 2;
+    sparse_masks *sparse = p.sparse;
+    uint8_t layer = 0;
+    int np = p.npainted;
+    p.sparse = NULL;
+    p.painted = &layer;
+    p.npainted = 3;
+    refused(&p, &d, "the dense painted layer count is 3", "maxImageArrayLayers (2)");
+    p.painted = NULL;
+    p.npainted = np;
+    p.sparse = sparse;
+    rt_pack_free(&p);
+}
+
+/* Check one SPIR-V file of the compute pack against a role. */
+static bool fits(const rt_pack *p, const char *file, rt_shader_role role, rt_error *e)
+{
+    char path[1024];
+    snprintf(path, sizeof path, "%s/shaders/%s", compute_dir, file);
+    FILE *f = fopen(path, "rb");
+    assert_non_null(f);
+    static uint32_t words[1 << 20];
+    size_t n = fread(words, 4, sizeof words / 4, f);
+    fclose(f);
+    rt_interface in;
+    assert_true(rt_interface_for(p, role, &in));
+    assert_true(rt_spirv_validate(words, n, path, e));
+    bool ok = rt_spirv_check(words, n, path, &in, e);
+    rt_interface_free(&in);
+    return ok;
+}
+
+static void test_compute_role(void **state)
+{
+    (void)state;
+    rt_pack p;
+    rt_error e = { 0 };
+    assert_true(rt_pack_load(&p, compute_dir, &e));
+    char shaders[1024];
+    snprintf(shaders, sizeof shaders, "%s/shaders", compute_dir);
+    DIR *dir = opendir(shaders);
+    assert_non_null(dir);
+    int ncomp = 0;
+    struct dirent *ent;
+    while ((ent = readdir(dir)) != NULL) {
+        size_t len = strlen(ent->d_name);
+        if (len > 9 && !strcmp(ent->d_name + len - 9, ".comp.spv")) {
+            if (!fits(&p, ent->d_name, RT_ROLE_COMPUTE, &e))
+                fail_msg("%s", e.msg);
+            assert_false(fits(&p, ent->d_name, RT_ROLE_COMPOSITE, &e));
+            assert_non_null(strstr(e.msg, "no fragment entry point"));
+            rt_error_clear(&e);
+            ncomp++;
+        }
+    }
+    closedir(dir);
+    printf("  %d compute variants fit the compute role\n", ncomp);
+    assert_int_equal(ncomp, p.ncombos + 1);   /* every composite and the uber */
+    assert_false(fits(&p, "0000.spv", RT_ROLE_COMPUTE, &e));
+    assert_non_null(strstr(e.msg, "no compute entry point"));
+    rt_error_clear(&e);
+    rt_pack_free(&p);
+}
+
+int main(int argc, char **argv)
+{
+    if (argc != 4) {
+        fprintf(stderr, "usage: test_pack_checks MINIMAL_PACK DESTRUCTION_PACK COMPUTE_PACK\n");
+        return 2;
+    }
+    minimal_dir = argv[1];
+    destr_dir = argv[2];
+    compute_dir = argv[3];
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_minimal),
+        cmocka_unit_test(test_dense_and_destruction),
+        cmocka_unit_test(test_compute_role),
+    };
+    return cmocka_run_group_tests(tests, NULL, NULL);
+}

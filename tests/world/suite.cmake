@@ -1,0 +1,48 @@
+# Large worlds and real data (large worlds): rasters through GDAL, terrain
+# holes.  test_gdal writes its GeoTIFFs with GDAL's C API; the colorado twin
+# builds examples/colorado from GeoTIFFs made from its PNGs at test time
+# (gen_geotiff) and checks it gives the same pack; test_holes renders holes.
+
+add_executable(test_gdal ${CMAKE_CURRENT_LIST_DIR}/test_gdal.c)
+target_link_libraries(test_gdal splatc PkgConfig::CMOCKA PkgConfig::GDAL)
+add_test(NAME world.test_gdal COMMAND test_gdal WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
+set_tests_properties(world.test_gdal PROPERTIES LABELS unit)
+
+add_executable(gen_geotiff ${CMAKE_CURRENT_LIST_DIR}/gen_geotiff.c)
+target_link_libraries(gen_geotiff splatc PkgConfig::GDAL)
+
+if(TARGET splatc_cli)
+  add_test(NAME world.colorado_geotiff_twin
+           COMMAND sh ${CMAKE_CURRENT_LIST_DIR}/colorado_twin.sh
+                   $<TARGET_FILE:splatc_cli> $<TARGET_FILE:gen_geotiff>
+                   ${CMAKE_CURRENT_BINARY_DIR}/colorado_twin
+           WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
+  set_tests_properties(world.colorado_geotiff_twin PROPERTIES LABELS cli TIMEOUT 600)
+endif()
+
+# Terrain holes on the device (label `render`, SPLAT_VALIDATE=1): a GeoTIFF
+# with nodata and a painted holes mask over a spike, built and rendered.
+if(TARGET splatrt)
+  set(HOLES_OUT ${CMAKE_BINARY_DIR}/tests/holes)
+  file(MAKE_DIRECTORY ${HOLES_OUT})
+  add_executable(test_holes ${CMAKE_CURRENT_LIST_DIR}/test_holes.c)
+  target_link_libraries(test_holes splatrt splatc PkgConfig::GDAL m)
+  add_test(NAME world.holes COMMAND test_holes ${HOLES_OUT}
+           WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
+  set_tests_properties(world.holes PROPERTIES LABELS render TIMEOUT 600
+                       ENVIRONMENT "SPLAT_VALIDATE=1")
+endif()
+
+# Shading far from the origin (label `render`, SPLAT_VALIDATE=1): the same
+# view near the origin and 100 / 1,000 / 5,000 km away on a 10,240 km
+# terrain, against each other and the double-precision reference.
+if(TARGET splatrt)
+  set(FAR_OUT ${CMAKE_BINARY_DIR}/tests/far)
+  file(MAKE_DIRECTORY ${FAR_OUT})
+  add_executable(test_far ${CMAKE_CURRENT_LIST_DIR}/test_far.c)
+  target_link_libraries(test_far splatrt splatc m)
+  add_test(NAME world.far COMMAND test_far ${FAR_OUT}
+           WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
+  set_tests_properties(world.far PROPERTIES LABELS render TIMEOUT 600
+                       ENVIRONMENT "SPLAT_VALIDATE=1")
+endif()
