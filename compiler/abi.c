@@ -148,6 +148,7 @@
     "}\n"
 
 const char SPLAT_GLSL_COMBO_COLOR[] = COMBO_COLOR_TEXT;
+const char SPLAT_GLSL_TERRAIN[] = SPLAT_GLSL_COMMON;
 const char SPLAT_GLSL_LIGHTING[] = LIGHTING_TEXT;
 
 const char SPLAT_GLSL_VERTEX[] =
@@ -306,6 +307,19 @@ const char SPLAT_GLSL_PRELUDE[] =
     "                        vec3(1.0, 0.9, 0.0), vec3(1.0, 0.1, 0.0), vec3(1.0));\n"
     "    int i = min(int(t), 4);\n"
     "    return mix(k[i], k[i + 1], t - float(i));\n"
+    "}\n"
+    /* The tiles view: the combination that shades the pixel, darker on
+     * the edges of its 8x8 tile in compute (the tile's choice); the
+     * patch's combination in fragments, as the combos view. */
+    "vec3 splat_combo_color(uint id);\n"
+    "vec3 splat_tile_color() {\n"
+    "#ifdef SPLAT_COMPUTE\n"
+    "    uvec2 q = gl_LocalInvocationID.xy;\n"
+    "    bool edge = q.x == 0u || q.y == 0u;\n"
+    "    return splat_combo_color(u_push.info.y) * (edge ? 0.6 : 1.0);\n"
+    "#else\n"
+    "    return splat_combo_color(u_push.info.y);\n"
+    "#endif\n"
     "}\n"
     "#if defined(SPLAT_COMPUTE) && defined(SPLAT_COUNT)\n"
     "vec3 splat_cost_color() { return splat_heat(float(splat_n_samples)); }\n"

@@ -203,7 +203,9 @@ enum {
     X(NORMAL, 3, "normal", '4', NONE,   ALL,       "n * 0.5 + 0.5")                    \
     X(SLOPE,  4, "slope",  '5', NONE,   FORWARD,   "vec3(splat_slope())")              \
     X(MASK,   5, "mask",   '7', NONE,   COMPOSITE, "vec3(0.0)") /* material view.y */  \
-    X(ALBEDO, 6, "albedo", '6', SRGB,   ALL,       "albedo")
+    X(ALBEDO, 6, "albedo", '6', SRGB,   ALL,       "albedo")                           \
+    X(TILES,  7, "tiles",  '8', NONE,   FORWARD,   "splat_tile_color()")               \
+    X(COST,   8, "cost",   '9', NONE,   FORWARD,   "splat_cost_color()")
 
 typedef enum splat_view {
 #define X(id, num, ...) SPLAT_VIEW_##id = num,
@@ -299,11 +301,15 @@ typedef struct splat_push {
  *   float dist): sun + sky ambient + fog; used by the prelude and by the
  *   runtime's resolve pass.
  * SPLAT_GLSL_VERTEX: the complete shared vertex shader (#version included).
- * SPLAT_GLSL_COMBO_COLOR: vec3 splat_combo_color(uint id). */
+ * SPLAT_GLSL_COMBO_COLOR: vec3 splat_combo_color(uint id).
+ * SPLAT_GLSL_TERRAIN: set 0's heightfield and frame block, the push block
+ *   and splat_height_at(uv), for the runtime's own compute passes (the
+ *   screen-space tile classification). */
 extern const char SPLAT_GLSL_PRELUDE[];
 extern const char SPLAT_GLSL_LIGHTING[];
 extern const char SPLAT_GLSL_VERTEX[];
 extern const char SPLAT_GLSL_COMBO_COLOR[];
+extern const char SPLAT_GLSL_TERRAIN[];
 
 /* The normal filter of Andersson 2007 Listing 1, honouring texel aspect, on the
  * CPU.  `h` returns the normalised height (0..1) at a texel, clamped to the

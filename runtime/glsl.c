@@ -15,7 +15,8 @@ bool rt_glsl_compile(const char *glsl, VkShaderStageFlagBits stage,
                      rt_error *e)
 {
     char *log = NULL;
-    int st = stage == VK_SHADER_STAGE_VERTEX_BIT ? SPV_STAGE_VERTEX : SPV_STAGE_FRAGMENT;
+    int st = stage == VK_SHADER_STAGE_VERTEX_BIT  ? SPV_STAGE_VERTEX :
+             stage == VK_SHADER_STAGE_COMPUTE_BIT ? SPV_STAGE_COMPUTE : SPV_STAGE_FRAGMENT;
     if (!spv_compile(glsl, st, name, words, nwords, &log)) {
         rt_fail(e, RT_E_SHADER, name, log ? log : "glslang failed");
         free(log);

@@ -319,6 +319,39 @@ static bool read_spirv(reader *r, json_t *obj, const char *where, rt_spirv *out)
     return rt_spirv_validate(out->words, out->nwords, path, r->e);
 }
 
+/* {"compute": {"glsl": …}} of a combination or the über-shader: the
+ * compute variant's GLSL text (PACK.md), NUL-terminated; optional (a pack
+ * without it cannot be drawn by the screen-space path). */
+static bool read_compute(reader *r, json_t *obj, const char *where, char **out)
+{
+    json_t *c = get(r, obj, "compute", where, false);
+    if (!c || json_is_null(c))
+        return true;
+    char w[96];
+    snprintf(w, sizeof w, "%s.compute", where);
+    const char *rel;
+    if (!get_string(r, c, "glsl", w, &rel))
+        return false;
+    char field[128];
+    snprintf(field, sizeof field, "%s.glsl", w);
+    size_t n = 0;
+    uint8_t *data = pack_file(r, field, rel, 0, MAX_SPIRV, &n);
+    if (!data)
+        return false;
+    char *text = realloc(data, n + 1);
+    if (!text) {
+        free(data);
+        return field_fail(r, field, "does not fit in memory");
+    }
+    text[n] = '\0';
+    if (strlen(text) != n) {
+        free(text);
+        return field_fail(r, field, "holds a NUL byte: not GLSL text");
+    }
+    *out = text;
+    return true;
+}
+
 /* ---- sections ------------------------------------------------------------ */
 
 static bool read_scene(reader *r, json_t *root)
@@ -769,8 +802,13 @@ static bool read_combos(reader *r, json_t *root)
                 return field_fail(r, where, "materials: index out of range");
             co->materials[k] = (int)json_integer_value(m);
         }
-        if (!read_spirv(r, c, where, &co->spirv))
+        if (!read_spirv(r, c, where, &co->spirv) || !read_compute(r, c, where, &co->compute))
             return false;
+        json_t *cost = get(r, c, "cost", where, false);
+        if (cost && (!json_is_number(cost) || !(json_number_value(cost) >= 0) ||
+                     json_number_value(cost) > 1e12))
+            return field_fail(r, where, "cost: must be a number >= 0");
+        co->cost = cost ? json_number_value(cost) : 0;
     }
     return true;
 }
@@ -966,7 +1004,8 @@ bool rt_pack_load(rt_pack *p, const char *dir, rt_error *e)
     if (ok) {
         json_t *ub = get(&r, root, "uber", "manifest", false);
         if (ub && !json_is_null(ub))
-            ok = read_spirv(&r, ub, "uber", &p->uber);
+            ok = read_spirv(&r, ub, "uber", &p->uber) &&
+                 read_compute(&r, ub, "uber", &p->uber_compute);
     }
     ok = ok && check_shaders(&r);
 done:
@@ -1009,12 +1048,14 @@ void rt_pack_free(rt_pack *p)
     }
     for (int i = 0; i < p->ncombos && p->combos; i++) {
         free(p->combos[i].materials);
+        free(p->combos[i].compute);
         free_spirv(&p->combos[i].spirv);
     }
     for (int i = 0; i < p->nlevels && p->levels; i++)
         free(p->levels[i].ids);
     free(p->holes);
     free_spirv(&p->uber);
+    free(p->uber_compute);
     free_spirv(&p->vertex);
     free(p->cameras);
     free(p->materials);

@@ -163,20 +163,28 @@ static bool make_set_layout(rt_device *d, const VkDescriptorSetLayoutBinding *b,
 
 static bool make_layouts(rt_device *d, int ntextures, rt_pipelines *pl, rt_error *e)
 {
+    const VkShaderStageFlags cs = VK_SHADER_STAGE_COMPUTE_BIT;
     const VkShaderStageFlags vf = VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT;
-    const VkShaderStageFlags fs = VK_SHADER_STAGE_FRAGMENT_BIT;
+    const VkShaderStageFlags fs = VK_SHADER_STAGE_FRAGMENT_BIT | cs;
     const VkDescriptorType smp = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
+    const VkDescriptorType sbuf = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+    /* One set 0 for both paths: the graphics passes leave the compute
+     * bindings (7-10) unwritten in their set, which they never read. */
     VkDescriptorSetLayoutBinding terrain[] = {
-        { SPLAT_BIND_HEIGHTFIELD, smp, 1, vf, NULL },
-        { SPLAT_BIND_FRAME, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 1, vf, NULL },
+        { SPLAT_BIND_HEIGHTFIELD, smp, 1, vf | cs, NULL },
+        { SPLAT_BIND_FRAME, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 1, vf | cs, NULL },
         { SPLAT_BIND_PAINTED, smp, 1, fs, NULL },
         { SPLAT_BIND_DESTRUCTION_ATLAS, smp, 1, fs, NULL },
         { SPLAT_BIND_DESTRUCTION_INDEX, smp, 1, fs, NULL },
         { SPLAT_BIND_PAINTED_INDEX, smp, 1, fs, NULL },   /* sparse masks */
         { SPLAT_BIND_PAINTED_LEVEL, smp, 1, fs, NULL },
         { SPLAT_BIND_HOLES, smp, 1, VK_SHADER_STAGE_VERTEX_BIT, NULL },
+        { SPLAT_BIND_DEPTH, smp, 1, cs, NULL },
+        { SPLAT_BIND_OUT, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, cs, NULL },
+        { SPLAT_BIND_TILES, sbuf, 1, cs, NULL },
+        { SPLAT_BIND_COUNTERS, sbuf, 1, cs, NULL },
     };
-    if (!make_set_layout(d, terrain, 8, &pl->set_terrain, e))
+    if (!make_set_layout(d, terrain, 12, &pl->set_terrain, e))
         return false;
     VkDescriptorSetLayoutBinding *mat = calloc((size_t)ntextures + 1, sizeof *mat);
     if (!mat)
@@ -203,6 +211,10 @@ static bool make_layouts(rt_device *d, int ntextures, rt_pipelines *pl, rt_error
     RT_VK(e, vkCreatePipelineLayout(d->dev, &li, NULL, &pl->layout));
     li.setLayoutCount = 3;
     RT_VK(e, vkCreatePipelineLayout(d->dev, &li, NULL, &pl->resolve_layout));
+    VkPushConstantRange cpush = { cs, 0, sizeof(splat_push) };
+    li.setLayoutCount = 2;
+    li.pPushConstantRanges = &cpush;
+    RT_VK(e, vkCreatePipelineLayout(d->dev, &li, NULL, &pl->compute_layout));
     return true;
 }
 
@@ -225,6 +237,7 @@ typedef enum kind {
     K_BASE,         /* multi-pass bottom material: 3 targets, depth write     */
     K_BLEND,        /* multi-pass upper materials: blend, depth EQUAL         */
     K_RESOLVE,      /* fullscreen, no depth, no vertex input                  */
+    K_DEPTH,        /* screen-space geometry pass: vertex stage, depth only   */
 } kind;
 
 static bool make_pipeline(rt_device *d, rt_pipelines *pl, VkShaderModule vs,
@@ -280,7 +293,7 @@ static bool make_pipeline(rt_device *d, rt_pipelines *pl, VkShaderModule vs,
     VkPipelineDepthStencilStateCreateInfo ds = {
         .sType = VK_STRUCTURE_TYPE_PIPELINE_DEPTH_STENCIL_STATE_CREATE_INFO,
         .depthTestEnable = k != K_RESOLVE,
-        .depthWriteEnable = k == K_OPAQUE || k == K_BASE,
+        .depthWriteEnable = k == K_OPAQUE || k == K_BASE || k == K_DEPTH,
         .depthCompareOp = k == K_BLEND ? VK_COMPARE_OP_EQUAL : VK_COMPARE_OP_GREATER_OR_EQUAL,
     };
     const VkColorComponentFlags all = VK_COLOR_COMPONENT_R_BIT | VK_COLOR_COMPONENT_G_BIT |
@@ -299,7 +312,7 @@ static bool make_pipeline(rt_device *d, rt_pipelines *pl, VkShaderModule vs,
         };
     VkPipelineColorBlendStateCreateInfo cb = {
         .sType = VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO,
-        .attachmentCount = (k == K_BASE || k == K_BLEND) ? 3 : 1,
+        .attachmentCount = (k == K_BASE || k == K_BLEND) ? 3 : k == K_DEPTH ? 0 : 1,
         .pAttachments = att,
     };
     VkDynamicState dyn[2] = { VK_DYNAMIC_STATE_VIEWPORT, VK_DYNAMIC_STATE_SCISSOR };
@@ -310,7 +323,7 @@ static bool make_pipeline(rt_device *d, rt_pipelines *pl, VkShaderModule vs,
     };
     VkGraphicsPipelineCreateInfo ci = {
         .sType = VK_STRUCTURE_TYPE_GRAPHICS_PIPELINE_CREATE_INFO,
-        .stageCount = 2,
+        .stageCount = k == K_DEPTH ? 1 : 2,
         .pStages = stages,
         .pVertexInputState = &vi,
         .pInputAssemblyState = &ia,
@@ -381,13 +394,117 @@ bool rt_pipelines_ref(rt_device *d, const rt_pack *p, const rt_passes *rp,
     return true;
 }
 
+/* ---- compute shading (screen-space path) --------------------------------- */
+
+/* The pack's compute GLSL with `#define SPLAT_COUNT 1` after its #version
+ * line (abi.h: the counting variant is never stored). */
+static char *with_count_define(const char *glsl)
+{
+    const char *nl = strchr(glsl, '\n');
+    size_t head = nl ? (size_t)(nl - glsl) + 1 : 0, n = strlen(glsl);
+    static const char def[] = "#define SPLAT_COUNT 1\n";
+    char *s = malloc(n + sizeof def);
+    if (!s)
+        return NULL;
+    memcpy(s, glsl, head);
+    memcpy(s + head, def, sizeof def - 1);
+    memcpy(s + head + sizeof def - 1, glsl + head, n - head + 1);
+    return s;
+}
+
+bool rt_pipelines_has_compute(const rt_pipelines *pl, int id, unsigned variant)
+{
+    return pl->compute && id >= 0 && id <= pl->ncombos &&
+           pl->compute[(size_t)id * RT_CVARIANTS + (variant % RT_CVARIANTS)] != VK_NULL_HANDLE;
+}
+
+bool rt_pipelines_compute(rt_device *d, const rt_pack *p, rt_pipelines *pl, int id,
+                          unsigned variant, VkPipeline *out, rt_error *e)
+{
+    if (id < 0 || id > pl->ncombos)
+        return rt_fail(e, RT_E_PACK_FIELD, p->dir, "compute pipeline of an unknown combination");
+    VkPipeline *slot = &pl->compute[(size_t)id * RT_CVARIANTS + (variant % RT_CVARIANTS)];
+    if (*slot) {
+        *out = *slot;
+        return true;
+    }
+    const char *glsl = id < p->ncombos ? p->combos[id].compute : p->uber_compute;
+    char name[64];
+    if (id < p->ncombos)
+        snprintf(name, sizeof name, "combination %d (compute)", id);
+    else
+        snprintf(name, sizeof name, "uber (compute)");
+    if (!glsl) {
+        char what[160];
+        snprintf(what, sizeof what, "the pack has no compute variant of %s: rebuild it with "
+                 "this splatc for --shading screen", name);
+        return rt_fail(e, RT_E_PACK_FIELD, p->dir, what);
+    }
+    char *src = (variant & RT_CVARIANT_COUNT) ? with_count_define(glsl) : NULL;
+    if ((variant & RT_CVARIANT_COUNT) && !src)
+        return rt_fail(e, RT_E_VULKAN, "pipelines", "out of memory");
+    uint32_t *words = NULL;
+    size_t n = 0;
+    rt_interface in;
+    bool have_in = false;
+    bool ok = rt_glsl_compile(src ? src : glsl, VK_SHADER_STAGE_COMPUTE_BIT, name, &words, &n, e) &&
+              rt_spirv_validate(words, n, name, e);
+    free(src);
+    if (ok) {
+        have_in = rt_interface_for(p, RT_ROLE_COMPUTE, &in);
+        ok = have_in ? rt_spirv_check(words, n, name, &in, e)
+                     : rt_fail(e, RT_E_VULKAN, "pipelines", "out of memory");
+    }
+    if (have_in)
+        rt_interface_free(&in);
+    VkShaderModule m = VK_NULL_HANDLE;
+    if (ok && make_module(d, words, n, &m, e)) {
+        static const uint32_t final_view = SPLAT_VIEW_FINAL;
+        static const VkSpecializationMapEntry entry = { SPLAT_SPEC_VIEW, 0, sizeof final_view };
+        static const VkSpecializationInfo spec = { 1, &entry, sizeof final_view, &final_view };
+        VkComputePipelineCreateInfo ci = {
+            .sType = VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO,
+            .stage = { .sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO,
+                       .stage = VK_SHADER_STAGE_COMPUTE_BIT, .module = m, .pName = "main",
+                       .pSpecializationInfo = (variant & RT_CVARIANT_DEBUG) ? NULL : &spec },
+            .layout = pl->compute_layout,
+        };
+        VkResult r = vkCreateComputePipelines(d->dev, pl->cache, 1, &ci, NULL, slot);
+        if (r != VK_SUCCESS)
+            ok = rt_fail(e, RT_E_VULKAN, "vkCreateComputePipelines", rt_vk_result_name(r));
+        vkDestroyShaderModule(d->dev, m, NULL);
+    } else {
+        ok = false;
+    }
+    free(words);
+    if (ok)
+        *out = *slot;
+    return ok;
+}
+
+bool rt_pipelines_depth(rt_device *d, rt_pipelines *pl, VkRenderPass pass, bool cull,
+                        VkPipeline *out, rt_error *e)
+{
+    VkPipeline *slot = &pl->depth[cull];
+    if (!*slot && !make_pipeline(d, pl, pl->vertex, VK_NULL_HANDLE, pass, K_DEPTH,
+                                 cull ? RT_VARIANT_CULL : 0, slot, e))
+        return false;
+    *out = *slot;
+    return true;
+}
+
 static void destroy_combos(rt_device *d, rt_pipelines *pl)
 {
     for (size_t i = 0; pl->combo && i < (size_t)pl->ncombos * RT_VARIANTS; i++)
         if (pl->combo[i])
             vkDestroyPipeline(d->dev, pl->combo[i], NULL);
+    for (size_t i = 0; pl->compute && i < ((size_t)pl->ncombos + 1) * RT_CVARIANTS; i++)
+        if (pl->compute[i])
+            vkDestroyPipeline(d->dev, pl->compute[i], NULL);
     free(pl->combo);
+    free(pl->compute);
     pl->combo = NULL;
+    pl->compute = NULL;
     pl->ncombos = 0;
 }
 
@@ -396,7 +513,8 @@ bool rt_pipelines_reset_combos(rt_device *d, const rt_pack *p, rt_pipelines *pl,
 {
     destroy_combos(d, pl);
     pl->combo = calloc((size_t)p->ncombos * RT_VARIANTS + 1, sizeof *pl->combo);
-    if (!pl->combo)
+    pl->compute = calloc(((size_t)p->ncombos + 1) * RT_CVARIANTS, sizeof *pl->compute);
+    if (!pl->combo || !pl->compute)
         return rt_fail(e, RT_E_VULKAN, "pipelines", "out of memory");
     pl->ncombos = p->ncombos;
     return true;
@@ -473,12 +591,17 @@ void rt_pipelines_destroy(rt_device *d, rt_pipelines *pl)
             vkDestroyPipeline(d->dev, pl->uber[i], NULL);
     if (pl->resolve)
         vkDestroyPipeline(d->dev, pl->resolve, NULL);
+    for (int i = 0; i < 2; i++)
+        if (pl->depth[i])
+            vkDestroyPipeline(d->dev, pl->depth[i], NULL);
     if (pl->vertex)
         vkDestroyShaderModule(d->dev, pl->vertex, NULL);
     if (pl->layout)
         vkDestroyPipelineLayout(d->dev, pl->layout, NULL);
     if (pl->resolve_layout)
         vkDestroyPipelineLayout(d->dev, pl->resolve_layout, NULL);
+    if (pl->compute_layout)
+        vkDestroyPipelineLayout(d->dev, pl->compute_layout, NULL);
     if (pl->set_terrain)
         vkDestroyDescriptorSetLayout(d->dev, pl->set_terrain, NULL);
     if (pl->set_material)

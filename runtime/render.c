@@ -38,6 +38,8 @@ struct rt_renderer {
     rt_pipelines      pl;
     VkDescriptorPool  dpool;
     VkDescriptorSet   set0, set1, set2;
+    VkDescriptorSet   set0c;           /* set 0 with the compute bindings   */
+    rt_screen        *screen;          /* NULL: forward shading only        */
     VkCommandBuffer   cb;
     VkFence           fence;
     VkQueryPool       qpool;
@@ -47,6 +49,8 @@ struct rt_renderer {
     splat_view        view;
     int               view_material;
     bool              wireframe;
+    bool              counting;        /* screen: counting variant (stats)  */
+    rt_shading        shading;         /* the path in use                   */
     double            lod_distance;
 };
 
@@ -145,11 +149,19 @@ static bool make_targets(rt_renderer *r, rt_error *e)
         return rt_fail(e, RT_E_NO_FORMAT, "render (and blend) to R32G32B32A32_SFLOAT");
     if (!rt_format_supports(d, VK_FORMAT_D32_SFLOAT, VK_FORMAT_FEATURE_DEPTH_STENCIL_ATTACHMENT_BIT))
         return rt_fail(e, RT_E_NO_FORMAT, "use D32_SFLOAT depth");
+    bool screen = r->desc.shading == RT_SHADING_SCREEN;
+    if (screen && !rt_format_supports(d, cf, VK_FORMAT_FEATURE_STORAGE_IMAGE_BIT))
+        return rt_fail(e, RT_E_NO_FORMAT, "store to R32G32B32A32_SFLOAT images (--shading screen)");
+    if (screen && !rt_format_supports(d, VK_FORMAT_D32_SFLOAT, VK_FORMAT_FEATURE_SAMPLED_IMAGE_BIT))
+        return rt_fail(e, RT_E_NO_FORMAT, "sample D32_SFLOAT depth (--shading screen)");
     if (!rt_image_create(d, (uint32_t)w, (uint32_t)h, 1, false, 1, cf,
                          VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT |
-                         VK_IMAGE_USAGE_SAMPLED_BIT, VK_IMAGE_ASPECT_COLOR_BIT, &r->color, e) ||
+                         VK_IMAGE_USAGE_SAMPLED_BIT |
+                         (screen ? VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT : 0),
+                         VK_IMAGE_ASPECT_COLOR_BIT, &r->color, e) ||
         !rt_image_create(d, (uint32_t)w, (uint32_t)h, 1, false, 1, VK_FORMAT_D32_SFLOAT,
-                         VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT, VK_IMAGE_ASPECT_DEPTH_BIT,
+                         VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT |
+                         (screen ? VK_IMAGE_USAGE_SAMPLED_BIT : 0), VK_IMAGE_ASPECT_DEPTH_BIT,
                          &r->depth, e))
         return false;
     if (!make_pass(d, 1, true, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, &r->rp.main, e))
@@ -263,14 +275,16 @@ static bool make_descriptors(rt_renderer *r, rt_error *e)
     for (int i = 0; i < p->nparams; i++)
         memcpy((uint8_t *)r->params_ubo.map + p->params[i].offset, p->params[i].value, 16);
 
-    VkDescriptorPoolSize sizes[2] = {
-        { VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 2 },
-        { VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 7 + (uint32_t)r->ntex + 3 },
+    VkDescriptorPoolSize sizes[4] = {
+        { VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 3 },
+        { VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 2 * 9 + (uint32_t)r->ntex + 3 },
+        { VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1 },
+        { VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 2 },
     };
     VkDescriptorPoolCreateInfo pci = {
         .sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO,
-        .maxSets = 3,
-        .poolSizeCount = 2,
+        .maxSets = 4,
+        .poolSizeCount = 4,
         .pPoolSizes = sizes,
     };
     RT_VK(e, vkCreateDescriptorPool(d->dev, &pci, NULL, &r->dpool));
@@ -286,6 +300,10 @@ static bool make_descriptors(rt_renderer *r, rt_error *e)
     r->set0 = sets[0];
     r->set1 = sets[1];
     r->set2 = r->desc.reference == RT_REF_MULTIPASS ? sets[2] : VK_NULL_HANDLE;
+    if (r->desc.shading == RT_SHADING_SCREEN) {
+        ai.descriptorSetCount = 1;
+        RT_VK(e, vkAllocateDescriptorSets(d->dev, &ai, &r->set0c));
+    }
 
     const VkImageLayout ro = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
     const rt_terrain_gpu *t = &r->terrain;
@@ -337,6 +355,20 @@ static bool make_descriptors(rt_renderer *r, rt_error *e)
     vkUpdateDescriptorSets(d->dev, (uint32_t)n, w, 0, NULL);
     free(timg);
     free(w);
+    if (r->set0c) {
+        /* the compute set 0: the same terrain bindings (screen.c adds 7-10) */
+        static const uint32_t terrain[] = {
+            SPLAT_BIND_HEIGHTFIELD, SPLAT_BIND_FRAME, SPLAT_BIND_PAINTED,
+            SPLAT_BIND_DESTRUCTION_ATLAS, SPLAT_BIND_DESTRUCTION_INDEX,
+            SPLAT_BIND_PAINTED_INDEX, SPLAT_BIND_PAINTED_LEVEL, SPLAT_BIND_HOLES,
+        };
+        VkCopyDescriptorSet cp[8];
+        for (int i = 0; i < 8; i++)
+            cp[i] = (VkCopyDescriptorSet){ .sType = VK_STRUCTURE_TYPE_COPY_DESCRIPTOR_SET,
+                .srcSet = r->set0, .srcBinding = terrain[i], .dstSet = r->set0c,
+                .dstBinding = terrain[i], .descriptorCount = 1 };
+        vkUpdateDescriptorSets(d->dev, 0, NULL, 8, cp);
+    }
     return true;
 }
 
@@ -365,7 +397,7 @@ static bool make_commands(rt_renderer *r, rt_error *e)
         VkQueryPoolCreateInfo qi = {
             .sType = VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO,
             .queryType = VK_QUERY_TYPE_TIMESTAMP,
-            .queryCount = 2,
+            .queryCount = 4,
         };
         RT_VK(e, vkCreateQueryPool(d->dev, &qi, NULL, &r->qpool));
     }
@@ -422,10 +454,13 @@ bool rt_renderer_create(rt_device *d, const rt_pack *p, const rt_render_desc *de
         !rt_pipelines_create(d, p, &r->rp, r->desc.reference, r->desc.pipeline_cache,
                              p->ntextures, &r->pl, e) ||
         !make_geometry(r, e) || !make_textures(r, e) || !make_descriptors(r, e) ||
-        !make_commands(r, e)) {
+        !make_commands(r, e) ||
+        (r->set0c && !rt_screen_create(d, p, &r->pl, &r->color, &r->depth,
+                                       r->terrain.nearest_clamp, r->set0c, &r->screen, e))) {
         rt_renderer_destroy(r);
         return false;
     }
+    r->shading = r->screen ? RT_SHADING_SCREEN : RT_SHADING_FORWARD;
     *out = r;
     return true;
 }
@@ -437,6 +472,7 @@ void rt_renderer_destroy(rt_renderer *r)
     rt_device *d = r->d;
     if (d->dev) {
         vkDeviceWaitIdle(d->dev);
+        rt_screen_destroy(r->screen);
         rt_pipelines_destroy(d, &r->pl);
         if (r->fence)
             vkDestroyFence(d->dev, r->fence, NULL);
@@ -517,6 +553,18 @@ void rt_renderer_set_view(rt_renderer *r, splat_view view, int material)
     r->view_material = material;
 }
 
+void rt_renderer_set_counting(rt_renderer *r, bool on) { r->counting = on; }
+
+bool rt_renderer_set_shading(rt_renderer *r, rt_shading s)
+{
+    if (s == RT_SHADING_SCREEN && !r->screen)
+        return false;
+    r->shading = s;
+    return true;
+}
+
+rt_shading rt_renderer_shading(const rt_renderer *r) { return r->shading; }
+
 void rt_renderer_set_wireframe(rt_renderer *r, bool on)
 {
     if (on && !r->d->wireframe) {
@@ -543,7 +591,7 @@ const rt_image *rt_renderer_target(const rt_renderer *r) { return &r->color; }
 /* Camera-relative view-projection: rotation only (positions reach the GPU
  * relative to the camera), perspective with reversed infinite Z and
  * Vulkan's downward y.  Column-major. */
-static void camera_matrix(const rt_camera *c, double aspect, float m[16])
+static void camera_matrix(const rt_camera *c, double aspect, double m[16])
 {
     double f[3], len = 0;
     for (int i = 0; i < 3; i++) {
@@ -573,19 +621,62 @@ static void camera_matrix(const rt_camera *c, double aspect, float m[16])
     double v[3][3] = { { s[0], s[1], s[2] }, { u[0], u[1], u[2] }, { -f[0], -f[1], -f[2] } };
     memset(m, 0, 16 * sizeof *m);
     for (int col = 0; col < 3; col++) {
-        m[col * 4 + 0] = (float)(t / aspect * v[0][col]);
-        m[col * 4 + 1] = (float)(-t * v[1][col]);
-        m[col * 4 + 2] = 0.0f;
-        m[col * 4 + 3] = (float)(-v[2][col]);
+        m[col * 4 + 0] = t / aspect * v[0][col];
+        m[col * 4 + 1] = -t * v[1][col];
+        m[col * 4 + 2] = 0.0;
+        m[col * 4 + 3] = -v[2][col];
     }
-    m[3 * 4 + 2] = (float)znear;
+    m[3 * 4 + 2] = znear;
+}
+
+/* Gauss-Jordan with partial pivoting, column-major 4x4, in double. */
+static void invert4(const double m[16], double out[16])
+{
+    double a[4][8];
+    for (int r = 0; r < 4; r++)
+        for (int c = 0; c < 4; c++) {
+            a[r][c] = m[c * 4 + r];
+            a[r][4 + c] = r == c;
+        }
+    for (int c = 0; c < 4; c++) {
+        int piv = c;
+        for (int r = c + 1; r < 4; r++)
+            if (fabs(a[r][c]) > fabs(a[piv][c]))
+                piv = r;
+        for (int k = 0; k < 8; k++) {
+            double t = a[c][k];
+            a[c][k] = a[piv][k];
+            a[piv][k] = t;
+        }
+        double d = a[c][c];
+        for (int k = 0; k < 8; k++)
+            a[c][k] /= d;
+        for (int r = 0; r < 4; r++)
+            if (r != c) {
+                double f = a[r][c];
+                for (int k = 0; k < 8; k++)
+                    a[r][k] -= f * a[c][k];
+            }
+    }
+    for (int r = 0; r < 4; r++)
+        for (int c = 0; c < 4; c++)
+            out[c * 4 + r] = a[r][4 + c];
 }
 
 static void fill_frame(rt_renderer *r, const rt_camera *c, splat_frame *fr)
 {
     const rt_pack *p = r->p;
     memset(fr, 0, sizeof *fr);
-    camera_matrix(c, (double)r->desc.width / r->desc.height, fr->view_proj);
+    double vp[16], inv[16];
+    camera_matrix(c, (double)r->desc.width / r->desc.height, vp);
+    invert4(vp, inv);
+    for (int i = 0; i < 16; i++) {
+        fr->view_proj[i] = (float)vp[i];
+        fr->inv_view_proj[i] = (float)inv[i];
+    }
+    fr->screen[0] = (float)r->desc.width;
+    fr->screen[1] = (float)r->desc.height;
+    fr->screen[2] = 0.0f;   /* the depth clear value (reversed Z) */
     for (int i = 0; i < 3; i++)
         fr->camera[i] = (float)c->position[i];
     /* Default lighting: a low morning sun from the south-east (about 20 deg
@@ -728,7 +819,56 @@ static bool abandon_frame(VkCommandBuffer cb)
     return false;
 }
 
-bool rt_renderer_frame(rt_renderer *r, const rt_camera *c, rt_frame_stats *st, rt_error *e)
+/* The variant of the compute shading pipelines this frame needs. */
+static unsigned compute_variant(const rt_renderer *r)
+{
+    return (r->view != SPLAT_VIEW_FINAL ? RT_CVARIANT_DEBUG : 0) |
+           (r->counting || r->view == SPLAT_VIEW_COST ? RT_CVARIANT_COUNT : 0);
+}
+
+/* The screen-space path (screen.c): the geometry pass draws the patches
+ * depth only, then classification and one dispatch per combination. */
+static bool record_screen(rt_renderer *r, VkCommandBuffer cb, const rt_camera *c,
+                          const VkViewport *vp, const VkRect2D *area, bool cull, int *binds,
+                          rt_error *e)
+{
+    unsigned cv = compute_variant(r);
+    rt_screen_begin(r->screen, cb, (cv & RT_CVARIANT_COUNT) != 0);
+    VkFramebuffer fb;
+    VkRenderPass pass = rt_screen_depth_pass(r->screen, &fb);
+    VkClearValue clear = { .depthStencil = { 0.0f, 0 } };
+    VkRenderPassBeginInfo rb = {
+        .sType = VK_STRUCTURE_TYPE_RENDER_PASS_BEGIN_INFO,
+        .renderPass = pass, .framebuffer = fb,
+        .renderArea = *area, .clearValueCount = 1, .pClearValues = &clear,
+    };
+    VkDescriptorSet sets[2] = { r->set0, r->set1 };
+    begin_terrain_pass(r, cb, &rb, vp, sets);
+    int n = r->qt.npatches;
+    if (n > 0) {
+        VkPipeline pipe;
+        if (!rt_pipelines_depth(r->d, &r->pl, pass, cull, &pipe, e))
+            return abandon_frame(cb);
+        vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_GRAPHICS, pipe);
+        (*binds)++;
+        draw_patches(r, cb, c, r->sorted, n);
+    }
+    vkCmdEndRenderPass(cb);
+    if (r->timestamps)
+        vkCmdWriteTimestamp(cb, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, r->qpool, 1);
+    rt_screen_classify(r->screen, cb, r->set0c, r->desc.clear,
+                       r->desc.reference == RT_REF_UBER || r->view == SPLAT_VIEW_MASK, binds);
+    if (r->timestamps)
+        vkCmdWriteTimestamp(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, r->qpool, 2);
+    VkDescriptorSet csets[2] = { r->set0c, r->set1 };
+    if (!rt_screen_dispatch(r->screen, cb, &r->pl, csets, cv, binds, e)) {
+        vkEndCommandBuffer(cb);
+        return false;
+    }
+    return true;
+}
+
+static bool draw_frame(rt_renderer *r, const rt_camera *c, rt_frame_stats *st, rt_error *e)
 {
     rt_device *d = r->d;
     double t0 = 1e3 * splat_now();
@@ -764,7 +904,7 @@ bool rt_renderer_frame(rt_renderer *r, const rt_camera *c, rt_frame_stats *st, r
     };
     RT_VK(e, vkBeginCommandBuffer(cb, &bi));
     if (r->timestamps) {
-        vkCmdResetQueryPool(cb, r->qpool, 0, 2);
+        vkCmdResetQueryPool(cb, r->qpool, 0, 4);
         vkCmdWriteTimestamp(cb, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, r->qpool, 0);
     }
     VkViewport vp = { 0, 0, (float)r->desc.width, (float)r->desc.height, 0, 1 };
@@ -776,8 +916,13 @@ bool rt_renderer_frame(rt_renderer *r, const rt_camera *c, rt_frame_stats *st, r
                        (cull ? RT_VARIANT_CULL : 0);
     VkClearValue clears[4];
     VkDescriptorSet sets[3] = { r->set0, r->set1, r->set2 };
+    bool screen = r->screen && r->shading == RT_SHADING_SCREEN &&
+                  r->desc.reference != RT_REF_MULTIPASS && !r->wireframe;
 
-    if (r->desc.reference == RT_REF_MULTIPASS) {
+    if (screen) {
+        if (!record_screen(r, cb, c, &vp, &area, cull, &binds, e))
+            return false;
+    } else if (r->desc.reference == RT_REF_MULTIPASS) {
         for (int i = 0; i < 3; i++)
             clears[i].color = (VkClearColorValue){ { 0, 0, 0, 0 } };
         clears[3].depthStencil = (VkClearDepthStencilValue){ 0.0f, 0 };
@@ -851,7 +996,7 @@ bool rt_renderer_frame(rt_renderer *r, const rt_camera *c, rt_frame_stats *st, r
         vkCmdEndRenderPass(cb);
     }
     if (r->timestamps)
-        vkCmdWriteTimestamp(cb, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, r->qpool, 1);
+        vkCmdWriteTimestamp(cb, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, r->qpool, 3);
     RT_VK(e, vkEndCommandBuffer(cb));
     VkSubmitInfo si = {
         .sType = VK_STRUCTURE_TYPE_SUBMIT_INFO,
@@ -873,14 +1018,54 @@ bool rt_renderer_frame(rt_renderer *r, const rt_camera *c, rt_frame_stats *st, r
         st->select_ms = select_ms;
         st->cpu_ms = cpu_ms;
         st->gpu_ms = -1;
-        if (r->timestamps) {
-            uint64_t q[2];
-            RT_VK(e, vkGetQueryPoolResults(d->dev, r->qpool, 0, 2, sizeof q, q, sizeof q[0],
+        st->screen = screen;
+        for (int i = 0; i < 3; i++)
+            st->pass_ms[i] = -1;
+        double ms = d->props.limits.timestampPeriod * 1e-6;
+        if (r->timestamps && screen) {
+            uint64_t q[4];
+            RT_VK(e, vkGetQueryPoolResults(d->dev, r->qpool, 0, 4, sizeof q, q, sizeof q[0],
                                            VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT));
-            st->gpu_ms = (double)(q[1] - q[0]) * d->props.limits.timestampPeriod * 1e-6;
+            st->gpu_ms = (double)(q[3] - q[0]) * ms;
+            for (int i = 0; i < 3; i++)
+                st->pass_ms[i] = (double)(q[i + 1] - q[i]) * ms;
+        } else if (r->timestamps) {
+            uint64_t q[4];
+            RT_VK(e, vkGetQueryPoolResults(d->dev, r->qpool, 0, 1, sizeof q[0], &q[0], sizeof q[0],
+                                           VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT));
+            RT_VK(e, vkGetQueryPoolResults(d->dev, r->qpool, 3, 1, sizeof q[3], &q[3], sizeof q[3],
+                                           VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT));
+            st->gpu_ms = (double)(q[3] - q[0]) * ms;
         }
+        if (screen)
+            rt_screen_read_stats(r->screen, &st->tiles);
     }
     return true;
+}
+
+/* A frame; on the screen-space path, drawn again while lists got tiles
+ * whose pipelines did not exist yet (compiled in between): at most once
+ * per variant in practice, since the classification is deterministic. */
+bool rt_renderer_frame(rt_renderer *r, const rt_camera *c, rt_frame_stats *st, rt_error *e)
+{
+    rt_frame_stats local;
+    if (!st)
+        st = &local;
+    for (int redraws = 0;; redraws++) {
+        if (!draw_frame(r, c, st, e))
+            return false;
+        st->redraws = redraws;
+        if (!st->screen)
+            return true;
+        int made = rt_screen_missing(r->screen, &r->pl, compute_variant(r), e);
+        if (made < 0)
+            return false;
+        if (made == 0)
+            return true;
+        if (redraws >= 3)
+            return rt_fail(e, RT_E_VULKAN, "screen-space shading",
+                           "tile lists still need new pipelines after 3 redraws");
+    }
 }
 
 bool rt_renderer_read(rt_renderer *r, float *rgba, rt_error *e)
@@ -1002,6 +1187,17 @@ bool rt_renderer_swap_pack(rt_renderer *r, const rt_pack *p, rt_error *e)
     for (int i = 0; i < p->nparams; i++)
         memcpy((uint8_t *)r->params_ubo.map + p->params[i].offset, p->params[i].value, 16);
     r->p = p;
+    if (r->screen) {
+        /* the classification's combination map and sets are the pack's */
+        rt_screen_destroy(r->screen);
+        r->screen = NULL;
+        if (!rt_screen_create(r->d, p, &r->pl, &r->color, &r->depth, r->terrain.nearest_clamp,
+                              r->set0c, &r->screen, e)) {
+            rt_screen_destroy(r->screen);
+            r->screen = NULL;
+            return false;
+        }
+    }
     return true;
 }
 

@@ -153,7 +153,8 @@ VkSamplerAddressMode rt_sampler_wrap(int ir_wrap);
 
 /* ---- glsl.c: GLSL -> SPIR-V for the runtime's own shaders -------------- */
 
-/* stage: VK_SHADER_STAGE_VERTEX_BIT or _FRAGMENT_BIT.  *words is malloc'd. */
+/* stage: VK_SHADER_STAGE_VERTEX_BIT, _FRAGMENT_BIT or _COMPUTE_BIT.
+ * *words is malloc'd. */
 bool rt_glsl_compile(const char *glsl, VkShaderStageFlagBits stage,
                      const char *name, uint32_t **words, size_t *nwords,
                      rt_error *e);
@@ -296,6 +297,8 @@ typedef struct rt_pack_combo {
     int     *materials;   /* scene indices, top first                       */
     int      nmaterials;
     rt_spirv spirv;
+    char    *compute;     /* compute variant's GLSL (PACK.md); NULL: none   */
+    double   cost;        /* per-pixel cost, op-table units; 0: not given   */
 } rt_pack_combo;
 
 typedef struct rt_pack_level {
@@ -336,6 +339,7 @@ typedef struct rt_pack {
     double           destr_origin[2], destr_size[2], destr_cell; /* metres */
     rt_pack_combo   *combos;    int ncombos;
     rt_spirv         uber;           /* words NULL if absent               */
+    char            *uber_compute;   /* its compute GLSL; NULL if absent    */
     rt_spirv         vertex;
     rt_pack_level   *levels;    int nlevels;
     char            *scene_path;     /* scene.source: scene.sg relative to
@@ -525,7 +529,18 @@ typedef struct rt_pipelines {
     int                   nref;
     VkPipeline            uber[RT_VARIANTS];
     VkPipeline            resolve;
+    VkPipelineLayout      compute_layout;/* sets 0, 1 + splat_push (compute) */
+    VkPipeline           *compute;       /* RT_CVARIANTS per combination, the
+                                            über-shader's last              */
+    VkPipeline            depth[2];      /* geometry pass, [RT_VARIANT_CULL] */
 } rt_pipelines;
+
+/* Variants of a compute shading pipeline (screen-space path), as bits. */
+enum {
+    RT_CVARIANT_DEBUG = 1,  /* any debug view (else specialised to final)   */
+    RT_CVARIANT_COUNT = 2,  /* the counting variant (abi.h SPLAT_COUNT)      */
+    RT_CVARIANTS      = 4,
+};
 
 /* Render passes the pipelines are made for (render.c creates them). */
 typedef struct rt_passes {
@@ -556,12 +571,61 @@ bool rt_pipelines_uber(rt_device *d, const rt_pack *p, const rt_passes *rp,
 bool rt_pipelines_ref(rt_device *d, const rt_pack *p, const rt_passes *rp,
                       rt_pipelines *pl, int m, bool cull, VkPipeline *out,
                       rt_error *e);
+/* The compute shading pipeline of combination `id` (p->ncombos: the
+ * über-shader) in `variant` (RT_CVARIANT_* bits), compiled from the pack's
+ * compute GLSL on first use (PACK.md): glslang, spirv-val, the interface
+ * check against set 0/1 and the push block, then the driver. */
+bool rt_pipelines_compute(rt_device *d, const rt_pack *p, rt_pipelines *pl, int id,
+                          unsigned variant, VkPipeline *out, rt_error *e);
+/* The screen-space path's geometry pass: the shared vertex shader alone,
+ * depth only (render pass `pass`), back faces culled or not. */
+bool rt_pipelines_depth(rt_device *d, rt_pipelines *pl, VkRenderPass pass, bool cull,
+                        VkPipeline *out, rt_error *e);
+/* Whether that pipeline exists already. */
+bool rt_pipelines_has_compute(const rt_pipelines *pl, int id, unsigned variant);
 /* Drop every combination pipeline (hot reload: the next frames make those
  * of the new pack); the array is resized to p->ncombos. */
 bool rt_pipelines_reset_combos(rt_device *d, const rt_pack *p, rt_pipelines *pl,
                                rt_error *e);
 /* Saves the cache (if it has a path) and destroys everything. */
 void rt_pipelines_destroy(rt_device *d, rt_pipelines *pl);
+
+/* ---- screen.c: screen-space shading (render.c drives it) -------------- */
+
+typedef struct rt_screen rt_screen;
+
+typedef struct rt_screen_stats {
+    int      tiles, tiles_total;  /* terrain tiles shaded; all tiles         */
+    int      tiles_uber;          /* tiles no combination covered            */
+    int      lists;               /* combinations (and über) with tiles      */
+    uint32_t pixels, layers_evaluated, layers_needed, samples;  /* counting */
+} rt_screen_stats;
+
+/* Buffers, the depth-only pass over `depth`, the classification pipeline;
+ * writes set 0's compute bindings (abi.h 7-10) into `set0`.  *out is set
+ * even on failure (free with rt_screen_destroy). */
+bool rt_screen_create(rt_device *d, const rt_pack *p, const rt_pipelines *pl,
+                      const rt_image *color, const rt_image *depth, VkSampler nearest,
+                      VkDescriptorSet set0, rt_screen **out, rt_error *e);
+void rt_screen_destroy(rt_screen *s);
+/* The geometry pass: depth only, ends in SHADER_READ_ONLY_OPTIMAL. */
+VkRenderPass rt_screen_depth_pass(const rt_screen *s, VkFramebuffer *fb);
+/* Before the geometry pass: reset the list counts (and the counters). */
+void rt_screen_begin(rt_screen *s, VkCommandBuffer cb, bool count);
+/* After it: the background, the classification (force_uber: every tile
+ * to the über-shader's list). */
+void rt_screen_classify(rt_screen *s, VkCommandBuffer cb, VkDescriptorSet set0,
+                        const float clear[4], bool force_uber, int *binds);
+/* Then one indirect dispatch per list whose pipeline in `variant`
+ * (RT_CVARIANT_*) exists; the colour image ends in TRANSFER_SRC_OPTIMAL. */
+bool rt_screen_dispatch(rt_screen *s, VkCommandBuffer cb, rt_pipelines *pl,
+                        const VkDescriptorSet sets[2], unsigned variant, int *binds,
+                        rt_error *e);
+/* After the frame completed: compiles the pipelines of lists that got
+ * tiles but were not dispatched; returns how many (> 0: draw the frame
+ * again), -1 on error. */
+int rt_screen_missing(rt_screen *s, rt_pipelines *pl, unsigned variant, rt_error *e);
+void rt_screen_read_stats(const rt_screen *s, rt_screen_stats *st);
 
 /* ---- render.c: drawing ------------------------------------------------- */
 
@@ -573,6 +637,13 @@ typedef struct rt_camera {
     double znear;         /* metres; default 0.25                           */
 } rt_camera;
 
+typedef enum rt_shading {
+    RT_SHADING_FORWARD = 0,   /* each patch shaded by its node's composite  */
+    RT_SHADING_SCREEN,        /* depth pass, 8x8 tiles classified, compute
+                                 shading (screen.c); the multi-pass
+                                 reference and wireframe stay forward       */
+} rt_shading;
+
 typedef struct rt_render_desc {
     int          width, height;
     rt_reference reference;
@@ -582,6 +653,7 @@ typedef struct rt_render_desc {
     bool         no_cull;           /* tests: never cull back faces           */
     double       lod_pixels;        /* screen error per grid step; default 3  */
     int          destruction_pool;  /* destruction tiles; 0: RT_DESTR_POOL_DEFAULT */
+    rt_shading   shading;           /* forward (default) or screen-space      */
 } rt_render_desc;
 
 typedef struct rt_frame_stats {
@@ -590,6 +662,11 @@ typedef struct rt_frame_stats {
     double gpu_ms;            /* timestamps; < 0 if unsupported              */
     double select_ms;         /* CPU quadtree selection + culling            */
     double cpu_ms;            /* whole CPU side of the frame                 */
+    double pass_ms[3];        /* screen: geometry, classification, shading
+                                 GPU ms (timestamps; < 0 if unsupported)     */
+    bool   screen;            /* drawn by the screen-space path              */
+    rt_screen_stats tiles;    /* its tiles and counters (screen only)        */
+    int    redraws;           /* frames drawn again after compiling pipelines */
 } rt_frame_stats;
 
 typedef struct rt_renderer rt_renderer;
@@ -605,6 +682,13 @@ void rt_default_camera(const rt_pack *p, rt_camera *c);
 /* Debug view and the material of the MASK view. */
 void rt_renderer_set_view(rt_renderer *r, splat_view view, int material);
 void rt_renderer_set_wireframe(rt_renderer *r, bool on);
+/* Screen-space path: frames with the counting variant of the shaders
+ * (abi.h SPLAT_COUNT), whose counters rt_frame_stats.tiles carries. */
+void rt_renderer_set_counting(rt_renderer *r, bool on);
+/* Switch paths; screen needs a renderer created with RT_SHADING_SCREEN
+ * (false otherwise). */
+bool rt_renderer_set_shading(rt_renderer *r, rt_shading s);
+rt_shading rt_renderer_shading(const rt_renderer *r);
 bool rt_renderer_set_param(rt_renderer *r, const char *name,
                            const float value[4], rt_error *e);
 /* Render one frame offscreen and wait for it. */

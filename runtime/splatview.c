@@ -21,6 +21,9 @@ static void usage(FILE *f)
         "  --frames N                render N frames (stats over them)\n"
         "  --stats                   patches, pipelines, GPU and CPU times, device\n"
         "  --reference multipass|uber   the multi-pass alpha reference or the uber-shader\n"
+        "  --shading forward|screen  forward: each patch shaded by its composite;\n"
+        "                            screen: depth pass, 8x8 tiles classified by\n"
+        "                            combination, shaded in compute (default forward)\n"
         "  --float-out FILE          also write the RGBA32F image (SPLATF32 format)\n"
         "  --param NAME=v[,v,v,v]    set a material param\n"
         "  --lod-pixels P            screen error per grid step (default 3)\n"
@@ -80,6 +83,7 @@ typedef struct opts {
     double camera[3], look[3], lod_pixels;
     float clear[4];
     rt_reference ref;
+    rt_shading shading;
     const char *params[64];
     int nparams;
     const char *include[64];    /* -I DIR: import folders for hot reload    */
@@ -185,6 +189,16 @@ static int parse_args(int argc, char **argv, opts *o)
             o->lod_pixels = atof(v);
             if (!(o->lod_pixels > 0)) {
                 fprintf(stderr, "splatview: --lod-pixels expects a positive number\n");
+                return 2;
+            }
+        } else if (!strcmp(a, "--shading")) {
+            NEED();
+            if (!strcmp(v, "forward"))
+                o->shading = RT_SHADING_FORWARD;
+            else if (!strcmp(v, "screen"))
+                o->shading = RT_SHADING_SCREEN;
+            else {
+                fprintf(stderr, "splatview: --shading expects forward or screen, found '%s'\n", v);
                 return 2;
             }
         } else if (!strcmp(a, "--reference")) {
@@ -385,7 +399,7 @@ static int headless(const opts *o)
         .width = o->width, .height = o->height, .reference = o->ref,
         .pipeline_cache = o->cache, .no_stitch = o->no_stitch,
         .no_cull = o->no_cull, .lod_pixels = o->lod_pixels,
-        .destruction_pool = o->destruction_pool,
+        .destruction_pool = o->destruction_pool, .shading = o->shading,
     };
     memcpy(rd.clear, o->clear, sizeof rd.clear);
     if (!rt_renderer_create(&dev, &pack, &rd, &r, &e) || !apply_params(o, r, &e) ||
@@ -393,18 +407,23 @@ static int headless(const opts *o)
         goto done;
     rt_renderer_set_view(r, view, material);
     int W = o->width > 0 ? o->width : 1280, H = o->height > 0 ? o->height : 720;
-    gpu = calloc((size_t)o->frames, sizeof *gpu);
-    sel = calloc((size_t)o->frames, sizeof *sel);
-    cpu = calloc((size_t)o->frames, sizeof *cpu);
-    if (!gpu || !sel || !cpu)
+    gpu = calloc((size_t)o->frames * 6, sizeof *gpu);
+    if (!gpu)
         goto done;
+    sel = gpu + o->frames;
+    cpu = sel + o->frames;
+    double *pass = cpu + o->frames;   /* 3 per frame: geometry, classify, shade */
     rt_frame_stats st = { 0 };
+    /* the cost view needs the counting variant's counters */
+    rt_renderer_set_counting(r, view == SPLAT_VIEW_COST);
     for (int f = 0; f < o->frames; f++) {
         if (!rt_renderer_frame(r, &cam, &st, &e))
             goto done;
         gpu[f] = st.gpu_ms;
         sel[f] = st.select_ms;
         cpu[f] = st.cpu_ms;
+        for (int k = 0; k < 3; k++)
+            pass[k * o->frames + f] = st.pass_ms[k];
     }
     if (o->out || o->float_out) {
         rgba = malloc((size_t)W * (size_t)H * 16);
@@ -436,8 +455,34 @@ static int headless(const opts *o)
             printf("gpu ms/frame: median %.3f  p10 %.3f  p90 %.3f\n", gm, gl, gh);
         else
             printf("gpu ms/frame: n/a (no timestamp support)\n");
+        if (st.screen) {
+            static const char *const names[3] = { "geometry (depth)", "classification",
+                                                  "shading (compute)" };
+            for (int k = 0; k < 3 && gm >= 0; k++) {
+                double m, l, h;
+                summary(pass + k * o->frames, o->frames, &m, &l, &h);
+                printf("  %-18s gpu ms: median %.3f  p10 %.3f  p90 %.3f\n", names[k], m, l, h);
+            }
+            printf("tiles: %d of %d shaded, %d lists, %d by the uber-shader\n", st.tiles.tiles,
+                   st.tiles.tiles_total, st.tiles.lists, st.tiles.tiles_uber);
+        }
         printf("quadtree cpu ms/frame: median %.4f  p10 %.4f  p90 %.4f\n", sm, sl, sh);
         printf("cpu ms/frame (record): median %.3f  p10 %.3f  p90 %.3f\n", cm, cl, ch);
+        if (st.screen) {
+            /* one more frame with the counting variant (not timed) */
+            rt_renderer_set_counting(r, true);
+            rt_frame_stats cs;
+            if (!rt_renderer_frame(r, &cam, &cs, &e))
+                goto done;
+            rt_renderer_set_counting(r, view == SPLAT_VIEW_COST);
+            double px = cs.tiles.pixels ? (double)cs.tiles.pixels : 1.0;
+            printf("layers per pixel: evaluated %.3f, needed %.3f (efficiency %.1f %%)\n",
+                   cs.tiles.layers_evaluated / px, cs.tiles.layers_needed / px,
+                   cs.tiles.layers_evaluated
+                       ? 100.0 * cs.tiles.layers_needed / cs.tiles.layers_evaluated : 100.0);
+            printf("texture samples per pixel: %.3f\n", cs.tiles.samples / px);
+        }
+        printf("shading: %s\n", st.screen ? "screen" : "forward");
         rt_painted_print_stats(&pack, stdout);
         if (rt_renderer_destruction(r))
             rt_destruction_print_stats(rt_renderer_destruction(r), stdout);
@@ -459,8 +504,6 @@ done:
     free(rgba);
     free(png);
     free(gpu);
-    free(sel);
-    free(cpu);
     return status;
 }
 

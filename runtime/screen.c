@@ -1,0 +1,526 @@
+/* screen.c — screen-space terrain shading (Moore 2018, "Screen Space
+ * Shading"): after a depth-only geometry pass (render.c draws the patches
+ * with rt_pipelines_depth), a classification compute pass takes, per 8x8
+ * pixel tile, the union of the material sets of the leaf cells its terrain
+ * pixels fall in (the pack's level-0 combination map), picks the cheapest
+ * compiled combination whose set covers it (else the über-shader) and
+ * appends the tile to that combination's list with an indirect dispatch
+ * count; then one indirect dispatch per list runs that composite's compute
+ * variant (abi.h "compute stage"), which lights and writes the pixels.
+ *
+ * Lists live in one buffer, a region of `ntiles` entries per list (list
+ * k at k * ntiles; k = ncombos is the über-shader's), so one pass with one
+ * atomic per tile builds them, no prefix sum.  Pipelines are compiled on
+ * first use: a list that gets tiles but has no pipeline yet is compiled
+ * after the frame and the frame is drawn again (rt_screen_missing), so a
+ * returned frame is always complete and the steady state reads back only
+ * the list counts. */
+#include "splatrt.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+#define MAX_WORDS 8      /* material set bits per tile: 256 materials */
+
+struct rt_screen {
+    rt_device            *d;
+    const rt_pack        *p;
+    int                   width, height, tiles_x, tiles_y, ntiles;
+    int                   nlists;            /* ncombos + 1 (über)          */
+    int                   words;             /* material set words; 0: every
+                                                tile goes to the über list  */
+    VkRenderPass          depth_pass;
+    VkFramebuffer         depth_fb;
+    VkDescriptorSetLayout set_layout;        /* set 2 of the classification */
+    VkPipelineLayout      layout;
+    VkPipeline            classify;
+    VkDescriptorPool      pool;
+    VkDescriptorSet       set;
+    rt_buffer             info, tiles, args, args_reset, counters;
+    unsigned             *dispatched;        /* per list: variant + 1 drawn  */
+    VkImage               color_img;
+};
+
+/* The classification shader: SPLAT_GLSL_TERRAIN (frame block) + this. */
+static const char classify_glsl[] =
+    "layout(local_size_x = 8, local_size_y = 8) in;\n"
+    "layout(set = 0, binding = 7) uniform sampler2D u_depth;\n"
+    "layout(set = 2, binding = 0, std430) readonly buffer cls_info_block {\n"
+    "    uint ncombos, words, cells_x, cells_z;\n"
+    "    uint ntiles, force_uber, cell_texels, pad;\n"
+    "    uint data[];   /* order[ncombos], masks[ncombos][words], cells[] */\n"
+    "} u_info;\n"
+    "layout(set = 2, binding = 1, std430) writeonly buffer cls_tiles_block {\n"
+    "    uint tiles[];\n"
+    "} u_lists;\n"
+    "layout(set = 2, binding = 2, std430) buffer cls_args_block {\n"
+    "    uint args[];   /* per list: x y z of vkCmdDispatchIndirect */\n"
+    "} u_args;\n"
+    "shared uint s_mask[WORDS];\n"
+    "shared uint s_any;\n"
+    "void add_cell(ivec2 c) {\n"
+    "    c = clamp(c, ivec2(0), ivec2(u_info.cells_x, u_info.cells_z) - 1);\n"
+    "    uint base = u_info.ncombos * (1u + u_info.words);\n"
+    "    uint id = u_info.data[base + uint(c.y) * u_info.cells_x + uint(c.x)];\n"
+    "    if (id >= u_info.ncombos) return;   /* all hole: never drawn */\n"
+    "    for (uint w = 0u; w < u_info.words; w++)\n"
+    "        atomicOr(s_mask[w], u_info.data[u_info.ncombos + id * u_info.words + w]);\n"
+    "    atomicOr(s_any, 1u);\n"
+    "}\n"
+    "void main() {\n"
+    "    uint li = gl_LocalInvocationIndex;\n"
+    "    if (li < uint(WORDS)) s_mask[li] = 0u;\n"
+    "    if (li == 0u) s_any = 0u;\n"
+    "    barrier();\n"
+    "    ivec2 px = ivec2(gl_WorkGroupID.xy * 8u + gl_LocalInvocationID.xy);\n"
+    "    if (all(lessThan(px, ivec2(u_frame.screen.xy)))) {\n"
+    "        float d = texelFetch(u_depth, px, 0).r;\n"
+    "        if (d != u_frame.screen.z) {\n"
+    "            vec2 ndc = (vec2(px) + 0.5) / u_frame.screen.xy * 2.0 - 1.0;\n"
+    "            vec4 p = u_frame.inv_view_proj * vec4(ndc, d, 1.0);\n"
+    "            vec2 local = p.xz / p.w + u_frame.camera.xz;\n"
+    "            vec2 cf = local / u_frame.terrain.xy * u_frame.texel.xy /\n"
+    "                      float(u_info.cell_texels);\n"
+    /* a pixel within 1/64 cell of an edge counts for both cells: the
+     * position from depth is rounded, the analysis is per closed cell */
+    "            ivec2 lo = ivec2(floor(cf - 1.0 / 64.0)), hi = ivec2(floor(cf + 1.0 / 64.0));\n"
+    "            add_cell(lo);\n"
+    "            if (hi.x != lo.x) add_cell(ivec2(hi.x, lo.y));\n"
+    "            if (hi.y != lo.y) add_cell(ivec2(lo.x, hi.y));\n"
+    "            if (hi.x != lo.x && hi.y != lo.y) add_cell(hi);\n"
+    "        }\n"
+    "    }\n"
+    "    barrier();\n"
+    "    if (li != 0u || s_any == 0u) return;   /* sky tile: skipped */\n"
+    "    uint pick = u_info.ncombos;             /* the über-shader */\n"
+    "    if (u_info.force_uber == 0u && u_info.words > 0u) {\n"
+    "        for (uint i = 0u; i < u_info.ncombos; i++) {\n"
+    "            uint c = u_info.data[i];\n"
+    "            bool covers = true;\n"
+    "            for (uint w = 0u; w < u_info.words && covers; w++)\n"
+    "                covers = (s_mask[w] & ~u_info.data[u_info.ncombos + c * u_info.words + w]) == 0u;\n"
+    "            if (covers) { pick = c; break; }\n"
+    "        }\n"
+    "    }\n"
+    "    uint slot = atomicAdd(u_args.args[pick * 3u], 1u);\n"
+    "    u_lists.tiles[pick * u_info.ntiles + slot] =\n"
+    "        gl_WorkGroupID.x | (gl_WorkGroupID.y << 16u);\n"
+    "}\n";
+
+/* Cheapest first: the pack's cost, then fewer materials, then id. */
+static const rt_pack *sort_pack;
+static int by_cost(const void *a, const void *b)
+{
+    const rt_pack_combo *x = &sort_pack->combos[*(const uint32_t *)a];
+    const rt_pack_combo *y = &sort_pack->combos[*(const uint32_t *)b];
+    if (x->cost != y->cost)
+        return x->cost < y->cost ? -1 : 1;
+    if (x->nmaterials != y->nmaterials)
+        return x->nmaterials - y->nmaterials;
+    return (*(const uint32_t *)a > *(const uint32_t *)b) - (*(const uint32_t *)a < *(const uint32_t *)b);
+}
+
+/* The classification's read-only data: header, order, masks, cell map. */
+static bool fill_info(rt_screen *s, rt_error *e)
+{
+    const rt_pack *p = s->p;
+    const rt_pack_level *leaf = &p->levels[0];
+    size_t n = (size_t)p->ncombos;
+    size_t cells = (size_t)leaf->width * (size_t)leaf->height;
+    size_t words = 8 + n + n * (size_t)s->words + cells;
+    if (!rt_buffer_create(s->d, words * 4, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, true, &s->info, e))
+        return false;
+    uint32_t *u = s->info.map;
+    memset(u, 0, words * 4);
+    u[0] = (uint32_t)n;
+    u[1] = (uint32_t)s->words;
+    u[2] = (uint32_t)leaf->width;
+    u[3] = (uint32_t)leaf->height;
+    u[4] = (uint32_t)s->ntiles;
+    u[5] = 0;
+    u[6] = (uint32_t)p->cell_texels;
+    uint32_t *order = u + 8, *masks = order + n, *map = masks + n * (size_t)s->words;
+    for (size_t i = 0; i < n; i++)
+        order[i] = (uint32_t)i;
+    sort_pack = p;
+    qsort(order, n, sizeof *order, by_cost);
+    for (size_t i = 0; i < n; i++)
+        for (int k = 0; k < p->combos[i].nmaterials && s->words > 0; k++) {
+            int m = p->combos[i].materials[k];
+            masks[i * (size_t)s->words + (size_t)(m / 32)] |= 1u << (m % 32);
+        }
+    for (size_t i = 0; i < cells; i++)
+        map[i] = leaf->ids[i];
+    return true;
+}
+
+static bool make_depth_pass(rt_screen *s, const rt_image *depth, rt_error *e)
+{
+    VkAttachmentDescription att = {
+        .format = VK_FORMAT_D32_SFLOAT,
+        .samples = VK_SAMPLE_COUNT_1_BIT,
+        .loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR,
+        .storeOp = VK_ATTACHMENT_STORE_OP_STORE,
+        .stencilLoadOp = VK_ATTACHMENT_LOAD_OP_DONT_CARE,
+        .stencilStoreOp = VK_ATTACHMENT_STORE_OP_DONT_CARE,
+        .initialLayout = VK_IMAGE_LAYOUT_UNDEFINED,
+        .finalLayout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+    };
+    VkAttachmentReference ref = { 0, VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL };
+    VkSubpassDescription sub = {
+        .pipelineBindPoint = VK_PIPELINE_BIND_POINT_GRAPHICS,
+        .pDepthStencilAttachment = &ref,
+    };
+    /* The last frame's compute reads finish before the depth is written;
+     * the depth is visible to this frame's compute passes. */
+    VkSubpassDependency dep[2] = {
+        { VK_SUBPASS_EXTERNAL, 0, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+          VK_PIPELINE_STAGE_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_LATE_FRAGMENT_TESTS_BIT,
+          VK_ACCESS_SHADER_READ_BIT,
+          VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT | VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_READ_BIT, 0 },
+        { 0, VK_SUBPASS_EXTERNAL,
+          VK_PIPELINE_STAGE_EARLY_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_LATE_FRAGMENT_TESTS_BIT,
+          VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+          VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT, VK_ACCESS_SHADER_READ_BIT, 0 },
+    };
+    VkRenderPassCreateInfo ci = {
+        .sType = VK_STRUCTURE_TYPE_RENDER_PASS_CREATE_INFO,
+        .attachmentCount = 1,
+        .pAttachments = &att,
+        .subpassCount = 1,
+        .pSubpasses = &sub,
+        .dependencyCount = 2,
+        .pDependencies = dep,
+    };
+    RT_VK(e, vkCreateRenderPass(s->d->dev, &ci, NULL, &s->depth_pass));
+    VkFramebufferCreateInfo fi = {
+        .sType = VK_STRUCTURE_TYPE_FRAMEBUFFER_CREATE_INFO,
+        .renderPass = s->depth_pass,
+        .attachmentCount = 1,
+        .pAttachments = &depth->view,
+        .width = (uint32_t)s->width,
+        .height = (uint32_t)s->height,
+        .layers = 1,
+    };
+    RT_VK(e, vkCreateFramebuffer(s->d->dev, &fi, NULL, &s->depth_fb));
+    return true;
+}
+
+static bool make_classify(rt_screen *s, const rt_pipelines *pl, rt_error *e)
+{
+    rt_device *d = s->d;
+    const VkDescriptorType sb = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+    const VkShaderStageFlags cs = VK_SHADER_STAGE_COMPUTE_BIT;
+    VkDescriptorSetLayoutBinding b[3] = {
+        { 0, sb, 1, cs, NULL }, { 1, sb, 1, cs, NULL }, { 2, sb, 1, cs, NULL },
+    };
+    VkDescriptorSetLayoutCreateInfo li = {
+        .sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO,
+        .bindingCount = 3,
+        .pBindings = b,
+    };
+    RT_VK(e, vkCreateDescriptorSetLayout(d->dev, &li, NULL, &s->set_layout));
+    VkDescriptorSetLayout sets[3] = { pl->set_terrain, pl->set_material, s->set_layout };
+    VkPushConstantRange push = { cs, 0, sizeof(splat_push) };
+    VkPipelineLayoutCreateInfo pi = {
+        .sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO,
+        .setLayoutCount = 3,
+        .pSetLayouts = sets,
+        .pushConstantRangeCount = 1,
+        .pPushConstantRanges = &push,
+    };
+    RT_VK(e, vkCreatePipelineLayout(d->dev, &pi, NULL, &s->layout));
+
+    VkDescriptorPoolSize size = { sb, 3 };
+    VkDescriptorPoolCreateInfo dpi = {
+        .sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO,
+        .maxSets = 1,
+        .poolSizeCount = 1,
+        .pPoolSizes = &size,
+    };
+    RT_VK(e, vkCreateDescriptorPool(d->dev, &dpi, NULL, &s->pool));
+    VkDescriptorSetAllocateInfo ai = {
+        .sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO,
+        .descriptorPool = s->pool,
+        .descriptorSetCount = 1,
+        .pSetLayouts = &s->set_layout,
+    };
+    RT_VK(e, vkAllocateDescriptorSets(d->dev, &ai, &s->set));
+    VkDescriptorBufferInfo bi[3] = {
+        { s->info.buf, 0, VK_WHOLE_SIZE }, { s->tiles.buf, 0, VK_WHOLE_SIZE },
+        { s->args.buf, 0, VK_WHOLE_SIZE },
+    };
+    VkWriteDescriptorSet w[3];
+    for (uint32_t i = 0; i < 3; i++)
+        w[i] = (VkWriteDescriptorSet){ .sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET,
+            .dstSet = s->set, .dstBinding = i, .descriptorCount = 1, .descriptorType = sb,
+            .pBufferInfo = &bi[i] };
+    vkUpdateDescriptorSets(d->dev, 3, w, 0, NULL);
+
+    size_t n = strlen(SPLAT_GLSL_TERRAIN) + strlen(classify_glsl) + 64;
+    char *src = malloc(n);
+    if (!src)
+        return rt_fail(e, RT_E_VULKAN, "classification", "out of memory");
+    snprintf(src, n, "#version 450\n#define WORDS %d\n%s%s", s->words > 0 ? s->words : 1,
+             SPLAT_GLSL_TERRAIN, classify_glsl);
+    uint32_t *words = NULL;
+    size_t nw = 0;
+    bool ok = rt_glsl_compile(src, VK_SHADER_STAGE_COMPUTE_BIT, "classify.comp", &words, &nw, e);
+    free(src);
+    if (!ok)
+        return false;
+    VkShaderModuleCreateInfo mi = {
+        .sType = VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO,
+        .codeSize = nw * 4,
+        .pCode = words,
+    };
+    VkShaderModule m;
+    VkResult r = vkCreateShaderModule(d->dev, &mi, NULL, &m);
+    free(words);
+    if (r != VK_SUCCESS)
+        return rt_fail(e, RT_E_VULKAN, "vkCreateShaderModule", rt_vk_result_name(r));
+    VkComputePipelineCreateInfo ci = {
+        .sType = VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO,
+        .stage = { .sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO,
+                   .stage = VK_SHADER_STAGE_COMPUTE_BIT, .module = m, .pName = "main" },
+        .layout = s->layout,
+    };
+    r = vkCreateComputePipelines(d->dev, pl->cache, 1, &ci, NULL, &s->classify);
+    vkDestroyShaderModule(d->dev, m, NULL);
+    if (r != VK_SUCCESS)
+        return rt_fail(e, RT_E_VULKAN, "vkCreateComputePipelines", rt_vk_result_name(r));
+    return true;
+}
+
+bool rt_screen_create(rt_device *d, const rt_pack *p, const rt_pipelines *pl,
+                      const rt_image *color, const rt_image *depth, VkSampler nearest,
+                      VkDescriptorSet set0, rt_screen **out, rt_error *e)
+{
+    *out = NULL;
+    rt_screen *s = calloc(1, sizeof *s);
+    if (!s)
+        return rt_fail(e, RT_E_VULKAN, "screen-space shading", "out of memory");
+    s->d = d;
+    s->p = p;
+    s->color_img = color->img;
+    s->width = (int)color->width;
+    s->height = (int)color->height;
+    s->tiles_x = (s->width + SPLAT_TILE - 1) / SPLAT_TILE;
+    s->tiles_y = (s->height + SPLAT_TILE - 1) / SPLAT_TILE;
+    s->ntiles = s->tiles_x * s->tiles_y;
+    s->nlists = p->ncombos + 1;
+    s->words = (p->nmaterials + 31) / 32;
+    if (s->words > MAX_WORDS)
+        s->words = 0;   /* too many materials to classify: über-shader only */
+    s->dispatched = calloc((size_t)s->nlists, sizeof *s->dispatched);
+    *out = s;
+    if (!s->dispatched)
+        return rt_fail(e, RT_E_VULKAN, "screen-space shading", "out of memory");
+    VkDeviceSize list_bytes = (VkDeviceSize)s->nlists * (VkDeviceSize)s->ntiles * 4;
+    if (list_bytes > d->props.limits.maxStorageBufferRange)
+        return rt_fail(e, RT_E_PACK_LIMIT, p->dir, "the tile lists (combinations x tiles x 4 bytes)",
+                       (unsigned long long)list_bytes, "maxStorageBufferRange",
+                       (unsigned long long)d->props.limits.maxStorageBufferRange);
+    const VkBufferUsageFlags sb = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
+    if (!rt_buffer_create(d, list_bytes, sb, false, &s->tiles, e) ||
+        !rt_buffer_create(d, (VkDeviceSize)s->nlists * 12,
+                          sb | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                          true, &s->args, e) ||
+        !rt_buffer_create(d, (VkDeviceSize)s->nlists * 12, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, true,
+                          &s->args_reset, e) ||
+        !rt_buffer_create(d, 16, sb | VK_BUFFER_USAGE_TRANSFER_DST_BIT, true, &s->counters, e) ||
+        !fill_info(s, e))
+        return false;
+    uint32_t *reset = s->args_reset.map;
+    for (int k = 0; k < s->nlists; k++) {
+        reset[3 * k] = 0;
+        reset[3 * k + 1] = 1;
+        reset[3 * k + 2] = 1;
+    }
+    memcpy(s->args.map, reset, (size_t)s->nlists * 12);
+    memset(s->counters.map, 0, 16);
+    if (!make_depth_pass(s, depth, e) || !make_classify(s, pl, e))
+        return false;
+
+    /* set 0's compute bindings (abi.h): depth, colour, tiles, counters */
+    VkDescriptorImageInfo img[2] = {
+        { nearest, depth->view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL },
+        { VK_NULL_HANDLE, color->view, VK_IMAGE_LAYOUT_GENERAL },
+    };
+    VkDescriptorBufferInfo buf[2] = {
+        { s->tiles.buf, 0, VK_WHOLE_SIZE }, { s->counters.buf, 0, VK_WHOLE_SIZE },
+    };
+    VkWriteDescriptorSet w[4];
+    const VkDescriptorType types[4] = {
+        VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE,
+        VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
+    };
+    const uint32_t binds[4] = { SPLAT_BIND_DEPTH, SPLAT_BIND_OUT, SPLAT_BIND_TILES,
+                                SPLAT_BIND_COUNTERS };
+    for (int i = 0; i < 4; i++)
+        w[i] = (VkWriteDescriptorSet){ .sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET,
+            .dstSet = set0, .dstBinding = binds[i], .descriptorCount = 1,
+            .descriptorType = types[i], .pImageInfo = i < 2 ? &img[i] : NULL,
+            .pBufferInfo = i >= 2 ? &buf[i - 2] : NULL };
+    vkUpdateDescriptorSets(d->dev, 4, w, 0, NULL);
+    return true;
+}
+
+void rt_screen_destroy(rt_screen *s)
+{
+    if (!s)
+        return;
+    rt_device *d = s->d;
+    if (d->dev) {
+        if (s->classify)
+            vkDestroyPipeline(d->dev, s->classify, NULL);
+        if (s->layout)
+            vkDestroyPipelineLayout(d->dev, s->layout, NULL);
+        if (s->pool)
+            vkDestroyDescriptorPool(d->dev, s->pool, NULL);
+        if (s->set_layout)
+            vkDestroyDescriptorSetLayout(d->dev, s->set_layout, NULL);
+        if (s->depth_fb)
+            vkDestroyFramebuffer(d->dev, s->depth_fb, NULL);
+        if (s->depth_pass)
+            vkDestroyRenderPass(d->dev, s->depth_pass, NULL);
+        rt_buffer_destroy(d, &s->info);
+        rt_buffer_destroy(d, &s->tiles);
+        rt_buffer_destroy(d, &s->args);
+        rt_buffer_destroy(d, &s->args_reset);
+        rt_buffer_destroy(d, &s->counters);
+    }
+    free(s->dispatched);
+    free(s);
+}
+
+VkRenderPass rt_screen_depth_pass(const rt_screen *s, VkFramebuffer *fb)
+{
+    *fb = s->depth_fb;
+    return s->depth_pass;
+}
+
+void rt_screen_begin(rt_screen *s, VkCommandBuffer cb, bool count)
+{
+    VkBufferCopy c = { 0, 0, (VkDeviceSize)s->nlists * 12 };
+    vkCmdCopyBuffer(cb, s->args_reset.buf, s->args.buf, 1, &c);
+    if (count)
+        vkCmdFillBuffer(cb, s->counters.buf, 0, 16, 0);
+    VkMemoryBarrier mb = {
+        .sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER,
+        .srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT,
+        .dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT,
+    };
+    vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+                         0, 1, &mb, 0, NULL, 0, NULL);
+}
+
+void rt_screen_classify(rt_screen *s, VkCommandBuffer cb, VkDescriptorSet set0,
+                        const float clear[4], bool force_uber, int *binds)
+{
+    ((uint32_t *)s->info.map)[5] = force_uber || s->words == 0;
+    /* the background, then the colour image for storage writes */
+    rt_cmd_image_barrier(cb, s->color_img, 0, 1, 1, VK_IMAGE_LAYOUT_UNDEFINED,
+                         VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 0, VK_ACCESS_TRANSFER_WRITE_BIT,
+                         VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT);
+    VkClearColorValue cv = { { clear[0], clear[1], clear[2], 1 } };
+    VkImageSubresourceRange range = { VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1 };
+    vkCmdClearColorImage(cb, s->color_img, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, &cv, 1, &range);
+    rt_cmd_image_barrier(cb, s->color_img, 0, 1, 1, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+                         VK_IMAGE_LAYOUT_GENERAL, VK_ACCESS_TRANSFER_WRITE_BIT,
+                         VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
+                         VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT);
+
+    vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, s->classify);
+    vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, s->layout, 0, 1, &set0, 0, NULL);
+    vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, s->layout, 2, 1, &s->set, 0, NULL);
+    vkCmdDispatch(cb, (uint32_t)s->tiles_x, (uint32_t)s->tiles_y, 1);
+    (*binds)++;
+    VkMemoryBarrier mb = {
+        .sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER,
+        .srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT,
+        .dstAccessMask = VK_ACCESS_INDIRECT_COMMAND_READ_BIT | VK_ACCESS_SHADER_READ_BIT,
+    };
+    vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+                         VK_PIPELINE_STAGE_DRAW_INDIRECT_BIT | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+                         0, 1, &mb, 0, NULL, 0, NULL);
+}
+
+bool rt_screen_dispatch(rt_screen *s, VkCommandBuffer cb, rt_pipelines *pl,
+                        const VkDescriptorSet sets[2], unsigned variant, int *binds,
+                        rt_error *e)
+{
+    rt_device *d = s->d;
+    const rt_pack *p = s->p;
+
+    /* one indirect dispatch per list whose pipeline exists (the others
+     * are found empty or compiled after the frame: rt_screen_missing) */
+    bool bound_sets = false;
+    for (int k = 0; k < s->nlists; k++) {
+        s->dispatched[k] = 0;
+        if (!rt_pipelines_has_compute(pl, k, variant))
+            continue;
+        VkPipeline pipe;
+        if (!rt_pipelines_compute(d, p, pl, k, variant, &pipe, e))
+            return false;
+        if (!bound_sets) {
+            vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, pl->compute_layout, 0, 2,
+                                    sets, 0, NULL);
+            bound_sets = true;
+        }
+        vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, pipe);
+        (*binds)++;
+        splat_push push;
+        memset(&push, 0, sizeof push);
+        push.info[1] = (uint32_t)k;
+        push.info[2] = (uint32_t)p->nmaterials;
+        push.info[3] = (uint32_t)k * (uint32_t)s->ntiles;
+        vkCmdPushConstants(cb, pl->compute_layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof push, &push);
+        vkCmdDispatchIndirect(cb, s->args.buf, (VkDeviceSize)k * 12);
+        s->dispatched[k] = variant + 1;
+    }
+    rt_cmd_image_barrier(cb, s->color_img, 0, 1, 1, VK_IMAGE_LAYOUT_GENERAL,
+                         VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_ACCESS_SHADER_WRITE_BIT,
+                         VK_ACCESS_TRANSFER_READ_BIT | VK_ACCESS_SHADER_READ_BIT,
+                         VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+                         VK_PIPELINE_STAGE_TRANSFER_BIT | VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT);
+    VkMemoryBarrier hb = {
+        .sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER,
+        .srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT,
+        .dstAccessMask = VK_ACCESS_HOST_READ_BIT,
+    };
+    vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_HOST_BIT,
+                         0, 1, &hb, 0, NULL, 0, NULL);
+    return true;
+}
+
+int rt_screen_missing(rt_screen *s, rt_pipelines *pl, unsigned variant, rt_error *e)
+{
+    const uint32_t *args = s->args.map;
+    int made = 0;
+    for (int k = 0; k < s->nlists; k++) {
+        if (args[3 * k] == 0 || s->dispatched[k] == variant + 1)
+            continue;
+        VkPipeline pipe;
+        if (!rt_pipelines_compute(s->d, s->p, pl, k, variant, &pipe, e))
+            return -1;
+        made++;
+    }
+    return made;
+}
+
+void rt_screen_read_stats(const rt_screen *s, rt_screen_stats *st)
+{
+    const uint32_t *args = s->args.map, *c = s->counters.map;
+    memset(st, 0, sizeof *st);
+    st->tiles_total = s->ntiles;
+    for (int k = 0; k < s->nlists; k++) {
+        st->tiles += (int)args[3 * k];
+        st->lists += args[3 * k] > 0;
+    }
+    st->tiles_uber = (int)args[3 * (s->nlists - 1)];
+    st->pixels = c[0];
+    st->layers_evaluated = c[1];
+    st->layers_needed = c[2];
+    st->samples = c[3];
+}
