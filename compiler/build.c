@@ -120,6 +120,9 @@ static bool inputs_key(build *b)
                      SPLATC_VERSION, SPLAT_ABI_VERSION, b->desc->flat,
                      splat_painted_format_name(b->desc->painted), b->desc->compute_spirv);
     XXH3_128bits_update(st, head, (size_t)n);
+    /* the ABI's GLSL too: a changed prelude is a changed compiler */
+    XXH3_128bits_update(st, SPLAT_GLSL_PRELUDE, strlen(SPLAT_GLSL_PRELUDE));
+    XXH3_128bits_update(st, SPLAT_GLSL_VERTEX, strlen(SPLAT_GLSL_VERTEX));
     bool ok = true;
     char **files = input_files(&b->scene);
     for (int i = 0; ok && files[i]; i++)

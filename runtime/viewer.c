@@ -7,8 +7,9 @@
  *
  * Keys: W/A/S/D move, Space/Ctrl up/down, mouse with the right button
  * held looks around, wheel changes speed, 1 final, 2 combinations, 3 LOD,
- * 4 normal, 5 slope, 6 albedo, 7 mask (again: next material), F wireframe,
- * R rebuild now, Q/Escape quit, left click: a crater there (destruction.c).
+ * 4 normal, 5 slope, 6 albedo, 7 mask (again: next material), 8 tiles,
+ * 9 cost, F wireframe, G forward / screen-space shading, R rebuild now,
+ * Q/Escape quit, left click: a crater there (destruction.c).
  *
  * --script runs without a person: "frames=N" renders N frames,
  * "view=NAME", "key=K" acts as if K was pressed, "screenshot=FILE" writes
@@ -155,6 +156,10 @@ static void key_action(viewer *v, int key)
     } else if (key == GLFW_KEY_F) {
         v->wire = !v->wire;
         rt_renderer_set_wireframe(v->r, v->wire);
+    } else if (key == GLFW_KEY_G) {
+        bool screen = rt_renderer_shading(v->r) == RT_SHADING_SCREEN;
+        if (!rt_renderer_set_shading(v->r, screen ? RT_SHADING_FORWARD : RT_SHADING_SCREEN))
+            snprintf(v->status, sizeof v->status, "no screen-space path (pack without compute variants)");
     } else if (key == GLFW_KEY_R) {
         v->last_check = -1e9;   /* check the files on the next frame */
         for (int i = 0; i < v->w.n; i++)
@@ -658,8 +663,9 @@ static bool frame(viewer *v, const char *shot, double *last, rt_error *e)
         shown = t;
         char title[512];
         snprintf(title, sizeof title,
-                 "splatview %s | %s%s | %.1f ms/frame (gpu %.1f) | %d patches, %d pipelines | %s",
-                 v->pack->name, rt_view_name(v->view), v->wire ? " wire" : "", dt * 1e3,
+                 "splatview %s | %s%s | %s | %.1f ms/frame (gpu %.1f) | %d patches, %d pipelines | %s",
+                 v->pack->name, rt_view_name(v->view), v->wire ? " wire" : "",
+                 st.screen ? "screen" : "forward", dt * 1e3,
                  st.gpu_ms, st.patches, st.pipelines, v->status);
         glfwSetWindowTitle(v->win, title);
     }
@@ -843,8 +849,18 @@ int rt_viewer_run(const rt_viewer_desc *desc)
     rt_render_desc rd = desc->render;
     rd.width = (int)v->extent.width;
     rd.height = (int)v->extent.height;
-    if (!rt_renderer_create(&v->dev, v->pack, &rd, &v->r, &e) || !make_tonemap(v, &e))
+    /* Screen-capable whenever the pack has compute variants, so the G key
+     * can switch paths; forward unless --shading screen asked for it. */
+    rd.shading = v->pack->uber_compute ? RT_SHADING_SCREEN : RT_SHADING_FORWARD;
+    bool made = rt_renderer_create(&v->dev, v->pack, &rd, &v->r, &e);
+    if (!made && rd.shading == RT_SHADING_SCREEN && desc->render.shading != RT_SHADING_SCREEN) {
+        rt_error_clear(&e);   /* the device cannot do the screen path */
+        rd.shading = RT_SHADING_FORWARD;
+        made = rt_renderer_create(&v->dev, v->pack, &rd, &v->r, &e);
+    }
+    if (!made || !make_tonemap(v, &e))
         goto done;
+    rt_renderer_set_shading(v->r, desc->render.shading);
     rt_renderer_set_view(v->r, v->view, v->material);
     /* the scene to watch: --scene, else the manifest's scene.source */
     char scene_buf[2048];

@@ -7,6 +7,9 @@
  *   imgcheck count IMG.png r,g,b         print pixels of exactly that colour
  *   imgcheck diff A.f32 B.f32 TOL        max |A - B| over RGB; exit 1 if > TOL
  *   imgcheck finite A.f32                exit 1 on any NaN or Inf
+ *   imgcheck close A.f32 B.f32 TOL FRAC PSNR   PSNR (dB, peak 1) and the
+ *                                        share of pixels within TOL; exit 1
+ *                                        below PSNR or under FRAC (0..1)
  *   imgcheck near A.f32 r,g,b TOL MAX    the share of pixels whose RGB is
  *                                        within TOL of (r, g, b) (floats);
  *                                        exit 1 if it is over MAX (0..1)
@@ -77,6 +80,57 @@ int main(int argc, char **argv)
                ref[2], k, n, 100 * share);
         free(a);
         return share <= max ? 0 : 1;
+    }
+    if (!strcmp(cmd, "close")) {
+        /* PSNR over RGB (peak 1) and the share of pixels whose largest
+         * channel difference is over TOL; fails below PSNR or when more
+         * than 1 - FRAC of the pixels are over TOL.  The pixels over TOL
+         * are told by how many have a sky (clear-colour) neighbour in
+         * either image: silhouettes. */
+        rt_error e = { 0 };
+        float *a = NULL, *b = NULL;
+        int w, h, w2, h2;
+        if (argc != 7 || !rt_read_float(argv[2], &a, &w, &h, &e) ||
+            !rt_read_float(argv[3], &b, &w2, &h2, &e) || w != w2 || h != h2) {
+            fprintf(stderr, "imgcheck: close A.f32 B.f32 TOL FRAC PSNR (one size)%s%s\n",
+                    e.msg ? ": " : "", e.msg ? e.msg : "");
+            free(a);
+            free(b);
+            return 2;
+        }
+        double tol = atof(argv[4]), frac = atof(argv[5]), min_psnr = atof(argv[6]), se = 0;
+        size_t n = (size_t)w * h, over = 0, edge = 0;
+        for (size_t i = 0; i < n; i++) {
+            double m = 0;
+            for (int c = 0; c < 3; c++) {
+                double d = (double)a[i * 4 + c] - (double)b[i * 4 + c];
+                se += d * d;
+                m = fmax(m, fabs(d));
+            }
+            if (m > tol) {
+                over++;
+                /* a neighbour that is background in one image only */
+                int x = (int)(i % (size_t)w), y = (int)(i / (size_t)w);
+                bool sil = false;
+                for (int dy = -1; dy <= 1 && !sil; dy++)
+                    for (int dx = -1; dx <= 1 && !sil; dx++) {
+                        int X = x + dx, Y = y + dy;
+                        if (X < 0 || Y < 0 || X >= w || Y >= h)
+                            continue;
+                        size_t j = (size_t)Y * (size_t)w + (size_t)X;
+                        sil = fabs(a[j * 4] - b[j * 4]) > 0.05 && (dx || dy);
+                    }
+                edge += sil;
+            }
+        }
+        double mse = se / (double)(n * 3);
+        double psnr = mse > 0 ? 10 * log10(1.0 / mse) : INFINITY;
+        double share = (double)(n - over) / (double)n;
+        printf("psnr %.2f dB, %.4f %% of pixels within %.4g (%zu over, %zu of them next to a "
+               "silhouette)\n", psnr, 100 * share, tol, over, edge);
+        free(a);
+        free(b);
+        return psnr >= min_psnr && share >= frac ? 0 : 1;
     }
     if (!strcmp(cmd, "diff") || !strcmp(cmd, "finite")) {
         rt_error e = { 0 };

@@ -74,5 +74,30 @@ if(TARGET splatrt AND TARGET splatview)
       set_tests_properties(render.example_${ex} PROPERTIES LABELS render TIMEOUT 600
         FIXTURES_REQUIRED ${ex}_pack ENVIRONMENT "SPLAT_VALIDATE=1")
     endwhile()
+
+    # The screen-space path against the forward path at every camera
+    # preset (screen.sh says what each kind of scene is held to).
+    add_test(NAME render.pack_notex
+      COMMAND $<TARGET_FILE:splatc_cli> build tests/render/notex.sg -o ${RENDER_OUT}/notex
+              --cache ${RENDER_OUT}/spv_cache
+      WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
+    set_tests_properties(render.pack_notex PROPERTIES LABELS render FIXTURES_SETUP notex_pack)
+    set(SCREEN_CASES
+      "colorado|textured|overview blanca valley spanish_peaks pivots trinidad"
+      "billingsley|procedural|overview ground peak"
+      "minimal|textured|overview"
+      "notex|notex|overview low")
+    foreach(sc IN LISTS SCREEN_CASES)
+      string(REPLACE "|" ";" f "${sc}")
+      list(GET f 0 pk)
+      list(GET f 1 kind)
+      list(GET f 2 presets)
+      separate_arguments(presets)
+      add_test(NAME render.screen_${pk}
+        COMMAND sh ${RENDER_DIR}/screen.sh $<TARGET_FILE:splatview> $<TARGET_FILE:imgcheck>
+                ${RENDER_OUT}/${pk} ${RENDER_OUT}/out ${kind} ${presets})
+      set_tests_properties(render.screen_${pk} PROPERTIES LABELS render TIMEOUT 900
+        FIXTURES_REQUIRED ${pk}_pack ENVIRONMENT "SPLAT_VALIDATE=1")
+    endforeach()
   endif()
 endif()

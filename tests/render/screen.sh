@@ -1,0 +1,64 @@
+#!/bin/sh
+# The screen-space path against the forward path (splatview --shading):
+#   screen.sh SPLATVIEW IMGCHECK PACK OUTDIR KIND PRESET...
+# at 320x180 (lavapipe), SPLAT_VALIDATE=1 (splatview exits 3 on any
+# validation message).  For each preset:
+#   - screen vs forward, RGBA32F.  KIND textured: PSNR >= 45 dB and
+#     >= 99.9 % of pixels within 4/255; KIND procedural (billingsley:
+#     noise textures with nearest-mip chains, where the compiler's exact
+#     uv derivatives and a quad's finite differences pick different mip
+#     levels on a few pixels): PSNR >= 45 dB and >= 99 %; KIND notex (no
+#     texture sampled): >= 99.8 % of pixels within 1e-5 and none over 1e-3
+#     (the position from depth and the interpolated varyings differ in
+#     their last fp32 bits; the heightfield's bilinear filter quantises
+#     the texel fraction to 8 bits, so such a difference can cross a
+#     weight step and move the slope, which steep slope ramps amplify:
+#     measured 2 and 73 of 57600 pixels over 1e-5, largest 3.3e-4);
+#   - soundness: screen vs screen with every tile on the über-shader
+#     (--reference uber) within 1/255, so classification dropped no
+#     material that is present.
+# Then, at the first preset: the tiles and cost views render, --stats
+# prints the per-pass times and the counting lines with needed <=
+# evaluated.
+set -u
+SV=$1 IC=$2 PACK=$3 OUT=$4/screen_$(basename "$3") KIND=$5
+shift 5
+mkdir -p "$OUT"
+export SPLAT_VALIDATE=1
+export SPLAT_PIPELINE_CACHE="$OUT/pipelines.bin"
+fail() { echo "FAIL: $*"; exit 1; }
+run() { echo "+ splatview $*"; "$SV" "$@" || fail "splatview $* (exit $?)"; }
+SIZE="--size 320x180"
+for cam in "$@"; do
+    c="--camera-preset $cam"
+    run "$PACK" --headless $SIZE $c --float-out "$OUT/$cam.f.f32"
+    run "$PACK" --headless $SIZE $c --shading screen --float-out "$OUT/$cam.s.f32"
+    run "$PACK" --headless $SIZE $c --shading screen --reference uber --float-out "$OUT/$cam.u.f32"
+    case $KIND in
+    textured)   "$IC" close "$OUT/$cam.f.f32" "$OUT/$cam.s.f32" 0.0157 0.999 45 ||
+                    fail "$cam: screen and forward differ (above)" ;;
+    procedural) "$IC" close "$OUT/$cam.f.f32" "$OUT/$cam.s.f32" 0.0157 0.99 45 ||
+                    fail "$cam: screen and forward differ (above)" ;;
+    notex)      "$IC" close "$OUT/$cam.f.f32" "$OUT/$cam.s.f32" 1e-5 0.998 80 ||
+                    fail "$cam: screen and forward differ (above)"
+                "$IC" diff "$OUT/$cam.f.f32" "$OUT/$cam.s.f32" 1e-3 ||
+                    fail "$cam: screen and forward differ by more than 1e-3" ;;
+    *)          fail "unknown kind $KIND" ;;
+    esac
+    "$IC" diff "$OUT/$cam.s.f32" "$OUT/$cam.u.f32" 0.0039 ||
+        fail "$cam: classification changed the picture (composites vs über-shader)"
+done
+c="--camera-preset $1"
+run "$PACK" --headless $SIZE $c --shading screen --view tiles -o "$OUT/tiles.png"
+"$IC" nonuniform "$OUT/tiles.png" || fail "the tiles view is uniform"
+run "$PACK" --headless $SIZE $c --shading screen --view cost -o "$OUT/cost.png"
+"$IC" nonuniform "$OUT/cost.png" || fail "the cost view is uniform"
+run "$PACK" --headless $SIZE $c --shading screen --stats --frames 2 > "$OUT/stats.txt"
+cat "$OUT/stats.txt"
+for line in "geometry (depth)" "classification" "shading (compute)" "tiles:" \
+            "layers per pixel: evaluated" "texture samples per pixel:" "shading: screen"; do
+    grep -q "$line" "$OUT/stats.txt" || fail "--stats lacks '$line'"
+done
+sed -n 's/^layers per pixel: evaluated \([0-9.]*\), needed \([0-9.]*\).*/\1 \2/p' "$OUT/stats.txt" |
+    awk '{ exit !($2 > 0 && $2 <= $1 + 1e-9) }' || fail "layers needed must be > 0 and <= evaluated"
+echo "ok"
