@@ -43,11 +43,11 @@ struct rt_screen {
 
 /* The classification shader: SPLAT_GLSL_TERRAIN (frame block) + this. */
 static const char classify_glsl[] =
-    "layout(local_size_x = 8, local_size_y = 8) in;\n"
+    "layout(local_size_x = 64) in;\n"
     "layout(set = 0, binding = 7) uniform sampler2D u_depth;\n"
     "layout(set = 2, binding = 0, std430) readonly buffer cls_info_block {\n"
     "    uint ncombos, words, cells_x, cells_z;\n"
-    "    uint ntiles, force_uber, cell_texels, pad;\n"
+    "    uint ntiles, force_uber, cell_texels, tiles_x;\n"
     "    uint data[];   /* order[ncombos], masks[ncombos][words], cells[] */\n"
     "} u_info;\n"
     "layout(set = 2, binding = 1, std430) writeonly buffer cls_tiles_block {\n"
@@ -56,55 +56,60 @@ static const char classify_glsl[] =
     "layout(set = 2, binding = 2, std430) buffer cls_args_block {\n"
     "    uint args[];   /* per list: x y z of vkCmdDispatchIndirect */\n"
     "} u_args;\n"
-    "shared uint s_mask[WORDS];\n"
-    "shared uint s_any;\n"
+    "uint mask[WORDS];\n"
+    "uint last = 0xffffffffu;\n"
+    "bool any_cell = false;\n"
     "void add_cell(ivec2 c) {\n"
     "    c = clamp(c, ivec2(0), ivec2(u_info.cells_x, u_info.cells_z) - 1);\n"
-    "    uint base = u_info.ncombos * (1u + u_info.words);\n"
-    "    uint id = u_info.data[base + uint(c.y) * u_info.cells_x + uint(c.x)];\n"
+    "    uint i = uint(c.y) * u_info.cells_x + uint(c.x);\n"
+    "    if (i == last) return;   /* most pixels of a tile share a cell */\n"
+    "    last = i;\n"
+    "    uint id = u_info.data[u_info.ncombos * (1u + u_info.words) + i];\n"
     "    if (id >= u_info.ncombos) return;   /* all hole: never drawn */\n"
     "    for (uint w = 0u; w < u_info.words; w++)\n"
-    "        atomicOr(s_mask[w], u_info.data[u_info.ncombos + id * u_info.words + w]);\n"
-    "    atomicOr(s_any, 1u);\n"
+    "        mask[w] |= u_info.data[u_info.ncombos + id * u_info.words + w];\n"
+    "    any_cell = true;\n"
     "}\n"
+    /* one invocation per tile: no shared memory and no barriers, which
+     * CPU drivers (lavapipe) pay for dearly */
     "void main() {\n"
-    "    uint li = gl_LocalInvocationIndex;\n"
-    "    if (li < uint(WORDS)) s_mask[li] = 0u;\n"
-    "    if (li == 0u) s_any = 0u;\n"
-    "    barrier();\n"
-    "    ivec2 px = ivec2(gl_WorkGroupID.xy * 8u + gl_LocalInvocationID.xy);\n"
-    "    if (all(lessThan(px, ivec2(u_frame.screen.xy)))) {\n"
+    "    uint t = gl_GlobalInvocationID.x;\n"
+    "    if (t >= u_info.ntiles) return;\n"
+    "    uvec2 tile = uvec2(t % u_info.tiles_x, t / u_info.tiles_x);\n"
+    "    for (int w = 0; w < WORDS; w++) mask[w] = 0u;\n"
+    "    ivec2 size = ivec2(u_frame.screen.xy);\n"
+    "    for (int y = 0; y < 8; y++)\n"
+    "    for (int x = 0; x < 8; x++) {\n"
+    "        ivec2 px = ivec2(tile * 8u) + ivec2(x, y);\n"
+    "        if (any(greaterThanEqual(px, size))) continue;\n"
     "        float d = texelFetch(u_depth, px, 0).r;\n"
-    "        if (d != u_frame.screen.z) {\n"
-    "            vec2 ndc = (vec2(px) + 0.5) / u_frame.screen.xy * 2.0 - 1.0;\n"
-    "            vec4 p = u_frame.inv_view_proj * vec4(ndc, d, 1.0);\n"
-    "            vec2 local = p.xz / p.w + u_frame.camera.xz;\n"
-    "            vec2 cf = local / u_frame.terrain.xy * u_frame.texel.xy /\n"
-    "                      float(u_info.cell_texels);\n"
+    "        if (d == u_frame.screen.z) continue;\n"
+    "        vec2 ndc = (vec2(px) + 0.5) / u_frame.screen.xy * 2.0 - 1.0;\n"
+    "        vec4 p = u_frame.inv_view_proj * vec4(ndc, d, 1.0);\n"
+    "        vec2 local = p.xz / p.w + u_frame.camera.xz;\n"
+    "        vec2 cf = local / u_frame.terrain.xy * u_frame.texel.xy /\n"
+    "                  float(u_info.cell_texels);\n"
     /* a pixel within 1/64 cell of an edge counts for both cells: the
      * position from depth is rounded, the analysis is per closed cell */
-    "            ivec2 lo = ivec2(floor(cf - 1.0 / 64.0)), hi = ivec2(floor(cf + 1.0 / 64.0));\n"
-    "            add_cell(lo);\n"
-    "            if (hi.x != lo.x) add_cell(ivec2(hi.x, lo.y));\n"
-    "            if (hi.y != lo.y) add_cell(ivec2(lo.x, hi.y));\n"
-    "            if (hi.x != lo.x && hi.y != lo.y) add_cell(hi);\n"
-    "        }\n"
+    "        ivec2 lo = ivec2(floor(cf - 1.0 / 64.0)), hi = ivec2(floor(cf + 1.0 / 64.0));\n"
+    "        add_cell(lo);\n"
+    "        if (hi.x != lo.x) add_cell(ivec2(hi.x, lo.y));\n"
+    "        if (hi.y != lo.y) add_cell(ivec2(lo.x, hi.y));\n"
+    "        if (hi.x != lo.x && hi.y != lo.y) add_cell(hi);\n"
     "    }\n"
-    "    barrier();\n"
-    "    if (li != 0u || s_any == 0u) return;   /* sky tile: skipped */\n"
-    "    uint pick = u_info.ncombos;             /* the über-shader */\n"
+    "    if (!any_cell) return;   /* sky tile: skipped */\n"
+    "    uint pick = u_info.ncombos;   /* the über-shader */\n"
     "    if (u_info.force_uber == 0u && u_info.words > 0u) {\n"
     "        for (uint i = 0u; i < u_info.ncombos; i++) {\n"
     "            uint c = u_info.data[i];\n"
     "            bool covers = true;\n"
     "            for (uint w = 0u; w < u_info.words && covers; w++)\n"
-    "                covers = (s_mask[w] & ~u_info.data[u_info.ncombos + c * u_info.words + w]) == 0u;\n"
+    "                covers = (mask[w] & ~u_info.data[u_info.ncombos + c * u_info.words + w]) == 0u;\n"
     "            if (covers) { pick = c; break; }\n"
     "        }\n"
     "    }\n"
     "    uint slot = atomicAdd(u_args.args[pick * 3u], 1u);\n"
-    "    u_lists.tiles[pick * u_info.ntiles + slot] =\n"
-    "        gl_WorkGroupID.x | (gl_WorkGroupID.y << 16u);\n"
+    "    u_lists.tiles[pick * u_info.ntiles + slot] = tile.x | (tile.y << 16u);\n"
     "}\n";
 
 /* Cheapest first: the pack's cost, then fewer materials, then id. */
@@ -139,6 +144,7 @@ static bool fill_info(rt_screen *s, rt_error *e)
     u[4] = (uint32_t)s->ntiles;
     u[5] = 0;
     u[6] = (uint32_t)p->cell_texels;
+    u[7] = (uint32_t)s->tiles_x;
     uint32_t *order = u + 8, *masks = order + n, *map = masks + n * (size_t)s->words;
     for (size_t i = 0; i < n; i++)
         order[i] = (uint32_t)i;
@@ -434,7 +440,7 @@ void rt_screen_classify(rt_screen *s, VkCommandBuffer cb, VkDescriptorSet set0,
     vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, s->classify);
     vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, s->layout, 0, 1, &set0, 0, NULL);
     vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, s->layout, 2, 1, &s->set, 0, NULL);
-    vkCmdDispatch(cb, (uint32_t)s->tiles_x, (uint32_t)s->tiles_y, 1);
+    vkCmdDispatch(cb, (uint32_t)(s->ntiles + 63) / 64, 1, 1);
     (*binds)++;
     VkMemoryBarrier mb = {
         .sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER,

@@ -20,6 +20,12 @@
  *         analytic    composites recompiled with the exact normal of the
  *                     function `splatbench analytic-hf` samples (only for
  *                     a pack built on such a heightfield)
+ *         screen      screen-space shading (--shading screen): depth pass,
+ *                     tile classification, compute composites; its rows
+ *                     add the three passes' GPU medians and, from one
+ *                     counting frame after the timed ones, layers
+ *                     evaluated / needed and samples per pixel
+ *         screen_uber the same with every tile on the über-shader
  *       pack=DIR renders another pack of the same terrain (compositors, fBm
  *       knobs); lod=P sets the LOD error threshold in pixels per grid step.
  *       Paths (--path): ground (2 m above the terrain looking 150 m ahead,
@@ -159,9 +165,10 @@ static double err_psnr(const err_acc *a)
 
 /* ---- variants -------------------------------------------------------------- */
 
-typedef enum kind { K_COMPOSITE, K_MULTIPASS, K_UBER, K_FLAT, K_FP16, K_SOBEL, K_ANALYTIC } kind;
+typedef enum kind { K_COMPOSITE, K_MULTIPASS, K_UBER, K_FLAT, K_FP16, K_SOBEL, K_ANALYTIC,
+                    K_SCREEN, K_SCREEN_UBER } kind;
 static const char *const kind_names[] = {"composite", "multipass", "uber", "flat", "fp16", "sobel",
-                                         "analytic"};
+                                         "analytic", "screen", "screen_uber"};
 
 typedef struct variant {
     char        *label;
@@ -173,6 +180,8 @@ typedef struct variant {
     rt_pack_combo *combos;  /* owned when the shaders differ, else NULL     */
     rt_renderer *r;
     double      *gpu, *cpu, *sel;
+    double      *pass[3];   /* screen: geometry, classification, shading */
+    rt_screen_stats tiles;  /* screen: the last frame's tiles (counted)  */
     int          patches, pipelines;
     err_acc      err;
     double       rss_delta;
@@ -323,6 +332,8 @@ static void variant_free(variant *v)
     free(v->gpu);
     free(v->cpu);
     free(v->sel);
+    for (int k = 0; k < 3; k++)
+        free(v->pass[k]);
 }
 
 /* LABEL=KIND[,pack=DIR][,lod=P] */
@@ -491,7 +502,8 @@ static int cmd_render(int argc, char **argv)
     for (int i = 0; i < nspecs; i++)
         if (!parse_variant(specs[i], pack_dir, &v[i])) {
             fprintf(stderr, "splatbench render: bad variant '%s' (LABEL=KIND[,pack=DIR][,lod=P];"
-                    " KIND composite|multipass|uber|flat|fp16|sobel|analytic; a pack from --pack"
+                    " KIND composite|multipass|uber|flat|fp16|sobel|analytic|screen|screen_uber;"
+                    " a pack from --pack"
                     " or pack=)\n",
                     specs[i]);
             return 2;
@@ -547,8 +559,10 @@ static int cmd_render(int argc, char **argv)
         rt_render_desc rd = {
             .width = width, .height = height, .lod_pixels = v[i].lod,
             .reference = v[i].k == K_MULTIPASS ? RT_REF_MULTIPASS
-                       : v[i].k == K_UBER ? RT_REF_UBER : RT_REF_NONE,
+                       : v[i].k == K_UBER || v[i].k == K_SCREEN_UBER ? RT_REF_UBER : RT_REF_NONE,
             .pipeline_cache = save ? cache : NULL,
+            .shading = v[i].k == K_SCREEN || v[i].k == K_SCREEN_UBER ? RT_SHADING_SCREEN
+                                                                     : RT_SHADING_FORWARD,
         };
         double before = rss_mb();
         if (!rt_renderer_create(&dev, &v[i].view, &rd, &v[i].r, &e))
@@ -561,6 +575,8 @@ static int cmd_render(int argc, char **argv)
         v[i].gpu = xcalloc((size_t)frames, sizeof(double));
         v[i].cpu = xcalloc((size_t)frames, sizeof(double));
         v[i].sel = xcalloc((size_t)frames, sizeof(double));
+        for (int k = 0; k < 3; k++)
+            v[i].pass[k] = xcalloc((size_t)frames, sizeof(double));
         /* warm-up frames: pipelines are made (and JIT-compiled) on first use */
         rt_camera cam;
         rt_frame_stats st;
@@ -585,6 +601,8 @@ static int cmd_render(int argc, char **argv)
             v[i].gpu[f] = st.gpu_ms;
             v[i].cpu[f] = st.cpu_ms;
             v[i].sel[f] = st.select_ms;
+            for (int k = 0; k < 3; k++)
+                v[i].pass[k][f] = st.pass_ms[k];
             v[i].patches = st.patches;
             v[i].pipelines = st.pipelines;
             if (!rt_renderer_read(v[i].r, i == ref ? refimg : img, &e))
@@ -597,6 +615,20 @@ static int cmd_render(int argc, char **argv)
                     goto done;
             }
         }
+    }
+
+    /* one counting frame per screen variant, after the timed ones */
+    for (int i = 0; i < nspecs; i++) {
+        if (v[i].k != K_SCREEN && v[i].k != K_SCREEN_UBER)
+            continue;
+        rt_camera cam;
+        rt_frame_stats st;
+        if (!path_camera(&packs[0], &pd, frames - 1, frames, &cam))
+            goto done;
+        rt_renderer_set_counting(v[i].r, true);
+        if (!rt_renderer_frame(v[i].r, &cam, &st, &e))
+            goto done;
+        v[i].tiles = st.tiles;
     }
 
     FILE *out = stdout;
@@ -613,7 +645,9 @@ static int cmd_render(int argc, char **argv)
     if (header)
         fprintf(out, "device,scene,path,width,height,variant,kind,pack,lod_pixels,frames,"
                      "gpu_med_ms,gpu_p10_ms,gpu_p90_ms,cpu_med_ms,select_med_ms,patches,"
-                     "pipelines,max_abs,mean_abs,psnr_db,nonfinite,rss_delta_mb,reference,view\n");
+                     "pipelines,max_abs,mean_abs,psnr_db,nonfinite,rss_delta_mb,reference,view,"
+                     "geometry_ms,classify_ms,shade_ms,tiles,tiles_uber,layers_evaluated,"
+                     "layers_needed,samples_per_px\n");
     /* the device name in CSV: its commas become ';' */
     char devname[VK_MAX_PHYSICAL_DEVICE_NAME_SIZE];
     snprintf(devname, sizeof devname, "%s", dev.props.deviceName);
@@ -625,16 +659,23 @@ static int cmd_render(int argc, char **argv)
         percentiles(v[i].gpu, frames, &gm, &g10, &g90);
         percentiles(v[i].cpu, frames, &cm, &c10, &c90);
         percentiles(v[i].sel, frames, &sm, &s10, &s90);
+        double pm[3] = { -1, -1, -1 }, lo, hi;
+        bool scr = v[i].k == K_SCREEN || v[i].k == K_SCREEN_UBER;
+        for (int k = 0; k < 3 && scr; k++)
+            percentiles(v[i].pass[k], frames, &pm[k], &lo, &hi);
+        double px = v[i].tiles.pixels ? (double)v[i].tiles.pixels : 1.0;
         const char *pk = strrchr(v[i].pack_dir, '/');
         fprintf(out, "\"%s\",%s,%s,%d,%d,%s,%s,%s,%g,%d,%.3f,%.3f,%.3f,%.3f,%.4f,%d,%d,"
-                     "%.6g,%.6g,%.2f,%ld,%.1f,%s,%s\n",
+                     "%.6g,%.6g,%.2f,%ld,%.1f,%s,%s,%.3f,%.3f,%.3f,%d,%d,%.4f,%.4f,%.3f\n",
                 devname, scene ? scene : v[i].base->name, pd.name, width, height,
                 v[i].label, kind_names[v[i].k], pk ? pk + 1 : v[i].pack_dir,
                 v[i].lod > 0 ? v[i].lod : 3.0, frames, gm, g10, g90, cm, sm,
                 v[i].patches, v[i].pipelines, v[i].err.max_abs,
                 v[i].err.n ? v[i].err.sum_abs / (double)v[i].err.n : 0.0,
                 err_psnr(&v[i].err), v[i].err.nonfinite, v[i].rss_delta, v[ref].label,
-                view_name);
+                view_name, pm[0], pm[1], pm[2], v[i].tiles.tiles, v[i].tiles.tiles_uber,
+                v[i].tiles.layers_evaluated / px, v[i].tiles.layers_needed / px,
+                v[i].tiles.samples / px);
     }
     if (csv)
         fclose(out);
