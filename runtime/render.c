@@ -407,6 +407,17 @@ static bool make_commands(rt_renderer *r, rt_error *e)
 
 /* ---- public ---------------------------------------------------------------- */
 
+/* The screen path's depth (rt_screen_depth): ray cast where asked, or by
+ * default on GPUs when the terrain has no holes (the ray caster does not
+ * cut them). */
+static bool use_raycast(const rt_renderer *r)
+{
+    if (r->desc.screen_depth == RT_DEPTH_RAYCAST)
+        return true;
+    return r->desc.screen_depth == RT_DEPTH_AUTO && !r->p->holes &&
+           r->d->props.deviceType != VK_PHYSICAL_DEVICE_TYPE_CPU;
+}
+
 bool rt_renderer_create(rt_device *d, const rt_pack *p, const rt_render_desc *desc,
                         rt_renderer **out, rt_error *e)
 {
@@ -456,7 +467,8 @@ bool rt_renderer_create(rt_device *d, const rt_pack *p, const rt_render_desc *de
         !make_geometry(r, e) || !make_textures(r, e) || !make_descriptors(r, e) ||
         !make_commands(r, e) ||
         (r->set0c && !rt_screen_create(d, p, &r->pl, &r->color, &r->depth,
-                                       r->terrain.nearest_clamp, r->set0c, &r->screen, e))) {
+                                       r->terrain.nearest_clamp, r->set0c, use_raycast(r),
+                                       &r->screen, e))) {
         rt_renderer_destroy(r);
         return false;
     }
@@ -843,17 +855,22 @@ static bool record_screen(rt_renderer *r, VkCommandBuffer cb, const rt_camera *c
         .renderArea = *area, .clearValueCount = 1, .pClearValues = &clear,
     };
     VkDescriptorSet sets[2] = { r->set0, r->set1 };
-    begin_terrain_pass(r, cb, &rb, vp, sets);
-    int n = r->qt.npatches;
-    if (n > 0) {
-        VkPipeline pipe;
-        if (!rt_pipelines_depth(r->d, &r->pl, pass, cull, &pipe, e))
-            return abandon_frame(cb);
-        vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_GRAPHICS, pipe);
+    if (rt_screen_raycasting(r->screen)) {
+        rt_screen_raycast(r->screen, cb, r->set0c);
         (*binds)++;
-        draw_patches(r, cb, c, r->sorted, n);
+    } else {
+        begin_terrain_pass(r, cb, &rb, vp, sets);
+        int n = r->qt.npatches;
+        if (n > 0) {
+            VkPipeline pipe;
+            if (!rt_pipelines_depth(r->d, &r->pl, pass, cull, &pipe, e))
+                return abandon_frame(cb);
+            vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_GRAPHICS, pipe);
+            (*binds)++;
+            draw_patches(r, cb, c, r->sorted, n);
+        }
+        vkCmdEndRenderPass(cb);
     }
-    vkCmdEndRenderPass(cb);
     if (r->timestamps)
         vkCmdWriteTimestamp(cb, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, r->qpool, 1);
     rt_screen_classify(r->screen, cb, r->set0c, r->desc.clear,
@@ -1192,7 +1209,7 @@ bool rt_renderer_swap_pack(rt_renderer *r, const rt_pack *p, rt_error *e)
         rt_screen_destroy(r->screen);
         r->screen = NULL;
         if (!rt_screen_create(r->d, p, &r->pl, &r->color, &r->depth, r->terrain.nearest_clamp,
-                              r->set0c, &r->screen, e)) {
+                              r->set0c, use_raycast(r), &r->screen, e)) {
             rt_screen_destroy(r->screen);
             r->screen = NULL;
             return false;

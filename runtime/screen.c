@@ -17,6 +17,7 @@
  * the list counts. */
 #include "splatrt.h"
 
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -39,6 +40,12 @@ struct rt_screen {
     rt_buffer             info, tiles, args, args_reset, counters;
     unsigned             *dispatched;        /* per list: variant + 1 drawn  */
     VkImage               color_img;
+    bool                  raycast;           /* depth by ray casting          */
+    VkPipeline            raycaster;
+    rt_image              maxmip, rdepth;    /* pyramid; R32F depth           */
+    VkSampler             mip_sampler;       /* every level (texelFetch)      */
+    int                   mip_levels;
+    bool                  rdepth_ready;      /* in GENERAL layout             */
 };
 
 /* The classification shader: SPLAT_GLSL_TERRAIN (frame block) + this. */
@@ -70,11 +77,37 @@ static const char classify_glsl[] =
     "        mask[w] |= u_info.data[u_info.ncombos + id * u_info.words + w];\n"
     "    any_cell = true;\n"
     "}\n"
+    /* Appending a tile: one atomic per list and subgroup where the
+     * subgroup operations allow (AGGREGATE), since tiles of one list hit
+     * one counter and a GPU serialises atomics on one address; the lowest
+     * list first, then the next, until every tile of the subgroup is in. */
+    "#ifdef AGGREGATE\n"
+    "bool pending = false;\n"
+    "void append(uint list, uint entry) {\n"
+    "    pending = true;\n"
+    "    while (subgroupAny(pending)) {\n"
+    "        uint leader = subgroupMin(pending ? list : 0xffffffffu);\n"
+    "        bool mine = pending && list == leader;\n"
+    "        uvec4 b = subgroupBallot(mine);\n"
+    "        uint rank = subgroupBallotExclusiveBitCount(b), base = 0u;\n"
+    "        if (mine && rank == 0u)\n"
+    "            base = atomicAdd(u_args.args[leader * 3u], subgroupBallotBitCount(b));\n"
+    "        base = subgroupMax(base);\n"
+    "        if (mine) {\n"
+    "            u_lists.tiles[leader * u_info.ntiles + base + rank] = entry;\n"
+    "            pending = false;\n"
+    "        }\n"
+    "    }\n"
+    "}\n"
+    "#else\n"
+    "void append(uint list, uint entry) {\n"
+    "    uint slot = atomicAdd(u_args.args[list * 3u], 1u);\n"
+    "    u_lists.tiles[list * u_info.ntiles + slot] = entry;\n"
+    "}\n"
+    "#endif\n"
     /* one invocation per tile: no shared memory and no barriers, which
      * CPU drivers (lavapipe) pay for dearly */
-    "void main() {\n"
-    "    uint t = gl_GlobalInvocationID.x;\n"
-    "    if (t >= u_info.ntiles) return;\n"
+    "void classify(uint t) {\n"
     "    uvec2 tile = uvec2(t % u_info.tiles_x, t / u_info.tiles_x);\n"
     "    for (int w = 0; w < WORDS; w++) mask[w] = 0u;\n"
     "    ivec2 size = ivec2(u_frame.screen.xy);\n"
@@ -108,8 +141,115 @@ static const char classify_glsl[] =
     "            if (covers) { pick = c; break; }\n"
     "        }\n"
     "    }\n"
-    "    uint slot = atomicAdd(u_args.args[pick * 3u], 1u);\n"
-    "    u_lists.tiles[pick * u_info.ntiles + slot] = tile.x | (tile.y << 16u);\n"
+    "    append(pick, tile.x | (tile.y << 16u));\n"
+    "}\n"
+    /* every invocation reaches append's subgroup loop or none past it */
+    "void main() {\n"
+    "    uint t = gl_GlobalInvocationID.x;\n"
+    "    if (t < u_info.ntiles) classify(t);\n"
+    "}\n";
+
+/* Depth by ray casting (Tevs et al. 2008, "Maximum mipmaps"): the ray
+ * through each pixel centre walks a pyramid of maximum heights from the
+ * top level down, skipping cells it passes above, and at the finest level
+ * meets the two triangles of the mesh quad exactly as the patches'
+ * finest LOD draws them (corners at texel edges, heights bilinear there,
+ * diagonal from (i, j) to (i+1, j+1): rt_grid_indices).  It writes the
+ * reversed-Z depth of the hit, or the clear value 0, into an R32F image
+ * that classification and shading read in place of the geometry pass's
+ * depth.  Level 0 holds, per quad, the largest texel of the 3x3 around
+ * it (a bound of its four bilinear corners); each level the largest of
+ * four; the grid is padded to a multiple of 2^(levels-1) so every level
+ * halves exactly (Vulkan's mip sizes round down). */
+static const char raycast_glsl[] =
+    "layout(local_size_x = 8, local_size_y = 8) in;\n"
+    "layout(set = 2, binding = 3) uniform sampler2D u_maxmip;\n"
+    "layout(set = 2, binding = 4, r32f) uniform writeonly image2D u_rdepth;\n"
+    "float corner(ivec2 k) { return splat_height_at(vec2(k) * u_frame.texel.zw); }\n"
+    /* The ray against mesh quad k's two triangles, in the quad's own
+     * coordinates (u, v in [0, 1]: precise however far the quad is):
+     * (0,0) (1,0) (1,1) where u >= v, (0,0) (1,1) (0,1) where v >= u.
+     * The nearest hit with t in [t0, t1], else -1. */
+    "float quad_hit(vec3 O, vec3 D, ivec2 k, float t0, float t1) {\n"
+    "    float ha = corner(k), hb = corner(k + ivec2(1, 0));\n"
+    "    float hc = corner(k + ivec2(1, 1)), hd = corner(k + ivec2(0, 1));\n"
+    "    vec2 o = O.xz - vec2(k);\n"
+    "    const float eps = 1e-4;\n"
+    "    float best = -1.0;\n"
+    "    for (int s = 0; s < 2; s++) {\n"
+    "        float A = s == 0 ? hb - ha : hc - hd, B = s == 0 ? hc - hb : hd - ha;\n"
+    "        float den = D.y - A * D.x - B * D.z;\n"
+    "        if (den == 0.0) continue;\n"
+    "        float t = (ha + A * o.x + B * o.y - O.y) / den;\n"
+    "        if (t < t0 || t > t1) continue;\n"
+    "        vec2 uv = o + D.xz * t;\n"
+    "        vec2 w = s == 0 ? uv : uv.yx;   /* w.x >= w.y in the triangle */\n"
+    "        if (w.x < -eps || w.x > 1.0 + eps || w.y < -eps || w.y > w.x + eps) continue;\n"
+    "        best = best < 0.0 ? t : min(best, t);\n"
+    "    }\n"
+    "    return best;\n"
+    "}\n"
+    "void main() {\n"
+    "    ivec2 px = ivec2(gl_GlobalInvocationID.xy);\n"
+    "    if (any(greaterThanEqual(px, ivec2(u_frame.screen.xy)))) return;\n"
+    "    vec2 ndc = (vec2(px) + 0.5) / u_frame.screen.xy * 2.0 - 1.0;\n"
+    "    vec4 q = u_frame.inv_view_proj * vec4(ndc, 1.0, 1.0);\n"
+    "    vec3 dir = normalize(q.xyz / q.w);\n"
+    "    vec2 sc = u_frame.texel.xy / u_frame.terrain.xy;   /* texels per metre */\n"
+    "    vec3 O = vec3(u_frame.camera.x * sc.x, u_frame.camera.y, u_frame.camera.z * sc.y);\n"
+    "    vec3 D = vec3(dir.x * sc.x, dir.y, dir.z * sc.y);   /* t: metres along dir */\n"
+    "    const int top = TOP;\n"
+    /* the box [0, W] x (-inf, highest height] x [0, H] */
+    "    vec3 lo = vec3(0.0, -1e30, 0.0);\n"
+    "    vec3 hi = vec3(u_frame.texel.x, u_frame.terrain.z + u_frame.terrain.w, u_frame.texel.y);\n"
+    "    vec3 inv = 1.0 / D;\n"
+    "    vec3 ta = (lo - O) * inv, tb = (hi - O) * inv;\n"
+    "    vec3 tn = min(ta, tb), tf = max(ta, tb);\n"
+    "    float t = max(max(max(tn.x, tn.y), tn.z), 0.0), tend = min(min(tf.x, tf.y), tf.z);\n"
+    "    float hit = -1.0;\n"
+    "    int L = top;\n"
+    /* a walk over cells by index (a DDA), so rounding in the position can
+     * never hold it in place: down into the child under the ray where
+     * the ray may meet the cell's contents, else across to the neighbour
+     * on the exit side, up to the parent when that leaves this one */
+    "    ivec2 c = clamp(ivec2(floor((O.xz + D.xz * t) / float(1 << L))), ivec2(0),\n"
+    "                    (ivec2(PW, PH) >> L) - 1);\n"
+    "    for (int it = 0; it < 16384 && t <= tend && hit < 0.0; it++) {\n"
+    "        float size = float(1 << L);\n"
+    "        vec2 b0 = vec2(c) * size, b1 = b0 + size;\n"
+    "        vec2 tx = (mix(b0, b1, greaterThan(D.xz, vec2(0.0))) - O.xz) * inv.xz;\n"
+    "        tx = mix(tx, vec2(1e30), equal(D.xz, vec2(0.0)));\n"
+    "        int axis = tx.x < tx.y ? 0 : 1;\n"
+    "        float te = min(min(tx.x, tx.y), tend);\n"
+    "        float top_h = texelFetch(u_maxmip, c, L).r;\n"
+    "        if (min(O.y + D.y * t, O.y + D.y * te) <= top_h) {\n"
+    "            if (L > 0) {   /* the ray may meet something in here: look closer */\n"
+    "                L--;\n"
+    "                vec2 p = (O.xz + D.xz * t) / (size * 0.5);\n"
+    "                c = clamp(ivec2(floor(p)), 2 * c, 2 * c + 1);\n"
+    "                continue;\n"
+    "            }\n"
+    "            float slack = 1e-5 * te + 1e-4;\n"
+    "            hit = quad_hit(O, D, c, t - slack, te + slack);\n"
+    "        }\n"
+    "        t = max(t, te);\n"
+    "        ivec2 cn = c;\n"
+    "        if (axis == 0) cn.x += D.x > 0.0 ? 1 : -1; else cn.y += D.z > 0.0 ? 1 : -1;\n"
+    "        if (any(lessThan(cn, ivec2(0))) || any(greaterThanEqual(cn, ivec2(PW, PH) >> L)))\n"
+    "            break;   /* off the terrain */\n"
+    "        if (L < top && any(notEqual(cn >> 1, c >> 1))) {\n"
+    "            L++;\n"
+    "            c = cn >> 1;\n"
+    "        } else {\n"
+    "            c = cn;\n"
+    "        }\n"
+    "    }\n"
+    "    float depth = 0.0;   /* the clear value: sky */\n"
+    "    if (hit >= 0.0) {\n"
+    "        vec4 clip = u_frame.view_proj * vec4(dir * hit, 1.0);\n"
+    "        depth = clip.z / clip.w;\n"
+    "    }\n"
+    "    imageStore(u_rdepth, px, vec4(depth));\n"
     "}\n";
 
 /* Cheapest first: the pack's cost, then fewer materials, then id. */
@@ -158,6 +298,86 @@ static bool fill_info(rt_screen *s, rt_error *e)
     for (size_t i = 0; i < cells; i++)
         map[i] = leaf->ids[i];
     return true;
+}
+
+/* The maximum-height pyramid of the ray caster (raycast_glsl), metres. */
+static bool make_maxmip(rt_screen *s, rt_error *e)
+{
+    const rt_pack *p = s->p;
+    int W = p->hf_width, H = p->hf_height, K = 6;
+    while (K > 0 && ((W >> K) < 1 || (H >> K) < 1))
+        K--;
+    int PW = ((W + (1 << K) - 1) >> K) << K, PH = ((H + (1 << K) - 1) >> K) << K;
+    if ((uint32_t)PW > s->d->props.limits.maxImageDimension2D ||
+        (uint32_t)PH > s->d->props.limits.maxImageDimension2D)
+        return rt_fail(e, RT_E_PACK_LIMIT, p->dir, "the ray caster's height pyramid width",
+                       (unsigned long long)(PW > PH ? PW : PH), "maxImageDimension2D",
+                       (unsigned long long)s->d->props.limits.maxImageDimension2D);
+    size_t total = 0;
+    for (int k = 0; k <= K; k++)
+        total += (size_t)(PW >> k) * (size_t)(PH >> k);
+    float *all = malloc(total * sizeof *all);
+    const uint8_t **levels = calloc((size_t)K + 1, sizeof *levels);
+    if (!all || !levels) {
+        free(all);
+        free(levels);
+        return rt_fail(e, RT_E_VULKAN, "ray caster", "out of memory");
+    }
+    /* a margin for the GPU's float rounding of texel * max_height */
+    double margin = 1e-4 * (fabs(p->max_height) + fabs(p->height_offset)) + 1e-3;
+    float *l0 = all;
+    for (int j = 0; j < PH; j++)
+        for (int i = 0; i < PW; i++) {
+            double m = -1e30;
+            for (int y = j - 1; y <= j + 1 && i < W && j < H; y++)
+                for (int x = i - 1; x <= i + 1; x++) {
+                    int cx = x < 0 ? 0 : x >= W ? W - 1 : x, cy = y < 0 ? 0 : y >= H ? H - 1 : y;
+                    double h = p->heights[(size_t)cy * (size_t)W + (size_t)cx] / 65535.0 *
+                               p->max_height + p->height_offset;
+                    m = h > m ? h : m;
+                }
+            l0[(size_t)j * (size_t)PW + (size_t)i] = (float)(m > -1e30 ? m + margin : -1e30);
+        }
+    levels[0] = (const uint8_t *)l0;
+    float *prev = l0;
+    for (int k = 1; k <= K; k++) {
+        int w = PW >> k, h = PH >> k, pw = PW >> (k - 1);
+        float *cur = prev + (size_t)pw * (size_t)(PH >> (k - 1));
+        for (int j = 0; j < h; j++)
+            for (int i = 0; i < w; i++) {
+                const float *q = prev + (size_t)(2 * j) * (size_t)pw + (size_t)(2 * i);
+                float m = q[0] > q[1] ? q[0] : q[1];
+                m = q[pw] > m ? q[pw] : m;
+                m = q[pw + 1] > m ? q[pw + 1] : m;
+                cur[(size_t)j * (size_t)w + (size_t)i] = m;
+            }
+        levels[k] = (const uint8_t *)cur;
+        prev = cur;
+    }
+    s->mip_levels = K + 1;
+    VkSamplerCreateInfo si = {
+        .sType = VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO,
+        .magFilter = VK_FILTER_NEAREST, .minFilter = VK_FILTER_NEAREST,
+        .mipmapMode = VK_SAMPLER_MIPMAP_MODE_NEAREST,
+        .addressModeU = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE,
+        .addressModeV = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE,
+        .addressModeW = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE,
+        .maxLod = VK_LOD_CLAMP_NONE,
+    };
+    VkResult vr = vkCreateSampler(s->d->dev, &si, NULL, &s->mip_sampler);
+    if (vr != VK_SUCCESS) {
+        free(levels);
+        free(all);
+        return rt_fail(e, RT_E_VULKAN, "vkCreateSampler", rt_vk_result_name(vr));
+    }
+    bool ok = rt_image_create(s->d, (uint32_t)PW, (uint32_t)PH, 1, false, (uint32_t)K + 1,
+                              VK_FORMAT_R32_SFLOAT,
+                              VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT,
+                              VK_IMAGE_ASPECT_COLOR_BIT, &s->maxmip, e) &&
+              rt_image_upload_levels(s->d, &s->maxmip, levels, e);
+    free(levels);
+    free(all);
+    return ok;
 }
 
 static bool make_depth_pass(rt_screen *s, const rt_image *depth, rt_error *e)
@@ -212,66 +432,19 @@ static bool make_depth_pass(rt_screen *s, const rt_image *depth, rt_error *e)
     return true;
 }
 
-static bool make_classify(rt_screen *s, const rt_pipelines *pl, rt_error *e)
+/* A compute pipeline of the runtime's own GLSL over s->layout. */
+static bool own_pipeline(rt_screen *s, const rt_pipelines *pl, const char *head, const char *body,
+                         const char *name, VkPipeline *out, rt_error *e)
 {
     rt_device *d = s->d;
-    const VkDescriptorType sb = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
-    const VkShaderStageFlags cs = VK_SHADER_STAGE_COMPUTE_BIT;
-    VkDescriptorSetLayoutBinding b[3] = {
-        { 0, sb, 1, cs, NULL }, { 1, sb, 1, cs, NULL }, { 2, sb, 1, cs, NULL },
-    };
-    VkDescriptorSetLayoutCreateInfo li = {
-        .sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO,
-        .bindingCount = 3,
-        .pBindings = b,
-    };
-    RT_VK(e, vkCreateDescriptorSetLayout(d->dev, &li, NULL, &s->set_layout));
-    VkDescriptorSetLayout sets[3] = { pl->set_terrain, pl->set_material, s->set_layout };
-    VkPushConstantRange push = { cs, 0, sizeof(splat_push) };
-    VkPipelineLayoutCreateInfo pi = {
-        .sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO,
-        .setLayoutCount = 3,
-        .pSetLayouts = sets,
-        .pushConstantRangeCount = 1,
-        .pPushConstantRanges = &push,
-    };
-    RT_VK(e, vkCreatePipelineLayout(d->dev, &pi, NULL, &s->layout));
-
-    VkDescriptorPoolSize size = { sb, 3 };
-    VkDescriptorPoolCreateInfo dpi = {
-        .sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO,
-        .maxSets = 1,
-        .poolSizeCount = 1,
-        .pPoolSizes = &size,
-    };
-    RT_VK(e, vkCreateDescriptorPool(d->dev, &dpi, NULL, &s->pool));
-    VkDescriptorSetAllocateInfo ai = {
-        .sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO,
-        .descriptorPool = s->pool,
-        .descriptorSetCount = 1,
-        .pSetLayouts = &s->set_layout,
-    };
-    RT_VK(e, vkAllocateDescriptorSets(d->dev, &ai, &s->set));
-    VkDescriptorBufferInfo bi[3] = {
-        { s->info.buf, 0, VK_WHOLE_SIZE }, { s->tiles.buf, 0, VK_WHOLE_SIZE },
-        { s->args.buf, 0, VK_WHOLE_SIZE },
-    };
-    VkWriteDescriptorSet w[3];
-    for (uint32_t i = 0; i < 3; i++)
-        w[i] = (VkWriteDescriptorSet){ .sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET,
-            .dstSet = s->set, .dstBinding = i, .descriptorCount = 1, .descriptorType = sb,
-            .pBufferInfo = &bi[i] };
-    vkUpdateDescriptorSets(d->dev, 3, w, 0, NULL);
-
-    size_t n = strlen(SPLAT_GLSL_TERRAIN) + strlen(classify_glsl) + 64;
+    size_t n = strlen(head) + strlen(SPLAT_GLSL_TERRAIN) + strlen(body) + 32;
     char *src = malloc(n);
     if (!src)
-        return rt_fail(e, RT_E_VULKAN, "classification", "out of memory");
-    snprintf(src, n, "#version 450\n#define WORDS %d\n%s%s", s->words > 0 ? s->words : 1,
-             SPLAT_GLSL_TERRAIN, classify_glsl);
+        return rt_fail(e, RT_E_VULKAN, name, "out of memory");
+    snprintf(src, n, "#version 450\n%s%s%s", head, SPLAT_GLSL_TERRAIN, body);
     uint32_t *words = NULL;
     size_t nw = 0;
-    bool ok = rt_glsl_compile(src, VK_SHADER_STAGE_COMPUTE_BIT, "classify.comp", &words, &nw, e);
+    bool ok = rt_glsl_compile(src, VK_SHADER_STAGE_COMPUTE_BIT, name, &words, &nw, e);
     free(src);
     if (!ok)
         return false;
@@ -291,16 +464,111 @@ static bool make_classify(rt_screen *s, const rt_pipelines *pl, rt_error *e)
                    .stage = VK_SHADER_STAGE_COMPUTE_BIT, .module = m, .pName = "main" },
         .layout = s->layout,
     };
-    r = vkCreateComputePipelines(d->dev, pl->cache, 1, &ci, NULL, &s->classify);
+    r = vkCreateComputePipelines(d->dev, pl->cache, 1, &ci, NULL, out);
     vkDestroyShaderModule(d->dev, m, NULL);
     if (r != VK_SUCCESS)
         return rt_fail(e, RT_E_VULKAN, "vkCreateComputePipelines", rt_vk_result_name(r));
     return true;
 }
 
+/* Whether the classification may append through subgroup operations. */
+static bool can_aggregate(rt_device *d)
+{
+    VkPhysicalDeviceSubgroupProperties sp = {
+        .sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SUBGROUP_PROPERTIES,
+    };
+    VkPhysicalDeviceProperties2 p2 = {
+        .sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2,
+        .pNext = &sp,
+    };
+    vkGetPhysicalDeviceProperties2(d->phys, &p2);
+    const VkSubgroupFeatureFlags need = VK_SUBGROUP_FEATURE_VOTE_BIT |
+        VK_SUBGROUP_FEATURE_BALLOT_BIT | VK_SUBGROUP_FEATURE_ARITHMETIC_BIT;
+    return (sp.supportedStages & VK_SHADER_STAGE_COMPUTE_BIT) &&
+           (sp.supportedOperations & need) == need;
+}
+
+/* Set 2 (lists, counts, the pyramid and the ray-cast depth), the layout,
+ * the classification and ray-casting pipelines. */
+static bool make_compute(rt_screen *s, const rt_pipelines *pl, VkSampler nearest, rt_error *e)
+{
+    rt_device *d = s->d;
+    const VkDescriptorType sb = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+    const VkShaderStageFlags cs = VK_SHADER_STAGE_COMPUTE_BIT;
+    VkDescriptorSetLayoutBinding b[5] = {
+        { 0, sb, 1, cs, NULL }, { 1, sb, 1, cs, NULL }, { 2, sb, 1, cs, NULL },
+        { 3, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, cs, NULL },
+        { 4, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, cs, NULL },
+    };
+    uint32_t nb = s->raycast ? 5 : 3;
+    VkDescriptorSetLayoutCreateInfo li = {
+        .sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO,
+        .bindingCount = nb,
+        .pBindings = b,
+    };
+    RT_VK(e, vkCreateDescriptorSetLayout(d->dev, &li, NULL, &s->set_layout));
+    VkDescriptorSetLayout sets[3] = { pl->set_terrain, pl->set_material, s->set_layout };
+    VkPushConstantRange push = { cs, 0, sizeof(splat_push) };
+    VkPipelineLayoutCreateInfo pi = {
+        .sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO,
+        .setLayoutCount = 3,
+        .pSetLayouts = sets,
+        .pushConstantRangeCount = 1,
+        .pPushConstantRanges = &push,
+    };
+    RT_VK(e, vkCreatePipelineLayout(d->dev, &pi, NULL, &s->layout));
+
+    VkDescriptorPoolSize sizes[3] = {
+        { sb, 3 }, { VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1 },
+        { VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1 },
+    };
+    VkDescriptorPoolCreateInfo dpi = {
+        .sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO,
+        .maxSets = 1,
+        .poolSizeCount = s->raycast ? 3 : 1,
+        .pPoolSizes = sizes,
+    };
+    RT_VK(e, vkCreateDescriptorPool(d->dev, &dpi, NULL, &s->pool));
+    VkDescriptorSetAllocateInfo ai = {
+        .sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO,
+        .descriptorPool = s->pool,
+        .descriptorSetCount = 1,
+        .pSetLayouts = &s->set_layout,
+    };
+    RT_VK(e, vkAllocateDescriptorSets(d->dev, &ai, &s->set));
+    VkDescriptorBufferInfo bi[3] = {
+        { s->info.buf, 0, VK_WHOLE_SIZE }, { s->tiles.buf, 0, VK_WHOLE_SIZE },
+        { s->args.buf, 0, VK_WHOLE_SIZE },
+    };
+    VkDescriptorImageInfo ii[2] = {
+        { s->mip_sampler, s->maxmip.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL },
+        { VK_NULL_HANDLE, s->rdepth.view, VK_IMAGE_LAYOUT_GENERAL },
+    };
+    VkWriteDescriptorSet w[5];
+    for (uint32_t i = 0; i < nb; i++)
+        w[i] = (VkWriteDescriptorSet){ .sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET,
+            .dstSet = s->set, .dstBinding = i, .descriptorCount = 1,
+            .descriptorType = b[i].descriptorType,
+            .pBufferInfo = i < 3 ? &bi[i] : NULL, .pImageInfo = i >= 3 ? &ii[i - 3] : NULL };
+    vkUpdateDescriptorSets(d->dev, nb, w, 0, NULL);
+
+    char head[256];
+    bool agg = can_aggregate(d);
+    snprintf(head, sizeof head, "#define WORDS %d\n%s", s->words > 0 ? s->words : 1,
+             agg ? "#define AGGREGATE 1\n#extension GL_KHR_shader_subgroup_vote : require\n"
+                   "#extension GL_KHR_shader_subgroup_ballot : require\n"
+                   "#extension GL_KHR_shader_subgroup_arithmetic : require\n" : "");
+    char rhead[128];
+    snprintf(rhead, sizeof rhead, "#define TOP %d\n#define PW %u\n#define PH %u\n",
+             s->mip_levels - 1, s->maxmip.width, s->maxmip.height);
+    return own_pipeline(s, pl, head, classify_glsl, "classify.comp", &s->classify, e) &&
+           (!s->raycast ||
+            own_pipeline(s, pl, rhead, raycast_glsl, "raycast.comp", &s->raycaster, e));
+}
+
 bool rt_screen_create(rt_device *d, const rt_pack *p, const rt_pipelines *pl,
                       const rt_image *color, const rt_image *depth, VkSampler nearest,
-                      VkDescriptorSet set0, rt_screen **out, rt_error *e)
+                      VkDescriptorSet set0, bool raycast, rt_screen **out, rt_error *e)
 {
     *out = NULL;
     rt_screen *s = calloc(1, sizeof *s);
@@ -309,6 +577,7 @@ bool rt_screen_create(rt_device *d, const rt_pack *p, const rt_pipelines *pl,
     s->d = d;
     s->p = p;
     s->color_img = color->img;
+    s->raycast = raycast;
     s->width = (int)color->width;
     s->height = (int)color->height;
     s->tiles_x = (s->width + SPLAT_TILE - 1) / SPLAT_TILE;
@@ -345,12 +614,20 @@ bool rt_screen_create(rt_device *d, const rt_pack *p, const rt_pipelines *pl,
     }
     memcpy(s->args.map, reset, (size_t)s->nlists * 12);
     memset(s->counters.map, 0, 16);
-    if (!make_depth_pass(s, depth, e) || !make_classify(s, pl, e))
+    if (raycast &&
+        (!make_maxmip(s, e) ||
+         !rt_image_create(d, color->width, color->height, 1, false, 1, VK_FORMAT_R32_SFLOAT,
+                          VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT,
+                          VK_IMAGE_ASPECT_COLOR_BIT, &s->rdepth, e)))
+        return false;
+    if (!make_depth_pass(s, depth, e) || !make_compute(s, pl, nearest, e))
         return false;
 
     /* set 0's compute bindings (abi.h): depth, colour, tiles, counters */
     VkDescriptorImageInfo img[2] = {
-        { nearest, depth->view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL },
+        raycast ? (VkDescriptorImageInfo){ nearest, s->rdepth.view, VK_IMAGE_LAYOUT_GENERAL }
+                : (VkDescriptorImageInfo){ nearest, depth->view,
+                                           VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL },
         { VK_NULL_HANDLE, color->view, VK_IMAGE_LAYOUT_GENERAL },
     };
     VkDescriptorBufferInfo buf[2] = {
@@ -380,6 +657,12 @@ void rt_screen_destroy(rt_screen *s)
     if (d->dev) {
         if (s->classify)
             vkDestroyPipeline(d->dev, s->classify, NULL);
+        if (s->raycaster)
+            vkDestroyPipeline(d->dev, s->raycaster, NULL);
+        rt_image_destroy(d, &s->maxmip);
+        if (s->mip_sampler)
+            vkDestroySampler(d->dev, s->mip_sampler, NULL);
+        rt_image_destroy(d, &s->rdepth);
         if (s->layout)
             vkDestroyPipelineLayout(d->dev, s->layout, NULL);
         if (s->pool)
@@ -404,6 +687,28 @@ VkRenderPass rt_screen_depth_pass(const rt_screen *s, VkFramebuffer *fb)
 {
     *fb = s->depth_fb;
     return s->depth_pass;
+}
+
+bool rt_screen_raycasting(const rt_screen *s) { return s->raycast; }
+
+void rt_screen_raycast(rt_screen *s, VkCommandBuffer cb, VkDescriptorSet set0)
+{
+    /* the last frame's reads end before this write; this write before
+     * this frame's reads (classification, shading) */
+    rt_cmd_image_barrier(cb, s->rdepth.img, 0, 1, 1,
+                         s->rdepth_ready ? VK_IMAGE_LAYOUT_GENERAL : VK_IMAGE_LAYOUT_UNDEFINED,
+                         VK_IMAGE_LAYOUT_GENERAL, VK_ACCESS_SHADER_READ_BIT,
+                         VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+                         VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT);
+    s->rdepth_ready = true;
+    vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, s->raycaster);
+    vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, s->layout, 0, 1, &set0, 0, NULL);
+    vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, s->layout, 2, 1, &s->set, 0, NULL);
+    vkCmdDispatch(cb, (uint32_t)s->tiles_x, (uint32_t)s->tiles_y, 1);
+    rt_cmd_image_barrier(cb, s->rdepth.img, 0, 1, 1, VK_IMAGE_LAYOUT_GENERAL,
+                         VK_IMAGE_LAYOUT_GENERAL, VK_ACCESS_SHADER_WRITE_BIT,
+                         VK_ACCESS_SHADER_READ_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+                         VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT);
 }
 
 void rt_screen_begin(rt_screen *s, VkCommandBuffer cb, bool count)

@@ -606,7 +606,11 @@ typedef struct rt_screen_stats {
  * even on failure (free with rt_screen_destroy). */
 bool rt_screen_create(rt_device *d, const rt_pack *p, const rt_pipelines *pl,
                       const rt_image *color, const rt_image *depth, VkSampler nearest,
-                      VkDescriptorSet set0, rt_screen **out, rt_error *e);
+                      VkDescriptorSet set0, bool raycast, rt_screen **out, rt_error *e);
+/* raycast: the depth comes from ray casting the heightfield in compute
+ * (screen.c) instead of the geometry pass. */
+bool rt_screen_raycasting(const rt_screen *s);
+void rt_screen_raycast(rt_screen *s, VkCommandBuffer cb, VkDescriptorSet set0);
 void rt_screen_destroy(rt_screen *s);
 /* The geometry pass: depth only, ends in SHADER_READ_ONLY_OPTIMAL. */
 VkRenderPass rt_screen_depth_pass(const rt_screen *s, VkFramebuffer *fb);
@@ -644,6 +648,14 @@ typedef enum rt_shading {
                                  reference and wireframe stay forward       */
 } rt_shading;
 
+typedef enum rt_screen_depth {
+    RT_DEPTH_AUTO = 0,   /* ray cast on GPUs (their raster front end is the
+                            floor), geometry pass on CPU drivers and for
+                            terrains with holes                           */
+    RT_DEPTH_RASTER,     /* the patches drawn depth only                  */
+    RT_DEPTH_RAYCAST,    /* maximum-mipmap ray casting in compute          */
+} rt_screen_depth;
+
 typedef struct rt_render_desc {
     int          width, height;
     rt_reference reference;
@@ -654,6 +666,7 @@ typedef struct rt_render_desc {
     double       lod_pixels;        /* screen error per grid step; default 3  */
     int          destruction_pool;  /* destruction tiles; 0: RT_DESTR_POOL_DEFAULT */
     rt_shading   shading;           /* forward (default) or screen-space      */
+    rt_screen_depth screen_depth;   /* screen path: where its depth comes from */
 } rt_render_desc;
 
 typedef struct rt_frame_stats {

@@ -24,6 +24,9 @@ static void usage(FILE *f)
         "  --shading forward|screen  forward: each patch shaded by its composite;\n"
         "                            screen: depth pass, 8x8 tiles classified by\n"
         "                            combination, shaded in compute (default forward)\n"
+        "  --screen-depth auto|raster|raycast   the screen path's depth: the patches\n"
+        "                            drawn depth only, or the heightfield ray cast in\n"
+        "                            compute (auto: ray cast on GPUs without holes)\n"
         "  --float-out FILE          also write the RGBA32F image (SPLATF32 format)\n"
         "  --param NAME=v[,v,v,v]    set a material param\n"
         "  --lod-pixels P            screen error per grid step (default 3)\n"
@@ -84,6 +87,7 @@ typedef struct opts {
     float clear[4];
     rt_reference ref;
     rt_shading shading;
+    rt_screen_depth screen_depth;
     const char *params[64];
     int nparams;
     const char *include[64];    /* -I DIR: import folders for hot reload    */
@@ -199,6 +203,19 @@ static int parse_args(int argc, char **argv, opts *o)
                 o->shading = RT_SHADING_SCREEN;
             else {
                 fprintf(stderr, "splatview: --shading expects forward or screen, found '%s'\n", v);
+                return 2;
+            }
+        } else if (!strcmp(a, "--screen-depth")) {
+            NEED();
+            if (!strcmp(v, "auto"))
+                o->screen_depth = RT_DEPTH_AUTO;
+            else if (!strcmp(v, "raster"))
+                o->screen_depth = RT_DEPTH_RASTER;
+            else if (!strcmp(v, "raycast"))
+                o->screen_depth = RT_DEPTH_RAYCAST;
+            else {
+                fprintf(stderr, "splatview: --screen-depth expects auto, raster or raycast, "
+                        "found '%s'\n", v);
                 return 2;
             }
         } else if (!strcmp(a, "--reference")) {
@@ -400,6 +417,7 @@ static int headless(const opts *o)
         .pipeline_cache = o->cache, .no_stitch = o->no_stitch,
         .no_cull = o->no_cull, .lod_pixels = o->lod_pixels,
         .destruction_pool = o->destruction_pool, .shading = o->shading,
+        .screen_depth = o->screen_depth,
     };
     memcpy(rd.clear, o->clear, sizeof rd.clear);
     if (!rt_renderer_create(&dev, &pack, &rd, &r, &e) || !apply_params(o, r, &e) ||
@@ -456,7 +474,7 @@ static int headless(const opts *o)
         else
             printf("gpu ms/frame: n/a (no timestamp support)\n");
         if (st.screen) {
-            static const char *const names[3] = { "geometry (depth)", "classification",
+            static const char *const names[3] = { "depth", "classification",
                                                   "shading (compute)" };
             for (int k = 0; k < 3 && gm >= 0; k++) {
                 double m, l, h;
@@ -519,7 +537,7 @@ int main(int argc, char **argv)
         .pack_dir = o.pack, .scene = o.scene, .width = o.width ? o.width : 1280,
         .height = o.height ? o.height : 720, .script = o.script,
         .render = { .reference = o.ref, .pipeline_cache = o.cache, .lod_pixels = o.lod_pixels,
-                    .shading = o.shading },
+                    .shading = o.shading, .screen_depth = o.screen_depth },
         .view = SPLAT_VIEW_FINAL,
     };
     memcpy(vd.render.clear, o.clear, sizeof o.clear);

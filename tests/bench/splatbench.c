@@ -26,6 +26,9 @@
  *                     counting frame after the timed ones, layers
  *                     evaluated / needed and samples per pixel
  *         screen_uber the same with every tile on the über-shader
+ *         screen_raster, screen_raycast   the screen path with its depth
+ *                     from the patches drawn depth only, or ray cast in
+ *                     compute (screen: the runtime's choice for the device)
  *       pack=DIR renders another pack of the same terrain (compositors, fBm
  *       knobs); lod=P sets the LOD error threshold in pixels per grid step.
  *       Paths (--path): ground (2 m above the terrain looking 150 m ahead,
@@ -166,9 +169,11 @@ static double err_psnr(const err_acc *a)
 /* ---- variants -------------------------------------------------------------- */
 
 typedef enum kind { K_COMPOSITE, K_MULTIPASS, K_UBER, K_FLAT, K_FP16, K_SOBEL, K_ANALYTIC,
-                    K_SCREEN, K_SCREEN_UBER } kind;
+                    K_SCREEN, K_SCREEN_UBER, K_SCREEN_RASTER, K_SCREEN_RAYCAST } kind;
 static const char *const kind_names[] = {"composite", "multipass", "uber", "flat", "fp16", "sobel",
-                                         "analytic", "screen", "screen_uber"};
+                                         "analytic", "screen", "screen_uber", "screen_raster",
+                                         "screen_raycast"};
+#define IS_SCREEN(k) ((k) >= K_SCREEN)
 
 typedef struct variant {
     char        *label;
@@ -502,7 +507,8 @@ static int cmd_render(int argc, char **argv)
     for (int i = 0; i < nspecs; i++)
         if (!parse_variant(specs[i], pack_dir, &v[i])) {
             fprintf(stderr, "splatbench render: bad variant '%s' (LABEL=KIND[,pack=DIR][,lod=P];"
-                    " KIND composite|multipass|uber|flat|fp16|sobel|analytic|screen|screen_uber;"
+                    " KIND composite|multipass|uber|flat|fp16|sobel|analytic|screen|screen_uber|"
+                    "screen_raster|screen_raycast;"
                     " a pack from --pack"
                     " or pack=)\n",
                     specs[i]);
@@ -561,8 +567,9 @@ static int cmd_render(int argc, char **argv)
             .reference = v[i].k == K_MULTIPASS ? RT_REF_MULTIPASS
                        : v[i].k == K_UBER || v[i].k == K_SCREEN_UBER ? RT_REF_UBER : RT_REF_NONE,
             .pipeline_cache = save ? cache : NULL,
-            .shading = v[i].k == K_SCREEN || v[i].k == K_SCREEN_UBER ? RT_SHADING_SCREEN
-                                                                     : RT_SHADING_FORWARD,
+            .shading = IS_SCREEN(v[i].k) ? RT_SHADING_SCREEN : RT_SHADING_FORWARD,
+            .screen_depth = v[i].k == K_SCREEN_RASTER ? RT_DEPTH_RASTER
+                          : v[i].k == K_SCREEN_RAYCAST ? RT_DEPTH_RAYCAST : RT_DEPTH_AUTO,
         };
         double before = rss_mb();
         if (!rt_renderer_create(&dev, &v[i].view, &rd, &v[i].r, &e))
@@ -619,7 +626,7 @@ static int cmd_render(int argc, char **argv)
 
     /* one counting frame per screen variant, after the timed ones */
     for (int i = 0; i < nspecs; i++) {
-        if (v[i].k != K_SCREEN && v[i].k != K_SCREEN_UBER)
+        if (!IS_SCREEN(v[i].k))
             continue;
         rt_camera cam;
         rt_frame_stats st;
@@ -660,7 +667,7 @@ static int cmd_render(int argc, char **argv)
         percentiles(v[i].cpu, frames, &cm, &c10, &c90);
         percentiles(v[i].sel, frames, &sm, &s10, &s90);
         double pm[3] = { -1, -1, -1 }, lo, hi;
-        bool scr = v[i].k == K_SCREEN || v[i].k == K_SCREEN_UBER;
+        bool scr = IS_SCREEN(v[i].k);
         for (int k = 0; k < 3 && scr; k++)
             percentiles(v[i].pass[k], frames, &pm[k], &lo, &hi);
         double px = v[i].tiles.pixels ? (double)v[i].tiles.pixels : 1.0;

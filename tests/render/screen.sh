@@ -55,7 +55,7 @@ run "$PACK" --headless $SIZE $c --shading screen --view cost -o "$OUT/cost.png"
 "$IC" nonuniform "$OUT/cost.png" || fail "the cost view is uniform"
 run "$PACK" --headless $SIZE $c --shading screen --stats --frames 2 > "$OUT/stats.txt"
 cat "$OUT/stats.txt"
-for line in "geometry (depth)" "classification" "shading (compute)" "tiles:" \
+for line in "  depth" "classification" "shading (compute)" "tiles:" \
             "layers per pixel: evaluated" "texture samples per pixel:" "shading: screen"; do
     grep -q "$line" "$OUT/stats.txt" || fail "--stats lacks '$line'"
 done
