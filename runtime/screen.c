@@ -37,7 +37,11 @@ struct rt_screen {
     VkPipeline            classify;
     VkDescriptorPool      pool;
     VkDescriptorSet       set;
-    rt_buffer             info, tiles, args, args_reset, counters;
+    /* device-local: info (uploaded once), tiles, args, counters (a GPU
+     * reads and atomically updates them; host memory would go over the
+     * bus); host-visible: args_reset (the per-frame reset source) and
+     * readback (args and counters copied back after the frame) */
+    rt_buffer             info, tiles, args, args_reset, counters, readback;
     unsigned             *dispatched;        /* per list: variant + 1 drawn  */
     VkImage               color_img;
     bool                  raycast;           /* depth by ray casting          */
@@ -54,7 +58,7 @@ static const char classify_glsl[] =
     "layout(set = 0, binding = 7) uniform sampler2D u_depth;\n"
     "layout(set = 2, binding = 0, std430) readonly buffer cls_info_block {\n"
     "    uint ncombos, words, cells_x, cells_z;\n"
-    "    uint ntiles, force_uber, cell_texels, tiles_x;\n"
+    "    uint ntiles, unused, cell_texels, tiles_x;\n"
     "    uint data[];   /* order[ncombos], masks[ncombos][words], cells[] */\n"
     "} u_info;\n"
     "layout(set = 2, binding = 1, std430) writeonly buffer cls_tiles_block {\n"
@@ -63,6 +67,7 @@ static const char classify_glsl[] =
     "layout(set = 2, binding = 2, std430) buffer cls_args_block {\n"
     "    uint args[];   /* per list: x y z of vkCmdDispatchIndirect */\n"
     "} u_args;\n"
+    "layout(set = 0, binding = 8, rgba32f) uniform writeonly image2D u_out;\n"
     "uint mask[WORDS];\n"
     "uint last = 0xffffffffu;\n"
     "bool any_cell = false;\n"
@@ -116,7 +121,10 @@ static const char classify_glsl[] =
     "        ivec2 px = ivec2(tile * 8u) + ivec2(x, y);\n"
     "        if (any(greaterThanEqual(px, size))) continue;\n"
     "        float d = texelFetch(u_depth, px, 0).r;\n"
-    "        if (d == u_frame.screen.z) continue;\n"
+    "        if (d == u_frame.screen.z) {   /* empty: the background */\n"
+    "            imageStore(u_out, px, u_push.patch_xz);\n"
+    "            continue;\n"
+    "        }\n"
     "        vec2 ndc = (vec2(px) + 0.5) / u_frame.screen.xy * 2.0 - 1.0;\n"
     "        vec4 p = u_frame.inv_view_proj * vec4(ndc, d, 1.0);\n"
     "        vec2 local = p.xz / p.w + u_frame.camera.xz;\n"
@@ -132,7 +140,7 @@ static const char classify_glsl[] =
     "    }\n"
     "    if (!any_cell) return;   /* sky tile: skipped */\n"
     "    uint pick = u_info.ncombos;   /* the über-shader */\n"
-    "    if (u_info.force_uber == 0u && u_info.words > 0u) {\n"
+    "    if (u_push.info.x == 0u && u_info.words > 0u) {\n"
     "        for (uint i = 0u; i < u_info.ncombos; i++) {\n"
     "            uint c = u_info.data[i];\n"
     "            bool covers = true;\n"
@@ -273,16 +281,19 @@ static bool fill_info(rt_screen *s, rt_error *e)
     size_t n = (size_t)p->ncombos;
     size_t cells = (size_t)leaf->width * (size_t)leaf->height;
     size_t words = 8 + n + n * (size_t)s->words + cells;
-    if (!rt_buffer_create(s->d, words * 4, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, true, &s->info, e))
+    rt_buffer staging;
+    if (!rt_buffer_create(s->d, words * 4, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT |
+                          VK_BUFFER_USAGE_TRANSFER_DST_BIT, false, &s->info, e) ||
+        !rt_buffer_create(s->d, words * 4, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, true, &staging, e))
         return false;
-    uint32_t *u = s->info.map;
+    uint32_t *u = staging.map;
     memset(u, 0, words * 4);
     u[0] = (uint32_t)n;
     u[1] = (uint32_t)s->words;
     u[2] = (uint32_t)leaf->width;
     u[3] = (uint32_t)leaf->height;
     u[4] = (uint32_t)s->ntiles;
-    u[5] = 0;
+    u[5] = 0;   /* unused */
     u[6] = (uint32_t)p->cell_texels;
     u[7] = (uint32_t)s->tiles_x;
     uint32_t *order = u + 8, *masks = order + n, *map = masks + n * (size_t)s->words;
@@ -297,7 +308,15 @@ static bool fill_info(rt_screen *s, rt_error *e)
         }
     for (size_t i = 0; i < cells; i++)
         map[i] = leaf->ids[i];
-    return true;
+    VkCommandBuffer cb;
+    bool ok = rt_oneshot_begin(s->d, &cb, e);
+    if (ok) {
+        VkBufferCopy c = { 0, 0, words * 4 };
+        vkCmdCopyBuffer(cb, staging.buf, s->info.buf, 1, &c);
+        ok = rt_oneshot_end(s->d, cb, e);
+    }
+    rt_buffer_destroy(s->d, &staging);
+    return ok;
 }
 
 /* The maximum-height pyramid of the ray caster (raycast_glsl), metres. */
@@ -599,11 +618,14 @@ bool rt_screen_create(rt_device *d, const rt_pack *p, const rt_pipelines *pl,
     const VkBufferUsageFlags sb = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
     if (!rt_buffer_create(d, list_bytes, sb, false, &s->tiles, e) ||
         !rt_buffer_create(d, (VkDeviceSize)s->nlists * 12,
-                          sb | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
-                          true, &s->args, e) ||
+                          sb | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT |
+                          VK_BUFFER_USAGE_TRANSFER_SRC_BIT, false, &s->args, e) ||
         !rt_buffer_create(d, (VkDeviceSize)s->nlists * 12, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, true,
                           &s->args_reset, e) ||
-        !rt_buffer_create(d, 16, sb | VK_BUFFER_USAGE_TRANSFER_DST_BIT, true, &s->counters, e) ||
+        !rt_buffer_create(d, 16, sb | VK_BUFFER_USAGE_TRANSFER_DST_BIT |
+                          VK_BUFFER_USAGE_TRANSFER_SRC_BIT, false, &s->counters, e) ||
+        !rt_buffer_create(d, (VkDeviceSize)s->nlists * 12 + 16, VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                          true, &s->readback, e) ||
         !fill_info(s, e))
         return false;
     uint32_t *reset = s->args_reset.map;
@@ -612,8 +634,7 @@ bool rt_screen_create(rt_device *d, const rt_pack *p, const rt_pipelines *pl,
         reset[3 * k + 1] = 1;
         reset[3 * k + 2] = 1;
     }
-    memcpy(s->args.map, reset, (size_t)s->nlists * 12);
-    memset(s->counters.map, 0, 16);
+    memset(s->readback.map, 0, (size_t)s->nlists * 12 + 16);
     if (raycast &&
         (!make_maxmip(s, e) ||
          !rt_image_create(d, color->width, color->height, 1, false, 1, VK_FORMAT_R32_SFLOAT,
@@ -678,6 +699,7 @@ void rt_screen_destroy(rt_screen *s)
         rt_buffer_destroy(d, &s->args);
         rt_buffer_destroy(d, &s->args_reset);
         rt_buffer_destroy(d, &s->counters);
+        rt_buffer_destroy(d, &s->readback);
     }
     free(s->dispatched);
     free(s);
@@ -729,22 +751,22 @@ void rt_screen_begin(rt_screen *s, VkCommandBuffer cb, bool count)
 void rt_screen_classify(rt_screen *s, VkCommandBuffer cb, VkDescriptorSet set0,
                         const float clear[4], bool force_uber, int *binds)
 {
-    ((uint32_t *)s->info.map)[5] = force_uber || s->words == 0;
-    /* the background, then the colour image for storage writes */
+    /* the colour image for storage writes: the classification writes the
+     * background of empty pixels, shading the terrain's */
     rt_cmd_image_barrier(cb, s->color_img, 0, 1, 1, VK_IMAGE_LAYOUT_UNDEFINED,
-                         VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 0, VK_ACCESS_TRANSFER_WRITE_BIT,
-                         VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT);
-    VkClearColorValue cv = { { clear[0], clear[1], clear[2], 1 } };
-    VkImageSubresourceRange range = { VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1 };
-    vkCmdClearColorImage(cb, s->color_img, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, &cv, 1, &range);
-    rt_cmd_image_barrier(cb, s->color_img, 0, 1, 1, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
-                         VK_IMAGE_LAYOUT_GENERAL, VK_ACCESS_TRANSFER_WRITE_BIT,
-                         VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
-                         VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT);
-
+                         VK_IMAGE_LAYOUT_GENERAL, 0, VK_ACCESS_SHADER_WRITE_BIT,
+                         VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT);
     vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, s->classify);
     vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, s->layout, 0, 1, &set0, 0, NULL);
     vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, s->layout, 2, 1, &s->set, 0, NULL);
+    /* abi.h's push block, read as: patch_xz the background colour,
+     * info.x 1 to send every tile to the über-shader */
+    splat_push push;
+    memset(&push, 0, sizeof push);
+    memcpy(push.patch_xz, clear, 3 * sizeof(float));
+    push.patch_xz[3] = 1.0f;
+    push.info[0] = force_uber || s->words == 0;
+    vkCmdPushConstants(cb, s->layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof push, &push);
     vkCmdDispatch(cb, (uint32_t)(s->ntiles + 63) / 64, 1, 1);
     (*binds)++;
     VkMemoryBarrier mb = {
@@ -795,19 +817,31 @@ bool rt_screen_dispatch(rt_screen *s, VkCommandBuffer cb, rt_pipelines *pl,
                          VK_ACCESS_TRANSFER_READ_BIT | VK_ACCESS_SHADER_READ_BIT,
                          VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
                          VK_PIPELINE_STAGE_TRANSFER_BIT | VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT);
-    VkMemoryBarrier hb = {
+    /* the list counts and counters back to the host */
+    VkMemoryBarrier tb = {
         .sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER,
         .srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT,
+        .dstAccessMask = VK_ACCESS_TRANSFER_READ_BIT,
+    };
+    vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
+                         0, 1, &tb, 0, NULL, 0, NULL);
+    VkBufferCopy ca = { 0, 0, (VkDeviceSize)s->nlists * 12 };
+    VkBufferCopy cc = { 0, (VkDeviceSize)s->nlists * 12, 16 };
+    vkCmdCopyBuffer(cb, s->args.buf, s->readback.buf, 1, &ca);
+    vkCmdCopyBuffer(cb, s->counters.buf, s->readback.buf, 1, &cc);
+    VkMemoryBarrier hb = {
+        .sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER,
+        .srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT,
         .dstAccessMask = VK_ACCESS_HOST_READ_BIT,
     };
-    vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_HOST_BIT,
+    vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_HOST_BIT,
                          0, 1, &hb, 0, NULL, 0, NULL);
     return true;
 }
 
 int rt_screen_missing(rt_screen *s, rt_pipelines *pl, unsigned variant, rt_error *e)
 {
-    const uint32_t *args = s->args.map;
+    const uint32_t *args = s->readback.map;
     int made = 0;
     for (int k = 0; k < s->nlists; k++) {
         if (args[3 * k] == 0 || s->dispatched[k] == variant + 1)
@@ -822,7 +856,7 @@ int rt_screen_missing(rt_screen *s, rt_pipelines *pl, unsigned variant, rt_error
 
 void rt_screen_read_stats(const rt_screen *s, rt_screen_stats *st)
 {
-    const uint32_t *args = s->args.map, *c = s->counters.map;
+    const uint32_t *args = s->readback.map, *c = args + 3 * s->nlists;
     memset(st, 0, sizeof *st);
     st->tiles_total = s->ntiles;
     for (int k = 0; k < s->nlists; k++) {
