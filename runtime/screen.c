@@ -167,7 +167,7 @@ static const char classify_glsl[] =
  * that classification and shading read in place of the geometry pass's
  * depth.  Level 0 holds, per quad, the largest texel of the 3x3 around
  * it (a bound of its four bilinear corners); each level the largest of
- * four; the grid is padded to a multiple of 2^(levels-1) so every level
+ * four, 8 levels up; the grid is padded to a multiple of 256 so every level
  * halves exactly (Vulkan's mip sizes round down). */
 static const char raycast_glsl[] =
     "layout(local_size_x = 8, local_size_y = 8) in;\n"
@@ -323,7 +323,7 @@ static bool fill_info(rt_screen *s, rt_error *e)
 static bool make_maxmip(rt_screen *s, rt_error *e)
 {
     const rt_pack *p = s->p;
-    int W = p->hf_width, H = p->hf_height, K = 6;
+    int W = p->hf_width, H = p->hf_height, K = 8;
     while (K > 0 && ((W >> K) < 1 || (H >> K) < 1))
         K--;
     int PW = ((W + (1 << K) - 1) >> K) << K, PH = ((H + (1 << K) - 1) >> K) << K;

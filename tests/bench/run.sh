@@ -302,6 +302,19 @@ for s in $SCENES; do
         done
     done
 done
+# (e) screen-space shading against forward on the same frames: the
+# runtime's choice of depth for the device (screen), both depths, and the
+# über-shader on every tile (the classification's soundness reference)
+for s in $SCENES; do
+    for size in $SIZES; do
+        for p in $PATHS; do
+            [ "$size" = 1920x1080 ] && [ "$MODE" = full ] && [ "$p" != ground ] && continue
+            render shading "$s" "$p" "$size" forward=composite screen=screen \
+                screen_raster=screen_raster screen_raycast=screen_raycast \
+                screen_uber=screen_uber
+        done
+    done
+done
 if [ "$MODE" = smoke ]; then
     stoch=$(comp_pack minimal stochastic_select)
     render knobs minimal ground 320x180 composite=composite fp16=fp16 sobel=sobel \

@@ -90,6 +90,48 @@ awk -F, '
     }' "$O/render.csv" | sort
 echo
 
+echo "## Screen-space shading (group shading: forward vs screen, same frames)"
+echo
+echo "Per pass: GPU medians of the depth pass (geometry or ray cast), the classification and the compute shading.  Layers per pixel evaluated / needed and samples per pixel come from one counting frame (abi.h SPLAT_COUNT) after the timed ones; efficiency = needed / evaluated.  Error: against the forward image of the same frame."
+echo
+echo "| scene | path | size | variant | GPU ms | speed-up vs forward | depth ms | classify ms | shade ms | tiles (uber) | layers eval / needed | efficiency | samples/px | PSNR dB |"
+echo "|---|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
+awk -F, 'NR > 1 && $1 == "shading" {
+        k = $3 "|" $4 "|" $5 "x" $6
+        if ($8 == "composite") { fwd[k] = $12; printf "| %s | %s | %sx%s | %s | %.3f | 1.00 | | | | | | | | |\n", $3, $4, $5, $6, $7, $12; next }
+        eff = $31 > 0 ? 100 * $32 / $31 : 0
+        printf "| %s | %s | %sx%s | %s | %.3f | %.2fx | %.3f | %.3f | %.3f | %d (%d) | %.2f / %.2f | %.0f %% | %.2f | %.1f |\n",
+            $3, $4, $5, $6, $7, $12, (k in fwd && $12 > 0 ? fwd[k] / $12 : 0), $26, $27, $28, $29, $30, $31, $32, eff, $33, $21 }' "$O/render.csv"
+echo
+echo "| target | measured | verdict |"
+echo "|---|---|---|"
+awk -F, -v dev="$dev" '
+    function verdict(ok) { return ok ? "MET" : "**MISSED**" }
+    NR > 1 && $1 == "shading" {
+        k = $3 "|" $4 "|" $5 "x" $6; t[k, $7] = $12; keys[k] = 1
+        if ($7 == "screen") { ev[k] = $31; nd[k] = $32 }
+        if ($7 == "screen_uber") su[k] = $12
+    }
+    END {
+        for (k in keys) {
+            split(k, a, "|"); f = t[k, "forward"]; s = t[k, "screen"]
+            if (f <= 0 || s <= 0) continue
+            gpu = dev !~ /llvmpipe/
+            if (a[1] == "colorado" && a[3] == "1920x1080" && gpu) {
+                printf "| shading target: colorado 1920x1080 screen >= 3x faster than forward (%s) | %.2fx (%.3f vs %.3f ms) | %s |\n", a[2], f / s, s, f, verdict(f / s >= 3)
+                printf "| shading target: colorado 1920x1080 screen <= 1.0 ms GPU (%s) | %.3f ms | %s |\n", a[2], s, verdict(s <= 1.0)
+            }
+            if (a[1] == "colorado" && a[3] == "1280x720" && !gpu) {
+                if (a[2] != "ground")
+                    printf "| shading target: lavapipe colorado 1280x720 screen >= 1.5x forward (%s) | %.2fx | %s |\n", a[2], f / s, verdict(f / s >= 1.5)
+                printf "| shading target: lavapipe colorado 1280x720 >= 10 fps, screen (%s) | %.1f fps | %s |\n", a[2], 1000 / s, verdict(1000 / s >= 10)
+            }
+            if (a[1] == "colorado" && a[2] != "ground" && ev[k] > 0)
+                printf "| shading target: efficiency >= 80 %% (colorado %s %s) | %.0f %% (%.2f of %.2f layers) | %s |\n", a[2], a[3], 100 * nd[k] / ev[k], nd[k], ev[k], verdict(nd[k] / ev[k] >= 0.8)
+        }
+    }' "$O/render.csv" | sort
+echo
+
 echo "## Renders: time and error per variant (side by side, same frames)"
 echo
 echo "Error: lit RGBA32F image against the group's reference variant (first of the group) on every frame of the path; max and mean |difference| over RGB, PSNR with peak 1; nonfinite = NaN/Inf values. Ratio = variant GPU median / reference GPU median."
