@@ -47,9 +47,13 @@ variant dshader dbase <<EOF2
 "$PE" set $M params.0.default '[0.5, 0, 0, 0]'
 EOF2
 cmp -s "$OUT/base/painted.sparse" "$OUT/mask/painted.sparse" && fail "the mask variant changed nothing"
-"$TR" "$OUT/base" "$OUT/heights=the heightfield's contents changed" \
-    "$OUT/scale=max_height" "$OUT/texture=a texture" "$OUT/sampler=a texture" \
-    "$OUT/mask=a painted mask changed" "$OUT/params=ok" "$OUT/shader=ok" || fail "minimal"
-"$TR" "$OUT/dbase" "$OUT/area=the destructible area changed" "$OUT/dshader=ok" ||
-    fail "destruction"
+# both shading paths (--screen: the screen-space path's tile classification)
+for path in "" --screen; do
+    "$TR" $path "$OUT/base" "$OUT/heights=the heightfield's contents changed" \
+        "$OUT/scale=max_height" "$OUT/texture=a texture" "$OUT/sampler=a texture" \
+        "$OUT/mask=a painted mask changed" "$OUT/params=ok" "$OUT/shader=ok" ||
+        fail "minimal $path"
+    "$TR" $path "$OUT/dbase" "$OUT/area=the destructible area changed" "$OUT/dshader=ok" ||
+        fail "destruction $path"
+done
 echo ok

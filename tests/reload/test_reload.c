@@ -5,8 +5,11 @@
  * variants whose PHRASE is "ok" (shader or parameter changes), take it and
  * render a frame.  SPLAT_VALIDATE=1: zero validation messages.
  *
- *   test_reload BASE VARIANT=PHRASE ...
- */
+ *   test_reload [--screen] BASE VARIANT=PHRASE ...
+ *
+ * --screen: the renderer draws with the screen-space path (its tile
+ * classification holds the pack's combination map, which a reload must
+ * replace too). */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -25,8 +28,14 @@ static void check(bool ok, const char *what, const char *detail)
 
 int main(int argc, char **argv)
 {
+    rt_render_desc rd = { .width = 64, .height = 48 };
+    if (argc > 1 && !strcmp(argv[1], "--screen")) {
+        rd.shading = RT_SHADING_SCREEN;
+        argv++;
+        argc--;
+    }
     if (argc < 3) {
-        fprintf(stderr, "usage: test_reload BASE VARIANT=PHRASE ...\n");
+        fprintf(stderr, "usage: test_reload [--screen] BASE VARIANT=PHRASE ...\n");
         return 2;
     }
     rt_error e = { 0 };
@@ -37,7 +46,6 @@ int main(int argc, char **argv)
         fprintf(stderr, "FAIL: setup: %s\n", e.msg);
         return 1;
     }
-    rt_render_desc rd = { .width = 64, .height = 48 };
     rt_camera cam;
     rt_default_camera(&base, &cam);
     if (!rt_renderer_create(&dev, &base, &rd, &r, &e) || !rt_renderer_frame(r, &cam, NULL, &e)) {
@@ -67,7 +75,9 @@ int main(int argc, char **argv)
         printf("%s: %s\n", dir, ok ? "reloaded" : e.msg);
         if (!strcmp(phrase, "ok")) {
             check(ok, dir, "a shader-only change was refused");
-            check(rt_renderer_frame(r, &cam, NULL, &e), dir, e.msg);
+            rt_frame_stats st;
+            check(rt_renderer_frame(r, &cam, &st, &e), dir, e.msg);
+            check(st.screen == (rd.shading == RT_SHADING_SCREEN), dir, "drawn by the wrong path");
         } else {
             check(!ok && e.id == RT_E_RELOAD, dir, "reloaded with changed data");
             check(!ok && e.msg && strstr(e.msg, phrase), dir, "the message does not name the input");

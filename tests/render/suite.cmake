@@ -98,6 +98,15 @@ if(TARGET splatrt AND TARGET splatview)
                 ${RENDER_OUT}/${pk} ${RENDER_OUT}/out ${kind} ${presets})
       set_tests_properties(render.screen_${pk} PROPERTIES LABELS render TIMEOUT 900
         FIXTURES_REQUIRED ${pk}_pack ENVIRONMENT "SPLAT_VALIDATE=1")
+      if(pk STREQUAL "minimal")   # the screen path under ASan + UBSan too
+        set_property(TEST render.screen_${pk} APPEND PROPERTY LABELS asan)
+      endif()
     endforeach()
+    # craters on the screen path (tests/destruction's pack)
+    add_test(NAME render.screen_destruction
+      COMMAND sh ${RENDER_DIR}/screen.sh $<TARGET_FILE:splatview> $<TARGET_FILE:imgcheck>
+              ${CMAKE_BINARY_DIR}/tests/destruction/pack ${RENDER_OUT}/out textured above)
+    set_tests_properties(render.screen_destruction PROPERTIES LABELS render TIMEOUT 600
+      FIXTURES_REQUIRED destruction_pack ENVIRONMENT "SPLAT_VALIDATE=1;CRATER=60")
   endif()
 endif()
