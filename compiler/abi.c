@@ -34,6 +34,8 @@
     "    uint layers_evaluated;\n"                                          \
     "    uint layers_needed;\n"                                             \
     "    uint samples;\n"                                                   \
+    "    uint branches;\n"                                                  \
+    "    uint branches_uniform;\n"                                          \
     "} u_counters;\n"                                                       \
     "#endif\n"                                                              \
     "vec3 v_rel;      /* camera-relative position (m), from depth */\n"     \
@@ -44,7 +46,8 @@
     "vec3 splat_nrm;  /* the terrain normal (Listing 1) at v_uv */\n"      \
     "vec3 splat_dpdx; /* position one pixel right, minus the position */\n" \
     "vec3 splat_dpdy; /* position one pixel down, minus the position */\n"  \
-    "uint splat_n_evaluated = 0u, splat_n_needed = 0u, splat_n_samples = 0u;\n"
+    "uint splat_n_evaluated = 0u, splat_n_needed = 0u, splat_n_samples = 0u;\n" \
+    "uint splat_n_branches = 0u, splat_n_uniform = 0u;\n"
 
 /* After splat_finish: depth reconstruction, FC5's position derivatives,
  * the real main() around the composite's (renamed splat_main).
@@ -93,6 +96,8 @@
     "    atomicAdd(u_counters.layers_evaluated, splat_n_evaluated);\n"      \
     "    atomicAdd(u_counters.layers_needed, splat_n_needed);\n"            \
     "    atomicAdd(u_counters.samples, splat_n_samples);\n"                 \
+    "    atomicAdd(u_counters.branches, splat_n_branches);\n"               \
+    "    atomicAdd(u_counters.branches_uniform, splat_n_uniform);\n"        \
     "#endif\n"                                                              \
     "    imageStore(u_out, splat_pixel, o_color);\n"                        \
     "}\n"                                                                   \
@@ -222,7 +227,12 @@ const char SPLAT_GLSL_PRELUDE[] =
      * quad-uniform control flow by induction.  Pixels with weight 0 that
      * run the branch add 0 * surface. */
     "#if defined(SPLAT_COMPUTE) && defined(SPLAT_COUNT)\n"
-    "bool splat_quad_any(bool c) { return subgroupAny(c); }\n"
+    "bool splat_quad_any(bool c) {\n"
+    "    bool a = subgroupAny(c);\n"
+    "    splat_n_branches += 1u;\n"
+    "    if (a == subgroupAll(c)) splat_n_uniform += 1u;   /* the subgroup agreed */\n"
+    "    return a;\n"
+    "}\n"
     "#elif defined(SPLAT_COMPUTE)\n"
     "bool splat_quad_any(bool c) { return c; }\n"
     "#else\n"

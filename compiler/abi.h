@@ -271,6 +271,8 @@ typedef struct splat_counters {
     uint32_t layers_evaluated; /* layers whose surface block ran              */
     uint32_t layers_needed;    /* layers whose weight is > 0 at the pixel     */
     uint32_t samples;          /* material texture samples taken              */
+    uint32_t branches;         /* dynamic branches (splat_quad_any) reached   */
+    uint32_t branches_uniform; /* of them, where the whole subgroup agreed    */
 } splat_counters;
 
 /* Push constants, vertex + fragment. */

@@ -622,10 +622,10 @@ bool rt_screen_create(rt_device *d, const rt_pack *p, const rt_pipelines *pl,
                           VK_BUFFER_USAGE_TRANSFER_SRC_BIT, false, &s->args, e) ||
         !rt_buffer_create(d, (VkDeviceSize)s->nlists * 12, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, true,
                           &s->args_reset, e) ||
-        !rt_buffer_create(d, 16, sb | VK_BUFFER_USAGE_TRANSFER_DST_BIT |
+        !rt_buffer_create(d, sizeof(splat_counters), sb | VK_BUFFER_USAGE_TRANSFER_DST_BIT |
                           VK_BUFFER_USAGE_TRANSFER_SRC_BIT, false, &s->counters, e) ||
-        !rt_buffer_create(d, (VkDeviceSize)s->nlists * 12 + 16, VK_BUFFER_USAGE_TRANSFER_DST_BIT,
-                          true, &s->readback, e) ||
+        !rt_buffer_create(d, (VkDeviceSize)s->nlists * 12 + sizeof(splat_counters),
+                          VK_BUFFER_USAGE_TRANSFER_DST_BIT, true, &s->readback, e) ||
         !fill_info(s, e))
         return false;
     uint32_t *reset = s->args_reset.map;
@@ -634,7 +634,7 @@ bool rt_screen_create(rt_device *d, const rt_pack *p, const rt_pipelines *pl,
         reset[3 * k + 1] = 1;
         reset[3 * k + 2] = 1;
     }
-    memset(s->readback.map, 0, (size_t)s->nlists * 12 + 16);
+    memset(s->readback.map, 0, (size_t)s->nlists * 12 + sizeof(splat_counters));
     if (raycast &&
         (!make_maxmip(s, e) ||
          !rt_image_create(d, color->width, color->height, 1, false, 1, VK_FORMAT_R32_SFLOAT,
@@ -738,7 +738,7 @@ void rt_screen_begin(rt_screen *s, VkCommandBuffer cb, bool count)
     VkBufferCopy c = { 0, 0, (VkDeviceSize)s->nlists * 12 };
     vkCmdCopyBuffer(cb, s->args_reset.buf, s->args.buf, 1, &c);
     if (count)
-        vkCmdFillBuffer(cb, s->counters.buf, 0, 16, 0);
+        vkCmdFillBuffer(cb, s->counters.buf, 0, sizeof(splat_counters), 0);
     VkMemoryBarrier mb = {
         .sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER,
         .srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT,
@@ -826,7 +826,7 @@ bool rt_screen_dispatch(rt_screen *s, VkCommandBuffer cb, rt_pipelines *pl,
     vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
                          0, 1, &tb, 0, NULL, 0, NULL);
     VkBufferCopy ca = { 0, 0, (VkDeviceSize)s->nlists * 12 };
-    VkBufferCopy cc = { 0, (VkDeviceSize)s->nlists * 12, 16 };
+    VkBufferCopy cc = { 0, (VkDeviceSize)s->nlists * 12, sizeof(splat_counters) };
     vkCmdCopyBuffer(cb, s->args.buf, s->readback.buf, 1, &ca);
     vkCmdCopyBuffer(cb, s->counters.buf, s->readback.buf, 1, &cc);
     VkMemoryBarrier hb = {
@@ -856,7 +856,9 @@ int rt_screen_missing(rt_screen *s, rt_pipelines *pl, unsigned variant, rt_error
 
 void rt_screen_read_stats(const rt_screen *s, rt_screen_stats *st)
 {
-    const uint32_t *args = s->readback.map, *c = args + 3 * s->nlists;
+    const uint32_t *args = s->readback.map;
+    splat_counters c;
+    memcpy(&c, args + 3 * s->nlists, sizeof c);
     memset(st, 0, sizeof *st);
     st->tiles_total = s->ntiles;
     for (int k = 0; k < s->nlists; k++) {
@@ -864,8 +866,10 @@ void rt_screen_read_stats(const rt_screen *s, rt_screen_stats *st)
         st->lists += args[3 * k] > 0;
     }
     st->tiles_uber = (int)args[3 * (s->nlists - 1)];
-    st->pixels = c[0];
-    st->layers_evaluated = c[1];
-    st->layers_needed = c[2];
-    st->samples = c[3];
+    st->pixels = c.pixels;
+    st->layers_evaluated = c.layers_evaluated;
+    st->layers_needed = c.layers_needed;
+    st->samples = c.samples;
+    st->branches = c.branches;
+    st->branches_uniform = c.branches_uniform;
 }

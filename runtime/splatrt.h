@@ -599,6 +599,7 @@ typedef struct rt_screen_stats {
     int      tiles_uber;          /* tiles no combination covered            */
     int      lists;               /* combinations (and über) with tiles      */
     uint32_t pixels, layers_evaluated, layers_needed, samples;  /* counting */
+    uint32_t branches, branches_uniform;   /* splat_counters (abi.h)         */
 } rt_screen_stats;
 
 /* Buffers, the depth-only pass over `depth`, the classification pipeline;

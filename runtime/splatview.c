@@ -499,6 +499,9 @@ static int headless(const opts *o)
                    cs.tiles.layers_evaluated
                        ? 100.0 * cs.tiles.layers_needed / cs.tiles.layers_evaluated : 100.0);
             printf("texture samples per pixel: %.3f\n", cs.tiles.samples / px);
+            printf("dynamic branches uniform over the subgroup: %.1f %% of %.2f per pixel\n",
+                   cs.tiles.branches ? 100.0 * cs.tiles.branches_uniform / cs.tiles.branches : 100.0,
+                   cs.tiles.branches / px);
         }
         printf("shading: %s\n", st.screen ? "screen" : "forward");
         rt_painted_print_stats(&pack, stdout);

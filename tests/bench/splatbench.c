@@ -654,7 +654,7 @@ static int cmd_render(int argc, char **argv)
                      "gpu_med_ms,gpu_p10_ms,gpu_p90_ms,cpu_med_ms,select_med_ms,patches,"
                      "pipelines,max_abs,mean_abs,psnr_db,nonfinite,rss_delta_mb,reference,view,"
                      "geometry_ms,classify_ms,shade_ms,tiles,tiles_uber,layers_evaluated,"
-                     "layers_needed,samples_per_px\n");
+                     "layers_needed,samples_per_px,branches_uniform_pct\n");
     /* the device name in CSV: its commas become ';' */
     char devname[VK_MAX_PHYSICAL_DEVICE_NAME_SIZE];
     snprintf(devname, sizeof devname, "%s", dev.props.deviceName);
@@ -673,7 +673,7 @@ static int cmd_render(int argc, char **argv)
         double px = v[i].tiles.pixels ? (double)v[i].tiles.pixels : 1.0;
         const char *pk = strrchr(v[i].pack_dir, '/');
         fprintf(out, "\"%s\",%s,%s,%d,%d,%s,%s,%s,%g,%d,%.3f,%.3f,%.3f,%.3f,%.4f,%d,%d,"
-                     "%.6g,%.6g,%.2f,%ld,%.1f,%s,%s,%.3f,%.3f,%.3f,%d,%d,%.4f,%.4f,%.3f\n",
+                     "%.6g,%.6g,%.2f,%ld,%.1f,%s,%s,%.3f,%.3f,%.3f,%d,%d,%.4f,%.4f,%.3f,%.1f\n",
                 devname, scene ? scene : v[i].base->name, pd.name, width, height,
                 v[i].label, kind_names[v[i].k], pk ? pk + 1 : v[i].pack_dir,
                 v[i].lod > 0 ? v[i].lod : 3.0, frames, gm, g10, g90, cm, sm,
@@ -682,7 +682,9 @@ static int cmd_render(int argc, char **argv)
                 err_psnr(&v[i].err), v[i].err.nonfinite, v[i].rss_delta, v[ref].label,
                 view_name, pm[0], pm[1], pm[2], v[i].tiles.tiles, v[i].tiles.tiles_uber,
                 v[i].tiles.layers_evaluated / px, v[i].tiles.layers_needed / px,
-                v[i].tiles.samples / px);
+                v[i].tiles.samples / px,
+                v[i].tiles.branches ? 100.0 * v[i].tiles.branches_uniform / v[i].tiles.branches
+                                    : 100.0);
     }
     if (csv)
         fclose(out);

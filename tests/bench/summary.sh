@@ -94,14 +94,14 @@ echo "## Screen-space shading (group shading: forward vs screen, same frames)"
 echo
 echo "Per pass: GPU medians of the depth pass (geometry or ray cast), the classification and the compute shading.  Layers per pixel evaluated / needed and samples per pixel come from one counting frame (abi.h SPLAT_COUNT) after the timed ones; efficiency = needed / evaluated.  Error: against the forward image of the same frame."
 echo
-echo "| scene | path | size | variant | GPU ms | speed-up vs forward | depth ms | classify ms | shade ms | tiles (uber) | layers eval / needed | efficiency | samples/px | PSNR dB |"
-echo "|---|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
+echo "| scene | path | size | variant | GPU ms | speed-up vs forward | depth ms | classify ms | shade ms | tiles (uber) | layers eval / needed | efficiency | samples/px | branches subgroup-uniform | PSNR dB |"
+echo "|---|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
 awk -F, 'NR > 1 && $1 == "shading" {
         k = $3 "|" $4 "|" $5 "x" $6
-        if ($8 == "composite") { fwd[k] = $12; printf "| %s | %s | %sx%s | %s | %.3f | 1.00 | | | | | | | | |\n", $3, $4, $5, $6, $7, $12; next }
+        if ($8 == "composite") { fwd[k] = $12; printf "| %s | %s | %sx%s | %s | %.3f | 1.00 | | | | | | | | | |\n", $3, $4, $5, $6, $7, $12; next }
         eff = $31 > 0 ? 100 * $32 / $31 : 0
-        printf "| %s | %s | %sx%s | %s | %.3f | %.2fx | %.3f | %.3f | %.3f | %d (%d) | %.2f / %.2f | %.0f %% | %.2f | %.1f |\n",
-            $3, $4, $5, $6, $7, $12, (k in fwd && $12 > 0 ? fwd[k] / $12 : 0), $26, $27, $28, $29, $30, $31, $32, eff, $33, $21 }' "$O/render.csv"
+        printf "| %s | %s | %sx%s | %s | %.3f | %.2fx | %.3f | %.3f | %.3f | %d (%d) | %.2f / %.2f | %.0f %% | %.2f | %.0f %% | %.1f |\n",
+            $3, $4, $5, $6, $7, $12, (k in fwd && $12 > 0 ? fwd[k] / $12 : 0), $26, $27, $28, $29, $30, $31, $32, eff, $33, $34, $21 }' "$O/render.csv"
 echo
 echo "| target | measured | verdict |"
 echo "|---|---|---|"
