@@ -24,6 +24,31 @@ do for [f in system("ls knob_*.dat 2>/dev/null")] {
     unset logscale y
 }
 
+if (system("test -s shading.dat && echo y") eq "y") {
+    set output "shading.png"
+    set key inside top right
+    unset xlabel
+    set title "Screen-space shading: forward GPU ms beside the screen path's passes (same frames)"
+    set style data histograms
+    set style histogram rowstacked
+    set style fill solid 0.8 border -1
+    set boxwidth 0.4
+    set xtics rotate by -30
+    set ylabel "GPU ms per frame"
+    set yrange [0:*]
+    plot "shading.dat" using 2:xtic(1) title "forward" lc rgb "#999999", \
+         newhistogram "" at 0.45, \
+         "" using 3 title "screen: depth" lc rgb "#1f77b4", \
+         "" using 4 title "classification" lc rgb "#ff7f0e", \
+         "" using 5 title "shading" lc rgb "#2ca02c", \
+         "" using 6 title "rest (barriers, copies)" lc rgb "#d62728"
+    set style data points
+    set style fill empty
+    set xtics norotate
+    set yrange [*:*]
+    set key outside right top
+}
+
 if (system("test -s ratios.dat && echo y") eq "y") {
     set output "ratios.png"
     set key inside top right

@@ -433,6 +433,13 @@ awk -F, 'NR > 1 && $1 == "main" { k = $3 "-" $4 "-" $5 "x" $6; t[k, $8] = $12; k
         printf "%s %.3f %.3f %.3f\n", k, t[k, "multipass"] / t[k, "composite"],
                t[k, "flat"] / t[k, "composite"], t[k, "uber"] / t[k, "composite"] }' \
     "$OUT/render.csv" | sort > "$OUT/ratios.dat"
+# screen-space shading: forward's time beside the screen path's passes
+awk -F, 'NR > 1 && $1 == "shading" { k = $3 "-" $4 "-" $5 "x" $6; keys[k] = 1
+        if ($8 == "composite") f[k] = $12
+        if ($8 == "screen") { d[k] = $26; c[k] = $27; s[k] = $28; t[k] = $12 } }
+    END { for (k in keys) if (k in t)
+        printf "%s %.3f %.3f %.3f %.3f %.3f\n", k, f[k], d[k], c[k], s[k], t[k] - d[k] - c[k] - s[k] }' \
+    "$OUT/render.csv" | sort > "$OUT/shading.dat"
 awk -F, 'NR > 1 { print $4, $17, $8 * 10 }' "$OUT/scale_hf.csv" > "$OUT/scale_hf.dat"
 awk -F, 'NR > 1 { print $5, $6, $9, $10, $13 }' "$OUT/scale_mat.csv" > "$OUT/scale_mat.dat"
 if command -v gnuplot >/dev/null 2>&1; then
