@@ -91,7 +91,7 @@
  * Counting variant (SPLAT_COUNT, compute only): not stored in the pack.
  *   The runtime compiles it on first use from the pack's compute GLSL with
  *   `#define SPLAT_COUNT 1` inserted after the #version line (glslang, as
- *   runtime/glsl.c does for its own shaders).  It adds binding 10 and
+ *   runtime/shader_compile.c does for its own).  It adds binding 10 and
  *   atomically adds, per terrain pixel, the fields of splat_counters
  *   below.  Its dynamic branches are subgroup-uniform (splat_quad_any is
  *   subgroupAny, GL_KHR_shader_subgroup_vote): a layer counts as evaluated

@@ -4,6 +4,7 @@
  * the command-line face
  * of splat_build (build.c).  Exit status 0 on success, 1 on input errors,
  * 2 on usage errors. */
+#include "cli.h"
 #include "scene.h"
 #include "util.h"
 

@@ -4,6 +4,7 @@
  *
  * DIR is created if missing.  Same seed and size give the same files.
  */
+#include "cli.h"
 #include "texgen.h"
 
 #include <errno.h>

@@ -16,6 +16,7 @@
  * then in -I folders, $SPLATC_PATH (':'-separated), the current folder and
  * the nearest folder above the input file that has a nodes/ folder (the
  * repository root for files inside it). */
+#include "cli.h"
 #include "ir.h"
 #include "scene.h"
 #include "sg.h"

@@ -357,9 +357,6 @@ typedef struct splat_build_stats {
 bool splat_build(const splat_build_desc *desc, splat_build_stats *stats,
                  sg_diags *d);
 
-/* ---- cli_build.c: `splatc build` (argv[0] is "build") ------------------ */
-
-int  splat_cli_build(int argc, char **argv);
 /* ---- search.c: where imports are found ---------------------------------- */
 
 /* The import search path, the one every entry point uses (splatc's

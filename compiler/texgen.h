@@ -21,7 +21,8 @@
  * vanishes in the distance; picking one texel per 2×2 block keeps the
  * value distribution of the level above).
  *
- * Sections: texgen.c (fields, images, examples, PNG), cli_texgen.c (CLI).
+ * Sections: texgen.c (fields, images, examples, PNG); the CLI command is
+ * cli_texgen.c (cli.h).
  */
 #ifndef SPLAT_TEXGEN_H
 #define SPLAT_TEXGEN_H
@@ -138,11 +139,5 @@ bool texgen_example_image(int i, int size, uint32_t seed, texgen_image *out);
  * textures that do not need them. */
 bool texgen_write_examples(const char *dir, int size, uint32_t seed,
                            bool all_mips, FILE *log, char **err);
-
-/* ---- cli_texgen.c ------------------------------------------------------ */
-
-/* `splatc texgen --out DIR [--seed N] [--size N] [--all-mips]`; returns the
- * exit status (0 ok, 1 error, 2 usage). */
-int splat_cli_texgen(int argc, char **argv);
 
 #endif

@@ -50,11 +50,13 @@ struct rt_screen {
     VkSampler             mip_sampler;       /* every level (texelFetch)      */
     int                   mip_levels;
     bool                  rdepth_ready;      /* in GENERAL layout             */
+    bool                  wide;              /* classification: a workgroup
+                                                per tile (GPUs), else an
+                                                invocation per tile (CPUs)   */
 };
 
 /* The classification shader: SPLAT_GLSL_TERRAIN (frame block) + this. */
 static const char classify_glsl[] =
-    "layout(local_size_x = 64) in;\n"
     "layout(set = 0, binding = 7) uniform sampler2D u_depth;\n"
     "layout(set = 2, binding = 0, std430) readonly buffer cls_info_block {\n"
     "    uint ncombos, words, cells_x, cells_z;\n"
@@ -110,52 +112,83 @@ static const char classify_glsl[] =
     "    u_lists.tiles[list * u_info.ntiles + slot] = entry;\n"
     "}\n"
     "#endif\n"
-    /* one invocation per tile: no shared memory and no barriers, which
-     * CPU drivers (lavapipe) pay for dearly */
+    /* one pixel: the background where empty, else its cell(s) */
+    "void pixel(ivec2 px) {\n"
+    "    float d = texelFetch(u_depth, px, 0).r;\n"
+    "    if (d == u_frame.screen.z) {   /* empty: the background */\n"
+    "        imageStore(u_out, px, u_push.patch_xz);\n"
+    "        return;\n"
+    "    }\n"
+    "    vec2 ndc = (vec2(px) + 0.5) / u_frame.screen.xy * 2.0 - 1.0;\n"
+    "    vec4 p = u_frame.inv_view_proj * vec4(ndc, d, 1.0);\n"
+    "    vec2 local = p.xz / p.w + u_frame.camera.xz;\n"
+    "    vec2 cf = local / u_frame.terrain.xy * u_frame.texel.xy / float(u_info.cell_texels);\n"
+    /* a pixel within 1/64 cell of an edge counts for both cells: the
+     * position from depth is rounded, the analysis is per closed cell */
+    "    ivec2 lo = ivec2(floor(cf - 1.0 / 64.0)), hi = ivec2(floor(cf + 1.0 / 64.0));\n"
+    "    add_cell(lo);\n"
+    "    if (hi.x != lo.x) add_cell(ivec2(hi.x, lo.y));\n"
+    "    if (hi.y != lo.y) add_cell(ivec2(lo.x, hi.y));\n"
+    "    if (hi.x != lo.x && hi.y != lo.y) add_cell(hi);\n"
+    "}\n"
+    /* the cheapest combination whose set covers mask, else the über-shader */
+    "uint pick() {\n"
+    "    if (u_push.info.x != 0u || u_info.words == 0u) return u_info.ncombos;\n"
+    "    for (uint i = 0u; i < u_info.ncombos; i++) {\n"
+    "        uint c = u_info.data[i];\n"
+    "        bool covers = true;\n"
+    "        for (uint w = 0u; w < u_info.words && covers; w++)\n"
+    "            covers = (mask[w] & ~u_info.data[u_info.ncombos + c * u_info.words + w]) == 0u;\n"
+    "        if (covers) return c;\n"
+    "    }\n"
+    "    return u_info.ncombos;\n"
+    "}\n"
+    "#ifdef WIDE\n"
+    /* GPUs: one workgroup per tile, one invocation per pixel; the sets
+     * ORed over each subgroup, then over the workgroup in shared memory */
+    "layout(local_size_x = 64) in;\n"
+    "shared uint s_mask[WORDS];\n"
+    "shared uint s_any;\n"
+    "void main() {\n"
+    "    uint li = gl_LocalInvocationIndex;\n"
+    "    if (li < uint(WORDS)) s_mask[li] = 0u;\n"
+    "    if (li == 0u) s_any = 0u;\n"
+    "    for (int w = 0; w < WORDS; w++) mask[w] = 0u;\n"
+    "    barrier();\n"
+    "    uvec2 tile = gl_WorkGroupID.xy;\n"
+    "    ivec2 px = ivec2(tile * 8u + uvec2(li & 7u, li >> 3u));\n"
+    "    if (all(lessThan(px, ivec2(u_frame.screen.xy)))) pixel(px);\n"
+    "    for (int w = 0; w < WORDS; w++) {\n"
+    "        uint v = subgroupOr(mask[w]);\n"
+    "        if (subgroupElect() && v != 0u) atomicOr(s_mask[w], v);\n"
+    "    }\n"
+    "    if (subgroupAny(any_cell) && subgroupElect()) atomicOr(s_any, 1u);\n"
+    "    barrier();\n"
+    "    if (li != 0u || s_any == 0u) return;   /* sky tile: skipped */\n"
+    "    for (int w = 0; w < WORDS; w++) mask[w] = s_mask[w];\n"
+    "    append(pick(), tile.x | (tile.y << 16u));\n"
+    "}\n"
+    "#else\n"
+    /* CPU drivers (lavapipe): one invocation per tile, no shared memory
+     * and no barriers, which they pay for dearly */
+    "layout(local_size_x = 64) in;\n"
     "void classify(uint t) {\n"
     "    uvec2 tile = uvec2(t % u_info.tiles_x, t / u_info.tiles_x);\n"
     "    for (int w = 0; w < WORDS; w++) mask[w] = 0u;\n"
     "    ivec2 size = ivec2(u_frame.screen.xy);\n"
     "    for (int y = 0; y < 8; y++)\n"
-    "    for (int x = 0; x < 8; x++) {\n"
-    "        ivec2 px = ivec2(tile * 8u) + ivec2(x, y);\n"
-    "        if (any(greaterThanEqual(px, size))) continue;\n"
-    "        float d = texelFetch(u_depth, px, 0).r;\n"
-    "        if (d == u_frame.screen.z) {   /* empty: the background */\n"
-    "            imageStore(u_out, px, u_push.patch_xz);\n"
-    "            continue;\n"
+    "        for (int x = 0; x < 8; x++) {\n"
+    "            ivec2 px = ivec2(tile * 8u) + ivec2(x, y);\n"
+    "            if (all(lessThan(px, size))) pixel(px);\n"
     "        }\n"
-    "        vec2 ndc = (vec2(px) + 0.5) / u_frame.screen.xy * 2.0 - 1.0;\n"
-    "        vec4 p = u_frame.inv_view_proj * vec4(ndc, d, 1.0);\n"
-    "        vec2 local = p.xz / p.w + u_frame.camera.xz;\n"
-    "        vec2 cf = local / u_frame.terrain.xy * u_frame.texel.xy /\n"
-    "                  float(u_info.cell_texels);\n"
-    /* a pixel within 1/64 cell of an edge counts for both cells: the
-     * position from depth is rounded, the analysis is per closed cell */
-    "        ivec2 lo = ivec2(floor(cf - 1.0 / 64.0)), hi = ivec2(floor(cf + 1.0 / 64.0));\n"
-    "        add_cell(lo);\n"
-    "        if (hi.x != lo.x) add_cell(ivec2(hi.x, lo.y));\n"
-    "        if (hi.y != lo.y) add_cell(ivec2(lo.x, hi.y));\n"
-    "        if (hi.x != lo.x && hi.y != lo.y) add_cell(hi);\n"
-    "    }\n"
-    "    if (!any_cell) return;   /* sky tile: skipped */\n"
-    "    uint pick = u_info.ncombos;   /* the über-shader */\n"
-    "    if (u_push.info.x == 0u && u_info.words > 0u) {\n"
-    "        for (uint i = 0u; i < u_info.ncombos; i++) {\n"
-    "            uint c = u_info.data[i];\n"
-    "            bool covers = true;\n"
-    "            for (uint w = 0u; w < u_info.words && covers; w++)\n"
-    "                covers = (mask[w] & ~u_info.data[u_info.ncombos + c * u_info.words + w]) == 0u;\n"
-    "            if (covers) { pick = c; break; }\n"
-    "        }\n"
-    "    }\n"
-    "    append(pick, tile.x | (tile.y << 16u));\n"
+    "    if (any_cell) append(pick(), tile.x | (tile.y << 16u));\n"
     "}\n"
     /* every invocation reaches append's subgroup loop or none past it */
     "void main() {\n"
     "    uint t = gl_GlobalInvocationID.x;\n"
     "    if (t < u_info.ntiles) classify(t);\n"
-    "}\n";
+    "}\n"
+    "#endif\n";
 
 /* Depth by ray casting (Tevs et al. 2008, "Maximum mipmaps"): the ray
  * through each pixel centre walks a pyramid of maximum heights from the
@@ -165,8 +198,9 @@ static const char classify_glsl[] =
  * diagonal from (i, j) to (i+1, j+1): rt_grid_indices).  It writes the
  * reversed-Z depth of the hit, or the clear value 0, into an R32F image
  * that classification and shading read in place of the geometry pass's
- * depth.  Level 0 holds, per quad, the largest texel of the 3x3 around
- * it (a bound of its four bilinear corners); each level the largest of
+ * depth.  Level 0 holds, per quad, the highest of its four corners (plus
+ * a margin for the GPU's rounding; craters only lower the terrain, so the
+ * bound stays valid under destruction); each level the largest of
  * four, 8 levels up; the grid is padded to a multiple of 256 so every level
  * halves exactly (Vulkan's mip sizes round down). */
 static const char raycast_glsl[] =
@@ -319,6 +353,22 @@ static bool fill_info(rt_screen *s, rt_error *e)
     return ok;
 }
 
+/* The mesh's height at corner (x, z) in metres, as the shaders read it:
+ * the heightfield sampled bilinearly at uv = (x / W, z / H), the mean of
+ * the (clamped) texels x-1..x, z-1..z (weights of exactly one half). */
+static double corner_height(const rt_pack *p, int x, int z)
+{
+    int W = p->hf_width, H = p->hf_height;
+    double sum = 0;
+    for (int k = 0; k < 4; k++) {
+        int cx = x - 1 + (k & 1), cz = z - 1 + (k >> 1);
+        cx = cx < 0 ? 0 : cx >= W ? W - 1 : cx;
+        cz = cz < 0 ? 0 : cz >= H ? H - 1 : cz;
+        sum += p->heights[(size_t)cz * (size_t)W + (size_t)cx];
+    }
+    return sum / 4.0 / 65535.0 * p->max_height + p->height_offset;
+}
+
 /* The maximum-height pyramid of the ray caster (raycast_glsl), metres. */
 static bool make_maxmip(rt_screen *s, rt_error *e)
 {
@@ -348,13 +398,8 @@ static bool make_maxmip(rt_screen *s, rt_error *e)
     for (int j = 0; j < PH; j++)
         for (int i = 0; i < PW; i++) {
             double m = -1e30;
-            for (int y = j - 1; y <= j + 1 && i < W && j < H; y++)
-                for (int x = i - 1; x <= i + 1; x++) {
-                    int cx = x < 0 ? 0 : x >= W ? W - 1 : x, cy = y < 0 ? 0 : y >= H ? H - 1 : y;
-                    double h = p->heights[(size_t)cy * (size_t)W + (size_t)cx] / 65535.0 *
-                               p->max_height + p->height_offset;
-                    m = h > m ? h : m;
-                }
+            for (int k = 0; k < 4 && i < W && j < H; k++)
+                m = fmax(m, corner_height(p, i + (k & 1), j + (k >> 1)));
             l0[(size_t)j * (size_t)PW + (size_t)i] = (float)(m > -1e30 ? m + margin : -1e30);
         }
     levels[0] = (const uint8_t *)l0;
@@ -571,12 +616,17 @@ static bool make_compute(rt_screen *s, const rt_pipelines *pl, VkSampler nearest
             .pBufferInfo = i < 3 ? &bi[i] : NULL, .pImageInfo = i >= 3 ? &ii[i - 3] : NULL };
     vkUpdateDescriptorSets(d->dev, nb, w, 0, NULL);
 
-    char head[256];
-    bool agg = can_aggregate(d);
-    snprintf(head, sizeof head, "#define WORDS %d\n%s", s->words > 0 ? s->words : 1,
-             agg ? "#define AGGREGATE 1\n#extension GL_KHR_shader_subgroup_vote : require\n"
+    char head[320];
+    bool sub = can_aggregate(d);
+    s->wide = sub && d->props.deviceType != VK_PHYSICAL_DEVICE_TYPE_CPU;
+    const char *force = getenv("SPLAT_CLASSIFY");   /* tests: wide | tile */
+    if (force && sub)
+        s->wide = !strcmp(force, "wide");
+    snprintf(head, sizeof head, "#define WORDS %d\n%s%s", s->words > 0 ? s->words : 1,
+             sub ? "#extension GL_KHR_shader_subgroup_vote : require\n"
                    "#extension GL_KHR_shader_subgroup_ballot : require\n"
-                   "#extension GL_KHR_shader_subgroup_arithmetic : require\n" : "");
+                   "#extension GL_KHR_shader_subgroup_arithmetic : require\n" : "",
+             s->wide ? "#define WIDE 1\n" : sub ? "#define AGGREGATE 1\n" : "");
     char rhead[128];
     snprintf(rhead, sizeof rhead, "#define TOP %d\n#define PW %u\n#define PH %u\n",
              s->mip_levels - 1, s->maxmip.width, s->maxmip.height);
@@ -767,7 +817,10 @@ void rt_screen_classify(rt_screen *s, VkCommandBuffer cb, VkDescriptorSet set0,
     push.patch_xz[3] = 1.0f;
     push.info[0] = force_uber || s->words == 0;
     vkCmdPushConstants(cb, s->layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof push, &push);
-    vkCmdDispatch(cb, (uint32_t)(s->ntiles + 63) / 64, 1, 1);
+    if (s->wide)
+        vkCmdDispatch(cb, (uint32_t)s->tiles_x, (uint32_t)s->tiles_y, 1);
+    else
+        vkCmdDispatch(cb, (uint32_t)(s->ntiles + 63) / 64, 1, 1);
     (*binds)++;
     VkMemoryBarrier mb = {
         .sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER,

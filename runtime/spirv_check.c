@@ -1,7 +1,7 @@
 /* spirv_check.c — a pack's SPIR-V against what the runtime will bind it to,
  * before any of it reaches the driver.
  *
- * spirv-val (glsl.c) only says a module is well formed.  A well-formed
+ * spirv-val (shader_compile.c) only says a module is well formed.  A well-formed
  * module of the wrong stage, or a fragment shader written for another
  * pipeline layout, still crashes drivers and the validation layer.  So
  * each module is reflected with SPIRV-Cross's C API (Debian

@@ -4,9 +4,9 @@
  * Everything public is prefixed rt_.  Library code never exits: a failing
  * call returns false and fills an rt_error (id + message).
  *
- * Sections, one per source file: errors + device.c, glsl.c, image.c,
- * pack.c, painted.c, terrain.c, quadtree.c, pipelines.c, render.c,
- * destruction.c, viewer.c.
+ * Sections, one per source file: errors + device.c, shader_compile.c,
+ * image.c, pack_load.c, painted_upload.c, terrain_upload.c, quadtree.c,
+ * pipelines.c, screen.c, render.c, destruction.c, viewer.c.
  */
 #ifndef SPLAT_RT_H
 #define SPLAT_RT_H
@@ -151,7 +151,7 @@ bool rt_format_supports(rt_device *d, VkFormat f, VkFormatFeatureFlags need);
 /* The sampler address mode of an ir_wrap (ir.h IR_WRAPS). */
 VkSamplerAddressMode rt_sampler_wrap(int ir_wrap);
 
-/* ---- glsl.c: GLSL -> SPIR-V for the runtime's own shaders -------------- */
+/* ---- shader_compile.c: GLSL -> SPIR-V for the runtime's shaders ------ */
 
 /* stage: VK_SHADER_STAGE_VERTEX_BIT, _FRAGMENT_BIT or _COMPUTE_BIT.
  * *words is malloc'd. */
@@ -255,7 +255,7 @@ void rt_interface_free(rt_interface *in);
 bool rt_spirv_check(const uint32_t *words, size_t nwords, const char *path,
                     const rt_interface *want, rt_error *e);
 
-/* ---- pack.c: reading a shader pack ------------------------------------ */
+/* ---- pack_load.c: reading a shader pack ------------------------------- */
 
 typedef struct rt_spirv {
     char     *path;       /* relative to the pack                          */
@@ -379,7 +379,7 @@ void rt_pack_free(rt_pack *p);
 int  rt_pack_material_find(const rt_pack *p, const char *name);   /* -1 */
 int  rt_pack_camera_find(const rt_pack *p, const char *name);     /* -1 */
 
-/* ---- painted.c: the sparse painted masks ------------------------------ */
+/* ---- painted_upload.c: the sparse painted masks ----------------------- */
 
 /* Parse the `n` bytes of `file` (painted.sparse, read by the pack loader)
  * into p->sparse and check them against the manifest (heightfield size,
@@ -394,7 +394,7 @@ bool rt_painted_upload(rt_device *d, const rt_pack *p, rt_image *atlas,
 /* Print the bytes of each mask representation next to dense. */
 void rt_painted_print_stats(const rt_pack *p, FILE *out);
 
-/* ---- terrain.c: heightfield on the GPU, node height bounds ------------ */
+/* ---- terrain_upload.c: heightfield on the GPU, node height bounds ----- */
 
 /* Min/max height (metres) of every quadtree node, from the texels its
  * vertices can sample (bilinear between texel centres, one texel border). */

@@ -59,6 +59,10 @@ for cam in "$@"; do
         fail "$cam: classification changed the picture (composites vs über-shader)"
 done
 c="--camera-preset $1"
+# the classification GPUs run (a workgroup per tile), forced here: the same
+# picture as the one CPU drivers run (an invocation per tile)
+SPLAT_CLASSIFY=wide run "$PACK" --headless $SIZE $c --shading screen --float-out "$OUT/wide.f32"
+"$IC" diff "$OUT/$1.s.f32" "$OUT/wide.f32" 0 || fail "the two classifications differ"
 run "$PACK" --headless $SIZE $c --shading screen --screen-depth raycast --float-out "$OUT/ray.f32"
 run "$PACK" --headless $SIZE $c --shading screen --screen-depth raster --lod-pixels 0.01 \
     --float-out "$OUT/full.f32"

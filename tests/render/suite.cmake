@@ -102,6 +102,12 @@ if(TARGET splatrt AND TARGET splatview)
         set_property(TEST render.screen_${pk} APPEND PROPERTY LABELS asan)
       endif()
     endforeach()
+    # SPLAT_VALIDATE=1 without the validation layer: a loud failure
+    add_test(NAME render.no_validation_layer
+      COMMAND sh ${RENDER_DIR}/no_layer.sh $<TARGET_FILE:splatview> ${RENDER_OUT}/minimal
+              ${RENDER_OUT}/out)
+    set_tests_properties(render.no_validation_layer PROPERTIES LABELS render
+      FIXTURES_REQUIRED minimal_pack)
     # craters on the screen path (tests/destruction's pack)
     add_test(NAME render.screen_destruction
       COMMAND sh ${RENDER_DIR}/screen.sh $<TARGET_FILE:splatview> $<TARGET_FILE:imgcheck>

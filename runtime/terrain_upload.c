@@ -1,4 +1,4 @@
-/* terrain.c — the heightfield on the GPU (R16_UNORM, fetched by the shared
+/* terrain_upload.c — the heightfield on the GPU (R16_UNORM, fetched by the shared
  * vertex shader) with the other images of the terrain descriptor set, and
  * the min/max height of every quadtree node for frustum culling and LOD
  * distances.
@@ -147,7 +147,7 @@ bool rt_terrain_upload(rt_device *d, const rt_pack *p, rt_terrain_gpu *t,
         !rt_image_upload(d, &t->height, p->heights, (size_t)W * H * 2, e))
         return false;
 
-    /* Painted masks: the sparse quad-tree (painted.c), or dense: one layer
+    /* Painted masks: the sparse quad-tree (painted_upload.c), or dense: one layer
      * each, one zero layer when the scene has none (index and level then
      * 1x1 placeholders for bindings 5 and 6). */
     uint8_t zero8[8] = { 0 };

@@ -1,4 +1,4 @@
-/* glsl.c — the runtime's shader compiler and SPIR-V checks, on top of
+/* shader_compile.c — the runtime's shader compiler and SPIR-V checks, on top of
  * libsplatc's spv.h (glslang's C API in process, SPIRV-Tools validation):
  * the runtime's own shaders (the multi-pass resolve pass, the viewer's tone
  * map) and the test fixtures compile through it, and every module a pack

@@ -1,5 +1,5 @@
-/* painted.c — the painted masks of a sparse pack (compiler/sparse.h) on the
- * GPU: painted.sparse (read by pack.c) parsed with sparse_read and checked against the
+/* painted_upload.c — the painted masks of a sparse pack (compiler/sparse.h) on the
+ * GPU: painted.sparse (read by pack_load.c) parsed with sparse_read and checked against the
  * manifest, then three images for set 0 (abi.h, SPLAT_PAINTED_SPARSE):
  *   binding 2  atlas  BC4_UNORM_BLOCK (R8_UNORM where the device has no BC
  *              textures: the blocks decoded on the CPU, rounded to 8 bits,

@@ -1,4 +1,4 @@
-/* pack.c — read a shader pack (compiler/PACK.md) and check it before the
+/* pack_load.c — read a shader pack (compiler/PACK.md) and check it before the
  * GPU sees any of it: the manifest's fields and types, every file it names
  * (present, right size), every SPIR-V module (spirv-val), every
  * combination id in combos.bin (in range).  A bad pack is a message that
@@ -695,7 +695,7 @@ static bool read_painted(reader *r, json_t *root)
                  SPLAT_MAX_PAINTED);
         return field_fail(r, "painted:", what);
     }
-    /* sparse quad-tree (painted.c) unless painted_format says dense;
+    /* sparse quad-tree (painted_upload.c) unless painted_format says dense;
      * absent: dense (PACK.md) */
     const char *fmt = "dense", *file = "painted.r8";
     if (get(r, root, "painted_format", "manifest", false) &&
@@ -708,7 +708,7 @@ static bool read_painted(reader *r, json_t *root)
         !get_string(r, root, "painted_file", "manifest", &file))
         return false;
     if (dense && p->npainted == 0)
-        return true;   /* no masks: one zero layer (terrain.c) */
+        return true;   /* no masks: one zero layer (terrain_upload.c) */
     /* a sparse pack's shaders sample the atlas even without masks (the
      * file then holds none), so it is read and bound the same way */
     if (!dense) {

@@ -1,0 +1,14 @@
+/* cli.h — the commands of the splatc executable that live in their own
+ * files (main.c dispatches the rest).  Not part of libsplatc: the CLI
+ * sources build into the executable only (compiler/CMakeLists.txt).
+ * Each takes argv[0] = the command's name and returns the exit status
+ * (0 ok, 1 error, 2 usage). */
+#ifndef SPLAT_CLI_H
+#define SPLAT_CLI_H
+
+/* `splatc build SCENE.sg -o PACKDIR ...` (cli_build.c) */
+int splat_cli_build(int argc, char **argv);
+/* `splatc texgen --out DIR [--seed N] [--size N] [--all-mips]` (cli_texgen.c) */
+int splat_cli_texgen(int argc, char **argv);
+
+#endif
