@@ -885,21 +885,19 @@ static bool record_screen(rt_renderer *r, VkCommandBuffer cb, const rt_camera *c
     return true;
 }
 
-static bool draw_frame(rt_renderer *r, const rt_camera *c, rt_frame_stats *st, rt_error *e)
+/* The quadtree selection, then the patches sorted by combination (a
+ * counting sort: one pipeline bind per group); returns how many
+ * combinations are in view.  Afterwards counts[k] ends group k, which
+ * starts at counts[k-1] (0 for k = 0). */
+static int select_and_sort(rt_renderer *r, const rt_camera *c, const splat_frame *fr,
+                           double *select_ms)
 {
-    rt_device *d = r->d;
-    double t0 = 1e3 * splat_now();
-    splat_frame *fr = r->frame_ubo.map;
-    fill_frame(r, c, fr);
-
     rt_select_desc sd = { .lod_distance = r->lod_distance, .cull = true };
     memcpy(sd.camera, c->position, sizeof sd.camera);
     memcpy(sd.view_proj, fr->view_proj, sizeof sd.view_proj);
     double ts = 1e3 * splat_now();
     rt_quadtree_select(&r->qt, &sd);
-    double select_ms = 1e3 * splat_now() - ts;
-
-    /* Counting sort by combination: one pipeline bind per group. */
+    *select_ms = 1e3 * splat_now() - ts;
     int n = r->qt.npatches;
     memset(r->counts, 0, sizeof *r->counts * (size_t)(r->ncombos + 1));
     for (int i = 0; i < n; i++)
@@ -911,7 +909,133 @@ static bool draw_frame(rt_renderer *r, const rt_camera *c, rt_frame_stats *st, r
     }
     for (int i = 0; i < n; i++)
         r->sorted[r->counts[r->qt.patches[i].combo]++] = r->qt.patches[i];
-    /* counts[k] now ends group k; group k starts at counts[k-1] (0 for k=0) */
+    return in_view;
+}
+
+/* The multi-pass reference: each material blended over every patch,
+ * bottom to top, then the resolve pass lights the blended surface. */
+static bool record_multipass(rt_renderer *r, VkCommandBuffer cb, const rt_camera *c,
+                             const VkViewport *vp, const VkRect2D *area, bool cull, int *binds,
+                             rt_error *e)
+{
+    VkClearValue clears[4];
+    VkDescriptorSet sets[3] = { r->set0, r->set1, r->set2 };
+    for (int i = 0; i < 3; i++)
+        clears[i].color = (VkClearColorValue){ { 0, 0, 0, 0 } };
+    clears[3].depthStencil = (VkClearDepthStencilValue){ 0.0f, 0 };
+    VkRenderPassBeginInfo rb = {
+        .sType = VK_STRUCTURE_TYPE_RENDER_PASS_BEGIN_INFO,
+        .renderPass = r->rp.multi, .framebuffer = r->fb_multi,
+        .renderArea = *area, .clearValueCount = 4, .pClearValues = clears,
+    };
+    begin_terrain_pass(r, cb, &rb, vp, sets);
+    for (int m = 0; m < r->pl.nref; m++) {
+        VkPipeline pipe;
+        if (!rt_pipelines_ref(r->d, r->p, &r->rp, &r->pl, m, cull, &pipe, e))
+            return abandon_frame(cb);
+        vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_GRAPHICS, pipe);
+        (*binds)++;
+        draw_patches(r, cb, c, r->sorted, r->qt.npatches);
+    }
+    vkCmdEndRenderPass(cb);
+    clears[0].color = (VkClearColorValue){ { r->desc.clear[0], r->desc.clear[1], r->desc.clear[2], 1 } };
+    rb.renderPass = r->rp.resolve;
+    rb.framebuffer = r->fb_resolve;
+    rb.clearValueCount = 1;
+    vkCmdBeginRenderPass(cb, &rb, VK_SUBPASS_CONTENTS_INLINE);
+    vkCmdSetViewport(cb, 0, 1, vp);
+    vkCmdSetScissor(cb, 0, 1, area);
+    vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_GRAPHICS, r->pl.resolve);
+    (*binds)++;
+    vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_GRAPHICS, r->pl.resolve_layout, 0, 3, sets, 0, NULL);
+    splat_push none;
+    memset(&none, 0, sizeof none);
+    vkCmdPushConstants(cb, r->pl.resolve_layout, VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT,
+                       0, sizeof none, &none);
+    vkCmdDraw(cb, 3, 1, 0, 0);
+    vkCmdEndRenderPass(cb);
+    return true;
+}
+
+/* The forward path: each group of patches with its composite (or every
+ * patch with the über-shader: --reference uber, and the MASK view, which
+ * composites do not carry: compiler/build_jobs.c). */
+static bool record_forward(rt_renderer *r, VkCommandBuffer cb, const rt_camera *c,
+                           const VkViewport *vp, const VkRect2D *area, unsigned variant,
+                           int *binds, rt_error *e)
+{
+    VkClearValue clears[2];
+    VkDescriptorSet sets[2] = { r->set0, r->set1 };
+    clears[0].color = (VkClearColorValue){ { r->desc.clear[0], r->desc.clear[1], r->desc.clear[2], 1 } };
+    clears[1].depthStencil = (VkClearDepthStencilValue){ 0.0f, 0 };
+    VkRenderPassBeginInfo rb = {
+        .sType = VK_STRUCTURE_TYPE_RENDER_PASS_BEGIN_INFO,
+        .renderPass = r->rp.main, .framebuffer = r->fb_main,
+        .renderArea = *area, .clearValueCount = 2, .pClearValues = clears,
+    };
+    begin_terrain_pass(r, cb, &rb, vp, sets);
+    int n = r->qt.npatches;
+    if (r->desc.reference == RT_REF_UBER || r->view == SPLAT_VIEW_MASK) {
+        if (n > 0) {
+            VkPipeline pipe;
+            if (!rt_pipelines_uber(r->d, r->p, &r->rp, &r->pl, variant, &pipe, e))
+                return abandon_frame(cb);
+            vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_GRAPHICS, pipe);
+            (*binds)++;
+        }
+        draw_patches(r, cb, c, r->sorted, n);
+    } else {
+        int start = 0;
+        for (int k = 0; k < r->ncombos; k++) {
+            int end = r->counts[k];
+            if (end > start) {
+                VkPipeline pipe;
+                if (!rt_pipelines_combo(r->d, r->p, &r->rp, &r->pl, k, variant, &pipe, e))
+                    return abandon_frame(cb);
+                vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_GRAPHICS, pipe);
+                (*binds)++;
+                draw_patches(r, cb, c, r->sorted + start, end - start);
+            }
+            start = end;
+        }
+    }
+    vkCmdEndRenderPass(cb);
+    return true;
+}
+
+/* GPU times from the timestamps: the whole frame, and on the screen path
+ * its three passes (queries 0 top, 1 after the depth, 2 after the
+ * classification, 3 bottom). */
+static bool read_times(rt_renderer *r, bool screen, rt_frame_stats *st, rt_error *e)
+{
+    rt_device *d = r->d;
+    st->gpu_ms = -1;
+    for (int i = 0; i < 3; i++)
+        st->pass_ms[i] = -1;
+    if (!r->timestamps)
+        return true;
+    double ms = d->props.limits.timestampPeriod * 1e-6;
+    const VkQueryResultFlags fl = VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT;
+    uint64_t q[4];
+    if (screen) {
+        RT_VK(e, vkGetQueryPoolResults(d->dev, r->qpool, 0, 4, sizeof q, q, sizeof q[0], fl));
+        for (int i = 0; i < 3; i++)
+            st->pass_ms[i] = (double)(q[i + 1] - q[i]) * ms;
+    } else {
+        RT_VK(e, vkGetQueryPoolResults(d->dev, r->qpool, 0, 1, sizeof q[0], &q[0], sizeof q[0], fl));
+        RT_VK(e, vkGetQueryPoolResults(d->dev, r->qpool, 3, 1, sizeof q[3], &q[3], sizeof q[3], fl));
+    }
+    st->gpu_ms = (double)(q[3] - q[0]) * ms;
+    return true;
+}
+
+static bool draw_frame(rt_renderer *r, const rt_camera *c, rt_frame_stats *st, rt_error *e)
+{
+    rt_device *d = r->d;
+    double t0 = 1e3 * splat_now(), select_ms;
+    splat_frame *fr = r->frame_ubo.map;
+    fill_frame(r, c, fr);
+    int in_view = select_and_sort(r, c, fr, &select_ms);
 
     VkCommandBuffer cb = r->cb;
     RT_VK(e, vkResetCommandBuffer(cb, 0));
@@ -931,87 +1055,14 @@ static bool draw_frame(rt_renderer *r, const rt_camera *c, rt_frame_stats *st, r
     unsigned variant = (r->wireframe ? RT_VARIANT_WIRE : 0) |
                        (r->view != SPLAT_VIEW_FINAL ? RT_VARIANT_DEBUG : 0) |
                        (cull ? RT_VARIANT_CULL : 0);
-    VkClearValue clears[4];
-    VkDescriptorSet sets[3] = { r->set0, r->set1, r->set2 };
     bool screen = r->screen && r->shading == RT_SHADING_SCREEN &&
                   r->desc.reference != RT_REF_MULTIPASS && !r->wireframe;
-
-    if (screen) {
-        if (!record_screen(r, cb, c, &vp, &area, cull, &binds, e))
-            return false;
-    } else if (r->desc.reference == RT_REF_MULTIPASS) {
-        for (int i = 0; i < 3; i++)
-            clears[i].color = (VkClearColorValue){ { 0, 0, 0, 0 } };
-        clears[3].depthStencil = (VkClearDepthStencilValue){ 0.0f, 0 };
-        VkRenderPassBeginInfo rb = {
-            .sType = VK_STRUCTURE_TYPE_RENDER_PASS_BEGIN_INFO,
-            .renderPass = r->rp.multi, .framebuffer = r->fb_multi,
-            .renderArea = area, .clearValueCount = 4, .pClearValues = clears,
-        };
-        begin_terrain_pass(r, cb, &rb, &vp, sets);
-        /* bottom to top, each material over every patch */
-        for (int m = 0; m < r->pl.nref; m++) {
-            VkPipeline pipe;
-            if (!rt_pipelines_ref(d, r->p, &r->rp, &r->pl, m, cull, &pipe, e))
-                return abandon_frame(cb);
-            vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_GRAPHICS, pipe);
-            binds++;
-            draw_patches(r, cb, c, r->sorted, n);
-        }
-        vkCmdEndRenderPass(cb);
-        clears[0].color = (VkClearColorValue){ { r->desc.clear[0], r->desc.clear[1], r->desc.clear[2], 1 } };
-        rb.renderPass = r->rp.resolve;
-        rb.framebuffer = r->fb_resolve;
-        rb.clearValueCount = 1;
-        vkCmdBeginRenderPass(cb, &rb, VK_SUBPASS_CONTENTS_INLINE);
-        vkCmdSetViewport(cb, 0, 1, &vp);
-        vkCmdSetScissor(cb, 0, 1, &area);
-        vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_GRAPHICS, r->pl.resolve);
-        binds++;
-        vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_GRAPHICS, r->pl.resolve_layout, 0, 3, sets, 0, NULL);
-        splat_push none;
-        memset(&none, 0, sizeof none);
-        vkCmdPushConstants(cb, r->pl.resolve_layout, VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT,
-                           0, sizeof none, &none);
-        vkCmdDraw(cb, 3, 1, 0, 0);
-        vkCmdEndRenderPass(cb);
-    } else {
-        clears[0].color = (VkClearColorValue){ { r->desc.clear[0], r->desc.clear[1], r->desc.clear[2], 1 } };
-        clears[1].depthStencil = (VkClearDepthStencilValue){ 0.0f, 0 };
-        VkRenderPassBeginInfo rb = {
-            .sType = VK_STRUCTURE_TYPE_RENDER_PASS_BEGIN_INFO,
-            .renderPass = r->rp.main, .framebuffer = r->fb_main,
-            .renderArea = area, .clearValueCount = 2, .pClearValues = clears,
-        };
-        begin_terrain_pass(r, cb, &rb, &vp, sets);
-        /* Composites carry no MASK view (compiler/build_jobs.c): the über-shader
-         * draws it, with every material's mask. */
-        if (r->desc.reference == RT_REF_UBER || r->view == SPLAT_VIEW_MASK) {
-            if (n > 0) {
-                VkPipeline pipe;
-                if (!rt_pipelines_uber(d, r->p, &r->rp, &r->pl, variant, &pipe, e))
-                    return abandon_frame(cb);
-                vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_GRAPHICS, pipe);
-                binds++;
-            }
-            draw_patches(r, cb, c, r->sorted, n);
-        } else {
-            int start = 0;
-            for (int k = 0; k < r->ncombos; k++) {
-                int end = r->counts[k];
-                if (end > start) {
-                    VkPipeline pipe;
-                    if (!rt_pipelines_combo(d, r->p, &r->rp, &r->pl, k, variant, &pipe, e))
-                        return abandon_frame(cb);
-                    vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_GRAPHICS, pipe);
-                    binds++;
-                    draw_patches(r, cb, c, r->sorted + start, end - start);
-                }
-                start = end;
-            }
-        }
-        vkCmdEndRenderPass(cb);
-    }
+    bool ok = screen ? record_screen(r, cb, c, &vp, &area, cull, &binds, e)
+            : r->desc.reference == RT_REF_MULTIPASS
+                     ? record_multipass(r, cb, c, &vp, &area, cull, &binds, e)
+                     : record_forward(r, cb, c, &vp, &area, variant, &binds, e);
+    if (!ok)
+        return false;
     if (r->timestamps)
         vkCmdWriteTimestamp(cb, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, r->qpool, 3);
     RT_VK(e, vkEndCommandBuffer(cb));
@@ -1024,40 +1075,20 @@ static bool draw_frame(rt_renderer *r, const rt_camera *c, rt_frame_stats *st, r
     RT_VK(e, vkQueueSubmit(d->queue, 1, &si, r->fence));
     RT_VK(e, vkWaitForFences(d->dev, 1, &r->fence, VK_TRUE, UINT64_MAX));
     RT_VK(e, vkResetFences(d->dev, 1, &r->fence));
-
-    if (st) {
-        memset(st, 0, sizeof *st);
-        st->patches = n;
-        st->culled = r->qt.nculled;
-        st->pipelines = binds;
-        st->combos_in_view = in_view;
-        st->backfaces_culled = cull;
-        st->select_ms = select_ms;
-        st->cpu_ms = cpu_ms;
-        st->gpu_ms = -1;
-        st->screen = screen;
-        for (int i = 0; i < 3; i++)
-            st->pass_ms[i] = -1;
-        double ms = d->props.limits.timestampPeriod * 1e-6;
-        if (r->timestamps && screen) {
-            uint64_t q[4];
-            RT_VK(e, vkGetQueryPoolResults(d->dev, r->qpool, 0, 4, sizeof q, q, sizeof q[0],
-                                           VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT));
-            st->gpu_ms = (double)(q[3] - q[0]) * ms;
-            for (int i = 0; i < 3; i++)
-                st->pass_ms[i] = (double)(q[i + 1] - q[i]) * ms;
-        } else if (r->timestamps) {
-            uint64_t q[4];
-            RT_VK(e, vkGetQueryPoolResults(d->dev, r->qpool, 0, 1, sizeof q[0], &q[0], sizeof q[0],
-                                           VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT));
-            RT_VK(e, vkGetQueryPoolResults(d->dev, r->qpool, 3, 1, sizeof q[3], &q[3], sizeof q[3],
-                                           VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT));
-            st->gpu_ms = (double)(q[3] - q[0]) * ms;
-        }
-        if (screen)
-            rt_screen_read_stats(r->screen, &st->tiles);
-    }
-    return true;
+    if (!st)
+        return true;
+    memset(st, 0, sizeof *st);
+    st->patches = r->qt.npatches;
+    st->culled = r->qt.nculled;
+    st->pipelines = binds;
+    st->combos_in_view = in_view;
+    st->backfaces_culled = cull;
+    st->select_ms = select_ms;
+    st->cpu_ms = cpu_ms;
+    st->screen = screen;
+    if (screen)
+        rt_screen_read_stats(r->screen, &st->tiles);
+    return read_times(r, screen, st, e);
 }
 
 /* A frame; on the screen-space path, drawn again while lists got tiles
