@@ -219,19 +219,12 @@ static bool texture_fits(build *b, const char *src)
     return false;
 }
 
-static json_t *manifest(build *b, char **tex_names, const char *dir)
+/* ---- manifest.json, one function per section (PACK.md) -------------------- */
+
+static json_t *jscene(build *b, const char *dir)
 {
     const splat_scene *s = &b->scene;
     const sg_scene *sc = s->desc;
-    const splat_layout *L = &b->layout;
-    const splat_analysis *a = &b->analysis;
-    json_t *m = json_object();
-    json_object_set_new(m, "format", json_string("splatc-pack"));
-    json_object_set_new(m, "version", json_integer(1));
-    json_object_set_new(m, "abi", json_integer(SPLAT_ABI_VERSION));
-    json_object_set_new(m, "compiler", json_string("splatc " SPLATC_VERSION));
-    json_object_set_new(m, "inputs", json_string(b->inputs));
-
     json_t *scene = json_object();
     json_object_set_new(scene, "name", json_string(sc->name ? sc->name : ""));
     /* relative to the pack folder (`dir` is its sibling: same answer) */
@@ -248,7 +241,7 @@ static json_t *manifest(build *b, char **tex_names, const char *dir)
     json_object_set_new(scene, "size", jreals(s->terrain.size, 2));
     json_object_set_new(scene, "max_height", json_real(s->terrain.max_height));
     json_object_set_new(scene, "height_offset", json_real(s->terrain.height_offset));
-    json_object_set_new(scene, "cell_texels", json_integer(a->cell_texels));
+    json_object_set_new(scene, "cell_texels", json_integer(b->analysis.cell_texels));
     json_t *cams = json_array();
     for (int i = 0; i < sc->ncameras; i++) {
         json_t *c = json_object();
@@ -267,15 +260,19 @@ static json_t *manifest(build *b, char **tex_names, const char *dir)
     } else {
         json_object_set_new(scene, "destruction", json_null());
     }
-    json_object_set_new(m, "scene", scene);
+    return scene;
+}
 
+static json_t *jmaterials(build *b)
+{
+    const splat_layout *L = &b->layout;
     char *scene_dir = splat_path_dir(b->desc->scene);
     json_t *mats = json_array();
     for (int k = 0; k < L->nmaterials; k++) {
         json_t *o = json_object();
         json_object_set_new(o, "name", json_string(L->materials[k]));
-        int pi = sg_material_find(s->prog, L->materials[k]);
-        sg_loc ml = pi >= 0 ? sg_material_loc(s->prog, pi) : (sg_loc){0};
+        int pi = sg_material_find(b->scene.prog, L->materials[k]);
+        sg_loc ml = pi >= 0 ? sg_material_loc(b->scene.prog, pi) : (sg_loc){0};
         char *src = ml.file ? splat_path_relative_real(scene_dir, ml.file) : xstrdup("");
         json_object_set_new(o, "source", json_string(src));
         free(src);
@@ -285,8 +282,11 @@ static json_t *manifest(build *b, char **tex_names, const char *dir)
         json_array_append_new(mats, o);
     }
     free(scene_dir);
-    json_object_set_new(m, "materials", mats);
+    return mats;
+}
 
+static json_t *jparams(const splat_layout *L)
+{
     static const char *const tnames[IR_T_COUNT] = {
         [IR_T_FLOAT] = "float", [IR_T_VEC2] = "vec2", [IR_T_VEC3] = "vec3",
         [IR_T_VEC4] = "vec4"};
@@ -302,9 +302,11 @@ static json_t *manifest(build *b, char **tex_names, const char *dir)
         json_object_set_new(o, "offset", json_integer(16 * i));
         json_array_append_new(params, o);
     }
-    json_object_set_new(m, "params", params);
-    json_object_set_new(m, "params_size", json_integer(16 * (L->nparams > 0 ? L->nparams : 1)));
+    return params;
+}
 
+static json_t *jtextures(const splat_layout *L, char **tex_names)
+{
     json_t *texs = json_array();
     for (int i = 0; i < L->ntextures; i++) {
         const ir_texture *t = &L->src->textures[L->textures[i]];
@@ -320,8 +322,11 @@ static json_t *manifest(build *b, char **tex_names, const char *dir)
             json_object_set_new(o, "mips", json_integer(mips));
         json_array_append_new(texs, o);
     }
-    json_object_set_new(m, "textures", texs);
+    return texs;
+}
 
+static json_t *jpainted(const splat_layout *L)
+{
     json_t *painted = json_array();
     for (int i = 0; i < L->npainted; i++) {
         json_t *o = json_object();
@@ -329,8 +334,11 @@ static json_t *manifest(build *b, char **tex_names, const char *dir)
         json_object_set_new(o, "layer", json_integer(i));
         json_array_append_new(painted, o);
     }
-    json_object_set_new(m, "painted", painted);
-    /* how they are stored: dense layers or the sparse quad-tree */
+    return painted;
+}
+
+static json_t *jsites(const splat_layout *L)
+{
     json_t *sites = json_array();
     for (int i = 0; i < L->nsites; i++) {
         const splat_site *st = &L->sites[i];
@@ -344,23 +352,25 @@ static json_t *manifest(build *b, char **tex_names, const char *dir)
             json_object_set_new(o, "scale", jreals(st->value, 2));
         json_array_append_new(sites, o);
     }
-    json_object_set_new(m, "world_sites", sites);
-    json_object_set_new(m, "painted_format",
-                        json_string(splat_painted_format_name(b->desc->painted)));
-    json_object_set_new(m, "painted_file",
-                        json_string(b->sparse_ok ? "painted.sparse" : "painted.r8"));
+    return sites;
+}
 
+/* The job of `kind` for combination i, or NULL. */
+static const job *find_job(const build *b, int i, int kind)
+{
+    for (int k = 0; k < b->njobs; k++)
+        if (b->jobs[k].index == i && (int)b->jobs[k].kind == kind)
+            return &b->jobs[k];
+    return NULL;
+}
+
+static json_t *jcombinations(build *b)
+{
+    const splat_analysis *a = &b->analysis;
     json_t *combos = json_array();
     for (int i = 0; i < a->ncombos; i++) {
-        const job *cj = NULL, *fj = NULL, *xj = NULL;
-        for (int k = 0; k < b->njobs; k++) {
-            if (b->jobs[k].index == i && b->jobs[k].kind == JOB_COMBO)
-                cj = &b->jobs[k];
-            if (b->jobs[k].index == i && b->jobs[k].kind == JOB_FLAT)
-                fj = &b->jobs[k];
-            if (b->jobs[k].index == i && b->jobs[k].kind == JOB_COMBO_COMPUTE)
-                xj = &b->jobs[k];
-        }
+        const job *cj = find_job(b, i, JOB_COMBO), *fj = find_job(b, i, JOB_FLAT);
+        const job *xj = find_job(b, i, JOB_COMBO_COMPUTE);
         json_t *o = json_object();
         json_object_set_new(o, "id", json_integer(i));
         json_object_set_new(o, "materials", jints(a->combos[i].materials,
@@ -381,14 +391,11 @@ static json_t *manifest(build *b, char **tex_names, const char *dir)
         json_object_set_new(o, "compute", jcompute(xj));
         json_array_append_new(combos, o);
     }
-    json_object_set_new(m, "combinations", combos);
-    json_t *uber = jshader("shaders/uber", NULL);
-    for (int k = 0; k < b->njobs; k++)
-        if (b->jobs[k].kind == JOB_UBER_COMPUTE)
-            json_object_set_new(uber, "compute", jcompute(&b->jobs[k]));
-    json_object_set_new(m, "uber", uber);
-    json_object_set_new(m, "vertex", jshader("shaders/terrain.vert", ""));
+    return combos;
+}
 
+static json_t *jquadtree(const splat_analysis *a)
+{
     json_t *qt = json_object();
     json_object_set_new(qt, "file", json_string("combos.bin"));
     json_t *levels = json_array();
@@ -403,7 +410,38 @@ static json_t *manifest(build *b, char **tex_names, const char *dir)
         offset += 2 * (size_t)a->levels[l].width * (size_t)a->levels[l].height;
     }
     json_object_set_new(qt, "levels", levels);
-    json_object_set_new(m, "quadtree", qt);
+    return qt;
+}
+
+static json_t *manifest(build *b, char **tex_names, const char *dir)
+{
+    const splat_layout *L = &b->layout;
+    json_t *m = json_object();
+    json_object_set_new(m, "format", json_string("splatc-pack"));
+    json_object_set_new(m, "version", json_integer(1));
+    json_object_set_new(m, "abi", json_integer(SPLAT_ABI_VERSION));
+    json_object_set_new(m, "compiler", json_string("splatc " SPLATC_VERSION));
+    json_object_set_new(m, "inputs", json_string(b->inputs));
+    json_object_set_new(m, "scene", jscene(b, dir));
+    json_object_set_new(m, "materials", jmaterials(b));
+    json_object_set_new(m, "params", jparams(L));
+    json_object_set_new(m, "params_size", json_integer(16 * (L->nparams > 0 ? L->nparams : 1)));
+    json_object_set_new(m, "textures", jtextures(L, tex_names));
+    json_object_set_new(m, "painted", jpainted(L));
+    json_object_set_new(m, "world_sites", jsites(L));
+    /* how the painted masks are stored: dense layers or the sparse quad-tree */
+    json_object_set_new(m, "painted_format",
+                        json_string(splat_painted_format_name(b->desc->painted)));
+    json_object_set_new(m, "painted_file",
+                        json_string(b->sparse_ok ? "painted.sparse" : "painted.r8"));
+    json_object_set_new(m, "combinations", jcombinations(b));
+    json_t *uber = jshader("shaders/uber", NULL);
+    for (int k = 0; k < b->njobs; k++)
+        if (b->jobs[k].kind == JOB_UBER_COMPUTE)
+            json_object_set_new(uber, "compute", jcompute(&b->jobs[k]));
+    json_object_set_new(m, "uber", uber);
+    json_object_set_new(m, "vertex", jshader("shaders/terrain.vert", ""));
+    json_object_set_new(m, "quadtree", jquadtree(&b->analysis));
     return m;
 }
 
