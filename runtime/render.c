@@ -856,11 +856,7 @@ static bool record_screen(rt_renderer *r, VkCommandBuffer cb, const rt_camera *c
     };
     VkDescriptorSet sets[2] = { r->set0, r->set1 };
     if (rt_screen_raycasting(r->screen)) {
-        /* the patches' LOD (rt_renderer_create): a grid step of s metres
-         * at distance d covers s * k / d pixels, split while > lod_pixels */
-        double k = r->desc.height / (2.0 * tan(M_PI / 6.0));
-        double texel = fmin(r->p->size[0] / r->p->hf_width, r->p->size[1] / r->p->hf_height);
-        rt_screen_raycast(r->screen, cb, r->set0c, (float)(r->desc.lod_pixels / (k * texel)));
+        rt_screen_raycast(r->screen, cb, r->set0c);
         (*binds)++;
     } else {
         begin_terrain_pass(r, cb, &rb, vp, sets);

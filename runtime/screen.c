@@ -208,22 +208,14 @@ static const char raycast_glsl[] =
     "layout(set = 2, binding = 3) uniform sampler2D u_maxmip;\n"
     "layout(set = 2, binding = 4, r32f) uniform writeonly image2D u_rdepth;\n"
     "float corner(ivec2 k) { return splat_height_at(vec2(k) * u_frame.texel.zw); }\n"
-    /* The ray against the two triangles of mesh quad c of level L (corners
-     * c * 2^L and (c + 1) * 2^L: the grid the patches of that LOD draw), in
-     * the quad's own coordinates (u, v in [0, 1]: precise however far the
-     * quad is): (0,0) (1,0) (1,1) where u >= v, (0,0) (1,1) (0,1) where
-     * v >= u.  The nearest hit with t in [t0, t1], else -1.  Where the
-     * grid gets coarser along a ray the two grids need not meet (the
-     * patches stitch them; a ray may pass through the step): no crack
-     * was visible on the example scenes (render test, screen.sh). */
-    "float quad_hit(vec3 O, vec3 D, ivec2 c, int L, float t0, float t1) {\n"
-    "    int n = 1 << L;\n"
-    "    ivec2 k = c * n;\n"
-    "    float ha = corner(k), hb = corner(k + ivec2(n, 0));\n"
-    "    float hc = corner(k + ivec2(n, n)), hd = corner(k + ivec2(0, n));\n"
-    "    vec2 o = (O.xz - vec2(k)) / float(n);\n"
-    "    vec3 d = vec3(D.x / float(n), D.y, D.z / float(n));\n"
-    "    D = d;\n"
+    /* The ray against mesh quad k's two triangles, in the quad's own
+     * coordinates (u, v in [0, 1]: precise however far the quad is):
+     * (0,0) (1,0) (1,1) where u >= v, (0,0) (1,1) (0,1) where v >= u.
+     * The nearest hit with t in [t0, t1], else -1. */
+    "float quad_hit(vec3 O, vec3 D, ivec2 k, float t0, float t1) {\n"
+    "    float ha = corner(k), hb = corner(k + ivec2(1, 0));\n"
+    "    float hc = corner(k + ivec2(1, 1)), hd = corner(k + ivec2(0, 1));\n"
+    "    vec2 o = O.xz - vec2(k);\n"
     "    const float eps = 1e-4;\n"
     "    float best = -1.0;\n"
     "    for (int s = 0; s < 2; s++) {\n"
@@ -258,9 +250,6 @@ static const char raycast_glsl[] =
     "    float t = max(max(max(tn.x, tn.y), tn.z), 0.0), tend = min(min(tf.x, tf.y), tf.z);\n"
     "    float hit = -1.0;\n"
     "    int L = top;\n"
-    /* the LOD of the patches (render.c): the grid step at distance t
-     * that covers lod_pixels pixels, g * t texels (push patch_xz.x) */
-    "    float g = u_push.patch_xz.x;\n"
     /* a walk over cells by index (a DDA), so rounding in the position can
      * never hold it in place: down into the child under the ray where
      * the ray may meet the cell's contents, else across to the neighbour
@@ -276,14 +265,14 @@ static const char raycast_glsl[] =
     "        float te = min(min(tx.x, tx.y), tend);\n"
     "        float top_h = texelFetch(u_maxmip, c, L).r;\n"
     "        if (min(O.y + D.y * t, O.y + D.y * te) <= top_h) {\n"
-    "            if (L > 0 && float(1 << L) > g * t) {   /* look closer */\n"
+    "            if (L > 0) {   /* the ray may meet something in here: look closer */\n"
     "                L--;\n"
     "                vec2 p = (O.xz + D.xz * t) / (size * 0.5);\n"
     "                c = clamp(ivec2(floor(p)), 2 * c, 2 * c + 1);\n"
     "                continue;\n"
     "            }\n"
     "            float slack = 1e-5 * te + 1e-4;\n"
-    "            hit = quad_hit(O, D, c, L, t - slack, te + slack);\n"
+    "            hit = quad_hit(O, D, c, t - slack, te + slack);\n"
     "        }\n"
     "        t = max(t, te);\n"
     "        ivec2 cn = c;\n"
@@ -774,7 +763,7 @@ VkRenderPass rt_screen_depth_pass(const rt_screen *s, VkFramebuffer *fb)
 
 bool rt_screen_raycasting(const rt_screen *s) { return s->raycast; }
 
-void rt_screen_raycast(rt_screen *s, VkCommandBuffer cb, VkDescriptorSet set0, float lod)
+void rt_screen_raycast(rt_screen *s, VkCommandBuffer cb, VkDescriptorSet set0)
 {
     /* the last frame's reads end before this write; this write before
      * this frame's reads (classification, shading) */
@@ -787,10 +776,6 @@ void rt_screen_raycast(rt_screen *s, VkCommandBuffer cb, VkDescriptorSet set0, f
     vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, s->raycaster);
     vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, s->layout, 0, 1, &set0, 0, NULL);
     vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, s->layout, 2, 1, &s->set, 0, NULL);
-    splat_push push;   /* patch_xz.x: texels of grid step per metre of distance */
-    memset(&push, 0, sizeof push);
-    push.patch_xz[0] = lod;
-    vkCmdPushConstants(cb, s->layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof push, &push);
     vkCmdDispatch(cb, (uint32_t)s->tiles_x, (uint32_t)s->tiles_y, 1);
     rt_cmd_image_barrier(cb, s->rdepth.img, 0, 1, 1, VK_IMAGE_LAYOUT_GENERAL,
                          VK_IMAGE_LAYOUT_GENERAL, VK_ACCESS_SHADER_WRITE_BIT,

@@ -609,11 +609,9 @@ bool rt_screen_create(rt_device *d, const rt_pack *p, const rt_pipelines *pl,
                       const rt_image *color, const rt_image *depth, VkSampler nearest,
                       VkDescriptorSet set0, bool raycast, rt_screen **out, rt_error *e);
 /* raycast: the depth comes from ray casting the heightfield in compute
- * (screen.c) instead of the geometry pass; `lod`: the coarsest grid step,
- * in texels per metre of distance, the patches would draw there (the
- * ray meets that LOD's mesh; 0: the finest everywhere). */
+ * (screen.c) instead of the geometry pass. */
 bool rt_screen_raycasting(const rt_screen *s);
-void rt_screen_raycast(rt_screen *s, VkCommandBuffer cb, VkDescriptorSet set0, float lod);
+void rt_screen_raycast(rt_screen *s, VkCommandBuffer cb, VkDescriptorSet set0);
 void rt_screen_destroy(rt_screen *s);
 /* The geometry pass: depth only, ends in SHADER_READ_ONLY_OPTIMAL. */
 VkRenderPass rt_screen_depth_pass(const rt_screen *s, VkFramebuffer *fb);
