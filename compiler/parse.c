@@ -587,7 +587,7 @@ static bool parse_import(parser *ps)
 
 typedef struct scene_parse {
     sg_scene *sc;
-    int cap_materials, cap_painted, cap_cameras;
+    int cap_materials, cap_material_locs, cap_painted, cap_cameras;
     bool has_hf_size;
     bool has[8];
     sg_loc materials_loc;   /* the `materials` setting, for an empty stack */
@@ -848,7 +848,9 @@ static bool scene_stmt(parser *ps, void *user)
         sg_token *open = cur(ps);
         if (!expect(ps, SG_TK_LBRACK, "'['"))
             return false;
-        int cap_locs = 0;
+        /* a second `materials =` replaces the first, as every setting
+         * does (both lists keep their capacity: found by fuzz_parse) */
+        sc->nmaterials = 0;
         sp->has[HAS_MATERIALS] = true;
         if (accept(ps, SG_TK_RBRACK))
             return true;
@@ -858,7 +860,7 @@ static bool scene_stmt(parser *ps, void *user)
                 return false;
             int n = sc->nmaterials;
             *SG_PUSH(ps->a, sc->materials, sc->nmaterials, sp->cap_materials) = tok_text(ps, m);
-            *SG_PUSH(ps->a, sc->material_locs, n, cap_locs) = loc_of(ps, m);
+            *SG_PUSH(ps->a, sc->material_locs, n, sp->cap_material_locs) = loc_of(ps, m);
         } while (accept(ps, SG_TK_COMMA));
         if (cur(ps)->kind != SG_TK_RBRACK) {
             if (cur(ps)->kind == SG_TK_EOF)

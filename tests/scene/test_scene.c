@@ -258,6 +258,34 @@ static void test_minimal_example(void **state)
 }
 
 /* The 15-material example on the real DEM: sound at sample points. */
+/* `materials =` twice: the second list replaces the first (fuzz_parse
+ * found the locations' array written past its end here). */
+static void test_materials_twice(void **state)
+{
+    (void)state;
+    static const char text[] =
+        "material a { out albedo = vec3(0.5) }\n"
+        "material b { out albedo = vec3(0.25) }\n"
+        "material c { out albedo = vec3(0.75) }\n"
+        "scene s {\n"
+        "    heightfield = \"hf16.png\"\n"
+        "    materials = [a, b, c, a, b]\n"
+        "    materials = [c, a]\n"
+        "}\n";
+    sg_diags d;
+    sg_diags_init(&d);
+    sg_program *p = sg_load_string("twice.sg", text, NULL, &d);
+    assert_non_null(p);
+    const sg_scene *sc = sg_program_scene(p);
+    assert_non_null(sc);
+    assert_int_equal(sc->nmaterials, 2);
+    assert_string_equal(sc->materials[0], "c");
+    assert_string_equal(sc->materials[1], "a");
+    assert_int_equal(sc->material_locs[1].line, 7);
+    sg_free(p);
+    sg_diags_free(&d);
+}
+
 static void test_colorado_sound(void **state)
 {
     splat_scene s;
@@ -282,6 +310,7 @@ int main(void)
         cmocka_unit_test(test_raw_matches_png),
         cmocka_unit_test(test_minimal_example),
         cmocka_unit_test(test_colorado_sound),
+        cmocka_unit_test(test_materials_twice),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
