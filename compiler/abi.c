@@ -339,7 +339,15 @@ const char SPLAT_GLSL_PRELUDE[] =
     "#ifdef SPLAT_PAINTED_SPARSE\n"
     SPARSE_GLSL_FUNCTIONS
     "float splat_painted(int layer) {\n"
+    "#ifdef SPLAT_PAINTED_PLACED\n"
+    /* a placed mask: its own uv over its rectangle, 0 outside */
+    "    vec4 r = splat_painted_rect[layer];\n"
+    "    vec2 muv = (v_uv - r.xy) * r.zw;\n"
+    "    if (any(lessThan(muv, vec2(0.0))) || any(greaterThan(muv, vec2(1.0)))) return 0.0;\n"
+    "    return splat_sparse_painted(muv, splat_painted_size[layer], layer);\n"
+    "#else\n"
     "    return splat_sparse_painted(v_uv, u_frame.texel.xy, layer);\n"
+    "#endif\n"
     "}\n"
     "#else\n"
     "float splat_painted(int layer) {\n"

@@ -197,6 +197,13 @@ static bool destruction_reaches(const sg_scene *sc, const ir_ienv *env,
 }
 
 /* Everything block_combo needs about the scene. */
+/* A placed mask (not heightfield-sized over the terrain): without the
+ * sparse data the analysis bounds it by [0, 1]. */
+static bool placed(const splat_scene *s, int j)
+{
+    return s->desc->painted[j].place_loc.line > 0;
+}
+
 typedef struct block_ctx {
     const splat_scene *s;
     const ir          *mir;         /* the masks alone                     */
@@ -231,9 +238,10 @@ static void block_combo(const block_ctx *bc, int x0, int z0, int x1, int z1,
     for (int k = 0; k < bc->mir->npainted; k++) {
         if (bc->painted_src[k] >= 0 && s->sparse) {
             double lo, hi;
-            sparse_range(s->sparse, bc->painted_src[k], x0, z0, x1, z1, &lo, &hi);
+            sparse_range_terrain(s->sparse, bc->painted_src[k], x0, z0, x1, z1, &lo,
+                                 &hi);
             bc->painted[k] = (ir_iv){ lo, hi };
-        } else if (bc->painted_src[k] >= 0)
+        } else if (bc->painted_src[k] >= 0 && !placed(s, bc->painted_src[k]))
             bc->painted[k] = painted_range(s->painted[bc->painted_src[k]], t->width,
                                            t->height, x0, z0, x1, z1);
         else

@@ -207,11 +207,14 @@ static bool load(build *b)
  * dense), then the analysis over them. */
 static bool analyse(build *b)
 {
+    if (!splat_painted_check_format(&b->scene, b->desc->painted, b->d))
+        return false;
     if (b->desc->painted != SPLAT_PAINTED_DENSE) {
         b->sparse_ok = splat_painted_build(&b->scene, b->desc->painted, &b->sparse, b->d);
         if (!b->sparse_ok)
             return false;
         b->scene.sparse = &b->sparse;
+        b->painted_places = sparse_glsl_places(&b->sparse);
     }
     b->analysis_ok = splat_analyze(&b->scene, &b->analysis, b->d);
     if (b->analysis_ok && b->desc->report) {
@@ -314,6 +317,7 @@ static bool build_finish(build *b)
         splat_analysis_free(&b->analysis);
     if (b->sparse_ok)
         sparse_free(&b->sparse);
+    free(b->painted_places);
     if (b->scene_ok)
         splat_scene_free(&b->scene);
     free(b->out);

@@ -58,6 +58,7 @@ typedef struct build {
     bool           analysis_ok;
     sparse_masks   sparse;    /* painted masks as stored (not dense)      */
     bool           sparse_ok;
+    char          *painted_places; /* sparse_glsl_places, or NULL            */
     splat_layout   layout;
     bool           layout_ok;
     combo_info    *combos;

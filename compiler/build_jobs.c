@@ -179,6 +179,7 @@ static bool add_composite(build *b, job_kind kind, int index, const int *materia
          * which keeps each composite about half as long for glslang. */
         j->composite = c;
         j->gdesc = (splat_glsl_desc){.flat = k == JOB_FLAT, .painted_sparse = b->sparse_ok,
+                                     .painted_places = b->painted_places,
                                      .no_mask_view = k != JOB_UBER && k != JOB_UBER_COMPUTE,
                                      .compute = compute};
     }

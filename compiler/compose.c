@@ -803,6 +803,8 @@ static void emit_header(emit *em, const splat_glsl_desc *desc)
         ir_buf_printf(o, "#define SPLAT_MULTIPASS 1\n");
     if (desc->painted_sparse)
         ir_buf_printf(o, "#define SPLAT_PAINTED_SPARSE 1\n");
+    if (desc->painted_sparse && desc->painted_places)
+        ir_buf_printf(o, "%s", desc->painted_places);
     if (desc->compute)
         ir_buf_printf(o, "#define SPLAT_COMPUTE 1\n");
     ir_buf_printf(o, "%s", SPLAT_GLSL_PRELUDE);

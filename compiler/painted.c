@@ -8,6 +8,8 @@
  *                                         near = 1000 1000 3000 3000 }
  *   -> sparse_mask_desc { .max_level = 2, .max_error = 0.05,
  *                         .near = texels under those metres }
+ *   painted road = "road.tif" { origin = 60000 40000, size = 10000 10000 }
+ *   -> .width, .height = the raster's, .rect = that square in terrain uv
  */
 #include "scene.h"
 #include "util.h"
@@ -42,6 +44,23 @@ static int texel_at(double m, double size, int n)
     return t < 0 ? 0 : t > n ? n : (int)t;
 }
 
+bool splat_painted_check_format(const splat_scene *s, splat_painted_format f,
+                                sg_diags *d)
+{
+    const sg_scene *sc = s->desc;
+    bool ok = true;
+    for (int i = 0; f == SPLAT_PAINTED_DENSE && i < sc->npainted; i++)
+        if (sc->painted[i].place_loc.line > 0) {
+            char msg[256];
+            snprintf(msg, sizeof msg, "painted mask '%s' is placed (origin, size); "
+                     "--painted dense stores heightfield-sized layers only (use bc4 "
+                     "or r8)", sc->painted[i].name);
+            sg_error(d, sc->painted[i].place_loc, SG_E_SCENE, msg);
+            ok = false;
+        }
+    return ok;
+}
+
 bool splat_painted_build(const splat_scene *s, splat_painted_format f,
                          sparse_masks *out, sg_diags *d)
 {
@@ -56,11 +75,25 @@ bool splat_painted_build(const splat_scene *s, splat_painted_format f,
         md[i].texels = s->painted[i];
         md[i].max_level = pm->max_level;
         md[i].max_error = pm->max_error;
+        /* a placed mask: its raster over origin .. origin + size, as
+         * terrain uv; `near` then in its own texels */
+        int w = t->width, h = t->height;
+        double o[2] = { 0, 0 }, sz[2] = { t->size[0], t->size[1] };
+        if (pm->place_loc.line > 0) {
+            w = md[i].width = s->painted_size[i][0];
+            h = md[i].height = s->painted_size[i][1];
+            memcpy(o, pm->origin, sizeof o);
+            memcpy(sz, pm->place, sizeof sz);
+            md[i].rect[0] = o[0] / t->size[0];
+            md[i].rect[1] = o[1] / t->size[1];
+            md[i].rect[2] = (o[0] + sz[0]) / t->size[0];
+            md[i].rect[3] = (o[1] + sz[1]) / t->size[1];
+        }
         if (pm->has_near) {
-            md[i].near[0] = texel_at(pm->near[0], t->size[0], t->width);
-            md[i].near[1] = texel_at(pm->near[1], t->size[1], t->height);
-            md[i].near[2] = texel_at(pm->near[2], t->size[0], t->width) + 1;
-            md[i].near[3] = texel_at(pm->near[3], t->size[1], t->height) + 1;
+            md[i].near[0] = texel_at(pm->near[0] - o[0], sz[0], w);
+            md[i].near[1] = texel_at(pm->near[1] - o[1], sz[1], h);
+            md[i].near[2] = texel_at(pm->near[2] - o[0], sz[0], w) + 1;
+            md[i].near[3] = texel_at(pm->near[3] - o[1], sz[1], h) + 1;
         }
     }
     sparse_desc sd = {

@@ -16,6 +16,7 @@
 
 #include <errno.h>
 #include <limits.h>
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
@@ -619,13 +620,14 @@ static char *scene_path(parser *ps, const char *rel)
 }
 
 /* painted_opts = "{" { ("max_level" "=" NUM | "max_error" "=" NUM |
- *                "near" "=" NUM NUM NUM NUM) [","] } "}" */
+ *                "near" "=" NUM NUM NUM NUM | "origin" "=" NUM NUM |
+ *                "size" "=" NUM NUM) [","] } "}" */
 static bool painted_stmt(parser *ps, void *user)
 {
     sg_scene_painted *pm = user;
     sg_token *key = cur(ps);
     sg_loc kloc = loc_of(ps, key);
-    const char *keys = "'max_level', 'max_error', 'near' or '}'";
+    const char *keys = "'max_level', 'max_error', 'near', 'origin', 'size' or '}'";
     if (key->kind != SG_TK_IDENT) {
         expected(ps, keys);
         return false;
@@ -650,6 +652,17 @@ static bool painted_stmt(parser *ps, void *user)
         if (ok && !(pm->near[2] > pm->near[0] && pm->near[3] > pm->near[1]))
             scene_error(ps, kloc, "near must be x0 z0 x1 z1 with x1 > x0 and z1 > z0%s", "");
         pm->has_near = ok;
+    } else if (is_kw(key, "origin") || is_kw(key, "size")) {
+        bool size = is_kw(key, "size");
+        next(ps);
+        double *v = size ? pm->place : pm->origin;
+        ok = expect(ps, SG_TK_EQ, "'='") && parse_numbers(ps, v, 2);
+        if (ok && size && !(v[0] > 0 && v[1] > 0 && v[0] < 1e9 && v[1] < 1e9))
+            scene_error(ps, kloc, "a painted mask's size must be positive metres, "
+                        "found %s", "a zero, negative or huge side");
+        else if (ok && !size && !(fabs(v[0]) < 1e9 && fabs(v[1]) < 1e9))
+            scene_error(ps, kloc, "a painted mask's origin is out of range%s", "");
+        if (ok) *(size ? &pm->place_loc : &pm->origin_loc) = kloc;
     } else {
         expected(ps, keys);
         return false;

@@ -122,6 +122,11 @@ static void check_scene(sg_program *p, const sg_scene *sc, sg_diags *d)
                 break;
             }
         }
+        if ((pm->origin_loc.line > 0) != (pm->place_loc.line > 0))
+            scene_error(d, loc_or(pm->origin_loc.line > 0 ? pm->origin_loc : pm->place_loc,
+                                  sc->loc),
+                        "painted mask '%s' is placed with both 'origin' and 'size' "
+                        "(terrain-local metres) or neither", pm->name);
     }
     if (sc->hf_format == SG_HF_R16 && sc->hf_width > 0 && sc->hf_height > 0)
         cells_fit(sc, sc->hf_width, sc->hf_height, d);
@@ -170,17 +175,23 @@ static bool is_png(const char *file)
     return dot && strcmp(dot, ".png") == 0;
 }
 
-/* An 8-bit greyscale raster of exactly w x h texels, or NULL (error at loc):
- * a PNG through stb_image, anything else through GDAL (raster.c). */
-static uint8_t *load_mask(const char *name, const char *file, int w, int h,
+/* An 8-bit greyscale raster of exactly *w x *h texels (any size, returned
+ * in *w, *h, when *w is 0), or NULL (error at loc): a PNG through
+ * stb_image, anything else through GDAL (raster.c). */
+static uint8_t *load_mask(const char *name, const char *file, int *pw, int *ph,
                           sg_loc loc, sg_diags *d)
 {
+    bool any = *pw == 0;
+    int w = *pw, h = *ph;
     if (!is_png(file)) {
         char what[160];
         snprintf(what, sizeof what, "painted mask '%s'", name);
         int fw = 0, fh = 0;
         uint8_t *px = splat_raster_mask(what, file, &fw, &fh, loc, d);
-        if (px && (fw != w || fh != h)) {
+        if (px && any) {
+            *pw = fw;
+            *ph = fh;
+        } else if (px && (fw != w || fh != h)) {
             scene_error(d, loc, "painted mask '%s' ('%s') is %d x %d texels; the "
                         "heightfield is %d x %d", name, file, fw, fh, w, h);
             free(px);
@@ -205,9 +216,13 @@ static uint8_t *load_mask(const char *name, const char *file, int w, int h,
                     comp, stbi_is_16_bit(file) ? 16 : 8);
         return NULL;
     }
-    if (fw != w || fh != h) {
+    if (any) {
+        *pw = w = fw;
+        *ph = h = fh;
+    } else if (fw != w || fh != h) {
         scene_error(d, loc, "painted mask '%s' ('%s') is %d x %d texels; the "
-                    "heightfield is %d x %d", name, file, fw, fh, w, h);
+                    "heightfield is %d x %d (or place it: { origin = X Z, size = W H })",
+                    name, file, fw, fh, w, h);
         return NULL;
     }
     if (!splat_raster_check_size("painted mask", file, fw, fh, loc, d))
@@ -239,7 +254,8 @@ static bool load_holes(splat_scene *s, sg_diags *d)
     splat_terrain *t = &s->terrain;
     sg_loc loc = loc_or(sc->holes_loc, sc->loc);
     if (sc->holes) {
-        uint8_t *m = load_mask("holes", sc->holes, t->width, t->height, loc, d);
+        int w = t->width, h = t->height;
+        uint8_t *m = load_mask("holes", sc->holes, &w, &h, loc, d);
         if (!m) return false;
         size_t n = (size_t)t->width * (size_t)t->height;
         for (size_t i = 0; i < n; i++)
@@ -259,15 +275,20 @@ static bool load_painted(splat_scene *s, sg_diags *d)
     const sg_scene *sc = s->desc;
     if (sc->npainted == 0) return true;
     s->painted = calloc((size_t)sc->npainted, sizeof *s->painted);
-    if (!s->painted) {
+    s->painted_size = calloc((size_t)sc->npainted, sizeof *s->painted_size);
+    if (!s->painted || !s->painted_size) {
         sg_error(d, sc->loc, SG_E_TOO_LARGE, "painted masks do not fit in memory");
         return false;
     }
     bool ok = true;
     for (int i = 0; i < sc->npainted; i++) {
         const sg_scene_painted *pm = &sc->painted[i];
-        s->painted[i] = load_mask(pm->name, pm->file, s->terrain.width,
-                                  s->terrain.height, loc_or(pm->loc, sc->loc), d);
+        int *wh = s->painted_size[i];
+        bool placed = pm->place_loc.line > 0;
+        wh[0] = placed ? 0 : s->terrain.width;
+        wh[1] = placed ? 0 : s->terrain.height;
+        s->painted[i] = load_mask(pm->name, pm->file, &wh[0], &wh[1],
+                                  loc_or(pm->loc, sc->loc), d);
         ok &= s->painted[i] != NULL;
     }
     return ok;
@@ -370,6 +391,7 @@ void splat_scene_free(splat_scene *s)
             free(s->painted[i]);
     }
     free(s->painted);
+    free(s->painted_size);
     splat_terrain_free(&s->terrain);
     ir_free(&s->ir);
     if (s->prog) sg_free(s->prog);

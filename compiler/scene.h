@@ -95,7 +95,9 @@ typedef struct splat_scene {
     sg_program    *prog;
     const sg_scene *desc;      /* owned by prog                               */
     splat_terrain  terrain;
-    uint8_t      **painted;    /* desc->npainted dense rasters, W*H bytes      */
+    uint8_t      **painted;    /* desc->npainted dense rasters, row-major      */
+    int          (*painted_size)[2]; /* each raster's texels: the heightfield's
+                                  W, H unless the mask is placed             */
     /* The painted masks as the pack stores them (painted.c), or NULL: the
      * analysis then bounds the dense rasters.  Not owned by the scene:
      * whoever built it (build.c) frees it. */
@@ -127,6 +129,10 @@ typedef enum splat_painted_format {
 const char *splat_painted_format_name(splat_painted_format f);  /* "bc4" … */
 bool splat_painted_format_parse(const char *s, splat_painted_format *f);
 
+/* Whether format `f` can store the scene's masks: dense cannot store a
+ * placed one (error at its `size`). */
+bool splat_painted_check_format(const splat_scene *s, splat_painted_format f,
+                                sg_diags *d);
 /* The scene's painted rasters as sparse masks in format `f` (BC4 or R8),
  * with each mask's options from the scene file (max_level, max_error,
  * near in metres -> texels).  Errors at the scene's painted entries. */
@@ -285,6 +291,8 @@ typedef struct splat_glsl_desc {
     bool        painted_sparse; /* #define SPLAT_PAINTED_SPARSE before the
                                  prelude: painted masks read the sparse
                                  quad-tree (abi.h bindings 2, 5, 6)         */
+    const char *painted_places; /* sparse_glsl_places: placed masks' rects
+                                 and sizes before the prelude, or NULL      */
     bool        compute;      /* the compute variant: #define SPLAT_COMPUTE
                                  before the prelude (abi.h "compute stage") */
 } splat_glsl_desc;

@@ -170,11 +170,16 @@ typedef enum sg_hf_format {
 typedef struct sg_scene_painted {
     char  *name;       /* the name materials use: painted { mask = "fields" } */
     char  *file;       /* 8-bit greyscale PNG (or any raster GDAL reads),
-                          same size as the heightfield                      */
+                          the heightfield's size unless placed               */
     sg_loc loc;
+    /* { origin = X Z, size = W H }: the raster, of any size, covers that
+     * rectangle (terrain-local metres) and reads 0 outside it.  Both or
+     * neither; a location with line 0 means "not given". */
+    double origin[2];  sg_loc origin_loc;
+    double place[2];   sg_loc place_loc;   /* the `size`                   */
     /* Sparse storage options (sparse.h), from an optional block after the
      * file: painted NAME = "FILE" { max_level = 2, max_error = 0.05,
-     * near = x0 z0 x1 z1 }.  Defaults: max_level 0 (full resolution),
+     * near = x0 z0 x1 z1, origin = X Z, size = W H }.  Defaults: max_level 0 (full resolution),
      * max_error 1 (no limit once max_level allows), no near rectangle. */
     int    max_level;  /* coarsest quad-tree level, 0..7                    */
     double max_error;  /* largest reduction error allowed, 0..1             */

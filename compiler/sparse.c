@@ -293,13 +293,39 @@ static void slot_origin(const sparse_masks *s, int slot, int *ox, int *oz)
     *oz = (slot / s->atlas_cols) * SPARSE_SLOT;
 }
 
+bool sparse_placed(const sparse_masks *s, int mask)
+{
+    const sparse_place *p = &s->place[mask];
+    return p->width != s->width || p->height != s->height || p->rect[0] != 0.0 ||
+           p->rect[1] != 0.0 || p->rect[2] != 1.0 || p->rect[3] != 1.0;
+}
+
+/* The floats the GLSL's splat_painted_rect holds (sparse_glsl_places). */
+static void place_floats(const sparse_place *p, float f[4])
+{
+    f[0] = (float)p->rect[0];
+    f[1] = (float)p->rect[1];
+    f[2] = (float)(1.0 / (p->rect[2] - p->rect[0]));
+    f[3] = (float)(1.0 / (p->rect[3] - p->rect[1]));
+}
+
 double sparse_sample(const sparse_masks *s, int mask, double u, double v)
 {
     assert(mask >= 0 && mask < s->nmasks);
+    const sparse_place *pl = &s->place[mask];
     /* the GLSL's float arithmetic, step by step */
-    float tx = (float)u * (float)s->width, tz = (float)v * (float)s->height;
-    int cx = clampi((int)floorf(tx * (1.0f / 32.0f)), 0, s->cells_x - 1);
-    int cz = clampi((int)floorf(tz * (1.0f / 32.0f)), 0, s->cells_z - 1);
+    float mu = (float)u, mv = (float)v;
+    if (sparse_placed(s, mask)) {
+        float r[4];
+        place_floats(pl, r);
+        mu = (mu - r[0]) * r[2];
+        mv = (mv - r[1]) * r[3];
+        if (!(mu >= 0.0f && mv >= 0.0f && mu <= 1.0f && mv <= 1.0f))   /* or NaN */
+            return 0.0;
+    }
+    float tx = mu * (float)pl->width, tz = mv * (float)pl->height;
+    int cx = clampi((int)floorf(tx * (1.0f / 32.0f)), 0, pl->cells_x - 1);
+    int cz = clampi((int)floorf(tz * (1.0f / 32.0f)), 0, pl->cells_z - 1);
     size_t at = cell_at(s, mask, cx, cz);
     unsigned e = s->index[at];
     if (e == SPARSE_CONST0)
@@ -414,9 +440,10 @@ static void compute_bounds(sparse_masks *s, const sparse_desc *d)
             }
     }
     for (int m = 0; m < d->nmasks; m++) {
-        raster r = { d->width, d->height, d->masks[m].texels };
-        for (int cz = 0; cz < s->cells_z; cz++)
-            for (int cx = 0; cx < s->cells_x; cx++) {
+        const sparse_place *pl = &s->place[m];
+        raster r = { pl->width, pl->height, d->masks[m].texels };
+        for (int cz = 0; cz < pl->cells_z; cz++)
+            for (int cx = 0; cx < pl->cells_x; cx++) {
                 bounds b = { 1.0, 0.0 };
                 /* (a) the original raster's bilinear footprint */
                 int lo = 255, hi = 0;
@@ -433,7 +460,7 @@ static void compute_bounds(sparse_masks *s, const sparse_desc *d)
                 for (int dz = -1; dz <= 1; dz++)
                     for (int dx = -1; dx <= 1; dx++) {
                         int nx = cx + dx, nz = cz + dz;
-                        if (nx < 0 || nz < 0 || nx >= s->cells_x || nz >= s->cells_z)
+                        if (nx < 0 || nz < 0 || nx >= pl->cells_x || nz >= pl->cells_z)
                             continue;
                         double ax0 = fmax(x0, 32.0 * nx), ax1 = fmin(x1, 32.0 * nx + 32);
                         double az0 = fmax(z0, 32.0 * nz), az1 = fmin(z1, 32.0 * nz + 32);
@@ -451,10 +478,11 @@ void sparse_range(const sparse_masks *s, int mask, int x0, int z0, int x1,
                   int z1, double *lo, double *hi)
 {
     assert(mask >= 0 && mask < s->nmasks && x0 < x1 && z0 < z1);
-    int cx0 = clampi(x0 / SPARSE_TILE, 0, s->cells_x - 1);
-    int cz0 = clampi(z0 / SPARSE_TILE, 0, s->cells_z - 1);
-    int cx1 = clampi((x1 - 1) / SPARSE_TILE, 0, s->cells_x - 1);
-    int cz1 = clampi((z1 - 1) / SPARSE_TILE, 0, s->cells_z - 1);
+    const sparse_place *pl = &s->place[mask];
+    int cx0 = clampi(x0 / SPARSE_TILE, 0, pl->cells_x - 1);
+    int cz0 = clampi(z0 / SPARSE_TILE, 0, pl->cells_z - 1);
+    int cx1 = clampi((x1 - 1) / SPARSE_TILE, 0, pl->cells_x - 1);
+    int cz1 = clampi((z1 - 1) / SPARSE_TILE, 0, pl->cells_z - 1);
     size_t ncell = (size_t)s->cells_x * s->cells_z;
     bounds b = { 1.0, 0.0 };
     for (int cz = cz0; cz <= cz1; cz++)
@@ -465,6 +493,78 @@ void sparse_range(const sparse_masks *s, int mask, int x0, int z0, int x1,
         }
     *lo = b.lo;
     *hi = b.hi;
+}
+
+/* Heightfield texels [a0, a1) on an axis -> the mask texels [t0, t1) that
+ * fragments there can read, widened for float rounding; *outside when
+ * some of them lie off the mask's rectangle.  Returns false when none is
+ * on it. */
+static bool map_axis(double a0, double a1, int hf, double r0, double r1, int n,
+                     int *t0, int *t1, bool *outside)
+{
+    /* the GPU's uv carries a few ulps of 1; the mapping (uv - r0) * s and
+     * the multiply by n a few ulps of n: one texel covers both */
+    double slop = 1.0 + 4e-6 * n / (r1 - r0);
+    double m0 = (a0 / hf - r0) / (r1 - r0) * n - slop;
+    double m1 = (a1 / hf - r0) / (r1 - r0) * n + slop;
+    *outside |= m0 < 0.0 || m1 > n;
+    if (m1 <= 0.0 || m0 >= n)
+        return false;
+    *t0 = m0 < 0.0 ? 0 : (int)floor(m0);
+    *t1 = m1 > n ? n : (int)ceil(m1);
+    if (*t1 <= *t0)
+        *t1 = *t0 + 1;
+    return true;
+}
+
+void sparse_range_terrain(const sparse_masks *s, int mask, int x0, int z0, int x1,
+                          int z1, double *lo, double *hi)
+{
+    if (!sparse_placed(s, mask)) {
+        sparse_range(s, mask, x0, z0, x1, z1, lo, hi);
+        return;
+    }
+    const sparse_place *pl = &s->place[mask];
+    int tx0, tx1, tz0, tz1;
+    bool outside = false;
+    bool on = map_axis(x0, x1, s->width, pl->rect[0], pl->rect[2], pl->width, &tx0, &tx1,
+                       &outside);
+    on &= map_axis(z0, z1, s->height, pl->rect[1], pl->rect[3], pl->height, &tz0, &tz1,
+                   &outside);
+    bounds b = { 1.0, 0.0 };
+    if (on)
+        sparse_range(s, mask, tx0, tz0, tx1, tz1, &b.lo, &b.hi);
+    if (outside || !on)
+        bounds_add(&b, 0.0);
+    *lo = b.lo;
+    *hi = b.hi;
+}
+
+char *sparse_glsl_places(const sparse_masks *s)
+{
+    bool any = false;
+    for (int m = 0; m < s->nmasks; m++)
+        any |= sparse_placed(s, m);
+    if (!any)
+        return NULL;
+    size_t cap = 160 + (size_t)s->nmasks * 160, len = 0;
+    char *out = xmalloc(cap);
+    len += (size_t)snprintf(out + len, cap - len, "#define SPLAT_PAINTED_PLACED 1\n"
+                            "const vec4 splat_painted_rect[%d] = vec4[%d](", s->nmasks,
+                            s->nmasks);
+    for (int m = 0; m < s->nmasks; m++) {
+        float r[4];
+        place_floats(&s->place[m], r);
+        len += (size_t)snprintf(out + len, cap - len, "%svec4(%.9g, %.9g, %.9g, %.9g)",
+                                m ? ", " : "", r[0], r[1], r[2], r[3]);
+    }
+    len += (size_t)snprintf(out + len, cap - len, ");\nconst vec2 splat_painted_size[%d] = "
+                            "vec2[%d](", s->nmasks, s->nmasks);
+    for (int m = 0; m < s->nmasks; m++)
+        len += (size_t)snprintf(out + len, cap - len, "%svec2(%d.0, %d.0)", m ? ", " : "",
+                                s->place[m].width, s->place[m].height);
+    snprintf(out + len, cap - len, ");\n");
+    return out;
 }
 
 /* ---- the build ---------------------------------------------------------- */
@@ -522,8 +622,42 @@ static bool check_desc(const sparse_desc *d, sparse_error *err)
                         "max_level must be 0..7 (the quad-tree's coarsest level)");
         if (!(md->max_error >= 0.0 && md->max_error <= 1.0))
             return fail(err, SPARSE_E_BAD_OPTION, name, "max_error must be in 0..1");
+        if (md->width < 0 || md->height < 0 || (md->width > 0) != (md->height > 0) ||
+            md->width > SPARSE_MAX_TEXELS || md->height > SPARSE_MAX_TEXELS)
+            return fail(err, SPARSE_E_BAD_OPTION, name,
+                        "a placed raster must be 1..65536 texels on each side");
+        const double *r = md->rect;
+        bool zero = r[0] == 0 && r[1] == 0 && r[2] == 0 && r[3] == 0;
+        bool in_range = true;
+        for (int i = 0; i < 4; i++)
+            in_range &= isfinite(r[i]) && fabs(r[i]) < 1e6;
+        if (!zero && !(in_range && r[2] - r[0] > 1e-9 && r[3] - r[1] > 1e-9))
+            return fail(err, SPARSE_E_BAD_OPTION, name,
+                        "its rectangle is empty or out of range (terrain uv within 1e6)");
     }
     return true;
+}
+
+/* Each mask's raster, rectangle and cells; the index grid the largest. */
+static void set_places(sparse_masks *s, const sparse_desc *d)
+{
+    s->place = xcalloc((size_t)(d->nmasks ? d->nmasks : 1), sizeof *s->place);
+    s->cells_x = d->nmasks ? 1 : (d->width + SPARSE_TILE - 1) / SPARSE_TILE;
+    s->cells_z = d->nmasks ? 1 : (d->height + SPARSE_TILE - 1) / SPARSE_TILE;
+    for (int m = 0; m < d->nmasks; m++) {
+        const sparse_mask_desc *md = &d->masks[m];
+        sparse_place *p = &s->place[m];
+        p->width = md->width ? md->width : d->width;
+        p->height = md->height ? md->height : d->height;
+        p->cells_x = (p->width + SPARSE_TILE - 1) / SPARSE_TILE;
+        p->cells_z = (p->height + SPARSE_TILE - 1) / SPARSE_TILE;
+        bool zero = md->rect[0] == 0 && md->rect[1] == 0 && md->rect[2] == 0 &&
+                    md->rect[3] == 0;
+        double unit[4] = { 0, 0, 1, 1 };
+        memcpy(p->rect, zero ? unit : md->rect, sizeof p->rect);
+        s->cells_x = p->cells_x > s->cells_x ? p->cells_x : s->cells_x;
+        s->cells_z = p->cells_z > s->cells_z ? p->cells_z : s->cells_z;
+    }
 }
 
 bool sparse_build(sparse_masks *s, const sparse_desc *d, sparse_error *err)
@@ -537,8 +671,7 @@ bool sparse_build(sparse_masks *s, const sparse_desc *d, sparse_error *err)
     s->height = d->height;
     s->nmasks = d->nmasks;
     s->format = d->format;
-    s->cells_x = (d->width + SPARSE_TILE - 1) / SPARSE_TILE;
-    s->cells_z = (d->height + SPARSE_TILE - 1) / SPARSE_TILE;
+    set_places(s, d);
     s->layers = (d->nmasks + 3) / 4 > 0 ? (d->nmasks + 3) / 4 : 1;
     size_t ncell = (size_t)s->cells_x * s->cells_z;
     s->index = xcalloc(ncell * 4 * s->layers, sizeof *s->index);
@@ -550,25 +683,27 @@ bool sparse_build(sparse_masks *s, const sparse_desc *d, sparse_error *err)
     int8_t *lvl = xcalloc(ncell, 1);
     for (int m = 0; m < d->nmasks; m++) {
         const sparse_mask_desc *md = &d->masks[m];
+        const sparse_place *pl = &s->place[m];
+        int ncx = pl->cells_x, ncz = pl->cells_z;
         sparse_mask_info *info = &s->info[m];
         info->name = strdup(md->name ? md->name : "");
         info->max_level = md->max_level;
         raster red[SPARSE_MAX_LEVEL + 1];
         uint8_t *owned[SPARSE_MAX_LEVEL + 1] = { 0 };
-        red[0] = (raster){ d->width, d->height, md->texels };
+        red[0] = (raster){ pl->width, pl->height, md->texels };
         for (int L = 1; L <= md->max_level; L++)
             owned[L] = reduce(&red[0], L, &red[L]);
 
-        for (int cz = 0; cz < s->cells_z; cz++)
-            for (int cx = 0; cx < s->cells_x; cx++) {
+        for (int cz = 0; cz < ncz; cz++)
+            for (int cx = 0; cx < ncx; cx++) {
                 make_slot(&red[0], cx, cz, slot);
-                lvl[cz * s->cells_x + cx] = slot_constant(slot) >= 0 ? -1 : 0;
+                lvl[(size_t)cz * ncx + cx] = slot_constant(slot) >= 0 ? -1 : 0;
             }
-        choose_levels(md, red, s->cells_x, s->cells_z, lvl, info);
+        choose_levels(md, red, ncx, ncz, lvl, info);
 
-        for (int cz = 0; cz < s->cells_z; cz++)
-            for (int cx = 0; cx < s->cells_x; cx++) {
-                int L = lvl[cz * s->cells_x + cx];
+        for (int cz = 0; cz < ncz; cz++)
+            for (int cx = 0; cx < ncx; cx++) {
+                int L = lvl[(size_t)cz * ncx + cx];
                 L = L < 0 ? 0 : L;
                 make_slot(&red[L], cx >> L, cz >> L, slot);
                 size_t at = cell_at(s, m, cx, cz);
@@ -616,6 +751,7 @@ void sparse_free(sparse_masks *s)
     free(s->atlas);
     free(s->lo);
     free(s->hi);
+    free(s->place);
     memset(s, 0, sizeof *s);
 }
 
@@ -629,7 +765,8 @@ void sparse_get_stats(const sparse_masks *s, sparse_stats *st)
     st->nmasks = s->nmasks;
     st->cells = (int)ncell;
     st->nslots = s->nslots;
-    st->dense_bytes = (size_t)s->nmasks * s->width * s->height;
+    for (int m = 0; m < s->nmasks; m++)
+        st->dense_bytes += (size_t)s->place[m].width * s->place[m].height;
     st->index_bytes = ncell * 4 * s->layers * sizeof *s->index;
     st->level_bytes = ncell * 4 * s->layers;
     st->atlas_bytes = s->atlas_bytes;
@@ -660,6 +797,11 @@ void sparse_print_stats(const sparse_masks *s, FILE *out)
         fprintf(out, "  %-16s %5d %7d %7d %7d %7d %9d %10.5f\n", i->name,
                 i->max_level, i->const0, i->const1, i->stored, i->reduced,
                 i->new_slots, i->reduce_error);
+        const sparse_place *p = &s->place[m];
+        if (sparse_placed(s, m))
+            fprintf(out, "  %-16s placed: %dx%d texels over terrain uv %.6g %.6g .. "
+                    "%.6g %.6g\n", "", p->width, p->height, p->rect[0], p->rect[1],
+                    p->rect[2], p->rect[3]);
     }
     fprintf(out, "  dense 8-bit        %12zu B\n", st.dense_bytes);
     fprintf(out, "  index (RGBA16UI)   %12zu B\n", st.index_bytes);
@@ -717,7 +859,7 @@ bool sparse_load_raster(const char *path, int width, int height,
 /* ---- pack file ------------------------------------------------------------ */
 
 static const char file_magic[8] = { 'S', 'P', 'L', 'A', 'T', 'S', 'P', 'M' };
-enum { FILE_VERSION = 1, FILE_HEADER_WORDS = 11 };
+enum { FILE_VERSION = 2, FILE_HEADER_WORDS = 11, PLACE_BYTES = 8 + 4 * 8 };
 
 static void put_u32(uint8_t *p, uint32_t v)
 {
@@ -757,6 +899,19 @@ bool sparse_write(const sparse_masks *s, FILE *f)
         put_u32(hdr + 8 + 4 * i, words[i]);
     if (fwrite(hdr, 1, sizeof hdr, f) != sizeof hdr)
         return false;
+    for (int m = 0; m < s->nmasks; m++) {
+        uint8_t b[PLACE_BYTES];
+        put_u32(b, (uint32_t)s->place[m].width);
+        put_u32(b + 4, (uint32_t)s->place[m].height);
+        for (int i = 0; i < 4; i++) {
+            uint64_t u;
+            memcpy(&u, &s->place[m].rect[i], 8);
+            put_u32(b + 8 + 8 * i, (uint32_t)u);
+            put_u32(b + 12 + 8 * i, (uint32_t)(u >> 32));
+        }
+        if (fwrite(b, 1, sizeof b, f) != sizeof b)
+            return false;
+    }
     size_t n = (size_t)s->cells_x * s->cells_z * 4 * s->layers;
     for (size_t i = 0; i < n; i++) {
         uint8_t b[2] = { (uint8_t)s->index[i], (uint8_t)(s->index[i] >> 8) };
@@ -767,6 +922,45 @@ bool sparse_write(const sparse_masks *s, FILE *f)
     return fwrite(s->level, 1, n, f) == n &&
            fwrite(s->atlas, 1, s->atlas_bytes, f) == s->atlas_bytes &&
            write_floats(s->lo, ncell, f) && write_floats(s->hi, ncell, f);
+}
+
+/* The masks' places after the header: each raster 1..SPARSE_MAX_TEXELS
+ * texels a side, its rectangle non-empty and finite, the index grid the
+ * largest mask's cells (the heightfield's with no mask).  s->place is set
+ * (and owned by s) when true. */
+static bool read_places(sparse_masks *s, const uint8_t *at)
+{
+    int cx = s->nmasks ? 1 : (s->width + 31) / 32, cz = s->nmasks ? 1 : (s->height + 31) / 32;
+    sparse_place *pl = calloc((size_t)(s->nmasks ? s->nmasks : 1), sizeof *pl);
+    if (!pl)
+        return false;
+    for (int m = 0; m < s->nmasks; m++, at += PLACE_BYTES) {
+        sparse_place *p = &pl[m];
+        uint32_t w = get_u32(at), h = get_u32(at + 4);
+        bool ok = w >= 1 && w <= SPARSE_MAX_TEXELS && h >= 1 && h <= SPARSE_MAX_TEXELS;
+        for (int i = 0; i < 4; i++) {
+            uint64_t u = (uint64_t)get_u32(at + 8 + 8 * i) |
+                         (uint64_t)get_u32(at + 12 + 8 * i) << 32;
+            memcpy(&p->rect[i], &u, 8);
+            ok = ok && isfinite(p->rect[i]) && fabs(p->rect[i]) < 1e6;
+        }
+        if (!ok || !(p->rect[2] - p->rect[0] > 1e-9 && p->rect[3] - p->rect[1] > 1e-9)) {
+            free(pl);
+            return false;
+        }
+        p->width = (int)w;
+        p->height = (int)h;
+        p->cells_x = (p->width + 31) / 32;
+        p->cells_z = (p->height + 31) / 32;
+        cx = p->cells_x > cx ? p->cells_x : cx;
+        cz = p->cells_z > cz ? p->cells_z : cz;
+    }
+    if (cx != s->cells_x || cz != s->cells_z) {
+        free(pl);
+        return false;
+    }
+    s->place = pl;
+    return true;
 }
 
 /* The header's words, checked, then the file's size against what they
@@ -800,12 +994,13 @@ bool sparse_read(sparse_masks *s, const uint8_t *data, size_t size, const char *
     s->atlas_rows = (int)w[10];
     /* the header must describe a consistent, reasonably sized object */
     if (s->width <= 0 || s->height <= 0 || s->nmasks > 4096 ||
+        size < HDR + (size_t)s->nmasks * PLACE_BYTES || !read_places(s, data + HDR) ||
         (s->format != SPARSE_R8 && s->format != SPARSE_BC4) ||
-        s->cells_x != (s->width + 31) / 32 || s->cells_z != (s->height + 31) / 32 ||
         s->layers != ((s->nmasks + 3) / 4 > 0 ? (s->nmasks + 3) / 4 : 1) ||
         s->nslots > SPARSE_MAX_SLOTS || s->atlas_cols <= 0 ||
         s->atlas_cols > 256 || s->atlas_rows <= 0 || s->atlas_rows > 256 ||
         s->atlas_cols * s->atlas_rows < s->nslots) {
+        free(s->place);
         memset(s, 0, sizeof *s);
         return fail(err, SPARSE_E_BAD_FILE, name, "inconsistent header");
     }
@@ -816,11 +1011,13 @@ bool sparse_read(sparse_masks *s, const uint8_t *data, size_t size, const char *
     size_t n = (size_t)s->cells_x * s->cells_z * 4 * s->layers;
     size_t ncell = (size_t)s->cells_x * s->cells_z * s->nmasks;
     /* all sizes < 2^48 here (each factor <= 65536 or a small constant) */
-    size_t want = HDR + n * 2 + n + s->atlas_bytes + ncell * 8;
+    size_t want = HDR + (size_t)s->nmasks * PLACE_BYTES + n * 2 + n + s->atlas_bytes +
+                  ncell * 8;
     if (size != want) {
         char what[160];
         snprintf(what, sizeof what, "%s: the header describes %zu bytes, the file has %zu",
                  size < want ? "truncated" : "trailing bytes", want, size);
+        free(s->place);
         memset(s, 0, sizeof *s);
         return fail(err, SPARSE_E_BAD_FILE, name, what);
     }
@@ -833,7 +1030,7 @@ bool sparse_read(sparse_masks *s, const uint8_t *data, size_t size, const char *
         sparse_free(s);
         return fail(err, SPARSE_E_BAD_FILE, name, "does not fit in memory");
     }
-    const uint8_t *at = data + HDR;
+    const uint8_t *at = data + HDR + (size_t)s->nmasks * PLACE_BYTES;
     bool ok = true;
     for (size_t i = 0; i < n; i++, at += 2) {
         s->index[i] = (uint16_t)(at[0] | at[1] << 8);

@@ -1,9 +1,11 @@
 /* sparse.h — painted masks as sparse quad-tree textures (Andersson 2007 §5.2.4,
  * Listing 3; slides 003 "Static sparse mask textures").
  *
- * A painted mask is an 8-bit raster of the heightfield's size (W x H
- * texels, row-major, row 0 = z 0, sampled bilinearly with clamp to edge at
- * heightfield uv: texel i has its centre at (i + 0.5) / W).  It is cut into
+ * A painted mask is an 8-bit raster (W x H texels, row-major, row 0 =
+ * z 0, sampled bilinearly with clamp to edge at its uv: texel i has its
+ * centre at (i + 0.5) / W).  By default it has the heightfield's size and
+ * covers the whole terrain; a placed mask has any size and covers a
+ * rectangle of the terrain (sparse_place), reading 0 outside it.  It is cut into
  * SPARSE_TILE x SPARSE_TILE tiles ("cells", one indirection texel each).
  * A cell whose values can never be anything but 0 (or 1) is a constant and
  * costs no atlas space; the other cells point into an atlas of unique,
@@ -64,6 +66,7 @@ enum {
     SPARSE_PAD = 2,            /* padding texels on each side of a slot      */
     SPARSE_SLOT = 36,          /* SPARSE_TILE + 2 * SPARSE_PAD               */
     SPARSE_MAX_LEVEL = 7,      /* coarsest quad-tree level a mask may use    */
+    SPARSE_MAX_TEXELS = 65536, /* a mask raster's side, at most               */
     SPARSE_CONST0 = 0,         /* index value of a constant-0 cell           */
     SPARSE_CONST1 = 0xFFFF,    /* index value of a constant-1 cell           */
     SPARSE_MAX_SLOTS = 0xFFFE, /* slots an index can address                 */
@@ -100,10 +103,14 @@ typedef struct sparse_error {
 
 /* ---- sparse.c: builder, CPU sampler, ranges, memory report --------------- */
 
-/* One mask.  Zero-initialised = full resolution everywhere. */
+/* One mask.  Zero-initialised = full resolution everywhere, the
+ * heightfield's size, over the whole terrain. */
 typedef struct sparse_mask_desc {
     const char    *name;       /* for reports and errors                     */
-    const uint8_t *texels;     /* W*H bytes, row-major, 255 = 1.0            */
+    const uint8_t *texels;     /* width*height bytes, row-major, 255 = 1.0   */
+    int    width, height;      /* the mask's raster; 0: the desc's (heightfield) */
+    double rect[4];            /* terrain uv u0 v0 u1 v1 the raster covers;
+                                  all 0: 0 0 1 1 (see sparse_place)          */
     int    max_level;          /* coarsest level allowed, 0..SPARSE_MAX_LEVEL */
     double max_error;          /* a block is reduced to level L only if its
                                   max |reduced - original| bilinear sample
@@ -113,7 +120,7 @@ typedef struct sparse_mask_desc {
 } sparse_mask_desc;
 
 typedef struct sparse_desc {
-    int width, height;               /* raster = heightfield texels          */
+    int width, height;               /* the heightfield's texels             */
     const sparse_mask_desc *masks;
     int nmasks;
     sparse_format format;
@@ -131,10 +138,24 @@ typedef struct sparse_mask_info {
                                 against the original (exact, before BC4)     */
 } sparse_mask_info;
 
+/* Where mask m lies (painted NAME = "FILE" { origin = X Z, size = W H }):
+ * its width x height raster covers the terrain-uv rectangle rect, so a
+ * fragment at terrain uv reads the mask at
+ *   muv = (uv - rect.xy) / (rect.zw - rect.xy),  t = muv * (width, height)
+ * and 0 where muv leaves [0, 1].  A mask that is not placed has the
+ * heightfield's size and rect 0 0 1 1: muv = uv, clamp to edge as before.
+ * Its cells are the first cells_x x cells_z of the shared index grid. */
+typedef struct sparse_place {
+    int    width, height;
+    int    cells_x, cells_z;
+    double rect[4];
+} sparse_place;
+
 typedef struct sparse_masks {
-    int width, height, nmasks;
+    int width, height, nmasks;       /* width, height: the heightfield's     */
     sparse_format format;
-    int cells_x, cells_z, layers;
+    int cells_x, cells_z, layers;    /* the index grid: the largest mask's   */
+    sparse_place *place;             /* nmasks                               */
     uint16_t *index;         /* [layers][cells_z][cells_x][4]                */
     uint8_t  *level;         /* [layers][cells_z][cells_x][4]                */
     int nslots, atlas_cols, atlas_rows, atlas_width, atlas_height;
@@ -151,15 +172,19 @@ typedef struct sparse_masks {
 bool sparse_build(sparse_masks *s, const sparse_desc *d, sparse_error *err);
 void sparse_free(sparse_masks *s);
 
-/* CPU twin of the GLSL: mask m at heightfield uv, bilinear in the atlas
- * (BC4 decoded with the format's palette, in float). */
+/* Whether mask m is placed (not heightfield-sized over the whole terrain). */
+bool sparse_placed(const sparse_masks *s, int mask);
+
+/* CPU twin of the GLSL: mask m at terrain uv, bilinear in the atlas
+ * (BC4 decoded with the format's palette, in float), 0 outside a placed
+ * mask's rectangle. */
 double sparse_sample(const sparse_masks *s, int mask, double u, double v);
 
 /* The reference: the raster's bilinear sample at uv, clamp to edge. */
 double sparse_raster_bilinear(const uint8_t *texels, int width, int height,
                               double u, double v);
 
-/* Bounds of mask m over every fragment whose raster position t = uv * (W, H)
+/* Bounds of mask m over every fragment whose mask raster position t
  * lies in the texel rectangle [x0, x1) x [z0, z1): the union of the cells'
  * bounds, each the min/max over (a) the original raster's bilinear
  * footprint of the cell (so the CPU reference is inside), (b) the stored
@@ -169,6 +194,20 @@ double sparse_raster_bilinear(const uint8_t *texels, int width, int height,
  * whose footprint is all 0 gives [0, 0].  Requires x0 < x1, z0 < z1. */
 void sparse_range(const sparse_masks *s, int mask, int x0, int z0, int x1,
                   int z1, double *lo, double *hi);
+/* The same over fragments whose heightfield raster position uv * (W, H)
+ * lies in [x0, x1) x [z0, z1) (heightfield texels, as the analysis cuts
+ * cells): sparse_range for a mask that is not placed; for a placed one the
+ * rectangle mapped into the mask's texels, widened by one texel for the
+ * float rounding of the mapping, with 0 joined where it reaches outside
+ * the mask's rectangle. */
+void sparse_range_terrain(const sparse_masks *s, int mask, int x0, int z0, int x1,
+                          int z1, double *lo, double *hi);
+
+/* The GLSL a placed pack defines before the prelude (NULL when no mask is
+ * placed): SPLAT_PAINTED_PLACED and, per mask, splat_painted_rect[m] =
+ * (u0, v0, 1 / (u1 - u0), 1 / (v1 - v0)) and splat_painted_size[m], as
+ * float literals that parse to the floats sparse_sample uses.  Malloc'd. */
+char *sparse_glsl_places(const sparse_masks *s);
 
 /* Memory report.  atlas_r8 / atlas_bc4: the atlas in each encoding, so the
  * report can show the option not taken. */
@@ -192,9 +231,10 @@ bool sparse_load_raster(const char *path, int width, int height,
                         uint8_t **texels, sparse_error *err);
 
 /* The pack file "painted.sparse" (little-endian): "SPLATSPM", u32 version
- * (1), u32 width, height, nmasks, format, cells_x, cells_z, layers, nslots,
- * atlas_cols, atlas_rows; then index (u16), level, atlas bytes, and the
- * per-cell bounds lo, hi (float32).  sparse_read parses a file's `size`
+ * (2), u32 width, height, nmasks, format, cells_x, cells_z, layers, nslots,
+ * atlas_cols, atlas_rows; per mask u32 width, height and f64 rect[4]; then
+ * index (u16), level, atlas bytes, and the per-cell bounds lo, hi
+ * (float32, [nmasks][cells_z][cells_x]).  sparse_read parses a file's `size`
  * bytes: the header is checked for consistency and against `size` before
  * anything is allocated; any mismatch is SPARSE_E_BAD_FILE. */
 bool sparse_write(const sparse_masks *s, FILE *f);
@@ -218,7 +258,8 @@ void sparse_bc4_decode(const uint8_t in[8], float out[16]);
     "float splat_sparse_painted(vec2 uv, vec2 size, int mask) {\n"            \
     "    ivec3 n = textureSize(u_painted_index, 0);\n"                        \
     "    vec2 t = uv * size;\n"                                               \
-    "    ivec2 cell = clamp(ivec2(floor(t * (1.0 / 32.0))), ivec2(0), n.xy - 1);\n" \
+    "    ivec2 last = min(n.xy, (ivec2(size) + 31) / 32) - 1;\n"                \
+    "    ivec2 cell = clamp(ivec2(floor(t * (1.0 / 32.0))), ivec2(0), last);\n" \
     "    ivec3 at = ivec3(cell, mask >> 2);\n"                                \
     "    uint e = texelFetch(u_painted_index, at, 0)[mask & 3];\n"            \
     "    if (e == 0u) return 0.0;\n"                                          \

@@ -61,7 +61,11 @@ static void fill_info(sparse_masks *s)
         snprintf(name, sizeof name, "mask %d", m);
         in->name = strdup(name);
         in->reduce_error = NAN;
+        /* a placed mask's own cells, the first of each row of the grid */
         for (size_t c = 0; c < ncell; c++) {
+            if ((int)(c % (size_t)s->cells_x) >= s->place[m].cells_x ||
+                (int)(c / (size_t)s->cells_x) >= s->place[m].cells_z)
+                continue;
             size_t at = ((size_t)(m / 4) * ncell + c) * 4 + (size_t)(m % 4);
             uint16_t e = s->index[at];
             in->const0 += e == SPARSE_CONST0;

@@ -1194,7 +1194,8 @@ static const char *reload_refused(const rt_pack *o, const rt_pack *p)
             a->atlas_rows != b->atlas_rows || a->cells_x != b->cells_x ||
             a->cells_z != b->cells_z || a->layers != b->layers ||
             !same_bytes(a->atlas, b->atlas, a->atlas_bytes) ||
-            !same_bytes(a->index, b->index, idx * 2) || !same_bytes(a->level, b->level, idx))
+            !same_bytes(a->index, b->index, idx * 2) || !same_bytes(a->level, b->level, idx) ||
+            !same_bytes(a->place, b->place, (size_t)a->nmasks * sizeof *a->place))
             return "a painted mask changed";
     }
     if (p->has_destruction != o->has_destruction ||

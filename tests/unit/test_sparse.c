@@ -388,8 +388,6 @@ static void test_ranges_sound(void **state)
     free(t);
 }
 
-/* ---- determinism and the pack file ------------------------------------------------------ */
-
 static char *write_mem(const sparse_masks *s, size_t *n)
 {
     char *buf = NULL;
@@ -398,6 +396,97 @@ static char *write_mem(const sparse_masks *s, size_t *n)
     fclose(f);
     return buf;
 }
+
+/* ---- placed masks ---------------------------------------------------------------------- */
+
+/* A mask of its own size over a rectangle of the terrain: the twin reads
+ * the raster at the mask's uv (0 outside the rectangle), sparse_range_terrain
+ * bounds every sample of heightfield-texel rectangles, the file keeps the
+ * place, and the GLSL constants name it. */
+static void test_placed_masks(void **state)
+{
+    int w = 300, h = 203, mw = 500, mh = 260;
+    uint8_t *t = gen_mixed(mw, mh, 61), *b = gen_fields(w, h, 6, 30, 62);
+    sparse_mask_desc md[2] = {
+        { .name = "placed", .texels = t, .width = mw, .height = mh,
+          .rect = { 0.2, 0.3, 0.45, 0.55 } },
+        { .name = "whole", .texels = b },
+    };
+    sparse_desc d = { .width = w, .height = h, .masks = md, .nmasks = 2, .format = SPARSE_R8 };
+    sparse_masks s;
+    assert_true(sparse_build(&s, &d, NULL));
+    assert_true(sparse_placed(&s, 0));
+    assert_false(sparse_placed(&s, 1));
+    assert_int_equal(s.cells_x, (mw + 31) / 32);      /* the largest mask's */
+    assert_int_equal(s.cells_z, (mh + 31) / 32);
+    uint32_t rs = 5;
+    double tol = float_tolerance(mw, mh) + 4.0 / mw;  /* + the fp32 mapping */
+    int inside = 0;
+    for (int k = 0; k < 40000; k++) {
+        double u = rng_unit(&rs) * 1.02 - 0.01, v = rng_unit(&rs) * 1.02 - 0.01;
+        double mu = (u - 0.2) / 0.25, mv = (v - 0.3) / 0.25;
+        double a = sparse_sample(&s, 0, u, v);
+        if (mu < -1e-5 || mv < -1e-5 || mu > 1 + 1e-5 || mv > 1 + 1e-5) {
+            assert_true(a == 0.0);
+            continue;
+        }
+        inside++;
+        double want = sparse_raster_bilinear(t, mw, mh, mu, mv);
+        if (mu > 1e-5 && mv > 1e-5 && mu < 1 - 1e-5 && mv < 1 - 1e-5 && fabs(a - want) > tol)
+            fail_msg("u %g v %g: twin %g, raster %g", u, v, a, want);
+        /* the whole-terrain mask is unchanged beside it */
+        assert_true(fabs(sparse_sample(&s, 1, u, v) -
+                         sparse_raster_bilinear(b, w, h, u, v)) <= float_tolerance(w, h));
+    }
+    assert_true(inside > 1500);
+    /* bounds over heightfield-texel rectangles hold every sample in them */
+    int zero = 0, some = 0;
+    for (int k = 0; k < 400; k++) {
+        int x0 = (int)(rng_unit(&rs) * w), z0 = (int)(rng_unit(&rs) * h);
+        int x1 = x0 + 1 + (int)(rng_unit(&rs) * 24), z1 = z0 + 1 + (int)(rng_unit(&rs) * 24);
+        x1 = x1 > w ? w : x1; z1 = z1 > h ? h : z1;
+        double lo, hi;
+        sparse_range_terrain(&s, 0, x0, z0, x1, z1, &lo, &hi);
+        zero += hi == 0.0;
+        some += hi > lo;
+        for (int p = 0; p < 200; p++) {
+            double u = (x0 + rng_unit(&rs) * (x1 - x0)) / w;
+            double v = (z0 + rng_unit(&rs) * (z1 - z0)) / h;
+            double a = sparse_sample(&s, 0, u, v);
+            if (!(a >= lo && a <= hi))
+                fail_msg("rect %d %d %d %d: %g outside [%g, %g]", x0, z0, x1, z1, a, lo, hi);
+        }
+    }
+    assert_true(zero > 50 && some > 20);
+    /* the file keeps the place; the GLSL names it */
+    size_t n;
+    char *f = write_mem(&s, &n);
+    sparse_masks r;
+    sparse_error err;
+    assert_true(sparse_read(&r, (const uint8_t *)f, n, "mem", &err));
+    assert_memory_equal(r.place, s.place, 2 * sizeof *s.place);
+    for (int k = 0; k < 2000; k++) {
+        double u = rng_unit(&rs), v = rng_unit(&rs);
+        assert_true(sparse_sample(&r, 0, u, v) == sparse_sample(&s, 0, u, v));
+    }
+    char *glsl = sparse_glsl_places(&s);
+    assert_non_null(glsl);
+    assert_non_null(strstr(glsl, "#define SPLAT_PAINTED_PLACED"));
+    assert_non_null(strstr(glsl, "vec2(500.0, 260.0), vec2(300.0, 203.0)"));
+    assert_non_null(strstr(glsl, "vec4(0.200000003, 0.300000012, 4, 4)"));
+    free(glsl);
+    sparse_free(&r);
+    free(f);
+    /* a forged place (a raster of 0 texels) is refused */
+    char *forged = write_mem(&s, &n);
+    memset(forged + 8 + 4 * 11, 0, 4);
+    assert_false(sparse_read(&r, (const uint8_t *)forged, n, "forged", &err));
+    free(forged);
+    sparse_free(&s);
+    free(t); free(b);
+}
+
+/* ---- determinism and the pack file ------------------------------------------------------ */
 
 static void test_deterministic_and_file(void **state)
 {
@@ -436,11 +525,11 @@ static void test_deterministic_and_file(void **state)
         assert_false(sparse_read(&r, (const uint8_t *)f1, cut, "cut", &err));
         assert_int_equal(err.id, SPARSE_E_BAD_FILE);
     }
-    /* a forged header (nmasks, hence layers and cells, raised) against the
+    /* a forged header (atlas rows raised) against the
      * same bytes: refused before allocating, naming the size */
     char *forged = malloc(n1);
     memcpy(forged, f1, n1);
-    forged[8 + 4 * 3] = 32, forged[8 + 4 * 7] = 8;   /* nmasks 32, layers 8 */
+    forged[8 + 4 * 10] = (char)200;                  /* atlas_rows 200       */
     assert_false(sparse_read(&r, (const uint8_t *)forged, n1, "forged", &err));
     assert_int_equal(err.id, SPARSE_E_BAD_FILE);
     assert_non_null(strstr(err.msg, "the header describes"));
@@ -816,6 +905,7 @@ int main(void)
         cmocka_unit_test(test_reduced_levels),
         cmocka_unit_test(test_no_seams),
         cmocka_unit_test(test_ranges_sound),
+        cmocka_unit_test(test_placed_masks),
         cmocka_unit_test(test_deterministic_and_file),
         cmocka_unit_test(test_bad_rasters),
         cmocka_unit_test(test_figure_fields),

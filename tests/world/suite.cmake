@@ -46,3 +46,18 @@ if(TARGET splatrt)
   set_tests_properties(world.far PROPERTIES LABELS render TIMEOUT 600
                        ENVIRONMENT "SPLAT_VALIDATE=1")
 endif()
+
+# A painted mask at its own resolution (label `render`, SPLAT_VALIDATE=1): a
+# 1 px/m road mask over 10 x 10 km of colorado (10^8 texels) placed with
+# { origin, size }: build memory, sparse share, road widths in the mask
+# view, composites against the über-shader.
+if(TARGET splatrt)
+  set(PLACED_OUT ${CMAKE_BINARY_DIR}/tests/placed)
+  file(MAKE_DIRECTORY ${PLACED_OUT})
+  add_executable(test_placed ${CMAKE_CURRENT_LIST_DIR}/test_placed.c)
+  target_link_libraries(test_placed splatrt splatc PkgConfig::GDAL m)
+  add_test(NAME world.placed_mask COMMAND test_placed ${PLACED_OUT}
+           WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
+  set_tests_properties(world.placed_mask PROPERTIES LABELS render TIMEOUT 600
+                       ENVIRONMENT "SPLAT_VALIDATE=1")
+endif()

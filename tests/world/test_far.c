@@ -17,8 +17,8 @@
  *     pixels of each view.
  * Without the pass the 5,000 km view fails both (position's fp32 ulp
  * there is 0.5 m).  Pictures go to OUTDIR. */
-#include "scene.h"
 #include "splatrt.h"
+#include "world_check.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -27,30 +27,10 @@
 
 #include <stb_image_write.h>
 
-static int failures;
-
-#define CHECK(cond, ...)                                                    \
-    do {                                                                    \
-        if (!(cond)) {                                                      \
-            failures++;                                                     \
-            fprintf(stderr, "FAIL %s:%d: %s: ", __FILE__, __LINE__, #cond); \
-            fprintf(stderr, __VA_ARGS__);                                   \
-            fputc('\n', stderr);                                            \
-        }                                                                   \
-    } while (0)
-
 enum { N = 1024, W = 256, H = 256 };
 static const double SIZE = 10240000.0, FOVY = M_PI / 3.0, ABOVE = 30.0;
 static const double X0 = 41234.5, Z0 = 47876.25;    /* near the origin */
 static const double OFFSETS[] = { 0.0, 1e5, 1e6, 5e6 };
-
-static char *join(const char *dir, const char *name)
-{
-    size_t n = strlen(dir) + strlen(name) + 2;
-    char *p = malloc(n);
-    snprintf(p, n, "%s/%s", dir, name);
-    return p;
-}
 
 /* The flat heightfield and two scenes over it: "tex" (far_base alone:
  * its albedo must not change with the offset) and "noise" (far_spots on
@@ -90,21 +70,13 @@ static bool write_inputs(const char *dir)
  * inputs would be kept as it is) and load it on the device. */
 static bool build(const char *dir, const char *name, rt_pack *pack)
 {
-    static const char *const search[] = { ".", NULL };
     char file[64];
     snprintf(file, sizeof file, "%s.sg", name);
     char *sg = join(dir, file);
     snprintf(file, sizeof file, "%s.pack", name);
     char *packdir = join(dir, file);
-    char rm[1200];
-    snprintf(rm, sizeof rm, "rm -rf '%s'", packdir);
     sg_diags d;
-    sg_diags_init(&d);
-    splat_build_desc bd = { .scene = sg, .out = packdir, .search_paths = search,
-                            .jobs = 2, .no_cache = true };
-    splat_build_stats st;
-    bool ok = system(rm) == 0 && splat_build(&bd, &st, &d);
-    if (!ok) sg_diags_print(&d, stderr);
+    bool ok = world_build(sg, packdir, SPLAT_PAINTED_BC4, &d);
     /* far.sg's uses of position are all periodic: no warning */
     for (int i = 0; i < d.n; i++)
         CHECK(d.items[i].severity != SG_WARNING, "warning: %s", d.items[i].msg);

@@ -17,8 +17,8 @@
  *     is terrain;
  *   - no validation messages.
  * Pictures of the views go to OUTDIR. */
-#include "scene.h"
 #include "splatrt.h"
+#include "world_check.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -28,18 +28,6 @@
 #include <gdal.h>
 #include <ogr_srs_api.h>
 #include <stb_image_write.h>
-
-static int failures;
-
-#define CHECK(cond, ...)                                                    \
-    do {                                                                    \
-        if (!(cond)) {                                                      \
-            failures++;                                                     \
-            fprintf(stderr, "FAIL %s:%d: %s: ", __FILE__, __LINE__, #cond); \
-            fprintf(stderr, __VA_ARGS__);                                   \
-            fputc('\n', stderr);                                            \
-        }                                                                   \
-    } while (0)
 
 enum { N = 257, W = 384, H = 384, CELL = 8 };
 static const double TEXEL = 4.0, CAM[3] = { 514, 1400, 514 }, FOVY = M_PI / 3.0;
@@ -51,14 +39,6 @@ static const float CLEAR[4] = { 1.0f, 0.0f, 1.0f, 1.0f };
 static bool in_rect(const int r[4], double tx, double tz, double grow)
 {
     return tx >= r[0] - grow && tx < r[2] + grow && tz >= r[1] - grow && tz < r[3] + grow;
-}
-
-static char *join(const char *dir, const char *name)
-{
-    size_t n = strlen(dir) + strlen(name) + 2;
-    char *p = malloc(n);
-    snprintf(p, n, "%s/%s", dir, name);
-    return p;
 }
 
 static bool write_inputs(const char *dir)
@@ -107,19 +87,8 @@ static bool build(const char *dir, char **pack)
 {
     char *sg = join(dir, "scene.sg");
     *pack = join(dir, "pack");
-    /* a fresh pack: an old one with the same inputs would be kept as is */
-    char rm[1200];
-    snprintf(rm, sizeof rm, "rm -rf '%s'", *pack);
-    if (system(rm) != 0)
-        return false;
-    static const char *const search[] = { ".", NULL };
-    splat_build_desc bd = { .scene = sg, .out = *pack, .search_paths = search,
-                            .jobs = 2, .no_cache = true };
-    splat_build_stats st;
     sg_diags d;
-    sg_diags_init(&d);
-    bool ok = splat_build(&bd, &st, &d);
-    if (!ok) sg_diags_print(&d, stderr);
+    bool ok = world_build(sg, *pack, SPLAT_PAINTED_BC4, &d);
     sg_diags_free(&d);
     free(sg);
     return ok;

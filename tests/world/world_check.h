@@ -1,0 +1,51 @@
+/* world_check.h — what the tests/world programs share (each is one file):
+ * CHECK, which counts a failure and goes on; join; and world_build, a
+ * fresh pack built with splatc's library (an old pack with the same inputs
+ * would be kept as it is), its diagnostics left in *d for the caller. */
+#ifndef WORLD_CHECK_H
+#define WORLD_CHECK_H
+
+#include "scene.h"
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+static int failures;
+
+#define CHECK(cond, ...)                                                    \
+    do {                                                                    \
+        if (!(cond)) {                                                      \
+            failures++;                                                     \
+            fprintf(stderr, "FAIL %s:%d: %s: ", __FILE__, __LINE__, #cond); \
+            fprintf(stderr, __VA_ARGS__);                                   \
+            fputc('\n', stderr);                                            \
+        }                                                                   \
+    } while (0)
+
+static char *join(const char *dir, const char *name)
+{
+    size_t n = strlen(dir) + strlen(name) + 2;
+    char *p = malloc(n);
+    if (p) snprintf(p, n, "%s/%s", dir, name);
+    return p;
+}
+
+/* Build scene file `sg` into `pack` (removed first), imports searched in
+ * "." (the repository root).  Diagnostics are printed on failure. */
+static bool world_build(const char *sg, const char *pack, splat_painted_format painted,
+                        sg_diags *d)
+{
+    char rm[1200];
+    snprintf(rm, sizeof rm, "rm -rf '%s'", pack);
+    static const char *const search[] = { ".", NULL };
+    splat_build_desc bd = { .scene = sg, .out = pack, .search_paths = search,
+                            .jobs = 2, .no_cache = true, .painted = painted };
+    splat_build_stats st;
+    sg_diags_init(d);
+    bool ok = system(rm) == 0 && splat_build(&bd, &st, d);
+    if (!ok && painted != SPLAT_PAINTED_DENSE) sg_diags_print(d, stderr);
+    return ok;
+}
+
+#endif
