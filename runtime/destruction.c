@@ -512,28 +512,25 @@ static void update_bounds(rt_destruction *ds, int tx0, int tz0, int tx1, int tz1
     }
 }
 
-bool rt_destruction_crater(rt_destruction *ds, const rt_crater *c, rt_crater_stats *st,
-                           rt_error *e)
-{
-    double t0 = 1e3 * splat_now();
-    rt_crater_stats local;
-    if (!st)
-        st = &local;
-    memset(st, 0, sizeof *st);
-    st->pool = ds->pool;
-    st->tiles_used = ds->used;
-    double r = c->radius;
-    if (!(r > 0) || !isfinite(r) || !isfinite(c->x) || !isfinite(c->z)) {
-        st->result = RT_CRATER_OUTSIDE;
-        return true;
-    }
-    double depth = c->depth > 0 ? c->depth : 0.0;
-    double strength = c->strength > 0 ? (c->strength < 1 ? c->strength : 1.0) : 1.0;
+/* One crater's work between the steps of rt_destruction_crater: the disc
+ * in cell units, the touched cells (ds->touched), and the rectangles of
+ * index texels and height texels that changed (x1 < 0: none). */
+typedef struct crater_work {
+    double lx, lz, rc, strength;      /* centre and radius in cells       */
+    int    ntouched, nnew, nclear;
+    int    ix0, iz0, ix1, iz1;        /* indirection texels               */
+    int    hx0, hz0, hx1, hz1;        /* height texels                    */
+    VkDeviceSize index_off, height_off;   /* in the staging buffer        */
+} crater_work;
 
-    /* 1. the cells the disc meets */
-    int n = ds->n, ntouched = 0, nnew = 0;
-    double lx = (c->x - ds->origin[0]) / ds->cell, lz = (c->z - ds->origin[1]) / ds->cell;
-    double rc = r / ds->cell;
+/* 1. The cells the disc meets, into ds->touched; how many lack a tile. */
+static void crater_cells(rt_destruction *ds, const rt_crater *c, crater_work *w)
+{
+    int n = ds->n;
+    w->lx = (c->x - ds->origin[0]) / ds->cell;
+    w->lz = (c->z - ds->origin[1]) / ds->cell;
+    w->rc = c->radius / ds->cell;
+    double lx = w->lx, lz = w->lz, rc = w->rc;
     int cx0 = (int)floor(lx - rc), cx1 = (int)floor(lx + rc);
     int cz0 = (int)floor(lz - rc), cz1 = (int)floor(lz + rc);
     cx0 = cx0 < 0 ? 0 : cx0;
@@ -546,37 +543,18 @@ bool rt_destruction_crater(rt_destruction *ds, const rt_crater *c, rt_crater_sta
             double qz = lz < z ? z : lz > z + 1 ? z + 1 : lz;
             if ((qx - lx) * (qx - lx) + (qz - lz) * (qz - lz) >= rc * rc)
                 continue;
-            ds->touched[ntouched++] = z * n + x;
-            nnew += ds->cell_tile[z * n + x] < 0;
+            ds->touched[w->ntouched++] = z * n + x;
+            w->nnew += ds->cell_tile[z * n + x] < 0;
         }
-    if (ntouched == 0) {
-        st->result = RT_CRATER_OUTSIDE;
-        st->cpu_ms = 1e3 * splat_now() - t0;
-        return true;
-    }
-    if (nnew > ds->nfree) {
-        /* Documented behaviour: refuse the whole crater, change nothing. */
-        fprintf(stderr, "splatrt: warning: destruction tile pool exhausted (%d of %d tiles "
-                "used, this crater needs %d more): crater at (%.1f, %.1f) m refused\n",
-                ds->used, ds->pool, nnew, c->x, c->z);
-        ds->refused++;
-        st->result = RT_CRATER_REFUSED;
-        st->cells = ntouched;
-        st->cpu_ms = 1e3 * splat_now() - t0;
-        return true;
-    }
-    int k = ds->slot;
-    if (ds->pending[k]) {   /* the oldest event still runs: its memory */
-        double tw = 1e3 * splat_now();
-        RT_VK(e, vkWaitForFences(ds->d->dev, 1, &ds->fence[k], VK_TRUE, UINT64_MAX));
-        RT_VK(e, vkResetFences(ds->d->dev, 1, &ds->fence[k]));
-        ds->pending[k] = false;
-        st->wait_ms = 1e3 * splat_now() - tw;
-    }
+}
 
-    /* 2. tiles and the indirection rectangle */
-    int ix0 = n, iz0 = n, ix1 = -1, iz1 = -1, nclear = 0;
-    for (int i = 0; i < ntouched; i++) {
+/* 2. A tile for each touched cell without one (cleared in the atlas), and
+ * the rectangle of indirection texels that changed, staged at offset 0. */
+static void crater_tiles(rt_destruction *ds, uint8_t *staging, crater_work *w)
+{
+    int n = ds->n;
+    w->ix0 = n, w->iz0 = n, w->ix1 = -1, w->iz1 = -1;
+    for (int i = 0; i < w->ntouched; i++) {
         int cell = ds->touched[i];
         if (ds->cell_tile[cell] >= 0)
             continue;
@@ -590,25 +568,31 @@ bool rt_destruction_crater(rt_destruction *ds, const rt_crater *c, rt_crater_sta
         px[2] = 0;
         px[3] = 255;
         int x = cell % n, z = cell / n;
-        ix0 = x < ix0 ? x : ix0;
-        ix1 = x > ix1 ? x : ix1;
-        iz0 = z < iz0 ? z : iz0;
-        iz1 = z > iz1 ? z : iz1;
-        ds->clears[nclear++] = (VkClearRect){
+        w->ix0 = x < w->ix0 ? x : w->ix0;
+        w->ix1 = x > w->ix1 ? x : w->ix1;
+        w->iz0 = z < w->iz0 ? z : w->iz0;
+        w->iz1 = z > w->iz1 ? z : w->iz1;
+        ds->clears[w->nclear++] = (VkClearRect){
             { { tx * RT_DESTR_TILE, tz * RT_DESTR_TILE }, { RT_DESTR_TILE, RT_DESTR_TILE } }, 0, 1 };
     }
-    uint8_t *staging = ds->staging[k].map;
-    VkDeviceSize off = 0, index_off = 0;
-    if (ix1 >= 0) {
-        int w = ix1 - ix0 + 1;
-        for (int z = iz0; z <= iz1; z++)
-            memcpy(staging + off + (size_t)(z - iz0) * (size_t)w * 4,
-                   ds->index + ((size_t)z * (size_t)n + (size_t)ix0) * 4, (size_t)w * 4);
-        off += (VkDeviceSize)w * (VkDeviceSize)(iz1 - iz0 + 1) * 4;
+    VkDeviceSize off = 0;
+    w->index_off = 0;
+    if (w->ix1 >= 0) {
+        int rw = w->ix1 - w->ix0 + 1;
+        for (int z = w->iz0; z <= w->iz1; z++)
+            memcpy(staging + off + (size_t)(z - w->iz0) * (size_t)rw * 4,
+                   ds->index + ((size_t)z * (size_t)n + (size_t)w->ix0) * 4, (size_t)rw * 4);
+        off += (VkDeviceSize)rw * (VkDeviceSize)(w->iz1 - w->iz0 + 1) * 4;
     }
+    w->height_off = (off + 3) & ~(VkDeviceSize)3;
+}
 
-    /* 4. heights: texel centres inside the disc and inside the grid */
-    double gx0 = ds->origin[0], gz0 = ds->origin[1], ext = n * ds->cell;
+/* 3. Heights: texel centres inside the disc and inside the grid sink by
+ * depth * (1 - d^2)^2; the changed rectangle is staged after the index. */
+static void crater_heights(rt_destruction *ds, const rt_crater *c, double depth,
+                           uint8_t *staging, crater_work *w, rt_crater_stats *st)
+{
+    double r = c->radius, gx0 = ds->origin[0], gz0 = ds->origin[1], ext = ds->n * ds->cell;
     double dx = ds->size[0] / ds->hw, dz = ds->size[1] / ds->hh;
     double ax0 = fmax(c->x - r, gx0), ax1 = fmin(c->x + r, gx0 + ext);
     double az0 = fmax(c->z - r, gz0), az1 = fmin(c->z + r, gz0 + ext);
@@ -619,7 +603,7 @@ bool rt_destruction_crater(rt_destruction *ds, const rt_crater *c, rt_crater_sta
     tx1 = tx1 >= ds->hw ? ds->hw - 1 : tx1;
     tz1 = tz1 >= ds->hh ? ds->hh - 1 : tz1;
     double units = depth / (ds->max_height > 0 ? ds->max_height : 1.0) * 65535.0;
-    int hx0 = ds->hw, hz0 = ds->hh, hx1 = -1, hz1 = -1;
+    w->hx0 = ds->hw, w->hz0 = ds->hh, w->hx1 = -1, w->hz1 = -1;
     for (int z = tz0; depth > 0 && z <= tz1; z++)
         for (int x = tx0; x <= tx1; x++) {
             double wx = (x + 0.5) * dx, wz = (z + 0.5) * dz;
@@ -636,46 +620,50 @@ bool rt_destruction_crater(rt_destruction *ds, const rt_crater *c, rt_crater_sta
                 continue;
             *h = nv;
             st->texels++;
-            hx0 = x < hx0 ? x : hx0;
-            hx1 = x > hx1 ? x : hx1;
-            hz0 = z < hz0 ? z : hz0;
-            hz1 = z > hz1 ? z : hz1;
+            w->hx0 = x < w->hx0 ? x : w->hx0;
+            w->hx1 = x > w->hx1 ? x : w->hx1;
+            w->hz0 = z < w->hz0 ? z : w->hz0;
+            w->hz1 = z > w->hz1 ? z : w->hz1;
         }
-    VkDeviceSize height_off = (off + 3) & ~(VkDeviceSize)3;
-    if (hx1 >= 0) {
-        int w = hx1 - hx0 + 1;
-        for (int z = hz0; z <= hz1; z++)
-            memcpy(staging + height_off + (size_t)(z - hz0) * (size_t)w * 2,
-                   ds->heights + (size_t)z * (size_t)ds->hw + (size_t)hx0, (size_t)w * 2);
-        st->upload[0] = hx0;
-        st->upload[1] = hz0;
-        st->upload[2] = w;
-        st->upload[3] = hz1 - hz0 + 1;
+    if (w->hx1 >= 0) {
+        int rw = w->hx1 - w->hx0 + 1;
+        for (int z = w->hz0; z <= w->hz1; z++)
+            memcpy(staging + w->height_off + (size_t)(z - w->hz0) * (size_t)rw * 2,
+                   ds->heights + (size_t)z * (size_t)ds->hw + (size_t)w->hx0, (size_t)rw * 2);
+        st->upload[0] = w->hx0;
+        st->upload[1] = w->hz0;
+        st->upload[2] = rw;
+        st->upload[3] = w->hz1 - w->hz0 + 1;
     }
+}
 
-    /* record: uploads, then the decals */
+/* 4. Record and submit on ring slot k: the uploads, then the decals. */
+static bool crater_submit(rt_destruction *ds, int k, const crater_work *w, rt_error *e)
+{
     VkCommandBuffer cb = ds->cb[k];
     RT_VK(e, vkResetCommandBuffer(cb, 0));
     VkCommandBufferBeginInfo bi = { .sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_BEGIN_INFO,
                                     .flags = VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT };
     RT_VK(e, vkBeginCommandBuffer(cb, &bi));
-    if (ix1 >= 0)
-        upload_rect(ds, ds->indir.img, index_off, ix0, iz0, ix1 - ix0 + 1, iz1 - iz0 + 1);
-    if (hx1 >= 0)
-        upload_rect(ds, ds->height->img, height_off, hx0, hz0, hx1 - hx0 + 1, hz1 - hz0 + 1);
+    if (w->ix1 >= 0)
+        upload_rect(ds, ds->indir.img, w->index_off, w->ix0, w->iz0, w->ix1 - w->ix0 + 1,
+                    w->iz1 - w->iz0 + 1);
+    if (w->hx1 >= 0)
+        upload_rect(ds, ds->height->img, w->height_off, w->hx0, w->hz0, w->hx1 - w->hx0 + 1,
+                    w->hz1 - w->hz0 + 1);
     VkRenderPassBeginInfo rb = {
         .sType = VK_STRUCTURE_TYPE_RENDER_PASS_BEGIN_INFO,
         .renderPass = ds->pass, .framebuffer = ds->fb,
         .renderArea = { { 0, 0 }, { ds->atlas.width, ds->atlas.height } },
     };
     vkCmdBeginRenderPass(cb, &rb, VK_SUBPASS_CONTENTS_INLINE);
-    if (nclear > 0) {
+    if (w->nclear > 0) {
         VkClearAttachment ca = { VK_IMAGE_ASPECT_COLOR_BIT, 0, { .color = { { 0, 0, 0, 0 } } } };
-        vkCmdClearAttachments(cb, 1, &ca, (uint32_t)nclear, ds->clears);
+        vkCmdClearAttachments(cb, 1, &ca, (uint32_t)w->nclear, ds->clears);
     }
     vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_GRAPHICS, ds->pipe);
-    for (int i = 0; i < ntouched; i++) {
-        int cell = ds->touched[i], x = cell % n, z = cell / n;
+    for (int i = 0; i < w->ntouched; i++) {
+        int cell = ds->touched[i], x = cell % ds->n, z = cell / ds->n;
         int slot = ds->cell_tile[cell];
         float tx = (float)(slot % ds->cols * RT_DESTR_TILE);
         float tz = (float)(slot / ds->cols * RT_DESTR_TILE);
@@ -684,7 +672,7 @@ bool rt_destruction_crater(rt_destruction *ds, const rt_crater *c, rt_crater_sta
         vkCmdSetViewport(cb, 0, 1, &vp);
         vkCmdSetScissor(cb, 0, 1, &sc);
         decal_push push = {
-            { (float)(lx - x), (float)(lz - z), (float)rc, (float)strength },
+            { (float)(w->lx - x), (float)(w->lz - z), (float)w->rc, (float)w->strength },
             { (float)(x * ds->cell), (float)(z * ds->cell), (float)ds->cell, 0.0f },
         };
         vkCmdPushConstants(cb, ds->layout, VK_SHADER_STAGE_FRAGMENT_BIT, 0, sizeof push, &push);
@@ -695,16 +683,63 @@ bool rt_destruction_crater(rt_destruction *ds, const rt_crater *c, rt_crater_sta
     VkSubmitInfo si = { .sType = VK_STRUCTURE_TYPE_SUBMIT_INFO,
                         .commandBufferCount = 1, .pCommandBuffers = &cb };
     RT_VK(e, vkQueueSubmit(ds->d->queue, 1, &si, ds->fence[k]));
+    return true;
+}
+
+bool rt_destruction_crater(rt_destruction *ds, const rt_crater *c, rt_crater_stats *st,
+                           rt_error *e)
+{
+    double t0 = 1e3 * splat_now();
+    rt_crater_stats local;
+    if (!st)
+        st = &local;
+    memset(st, 0, sizeof *st);
+    st->pool = ds->pool;
+    st->tiles_used = ds->used;
+    if (!(c->radius > 0) || !isfinite(c->radius) || !isfinite(c->x) || !isfinite(c->z)) {
+        st->result = RT_CRATER_OUTSIDE;
+        return true;
+    }
+    double depth = c->depth > 0 ? c->depth : 0.0;
+    crater_work w = { .strength = c->strength > 0 ? (c->strength < 1 ? c->strength : 1.0)
+                                                  : 1.0 };
+    crater_cells(ds, c, &w);
+    if (w.ntouched == 0) {
+        st->result = RT_CRATER_OUTSIDE;
+        st->cpu_ms = 1e3 * splat_now() - t0;
+        return true;
+    }
+    if (w.nnew > ds->nfree) {
+        /* Documented behaviour: refuse the whole crater, change nothing. */
+        fprintf(stderr, "splatrt: warning: destruction tile pool exhausted (%d of %d tiles "
+                "used, this crater needs %d more): crater at (%.1f, %.1f) m refused\n",
+                ds->used, ds->pool, w.nnew, c->x, c->z);
+        ds->refused++;
+        st->result = RT_CRATER_REFUSED;
+        st->cells = w.ntouched;
+        st->cpu_ms = 1e3 * splat_now() - t0;
+        return true;
+    }
+    int k = ds->slot;
+    if (ds->pending[k]) {   /* the oldest event still runs: its memory */
+        double tw = 1e3 * splat_now();
+        RT_VK(e, vkWaitForFences(ds->d->dev, 1, &ds->fence[k], VK_TRUE, UINT64_MAX));
+        RT_VK(e, vkResetFences(ds->d->dev, 1, &ds->fence[k]));
+        ds->pending[k] = false;
+        st->wait_ms = 1e3 * splat_now() - tw;
+    }
+    crater_tiles(ds, ds->staging[k].map, &w);
+    crater_heights(ds, c, depth, ds->staging[k].map, &w, st);
+    if (!crater_submit(ds, k, &w, e))
+        return false;
     ds->pending[k] = true;
     ds->slot = (k + 1) % RT_DESTR_RING;
-
-    /* 5. node bounds */
-    if (hx1 >= 0)
-        update_bounds(ds, hx0, hz0, hx1, hz1);
+    if (w.hx1 >= 0)     /* 5. node bounds */
+        update_bounds(ds, w.hx0, w.hz0, w.hx1, w.hz1);
 
     st->result = RT_CRATER_DONE;
-    st->cells = ntouched;
-    st->tiles_new = nclear;
+    st->cells = w.ntouched;
+    st->tiles_new = w.nclear;
     st->tiles_used = ds->used;
     st->cpu_ms = 1e3 * splat_now() - t0 - st->wait_ms;
     ds->craters++;
