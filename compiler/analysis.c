@@ -290,6 +290,129 @@ static bool bits_empty(const uint64_t *bits, int words)
 
 /* ---- the analysis ------------------------------------------------------- */
 
+/* The masks alone, imported into a small ir of their own (the interval
+ * evaluator's cost per call grows with the ir below the root, and the
+ * scene's ir is mostly surfaces the analysis never reads): masks[m] is
+ * material m's mask root in *mir, painted_src[k] the scene raster of
+ * mir's painted mask k (-1: none).  False (error at the scene) if a
+ * material has no mask root. */
+static bool mask_ir(const splat_scene *s, ir *mir, ir_ref *masks, int **painted_src,
+                    sg_diags *d)
+{
+    const sg_scene *sc = s->desc;
+    bool ok = true;
+    ir_import_map *map = ir_import_begin(mir, &s->ir);
+    for (int m = 1; m < s->nmaterials; m++) {
+        char name[512];
+        snprintf(name, sizeof name, "%s.mask", sc->materials[m]);
+        ir_ref root = ir_find_root(&s->ir, name);
+        if (!ir_ref_ok(root)) {
+            char msg[600];
+            snprintf(msg, sizeof msg, "material '%s' has no mask root", sc->materials[m]);
+            sg_error(d, sc->loc, SG_E_INTERNAL, msg);
+            ok = false;
+            break;
+        }
+        masks[m] = ir_import(map, root);
+    }
+    ir_import_end(map);
+    *painted_src = xcalloc((size_t)(mir->npainted ? mir->npainted : 1), sizeof **painted_src);
+    for (int k = 0; k < mir->npainted; k++) {
+        (*painted_src)[k] = -1;
+        for (int j = 0; j < sc->npainted; j++)
+            if (s->painted && s->painted[j] &&
+                strcmp(mir->painted[k].name, sc->painted[j].name) == 0)
+                (*painted_src)[k] = j;
+    }
+    return ok;
+}
+
+/* Levels: 0 = cells, each next one halves the sides (rounding up). */
+static void alloc_levels(splat_analysis *a)
+{
+    int nlevels = 1;
+    for (int w = a->cells_x, h = a->cells_z; w > 1 || h > 1; nlevels++) {
+        w = (w + 1) / 2;
+        h = (h + 1) / 2;
+    }
+    a->levels = xcalloc((size_t)nlevels, sizeof *a->levels);
+    a->nlevels = nlevels;
+    for (int L = 0, w = a->cells_x, h = a->cells_z; L < nlevels; L++) {
+        a->levels[L].width = w;
+        a->levels[L].height = h;
+        a->levels[L].ids = xcalloc((size_t)w * (size_t)h, sizeof(uint16_t));
+        w = (w + 1) / 2;
+        h = (h + 1) / 2;
+    }
+}
+
+/* Level 0: each cell's combination from its bounds (block_combo), its
+ * member bits into bits[cell]. */
+static bool analyze_cells(const block_ctx *bc, combo_set *cs, uint64_t *bits, sg_diags *d)
+{
+    const splat_scene *s = bc->s;
+    const splat_terrain *t = &s->terrain;
+    splat_analysis *a = cs->a;
+    int T = a->cell_texels;
+    for (int cz = 0; cz < a->cells_z; cz++)
+        for (int cx = 0; cx < a->cells_x; cx++) {
+            int x0 = cx * T, z0 = cz * T;
+            int x1 = x0 + T < t->width ? x0 + T : t->width;
+            int z1 = z0 + T < t->height ? z0 + T : t->height;
+            uint64_t *cell = bits + ((size_t)cz * a->cells_x + cx) * cs->words;
+            if (all_hole(t, x0, z0, x1, z1)) {     /* no members: a hole */
+                a->levels[0].ids[(size_t)cz * a->cells_x + cx] = SPLAT_COMBO_HOLE;
+                a->hole_cells++;
+                continue;
+            }
+            block_combo(bc, x0, z0, x1, z1, cell);
+            int id = intern_checked(cs, cell, s->nmaterials, s->desc, d);
+            if (id < 0)
+                return false;
+            a->levels[0].ids[(size_t)cz * a->cells_x + cx] = (uint16_t)id;
+            a->combos[id].ncells++;
+            a->combos[id].nnodes++;
+        }
+    return true;
+}
+
+/* Level L from level L - 1: each node the union of its (up to four)
+ * children's bits, which *bits holds and is replaced by level L's. */
+static bool analyze_level(const splat_scene *s, combo_set *cs, int L, uint64_t **bits,
+                          sg_diags *d)
+{
+    splat_analysis *a = cs->a;
+    const splat_level *below = &a->levels[L - 1];
+    splat_level *lv = &a->levels[L];
+    size_t nn = (size_t)lv->width * (size_t)lv->height;
+    uint64_t *up = xcalloc(nn * (size_t)cs->words, sizeof *up);
+    bool ok = true;
+    for (int z = 0; ok && z < lv->height; z++)
+        for (int x = 0; ok && x < lv->width; x++) {
+            uint64_t *node = up + ((size_t)z * lv->width + x) * cs->words;
+            for (int dz = 0; dz < 2; dz++)
+                for (int dx = 0; dx < 2; dx++) {
+                    int bx = 2 * x + dx, bz = 2 * z + dz;
+                    if (bx >= below->width || bz >= below->height) continue;
+                    const uint64_t *child = *bits + ((size_t)bz * below->width + bx) * cs->words;
+                    for (int w = 0; w < cs->words; w++) node[w] |= child[w];
+                }
+            if (bits_empty(node, cs->words)) {    /* every child a hole */
+                lv->ids[(size_t)z * lv->width + x] = SPLAT_COMBO_HOLE;
+                continue;
+            }
+            int id = intern_checked(cs, node, s->nmaterials, s->desc, d);
+            ok = id >= 0;
+            if (ok) {
+                lv->ids[(size_t)z * lv->width + x] = (uint16_t)id;
+                a->combos[id].nnodes++;
+            }
+        }
+    free(*bits);
+    *bits = up;
+    return ok;
+}
+
 bool splat_analyze(const splat_scene *s, splat_analysis *a, sg_diags *d)
 {
     double t0 = splat_now();
@@ -303,150 +426,23 @@ bool splat_analyze(const splat_scene *s, splat_analysis *a, sg_diags *d)
     a->cells_z = (t->height + T - 1) / T;
     a->naive_subsets = n > 0 ? ldexp(1.0, n - 1) : 0;
 
-    combo_set cs = { .a = a, .words = (n + 63) / 64 };
-    if (cs.words == 0) cs.words = 1;
-    ir_ref *masks = calloc((size_t)(n ? n : 1), sizeof *masks);
-    uint64_t *bits = NULL;
-    ir_iv *painted = NULL;
-    int *painted_src = NULL;    /* mask ir's painted k -> scene raster, -1 */
-    bool ok = masks != NULL;
-    if (!ok) sg_error(d, sc->loc, SG_E_TOO_LARGE, "out of memory in the analysis");
-
-    /* The masks alone, imported into a small ir of their own: the interval
-     * evaluator's cost per call grows with the ir below the root, and the
-     * scene's ir is mostly surfaces (albedo, normal …) the analysis never
-     * reads. */
+    combo_set cs = { .a = a, .words = n > 64 ? (n + 63) / 64 : 1 };
+    ir_ref *masks = xcalloc((size_t)(n ? n : 1), sizeof *masks);
+    int *painted_src = NULL;
     ir mir;
     ir_init(&mir);
-    ir_import_map *map = ok ? ir_import_begin(&mir, &s->ir) : NULL;
-    for (int m = 1; ok && m < n; m++) {
-        char name[512];
-        snprintf(name, sizeof name, "%s.mask", sc->materials[m]);
-        ir_ref root = ir_find_root(&s->ir, name);
-        if (!ir_ref_ok(root)) {
-            char msg[600];
-            snprintf(msg, sizeof msg, "material '%s' has no mask root", sc->materials[m]);
-            sg_error(d, sc->loc, SG_E_INTERNAL, msg);
-            ok = false;
-            break;
-        }
-        masks[m] = ir_import(map, root);
-    }
-    if (map) ir_import_end(map);
-    if (ok) {
-        size_t np = (size_t)(mir.npainted ? mir.npainted : 1);
-        painted = calloc(np, sizeof *painted);
-        painted_src = calloc(np, sizeof *painted_src);
-        ok = painted && painted_src;
-        if (!ok) sg_error(d, sc->loc, SG_E_TOO_LARGE, "out of memory in the analysis");
-    }
-    for (int k = 0; ok && k < mir.npainted; k++) {
-        painted_src[k] = -1;
-        for (int j = 0; j < sc->npainted; j++)
-            if (s->painted && s->painted[j] &&
-                strcmp(mir.painted[k].name, sc->painted[j].name) == 0)
-                painted_src[k] = j;
-    }
-
-    /* Levels: 0 = cells, each next one halves the sides (rounding up). */
-    int nlevels = 1;
-    for (int w = a->cells_x, h = a->cells_z; w > 1 || h > 1; nlevels++) {
-        w = (w + 1) / 2;
-        h = (h + 1) / 2;
-    }
-    if (ok) {
-        a->levels = calloc((size_t)nlevels, sizeof *a->levels);
-        ok = a->levels != NULL;
-        if (!ok) sg_error(d, sc->loc, SG_E_TOO_LARGE, "out of memory in the analysis");
-    }
-    if (ok) a->nlevels = nlevels;
-    for (int L = 0, w = a->cells_x, h = a->cells_z; ok && L < nlevels; L++) {
-        a->levels[L].width = w;
-        a->levels[L].height = h;
-        a->levels[L].ids = calloc((size_t)w * (size_t)h, sizeof(uint16_t));
-        if (!a->levels[L].ids) {
-            sg_error(d, sc->loc, SG_E_TOO_LARGE, "out of memory in the analysis");
-            ok = false;
-        }
-        w = (w + 1) / 2;
-        h = (h + 1) / 2;
-    }
-
-    /* Member bitsets of the current level's nodes. */
+    bool ok = mask_ir(s, &mir, masks, &painted_src, d);
+    ir_iv *painted = xcalloc((size_t)(mir.npainted ? mir.npainted : 1), sizeof *painted);
+    alloc_levels(a);
+    /* member bitsets of the current level's nodes */
     size_t ncells = (size_t)a->cells_x * (size_t)a->cells_z;
-    if (ok) {
-        bits = calloc(ncells * (size_t)cs.words, sizeof *bits);
-        ok = bits != NULL;
-        if (!ok) sg_error(d, sc->loc, SG_E_TOO_LARGE, "out of memory in the analysis");
-    }
-
+    uint64_t *bits = xcalloc(ncells * (size_t)cs.words, sizeof *bits);
     block_ctx bc = { .s = s, .mir = &mir, .masks = masks, .painted_src = painted_src,
                      .painted = painted, .texel_x = t->size[0] / t->width,
                      .texel_z = t->size[1] / t->height };
-
-    /* Level 0: the cells. */
-    for (int cz = 0; ok && cz < a->cells_z; cz++) {
-        for (int cx = 0; ok && cx < a->cells_x; cx++) {
-            int x0 = cx * T, z0 = cz * T;
-            int x1 = x0 + T < t->width ? x0 + T : t->width;
-            int z1 = z0 + T < t->height ? z0 + T : t->height;
-            uint64_t *cell = bits + ((size_t)cz * a->cells_x + cx) * cs.words;
-            if (all_hole(t, x0, z0, x1, z1)) {     /* no members: a hole */
-                a->levels[0].ids[(size_t)cz * a->cells_x + cx] = SPLAT_COMBO_HOLE;
-                a->hole_cells++;
-                continue;
-            }
-            block_combo(&bc, x0, z0, x1, z1, cell);
-            int id = intern_checked(&cs, cell, n, sc, d);
-            if (id < 0) {
-                ok = false;
-                break;
-            }
-            a->levels[0].ids[(size_t)cz * a->cells_x + cx] = (uint16_t)id;
-            a->combos[id].ncells++;
-            a->combos[id].nnodes++;
-        }
-    }
-
-    /* Higher levels: the union of the (up to four) children. */
-    for (int L = 1; ok && L < a->nlevels; L++) {
-        const splat_level *below = &a->levels[L - 1];
-        splat_level *lv = &a->levels[L];
-        size_t nn = (size_t)lv->width * (size_t)lv->height;
-        uint64_t *up = calloc(nn * (size_t)cs.words, sizeof *up);
-        if (!up) {
-            sg_error(d, sc->loc, SG_E_TOO_LARGE, "out of memory in the analysis");
-            ok = false;
-            break;
-        }
-        for (int z = 0; ok && z < lv->height; z++) {
-            for (int x = 0; ok && x < lv->width; x++) {
-                uint64_t *node = up + ((size_t)z * lv->width + x) * cs.words;
-                for (int dz = 0; dz < 2; dz++) {
-                    for (int dx = 0; dx < 2; dx++) {
-                        int bx = 2 * x + dx, bz = 2 * z + dz;
-                        if (bx >= below->width || bz >= below->height) continue;
-                        const uint64_t *child =
-                            bits + ((size_t)bz * below->width + bx) * cs.words;
-                        for (int w = 0; w < cs.words; w++) node[w] |= child[w];
-                    }
-                }
-                if (bits_empty(node, cs.words)) {    /* every child a hole */
-                    lv->ids[(size_t)z * lv->width + x] = SPLAT_COMBO_HOLE;
-                    continue;
-                }
-                int id = intern_checked(&cs, node, n, sc, d);
-                if (id < 0) {
-                    ok = false;
-                    break;
-                }
-                lv->ids[(size_t)z * lv->width + x] = (uint16_t)id;
-                a->combos[id].nnodes++;
-            }
-        }
-        free(bits);
-        bits = up;
-    }
+    ok = ok && analyze_cells(&bc, &cs, bits, d);
+    for (int L = 1; ok && L < a->nlevels; L++)
+        ok = analyze_level(s, &cs, L, &bits, d);
     for (int i = 0; i < a->ncombos; i++)
         if (a->combos[i].nmaterials > a->largest)
             a->largest = a->combos[i].nmaterials;
