@@ -712,6 +712,107 @@ static bool sub_stmt(parser *ps, void *user)
     return ok;
 }
 
+/* camera NAME { position = X Y Z, look = X Y Z }, after "camera" */
+static bool camera_decl(parser *ps, scene_parse *sp)
+{
+    sg_scene *sc = sp->sc;
+    sg_token *name = cur(ps);
+    if (!expect(ps, SG_TK_IDENT, "a camera name"))
+        return false;
+    sg_scene_camera *cam = SG_PUSH(ps->a, sc->cameras, sc->ncameras, sp->cap_cameras);
+    cam->name = tok_text(ps, name);
+    cam->loc = loc_of(ps, name);
+    sub_block b = { sp, cam };
+    parse_block(ps, "block of camera", sub_stmt, &b);
+    return true;
+}
+
+/* painted NAME = "FILE" [painted_opts], after "painted"; NAME holes is
+ * the terrain's holes mask, which takes no options */
+static bool painted_decl(parser *ps, scene_parse *sp)
+{
+    sg_scene *sc = sp->sc;
+    sg_token *name = cur(ps);
+    if (!expect(ps, SG_TK_IDENT, "a painted mask name") || !expect(ps, SG_TK_EQ, "'='"))
+        return false;
+    sg_token *file = cur(ps);
+    if (!expect(ps, SG_TK_STRING, "a file name in quotes"))
+        return false;
+    if (is_kw(name, "holes")) {
+        if (sc->holes)
+            sg_error(ps->d, loc_of(ps, name), SG_E_DUPLICATE, "painted mask", "holes",
+                     sc->holes_loc.file, sc->holes_loc.line, sc->holes_loc.col);
+        sc->holes = scene_path(ps, file->str);
+        sc->holes_loc = loc_of(ps, name);
+        if (cur(ps)->kind == SG_TK_LBRACE) {
+            scene_error(ps, loc_of(ps, cur(ps)), "the holes mask takes no "
+                        "options (it is not stored as a painted layer)%s", "");
+            return false;
+        }
+        return true;
+    }
+    sg_scene_painted *pm = SG_PUSH(ps->a, sc->painted, sc->npainted, sp->cap_painted);
+    pm->name = tok_text(ps, name);
+    pm->file = scene_path(ps, file->str);
+    pm->loc = loc_of(ps, name);
+    pm->max_error = 1.0;
+    if (cur(ps)->kind == SG_TK_LBRACE)
+        parse_block(ps, "block of painted mask options", painted_stmt, pm);
+    return true;
+}
+
+/* heightfield = "FILE": the format from the extension */
+static bool heightfield_value(parser *ps, scene_parse *sp)
+{
+    sg_scene *sc = sp->sc;
+    sg_token *file = cur(ps);
+    if (!expect(ps, SG_TK_STRING, "a file name in quotes"))
+        return false;
+    sc->heightfield = scene_path(ps, file->str);
+    sc->heightfield_loc = loc_of(ps, file);
+    const char *dot = strrchr(file->str, '.');
+    if (dot && !strcmp(dot, ".png"))
+        sc->hf_format = SG_HF_PNG;
+    else if (dot && (!strcmp(dot, ".r16") || !strcmp(dot, ".raw")))
+        sc->hf_format = SG_HF_R16;
+    else
+        sc->hf_format = SG_HF_GDAL;   /* .tif, .hgt, .asc, …: raster.c */
+    sp->has[HAS_HF] = true;
+    return true;
+}
+
+/* materials = "[" [ IDENT { "," IDENT } ] "]", after "=".  A second
+ * `materials =` replaces the first, as every setting does (both lists
+ * keep their capacity: found by fuzz_parse). */
+static bool materials_list(parser *ps, scene_parse *sp)
+{
+    sg_scene *sc = sp->sc;
+    sg_token *open = cur(ps);
+    if (!expect(ps, SG_TK_LBRACK, "'['"))
+        return false;
+    sc->nmaterials = 0;
+    sp->has[HAS_MATERIALS] = true;
+    if (accept(ps, SG_TK_RBRACK))
+        return true;
+    do {
+        sg_token *m = cur(ps);
+        if (!expect(ps, SG_TK_IDENT, "a material name"))
+            return false;
+        int n = sc->nmaterials;
+        *SG_PUSH(ps->a, sc->materials, sc->nmaterials, sp->cap_materials) = tok_text(ps, m);
+        *SG_PUSH(ps->a, sc->material_locs, n, sp->cap_material_locs) = loc_of(ps, m);
+    } while (accept(ps, SG_TK_COMMA));
+    if (cur(ps)->kind != SG_TK_RBRACK) {
+        if (cur(ps)->kind == SG_TK_EOF)
+            sg_error(ps->d, loc_of(ps, open), SG_E_UNTERMINATED, "'['", open->line);
+        else
+            expected(ps, "',' or ']'");
+        return false;
+    }
+    next(ps);
+    return true;
+}
+
 /* scene_stmt = "heightfield" "=" STRING | "heightfield_size" "=" NUM NUM
  *            | "size" "=" NUM NUM | "max_height" "=" NUM
  *            | "height_offset" "=" NUM | "cell" "=" NUM
@@ -739,68 +840,17 @@ static bool scene_stmt(parser *ps, void *user)
     }
     if (is_kw(key, "camera")) {
         next(ps);
-        sg_token *name = cur(ps);
-        if (!expect(ps, SG_TK_IDENT, "a camera name"))
-            return false;
-        sg_scene_camera *cam = SG_PUSH(ps->a, sc->cameras, sc->ncameras, sp->cap_cameras);
-        cam->name = tok_text(ps, name);
-        cam->loc = loc_of(ps, name);
-        sub_block b = { sp, cam };
-        parse_block(ps, "block of camera", sub_stmt, &b);
-        return true;
+        return camera_decl(ps, sp);
     }
     if (is_kw(key, "painted")) {
         next(ps);
-        sg_token *name = cur(ps);
-        if (!expect(ps, SG_TK_IDENT, "a painted mask name") ||
-            !expect(ps, SG_TK_EQ, "'='"))
-            return false;
-        sg_token *file = cur(ps);
-        if (!expect(ps, SG_TK_STRING, "a file name in quotes"))
-            return false;
-        if (is_kw(name, "holes")) {
-            /* the terrain's holes: a mask of its own, not a painted layer */
-            if (sc->holes)
-                sg_error(ps->d, loc_of(ps, name), SG_E_DUPLICATE, "painted mask",
-                         "holes", sc->holes_loc.file, sc->holes_loc.line,
-                         sc->holes_loc.col);
-            sc->holes = scene_path(ps, file->str);
-            sc->holes_loc = loc_of(ps, name);
-            if (cur(ps)->kind == SG_TK_LBRACE) {
-                scene_error(ps, loc_of(ps, cur(ps)), "the holes mask takes no "
-                            "options (it is not stored as a painted layer)%s", "");
-                return false;
-            }
-            return true;
-        }
-        sg_scene_painted *pm = SG_PUSH(ps->a, sc->painted, sc->npainted, sp->cap_painted);
-        pm->name = tok_text(ps, name);
-        pm->file = scene_path(ps, file->str);
-        pm->loc = loc_of(ps, name);
-        pm->max_error = 1.0;
-        if (cur(ps)->kind == SG_TK_LBRACE)
-            parse_block(ps, "block of painted mask options", painted_stmt, pm);
-        return true;
+        return painted_decl(ps, sp);
     }
     next(ps);
     if (!expect(ps, SG_TK_EQ, "'='"))
         return false;
-    if (is_kw(key, "heightfield")) {
-        sg_token *file = cur(ps);
-        if (!expect(ps, SG_TK_STRING, "a file name in quotes"))
-            return false;
-        sc->heightfield = scene_path(ps, file->str);
-        sc->heightfield_loc = loc_of(ps, file);
-        const char *dot = strrchr(file->str, '.');
-        if (dot && !strcmp(dot, ".png"))
-            sc->hf_format = SG_HF_PNG;
-        else if (dot && (!strcmp(dot, ".r16") || !strcmp(dot, ".raw")))
-            sc->hf_format = SG_HF_R16;
-        else
-            sc->hf_format = SG_HF_GDAL;   /* .tif, .hgt, .asc, …: raster.c */
-        sp->has[HAS_HF] = true;
-        return true;
-    }
+    if (is_kw(key, "heightfield"))
+        return heightfield_value(ps, sp);
     if (is_kw(key, "heightfield_size")) {
         double wh[2];
         if (!parse_numbers(ps, wh, 2))
@@ -858,32 +908,7 @@ static bool scene_stmt(parser *ps, void *user)
     }
     if (is_kw(key, "materials")) {
         sp->materials_loc = kloc;
-        sg_token *open = cur(ps);
-        if (!expect(ps, SG_TK_LBRACK, "'['"))
-            return false;
-        /* a second `materials =` replaces the first, as every setting
-         * does (both lists keep their capacity: found by fuzz_parse) */
-        sc->nmaterials = 0;
-        sp->has[HAS_MATERIALS] = true;
-        if (accept(ps, SG_TK_RBRACK))
-            return true;
-        do {
-            sg_token *m = cur(ps);
-            if (!expect(ps, SG_TK_IDENT, "a material name"))
-                return false;
-            int n = sc->nmaterials;
-            *SG_PUSH(ps->a, sc->materials, sc->nmaterials, sp->cap_materials) = tok_text(ps, m);
-            *SG_PUSH(ps->a, sc->material_locs, n, sp->cap_material_locs) = loc_of(ps, m);
-        } while (accept(ps, SG_TK_COMMA));
-        if (cur(ps)->kind != SG_TK_RBRACK) {
-            if (cur(ps)->kind == SG_TK_EOF)
-                sg_error(ps->d, loc_of(ps, open), SG_E_UNTERMINATED, "'['", open->line);
-            else
-                expected(ps, "',' or ']'");
-            return false;
-        }
-        next(ps);
-        return true;
+        return materials_list(ps, sp);
     }
     char buf[96];
     sg_error(ps->d, kloc, SG_E_SYNTAX,

@@ -166,8 +166,10 @@ EOF
 
 # -- forged and truncated binary files
 case_ sparse_forged_header bc4 "painted.sparse', which is not a sparse mask file: truncated: the header describes" <<EOF
-printf '\310\0\0\0' | dd of=painted.sparse bs=1 seek=20 conv=notrunc 2>/dev/null
-printf '\62\0\0\0' | dd of=painted.sparse bs=1 seek=36 conv=notrunc 2>/dev/null
+printf '\310\0\0\0' | dd of=painted.sparse bs=1 seek=48 conv=notrunc 2>/dev/null
+EOF
+case_ sparse_forged_place bc4 "painted.sparse', which is not a sparse mask file: inconsistent header" <<EOF
+printf '\0\0\0\0' | dd of=painted.sparse bs=1 seek=52 conv=notrunc 2>/dev/null
 EOF
 case_ sparse_huge_field bc4 "painted.sparse', which is not a sparse mask file: inconsistent header (a field over 65536)" <<EOF
 printf '\377\377\377\177' | dd of=painted.sparse bs=1 seek=12 conv=notrunc 2>/dev/null
