@@ -33,7 +33,7 @@
  *
  * Memory (slides: 2048 m at 4 px/m is 64 MB dense): rt_destruction_memory
  * gives the figures for any configuration. */
-#include "splatrt.h"
+#include "rt_internal.h"
 #include "util.h"
 
 #include <math.h>

@@ -6,7 +6,7 @@
  * debug messenger that prints and counts every warning and error, so tests
  * can demand zero; asked for and not installed is an error
  * (RT_E_NO_VALIDATION), never a silent run without it. */
-#include "splatrt.h"
+#include "rt_internal.h"
 #include "ir.h"
 
 #include <ctype.h>

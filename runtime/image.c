@@ -1,7 +1,7 @@
 /* image.c — pictures out of the renderer: an 8-bit PNG after a simple tone
  * map and sRGB encode on the CPU, and the raw RGBA32F image (format in
  * splatrt.h) for exact comparisons. */
-#include "splatrt.h"
+#include "rt_internal.h"
 
 #include <errno.h>
 #include <math.h>

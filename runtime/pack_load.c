@@ -3,7 +3,7 @@
  * (present, right size), every SPIR-V module (spirv-val), every
  * combination id in combos.bin (in range).  A bad pack is a message that
  * names the file and the field, never a crash or a validation error. */
-#include "splatrt.h"
+#include "rt_internal.h"
 #include "ir.h"
 
 #include <errno.h>

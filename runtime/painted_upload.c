@@ -8,7 +8,7 @@
  *   binding 6  level  RGBA8_UINT, same shape
  * Sampled with the linear clamp sampler (atlas) and texelFetch (index and
  * level: the sampler does not matter). */
-#include "splatrt.h"
+#include "rt_internal.h"
 
 #include <errno.h>
 #include <math.h>

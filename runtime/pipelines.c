@@ -4,7 +4,7 @@
  * material and a resolve pass that lights the blended surface with the
  * ABI's splat_light), the über-shader pipeline, and a pipeline cache kept
  * on disk between runs. */
-#include "splatrt.h"
+#include "rt_internal.h"
 
 #include <errno.h>
 #include <stdlib.h>

@@ -22,7 +22,7 @@
  *     |/|/|/|/|  -->   |\ /|\ /|      onto their even neighbours; the
  *     x-x-x-x-x        x-x-x-x-x      triangles that collapse are dropped
  */
-#include "splatrt.h"
+#include "rt_internal.h"
 
 #include <math.h>
 #include <stdlib.h>

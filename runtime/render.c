@@ -8,7 +8,7 @@
  * Nothing in the frame loop allocates or uploads textures: the per-frame
  * work is the selection (preallocated arrays), a counting sort by
  * combination, a uniform write into mapped memory and one command buffer. */
-#include "splatrt.h"
+#include "rt_internal.h"
 #include "util.h"
 
 #include <math.h>

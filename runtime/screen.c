@@ -15,7 +15,7 @@
  * after the frame and the frame is drawn again (rt_screen_missing), so a
  * returned frame is always complete and the steady state reads back only
  * the list counts. */
-#include "splatrt.h"
+#include "rt_internal.h"
 
 #include <math.h>
 #include <stdlib.h>

@@ -4,7 +4,7 @@
  * map) and the test fixtures compile through it, and every module a pack
  * brings is validated before the driver sees it, so a corrupt file is an
  * error message, never a validation error or a driver crash. */
-#include "splatrt.h"
+#include "rt_internal.h"
 
 #include <stdlib.h>
 

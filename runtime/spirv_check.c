@@ -17,7 +17,7 @@
  * interface of each pack shader role.  A new pipeline kind (compute
  * passes, shadow maps) adds its rows to rt_abi_bindings and, if it binds
  * pack shaders, a role. */
-#include "splatrt.h"
+#include "rt_internal.h"
 
 #include <stdarg.h>
 #include <stdlib.h>

@@ -1,12 +1,16 @@
 /* splatrt.h — libsplatrt, the Vulkan terrain runtime: a shader pack
  * (compiler/PACK.md) turned into pictures (compiler/DESIGN.md §8, Andersson 2007 §5.4).
  *
- * Everything public is prefixed rt_.  Library code never exits: a failing
- * call returns false and fills an rt_error (id + message).
+ * The public API (installed): a device, a pack, a renderer that draws it
+ * from a camera (forward or screen-space shading, debug views, craters),
+ * pictures written out, and the GLFW viewer.  Everything is prefixed rt_.
+ * Library code never exits: a failing call returns false and fills an
+ * rt_error (id + message).  The library's internals (Vulkan helpers,
+ * shader checks, uploads, the quadtree, pipelines, the screen path) are in
+ * rt_internal.h, as Lua keeps lstate.h beside lua.h.
  *
- * Sections, one per source file: errors + device.c, shader_compile.c,
- * image.c, pack_load.c, painted_upload.c, terrain_upload.c, quadtree.c,
- * pipelines.c, screen.c, render.c, destruction.c, viewer.c.
+ * Sections: errors + device.c, image.c, pack_load.c, render.c,
+ * destruction.c, viewer.c.
  */
 #ifndef SPLAT_RT_H
 #define SPLAT_RT_H
@@ -54,19 +58,7 @@ typedef struct rt_error {
     char       *msg;   /* formatted message, owned; NULL when id == RT_OK */
 } rt_error;
 
-/* Record an error (printf arguments for the id's format); returns false so
- * that `return rt_fail(e, RT_E_IO, ...)` reads naturally.  `e` may be NULL. */
-bool        rt_fail(rt_error *e, rt_error_id id, ...);
 void        rt_error_clear(rt_error *e);
-const char *rt_vk_result_name(VkResult r);
-
-/* Check a VkResult at run time (never only inside assert). */
-#define RT_VK(e, call)                                                      \
-    do {                                                                    \
-        VkResult rt_vk_r_ = (call);                                         \
-        if (rt_vk_r_ != VK_SUCCESS)                                         \
-            return rt_fail((e), RT_E_VULKAN, #call, rt_vk_result_name(rt_vk_r_)); \
-    } while (0)
 
 /* ---- device.c: instance, device, memory -------------------------------- */
 
@@ -119,49 +111,6 @@ typedef struct rt_image {
     uint32_t       width, height, layers, mips;
 } rt_image;
 
-bool rt_buffer_create(rt_device *d, VkDeviceSize size, VkBufferUsageFlags usage,
-                      bool host_visible, rt_buffer *b, rt_error *e);
-void rt_buffer_destroy(rt_device *d, rt_buffer *b);
-/* A 2D image with a view of every layer and mip (a 2D_ARRAY view when
- * `array`, even for one layer). */
-bool rt_image_create(rt_device *d, uint32_t w, uint32_t h, uint32_t layers,
-                     bool array, uint32_t mips, VkFormat fmt, VkImageUsageFlags usage,
-                     VkImageAspectFlags aspect, rt_image *img, rt_error *e);
-void rt_image_destroy(rt_device *d, rt_image *img);
-/* Upload tightly packed texels into mip 0 of every layer, then either build
- * the mip chain by blits (mips > 1) and leave the image in
- * SHADER_READ_ONLY_OPTIMAL.  Blocks until done (load time only). */
-bool rt_image_upload(rt_device *d, rt_image *img, const void *data,
-                     size_t bytes, rt_error *e);
-/* Upload every mip level of a one-layer RGBA8 image from `levels[m]`
- * (tightly packed, max(1, w >> m) x max(1, h >> m)) instead of blitting:
- * for mips that must not be box-filtered.  Leaves SHADER_READ_ONLY. */
-bool rt_image_upload_levels(rt_device *d, rt_image *img, const uint8_t *const *levels,
-                            rt_error *e);
-/* One-time command buffer helpers (load time only). */
-bool rt_oneshot_begin(rt_device *d, VkCommandBuffer *cb, rt_error *e);
-bool rt_oneshot_end(rt_device *d, VkCommandBuffer cb, rt_error *e);
-/* Record a layout transition of mips [mip, mip + nmips) of the first
- * `layers` layers of a colour image. */
-void rt_cmd_image_barrier(VkCommandBuffer cb, VkImage img, uint32_t mip, uint32_t nmips,
-                          uint32_t layers, VkImageLayout from, VkImageLayout to,
-                          VkAccessFlags src_access, VkAccessFlags dst_access,
-                          VkPipelineStageFlags src, VkPipelineStageFlags dst);
-bool rt_format_supports(rt_device *d, VkFormat f, VkFormatFeatureFlags need);
-/* The sampler address mode of an ir_wrap (ir.h IR_WRAPS). */
-VkSamplerAddressMode rt_sampler_wrap(int ir_wrap);
-
-/* ---- shader_compile.c: GLSL -> SPIR-V for the runtime's shaders ------ */
-
-/* stage: VK_SHADER_STAGE_VERTEX_BIT, _FRAGMENT_BIT or _COMPUTE_BIT.
- * *words is malloc'd. */
-bool rt_glsl_compile(const char *glsl, VkShaderStageFlagBits stage,
-                     const char *name, uint32_t **words, size_t *nwords,
-                     rt_error *e);
-/* SPIRV-Tools validation for Vulkan 1.2; message in e on failure. */
-bool rt_spirv_validate(const uint32_t *words, size_t nwords, const char *name,
-                       rt_error *e);
-
 /* ---- image.c: writing pictures ---------------------------------------- */
 
 /* How float colours become 8-bit PNG pixels. */
@@ -184,76 +133,6 @@ bool rt_write_png(const char *path, const uint8_t *rgba8, int w, int h,
 bool rt_write_float(const char *path, const float *rgba, int w, int h,
                     rt_error *e);
 bool rt_read_float(const char *path, float **rgba, int *w, int *h, rt_error *e);
-
-/* ---- spirv_check.c: a pack shader against what it is bound to --------- */
-
-typedef enum rt_res {
-    RT_RES_UNIFORM = 1,       /* uniform block                              */
-    RT_RES_SAMPLED,           /* combined image sampler                     */
-    RT_RES_STORAGE_IMAGE,
-    RT_RES_STORAGE_BUFFER,
-} rt_res;
-
-enum { RT_FLOAT = 1, RT_UINT, RT_INT };             /* image component types */
-enum { RT_IMAGE_2D = 1 };                           /* SpvDim2D              */
-typedef enum rt_painted_when {
-    RT_PAINTED_ANY = 0, RT_PAINTED_DENSE, RT_PAINTED_SPARSE,
-} rt_painted_when;
-
-/* One binding of a pipeline layout, as a shader may declare it. */
-typedef struct rt_binding_rule {
-    uint32_t set, binding;
-    rt_res   kind;
-    uint8_t  dim;             /* images: SpvDim (RT_IMAGE_2D)               */
-    bool     arrayed;         /* images: 2D array                           */
-    uint8_t  comp;            /* images: RT_FLOAT / RT_UINT / RT_INT        */
-    uint32_t bytes;           /* blocks: at most this many bytes declared   */
-    VkShaderStageFlags stages; /* stages the layout makes it visible to     */
-    rt_painted_when painted;  /* packs whose painted format has this row    */
-} rt_binding_rule;
-
-/* The ABI's set-0 rows (compiler/abi.h), one per binding and painted
- * format: a new set-0 binding (compute passes, shadows) is one more row. */
-extern const rt_binding_rule rt_abi_bindings[];
-extern const int rt_abi_nbindings;
-
-typedef struct rt_varying {
-    uint32_t location;
-    int      components;      /* float vector size                          */
-} rt_varying;
-
-/* What a shader must fit. */
-typedef struct rt_interface {
-    const char *what;               /* "a composite fragment shader"        */
-    VkShaderStageFlagBits stage;    /* entry point "main" of this stage     */
-    const rt_binding_rule *bindings; int nbindings;
-    rt_painted_when painted;        /* the pack's painted format            */
-    uint32_t push_bytes;            /* push-constant block at most          */
-    const uint32_t *spec_ids; int nspec;   /* constant_ids the runtime sets */
-    const rt_varying *inputs; int ninputs;   /* allowed stage inputs        */
-    const rt_varying *outputs; int noutputs; /* allowed stage outputs       */
-    bool     outputs_exact;         /* every listed output written          */
-    int      colour_targets;        /* fragment: float outputs at locations
-                                       below this, instead of `outputs`     */
-} rt_interface;
-
-struct rt_pack;
-
-typedef enum rt_shader_role {
-    RT_ROLE_VERTEX, RT_ROLE_COMPOSITE, RT_ROLE_REFERENCE,
-    RT_ROLE_COMPUTE,      /* the compute variants (*.comp.spv, abi.h)       */
-    RT_ROLE_COUNT,
-} rt_shader_role;
-
-/* The interface of a pack shader role: the ABI rows plus the pack's set 1
- * (params block of params_size bytes, its textures).  Free with
- * rt_interface_free; false: out of memory. */
-bool rt_interface_for(const struct rt_pack *p, rt_shader_role role, rt_interface *out);
-void rt_interface_free(rt_interface *in);
-/* Reflect `words` (already through spirv-val) with SPIRV-Cross and check
- * it against `want`; RT_E_PACK_SHADER naming `path` and the mismatch. */
-bool rt_spirv_check(const uint32_t *words, size_t nwords, const char *path,
-                    const rt_interface *want, rt_error *e);
 
 /* ---- pack_load.c: reading a shader pack ------------------------------- */
 
@@ -353,24 +232,6 @@ typedef struct rt_pack {
  * combination id in combos.bin is in range.  Errors name the pack file
  * and what is wrong. */
 bool rt_pack_load(rt_pack *p, const char *dir, rt_error *e);
-/* The runtime's one way into a pack folder: open `rel` below the folder
- * `dirfd` component by component with O_NOFOLLOW — no absolute path, no
- * "..", no symbolic link on the way, a regular file at the end (never a
- * FIFO or device).  Returns the descriptor, or -1 with `why` saying what
- * is wrong ("is a symbolic link ..."). */
-int      rt_pack_open_file(int dirfd, const char *rel, char *why, size_t nwhy);
-/* rt_pack_open_file, then the whole file if fstat says it has at most
- * `max` bytes (bounded reads; NUL appended, not counted in *n). */
-uint8_t *rt_pack_read_file(int dirfd, const char *rel, size_t max, size_t *n, char *why,
-                           size_t nwhy);
-/* combos.bin (PACK.md) of `n` bytes: the rt_level_count(cells_x, cells_z)
- * levels, level L (cells halved L times, rounding up) at offsets[L]; every
- * level inside the file and every id below ncombos, checked before each
- * level is allocated (SPLAT_COMBO_HOLE is also accepted when `holes`: the
- * pack has a holes raster).  Fills levels[0..nlevels); errors name `path`. */
-bool rt_combos_parse(const uint8_t *data, size_t n, int cells_x, int cells_z,
-                     const int64_t *offsets, int ncombos, bool holes,
-                     rt_pack_level *levels, const char *path, rt_error *e);
 /* Each size of the pack against the device's limits (maxImageDimension2D,
  * maxImageArrayLayers, samplers per stage, uniform range), before any of
  * it is created; RT_E_PACK_LIMIT naming the limit. */
@@ -378,259 +239,6 @@ bool rt_pack_check_device(const rt_pack *p, const rt_device *d, rt_error *e);
 void rt_pack_free(rt_pack *p);
 int  rt_pack_material_find(const rt_pack *p, const char *name);   /* -1 */
 int  rt_pack_camera_find(const rt_pack *p, const char *name);     /* -1 */
-
-/* ---- painted_upload.c: the sparse painted masks ----------------------- */
-
-/* Parse the `n` bytes of `file` (painted.sparse, read by the pack loader)
- * into p->sparse and check them against the manifest (heightfield size,
- * mask count); errors name `manifest` and `file`. */
-bool rt_painted_read(rt_pack *p, const char *manifest, const char *file,
-                     const uint8_t *data, size_t n, rt_error *e);
-/* Upload p->sparse: atlas (BC4_UNORM_BLOCK, or R8_UNORM decoded on the
- * CPU when the device lacks BC textures), index RGBA16UI and level
- * RGBA8UI 2D arrays. */
-bool rt_painted_upload(rt_device *d, const rt_pack *p, rt_image *atlas,
-                       rt_image *index, rt_image *level, rt_error *e);
-/* Print the bytes of each mask representation next to dense. */
-void rt_painted_print_stats(const rt_pack *p, FILE *out);
-
-/* ---- terrain_upload.c: heightfield on the GPU, node height bounds ----- */
-
-/* Min/max height (metres) of every quadtree node, from the texels its
- * vertices can sample (bilinear between texel centres, one texel border). */
-typedef struct rt_bounds {
-    int     nlevels;
-    int    *width, *height;   /* nodes per level                            */
-    float **hmin, **hmax;     /* per level, row-major                       */
-} rt_bounds;
-
-bool rt_bounds_build(rt_bounds *b, const uint16_t *texels, int w, int h,
-                     int cell_texels, double max_height, double offset);
-void rt_bounds_free(rt_bounds *b);
-/* Leaf (x, z): the min and max height (metres) of the texels it can show,
- * its cell plus one texel around (the build, and destruction's update). */
-void rt_bounds_leaf(rt_bounds *b, const uint16_t *texels, int w, int h, int cell_texels,
-                    double max_height, double offset, int x, int z);
-/* Node (x, z) of level L >= 1: the min and max of its (up to 4) children
- * on level L - 1 (the build, and destruction's update after a crater). */
-void rt_bounds_merge(rt_bounds *b, int L, int x, int z);
-/* Level grid of PACK.md: cells, then halve (rounding up) until 1x1. */
-int  rt_level_count(int cells_x, int cells_z);
-
-/* GPU resources of the terrain descriptor set (set 0) but the frame UBO. */
-typedef struct rt_terrain_gpu {
-    rt_image  height;       /* R16_UNORM                                    */
-    rt_image  painted;      /* R8_UNORM array, >= 1 layer; sparse: the atlas */
-    rt_image  painted_index; /* RGBA16UI array (1x1 when dense)              */
-    rt_image  painted_level; /* RGBA8UI array (1x1 when dense)               */
-    rt_image  destr_atlas;  /* R8_UNORM destruction mask tiles (destruction.c) */
-    rt_image  destr_index;  /* RGBA8 1x1, a = 0: nothing destroyed          */
-    rt_image  holes;        /* R8_UNORM W x H (1x1 of 0: none), binding 12  */
-    VkSampler linear_clamp, nearest_clamp;
-} rt_terrain_gpu;
-
-bool rt_terrain_upload(rt_device *d, const rt_pack *p, rt_terrain_gpu *t,
-                       rt_error *e);
-void rt_terrain_destroy(rt_device *d, rt_terrain_gpu *t);
-
-/* ---- quadtree.c: restricted quadtree LOD, culling, stitching ---------- */
-
-/* Edges of a patch: N = z min, E = x max, S = z max, W = x min. */
-enum { RT_EDGE_N = 1, RT_EDGE_E = 2, RT_EDGE_S = 4, RT_EDGE_W = 8 };
-#define RT_PERMS 9   /* none, N, E, S, W, NE, ES, SW, WN (Andersson 2007 Fig. 18) */
-
-/* The index-buffer permutation drawn for a set of coarser edges, and the
- * coarser edges of a permutation. */
-int      rt_perm_of_edges(unsigned edges);   /* -1 for opposite edges       */
-unsigned rt_edges_of_perm(int perm);
-/* Vertices of the shared grid: SPLAT_GRID^2 vec2 in 0..1, x fastest. */
-void     rt_grid_vertices(float *xy);
-/* Triangle list of one permutation over the grid: odd vertices of the
- * coarser edges are folded onto their even neighbours (an edge collapse),
- * so those edges use only every other vertex, and the triangles that
- * became degenerate are dropped.  Returns the index count; `out` may be
- * NULL to ask for it (at most 6 * (SPLAT_GRID-1)^2). */
-uint32_t rt_grid_indices(int perm, uint16_t *out);
-
-typedef struct rt_patch {
-    uint8_t  level, perm;
-    uint16_t combo;
-    int      x, z;            /* node at `level`                            */
-} rt_patch;
-
-typedef struct rt_select_desc {
-    double camera[3];          /* terrain-local metres                       */
-    float  view_proj[16];      /* camera-relative world -> clip             */
-    double lod_distance;       /* split while distance < this * node size   */
-    bool   cull;               /* frustum culling (default on by caller)   */
-    int    max_level_bias;     /* tests: 0                                   */
-} rt_select_desc;
-
-typedef struct rt_quadtree {
-    int        nlevels;
-    int       *width, *height;    /* nodes per level                         */
-    int        cell_texels, hf_width, hf_height;
-    double     size[2];           /* terrain metres                          */
-    const rt_bounds *bounds;
-    const uint16_t *const *combo_ids; /* per level (pack); NULL: all 0     */
-    uint8_t  **split;             /* per level scratch, reused every frame   */
-    rt_patch  *patches;           /* the selection (drawn patches)           */
-    int        npatches, cap;
-    int        nculled;           /* leaves dropped by the frustum           */
-    int        nholes;            /* nodes not drawn: all hole (PACK.md)     */
-} rt_quadtree;
-
-bool rt_quadtree_init(rt_quadtree *q, const rt_bounds *b, int cell_texels,
-                      int hf_width, int hf_height, const double size[2]);
-void rt_quadtree_free(rt_quadtree *q);
-/* Select the patches for a camera: split by distance, restrict so that edge
- * neighbours differ by at most one level, cull, pick each patch's
- * permutation.  No allocation after init. */
-void rt_quadtree_select(rt_quadtree *q, const rt_select_desc *s);
-/* World rectangle of a node (metres; may overhang the terrain). */
-void rt_node_rect(const rt_quadtree *q, int level, int x, int z,
-                  double *x0, double *z0, double *sx, double *sz);
-
-/* ---- pipelines.c: layouts, pipelines, the on-disk pipeline cache ------ */
-
-typedef enum rt_reference {
-    RT_REF_NONE = 0,      /* per-combination composites                     */
-    RT_REF_MULTIPASS,     /* one blended pass per material + resolve        */
-    RT_REF_UBER,          /* every patch with the über-shader               */
-} rt_reference;
-
-/* Variants of a pipeline, as bits; each is made on first use. */
-enum {
-    RT_VARIANT_WIRE  = 1,  /* line fill                                     */
-    RT_VARIANT_DEBUG = 2,  /* any debug view, read from u_frame each frame;
-                              without it the fragment shader is specialised
-                              to SPLAT_VIEW_FINAL (abi.h SPLAT_SPEC_VIEW) and
-                              carries no debug-view code                    */
-    RT_VARIANT_CULL  = 4,  /* back faces culled: only while the camera is
-                              above the terrain (render.c), where it hides
-                              nothing visible (a few ridge pixels change
-                              where depth rounding let a back face win)     */
-    RT_VARIANTS      = 8,
-};
-
-typedef struct rt_pipelines {
-    VkDescriptorSetLayout set_terrain;   /* set 0 (abi.h)                    */
-    VkDescriptorSetLayout set_material;  /* set 1: params + textures         */
-    VkDescriptorSetLayout set_resolve;   /* set 2 of the resolve pass        */
-    VkPipelineLayout      layout;        /* sets 0, 1 + splat_push           */
-    VkPipelineLayout      resolve_layout;/* sets 0, 1, 2 + splat_push        */
-    VkPipelineCache       cache;
-    char                 *cache_path;    /* NULL: not saved                  */
-    VkShaderModule        vertex;
-    VkPipeline           *combo;         /* RT_VARIANTS per combination      */
-    int                   ncombos;
-    VkPipeline           *ref;           /* multi-pass: 2 per material
-                                            (RT_VARIANT_CULL or not)         */
-    int                   nref;
-    VkPipeline            uber[RT_VARIANTS];
-    VkPipeline            resolve;
-    VkPipelineLayout      compute_layout;/* sets 0, 1 + splat_push (compute) */
-    VkPipeline           *compute;       /* RT_CVARIANTS per combination, the
-                                            über-shader's last              */
-    VkPipeline            depth[2];      /* geometry pass, [RT_VARIANT_CULL] */
-} rt_pipelines;
-
-/* Variants of a compute shading pipeline (screen-space path), as bits. */
-enum {
-    RT_CVARIANT_DEBUG = 1,  /* any debug view (else specialised to final)   */
-    RT_CVARIANT_COUNT = 2,  /* the counting variant (abi.h SPLAT_COUNT)      */
-    RT_CVARIANTS      = 4,
-};
-
-/* Render passes the pipelines are made for (render.c creates them). */
-typedef struct rt_passes {
-    VkRenderPass main;       /* RGBA32F colour + D32 depth                   */
-    VkRenderPass multi;      /* three RGBA32F blend targets + D32 depth      */
-    VkRenderPass resolve;    /* RGBA32F colour                               */
-} rt_passes;
-
-/* Layouts, the pipeline cache and the resolve pass for RT_REF_MULTIPASS;
- * checks that the shaders `ref` needs are in the pack.  Combination,
- * über-shader and reference pipelines are made on first use
- * (rt_pipelines_combo/uber/ref): a view of colorado needs 20 of its 166,
- * and lavapipe compiles each in tens of milliseconds or more. */
-bool rt_pipelines_create(rt_device *d, const rt_pack *p, const rt_passes *rp,
-                         rt_reference ref, const char *cache_path,
-                         int ntextures, rt_pipelines *pl, rt_error *e);
-/* The pipeline of combination `id` in `variant` (RT_VARIANT_* bits), made
- * now if it does not exist yet. */
-bool rt_pipelines_combo(rt_device *d, const rt_pack *p, const rt_passes *rp,
-                        rt_pipelines *pl, int id, unsigned variant, VkPipeline *out,
-                        rt_error *e);
-/* The über-shader's pipeline in `variant`, made on first use. */
-bool rt_pipelines_uber(rt_device *d, const rt_pack *p, const rt_passes *rp,
-                       rt_pipelines *pl, unsigned variant, VkPipeline *out,
-                       rt_error *e);
-/* The multi-pass reference pass of scene material `m` (blended above
- * material 0), back faces culled or not, made on first use. */
-bool rt_pipelines_ref(rt_device *d, const rt_pack *p, const rt_passes *rp,
-                      rt_pipelines *pl, int m, bool cull, VkPipeline *out,
-                      rt_error *e);
-/* The compute shading pipeline of combination `id` (p->ncombos: the
- * über-shader) in `variant` (RT_CVARIANT_* bits), compiled from the pack's
- * compute GLSL on first use (PACK.md): glslang, spirv-val, the interface
- * check against set 0/1 and the push block, then the driver. */
-bool rt_pipelines_compute(rt_device *d, const rt_pack *p, rt_pipelines *pl, int id,
-                          unsigned variant, VkPipeline *out, rt_error *e);
-/* The screen-space path's geometry pass: the shared vertex shader alone,
- * depth only (render pass `pass`), back faces culled or not. */
-bool rt_pipelines_depth(rt_device *d, rt_pipelines *pl, VkRenderPass pass, bool cull,
-                        VkPipeline *out, rt_error *e);
-/* Whether that pipeline exists already. */
-bool rt_pipelines_has_compute(const rt_pipelines *pl, int id, unsigned variant);
-/* Drop every combination pipeline (hot reload: the next frames make those
- * of the new pack); the array is resized to p->ncombos. */
-bool rt_pipelines_reset_combos(rt_device *d, const rt_pack *p, rt_pipelines *pl,
-                               rt_error *e);
-/* Saves the cache (if it has a path) and destroys everything. */
-void rt_pipelines_destroy(rt_device *d, rt_pipelines *pl);
-
-/* ---- screen.c: screen-space shading (render.c drives it) -------------- */
-
-typedef struct rt_screen rt_screen;
-
-typedef struct rt_screen_stats {
-    int      tiles, tiles_total;  /* terrain tiles shaded; all tiles         */
-    int      tiles_uber;          /* tiles no combination covered            */
-    int      lists;               /* combinations (and über) with tiles      */
-    uint32_t pixels, layers_evaluated, layers_needed, samples;  /* counting */
-    uint32_t branches, branches_uniform;   /* splat_counters (abi.h)         */
-} rt_screen_stats;
-
-/* Buffers, the depth-only pass over `depth`, the classification pipeline;
- * writes set 0's compute bindings (abi.h 7-10) into `set0`.  *out is set
- * even on failure (free with rt_screen_destroy). */
-bool rt_screen_create(rt_device *d, const rt_pack *p, const rt_pipelines *pl,
-                      const rt_image *color, const rt_image *depth, VkSampler nearest,
-                      VkDescriptorSet set0, bool raycast, rt_screen **out, rt_error *e);
-/* raycast: the depth comes from ray casting the heightfield in compute
- * (screen.c) instead of the geometry pass. */
-bool rt_screen_raycasting(const rt_screen *s);
-void rt_screen_raycast(rt_screen *s, VkCommandBuffer cb, VkDescriptorSet set0);
-void rt_screen_destroy(rt_screen *s);
-/* The geometry pass: depth only, ends in SHADER_READ_ONLY_OPTIMAL. */
-VkRenderPass rt_screen_depth_pass(const rt_screen *s, VkFramebuffer *fb);
-/* Before the geometry pass: reset the list counts (and the counters). */
-void rt_screen_begin(rt_screen *s, VkCommandBuffer cb, bool count);
-/* After it: the background, the classification (force_uber: every tile
- * to the über-shader's list). */
-void rt_screen_classify(rt_screen *s, VkCommandBuffer cb, VkDescriptorSet set0,
-                        const float clear[4], bool force_uber, int *binds);
-/* Then one indirect dispatch per list whose pipeline in `variant`
- * (RT_CVARIANT_*) exists; the colour image ends in TRANSFER_SRC_OPTIMAL. */
-bool rt_screen_dispatch(rt_screen *s, VkCommandBuffer cb, rt_pipelines *pl,
-                        const VkDescriptorSet sets[2], unsigned variant, int *binds,
-                        rt_error *e);
-/* After the frame completed: compiles the pipelines of lists that got
- * tiles but were not dispatched; returns how many (> 0: draw the frame
- * again), -1 on error. */
-int rt_screen_missing(rt_screen *s, rt_pipelines *pl, unsigned variant, rt_error *e);
-void rt_screen_read_stats(const rt_screen *s, rt_screen_stats *st);
 
 /* ---- render.c: drawing ------------------------------------------------- */
 
@@ -656,6 +264,21 @@ typedef enum rt_screen_depth {
     RT_DEPTH_RASTER,     /* the patches drawn depth only                  */
     RT_DEPTH_RAYCAST,    /* maximum-mipmap ray casting in compute          */
 } rt_screen_depth;
+
+typedef enum rt_reference {
+    RT_REF_NONE = 0,      /* per-combination composites                     */
+    RT_REF_MULTIPASS,     /* one blended pass per material + resolve        */
+    RT_REF_UBER,          /* every patch with the über-shader               */
+} rt_reference;
+
+/* The screen-space path's tiles and counters of a frame (screen.c). */
+typedef struct rt_screen_stats {
+    int      tiles, tiles_total;  /* terrain tiles shaded; all tiles         */
+    int      tiles_uber;          /* tiles no combination covered            */
+    int      lists;               /* combinations (and über) with tiles      */
+    uint32_t pixels, layers_evaluated, layers_needed, samples;  /* counting */
+    uint32_t branches, branches_uniform;   /* splat_counters (abi.h)         */
+} rt_screen_stats;
 
 typedef struct rt_render_desc {
     int          width, height;
@@ -792,22 +415,7 @@ typedef struct rt_destruction_figures {
 
 void rt_destruction_memory(double area_m, double px_per_m, double cell_m,
                            double coverage, rt_destruction_figures *f);
-/* *out stays NULL when the pack has no destructible area.  `height` and
- * `bounds` are the renderer's; they are updated by craters. */
-bool rt_destruction_create(rt_device *d, const rt_pack *p, int pool_tiles,
-                           rt_image *height, rt_bounds *bounds, rt_destruction **out,
-                           rt_error *e);
-void rt_destruction_destroy(rt_destruction *ds);
-void rt_destruction_frame(const rt_destruction *ds, splat_frame *fr);
-void rt_destruction_views(const rt_destruction *ds, VkImageView *atlas, VkImageView *index);
-const uint16_t *rt_destruction_heights(const rt_destruction *ds);
-bool rt_destruction_crater(rt_destruction *ds, const rt_crater *c, rt_crater_stats *st,
-                           rt_error *e);
-/* Wait until the last crater's commands are done. */
-bool rt_destruction_wait(rt_destruction *ds, rt_error *e);
-void rt_destruction_print_stats(const rt_destruction *ds, FILE *out);
 /* Helpers shared with the renderer and tests. */
-bool   rt_read_r16(rt_device *d, const rt_image *img, uint16_t *out, rt_error *e);
 double rt_height_at(const uint16_t *heights, const rt_pack *p, double x, double z);
 bool   rt_heightfield_pick(const uint16_t *heights, const rt_pack *p, const double o[3],
                            const double dir[3], double hit[3]);

@@ -7,7 +7,7 @@
  * centres around it, so a leaf cell covering texels [x0, x1) can show any
  * height of texels [x0 - 1, x1] (clamped): those are the texels its bounds
  * take.  Coarser nodes take the union of their children. */
-#include "splatrt.h"
+#include "rt_internal.h"
 
 #include <stdlib.h>
 #include <string.h>

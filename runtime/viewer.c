@@ -16,7 +16,7 @@
  * the swapchain image as the window shows it, "wait_reload=SECONDS" renders
  * until a hot reload succeeded (compile errors on the way are shown and
  * survived; the time running out fails the script), "quit" ends. */
-#include "splatrt.h"
+#include "rt_internal.h"
 #include "util.h"
 #include "scene.h"
 

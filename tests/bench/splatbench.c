@@ -43,7 +43,7 @@
  *       max/mean abs error and PSNR of two --float-out images.
  *
  * Exit status: 0 ok, 1 a failure (message on stderr), 2 usage. */
-#include "splatrt.h"
+#include "rt_internal.h"
 
 #include <errno.h>
 #include <jansson.h>

@@ -18,7 +18,7 @@
  *     warning on stderr, and changes neither the mask nor the heights,
  *     while a later crater over tiles it already has still works.
  * Pictures of the final and mask views go to OUTDIR. */
-#include "splatrt.h"
+#include "rt_internal.h"
 
 #include <math.h>
 #include <stdlib.h>

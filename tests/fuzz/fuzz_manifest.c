@@ -9,7 +9,7 @@
 #include <string.h>
 #include <unistd.h>
 
-#include "splatrt.h"
+#include "rt_internal.h"
 
 int LLVMFuzzerInitialize(int *argc, char ***argv);
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);

@@ -11,7 +11,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "splatrt.h"
+#include "rt_internal.h"
 #include "spv.h"
 
 struct harness {

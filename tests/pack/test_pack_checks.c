@@ -20,7 +20,7 @@
 
 #include <string.h>
 
-#include "splatrt.h"
+#include "rt_internal.h"
 
 static const char *minimal_dir, *destr_dir, *compute_dir;
 

@@ -14,7 +14,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "splatrt.h"
+#include "rt_internal.h"
 
 static int failures;
 

@@ -14,7 +14,7 @@
  *                                        within TOL of (r, g, b) (floats);
  *                                        exit 1 if it is over MAX (0..1)
  */
-#include "splatrt.h"
+#include "rt_internal.h"
 
 #include <math.h>
 #include <stdlib.h>

@@ -9,7 +9,7 @@
  *
  *   make_fixture OUTDIR
  */
-#include "splatrt.h"
+#include "rt_internal.h"
 
 #include <errno.h>
 #include <math.h>

@@ -40,7 +40,7 @@
 #include <string.h>
 
 #include "sparse.h"
-#include "splatrt.h"
+#include "rt_internal.h"
 #include "spv.h"
 
 #define VK(call)                                                              \

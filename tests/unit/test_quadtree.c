@@ -14,7 +14,7 @@
 #include <string.h>
 #include <time.h>
 
-#include "splatrt.h"
+#include "rt_internal.h"
 
 enum { N = SPLAT_GRID, LAST = SPLAT_GRID - 1, MAXIDX = 6 * LAST * LAST };
 

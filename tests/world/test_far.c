@@ -17,7 +17,7 @@
  *     pixels of each view.
  * Without the pass the 5,000 km view fails both (position's fp32 ulp
  * there is 0.5 m).  Pictures go to OUTDIR. */
-#include "splatrt.h"
+#include "rt_internal.h"
 #include "world_check.h"
 
 #include <math.h>

@@ -17,7 +17,7 @@
  *     is terrain;
  *   - no validation messages.
  * Pictures of the views go to OUTDIR. */
-#include "splatrt.h"
+#include "rt_internal.h"
 #include "world_check.h"
 
 #include <math.h>

@@ -21,7 +21,7 @@
  *     selection from screen derivatives differs at the road's edges);
  *   - no validation messages.
  * Pictures of the views go to OUTDIR. */
-#include "splatrt.h"
+#include "rt_internal.h"
 #include "world_check.h"
 
 #include <math.h>
