@@ -46,7 +46,7 @@
  * material (not per texel), on an ir holding only the masks, and only down
  * to the cell's first opaque material.
  */
-#include "scene.h"
+#include "analysis.h"
 #include "util.h"
 
 #include "abi.h"

@@ -16,10 +16,11 @@
  * so a reader — another `splatc build` running at the same time — never
  * sees half an entry; a damaged entry reads as a miss.
  */
-#include "scene.h"
+#include "cache.h"
 #include "util.h"
 
 #include <errno.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>

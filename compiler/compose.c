@@ -36,7 +36,7 @@
  *     float v5 = 1.0 - v4;
  *     if (v5 > 0.0) { ...grass surface...; s_albedo += v5 * ...; }
  */
-#include "scene.h"
+#include "compose.h"
 
 #include <assert.h>
 #include <float.h>

@@ -11,7 +11,7 @@
  *   painted road = "road.tif" { origin = 60000 40000, size = 10000 10000 }
  *   -> .width, .height = the raster's, .rect = that square in terrain uv
  */
-#include "scene.h"
+#include "scene_load.h"
 #include "util.h"
 
 #include <math.h>

@@ -29,7 +29,7 @@
  * layout's source ir), in node order, so their numbers are the same in
  * every shader of the pack and the manifest lists them (PACK.md).
  */
-#include "scene.h"
+#include "compose.h"
 
 #include <math.h>
 #include <stdio.h>

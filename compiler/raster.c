@@ -31,7 +31,7 @@
  * data is read in strips of rows.  GDAL's own messages are kept off
  * stderr and folded into our diagnostics.
  */
-#include "scene.h"
+#include "terrain.h"
 
 #include "abi.h"
 

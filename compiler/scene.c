@@ -17,7 +17,7 @@
  * folder, then the caller's search paths; without any, splat_search_path's
  * (search.c: $SPLATC_PATH, ".", the project root, the installed nodes).
  */
-#include "scene.h"
+#include "compose.h"
 #include "abi.h"
 #include "util.h"
 

@@ -10,7 +10,7 @@
  * file's folder and the scene's come before all of these (parse.c,
  * scene.c).
  */
-#include "scene.h"
+#include "scene_load.h"
 #include "util.h"
 
 #include <limits.h>

@@ -30,7 +30,7 @@
  * Painted masks (analysis.c) are convex combinations of 8-bit texels and
  * are not widened when constant, so an all-0 / all-1 area stays exact.
  */
-#include "scene.h"
+#include "terrain.h"
 
 #include <errno.h>
 #include <math.h>

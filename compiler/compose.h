@@ -1,0 +1,130 @@
+/* compose.h — the compositor that turns a combination into one composite
+ * shader (compiler/DESIGN.md §6; compose.c).
+ */
+#ifndef SPLAT_COMPOSE_H
+#define SPLAT_COMPOSE_H
+
+#include "analysis.h"
+
+/* ---- compose.c: composite shaders (compiler/DESIGN.md §6) -------------- */
+
+/* The material-set resources every shader of a pack shares (abi.h, set 1):
+ * one uniform slot per param of the source ir (in its order), one binding
+ * per distinct texture (file + sampler state, in order of first use), one
+ * painted layer per name.  The strings stay owned by the caller. */
+typedef struct splat_layout {
+    const ir      *src;        /* every material lowered: "<name>.mask", …    */
+    sg_program    *prog;       /* holds the compositor; NULL: built-in alpha  */
+    const char    *compositor; /* shader name; NULL = "linear_alpha"          */
+    const char   **materials;  /* names, bottom (0) first                     */
+    int            nmaterials;
+    const char   **painted;    /* painted mask names, layer order             */
+    int            npainted;
+    int           *texture_of; /* src texture index -> layout texture index   */
+    int           *textures;   /* layout texture -> its first src texture     */
+    int            ntextures;
+    int            nparams;    /* = src->nparams; slot i = src param i        */
+    /* every material's precise sites, u_frame.world[k] (precision.c) */
+    splat_site     sites[SPLAT_WORLD_SITES];
+    int            nsites;
+} splat_layout;
+
+/* precision.c.  Find the layout's sites (splat_layout_init calls it). */
+bool   splat_sites_find(splat_layout *L);
+/* glsl_names.override for `ir` (a composite's emission copy; param_of:
+ * its params -> layout slots, -1 for none; input_of: the terrain input a
+ * param stands for, -1 for none): the camera-relative forms of the uses
+ * of L's sites; free with splat_sites_overrides_free. */
+char **splat_sites_overrides(const splat_layout *L, const ir *ir,
+                             const int *param_of, const int *input_of,
+                             const glsl_names *names);
+void   splat_sites_overrides_free(const ir *ir, char **ov);
+/* A warning per material whose terrain.position uses stay absolute fp32,
+ * with the distance at which their error passes a quarter texel. */
+struct splat_scene;
+void   splat_sites_warn(const struct splat_scene *s, sg_diags *d);
+
+/* `materials` and `painted` arrays are copied (not the strings). */
+bool splat_layout_init(splat_layout *L, const ir *src, sg_program *prog,
+                       const char *compositor,
+                       const char *const *materials, int nmaterials,
+                       const char *const *painted, int npainted, sg_diags *d);
+bool splat_layout_from_scene(splat_layout *L, const splat_scene *s, sg_diags *d);
+/* Compositor shader `name` of `prog` keeps its soundness contract (DESIGN
+ * §6): weight 0 where m = 0, T_next 0 where m = 1, over T in [0, 1] —
+ * proved with the interval evaluator, or a COMPOSITOR_CONTRACT error at
+ * `at` where it proves the contract broken (compose.c says how; slack it
+ * can neither prove nor refute passes).  splat_scene_load checks the
+ * scene's compositor. */
+bool splat_compositor_check(sg_program *prog, const char *name, sg_loc at, sg_diags *d);
+void splat_layout_free(splat_layout *L);
+/* Index of the layout texture equal (file + sampler state) to `t`, or -1. */
+int  splat_layout_texture(const splat_layout *L, const ir_texture *t);
+
+typedef struct splat_compose_desc {
+    const int *materials;  /* scene material indices, top first; the last is
+                              the bottom layer: opaque wherever the
+                              combination is used, so its mask is taken as 1 */
+    int        nmaterials;
+    bool       reference;  /* one material alone: a multi-pass reference pass
+                              (mask 1 only for scene material 0)             */
+} splat_compose_desc;
+
+typedef struct splat_layer {
+    int    material;       /* scene material index                          */
+    ir_ref T;              /* coverage left before this layer               */
+    ir_ref mask;           /* the mask the compositor sees (clamped 0..1)   */
+    ir_ref weight;         /* compositor weight                             */
+    ir_ref T_next;         /* coverage left after it (NONE for the last)    */
+    ir_ref view_mask;      /* its own mask, clamped, for SPLAT_VIEW_MASK    */
+    ir_ref out[SG_OUT_COUNT];   /* mask (= .mask) and the surface outputs  */
+} splat_layer;
+
+/* One composite: the combination's materials imported into one ir (shared
+ * subtrees are one node, duplicate textures merged, params by name), the
+ * compositor inlined once per layer, then optimised.  Roots:
+ *   "layer<j>.{T,mask,weight,T_next,view_mask,albedo,normal,roughness,height}"
+ *   "composite.{albedo,normal,roughness,height}" = sum_j weight_j * s_j
+ *   (the normal not yet normalised), for the CPU reference. */
+typedef struct splat_composite {
+    ir           ir;
+    splat_layer *layers;      /* top first                                   */
+    int          nlayers;
+    bool         reference;
+    int         *textures;    /* layout textures used, ascending             */
+    int          ntextures;
+    int         *params;      /* layout params used, ascending               */
+    int          nparams;
+} splat_composite;
+
+bool splat_compose(const splat_layout *L, const splat_compose_desc *desc,
+                   splat_composite *c, sg_diags *d);
+void splat_composite_free(splat_composite *c);
+
+/* Estimated per-pixel cost of shading with `c` when every layer runs
+ * (the most a pixel pays): ir_cost over all its values, in the op table's
+ * cost units (ir.h IR_OPS).  The manifest's "cost": the runtime picks the
+ * cheapest combination covering a tile. */
+double splat_composite_cost(const splat_composite *c);
+
+typedef struct splat_glsl_desc {
+    const char *title;        /* first header comment line                   */
+    bool        flat;         /* no dynamic branches (benchmark variant)     */
+    bool        no_mask_view; /* leave out the SPLAT_VIEW_MASK branch        */
+    bool        painted_sparse; /* #define SPLAT_PAINTED_SPARSE before the
+                                 prelude: painted masks read the sparse
+                                 quad-tree (abi.h bindings 2, 5, 6)         */
+    const char *painted_places; /* sparse_glsl_places: placed masks' rects
+                                 and sizes before the prelude, or NULL      */
+    bool        compute;      /* the compute variant: #define SPLAT_COMPUTE
+                                 before the prelude (abi.h "compute stage") */
+} splat_glsl_desc;
+
+/* The complete Vulkan GLSL 450 fragment shader of `c`: for a composite,
+ * front-to-back with every value placed in the innermost region that
+ * dominates its uses (`if (T > 0.0)` per layer, nested; the surface under
+ * `if (w > 0.0)`); for a reference, one pass under SPLAT_MULTIPASS. */
+void splat_composite_glsl(const splat_layout *L, const splat_composite *c,
+                          const splat_glsl_desc *desc, ir_buf *out);
+
+#endif
