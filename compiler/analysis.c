@@ -143,9 +143,9 @@ static int intern_checked(combo_set *cs, const uint64_t *bits, int nmaterials,
 {
     int id = set_intern(cs, bits, nmaterials);
     if (id < 0) {
-        sg_error(d, sc->loc, SG_E_TOO_LARGE, "out of memory in the analysis");
+        sg_error(d, sc->loc, SG_E_OUT_OF_MEMORY, "out of memory in the analysis");
     } else if (id >= (int)SPLAT_COMBO_HOLE) {
-        sg_error(d, sc->loc, SG_E_TOO_LARGE,
+        sg_error(d, sc->loc, SG_E_OVER_LIMIT,
                  "the scene has more than 65535 material combinations");
         id = -1;
     }
@@ -447,7 +447,7 @@ bool splat_analyze(const splat_scene *s, splat_analysis *a, sg_diags *d)
         if (a->combos[i].nmaterials > a->largest)
             a->largest = a->combos[i].nmaterials;
     if (ok && a->ncombos == 0) {
-        sg_error(d, loc_hole(sc), SG_E_SCENE, "the whole terrain is a hole "
+        sg_error(d, loc_hole(sc), SG_E_EMPTY_TERRAIN, "the whole terrain is a hole "
                  "(holes mask and nodata cover every texel)");
         ok = false;
     }

@@ -97,7 +97,7 @@ bool splat_layout_init(splat_layout *L, const ir *src, sg_program *prog,
         }
     }
     if (!splat_sites_find(L)) {
-        sg_error(d, (sg_loc){0}, SG_E_TOO_LARGE, "out of memory");
+        sg_error(d, (sg_loc){0}, SG_E_OUT_OF_MEMORY, "out of memory");
         splat_layout_free(L);
         return false;
     }
@@ -260,7 +260,7 @@ static void collect_used(const splat_layout *L, splat_composite *c, sg_diags *d)
             for (int p = 0; p < L->npainted; p++)
                 found |= strcmp(L->painted[p], ir->painted[n->imm].name) == 0;
             if (!found)
-                sg_error(d, (sg_loc){0}, SG_E_SCENE, "unknown painted mask");
+                sg_error(d, (sg_loc){0}, SG_E_UNDECLARED, "unknown painted mask");
         }
     }
     c->textures = xcalloc((size_t)L->ntextures, sizeof *c->textures);

@@ -30,7 +30,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* A material whose IR grows beyond this many nodes is TOO_LARGE (a graph
+/* A material whose IR grows beyond this many nodes is OVER_LIMIT (a graph
  * that doubles at every level of nesting would otherwise exhaust memory). */
 #define MAX_IR_NODES (1u << 22)
 
@@ -323,7 +323,7 @@ static bool inline_shader(lowerer *L, int si, const ir_ref *ins, ir_ref *outs,
             char msg[200];
             snprintf(msg, sizeof msg, "'%s' expands to more than %u IR nodes", s->name,
                      MAX_IR_NODES);
-            sg_error(L->d, n->loc, SG_E_TOO_LARGE, msg);
+            sg_error(L->d, n->loc, SG_E_OVER_LIMIT, msg);
             ok = false;
         }
     }
@@ -347,7 +347,7 @@ static bool program_ok(sg_program *p, sg_diags *d, const char *what, sg_loc loc)
         return true;
     char msg[300];
     snprintf(msg, sizeof msg, "cannot lower '%s': the program has errors", what);
-    sg_error(d, loc, SG_E_BAD_VALUE, msg);
+    sg_error(d, loc, SG_E_HAS_ERRORS, msg);
     return false;
 }
 

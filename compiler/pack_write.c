@@ -215,7 +215,7 @@ static bool texture_fits(build *b, const char *src)
     char msg[512];
     snprintf(msg, sizeof msg, "texture '%s' is %d x %d texels, over the pack limit of %d "
              "per side", src, w, h, SPLAT_MAX_TEXTURE);
-    sg_error(b->d, b->loc, SG_E_TOO_LARGE, msg);
+    sg_error(b->d, b->loc, SG_E_OVER_LIMIT, msg);
     return false;
 }
 
@@ -595,7 +595,7 @@ static bool replaceable(build *b, const char *path, bool *exists)
     }
     char msg[PATH_MAX + 64];
     snprintf(msg, sizeof msg, "refusing to replace '%s': it is not a shader pack", path);
-    sg_error(b->d, b->loc, SG_E_SCENE, msg);
+    sg_error(b->d, b->loc, SG_E_NOT_A_PACK, msg);
     return false;
 }
 

@@ -55,7 +55,7 @@ bool splat_painted_check_format(const splat_scene *s, splat_painted_format f,
             snprintf(msg, sizeof msg, "painted mask '%s' is placed (origin, size); "
                      "--painted dense stores heightfield-sized layers only (use bc4 "
                      "or r8)", sc->painted[i].name);
-            sg_error(d, sc->painted[i].place_loc, SG_E_SCENE, msg);
+            sg_error(d, sc->painted[i].place_loc, SG_E_SETTING, msg);
             ok = false;
         }
     return ok;
@@ -104,7 +104,7 @@ bool splat_painted_build(const splat_scene *s, splat_painted_format f,
     bool ok = sparse_build(out, &sd, &err);
     if (!ok) {
         sg_loc loc = n > 0 && sc->painted[0].loc.file ? sc->painted[0].loc : sc->loc;
-        sg_error(d, loc, SG_E_SCENE, err.msg);
+        sg_error(d, loc, SG_E_RASTER, err.msg);
     }
     free(md);
     return ok;

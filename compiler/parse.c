@@ -208,7 +208,7 @@ static bool parse_value(parser *ps, sg_value *v)
             char msg[96];
             snprintf(msg, sizeof msg, "%.*s needs %d components, found %d",
                      t->len, t->start, w, n);
-            sg_error(ps->d, v->loc, SG_E_BAD_VALUE, msg);
+            sg_error(ps->d, v->loc, SG_E_BAD_COMPONENTS, msg);
             return false;
         }
         v->kind = SG_V_VEC;
@@ -503,7 +503,7 @@ static void bad_setting(parser *ps, const sg_value *v, const char *key, const ch
 {
     char msg[200];
     snprintf(msg, sizeof msg, "'%s' must be %s", key, allowed);
-    sg_error(ps->d, v->loc, SG_E_BAD_VALUE, msg);
+    sg_error(ps->d, v->loc, SG_E_BAD_OPTION, msg);
 }
 
 static void add_texture_setting(parser *ps, void *user, sg_token *key, sg_value *v)
@@ -541,7 +541,7 @@ static void add_texture_setting(parser *ps, void *user, sg_token *key, sg_value 
         char msg[160];
         snprintf(msg, sizeof msg, "unknown texture setting '%.*s' "
                  "(expected file, filter, mip, wrap or srgb)", key->len, key->start);
-        sg_error(ps->d, loc_of(ps, key), SG_E_BAD_VALUE, msg);
+        sg_error(ps->d, loc_of(ps, key), SG_E_BAD_OPTION, msg);
     }
 }
 
@@ -563,7 +563,7 @@ static bool parse_texture(parser *ps)
     if (!t->file) {
         char msg[160];
         snprintf(msg, sizeof msg, "texture '%s' needs a file = \"...\"", t->name);
-        sg_error(ps->d, t->loc, SG_E_BAD_VALUE, msg);
+        sg_error(ps->d, t->loc, SG_E_MISSING_SETTING, msg);
         t->file = "";
     }
     sg_program *p = ps->p;
@@ -596,11 +596,12 @@ typedef struct scene_parse {
 
 enum { HAS_HF, HAS_SIZE, HAS_MAXH, HAS_MATERIALS };
 
-static void scene_error(parser *ps, sg_loc loc, const char *fmt, const char *a)
+static void scene_error(parser *ps, sg_error_id id, sg_loc loc, const char *fmt,
+                        const char *a)
 {
     char msg[256];
     snprintf(msg, sizeof msg, fmt, a);
-    sg_error(ps->d, loc, SG_E_SCENE, msg);
+    sg_error(ps->d, loc, id, msg);
 }
 
 static bool parse_numbers(parser *ps, double *out, int n)
@@ -638,19 +639,19 @@ static bool painted_stmt(parser *ps, void *user)
         double v;
         ok = expect(ps, SG_TK_EQ, "'='") && parse_number(ps, &v);
         if (ok && !(v >= 0 && v <= 7 && v == (int)v))
-            scene_error(ps, kloc, "max_level must be a whole number 0..7%s", "");
+            scene_error(ps, SG_E_SETTING, kloc, "max_level must be a whole number 0..7%s", "");
         else if (ok)
             pm->max_level = (int)v;
     } else if (is_kw(key, "max_error")) {
         next(ps);
         ok = expect(ps, SG_TK_EQ, "'='") && parse_number(ps, &pm->max_error);
         if (ok && !(pm->max_error >= 0 && pm->max_error <= 1))
-            scene_error(ps, kloc, "max_error must be between 0 and 1%s", "");
+            scene_error(ps, SG_E_SETTING, kloc, "max_error must be between 0 and 1%s", "");
     } else if (is_kw(key, "near")) {
         next(ps);
         ok = expect(ps, SG_TK_EQ, "'='") && parse_numbers(ps, pm->near, 4);
         if (ok && !(pm->near[2] > pm->near[0] && pm->near[3] > pm->near[1]))
-            scene_error(ps, kloc, "near must be x0 z0 x1 z1 with x1 > x0 and z1 > z0%s", "");
+            scene_error(ps, SG_E_SETTING, kloc, "near must be x0 z0 x1 z1 with x1 > x0 and z1 > z0%s", "");
         pm->has_near = ok;
     } else if (is_kw(key, "origin") || is_kw(key, "size")) {
         bool size = is_kw(key, "size");
@@ -658,10 +659,10 @@ static bool painted_stmt(parser *ps, void *user)
         double *v = size ? pm->place : pm->origin;
         ok = expect(ps, SG_TK_EQ, "'='") && parse_numbers(ps, v, 2);
         if (ok && size && !(v[0] > 0 && v[1] > 0 && v[0] < 1e9 && v[1] < 1e9))
-            scene_error(ps, kloc, "a painted mask's size must be positive metres, "
+            scene_error(ps, SG_E_SETTING, kloc, "a painted mask's size must be positive metres, "
                         "found %s", "a zero, negative or huge side");
         else if (ok && !size && !(fabs(v[0]) < 1e9 && fabs(v[1]) < 1e9))
-            scene_error(ps, kloc, "a painted mask's origin is out of range%s", "");
+            scene_error(ps, SG_E_SETTING, kloc, "a painted mask's origin is out of range%s", "");
         if (ok) *(size ? &pm->place_loc : &pm->origin_loc) = kloc;
     } else {
         expected(ps, keys);
@@ -702,7 +703,7 @@ static bool sub_stmt(parser *ps, void *user)
         next(ps);
         ok = expect(ps, SG_TK_EQ, "'='") && parse_number(ps, &sc->destruction_cell);
         if (ok && !(sc->destruction_cell > 0))
-            scene_error(ps, loc_of(ps, key), "destruction cell must be positive%s", "");
+            scene_error(ps, SG_E_SETTING, loc_of(ps, key), "destruction cell must be positive%s", "");
     } else {
         expected(ps, b->cam ? "'position', 'look' or '}'" : "'origin', 'size', 'cell' or '}'");
         return false;
@@ -745,7 +746,7 @@ static bool painted_decl(parser *ps, scene_parse *sp)
         sc->holes = scene_path(ps, file->str);
         sc->holes_loc = loc_of(ps, name);
         if (cur(ps)->kind == SG_TK_LBRACE) {
-            scene_error(ps, loc_of(ps, cur(ps)), "the holes mask takes no "
+            scene_error(ps, SG_E_SETTING, loc_of(ps, cur(ps)), "the holes mask takes no "
                         "options (it is not stored as a painted layer)%s", "");
             return false;
         }
@@ -857,7 +858,7 @@ static bool scene_stmt(parser *ps, void *user)
             return false;
         if (!(wh[0] >= 1 && wh[1] >= 1 && wh[0] <= INT_MAX && wh[1] <= INT_MAX) ||
             wh[0] != (int)wh[0] || wh[1] != (int)wh[1])
-            scene_error(ps, kloc, "heightfield_size must be two positive whole numbers%s", "");
+            scene_error(ps, SG_E_SETTING, kloc, "heightfield_size must be two positive whole numbers%s", "");
         else {
             sc->hf_width = (int)wh[0];
             sc->hf_height = (int)wh[1];
@@ -870,7 +871,7 @@ static bool scene_stmt(parser *ps, void *user)
             return false;
         sc->size_loc = kloc;
         if (!(sc->size[0] > 0 && sc->size[1] > 0))
-            scene_error(ps, kloc, "world size must be positive (x and z metres)%s", "");
+            scene_error(ps, SG_E_SETTING, kloc, "world size must be positive (x and z metres)%s", "");
         sp->has[HAS_SIZE] = true;
         return true;
     }
@@ -879,7 +880,7 @@ static bool scene_stmt(parser *ps, void *user)
             return false;
         sc->max_height_loc = kloc;
         if (sc->max_height < 0)
-            scene_error(ps, kloc, "max_height must not be negative%s", "");
+            scene_error(ps, SG_E_SETTING, kloc, "max_height must not be negative%s", "");
         sp->has[HAS_MAXH] = true;
         return true;
     }
@@ -893,7 +894,7 @@ static bool scene_stmt(parser *ps, void *user)
             return false;
         sc->cell_texels_loc = kloc;
         if (!(c >= 1 && c <= 65536 && c == (int)c))
-            scene_error(ps, kloc, "cell must be a whole number of texels (1..65536)%s", "");
+            scene_error(ps, SG_E_SETTING, kloc, "cell must be a whole number of texels (1..65536)%s", "");
         else
             sc->cell_texels = (int)c;
         return true;
@@ -942,20 +943,20 @@ static bool parse_scene(parser *ps)
     bool gdal = sp.has[HAS_HF] && sc->hf_format == SG_HF_GDAL;
     for (int i = 0; i < 4; i++)
         if (!sp.has[i] && !(gdal && (i == HAS_SIZE || i == HAS_MAXH)))
-            scene_error(ps, sc->loc, "scene needs '%s = ...'", need[i]);
+            scene_error(ps, SG_E_MISSING_SETTING, sc->loc, "scene needs '%s = ...'", need[i]);
     /* A GDAL raster's heights are used as stored (raster.c). */
     if (gdal && sc->max_height_loc.line > 0)
-        scene_error(ps, sc->max_height_loc, "max_height comes from the heights "
+        scene_error(ps, SG_E_SETTING, sc->max_height_loc, "max_height comes from the heights "
                     "stored in '%s' (a GDAL raster); remove it", sc->heightfield);
     if (gdal && sc->height_offset_loc.line > 0)
-        scene_error(ps, sc->height_offset_loc, "height_offset comes from the "
+        scene_error(ps, SG_E_SETTING, sc->height_offset_loc, "height_offset comes from the "
                     "heights stored in '%s' (a GDAL raster); remove it",
                     sc->heightfield);
     if (sp.has[HAS_MATERIALS] && sc->nmaterials == 0)
-        scene_error(ps, sp.materials_loc, "scene needs at least one material "
+        scene_error(ps, SG_E_MISSING_SETTING, sp.materials_loc, "scene needs at least one material "
                     "(materials = [BOTTOM, …, TOP])%s", "");
     if (sp.has[HAS_HF] && sc->hf_format == SG_HF_R16 && !sp.has_hf_size)
-        scene_error(ps, sc->heightfield_loc,
+        scene_error(ps, SG_E_MISSING_SETTING, sc->heightfield_loc,
                     "raw heightfield '%s' needs heightfield_size = WIDTH HEIGHT",
                     sc->heightfield);
     if (ps->fi == 0) {

@@ -65,7 +65,7 @@ bool splat_raster_check_size(const char *what, const char *path, long long w,
     char msg[512];
     snprintf(msg, sizeof msg, "%s '%s' is %lld x %lld texels, over the pack limit "
              "of %d per side", what, path, w, h, SPLAT_MAX_HEIGHTFIELD);
-    sg_error(d, loc, SG_E_SCENE, msg);
+    sg_error(d, loc, SG_E_OVER_LIMIT, msg);
     return false;
 }
 
@@ -174,7 +174,7 @@ static bool metres_per_unit(GDALDatasetH ds, const double gt[6], int h,
         if (!(a > 0) || !(rad > 0) || !isfinite(phi) || fabs(phi) > M_PI / 2) {
             snprintf(msg, sizeof msg, "heightfield '%s': geographic coordinates "
                      "with centre latitude %g are out of range", path, lat_units);
-            sg_error(d, loc, SG_E_SCENE, msg);
+            sg_error(d, loc, SG_E_RASTER, msg);
             return false;
         }
         double f = invf > 0 ? 1.0 / invf : 0.0;
@@ -195,7 +195,7 @@ static bool metres_per_unit(GDALDatasetH ds, const double gt[6], int h,
     if (!(m > 0) || !isfinite(m)) {
         snprintf(msg, sizeof msg, "heightfield '%s': its coordinate system's "
                  "linear unit is not a length", path);
-        sg_error(d, loc, SG_E_SCENE, msg);
+        sg_error(d, loc, SG_E_RASTER, msg);
         return false;
     }
     *fx = *fz = m;
@@ -227,7 +227,7 @@ bool splat_raster_heightfield(splat_terrain *t, const char *path, bool size_give
     if (GDALDataTypeIsComplex(type)) {
         snprintf(msg, sizeof msg, "heightfield '%s' holds complex numbers (%s)",
                  path, type_name(type));
-        sg_error(d, loc, SG_E_SCENE, msg);
+        sg_error(d, loc, SG_E_RASTER, msg);
         goto done;
     }
 
@@ -240,7 +240,7 @@ bool splat_raster_heightfield(splat_terrain *t, const char *path, bool size_give
                      "degenerate geotransform (%g %g %g %g %g %g); warp it "
                      "north-up first (gdalwarp)", path, gt[0], gt[1], gt[2],
                      gt[3], gt[4], gt[5]);
-            sg_error(d, loc, SG_E_SCENE, msg);
+            sg_error(d, loc, SG_E_RASTER, msg);
             goto done;
         }
         double fx, fz;
@@ -255,14 +255,14 @@ bool splat_raster_heightfield(splat_terrain *t, const char *path, bool size_give
     } else if (!size_given) {
         snprintf(msg, sizeof msg, "heightfield '%s' has no geotransform: give "
                  "the world size (size = X Z metres)", path);
-        sg_error(d, loc, SG_E_SCENE, msg);
+        sg_error(d, loc, SG_E_RASTER, msg);
         goto done;
     }
     if (!(t->size[0] > 0) || !(t->size[1] > 0) || !isfinite(t->size[0]) ||
         !isfinite(t->size[1])) {
         snprintf(msg, sizeof msg, "heightfield '%s' gives a world size of "
                  "%g x %g m", path, t->size[0], t->size[1]);
-        sg_error(d, loc, SG_E_SCENE, msg);
+        sg_error(d, loc, SG_E_RASTER, msg);
         goto done;
     }
 
@@ -278,7 +278,7 @@ bool splat_raster_heightfield(splat_terrain *t, const char *path, bool size_give
     buf = malloc((size_t)w * (size_t)rows * sizeof *buf);
     t->texels = malloc(n * sizeof *t->texels);
     if (!buf || !t->texels) {
-        sg_error(d, loc, SG_E_TOO_LARGE, "heightfield does not fit in memory");
+        sg_error(d, loc, SG_E_OUT_OF_MEMORY, "heightfield does not fit in memory");
         goto done;
     }
     double lo = INFINITY, hi = -INFINITY, rlo = INFINITY, rhi = -INFINITY;
@@ -304,11 +304,11 @@ bool splat_raster_heightfield(splat_terrain *t, const char *path, bool size_give
     if (nholes == n || !isfinite(lo) || !isfinite(hi)) {
         snprintf(msg, sizeof msg, "heightfield '%s' has no valid height (every "
                  "texel is nodata or not finite)", path);
-        sg_error(d, loc, SG_E_SCENE, msg);
+        sg_error(d, loc, SG_E_RASTER, msg);
         goto done;
     }
     if (nholes > 0 && !(holes = calloc(n, 1))) {
-        sg_error(d, loc, SG_E_TOO_LARGE, "heightfield does not fit in memory");
+        sg_error(d, loc, SG_E_OUT_OF_MEMORY, "heightfield does not fit in memory");
         goto done;
     }
 
@@ -392,7 +392,7 @@ uint8_t *splat_raster_mask(const char *what, const char *path, int *out_w,
     if (type != GDT_Byte && !fp) {
         snprintf(msg, sizeof msg, "%s '%s' holds %s values; expected 8-bit "
                  "(0..255) or floating point (0..1)", what, path, type_name(type));
-        sg_error(d, loc, SG_E_SCENE, msg);
+        sg_error(d, loc, SG_E_RASTER, msg);
         goto done;
     }
     nodata nd = band_nodata(band);
@@ -400,7 +400,7 @@ uint8_t *splat_raster_mask(const char *what, const char *path, int *out_w,
     buf = malloc((size_t)w * (size_t)rows * sizeof *buf);
     out = malloc((size_t)w * (size_t)h);
     if (!buf || !out) {
-        sg_error(d, loc, SG_E_TOO_LARGE, "painted mask does not fit in memory");
+        sg_error(d, loc, SG_E_OUT_OF_MEMORY, "painted mask does not fit in memory");
         goto fail;
     }
     for (int y = 0; y < h; y += rows) {

@@ -114,7 +114,7 @@ static ir_type apply_swizzle(checker *c, sg_value *v, ir_type base)
             char msg[128];
             snprintf(msg, sizeof msg, "swizzle '.%s' reads past the end of a %s",
                      v->swizzle, ir_type_name(base));
-            sg_error(c->d, v->loc, SG_E_BAD_VALUE, msg);
+            sg_error(c->d, v->loc, SG_E_BAD_SWIZZLE, msg);
             return IR_T_ERROR;
         }
     return ir_type_vec(n);
@@ -179,7 +179,7 @@ static bool resolve_path(checker *c, sg_value *v, bool allow_locals)
                 char msg[300];
                 snprintf(msg, sizeof msg, "node '%s' has %d outputs: write '%s.<output>'",
                          n->name, nout, n->name);
-                sg_error(c->d, v->loc, SG_E_BAD_VALUE, msg);
+                sg_error(c->d, v->loc, SG_E_BAD_REFERENCE, msg);
                 return false;
             }
         } else {
@@ -221,7 +221,7 @@ static bool resolve_path(checker *c, sg_value *v, bool allow_locals)
             char msg[300];
             snprintf(msg, sizeof msg, "a default value cannot use '%s': only constants, "
                      "textures and terrain inputs", first);
-            sg_error(c->d, v->loc, SG_E_BAD_VALUE, msg);
+            sg_error(c->d, v->loc, SG_E_BAD_DEFAULT, msg);
         } else {
             sg_error(c->d, v->loc, SG_E_UNKNOWN_NAME, path_text(v, buf, sizeof buf));
         }
@@ -233,7 +233,7 @@ static bool resolve_path(checker *c, sg_value *v, bool allow_locals)
             char msg[300];
             snprintf(msg, sizeof msg, "'%s' is not a swizzle (x y z w or r g b a, "
                      "up to 4) in '%s'", v->parts[rest], path_text(v, buf, sizeof buf));
-            sg_error(c->d, v->loc, SG_E_BAD_VALUE, msg);
+            sg_error(c->d, v->loc, SG_E_BAD_SWIZZLE, msg);
             return false;
         }
         v->swizzle = v->parts[rest];
@@ -591,7 +591,7 @@ static void resolve_node_type(checker *c, sg_node *n)
             char msg[300];
             snprintf(msg, sizeof msg, "'%s' is a material; only shaders can be "
                      "instantiated as nodes", s->name);
-            sg_error(c->d, n->type_loc, SG_E_BAD_VALUE, msg);
+            sg_error(c->d, n->type_loc, SG_E_BAD_REFERENCE, msg);
             return;
         }
         n->kind = SG_NODE_INSTANCE;
@@ -607,7 +607,7 @@ static void check_default(checker *c, sg_port *port, bool is_param)
 {
     sg_value *v = &port->value;
     if (is_param && v->kind != SG_V_NUMBER && v->kind != SG_V_VEC) {
-        sg_error(c->d, v->loc, SG_E_BAD_VALUE,
+        sg_error(c->d, v->loc, SG_E_BAD_DEFAULT,
                  "a param's default must be a number or vecN(...)");
         return;
     }
@@ -625,7 +625,7 @@ static void check_default(checker *c, sg_port *port, bool is_param)
         char msg[200];
         snprintf(msg, sizeof msg, "range of param '%s' is empty (%g > %g)", port->name,
                  port->lo, port->hi);
-        sg_error(c->d, v->loc, SG_E_BAD_VALUE, msg);
+        sg_error(c->d, v->loc, SG_E_EMPTY_RANGE, msg);
     }
 }
 
@@ -751,7 +751,7 @@ static void declare_globals(checker *c)
             char msg[200];
             snprintf(msg, sizeof msg, "'%s' is a built-in node type and cannot be redefined",
                      s->name);
-            sg_error(c->d, s->loc, SG_E_BAD_VALUE, msg);
+            sg_error(c->d, s->loc, SG_E_REDEFINED, msg);
             continue;
         }
         int old = sg_map_put(&p->globals, s->name, i << 1 | SG_G_SHADER);
@@ -819,7 +819,7 @@ static void check_scene(checker *c)
             if (g >= 0) {
                 char msg[300];
                 snprintf(msg, sizeof msg, "'%s' is not a material", sc->materials[i]);
-                sg_error(c->d, sc->material_locs[i], SG_E_SCENE, msg);
+                sg_error(c->d, sc->material_locs[i], SG_E_BAD_REFERENCE, msg);
             } else {
                 sg_error(c->d, sc->material_locs[i], SG_E_UNKNOWN_NAME, sc->materials[i]);
             }
@@ -828,7 +828,7 @@ static void check_scene(checker *c)
         char msg[300];
         snprintf(msg, sizeof msg, "compositor '%s' is not a shader of this program "
                  "(import \"nodes/compositors.sg\"?)", sc->compositor);
-        sg_error(c->d, sc->compositor_loc, SG_E_SCENE, msg);
+        sg_error(c->d, sc->compositor_loc, SG_E_UNDECLARED, msg);
     }
 }
 

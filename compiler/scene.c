@@ -38,17 +38,17 @@ static sg_loc loc_or(sg_loc loc, sg_loc fallback)
     return loc.line > 0 ? loc : fallback;
 }
 
-static void scene_error(sg_diags *d, sg_loc loc, const char *fmt, ...)
-    __attribute__((format(printf, 3, 4)));
+static void scene_error(sg_diags *d, sg_error_id id, sg_loc loc, const char *fmt, ...)
+    __attribute__((format(printf, 4, 5)));
 
-static void scene_error(sg_diags *d, sg_loc loc, const char *fmt, ...)
+static void scene_error(sg_diags *d, sg_error_id id, sg_loc loc, const char *fmt, ...)
 {
     char msg[512];
     va_list ap;
     va_start(ap, fmt);
     vsnprintf(msg, sizeof msg, fmt, ap);
     va_end(ap);
-    sg_error(d, loc, SG_E_SCENE, msg);
+    sg_error(d, loc, id, msg);
 }
 
 static bool is_pow2(int v) { return v > 0 && (v & (v - 1)) == 0; }
@@ -61,7 +61,7 @@ static bool cells_fit(const sg_scene *sc, int w, int h, sg_diags *d)
     int side = w > h ? w : h, cell = sc->cell_texels > 0 ? sc->cell_texels : 32;
     if ((side + cell - 1) / cell <= SPLAT_MAX_CELLS)
         return true;
-    scene_error(d, loc_or(sc->cell_texels_loc, sc->loc), "a cell of %d texels gives %d leaf "
+    scene_error(d, SG_E_OVER_LIMIT, loc_or(sc->cell_texels_loc, sc->loc), "a cell of %d texels gives %d leaf "
                 "cells per side over the %d x %d heightfield, over the pack limit of %d",
                 cell, (side + cell - 1) / cell, w, h, SPLAT_MAX_CELLS);
     return false;
@@ -71,23 +71,23 @@ static bool cells_fit(const sg_scene *sc, int w, int h, sg_diags *d)
 static void check_scene(sg_program *p, const sg_scene *sc, sg_diags *d)
 {
     if (!sc->heightfield)
-        scene_error(d, sc->loc, "scene '%s' has no heightfield "
+        scene_error(d, SG_E_MISSING_SETTING, sc->loc, "scene '%s' has no heightfield "
                     "(heightfield = \"FILE.png\")", sc->name);
     bool gdal = sc->hf_format == SG_HF_GDAL;   /* size may come from the file */
     if ((!gdal || sc->size_loc.line > 0) &&
         (!(sc->size[0] > 0) || !(sc->size[1] > 0) || !isfinite(sc->size[0]) ||
          !isfinite(sc->size[1])))
-        scene_error(d, loc_or(sc->size_loc, sc->loc), "world size must be two "
+        scene_error(d, SG_E_SETTING, loc_or(sc->size_loc, sc->loc), "world size must be two "
                     "positive lengths in metres, found %g %g",
                     sc->size[0], sc->size[1]);
     if (!(sc->max_height >= 0) || !isfinite(sc->max_height))
-        scene_error(d, loc_or(sc->max_height_loc, sc->loc), "max_height must "
+        scene_error(d, SG_E_SETTING, loc_or(sc->max_height_loc, sc->loc), "max_height must "
                     "be 0 or more metres, found %g", sc->max_height);
     if (!isfinite(sc->height_offset))
-        scene_error(d, sc->loc, "height_offset must be finite, found %g",
+        scene_error(d, SG_E_SETTING, sc->loc, "height_offset must be finite, found %g",
                     sc->height_offset);
     if (sc->nmaterials == 0)
-        scene_error(d, sc->loc, "scene '%s' has an empty material stack "
+        scene_error(d, SG_E_MISSING_SETTING, sc->loc, "scene '%s' has an empty material stack "
                     "(materials = [BOTTOM, …, TOP])", sc->name);
     for (int i = 0; i < sc->nmaterials; i++) {
         sg_loc loc = sc->material_locs ? loc_or(sc->material_locs[i], sc->loc)
@@ -108,7 +108,7 @@ static void check_scene(sg_program *p, const sg_scene *sc, sg_diags *d)
     int cell = sc->cell_texels;
     if (cell != 0 || sc->cell_texels_loc.line > 0) {   /* 0 unset: default */
         if (!is_pow2(cell) || cell > 4096)
-            scene_error(d, loc_or(sc->cell_texels_loc, sc->loc), "cell must be "
+            scene_error(d, SG_E_SETTING, loc_or(sc->cell_texels_loc, sc->loc), "cell must be "
                         "a power of two from 1 to 4096 heightfield texels, "
                         "found %d", cell);
     }
@@ -123,7 +123,7 @@ static void check_scene(sg_program *p, const sg_scene *sc, sg_diags *d)
             }
         }
         if ((pm->origin_loc.line > 0) != (pm->place_loc.line > 0))
-            scene_error(d, loc_or(pm->origin_loc.line > 0 ? pm->origin_loc : pm->place_loc,
+            scene_error(d, SG_E_SETTING, loc_or(pm->origin_loc.line > 0 ? pm->origin_loc : pm->place_loc,
                                   sc->loc),
                         "painted mask '%s' is placed with both 'origin' and 'size' "
                         "(terrain-local metres) or neither", pm->name);
@@ -131,7 +131,7 @@ static void check_scene(sg_program *p, const sg_scene *sc, sg_diags *d)
     if (sc->hf_format == SG_HF_R16 && sc->hf_width > 0 && sc->hf_height > 0)
         cells_fit(sc, sc->hf_width, sc->hf_height, d);
     if (sc->npainted > SPLAT_MAX_PAINTED)
-        scene_error(d, loc_or(sc->painted[SPLAT_MAX_PAINTED].loc, sc->loc), "scene '%s' "
+        scene_error(d, SG_E_OVER_LIMIT, loc_or(sc->painted[SPLAT_MAX_PAINTED].loc, sc->loc), "scene '%s' "
                     "declares %d painted masks, over the pack limit of %d", sc->name,
                     sc->npainted, SPLAT_MAX_PAINTED);
     if (sc->has_destruction) {
@@ -139,7 +139,7 @@ static void check_scene(sg_program *p, const sg_scene *sc, sg_diags *d)
         double side = fmax(sc->destruction_size[0], sc->destruction_size[1]);
         double cells = ceil(side / sc->destruction_cell);
         if (sc->destruction_cell > 0 && side > 0 && !(cells <= SPLAT_MAX_DESTRUCTION_CELLS))
-            scene_error(d, dloc, "the destructible area is %.0f cells of %g m per side, over "
+            scene_error(d, SG_E_OVER_LIMIT, dloc, "the destructible area is %.0f cells of %g m per side, over "
                         "the pack limit of %d (a larger cell or a smaller area)", cells,
                         sc->destruction_cell, SPLAT_MAX_DESTRUCTION_CELLS);
         /* (a GDAL heightfield's size is known once it is read) */
@@ -147,7 +147,7 @@ static void check_scene(sg_program *p, const sg_scene *sc, sg_diags *d)
             !(sc->destruction_origin[0] >= 0 && sc->destruction_origin[1] >= 0 &&
               sc->destruction_origin[0] + sc->destruction_size[0] <= sc->size[0] &&
               sc->destruction_origin[1] + sc->destruction_size[1] <= sc->size[1]))
-            scene_error(d, dloc, "the destructible area (origin %g %g, size %g %g) must lie "
+            scene_error(d, SG_E_SETTING, dloc, "the destructible area (origin %g %g, size %g %g) must lie "
                         "inside the terrain (0 0 to %g %g)", sc->destruction_origin[0],
                         sc->destruction_origin[1], sc->destruction_size[0],
                         sc->destruction_size[1], sc->size[0], sc->size[1]);
@@ -156,13 +156,13 @@ static void check_scene(sg_program *p, const sg_scene *sc, sg_diags *d)
         if (!(sc->destruction_size[0] > 0) || !(sc->destruction_size[1] > 0) ||
             !isfinite(sc->destruction_size[0]) || !isfinite(sc->destruction_size[1]) ||
             !isfinite(sc->destruction_origin[0]) || !isfinite(sc->destruction_origin[1]))
-            scene_error(d, sc->loc, "the destructible area needs a finite "
+            scene_error(d, SG_E_SETTING, sc->loc, "the destructible area needs a finite "
                         "origin and a positive size, found origin %g %g, "
                         "size %g %g", sc->destruction_origin[0],
                         sc->destruction_origin[1], sc->destruction_size[0],
                         sc->destruction_size[1]);
         if (!(sc->destruction_cell > 0) || !isfinite(sc->destruction_cell))
-            scene_error(d, sc->loc, "the destructible area's cell must be a "
+            scene_error(d, SG_E_SETTING, sc->loc, "the destructible area's cell must be a "
                         "positive size in metres, found %g", sc->destruction_cell);
     }
 }
@@ -192,7 +192,7 @@ static uint8_t *load_mask(const char *name, const char *file, int *pw, int *ph,
             *pw = fw;
             *ph = fh;
         } else if (px && (fw != w || fh != h)) {
-            scene_error(d, loc, "painted mask '%s' ('%s') is %d x %d texels; the "
+            scene_error(d, SG_E_RASTER, loc, "painted mask '%s' ('%s') is %d x %d texels; the "
                         "heightfield is %d x %d", name, file, fw, fh, w, h);
             free(px);
             px = NULL;
@@ -211,7 +211,7 @@ static uint8_t *load_mask(const char *name, const char *file, int *pw, int *ph,
         return NULL;
     }
     if (comp != 1 || stbi_is_16_bit(file)) {
-        scene_error(d, loc, "painted mask '%s' ('%s') must be an 8-bit "
+        scene_error(d, SG_E_RASTER, loc, "painted mask '%s' ('%s') must be an 8-bit "
                     "greyscale image, found %d channels of %d bits", name, file,
                     comp, stbi_is_16_bit(file) ? 16 : 8);
         return NULL;
@@ -220,7 +220,7 @@ static uint8_t *load_mask(const char *name, const char *file, int *pw, int *ph,
         *pw = w = fw;
         *ph = h = fh;
     } else if (fw != w || fh != h) {
-        scene_error(d, loc, "painted mask '%s' ('%s') is %d x %d texels; the "
+        scene_error(d, SG_E_RASTER, loc, "painted mask '%s' ('%s') is %d x %d texels; the "
                     "heightfield is %d x %d (or place it: { origin = X Z, size = W H })",
                     name, file, fw, fh, w, h);
         return NULL;
@@ -241,7 +241,7 @@ static uint8_t *load_mask(const char *name, const char *file, int *pw, int *ph,
     size_t n = (size_t)w * (size_t)h;
     uint8_t *out = malloc(n);
     if (out) memcpy(out, px, n);
-    else sg_error(d, loc, SG_E_TOO_LARGE, "painted mask does not fit in memory");
+    else sg_error(d, loc, SG_E_OUT_OF_MEMORY, "painted mask does not fit in memory");
     stbi_image_free(px);
     return out;
 }
@@ -264,7 +264,7 @@ static bool load_holes(splat_scene *s, sg_diags *d)
         t->holes = m;
     }
     if (!splat_terrain_fill_holes(t)) {
-        sg_error(d, loc, SG_E_TOO_LARGE, "the terrain's holes do not fit in memory");
+        sg_error(d, loc, SG_E_OUT_OF_MEMORY, "the terrain's holes do not fit in memory");
         return false;
     }
     return true;
@@ -277,7 +277,7 @@ static bool load_painted(splat_scene *s, sg_diags *d)
     s->painted = calloc((size_t)sc->npainted, sizeof *s->painted);
     s->painted_size = calloc((size_t)sc->npainted, sizeof *s->painted_size);
     if (!s->painted || !s->painted_size) {
-        sg_error(d, sc->loc, SG_E_TOO_LARGE, "painted masks do not fit in memory");
+        sg_error(d, sc->loc, SG_E_OUT_OF_MEMORY, "painted masks do not fit in memory");
         return false;
     }
     bool ok = true;
@@ -315,7 +315,7 @@ static bool lower_materials(splat_scene *s, sg_diags *d)
         for (int k = before; k < s->ir.npainted; k++) {
             sg_loc loc = sc->material_locs ? loc_or(sc->material_locs[i], sc->loc)
                                            : sc->loc;
-            scene_error(d, loc, "material '%s' reads painted mask '%s', which "
+            scene_error(d, SG_E_UNDECLARED, loc, "material '%s' reads painted mask '%s', which "
                         "scene '%s' does not declare (painted %s = \"FILE.png\")",
                         sc->materials[i], s->ir.painted[k].name, sc->name,
                         s->ir.painted[k].name);
@@ -342,13 +342,13 @@ bool splat_scene_load(splat_scene *s, const char *path,
 
     s->prog = sg_load(path, (const char *const *)paths, d);
     if (!s->prog) {
-        sg_error(d, (sg_loc){ path, 0, 0 }, SG_E_TOO_LARGE, "out of memory");
+        sg_error(d, (sg_loc){ path, 0, 0 }, SG_E_OUT_OF_MEMORY, "out of memory");
         goto fail;
     }
     if (d->nerrors > errors) goto fail;
     s->desc = sg_program_scene(s->prog);
     if (!s->desc) {
-        scene_error(d, (sg_loc){ path, 1, 1 }, "'%s' declares no scene "
+        scene_error(d, SG_E_MISSING_SETTING, (sg_loc){ path, 1, 1 }, "'%s' declares no scene "
                     "(scene NAME { heightfield = …, materials = […] })", path);
         goto fail;
     }

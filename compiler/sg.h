@@ -41,10 +41,23 @@ typedef struct sg_loc {
     X(MISSING_IMPORT,"cannot import '%s': %s")                              \
     X(IMPORT_CYCLE,  "import cycle: %s")                                    \
     X(BAD_OUTPUT,    "'%s' is not a material output (mask, albedo, normal, roughness, height)") \
-    X(BAD_VALUE,     "%s")                                                  \
     X(TOO_DEEP,      "nesting deeper than %d levels")                       \
-    X(TOO_LARGE,     "%s")                                                  \
-    X(SCENE,         "%s")                                                  \
+    X(BAD_SWIZZLE,   "%s")      /* .xyzw past a value's end, or no swizzle */ \
+    X(BAD_REFERENCE, "%s")      /* a name of the wrong kind used here      */ \
+    X(BAD_DEFAULT,   "%s")      /* a default a param or input cannot take  */ \
+    X(BAD_COMPONENTS, "%s")     /* vecN(...) with the wrong count          */ \
+    X(BAD_OPTION,    "%s")      /* a texture or node option's value        */ \
+    X(EMPTY_RANGE,   "%s")      /* param range lo > hi                     */ \
+    X(REDEFINED,     "%s")      /* a built-in node type defined again      */ \
+    X(HAS_ERRORS,    "%s")      /* lowering a program that has errors      */ \
+    X(SETTING,       "%s")      /* a scene setting's value                 */ \
+    X(MISSING_SETTING, "%s")    /* a setting the scene needs               */ \
+    X(UNDECLARED,    "%s")      /* a painted mask or compositor not there  */ \
+    X(RASTER,        "%s")      /* a heightfield or mask raster's content  */ \
+    X(OVER_LIMIT,    "%s")      /* over a pack or device limit (PACK.md)   */ \
+    X(EMPTY_TERRAIN, "%s")      /* holes cover the whole terrain           */ \
+    X(NOT_A_PACK,    "%s")      /* the output folder is not a shader pack  */ \
+    X(OUT_OF_MEMORY, "%s")                                                  \
     X(INTERNAL,      "internal compiler error: %s")
 
 typedef enum sg_error_id {

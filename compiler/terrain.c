@@ -67,13 +67,13 @@ static bool load_png(splat_terrain *t, const char *path, sg_loc loc, sg_diags *d
         char msg[256];
         snprintf(msg, sizeof msg, "heightfield '%s' has %d channels; expected a "
                  "greyscale image (1 channel, 8 or 16 bits)", path, comp);
-        sg_error(d, loc, SG_E_SCENE, msg);
+        sg_error(d, loc, SG_E_RASTER, msg);
         return false;
     }
     size_t n = (size_t)w * (size_t)h;
     t->texels = malloc(n * sizeof *t->texels);
     if (!t->texels) {
-        sg_error(d, loc, SG_E_TOO_LARGE, "heightfield does not fit in memory");
+        sg_error(d, loc, SG_E_OUT_OF_MEMORY, "heightfield does not fit in memory");
         return false;
     }
     int lw, lh, lc;
@@ -112,7 +112,7 @@ static bool load_r16(splat_terrain *t, const char *path, int w, int h,
     if (w <= 0 || h <= 0) {
         snprintf(msg, sizeof msg, "raw heightfield '%s' needs its size: "
                  "heightfield_size = WIDTH HEIGHT", path);
-        sg_error(d, loc, SG_E_SCENE, msg);
+        sg_error(d, loc, SG_E_RASTER, msg);
         return false;
     }
     if (!splat_raster_check_size("heightfield", path, w, h, loc, d))
@@ -135,7 +135,7 @@ static bool load_r16(splat_terrain *t, const char *path, int w, int h,
         snprintf(msg, sizeof msg, "raw heightfield '%s' is %ld bytes; "
                  "heightfield_size = %d %d needs %zu (16-bit little-endian)",
                  path, len, w, h, n * 2);
-        sg_error(d, loc, SG_E_SCENE, msg);
+        sg_error(d, loc, SG_E_RASTER, msg);
         fclose(f);
         return false;
     }
@@ -146,7 +146,7 @@ static bool load_r16(splat_terrain *t, const char *path, int w, int h,
         free(t->texels);
         t->texels = NULL;
         fclose(f);
-        sg_error(d, loc, SG_E_TOO_LARGE, "heightfield does not fit in memory");
+        sg_error(d, loc, SG_E_OUT_OF_MEMORY, "heightfield does not fit in memory");
         return false;
     }
     size_t got = fread(raw, 1, n * 2, f);

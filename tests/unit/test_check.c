@@ -60,8 +60,8 @@ static void test_unknown_names(void **state)
                2, 22, "unknown name 'terrain.hieght'");
     expect_one("material m {\n  out colour = 1\n}\n", SG_E_BAD_OUTPUT, 2, 7, NULL);
     expect_one("material m {\n  node s : terrain.slope\n  out mask = s.out.q\n}\n",
-               SG_E_BAD_VALUE, 3, 14, NULL);
-    expect_one("material a { }\nmaterial m {\n  node x : a\n}\n", SG_E_BAD_VALUE, 3, 12,
+               SG_E_BAD_SWIZZLE, 3, 14, NULL);
+    expect_one("material a { }\nmaterial m {\n  node x : a\n}\n", SG_E_BAD_REFERENCE, 3, 12,
                "'a' is a material; only shaders can be instantiated as nodes");
 }
 
@@ -97,12 +97,12 @@ static void test_types(void **state)
                "type mismatch: output 'albedo' expects vec3, found vec2");
     expect_ok("material m {\n  out albedo = 0.5\n  out roughness = 0.2\n}\n");
     /* a swizzle past the end */
-    expect_one("material m {\n  out mask = terrain.uv.z\n}\n", SG_E_BAD_VALUE, 2, 14,
+    expect_one("material m {\n  out mask = terrain.uv.z\n}\n", SG_E_BAD_SWIZZLE, 2, 14,
                "swizzle '.z' reads past the end of a vec2");
     /* param defaults and ranges */
     expect_one("material m {\n  param vec2 p = vec3(1, 2, 3)\n}\n", SG_E_TYPE_MISMATCH, 2, 18,
                NULL);
-    expect_one("material m {\n  param float p = 0.5 range 1 0\n}\n", SG_E_BAD_VALUE, 2, 19,
+    expect_one("material m {\n  param float p = 0.5 range 1 0\n}\n", SG_E_EMPTY_RANGE, 2, 19,
                NULL);
 }
 
@@ -121,7 +121,7 @@ static void test_missing_and_duplicate(void **state)
                SG_E_DUPLICATE, 3, 8, "duplicate shader 's' (first defined at t.sg:1:8)");
     expect_one("material m {\n  out mask = 1\n  out mask = 0\n}\n", SG_E_DUPLICATE, 3, 7,
                NULL);
-    expect_one("shader mix { out float o = 1 }\n", SG_E_BAD_VALUE, 1, 8,
+    expect_one("shader mix { out float o = 1 }\n", SG_E_REDEFINED, 1, 8,
                "'mix' is a built-in node type and cannot be redefined");
 }
 

@@ -231,13 +231,13 @@ static void test_load_raw_r16(void **state)
     /* The wrong size, and no size at all, are errors at the location. */
     sg_diags_init(&d);
     assert_false(splat_terrain_load(&t, path, SG_HF_R16, 4, 2, LOC, &d));
-    assert_one_error(&d, SG_E_SCENE);
+    assert_one_error(&d, SG_E_RASTER);
     assert_non_null(strstr(d.items[0].msg, "12 bytes"));
     assert_null(t.texels);
     sg_diags_free(&d);
     sg_diags_init(&d);
     assert_false(splat_terrain_load(&t, path, SG_HF_R16, 0, 0, LOC, &d));
-    assert_one_error(&d, SG_E_SCENE);
+    assert_one_error(&d, SG_E_RASTER);
     sg_diags_free(&d);
 }
 
@@ -271,7 +271,7 @@ static void test_load_errors(void **state)
     sg_diags_init(&d);
     assert_false(splat_terrain_load(&t, tmp_path("rgb16.png"), SG_HF_PNG, 0, 0,
                                     LOC, &d));
-    assert_one_error(&d, SG_E_SCENE);
+    assert_one_error(&d, SG_E_RASTER);
     assert_non_null(strstr(d.items[0].msg, "3 channels"));
     sg_diags_free(&d);
     unsigned char rgb8[2 * 2 * 3] = { 0 };
@@ -279,7 +279,7 @@ static void test_load_errors(void **state)
     sg_diags_init(&d);
     assert_false(splat_terrain_load(&t, tmp_path("rgb8.png"), SG_HF_PNG, 0, 0,
                                     LOC, &d));
-    assert_one_error(&d, SG_E_SCENE);
+    assert_one_error(&d, SG_E_RASTER);
     sg_diags_free(&d);
     assert_null(t.texels);
 }

@@ -249,17 +249,17 @@ static void test_errors(void **state)
         sg_error_id id;
         const char *text;
     } cases[] = {
-        { "rot.tif", "", SG_E_SCENE, "rotated" },
-        { "nogt.tif", "", SG_E_SCENE, "no geotransform" },
-        { "allnd.tif", "", SG_E_SCENE, "no valid height" },
+        { "rot.tif", "", SG_E_RASTER, "rotated" },
+        { "nogt.tif", "", SG_E_RASTER, "no geotransform" },
+        { "allnd.tif", "", SG_E_RASTER, "no valid height" },
         { "junk.tif", "", SG_E_IO, "not a raster GDAL reads" },
         { "missing.tif", "", SG_E_IO, "No such file" },
-        { "nogt.tif", "    size = 2 2\n    max_height = 10\n", SG_E_SCENE,
+        { "nogt.tif", "    size = 2 2\n    max_height = 10\n", SG_E_SETTING,
           "max_height comes from the heights" },
         { "x.vrt", "    size = 2 2\n", SG_E_IO, "not a raster GDAL reads" },
-        { "nogt.tif", "    size = 2 2\n    painted fields = \"m3.tif\"\n", SG_E_SCENE,
+        { "nogt.tif", "    size = 2 2\n    painted fields = \"m3.tif\"\n", SG_E_RASTER,
           "is 3 x 3 texels; the heightfield is 2 x 2" },
-        { "nogt.tif", "    size = 2 2\n    painted holes = \"m16.tif\"\n", SG_E_SCENE,
+        { "nogt.tif", "    size = 2 2\n    painted holes = \"m16.tif\"\n", SG_E_RASTER,
           "holds UInt16 values" },
     };
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; i++) {
