@@ -589,12 +589,7 @@ static bool parse_import(parser *ps)
 typedef struct scene_parse {
     sg_scene *sc;
     int cap_materials, cap_material_locs, cap_painted, cap_cameras;
-    bool has_hf_size;
-    bool has[8];
-    sg_loc materials_loc;   /* the `materials` setting, for an empty stack */
 } scene_parse;
-
-enum { HAS_HF, HAS_SIZE, HAS_MAXH, HAS_MATERIALS };
 
 static void scene_error(parser *ps, sg_error_id id, sg_loc loc, const char *fmt,
                         const char *a)
@@ -636,33 +631,23 @@ static bool painted_stmt(parser *ps, void *user)
     bool ok;
     if (is_kw(key, "max_level")) {
         next(ps);
-        double v;
+        double v = -1;
         ok = expect(ps, SG_TK_EQ, "'='") && parse_number(ps, &v);
-        if (ok && !(v >= 0 && v <= 7 && v == (int)v))
-            scene_error(ps, SG_E_SETTING, kloc, "max_level must be a whole number 0..7%s", "");
-        else if (ok)
-            pm->max_level = (int)v;
+        pm->max_level = v >= 0 && v <= 7 && v == (int)v ? (int)v : -1;
+        pm->max_level_loc = kloc;
     } else if (is_kw(key, "max_error")) {
         next(ps);
         ok = expect(ps, SG_TK_EQ, "'='") && parse_number(ps, &pm->max_error);
-        if (ok && !(pm->max_error >= 0 && pm->max_error <= 1))
-            scene_error(ps, SG_E_SETTING, kloc, "max_error must be between 0 and 1%s", "");
+        pm->max_error_loc = kloc;
     } else if (is_kw(key, "near")) {
         next(ps);
         ok = expect(ps, SG_TK_EQ, "'='") && parse_numbers(ps, pm->near, 4);
-        if (ok && !(pm->near[2] > pm->near[0] && pm->near[3] > pm->near[1]))
-            scene_error(ps, SG_E_SETTING, kloc, "near must be x0 z0 x1 z1 with x1 > x0 and z1 > z0%s", "");
         pm->has_near = ok;
+        pm->near_loc = kloc;
     } else if (is_kw(key, "origin") || is_kw(key, "size")) {
         bool size = is_kw(key, "size");
         next(ps);
-        double *v = size ? pm->place : pm->origin;
-        ok = expect(ps, SG_TK_EQ, "'='") && parse_numbers(ps, v, 2);
-        if (ok && size && !(v[0] > 0 && v[1] > 0 && v[0] < 1e9 && v[1] < 1e9))
-            scene_error(ps, SG_E_SETTING, kloc, "a painted mask's size must be positive metres, "
-                        "found %s", "a zero, negative or huge side");
-        else if (ok && !size && !(fabs(v[0]) < 1e9 && fabs(v[1]) < 1e9))
-            scene_error(ps, SG_E_SETTING, kloc, "a painted mask's origin is out of range%s", "");
+        ok = expect(ps, SG_TK_EQ, "'='") && parse_numbers(ps, size ? pm->place : pm->origin, 2);
         if (ok) *(size ? &pm->place_loc : &pm->origin_loc) = kloc;
     } else {
         expected(ps, keys);
@@ -701,9 +686,8 @@ static bool sub_stmt(parser *ps, void *user)
                                                     : sc->destruction_size, 2);
     } else if (!b->cam && is_kw(key, "cell")) {
         next(ps);
+        sc->destruction_cell_loc = loc_of(ps, key);
         ok = expect(ps, SG_TK_EQ, "'='") && parse_number(ps, &sc->destruction_cell);
-        if (ok && !(sc->destruction_cell > 0))
-            scene_error(ps, SG_E_SETTING, loc_of(ps, key), "destruction cell must be positive%s", "");
     } else {
         expected(ps, b->cam ? "'position', 'look' or '}'" : "'origin', 'size', 'cell' or '}'");
         return false;
@@ -778,7 +762,6 @@ static bool heightfield_value(parser *ps, scene_parse *sp)
         sc->hf_format = SG_HF_R16;
     else
         sc->hf_format = SG_HF_GDAL;   /* .tif, .hgt, .asc, …: raster.c */
-    sp->has[HAS_HF] = true;
     return true;
 }
 
@@ -792,7 +775,6 @@ static bool materials_list(parser *ps, scene_parse *sp)
     if (!expect(ps, SG_TK_LBRACK, "'['"))
         return false;
     sc->nmaterials = 0;
-    sp->has[HAS_MATERIALS] = true;
     if (accept(ps, SG_TK_RBRACK))
         return true;
     do {
@@ -856,32 +838,23 @@ static bool scene_stmt(parser *ps, void *user)
         double wh[2];
         if (!parse_numbers(ps, wh, 2))
             return false;
-        if (!(wh[0] >= 1 && wh[1] >= 1 && wh[0] <= INT_MAX && wh[1] <= INT_MAX) ||
-            wh[0] != (int)wh[0] || wh[1] != (int)wh[1])
-            scene_error(ps, SG_E_SETTING, kloc, "heightfield_size must be two positive whole numbers%s", "");
-        else {
-            sc->hf_width = (int)wh[0];
-            sc->hf_height = (int)wh[1];
-        }
-        sp->has_hf_size = true;
+        bool whole = wh[0] >= 1 && wh[1] >= 1 && wh[0] <= INT_MAX && wh[1] <= INT_MAX &&
+                     wh[0] == (int)wh[0] && wh[1] == (int)wh[1];
+        sc->hf_width = whole ? (int)wh[0] : -1;
+        sc->hf_height = whole ? (int)wh[1] : -1;
+        sc->hf_size_loc = kloc;
         return true;
     }
     if (is_kw(key, "size")) {
         if (!parse_numbers(ps, sc->size, 2))
             return false;
         sc->size_loc = kloc;
-        if (!(sc->size[0] > 0 && sc->size[1] > 0))
-            scene_error(ps, SG_E_SETTING, kloc, "world size must be positive (x and z metres)%s", "");
-        sp->has[HAS_SIZE] = true;
         return true;
     }
     if (is_kw(key, "max_height")) {
         if (!parse_number(ps, &sc->max_height))
             return false;
         sc->max_height_loc = kloc;
-        if (sc->max_height < 0)
-            scene_error(ps, SG_E_SETTING, kloc, "max_height must not be negative%s", "");
-        sp->has[HAS_MAXH] = true;
         return true;
     }
     if (is_kw(key, "height_offset")) {
@@ -893,10 +866,7 @@ static bool scene_stmt(parser *ps, void *user)
         if (!parse_number(ps, &c))
             return false;
         sc->cell_texels_loc = kloc;
-        if (!(c >= 1 && c <= 65536 && c == (int)c))
-            scene_error(ps, SG_E_SETTING, kloc, "cell must be a whole number of texels (1..65536)%s", "");
-        else
-            sc->cell_texels = (int)c;
+        sc->cell_texels = c >= 1 && c <= 65536 && c == (int)c ? (int)c : -1;
         return true;
     }
     if (is_kw(key, "compositor")) {
@@ -908,7 +878,7 @@ static bool scene_stmt(parser *ps, void *user)
         return true;
     }
     if (is_kw(key, "materials")) {
-        sp->materials_loc = kloc;
+        sc->materials_loc = kloc;
         return materials_list(ps, sp);
     }
     char buf[96];
@@ -939,26 +909,7 @@ static bool parse_scene(parser *ps)
     snprintf(what, sizeof what, "block of scene '%s'", sc->name);
     parse_block(ps, sg_strdup(ps->a, what), scene_stmt, &sp);
 
-    static const char *const need[] = { "heightfield", "size", "max_height", "materials" };
-    bool gdal = sp.has[HAS_HF] && sc->hf_format == SG_HF_GDAL;
-    for (int i = 0; i < 4; i++)
-        if (!sp.has[i] && !(gdal && (i == HAS_SIZE || i == HAS_MAXH)))
-            scene_error(ps, SG_E_MISSING_SETTING, sc->loc, "scene needs '%s = ...'", need[i]);
-    /* A GDAL raster's heights are used as stored (raster.c). */
-    if (gdal && sc->max_height_loc.line > 0)
-        scene_error(ps, SG_E_SETTING, sc->max_height_loc, "max_height comes from the heights "
-                    "stored in '%s' (a GDAL raster); remove it", sc->heightfield);
-    if (gdal && sc->height_offset_loc.line > 0)
-        scene_error(ps, SG_E_SETTING, sc->height_offset_loc, "height_offset comes from the "
-                    "heights stored in '%s' (a GDAL raster); remove it",
-                    sc->heightfield);
-    if (sp.has[HAS_MATERIALS] && sc->nmaterials == 0)
-        scene_error(ps, SG_E_MISSING_SETTING, sp.materials_loc, "scene needs at least one material "
-                    "(materials = [BOTTOM, …, TOP])%s", "");
-    if (sp.has[HAS_HF] && sc->hf_format == SG_HF_R16 && !sp.has_hf_size)
-        scene_error(ps, SG_E_MISSING_SETTING, sc->heightfield_loc,
-                    "raw heightfield '%s' needs heightfield_size = WIDTH HEIGHT",
-                    sc->heightfield);
+    sg_scene_check(sc, ps->d);
     if (ps->fi == 0) {
         if (ps->p->scene) {
             sg_error(ps->d, sc->loc, SG_E_DUPLICATE, "scene", sc->name,

@@ -4,7 +4,7 @@
  *
  * Pipeline (splat_scene_load):
  *   sg_load(scene.sg)            parse, resolve imports, type-check
- *   check_scene                  every scene field, all errors at once
+ *   check_materials              the stack's names against the program
  *   splat_terrain_load           the heightfield (terrain.c)
  *   load_painted                 8-bit greyscale rasters, heightfield size
  *   lower_materials              "<name>.mask", ".albedo", … roots in s->ir
@@ -51,44 +51,10 @@ static void scene_error(sg_diags *d, sg_error_id id, sg_loc loc, const char *fmt
     sg_error(d, loc, id, msg);
 }
 
-static bool is_pow2(int v) { return v > 0 && (v & (v - 1)) == 0; }
-
-/* Leaf cells per side within the pack limit (abi.h): for a raw
- * heightfield from its declared size, before it is read; for a PNG once
- * its size is known. */
-static bool cells_fit(const sg_scene *sc, int w, int h, sg_diags *d)
+/* What sg_scene_check (scene_check.c, at parse time) cannot see: the
+ * material names against the program. */
+static void check_materials(sg_program *p, const sg_scene *sc, sg_diags *d)
 {
-    int side = w > h ? w : h, cell = sc->cell_texels > 0 ? sc->cell_texels : 32;
-    if ((side + cell - 1) / cell <= SPLAT_MAX_CELLS)
-        return true;
-    scene_error(d, SG_E_OVER_LIMIT, loc_or(sc->cell_texels_loc, sc->loc), "a cell of %d texels gives %d leaf "
-                "cells per side over the %d x %d heightfield, over the pack limit of %d",
-                cell, (side + cell - 1) / cell, w, h, SPLAT_MAX_CELLS);
-    return false;
-}
-
-/* Every scene field that can be checked without reading files. */
-static void check_scene(sg_program *p, const sg_scene *sc, sg_diags *d)
-{
-    if (!sc->heightfield)
-        scene_error(d, SG_E_MISSING_SETTING, sc->loc, "scene '%s' has no heightfield "
-                    "(heightfield = \"FILE.png\")", sc->name);
-    bool gdal = sc->hf_format == SG_HF_GDAL;   /* size may come from the file */
-    if ((!gdal || sc->size_loc.line > 0) &&
-        (!(sc->size[0] > 0) || !(sc->size[1] > 0) || !isfinite(sc->size[0]) ||
-         !isfinite(sc->size[1])))
-        scene_error(d, SG_E_SETTING, loc_or(sc->size_loc, sc->loc), "world size must be two "
-                    "positive lengths in metres, found %g %g",
-                    sc->size[0], sc->size[1]);
-    if (!(sc->max_height >= 0) || !isfinite(sc->max_height))
-        scene_error(d, SG_E_SETTING, loc_or(sc->max_height_loc, sc->loc), "max_height must "
-                    "be 0 or more metres, found %g", sc->max_height);
-    if (!isfinite(sc->height_offset))
-        scene_error(d, SG_E_SETTING, sc->loc, "height_offset must be finite, found %g",
-                    sc->height_offset);
-    if (sc->nmaterials == 0)
-        scene_error(d, SG_E_MISSING_SETTING, sc->loc, "scene '%s' has an empty material stack "
-                    "(materials = [BOTTOM, …, TOP])", sc->name);
     for (int i = 0; i < sc->nmaterials; i++) {
         sg_loc loc = sc->material_locs ? loc_or(sc->material_locs[i], sc->loc)
                                        : sc->loc;
@@ -104,66 +70,6 @@ static void check_scene(sg_program *p, const sg_scene *sc, sg_diags *d)
                 break;
             }
         }
-    }
-    int cell = sc->cell_texels;
-    if (cell != 0 || sc->cell_texels_loc.line > 0) {   /* 0 unset: default */
-        if (!is_pow2(cell) || cell > 4096)
-            scene_error(d, SG_E_SETTING, loc_or(sc->cell_texels_loc, sc->loc), "cell must be "
-                        "a power of two from 1 to 4096 heightfield texels, "
-                        "found %d", cell);
-    }
-    for (int i = 0; i < sc->npainted; i++) {
-        const sg_scene_painted *pm = &sc->painted[i];
-        for (int j = 0; j < i; j++) {
-            if (strcmp(pm->name, sc->painted[j].name) == 0) {
-                sg_error(d, loc_or(pm->loc, sc->loc), SG_E_DUPLICATE,
-                         "painted mask", pm->name, sc->painted[j].loc.file,
-                         sc->painted[j].loc.line, sc->painted[j].loc.col);
-                break;
-            }
-        }
-        if ((pm->origin_loc.line > 0) != (pm->place_loc.line > 0))
-            scene_error(d, SG_E_SETTING, loc_or(pm->origin_loc.line > 0 ? pm->origin_loc : pm->place_loc,
-                                  sc->loc),
-                        "painted mask '%s' is placed with both 'origin' and 'size' "
-                        "(terrain-local metres) or neither", pm->name);
-    }
-    if (sc->hf_format == SG_HF_R16 && sc->hf_width > 0 && sc->hf_height > 0)
-        cells_fit(sc, sc->hf_width, sc->hf_height, d);
-    if (sc->npainted > SPLAT_MAX_PAINTED)
-        scene_error(d, SG_E_OVER_LIMIT, loc_or(sc->painted[SPLAT_MAX_PAINTED].loc, sc->loc), "scene '%s' "
-                    "declares %d painted masks, over the pack limit of %d", sc->name,
-                    sc->npainted, SPLAT_MAX_PAINTED);
-    if (sc->has_destruction) {
-        sg_loc dloc = loc_or(sc->destruction_loc, sc->loc);
-        double side = fmax(sc->destruction_size[0], sc->destruction_size[1]);
-        double cells = ceil(side / sc->destruction_cell);
-        if (sc->destruction_cell > 0 && side > 0 && !(cells <= SPLAT_MAX_DESTRUCTION_CELLS))
-            scene_error(d, SG_E_OVER_LIMIT, dloc, "the destructible area is %.0f cells of %g m per side, over "
-                        "the pack limit of %d (a larger cell or a smaller area)", cells,
-                        sc->destruction_cell, SPLAT_MAX_DESTRUCTION_CELLS);
-        /* (a GDAL heightfield's size is known once it is read) */
-        if ((!gdal || sc->size_loc.line > 0) &&
-            !(sc->destruction_origin[0] >= 0 && sc->destruction_origin[1] >= 0 &&
-              sc->destruction_origin[0] + sc->destruction_size[0] <= sc->size[0] &&
-              sc->destruction_origin[1] + sc->destruction_size[1] <= sc->size[1]))
-            scene_error(d, SG_E_SETTING, dloc, "the destructible area (origin %g %g, size %g %g) must lie "
-                        "inside the terrain (0 0 to %g %g)", sc->destruction_origin[0],
-                        sc->destruction_origin[1], sc->destruction_size[0],
-                        sc->destruction_size[1], sc->size[0], sc->size[1]);
-    }
-    if (sc->has_destruction) {
-        if (!(sc->destruction_size[0] > 0) || !(sc->destruction_size[1] > 0) ||
-            !isfinite(sc->destruction_size[0]) || !isfinite(sc->destruction_size[1]) ||
-            !isfinite(sc->destruction_origin[0]) || !isfinite(sc->destruction_origin[1]))
-            scene_error(d, SG_E_SETTING, sc->loc, "the destructible area needs a finite "
-                        "origin and a positive size, found origin %g %g, "
-                        "size %g %g", sc->destruction_origin[0],
-                        sc->destruction_origin[1], sc->destruction_size[0],
-                        sc->destruction_size[1]);
-        if (!(sc->destruction_cell > 0) || !isfinite(sc->destruction_cell))
-            scene_error(d, SG_E_SETTING, sc->loc, "the destructible area's cell must be a "
-                        "positive size in metres, found %g", sc->destruction_cell);
     }
 }
 
@@ -354,7 +260,7 @@ bool splat_scene_load(splat_scene *s, const char *path,
     }
     const sg_scene *sc = s->desc;
     s->nmaterials = sc->nmaterials;
-    check_scene(s->prog, sc, d);
+    check_materials(s->prog, sc, d);
     if (d->nerrors > errors) goto fail;
 
     /* 0: a GDAL raster's size comes from its geotransform */
@@ -367,7 +273,7 @@ bool splat_scene_load(splat_scene *s, const char *path,
                             loc_or(sc->heightfield_loc, sc->loc), d))
         goto fail;
     if (sc->hf_format != SG_HF_R16 &&
-        !cells_fit(sc, s->terrain.width, s->terrain.height, d))
+        !sg_scene_cells_fit(sc, s->terrain.width, s->terrain.height, d))
         goto fail;
     if (!load_holes(s, d) || !load_painted(s, d) || !lower_materials(s, d) ||
         d->nerrors > errors)

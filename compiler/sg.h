@@ -194,10 +194,12 @@ typedef struct sg_scene_painted {
      * file: painted NAME = "FILE" { max_level = 2, max_error = 0.05,
      * near = x0 z0 x1 z1, origin = X Z, size = W H }.  Defaults: max_level 0 (full resolution),
      * max_error 1 (no limit once max_level allows), no near rectangle. */
-    int    max_level;  /* coarsest quad-tree level, 0..7                    */
+    int    max_level;  /* coarsest quad-tree level, 0..7 (-1: not a whole
+                          number; sg_scene_check reports it)               */
     double max_error;  /* largest reduction error allowed, 0..1             */
     bool   has_near;
     double near[4];    /* terrain-local metres x0 z0 x1 z1 kept at level 0   */
+    sg_loc max_level_loc, max_error_loc, near_loc;
 } sg_scene_painted;
 
 typedef struct sg_scene_camera {
@@ -211,7 +213,9 @@ typedef struct sg_scene {
     sg_loc loc;
     char  *heightfield;      sg_loc heightfield_loc;
     sg_hf_format hf_format;  /* from the extension: .png, .r16/.raw, else GDAL */
-    int    hf_width, hf_height; /* required for raw R16, 0 otherwise       */
+    int    hf_width, hf_height; /* required for raw R16, 0 otherwise (-1:
+                                   not whole numbers)                     */
+    sg_loc hf_size_loc;
     /* size and max_height: required for PNG and raw heightfields; for a
      * GDAL one size is optional (default: the geotransform's) and
      * max_height / height_offset are not allowed (the file's heights are
@@ -223,14 +227,24 @@ typedef struct sg_scene {
      * not a painted layer.  NULL if none. */
     char  *holes;            sg_loc holes_loc;
     char **materials;        sg_loc *material_locs; int nmaterials; /* bottom first */
+    sg_loc materials_loc;    /* the `materials` setting                   */
     char  *compositor;       sg_loc compositor_loc; /* default "linear_alpha" */
     sg_scene_painted *painted; int npainted;
     bool   has_destruction;  sg_loc destruction_loc; /* the block's keyword */
     double destruction_origin[2], destruction_size[2];
     double destruction_cell;                       /* default 16 m         */
+    sg_loc destruction_cell_loc;
     int    cell_texels;      sg_loc cell_texels_loc; /* default 32         */
     sg_scene_camera *cameras; int ncameras;
 } sg_scene;
+
+/* scene_check.c: every check of a scene block that needs neither files
+ * nor the program (missing settings, ranges, contradictions, pack
+ * limits), all errors at once; the parser calls it at the block's end.
+ * sg_scene_cells_fit: the leaf cells of a w x h heightfield within the
+ * pack limit (scene.c calls it again once a raster's size is known). */
+bool sg_scene_check(const sg_scene *sc, sg_diags *d);
+bool sg_scene_cells_fit(const sg_scene *sc, int w, int h, sg_diags *d);
 
 /* The scene of the program's root file, or NULL if it declares none. */
 const sg_scene *sg_program_scene(const sg_program *p);
