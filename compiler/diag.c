@@ -164,6 +164,14 @@ void sg_error(sg_diags *d, sg_loc loc, sg_error_id id, ...)
     va_end(ap);
 }
 
+void sg_errorf(sg_diags *d, sg_loc loc, sg_error_id id, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    add(d, loc, SG_ERROR, id, fmt, ap);
+    va_end(ap);
+}
+
 void sg_warning(sg_diags *d, sg_loc loc, const char *fmt, ...)
 {
     va_list ap;

@@ -33,30 +33,14 @@
 
 /* ---- checks ------------------------------------------------------------- */
 
-static sg_loc loc_or(sg_loc loc, sg_loc fallback)
-{
-    return loc.line > 0 ? loc : fallback;
-}
 
-static void scene_error(sg_diags *d, sg_error_id id, sg_loc loc, const char *fmt, ...)
-    __attribute__((format(printf, 4, 5)));
-
-static void scene_error(sg_diags *d, sg_error_id id, sg_loc loc, const char *fmt, ...)
-{
-    char msg[512];
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(msg, sizeof msg, fmt, ap);
-    va_end(ap);
-    sg_error(d, loc, id, msg);
-}
 
 /* What sg_scene_check (scene_check.c, at parse time) cannot see: the
  * material names against the program. */
 static void check_materials(sg_program *p, const sg_scene *sc, sg_diags *d)
 {
     for (int i = 0; i < sc->nmaterials; i++) {
-        sg_loc loc = sc->material_locs ? loc_or(sc->material_locs[i], sc->loc)
+        sg_loc loc = sc->material_locs ? sg_loc_or(sc->material_locs[i], sc->loc)
                                        : sc->loc;
         if (sg_material_find(p, sc->materials[i]) < 0) {
             sg_error(d, loc, SG_E_UNKNOWN_NAME, sc->materials[i]);
@@ -98,7 +82,7 @@ static uint8_t *load_mask(const char *name, const char *file, int *pw, int *ph,
             *pw = fw;
             *ph = fh;
         } else if (px && (fw != w || fh != h)) {
-            scene_error(d, SG_E_RASTER, loc, "painted mask '%s' ('%s') is %d x %d texels; the "
+            sg_errorf(d, loc, SG_E_RASTER, "painted mask '%s' ('%s') is %d x %d texels; the "
                         "heightfield is %d x %d", name, file, fw, fh, w, h);
             free(px);
             px = NULL;
@@ -117,7 +101,7 @@ static uint8_t *load_mask(const char *name, const char *file, int *pw, int *ph,
         return NULL;
     }
     if (comp != 1 || stbi_is_16_bit(file)) {
-        scene_error(d, SG_E_RASTER, loc, "painted mask '%s' ('%s') must be an 8-bit "
+        sg_errorf(d, loc, SG_E_RASTER, "painted mask '%s' ('%s') must be an 8-bit "
                     "greyscale image, found %d channels of %d bits", name, file,
                     comp, stbi_is_16_bit(file) ? 16 : 8);
         return NULL;
@@ -126,7 +110,7 @@ static uint8_t *load_mask(const char *name, const char *file, int *pw, int *ph,
         *pw = w = fw;
         *ph = h = fh;
     } else if (fw != w || fh != h) {
-        scene_error(d, SG_E_RASTER, loc, "painted mask '%s' ('%s') is %d x %d texels; the "
+        sg_errorf(d, loc, SG_E_RASTER, "painted mask '%s' ('%s') is %d x %d texels; the "
                     "heightfield is %d x %d (or place it: { origin = X Z, size = W H })",
                     name, file, fw, fh, w, h);
         return NULL;
@@ -158,7 +142,7 @@ static bool load_holes(splat_scene *s, sg_diags *d)
 {
     const sg_scene *sc = s->desc;
     splat_terrain *t = &s->terrain;
-    sg_loc loc = loc_or(sc->holes_loc, sc->loc);
+    sg_loc loc = sg_loc_or(sc->holes_loc, sc->loc);
     if (sc->holes) {
         int w = t->width, h = t->height;
         uint8_t *m = load_mask("holes", sc->holes, &w, &h, loc, d);
@@ -194,7 +178,7 @@ static bool load_painted(splat_scene *s, sg_diags *d)
         wh[0] = placed ? 0 : s->terrain.width;
         wh[1] = placed ? 0 : s->terrain.height;
         s->painted[i] = load_mask(pm->name, pm->file, &wh[0], &wh[1],
-                                  loc_or(pm->loc, sc->loc), d);
+                                  sg_loc_or(pm->loc, sc->loc), d);
         ok &= s->painted[i] != NULL;
     }
     return ok;
@@ -219,9 +203,9 @@ static bool lower_materials(splat_scene *s, sg_diags *d)
         /* Painted masks first named by this material are not the scene's:
          * the error at the stack entry, a note at the material. */
         for (int k = before; k < s->ir.npainted; k++) {
-            sg_loc loc = sc->material_locs ? loc_or(sc->material_locs[i], sc->loc)
+            sg_loc loc = sc->material_locs ? sg_loc_or(sc->material_locs[i], sc->loc)
                                            : sc->loc;
-            scene_error(d, SG_E_UNDECLARED, loc, "material '%s' reads painted mask '%s', which "
+            sg_errorf(d, loc, SG_E_UNDECLARED, "material '%s' reads painted mask '%s', which "
                         "scene '%s' does not declare (painted %s = \"FILE.png\")",
                         sc->materials[i], s->ir.painted[k].name, sc->name,
                         s->ir.painted[k].name);
@@ -254,7 +238,7 @@ bool splat_scene_load(splat_scene *s, const char *path,
     if (d->nerrors > errors) goto fail;
     s->desc = sg_program_scene(s->prog);
     if (!s->desc) {
-        scene_error(d, SG_E_MISSING_SETTING, (sg_loc){ path, 1, 1 }, "'%s' declares no scene "
+        sg_errorf(d, (sg_loc){ path, 1, 1 }, SG_E_MISSING_SETTING, "'%s' declares no scene "
                     "(scene NAME { heightfield = …, materials = […] })", path);
         goto fail;
     }
@@ -270,7 +254,7 @@ bool splat_scene_load(splat_scene *s, const char *path,
     s->terrain.height_offset = sc->height_offset;
     if (!splat_terrain_load(&s->terrain, sc->heightfield, sc->hf_format,
                             sc->hf_width, sc->hf_height,
-                            loc_or(sc->heightfield_loc, sc->loc), d))
+                            sg_loc_or(sc->heightfield_loc, sc->loc), d))
         goto fail;
     if (sc->hf_format != SG_HF_R16 &&
         !sg_scene_cells_fit(sc, s->terrain.width, s->terrain.height, d))
@@ -279,7 +263,7 @@ bool splat_scene_load(splat_scene *s, const char *path,
         d->nerrors > errors)
         goto fail;
     if (!splat_compositor_check(s->prog, sc->compositor ? sc->compositor : "linear_alpha",
-                                loc_or(sc->compositor_loc, sc->loc), d))
+                                sg_loc_or(sc->compositor_loc, sc->loc), d))
         goto fail;
 
     splat_search_path_free(paths);

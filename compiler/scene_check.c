@@ -17,23 +17,6 @@
 #include <stdio.h>
 #include <string.h>
 
-static sg_loc loc_or(sg_loc a, sg_loc b)
-{
-    return a.line > 0 ? a : b;
-}
-
-static void check_error(sg_diags *d, sg_error_id id, sg_loc loc, const char *fmt, ...)
-    __attribute__((format(printf, 4, 5)));
-
-static void check_error(sg_diags *d, sg_error_id id, sg_loc loc, const char *fmt, ...)
-{
-    char msg[512];
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(msg, sizeof msg, fmt, ap);
-    va_end(ap);
-    sg_error(d, loc, id, msg);
-}
 
 static bool is_pow2(int v) { return v > 0 && (v & (v - 1)) == 0; }
 
@@ -42,7 +25,7 @@ bool sg_scene_cells_fit(const sg_scene *sc, int w, int h, sg_diags *d)
     int side = w > h ? w : h, cell = sc->cell_texels > 0 ? sc->cell_texels : 32;
     if ((side + cell - 1) / cell <= SPLAT_MAX_CELLS)
         return true;
-    check_error(d, SG_E_OVER_LIMIT, loc_or(sc->cell_texels_loc, sc->loc), "a cell of %d "
+    sg_errorf(d, sg_loc_or(sc->cell_texels_loc, sc->loc), SG_E_OVER_LIMIT, "a cell of %d "
                 "texels gives %d leaf cells per side over the %d x %d heightfield, over "
                 "the pack limit of %d", cell, (side + cell - 1) / cell, w, h, SPLAT_MAX_CELLS);
     return false;
@@ -57,34 +40,34 @@ static void check_terrain(const sg_scene *sc, sg_diags *d)
                     sc->max_height_loc.line > 0 || gdal, sc->materials_loc.line > 0 };
     for (int i = 0; i < 4; i++)
         if (!has[i])
-            check_error(d, SG_E_MISSING_SETTING, sc->loc, "scene needs '%s = ...'", need[i]);
+            sg_errorf(d, sc->loc, SG_E_MISSING_SETTING, "scene needs '%s = ...'", need[i]);
     if (has[3] && sc->nmaterials == 0)
-        check_error(d, SG_E_MISSING_SETTING, sc->materials_loc, "scene needs at least one "
+        sg_errorf(d, sc->materials_loc, SG_E_MISSING_SETTING, "scene needs at least one "
                     "material (materials = [BOTTOM, …, TOP])");
     if (sc->heightfield && sc->hf_format == SG_HF_R16 && sc->hf_size_loc.line == 0)
-        check_error(d, SG_E_MISSING_SETTING, sc->heightfield_loc, "raw heightfield '%s' "
+        sg_errorf(d, sc->heightfield_loc, SG_E_MISSING_SETTING, "raw heightfield '%s' "
                     "needs heightfield_size = WIDTH HEIGHT", sc->heightfield);
     if (sc->hf_size_loc.line > 0 && !(sc->hf_width >= 1 && sc->hf_height >= 1))
-        check_error(d, SG_E_SETTING, sc->hf_size_loc, "heightfield_size must be two positive "
+        sg_errorf(d, sc->hf_size_loc, SG_E_SETTING, "heightfield_size must be two positive "
                     "whole numbers");
     /* a GDAL raster's heights are used as stored (raster.c) */
     if (gdal && sc->max_height_loc.line > 0)
-        check_error(d, SG_E_SETTING, sc->max_height_loc, "max_height comes from the heights "
+        sg_errorf(d, sc->max_height_loc, SG_E_SETTING, "max_height comes from the heights "
                     "stored in '%s' (a GDAL raster); remove it", sc->heightfield);
     if (gdal && sc->height_offset_loc.line > 0)
-        check_error(d, SG_E_SETTING, sc->height_offset_loc, "height_offset comes from the "
+        sg_errorf(d, sc->height_offset_loc, SG_E_SETTING, "height_offset comes from the "
                     "heights stored in '%s' (a GDAL raster); remove it", sc->heightfield);
     if (sc->size_loc.line > 0 && !(sc->size[0] > 0 && sc->size[1] > 0 &&
                                    isfinite(sc->size[0]) && isfinite(sc->size[1])))
-        check_error(d, SG_E_SETTING, sc->size_loc, "world size must be positive (x and z "
+        sg_errorf(d, sc->size_loc, SG_E_SETTING, "world size must be positive (x and z "
                     "metres)");
     if (sc->max_height_loc.line > 0 && !(sc->max_height >= 0 && isfinite(sc->max_height)))
-        check_error(d, SG_E_SETTING, sc->max_height_loc, "max_height must not be negative");
+        sg_errorf(d, sc->max_height_loc, SG_E_SETTING, "max_height must not be negative");
     if (!isfinite(sc->height_offset))
-        check_error(d, SG_E_SETTING, loc_or(sc->height_offset_loc, sc->loc), "height_offset "
+        sg_errorf(d, sg_loc_or(sc->height_offset_loc, sc->loc), SG_E_SETTING, "height_offset "
                     "must be finite, found %g", sc->height_offset);
     if (!is_pow2(sc->cell_texels) || sc->cell_texels > 4096)
-        check_error(d, SG_E_SETTING, loc_or(sc->cell_texels_loc, sc->loc), "cell must be a "
+        sg_errorf(d, sg_loc_or(sc->cell_texels_loc, sc->loc), SG_E_SETTING, "cell must be a "
                     "power of two from 1 to 4096 heightfield texels");
     else if (sc->hf_format == SG_HF_R16 && sc->hf_width > 0 && sc->hf_height > 0)
         sg_scene_cells_fit(sc, sc->hf_width, sc->hf_height, d);
@@ -93,27 +76,27 @@ static void check_terrain(const sg_scene *sc, sg_diags *d)
 static void check_painted(const sg_scene *sc, const sg_scene_painted *pm, sg_diags *d)
 {
     if (pm->max_level_loc.line > 0 && !(pm->max_level >= 0 && pm->max_level <= 7))
-        check_error(d, SG_E_SETTING, pm->max_level_loc, "max_level must be a whole number "
+        sg_errorf(d, pm->max_level_loc, SG_E_SETTING, "max_level must be a whole number "
                     "0..7");
     if (!(pm->max_error >= 0 && pm->max_error <= 1))
-        check_error(d, SG_E_SETTING, loc_or(pm->max_error_loc, pm->loc), "max_error must be "
+        sg_errorf(d, sg_loc_or(pm->max_error_loc, pm->loc), SG_E_SETTING, "max_error must be "
                     "between 0 and 1");
     if (pm->has_near && !(pm->near[2] > pm->near[0] && pm->near[3] > pm->near[1]))
-        check_error(d, SG_E_SETTING, loc_or(pm->near_loc, pm->loc), "near must be x0 z0 x1 z1 "
+        sg_errorf(d, sg_loc_or(pm->near_loc, pm->loc), SG_E_SETTING, "near must be x0 z0 x1 z1 "
                     "with x1 > x0 and z1 > z0");
     const double *o = pm->origin, *s = pm->place;
     if (pm->place_loc.line > 0 && !(s[0] > 0 && s[1] > 0 && s[0] < 1e9 && s[1] < 1e9))
-        check_error(d, SG_E_SETTING, pm->place_loc, "a painted mask's size must be positive "
+        sg_errorf(d, pm->place_loc, SG_E_SETTING, "a painted mask's size must be positive "
                     "metres, found %g %g", s[0], s[1]);
     if (pm->origin_loc.line > 0 && !(fabs(o[0]) < 1e9 && fabs(o[1]) < 1e9))
-        check_error(d, SG_E_SETTING, pm->origin_loc, "a painted mask's origin is out of range");
+        sg_errorf(d, pm->origin_loc, SG_E_SETTING, "a painted mask's origin is out of range");
     if ((pm->origin_loc.line > 0) != (pm->place_loc.line > 0))
-        check_error(d, SG_E_SETTING, pm->origin_loc.line > 0 ? pm->origin_loc : pm->place_loc,
+        sg_errorf(d, pm->origin_loc.line > 0 ? pm->origin_loc : pm->place_loc, SG_E_SETTING,
                     "painted mask '%s' is placed with both 'origin' and 'size' "
                     "(terrain-local metres) or neither", pm->name);
     for (const sg_scene_painted *q = sc->painted; q < pm; q++)
         if (strcmp(pm->name, q->name) == 0) {
-            sg_error(d, loc_or(pm->loc, sc->loc), SG_E_DUPLICATE, "painted mask", pm->name,
+            sg_error(d, sg_loc_or(pm->loc, sc->loc), SG_E_DUPLICATE, "painted mask", pm->name,
                      q->loc.file, q->loc.line, q->loc.col);
             break;
         }
@@ -121,27 +104,27 @@ static void check_painted(const sg_scene *sc, const sg_scene_painted *pm, sg_dia
 
 static void check_destruction(const sg_scene *sc, sg_diags *d)
 {
-    sg_loc dloc = loc_or(sc->destruction_loc, sc->loc);
+    sg_loc dloc = sg_loc_or(sc->destruction_loc, sc->loc);
     const double *o = sc->destruction_origin, *s = sc->destruction_size;
     double cell = sc->destruction_cell;
     if (!(s[0] > 0) || !(s[1] > 0) || !isfinite(s[0]) || !isfinite(s[1]) ||
         !isfinite(o[0]) || !isfinite(o[1]))
-        check_error(d, SG_E_SETTING, dloc, "the destructible area needs a finite origin and "
+        sg_errorf(d, dloc, SG_E_SETTING, "the destructible area needs a finite origin and "
                     "a positive size, found origin %g %g, size %g %g", o[0], o[1], s[0], s[1]);
     if (!(cell > 0) || !isfinite(cell)) {
-        check_error(d, SG_E_SETTING, loc_or(sc->destruction_cell_loc, dloc), "destruction "
+        sg_errorf(d, sg_loc_or(sc->destruction_cell_loc, dloc), SG_E_SETTING, "destruction "
                     "cell must be a positive size in metres, found %g", cell);
         return;
     }
     double side = fmax(s[0], s[1]), cells = ceil(side / cell);
     if (side > 0 && !(cells <= SPLAT_MAX_DESTRUCTION_CELLS))
-        check_error(d, SG_E_OVER_LIMIT, dloc, "the destructible area is %.0f cells of %g m "
+        sg_errorf(d, dloc, SG_E_OVER_LIMIT, "the destructible area is %.0f cells of %g m "
                     "per side, over the pack limit of %d (a larger cell or a smaller area)",
                     cells, cell, SPLAT_MAX_DESTRUCTION_CELLS);
     /* a GDAL heightfield's size is known once it is read (scene.c) */
     if (sc->size_loc.line > 0 &&
         !(o[0] >= 0 && o[1] >= 0 && o[0] + s[0] <= sc->size[0] && o[1] + s[1] <= sc->size[1]))
-        check_error(d, SG_E_SETTING, dloc, "the destructible area (origin %g %g, size %g %g) "
+        sg_errorf(d, dloc, SG_E_SETTING, "the destructible area (origin %g %g, size %g %g) "
                     "must lie inside the terrain (0 0 to %g %g)", o[0], o[1], s[0], s[1],
                     sc->size[0], sc->size[1]);
 }
@@ -153,7 +136,7 @@ bool sg_scene_check(const sg_scene *sc, sg_diags *d)
     for (int i = 0; i < sc->npainted; i++)
         check_painted(sc, &sc->painted[i], d);
     if (sc->npainted > SPLAT_MAX_PAINTED)
-        check_error(d, SG_E_OVER_LIMIT, loc_or(sc->painted[SPLAT_MAX_PAINTED].loc, sc->loc),
+        sg_errorf(d, sg_loc_or(sc->painted[SPLAT_MAX_PAINTED].loc, sc->loc), SG_E_OVER_LIMIT,
                     "scene '%s' declares %d painted masks, over the pack limit of %d",
                     sc->name, sc->npainted, SPLAT_MAX_PAINTED);
     if (sc->has_destruction)

@@ -89,6 +89,14 @@ void sg_diags_init(sg_diags *d);
 void sg_diags_free(sg_diags *d);
 /* Record a diagnostic; the message is formatted from the id's format. */
 void sg_error(sg_diags *d, sg_loc loc, sg_error_id id, ...);
+/* `loc` if it was given (line > 0), else `fallback`. */
+static inline sg_loc sg_loc_or(sg_loc loc, sg_loc fallback)
+{
+    return loc.line > 0 ? loc : fallback;
+}
+/* An error of an id whose format is "%s", the message from `fmt`. */
+void sg_errorf(sg_diags *d, sg_loc loc, sg_error_id id, const char *fmt, ...)
+    __attribute__((format(printf, 4, 5)));
 void sg_note(sg_diags *d, sg_loc loc, const char *fmt, ...)
     __attribute__((format(printf, 3, 4)));
 /* A warning: printed like an error, but the input is accepted. */
