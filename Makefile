@@ -21,7 +21,7 @@ PKGS := cmake make gcc g++ pkg-config clang libclang-rt-14-dev \
         libvulkan-dev mesa-vulkan-drivers vulkan-validationlayers vulkan-tools \
         libglfw3-dev libstb-dev libjansson-dev libcmocka-dev libxxhash-dev \
         libgdal-dev \
-        gnuplot-nox xvfb xauth graphviz
+        gnuplot-nox xvfb xauth graphviz time
 
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 

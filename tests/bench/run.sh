@@ -172,6 +172,20 @@ if [ "$MODE" != smoke ] && [ -x "$GEN" ]; then
     unset SPLATC_PATH
 fi
 
+# ---- (a) a painted mask at its own resolution: 1 px/m over 10 x 10 km of
+# colorado, 10^8 texels (tests/world/test_placed.c writes the inputs) --------
+PLACED=$B/tests/test_placed
+if [ "$MODE" != smoke ] && [ -x "$PLACED" ]; then
+    log "compile placed_1e8 (cold)"
+    T=$W/placed_1e8
+    mkdir -p "$T"
+    "$PLACED" --inputs "$T"
+    export SPLATC_PATH="$REPO"
+    build_row cold "$T/scene.sg" "$W/pack-placed" --no-cache
+    unset SPLATC_PATH
+    rm -rf "$W/pack-placed" "$T/road.tif"
+fi
+
 # ---- (a) scaling with heightfield texels: 1x, 4x, 16x ---------------------
 CSV=$OUT/scale_hf.csv
 echo "$COMPILE_HEAD" > "$CSV"

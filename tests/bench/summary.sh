@@ -34,6 +34,13 @@ awk -F, '
         if ($15 != "NA") printf "| build target: peak memory < 500 MB | %.0f MB | %s |\n", $15, verdict($15 < 500)
         cold = 1
     }
+    FILENAME ~ /compile.csv/ && $2 == "placed_1e8" {
+        printf "| large worlds: 10^8-texel placed mask (1 px/m over 10 x 10 km), build < 10 s | %.2f s wall | %s |\n", $14, verdict($14 < 10)
+        if ($15 != "NA") printf "| large worlds: that build, peak memory < 1 GB | %.0f MB | %s |\n", $15, verdict($15 < 1024)
+    }
+    FILENAME ~ /compile.csv/ && $2 == "colorado_geotiff" {
+        printf "| large worlds: colorado from GeoTIFFs through GDAL (cold) | %.2f s wall, %s MB peak | reported |\n", $14, $15
+    }
     FILENAME ~ /compile.csv/ && $2 == "colorado" && $3 == "warm" {
         printf "| build target: colorado rebuild with nothing changed < 0.3 s | %.2f s wall (%.2fx the target) | %s |\n", $14, $14 / 0.3, verdict($14 < 0.3)
     }

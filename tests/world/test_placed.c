@@ -3,6 +3,7 @@
  * message fails).
  *
  *   test_placed OUTDIR
+ *   test_placed --inputs OUTDIR    (only write the inputs: make bench)
  *
  * Writes a 10,000 x 10,000 texel road mask (1 px/m over 10 x 10 km, 10^8
  * texels, all 0 but a 4 m road along x, an 8 m road along z and a 4 m ring)
@@ -290,8 +291,10 @@ static void check_screen(const rt_pack *p, rt_device *dev, const rt_camera *cam,
 
 int main(int argc, char **argv)
 {
+    if (argc == 3 && strcmp(argv[1], "--inputs") == 0)
+        return write_inputs(argv[2]) ? 0 : 1;
     if (argc != 2) {
-        fprintf(stderr, "usage: test_placed OUTDIR (run from the repository root)\n");
+        fprintf(stderr, "usage: test_placed [--inputs] OUTDIR (run from the repository root)\n");
         return 2;
     }
     const char *dir = argv[1];
