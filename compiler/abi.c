@@ -121,6 +121,7 @@
     "    mat4 inv_view_proj;\n"                                             \
     "    vec4 screen;\n"                                                    \
     "    vec4 world[" SPLAT_STR(SPLAT_WORLD_SITES) "];\n"                   \
+    "    vec4 light;\n"                                                     \
     "} u_frame;\n"                                                          \
     "layout(push_constant, std430) uniform splat_push_block {\n"            \
     "    vec4 patch_xz;\n"                                                  \
@@ -140,16 +141,33 @@
     "                float((h >> 16) & 255u)) / 255.0 * 0.8 + 0.2;\n" \
     "}\n"
 
+/* Preview lighting, linear, before the tone map: Lambert sun and a
+ * hemisphere sky ambient (zenith u_frame.sky_color for a normal up, half
+ * of it sideways), a small roughness-weighted sun lobe, fog towards the
+ * background colour (u_frame.fog: far terrain fades into what is drawn
+ * behind it, so the shading paths' silhouettes agree): density fog.a at
+ * height light.x, falling off by exp(-light.y * (y - light.x)) (0: the
+ * same everywhere), integrated exactly along the ray (Quilez, "Better
+ * fog"); then the exposure light.z.  v, surface -> camera, is what a view
+ * dependent model (GGX) will need: tried, its sun lobe turned the screen
+ * path's normal differences on far terrain into glints one path has and
+ * the other not (runtime/DESIGN.md). */
 #define LIGHTING_TEXT \
-    "vec3 splat_light(vec3 albedo, vec3 n, float rough, float dist) {\n" \
+    "float splat_fog(float dist, vec3 v) {\n" \
+    "    float k = u_frame.light.y;\n" \
+    "    float at_cam = u_frame.fog.a * exp(-k * (u_frame.camera.y - u_frame.light.x));\n" \
+    "    float t = -k * v.y * dist;   /* k times the height from camera to surface */\n" \
+    "    float path = abs(t) > 1e-4 ? (1.0 - exp(-t)) / t : 1.0;\n" \
+    "    return 1.0 - exp(-max(at_cam * dist * path, 0.0));\n" \
+    "}\n" \
+    "vec3 splat_light(vec3 albedo, vec3 n, float rough, float dist, vec3 v) {\n" \
     "    vec3 l = u_frame.sun_dir.xyz;\n" \
     "    float ndl = max(dot(n, l), 0.0);\n" \
-    "    float sky = 0.5 + 0.5 * n.y;\n" \
     "    vec3 c = albedo * (u_frame.sun_color.rgb * ndl\n" \
-    "                       + u_frame.sky_color.rgb * sky);\n" \
+    "                       + u_frame.sky_color.rgb * (0.5 + 0.5 * n.y));\n" \
     "    c += u_frame.sun_color.rgb * 0.04 * (1.0 - rough) * pow(ndl, 8.0);\n" \
-    "    float f = 1.0 - exp(-max(dist, 0.0) * u_frame.fog.a);\n" \
-    "    return mix(c, u_frame.fog.rgb, f);\n" \
+    "    c = mix(c, u_frame.fog.rgb, splat_fog(dist, v));\n" \
+    "    return c * u_frame.light.z;\n" \
     "}\n"
 
 const char SPLAT_GLSL_COMBO_COLOR[] = COMBO_COLOR_TEXT;
@@ -376,11 +394,11 @@ const char SPLAT_GLSL_PRELUDE[] =
     "    o_normal = vec4(normal, coverage);\n"
     "    o_misc = vec4(rough, height, dist, coverage);\n"
     "#else\n"
-    "    vec3 n = normalize(normal);\n"
+    "    vec3 n = normalize(normal), to_cam = splat_view_direction();\n"
     "    vec3 c;\n"
     "    switch (splat_view()) {\n"
     SPLAT_VIEWS(SPLAT_VIEW_CASE_FORWARD)   /* abi.h */
-    "    default: c = splat_light(albedo, n, rough, dist); break;\n"
+    "    default: c = splat_light(albedo, n, rough, dist, to_cam); break;\n"
     "    }\n"
     "    o_color = vec4(c, 1.0);\n"
     "#endif\n"

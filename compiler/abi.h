@@ -109,7 +109,7 @@
 
 #include <stdint.h>
 
-#define SPLAT_ABI_VERSION 1
+#define SPLAT_ABI_VERSION 2   /* 2: splat_frame.light, GGX lighting */
 
 enum {
     SPLAT_SET_TERRAIN = 0,
@@ -197,7 +197,7 @@ enum {
  *
  * A new view: a row here (and its colour's inputs, if new, in abi.c). */
 #define SPLAT_VIEWS(X)                                                              \
-    X(FINAL,  0, "final",  '1', FILMIC, ALL,       "splat_light(albedo, n, rough, dist)") \
+    X(FINAL,  0, "final",  '1', FILMIC, ALL,       "splat_light(albedo, n, rough, dist, to_cam)") \
     X(COMBOS, 1, "combos", '2', NONE,   FORWARD,   "splat_combo_color(u_push.info.y)") \
     X(LOD,    2, "lod",    '3', NONE,   FORWARD,   "splat_combo_color(u_push.info.x + 1000u)") \
     X(NORMAL, 3, "normal", '4', NONE,   ALL,       "n * 0.5 + 0.5")                    \
@@ -261,6 +261,11 @@ typedef struct splat_frame {
      * components of the site and S its scale (c * S for a product),
      * computed in double on the CPU every frame. */
     float world[4 * SPLAT_WORLD_SITES];
+    /* Lighting (the scene's `light` block, splatview's options): x: fog
+     * base height (terrain-local m), y: fog height falloff (1/m; 0: the
+     * same density at every height), z: exposure (a linear factor applied
+     * to the lit colour), w: 0. */
+    float light[4];
 } splat_frame;
 
 /* Counters of the counting variant (SPLAT_COUNT), set 0 binding 10, std430;
@@ -300,7 +305,8 @@ typedef struct splat_push {
  *   splat_finish writes the outputs for the current view (single pass) or
  *   the three blend targets (SPLAT_MULTIPASS).
  * SPLAT_GLSL_LIGHTING: vec3 splat_light(vec3 albedo, vec3 n, float rough,
- *   float dist): sun + sky ambient + fog; used by the prelude and by the
+ *   float dist, vec3 to_camera): sun + sky ambient + (height) fog, times
+ *   the exposure (abi.c explains).  Used by the prelude and by the
  *   runtime's resolve pass.
  * SPLAT_GLSL_VERTEX: the complete shared vertex shader (#version included).
  * SPLAT_GLSL_COMBO_COLOR: vec3 splat_combo_color(uint id).

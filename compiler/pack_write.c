@@ -251,6 +251,19 @@ static json_t *jscene(build *b, const char *dir)
         json_array_append_new(cams, c);
     }
     json_object_set_new(scene, "cameras", cams);
+    if (sc->has_light) {   /* the keys given; the runtime has the rest */
+        static const struct { const char *key; int n; } keys[] = {
+#define X(id, key, n, lo, hi) { key, n },
+            SG_LIGHT_KEYS(X)
+#undef X
+        };
+        json_t *l = json_object();
+        for (int k = 0; k < SG_LIGHT_COUNT; k++)
+            if (sc->light.given & 1u << k)
+                json_object_set_new(l, keys[k].key, keys[k].n == 1 ? json_real(sc->light.v[k][0])
+                                                                    : jreals(sc->light.v[k], keys[k].n));
+        json_object_set_new(scene, "light", l);
+    }
     if (sc->has_destruction) {
         json_t *dd = json_object();
         json_object_set_new(dd, "origin", jreals(sc->destruction_origin, 2));

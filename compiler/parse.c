@@ -697,6 +697,35 @@ static bool sub_stmt(parser *ps, void *user)
     return ok;
 }
 
+/* light = "light" "{" { KEY "=" NUM... [","] } "}" (sg.h SG_LIGHT_KEYS) */
+static bool light_stmt(parser *ps, void *user)
+{
+    sg_scene_light *l = user;
+    static const struct { const char *key; int n; } keys[] = {
+#define X(id, key, n, lo, hi) { key, n },
+        SG_LIGHT_KEYS(X)
+#undef X
+    };
+    const char *expect_keys = "'sun', 'sun_color', 'intensity', 'sky', 'fog_density', "
+                              "'fog_height', 'exposure' or '}'";
+    sg_token *key = cur(ps);
+    int k = 0;
+    while (key->kind == SG_TK_IDENT && k < SG_LIGHT_COUNT && !is_kw(key, keys[k].key))
+        k++;
+    if (key->kind != SG_TK_IDENT || k == SG_LIGHT_COUNT) {
+        expected(ps, expect_keys);
+        return false;
+    }
+    l->loc[k] = loc_of(ps, key);
+    next(ps);
+    bool ok = expect(ps, SG_TK_EQ, "'='") && parse_numbers(ps, l->v[k], keys[k].n);
+    if (ok) {
+        l->given |= 1u << k;
+        accept(ps, SG_TK_COMMA);
+    }
+    return ok;
+}
+
 /* camera NAME { position = X Y Z, look = X Y Z }, after "camera" */
 static bool camera_decl(parser *ps, scene_parse *sp)
 {
@@ -821,6 +850,13 @@ static bool scene_stmt(parser *ps, void *user)
         parse_block(ps, "block of destruction", sub_stmt, &b);
         return true;
     }
+    if (is_kw(key, "light")) {
+        next(ps);
+        sc->has_light = true;
+        sc->light_loc = kloc;
+        parse_block(ps, "block of light", light_stmt, &sc->light);
+        return true;
+    }
     if (is_kw(key, "camera")) {
         next(ps);
         return camera_decl(ps, sp);
@@ -884,7 +920,7 @@ static bool scene_stmt(parser *ps, void *user)
     char buf[96];
     sg_error(ps->d, kloc, SG_E_SYNTAX,
              "a scene setting (heightfield, heightfield_size, size, max_height, "
-             "height_offset, materials, compositor, painted, destruction, cell, camera)",
+             "height_offset, materials, compositor, painted, destruction, cell, camera, light)",
              sg_tok_describe(key, buf, sizeof buf));
     return false;
 }

@@ -216,6 +216,33 @@ typedef struct sg_scene_camera {
     sg_loc loc;
 } sg_scene_camera;
 
+/* light { sun = AZIMUTH ELEVATION, sun_color = R G B, intensity = X,
+ *         sky = R G B, fog_density = D, fog_height = H, exposure = EV }:
+ * the preview lighting (runtime/light.c holds the defaults of the keys
+ * left out).  X(id, key, numbers, lo, hi): every number in [lo, hi],
+ * except the sun's azimuth (-360..360). */
+#define SG_LIGHT_KEYS(X)                                                    \
+    X(SUN,         "sun",         2, -90.0, 90.0)                           \
+    X(SUN_COLOR,   "sun_color",   3, 0.0, 1e4)                              \
+    X(INTENSITY,   "intensity",   1, 0.0, 1e4)                              \
+    X(SKY,         "sky",         3, 0.0, 1e4)                              \
+    X(FOG_DENSITY, "fog_density", 1, 0.0, 1.0)                              \
+    X(FOG_HEIGHT,  "fog_height",  1, -1e9, 1e9)                             \
+    X(EXPOSURE,    "exposure",    1, -20.0, 20.0)
+
+enum {
+#define X(id, key, n, lo, hi) SG_LIGHT_##id,
+    SG_LIGHT_KEYS(X)
+#undef X
+    SG_LIGHT_COUNT
+};
+
+typedef struct sg_scene_light {
+    unsigned given;                  /* bit k: key k was set              */
+    double   v[SG_LIGHT_COUNT][3];
+    sg_loc   loc[SG_LIGHT_COUNT];
+} sg_scene_light;
+
 typedef struct sg_scene {
     char  *name;
     sg_loc loc;
@@ -244,6 +271,8 @@ typedef struct sg_scene {
     sg_loc destruction_cell_loc;
     int    cell_texels;      sg_loc cell_texels_loc; /* default 32         */
     sg_scene_camera *cameras; int ncameras;
+    bool   has_light;        sg_loc light_loc;
+    sg_scene_light light;
 } sg_scene;
 
 /* scene_check.c: every check of a scene block that needs neither files

@@ -15,6 +15,7 @@
 #include <unistd.h>
 
 #include <jansson.h>
+#include <stddef.h>
 #include <stb_image.h>
 
 typedef struct reader {
@@ -354,6 +355,37 @@ static bool read_compute(reader *r, json_t *obj, const char *where, char **out)
 
 /* ---- sections ------------------------------------------------------------ */
 
+/* scene.light (optional, and each of its fields): over the defaults. */
+static bool read_light(reader *r, json_t *scene)
+{
+    rt_light *l = &r->p->light;
+    rt_light_default(l);
+    json_t *o = get(r, scene, "light", "scene", false);
+    if (!o)
+        return true;
+    if (!json_is_object(o))
+        return field_fail(r, "scene.light:", "must be an object");
+    static const struct { const char *key; int n; size_t at; } f[] = {
+        { "sun", 2, offsetof(rt_light, sun) },
+        { "sun_color", 3, offsetof(rt_light, sun_color) },
+        { "intensity", 1, offsetof(rt_light, intensity) },
+        { "sky", 3, offsetof(rt_light, sky) },
+        { "fog_density", 1, offsetof(rt_light, fog_density) },
+        { "fog_height", 1, offsetof(rt_light, fog_height) },
+        { "exposure", 1, offsetof(rt_light, exposure) },
+    };
+    for (size_t i = 0; i < sizeof f / sizeof f[0]; i++) {
+        double *v = (double *)((char *)l + f[i].at);
+        if (!json_object_get(o, f[i].key))
+            continue;
+        if (f[i].n == 1 ? !get_number(r, o, f[i].key, "scene.light", v)
+                        : !get_vec(r, o, f[i].key, "scene.light", f[i].n, v))
+            return false;
+    }
+    const char *bad = rt_light_check(l);
+    return bad ? field_fail(r, "scene.light:", bad) : true;
+}
+
 static bool read_scene(reader *r, json_t *root)
 {
     rt_pack *p = r->p;
@@ -447,6 +479,8 @@ static bool read_scene(reader *r, json_t *root)
         }
         p->has_destruction = true;
     }
+    if (!read_light(r, scene))
+        return false;
     json_t *cams = get_array(r, scene, "cameras", "scene", false);
     if (cams) {
         p->ncameras = (int)json_array_size(cams);

@@ -38,9 +38,13 @@ static const char resolve_frag_main[] =
     "    vec3 nn = normalize(ns.xyz);\n"
     "    vec3 albedo = a.rgb, n = nn, c;\n"
     "    float rough = m.r, dist = m.b;\n"
+    /* the pixel's ray, surface -> camera (v_rel is 0 in this pass) */
+    "    vec2 ndc = gl_FragCoord.xy / u_frame.screen.xy * 2.0 - 1.0;\n"
+    "    vec4 q = u_frame.inv_view_proj * vec4(ndc, 0.5, 1.0);\n"
+    "    vec3 to_cam = -normalize(q.xyz / q.w);\n"
     "    switch (u_frame.view.x) {\n"
     SPLAT_VIEWS(SPLAT_VIEW_CASE_RESOLVE)   /* abi.h: the views it can show */
-    "    default: c = splat_light(albedo, n, rough, dist); break;\n"
+    "    default: c = splat_light(albedo, n, rough, dist, to_cam); break;\n"
     "    }\n"
     "    o_color = vec4(c, 1.0);\n"
     "}\n";

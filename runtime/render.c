@@ -20,6 +20,8 @@ struct rt_renderer {
     rt_device        *d;
     const rt_pack    *p;
     rt_render_desc    desc;
+    rt_light          light;           /* the pack's, or set_light's        */
+    bool              light_set;
     rt_terrain_gpu    terrain;
     rt_destruction   *destr;           /* NULL: no destructible area        */
     rt_bounds         bounds;
@@ -418,6 +420,8 @@ static bool use_raycast(const rt_renderer *r)
            r->d->props.deviceType != VK_PHYSICAL_DEVICE_TYPE_CPU;
 }
 
+static void pack_light(rt_renderer *r, const rt_pack *p);
+
 bool rt_renderer_create(rt_device *d, const rt_pack *p, const rt_render_desc *desc,
                         rt_renderer **out, rt_error *e)
 {
@@ -430,6 +434,7 @@ bool rt_renderer_create(rt_device *d, const rt_pack *p, const rt_render_desc *de
     r->d = d;
     r->p = p;
     r->desc = *desc;
+    pack_light(r, p);
     if (r->desc.width <= 0)
         r->desc.width = 1280;
     if (r->desc.height <= 0)
@@ -577,6 +582,29 @@ bool rt_renderer_set_shading(rt_renderer *r, rt_shading s)
 
 rt_shading rt_renderer_shading(const rt_renderer *r) { return r->shading; }
 
+/* The pack's light with the desc's overrides. */
+static void pack_light(rt_renderer *r, const rt_pack *p)
+{
+    r->light = p->light;
+    if (r->desc.sun_set)
+        memcpy(r->light.sun, r->desc.sun, sizeof r->light.sun);
+    if (r->desc.exposure_set)
+        r->light.exposure = r->desc.exposure;
+    if (r->desc.fog_set)
+        r->light.fog_density = r->desc.fog_density;
+}
+
+void rt_renderer_set_light(rt_renderer *r, const rt_light *l)
+{
+    r->light = *l;
+    r->light_set = true;
+}
+
+const rt_light *rt_renderer_light(const rt_renderer *r)
+{
+    return &r->light;
+}
+
 void rt_renderer_set_wireframe(rt_renderer *r, bool on)
 {
     if (on && !r->d->wireframe) {
@@ -691,21 +719,7 @@ static void fill_frame(rt_renderer *r, const rt_camera *c, splat_frame *fr)
     fr->screen[2] = 0.0f;   /* the depth clear value (reversed Z) */
     for (int i = 0; i < 3; i++)
         fr->camera[i] = (float)c->position[i];
-    /* Default lighting: a low morning sun from the south-east (about 20 deg
-     * up) so even gentle relief reads as light and shade; warm sun, blue
-     * sky ambient (sun : sky about 5 : 1 on flat ground); fog in the
-     * background colour with a density scaled to the scene's extent, so
-     * any scene fades to about 78 % fog at its far side whatever its size
-     * (colorado: 8 % at 10 km). */
-    double sun[3] = { 0.55, 0.36, 0.75 };
-    double sl = sqrt(sun[0] * sun[0] + sun[1] * sun[1] + sun[2] * sun[2]);
-    for (int i = 0; i < 3; i++)
-        fr->sun_dir[i] = (float)(sun[i] / sl);
-    fr->sun_color[0] = 2.9f; fr->sun_color[1] = 2.7f; fr->sun_color[2] = 2.35f;
-    fr->sky_color[0] = 0.16f; fr->sky_color[1] = 0.22f; fr->sky_color[2] = 0.34f;
-    double ext = p->size[0] > p->size[1] ? p->size[0] : p->size[1];
-    memcpy(fr->fog, r->desc.clear, 3 * sizeof(float));
-    fr->fog[3] = (float)(1.5 / ext);
+    rt_light_frame(&r->light, p, r->desc.clear, fr);
     fr->terrain[0] = (float)p->size[0];
     fr->terrain[1] = (float)p->size[1];
     fr->terrain[2] = (float)p->max_height;
@@ -1236,6 +1250,8 @@ bool rt_renderer_swap_pack(rt_renderer *r, const rt_pack *p, rt_error *e)
     for (int i = 0; i < p->nparams; i++)
         memcpy((uint8_t *)r->params_ubo.map + p->params[i].offset, p->params[i].value, 16);
     r->p = p;
+    if (!r->light_set)
+        pack_light(r, p);
     if (r->screen) {
         /* the classification's combination map and sets are the pack's */
         rt_screen_destroy(r->screen);

@@ -421,4 +421,10 @@ bool rt_destruction_wait(rt_destruction *ds, rt_error *e);
 void rt_destruction_print_stats(const rt_destruction *ds, FILE *out);
 bool   rt_read_r16(rt_device *d, const rt_image *img, uint16_t *out, rt_error *e);
 
+/* ---- light.c: the frame's lighting fields ------------------------------ */
+
+/* The frame's sun, sky, fog and exposure; fog towards `background`. */
+void rt_light_frame(const rt_light *l, const rt_pack *p, const float background[3],
+                    splat_frame *fr);
+
 #endif

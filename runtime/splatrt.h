@@ -193,6 +193,26 @@ typedef struct rt_pack_site {
     double scale[2];        /* constant scale per component              */
 } rt_pack_site;
 
+/* Preview lighting (light.c): the scene's `light` block, splatview's
+ * --sun, --exposure and --fog-density, the viewer's keys.  NAN fog
+ * fields: the defaults light.c derives from the terrain. */
+typedef struct rt_light {
+    double sun[2];         /* azimuth (degrees clockwise from north, -z),
+                              elevation (degrees)                         */
+    double sun_color[3];   /* linear; times intensity                      */
+    double intensity;      /* the sun's irradiance times pi                */
+    double sky[3];         /* zenith colour (linear): sky and ambient      */
+    double fog_density;    /* per metre at fog_height; NAN: default        */
+    double fog_height;     /* terrain-local metres; NAN: lowest terrain    */
+    double exposure;       /* EV: the lit colour times 2^exposure          */
+} rt_light;
+
+void rt_light_default(rt_light *l);
+/* The unit vector towards the sun. */
+void rt_light_sun_dir(const rt_light *l, double dir[3]);
+/* NULL if every field is in range, else what is wrong. */
+const char *rt_light_check(const rt_light *l);
+
 typedef struct rt_pack {
     char            *dir;
     char            *name;
@@ -223,6 +243,7 @@ typedef struct rt_pack {
     rt_pack_level   *levels;    int nlevels;
     char            *scene_path;     /* scene.source: scene.sg relative to
                                         the pack (hot reload), or NULL      */
+    rt_light         light;          /* scene.light over the defaults       */
 } rt_pack;
 
 /* Read and check a pack, untrusted input: every file it names is a
@@ -291,6 +312,9 @@ typedef struct rt_render_desc {
     int          destruction_pool;  /* destruction tiles; 0: RT_DESTR_POOL_DEFAULT */
     rt_shading   shading;           /* forward (default) or screen-space      */
     rt_screen_depth screen_depth;   /* screen path: where its depth comes from */
+    /* lighting over the pack's (splatview --sun, --exposure, --fog-density) */
+    bool         sun_set, exposure_set, fog_set;
+    double       sun[2], exposure, fog_density;
 } rt_render_desc;
 
 typedef struct rt_frame_stats {
@@ -319,6 +343,10 @@ void rt_default_camera(const rt_pack *p, rt_camera *c);
 /* Debug view and the material of the MASK view. */
 void rt_renderer_set_view(rt_renderer *r, splat_view view, int material);
 void rt_renderer_set_wireframe(rt_renderer *r, bool on);
+/* The lighting of the next frames (default: the pack's); a hot reload
+ * keeps one set here. */
+void rt_renderer_set_light(rt_renderer *r, const rt_light *l);
+const rt_light *rt_renderer_light(const rt_renderer *r);
 /* Screen-space path: frames with the counting variant of the shaders
  * (abi.h SPLAT_COUNT), whose counters rt_frame_stats.tiles carries. */
 void rt_renderer_set_counting(rt_renderer *r, bool on);

@@ -1,6 +1,6 @@
 /* splatview — render a shader pack: headless to PNG (and raw floats), or in
  * a GLFW window with a fly camera and hot reload.  See usage() below. */
-#include "splatrt.h"
+#include "rt_internal.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -30,6 +30,10 @@ static void usage(FILE *f)
         "  --float-out FILE          also write the RGBA32F image (SPLATF32 format)\n"
         "  --param NAME=v[,v,v,v]    set a material param\n"
         "  --lod-pixels P            screen error per grid step (default 3)\n"
+        "  --sun AZ,EL               the sun: azimuth (degrees clockwise from north)\n"
+        "                            and elevation, over the scene's light block\n"
+        "  --exposure EV             exposure in stops (default: the scene's, or 0)\n"
+        "  --fog-density D           fog per metre at the fog height (0: none)\n"
         "  --clear r,g,b             background colour (linear)\n"
         "  --pipeline-cache FILE     pipeline cache file\n"
         "  --scene FILE              scene.sg to watch for hot reload (viewer)\n"
@@ -96,7 +100,20 @@ typedef struct opts {
     int ncraters;
     double crater_at_view;      /* --crater-at-view RADIUS (0: none)        */
     int destruction_pool;       /* --destruction-pool N                      */
+    bool sun_set, exposure_set, fog_set;   /* --sun, --exposure, --fog-density */
+    double sun[2], exposure, fog_density;
 } opts;
+
+/* --sun, --exposure, --fog-density into a render desc. */
+static void light_options(const opts *o, rt_render_desc *rd)
+{
+    rd->sun_set = o->sun_set;
+    rd->exposure_set = o->exposure_set;
+    rd->fog_set = o->fog_set;
+    memcpy(rd->sun, o->sun, sizeof rd->sun);
+    rd->exposure = o->exposure;
+    rd->fog_density = o->fog_density;
+}
 
 /* "x,z,radius[,depth]" in metres; depth defaults to radius / 4. */
 static bool parse_crater(const char *s, rt_crater *c)
@@ -195,6 +212,29 @@ static int parse_args(int argc, char **argv, opts *o)
                 fprintf(stderr, "splatview: --lod-pixels expects a positive number\n");
                 return 2;
             }
+        } else if (!strcmp(a, "--sun")) {
+            NEED();
+            char *end;
+            o->sun[0] = strtod(v, &end);
+            o->sun[1] = *end == ',' ? strtod(end + 1, &end) : NAN;
+            if (*end || !(fabs(o->sun[0]) <= 360) || !(o->sun[1] >= -90 && o->sun[1] <= 90)) {
+                fprintf(stderr, "splatview: --sun expects AZIMUTH,ELEVATION in degrees "
+                        "(-360..360, -90..90), found '%s'\n", v);
+                return 2;
+            }
+            o->sun_set = true;
+        } else if (!strcmp(a, "--exposure") || !strcmp(a, "--fog-density")) {
+            NEED();
+            char *end;
+            double x = strtod(v, &end);
+            bool fog = !strcmp(a, "--fog-density");
+            if (*end || end == v || (fog ? !(x >= 0 && x <= 1) : !(x >= -20 && x <= 20))) {
+                fprintf(stderr, "splatview: %s expects %s, found '%s'\n", a,
+                        fog ? "a density 0..1 per metre" : "stops -20..20", v);
+                return 2;
+            }
+            *(fog ? &o->fog_density : &o->exposure) = x;
+            *(fog ? &o->fog_set : &o->exposure_set) = true;
         } else if (!strcmp(a, "--shading")) {
             NEED();
             if (!strcmp(v, "forward"))
@@ -419,6 +459,7 @@ static int headless(const opts *o)
         .destruction_pool = o->destruction_pool, .shading = o->shading,
         .screen_depth = o->screen_depth,
     };
+    light_options(o, &rd);
     memcpy(rd.clear, o->clear, sizeof rd.clear);
     if (!rt_renderer_create(&dev, &pack, &rd, &r, &e) || !apply_params(o, r, &e) ||
         !apply_craters(o, r, &cam, &e))
@@ -544,6 +585,7 @@ int main(int argc, char **argv)
         .view = SPLAT_VIEW_FINAL,
     };
     memcpy(vd.render.clear, o.clear, sizeof o.clear);
+    light_options(&o, &vd.render);
     vd.have_camera = o.have_camera || o.preset;
     if (o.have_camera) {
         memcpy(vd.camera.position, o.camera, sizeof o.camera);

@@ -164,6 +164,19 @@ static void key_action(viewer *v, int key)
         v->last_check = -1e9;   /* check the files on the next frame */
         for (int i = 0; i < v->w.n; i++)
             v->w.mtimes[i] = -1;
+    } else if (key == GLFW_KEY_J || key == GLFW_KEY_L || key == GLFW_KEY_I ||
+               key == GLFW_KEY_K || key == GLFW_KEY_EQUAL || key == GLFW_KEY_MINUS) {
+        /* the light: J / L turn the sun by 15 degrees, I / K raise and
+         * lower it by 5, + / - change the exposure by half a stop */
+        rt_light l = *rt_renderer_light(v->r);
+        l.sun[0] = fmod(l.sun[0] + (key == GLFW_KEY_L ? 15 : key == GLFW_KEY_J ? -15 : 0), 360.0);
+        l.sun[1] += key == GLFW_KEY_I ? 5 : key == GLFW_KEY_K ? -5 : 0;
+        l.sun[1] = l.sun[1] > 90 ? 90 : l.sun[1] < -10 ? -10 : l.sun[1];
+        l.exposure += key == GLFW_KEY_EQUAL ? 0.5 : key == GLFW_KEY_MINUS ? -0.5 : 0;
+        l.exposure = l.exposure > 20 ? 20 : l.exposure < -20 ? -20 : l.exposure;
+        rt_renderer_set_light(v->r, &l);
+        snprintf(v->status, sizeof v->status, "sun %.0f %.0f, exposure %+.1f EV", l.sun[0],
+                 l.sun[1], l.exposure);
     } else if (key == GLFW_KEY_Q || key == GLFW_KEY_ESCAPE) {
         v->quit = true;
     }

@@ -123,7 +123,7 @@ bad_packs)
     expect_error short_heightfield "heightfield.r16', which has 1000 bytes"
     fresh combo_range; printf '\377\177' | dd of="$OUT/combo_range/combos.bin" bs=1 seek=2 conv=notrunc 2>/dev/null
     expect_error combo_range "combination id 32767 out of range"
-    fresh bad_version; sed -i 's/"abi": 1/"abi": 99/' "$OUT/bad_version/manifest.json"
+    fresh bad_version; sed -i 's/"abi": 2/"abi": 99/' "$OUT/bad_version/manifest.json"
     expect_error bad_version "abi 99"
     ;;
 viewer)

@@ -115,4 +115,15 @@ if(TARGET splatrt AND TARGET splatview)
     set_tests_properties(render.screen_destruction PROPERTIES LABELS render TIMEOUT 600
       FIXTURES_REQUIRED destruction_pack ENVIRONMENT "SPLAT_VALIDATE=1;CRATER=60")
   endif()
+  # preview lighting: the light block, exposure, sun, view and fog
+  # (test_lighting.c builds its own packs of examples/minimal)
+  if(TARGET splatc)
+    add_executable(test_lighting ${RENDER_DIR}/test_lighting.c)
+    target_link_libraries(test_lighting splatrt splatc m)
+    file(MAKE_DIRECTORY ${RENDER_OUT}/lighting)
+    add_test(NAME render.lighting COMMAND test_lighting ${RENDER_OUT}/lighting
+             WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
+    set_tests_properties(render.lighting PROPERTIES LABELS render TIMEOUT 600
+                         ENVIRONMENT "SPLAT_VALIDATE=1")
+  endif()
 endif()

@@ -23,7 +23,7 @@ static int failures;
         }                                                                   \
     } while (0)
 
-static char *join(const char *dir, const char *name)
+static inline char *join(const char *dir, const char *name)
 {
     size_t n = strlen(dir) + strlen(name) + 2;
     char *p = malloc(n);
@@ -33,7 +33,7 @@ static char *join(const char *dir, const char *name)
 
 /* Build scene file `sg` into `pack` (removed first), imports searched in
  * "." (the repository root).  Diagnostics are printed on failure. */
-static bool world_build(const char *sg, const char *pack, splat_painted_format painted,
+static inline bool world_build(const char *sg, const char *pack, splat_painted_format painted,
                         sg_diags *d)
 {
     char rm[1200];
