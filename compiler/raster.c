@@ -210,6 +210,47 @@ static const char *type_name(GDALDataType t)
     return n ? n : "unknown";
 }
 
+/* The world size (unless given) and origin from the geotransform: north
+ * up, each axis's unit in metres (metres_per_unit); a raster without one
+ * needs `size`. */
+static bool world_size(GDALDatasetH ds, const char *path, bool size_given, int w, int h,
+                       splat_terrain *t, sg_loc loc, sg_diags *d)
+{
+    char msg[512];
+    double gt[6];
+    if (GDALGetGeoTransform(ds, gt) == CE_None) {
+        if (gt[2] != 0 || gt[4] != 0 || !(gt[1] != 0) || !(gt[5] != 0) ||
+            !isfinite(gt[0]) || !isfinite(gt[1]) || !isfinite(gt[3]) || !isfinite(gt[5])) {
+            sg_errorf(d, loc, SG_E_RASTER, "heightfield '%s' has a rotated, sheared or "
+                      "degenerate geotransform (%g %g %g %g %g %g); warp it north-up "
+                      "first (gdalwarp)", path, gt[0], gt[1], gt[2], gt[3], gt[4], gt[5]);
+            return false;
+        }
+        double fx, fz;
+        if (!metres_per_unit(ds, gt, h, path, loc, d, &fx, &fz))
+            return false;
+        t->origin[0] = gt[0];
+        t->origin[1] = gt[3];
+        if (!size_given) {
+            t->size[0] = fabs(gt[1]) * fx * w;
+            t->size[1] = fabs(gt[5]) * fz * h;
+        }
+    } else if (!size_given) {
+        snprintf(msg, sizeof msg, "heightfield '%s' has no geotransform: give "
+                 "the world size (size = X Z metres)", path);
+        sg_error(d, loc, SG_E_RASTER, msg);
+        return false;
+    }
+    if (!(t->size[0] > 0) || !(t->size[1] > 0) || !isfinite(t->size[0]) ||
+        !isfinite(t->size[1])) {
+        snprintf(msg, sizeof msg, "heightfield '%s' gives a world size of "
+                 "%g x %g m", path, t->size[0], t->size[1]);
+        sg_error(d, loc, SG_E_RASTER, msg);
+        return false;
+    }
+    return true;
+}
+
 bool splat_raster_heightfield(splat_terrain *t, const char *path, bool size_given,
                               sg_loc loc, sg_diags *d)
 {
@@ -231,40 +272,8 @@ bool splat_raster_heightfield(splat_terrain *t, const char *path, bool size_give
         goto done;
     }
 
-    /* size and origin */
-    double gt[6];
-    if (GDALGetGeoTransform(ds, gt) == CE_None) {
-        if (gt[2] != 0 || gt[4] != 0 || !(gt[1] != 0) || !(gt[5] != 0) ||
-            !isfinite(gt[0]) || !isfinite(gt[1]) || !isfinite(gt[3]) || !isfinite(gt[5])) {
-            snprintf(msg, sizeof msg, "heightfield '%s' has a rotated, sheared or "
-                     "degenerate geotransform (%g %g %g %g %g %g); warp it "
-                     "north-up first (gdalwarp)", path, gt[0], gt[1], gt[2],
-                     gt[3], gt[4], gt[5]);
-            sg_error(d, loc, SG_E_RASTER, msg);
-            goto done;
-        }
-        double fx, fz;
-        if (!metres_per_unit(ds, gt, h, path, loc, d, &fx, &fz))
-            goto done;
-        t->origin[0] = gt[0];
-        t->origin[1] = gt[3];
-        if (!size_given) {
-            t->size[0] = fabs(gt[1]) * fx * w;
-            t->size[1] = fabs(gt[5]) * fz * h;
-        }
-    } else if (!size_given) {
-        snprintf(msg, sizeof msg, "heightfield '%s' has no geotransform: give "
-                 "the world size (size = X Z metres)", path);
-        sg_error(d, loc, SG_E_RASTER, msg);
+    if (!world_size(ds, path, size_given, w, h, t, loc, d))
         goto done;
-    }
-    if (!(t->size[0] > 0) || !(t->size[1] > 0) || !isfinite(t->size[0]) ||
-        !isfinite(t->size[1])) {
-        snprintf(msg, sizeof msg, "heightfield '%s' gives a world size of "
-                 "%g x %g m", path, t->size[0], t->size[1]);
-        sg_error(d, loc, SG_E_RASTER, msg);
-        goto done;
-    }
 
     /* heights: pass 1, the valid range and the holes */
     int has_scale = 0, has_off = 0;
