@@ -19,23 +19,12 @@
  *     while a later crater over tiles it already has still works.
  * Pictures of the final and mask views go to OUTDIR. */
 #include "rt_internal.h"
+#include "../check.h"
 
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
-
-static int failures;
-
-#define CHECK(cond, ...)                                                    \
-    do {                                                                    \
-        if (!(cond)) {                                                      \
-            failures++;                                                     \
-            fprintf(stderr, "FAIL %s:%d: %s: ", __FILE__, __LINE__, #cond); \
-            fprintf(stderr, __VA_ARGS__);                                   \
-            fputc('\n', stderr);                                            \
-        }                                                                   \
-    } while (0)
 
 enum { W = 384, H = 384 };
 static const double CAM_Y = 700.0, FOVY = M_PI / 3.0;

@@ -17,7 +17,7 @@
  *     fog pulls it towards the sky;
  *   - a `light` value out of range is a located scene error. */
 #include "rt_internal.h"
-#include "../world/world_check.h"
+#include "../check.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -25,14 +25,6 @@
 #include <string.h>
 
 enum { W = 320, H = 200 };
-
-static bool build(const char *scene, const char *out)
-{
-    sg_diags d;
-    bool ok = world_build(scene, out, SPLAT_PAINTED_BC4, &d);
-    sg_diags_free(&d);
-    return ok;
-}
 
 /* The scene with a light block (and `extra` lines in it), next to the
  * example so its imports and rasters resolve. */
@@ -107,7 +99,7 @@ static void check_bad_light(const char *dir)
     char out[512];
     snprintf(out, sizeof out, "%s/bad_pack", dir);
     sg_diags d;
-    CHECK(!world_build(sg, out, SPLAT_PAINTED_DENSE, &d), "an elevation of 120 built");
+    CHECK(!build_pack(sg, out, SPLAT_PAINTED_BC4, &d), "an elevation of 120 built");
     bool found = false;
     for (int i = 0; i < d.n; i++)
         found |= d.items[i].id == SG_E_SETTING && d.items[i].loc.line > 0 &&
@@ -128,7 +120,7 @@ int main(int argc, char **argv)
     snprintf(lit, sizeof lit, "%s/lit", dir);
     snprintf(sg, sizeof sg, "examples/minimal/.lighting_test.sg");
     bool ok = write_scene(sg, "exposure = 1, sun = 200 35, fog_density = 0") &&
-              build("examples/minimal/scene.sg", plain) && build(sg, lit);
+              build_pack_ok("examples/minimal/scene.sg", plain) && build_pack_ok(sg, lit);
     remove(sg);
     if (!ok) {
         fprintf(stderr, "FAIL: the packs do not build\n");

@@ -18,7 +18,7 @@
  * Without the pass the 5,000 km view fails both (position's fp32 ulp
  * there is 0.5 m).  Pictures go to OUTDIR. */
 #include "rt_internal.h"
-#include "world_check.h"
+#include "../check.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -76,7 +76,8 @@ static bool build(const char *dir, const char *name, rt_pack *pack)
     snprintf(file, sizeof file, "%s.pack", name);
     char *packdir = join(dir, file);
     sg_diags d;
-    bool ok = world_build(sg, packdir, SPLAT_PAINTED_BC4, &d);
+    bool ok = build_pack(sg, packdir, SPLAT_PAINTED_BC4, &d);
+    if (!ok) sg_diags_print(&d, stderr);
     /* far.sg's uses of position are all periodic: no warning */
     for (int i = 0; i < d.n; i++)
         CHECK(d.items[i].severity != SG_WARNING, "warning: %s", d.items[i].msg);

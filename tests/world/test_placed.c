@@ -23,7 +23,7 @@
  *   - no validation messages.
  * Pictures of the views go to OUTDIR. */
 #include "rt_internal.h"
-#include "world_check.h"
+#include "../check.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -123,11 +123,9 @@ static bool build(const char *dir, char **pack)
 {
     char *sg = join(dir, "scene.sg");
     *pack = join(dir, "pack");
-    sg_diags d;
     double t0 = now();
-    bool ok = world_build(sg, *pack, SPLAT_PAINTED_BC4, &d);
+    bool ok = build_pack_ok(sg, *pack);
     double secs = now() - t0;
-    sg_diags_free(&d);
     free(sg);
     struct rusage ru;
     getrusage(RUSAGE_SELF, &ru);
@@ -143,7 +141,7 @@ static void check_dense_refused(const char *dir)
 {
     char *sg = join(dir, "scene.sg"), *out = join(dir, "dense_pack");
     sg_diags d;
-    CHECK(!world_build(sg, out, SPLAT_PAINTED_DENSE, &d), "--painted dense built a placed mask");
+    CHECK(!build_pack(sg, out, SPLAT_PAINTED_DENSE, &d), "--painted dense built a placed mask");
     char *text = NULL;
     size_t n = 0;
     FILE *f = open_memstream(&text, &n);

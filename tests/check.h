@@ -1,9 +1,10 @@
-/* world_check.h — what the tests/world programs share (each is one file):
- * CHECK, which counts a failure and goes on; join; and world_build, a
+/* check.h — what the device test programs share (tests/world, the
+ * lighting and destruction tests; each is one file): CHECK, which counts
+ * a failure and goes on; join; and build_pack, a
  * fresh pack built with splatc's library (an old pack with the same inputs
  * would be kept as it is), its diagnostics left in *d for the caller. */
-#ifndef WORLD_CHECK_H
-#define WORLD_CHECK_H
+#ifndef SPLAT_TESTS_CHECK_H
+#define SPLAT_TESTS_CHECK_H
 
 #include "scene.h"
 
@@ -32,9 +33,9 @@ static inline char *join(const char *dir, const char *name)
 }
 
 /* Build scene file `sg` into `pack` (removed first), imports searched in
- * "." (the repository root).  Diagnostics are printed on failure. */
-static inline bool world_build(const char *sg, const char *pack, splat_painted_format painted,
-                        sg_diags *d)
+ * "." (the repository root); the diagnostics in *d (free them). */
+static inline bool build_pack(const char *sg, const char *pack, splat_painted_format painted,
+                              sg_diags *d)
 {
     char rm[1200];
     snprintf(rm, sizeof rm, "rm -rf '%s'", pack);
@@ -43,8 +44,16 @@ static inline bool world_build(const char *sg, const char *pack, splat_painted_f
                             .jobs = 2, .no_cache = true, .painted = painted };
     splat_build_stats st;
     sg_diags_init(d);
-    bool ok = system(rm) == 0 && splat_build(&bd, &st, d);
-    if (!ok && painted != SPLAT_PAINTED_DENSE) sg_diags_print(d, stderr);
+    return system(rm) == 0 && splat_build(&bd, &st, d);
+}
+
+/* build_pack for a scene that must build: diagnostics printed if not. */
+static inline bool build_pack_ok(const char *sg, const char *pack)
+{
+    sg_diags d;
+    bool ok = build_pack(sg, pack, SPLAT_PAINTED_BC4, &d);
+    if (!ok) sg_diags_print(&d, stderr);
+    sg_diags_free(&d);
     return ok;
 }
 
