@@ -170,6 +170,19 @@
     "    return c * u_frame.light.z;\n" \
     "}\n"
 
+const splat_light_key splat_light_keys[SPLAT_LIGHT_COUNT] = {
+#define X(id, key, n, lo, hi) { key, n, lo, hi },
+    SPLAT_LIGHT_KEYS(X)
+#undef X
+};
+
+void splat_light_range(int k, int i, double *lo, double *hi)
+{
+    bool azimuth = k == SPLAT_LIGHT_SUN && i == 0;
+    *lo = azimuth ? -360.0 : splat_light_keys[k].lo;
+    *hi = azimuth ? 360.0 : splat_light_keys[k].hi;
+}
+
 const char SPLAT_GLSL_COMBO_COLOR[] = COMBO_COLOR_TEXT;
 const char SPLAT_GLSL_TERRAIN[] = SPLAT_GLSL_COMMON;
 const char SPLAT_GLSL_LIGHTING[] = LIGHTING_TEXT;

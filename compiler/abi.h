@@ -234,6 +234,38 @@ SPLAT_VIEWS(X)
 #define SPLAT_VIEW_CASE_RESOLVE(id, num, name, key, tm, where, glsl) \
     SPLAT_VIEW_IN_RESOLVE_##where(num, glsl)
 
+/* The scene's `light { sun = AZIMUTH ELEVATION, sun_color = R G B,
+ * intensity = X, sky = R G B, fog_density = D, fog_height = H, exposure =
+ * EV }`, as the parser reads it, the manifest's scene.light carries it and
+ * runtime/light.c's rt_light holds it, in this order (runtime/light.c has
+ * the defaults of keys left out).  X(id, key, numbers, lo, hi): every
+ * number within [lo, hi], the sun's azimuth within -360..360. */
+#define SPLAT_LIGHT_KEYS(X)                                                 \
+    X(SUN,         "sun",         2, -90.0, 90.0)                           \
+    X(SUN_COLOR,   "sun_color",   3, 0.0, 1e4)                              \
+    X(INTENSITY,   "intensity",   1, 0.0, 1e4)                              \
+    X(SKY,         "sky",         3, 0.0, 1e4)                              \
+    X(FOG_DENSITY, "fog_density", 1, 0.0, 1.0)                              \
+    X(FOG_HEIGHT,  "fog_height",  1, -1e9, 1e9)                             \
+    X(EXPOSURE,    "exposure",    1, -20.0, 20.0)
+
+enum {
+#define X(id, key, n, lo, hi) SPLAT_LIGHT_##id,
+    SPLAT_LIGHT_KEYS(X)
+#undef X
+    SPLAT_LIGHT_COUNT
+};
+
+typedef struct splat_light_key {
+    const char *key;
+    int         n;          /* numbers                                    */
+    double      lo, hi;
+} splat_light_key;
+
+extern const splat_light_key splat_light_keys[SPLAT_LIGHT_COUNT];
+/* Number i of key k within its range (the sun's azimuth: -360..360). */
+void splat_light_range(int k, int i, double *lo, double *hi);
+
 /* Per-frame uniform block, set 0 binding 1. */
 typedef struct splat_frame {
     float view_proj[16];     /* camera-relative world -> clip (column-major) */

@@ -252,16 +252,13 @@ static json_t *jscene(build *b, const char *dir)
     }
     json_object_set_new(scene, "cameras", cams);
     if (sc->has_light) {   /* the keys given; the runtime has the rest */
-        static const struct { const char *key; int n; } keys[] = {
-#define X(id, key, n, lo, hi) { key, n },
-            SG_LIGHT_KEYS(X)
-#undef X
-        };
         json_t *l = json_object();
-        for (int k = 0; k < SG_LIGHT_COUNT; k++)
+        for (int k = 0; k < SPLAT_LIGHT_COUNT; k++) {
+            const splat_light_key *lk = &splat_light_keys[k];
             if (sc->light.given & 1u << k)
-                json_object_set_new(l, keys[k].key, keys[k].n == 1 ? json_real(sc->light.v[k][0])
-                                                                    : jreals(sc->light.v[k], keys[k].n));
+                json_object_set_new(l, lk->key, lk->n == 1 ? json_real(sc->light.v[k][0])
+                                                           : jreals(sc->light.v[k], lk->n));
+        }
         json_object_set_new(scene, "light", l);
     }
     if (sc->has_destruction) {

@@ -697,28 +697,23 @@ static bool sub_stmt(parser *ps, void *user)
     return ok;
 }
 
-/* light = "light" "{" { KEY "=" NUM... [","] } "}" (sg.h SG_LIGHT_KEYS) */
+/* light = "light" "{" { KEY "=" NUM... [","] } "}" (abi.h SPLAT_LIGHT_KEYS) */
 static bool light_stmt(parser *ps, void *user)
 {
     sg_scene_light *l = user;
-    static const struct { const char *key; int n; } keys[] = {
-#define X(id, key, n, lo, hi) { key, n },
-        SG_LIGHT_KEYS(X)
-#undef X
-    };
-    const char *expect_keys = "'sun', 'sun_color', 'intensity', 'sky', 'fog_density', "
-                              "'fog_height', 'exposure' or '}'";
     sg_token *key = cur(ps);
     int k = 0;
-    while (key->kind == SG_TK_IDENT && k < SG_LIGHT_COUNT && !is_kw(key, keys[k].key))
+    while (key->kind == SG_TK_IDENT && k < SPLAT_LIGHT_COUNT &&
+           !is_kw(key, splat_light_keys[k].key))
         k++;
-    if (key->kind != SG_TK_IDENT || k == SG_LIGHT_COUNT) {
-        expected(ps, expect_keys);
+    if (key->kind != SG_TK_IDENT || k == SPLAT_LIGHT_COUNT) {
+        expected(ps, "'sun', 'sun_color', 'intensity', 'sky', 'fog_density', "
+                     "'fog_height', 'exposure' or '}'");
         return false;
     }
     l->loc[k] = loc_of(ps, key);
     next(ps);
-    bool ok = expect(ps, SG_TK_EQ, "'='") && parse_numbers(ps, l->v[k], keys[k].n);
+    bool ok = expect(ps, SG_TK_EQ, "'='") && parse_numbers(ps, l->v[k], splat_light_keys[k].n);
     if (ok) {
         l->given |= 1u << k;
         accept(ps, SG_TK_COMMA);

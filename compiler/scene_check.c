@@ -131,27 +131,17 @@ static void check_destruction(const sg_scene *sc, sg_diags *d)
 
 static void check_light(const sg_scene_light *l, sg_diags *d)
 {
-    static const struct { const char *key; int n; double lo, hi; } keys[] = {
-#define X(id, key, n, lo, hi) { key, n, lo, hi },
-        SG_LIGHT_KEYS(X)
-#undef X
-    };
-    for (int k = 0; k < SG_LIGHT_COUNT; k++) {
-        if (!(l->given & 1u << k))
-            continue;
-        for (int i = 0; i < keys[k].n; i++) {
-            double v = l->v[k][i];
-            /* the sun: AZIMUTH ELEVATION; the azimuth turns all the way */
-            double lo = k == SG_LIGHT_SUN && i == 0 ? -360 : keys[k].lo;
-            double hi = k == SG_LIGHT_SUN && i == 0 ? 360 : keys[k].hi;
+    for (int k = 0; k < SPLAT_LIGHT_COUNT; k++)
+        for (int i = 0; l->given & 1u << k && i < splat_light_keys[k].n; i++) {
+            double v = l->v[k][i], lo, hi;
+            splat_light_range(k, i, &lo, &hi);
             if (!(v >= lo && v <= hi)) {
                 sg_errorf(d, l->loc[k], SG_E_SETTING, "light %s: %g is outside %g..%g%s",
-                          keys[k].key, v, lo, hi, k == SG_LIGHT_SUN ?
+                          splat_light_keys[k].key, v, lo, hi, k == SPLAT_LIGHT_SUN ?
                           " (AZIMUTH -360..360, ELEVATION -90..90 degrees)" : "");
                 break;
             }
         }
-    }
 }
 
 bool sg_scene_check(const sg_scene *sc, sg_diags *d)

@@ -11,6 +11,7 @@
 #include <stdbool.h>
 #include <stdio.h>
 
+#include "abi.h"
 #include "ir.h"
 
 /* ---- diagnostics (diag.c) ---------------------------------------------- */
@@ -216,31 +217,11 @@ typedef struct sg_scene_camera {
     sg_loc loc;
 } sg_scene_camera;
 
-/* light { sun = AZIMUTH ELEVATION, sun_color = R G B, intensity = X,
- *         sky = R G B, fog_density = D, fog_height = H, exposure = EV }:
- * the preview lighting (runtime/light.c holds the defaults of the keys
- * left out).  X(id, key, numbers, lo, hi): every number in [lo, hi],
- * except the sun's azimuth (-360..360). */
-#define SG_LIGHT_KEYS(X)                                                    \
-    X(SUN,         "sun",         2, -90.0, 90.0)                           \
-    X(SUN_COLOR,   "sun_color",   3, 0.0, 1e4)                              \
-    X(INTENSITY,   "intensity",   1, 0.0, 1e4)                              \
-    X(SKY,         "sky",         3, 0.0, 1e4)                              \
-    X(FOG_DENSITY, "fog_density", 1, 0.0, 1.0)                              \
-    X(FOG_HEIGHT,  "fog_height",  1, -1e9, 1e9)                             \
-    X(EXPOSURE,    "exposure",    1, -20.0, 20.0)
-
-enum {
-#define X(id, key, n, lo, hi) SG_LIGHT_##id,
-    SG_LIGHT_KEYS(X)
-#undef X
-    SG_LIGHT_COUNT
-};
-
+/* The scene's light block: abi.h SPLAT_LIGHT_KEYS. */
 typedef struct sg_scene_light {
     unsigned given;                  /* bit k: key k was set              */
-    double   v[SG_LIGHT_COUNT][3];
-    sg_loc   loc[SG_LIGHT_COUNT];
+    double   v[SPLAT_LIGHT_COUNT][3];
+    sg_loc   loc[SPLAT_LIGHT_COUNT];
 } sg_scene_light;
 
 typedef struct sg_scene {

@@ -17,6 +17,8 @@
 #include "rt_internal.h"
 
 #include <math.h>
+#include <stddef.h>
+#include <stdio.h>
 
 void rt_light_default(rt_light *l)
 {
@@ -63,21 +65,31 @@ void rt_light_frame(const rt_light *l, const rt_pack *p, const float background[
     fr->light[3] = 0.0f;
 }
 
+/* rt_light's fields in abi.h SPLAT_LIGHT_KEYS order. */
+static const size_t field_of[SPLAT_LIGHT_COUNT] = {
+    offsetof(rt_light, sun), offsetof(rt_light, sun_color), offsetof(rt_light, intensity),
+    offsetof(rt_light, sky), offsetof(rt_light, fog_density), offsetof(rt_light, fog_height),
+    offsetof(rt_light, exposure),
+};
+
+double *rt_light_values(rt_light *l, int key)
+{
+    return (double *)((char *)l + field_of[key]);
+}
+
 const char *rt_light_check(const rt_light *l)
 {
-    for (int i = 0; i < 3; i++)
-        if (!(l->sun_color[i] >= 0 && l->sun_color[i] <= 1e4) ||
-            !(l->sky[i] >= 0 && l->sky[i] <= 1e4))
-            return "colours must be 0 or more (linear)";
-    if (!(fabs(l->sun[0]) <= 360.0) || !(l->sun[1] >= -90.0 && l->sun[1] <= 90.0))
-        return "sun must be AZIMUTH (-360..360) ELEVATION (-90..90) degrees";
-    if (!(l->intensity >= 0 && l->intensity <= 1e4))
-        return "intensity must be 0..10000";
-    if (!isnan(l->fog_density) && !(l->fog_density >= 0 && l->fog_density <= 1))
-        return "fog_density must be 0..1 per metre";
-    if (!isnan(l->fog_height) && !isfinite(l->fog_height))
-        return "fog_height must be finite";
-    if (!(l->exposure >= -20 && l->exposure <= 20))
-        return "exposure must be -20..20 EV";
+    static char why[160];
+    for (int k = 0; k < SPLAT_LIGHT_COUNT; k++)
+        for (int i = 0; i < splat_light_keys[k].n; i++) {
+            double v = rt_light_values((rt_light *)l, k)[i], lo, hi;
+            splat_light_range(k, i, &lo, &hi);
+            bool unset = isnan(v) && (k == SPLAT_LIGHT_FOG_DENSITY || k == SPLAT_LIGHT_FOG_HEIGHT);
+            if (!unset && !(v >= lo && v <= hi)) {
+                snprintf(why, sizeof why, "%s: %g is outside %g..%g", splat_light_keys[k].key,
+                         v, lo, hi);
+                return why;
+            }
+        }
     return NULL;
 }

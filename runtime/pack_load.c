@@ -15,7 +15,6 @@
 #include <unistd.h>
 
 #include <jansson.h>
-#include <stddef.h>
 #include <stb_image.h>
 
 typedef struct reader {
@@ -365,21 +364,12 @@ static bool read_light(reader *r, json_t *scene)
         return true;
     if (!json_is_object(o))
         return field_fail(r, "scene.light:", "must be an object");
-    static const struct { const char *key; int n; size_t at; } f[] = {
-        { "sun", 2, offsetof(rt_light, sun) },
-        { "sun_color", 3, offsetof(rt_light, sun_color) },
-        { "intensity", 1, offsetof(rt_light, intensity) },
-        { "sky", 3, offsetof(rt_light, sky) },
-        { "fog_density", 1, offsetof(rt_light, fog_density) },
-        { "fog_height", 1, offsetof(rt_light, fog_height) },
-        { "exposure", 1, offsetof(rt_light, exposure) },
-    };
-    for (size_t i = 0; i < sizeof f / sizeof f[0]; i++) {
-        double *v = (double *)((char *)l + f[i].at);
-        if (!json_object_get(o, f[i].key))
-            continue;
-        if (f[i].n == 1 ? !get_number(r, o, f[i].key, "scene.light", v)
-                        : !get_vec(r, o, f[i].key, "scene.light", f[i].n, v))
+    for (int k = 0; k < SPLAT_LIGHT_COUNT; k++) {
+        const splat_light_key *lk = &splat_light_keys[k];
+        double *v = rt_light_values(l, k);
+        if (json_object_get(o, lk->key) &&
+            !(lk->n == 1 ? get_number(r, o, lk->key, "scene.light", v)
+                         : get_vec(r, o, lk->key, "scene.light", lk->n, v)))
             return false;
     }
     const char *bad = rt_light_check(l);

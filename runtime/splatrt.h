@@ -210,7 +210,10 @@ typedef struct rt_light {
 void rt_light_default(rt_light *l);
 /* The unit vector towards the sun. */
 void rt_light_sun_dir(const rt_light *l, double dir[3]);
-/* NULL if every field is in range, else what is wrong. */
+/* Key k's numbers (abi.h SPLAT_LIGHT_KEYS order: sun, sun_color, …). */
+double *rt_light_values(rt_light *l, int key);
+/* NULL if every field is within abi.h's ranges (NAN fog fields: the
+ * defaults), else what is wrong (a static string). */
 const char *rt_light_check(const rt_light *l);
 
 typedef struct rt_pack {
