@@ -21,6 +21,7 @@
  *   atlas 1 x 1 slots = 36 x 36 texels.
  */
 #include "sparse.h"
+#include "ir.h"
 #include "util.h"
 
 #include <assert.h>
@@ -547,24 +548,22 @@ char *sparse_glsl_places(const sparse_masks *s)
         any |= sparse_placed(s, m);
     if (!any)
         return NULL;
-    size_t cap = 160 + (size_t)s->nmasks * 160, len = 0;
-    char *out = xmalloc(cap);
-    len += (size_t)snprintf(out + len, cap - len, "#define SPLAT_PAINTED_PLACED 1\n"
-                            "const vec4 splat_painted_rect[%d] = vec4[%d](", s->nmasks,
-                            s->nmasks);
+    ir_buf b = { 0 };
+    ir_buf_printf(&b, "#define SPLAT_PAINTED_PLACED 1\n"
+                      "const vec4 splat_painted_rect[%d] = vec4[%d](", s->nmasks, s->nmasks);
     for (int m = 0; m < s->nmasks; m++) {
         float r[4];
         place_floats(&s->place[m], r);
-        len += (size_t)snprintf(out + len, cap - len, "%svec4(%.9g, %.9g, %.9g, %.9g)",
-                                m ? ", " : "", r[0], r[1], r[2], r[3]);
+        ir_buf_printf(&b, "%svec4(%.9g, %.9g, %.9g, %.9g)", m ? ", " : "", r[0], r[1], r[2],
+                      r[3]);
     }
-    len += (size_t)snprintf(out + len, cap - len, ");\nconst vec2 splat_painted_size[%d] = "
-                            "vec2[%d](", s->nmasks, s->nmasks);
+    ir_buf_printf(&b, ");\nconst vec2 splat_painted_size[%d] = vec2[%d](", s->nmasks,
+                  s->nmasks);
     for (int m = 0; m < s->nmasks; m++)
-        len += (size_t)snprintf(out + len, cap - len, "%svec2(%d.0, %d.0)", m ? ", " : "",
-                                s->place[m].width, s->place[m].height);
-    snprintf(out + len, cap - len, ");\n");
-    return out;
+        ir_buf_printf(&b, "%svec2(%d.0, %d.0)", m ? ", " : "", s->place[m].width,
+                      s->place[m].height);
+    ir_buf_printf(&b, ");\n");
+    return b.s;
 }
 
 /* ---- the build ---------------------------------------------------------- */
@@ -605,6 +604,21 @@ static void layout_atlas(sparse_masks *s, const slot_store *st)
     free(r8);
 }
 
+/* A desc's rect of all zeros means "the whole terrain". */
+static bool rect_given(const double r[4])
+{
+    return r[0] != 0 || r[1] != 0 || r[2] != 0 || r[3] != 0;
+}
+
+/* A place's cells from its raster; the grid grown to hold them. */
+static void place_cells(sparse_place *p, int *grid_x, int *grid_z)
+{
+    p->cells_x = (p->width + SPARSE_TILE - 1) / SPARSE_TILE;
+    p->cells_z = (p->height + SPARSE_TILE - 1) / SPARSE_TILE;
+    *grid_x = p->cells_x > *grid_x ? p->cells_x : *grid_x;
+    *grid_z = p->cells_z > *grid_z ? p->cells_z : *grid_z;
+}
+
 static bool check_desc(const sparse_desc *d, sparse_error *err)
 {
     if (d->width <= 0 || d->height <= 0 || d->nmasks < 0 ||
@@ -627,11 +641,10 @@ static bool check_desc(const sparse_desc *d, sparse_error *err)
             return fail(err, SPARSE_E_BAD_OPTION, name,
                         "a placed raster must be 1..65536 texels on each side");
         const double *r = md->rect;
-        bool zero = r[0] == 0 && r[1] == 0 && r[2] == 0 && r[3] == 0;
         bool in_range = true;
         for (int i = 0; i < 4; i++)
             in_range &= isfinite(r[i]) && fabs(r[i]) < 1e6;
-        if (!zero && !(in_range && r[2] - r[0] > 1e-9 && r[3] - r[1] > 1e-9))
+        if (rect_given(r) && !(in_range && r[2] - r[0] > 1e-9 && r[3] - r[1] > 1e-9))
             return fail(err, SPARSE_E_BAD_OPTION, name,
                         "its rectangle is empty or out of range (terrain uv within 1e6)");
     }
@@ -649,14 +662,9 @@ static void set_places(sparse_masks *s, const sparse_desc *d)
         sparse_place *p = &s->place[m];
         p->width = md->width ? md->width : d->width;
         p->height = md->height ? md->height : d->height;
-        p->cells_x = (p->width + SPARSE_TILE - 1) / SPARSE_TILE;
-        p->cells_z = (p->height + SPARSE_TILE - 1) / SPARSE_TILE;
-        bool zero = md->rect[0] == 0 && md->rect[1] == 0 && md->rect[2] == 0 &&
-                    md->rect[3] == 0;
-        double unit[4] = { 0, 0, 1, 1 };
-        memcpy(p->rect, zero ? unit : md->rect, sizeof p->rect);
-        s->cells_x = p->cells_x > s->cells_x ? p->cells_x : s->cells_x;
-        s->cells_z = p->cells_z > s->cells_z ? p->cells_z : s->cells_z;
+        static const double unit[4] = { 0, 0, 1, 1 };
+        memcpy(p->rect, rect_given(md->rect) ? md->rect : unit, sizeof p->rect);
+        place_cells(p, &s->cells_x, &s->cells_z);
     }
 }
 
@@ -950,10 +958,7 @@ static bool read_places(sparse_masks *s, const uint8_t *at)
         }
         p->width = (int)w;
         p->height = (int)h;
-        p->cells_x = (p->width + 31) / 32;
-        p->cells_z = (p->height + 31) / 32;
-        cx = p->cells_x > cx ? p->cells_x : cx;
-        cz = p->cells_z > cz ? p->cells_z : cz;
+        place_cells(p, &cx, &cz);
     }
     if (cx != s->cells_x || cz != s->cells_z) {
         free(pl);
