@@ -7,6 +7,7 @@
 #define SPLAT_TESTS_CHECK_H
 
 #include "scene.h"
+#include "splatrt.h"
 
 #include <stdio.h>
 #include <stdlib.h>
@@ -55,6 +56,42 @@ static inline bool build_pack_ok(const char *sg, const char *pack)
     if (!ok) sg_diags_print(&d, stderr);
     sg_diags_free(&d);
     return ok;
+}
+
+/* One frame of `view` (`material` for the MASK view) from `cam` with
+ * `rd` (its width, height, reference, shading, clear, light), read back
+ * as RGBA32F; NULL (and a failure counted) if any step fails. */
+static inline float *render_frame(rt_device *dev, const rt_pack *p, const rt_render_desc *rd,
+                                  splat_view view, int material, const rt_camera *cam)
+{
+    rt_error e = { 0 };
+    rt_renderer *r = NULL;
+    float *rgba = malloc((size_t)rd->width * (size_t)rd->height * 16);
+    bool ok = rgba && rt_renderer_create(dev, p, rd, &r, &e);
+    if (ok) rt_renderer_set_view(r, view, material);
+    ok = ok && rt_renderer_frame(r, cam, NULL, &e) && rt_renderer_read(r, rgba, &e);
+    CHECK(ok, "render: %s", e.msg ? e.msg : "?");
+    if (r) rt_renderer_destroy(r);
+    rt_error_clear(&e);
+    if (!ok) {
+        free(rgba);
+        return NULL;
+    }
+    return rgba;
+}
+
+/* DIR/NAME as a PNG, tone-mapped as the view's screenshots are. */
+static inline void write_picture(const char *dir, const char *name, const float *rgba,
+                                 int w, int h, splat_view view)
+{
+    rt_error e = { 0 };
+    uint8_t *px = malloc((size_t)w * (size_t)h * 4);
+    char *png = join(dir, name);
+    if (px) rt_tonemap_rgba8(rgba, w, h, rt_view_tonemap(view), px);
+    CHECK(px && rt_write_png(png, px, w, h, &e), "%s: %s", png, e.msg ? e.msg : "");
+    rt_error_clear(&e);
+    free(png);
+    free(px);
 }
 
 #endif

@@ -50,19 +50,7 @@ static float *render(rt_device *dev, const rt_pack *p, const rt_render_desc *rdi
     rd.width = W;
     rd.height = H;
     rd.clear[0] = 1.0f, rd.clear[2] = 1.0f, rd.clear[3] = 1.0f;   /* magenta */
-    rt_error e = { 0 };
-    rt_renderer *r = NULL;
-    float *px = malloc((size_t)W * H * 16);
-    bool ok = px && rt_renderer_create(dev, p, &rd, &r, &e) &&
-              rt_renderer_frame(r, cam, NULL, &e) && rt_renderer_read(r, px, &e);
-    CHECK(ok, "render: %s", e.msg ? e.msg : "?");
-    if (r) rt_renderer_destroy(r);
-    rt_error_clear(&e);
-    if (!ok) {
-        free(px);
-        return NULL;
-    }
-    return px;
+    return render_frame(dev, p, &rd, SPLAT_VIEW_FINAL, 0, cam);
 }
 
 static bool background(const float *c)

@@ -138,17 +138,12 @@ static void ground_at(int px, int py, double y, double *x, double *z)
 static void check_view(const rt_pack *pack, rt_device *dev, rt_reference ref,
                        splat_view view, const char *dir, const char *name)
 {
-    rt_error e = { 0 };
     rt_render_desc rd = { .width = W, .height = H, .reference = ref,
                           .clear = { CLEAR[0], CLEAR[1], CLEAR[2], CLEAR[3] } };
-    rt_renderer *r = NULL;
-    float *rgba = malloc((size_t)W * H * 16);
     rt_camera cam = { .position = { CAM[0], CAM[1], CAM[2] },
                       .look = { CAM[0], 0, CAM[2] }, .fovy = FOVY };
-    bool ok = rgba && rt_renderer_create(dev, pack, &rd, &r, &e);
-    if (ok) rt_renderer_set_view(r, view, 0);
-    ok = ok && rt_renderer_frame(r, &cam, NULL, &e) && rt_renderer_read(r, rgba, &e);
-    CHECK(ok, "%s: %s", name, e.msg ? e.msg : "?");
+    float *rgba = render_frame(dev, pack, &rd, view, 0, &cam);
+    bool ok = rgba != NULL;
     int hole = 0, ground = 0;
     for (int py = 0; ok && py < H; py++)
         for (int px = 0; px < W; px++) {
@@ -184,18 +179,9 @@ static void check_view(const rt_pack *pack, rt_device *dev, rt_reference ref,
           name, hole, ground);
     printf("%s: %d pixels inside holes are background, %d outside are terrain\n",
            name, hole, ground);
-    if (ok) {
-        uint8_t *px = malloc((size_t)W * H * 4);
-        char *png = join(dir, name);
-        rt_tonemap_rgba8(rgba, W, H, view == SPLAT_VIEW_FINAL ? RT_TONEMAP_FILMIC
-                                                               : RT_TONEMAP_NONE, px);
-        CHECK(px && rt_write_png(png, px, W, H, &e), "%s", png);
-        free(png);
-        free(px);
-    }
-    if (r) rt_renderer_destroy(r);
+    if (ok)
+        write_picture(dir, name, rgba, W, H, view);
     free(rgba);
-    rt_error_clear(&e);
 }
 
 int main(int argc, char **argv)

@@ -185,34 +185,14 @@ static double ground(const rt_pack *p, double x, double z)
     return p->height_offset + h / 65535.0 * p->max_height;
 }
 
-static float *render(const rt_pack *pack, rt_device *dev, rt_reference ref, splat_view view,
-                     const rt_camera *cam, const char *dir, const char *name)
+/* A frame of the paint material's `view` (forward, or the screen path),
+ * also written to DIR/NAME. */
+static float *render(const rt_pack *pack, rt_device *dev, rt_reference ref, rt_shading shading,
+                     splat_view view, const rt_camera *cam, const char *dir, const char *name)
 {
-    bool screen = strncmp(name, "screen", 6) == 0;   /* the screen-space path */
-    rt_error e = { 0 };
-    rt_render_desc rd = { .width = W, .height = H, .reference = ref };
-    rt_renderer *r = NULL;
-    float *rgba = malloc((size_t)W * H * 16);
-    bool ok = rgba && rt_renderer_create(dev, pack, &rd, &r, &e);
-    if (ok) rt_renderer_set_view(r, view, 1);
-    if (ok && screen) rt_renderer_set_shading(r, RT_SHADING_SCREEN);
-    ok = ok && rt_renderer_frame(r, cam, NULL, &e) && rt_renderer_read(r, rgba, &e);
-    CHECK(ok, "%s: %s", name, e.msg ? e.msg : "?");
-    if (ok) {
-        uint8_t *px = malloc((size_t)W * H * 4);
-        char *png = join(dir, name);
-        rt_tonemap_rgba8(rgba, W, H, view == SPLAT_VIEW_FINAL ? RT_TONEMAP_FILMIC
-                                                               : RT_TONEMAP_NONE, px);
-        CHECK(px && rt_write_png(png, px, W, H, &e), "%s", png);
-        free(png);
-        free(px);
-    }
-    if (r) rt_renderer_destroy(r);
-    rt_error_clear(&e);
-    if (!ok) {
-        free(rgba);
-        return NULL;
-    }
+    rt_render_desc rd = { .width = W, .height = H, .reference = ref, .shading = shading };
+    float *rgba = render_frame(dev, pack, &rd, view, 1, cam);
+    if (rgba) write_picture(dir, name, rgba, W, H, view);
     return rgba;
 }
 
@@ -224,7 +204,7 @@ static void check_width(const rt_pack *p, rt_device *dev, double mx, double mz,
     double x = ORIGIN[0] + mx, z = ORIGIN[1] + mz, y = ground(p, x, z);
     rt_camera cam = { .position = { x, y + 60.0, z + 1e-3 }, .look = { x, y, z },
                       .fovy = FOVY };
-    float *m = render(p, dev, RT_REF_NONE, SPLAT_VIEW_MASK, &cam, dir, name);
+    float *m = render(p, dev, RT_REF_NONE, RT_SHADING_FORWARD, SPLAT_VIEW_MASK, &cam, dir, name);
     if (!m) return;
     int row = 0, col = 0;
     for (int i = 0; i < W; i++) {
@@ -248,8 +228,8 @@ static void check_sound(const rt_pack *p, rt_device *dev, const rt_camera *cam,
     char a[64], b[64];
     snprintf(a, sizeof a, "%s_final.png", name);
     snprintf(b, sizeof b, "%s_uber.png", name);
-    float *c = render(p, dev, RT_REF_NONE, SPLAT_VIEW_FINAL, cam, dir, a);
-    float *u = render(p, dev, RT_REF_UBER, SPLAT_VIEW_FINAL, cam, dir, b);
+    float *c = render(p, dev, RT_REF_NONE, RT_SHADING_FORWARD, SPLAT_VIEW_FINAL, cam, dir, a);
+    float *u = render(p, dev, RT_REF_UBER, RT_SHADING_FORWARD, SPLAT_VIEW_FINAL, cam, dir, b);
     if (c && u) {
         double worst = 0.0;
         int red = 0;
@@ -270,8 +250,10 @@ static void check_sound(const rt_pack *p, rt_device *dev, const rt_camera *cam,
 static void check_screen(const rt_pack *p, rt_device *dev, const rt_camera *cam,
                          const char *dir)
 {
-    float *f = render(p, dev, RT_REF_NONE, SPLAT_VIEW_FINAL, cam, dir, "close_final.png");
-    float *s = render(p, dev, RT_REF_NONE, SPLAT_VIEW_FINAL, cam, dir, "screen_close.png");
+    float *f = render(p, dev, RT_REF_NONE, RT_SHADING_FORWARD, SPLAT_VIEW_FINAL, cam, dir,
+                      "close_final.png");
+    float *s = render(p, dev, RT_REF_NONE, RT_SHADING_SCREEN, SPLAT_VIEW_FINAL, cam, dir,
+                      "screen_close.png");
     if (f && s) {
         size_t close = 0, n = (size_t)W * H;
         for (size_t i = 0; i < n; i++) {
