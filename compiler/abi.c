@@ -141,17 +141,27 @@
     "                float((h >> 16) & 255u)) / 255.0 * 0.8 + 0.2;\n" \
     "}\n"
 
-/* Preview lighting, linear, before the tone map: Lambert sun and a
- * hemisphere sky ambient (zenith u_frame.sky_color for a normal up, half
- * of it sideways), a small roughness-weighted sun lobe, fog towards the
- * background colour (u_frame.fog: far terrain fades into what is drawn
- * behind it, so the shading paths' silhouettes agree): density fog.a at
- * height light.x, falling off by exp(-light.y * (y - light.x)) (0: the
- * same everywhere), integrated exactly along the ray (Quilez, "Better
- * fog"); then the exposure light.z.  v, surface -> camera, is what a view
- * dependent model (GGX) will need: tried, its sun lobe turned the screen
- * path's normal differences on far terrain into glints one path has and
- * the other not (runtime/DESIGN.md). */
+/* Preview lighting in linear radiance, before the tone map (runtime/
+ * image.c, viewer.c).  Sun: GGX / Trowbridge-Reitz distribution D with
+ * alpha = rough^2, Smith height-correlated visibility V (Heitz 2014),
+ * Schlick Fresnel F with F0 = 0.04 (dielectrics); diffuse Lambert weighted
+ * by 1 - F so reflected energy is not counted twice:
+ *     Lo = (albedo (1 - F) + pi D V F) * sun * ndl
+ *        + albedo * sky * (0.5 + 0.5 n.y)            (hemisphere sky)
+ * with sun = u_frame.sun_color, the sun's irradiance / pi, times the
+ * sun's visibility from the shadow map (runtime/shadow.c).  Specular
+ * anti-aliasing, the same in every shading path: alpha^2 is widened by
+ * the normal variance a pixel averages and no path sees, which grows with
+ * the pixel's footprint over a heightfield texel:
+ *     alpha^2 += min(0.01 * (footprint / texel)^2, 0.18)
+ * (footprint = dist * u_frame.screen.w, radians per pixel; 0.18: the
+ * clamp of Kaplanyan et al. 2016).  Then fog towards the background
+ * colour (u_frame.fog: far terrain fades into what is drawn behind it):
+ * density fog.a at height light.x, falling off by exp(-light.y * (y -
+ * light.x)) (0: the same everywhere), integrated exactly along the ray
+ * (Quilez, "Better fog"); then the exposure factor light.z.
+ * v: surface -> camera.  tests/render/test_lighting.c holds a double
+ * twin of this model. */
 #define LIGHTING_TEXT \
     "float splat_fog(float dist, vec3 v) {\n" \
     "    float k = u_frame.light.y;\n" \
@@ -160,15 +170,40 @@
     "    float path = abs(t) > 1e-4 ? (1.0 - exp(-t)) / t : 1.0;\n" \
     "    return 1.0 - exp(-max(at_cam * dist * path, 0.0));\n" \
     "}\n" \
-    "vec3 splat_light(vec3 albedo, vec3 n, float rough, float dist, vec3 v) {\n" \
-    "    vec3 l = u_frame.sun_dir.xyz;\n" \
+    "float splat_alpha2(float rough, float dist) {\n" \
+    "    float a = clamp(rough, 0.02, 1.0);\n" \
+    "    float texel = u_frame.terrain.x * u_frame.texel.z;\n" \
+    "    float r = dist * u_frame.screen.w / texel;\n" \
+    "    return min(a * a * a * a + min(0.01 * r * r, 0.18), 1.0);\n" \
+    "}\n" \
+    "vec3 splat_sun_brdf(vec3 albedo, vec3 n, float a2, vec3 l, vec3 v) {\n" \
     "    float ndl = max(dot(n, l), 0.0);\n" \
-    "    vec3 c = albedo * (u_frame.sun_color.rgb * ndl\n" \
-    "                       + u_frame.sky_color.rgb * (0.5 + 0.5 * n.y));\n" \
-    "    c += u_frame.sun_color.rgb * 0.04 * (1.0 - rough) * pow(ndl, 8.0);\n" \
+    "    if (ndl <= 0.0) return vec3(0.0);\n" \
+    "    float ndv = max(dot(n, v), 1e-4);\n" \
+    "    vec3 h = normalize(l + v);\n" \
+    "    float ndh = max(dot(n, h), 0.0), vdh = max(dot(v, h), 0.0);\n" \
+    "    float q = ndh * ndh * (a2 - 1.0) + 1.0;\n" \
+    "    float d = a2 / (3.14159265 * q * q);\n" \
+    "    float vis = 0.5 / (ndl * sqrt(ndv * ndv * (1.0 - a2) + a2)\n" \
+    "                       + ndv * sqrt(ndl * ndl * (1.0 - a2) + a2));\n" \
+    "    float f = 0.04 + 0.96 * pow(1.0 - vdh, 5.0);\n" \
+    "    return (albedo * (1.0 - f) + 3.14159265 * d * vis * f) * ndl;\n" \
+    "}\n" \
+    "layout(set = 0, binding = 11) uniform sampler2D u_shadow;\n" \
+    "float splat_sun_visible(float dist, vec3 v) {\n" \
+    "    if (u_frame.light.w <= 0.0) return 1.0;\n" \
+    "    vec2 p = u_frame.camera.xz - v.xz * dist;   /* terrain-local metres */\n" \
+    "    return textureLod(u_shadow, p / u_frame.terrain.xy, 0.0).r;\n" \
+    "}\n" \
+    "vec3 splat_light(vec3 albedo, vec3 n, float rough, float dist, vec3 v) {\n" \
+    "    vec3 c = u_frame.sun_color.rgb * splat_sun_visible(dist, v)\n" \
+    "             * splat_sun_brdf(albedo, n, splat_alpha2(rough, dist), u_frame.sun_dir.xyz, v);\n" \
+    "    c += albedo * u_frame.sky_color.rgb * (0.5 + 0.5 * n.y);\n" \
     "    c = mix(c, u_frame.fog.rgb, splat_fog(dist, v));\n" \
     "    return c * u_frame.light.z;\n" \
     "}\n"
+
+_Static_assert(SPLAT_BIND_SHADOW == 11, "LIGHTING_TEXT's u_shadow binding");
 
 const splat_light_key splat_light_keys[SPLAT_LIGHT_COUNT] = {
 #define X(id, key, n, lo, hi) { key, n, lo, hi },

@@ -21,6 +21,10 @@
  *   binding 6  usampler2DArray painted levels, RGBA8_UINT, same shape
  *              and splat_painted(layer) samples them (sparse_sample on the
  *              CPU); the masks must be heightfield-sized (u_frame.texel.xy).
+ *   binding 11 sampler2D       sun visibility (fragment, compute), R8_UNORM,
+ *                              heightfield-sized, linear, clamp: the
+ *                              runtime's shadow map (runtime/shadow.c), read
+ *                              by splat_light when u_frame.light.w > 0.
  *   binding 12 sampler2D       holes (vertex stage), R8_UNORM, heightfield-
  *                              sized, linear, clamp: 1 where the terrain is
  *                              cut (a 1x1 texel of 0 when it has none).  The
@@ -109,7 +113,7 @@
 
 #include <stdint.h>
 
-#define SPLAT_ABI_VERSION 2   /* 2: splat_frame.light, GGX lighting */
+#define SPLAT_ABI_VERSION 3   /* 2: splat_frame.light; 3: GGX lighting, screen.w */
 
 enum {
     SPLAT_SET_TERRAIN = 0,
@@ -128,7 +132,8 @@ enum {
     SPLAT_BIND_OUT = 8,            /* compute only: rgba32f storage image */
     SPLAT_BIND_TILES = 9,          /* compute only: uint tiles[]          */
     SPLAT_BIND_COUNTERS = 10,      /* compute, SPLAT_COUNT only           */
-    SPLAT_BIND_SHADOW = 11,        /* heightfield shadows (lighting)      */
+    SPLAT_BIND_SHADOW = 11,        /* fragment + compute: sun visibility,
+                                      R8 per heightfield texel (shadow.c) */
 
     SPLAT_TILE = 8,                /* compute: pixels per tile side = local size */
 
@@ -287,7 +292,9 @@ typedef struct splat_frame {
     float inv_view_proj[16]; /* clip -> camera-relative world (inverse of
                                 view_proj; compute: depth reconstruction) */
     float screen[4];         /* x: width, y: height (px), z: depth value of
-                                empty / sky pixels (0 with reversed Z), w: 0 */
+                                empty / sky pixels (0 with reversed Z), w:
+                                radians per pixel (vertical field of view /
+                                height, for the footprint of a pixel)      */
     /* Site k of the pack's "world_sites" (PACK.md, precision.c): xy =
      * floor(c / S), zw = c / S - xy, with c the camera's two position
      * components of the site and S its scale (c * S for a product),
@@ -296,7 +303,8 @@ typedef struct splat_frame {
     /* Lighting (the scene's `light` block, splatview's options): x: fog
      * base height (terrain-local m), y: fog height falloff (1/m; 0: the
      * same density at every height), z: exposure (a linear factor applied
-     * to the lit colour), w: 0. */
+     * to the lit colour), w: 1 to darken the sun by the shadow map
+     * (SPLAT_BIND_SHADOW), 0: no shadows. */
     float light[4];
 } splat_frame;
 

@@ -886,8 +886,7 @@ static void camera_ray(const rt_camera *c, double aspect, double nx, double ny, 
         s[i] /= sl;
     double u[3] = { s[1] * f[2] - s[2] * f[1], s[2] * f[0] - s[0] * f[2],
                     s[0] * f[1] - s[1] * f[0] };
-    double fovy = c->fovy > 0 ? c->fovy : M_PI / 3.0;
-    double t = tan(fovy / 2.0);
+    double t = tan(rt_camera_fovy(c) / 2.0);
     for (int i = 0; i < 3; i++)
         dir[i] = f[i] + s[i] * nx * t * aspect - u[i] * ny * t;
 }

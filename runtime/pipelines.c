@@ -183,12 +183,13 @@ static bool make_layouts(rt_device *d, int ntextures, rt_pipelines *pl, rt_error
         { SPLAT_BIND_PAINTED_INDEX, smp, 1, fs, NULL },   /* sparse masks */
         { SPLAT_BIND_PAINTED_LEVEL, smp, 1, fs, NULL },
         { SPLAT_BIND_HOLES, smp, 1, VK_SHADER_STAGE_VERTEX_BIT, NULL },
+        { SPLAT_BIND_SHADOW, smp, 1, fs, NULL },
         { SPLAT_BIND_DEPTH, smp, 1, cs, NULL },
         { SPLAT_BIND_OUT, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, cs, NULL },
         { SPLAT_BIND_TILES, sbuf, 1, cs, NULL },
         { SPLAT_BIND_COUNTERS, sbuf, 1, cs, NULL },
     };
-    if (!make_set_layout(d, terrain, 12, &pl->set_terrain, e))
+    if (!make_set_layout(d, terrain, sizeof terrain / sizeof *terrain, &pl->set_terrain, e))
         return false;
     VkDescriptorSetLayoutBinding *mat = calloc((size_t)ntextures + 1, sizeof *mat);
     if (!mat)

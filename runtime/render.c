@@ -22,6 +22,8 @@ struct rt_renderer {
     rt_render_desc    desc;
     rt_light          light;           /* the pack's, or set_light's        */
     bool              light_set;
+    bool              shadow_stale;    /* heights changed since the map     */
+    double            shadow_sun[3];   /* the sun the map was made for      */
     rt_terrain_gpu    terrain;
     rt_destruction   *destr;           /* NULL: no destructible area        */
     rt_bounds         bounds;
@@ -279,7 +281,7 @@ static bool make_descriptors(rt_renderer *r, rt_error *e)
 
     VkDescriptorPoolSize sizes[4] = {
         { VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 3 },
-        { VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 2 * 9 + (uint32_t)r->ntex + 3 },
+        { VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 2 * 10 + (uint32_t)r->ntex + 3 },
         { VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1 },
         { VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 2 },
     };
@@ -310,7 +312,7 @@ static bool make_descriptors(rt_renderer *r, rt_error *e)
     const VkImageLayout ro = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
     const rt_terrain_gpu *t = &r->terrain;
     int n = 0;
-    VkDescriptorImageInfo img[10 + 3];
+    VkDescriptorImageInfo img[11 + 3];
     VkDescriptorImageInfo *timg = calloc((size_t)r->ntex + 1, sizeof *timg);
     VkWriteDescriptorSet *w = calloc((size_t)r->ntex + 16, sizeof *w);
     if (!timg || !w) {
@@ -343,6 +345,8 @@ static bool make_descriptors(rt_renderer *r, rt_error *e)
     W(r->set0, SPLAT_BIND_PAINTED_LEVEL, smp, &img[8], NULL);
     img[9] = (VkDescriptorImageInfo){ t->linear_clamp, t->holes.view, ro };
     W(r->set0, SPLAT_BIND_HOLES, smp, &img[9], NULL);
+    img[10] = (VkDescriptorImageInfo){ t->linear_clamp, t->shadow.view, ro };
+    W(r->set0, SPLAT_BIND_SHADOW, smp, &img[10], NULL);
     W(r->set1, SPLAT_BIND_PARAMS, ubo, NULL, &pb);
     for (int i = 0; i < r->ntex; i++) {
         timg[i] = (VkDescriptorImageInfo){ r->tex_smp[i], r->tex[i].view, ro };
@@ -363,13 +367,15 @@ static bool make_descriptors(rt_renderer *r, rt_error *e)
             SPLAT_BIND_HEIGHTFIELD, SPLAT_BIND_FRAME, SPLAT_BIND_PAINTED,
             SPLAT_BIND_DESTRUCTION_ATLAS, SPLAT_BIND_DESTRUCTION_INDEX,
             SPLAT_BIND_PAINTED_INDEX, SPLAT_BIND_PAINTED_LEVEL, SPLAT_BIND_HOLES,
+            SPLAT_BIND_SHADOW,
         };
-        VkCopyDescriptorSet cp[8];
-        for (int i = 0; i < 8; i++)
+        enum { N = sizeof terrain / sizeof *terrain };
+        VkCopyDescriptorSet cp[N];
+        for (int i = 0; i < N; i++)
             cp[i] = (VkCopyDescriptorSet){ .sType = VK_STRUCTURE_TYPE_COPY_DESCRIPTOR_SET,
                 .srcSet = r->set0, .srcBinding = terrain[i], .dstSet = r->set0c,
                 .dstBinding = terrain[i], .descriptorCount = 1 };
-        vkUpdateDescriptorSets(d->dev, 0, NULL, 8, cp);
+        vkUpdateDescriptorSets(d->dev, 0, NULL, N, cp);
     }
     return true;
 }
@@ -431,6 +437,7 @@ bool rt_renderer_create(rt_device *d, const rt_pack *p, const rt_render_desc *de
     rt_renderer *r = calloc(1, sizeof *r);
     if (!r)
         return rt_fail(e, RT_E_VULKAN, "renderer", "out of memory");
+    r->shadow_stale = true;
     r->d = d;
     r->p = p;
     r->desc = *desc;
@@ -631,6 +638,11 @@ const rt_image *rt_renderer_target(const rt_renderer *r) { return &r->color; }
 /* Camera-relative view-projection: rotation only (positions reach the GPU
  * relative to the camera), perspective with reversed infinite Z and
  * Vulkan's downward y.  Column-major. */
+double rt_camera_fovy(const rt_camera *c)
+{
+    return c->fovy > 0 ? c->fovy : M_PI / 3.0;
+}
+
 static void camera_matrix(const rt_camera *c, double aspect, double m[16])
 {
     double f[3], len = 0;
@@ -654,7 +666,7 @@ static void camera_matrix(const rt_camera *c, double aspect, double m[16])
     for (int i = 0; i < 3; i++)
         s[i] /= sl;
     double u[3] = { s[1] * f[2] - s[2] * f[1], s[2] * f[0] - s[0] * f[2], s[0] * f[1] - s[1] * f[0] };
-    double fovy = c->fovy > 0 ? c->fovy : M_PI / 3.0;
+    double fovy = rt_camera_fovy(c);
     double znear = c->znear > 0 ? c->znear : 0.25;
     double t = 1.0 / tan(fovy / 2.0);
     /* rows of view: s, u, -f; clip = P * view */
@@ -717,9 +729,11 @@ static void fill_frame(rt_renderer *r, const rt_camera *c, splat_frame *fr)
     fr->screen[0] = (float)r->desc.width;
     fr->screen[1] = (float)r->desc.height;
     fr->screen[2] = 0.0f;   /* the depth clear value (reversed Z) */
+    fr->screen[3] = (float)(2.0 * tan(rt_camera_fovy(c) / 2.0) / r->desc.height);
     for (int i = 0; i < 3; i++)
         fr->camera[i] = (float)c->position[i];
     rt_light_frame(&r->light, p, r->desc.clear, fr);
+    fr->light[3] = r->desc.no_shadows ? 0.0f : 1.0f;
     fr->terrain[0] = (float)p->size[0];
     fr->terrain[1] = (float)p->size[1];
     fr->terrain[2] = (float)p->max_height;
@@ -1108,15 +1122,46 @@ static bool draw_frame(rt_renderer *r, const rt_camera *c, rt_frame_stats *st, r
 /* A frame; on the screen-space path, drawn again while lists got tiles
  * whose pipelines did not exist yet (compiled in between): at most once
  * per variant in practice, since the classification is deterministic. */
+/* A new shadow map (shadow.c) when the sun moved or a crater changed the
+ * heights since the last; its CPU time in *ms (0: none was needed). */
+static bool update_shadow(rt_renderer *r, double *ms, rt_error *e)
+{
+    *ms = 0;
+    double sun[3];
+    rt_light_sun_dir(&r->light, sun);
+    if (r->desc.no_shadows ||
+        (!r->shadow_stale && !memcmp(sun, r->shadow_sun, sizeof sun)))
+        return true;
+    const rt_pack *p = r->p;
+    size_t n = (size_t)p->hf_width * (size_t)p->hf_height;
+    uint8_t *map = malloc(n);
+    if (!map)
+        return rt_fail(e, RT_E_VULKAN, "shadow map", "out of memory");
+    double t0 = splat_now();
+    rt_shadow_map(rt_renderer_heights(r), p, &r->bounds, sun, map);
+    *ms = 1e3 * (splat_now() - t0);
+    bool ok = rt_image_upload(r->d, &r->terrain.shadow, map, n, e);
+    free(map);
+    if (ok) {
+        memcpy(r->shadow_sun, sun, sizeof sun);
+        r->shadow_stale = false;
+    }
+    return ok;
+}
+
 bool rt_renderer_frame(rt_renderer *r, const rt_camera *c, rt_frame_stats *st, rt_error *e)
 {
     rt_frame_stats local;
     if (!st)
         st = &local;
+    double shadow_ms;
+    if (!update_shadow(r, &shadow_ms, e))
+        return false;
     for (int redraws = 0;; redraws++) {
         if (!draw_frame(r, c, st, e))
             return false;
         st->redraws = redraws;
+        st->shadow_ms = shadow_ms;
         if (!st->screen)
             return true;
         int made = rt_screen_missing(r->screen, &r->pl, compute_variant(r), e);
@@ -1275,6 +1320,7 @@ bool rt_renderer_crater(rt_renderer *r, const rt_crater *c, rt_crater_stats *st,
         }
         return true;
     }
+    r->shadow_stale = true;
     return rt_destruction_crater(r->destr, c, st, e);
 }
 

@@ -209,6 +209,7 @@ typedef struct rt_terrain_gpu {
     rt_image  destr_atlas;  /* R8_UNORM destruction mask tiles (destruction.c) */
     rt_image  destr_index;  /* RGBA8 1x1, a = 0: nothing destroyed          */
     rt_image  holes;        /* R8_UNORM W x H (1x1 of 0: none), binding 12  */
+    rt_image  shadow;       /* R8_UNORM W x H sun visibility (shadow.c)     */
     VkSampler linear_clamp, nearest_clamp;
 } rt_terrain_gpu;
 
@@ -368,6 +369,11 @@ bool rt_pipelines_reset_combos(rt_device *d, const rt_pack *p, rt_pipelines *pl,
 /* Saves the cache (if it has a path) and destroys everything. */
 void rt_pipelines_destroy(rt_device *d, rt_pipelines *pl);
 
+/* ---- render.c: the frame ----------------------------------------------- */
+
+/* The camera's vertical field of view in radians (its default if unset). */
+double rt_camera_fovy(const rt_camera *c);
+
 /* ---- screen.c: screen-space shading (render.c drives it) -------------- */
 
 typedef struct rt_screen rt_screen;
@@ -420,6 +426,14 @@ bool rt_destruction_crater(rt_destruction *ds, const rt_crater *c, rt_crater_sta
 bool rt_destruction_wait(rt_destruction *ds, rt_error *e);
 void rt_destruction_print_stats(const rt_destruction *ds, FILE *out);
 bool   rt_read_r16(rt_device *d, const rt_image *img, uint16_t *out, rt_error *e);
+
+/* ---- shadow.c: the sun-visibility map ---------------------------------- */
+
+/* out (hf_width x hf_height, 255 = sun fully visible) for the sun
+ * direction `sun` (towards the sun, unit) over `heights` with their
+ * quadtree bounds `b`. */
+void rt_shadow_map(const uint16_t *heights, const rt_pack *p, const rt_bounds *b,
+                   const double sun[3], uint8_t *out);
 
 /* ---- light.c: the frame's lighting fields ------------------------------ */
 

@@ -318,6 +318,7 @@ typedef struct rt_render_desc {
     /* lighting over the pack's (splatview --sun, --exposure, --fog-density) */
     bool         sun_set, exposure_set, fog_set;
     double       sun[2], exposure, fog_density;
+    bool         no_shadows;        /* the sun casts none (splatview --no-shadows) */
 } rt_render_desc;
 
 typedef struct rt_frame_stats {
@@ -331,6 +332,8 @@ typedef struct rt_frame_stats {
     bool   screen;            /* drawn by the screen-space path              */
     rt_screen_stats tiles;    /* its tiles and counters (screen only)        */
     int    redraws;           /* frames drawn again after compiling pipelines */
+    double shadow_ms;         /* CPU ms of a new shadow map (the sun moved or
+                                 a crater changed heights); 0: none needed  */
 } rt_frame_stats;
 
 typedef struct rt_renderer rt_renderer;

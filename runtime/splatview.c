@@ -34,6 +34,7 @@ static void usage(FILE *f)
         "                            and elevation, over the scene's light block\n"
         "  --exposure EV             exposure in stops (default: the scene's, or 0)\n"
         "  --fog-density D           fog per metre at the fog height (0: none)\n"
+        "  --no-shadows              the sun casts no terrain shadows\n"
         "  --clear r,g,b             background colour (linear)\n"
         "  --pipeline-cache FILE     pipeline cache file\n"
         "  --scene FILE              scene.sg to watch for hot reload (viewer)\n"
@@ -85,7 +86,7 @@ static void summary(double *v, int n, double *med, double *lo, double *hi)
 
 typedef struct opts {
     const char *pack, *out, *float_out, *preset, *view, *cache, *scene, *script;
-    bool headless, stats, have_camera, have_look, no_stitch, no_cull;
+    bool headless, stats, have_camera, have_look, no_stitch, no_cull, no_shadows;
     int width, height, frames;
     double camera[3], look[3], lod_pixels;
     float clear[4];
@@ -159,6 +160,8 @@ static int parse_args(int argc, char **argv, opts *o)
             o->no_stitch = true;
         } else if (!strcmp(a, "--no-cull")) {
             o->no_cull = true;
+        } else if (!strcmp(a, "--no-shadows")) {
+            o->no_shadows = true;
         } else if (!strcmp(a, "-o")) {
             NEED(); o->out = v;
         } else if (!strcmp(a, "--float-out")) {
@@ -455,7 +458,7 @@ static int headless(const opts *o)
     rt_render_desc rd = {
         .width = o->width, .height = o->height, .reference = o->ref,
         .pipeline_cache = o->cache, .no_stitch = o->no_stitch,
-        .no_cull = o->no_cull, .lod_pixels = o->lod_pixels,
+        .no_cull = o->no_cull, .lod_pixels = o->lod_pixels, .no_shadows = o->no_shadows,
         .destruction_pool = o->destruction_pool, .shading = o->shading,
         .screen_depth = o->screen_depth,
     };
@@ -473,12 +476,14 @@ static int headless(const opts *o)
     cpu = sel + o->frames;
     double *pass = cpu + o->frames;   /* 3 per frame: geometry, classify, shade */
     rt_frame_stats st = { 0 };
+    double shadow_ms = 0;   /* the first frame makes the shadow map */
     /* the cost view needs the counting variant's counters */
     rt_renderer_set_counting(r, view == SPLAT_VIEW_COST);
     for (int f = 0; f < o->frames; f++) {
         if (!rt_renderer_frame(r, &cam, &st, &e))
             goto done;
         gpu[f] = st.gpu_ms;
+        shadow_ms += st.shadow_ms;
         sel[f] = st.select_ms;
         cpu[f] = st.cpu_ms;
         for (int k = 0; k < 3; k++)
@@ -526,6 +531,11 @@ static int headless(const opts *o)
                    st.tiles.tiles_total, st.tiles.lists, st.tiles.tiles_uber);
         }
         printf("quadtree cpu ms/frame: median %.4f  p10 %.4f  p90 %.4f\n", sm, sl, sh);
+        if (o->no_shadows)
+            printf("shadow map: off\n");
+        else
+            printf("shadow map cpu ms: %.2f (when the sun moves or a crater lands; "
+                   "per frame a texture tap)\n", shadow_ms);
         printf("cpu ms/frame (record): median %.3f  p10 %.3f  p90 %.3f\n", cm, cl, ch);
         if (st.screen) {
             /* one more frame with the counting variant (not timed) */

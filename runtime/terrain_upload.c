@@ -177,6 +177,16 @@ bool rt_terrain_upload(rt_device *d, const rt_pack *p, rt_terrain_gpu *t,
         !rt_image_upload(d, &t->holes, p->holes ? p->holes : zero4,
                          p->holes ? (size_t)W * H : 1, e))
         return false;
+    /* Sun visibility (binding 11): all lit until the renderer's first
+     * shadow map (shadow.c) replaces it. */
+    uint8_t *lit = malloc((size_t)W * H);
+    bool made = lit && rt_image_create(d, W, H, 1, false, 1, VK_FORMAT_R8_UNORM, use,
+                                       VK_IMAGE_ASPECT_COLOR_BIT, &t->shadow, e);
+    if (made) memset(lit, 255, (size_t)W * H);
+    made = made && rt_image_upload(d, &t->shadow, lit, (size_t)W * H, e);
+    free(lit);
+    if (!made)
+        return e->msg ? false : rt_fail(e, RT_E_VULKAN, "shadow map", "out of memory");
     /* Destruction: nothing destroyed (index alpha 0) until a crater fills it
      * (destruction.c). */
     if (!rt_image_create(d, 1, 1, 1, false, 1, VK_FORMAT_R8_UNORM, use,
@@ -199,6 +209,7 @@ void rt_terrain_destroy(rt_device *d, rt_terrain_gpu *t)
     rt_image_destroy(d, &t->destr_atlas);
     rt_image_destroy(d, &t->destr_index);
     rt_image_destroy(d, &t->holes);
+    rt_image_destroy(d, &t->shadow);
     if (t->linear_clamp)
         vkDestroySampler(d->dev, t->linear_clamp, NULL);
     if (t->nearest_clamp)

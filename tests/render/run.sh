@@ -12,6 +12,10 @@
 #     on an H200 (tests/bench/RESULTS.md).  1e-5 is ~40 fp32 ulps of 1.0:
 #     a compositor error of even 1/255 on one pixel fails.  No driver tested
 #     needs more; one that does gets 1e-4 here, named, with its measurement.
+#     Under the GGX sun (view dependent: a highlight's slope turns those
+#     ulps of the normal into up to 5.8e-4, on 10 of 64000 pixels of the
+#     fixture's overview) the final image is held to 1e-5 on >= 99.9 % of
+#     pixels and 1e-3 on all: a 1/255 compositor error still fails.
 #   composite vs uber 1e-5: the same material code, other branching.
 #   culled vs not culled 1e-6: the same triangles front-facing; only hidden
 #     back faces are dropped, so equal up to nothing (1e-6 absorbs nothing
@@ -67,7 +71,8 @@ reference_multipass)
     for cam in overview ridge; do
         run "$PACK" --headless --size 320x200 --camera-preset $cam --float-out "$OUT/c_$cam.f32"
         run "$PACK" --headless --size 320x200 --camera-preset $cam --reference multipass --float-out "$OUT/m_$cam.f32"
-        "$IC" diff "$OUT/c_$cam.f32" "$OUT/m_$cam.f32" 1e-5 || fail "multipass differs ($cam)"
+        "$IC" close "$OUT/c_$cam.f32" "$OUT/m_$cam.f32" 1e-5 0.999 80 &&
+            "$IC" diff "$OUT/c_$cam.f32" "$OUT/m_$cam.f32" 1e-3 || fail "multipass differs ($cam)"
     done
     ;;
 reference_uber)
@@ -99,6 +104,7 @@ stats)
     ;;
 bad_packs)
     expect_error() {   # name, expected message part
+        rm -f "$OUT/$1.png"   # from an earlier run
         "$SV" "$OUT/$1" --headless --size 32x32 -o "$OUT/$1.png" > "$OUT/$1.log" 2>&1
         rc=$?
         cat "$OUT/$1.log"
@@ -123,7 +129,7 @@ bad_packs)
     expect_error short_heightfield "heightfield.r16', which has 1000 bytes"
     fresh combo_range; printf '\377\177' | dd of="$OUT/combo_range/combos.bin" bs=1 seek=2 conv=notrunc 2>/dev/null
     expect_error combo_range "combination id 32767 out of range"
-    fresh bad_version; sed -i 's/"abi": 2/"abi": 99/' "$OUT/bad_version/manifest.json"
+    fresh bad_version; sed -i 's/"abi": [0-9]*/"abi": 99/' "$OUT/bad_version/manifest.json"
     expect_error bad_version "abi 99"
     ;;
 viewer)

@@ -125,5 +125,16 @@ if(TARGET splatrt AND TARGET splatview)
              WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
     set_tests_properties(render.lighting PROPERTIES LABELS render TIMEOUT 600
                          ENVIRONMENT "SPLAT_VALIDATE=1")
+    # the lighting model against its double twin, on three paths, and the
+    # terrain's shadows
+    foreach(t brdf shadow)
+      add_executable(test_${t} ${RENDER_DIR}/test_${t}.c)
+      target_link_libraries(test_${t} splatrt splatc m)
+      file(MAKE_DIRECTORY ${RENDER_OUT}/${t})
+      add_test(NAME render.${t} COMMAND test_${t} ${RENDER_OUT}/${t}
+               WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
+      set_tests_properties(render.${t} PROPERTIES LABELS render TIMEOUT 600
+                           ENVIRONMENT "SPLAT_VALIDATE=1")
+    endforeach()
   endif()
 endif()
