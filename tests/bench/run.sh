@@ -329,6 +329,17 @@ for s in $SCENES; do
         done
     done
 done
+# (f) preview lighting (issue 16): the GGX sun with the terrain's shadows,
+# without them, and the lighting before issue 16, on the same frames
+for s in $SCENES; do
+    for size in $SIZES; do
+        for p in $PATHS; do
+            [ "$size" = 1920x1080 ] && [ "$MODE" = full ] && [ "$p" != ground ] && continue
+            render lighting "$s" "$p" "$size" lit=composite noshadow=composite,noshadow \
+                lambert=lambert,noshadow
+        done
+    done
+done
 if [ "$MODE" = smoke ]; then
     stoch=$(comp_pack minimal stochastic_select)
     render knobs minimal ground 320x180 composite=composite fp16=fp16 sobel=sobel \

@@ -20,6 +20,9 @@
  *         analytic    composites recompiled with the exact normal of the
  *                     function `splatbench analytic-hf` samples (only for
  *                     a pack built on such a heightfield)
+ *         lambert     composites recompiled with the lighting before issue
+ *                     16 (Lambert sun, a small lobe, no shadow tap): the
+ *                     baseline the GGX sun and the shadows are timed against
  *         screen      screen-space shading (--shading screen): depth pass,
  *                     tile classification, compute composites; its rows
  *                     add the three passes' GPU medians and, from one
@@ -30,7 +33,8 @@
  *                     from the patches drawn depth only, or ray cast in
  *                     compute (screen: the runtime's choice for the device)
  *       pack=DIR renders another pack of the same terrain (compositors, fBm
- *       knobs); lod=P sets the LOD error threshold in pixels per grid step.
+ *       knobs); lod=P sets the LOD error threshold in pixels per grid step;
+ *       noshadow renders without the terrain's shadows (--no-shadows).
  *       Paths (--path): ground (2 m above the terrain looking 150 m ahead,
  *       from --start-preset NAME or --start x,z,dx,dz), topdown, grazing.
  *   splatbench upscale IN.png K OUT
@@ -169,10 +173,10 @@ static double err_psnr(const err_acc *a)
 /* ---- variants -------------------------------------------------------------- */
 
 typedef enum kind { K_COMPOSITE, K_MULTIPASS, K_UBER, K_FLAT, K_FP16, K_SOBEL, K_ANALYTIC,
-                    K_SCREEN, K_SCREEN_UBER, K_SCREEN_RASTER, K_SCREEN_RAYCAST } kind;
+                    K_LAMBERT, K_SCREEN, K_SCREEN_UBER, K_SCREEN_RASTER, K_SCREEN_RAYCAST } kind;
 static const char *const kind_names[] = {"composite", "multipass", "uber", "flat", "fp16", "sobel",
-                                         "analytic", "screen", "screen_uber", "screen_raster",
-                                         "screen_raycast"};
+                                         "analytic", "lambert", "screen", "screen_uber",
+                                         "screen_raster", "screen_raycast"};
 #define IS_SCREEN(k) ((k) >= K_SCREEN)
 
 typedef struct variant {
@@ -180,6 +184,8 @@ typedef struct variant {
     kind         k;
     const char  *pack_dir;
     double       lod;
+    bool         no_shadows;
+    double       shadow_ms; /* CPU ms of the shadow map (the first frame)   */
     rt_pack     *base;      /* loaded pack (shared by variants of one dir)  */
     rt_pack      view;      /* shallow copy with this variant's combos      */
     rt_pack_combo *combos;  /* owned when the shaders differ, else NULL     */
@@ -211,6 +217,18 @@ static const char sobel_normal[] =
     "    float gz = ((h00 + 2.0 * h10 + h20) - (h02 + 2.0 * h12 + h22)) * 0.25;\n"
     "    vec3 n = vec3(gx * u_frame.terrain.z / dx, 2.0, gz * u_frame.terrain.z / dz);\n"
     "    return normalize(n);\n"
+    "}\n";
+
+/* The preview lighting before issue 16 (abi.c's splat_light then). */
+static const char lambert_light[] =
+    "vec3 splat_light(vec3 albedo, vec3 n, float rough, float dist, vec3 v) {\n"
+    "    vec3 l = u_frame.sun_dir.xyz;\n"
+    "    float ndl = max(dot(n, l), 0.0);\n"
+    "    vec3 c = albedo * (u_frame.sun_color.rgb * ndl\n"
+    "                       + u_frame.sky_color.rgb * (0.5 + 0.5 * n.y));\n"
+    "    c += u_frame.sun_color.rgb * 0.04 * (1.0 - rough) * pow(ndl, 8.0);\n"
+    "    c = mix(c, u_frame.fog.rgb, splat_fog(dist, v));\n"
+    "    return c * u_frame.light.z;\n"
     "}\n";
 
 /* The analytic heightfield: normalised height at heightfield uv (u, v),
@@ -251,14 +269,16 @@ static char *transform_glsl(const char *src, kind k, const char *name)
         end = at;
         insert = "precision mediump float;\n";
     } else {
-        at = strstr(src, "vec3 splat_normal_at(vec2 uv) {\n");
+        const char *fn = k == K_LAMBERT ? "vec3 splat_light(vec3 albedo, vec3 n, float rough,"
+                                        : "vec3 splat_normal_at(vec2 uv) {\n";
+        at = strstr(src, fn);
         end = at ? strstr(at, "\n}\n") : NULL;
         if (!end) {
-            fprintf(stderr, "splatbench: %s: no splat_normal_at() to replace\n", name);
+            fprintf(stderr, "splatbench: %s: no '%s' to replace\n", name, fn);
             return NULL;
         }
         end += 3;
-        insert = k == K_SOBEL ? sobel_normal : analytic_normal;
+        insert = k == K_SOBEL ? sobel_normal : k == K_LAMBERT ? lambert_light : analytic_normal;
     }
     size_t a = (size_t)(at - src), b = strlen(end), c = strlen(insert);
     char *out = xcalloc(a + b + c + 1, 1);
@@ -273,7 +293,8 @@ static char *transform_glsl(const char *src, kind k, const char *name)
 static bool variant_shaders(variant *v)
 {
     v->view = *v->base;
-    if (v->k != K_FLAT && v->k != K_FP16 && v->k != K_SOBEL && v->k != K_ANALYTIC)
+    if (v->k != K_FLAT && v->k != K_FP16 && v->k != K_SOBEL && v->k != K_ANALYTIC &&
+        v->k != K_LAMBERT)
         return true;
     char path[4096];
     snprintf(path, sizeof path, "%s/manifest.json", v->pack_dir);
@@ -355,6 +376,8 @@ static bool parse_variant(const char *s, const char *default_pack, variant *v)
     for (char *t = strtok_r(rest, ",", &save); t && ok; t = strtok_r(NULL, ",", &save)) {
         if (!strncmp(t, "pack=", 5)) {
             v->pack_dir = strdup(t + 5);   /* lives as long as the process */
+        } else if (!strcmp(t, "noshadow")) {
+            v->no_shadows = true;
         } else if (!strncmp(t, "lod=", 4)) {
             v->lod = atof(t + 4);
             ok = v->lod > 0;
@@ -564,6 +587,7 @@ static int cmd_render(int argc, char **argv)
     for (int i = 0; i < nspecs; i++) {
         rt_render_desc rd = {
             .width = width, .height = height, .lod_pixels = v[i].lod,
+            .no_shadows = v[i].no_shadows,
             .reference = v[i].k == K_MULTIPASS ? RT_REF_MULTIPASS
                        : v[i].k == K_UBER || v[i].k == K_SCREEN_UBER ? RT_REF_UBER : RT_REF_NONE,
             .pipeline_cache = save ? cache : NULL,
@@ -592,6 +616,7 @@ static int cmd_render(int argc, char **argv)
                 goto done;
             if (!rt_renderer_frame(v[i].r, &cam, &st, &e))
                 goto done;
+            v[i].shadow_ms += st.shadow_ms;
         }
         v[i].rss_delta = rss_mb() - before;
     }
@@ -654,7 +679,7 @@ static int cmd_render(int argc, char **argv)
                      "gpu_med_ms,gpu_p10_ms,gpu_p90_ms,cpu_med_ms,select_med_ms,patches,"
                      "pipelines,max_abs,mean_abs,psnr_db,nonfinite,rss_delta_mb,reference,view,"
                      "geometry_ms,classify_ms,shade_ms,tiles,tiles_uber,layers_evaluated,"
-                     "layers_needed,samples_per_px,branches_uniform_pct\n");
+                     "layers_needed,samples_per_px,branches_uniform_pct,shadow_map_ms\n");
     /* the device name in CSV: its commas become ';' */
     char devname[VK_MAX_PHYSICAL_DEVICE_NAME_SIZE];
     snprintf(devname, sizeof devname, "%s", dev.props.deviceName);
@@ -673,7 +698,8 @@ static int cmd_render(int argc, char **argv)
         double px = v[i].tiles.pixels ? (double)v[i].tiles.pixels : 1.0;
         const char *pk = strrchr(v[i].pack_dir, '/');
         fprintf(out, "\"%s\",%s,%s,%d,%d,%s,%s,%s,%g,%d,%.3f,%.3f,%.3f,%.3f,%.4f,%d,%d,"
-                     "%.6g,%.6g,%.2f,%ld,%.1f,%s,%s,%.3f,%.3f,%.3f,%d,%d,%.4f,%.4f,%.3f,%.1f\n",
+                     "%.6g,%.6g,%.2f,%ld,%.1f,%s,%s,%.3f,%.3f,%.3f,%d,%d,%.4f,%.4f,%.3f,%.1f,"
+                     "%.2f\n",
                 devname, scene ? scene : v[i].base->name, pd.name, width, height,
                 v[i].label, kind_names[v[i].k], pk ? pk + 1 : v[i].pack_dir,
                 v[i].lod > 0 ? v[i].lod : 3.0, frames, gm, g10, g90, cm, sm,
@@ -684,7 +710,8 @@ static int cmd_render(int argc, char **argv)
                 v[i].tiles.layers_evaluated / px, v[i].tiles.layers_needed / px,
                 v[i].tiles.samples / px,
                 v[i].tiles.branches ? 100.0 * v[i].tiles.branches_uniform / v[i].tiles.branches
-                                    : 100.0);
+                                    : 100.0,
+                v[i].shadow_ms);
     }
     if (csv)
         fclose(out);

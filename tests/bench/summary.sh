@@ -97,6 +97,19 @@ awk -F, '
     }' "$O/render.csv" | sort
 echo
 
+echo "## Preview lighting (group lighting: same frames)"
+echo
+echo "lit: the GGX sun with the terrain's shadows (one shadow-map tap per pixel); noshadow: the same without the tap; lambert: the lighting before issue 16 (Lambert sun and a small lobe), recompiled into the same composites.  The shadow map is made on the CPU when the sun or the heights change, not per frame: its time is the last column."
+echo
+echo "| scene | path | size | lit GPU ms | noshadow GPU ms | lambert GPU ms | shadows cost (lit / noshadow) | GGX vs before (noshadow / lambert) | lit vs before | shadow map CPU ms |"
+echo "|---|---|---|---:|---:|---:|---:|---:|---:|---:|"
+awk -F, 'NR > 1 && $1 == "lighting" { k = $3 "|" $4 "|" $5 "x" $6; keys[k] = 1; t[k, $7] = $12
+        if ($7 == "lit") sm[k] = $35 }
+    END { for (k in keys) { split(k, a, "|"); l = t[k, "lit"]; n = t[k, "noshadow"]; b = t[k, "lambert"]
+            if (l <= 0 || n <= 0 || b <= 0) continue
+            printf "| %s | %s | %s | %.3f | %.3f | %.3f | %.3f | %.3f | %.3f | %.1f |\n", a[1], a[2], a[3], l, n, b, l / n, n / b, l / b, sm[k] } }' "$O/render.csv" | sort
+echo
+
 echo "## Screen-space shading (group shading: forward vs screen, same frames)"
 echo
 echo "Per pass: GPU medians of the depth pass (geometry or ray cast), the classification and the compute shading.  Layers per pixel evaluated / needed and samples per pixel come from one counting frame (abi.h SPLAT_COUNT) after the timed ones; efficiency = needed / evaluated.  Error: against the forward image of the same frame."
