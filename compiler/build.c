@@ -116,10 +116,12 @@ static bool inputs_key(build *b)
     XXH3_128bits_reset(st);
     char head[128];
     int n = snprintf(head, sizeof head,
-                     "splatc %s\nabi %d\nflat %d\npainted %s\ncompute-spirv %d\n",
+                     "splatc %s\nabi %d\nflat %d\npainted %s\ncompute-spirv %d\npreview ",
                      SPLATC_VERSION, SPLAT_ABI_VERSION, b->desc->flat,
                      splat_painted_format_name(b->desc->painted), b->desc->compute_spirv);
     XXH3_128bits_update(st, head, (size_t)n);
+    if (b->desc->preview)   /* the name and its end */
+        XXH3_128bits_update(st, b->desc->preview, strlen(b->desc->preview) + 1);
     /* the ABI's GLSL too: a changed prelude is a changed compiler */
     XXH3_128bits_update(st, SPLAT_GLSL_PRELUDE, strlen(SPLAT_GLSL_PRELUDE));
     XXH3_128bits_update(st, SPLAT_GLSL_VERTEX, strlen(SPLAT_GLSL_VERTEX));
@@ -198,6 +200,11 @@ static bool up_to_date(build *b, int *ncombos)
 static bool load(build *b)
 {
     b->scene_ok = splat_scene_load(&b->scene, b->desc->scene, b->desc->search_paths, b->d);
+    if (b->scene_ok && b->desc->preview &&
+        !splat_scene_preview(&b->scene, b->desc->preview, b->d)) {
+        splat_scene_free(&b->scene);
+        b->scene_ok = false;
+    }
     if (b->scene_ok)   /* here, so an up-to-date build warns the same */
         splat_sites_warn(&b->scene, b->d);   /* precision.c */
     return b->scene_ok;

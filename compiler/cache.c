@@ -54,29 +54,6 @@ void splat_shader_key(const char *glsl, int stage, char key[SPLAT_KEY_CHARS + 1]
              (unsigned long long)h.high64, (unsigned long long)h.low64);
 }
 
-/* mkdir -p; true if the folder exists afterwards. */
-static bool make_dirs(const char *path)
-{
-    char *p = strdup(path);
-    if (!p)
-        return false;
-    for (char *s = p + 1; *s; s++) {
-        if (*s != '/')
-            continue;
-        *s = 0;
-        if (mkdir(p, 0777) != 0 && errno != EEXIST) {
-            free(p);
-            return false;
-        }
-        *s = '/';
-    }
-    bool ok = mkdir(p, 0777) == 0 || errno == EEXIST;
-    struct stat sb;
-    ok = ok && stat(p, &sb) == 0 && S_ISDIR(sb.st_mode);
-    free(p);
-    return ok;
-}
-
 static char *join(const char *a, const char *b)
 {
     size_t n = strlen(a) + strlen(b) + 2;
@@ -107,7 +84,7 @@ bool splat_cache_open(splat_cache *c, const char *dir)
         return false;
     c->dir = join(base, "spv1");
     free(base);
-    if (!make_dirs(c->dir)) {
+    if (!splat_make_dirs(c->dir)) {
         splat_cache_close(c);
         return false;
     }
@@ -125,7 +102,7 @@ static char *entry_path(const splat_cache *c, const char *key, bool make_fanout)
     char sub[3] = {key[0], key[1], 0};
     char *fan = join(c->dir, sub);
     if (make_fanout)
-        make_dirs(fan);
+        splat_make_dirs(fan);
     char file[SPLAT_KEY_CHARS + 8];
     snprintf(file, sizeof file, "%s.spv", key);
     char *path = join(fan, file);

@@ -1,6 +1,6 @@
 /* cli_build.c — `splatc build SCENE.sg -o PACKDIR [-j N] [--stats]
  * [--cache DIR | --no-cache] [--flat] [--compute-spirv] [--painted bc4|r8|dense]
- * [-I DIR]... [--depfile FILE] [--json]`:
+ * [-I DIR]... [--depfile FILE] [--preview MATERIAL] [--json]`:
  * the command-line face
  * of splat_build (build.c).  Exit status 0 on success, 1 on input errors,
  * 2 on usage errors. */
@@ -30,6 +30,9 @@ static const char usage[] =
     "                 '.', the project root, the installed nodes)\n"
     "  --depfile FILE write a Make/Ninja depfile: PACKDIR/manifest.json and\n"
     "                 every file the pack was made from\n"
+    "  --preview M    write material M's swatch pack instead: M alone on a\n"
+    "                 built-in test hill under the scene's light (splatview\n"
+    "                 --material renders it)\n"
     "  --json         diagnostics as JSON Lines on stderr (for editors)\n";
 
 static void print_stats(const splat_build_stats *st, FILE *out)
@@ -107,6 +110,9 @@ int splat_cli_build(int argc, char **argv)
             i++;
         } else if (strcmp(a, "--depfile") == 0 && next) {
             desc.depfile = next;
+            i++;
+        } else if (strcmp(a, "--preview") == 0 && next) {
+            desc.preview = next;
             i++;
         } else if (strcmp(a, "--json") == 0) {
             json = true;

@@ -282,6 +282,10 @@ void splat_scene_free(splat_scene *s)
     }
     free(s->painted);
     free(s->painted_size);
+    if (s->own_desc) {
+        free(s->own_desc->cameras);
+        free(s->own_desc);
+    }
     splat_terrain_free(&s->terrain);
     ir_free(&s->ir);
     if (s->prog) sg_free(s->prog);

@@ -31,6 +31,8 @@ typedef struct splat_build_desc {
     FILE              *report;       /* non-NULL: the analysis report here    */
     const char        *depfile;      /* non-NULL: write a Make/Ninja depfile
                                         of every input here (build.c)     */
+    const char        *preview;      /* non-NULL: this material's swatch pack
+                                        instead (preview.c)               */
 } splat_build_desc;
 
 typedef struct splat_build_stats {

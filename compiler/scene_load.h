@@ -25,6 +25,8 @@ typedef struct splat_scene {
     int            nmaterials; /* desc->nmaterials, bottom (0) first          */
     /* Every material lowered into one shared ir: roots "<name>.mask", … */
     ir             ir;
+    sg_scene      *own_desc;   /* a preview's altered copy that desc points
+                                  to (preview.c), or NULL                   */
 } splat_scene;
 
 /* Parse and check the scene file and its imports, load the heightfield and
@@ -37,6 +39,13 @@ typedef struct splat_scene {
 bool splat_scene_load(splat_scene *s, const char *path,
                       const char *const *search_paths, sg_diags *d);
 void splat_scene_free(splat_scene *s);
+
+/* preview.c: turn a loaded scene into material `material`'s swatch scene:
+ * that material alone on a built-in test hill (a hemisphere of every
+ * slope on a flat ring, 128 m), the scene's light without fog, painted
+ * masks read as 0, one camera preset "swatch".  A located error if the
+ * scene has no such material. */
+bool splat_scene_preview(splat_scene *s, const char *material, sg_diags *d);
 
 /* ---- painted.c: how a pack stores the painted masks -------------------- */
 

@@ -242,3 +242,26 @@ bool splat_write_atomic(const char *path, const void *data, size_t n)
     errno = err;
     return err == 0;
 }
+
+/* mkdir -p; true if the folder exists afterwards. */
+bool splat_make_dirs(const char *path)
+{
+    char *p = strdup(path);
+    if (!p)
+        return false;
+    for (char *s = p + 1; *s; s++) {
+        if (*s != '/')
+            continue;
+        *s = 0;
+        if (mkdir(p, 0777) != 0 && errno != EEXIST) {
+            free(p);
+            return false;
+        }
+        *s = '/';
+    }
+    bool ok = mkdir(p, 0777) == 0 || errno == EEXIST;
+    struct stat sb;
+    ok = ok && stat(p, &sb) == 0 && S_ISDIR(sb.st_mode);
+    free(p);
+    return ok;
+}

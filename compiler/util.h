@@ -43,6 +43,8 @@ char *splat_path_relative(const char *from, const char *to);
  * when either does not resolve. */
 char *splat_path_relative_real(const char *base, const char *path);
 bool  splat_is_dir(const char *path);
+/* mkdir -p; true if the folder exists afterwards. */
+bool  splat_make_dirs(const char *path);
 
 /* ---- files ---------------------------------------------------------------- */
 

@@ -470,6 +470,8 @@ typedef struct rt_viewer_desc {
     const char *view_name;    /* --view text, parsed against the pack       */
     const char *const *include; /* -I folders for the scene's imports, as   */
     int         ninclude;       /* splatc has them (splat_search_path)      */
+    const char *preview;        /* a material's swatch pack: hot reload
+                                   rebuilds it with splatc build --preview  */
 } rt_viewer_desc;
 
 /* Runs until the window closes or the script quits; returns the exit

@@ -1,6 +1,8 @@
 /* splatview — render a shader pack: headless to PNG (and raw floats), or in
  * a GLFW window with a fly camera and hot reload.  See usage() below. */
 #include "rt_internal.h"
+#include "scene.h"
+#include "util.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -38,6 +40,10 @@ static void usage(FILE *f)
         "  --clear r,g,b             background colour (linear)\n"
         "  --pipeline-cache FILE     pipeline cache file\n"
         "  --scene FILE              scene.sg to watch for hot reload (viewer)\n"
+        "  --material M              material M alone on a built-in test hill under the\n"
+        "                            scene's light (a swatch; the pack's scene.source or\n"
+        "                            --scene is built with splatc build --preview M\n"
+        "                            into the cache; hot reload rebuilds it)\n"
         "  -I DIR                    search DIR for the scene's imports, as splatc\n"
         "                            build -I does (repeatable; also $SPLATC_PATH)\n"
         "  --script S                viewer script: \"frames=30;screenshot=out.png;quit\"\n"
@@ -86,6 +92,8 @@ static void summary(double *v, int n, double *med, double *lo, double *hi)
 
 typedef struct opts {
     const char *pack, *out, *float_out, *preset, *view, *cache, *scene, *script;
+    const char *material;       /* --material M: its swatch pack instead    */
+    char *preview_dir;          /* where that pack is built                 */
     bool headless, stats, have_camera, have_look, no_stitch, no_cull, no_shadows;
     int width, height, frames;
     double camera[3], look[3], lod_pixels;
@@ -282,6 +290,14 @@ static int parse_args(int argc, char **argv, opts *o)
             NEED(); o->cache = v;
         } else if (!strcmp(a, "--scene")) {
             NEED(); o->scene = v;
+        } else if (!strcmp(a, "--material")) {
+            NEED(); o->material = v;
+            if (!*v || strspn(v, "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ"
+                                 "0123456789_") != strlen(v)) {
+                fprintf(stderr, "splatview: --material expects a material's name, found "
+                        "'%s'\n", v);
+                return 2;
+            }
         } else if (!strcmp(a, "-I")) {
             NEED();
             if (o->ninclude == 64) {
@@ -579,11 +595,70 @@ done:
     return status;
 }
 
+/* --material: the scene (--scene, else the pack's scene.source) built as
+ * that material's swatch pack (splatc build --preview) under the cache
+ * folder; o->pack then names it.  Exit status, 0 when built. */
+static int build_preview(opts *o)
+{
+    char *scene = o->scene ? strdup(o->scene) : NULL;
+    if (!scene) {
+        rt_pack p;
+        rt_error e = { 0 };
+        if (!rt_pack_load(&p, o->pack, &e)) {
+            fprintf(stderr, "splatview: %s\n", e.msg);
+            rt_error_clear(&e);
+            return 1;
+        }
+        scene = p.scene_path ? splat_path_join(o->pack, p.scene_path) : NULL;
+        rt_pack_free(&p);
+        if (!scene) {
+            fprintf(stderr, "splatview: --material: the pack names no scene.source; "
+                            "give --scene FILE\n");
+            return 1;
+        }
+        o->scene = scene;   /* for hot reload; lives as long as the process */
+    }
+    char *abs = splat_path_absolute(scene), *cache = splat_cache_default_dir();
+    uint64_t h = 1469598103934665603ull;   /* FNV-1a of the scene's path */
+    for (const char *c = abs ? abs : scene; *c; c++)
+        h = (h ^ (uint8_t)*c) * 1099511628211ull;
+    char name[64];
+    snprintf(name, sizeof name, "preview/%016llx-", (unsigned long long)h);
+    char *dir = cache ? splat_path_join(cache, name) : NULL;
+    free(abs);
+    free(cache);
+    if (!dir || !splat_make_dirs(dir)) {
+        fprintf(stderr, "splatview: --material: no cache folder for the swatch pack "
+                        "(set XDG_CACHE_HOME or SPLATC_CACHE)\n");
+        free(dir);
+        return 1;
+    }
+    o->preview_dir = xasprintf("%s/%s", dir, o->material);
+    free(dir);
+    char **paths = splat_search_path(o->include, o->ninclude, o->scene);
+    splat_build_desc bd = { .scene = o->scene, .out = o->preview_dir,
+                            .search_paths = (const char *const *)paths, .jobs = 2,
+                            .preview = o->material };
+    splat_build_stats st;
+    sg_diags d;
+    sg_diags_init(&d);
+    bool ok = splat_build(&bd, &st, &d);
+    sg_diags_print(&d, stderr);
+    sg_diags_free(&d);
+    splat_search_path_free(paths);
+    if (!ok)
+        return 1;
+    o->pack = o->preview_dir;
+    return 0;
+}
+
 int main(int argc, char **argv)
 {
     opts o;
     int rc = parse_args(argc, argv, &o);
     if (rc)
+        return rc;
+    if (o.material && (rc = build_preview(&o)) != 0)
         return rc;
     if (o.headless)
         return headless(&o);
@@ -605,5 +680,6 @@ int main(int argc, char **argv)
     vd.view_name = o.view;
     vd.include = o.include;
     vd.ninclude = o.ninclude;
+    vd.preview = o.material;
     return rt_viewer_run(&vd);
 }

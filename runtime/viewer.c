@@ -301,7 +301,8 @@ static void reload(viewer *v)
     sg_diags d;
     sg_diags_init(&d);
     splat_build_desc bd = { .scene = v->scene, .out = v->desc->pack_dir,
-                            .search_paths = (const char *const *)paths, .jobs = 2 };
+                            .search_paths = (const char *const *)paths, .jobs = 2,
+                            .preview = v->desc->preview };
     splat_build_stats bs;
     double t0 = splat_now();
     bool ok = splat_build(&bd, &bs, &d);

@@ -207,6 +207,42 @@ hot_reload)
     grep -q "reloaded" "$OUT/viewer.log" || fail "no reload"
     cmp -s "$OUT/a.png" "$OUT/b.png" && fail "the picture did not change after the edit"
     ;;
+preview)
+    # splatview --material: one material of a copy of examples/minimal alone
+    # on the built-in test hill (splatc build --preview), headless, then in
+    # the viewer across an edit of that material (hot reload rebuilds it)
+    ROOT=$(cd "$(dirname "$0")/../.." && pwd)
+    rm -rf "$OUT/src" "$OUT/pack" "$OUT/cache" "$OUT"/*.png
+    mkdir -p "$OUT/src/examples"
+    cp -r "$ROOT/examples/minimal" "$OUT/src/examples/" && cp -r "$ROOT/graphs" "$ROOT/nodes" "$OUT/src/"
+    SCENE="$OUT/src/examples/minimal/scene.sg"
+    export XDG_CACHE_HOME="$OUT/cache"
+    "$SPLATC" build "$SCENE" -o "$OUT/pack" --no-cache > /dev/null || fail "splatc build"
+    run "$OUT/pack" --material field --headless --size 160x100 -o "$OUT/field.png"
+    run "$OUT/pack" --material rock --headless --size 160x100 -o "$OUT/rock.png"
+    for m in field rock; do
+        "$IC" nonuniform "$OUT/$m.png" || fail "the $m swatch is uniform"
+    done
+    cmp -s "$OUT/field.png" "$OUT/rock.png" && fail "two materials gave the same swatch"
+    ls "$OUT"/cache/splatc/preview/*/field/manifest.json > /dev/null || fail "no swatch pack in the cache"
+    "$SV" "$OUT/pack" --material nope --headless --size 16x16 -o "$OUT/x.png" 2> "$OUT/err.txt" &&
+        fail "an unknown material was previewed"
+    grep -q "no material 'nope' in scene 'minimal' to preview" "$OUT/err.txt" ||
+        fail "unclear error: $(cat "$OUT/err.txt")"
+    "$SV" "$OUT/pack" --material ../x --headless --size 16x16 -o "$OUT/x.png" 2> "$OUT/err.txt"
+    [ $? = 2 ] || fail "a material name with a path was accepted"
+    [ -e "$OUT/x.png" ] && fail "a picture was written for a bad material"
+    command -v xvfb-run > /dev/null || { echo "SKIP: no xvfb-run for the viewer part"; exit 77; }
+    viewer_until_shot "$OUT/a.png" "$OUT/viewer.log" "$OUT/pack" --material field --size 160x100 \
+        --script "frames=3;screenshot=$OUT/a.png;wait_reload=150;frames=2;screenshot=$OUT/b.png;quit"
+    sed -i 's/vec3(0.55, 0.47, 0.22)/vec3(0.9, 0.05, 0.05)/' "$SCENE"
+    wait $pid
+    rc=$?
+    cat "$OUT/viewer.log"
+    [ $rc = 0 ] || fail "viewer exit $rc"
+    grep -q "reloaded" "$OUT/viewer.log" || fail "no reload"
+    cmp -s "$OUT/a.png" "$OUT/b.png" && fail "the swatch did not change after the edit"
+    ;;
 real)
     # a pack written by splatc build: pictures, combination colours, and the
     # exactness of the composites against both references

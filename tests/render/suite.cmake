@@ -43,7 +43,7 @@ if(TARGET splatrt AND TARGET splatview)
       FIXTURES_REQUIRED minimal_pack ENVIRONMENT "SPLAT_VALIDATE=1" TIMEOUT 300)
     # hot reload of an edited scene; _search: imports found only through
     # -I or $SPLATC_PATH, as splatc build finds them
-    foreach(case hot_reload hot_reload_search)
+    foreach(case hot_reload hot_reload_search preview)
       add_test(NAME render.${case}
         COMMAND sh ${RENDER_DIR}/run.sh ${case} $<TARGET_FILE:splatview>
                 $<TARGET_FILE:imgcheck> ${RENDER_OUT}/minimal ${RENDER_OUT}/out)
