@@ -75,7 +75,7 @@ bool splat_scene_preview(splat_scene *s, const char *material, sg_diags *d)
     sg_scene_camera *cam = xcalloc(1, sizeof *cam);
     *cam = (sg_scene_camera){
         .name = (char *)swatch,
-        .position = { HILL_SIZE / 2 + 62, 52, HILL_SIZE / 2 + 74 },
+        .position = { HILL_SIZE / 2 - 66, 50, HILL_SIZE / 2 + 70 },   /* south-west */
         .look = { HILL_SIZE / 2, 14, HILL_SIZE / 2 },
         .loc = sc->loc,
     };
