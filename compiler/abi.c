@@ -155,14 +155,35 @@
  * the pixel's footprint over a heightfield texel:
  *     alpha^2 += min(0.01 * (footprint / texel)^2, 0.18)
  * (footprint = dist * u_frame.screen.w, radians per pixel; 0.18: the
- * clamp of Kaplanyan et al. 2016).  Then fog towards the background
- * colour (u_frame.fog: far terrain fades into what is drawn behind it):
+ * clamp of Kaplanyan et al. 2016).  Then fog towards what is drawn
+ * behind the terrain: the sky along the view ray when it is drawn, else
+ * the background colour u_frame.fog (far terrain fades into it):
  * density fog.a at height light.x, falling off by exp(-light.y * (y -
  * light.x)) (0: the same everywhere), integrated exactly along the ray
  * (Quilez, "Better fog"); then the exposure factor light.z.
  * v: surface -> camera.  tests/render/test_lighting.c holds a double
  * twin of this model. */
+/* The analytic sky, radiance along unit direction d (before exposure): a
+ * gradient from the horizon's haze (the zenith colour half way to grey
+ * of 1.5 times its luminance) up to the zenith, 2.2 times the scene's
+ * `sky` (mix by elevation^0.45; the ambient term keeps the scene's value:
+ * about half the sky is hidden from terrain by terrain, which the preview
+ * does not trace), plus a sun glow (the sun's colour times 0.02 mu^8 +
+ * 0.25 mu^256, mu the cosine to the sun); below the horizon the haze.
+ * Drawn behind the terrain when u_frame.sky_color.a is 1 (the default
+ * background of the final view: runtime/render.c), and then the colour
+ * fog fades into, so far terrain meets the sky behind it. */
+#define SKY_TEXT \
+    "vec3 splat_sky(vec3 d) {\n" \
+    "    vec3 zen = u_frame.sky_color.rgb * 2.2;\n" \
+    "    vec3 hor = mix(zen, vec3(dot(zen, vec3(0.2126, 0.7152, 0.0722)) * 1.5), 0.5);\n" \
+    "    vec3 c = mix(hor, zen, pow(max(d.y, 0.0), 0.45));\n" \
+    "    float mu = max(dot(d, u_frame.sun_dir.xyz), 0.0);\n" \
+    "    return c + u_frame.sun_color.rgb * (0.02 * pow(mu, 8.0) + 0.25 * pow(mu, 256.0));\n" \
+    "}\n"
+
 #define LIGHTING_TEXT \
+    SKY_TEXT \
     "float splat_fog(float dist, vec3 v) {\n" \
     "    float k = u_frame.light.y;\n" \
     "    float at_cam = u_frame.fog.a * exp(-k * (u_frame.camera.y - u_frame.light.x));\n" \
@@ -199,7 +220,8 @@
     "    vec3 c = u_frame.sun_color.rgb * splat_sun_visible(dist, v)\n" \
     "             * splat_sun_brdf(albedo, n, splat_alpha2(rough, dist), u_frame.sun_dir.xyz, v);\n" \
     "    c += albedo * u_frame.sky_color.rgb * (0.5 + 0.5 * n.y);\n" \
-    "    c = mix(c, u_frame.fog.rgb, splat_fog(dist, v));\n" \
+    "    vec3 fog = u_frame.sky_color.a > 0.0 ? splat_sky(-v) : u_frame.fog.rgb;\n" \
+    "    c = mix(c, fog, splat_fog(dist, v));\n" \
     "    return c * u_frame.light.z;\n" \
     "}\n"
 
@@ -221,6 +243,7 @@ void splat_light_range(int k, int i, double *lo, double *hi)
 const char SPLAT_GLSL_COMBO_COLOR[] = COMBO_COLOR_TEXT;
 const char SPLAT_GLSL_TERRAIN[] = SPLAT_GLSL_COMMON;
 const char SPLAT_GLSL_LIGHTING[] = LIGHTING_TEXT;
+const char SPLAT_GLSL_SKY[] = SKY_TEXT;
 
 const char SPLAT_GLSL_VERTEX[] =
     "#version 450\n"

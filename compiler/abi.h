@@ -277,7 +277,9 @@ typedef struct splat_frame {
     float camera[4];         /* xyz: camera, terrain-local metres            */
     float sun_dir[4];        /* xyz: unit vector towards the sun             */
     float sun_color[4];      /* rgb: sun radiance                            */
-    float sky_color[4];      /* rgb: sky ambient (hemisphere, up)            */
+    float sky_color[4];      /* rgb: sky ambient (hemisphere, up) and the
+                                analytic sky's zenith; a: 1 when that sky
+                                is drawn behind the terrain (splat_sky)     */
     float fog[4];            /* rgb: fog colour; a: density per metre        */
     float terrain[4];        /* x: size x (m), y: size z (m), z: max height
                                 (m), w: height offset (m)                   */
@@ -355,6 +357,9 @@ typedef struct splat_push {
  *   screen-space tile classification). */
 extern const char SPLAT_GLSL_PRELUDE[];
 extern const char SPLAT_GLSL_LIGHTING[];
+/* vec3 splat_sky(vec3 d): the analytic sky's radiance along d (abi.c),
+ * reading only u_frame: for the runtime's background passes. */
+extern const char SPLAT_GLSL_SKY[];
 extern const char SPLAT_GLSL_VERTEX[];
 extern const char SPLAT_GLSL_COMBO_COLOR[];
 extern const char SPLAT_GLSL_TERRAIN[];

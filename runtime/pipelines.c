@@ -25,6 +25,15 @@ static const char resolve_vert[] =
     "    v_rel = vec3(0.0); v_uv = p; v_local = vec3(0.0);\n"
     "}\n";
 
+/* The sky behind the terrain (forward path): the same triangle at depth
+ * 0, drawn last with depth test EQUAL, so only where no terrain wrote. */
+static const char sky_frag_main[] =
+    "void main() {\n"
+    "    vec2 ndc = gl_FragCoord.xy / u_frame.screen.xy * 2.0 - 1.0;\n"
+    "    vec4 q = u_frame.inv_view_proj * vec4(ndc, 0.5, 1.0);\n"
+    "    o_color = vec4(splat_sky(normalize(q.xyz / q.w)) * u_frame.light.z, 1.0);\n"
+    "}\n";
+
 static const char resolve_frag_main[] =
     "layout(set = 2, binding = 0) uniform sampler2D r_albedo;\n"
     "layout(set = 2, binding = 1) uniform sampler2D r_normal;\n"
@@ -32,16 +41,20 @@ static const char resolve_frag_main[] =
     "void main() {\n"
     "    ivec2 p = ivec2(gl_FragCoord.xy);\n"
     "    vec4 a = texelFetch(r_albedo, p, 0);\n"
-    "    if (a.a <= 0.0) discard;          /* no terrain: keep the clear colour */\n"
+    /* the pixel's ray, surface -> camera (v_rel is 0 in this pass) */
+    "    vec2 ndc = gl_FragCoord.xy / u_frame.screen.xy * 2.0 - 1.0;\n"
+    "    vec4 q = u_frame.inv_view_proj * vec4(ndc, 0.5, 1.0);\n"
+    "    vec3 to_cam = -normalize(q.xyz / q.w);\n"
+    "    if (a.a <= 0.0) {   /* no terrain: the sky, or keep the clear colour */\n"
+    "        if (u_frame.sky_color.a <= 0.0) discard;\n"
+    "        o_color = vec4(splat_sky(-to_cam) * u_frame.light.z, 1.0);\n"
+    "        return;\n"
+    "    }\n"
     "    vec4 ns = texelFetch(r_normal, p, 0);\n"
     "    vec4 m = texelFetch(r_misc, p, 0);\n"
     "    vec3 nn = normalize(ns.xyz);\n"
     "    vec3 albedo = a.rgb, n = nn, c;\n"
     "    float rough = m.r, dist = m.b;\n"
-    /* the pixel's ray, surface -> camera (v_rel is 0 in this pass) */
-    "    vec2 ndc = gl_FragCoord.xy / u_frame.screen.xy * 2.0 - 1.0;\n"
-    "    vec4 q = u_frame.inv_view_proj * vec4(ndc, 0.5, 1.0);\n"
-    "    vec3 to_cam = -normalize(q.xyz / q.w);\n"
     "    switch (u_frame.view.x) {\n"
     SPLAT_VIEWS(SPLAT_VIEW_CASE_RESOLVE)   /* abi.h: the views it can show */
     "    default: c = splat_light(albedo, n, rough, dist, to_cam); break;\n"
@@ -243,6 +256,7 @@ typedef enum kind {
     K_BLEND,        /* multi-pass upper materials: blend, depth EQUAL         */
     K_RESOLVE,      /* fullscreen, no depth, no vertex input                  */
     K_DEPTH,        /* screen-space geometry pass: vertex stage, depth only   */
+    K_SKY,          /* fullscreen, depth EQUAL the clear value, no write      */
 } kind;
 
 static bool make_pipeline(rt_device *d, rt_pipelines *pl, VkShaderModule vs,
@@ -266,9 +280,9 @@ static bool make_pipeline(rt_device *d, rt_pipelines *pl, VkShaderModule vs,
     VkVertexInputAttributeDescription va = { 0, 0, VK_FORMAT_R32G32_SFLOAT, 0 };
     VkPipelineVertexInputStateCreateInfo vi = {
         .sType = VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO,
-        .vertexBindingDescriptionCount = k == K_RESOLVE ? 0 : 1,
+        .vertexBindingDescriptionCount = k == K_RESOLVE || k == K_SKY ? 0 : 1,
         .pVertexBindingDescriptions = &vb,
-        .vertexAttributeDescriptionCount = k == K_RESOLVE ? 0 : 1,
+        .vertexAttributeDescriptionCount = k == K_RESOLVE || k == K_SKY ? 0 : 1,
         .pVertexAttributeDescriptions = &va,
     };
     VkPipelineInputAssemblyStateCreateInfo ia = {
@@ -299,7 +313,8 @@ static bool make_pipeline(rt_device *d, rt_pipelines *pl, VkShaderModule vs,
         .sType = VK_STRUCTURE_TYPE_PIPELINE_DEPTH_STENCIL_STATE_CREATE_INFO,
         .depthTestEnable = k != K_RESOLVE,
         .depthWriteEnable = k == K_OPAQUE || k == K_BASE || k == K_DEPTH,
-        .depthCompareOp = k == K_BLEND ? VK_COMPARE_OP_EQUAL : VK_COMPARE_OP_GREATER_OR_EQUAL,
+        .depthCompareOp = k == K_BLEND || k == K_SKY ? VK_COMPARE_OP_EQUAL
+                                                     : VK_COMPARE_OP_GREATER_OR_EQUAL,
     };
     const VkColorComponentFlags all = VK_COLOR_COMPONENT_R_BIT | VK_COLOR_COMPONENT_G_BIT |
                                       VK_COLOR_COMPONENT_B_BIT | VK_COLOR_COMPONENT_A_BIT;
@@ -525,21 +540,25 @@ bool rt_pipelines_reset_combos(rt_device *d, const rt_pack *p, rt_pipelines *pl,
     return true;
 }
 
-static bool resolve_pipeline(rt_device *d, rt_pipelines *pl, VkRenderPass pass, rt_error *e)
+/* A fullscreen-triangle pipeline of the runtime's own: the resolve pass
+ * (K_RESOLVE) or the sky (K_SKY), fragment = the prelude + `main_text`. */
+static bool fullscreen_pipeline(rt_device *d, rt_pipelines *pl, VkRenderPass pass, kind k,
+                                const char *main_text, const char *name, VkPipeline *out,
+                                rt_error *e)
 {
-    size_t n = strlen(SPLAT_GLSL_PRELUDE) + strlen(resolve_frag_main) + 32;
+    size_t n = strlen(SPLAT_GLSL_PRELUDE) + strlen(main_text) + 32;
     char *src = malloc(n);
     if (!src)
-        return rt_fail(e, RT_E_VULKAN, "resolve", "out of memory");
-    snprintf(src, n, "#version 450\n%s%s", SPLAT_GLSL_PRELUDE, resolve_frag_main);
+        return rt_fail(e, RT_E_VULKAN, name, "out of memory");
+    snprintf(src, n, "#version 450\n%s%s", SPLAT_GLSL_PRELUDE, main_text);
     uint32_t *vw = NULL, *fw = NULL;
     size_t vn = 0, fn = 0;
-    bool ok = rt_glsl_compile(resolve_vert, VK_SHADER_STAGE_VERTEX_BIT, "resolve.vert", &vw, &vn, e) &&
-              rt_glsl_compile(src, VK_SHADER_STAGE_FRAGMENT_BIT, "resolve.frag", &fw, &fn, e);
+    bool ok = rt_glsl_compile(resolve_vert, VK_SHADER_STAGE_VERTEX_BIT, "fullscreen.vert", &vw, &vn, e) &&
+              rt_glsl_compile(src, VK_SHADER_STAGE_FRAGMENT_BIT, name, &fw, &fn, e);
     free(src);
     VkShaderModule vm = VK_NULL_HANDLE, fm = VK_NULL_HANDLE;
     ok = ok && make_module(d, vw, vn, &vm, e) && make_module(d, fw, fn, &fm, e) &&
-         make_pipeline(d, pl, vm, fm, pass, K_RESOLVE, RT_VARIANT_DEBUG, &pl->resolve, e);
+         make_pipeline(d, pl, vm, fm, pass, k, RT_VARIANT_DEBUG, out, e);
     if (vm)
         vkDestroyShaderModule(d->dev, vm, NULL);
     if (fm)
@@ -571,12 +590,13 @@ bool rt_pipelines_create(rt_device *d, const rt_pack *p, const rt_passes *rp,
         if (!pl->ref)
             return rt_fail(e, RT_E_VULKAN, "pipelines", "out of memory");
         pl->nref = p->nmaterials;
-        if (!resolve_pipeline(d, pl, rp->resolve, e))
+        if (!fullscreen_pipeline(d, pl, rp->resolve, K_RESOLVE, resolve_frag_main, "resolve.frag",
+                                 &pl->resolve, e))
             return false;
     }
     if (ref == RT_REF_UBER && !p->uber.words)
         return rt_fail(e, RT_E_PACK_FIELD, p->dir, "the pack has no uber shader");
-    return true;
+    return fullscreen_pipeline(d, pl, rp->main, K_SKY, sky_frag_main, "sky.frag", &pl->sky, e);
 }
 
 void rt_pipelines_destroy(rt_device *d, rt_pipelines *pl)
@@ -596,6 +616,8 @@ void rt_pipelines_destroy(rt_device *d, rt_pipelines *pl)
             vkDestroyPipeline(d->dev, pl->uber[i], NULL);
     if (pl->resolve)
         vkDestroyPipeline(d->dev, pl->resolve, NULL);
+    if (pl->sky)
+        vkDestroyPipeline(d->dev, pl->sky, NULL);
     for (int i = 0; i < 2; i++)
         if (pl->depth[i])
             vkDestroyPipeline(d->dev, pl->depth[i], NULL);

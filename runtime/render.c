@@ -23,6 +23,7 @@ struct rt_renderer {
     rt_light          light;           /* the pack's, or set_light's        */
     bool              light_set;
     bool              shadow_stale;    /* heights changed since the map     */
+    bool              default_clear;   /* no background given: the sky      */
     double            shadow_sun[3];   /* the sun the map was made for      */
     rt_terrain_gpu    terrain;
     rt_destruction   *destr;           /* NULL: no destructible area        */
@@ -449,8 +450,10 @@ bool rt_renderer_create(rt_device *d, const rt_pack *p, const rt_render_desc *de
     if (r->desc.lod_pixels <= 0)
         r->desc.lod_pixels = 3.0;
     if (r->desc.clear[3] == 0 && r->desc.clear[0] == 0 && r->desc.clear[1] == 0 && r->desc.clear[2] == 0) {
+        /* the final view draws the analytic sky; the others this colour */
         static const float sky[4] = { 0.35f, 0.52f, 0.85f, 1.0f };
         memcpy(r->desc.clear, sky, sizeof sky);
+        r->default_clear = true;
     }
     r->ncombos = p->ncombos;
     r->combo_ids = calloc((size_t)p->nlevels, sizeof *r->combo_ids);
@@ -715,6 +718,13 @@ static void invert4(const double m[16], double out[16])
             out[c * 4 + r] = a[r][4 + c];
 }
 
+/* The analytic sky (abi.c splat_sky) is the background of the final view
+ * unless the caller gave a background colour. */
+static bool sky_drawn(const rt_renderer *r)
+{
+    return r->default_clear && r->view == SPLAT_VIEW_FINAL && !r->wireframe;
+}
+
 static void fill_frame(rt_renderer *r, const rt_camera *c, splat_frame *fr)
 {
     const rt_pack *p = r->p;
@@ -734,6 +744,7 @@ static void fill_frame(rt_renderer *r, const rt_camera *c, splat_frame *fr)
         fr->camera[i] = (float)c->position[i];
     rt_light_frame(&r->light, p, r->desc.clear, fr);
     fr->light[3] = r->desc.no_shadows ? 0.0f : 1.0f;
+    fr->sky_color[3] = sky_drawn(r) ? 1.0f : 0.0f;
     fr->terrain[0] = (float)p->size[0];
     fr->terrain[1] = (float)p->size[1];
     fr->terrain[2] = (float)p->max_height;
@@ -1026,6 +1037,11 @@ static bool record_forward(rt_renderer *r, VkCommandBuffer cb, const rt_camera *
             }
             start = end;
         }
+    }
+    if (sky_drawn(r)) {   /* where no terrain wrote depth */
+        vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_GRAPHICS, r->pl.sky);
+        (*binds)++;
+        vkCmdDraw(cb, 3, 1, 0, 0);
     }
     vkCmdEndRenderPass(cb);
     return true;

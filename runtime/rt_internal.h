@@ -308,6 +308,7 @@ typedef struct rt_pipelines {
     int                   nref;
     VkPipeline            uber[RT_VARIANTS];
     VkPipeline            resolve;
+    VkPipeline            sky;           /* the analytic sky, forward path  */
     VkPipelineLayout      compute_layout;/* sets 0, 1 + splat_push (compute) */
     VkPipeline           *compute;       /* RT_CVARIANTS per combination, the
                                             über-shader's last              */

@@ -115,11 +115,14 @@ static const char classify_glsl[] =
     /* one pixel: the background where empty, else its cell(s) */
     "void pixel(ivec2 px) {\n"
     "    float d = texelFetch(u_depth, px, 0).r;\n"
-    "    if (d == u_frame.screen.z) {   /* empty: the background */\n"
-    "        imageStore(u_out, px, u_push.patch_xz);\n"
+    "    vec2 ndc = (vec2(px) + 0.5) / u_frame.screen.xy * 2.0 - 1.0;\n"
+    "    if (d == u_frame.screen.z) {   /* empty: the sky, or the background colour */\n"
+    "        vec4 q = u_frame.inv_view_proj * vec4(ndc, 0.5, 1.0);\n"
+    "        imageStore(u_out, px, u_frame.sky_color.a > 0.0\n"
+    "            ? vec4(splat_sky(normalize(q.xyz / q.w)) * u_frame.light.z, 1.0)\n"
+    "            : u_push.patch_xz);\n"
     "        return;\n"
     "    }\n"
-    "    vec2 ndc = (vec2(px) + 0.5) / u_frame.screen.xy * 2.0 - 1.0;\n"
     "    vec4 p = u_frame.inv_view_proj * vec4(ndc, d, 1.0);\n"
     "    vec2 local = p.xz / p.w + u_frame.camera.xz;\n"
     "    vec2 cf = local / u_frame.terrain.xy * u_frame.texel.xy / float(u_info.cell_texels);\n"
@@ -501,11 +504,12 @@ static bool own_pipeline(rt_screen *s, const rt_pipelines *pl, const char *head,
                          const char *name, VkPipeline *out, rt_error *e)
 {
     rt_device *d = s->d;
-    size_t n = strlen(head) + strlen(SPLAT_GLSL_TERRAIN) + strlen(body) + 32;
+    size_t n = strlen(head) + strlen(SPLAT_GLSL_TERRAIN) + strlen(SPLAT_GLSL_SKY) +
+               strlen(body) + 32;
     char *src = malloc(n);
     if (!src)
         return rt_fail(e, RT_E_VULKAN, name, "out of memory");
-    snprintf(src, n, "#version 450\n%s%s%s", head, SPLAT_GLSL_TERRAIN, body);
+    snprintf(src, n, "#version 450\n%s%s%s%s", head, SPLAT_GLSL_TERRAIN, SPLAT_GLSL_SKY, body);
     uint32_t *words = NULL;
     size_t nw = 0;
     bool ok = rt_glsl_compile(src, VK_SHADER_STAGE_COMPUTE_BIT, name, &words, &nw, e);
