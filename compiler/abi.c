@@ -147,7 +147,7 @@
  * Schlick Fresnel F with F0 = 0.04 (dielectrics); diffuse Lambert weighted
  * by 1 - F so reflected energy is not counted twice:
  *     Lo = (albedo (1 - F) + pi D V F) * sun * ndl
- *        + albedo * sky * (0.5 + 0.5 n.y)            (hemisphere sky)
+ *        + albedo * splat_sky_ambient(n)             (the sky, below)
  * with sun = u_frame.sun_color, the sun's irradiance / pi, times the
  * sun's visibility from the shadow map (runtime/shadow.c).  Specular
  * anti-aliasing, the same in every shading path: alpha^2 is widened by
@@ -166,20 +166,29 @@
 /* The analytic sky, radiance along unit direction d (before exposure): a
  * gradient from the horizon's haze (the zenith colour half way to grey
  * of 1.5 times its luminance) up to the zenith, 2.2 times the scene's
- * `sky` (mix by elevation^0.45; the ambient term keeps the scene's value:
- * about half the sky is hidden from terrain by terrain, which the preview
- * does not trace), plus a sun glow (the sun's colour times 0.02 mu^8 +
- * 0.25 mu^256, mu the cosine to the sun); below the horizon the haze.
+ * `sky` (mix by elevation^0.45), plus a sun glow (the sun's colour times
+ * 0.02 mu^8 + 0.25 mu^256, mu the cosine to the sun); below the horizon
+ * the haze.  The ambient light of a surface of normal n is the same
+ * gradient seen by a hemisphere: 0.5 mix(horizon, zenith, 0.5 + 0.5 n.y)
+ * (irradiance / pi of the gradient between its horizon and zenith
+ * radiance, halved for the sky that surrounding terrain hides, which the
+ * preview does not trace; glow left out).
  * Drawn behind the terrain when u_frame.sky_color.a is 1 (the default
  * background of the final view: runtime/render.c), and then the colour
  * fog fades into, so far terrain meets the sky behind it. */
 #define SKY_TEXT \
+    "vec3 splat_sky_zenith() { return u_frame.sky_color.rgb * 2.2; }\n" \
+    "vec3 splat_sky_horizon() {\n" \
+    "    vec3 zen = splat_sky_zenith();\n" \
+    "    return mix(zen, vec3(dot(zen, vec3(0.2126, 0.7152, 0.0722)) * 1.5), 0.5);\n" \
+    "}\n" \
     "vec3 splat_sky(vec3 d) {\n" \
-    "    vec3 zen = u_frame.sky_color.rgb * 2.2;\n" \
-    "    vec3 hor = mix(zen, vec3(dot(zen, vec3(0.2126, 0.7152, 0.0722)) * 1.5), 0.5);\n" \
-    "    vec3 c = mix(hor, zen, pow(max(d.y, 0.0), 0.45));\n" \
+    "    vec3 c = mix(splat_sky_horizon(), splat_sky_zenith(), pow(max(d.y, 0.0), 0.45));\n" \
     "    float mu = max(dot(d, u_frame.sun_dir.xyz), 0.0);\n" \
     "    return c + u_frame.sun_color.rgb * (0.02 * pow(mu, 8.0) + 0.25 * pow(mu, 256.0));\n" \
+    "}\n" \
+    "vec3 splat_sky_ambient(vec3 n) {\n" \
+    "    return 0.5 * mix(splat_sky_horizon(), splat_sky_zenith(), 0.5 + 0.5 * n.y);\n" \
     "}\n"
 
 #define LIGHTING_TEXT \
@@ -219,7 +228,7 @@
     "vec3 splat_light(vec3 albedo, vec3 n, float rough, float dist, vec3 v) {\n" \
     "    vec3 c = u_frame.sun_color.rgb * splat_sun_visible(dist, v)\n" \
     "             * splat_sun_brdf(albedo, n, splat_alpha2(rough, dist), u_frame.sun_dir.xyz, v);\n" \
-    "    c += albedo * u_frame.sky_color.rgb * (0.5 + 0.5 * n.y);\n" \
+    "    c += albedo * splat_sky_ambient(n);\n" \
     "    vec3 fog = u_frame.sky_color.a > 0.0 ? splat_sky(-v) : u_frame.fog.rgb;\n" \
     "    c = mix(c, fog, splat_fog(dist, v));\n" \
     "    return c * u_frame.light.z;\n" \

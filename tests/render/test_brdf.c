@@ -79,9 +79,18 @@ static void model(double rough, double dist, double pixel_angle, double texel,
     double vis = 0.5 / (ndl * sqrt(ndv * ndv * (1 - a2) + a2) +
                         ndv * sqrt(ndl * ndl * (1 - a2) + a2));
     double f = 0.04 + 0.96 * pow(1 - vdh, 5);
+    /* the sky's ambient: 0.5 mix(horizon, zenith, 0.5 + 0.5 n.y), the
+     * zenith 2.2 sky, the horizon half way to grey of 1.5 its luminance */
+    double zen[3], lum = 0;
+    for (int i = 0; i < 3; i++) {
+        zen[i] = 2.2 * SKY[i];
+        lum += zen[i] * (i == 0 ? 0.2126 : i == 1 ? 0.7152 : 0.0722);
+    }
     for (int i = 0; i < 3; i++) {
         double sun = (ALBEDO[i] * (1 - f) + M_PI * d * vis * f) * ndl * INTENSITY;
-        out[i] = (sun + ALBEDO[i] * SKY[i] * (0.5 + 0.5 * n[1])) * exp2(EXPOSURE);
+        double hor = 0.5 * zen[i] + 0.5 * 1.5 * lum, t = 0.5 + 0.5 * n[1];
+        double sky = 0.5 * (hor * (1 - t) + zen[i] * t);
+        out[i] = (sun + ALBEDO[i] * sky) * exp2(EXPOSURE);
     }
 }
 
