@@ -602,6 +602,10 @@ static void pack_light(rt_renderer *r, const rt_pack *p)
         r->light.exposure = r->desc.exposure;
     if (r->desc.fog_set)
         r->light.fog_density = r->desc.fog_density;
+    for (int k = 0; k < SPLAT_LIGHT_COUNT; k++)
+        if (r->desc.light_keys & (1u << k))
+            memcpy(rt_light_values(&r->light, k), r->desc.light[k],
+                   (size_t)splat_light_keys[k].n * sizeof(double));
 }
 
 void rt_renderer_set_light(rt_renderer *r, const rt_light *l)

@@ -319,6 +319,11 @@ typedef struct rt_render_desc {
     bool         sun_set, exposure_set, fog_set;
     double       sun[2], exposure, fog_density;
     bool         no_shadows;        /* the sun casts none (splatview --no-shadows) */
+    /* any light key over the pack's (splatview --light KEY=V,...): bit k
+     * of light_keys set = abi.h SPLAT_LIGHT_KEYS row k given, its values
+     * in light[k]; applied after sun / exposure / fog_density above */
+    unsigned     light_keys;
+    double       light[SPLAT_LIGHT_COUNT][3];
 } rt_render_desc;
 
 typedef struct rt_frame_stats {

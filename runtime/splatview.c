@@ -37,6 +37,8 @@ static void usage(FILE *f)
         "  --exposure EV             exposure in stops (default: the scene's, or 0)\n"
         "  --fog-density D           fog per metre at the fog height (0: none)\n"
         "  --no-shadows              the sun casts no terrain shadows\n"
+        "  --light KEY=V[,V,V]       any key of the scene's light block (sun, sun_color,\n"
+        "                            intensity, sky, fog_density, fog_height, exposure)\n"
         "  --clear r,g,b             background colour (linear)\n"
         "  --pipeline-cache FILE     pipeline cache file\n"
         "  --scene FILE              scene.sg to watch for hot reload (viewer)\n"
@@ -111,11 +113,48 @@ typedef struct opts {
     int destruction_pool;       /* --destruction-pool N                      */
     bool sun_set, exposure_set, fog_set;   /* --sun, --exposure, --fog-density */
     double sun[2], exposure, fog_density;
+    unsigned light_keys;                   /* --light KEY=V,...              */
+    double light[SPLAT_LIGHT_COUNT][3];
 } opts;
+
+/* --light KEY=V[,V,V]: any key of the scene's light block (abi.h
+ * SPLAT_LIGHT_KEYS), its values in range. */
+static bool parse_light(const char *s, opts *o)
+{
+    const char *eq = strchr(s, '=');
+    for (int k = 0; eq && k < SPLAT_LIGHT_COUNT; k++) {
+        const splat_light_key *key = &splat_light_keys[k];
+        if (strlen(key->key) != (size_t)(eq - s) || strncmp(s, key->key, (size_t)(eq - s)))
+            continue;
+        const char *p = eq + 1;
+        for (int i = 0; i < key->n; i++) {
+            char *end;
+            double v = strtod(p, &end), lo, hi;
+            splat_light_range(k, i, &lo, &hi);
+            if (end == p || !(v >= lo && v <= hi) || *end != (i + 1 < key->n ? ',' : '\0')) {
+                fprintf(stderr, "splatview: --light %s expects %d number%s (number %d in "
+                        "%g..%g), found '%s'\n", key->key, key->n,
+                        key->n > 1 ? "s separated by commas" : "", i + 1, lo, hi, s);
+                return false;
+            }
+            o->light[k][i] = v;
+            p = end + 1;
+        }
+        o->light_keys |= 1u << k;
+        return true;
+    }
+    fprintf(stderr, "splatview: --light expects KEY=VALUES with KEY one of");
+    for (int k = 0; k < SPLAT_LIGHT_COUNT; k++)
+        fprintf(stderr, " %s", splat_light_keys[k].key);
+    fprintf(stderr, ", found '%s'\n", s);
+    return false;
+}
 
 /* --sun, --exposure, --fog-density into a render desc. */
 static void light_options(const opts *o, rt_render_desc *rd)
 {
+    rd->light_keys = o->light_keys;
+    memcpy(rd->light, o->light, sizeof rd->light);
     rd->sun_set = o->sun_set;
     rd->exposure_set = o->exposure_set;
     rd->fog_set = o->fog_set;
@@ -234,6 +273,10 @@ static int parse_args(int argc, char **argv, opts *o)
                 return 2;
             }
             o->sun_set = true;
+        } else if (!strcmp(a, "--light")) {
+            NEED();
+            if (!parse_light(v, o))
+                return 2;
         } else if (!strcmp(a, "--exposure") || !strcmp(a, "--fog-density")) {
             NEED();
             char *end;

@@ -9,8 +9,9 @@
  *   - the manifest carries the block and the pack loader reads it;
  *   - exposure is a factor on the linear image: +1 EV doubles every
  *     terrain pixel (the background keeps its clear colour);
- *   - the block and splatview's overrides (rt_render_desc) give the same
- *     image: the scene's light = the same light set from outside;
+ *   - the block and splatview's overrides (rt_render_desc: --sun etc. and
+ *     the generic --light KEY=V keys) give the same image: the scene's
+ *     light = the same light set from outside;
  *   - the sun matters: a high sun lights the terrain more than one 5
  *     degrees up, and turning it 180 degrees changes the picture;
  *   - no fog (fog_density 0) leaves far terrain its own colour, default
@@ -151,10 +152,21 @@ int main(int argc, char **argv)
     same.sun_set = true, same.sun[0] = 200, same.sun[1] = 35;
     same.fog_set = true, same.fog_density = 0;
     float *c = render(&dev, &pl, &base, &cam), *d = render(&dev, &pp, &same, &cam);
-    if (c && d) {
-        printf("light block vs the same overrides: max difference %.3g\n", max_diff(c, d));
+    /* and through the generic keys (splatview --light KEY=V,...) */
+    rt_render_desc keyed = base;
+    keyed.light_keys = 1u << SPLAT_LIGHT_EXPOSURE | 1u << SPLAT_LIGHT_SUN |
+                       1u << SPLAT_LIGHT_FOG_DENSITY;
+    keyed.light[SPLAT_LIGHT_EXPOSURE][0] = 1.0;
+    keyed.light[SPLAT_LIGHT_SUN][0] = 200, keyed.light[SPLAT_LIGHT_SUN][1] = 35;
+    keyed.light[SPLAT_LIGHT_FOG_DENSITY][0] = 0;
+    float *k = render(&dev, &pp, &keyed, &cam);
+    if (c && d && k) {
+        printf("light block vs the same overrides: max difference %.3g, through the keys "
+               "%.3g\n", max_diff(c, d), max_diff(c, k));
         CHECK(max_diff(c, d) == 0, "the block and the overrides differ by %g", max_diff(c, d));
+        CHECK(max_diff(c, k) == 0, "the block and the keys differ by %g", max_diff(c, k));
     }
+    free(k);
     /* the sun: high vs low, and turned */
     rt_render_desc hi = base, lo = base, turned = base;
     hi.sun_set = lo.sun_set = turned.sun_set = true;
