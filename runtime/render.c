@@ -614,6 +614,11 @@ void rt_renderer_set_light(rt_renderer *r, const rt_light *l)
     r->light_set = true;
 }
 
+void rt_renderer_set_shadows(rt_renderer *r, bool on)
+{
+    r->desc.no_shadows = !on;
+}
+
 const rt_light *rt_renderer_light(const rt_renderer *r)
 {
     return &r->light;

@@ -357,6 +357,8 @@ void rt_renderer_set_wireframe(rt_renderer *r, bool on);
 /* The lighting of the next frames (default: the pack's); a hot reload
  * keeps one set here. */
 void rt_renderer_set_light(rt_renderer *r, const rt_light *l);
+/* Terrain shadows on or off (rt_render_desc.no_shadows; the viewer's H). */
+void rt_renderer_set_shadows(rt_renderer *r, bool on);
 const rt_light *rt_renderer_light(const rt_renderer *r);
 /* Screen-space path: frames with the counting variant of the shaders
  * (abi.h SPLAT_COUNT), whose counters rt_frame_stats.tiles carries. */

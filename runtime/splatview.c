@@ -709,7 +709,8 @@ int main(int argc, char **argv)
         .pack_dir = o.pack, .scene = o.scene, .width = o.width ? o.width : 1280,
         .height = o.height ? o.height : 720, .script = o.script,
         .render = { .reference = o.ref, .pipeline_cache = o.cache, .lod_pixels = o.lod_pixels,
-                    .shading = o.shading, .screen_depth = o.screen_depth },
+                    .shading = o.shading, .screen_depth = o.screen_depth,
+                    .no_shadows = o.no_shadows },
         .view = SPLAT_VIEW_FINAL,
     };
     memcpy(vd.render.clear, o.clear, sizeof o.clear);

@@ -92,7 +92,7 @@ typedef struct viewer {
     double         yaw, pitch, speed;
     splat_view     view;
     int            material;
-    bool           wire, quit, dragging;
+    bool           wire, quit, dragging, no_shadows;
     double         mx, my;
     /* hot reload */
     watch          w;
@@ -177,6 +177,10 @@ static void key_action(viewer *v, int key)
         rt_renderer_set_light(v->r, &l);
         snprintf(v->status, sizeof v->status, "sun %.0f %.0f, exposure %+.1f EV", l.sun[0],
                  l.sun[1], l.exposure);
+    } else if (key == GLFW_KEY_H) {
+        v->no_shadows = !v->no_shadows;
+        rt_renderer_set_shadows(v->r, !v->no_shadows);
+        snprintf(v->status, sizeof v->status, "shadows %s", v->no_shadows ? "off" : "on");
     } else if (key == GLFW_KEY_Q || key == GLFW_KEY_ESCAPE) {
         v->quit = true;
     }
@@ -861,6 +865,7 @@ int rt_viewer_run(const rt_viewer_desc *desc)
     if (!make_swapchain(v, &e))
         goto done;
     rt_render_desc rd = desc->render;
+    v->no_shadows = rd.no_shadows;
     rd.width = (int)v->extent.width;
     rd.height = (int)v->extent.height;
     /* Screen-capable whenever the pack has compute variants, so the G key
