@@ -10,6 +10,9 @@
 #   depfile    `splatc build --depfile`: every input listed (graphs,
 #              imports, rasters, textures, mips), Make-escaped, and make
 #              rebuilds exactly when one of them changes; --json diagnostics
+#   preview    `splatc build --preview M`: M alone on the 257^2 test hill,
+#              camera `swatch`, no fog; deterministic; an unknown material
+#              is a located error and writes nothing
 #   malformed  empty file, binary garbage, truncated files, 10 MB inputs,
 #              10000-deep instance nesting: exit 1 with a diagnostic, no crash
 #              or hang
@@ -193,6 +196,23 @@ depfile)
         > /dev/null || { fail "--json: no UNKNOWN_NODE at 2:14"; cat "$TMP/err"; }
     jq -e -s 'length >= 1 and all(.[]; has("file") and has("severity") and has("message"))' \
         "$TMP/err" > /dev/null || fail "--json: not JSON Lines of diagnostics"
+    ;;
+preview)
+    run 0 "$SPLATC" build examples/minimal/scene.sg -o "$TMP/sw" --preview rock --no-cache
+    jq -e '[.materials[].name] == ["rock"] and [.scene.cameras[].name] == ["swatch"] and
+           .scene.size == [128, 128] and .scene.heightfield.width == 257 and
+           .scene.light.fog_density == 0' "$TMP/sw/manifest.json" > /dev/null ||
+        fail "the swatch pack is not rock alone on the test hill"
+    run 0 "$SPLATC" build examples/minimal/scene.sg -o "$TMP/sw2" --preview rock --no-cache
+    cmp -s "$TMP/sw/heightfield.r16" "$TMP/sw2/heightfield.r16" &&
+        cmp -s "$TMP/sw/combos.bin" "$TMP/sw2/combos.bin" || fail "two swatch builds differ"
+    run 0 "$SPLATC" build examples/minimal/scene.sg -o "$TMP/sw3" --preview field --no-cache
+    jq -e '[.materials[].name] == ["field"]' "$TMP/sw3/manifest.json" > /dev/null ||
+        fail "--preview field did not build field alone"
+    run 1 "$SPLATC" build examples/minimal/scene.sg -o "$TMP/nope" --preview nope
+    grep -q "scene.sg:[0-9]*:[0-9]*: error: no material 'nope' in scene 'minimal'" "$TMP/err" ||
+        fail "unclear error: $(cat "$TMP/err")"
+    [ -e "$TMP/nope" ] && fail "a failed preview wrote a pack"
     ;;
 malformed)
     : > "$TMP/empty.sg"
