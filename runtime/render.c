@@ -22,7 +22,9 @@ struct rt_renderer {
     rt_render_desc    desc;
     rt_light          light;           /* the pack's, or set_light's        */
     bool              light_set;
-    bool              shadow_stale;    /* heights changed since the map     */
+    bool              shadow_stale;    /* the whole map is to be made       */
+    int               shadow_rect[4];  /* texels craters changed since      */
+    uint8_t          *shadow_map;      /* the CPU copy of the last map      */
     bool              default_clear;   /* no background given: the sky      */
     double            shadow_sun[3];   /* the sun the map was made for      */
     rt_terrain_gpu    terrain;
@@ -496,6 +498,7 @@ void rt_renderer_destroy(rt_renderer *r)
 {
     if (!r)
         return;
+    free(r->shadow_map);
     rt_device *d = r->d;
     if (d->dev) {
         vkDeviceWaitIdle(d->dev);
@@ -1147,31 +1150,34 @@ static bool draw_frame(rt_renderer *r, const rt_camera *c, rt_frame_stats *st, r
 /* A frame; on the screen-space path, drawn again while lists got tiles
  * whose pipelines did not exist yet (compiled in between): at most once
  * per variant in practice, since the classification is deterministic. */
-/* A new shadow map (shadow.c) when the sun moved or a crater changed the
- * heights since the last; its CPU time in *ms (0: none was needed). */
+/* A new shadow map (shadow.c) when the sun moved, or its texels a crater
+ * may have changed since the last; its CPU time in *ms (0: none was
+ * needed). */
 static bool update_shadow(rt_renderer *r, double *ms, rt_error *e)
 {
     *ms = 0;
     double sun[3];
     rt_light_sun_dir(&r->light, sun);
-    if (r->desc.no_shadows ||
-        (!r->shadow_stale && !memcmp(sun, r->shadow_sun, sizeof sun)))
+    if (r->desc.no_shadows)
+        return true;
+    bool full = r->shadow_stale || !r->shadow_map || memcmp(sun, r->shadow_sun, sizeof sun);
+    bool part = r->shadow_rect[0] < r->shadow_rect[2] && r->shadow_rect[1] < r->shadow_rect[3];
+    if (!full && !part)
         return true;
     const rt_pack *p = r->p;
     size_t n = (size_t)p->hf_width * (size_t)p->hf_height;
-    uint8_t *map = malloc(n);
-    if (!map)
+    if (!r->shadow_map && !(r->shadow_map = malloc(n)))
         return rt_fail(e, RT_E_VULKAN, "shadow map", "out of memory");
     double t0 = splat_now();
-    rt_shadow_map(rt_renderer_heights(r), p, &r->bounds, sun, map);
+    rt_shadow_map(rt_renderer_heights(r), p, &r->bounds, sun, full ? NULL : r->shadow_rect,
+                  r->shadow_map);
     *ms = 1e3 * (splat_now() - t0);
-    bool ok = rt_image_upload(r->d, &r->terrain.shadow, map, n, e);
-    free(map);
-    if (ok) {
-        memcpy(r->shadow_sun, sun, sizeof sun);
-        r->shadow_stale = false;
-    }
-    return ok;
+    if (!rt_image_upload(r->d, &r->terrain.shadow, r->shadow_map, n, e))
+        return false;
+    memcpy(r->shadow_sun, sun, sizeof sun);
+    r->shadow_stale = false;
+    memset(r->shadow_rect, 0, sizeof r->shadow_rect);
+    return true;
 }
 
 bool rt_renderer_frame(rt_renderer *r, const rt_camera *c, rt_frame_stats *st, rt_error *e)
@@ -1345,8 +1351,23 @@ bool rt_renderer_crater(rt_renderer *r, const rt_crater *c, rt_crater_stats *st,
         }
         return true;
     }
-    r->shadow_stale = true;
-    return rt_destruction_crater(r->destr, c, st, e);
+    rt_crater_stats local;
+    if (!st)
+        st = &local;
+    if (!rt_destruction_crater(r->destr, c, st, e))
+        return false;
+    /* the shadow map's texels the lowered disc can shade or unshade */
+    double sun[3];
+    int rect[4], *d = r->shadow_rect;
+    rt_light_sun_dir(&r->light, sun);
+    if (st->result == RT_CRATER_DONE &&
+        rt_shadow_crater_rect(r->p, &r->bounds, sun, c->x, c->z, c->radius, rect)) {
+        bool empty = d[0] >= d[2] || d[1] >= d[3];
+        for (int k = 0; k < 4; k++)
+            d[k] = empty ? rect[k] : k < 2 ? (rect[k] < d[k] ? rect[k] : d[k])
+                                           : (rect[k] > d[k] ? rect[k] : d[k]);
+    }
+    return true;
 }
 
 rt_destruction *rt_renderer_destruction(rt_renderer *r) { return r->destr; }

@@ -432,9 +432,15 @@ bool   rt_read_r16(rt_device *d, const rt_image *img, uint16_t *out, rt_error *e
 
 /* out (hf_width x hf_height, 255 = sun fully visible) for the sun
  * direction `sun` (towards the sun, unit) over `heights` with their
- * quadtree bounds `b`. */
+ * quadtree bounds `b`: the texels of rect (x0, z0, x1, z1, end exclusive;
+ * NULL: all), the others left as they are. */
 void rt_shadow_map(const uint16_t *heights, const rt_pack *p, const rt_bounds *b,
-                   const double sun[3], uint8_t *out);
+                   const double sun[3], const int rect[4], uint8_t *out);
+/* The texels whose map a change of heights inside the disc (x, z, radius
+ * in metres) can change, for that sun: true and *rect set; false when no
+ * texel's can (sun below the horizon or overhead). */
+bool rt_shadow_crater_rect(const rt_pack *p, const rt_bounds *b, const double sun[3],
+                           double x, double z, double radius, int rect[4]);
 
 /* ---- light.c: the frame's lighting fields ------------------------------ */
 

@@ -12,6 +12,11 @@
  * radius) above the horizon the march found: 0.5 + m / (2 tan r), clamped,
  * with m the lowest clearance angle's tangent along the ray.
  *
+ * A crater remakes only the texels whose march can pass over its disc: the
+ * disc swept away from the sun by (highest - lowest) / rise, plus two
+ * texels (rt_shadow_crater_rect; render.shadow checks the result equals
+ * the whole map made again).
+ *
  * Why a map marched on the CPU, not a per-pixel march nor a horizon map:
  * the sun and the heights change only on an event (the viewer's sun keys,
  * a light override, a crater), so a frame pays one texture tap per pixel
@@ -100,11 +105,11 @@ static uint8_t visibility(const march *m, double x0, double z0, double y0, doubl
     return (uint8_t)lrint(v * 255.0);
 }
 
-/* Rows [j0, j1) of the map. */
+/* Rows [j0, j1), columns [i0, i1) of the map. */
 typedef struct rows {
     const march *m;
     uint8_t     *out;
-    int          j0, j1;
+    int          j0, j1, i0, i1;
     double       step;
 } rows;
 
@@ -115,7 +120,7 @@ static void *map_rows(void *arg)
     int W = p->hf_width, H = p->hf_height;
     double sx = p->size[0] / W, sz = p->size[1] / H;
     for (int j = r->j0; j < r->j1; j++)
-        for (int i = 0; i < W; i++) {
+        for (int i = r->i0; i < r->i1; i++) {
             double x = (i + 0.5) * sx, z = (j + 0.5) * sz;
             double y = rt_height_at(r->m->heights, p, x, z) + 1e-4 * (p->max_height + 1.0);
             r->out[(size_t)j * (size_t)W + (size_t)i] = visibility(r->m, x, z, y, r->step);
@@ -123,10 +128,36 @@ static void *map_rows(void *arg)
     return NULL;
 }
 
-void rt_shadow_map(const uint16_t *heights, const rt_pack *p, const rt_bounds *b,
-                   const double sun[3], uint8_t *out)
+bool rt_shadow_crater_rect(const rt_pack *p, const rt_bounds *b, const double sun[3],
+                           double x, double z, double radius, int rect[4])
 {
     int W = p->hf_width, H = p->hf_height;
+    double flat = sqrt(sun[0] * sun[0] + sun[2] * sun[2]);
+    if (sun[1] <= -SUN_TAN * flat || flat < 1e-9)
+        return false;   /* the map does not depend on the heights */
+    /* a march reaches the disc only from up to L before it, away from the
+     * sun: L = (highest - lowest) / rise */
+    double rise = sun[1] / flat, span = b->hmax[b->nlevels - 1][0] - b->hmin[b->nlevels - 1][0];
+    double len = rise > 1e-9 ? span / rise : p->size[0] + p->size[1];
+    len = fmin(len, p->size[0] + p->size[1]);
+    double ex = -sun[0] / flat * len, ez = -sun[2] / flat * len;
+    double sx = p->size[0] / W, sz = p->size[1] / H;
+    double lo[2] = { fmin(x, x + ex) - radius, fmin(z, z + ez) - radius };
+    double hi[2] = { fmax(x, x + ex) + radius, fmax(z, z + ez) + radius };
+    /* two texels more: bilinear reads around the changed ones */
+    rect[0] = (int)fmax(0, floor(lo[0] / sx) - 2);
+    rect[1] = (int)fmax(0, floor(lo[1] / sz) - 2);
+    rect[2] = (int)fmin(W, ceil(hi[0] / sx) + 3);
+    rect[3] = (int)fmin(H, ceil(hi[1] / sz) + 3);
+    return true;
+}
+
+void rt_shadow_map(const uint16_t *heights, const rt_pack *p, const rt_bounds *b,
+                   const double sun[3], const int rect[4], uint8_t *out)
+{
+    int W = p->hf_width, H = p->hf_height;
+    int i0 = rect ? rect[0] : 0, j0 = rect ? rect[1] : 0;
+    int i1 = rect ? rect[2] : W, j1 = rect ? rect[3] : H;
     double flat = sqrt(sun[0] * sun[0] + sun[2] * sun[2]);
     size_t n = (size_t)W * (size_t)H;
     if (sun[1] <= -SUN_TAN * flat || flat < 1e-9) {   /* below the horizon, or overhead */
@@ -134,6 +165,8 @@ void rt_shadow_map(const uint16_t *heights, const rt_pack *p, const rt_bounds *b
             out[i] = sun[1] > 0 ? 255 : 0;
         return;
     }
+    if (i0 >= i1 || j0 >= j1)
+        return;
     double sx = p->size[0] / W, sz = p->size[1] / H;
     march m = {
         .heights = heights, .p = p, .b = b,
@@ -145,13 +178,13 @@ void rt_shadow_map(const uint16_t *heights, const rt_pack *p, const rt_bounds *b
     enum { MAX_THREADS = 32 };
     long cores = sysconf(_SC_NPROCESSORS_ONLN);
     int nt = cores < 1 ? 1 : cores > MAX_THREADS ? MAX_THREADS : (int)cores;
-    nt = nt > H ? H : nt;
+    nt = nt > j1 - j0 ? j1 - j0 : nt;
     rows part[MAX_THREADS];
     pthread_t tid[MAX_THREADS];
     bool started[MAX_THREADS] = { false };
     for (int k = 0; k < nt; k++) {
-        part[k] = (rows){ &m, out, (int)((long)H * k / nt), (int)((long)H * (k + 1) / nt),
-                          0.5 * fmin(sx, sz) };
+        part[k] = (rows){ &m, out, j0 + (int)((long)(j1 - j0) * k / nt),
+                          j0 + (int)((long)(j1 - j0) * (k + 1) / nt), i0, i1, 0.5 * fmin(sx, sz) };
         started[k] = k > 0 && pthread_create(&tid[k], NULL, map_rows, &part[k]) == 0;
     }
     for (int k = 0; k < nt; k++)

@@ -11,7 +11,9 @@
  *     further west, within 2 texels (the half-lit point along the row
  *     through the box), on the forward and the screen-space path;
  *   - rd.no_shadows (splatview --no-shadows) lights that ground;
- *   - a crater on the box (3 m deep) lowers it: the shadow gets shorter;
+ *   - a crater on the box (3 m deep) lowers it: the shadow gets shorter,
+ *     and the map remade only where the crater can matter is the whole
+ *     map made again (the sun turned away and back);
  *   - turning the sun to the west moves the shadow to the box's east. */
 #include "rt_internal.h"
 #include "../check.h"
@@ -181,7 +183,25 @@ int main(int argc, char **argv)
             CHECK(st.shadow_ms > 0, "no new shadow map after the crater");
             write_picture(dir, "crater.png", after, W, H, SPLAT_VIEW_FINAL);
         }
-        rt_light l = *rt_renderer_light(r);
+        /* the same map made whole: the sun turned by a degree and back */
+        rt_light l = *rt_renderer_light(r), turned = l;
+        turned.sun[0] += 1;
+        rt_renderer_set_light(r, &turned);
+        float *t = frame(r, &cam);
+        rt_renderer_set_light(r, &l);
+        rt_frame_stats fs;
+        CHECK(rt_renderer_frame(r, &cam, &fs, &e), "frame: %s", e.msg ? e.msg : "?");
+        float *whole = frame(r, &cam);
+        if (after && whole) {
+            double worst = 0;
+            for (size_t i = 0; i < (size_t)W * H * 4; i++)
+                worst = fmax(worst, fabs((double)after[i] - whole[i]));
+            printf("the crater's part of the map (%.2f ms) against the whole map (%.2f ms): "
+                   "max difference %g\n", st.shadow_ms, fs.shadow_ms, worst);
+            CHECK(worst == 0, "the partial map differs from the whole by %g", worst);
+        }
+        free(t);
+        free(whole);
         l.sun[0] = 270;
         rt_renderer_set_light(r, &l);
         float *west = frame(r, &cam);
