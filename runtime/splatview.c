@@ -7,6 +7,7 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include <xxhash.h>
 
 static void usage(FILE *f)
 {
@@ -662,11 +663,10 @@ static int build_preview(opts *o)
         o->scene = scene;   /* for hot reload; lives as long as the process */
     }
     char *abs = splat_path_absolute(scene), *cache = splat_cache_default_dir();
-    uint64_t h = 1469598103934665603ull;   /* FNV-1a of the scene's path */
-    for (const char *c = abs ? abs : scene; *c; c++)
-        h = (h ^ (uint8_t)*c) * 1099511628211ull;
+    const char *key = abs ? abs : scene;   /* one folder per scene file */
+    unsigned long long h = (unsigned long long)XXH3_64bits(key, strlen(key));
     char name[64];
-    snprintf(name, sizeof name, "preview/%016llx-", (unsigned long long)h);
+    snprintf(name, sizeof name, "preview/%016llx-", h);
     char *dir = cache ? splat_path_join(cache, name) : NULL;
     free(abs);
     free(cache);

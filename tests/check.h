@@ -58,6 +58,22 @@ static inline bool build_pack_ok(const char *sg, const char *pack)
     return ok;
 }
 
+/* One frame of renderer r from cam, read back (w x h RGBA32F, free it);
+ * NULL, counted as a failure, if it cannot be drawn. */
+static inline float *frame_of(rt_renderer *r, const rt_camera *cam, int w, int h)
+{
+    rt_error e = { 0 };
+    float *rgba = malloc((size_t)w * (size_t)h * 16);
+    bool ok = rgba && rt_renderer_frame(r, cam, NULL, &e) && rt_renderer_read(r, rgba, &e);
+    CHECK(ok, "frame: %s", e.msg ? e.msg : "?");
+    rt_error_clear(&e);
+    if (!ok) {
+        free(rgba);
+        return NULL;
+    }
+    return rgba;
+}
+
 /* One frame of `view` (`material` for the MASK view) from `cam` with
  * `rd` (its width, height, reference, shading, clear, light), read back
  * as RGBA32F; NULL (and a failure counted) if any step fails. */
@@ -66,17 +82,14 @@ static inline float *render_frame(rt_device *dev, const rt_pack *p, const rt_ren
 {
     rt_error e = { 0 };
     rt_renderer *r = NULL;
-    float *rgba = malloc((size_t)rd->width * (size_t)rd->height * 16);
-    bool ok = rgba && rt_renderer_create(dev, p, rd, &r, &e);
-    if (ok) rt_renderer_set_view(r, view, material);
-    ok = ok && rt_renderer_frame(r, cam, NULL, &e) && rt_renderer_read(r, rgba, &e);
-    CHECK(ok, "render: %s", e.msg ? e.msg : "?");
-    if (r) rt_renderer_destroy(r);
+    bool ok = rt_renderer_create(dev, p, rd, &r, &e);
+    CHECK(ok, "renderer: %s", e.msg ? e.msg : "?");
     rt_error_clear(&e);
-    if (!ok) {
-        free(rgba);
+    if (!ok)
         return NULL;
-    }
+    rt_renderer_set_view(r, view, material);
+    float *rgba = frame_of(r, cam, rd->width, rd->height);
+    rt_renderer_destroy(r);
     return rgba;
 }
 

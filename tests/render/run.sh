@@ -39,6 +39,26 @@ viewer_until_shot() {
     sleep 1
 }
 
+# viewer_done LOG [WHAT]: wait for the viewer viewer_until_shot started,
+# show its log, fail unless it exited 0
+viewer_done() {
+    wait $pid
+    rc=$?
+    cat "$1"
+    [ $rc = 0 ] || fail "viewer exit $rc${2:+ ($2)}"
+}
+
+# minimal_copy: examples/minimal with the graphs and nodes it imports
+# under $OUT/src (fresh), its scene in $SCENE
+minimal_copy() {
+    ROOT=$(cd "$(dirname "$0")/../.." && pwd)
+    rm -rf "$OUT/src" "$OUT/pack" "$OUT/cache" "$OUT"/*.png
+    mkdir -p "$OUT/src/examples"
+    cp -r "$ROOT/examples/minimal" "$OUT/src/examples/" && cp -r "$ROOT/graphs" "$ROOT/nodes" "$OUT/src/" ||
+        fail "copy"
+    SCENE="$OUT/src/examples/minimal/scene.sg"
+}
+
 case $case_ in
 final)
     run "$PACK" --headless --size 320x200 -o "$OUT/final.png"
@@ -173,10 +193,7 @@ hot_reload_search)
             --scene "$SCENE" --camera-preset overview \
             --script "frames=2;screenshot=$OUT/$how-a.png;wait_reload=150;frames=2;screenshot=$OUT/$how-b.png;quit"
         sed -i 's/vec3(0.55, 0.47, 0.22)/vec3(0.9, 0.05, 0.05)/' "$SCENE"
-        wait $pid
-        rc=$?
-        cat "$OUT/$how.log"
-        [ $rc = 0 ] || fail "viewer exit $rc ($how)"
+        viewer_done "$OUT/$how.log" "$how"
         grep -q "does not compile" "$OUT/$how.log" && fail "hot reload could not resolve the imports ($how)"
         grep -q "reloaded" "$OUT/$how.log" || fail "no reload ($how)"
     done
@@ -186,11 +203,7 @@ hot_reload)
     # edit a material of a copy of examples/minimal while the viewer runs:
     # first a syntax error (shown, survived), then a new colour (reloaded)
     command -v xvfb-run > /dev/null || { echo "SKIP: no xvfb-run"; exit 77; }
-    ROOT=$(cd "$(dirname "$0")/../.." && pwd)
-    rm -rf "$OUT/src" "$OUT/pack" "$OUT"/*.png
-    mkdir -p "$OUT/src/examples"
-    cp -r "$ROOT/examples/minimal" "$OUT/src/examples/" && cp -r "$ROOT/graphs" "$ROOT/nodes" "$OUT/src/"
-    SCENE="$OUT/src/examples/minimal/scene.sg"
+    minimal_copy
     "$SPLATC" build "$SCENE" -o "$OUT/pack" --no-cache > /dev/null || fail "splatc build"
     # no --scene: the viewer finds the scene through the manifest's scene.source
     viewer_until_shot "$OUT/a.png" "$OUT/viewer.log" "$OUT/pack" --size 320x200 \
@@ -199,10 +212,7 @@ hot_reload)
     sed -i 's/node rows : mul {/node rows : mul {{/' "$SCENE"
     sleep 2
     sed -i 's/node rows : mul {{/node rows : mul {/; s/vec3(0.55, 0.47, 0.22)/vec3(0.9, 0.05, 0.05)/; s/a = 0.8, b = 1.0/a = 0.2, b = 1.0/' "$SCENE"
-    wait $pid
-    rc=$?
-    cat "$OUT/viewer.log"
-    [ $rc = 0 ] || fail "viewer exit $rc"
+    viewer_done "$OUT/viewer.log"
     grep -q "does not compile" "$OUT/viewer.log" || fail "the syntax error was not reported"
     grep -q "reloaded" "$OUT/viewer.log" || fail "no reload"
     cmp -s "$OUT/a.png" "$OUT/b.png" && fail "the picture did not change after the edit"
@@ -211,11 +221,7 @@ preview)
     # splatview --material: one material of a copy of examples/minimal alone
     # on the built-in test hill (splatc build --preview), headless, then in
     # the viewer across an edit of that material (hot reload rebuilds it)
-    ROOT=$(cd "$(dirname "$0")/../.." && pwd)
-    rm -rf "$OUT/src" "$OUT/pack" "$OUT/cache" "$OUT"/*.png
-    mkdir -p "$OUT/src/examples"
-    cp -r "$ROOT/examples/minimal" "$OUT/src/examples/" && cp -r "$ROOT/graphs" "$ROOT/nodes" "$OUT/src/"
-    SCENE="$OUT/src/examples/minimal/scene.sg"
+    minimal_copy
     export XDG_CACHE_HOME="$OUT/cache"
     "$SPLATC" build "$SCENE" -o "$OUT/pack" --no-cache > /dev/null || fail "splatc build"
     run "$OUT/pack" --material field --headless --size 160x100 -o "$OUT/field.png"
@@ -236,10 +242,7 @@ preview)
     viewer_until_shot "$OUT/a.png" "$OUT/viewer.log" "$OUT/pack" --material field --size 160x100 \
         --script "frames=3;screenshot=$OUT/a.png;wait_reload=150;frames=2;screenshot=$OUT/b.png;quit"
     sed -i 's/vec3(0.55, 0.47, 0.22)/vec3(0.9, 0.05, 0.05)/' "$SCENE"
-    wait $pid
-    rc=$?
-    cat "$OUT/viewer.log"
-    [ $rc = 0 ] || fail "viewer exit $rc"
+    viewer_done "$OUT/viewer.log"
     grep -q "reloaded" "$OUT/viewer.log" || fail "no reload"
     cmp -s "$OUT/a.png" "$OUT/b.png" && fail "the swatch did not change after the edit"
     ;;

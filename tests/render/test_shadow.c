@@ -94,20 +94,6 @@ static int column(double x)
     return (int)floor(((x - N / 2.0) * t / ABOVE + 1.0) * W / 2.0);
 }
 
-static float *frame(rt_renderer *r, const rt_camera *cam)
-{
-    rt_error e = { 0 };
-    float *img = malloc((size_t)W * H * 16);
-    bool ok = img && rt_renderer_frame(r, cam, NULL, &e) && rt_renderer_read(r, img, &e);
-    CHECK(ok, "frame: %s", e.msg ? e.msg : "?");
-    rt_error_clear(&e);
-    if (!ok) {
-        free(img);
-        return NULL;
-    }
-    return img;
-}
-
 int main(int argc, char **argv)
 {
     if (argc != 2) {
@@ -165,7 +151,7 @@ int main(int argc, char **argv)
     CHECK(rt_renderer_create(&dev, &p, &rd, &r, &e), "renderer: %s", e.msg ? e.msg : "?");
     rt_error_clear(&e);
     if (r) {
-        float *before = frame(r, &cam);
+        float *before = frame_of(r, &cam, W, H);
         rt_crater c = { .x = 95, .z = 64, .radius = 8, .depth = 3 };
         rt_crater_stats cs;
         CHECK(rt_renderer_crater(r, &c, &cs, &e) && cs.result == RT_CRATER_DONE, "crater: %s",
@@ -174,7 +160,7 @@ int main(int argc, char **argv)
         rt_frame_stats st;
         float *after = NULL;
         CHECK(rt_renderer_frame(r, &cam, &st, &e), "frame: %s", e.msg ? e.msg : "?");
-        after = frame(r, &cam);
+        after = frame_of(r, &cam, W, H);
         if (before && after) {
             double b = half_lit_x(before, edge_px, -1), a = half_lit_x(after, edge_px, -1);
             printf("crater on the box: the shadow ends at %.2f m (was %.2f m); map remade in "
@@ -187,11 +173,11 @@ int main(int argc, char **argv)
         rt_light l = *rt_renderer_light(r), turned = l;
         turned.sun[0] += 1;
         rt_renderer_set_light(r, &turned);
-        float *t = frame(r, &cam);
+        float *t = frame_of(r, &cam, W, H);
         rt_renderer_set_light(r, &l);
         rt_frame_stats fs;
         CHECK(rt_renderer_frame(r, &cam, &fs, &e), "frame: %s", e.msg ? e.msg : "?");
-        float *whole = frame(r, &cam);
+        float *whole = frame_of(r, &cam, W, H);
         if (after && whole) {
             double worst = 0;
             for (size_t i = 0; i < (size_t)W * H * 4; i++)
@@ -204,7 +190,7 @@ int main(int argc, char **argv)
         free(whole);
         l.sun[0] = 270;
         rt_renderer_set_light(r, &l);
-        float *west = frame(r, &cam);
+        float *west = frame_of(r, &cam, W, H);
         if (west) {
             int east_px = column(100.5 + 10);
             printf("sun in the west: 10 m east of the box %.4f, 10 m west %.4f\n",
