@@ -20,9 +20,61 @@
 
 /* ---- compute stage (abi.h "compute stage"): declarations and main --------- */
 
+/* The undergrowth mask variant (SPLAT_UNDERGROWTH, with SPLAT_COMPUTE;
+ * abi.h "undergrowth masks"): one invocation per texel of a cell's
+ * SPLAT_UG_TEXELS^2 grid, seen from straight above at a fixed distance,
+ * so the masks depend on the cell alone, never on the camera.  Each
+ * undergrowth material's composited weight (splat_ug_weight, called by
+ * the composite where the layer's weight is computed), the terrain normal
+ * and the composite's albedo are packed into u_ug.words. */
+#define UG_DECLS                                                            \
+    "layout(set = 2, binding = 0, std430) writeonly buffer splat_ug_block {\n" \
+    "    uint words[];\n"                                                   \
+    "} u_ug;\n"                                                             \
+    "float splat_ug_w[" SPLAT_STR(SPLAT_UG_SLOTS) "];\n"                     \
+    "vec3 splat_ug_albedo;\n"                                               \
+    "void splat_ug_weight(int s, float w) { splat_ug_w[s] = w; }\n"
+
+#define UG_MAIN                                                             \
+    "void splat_begin() {\n"                                                \
+    "    splat_pixel = ivec2(gl_GlobalInvocationID.xy);\n"                  \
+    "    float step = u_push.patch_xz.z / " SPLAT_STR(SPLAT_UG_TEXELS) ".0;\n" \
+    "    vec2 xz = u_push.patch_xz.xy + (vec2(splat_pixel) + 0.5) * step;\n" \
+    "    v_uv = xz / u_frame.terrain.xy;\n"                                 \
+    "    v_local = vec3(xz.x, splat_height_at(v_uv), xz.y);\n"              \
+    "    v_rel = v_local - u_frame.camera.xyz;\n"                           \
+    "    splat_nrm = splat_normal_at(v_uv);\n"                              \
+    "    float ny = max(splat_nrm.y, 0.05);\n"                              \
+    "    splat_dpdx = vec3(step, -step * splat_nrm.x / ny, 0.0);\n"         \
+    "    splat_dpdy = vec3(0.0, -step * splat_nrm.z / ny, step);\n"         \
+    "    for (int i = 0; i < " SPLAT_STR(SPLAT_UG_SLOTS) "; i++) splat_ug_w[i] = 0.0;\n" \
+    "    splat_ug_albedo = vec3(0.0);\n"                                    \
+    "}\n"                                                                   \
+    "void splat_main();\n"                                                  \
+    "void main() {\n"                                                       \
+    "    vec2 q = u_push.patch_xz.xy + (vec2(gl_GlobalInvocationID.xy) + 0.5)\n" \
+    "             * (u_push.patch_xz.z / " SPLAT_STR(SPLAT_UG_TEXELS) ".0);\n"  \
+    "    if (any(lessThan(q, u_push.patch_uv.xy)) ||\n"                     \
+    "        any(greaterThanEqual(q, u_push.patch_uv.zw))) return;\n"       \
+    "    splat_begin();\n"                                                  \
+    "    splat_main();\n"                                                   \
+    "    uint nw = u_push.info.z;\n"                                        \
+    "    uint at = u_push.info.x + (uint(splat_pixel.y) * " SPLAT_STR(SPLAT_UG_TEXELS) "u\n" \
+    "              + uint(splat_pixel.x)) * (nw + 2u);\n"                   \
+    "    for (uint k = 0u; k < nw; k++)\n"                                  \
+    "        u_ug.words[at + k] = packUnorm4x8(vec4(splat_ug_w[4u * k], splat_ug_w[4u * k + 1u],\n" \
+    "                                               splat_ug_w[4u * k + 2u], splat_ug_w[4u * k + 3u]));\n" \
+    "    u_ug.words[at + nw] = packSnorm4x8(vec4(splat_nrm, 0.0));\n"        \
+    "    u_ug.words[at + nw + 1u] = packUnorm4x8(vec4(clamp(splat_ug_albedo, 0.0, 1.0), 1.0));\n" \
+    "}\n"                                                                   \
+    "#define main splat_main\n"
+
 /* Bindings 7-10 and the globals that stand for the fragment varyings. */
 #define COMPUTE_DECLS                                                       \
     "layout(local_size_x = 8, local_size_y = 8) in;\n"                      \
+    "#ifdef SPLAT_UNDERGROWTH\n"                                            \
+    UG_DECLS                                                                \
+    "#else\n"                                                               \
     "layout(set = 0, binding = 7) uniform sampler2D u_depth;\n"             \
     "layout(set = 0, binding = 8, rgba32f) uniform writeonly image2D u_out;\n" \
     "layout(set = 0, binding = 9, std430) readonly buffer splat_tiles_block {\n" \
@@ -37,6 +89,7 @@
     "    uint branches;\n"                                                  \
     "    uint branches_uniform;\n"                                          \
     "} u_counters;\n"                                                       \
+    "#endif\n"                                                              \
     "#endif\n"                                                              \
     "vec3 v_rel;      /* camera-relative position (m), from depth */\n"     \
     "vec2 v_uv;       /* heightfield uv */\n"                               \
@@ -365,6 +418,11 @@ const char SPLAT_GLSL_PRELUDE[] =
     "vec3 splat_position() { return vec3(v_local.x, splat_height(), v_local.z); }\n"
     "vec2 splat_uv() { return v_uv; }\n"
     "vec3 splat_offset() { return v_rel; }\n"
+    /* undergrowth masks: seen from SPLAT_UG_DISTANCE straight above */
+    "#ifdef SPLAT_UNDERGROWTH\n"
+    "float splat_view_distance() { return " SPLAT_STR(SPLAT_UG_DISTANCE) "; }\n"
+    "vec3 splat_view_direction() { return vec3(0.0, 1.0, 0.0); }\n"
+    "#else\n"
     "float splat_view_distance() { return length(v_rel); }\n"
     /* v_rel = surface - camera (terrain-local axes), so surface -> camera
      * is its negation; the camera exactly on the surface reads straight up */
@@ -372,6 +430,7 @@ const char SPLAT_GLSL_PRELUDE[] =
     "    float l = length(v_rel);\n"
     "    return l > 0.0 ? -v_rel / l : vec3(0.0, 1.0, 0.0);\n"
     "}\n"
+    "#endif\n"
     /* Screen-space derivatives of the inputs (d/dx: axis 0, d/dy: 1), the
      * leaves ir_differentiate writes.  All follow from the position's:
      * FC5's plane step in compute, the quad's dFdx / dFdy in fragments.
@@ -469,7 +528,9 @@ const char SPLAT_GLSL_PRELUDE[] =
     "void splat_finish(vec3 albedo, vec3 normal, float rough, float height,\n"
     "                  float coverage) {\n"
     "    float dist = splat_view_distance();\n"
-    "#ifdef SPLAT_MULTIPASS\n"
+    "#if defined(SPLAT_UNDERGROWTH)\n"
+    "    splat_ug_albedo = albedo;\n"
+    "#elif defined(SPLAT_MULTIPASS)\n"
     "    o_albedo = vec4(albedo, coverage);\n"
     "    o_normal = vec4(normal, coverage);\n"
     "    o_misc = vec4(rough, height, dist, coverage);\n"
@@ -483,7 +544,9 @@ const char SPLAT_GLSL_PRELUDE[] =
     "    o_color = vec4(c, 1.0);\n"
     "#endif\n"
     "}\n"
-    "#ifdef SPLAT_COMPUTE\n"
+    "#if defined(SPLAT_UNDERGROWTH)\n"
+    UG_MAIN
+    "#elif defined(SPLAT_COMPUTE)\n"
     COMPUTE_MAIN
     "#endif\n";
 

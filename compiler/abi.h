@@ -107,6 +107,26 @@
  *   reads.  The cost view's row (SPLAT_VIEWS) writes splat_cost_color():
  *   those samples as a heat colour (splat_heat: 0 black, 4 blue, 8 green,
  *   16 yellow, 32 red, 64+ white), black outside the counting variant.
+ *
+ * ---- undergrowth masks (seed 000 §5.5) ----------------------
+ * A combination holding undergrowth-bearing materials also comes as an
+ * undergrowth mask shader (pack: NNNN.ug.comp): its compute variant with
+ * `#define SPLAT_UNDERGROWTH 1` too.  One invocation per texel of a
+ * cell's SPLAT_UG_TEXELS^2 grid (8x8 workgroups, SPLAT_UG_TEXELS / 8
+ * squared of them), the texel's centre in terrain-local metres at
+ * patch_xz.xy + (texel + 0.5) * patch_xz.z / SPLAT_UG_TEXELS, written
+ * only inside the rectangle patch_uv.xy (inclusive) to patch_uv.zw
+ * (exclusive), terrain-local metres: the leaf cell whose combination
+ * this is (a cell spanning several leaf cells runs each one's); height,
+ * normal, painted and destruction masks as in the fragment stage; the
+ * view distance is SPLAT_UG_DISTANCE and the view straight down, so the
+ * masks depend on the cell alone (the runtime binds a frame block whose
+ * camera is the origin).  Set 2 binding 0: buffer splat_ug_block { uint
+ * words[]; } (std430), written at info.x + texel index * (info.z + 2):
+ * info.z words of packUnorm4x8 composited weights (undergrowth slot s in
+ * word s / 4, component s % 4: the weight after the compositor, so a
+ * covered layer grows nothing), then packSnorm4x8(terrain normal, 0),
+ * then packUnorm4x8(composite albedo, 1).
  */
 #ifndef SPLAT_ABI_H
 #define SPLAT_ABI_H
@@ -114,6 +134,12 @@
 #include <stdint.h>
 
 #define SPLAT_ABI_VERSION 3   /* 2: splat_frame.light; 3: GGX lighting, screen.w */
+
+/* Undergrowth masks (above): texels per cell side, undergrowth-bearing
+ * materials at most (4 per word), the fixed view distance (m). */
+#define SPLAT_UG_TEXELS 64
+#define SPLAT_UG_SLOTS 16
+#define SPLAT_UG_DISTANCE 2.0
 
 enum {
     SPLAT_SET_TERRAIN = 0,

@@ -94,6 +94,11 @@ static char **input_files(const splat_scene *s)
         for (int k = 1, m = build_mip_count(s->ir.textures[i].file); k <= m; k++)
             ADD(build_mip_path(s->ir.textures[i].file, k));
     }
+    /* undergrowth meshes from OBJ files */
+    for (int m = 0; m < sg_material_count(s->prog); m++)
+        for (int k = 0; k < sg_undergrowth_count(s->prog, m); k++)
+            if (sg_undergrowth_get(s->prog, m, k)->obj)
+                ADD(xstrdup(sg_undergrowth_get(s->prog, m, k)->obj));
 #undef ADD
     return v;
 }
@@ -234,7 +239,8 @@ static bool analyse(build *b)
 static bool layout(build *b)
 {
     b->layout_ok = splat_layout_from_scene(&b->layout, &b->scene, b->d);
-    return b->layout_ok;
+    b->ug_ok = b->layout_ok && splat_ug_init(&b->ug, &b->scene, b->d);
+    return b->ug_ok;
 }
 
 static bool write_out(build *b)
@@ -320,6 +326,7 @@ static bool build_finish(build *b)
     build_jobs_free(b);
     if (b->layout_ok)
         splat_layout_free(&b->layout);
+    splat_ug_free(&b->ug);
     if (b->analysis_ok)
         splat_analysis_free(&b->analysis);
     if (b->sparse_ok)

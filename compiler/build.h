@@ -12,6 +12,7 @@
 #define SPLAT_BUILD_H
 
 #include "scene.h"
+#include "undergrowth.h"
 #include "util.h"
 
 /* ---- shaders to compile (build_jobs.c) ----------------------------------- */
@@ -19,6 +20,7 @@
 typedef enum job_kind {
     JOB_COMBO, JOB_FLAT, JOB_UBER, JOB_REF, JOB_VERTEX,
     JOB_COMBO_COMPUTE, JOB_UBER_COMPUTE,   /* abi.h "compute stage" */
+    JOB_COMBO_UG,                          /* abi.h "undergrowth masks" */
 } job_kind;
 
 typedef struct job {
@@ -61,6 +63,8 @@ typedef struct build {
     char          *painted_places; /* sparse_glsl_places, or NULL            */
     splat_layout   layout;
     bool           layout_ok;
+    splat_ug       ug;        /* the undergrowth blocks and their meshes  */
+    bool           ug_ok;
     combo_info    *combos;
     job           *jobs;
     int            njobs, capjobs;

@@ -146,17 +146,21 @@ static bool add_composite(build *b, job_kind kind, int index, const int *materia
     const splat_composite *c = pc;
     /* the variants of this composite: fragment, then flat (--flat) and
      * compute (composites and the über-shader) */
-    job_kind kinds[3] = {kind};
+    job_kind kinds[4] = {kind};
     int nkinds = 1;
     if (kind == JOB_COMBO && b->desc->flat)
         kinds[nkinds++] = JOB_FLAT;
     if (kind == JOB_COMBO || kind == JOB_UBER)
         kinds[nkinds++] = kind == JOB_COMBO ? JOB_COMBO_COMPUTE : JOB_UBER_COMPUTE;
+    if (kind == JOB_COMBO && splat_ug_in(&b->ug, materials, n))
+        kinds[nkinds++] = JOB_COMBO_UG;
     for (int pass = 0; pass < nkinds; pass++) {
         job_kind k = kinds[pass];
-        bool compute = k == JOB_COMBO_COMPUTE || k == JOB_UBER_COMPUTE;
+        bool compute = k == JOB_COMBO_COMPUTE || k == JOB_UBER_COMPUTE || k == JOB_COMBO_UG;
         char *file;
-        if (k == JOB_REF)
+        if (k == JOB_COMBO_UG)
+            file = xasprintf("shaders/%04d.ug.comp", index);
+        else if (k == JOB_REF)
             file = xasprintf("shaders/ref_%04d", index);
         else if (k == JOB_UBER || k == JOB_UBER_COMPUTE)
             file = xasprintf(compute ? "shaders/uber.comp" : "shaders/uber");
@@ -173,7 +177,8 @@ static bool add_composite(build *b, job_kind kind, int index, const int *materia
                      compute ? " (compute)" : "");
         else
             snprintf(j->title, sizeof j->title, "composite of combination %d%s", index,
-                     k == JOB_FLAT ? " (flat: no branches)" : compute ? " (compute)" : "");
+                     k == JOB_FLAT ? " (flat: no branches)" :
+                     k == JOB_COMBO_UG ? " (undergrowth masks)" : compute ? " (compute)" : "");
         /* The MASK debug view recomputes every layer's mask: only the
          * über-shader carries it (the runtime draws that view with it),
          * which keeps each composite about half as long for glslang. */
@@ -181,7 +186,8 @@ static bool add_composite(build *b, job_kind kind, int index, const int *materia
         j->gdesc = (splat_glsl_desc){.flat = k == JOB_FLAT, .painted_sparse = b->sparse_ok,
                                      .painted_places = b->painted_places,
                                      .no_mask_view = k != JOB_UBER && k != JOB_UBER_COMPUTE,
-                                     .compute = compute};
+                                     .compute = compute,
+                                     .ug_slot = k == JOB_COMBO_UG ? b->ug.slot_of : NULL};
     }
     if (info) {
         info->ntextures = c->ntextures;

@@ -500,6 +500,7 @@ typedef struct emit {
     ir_buf                *out;
     sched                  s;
     char                   indent[256];
+    const int             *ug_slot;  /* desc->ug_slot                        */
 } emit;
 
 static ir_ref map_ref(const uint32_t *map, ir_ref r)
@@ -672,6 +673,9 @@ static void emit_accumulate(emit *em, const splat_layer *l, int depth)
     bool unit = is_const(&em->ir, l->weight, &wv) && wv == 1.0;
     char *w = value(em, l->weight, depth);
     ir_buf_printf(em->out, "%ssplat_count_layer(%s);\n", indent_at(em, depth), w);
+    if (em->ug_slot && em->ug_slot[l->material] >= 0)
+        ir_buf_printf(em->out, "%ssplat_ug_weight(%d, %s);\n", indent_at(em, depth),
+                      em->ug_slot[l->material], w);
     for (int o = 1; o < SG_OUT_COUNT; o++) {
         char *x = value(em, l->out[o], depth);
         if (unit)
@@ -807,6 +811,8 @@ static void emit_header(emit *em, const splat_glsl_desc *desc)
         ir_buf_printf(o, "%s", desc->painted_places);
     if (desc->compute)
         ir_buf_printf(o, "#define SPLAT_COMPUTE 1\n");
+    if (desc->ug_slot)
+        ir_buf_printf(o, "#define SPLAT_UNDERGROWTH 1\n");
     ir_buf_printf(o, "%s", SPLAT_GLSL_PRELUDE);
     ir_buf_printf(o, "layout(set = %d, binding = %d, std140) uniform splat_params_block {\n"
                      "    vec4 slot[%d];\n} u_params;\n",
@@ -929,7 +935,9 @@ static void differentiated(const splat_composite *c, ir *dst, splat_layer *layer
 void splat_composite_glsl(const splat_layout *L, const splat_composite *c,
                           const splat_glsl_desc *desc, ir_buf *out)
 {
-    emit em = {.L = L, .c = c, .out = out, .src = &c->ir, .src_layers = c->layers};
+    emit em = {.L = L, .c = c, .out = out, .src = &c->ir, .src_layers = c->layers,
+               .ug_slot = desc->ug_slot};
+    assert(!desc->ug_slot || desc->compute);
     ir dir;
     splat_layer *dlayers = NULL;
     assert(!(desc->compute && c->reference));

@@ -118,6 +118,9 @@ typedef struct splat_glsl_desc {
                                  and sizes before the prelude, or NULL      */
     bool        compute;      /* the compute variant: #define SPLAT_COMPUTE
                                  before the prelude (abi.h "compute stage") */
+    const int  *ug_slot;      /* with compute: the undergrowth mask variant
+                                 (abi.h "undergrowth masks"); per scene
+                                 material its slot, -1 for none         */
 } splat_glsl_desc;
 
 /* The complete Vulkan GLSL 450 fragment shader of `c`: for a composite,

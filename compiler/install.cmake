@@ -8,7 +8,7 @@ set(SPLAT_PUBLIC_HEADERS
   ${PROJECT_SOURCE_DIR}/compiler/sg.h ${PROJECT_SOURCE_DIR}/compiler/scene.h
   ${PROJECT_SOURCE_DIR}/compiler/terrain.h ${PROJECT_SOURCE_DIR}/compiler/scene_load.h
   ${PROJECT_SOURCE_DIR}/compiler/analysis.h ${PROJECT_SOURCE_DIR}/compiler/compose.h
-  ${PROJECT_SOURCE_DIR}/compiler/cache.h
+  ${PROJECT_SOURCE_DIR}/compiler/cache.h ${PROJECT_SOURCE_DIR}/compiler/mesh.h
   ${PROJECT_SOURCE_DIR}/compiler/sparse.h ${PROJECT_SOURCE_DIR}/compiler/shader.h
   ${PROJECT_SOURCE_DIR}/compiler/spv.h ${PROJECT_SOURCE_DIR}/compiler/texgen.h
   ${PROJECT_SOURCE_DIR}/compiler/util.h ${PROJECT_SOURCE_DIR}/runtime/splatrt.h)

@@ -399,9 +399,49 @@ static json_t *jcombinations(build *b)
         json_object_set_new(o, "hash", json_string(cj->key));
         json_object_set_new(o, "cost", json_real(b->combos[i].cost));
         json_object_set_new(o, "compute", jcompute(xj));
+        const job *uj = find_job(b, i, JOB_COMBO_UG);
+        if (uj)
+            json_object_set_new(o, "undergrowth", jcompute(uj));
         json_array_append_new(combos, o);
     }
     return combos;
+}
+
+/* The undergrowth table (PACK.md "Undergrowth"), or NULL when no material
+ * carries any. */
+static json_t *jundergrowth(const splat_ug *u)
+{
+    if (u->nblocks == 0)
+        return NULL;
+    json_t *o = json_object();
+    json_object_set_new(o, "file", json_string("meshes.bin"));
+    json_object_set_new(o, "slots", json_integer(u->nslots));
+    json_object_set_new(o, "texels", json_integer(SPLAT_UG_TEXELS));
+    json_t *meshes = json_array();
+    for (int i = 0; i < u->nmeshes; i++) {
+        json_t *m = json_object();
+        json_object_set_new(m, "name", json_string(u->mesh_names[i]));
+        json_object_set_new(m, "vertices", json_integer(u->meshes[i].nv));
+        json_object_set_new(m, "indices", json_integer(u->meshes[i].nidx));
+        json_array_append_new(meshes, m);
+    }
+    json_object_set_new(o, "meshes", meshes);
+    json_t *blocks = json_array();
+    for (int i = 0; i < u->nblocks; i++) {
+        const splat_ug_block *k = &u->blocks[i];
+        json_t *m = json_object();
+        json_object_set_new(m, "material", json_integer(k->material));
+        json_object_set_new(m, "slot", json_integer(k->slot));
+        json_object_set_new(m, "mesh", json_integer(k->mesh));
+        json_object_set_new(m, "density", json_real(k->u->density));
+        json_object_set_new(m, "scale", jreals(k->u->scale, 2));
+        json_object_set_new(m, "align", json_string(k->u->align_normal ? "normal" : "upright"));
+        json_object_set_new(m, "blend", json_real(k->u->blend));
+        json_object_set_new(m, "color", jreals(k->u->color, 3));
+        json_array_append_new(blocks, m);
+    }
+    json_object_set_new(o, "blocks", blocks);
+    return o;
 }
 
 static json_t *jquadtree(const splat_analysis *a)
@@ -452,12 +492,20 @@ static json_t *manifest(build *b, char **tex_names, const char *dir)
     json_object_set_new(m, "uber", uber);
     json_object_set_new(m, "vertex", jshader("shaders/terrain.vert", ""));
     json_object_set_new(m, "quadtree", jquadtree(&b->analysis));
+    json_t *ug = jundergrowth(&b->ug);
+    if (ug)
+        json_object_set_new(m, "undergrowth", ug);
     return m;
 }
 
 static bool put_sparse(FILE *f, const void *user)
 {
     return sparse_write(user, f);
+}
+
+static bool put_meshes(FILE *f, const void *user)
+{
+    return splat_ug_write_meshes(user, f);
 }
 
 static bool write_sparse(build *b, const char *dir)
@@ -523,6 +571,9 @@ static bool write_contents(build *b, const char *dir)
     ok = ok && write_file(b, dir, "combos.bin", bytes, 2 * total);
     free(bytes);
     free(ids);
+
+    if (ok && b->ug.nblocks > 0)
+        ok = write_with(b, dir, "meshes.bin", put_meshes, &b->ug);
 
     for (int i = 0; ok && i < b->njobs; i++) {
         const job *j = &b->jobs[i];

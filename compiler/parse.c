@@ -11,6 +11,7 @@
  * Imports are loaded depth first after the importing file is parsed; a
  * file reached twice (diamond) is parsed once; a file reached while it is
  * still being loaded is an import cycle. */
+#include "mesh.h"
 #include "sg_internal.h"
 #include "util.h"
 
@@ -231,7 +232,8 @@ typedef void (*binding_fn)(parser *ps, void *user, sg_token *key, sg_value *v);
 static bool starts_statement(parser *ps, const sg_token *t)
 {
     return line_start(ps, t) && peek_at(ps, 1)->kind != SG_TK_EQ &&
-           (is_kw(t, "node") || is_kw(t, "out") || is_kw(t, "in") || is_kw(t, "param"));
+           (is_kw(t, "node") || is_kw(t, "out") || is_kw(t, "in") || is_kw(t, "param") ||
+            is_kw(t, "undergrowth"));
 }
 
 /* Returns false if the list had errors (some bindings may be missing). */
@@ -411,7 +413,18 @@ static bool parse_param(parser *ps, sg_shader *s)
  * block is closed (or found unterminated). */
 typedef bool (*stmt_fn)(parser *ps, void *user);
 
+static void parse_block_in(parser *ps, const char *what, stmt_fn stmt, void *user,
+                           bool in_material);
+
 static void parse_block(parser *ps, const char *what, stmt_fn stmt, void *user)
+{
+    parse_block_in(ps, what, stmt, user, false);
+}
+
+/* in_material: a block inside a material's, so a material statement
+ * starting a later line (`node`, `out`, …) also means it was not closed. */
+static void parse_block_in(parser *ps, const char *what, stmt_fn stmt, void *user,
+                           bool in_material)
 {
     sg_token *open = cur(ps);
     if (!expect(ps, SG_TK_LBRACE, "'{'"))
@@ -422,7 +435,8 @@ static void parse_block(parser *ps, const char *what, stmt_fn stmt, void *user)
             next(ps);
             return;
         }
-        if (t->kind == SG_TK_EOF || (top_keyword(t) && line_start(ps, t))) {
+        if (t->kind == SG_TK_EOF || (top_keyword(t) && line_start(ps, t)) ||
+            (in_material && t->line > open->line && starts_statement(ps, t))) {
             sg_error(ps->d, loc_of(ps, open), SG_E_UNTERMINATED, what, open->line);
             return;
         }
@@ -436,8 +450,205 @@ static void parse_block(parser *ps, const char *what, stmt_fn stmt, void *user)
     }
 }
 
+/* ---- undergrowth ----------------------------------------------------------- */
+
+static const char *const ug_keys[] = { "density", "scale", "align", "blend", "color" };
+enum { UG_NKEYS = 5 };
+
+typedef struct ug_parse {
+    sg_undergrowth *u;
+    sg_loc          seen[UG_NKEYS];   /* where each key was set (line 0: not yet) */
+} ug_parse;
+
+/* A number in [lo, hi] (lo excluded if open_lo) for `key`, or SETTING. */
+static bool ug_number(parser *ps, const char *key, double lo, double hi, bool open_lo,
+                      double *x)
+{
+    sg_loc at = loc_of(ps, cur(ps));
+    if (!parse_number(ps, x))
+        return false;
+    if ((open_lo ? *x > lo : *x >= lo) && *x <= hi)
+        return true;
+    sg_errorf(ps->d, at, SG_E_SETTING, "'%s' must be in %c%g, %g], found %g", key,
+              open_lo ? '(' : '[', lo, hi, *x);
+    return true;   /* well-formed: parsing goes on */
+}
+
+/* ug_setting = "density" "=" NUM | "scale" "=" NUM [ NUM ]
+ *            | "align" "=" ("normal" | "upright") | "blend" "=" NUM
+ *            | "color" "=" "vec3" "(" NUM "," NUM "," NUM ")" */
+static bool ug_stmt(parser *ps, void *user)
+{
+    ug_parse *up = user;
+    sg_undergrowth *u = up->u;
+    sg_token *key = cur(ps);
+    if (key->kind != SG_TK_IDENT) {
+        expected(ps, "an undergrowth setting (density, scale, align, blend, color) or '}'");
+        return false;
+    }
+    sg_loc kloc = loc_of(ps, key);
+    int k = 0;
+    while (k < UG_NKEYS && !is_kw(key, ug_keys[k]))
+        k++;
+    if (k == UG_NKEYS) {
+        sg_errorf(ps->d, kloc, SG_E_BAD_OPTION, "unknown undergrowth setting '%.*s' "
+                  "(expected density, scale, align, blend or color)", key->len, key->start);
+        /* skip its value (vec3(…) whole), then to ',', '}' or the next line */
+        next(ps);
+        sg_value v;
+        if (accept(ps, SG_TK_EQ) && cur(ps)->kind != SG_TK_RBRACE)
+            parse_value(ps, &v);
+        while (cur(ps)->kind != SG_TK_EOF && cur(ps)->kind != SG_TK_RBRACE &&
+               cur(ps)->kind != SG_TK_COMMA && cur(ps)->line == key->line)
+            next(ps);
+        accept(ps, SG_TK_COMMA);
+        return true;
+    }
+    if (up->seen[k].line)
+        sg_error(ps->d, kloc, SG_E_DUPLICATE, "undergrowth setting", ug_keys[k],
+                 up->seen[k].file, up->seen[k].line, up->seen[k].col);
+    else
+        up->seen[k] = kloc;
+    next(ps);
+    if (!expect(ps, SG_TK_EQ, "'='"))
+        return false;
+    sg_token *vt = cur(ps);
+    sg_loc vloc = loc_of(ps, vt);
+    char buf[96];
+    switch (k) {
+    case 0:
+        if (!ug_number(ps, "density", 0, 64, true, &u->density))
+            return false;
+        break;
+    case 1:
+        if (!parse_number(ps, &u->scale[0]))
+            return false;
+        u->scale[1] = u->scale[0];
+        if (cur(ps)->kind == SG_TK_NUMBER)
+            u->scale[1] = next(ps)->num;
+        if (!(u->scale[0] > 0 && u->scale[0] <= u->scale[1] && u->scale[1] <= 100))
+            sg_errorf(ps->d, vloc, SG_E_SETTING, "'scale' must be LO HI with 0 < LO <= HI "
+                      "<= 100, found %g %g", u->scale[0], u->scale[1]);
+        break;
+    case 2:
+        if (is_kw(vt, "normal") || is_kw(vt, "upright")) {
+            u->align_normal = is_kw(vt, "normal");
+        } else {
+            if (vt->kind != SG_TK_IDENT && vt->kind != SG_TK_NUMBER && vt->kind != SG_TK_STRING) {
+                expected(ps, "normal or upright");
+                return false;
+            }
+            sg_errorf(ps->d, vloc, SG_E_SETTING, "'align' must be normal or upright, found %s",
+                      sg_tok_describe(vt, buf, sizeof buf));
+        }
+        next(ps);
+        break;
+    case 3:
+        if (!ug_number(ps, "blend", 0, 1, false, &u->blend))
+            return false;
+        break;
+    case 4: {
+        sg_value v;
+        if (!parse_value(ps, &v))
+            return false;
+        if (v.kind != SG_V_VEC || v.width != 3) {
+            sg_errorf(ps->d, vloc, SG_E_SETTING, "'color' must be vec3(r, g, b), "
+                      "linear, each in [0, 1]");
+            break;
+        }
+        if (!(v.num[0] >= 0 && v.num[0] <= 1 && v.num[1] >= 0 && v.num[1] <= 1 &&
+              v.num[2] >= 0 && v.num[2] <= 1))
+            sg_errorf(ps->d, vloc, SG_E_SETTING, "'color' components must be in [0, 1] "
+                      "(linear), found vec3(%g, %g, %g)", v.num[0], v.num[1], v.num[2]);
+        memcpy(u->color, v.num, sizeof u->color);
+        break;
+    }
+    }
+    accept(ps, SG_TK_COMMA);
+    return true;
+}
+
+/* Load and check an undergrowth block's OBJ file now, so its errors are
+ * located at the string (the pack writer loads it again). */
+static void check_obj(parser *ps, const char *path, sg_loc at)
+{
+    splat_mesh m;
+    char *err = NULL;
+    if (!splat_mesh_obj(path, &m, &err)) {
+        sg_error(ps->d, at, SG_E_IO, path, err);
+        free(err);
+        return;
+    }
+    if (m.nv > SPLAT_MESH_MAX_VERTICES || m.nidx > SPLAT_MESH_MAX_INDICES)
+        sg_errorf(ps->d, at, SG_E_OVER_LIMIT, "mesh '%s' has %u vertices and %u indices; "
+                  "an undergrowth mesh may have at most %d and %d", path, m.nv, m.nidx,
+                  SPLAT_MESH_MAX_VERTICES, SPLAT_MESH_MAX_INDICES);
+    splat_mesh_free(&m);
+}
+
+/* undergrowth = "undergrowth" (IDENT | STRING) [ "{" { ug_setting [","] } "}" ]
+ * IDENT names a built-in mesh (mesh.h), STRING an OBJ file relative to
+ * this file's folder (as a texture's file). */
+static bool parse_undergrowth(parser *ps, sg_shader *s)
+{
+    static const double colors[][3] = {      /* per built-in mesh, then OBJ */
+        { 0.16, 0.30, 0.06 }, { 0.12, 0.26, 0.05 }, { 0.35, 0.33, 0.30 }, { 0.5, 0.5, 0.5 },
+    };
+    sg_undergrowth u = { .density = 1, .scale = { 1, 1 }, .blend = 0.5 };
+    u.loc = loc_of(ps, next(ps));
+    sg_token *m = cur(ps);
+    bool known = true;
+    int kind = 0;
+    if (m->kind == SG_TK_IDENT) {
+        while (splat_mesh_builtins[kind] && !is_kw(m, splat_mesh_builtins[kind]))
+            kind++;
+        if (splat_mesh_builtins[kind]) {
+            u.mesh = splat_mesh_builtins[kind];
+        } else {
+            sg_errorf(ps->d, loc_of(ps, m), SG_E_BAD_OPTION, "unknown undergrowth mesh "
+                      "'%.*s' (built-in meshes: grass, plant, stone; or an OBJ file in quotes)",
+                      m->len, m->start);
+            known = false;
+        }
+    } else if (m->kind == SG_TK_STRING) {
+        kind = (int)(sizeof colors / sizeof colors[0]) - 1;
+        char *path = splat_path_join(ps->f->dir, m->str);
+        u.obj = sg_strdup(ps->a, path);
+        free(path);
+        check_obj(ps, u.obj, loc_of(ps, m));
+    } else {
+        expected(ps, "a mesh (grass, plant, stone or an OBJ file in quotes)");
+        return false;
+    }
+    next(ps);
+    memcpy(u.color, colors[kind], sizeof u.color);
+    if (cur(ps)->kind == SG_TK_LBRACE) {
+        ug_parse up = { &u, { { 0 } } };
+        char what[160];
+        snprintf(what, sizeof what, "block of undergrowth '%.*s'", m->len, m->start);
+        parse_block_in(ps, what, ug_stmt, &up, true);
+    }
+    if (!known)
+        return true;
+    if (s->nug == SG_MAX_UNDERGROWTH) {
+        sg_errorf(ps->d, u.loc, SG_E_OVER_LIMIT, "material '%s' has more than %d "
+                  "undergrowth blocks", s->name, SG_MAX_UNDERGROWTH);
+        return true;
+    }
+    if (s->nug == 0 && ps->p->nug_materials == SG_MAX_UG_MATERIALS) {
+        sg_errorf(ps->d, u.loc, SG_E_OVER_LIMIT, "more than %d materials have undergrowth "
+                  "(the undergrowth masks hold %d weights)", SG_MAX_UG_MATERIALS,
+                  SG_MAX_UG_MATERIALS);
+        return true;
+    }
+    if (s->nug == 0)
+        ps->p->nug_materials++;
+    *SG_PUSH(ps->a, s->ug, s->nug, s->capug) = u;
+    return true;
+}
+
 /* shader_stmt   = in | out | node
- * material_stmt = param | out | node */
+ * material_stmt = param | out | node | undergrowth */
 static bool shader_stmt(parser *ps, void *user)
 {
     sg_shader *s = user;
@@ -450,7 +661,9 @@ static bool shader_stmt(parser *ps, void *user)
         return parse_in(ps, s);
     if (s->is_material && is_kw(t, "param"))
         return parse_param(ps, s);
-    expected(ps, s->is_material ? "'param', 'node', 'out' or '}'"
+    if (s->is_material && is_kw(t, "undergrowth"))
+        return parse_undergrowth(ps, s);
+    expected(ps, s->is_material ? "'param', 'node', 'out', 'undergrowth' or '}'"
                                 : "'in', 'node', 'out' or '}'");
     return false;
 }
@@ -1199,3 +1412,11 @@ int sg_material_find(const sg_program *p, const char *name)
     return -1;
 }
 const sg_scene *sg_program_scene(const sg_program *p) { return p->scene; }
+int sg_undergrowth_count(const sg_program *p, int material)
+{
+    return p->shaders[p->materials[material]]->nug;
+}
+const sg_undergrowth *sg_undergrowth_get(const sg_program *p, int material, int k)
+{
+    return &p->shaders[p->materials[material]]->ug[k];
+}

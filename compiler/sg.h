@@ -140,6 +140,27 @@ const char *sg_material_name(const sg_program *p, int i);
 sg_loc      sg_material_loc(const sg_program *p, int i);
 int         sg_material_find(const sg_program *p, const char *name); /* -1 */
 
+/* A material's `undergrowth` block (seed 000 §5.5): instances of a mesh
+ * scattered where the material's composited weight says (DESIGN.md §3).
+ * The OBJ file, if any, was loaded and checked by sg_load. */
+typedef struct sg_undergrowth {
+    const char *mesh;      /* built-in mesh name ("grass", "plant", "stone"), or NULL */
+    const char *obj;       /* an OBJ file's path (resolved as texture paths are), or NULL */
+    double density;        /* instances per m^2, (0, 64] */
+    double scale[2];       /* lo, hi */
+    bool   align_normal;   /* align = normal (else upright) */
+    double blend;          /* 0..1 */
+    double color[3];       /* linear */
+    sg_loc loc;            /* the `undergrowth` keyword */
+} sg_undergrowth;
+/* At most SG_MAX_UNDERGROWTH blocks per material, SG_MAX_UG_MATERIALS
+ * undergrowth-bearing materials per program (OVER_LIMIT). */
+#define SG_MAX_UNDERGROWTH  4
+#define SG_MAX_UG_MATERIALS 16
+/* The undergrowth blocks of material i (sg_material_name's index), in source order. */
+int sg_undergrowth_count(const sg_program *p, int material);
+const sg_undergrowth *sg_undergrowth_get(const sg_program *p, int material, int k);
+
 /* Lower material `name` into `out` (which may already hold other
  * materials: shared subtrees are shared).  Sets the roots
  * "<name>.mask", ".albedo", ".normal", ".roughness", ".height", filling

@@ -182,6 +182,7 @@ typedef struct sg_shader {
     sg_port *outs;   int nouts, capouts;
     sg_port *params; int nparams, capparams;
     sg_node *nodes;  int nnodes, capnodes;
+    sg_undergrowth *ug; int nug, capug;  /* materials: undergrowth blocks */
     /* resolved */
     int     *order;         /* node indices, dependencies first          */
     int      norder;
@@ -213,6 +214,7 @@ struct sg_program {
     sg_scene   *scene;   /* the root file's scene, or NULL              */
     char      **search;  int nsearch;
     int         load_errors; /* errors while loading and checking       */
+    int         nug_materials; /* materials with undergrowth blocks     */
 };
 
 /* ---- parse.c ------------------------------------------------------------ */

@@ -322,13 +322,13 @@ static bool read_spirv(reader *r, json_t *obj, const char *where, rt_spirv *out)
 /* {"compute": {"glsl": …}} of a combination or the über-shader: the
  * compute variant's GLSL text (PACK.md), NUL-terminated; optional (a pack
  * without it cannot be drawn by the screen-space path). */
-static bool read_compute(reader *r, json_t *obj, const char *where, char **out)
+static bool read_glsl(reader *r, json_t *obj, const char *key, const char *where, char **out)
 {
-    json_t *c = get(r, obj, "compute", where, false);
+    json_t *c = get(r, obj, key, where, false);
     if (!c || json_is_null(c))
         return true;
     char w[96];
-    snprintf(w, sizeof w, "%s.compute", where);
+    snprintf(w, sizeof w, "%s.%s", where, key);
     const char *rel;
     if (!get_string(r, c, "glsl", w, &rel))
         return false;
@@ -353,6 +353,133 @@ static bool read_compute(reader *r, json_t *obj, const char *where, char **out)
 }
 
 /* ---- sections ------------------------------------------------------------ */
+
+static uint32_t le32(const uint8_t *b)
+{
+    return (uint32_t)b[0] | (uint32_t)b[1] << 8 | (uint32_t)b[2] << 16 | (uint32_t)b[3] << 24;
+}
+
+/* meshes.bin (PACK.md): its header against the manifest's meshes, then
+ * every vertex finite and every index inside its mesh. */
+static bool read_meshes(reader *r, const char *rel, rt_pack_ug *u)
+{
+    size_t n = 0;
+    uint8_t *data = pack_file(r, "undergrowth.file", rel, 0, MAX_BINARY, &n);
+    if (!data)
+        return false;
+    size_t head = 16 + 8 * (size_t)u->nmeshes;
+    size_t want = head + 32 * (size_t)u->nvertices + 4 * (size_t)u->nindices;
+    const char *bad = NULL;
+    if (n != want || memcmp(data, "SPLATMSH", 8) || le32(data + 8) != 1 ||
+        le32(data + 12) != (uint32_t)u->nmeshes)
+        bad = "does not match the manifest's meshes (size, magic, version or count)";
+    for (int i = 0; !bad && i < u->nmeshes; i++)
+        if (le32(data + 16 + 8 * i) != u->meshes[i].nv ||
+            le32(data + 20 + 8 * i) != u->meshes[i].nidx)
+            bad = "has mesh sizes other than the manifest's";
+    u->vertices = bad ? NULL : malloc(32 * (size_t)u->nvertices + 1);
+    u->indices = bad ? NULL : malloc(4 * (size_t)u->nindices + 1);
+    if (!bad && (!u->vertices || !u->indices))
+        bad = "does not fit in memory";
+    const uint8_t *at = data + head;
+    for (int i = 0; !bad && i < u->nmeshes; i++) {
+        const rt_pack_ug_mesh *m = &u->meshes[i];
+        for (uint32_t k = 0; k < 8 * m->nv; k++, at += 4) {
+            uint32_t w = le32(at);
+            float f;
+            memcpy(&f, &w, 4);
+            if (!isfinite(f) || fabsf(f) > 1e3f)
+                bad = "holds a vertex value that is not finite or over 1000";
+            u->vertices[8 * (size_t)m->first_vertex + k] = f;
+        }
+        for (uint32_t k = 0; k < m->nidx; k++, at += 4) {
+            uint32_t x = le32(at);
+            if (x >= m->nv)
+                bad = "holds an index past its mesh's vertices";
+            u->indices[m->first_index + k] = x;
+        }
+    }
+    free(data);
+    if (bad)
+        return rt_fail(r->e, RT_E_PACK_FILE, r->manifest, "undergrowth.file", rel, bad);
+    return true;
+}
+
+/* "undergrowth" (optional): slots, meshes, blocks, meshes.bin. */
+static bool read_undergrowth(reader *r, json_t *root)
+{
+    json_t *o = get(r, root, "undergrowth", "manifest", false);
+    if (!o || json_is_null(o))
+        return true;
+    rt_pack_ug *u = &r->p->ug;
+    int texels;
+    const char *file;
+    if (!get_int(r, o, "slots", "undergrowth", 1, SPLAT_UG_SLOTS, &u->nslots) ||
+        !get_int(r, o, "texels", "undergrowth", SPLAT_UG_TEXELS, SPLAT_UG_TEXELS, &texels) ||
+        !get_string(r, o, "file", "undergrowth", &file))
+        return false;
+    json_t *ms = get_array(r, o, "meshes", "undergrowth", true);
+    json_t *bs = ms ? get_array(r, o, "blocks", "undergrowth", true) : NULL;
+    if (!bs)
+        return false;
+    if (json_array_size(ms) < 1 || json_array_size(ms) > 64)
+        return field_fail(r, "undergrowth.meshes:", "must have 1 to 64 entries");
+    if (json_array_size(bs) < 1 || json_array_size(bs) > 64)
+        return field_fail(r, "undergrowth.blocks:", "must have 1 to 64 entries");
+    u->nmeshes = (int)json_array_size(ms);
+    u->nblocks = (int)json_array_size(bs);
+    u->meshes = calloc((size_t)u->nmeshes, sizeof *u->meshes);
+    u->blocks = calloc((size_t)u->nblocks, sizeof *u->blocks);
+    if (!u->meshes || !u->blocks)
+        return false;
+    for (int i = 0; i < u->nmeshes; i++) {
+        char where[64];
+        snprintf(where, sizeof where, "undergrowth.meshes[%d]", i);
+        json_t *m = json_array_get(ms, (size_t)i);
+        int nv, ni;
+        const char *name;
+        if (!get_int(r, m, "vertices", where, 1, 65536, &nv) ||
+            !get_int(r, m, "indices", where, 3, 196608, &ni) ||
+            !get_string(r, m, "name", where, &name))
+            return false;
+        if (ni % 3)
+            return field_fail(r, where, "indices: must be a multiple of 3");
+        unsigned flags = strcmp(name, "plant") == 0 ? 3u : strcmp(name, "grass") == 0 ? 2u : 0u;
+        u->meshes[i] = (rt_pack_ug_mesh){ (uint32_t)nv, (uint32_t)ni, u->nvertices, u->nindices,
+                                          flags };
+        u->nvertices += (uint32_t)nv;
+        u->nindices += (uint32_t)ni;
+    }
+    for (int i = 0; i < u->nblocks; i++) {
+        char where[64];
+        snprintf(where, sizeof where, "undergrowth.blocks[%d]", i);
+        json_t *b = json_array_get(bs, (size_t)i);
+        rt_pack_ug_block *k = &u->blocks[i];
+        const char *align;
+        if (!get_int(r, b, "material", where, 0, r->p->nmaterials - 1, &k->material) ||
+            !get_int(r, b, "slot", where, 0, u->nslots - 1, &k->slot) ||
+            !get_int(r, b, "mesh", where, 0, u->nmeshes - 1, &k->mesh) ||
+            !get_number(r, b, "density", where, &k->density) ||
+            !get_vec(r, b, "scale", where, 2, k->scale) ||
+            !get_number(r, b, "blend", where, &k->blend) ||
+            !get_vec(r, b, "color", where, 3, k->color) ||
+            !get_string(r, b, "align", where, &align))
+            return false;
+        if (!(k->density > 0 && k->density <= 64))
+            return field_fail(r, where, "density: must be in (0, 64]");
+        if (!(k->scale[0] > 0 && k->scale[0] <= k->scale[1] && k->scale[1] <= 100))
+            return field_fail(r, where, "scale: must be 0 < lo <= hi <= 100");
+        if (!(k->blend >= 0 && k->blend <= 1))
+            return field_fail(r, where, "blend: must be in [0, 1]");
+        for (int c = 0; c < 3; c++)
+            if (!(k->color[c] >= 0 && k->color[c] <= 1))
+                return field_fail(r, where, "color: must be in [0, 1]");
+        if (strcmp(align, "normal") && strcmp(align, "upright"))
+            return field_fail(r, where, "align: must be \"normal\" or \"upright\"");
+        k->align_normal = strcmp(align, "normal") == 0;
+    }
+    return read_meshes(r, file, u);
+}
 
 /* scene.light (optional, and each of its fields): over the defaults. */
 static bool read_light(reader *r, json_t *scene)
@@ -826,7 +953,9 @@ static bool read_combos(reader *r, json_t *root)
                 return field_fail(r, where, "materials: index out of range");
             co->materials[k] = (int)json_integer_value(m);
         }
-        if (!read_spirv(r, c, where, &co->spirv) || !read_compute(r, c, where, &co->compute))
+        if (!read_spirv(r, c, where, &co->spirv) ||
+            !read_glsl(r, c, "compute", where, &co->compute) ||
+            !read_glsl(r, c, "undergrowth", where, &co->ug_compute))
             return false;
         json_t *cost = get(r, c, "cost", where, false);
         if (cost && (!json_is_number(cost) || !(json_number_value(cost) >= 0) ||
@@ -1019,8 +1148,7 @@ bool rt_pack_load(rt_pack *p, const char *dir, rt_error *e)
     }
     ok = read_scene(&r, root) && read_materials(&r, root) && read_params(&r, root) &&
          read_textures(&r, root) && read_painted(&r, root) && read_sites(&r, root) &&
-         read_combos(&r, root) &&
-         read_quadtree(&r, root);
+         read_combos(&r, root) && read_quadtree(&r, root) && read_undergrowth(&r, root);
     if (ok) {
         json_t *vx = get(&r, root, "vertex", "manifest", true);
         ok = vx && read_spirv(&r, vx, "vertex", &p->vertex);
@@ -1029,7 +1157,7 @@ bool rt_pack_load(rt_pack *p, const char *dir, rt_error *e)
         json_t *ub = get(&r, root, "uber", "manifest", false);
         if (ub && !json_is_null(ub))
             ok = read_spirv(&r, ub, "uber", &p->uber) &&
-                 read_compute(&r, ub, "uber", &p->uber_compute);
+                 read_glsl(&r, ub, "compute", "uber", &p->uber_compute);
     }
     ok = ok && check_shaders(&r);
 done:
@@ -1073,6 +1201,7 @@ void rt_pack_free(rt_pack *p)
     for (int i = 0; i < p->ncombos && p->combos; i++) {
         free(p->combos[i].materials);
         free(p->combos[i].compute);
+        free(p->combos[i].ug_compute);
         free_spirv(&p->combos[i].spirv);
     }
     for (int i = 0; i < p->nlevels && p->levels; i++)
@@ -1080,6 +1209,10 @@ void rt_pack_free(rt_pack *p)
     free(p->holes);
     free_spirv(&p->uber);
     free(p->uber_compute);
+    free(p->ug.blocks);
+    free(p->ug.meshes);
+    free(p->ug.vertices);
+    free(p->ug.indices);
     free_spirv(&p->vertex);
     free(p->cameras);
     free(p->materials);

@@ -47,6 +47,8 @@ struct rt_renderer {
     VkDescriptorSet   set0, set1, set2;
     VkDescriptorSet   set0c;           /* set 0 with the compute bindings   */
     rt_screen        *screen;          /* NULL: forward shading only        */
+    rt_ug            *ug;              /* NULL: no undergrowth (undergrowth.c) */
+    bool              ug_off;          /* not drawn (the viewer's U)        */
     VkCommandBuffer   cb;
     VkFence           fence;
     VkQueryPool       qpool;
@@ -86,7 +88,7 @@ static bool make_pass(rt_device *d, uint32_t ncolor, bool depth, VkImageLayout c
             .format = VK_FORMAT_D32_SFLOAT,
             .samples = VK_SAMPLE_COUNT_1_BIT,
             .loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR,
-            .storeOp = VK_ATTACHMENT_STORE_OP_DONT_CARE,
+            .storeOp = VK_ATTACHMENT_STORE_OP_STORE,   /* undergrowth tests it */
             .stencilLoadOp = VK_ATTACHMENT_LOAD_OP_DONT_CARE,
             .stencilStoreOp = VK_ATTACHMENT_STORE_OP_DONT_CARE,
             .initialLayout = VK_IMAGE_LAYOUT_UNDEFINED,
@@ -423,6 +425,9 @@ static bool make_commands(rt_renderer *r, rt_error *e)
  * cut them). */
 static bool use_raycast(const rt_renderer *r)
 {
+    /* undergrowth is depth-tested against the terrain's depth attachment */
+    if (r->p->ug.nslots > 0 && !r->desc.no_undergrowth)
+        return false;
     if (r->desc.screen_depth == RT_DEPTH_RAYCAST)
         return true;
     return r->desc.screen_depth == RT_DEPTH_AUTO && !r->p->holes &&
@@ -430,6 +435,18 @@ static bool use_raycast(const rt_renderer *r)
 }
 
 static void pack_light(rt_renderer *r, const rt_pack *p);
+
+static bool make_undergrowth(rt_renderer *r, rt_error *e)
+{
+    if (r->desc.no_undergrowth || r->p->ug.nslots == 0)
+        return true;
+    rt_ug_targets t = {
+        .color = &r->color, .depth = &r->depth, .height = &r->terrain.height,
+        .width = r->desc.width, .height_px = r->desc.height,
+        .nearest = r->terrain.nearest_clamp, .set0 = r->set0, .timestamps = r->timestamps,
+    };
+    return rt_ug_create(r->d, r->p, &r->pl, &r->qt, &t, r->desc.undergrowth_radius, &r->ug, e);
+}
 
 bool rt_renderer_create(rt_device *d, const rt_pack *p, const rt_render_desc *desc,
                         rt_renderer **out, rt_error *e)
@@ -490,6 +507,10 @@ bool rt_renderer_create(rt_device *d, const rt_pack *p, const rt_render_desc *de
         return false;
     }
     r->shading = r->screen ? RT_SHADING_SCREEN : RT_SHADING_FORWARD;
+    if (!make_undergrowth(r, e)) {
+        rt_renderer_destroy(r);
+        return false;
+    }
     *out = r;
     return true;
 }
@@ -502,6 +523,7 @@ void rt_renderer_destroy(rt_renderer *r)
     rt_device *d = r->d;
     if (d->dev) {
         vkDeviceWaitIdle(d->dev);
+        rt_ug_destroy(r->ug);
         rt_screen_destroy(r->screen);
         rt_pipelines_destroy(d, &r->pl);
         if (r->fence)
@@ -641,6 +663,7 @@ bool rt_renderer_set_param(rt_renderer *r, const char *name, const float value[4
     for (int i = 0; i < r->p->nparams; i++)
         if (!strcmp(r->p->params[i].name, name)) {
             memcpy((uint8_t *)r->params_ubo.map + r->p->params[i].offset, value, 16);
+            rt_ug_invalidate(r->ug, NULL);   /* the masks may have changed */
             return true;
         }
     char what[256];
@@ -1107,6 +1130,9 @@ static bool draw_frame(rt_renderer *r, const rt_camera *c, rt_frame_stats *st, r
     VkViewport vp = { 0, 0, (float)r->desc.width, (float)r->desc.height, 0, 1 };
     VkRect2D area = { { 0, 0 }, { (uint32_t)r->desc.width, (uint32_t)r->desc.height } };
     int binds = 0;
+    bool ug = r->ug && !r->ug_off && r->view == SPLAT_VIEW_FINAL && !r->wireframe;
+    if (ug && !rt_ug_generate(r->ug, cb, c, fr, r->set1, 0, e))
+        return abandon_frame(cb);
     bool cull = !r->desc.no_cull && camera_above_terrain(r, c);
     unsigned variant = (r->wireframe ? RT_VARIANT_WIRE : 0) |
                        (r->view != SPLAT_VIEW_FINAL ? RT_VARIANT_DEBUG : 0) |
@@ -1119,6 +1145,8 @@ static bool draw_frame(rt_renderer *r, const rt_camera *c, rt_frame_stats *st, r
                      : record_forward(r, cb, c, &vp, &area, variant, &binds, e);
     if (!ok)
         return false;
+    if (ug)
+        rt_ug_draw(r->ug, cb, screen, r->set0, r->set1, &vp, &area);
     if (r->timestamps)
         vkCmdWriteTimestamp(cb, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, r->qpool, 3);
     RT_VK(e, vkEndCommandBuffer(cb));
@@ -1144,6 +1172,7 @@ static bool draw_frame(rt_renderer *r, const rt_camera *c, rt_frame_stats *st, r
     st->screen = screen;
     if (screen)
         rt_screen_read_stats(r->screen, &st->tiles);
+    rt_ug_read_stats(ug ? r->ug : NULL, &st->undergrowth);
     return read_times(r, screen, st, e);
 }
 
@@ -1328,6 +1357,10 @@ bool rt_renderer_swap_pack(rt_renderer *r, const rt_pack *p, rt_error *e)
     r->p = p;
     if (!r->light_set)
         pack_light(r, p);
+    rt_ug_destroy(r->ug);   /* blocks, meshes and mask shaders are the pack's */
+    r->ug = NULL;
+    if (!make_undergrowth(r, e))
+        return false;
     if (r->screen) {
         /* the classification's combination map and sets are the pack's */
         rt_screen_destroy(r->screen);
@@ -1356,6 +1389,11 @@ bool rt_renderer_crater(rt_renderer *r, const rt_crater *c, rt_crater_stats *st,
         st = &local;
     if (!rt_destruction_crater(r->destr, c, st, e))
         return false;
+    if (st->result == RT_CRATER_DONE) {
+        double rect[4] = { c->x - c->radius, c->z - c->radius, c->x + c->radius,
+                           c->z + c->radius };
+        rt_ug_invalidate(r->ug, rect);
+    }
     /* the shadow map's texels the lowered disc can shade or unshade */
     double sun[3];
     int rect[4], *d = r->shadow_rect;
@@ -1371,6 +1409,14 @@ bool rt_renderer_crater(rt_renderer *r, const rt_crater *c, rt_crater_stats *st,
 }
 
 rt_destruction *rt_renderer_destruction(rt_renderer *r) { return r->destr; }
+
+void rt_renderer_set_undergrowth(rt_renderer *r, bool on) { r->ug_off = !on; }
+
+int rt_renderer_undergrowth_cell(rt_renderer *r, int ix, int iz, rt_ug_instance *out, int max,
+                                 rt_error *e)
+{
+    return rt_ug_read_cell(r->ug, ix, iz, out, max, e);
+}
 
 const uint16_t *rt_renderer_heights(const rt_renderer *r)
 {

@@ -410,6 +410,41 @@ bool rt_screen_dispatch(rt_screen *s, VkCommandBuffer cb, rt_pipelines *pl,
 int rt_screen_missing(rt_screen *s, rt_pipelines *pl, unsigned variant, rt_error *e);
 void rt_screen_read_stats(const rt_screen *s, rt_screen_stats *st);
 
+/* ---- undergrowth.c: cells, generation, drawing (render.c drives it) ---- */
+
+typedef struct rt_ug rt_ug;
+
+/* What the draw pass renders into and reads. */
+typedef struct rt_ug_targets {
+    const rt_image *color, *depth, *height;
+    int             width, height_px;
+    VkSampler       nearest;
+    VkDescriptorSet set0;         /* the graphics set 0 (terrain bindings)  */
+    bool            timestamps;   /* the queue has them: GPU ms in the stats */
+} rt_ug_targets;
+
+/* *out stays NULL when the pack has no undergrowth; set even on failure
+ * (free with rt_ug_destroy).  radius 0: RT_UG_RADIUS. */
+bool rt_ug_create(rt_device *d, const rt_pack *p, rt_pipelines *pl, const rt_quadtree *qt,
+                  const rt_ug_targets *t, double radius, rt_ug **out, rt_error *e);
+void rt_ug_destroy(rt_ug *u);
+/* Allocate the cells around the camera and record the generation of up to
+ * `budget` pending ones (<= 0: all), frustum first, near first. */
+bool rt_ug_generate(rt_ug *u, VkCommandBuffer cb, const rt_camera *c, const splat_frame *fr,
+                    VkDescriptorSet set1, int budget, rt_error *e);
+/* After the terrain: the instances of the visible cells, front to back;
+ * depth_read_only: the depth was left SHADER_READ_ONLY (screen path). */
+void rt_ug_draw(rt_ug *u, VkCommandBuffer cb, bool depth_read_only, VkDescriptorSet set0,
+                VkDescriptorSet set1, const VkViewport *vp, const VkRect2D *area);
+/* Regenerate the cells touching rect (x0, z0, x1, z1 terrain-local m) or,
+ * NULL, every cell. */
+void rt_ug_invalidate(rt_ug *u, const double *rect);
+/* After the frame completed. */
+void rt_ug_read_stats(rt_ug *u, rt_ug_stats *st);
+/* The instances of cell (ix, iz) (its origin at 16 m times those), up to
+ * max; 0 if the cell is not generated, -1 on error. */
+int  rt_ug_read_cell(rt_ug *u, int ix, int iz, rt_ug_instance *out, int max, rt_error *e);
+
 /* ---- destruction.c: the renderer's side ------------------------------- */
 
 /* *out stays NULL when the pack has no destructible area.  `height` and

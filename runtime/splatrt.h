@@ -177,6 +177,7 @@ typedef struct rt_pack_combo {
     int      nmaterials;
     rt_spirv spirv;
     char    *compute;     /* compute variant's GLSL (PACK.md); NULL: none   */
+    char    *ug_compute;  /* undergrowth mask GLSL (PACK.md); NULL: none    */
     double   cost;        /* per-pixel cost, op-table units; 0: not given   */
 } rt_pack_combo;
 
@@ -216,6 +217,32 @@ double *rt_light_values(rt_light *l, int key);
  * defaults), else what is wrong (a static string). */
 const char *rt_light_check(const rt_light *l);
 
+/* Undergrowth (PACK.md "Undergrowth"): a block of a material, and the
+ * meshes, every one's vertices (8 floats: position, normal, uv) and
+ * indices concatenated. */
+typedef struct rt_pack_ug_block {
+    int      material, slot, mesh;
+    double   density, scale[2], blend, color[3];
+    bool     align_normal;
+} rt_pack_ug_block;
+
+typedef struct rt_pack_ug_mesh {
+    uint32_t nv, nidx;
+    uint32_t first_vertex, first_index;
+    unsigned flags;        /* 1: a leaf cut from its quads (plant), 2: lit
+                              with the terrain normal (grass, plant)     */
+} rt_pack_ug_mesh;
+
+typedef struct rt_pack_ug {
+    int               nslots;      /* 0: the pack has no undergrowth        */
+    rt_pack_ug_block *blocks;  int nblocks;
+    rt_pack_ug_mesh  *meshes;  int nmeshes;
+    float            *vertices;    /* 8 per vertex                          */
+    uint32_t          nvertices;
+    uint32_t         *indices;     /* per mesh, from its own vertex 0       */
+    uint32_t          nindices;
+} rt_pack_ug;
+
 typedef struct rt_pack {
     char            *dir;
     char            *name;
@@ -247,6 +274,7 @@ typedef struct rt_pack {
     char            *scene_path;     /* scene.source: scene.sg relative to
                                         the pack (hot reload), or NULL      */
     rt_light         light;          /* scene.light over the defaults       */
+    rt_pack_ug       ug;             /* undergrowth; ug.nslots 0: none      */
 } rt_pack;
 
 /* Read and check a pack, untrusted input: every file it names is a
@@ -319,12 +347,34 @@ typedef struct rt_render_desc {
     bool         sun_set, exposure_set, fog_set;
     double       sun[2], exposure, fog_density;
     bool         no_shadows;        /* the sun casts none (splatview --no-shadows) */
+    bool         no_undergrowth;    /* draw no undergrowth (--no-undergrowth)  */
+    double       undergrowth_radius; /* m around the camera; 0: RT_UG_RADIUS    */
     /* any light key over the pack's (splatview --light KEY=V,...): bit k
      * of light_keys set = abi.h SPLAT_LIGHT_KEYS row k given, its values
      * in light[k]; applied after sun / exposure / fog_density above */
     unsigned     light_keys;
     double       light[SPLAT_LIGHT_COUNT][3];
 } rt_render_desc;
+
+/* One undergrowth instance as the GPU stores it (32 bytes). */
+typedef struct rt_ug_instance {
+    float    pos[3];      /* root, terrain-local metres                  */
+    float    scale;
+    uint32_t normal;      /* packSnorm4x8 of the terrain normal          */
+    uint32_t color;       /* packUnorm4x8: rgb, 1                        */
+    float    angle;       /* radians about the up (or normal) axis       */
+    uint32_t block;       /* pack undergrowth block                      */
+} rt_ug_instance;
+
+/* Undergrowth of a frame (runtime/undergrowth.c). */
+#define RT_UG_RADIUS 96.0     /* default radius of the cells around the camera */
+typedef struct rt_ug_stats {
+    int    cells;             /* cells allocated around the camera          */
+    int    generated;         /* of them, generated in this frame           */
+    long   instances;         /* instances in the allocated cells           */
+    double gen_ms, draw_ms;   /* GPU ms (timestamps; < 0 if unsupported)    */
+    size_t bytes_per_cell;    /* masks + instance capacity + draw arguments */
+} rt_ug_stats;
 
 typedef struct rt_frame_stats {
     int    patches, culled, pipelines, combos_in_view;
@@ -339,6 +389,7 @@ typedef struct rt_frame_stats {
     int    redraws;           /* frames drawn again after compiling pipelines */
     double shadow_ms;         /* CPU ms of a new shadow map (the sun moved or
                                  a crater changed heights); 0: none needed  */
+    rt_ug_stats undergrowth;  /* cells, instances, generation and draw     */
 } rt_frame_stats;
 
 typedef struct rt_renderer rt_renderer;
@@ -357,6 +408,14 @@ void rt_renderer_set_wireframe(rt_renderer *r, bool on);
 /* The lighting of the next frames (default: the pack's); a hot reload
  * keeps one set here. */
 void rt_renderer_set_light(rt_renderer *r, const rt_light *l);
+/* Undergrowth drawn or not (the viewer's U); a renderer created with
+ * rt_render_desc.no_undergrowth has none to draw. */
+void rt_renderer_set_undergrowth(rt_renderer *r, bool on);
+/* The instances of undergrowth cell (ix, iz), the 16 m cell whose origin
+ * is (16 ix, 16 iz) terrain-local metres, as generated (up to max; 0 when
+ * that cell is not allocated and generated, -1 on error): for tests. */
+int  rt_renderer_undergrowth_cell(rt_renderer *r, int ix, int iz, rt_ug_instance *out, int max,
+                                  rt_error *e);
 /* Terrain shadows on or off (rt_render_desc.no_shadows; the viewer's H). */
 void rt_renderer_set_shadows(rt_renderer *r, bool on);
 const rt_light *rt_renderer_light(const rt_renderer *r);

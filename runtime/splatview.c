@@ -38,6 +38,7 @@ static void usage(FILE *f)
         "  --exposure EV             exposure in stops (default: the scene's, or 0)\n"
         "  --fog-density D           fog per metre at the fog height (0: none)\n"
         "  --no-shadows              the sun casts no terrain shadows\n"
+        "  --no-undergrowth          draw no undergrowth (grass, plants, stones)\n"
         "  --light KEY=V[,V,V]       any key of the scene's light block (sun, sun_color,\n"
         "                            intensity, sky, fog_density, fog_height, exposure)\n"
         "  --clear r,g,b             background colour (linear)\n"
@@ -98,6 +99,7 @@ typedef struct opts {
     const char *material;       /* --material M: its swatch pack instead    */
     char *preview_dir;          /* where that pack is built                 */
     bool headless, stats, have_camera, have_look, no_stitch, no_cull, no_shadows;
+    bool no_undergrowth;
     int width, height, frames;
     double camera[3], look[3], lod_pixels;
     float clear[4];
@@ -210,6 +212,8 @@ static int parse_args(int argc, char **argv, opts *o)
             o->no_cull = true;
         } else if (!strcmp(a, "--no-shadows")) {
             o->no_shadows = true;
+        } else if (!strcmp(a, "--no-undergrowth")) {
+            o->no_undergrowth = true;
         } else if (!strcmp(a, "-o")) {
             NEED(); o->out = v;
         } else if (!strcmp(a, "--float-out")) {
@@ -519,6 +523,7 @@ static int headless(const opts *o)
         .width = o->width, .height = o->height, .reference = o->ref,
         .pipeline_cache = o->cache, .no_stitch = o->no_stitch,
         .no_cull = o->no_cull, .lod_pixels = o->lod_pixels, .no_shadows = o->no_shadows,
+        .no_undergrowth = o->no_undergrowth,
         .destruction_pool = o->destruction_pool, .shading = o->shading,
         .screen_depth = o->screen_depth,
     };
@@ -529,14 +534,17 @@ static int headless(const opts *o)
         goto done;
     rt_renderer_set_view(r, view, material);
     int W = o->width > 0 ? o->width : 1280, H = o->height > 0 ? o->height : 720;
-    gpu = calloc((size_t)o->frames * 6, sizeof *gpu);
+    gpu = calloc((size_t)o->frames * 7, sizeof *gpu);
     if (!gpu)
         goto done;
     sel = gpu + o->frames;
     cpu = sel + o->frames;
     double *pass = cpu + o->frames;   /* 3 per frame: geometry, classify, shade */
+    double *ug_draw = pass + 3 * o->frames;
     rt_frame_stats st = { 0 };
     double shadow_ms = 0;   /* the first frame makes the shadow map */
+    double ug_gen_ms = 0;   /* and generates the undergrowth's cells */
+    int ug_generated = 0;
     /* the cost view needs the counting variant's counters */
     rt_renderer_set_counting(r, view == SPLAT_VIEW_COST);
     for (int f = 0; f < o->frames; f++) {
@@ -548,6 +556,11 @@ static int headless(const opts *o)
         cpu[f] = st.cpu_ms;
         for (int k = 0; k < 3; k++)
             pass[k * o->frames + f] = st.pass_ms[k];
+        ug_draw[f] = st.undergrowth.draw_ms;
+        if (st.undergrowth.generated > 0) {
+            ug_gen_ms += st.undergrowth.gen_ms;
+            ug_generated += st.undergrowth.generated;
+        }
     }
     if (o->out || o->float_out) {
         rgba = malloc((size_t)W * (size_t)H * 16);
@@ -596,6 +609,18 @@ static int headless(const opts *o)
         else
             printf("shadow map cpu ms: %.2f (when the sun moves or a crater lands; "
                    "per frame a texture tap)\n", shadow_ms);
+        if (pack.ug.nslots > 0 && !o->no_undergrowth && view == SPLAT_VIEW_FINAL) {
+            double um, ul, uh;
+            summary(ug_draw, o->frames, &um, &ul, &uh);
+            printf("undergrowth: %d cells, %ld instances, %.3f ms generation\n",
+                   st.undergrowth.cells, st.undergrowth.instances, ug_gen_ms);
+            printf("  generated %d cells (%.4f ms per cell), draw gpu ms/frame: median %.3f  "
+                   "p10 %.3f  p90 %.3f, %zu bytes per cell\n", ug_generated,
+                   ug_generated ? ug_gen_ms / ug_generated : 0.0, um, ul, uh,
+                   st.undergrowth.bytes_per_cell);
+        } else if (pack.ug.nslots > 0) {
+            printf("undergrowth: off\n");
+        }
         printf("cpu ms/frame (record): median %.3f  p10 %.3f  p90 %.3f\n", cm, cl, ch);
         if (st.screen) {
             /* one more frame with the counting variant (not timed) */
@@ -710,7 +735,7 @@ int main(int argc, char **argv)
         .height = o.height ? o.height : 720, .script = o.script,
         .render = { .reference = o.ref, .pipeline_cache = o.cache, .lod_pixels = o.lod_pixels,
                     .shading = o.shading, .screen_depth = o.screen_depth,
-                    .no_shadows = o.no_shadows },
+                    .no_shadows = o.no_shadows, .no_undergrowth = o.no_undergrowth },
         .view = SPLAT_VIEW_FINAL,
     };
     memcpy(vd.render.clear, o.clear, sizeof o.clear);

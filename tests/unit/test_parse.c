@@ -201,7 +201,7 @@ static void test_recovery(void **state)
     assert_string_equal(d.items[0].msg,
                         "expected a value (number, vecN(...), string or name), found '}'");
     assert_diag(&d, 1, SG_E_SYNTAX, 4, 5);
-    assert_string_equal(d.items[1].msg, "expected 'param', 'node', 'out' or '}', found 'nod'");
+    assert_string_equal(d.items[1].msg, "expected 'param', 'node', 'out', 'undergrowth' or '}', found 'nod'");
     assert_diag(&d, 2, SG_E_SYNTAX, 5, 19);
     assert_diag(&d, 3, SG_E_SYNTAX, 8, 1);
     assert_diag(&d, 4, SG_E_SYNTAX, 9, 15);
@@ -334,6 +334,82 @@ static void test_imports(void **state)
     }
 }
 
+/* Undergrowth blocks through the public API: settings, defaults per mesh,
+ * OBJ paths relative to the declaring file, source order. */
+static void test_undergrowth(void **state)
+{
+    char dir[] = "/tmp/splat_parse_XXXXXX";
+    assert_non_null(mkdtemp(dir));
+    char path[256], obj[256];
+    snprintf(path, sizeof path, "%s/rocks", dir);
+    assert_int_equal(mkdir(path, 0777), 0);
+    snprintf(obj, sizeof obj, "%s/rocks/r.obj", dir);
+    FILE *f = fopen(obj, "w");
+    fputs("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", f);
+    fclose(f);
+    snprintf(path, sizeof path, "%s/m.sg", dir);
+    sg_diags d;
+    sg_diags_init(&d);
+    sg_program *p = sg_load_string(path,
+        "material bare { out mask = 1 }\n"
+        "material m {\n"
+        "    undergrowth grass { density = 2.0, scale = 0.6 1.2, align = normal, blend = 0.6, color = vec3(0.20, 0.32, 0.08) }\n"
+        "    undergrowth \"rocks/r.obj\" { density = 0.05 }\n"
+        "    out mask = 1\n"
+        "    undergrowth stone { scale = 2\n"
+        "        align = upright }\n"
+        "    undergrowth plant\n"
+        "}\n", NULL, &d);
+    sg_diags_print(&d, stderr);
+    assert_int_equal(d.nerrors, 0);
+    assert_int_equal(sg_undergrowth_count(p, sg_material_find(p, "bare")), 0);
+    int m = sg_material_find(p, "m");
+    assert_int_equal(sg_undergrowth_count(p, m), 4);
+
+    const sg_undergrowth *u = sg_undergrowth_get(p, m, 0);
+    assert_string_equal(u->mesh, "grass");
+    assert_null(u->obj);
+    assert_true(u->density == 2.0 && u->scale[0] == 0.6 && u->scale[1] == 1.2);
+    assert_true(u->align_normal && u->blend == 0.6);
+    assert_true(u->color[0] == 0.20 && u->color[1] == 0.32 && u->color[2] == 0.08);
+    assert_string_equal(u->loc.file, path);
+    assert_int_equal(u->loc.line, 3);
+    assert_int_equal(u->loc.col, 5);
+
+    u = sg_undergrowth_get(p, m, 1);             /* defaults; OBJ grey */
+    assert_null(u->mesh);
+    assert_string_equal(u->obj, obj);
+    assert_true(u->density == 0.05 && u->scale[0] == 1 && u->scale[1] == 1);
+    assert_true(!u->align_normal && u->blend == 0.5);
+    assert_true(u->color[0] == 0.5 && u->color[1] == 0.5 && u->color[2] == 0.5);
+
+    u = sg_undergrowth_get(p, m, 2);             /* one scale: lo = hi */
+    assert_string_equal(u->mesh, "stone");
+    assert_true(u->density == 1 && u->scale[0] == 2 && u->scale[1] == 2);
+    assert_true(u->color[0] == 0.35 && u->color[1] == 0.33 && u->color[2] == 0.30);
+    u = sg_undergrowth_get(p, m, 3);
+    assert_string_equal(u->mesh, "plant");
+    assert_true(u->color[0] == 0.12 && u->color[1] == 0.26 && u->color[2] == 0.05);
+    sg_free(p);
+    sg_diags_free(&d);
+
+    /* 17 materials with undergrowth: the 17th is over the limit */
+    size_t cap = 4096, n = 0;
+    char *text = malloc(cap);
+    for (int i = 0; i < 17; i++)
+        n += (size_t)snprintf(text + n, cap - n, "material m%d { undergrowth grass }\n", i);
+    sg_diags_init(&d);
+    p = sg_load_string("many.sg", text, NULL, &d);
+    assert_int_equal(d.nerrors, 1);
+    assert_int_equal(d.items[0].id, SG_E_OVER_LIMIT);
+    assert_int_equal(d.items[0].loc.line, 17);
+    sg_free(p);
+    sg_diags_free(&d);
+    free(text);
+    snprintf(path, sizeof path, "rm -rf '%s'", dir);
+    assert_int_equal(system(path), 0);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -344,6 +420,7 @@ int main(void)
         cmocka_unit_test(test_unterminated),
         cmocka_unit_test(test_empty_and_truncated),
         cmocka_unit_test(test_imports),
+        cmocka_unit_test(test_undergrowth),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

@@ -1,0 +1,128 @@
+/* undergrowth.c — the scene's undergrowth blocks, slots and meshes. */
+#include "undergrowth.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+#include "util.h"
+
+static int mesh_index(splat_ug *u, const sg_undergrowth *g, sg_diags *d)
+{
+    const char *key = g->obj ? g->obj : g->mesh;
+    for (int i = 0; i < u->nmeshes; i++)
+        if (strcmp(u->mesh_keys[i], key) == 0)
+            return i;
+    splat_mesh m = {0};
+    if (g->obj) {
+        char *err = NULL;
+        if (!splat_mesh_obj(g->obj, &m, &err)) {
+            sg_errorf(d, g->loc, SG_E_SETTING, "cannot use mesh '%s': %s", g->obj,
+                      err ? err : "unreadable");
+            free(err);
+            return -1;
+        }
+    } else if (!splat_mesh_builtin(g->mesh, &m)) {
+        sg_errorf(d, g->loc, SG_E_SETTING, "unknown built-in mesh '%s'", g->mesh);
+        return -1;
+    }
+    int i = u->nmeshes++;
+    u->meshes = xrealloc(u->meshes, sizeof *u->meshes * (size_t)u->nmeshes);
+    u->mesh_names = xrealloc(u->mesh_names, sizeof *u->mesh_names * (size_t)u->nmeshes);
+    u->mesh_keys = xrealloc(u->mesh_keys, sizeof *u->mesh_keys * (size_t)u->nmeshes);
+    u->meshes[i] = m;
+    const char *base = strrchr(key, '/');
+    u->mesh_names[i] = xstrdup(base ? base + 1 : key);
+    u->mesh_keys[i] = key;
+    return i;
+}
+
+bool splat_ug_init(splat_ug *u, const splat_scene *s, sg_diags *d)
+{
+    memset(u, 0, sizeof *u);
+    u->slot_of = xcalloc((size_t)s->nmaterials, sizeof *u->slot_of);
+    for (int i = 0; i < s->nmaterials; i++) {
+        u->slot_of[i] = -1;
+        int pm = sg_material_find(s->prog, s->desc->materials[i]);
+        int n = pm >= 0 ? sg_undergrowth_count(s->prog, pm) : 0;
+        if (n == 0)
+            continue;
+        if (u->nslots == SPLAT_UG_SLOTS) {
+            sg_errorf(d, s->desc->material_locs[i], SG_E_OVER_LIMIT,
+                      "more than %d materials of the scene carry undergrowth",
+                      SPLAT_UG_SLOTS);
+            return false;
+        }
+        u->slot_of[i] = u->nslots++;
+        for (int k = 0; k < n; k++) {
+            const sg_undergrowth *g = sg_undergrowth_get(s->prog, pm, k);
+            int mesh = mesh_index(u, g, d);
+            if (mesh < 0)
+                return false;
+            u->blocks = xrealloc(u->blocks, sizeof *u->blocks * (size_t)(u->nblocks + 1));
+            u->blocks[u->nblocks++] = (splat_ug_block){
+                .material = i, .slot = u->slot_of[i], .mesh = mesh, .u = g};
+        }
+    }
+    return true;
+}
+
+void splat_ug_free(splat_ug *u)
+{
+    for (int i = 0; i < u->nmeshes; i++) {
+        splat_mesh_free(&u->meshes[i]);
+        free(u->mesh_names[i]);
+    }
+    free(u->meshes);
+    free(u->mesh_names);
+    free(u->mesh_keys);
+    free(u->blocks);
+    free(u->slot_of);
+    memset(u, 0, sizeof *u);
+}
+
+bool splat_ug_in(const splat_ug *u, const int *materials, int n)
+{
+    for (int i = 0; i < n; i++)
+        if (u->slot_of && u->slot_of[materials[i]] >= 0)
+            return true;
+    return false;
+}
+
+static bool put_u32(FILE *f, uint32_t v)
+{
+    uint8_t b[4] = {v & 255, (v >> 8) & 255, (v >> 16) & 255, v >> 24};
+    return fwrite(b, 1, 4, f) == 4;
+}
+
+static bool put_f32(FILE *f, float x)
+{
+    uint32_t v;
+    memcpy(&v, &x, 4);
+    return put_u32(f, v);
+}
+
+/* "SPLATMSH", version 1, count; per mesh its vertex and index counts;
+ * then per mesh its vertices (8 floats: position, normal, uv) and its
+ * indices (uint32), all little-endian. */
+bool splat_ug_write_meshes(const splat_ug *u, FILE *f)
+{
+    bool ok = fwrite("SPLATMSH", 1, 8, f) == 8 && put_u32(f, 1) &&
+              put_u32(f, (uint32_t)u->nmeshes);
+    for (int i = 0; ok && i < u->nmeshes; i++)
+        ok = put_u32(f, u->meshes[i].nv) && put_u32(f, u->meshes[i].nidx);
+    for (int i = 0; ok && i < u->nmeshes; i++) {
+        const splat_mesh *m = &u->meshes[i];
+        for (uint32_t v = 0; ok && v < m->nv; v++) {
+            const splat_mesh_vertex *x = &m->v[v];
+            for (int k = 0; ok && k < 3; k++)
+                ok = put_f32(f, x->pos[k]);
+            for (int k = 0; ok && k < 3; k++)
+                ok = put_f32(f, x->nrm[k]);
+            for (int k = 0; ok && k < 2; k++)
+                ok = put_f32(f, x->uv[k]);
+        }
+        for (uint32_t k = 0; ok && k < m->nidx; k++)
+            ok = put_u32(f, m->idx[k]);
+    }
+    return ok;
+}

@@ -1,0 +1,1022 @@
+/* undergrowth.c — procedural undergrowth from the terrain's own material
+ * masks (Andersson 2007 §5.5, seed 000): grass, plants and stones grow
+ * wherever an undergrowth-bearing material's composited weight says,
+ * follow repainting and craters, and need no index maps of their own.
+ *
+ * A fixed pool of 16 x 16 m cells is allocated by 2D distance from the
+ * camera (every cell whose centre lies within the radius), never by the
+ * frustum; cells in the frustum are generated first.  Generating a cell
+ * happens on the GPU, in the frame's command buffer, with no read back:
+ *   1. the mask pass: each leaf cell the cell overlaps runs its
+ *      combination's undergrowth mask shader (abi.h "undergrowth masks")
+ *      over the cell's 64 x 64 texels inside that leaf, writing every
+ *      undergrowth material's composited weight, the terrain normal and
+ *      the composite's albedo;
+ *   2. the scatter pass, one workgroup per block (a material's
+ *      `undergrowth`): a jittered grid at the block's density, Russian
+ *      roulette on the material's weight, scale and rotation from a hash
+ *      of the cell's integer position (the same instances on every run
+ *      and from every camera), the root on the heightfield (bilinear as
+ *      the terrain), colour blended with the terrain's albedo at the root.
+ *      Instances are compacted by a workgroup prefix sum in candidate
+ *      order, so the buffer is deterministic (no atomics), and the count
+ *      goes straight into the block's indirect draw arguments.
+ * Drawing is one indexed indirect draw per block and cell, cells front to
+ * back, after the terrain into its colour and depth; lit by splat_light
+ * (abi.c) with the terrain normal (grass, plants) or the mesh's (stones,
+ * OBJ meshes).
+ */
+#include "rt_internal.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define CELL    16.0                 /* metres per cell side                */
+#define TEXELS  SPLAT_UG_TEXELS      /* mask texels per cell side           */
+#define MAX_INSTANCE_BYTES ((VkDeviceSize)256 << 20)
+
+enum { CELL_FREE, CELL_PENDING, CELL_READY };
+
+typedef struct ug_cell {
+    int   ix, iz;      /* cell index: origin (ix, iz) * CELL metres        */
+    int   state;
+    bool  wanted;      /* within the radius this frame                     */
+    double dist;       /* 2D distance of its centre from the camera        */
+    bool  visible;     /* in the frustum this frame                        */
+} ug_cell;
+
+/* Push constants of the scatter pass (std430, 64 bytes). */
+typedef struct ug_push {
+    float    origin[2];
+    int32_t  cell[2];
+    uint32_t slot, nw, cap, mask_base;
+    float    terrain[4];      /* size x, size z, max height, offset       */
+    int32_t  hf[2];
+    uint32_t pad[2];
+} ug_push;
+
+struct rt_ug {
+    rt_device            *d;
+    const rt_pack        *p;
+    rt_pipelines         *pl;
+    const rt_quadtree    *qt;
+    int                   pool, nblocks, nw;   /* nw: weight words per texel */
+    uint32_t              cap;                 /* instances per cell         */
+    uint32_t             *block_base;          /* first instance in a cell   */
+    uint32_t             *block_grid;          /* candidates per side        */
+    double                radius;
+    ug_cell              *cells;
+    int                  *order;               /* draw order, front to back  */
+    rt_buffer             masks, inst, args, blocks, vbuf, ibuf, frame;
+    VkDescriptorSetLayout set_terrain;         /* set 0 of the mask pass     */
+    VkDescriptorSetLayout set_mask, set_gen, set_draw;
+    VkPipelineLayout      mask_layout, gen_layout, draw_layout;
+    VkPipeline           *mask_pipes;          /* per combination            */
+    VkPipeline            gen_pipe, draw_pipe;
+    VkDescriptorPool      dpool;
+    VkDescriptorSet       set0, mask_set, gen_set, draw_set;
+    VkRenderPass          pass_att, pass_ro;   /* depth in attachment / read */
+    VkFramebuffer         fb;
+    VkQueryPool           qpool;               /* VK_NULL_HANDLE: no timestamps */
+    int                   generated;           /* this frame                 */
+    bool                  drawn;
+};
+
+/* ---- shaders ---------------------------------------------------------------- */
+
+static const char gen_glsl[] =
+    "#version 450\n"
+    "layout(local_size_x = 64) in;\n"
+    "layout(set = 0, binding = 0, std430) readonly buffer M { uint w[]; } u_mask;\n"
+    "struct Inst { vec4 p; uvec4 q; };\n"
+    "layout(set = 0, binding = 1, std430) writeonly buffer I { Inst v[]; } u_inst;\n"
+    "layout(set = 0, binding = 2, std430) buffer A { uint a[]; } u_args;\n"
+    "layout(set = 0, binding = 3, std430) readonly buffer B { vec4 b[]; } u_blocks;\n"
+    "layout(set = 0, binding = 4) uniform sampler2D u_height;\n"
+    "layout(push_constant, std430) uniform P {\n"
+    "    vec2 origin; ivec2 cell; uint slot, nw, cap, mask_base;\n"
+    "    vec4 terrain; ivec2 hf;\n"
+    "} u_p;\n"
+    "shared uint s_scan[64];\n"
+    "uint hash(uint x) {\n"
+    "    x ^= x >> 16; x *= 0x7feb352du; x ^= x >> 15; x *= 0x846ca68bu; x ^= x >> 16;\n"
+    "    return x;\n"
+    "}\n"
+    "float rnd(inout uint s) { s = hash(s + 0x9e3779b9u); return float(s >> 8) * (1.0 / 16777216.0); }\n"
+    /* bilinear between texel centres, as the terrain's vertices sample */
+    "float height_at(vec2 xz) {\n"
+    "    vec2 t = xz / u_p.terrain.xy * vec2(u_p.hf) - 0.5;\n"
+    "    ivec2 i = ivec2(floor(t)), m = u_p.hf - 1;\n"
+    "    vec2 f = t - vec2(i);\n"
+    "    float h00 = texelFetch(u_height, clamp(i, ivec2(0), m), 0).r;\n"
+    "    float h10 = texelFetch(u_height, clamp(i + ivec2(1, 0), ivec2(0), m), 0).r;\n"
+    "    float h01 = texelFetch(u_height, clamp(i + ivec2(0, 1), ivec2(0), m), 0).r;\n"
+    "    float h11 = texelFetch(u_height, clamp(i + ivec2(1, 1), ivec2(0), m), 0).r;\n"
+    "    float h = mix(mix(h00, h10, f.x), mix(h01, h11, f.x), f.y);\n"
+    "    return h * u_p.terrain.z + u_p.terrain.w;\n"
+    "}\n"
+    "void main() {\n"
+    "    uint b = gl_WorkGroupID.x, lid = gl_LocalInvocationID.x;\n"
+    "    vec4 b0 = u_blocks.b[3u * b], b1 = u_blocks.b[3u * b + 1u], b2 = u_blocks.b[3u * b + 2u];\n"
+    "    uint n = uint(b2.x), total = n * n, base = u_p.slot * u_p.cap + uint(b2.y);\n"
+    "    uint ms = uint(b1.w);\n"
+    "    float keep = b0.x * " "256.0" " / float(total);\n"
+    "    float step = 16.0 / float(n);\n"
+    "    uint seed0 = hash(uint(u_p.cell.x) * 73856093u ^ uint(u_p.cell.y) * 19349663u ^ b * 83492791u);\n"
+    "    uint run = 0u;\n"
+    "    for (uint c = 0u; c < total; c += 64u) {\n"
+    "        uint k = c + lid;\n"
+    "        bool ok = false;\n"
+    "        Inst it;\n"
+    "        if (k < total) {\n"
+    "            uint s = hash(seed0 ^ hash(k));\n"
+    "            vec2 g = vec2(float(k % n), float(k / n));\n"
+    "            vec2 l = (g + vec2(rnd(s), rnd(s))) * step;\n"
+    "            ivec2 tx = min(ivec2(l * (64.0 / 16.0)), ivec2(63));\n"
+    "            uint at = u_p.mask_base + uint(tx.y * 64 + tx.x) * (u_p.nw + 2u);\n"
+    "            float w = unpackUnorm4x8(u_mask.w[at + ms / 4u])[ms % 4u];\n"
+    "            ok = rnd(s) < w * keep;\n"
+    "            vec3 nrm = unpackSnorm4x8(u_mask.w[at + u_p.nw]).xyz;\n"
+    "            vec3 alb = unpackUnorm4x8(u_mask.w[at + u_p.nw + 1u]).rgb;\n"
+    "            vec2 xz = u_p.origin + l;\n"
+    "            float sc = mix(b0.y, b0.z, rnd(s));\n"
+    "            float ang = rnd(s) * 6.2831853;\n"
+    "            vec3 col = mix(b1.rgb, alb, b0.w);\n"
+    "            it.p = vec4(xz.x, height_at(xz), xz.y, sc);\n"
+    "            it.q = uvec4(packSnorm4x8(vec4(nrm, 0.0)), packUnorm4x8(vec4(col, 1.0)),\n"
+    "                         floatBitsToUint(ang), b);\n"
+    "        }\n"
+    "        s_scan[lid] = ok ? 1u : 0u;\n"
+    "        barrier();\n"
+    "        for (uint o = 1u; o < 64u; o <<= 1u) {\n"
+    "            uint v = lid >= o ? s_scan[lid - o] : 0u;\n"
+    "            barrier();\n"
+    "            s_scan[lid] += v;\n"
+    "            barrier();\n"
+    "        }\n"
+    "        if (ok) u_inst.v[base + run + s_scan[lid] - 1u] = it;\n"
+    "        run += s_scan[63];\n"
+    "        barrier();\n"
+    "    }\n"
+    "    if (lid == 0u) u_args.a[(u_p.slot * uint(u_blocks.b[2].w) + b) * 5u + 1u] = run;\n"
+    "}\n";
+
+/* The draw pass: SPLAT_GLSL_TERRAIN (frame block) + this vertex main; the
+ * prelude + draw_frag_main as the fragment shader (it reads v_rel, v_uv,
+ * v_local at locations 0-2, as the terrain's). */
+static const char draw_vert_main[] =
+    "struct Inst { vec4 p; uvec4 q; };\n"
+    "layout(set = 2, binding = 0, std430) readonly buffer B { vec4 b[]; } u_blocks;\n"
+    "layout(set = 2, binding = 1, std430) readonly buffer I { Inst v[]; } u_inst;\n"
+    "layout(location = 0) in vec3 a_pos;\n"
+    "layout(location = 1) in vec3 a_nrm;\n"
+    "layout(location = 2) in vec2 a_uv;\n"
+    "out gl_PerVertex { vec4 gl_Position; };\n"
+    "layout(location = 0) out vec3 v_rel;\n"
+    "layout(location = 1) out vec2 v_uv;\n"
+    "layout(location = 2) out vec3 v_local;\n"
+    "layout(location = 3) out vec3 g_color;\n"
+    "layout(location = 4) out vec3 g_normal;\n"
+    "layout(location = 5) out vec2 g_uv;\n"
+    "layout(location = 6) flat out uint g_flags;\n"
+    "void main() {\n"
+    "    Inst it = u_inst.v[gl_InstanceIndex];\n"
+    "    uint flags = uint(u_blocks.b[3u * it.q.w + 2u].z);\n"
+    "    vec3 n = normalize(unpackSnorm4x8(it.q.x).xyz + vec3(0.0, 1e-4, 0.0));\n"
+    "    float a = uintBitsToFloat(it.q.z), c = cos(a), s = sin(a);\n"
+    "    vec3 p = a_pos * it.p.w;\n"
+    "    p = vec3(c * p.x + s * p.z, p.y, -s * p.x + c * p.z);\n"
+    "    vec3 m = vec3(c * a_nrm.x + s * a_nrm.z, a_nrm.y, -s * a_nrm.x + c * a_nrm.z);\n"
+    "    if ((flags & 4u) != 0u) {   /* aligned to the terrain normal */\n"
+    "        vec3 t = normalize(cross(vec3(0.0, 0.0, 1.0), n));\n"
+    "        vec3 bt = cross(t, n);\n"
+    "        p = t * p.x + n * p.y - bt * p.z;\n"
+    "        m = t * m.x + n * m.y - bt * m.z;\n"
+    "    }\n"
+    "    v_local = it.p.xyz + p;\n"
+    "    v_rel = v_local - u_frame.camera.xyz;\n"
+    "    v_uv = v_local.xz / u_frame.terrain.xy;\n"
+    "    g_color = unpackUnorm4x8(it.q.y).rgb;\n"
+    "    g_normal = (flags & 2u) != 0u ? n : m;\n"
+    "    g_uv = a_uv;\n"
+    "    g_flags = flags;\n"
+    "    gl_Position = u_frame.view_proj * vec4(v_rel, 1.0);\n"
+    "}\n";
+
+static const char draw_frag_main[] =
+    "layout(location = 3) in vec3 g_color;\n"
+    "layout(location = 4) in vec3 g_normal;\n"
+    "layout(location = 5) in vec2 g_uv;\n"
+    "layout(location = 6) flat in uint g_flags;\n"
+    "void main() {\n"
+    "    if ((g_flags & 1u) != 0u) {   /* a leaf cut from the quad */\n"
+    "        float x = abs(g_uv.x * 2.0 - 1.0);\n"
+    "        if (x > 0.9 * sin(clamp(g_uv.y, 0.0, 1.0) * 3.14159)) discard;\n"
+    "    }\n"
+    "    float dist = length(v_rel);\n"
+    "    vec3 v = dist > 0.0 ? -v_rel / dist : vec3(0.0, 1.0, 0.0);\n"
+    "    vec3 n = normalize(g_normal);\n"
+    "    if ((g_flags & 2u) == 0u && !gl_FrontFacing) n = -n;\n"
+    "    float ao = mix(0.5, 1.0, clamp(g_uv.y, 0.0, 1.0));   /* darker at the root */\n"
+    "    o_color = vec4(splat_light(g_color * ao, n, 0.9, dist, v), 1.0);\n"
+    "}\n";
+
+/* ---- creation ----------------------------------------------------------------- */
+
+static bool set_layout(rt_device *d, const VkDescriptorSetLayoutBinding *b, uint32_t n,
+                       VkDescriptorSetLayout *out, rt_error *e)
+{
+    VkDescriptorSetLayoutCreateInfo ci = {
+        .sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO,
+        .bindingCount = n, .pBindings = b,
+    };
+    RT_VK(e, vkCreateDescriptorSetLayout(d->dev, &ci, NULL, out));
+    return true;
+}
+
+static bool pipe_layout(rt_device *d, const VkDescriptorSetLayout *sets, uint32_t n,
+                        VkShaderStageFlags stages, uint32_t push, VkPipelineLayout *out,
+                        rt_error *e)
+{
+    VkPushConstantRange pr = { stages, 0, push };
+    VkPipelineLayoutCreateInfo ci = {
+        .sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO,
+        .setLayoutCount = n, .pSetLayouts = sets,
+        .pushConstantRangeCount = 1, .pPushConstantRanges = &pr,
+    };
+    RT_VK(e, vkCreatePipelineLayout(d->dev, &ci, NULL, out));
+    return true;
+}
+
+static bool module(rt_device *d, const char *glsl, VkShaderStageFlagBits stage,
+                   const char *name, VkShaderModule *out, rt_error *e)
+{
+    uint32_t *w = NULL;
+    size_t n = 0;
+    bool ok = rt_glsl_compile(glsl, stage, name, &w, &n, e) && rt_spirv_validate(w, n, name, e);
+    if (ok) {
+        VkShaderModuleCreateInfo ci = {
+            .sType = VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO,
+            .codeSize = n * 4, .pCode = w,
+        };
+        VkResult r = vkCreateShaderModule(d->dev, &ci, NULL, out);
+        if (r != VK_SUCCESS)
+            ok = rt_fail(e, RT_E_VULKAN, "vkCreateShaderModule", rt_vk_result_name(r));
+    }
+    free(w);
+    return ok;
+}
+
+static bool compute_pipe(rt_device *d, VkPipelineLayout layout, const char *glsl,
+                         const char *name, VkPipeline *out, rt_error *e)
+{
+    VkShaderModule m;
+    if (!module(d, glsl, VK_SHADER_STAGE_COMPUTE_BIT, name, &m, e))
+        return false;
+    VkComputePipelineCreateInfo ci = {
+        .sType = VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO,
+        .stage = { .sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO,
+                   .stage = VK_SHADER_STAGE_COMPUTE_BIT, .module = m, .pName = "main" },
+        .layout = layout,
+    };
+    VkResult r = vkCreateComputePipelines(d->dev, VK_NULL_HANDLE, 1, &ci, NULL, out);
+    vkDestroyShaderModule(d->dev, m, NULL);
+    if (r != VK_SUCCESS)
+        return rt_fail(e, RT_E_VULKAN, "vkCreateComputePipelines", rt_vk_result_name(r));
+    return true;
+}
+
+/* Colour RGBA32F loaded and left TRANSFER_SRC (as every path leaves it);
+ * depth loaded from `depth_in` (the forward and multi-pass paths leave
+ * it an attachment, the screen path's geometry pass SHADER_READ_ONLY). */
+static bool make_pass(rt_device *d, VkImageLayout depth_in, VkRenderPass *out, rt_error *e)
+{
+    VkAttachmentDescription att[2] = {
+        { 0, VK_FORMAT_R32G32B32A32_SFLOAT, VK_SAMPLE_COUNT_1_BIT, VK_ATTACHMENT_LOAD_OP_LOAD,
+          VK_ATTACHMENT_STORE_OP_STORE, VK_ATTACHMENT_LOAD_OP_DONT_CARE,
+          VK_ATTACHMENT_STORE_OP_DONT_CARE, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+          VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL },
+        { 0, VK_FORMAT_D32_SFLOAT, VK_SAMPLE_COUNT_1_BIT, VK_ATTACHMENT_LOAD_OP_LOAD,
+          VK_ATTACHMENT_STORE_OP_STORE, VK_ATTACHMENT_LOAD_OP_DONT_CARE,
+          VK_ATTACHMENT_STORE_OP_DONT_CARE, depth_in, depth_in },
+    };
+    VkAttachmentReference cref = { 0, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL };
+    VkAttachmentReference dref = { 1, VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL };
+    VkSubpassDescription sub = {
+        .pipelineBindPoint = VK_PIPELINE_BIND_POINT_GRAPHICS,
+        .colorAttachmentCount = 1, .pColorAttachments = &cref,
+        .pDepthStencilAttachment = &dref,
+    };
+    VkSubpassDependency dep[2] = {
+        { VK_SUBPASS_EXTERNAL, 0,
+          VK_PIPELINE_STAGE_TRANSFER_BIT | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT |
+          VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT | VK_PIPELINE_STAGE_LATE_FRAGMENT_TESTS_BIT |
+          VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT,
+          VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT | VK_PIPELINE_STAGE_EARLY_FRAGMENT_TESTS_BIT |
+          VK_PIPELINE_STAGE_LATE_FRAGMENT_TESTS_BIT,
+          VK_ACCESS_TRANSFER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_SHADER_READ_BIT |
+          VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT | VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT,
+          VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT | VK_ACCESS_COLOR_ATTACHMENT_READ_BIT |
+          VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT | VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_READ_BIT, 0 },
+        { 0, VK_SUBPASS_EXTERNAL, VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT,
+          VK_PIPELINE_STAGE_TRANSFER_BIT | VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT,
+          VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT,
+          VK_ACCESS_TRANSFER_READ_BIT | VK_ACCESS_SHADER_READ_BIT, 0 },
+    };
+    VkRenderPassCreateInfo ci = {
+        .sType = VK_STRUCTURE_TYPE_RENDER_PASS_CREATE_INFO,
+        .attachmentCount = 2, .pAttachments = att, .subpassCount = 1, .pSubpasses = &sub,
+        .dependencyCount = 2, .pDependencies = dep,
+    };
+    RT_VK(e, vkCreateRenderPass(d->dev, &ci, NULL, out));
+    return true;
+}
+
+static bool draw_pipeline(rt_ug *u, rt_error *e)
+{
+    rt_device *d = u->d;
+    size_t nv = strlen(SPLAT_GLSL_TERRAIN) + strlen(draw_vert_main) + 32;
+    size_t nf = strlen(SPLAT_GLSL_PRELUDE) + strlen(draw_frag_main) + 32;
+    char *vs = malloc(nv), *fs = malloc(nf);
+    if (!vs || !fs) {
+        free(vs);
+        free(fs);
+        return rt_fail(e, RT_E_VULKAN, "undergrowth", "out of memory");
+    }
+    snprintf(vs, nv, "#version 450\n%s%s", SPLAT_GLSL_TERRAIN, draw_vert_main);
+    snprintf(fs, nf, "#version 450\n%s%s", SPLAT_GLSL_PRELUDE, draw_frag_main);
+    VkShaderModule vm = VK_NULL_HANDLE, fm = VK_NULL_HANDLE;
+    bool ok = module(d, vs, VK_SHADER_STAGE_VERTEX_BIT, "undergrowth.vert", &vm, e) &&
+              module(d, fs, VK_SHADER_STAGE_FRAGMENT_BIT, "undergrowth.frag", &fm, e);
+    free(vs);
+    free(fs);
+    if (ok) {
+        VkPipelineShaderStageCreateInfo st[2] = {
+            { .sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO,
+              .stage = VK_SHADER_STAGE_VERTEX_BIT, .module = vm, .pName = "main" },
+            { .sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO,
+              .stage = VK_SHADER_STAGE_FRAGMENT_BIT, .module = fm, .pName = "main" },
+        };
+        VkVertexInputBindingDescription vb = { 0, 32, VK_VERTEX_INPUT_RATE_VERTEX };
+        VkVertexInputAttributeDescription va[3] = {
+            { 0, 0, VK_FORMAT_R32G32B32_SFLOAT, 0 },
+            { 1, 0, VK_FORMAT_R32G32B32_SFLOAT, 12 },
+            { 2, 0, VK_FORMAT_R32G32_SFLOAT, 24 },
+        };
+        VkPipelineVertexInputStateCreateInfo vi = {
+            .sType = VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO,
+            .vertexBindingDescriptionCount = 1, .pVertexBindingDescriptions = &vb,
+            .vertexAttributeDescriptionCount = 3, .pVertexAttributeDescriptions = va,
+        };
+        VkPipelineInputAssemblyStateCreateInfo ia = {
+            .sType = VK_STRUCTURE_TYPE_PIPELINE_INPUT_ASSEMBLY_STATE_CREATE_INFO,
+            .topology = VK_PRIMITIVE_TOPOLOGY_TRIANGLE_LIST,
+        };
+        VkPipelineViewportStateCreateInfo vps = {
+            .sType = VK_STRUCTURE_TYPE_PIPELINE_VIEWPORT_STATE_CREATE_INFO,
+            .viewportCount = 1, .scissorCount = 1,
+        };
+        VkPipelineRasterizationStateCreateInfo rs = {
+            .sType = VK_STRUCTURE_TYPE_PIPELINE_RASTERIZATION_STATE_CREATE_INFO,
+            .polygonMode = VK_POLYGON_MODE_FILL, .cullMode = VK_CULL_MODE_NONE,
+            .frontFace = VK_FRONT_FACE_COUNTER_CLOCKWISE, .lineWidth = 1.0f,
+        };
+        VkPipelineMultisampleStateCreateInfo ms = {
+            .sType = VK_STRUCTURE_TYPE_PIPELINE_MULTISAMPLE_STATE_CREATE_INFO,
+            .rasterizationSamples = VK_SAMPLE_COUNT_1_BIT,
+        };
+        VkPipelineDepthStencilStateCreateInfo ds = {   /* reversed Z */
+            .sType = VK_STRUCTURE_TYPE_PIPELINE_DEPTH_STENCIL_STATE_CREATE_INFO,
+            .depthTestEnable = VK_TRUE, .depthWriteEnable = VK_TRUE,
+            .depthCompareOp = VK_COMPARE_OP_GREATER,
+        };
+        VkPipelineColorBlendAttachmentState cba = { .colorWriteMask = 0xf };
+        VkPipelineColorBlendStateCreateInfo cb = {
+            .sType = VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO,
+            .attachmentCount = 1, .pAttachments = &cba,
+        };
+        VkDynamicState dyn[2] = { VK_DYNAMIC_STATE_VIEWPORT, VK_DYNAMIC_STATE_SCISSOR };
+        VkPipelineDynamicStateCreateInfo dy = {
+            .sType = VK_STRUCTURE_TYPE_PIPELINE_DYNAMIC_STATE_CREATE_INFO,
+            .dynamicStateCount = 2, .pDynamicStates = dyn,
+        };
+        VkGraphicsPipelineCreateInfo ci = {
+            .sType = VK_STRUCTURE_TYPE_GRAPHICS_PIPELINE_CREATE_INFO,
+            .stageCount = 2, .pStages = st, .pVertexInputState = &vi,
+            .pInputAssemblyState = &ia, .pViewportState = &vps, .pRasterizationState = &rs,
+            .pMultisampleState = &ms, .pDepthStencilState = &ds, .pColorBlendState = &cb,
+            .pDynamicState = &dy, .layout = u->draw_layout, .renderPass = u->pass_att,
+        };
+        VkResult r = vkCreateGraphicsPipelines(d->dev, VK_NULL_HANDLE, 1, &ci, NULL, &u->draw_pipe);
+        if (r != VK_SUCCESS)
+            ok = rt_fail(e, RT_E_VULKAN, "vkCreateGraphicsPipelines", rt_vk_result_name(r));
+    }
+    if (vm)
+        vkDestroyShaderModule(d->dev, vm, NULL);
+    if (fm)
+        vkDestroyShaderModule(d->dev, fm, NULL);
+    return ok;
+}
+
+/* The block table (set 0 binding 3 of the scatter pass, set 2 binding 0
+ * of the draw): per block three vec4s, (density, scale lo, scale hi,
+ * blend), (colour, slot), (candidates per side, first instance in the
+ * cell, flags, 0); block 0's last is the block count. */
+static void fill_blocks(rt_ug *u, float *b)
+{
+    const rt_pack_ug *pu = &u->p->ug;
+    uint32_t at = 0;
+    for (int i = 0; i < u->nblocks; i++) {
+        const rt_pack_ug_block *k = &pu->blocks[i];
+        /* enough candidates that keep = density * 256 / n^2 <= 1 */
+        uint32_t n = (uint32_t)ceil(sqrt(k->density * CELL * CELL));
+        u->block_grid[i] = n;
+        u->block_base[i] = at;
+        at += n * n;
+        unsigned flags = pu->meshes[k->mesh].flags | (k->align_normal ? 4u : 0u);
+        float v[12] = { (float)k->density, (float)k->scale[0], (float)k->scale[1],
+                        (float)k->blend, (float)k->color[0], (float)k->color[1],
+                        (float)k->color[2], (float)k->slot, (float)n, (float)u->block_base[i],
+                        (float)flags, 0.0f };
+        memcpy(b + 12 * i, v, sizeof v);
+    }
+    b[11] = (float)u->nblocks;   /* block 0's last: the block count */
+    u->cap = at;
+}
+
+static bool make_sets(rt_ug *u, VkDescriptorSet set0_src, const rt_image *height,
+                      VkSampler nearest, rt_error *e)
+{
+    rt_device *d = u->d;
+    VkDescriptorPoolSize sizes[3] = {
+        { VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 8 },
+        { VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 16 },
+        { VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 2 },
+    };
+    VkDescriptorPoolCreateInfo pci = {
+        .sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO,
+        .maxSets = 4, .poolSizeCount = 3, .pPoolSizes = sizes,
+    };
+    RT_VK(e, vkCreateDescriptorPool(d->dev, &pci, NULL, &u->dpool));
+    VkDescriptorSetLayout layouts[4] = { u->set_terrain, u->set_mask, u->set_gen, u->set_draw };
+    VkDescriptorSet sets[4];
+    VkDescriptorSetAllocateInfo ai = {
+        .sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO,
+        .descriptorPool = u->dpool, .descriptorSetCount = 4, .pSetLayouts = layouts,
+    };
+    RT_VK(e, vkAllocateDescriptorSets(d->dev, &ai, sets));
+    u->set0 = sets[0];
+    u->mask_set = sets[1];
+    u->gen_set = sets[2];
+    u->draw_set = sets[3];
+    /* set 0 of the mask pass: the terrain's, but the frame block whose
+     * camera is the origin (abi.h "undergrowth masks") */
+    static const uint32_t terrain[] = {
+        SPLAT_BIND_HEIGHTFIELD, SPLAT_BIND_PAINTED, SPLAT_BIND_DESTRUCTION_ATLAS,
+        SPLAT_BIND_DESTRUCTION_INDEX, SPLAT_BIND_PAINTED_INDEX, SPLAT_BIND_PAINTED_LEVEL,
+        SPLAT_BIND_HOLES, SPLAT_BIND_SHADOW,
+    };
+    enum { N = sizeof terrain / sizeof *terrain };
+    VkCopyDescriptorSet cp[N];
+    for (int i = 0; i < N; i++)
+        cp[i] = (VkCopyDescriptorSet){ .sType = VK_STRUCTURE_TYPE_COPY_DESCRIPTOR_SET,
+            .srcSet = set0_src, .srcBinding = terrain[i], .dstSet = u->set0,
+            .dstBinding = terrain[i], .descriptorCount = 1 };
+    VkDescriptorBufferInfo fb = { u->frame.buf, 0, sizeof(splat_frame) };
+    VkDescriptorBufferInfo mb = { u->masks.buf, 0, VK_WHOLE_SIZE };
+    VkDescriptorBufferInfo ib = { u->inst.buf, 0, VK_WHOLE_SIZE };
+    VkDescriptorBufferInfo ab = { u->args.buf, 0, VK_WHOLE_SIZE };
+    VkDescriptorBufferInfo bb = { u->blocks.buf, 0, VK_WHOLE_SIZE };
+    VkDescriptorImageInfo hi = { nearest, height->view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL };
+    const VkDescriptorType sb = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+#define W(set_, b_, type_, img_, buf_) \
+    (VkWriteDescriptorSet){ .sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, \
+        .dstSet = set_, .dstBinding = b_, .descriptorCount = 1, .descriptorType = type_, \
+        .pImageInfo = img_, .pBufferInfo = buf_ }
+    VkWriteDescriptorSet w[] = {
+        W(u->set0, SPLAT_BIND_FRAME, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, NULL, &fb),
+        W(u->mask_set, 0, sb, NULL, &mb),
+        W(u->gen_set, 0, sb, NULL, &mb), W(u->gen_set, 1, sb, NULL, &ib),
+        W(u->gen_set, 2, sb, NULL, &ab), W(u->gen_set, 3, sb, NULL, &bb),
+        W(u->gen_set, 4, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, &hi, NULL),
+        W(u->draw_set, 0, sb, NULL, &bb), W(u->draw_set, 1, sb, NULL, &ib),
+    };
+#undef W
+    vkUpdateDescriptorSets(d->dev, sizeof w / sizeof *w, w, N, cp);
+    return true;
+}
+
+static bool make_layouts(rt_ug *u, rt_error *e)
+{
+    rt_device *d = u->d;
+    const VkShaderStageFlags cs = VK_SHADER_STAGE_COMPUTE_BIT;
+    const VkDescriptorType sb = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+    /* the terrain's set 0 without the screen path's bindings (7-10),
+     * which the mask pass neither declares nor has to fill */
+    const VkDescriptorType smp = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
+    VkDescriptorSetLayoutBinding terrain[] = {
+        { SPLAT_BIND_HEIGHTFIELD, smp, 1, cs, NULL },
+        { SPLAT_BIND_FRAME, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 1, cs, NULL },
+        { SPLAT_BIND_PAINTED, smp, 1, cs, NULL },
+        { SPLAT_BIND_DESTRUCTION_ATLAS, smp, 1, cs, NULL },
+        { SPLAT_BIND_DESTRUCTION_INDEX, smp, 1, cs, NULL },
+        { SPLAT_BIND_PAINTED_INDEX, smp, 1, cs, NULL },
+        { SPLAT_BIND_PAINTED_LEVEL, smp, 1, cs, NULL },
+        { SPLAT_BIND_HOLES, smp, 1, cs, NULL },
+        { SPLAT_BIND_SHADOW, smp, 1, cs, NULL },
+    };
+    VkDescriptorSetLayoutBinding mask[] = { { 0, sb, 1, cs, NULL } };
+    VkDescriptorSetLayoutBinding gen[] = {
+        { 0, sb, 1, cs, NULL }, { 1, sb, 1, cs, NULL }, { 2, sb, 1, cs, NULL },
+        { 3, sb, 1, cs, NULL }, { 4, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, cs, NULL },
+    };
+    VkDescriptorSetLayoutBinding draw[] = {
+        { 0, sb, 1, VK_SHADER_STAGE_VERTEX_BIT, NULL }, { 1, sb, 1, VK_SHADER_STAGE_VERTEX_BIT, NULL },
+    };
+    if (!set_layout(d, terrain, sizeof terrain / sizeof *terrain, &u->set_terrain, e) ||
+        !set_layout(d, mask, 1, &u->set_mask, e) || !set_layout(d, gen, 5, &u->set_gen, e) ||
+        !set_layout(d, draw, 2, &u->set_draw, e))
+        return false;
+    VkDescriptorSetLayout ms[3] = { u->set_terrain, u->pl->set_material, u->set_mask };
+    VkDescriptorSetLayout ds[3] = { u->pl->set_terrain, u->pl->set_material, u->set_draw };
+    return pipe_layout(d, ms, 3, cs, sizeof(splat_push), &u->mask_layout, e) &&
+           pipe_layout(d, &u->set_gen, 1, cs, sizeof(ug_push), &u->gen_layout, e) &&
+           pipe_layout(d, ds, 3, VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT,
+                       sizeof(splat_push), &u->draw_layout, e);
+}
+
+static bool make_buffers(rt_ug *u, rt_error *e)
+{
+    rt_device *d = u->d;
+    const rt_pack_ug *pu = &u->p->ug;
+    const VkBufferUsageFlags st = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
+    VkDeviceSize mask_bytes = (VkDeviceSize)u->pool * TEXELS * TEXELS * (u->nw + 2) * 4;
+    VkDeviceSize inst_bytes = (VkDeviceSize)u->pool * u->cap * 32;
+    if (inst_bytes > MAX_INSTANCE_BYTES || inst_bytes > d->props.limits.maxStorageBufferRange ||
+        mask_bytes > d->props.limits.maxStorageBufferRange)
+        return rt_fail(e, RT_E_PACK_LIMIT, u->p->dir, "undergrowth's instance buffer (bytes)",
+                       (unsigned long long)inst_bytes, "the device's storage buffer range or 256 MiB",
+                       (unsigned long long)(MAX_INSTANCE_BYTES < d->props.limits.maxStorageBufferRange
+                                                ? MAX_INSTANCE_BYTES
+                                                : d->props.limits.maxStorageBufferRange));
+    if (!rt_buffer_create(d, mask_bytes, st | VK_BUFFER_USAGE_TRANSFER_DST_BIT, false, &u->masks, e) ||
+        !rt_buffer_create(d, inst_bytes + 32, st | VK_BUFFER_USAGE_TRANSFER_SRC_BIT, false,
+                          &u->inst, e) ||
+        !rt_buffer_create(d, (VkDeviceSize)u->pool * u->nblocks * 20,
+                          st | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT, true, &u->args, e) ||
+        !rt_buffer_create(d, (VkDeviceSize)u->nblocks * 48, st, true, &u->blocks, e) ||
+        !rt_buffer_create(d, (VkDeviceSize)pu->nvertices * 32, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT,
+                          true, &u->vbuf, e) ||
+        !rt_buffer_create(d, (VkDeviceSize)pu->nindices * 4, VK_BUFFER_USAGE_INDEX_BUFFER_BIT,
+                          true, &u->ibuf, e) ||
+        !rt_buffer_create(d, sizeof(splat_frame), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, true,
+                          &u->frame, e))
+        return false;
+    memcpy(u->vbuf.map, pu->vertices, (size_t)pu->nvertices * 32);
+    memcpy(u->ibuf.map, pu->indices, (size_t)pu->nindices * 4);
+    fill_blocks(u, u->blocks.map);
+    memset(u->args.map, 0, (size_t)u->args.size);
+    return true;
+}
+
+bool rt_ug_create(rt_device *d, const rt_pack *p, rt_pipelines *pl, const rt_quadtree *qt,
+                  const rt_ug_targets *t, double radius, rt_ug **out, rt_error *e)
+{
+    *out = NULL;
+    if (p->ug.nslots == 0)
+        return true;
+    rt_ug *u = calloc(1, sizeof *u);
+    if (!u)
+        return rt_fail(e, RT_E_VULKAN, "undergrowth", "out of memory");
+    *out = u;
+    u->d = d;
+    u->p = p;
+    u->pl = pl;
+    u->qt = qt;
+    u->radius = radius > 0 ? radius : RT_UG_RADIUS;
+    int side = (int)ceil(2 * u->radius / CELL) + 2;
+    u->pool = side * side;
+    u->nblocks = p->ug.nblocks;
+    u->nw = (p->ug.nslots + 3) / 4;
+    u->cells = calloc((size_t)u->pool, sizeof *u->cells);
+    u->order = calloc((size_t)u->pool, sizeof *u->order);
+    u->block_base = calloc((size_t)u->nblocks, sizeof *u->block_base);
+    u->block_grid = calloc((size_t)u->nblocks, sizeof *u->block_grid);
+    u->mask_pipes = calloc((size_t)p->ncombos + 1, sizeof *u->mask_pipes);
+    if (!u->cells || !u->order || !u->block_base || !u->block_grid || !u->mask_pipes)
+        return rt_fail(e, RT_E_VULKAN, "undergrowth", "out of memory");
+    fill_blocks(u, (float[12 * 64]){0});   /* u->cap before the buffers */
+    VkQueryPoolCreateInfo qi = {
+        .sType = VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO,
+        .queryType = VK_QUERY_TYPE_TIMESTAMP, .queryCount = 4,
+    };
+    if (!make_layouts(u, e) || !make_buffers(u, e) ||
+        !make_sets(u, t->set0, t->height, t->nearest, e) ||
+        !make_pass(d, VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL, &u->pass_att, e) ||
+        !make_pass(d, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, &u->pass_ro, e) ||
+        !compute_pipe(d, u->gen_layout, gen_glsl, "undergrowth scatter", &u->gen_pipe, e) ||
+        !draw_pipeline(u, e))
+        return false;
+    VkImageView views[2] = { t->color->view, t->depth->view };
+    VkFramebufferCreateInfo fci = {
+        .sType = VK_STRUCTURE_TYPE_FRAMEBUFFER_CREATE_INFO,
+        .renderPass = u->pass_att, .attachmentCount = 2, .pAttachments = views,
+        .width = (uint32_t)t->width, .height = (uint32_t)t->height_px, .layers = 1,
+    };
+    RT_VK(e, vkCreateFramebuffer(d->dev, &fci, NULL, &u->fb));
+    if (t->timestamps)
+        RT_VK(e, vkCreateQueryPool(d->dev, &qi, NULL, &u->qpool));
+    return true;
+}
+
+void rt_ug_destroy(rt_ug *u)
+{
+    if (!u)
+        return;
+    rt_device *d = u->d;
+    for (int i = 0; u->mask_pipes && i <= u->p->ncombos; i++)
+        if (u->mask_pipes[i])
+            vkDestroyPipeline(d->dev, u->mask_pipes[i], NULL);
+    VkPipeline pipes[2] = { u->gen_pipe, u->draw_pipe };
+    for (int i = 0; i < 2; i++)
+        if (pipes[i])
+            vkDestroyPipeline(d->dev, pipes[i], NULL);
+    VkPipelineLayout pls[3] = { u->mask_layout, u->gen_layout, u->draw_layout };
+    for (int i = 0; i < 3; i++)
+        if (pls[i])
+            vkDestroyPipelineLayout(d->dev, pls[i], NULL);
+    VkDescriptorSetLayout sls[4] = { u->set_terrain, u->set_mask, u->set_gen, u->set_draw };
+    for (int i = 0; i < 4; i++)
+        if (sls[i])
+            vkDestroyDescriptorSetLayout(d->dev, sls[i], NULL);
+    if (u->dpool)
+        vkDestroyDescriptorPool(d->dev, u->dpool, NULL);
+    if (u->fb)
+        vkDestroyFramebuffer(d->dev, u->fb, NULL);
+    if (u->pass_att)
+        vkDestroyRenderPass(d->dev, u->pass_att, NULL);
+    if (u->pass_ro)
+        vkDestroyRenderPass(d->dev, u->pass_ro, NULL);
+    if (u->qpool)
+        vkDestroyQueryPool(d->dev, u->qpool, NULL);
+    rt_buffer *bufs[] = { &u->masks, &u->inst, &u->args, &u->blocks, &u->vbuf, &u->ibuf, &u->frame };
+    for (size_t i = 0; i < sizeof bufs / sizeof *bufs; i++)
+        rt_buffer_destroy(d, bufs[i]);
+    free(u->mask_pipes);
+    free(u->cells);
+    free(u->order);
+    free(u->block_base);
+    free(u->block_grid);
+    free(u);
+}
+
+/* ---- cells ---------------------------------------------------------------------- */
+
+static ug_cell *find_cell(rt_ug *u, int ix, int iz)
+{
+    for (int i = 0; i < u->pool; i++)
+        if (u->cells[i].state != CELL_FREE && u->cells[i].ix == ix && u->cells[i].iz == iz)
+            return &u->cells[i];
+    return NULL;
+}
+
+/* Whether the box [lo, hi] (camera-relative) is outside one clip plane. */
+static bool box_outside(const float *m, const double lo[3], const double hi[3])
+{
+    for (int plane = 0; plane < 5; plane++) {
+        bool all_out = true;
+        for (int c = 0; c < 8 && all_out; c++) {
+            double p[3] = { c & 1 ? hi[0] : lo[0], c & 2 ? hi[1] : lo[1], c & 4 ? hi[2] : lo[2] };
+            double v[4];
+            for (int r = 0; r < 4; r++)   /* column-major */
+                v[r] = m[r] * p[0] + m[4 + r] * p[1] + m[8 + r] * p[2] + m[12 + r];
+            double d = plane == 0 ? v[3] + v[0] : plane == 1 ? v[3] - v[0]
+                     : plane == 2 ? v[3] + v[1] : plane == 3 ? v[3] - v[1] : v[3] - v[2];
+            all_out = d < 0;
+        }
+        if (all_out)
+            return true;
+    }
+    return false;
+}
+
+/* Draw and generation order: visible before not, near before far. */
+static bool before(const ug_cell *x, const ug_cell *y)
+{
+    if (x->visible != y->visible)
+        return x->visible;
+    return x->dist < y->dist;
+}
+
+/* Allocate every cell within the radius (freeing those outside), then
+ * order the pool: visible before not, near before far. */
+static void allocate(rt_ug *u, const rt_camera *c, const float view_proj[16])
+{
+    const rt_pack *p = u->p;
+    for (int i = 0; i < u->pool; i++)
+        u->cells[i].wanted = false;
+    double r = u->radius, cx = c->position[0], cz = c->position[2];
+    int x0 = (int)floor((cx - r) / CELL), x1 = (int)floor((cx + r) / CELL);
+    int z0 = (int)floor((cz - r) / CELL), z1 = (int)floor((cz + r) / CELL);
+    int maxx = (int)ceil(p->size[0] / CELL) - 1, maxz = (int)ceil(p->size[1] / CELL) - 1;
+    for (int iz = z0 < 0 ? 0 : z0; iz <= z1 && iz <= maxz; iz++)
+        for (int ix = x0 < 0 ? 0 : x0; ix <= x1 && ix <= maxx; ix++) {
+            double dx = (ix + 0.5) * CELL - cx, dz = (iz + 0.5) * CELL - cz;
+            if (dx * dx + dz * dz > r * r)
+                continue;
+            ug_cell *cl = find_cell(u, ix, iz);
+            if (!cl)
+                for (int i = 0; i < u->pool && !cl; i++)
+                    if (u->cells[i].state == CELL_FREE)
+                        cl = &u->cells[i];
+            if (!cl)
+                continue;   /* the pool is sized for the disc: not reached */
+            if (cl->state == CELL_FREE)
+                *cl = (ug_cell){ .ix = ix, .iz = iz, .state = CELL_PENDING };
+            cl->wanted = true;
+            cl->dist = sqrt(dx * dx + dz * dz);
+        }
+    /* cells that left the disc are free now; the disc's new ones take
+     * them next frame at the latest (a full pool frees before it fills) */
+    for (int i = 0; i < u->pool; i++)
+        if (!u->cells[i].wanted)
+            u->cells[i].state = CELL_FREE;
+    double hmin = p->height_offset, hmax = p->height_offset + p->max_height;
+    for (int i = 0; i < u->pool; i++) {
+        ug_cell *cl = &u->cells[i];
+        u->order[i] = i;
+        if (cl->state == CELL_FREE)
+            continue;
+        double lo[3] = { cl->ix * CELL - cx, hmin - c->position[1] - 2, cl->iz * CELL - cz };
+        double hi[3] = { lo[0] + CELL, hmax - c->position[1] + 8, lo[2] + CELL };
+        cl->visible = !box_outside(view_proj, lo, hi);
+    }
+    for (int i = 1; i < u->pool; i++)   /* insertion sort: a few hundred cells */
+        for (int j = i; j > 0 && before(&u->cells[u->order[j]], &u->cells[u->order[j - 1]]); j--) {
+            int t = u->order[j];
+            u->order[j] = u->order[j - 1];
+            u->order[j - 1] = t;
+        }
+}
+
+void rt_ug_invalidate(rt_ug *u, const double *rect)
+{
+    if (!u)
+        return;
+    for (int i = 0; i < u->pool; i++) {
+        ug_cell *cl = &u->cells[i];
+        if (cl->state != CELL_READY)
+            continue;
+        if (rect && (cl->ix * CELL > rect[2] || (cl->ix + 1) * CELL < rect[0] ||
+                     cl->iz * CELL > rect[3] || (cl->iz + 1) * CELL < rect[1]))
+            continue;
+        cl->state = CELL_PENDING;
+    }
+}
+
+/* ---- generation ------------------------------------------------------------------- */
+
+static bool mask_pipeline(rt_ug *u, int combo, VkPipeline *out, rt_error *e)
+{
+    if (!u->mask_pipes[combo]) {
+        const char *glsl = u->p->combos[combo].ug_compute;
+        char name[64];
+        snprintf(name, sizeof name, "combination %d (undergrowth masks)", combo);
+        if (!glsl) {
+            *out = VK_NULL_HANDLE;   /* grows nothing: the texels stay 0 */
+            return true;
+        }
+        if (!compute_pipe(u->d, u->mask_layout, glsl, name, &u->mask_pipes[combo], e))
+            return false;
+    }
+    *out = u->mask_pipes[combo];
+    return true;
+}
+
+static void barrier(VkCommandBuffer cb, VkPipelineStageFlags src, VkAccessFlags sa,
+                    VkPipelineStageFlags dst, VkAccessFlags da)
+{
+    VkMemoryBarrier mb = { .sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER,
+                           .srcAccessMask = sa, .dstAccessMask = da };
+    vkCmdPipelineBarrier(cb, src, dst, 0, 1, &mb, 0, NULL, 0, NULL);
+}
+
+/* The mask dispatches of cell `cl` in pool slot `slot`: one per leaf cell
+ * it overlaps, clipped to that leaf. */
+static bool record_masks(rt_ug *u, VkCommandBuffer cb, const ug_cell *cl, int slot,
+                         VkDescriptorSet set1, rt_error *e)
+{
+    const rt_pack *p = u->p;
+    const rt_pack_level *L0 = &p->levels[0];
+    double lx0, lz0, lsx, lsz;
+    rt_node_rect(u->qt, 0, 0, 0, &lx0, &lz0, &lsx, &lsz);
+    double x0 = cl->ix * CELL, z0 = cl->iz * CELL;
+    int ax = (int)floor(x0 / lsx), bx = (int)floor((x0 + CELL) / lsx);
+    int az = (int)floor(z0 / lsz), bz = (int)floor((z0 + CELL) / lsz);
+    VkDescriptorSet sets[3] = { u->set0, set1, u->mask_set };
+    vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, u->mask_layout, 0, 3, sets, 0, NULL);
+    for (int lz = az; lz <= bz; lz++)
+        for (int lx = ax; lx <= bx; lx++) {
+            if (lx < 0 || lz < 0 || lx >= L0->width || lz >= L0->height)
+                continue;
+            unsigned id = L0->ids[(size_t)lz * (size_t)L0->width + (size_t)lx];
+            if (id == SPLAT_COMBO_HOLE)
+                continue;
+            VkPipeline pipe;
+            if (!mask_pipeline(u, (int)id, &pipe, e))
+                return false;
+            if (!pipe)
+                continue;
+            vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, pipe);
+            splat_push push = {
+                .patch_xz = { (float)x0, (float)z0, (float)CELL, 0 },
+                .patch_uv = { (float)(lx * lsx), (float)(lz * lsz), (float)((lx + 1) * lsx),
+                              (float)((lz + 1) * lsz) },
+                .info = { (uint32_t)slot * TEXELS * TEXELS * (uint32_t)(u->nw + 2), 0,
+                          (uint32_t)u->nw, 0 },
+            };
+            vkCmdPushConstants(cb, u->mask_layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof push, &push);
+            vkCmdDispatch(cb, TEXELS / 8, TEXELS / 8, 1);
+        }
+    return true;
+}
+
+/* The draw arguments of a slot's blocks (instance counts 0 until its
+ * scatter pass writes them). */
+static void reset_args(rt_ug *u, int slot)
+{
+    uint32_t *a = (uint32_t *)u->args.map + (size_t)slot * u->nblocks * 5;
+    for (int b = 0; b < u->nblocks; b++) {
+        const rt_pack_ug_mesh *m = &u->p->ug.meshes[u->p->ug.blocks[b].mesh];
+        uint32_t v[5] = { m->nidx, 0, m->first_index, m->first_vertex,
+                          (uint32_t)slot * u->cap + u->block_base[b] };
+        memcpy(a + 5 * b, v, sizeof v);
+    }
+}
+
+bool rt_ug_generate(rt_ug *u, VkCommandBuffer cb, const rt_camera *c, const splat_frame *fr,
+                    VkDescriptorSet set1, int budget, rt_error *e)
+{
+    u->generated = 0;
+    allocate(u, c, fr->view_proj);
+    /* the mask pass's frame block: this frame's, seen from the origin */
+    splat_frame *uf = u->frame.map;
+    *uf = *fr;
+    memset(uf->camera, 0, sizeof uf->camera);
+    for (int k = 0; k < u->p->nsites; k++)
+        for (int a = 0; a < 4; a++)
+            uf->world[4 * k + a] = 0.0f;
+    if (u->qpool) {
+        vkCmdResetQueryPool(cb, u->qpool, 0, 4);
+        vkCmdWriteTimestamp(cb, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, u->qpool, 0);
+    }
+    int todo[1024], n = 0;
+    for (int i = 0; i < u->pool && n < (int)(sizeof todo / sizeof *todo); i++) {
+        int k = u->order[i];
+        if (u->cells[k].state == CELL_PENDING && (budget <= 0 || n < budget))
+            todo[n++] = k;
+    }
+    if (n > 0) {
+        VkDeviceSize per = (VkDeviceSize)TEXELS * TEXELS * (u->nw + 2) * 4;
+        for (int i = 0; i < n; i++) {
+            vkCmdFillBuffer(cb, u->masks.buf, per * (VkDeviceSize)todo[i], per, 0);
+            reset_args(u, todo[i]);
+        }
+        barrier(cb, VK_PIPELINE_STAGE_TRANSFER_BIT | VK_PIPELINE_STAGE_DRAW_INDIRECT_BIT |
+                    VK_PIPELINE_STAGE_VERTEX_SHADER_BIT,
+                VK_ACCESS_TRANSFER_WRITE_BIT | VK_ACCESS_INDIRECT_COMMAND_READ_BIT |
+                    VK_ACCESS_SHADER_READ_BIT,
+                VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+                VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_SHADER_READ_BIT);
+        for (int i = 0; i < n; i++)
+            if (!record_masks(u, cb, &u->cells[todo[i]], todo[i], set1, e))
+                return false;
+        barrier(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
+                VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT);
+        vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, u->gen_pipe);
+        vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, u->gen_layout, 0, 1,
+                                &u->gen_set, 0, NULL);
+        const rt_pack *p = u->p;
+        for (int i = 0; i < n; i++) {
+            const ug_cell *cl = &u->cells[todo[i]];
+            ug_push push = {
+                .origin = { (float)(cl->ix * CELL), (float)(cl->iz * CELL) },
+                .cell = { cl->ix, cl->iz }, .slot = (uint32_t)todo[i], .nw = (uint32_t)u->nw,
+                .cap = u->cap,
+                .mask_base = (uint32_t)todo[i] * TEXELS * TEXELS * (uint32_t)(u->nw + 2),
+                .terrain = { (float)p->size[0], (float)p->size[1], (float)p->max_height,
+                             (float)p->height_offset },
+                .hf = { p->hf_width, p->hf_height },
+            };
+            vkCmdPushConstants(cb, u->gen_layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof push, &push);
+            vkCmdDispatch(cb, (uint32_t)u->nblocks, 1, 1);
+            u->cells[todo[i]].state = CELL_READY;
+        }
+        barrier(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
+                VK_PIPELINE_STAGE_DRAW_INDIRECT_BIT | VK_PIPELINE_STAGE_VERTEX_SHADER_BIT |
+                    VK_PIPELINE_STAGE_HOST_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT,
+                VK_ACCESS_INDIRECT_COMMAND_READ_BIT | VK_ACCESS_SHADER_READ_BIT |
+                    VK_ACCESS_HOST_READ_BIT | VK_ACCESS_TRANSFER_READ_BIT);
+    }
+    if (u->qpool)
+        vkCmdWriteTimestamp(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, u->qpool, 1);
+    u->generated = n;
+    return true;
+}
+
+void rt_ug_draw(rt_ug *u, VkCommandBuffer cb, bool depth_read_only, VkDescriptorSet set0,
+                VkDescriptorSet set1, const VkViewport *vp, const VkRect2D *area)
+{
+    u->drawn = true;
+    if (u->qpool)
+        vkCmdWriteTimestamp(cb, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, u->qpool, 2);
+    VkRenderPassBeginInfo rb = {
+        .sType = VK_STRUCTURE_TYPE_RENDER_PASS_BEGIN_INFO,
+        .renderPass = depth_read_only ? u->pass_ro : u->pass_att, .framebuffer = u->fb,
+        .renderArea = *area,
+    };
+    vkCmdBeginRenderPass(cb, &rb, VK_SUBPASS_CONTENTS_INLINE);
+    vkCmdSetViewport(cb, 0, 1, vp);
+    vkCmdSetScissor(cb, 0, 1, area);
+    vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_GRAPHICS, u->draw_pipe);
+    VkDescriptorSet sets[3] = { set0, set1, u->draw_set };
+    vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_GRAPHICS, u->draw_layout, 0, 3, sets, 0, NULL);
+    VkDeviceSize zero = 0;
+    vkCmdBindVertexBuffers(cb, 0, 1, &u->vbuf.buf, &zero);
+    vkCmdBindIndexBuffer(cb, u->ibuf.buf, 0, VK_INDEX_TYPE_UINT32);
+    for (int i = 0; i < u->pool; i++) {   /* front to back */
+        int k = u->order[i];
+        if (u->cells[k].state != CELL_READY || !u->cells[k].visible)
+            continue;
+        VkDeviceSize at = (VkDeviceSize)k * u->nblocks * 20;
+        for (int b = 0; b < u->nblocks; b++)
+            vkCmdDrawIndexedIndirect(cb, u->args.buf, at + 20 * (VkDeviceSize)b, 1, 20);
+    }
+    vkCmdEndRenderPass(cb);
+    if (u->qpool)
+        vkCmdWriteTimestamp(cb, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, u->qpool, 3);
+}
+
+void rt_ug_read_stats(rt_ug *u, rt_ug_stats *st)
+{
+    memset(st, 0, sizeof *st);
+    st->gen_ms = st->draw_ms = -1;
+    if (!u)
+        return;
+    st->generated = u->generated;
+    const uint32_t *a = u->args.map;
+    for (int i = 0; i < u->pool; i++) {
+        if (u->cells[i].state != CELL_READY)
+            continue;
+        st->cells++;
+        for (int b = 0; b < u->nblocks; b++)
+            st->instances += a[((size_t)i * u->nblocks + b) * 5 + 1];
+    }
+    st->bytes_per_cell = (size_t)TEXELS * TEXELS * (size_t)(u->nw + 2) * 4 +
+                         (size_t)u->cap * 32 + (size_t)u->nblocks * 20;
+    if (!u->qpool)
+        return;
+    uint64_t q[4];
+    const VkQueryResultFlags fl = VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT;
+    double ms = u->d->props.limits.timestampPeriod * 1e-6;
+    if (vkGetQueryPoolResults(u->d->dev, u->qpool, 0, 2, sizeof q, q, sizeof q[0], fl) == VK_SUCCESS)
+        st->gen_ms = (double)(q[1] - q[0]) * ms;
+    if (u->drawn &&
+        vkGetQueryPoolResults(u->d->dev, u->qpool, 2, 2, 2 * sizeof q[0], q + 2, sizeof q[0], fl) ==
+            VK_SUCCESS)
+        st->draw_ms = (double)(q[3] - q[2]) * ms;
+    u->drawn = false;
+}
+
+int rt_ug_read_cell(rt_ug *u, int ix, int iz, rt_ug_instance *out, int max, rt_error *e)
+{
+    ug_cell *cl = u ? find_cell(u, ix, iz) : NULL;
+    if (!cl || cl->state != CELL_READY)
+        return 0;
+    int slot = (int)(cl - u->cells);
+    const uint32_t *a = (const uint32_t *)u->args.map + (size_t)slot * u->nblocks * 5;
+    rt_buffer st;
+    if (!rt_buffer_create(u->d, (VkDeviceSize)u->cap * 32, VK_BUFFER_USAGE_TRANSFER_DST_BIT, true,
+                          &st, e))
+        return -1;
+    VkCommandBuffer cb;
+    if (!rt_oneshot_begin(u->d, &cb, e)) {
+        rt_buffer_destroy(u->d, &st);
+        return -1;
+    }
+    VkBufferCopy region = { (VkDeviceSize)slot * u->cap * 32, 0, (VkDeviceSize)u->cap * 32 };
+    vkCmdCopyBuffer(cb, u->inst.buf, st.buf, 1, &region);
+    if (!rt_oneshot_end(u->d, cb, e)) {
+        rt_buffer_destroy(u->d, &st);
+        return -1;
+    }
+    int n = 0;
+    for (int b = 0; b < u->nblocks; b++)
+        for (uint32_t k = 0; k < a[5 * b + 1] && n < max; k++, n++) {
+            const uint8_t *src = (const uint8_t *)st.map + 32 * (size_t)(u->block_base[b] + k);
+            memcpy(&out[n], src, 32);
+        }
+    rt_buffer_destroy(u->d, &st);
+    return n;
+}

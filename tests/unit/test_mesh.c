@@ -1,0 +1,234 @@
+/* test_mesh.c — undergrowth meshes (mesh.h): every built-in is a sound
+ * triangle list of the stated size, deterministic; OBJ files round-trip
+ * (a cube with and without normals) and broken ones give a message. */
+#include <setjmp.h>
+#include <stdarg.h>
+#include <stddef.h>
+#include <cmocka.h>
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "mesh.h"
+
+typedef struct box { float lo[3], hi[3]; } box;
+
+/* Indices in range, whole triangles, unit normals, uv in [0, 1]; the box. */
+static box check_sound(const splat_mesh *m)
+{
+    assert_true(m->nv > 0);
+    assert_true(m->nidx > 0);
+    assert_int_equal(m->nidx % 3, 0);
+    for (uint32_t i = 0; i < m->nidx; i++)
+        assert_true(m->idx[i] < m->nv);
+    box b = { { INFINITY, INFINITY, INFINITY }, { -INFINITY, -INFINITY, -INFINITY } };
+    for (uint32_t i = 0; i < m->nv; i++) {
+        const splat_mesh_vertex *v = &m->v[i];
+        double len = sqrt(v->nrm[0] * v->nrm[0] + v->nrm[1] * v->nrm[1] + v->nrm[2] * v->nrm[2]);
+        assert_true(fabs(len - 1) < 1e-5);
+        assert_true(v->uv[1] >= 0 && v->uv[1] <= 1);
+        for (int k = 0; k < 3; k++) {
+            b.lo[k] = fminf(b.lo[k], v->pos[k]);
+            b.hi[k] = fmaxf(b.hi[k], v->pos[k]);
+        }
+    }
+    return b;
+}
+
+static void test_builtins(void **state)
+{
+    splat_mesh m;
+    int n = 0;
+    for (; splat_mesh_builtins[n]; n++) {
+        assert_true(splat_mesh_builtin(splat_mesh_builtins[n], &m));
+        box b = check_sound(&m);
+        /* deterministic: the same bytes again */
+        splat_mesh again;
+        assert_true(splat_mesh_builtin(splat_mesh_builtins[n], &again));
+        assert_int_equal(again.nv, m.nv);
+        assert_int_equal(again.nidx, m.nidx);
+        assert_memory_equal(again.v, m.v, m.nv * sizeof *m.v);
+        assert_memory_equal(again.idx, m.idx, m.nidx * sizeof *m.idx);
+        splat_mesh_free(&again);
+
+        const char *name = splat_mesh_builtins[n];
+        if (!strcmp(name, "grass")) {
+            assert_int_equal(m.nv, 12 * 6);               /* 12 blades, 3 x 2 */
+            assert_true(fabsf(b.lo[1]) < 1e-6f);
+            assert_true(b.hi[1] >= 0.35f && b.hi[1] <= 0.5f + 1e-6f);
+            for (int k = 0; k < 3; k += 2)
+                assert_true(b.lo[k] > -0.3f && b.hi[k] < 0.3f);
+            for (uint32_t i = 0; i < m.nv; i++)         /* lit like the ground */
+                assert_true(m.v[i].nrm[1] > 0.9f);
+        } else if (!strcmp(name, "plant")) {
+            assert_int_equal(m.nidx, 12);                 /* two quads */
+            for (int k = 0; k < 3; k += 2) {
+                assert_true(fabsf(b.lo[k] + 0.3f) < 1e-6f);
+                assert_true(fabsf(b.hi[k] - 0.3f) < 1e-6f);
+            }
+            assert_true(fabsf(b.lo[1]) < 1e-6f && fabsf(b.hi[1] - 0.6f) < 1e-6f);
+        } else {
+            assert_string_equal(name, "stone");
+            assert_true(b.lo[1] < 0 && b.lo[1] > -0.1f);   /* sunk in the ground */
+            assert_true(b.hi[1] > 0.15f && b.hi[1] <= 0.25f);
+            for (int k = 0; k < 3; k += 2)
+                assert_true(b.hi[k] - b.lo[k] > 0.3f && b.hi[k] - b.lo[k] < 0.5f);
+            /* flat normals, pointing out of the stone: each face's
+             * vertices share the normal, and the winding agrees */
+            for (uint32_t t = 0; t < m.nidx; t += 3) {
+                const float *p0 = m.v[m.idx[t]].pos, *p1 = m.v[m.idx[t + 1]].pos,
+                            *p2 = m.v[m.idx[t + 2]].pos, *nrm = m.v[m.idx[t]].nrm;
+                float a[3], c[3];
+                for (int k = 0; k < 3; k++)
+                    a[k] = p1[k] - p0[k], c[k] = p2[k] - p0[k];
+                float x[3] = { a[1] * c[2] - a[2] * c[1], a[2] * c[0] - a[0] * c[2],
+                               a[0] * c[1] - a[1] * c[0] };
+                assert_true(x[0] * nrm[0] + x[1] * nrm[1] + x[2] * nrm[2] > 0);
+                assert_memory_equal(m.v[m.idx[t + 1]].nrm, nrm, sizeof m.v->nrm);
+                float mid = (p0[0] + p1[0] + p2[0]) * nrm[0] +
+                            ((p0[1] + p1[1] + p2[1]) / 3 - 0.07f) * 3 * nrm[1] +
+                            (p0[2] + p1[2] + p2[2]) * nrm[2];
+                assert_true(mid > 0);
+            }
+        }
+        splat_mesh_free(&m);
+    }
+    assert_int_equal(n, 3);
+    assert_false(splat_mesh_builtin("fern", &m));
+}
+
+static char dir[64];
+
+static char *write_file(const char *name, const char *text)
+{
+    static char path[128];
+    snprintf(path, sizeof path, "%s/%s", dir, name);
+    FILE *f = fopen(path, "w");
+    assert_non_null(f);
+    fputs(text, f);
+    fclose(f);
+    return path;
+}
+
+/* The unit cube [0,1]^3, quads wound counter-clockwise seen from outside. */
+static const char cube_v[] =
+    "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0 0 1\nv 1 0 1\nv 1 1 1\nv 0 1 1\n";
+static const char cube_f[] =
+    "f 1 4 3 2\nf 5 6 7 8\nf 1 2 6 5\nf 4 8 7 3\nf 1 5 8 4\nf 2 3 7 6\n";
+
+static void test_obj_cube(void **state)
+{
+    char text[2048], *err = NULL;
+    splat_mesh m;
+
+    /* no normals, no uv: flat normals (4 vertices a face after merging),
+     * uv.y from height */
+    snprintf(text, sizeof text, "# cube\n%s%s", cube_v, cube_f);
+    assert_true(splat_mesh_obj(write_file("cube.obj", text), &m, &err));
+    assert_null(err);
+    check_sound(&m);
+    assert_int_equal(m.nidx, 36);
+    assert_int_equal(m.nv, 24);
+    for (uint32_t t = 0; t < m.nidx; t += 3) {
+        const splat_mesh_vertex *v = &m.v[m.idx[t]];
+        float out = 0;               /* normal . (centroid - cube centre) */
+        for (int k = 0; k < 3; k++) {
+            float c = (m.v[m.idx[t]].pos[k] + m.v[m.idx[t + 1]].pos[k] +
+                       m.v[m.idx[t + 2]].pos[k]) / 3 - 0.5f;
+            out += v->nrm[k] * c;
+            assert_true(fabsf(v->nrm[k]) < 1e-6f || fabsf(fabsf(v->nrm[k]) - 1) < 1e-6f);
+        }
+        assert_true(out > 0);
+    }
+    for (uint32_t i = 0; i < m.nv; i++) {
+        assert_true(m.v[i].uv[0] == 0.5f);
+        assert_true(m.v[i].uv[1] == m.v[i].pos[1]);
+    }
+    splat_mesh_free(&m);
+
+    /* smooth normals and uv from the file: the 8 corners, 12 triangles;
+     * uv.y clamped to [0, 1] */
+    char vn[512] = "", f[512] = "";
+    for (int i = 0; i < 8; i++) {
+        int x = (i == 1 || i == 2 || i == 5 || i == 6), y = (i == 2 || i == 3 || i >= 6), z = i >= 4;
+        char line[64];
+        snprintf(line, sizeof line, "vn %d %d %d\nvt %d %d\n", 2 * x - 1, 2 * y - 1, 2 * z - 1,
+                 x, 3 * y - 1);
+        strcat(vn, line);
+    }
+    for (const char *p = cube_f; *p; p++) {
+        if (*p >= '1' && *p <= '8') {
+            char c[16];
+            snprintf(c, sizeof c, "%c/%c/%c", *p, *p, *p);
+            strcat(f, c);
+        } else {
+            strncat(f, p, 1);
+        }
+    }
+    snprintf(text, sizeof text, "%s%s%s", cube_v, vn, f);
+    assert_true(splat_mesh_obj(write_file("smooth.obj", text), &m, &err));
+    check_sound(&m);
+    assert_int_equal(m.nidx, 36);
+    assert_int_equal(m.nv, 8);
+    for (uint32_t i = 0; i < m.nv; i++) {
+        assert_true(fabsf(m.v[i].nrm[1] - (m.v[i].pos[1] - 0.5f) * 2 / sqrtf(3)) < 1e-5f);
+        assert_true(m.v[i].uv[1] == m.v[i].pos[1]);     /* -1 -> 0, 2 -> 1 */
+        assert_true(m.v[i].uv[0] == m.v[i].pos[0]);
+    }
+    splat_mesh_free(&m);
+}
+
+static void test_obj_errors(void **state)
+{
+    splat_mesh m;
+    char *err = NULL;
+    static const struct { const char *name, *text, *msg; } bad[] = {
+        { "empty.obj", "", "no triangles" },
+        { "points.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\n", "no triangles" },
+        { "range.obj", "v 0 0 0\nv 1 0 0\nf 1 2 3\n", "a face refers to" },
+        { "zero.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n", "not an OBJ file" },
+    };
+    for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
+        assert_false(splat_mesh_obj(write_file(bad[i].name, bad[i].text), &m, &err));
+        assert_non_null(err);
+        if (!strstr(err, bad[i].msg))
+            fail_msg("%s: '%s' lacks '%s'", bad[i].name, err, bad[i].msg);
+        assert_null(m.v);
+        free(err);
+        err = NULL;
+    }
+    char path[128];
+    snprintf(path, sizeof path, "%s/nope.obj", dir);
+    assert_false(splat_mesh_obj(path, &m, &err));
+    assert_string_equal(err, "No such file or directory");
+    free(err);
+    assert_false(splat_mesh_obj(dir, &m, &err));          /* a folder */
+    assert_string_equal(err, "not a regular file");
+    free(err);
+}
+
+static int setup(void **state)
+{
+    snprintf(dir, sizeof dir, "/tmp/test_mesh_XXXXXX");
+    return mkdtemp(dir) ? 0 : -1;
+}
+
+static int teardown(void **state)
+{
+    char cmd[128];
+    snprintf(cmd, sizeof cmd, "rm -rf '%s'", dir);
+    return system(cmd) == 0 ? 0 : -1;
+}
+
+int main(void)
+{
+    const struct CMUnitTest tests[] = {
+        cmocka_unit_test(test_builtins),
+        cmocka_unit_test(test_obj_cube),
+        cmocka_unit_test(test_obj_errors),
+    };
+    return cmocka_run_group_tests(tests, setup, teardown);
+}
