@@ -1,0 +1,246 @@
+/* test_undergrowth.c — undergrowth from material masks (runtime/
+ * undergrowth.c) on a Vulkan device with SPLAT_VALIDATE=1 (any validation
+ * message fails).
+ *
+ *   test_undergrowth OUTDIR   (run from the repository root)
+ *
+ * A flat 128 m square: `ground` below, `meadow` above it with mask 0.5
+ * everywhere and two undergrowth blocks (grass at 2 per m^2, stones at
+ * 0.1), `burnt` on top where the destruction mask is.  Seen from above
+ * the centre, every 16 m cell of the square is allocated (radius 96 m):
+ *   - each cell's instance count of each block lies within 3 sigma of
+ *     density x area x composited weight (the binomial of the jittered
+ *     grid's candidates, each kept with probability keep x weight; the
+ *     weight as the mask pass stores it, 128/255): of the 128 counts at
+ *     most 2 beyond 3 sigma (0.35 expected), none beyond 4, and the mean
+ *     per cell within 3 sigma of its own spread;
+ *   - a second renderer (another run) gives byte-identical instances in
+ *     every cell, and so does a camera 40 m away in the cells both share;
+ *   - a crater (burnt's mask 1 inside) leaves fewer than 2 % of the
+ *     instances that stood in its inner disc;
+ *   - with rd.no_undergrowth the picture is byte for byte the picture of
+ *     the same scene without undergrowth blocks. */
+#include "rt_internal.h"
+#include "../check.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include <stb_image_write.h>
+
+enum { N = 129, W = 256, H = 192, CELLS = 8, MAXI = 4096 };
+static const double WEIGHT = 128.0 / 255.0;
+
+static bool write_scene(const char *dir, const char *name, bool undergrowth)
+{
+    char *sg = join(dir, name);
+    FILE *f = fopen(sg, "w");
+    free(sg);
+    if (!f)
+        return false;
+    fprintf(f, "import \"nodes/compositors.sg\"\nimport \"nodes/masks.sg\"\n"
+               "material ground {\n    out albedo = vec3(0.30, 0.25, 0.20)\n}\n"
+               "material meadow {\n    out mask = 0.5\n    out albedo = vec3(0.2, 0.4, 0.1)\n%s}\n"
+               "material burnt {\n    node r : ramp { x = terrain.destruction, lo = 0.02, "
+               "hi = 0.25 }\n    out mask = r.out\n    out albedo = vec3(0.03, 0.03, 0.03)\n}\n"
+               "scene meadow {\n    heightfield = \"flat.png\"\n    size = 128 128\n"
+               "    max_height = 10\n    materials = [ground, meadow, burnt]\n    cell = 16\n"
+               "    destruction { origin = 0 0, size = 128 128, cell = 16 }\n}\n",
+            undergrowth ? "    undergrowth grass { density = 2, scale = 0.8 1.2 }\n"
+                          "    undergrowth stone { density = 0.1, align = normal }\n" : "");
+    return fclose(f) == 0;
+}
+
+static bool write_inputs(const char *dir)
+{
+    static uint8_t hf[N * N];
+    char *png = join(dir, "flat.png");
+    bool ok = stbi_write_png(png, N, N, 1, hf, N) != 0;
+    free(png);
+    return ok && write_scene(dir, "meadow.sg", true) && write_scene(dir, "bare.sg", false);
+}
+
+static rt_renderer *renderer(rt_device *dev, const rt_pack *p, bool off)
+{
+    rt_render_desc rd = { .width = W, .height = H, .no_undergrowth = off };
+    rt_error e = { 0 };
+    rt_renderer *r = NULL;
+    CHECK(rt_renderer_create(dev, p, &rd, &r, &e), "renderer: %s", e.msg ? e.msg : "?");
+    rt_error_clear(&e);
+    return r;
+}
+
+static int cell_of(rt_renderer *r, int ix, int iz, rt_ug_instance *out)
+{
+    rt_error e = { 0 };
+    int n = rt_renderer_undergrowth_cell(r, ix, iz, out, MAXI, &e);
+    CHECK(n >= 0, "read cell %d %d: %s", ix, iz, e.msg ? e.msg : "?");
+    rt_error_clear(&e);
+    return n;
+}
+
+/* Instances of block b in cell (ix, iz), and those within `radius` of (x, z). */
+static int count(const rt_ug_instance *v, int n, unsigned b, double x, double z, double radius)
+{
+    int c = 0;
+    for (int i = 0; i < n; i++)
+        c += v[i].block == b && hypot(v[i].pos[0] - x, v[i].pos[2] - z) <= radius;
+    return c;
+}
+
+int main(int argc, char **argv)
+{
+    if (argc != 2) {
+        fprintf(stderr, "usage: test_undergrowth OUTDIR (run from the repository root)\n");
+        return 2;
+    }
+    const char *dir = argv[1];
+    char *sg = join(dir, "meadow.sg"), *packdir = join(dir, "meadow.pack");
+    char *bsg = join(dir, "bare.sg"), *bpackdir = join(dir, "bare.pack");
+    rt_pack p, bp;
+    rt_device dev;
+    rt_error e = { 0 };
+    if (!write_inputs(dir) || !build_pack_ok(sg, packdir) || !build_pack_ok(bsg, bpackdir) ||
+        !rt_pack_load(&p, packdir, &e) || !rt_pack_load(&bp, bpackdir, &e) ||
+        !rt_device_create(&dev, NULL, &e)) {
+        fprintf(stderr, "FAIL: setup: %s\n", e.msg ? e.msg : "the scene does not build");
+        return 1;
+    }
+    CHECK(p.ug.nslots == 1 && p.ug.nblocks == 2, "pack undergrowth: %d slots, %d blocks",
+          p.ug.nslots, p.ug.nblocks);
+    CHECK(bp.ug.nslots == 0, "the bare pack has undergrowth");
+    rt_camera cam = { .position = { 64, 100, 64 }, .look = { 64, 0, 64.01 } };
+    rt_ug_instance *a = malloc(sizeof *a * MAXI), *b = malloc(sizeof *b * MAXI);
+    rt_renderer *r1 = renderer(&dev, &p, false), *r2 = renderer(&dev, &p, false);
+    if (!a || !b || !r1 || !r2)
+        return 1;
+
+    /* counts per cell against the binomial of each block */
+    rt_frame_stats st;
+    CHECK(rt_renderer_frame(r1, &cam, &st, &e), "frame: %s", e.msg ? e.msg : "?");
+    printf("undergrowth: %d cells, %ld instances\n", st.undergrowth.cells,
+           st.undergrowth.instances);
+    CHECK(st.undergrowth.cells == CELLS * CELLS, "%d cells allocated, want %d",
+          st.undergrowth.cells, CELLS * CELLS);
+    static const double density[2] = { 2.0, 0.1 };
+    double worst[2] = { 0, 0 }, sum[2] = { 0, 0 }, mean_of[2], sigma_of[2];
+    int outliers = 0;
+    for (int iz = 0; iz < CELLS; iz++)
+        for (int ix = 0; ix < CELLS; ix++) {
+            int n = cell_of(r1, ix, iz, a);
+            for (unsigned k = 0; k < 2; k++) {
+                double side = ceil(sqrt(density[k] * 256.0)), cand = side * side;
+                double prob = density[k] * 256.0 / cand * WEIGHT;
+                double mean = cand * prob, sigma = sqrt(cand * prob * (1 - prob));
+                mean_of[k] = mean;
+                sigma_of[k] = sigma;
+                int c = count(a, n, k, 0, 0, 1e9);
+                double z = fabs(c - mean) / sigma;
+                worst[k] = z > worst[k] ? z : worst[k];
+                sum[k] += c;
+                outliers += z > 3.0;
+                CHECK(z <= 4.0, "cell %d %d block %u: %d instances, expected %.1f +- %.1f", ix,
+                      iz, k, c, mean, sigma);
+            }
+        }
+    for (int k = 0; k < 2; k++) {
+        double m = sum[k] / (CELLS * CELLS);
+        printf("block %d: mean %.2f per cell, expected %.2f +- %.2f; worst cell %.2f sigma\n", k,
+               m, mean_of[k], sigma_of[k], worst[k]);
+        CHECK(fabs(m - mean_of[k]) <= 3 * sigma_of[k] / CELLS, "block %d: mean %.2f per cell, "
+              "expected %.2f", k, m, mean_of[k]);
+    }
+    /* 128 cell counts: beyond 3 sigma expected 0.35 times, more than 2 with
+     * probability 0.5 % */
+    printf("cells beyond 3 sigma: %d of %d\n", outliers, 2 * CELLS * CELLS);
+    CHECK(outliers <= 2, "%d cell counts beyond 3 sigma", outliers);
+
+    /* the same instances from another run, and from another camera */
+    rt_camera moved = cam;
+    moved.position[0] += 40;
+    moved.look[0] += 40;
+    CHECK(rt_renderer_frame(r2, &cam, NULL, &e), "frame: %s", e.msg ? e.msg : "?");
+    int same = 0, cells = 0;
+    for (int pass = 0; pass < 2; pass++) {
+        if (pass == 1)
+            CHECK(rt_renderer_frame(r2, &moved, NULL, &e), "frame: %s", e.msg ? e.msg : "?");
+        for (int iz = 0; iz < CELLS; iz++)
+            for (int ix = 0; ix < CELLS; ix++) {
+                int n = cell_of(r1, ix, iz, a), m = cell_of(r2, ix, iz, b);
+                if (m == 0 && pass == 1)
+                    continue;   /* not in the moved camera's disc */
+                cells++;
+                same += n == m && n > 0 && memcmp(a, b, sizeof *a * (size_t)n) == 0;
+                CHECK(n == m && memcmp(a, b, sizeof *a * (size_t)n) == 0,
+                      "cell %d %d differs (%s): %d vs %d instances", ix, iz,
+                      pass ? "moved camera" : "second run", n, m);
+            }
+    }
+    printf("identical cells: %d of %d (two runs, then a camera 40 m away)\n", same, cells);
+    rt_renderer_destroy(r2);
+
+    /* a crater: burnt covers its inner disc, the meadow's instances go */
+    const double cx = 40, cz = 40, radius = 12, inner = 0.4 * radius;
+    int before = 0, after = 0;
+    for (int pass = 0; pass < 2; pass++) {
+        if (pass == 1) {
+            rt_crater c = { .x = cx, .z = cz, .radius = radius, .depth = 0 };
+            rt_crater_stats cs;
+            CHECK(rt_renderer_crater(r1, &c, &cs, &e) && cs.result == RT_CRATER_DONE,
+                  "crater: %s", e.msg ? e.msg : "refused");
+            CHECK(rt_renderer_frame(r1, &cam, &st, &e), "frame: %s", e.msg ? e.msg : "?");
+            CHECK(st.undergrowth.generated > 0 && st.undergrowth.generated < CELLS * CELLS,
+                  "the crater regenerated %d cells", st.undergrowth.generated);
+        }
+        for (int iz = 1; iz <= 3; iz++)
+            for (int ix = 1; ix <= 3; ix++) {
+                int n = cell_of(r1, ix, iz, a);
+                for (unsigned k = 0; k < 2; k++)
+                    *(pass ? &after : &before) += count(a, n, k, cx, cz, inner);
+            }
+    }
+    printf("crater: %d instances within %.1f m before, %d after\n", before, inner, after);
+    CHECK(before > 50 && after * 50 <= before, "crater: %d instances before, %d after", before,
+          after);
+    float *img = frame_of(r1, &cam, W, H);
+    if (img)
+        write_picture(dir, "meadow.png", img, W, H, SPLAT_VIEW_FINAL);
+    free(img);
+    rt_renderer_destroy(r1);
+
+    /* undergrowth off: today's picture, to the byte */
+    rt_renderer *off = renderer(&dev, &p, true), *bare = renderer(&dev, &bp, false);
+    rt_camera low = { .position = { 20, 3, 20 }, .look = { 60, 0, 50 } };
+    float *x = off ? frame_of(off, &low, W, H) : NULL, *y = bare ? frame_of(bare, &low, W, H) : NULL;
+    CHECK(x && y && memcmp(x, y, (size_t)W * H * 16) == 0,
+          "no_undergrowth differs from the scene without undergrowth");
+    if (x)
+        write_picture(dir, "off.png", x, W, H, SPLAT_VIEW_FINAL);
+    free(x);
+    free(y);
+    rt_renderer *on = renderer(&dev, &p, false);
+    float *z = on ? frame_of(on, &low, W, H) : NULL;
+    if (z)
+        write_picture(dir, "ground.png", z, W, H, SPLAT_VIEW_FINAL);
+    free(z);
+    rt_renderer_destroy(on);
+    rt_renderer_destroy(off);
+    rt_renderer_destroy(bare);
+
+    free(a);
+    free(b);
+    free(sg);
+    free(packdir);
+    free(bsg);
+    free(bpackdir);
+    rt_pack_free(&p);
+    rt_pack_free(&bp);
+    int msgs = rt_device_messages(&dev);
+    CHECK(msgs == 0, "%d validation messages", msgs);
+    rt_device_destroy(&dev);
+    if (failures)
+        fprintf(stderr, "%d failures\n", failures);
+    return failures ? 1 : 0;
+}
