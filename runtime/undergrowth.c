@@ -185,7 +185,9 @@ static const char draw_vert_main[] =
     "    uint flags = uint(u_blocks.b[3u * it.q.w + 2u].z);\n"
     "    vec3 n = normalize(unpackSnorm4x8(it.q.x).xyz + vec3(0.0, 1e-4, 0.0));\n"
     "    float a = uintBitsToFloat(it.q.z), c = cos(a), s = sin(a);\n"
-    "    vec3 p = a_pos * it.p.w;\n"
+    "    /* shrink away over the last quarter of the radius (push patch_xz.x) */\n"
+    "    float r = u_push.patch_xz.x, d = length(it.p.xz - u_frame.camera.xz);\n"
+    "    vec3 p = a_pos * it.p.w * clamp((r - d) / (0.25 * r), 0.0, 1.0);\n"
     "    p = vec3(c * p.x + s * p.z, p.y, -s * p.x + c * p.z);\n"
     "    vec3 m = vec3(c * a_nrm.x + s * a_nrm.z, a_nrm.y, -s * a_nrm.x + c * a_nrm.z);\n"
     "    if ((flags & 4u) != 0u) {   /* aligned to the terrain normal */\n"
@@ -717,13 +719,23 @@ static void allocate(rt_ug *u, const rt_camera *c, const float view_proj[16])
     for (int i = 0; i < u->pool; i++)
         u->cells[i].wanted = false;
     double r = u->radius, cx = c->position[0], cz = c->position[2];
+    /* from higher above the ground than the radius nothing would show:
+     * no cells (so views from the air pay nothing) */
+    int tx = (int)(cx / p->size[0] * (p->hf_width - 1) + 0.5);
+    int tz = (int)(cz / p->size[1] * (p->hf_height - 1) + 0.5);
+    tx = tx < 0 ? 0 : tx >= p->hf_width ? p->hf_width - 1 : tx;
+    tz = tz < 0 ? 0 : tz >= p->hf_height ? p->hf_height - 1 : tz;
+    double below = p->heights[(size_t)tz * (size_t)p->hf_width + (size_t)tx] / 65535.0 *
+                   p->max_height + p->height_offset;
+    if (c->position[1] - below > r)
+        r = 0;
     int x0 = (int)floor((cx - r) / CELL), x1 = (int)floor((cx + r) / CELL);
     int z0 = (int)floor((cz - r) / CELL), z1 = (int)floor((cz + r) / CELL);
     int maxx = (int)ceil(p->size[0] / CELL) - 1, maxz = (int)ceil(p->size[1] / CELL) - 1;
     for (int iz = z0 < 0 ? 0 : z0; iz <= z1 && iz <= maxz; iz++)
         for (int ix = x0 < 0 ? 0 : x0; ix <= x1 && ix <= maxx; ix++) {
             double dx = (ix + 0.5) * CELL - cx, dz = (iz + 0.5) * CELL - cz;
-            if (dx * dx + dz * dz > r * r)
+            if (dx * dx + dz * dz > r * r || r == 0)
                 continue;
             ug_cell *cl = find_cell(u, ix, iz);
             if (!cl)
@@ -942,6 +954,9 @@ void rt_ug_draw(rt_ug *u, VkCommandBuffer cb, bool depth_read_only, VkDescriptor
     vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_GRAPHICS, u->draw_pipe);
     VkDescriptorSet sets[3] = { set0, set1, u->draw_set };
     vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_GRAPHICS, u->draw_layout, 0, 3, sets, 0, NULL);
+    splat_push push = { .patch_xz = { (float)u->radius, 0, 0, 0 } };
+    vkCmdPushConstants(cb, u->draw_layout, VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT,
+                       0, sizeof push, &push);
     VkDeviceSize zero = 0;
     vkCmdBindVertexBuffers(cb, 0, 1, &u->vbuf.buf, &zero);
     vkCmdBindIndexBuffer(cb, u->ibuf.buf, 0, VK_INDEX_TYPE_UINT32);

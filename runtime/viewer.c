@@ -92,7 +92,7 @@ typedef struct viewer {
     double         yaw, pitch, speed;
     splat_view     view;
     int            material;
-    bool           wire, quit, dragging, no_shadows;
+    bool           wire, quit, dragging, no_shadows, no_undergrowth;
     double         mx, my;
     /* hot reload */
     watch          w;
@@ -177,6 +177,11 @@ static void key_action(viewer *v, int key)
         rt_renderer_set_light(v->r, &l);
         snprintf(v->status, sizeof v->status, "sun %.0f %.0f, exposure %+.1f EV", l.sun[0],
                  l.sun[1], l.exposure);
+    } else if (key == GLFW_KEY_U) {
+        v->no_undergrowth = !v->no_undergrowth;
+        rt_renderer_set_undergrowth(v->r, !v->no_undergrowth);
+        snprintf(v->status, sizeof v->status, "undergrowth %s",
+                 v->no_undergrowth ? "off" : "on");
     } else if (key == GLFW_KEY_H) {
         v->no_shadows = !v->no_shadows;
         rt_renderer_set_shadows(v->r, !v->no_shadows);

@@ -340,6 +340,16 @@ for s in $SCENES; do
         done
     done
 done
+# (g) undergrowth (issue 12): the ground path (2 m above the terrain and
+# moving, so cells enter the disc every frame and are generated) with and
+# without it, on both paths; scenes whose materials carry undergrowth
+for s in $SCENES; do
+    [ "$s" = billingsley ] && continue
+    for size in $SIZES; do
+        render undergrowth "$s" ground "$size" off=composite on=composite,ug \
+            screen_off=screen screen_on=screen,ug
+    done
+done
 if [ "$MODE" = smoke ]; then
     stoch=$(comp_pack minimal stochastic_select)
     render knobs minimal ground 320x180 composite=composite fp16=fp16 sobel=sobel \

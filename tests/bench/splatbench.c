@@ -34,7 +34,11 @@
  *                     compute (screen: the runtime's choice for the device)
  *       pack=DIR renders another pack of the same terrain (compositors, fBm
  *       knobs); lod=P sets the LOD error threshold in pixels per grid step;
- *       noshadow renders without the terrain's shadows (--no-shadows).
+ *       noshadow renders without the terrain's shadows (--no-shadows); ug
+ *       draws the pack's undergrowth (off otherwise, so the other groups
+ *       time what they always timed): its rows add the generation GPU ms
+ *       per frame and per generated cell, the draw GPU ms per frame, the
+ *       instances and the memory per cell.
  *       Paths (--path): ground (2 m above the terrain looking 150 m ahead,
  *       from --start-preset NAME or --start x,z,dx,dz), topdown, grazing.
  *   splatbench upscale IN.png K OUT
@@ -185,7 +189,11 @@ typedef struct variant {
     const char  *pack_dir;
     double       lod;
     bool         no_shadows;
+    bool         ug;        /* draw the undergrowth                         */
     double       shadow_ms; /* CPU ms of the shadow map (the first frame)   */
+    double      *ug_gen, *ug_draw; /* per timed frame, GPU ms               */
+    long         ug_cells;  /* cells generated over the timed frames        */
+    rt_ug_stats  ug_last;   /* the last frame's                             */
     rt_pack     *base;      /* loaded pack (shared by variants of one dir)  */
     rt_pack      view;      /* shallow copy with this variant's combos      */
     rt_pack_combo *combos;  /* owned when the shaders differ, else NULL     */
@@ -358,6 +366,8 @@ static void variant_free(variant *v)
     free(v->gpu);
     free(v->cpu);
     free(v->sel);
+    free(v->ug_gen);
+    free(v->ug_draw);
     for (int k = 0; k < 3; k++)
         free(v->pass[k]);
 }
@@ -378,6 +388,8 @@ static bool parse_variant(const char *s, const char *default_pack, variant *v)
             v->pack_dir = strdup(t + 5);   /* lives as long as the process */
         } else if (!strcmp(t, "noshadow")) {
             v->no_shadows = true;
+        } else if (!strcmp(t, "ug")) {
+            v->ug = true;
         } else if (!strncmp(t, "lod=", 4)) {
             v->lod = atof(t + 4);
             ok = v->lod > 0;
@@ -587,7 +599,7 @@ static int cmd_render(int argc, char **argv)
     for (int i = 0; i < nspecs; i++) {
         rt_render_desc rd = {
             .width = width, .height = height, .lod_pixels = v[i].lod,
-            .no_shadows = v[i].no_shadows,
+            .no_shadows = v[i].no_shadows, .no_undergrowth = !v[i].ug,
             .reference = v[i].k == K_MULTIPASS ? RT_REF_MULTIPASS
                        : v[i].k == K_UBER || v[i].k == K_SCREEN_UBER ? RT_REF_UBER : RT_REF_NONE,
             .pipeline_cache = save ? cache : NULL,
@@ -608,6 +620,8 @@ static int cmd_render(int argc, char **argv)
         v[i].sel = xcalloc((size_t)frames, sizeof(double));
         for (int k = 0; k < 3; k++)
             v[i].pass[k] = xcalloc((size_t)frames, sizeof(double));
+        v[i].ug_gen = xcalloc((size_t)frames, sizeof(double));
+        v[i].ug_draw = xcalloc((size_t)frames, sizeof(double));
         /* warm-up frames: pipelines are made (and JIT-compiled) on first use */
         rt_camera cam;
         rt_frame_stats st;
@@ -635,6 +649,10 @@ static int cmd_render(int argc, char **argv)
             v[i].sel[f] = st.select_ms;
             for (int k = 0; k < 3; k++)
                 v[i].pass[k][f] = st.pass_ms[k];
+            v[i].ug_gen[f] = st.undergrowth.gen_ms;
+            v[i].ug_draw[f] = st.undergrowth.draw_ms;
+            v[i].ug_cells += st.undergrowth.generated;
+            v[i].ug_last = st.undergrowth;
             v[i].patches = st.patches;
             v[i].pipelines = st.pipelines;
             if (!rt_renderer_read(v[i].r, i == ref ? refimg : img, &e))
@@ -679,7 +697,9 @@ static int cmd_render(int argc, char **argv)
                      "gpu_med_ms,gpu_p10_ms,gpu_p90_ms,cpu_med_ms,select_med_ms,patches,"
                      "pipelines,max_abs,mean_abs,psnr_db,nonfinite,rss_delta_mb,reference,view,"
                      "geometry_ms,classify_ms,shade_ms,tiles,tiles_uber,layers_evaluated,"
-                     "layers_needed,samples_per_px,branches_uniform_pct,shadow_map_ms\n");
+                     "layers_needed,samples_per_px,branches_uniform_pct,shadow_map_ms,"
+                     "ug_gen_med_ms,ug_gen_ms_per_cell,ug_draw_med_ms,ug_cells_per_frame,"
+                     "ug_instances,ug_bytes_per_cell\n");
     /* the device name in CSV: its commas become ';' */
     char devname[VK_MAX_PHYSICAL_DEVICE_NAME_SIZE];
     snprintf(devname, sizeof devname, "%s", dev.props.deviceName);
@@ -696,10 +716,17 @@ static int cmd_render(int argc, char **argv)
         for (int k = 0; k < 3 && scr; k++)
             percentiles(v[i].pass[k], frames, &pm[k], &lo, &hi);
         double px = v[i].tiles.pixels ? (double)v[i].tiles.pixels : 1.0;
+        double ugm = -1, ugd = -1, gen_sum = 0;
+        if (v[i].ug) {
+            percentiles(v[i].ug_gen, frames, &ugm, &lo, &hi);
+            percentiles(v[i].ug_draw, frames, &ugd, &lo, &hi);
+            for (int f = 0; f < frames; f++)
+                gen_sum += v[i].ug_gen[f];
+        }
         const char *pk = strrchr(v[i].pack_dir, '/');
         fprintf(out, "\"%s\",%s,%s,%d,%d,%s,%s,%s,%g,%d,%.3f,%.3f,%.3f,%.3f,%.4f,%d,%d,"
                      "%.6g,%.6g,%.2f,%ld,%.1f,%s,%s,%.3f,%.3f,%.3f,%d,%d,%.4f,%.4f,%.3f,%.1f,"
-                     "%.2f\n",
+                     "%.2f,%.4f,%.4f,%.4f,%.2f,%ld,%zu\n",
                 devname, scene ? scene : v[i].base->name, pd.name, width, height,
                 v[i].label, kind_names[v[i].k], pk ? pk + 1 : v[i].pack_dir,
                 v[i].lod > 0 ? v[i].lod : 3.0, frames, gm, g10, g90, cm, sm,
@@ -711,7 +738,9 @@ static int cmd_render(int argc, char **argv)
                 v[i].tiles.samples / px,
                 v[i].tiles.branches ? 100.0 * v[i].tiles.branches_uniform / v[i].tiles.branches
                                     : 100.0,
-                v[i].shadow_ms);
+                v[i].shadow_ms, ugm, v[i].ug_cells ? gen_sum / (double)v[i].ug_cells : -1.0,
+                ugd, (double)v[i].ug_cells / frames, v[i].ug_last.instances,
+                v[i].ug_last.bytes_per_cell);
     }
     if (csv)
         fclose(out);

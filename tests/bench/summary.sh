@@ -110,6 +110,21 @@ awk -F, 'NR > 1 && $1 == "lighting" { k = $3 "|" $4 "|" $5 "x" $6; keys[k] = 1; 
             printf "| %s | %s | %s | %.3f | %.3f | %.3f | %.3f | %.3f | %.3f | %.1f |\n", a[1], a[2], a[3], l, n, b, l / n, n / b, l / b, sm[k] } }' "$O/render.csv" | sort
 echo
 
+echo "## Undergrowth (group undergrowth: same frames, the ground path)"
+echo
+echo "The camera moves 2 m above the terrain, so cells enter the disc around it and are generated every frame (mask pass + scatter pass on the GPU, no read back).  on / off: the frame with and without undergrowth; gen: the generation's GPU ms per frame (median) and per generated cell; draw: the instanced draws' GPU ms per frame (median)."
+echo
+echo "| scene | size | variant | GPU ms | off GPU ms | cost (on - off) | gen ms/frame | gen ms/cell | cells/frame | draw ms/frame | instances | KiB/cell |"
+echo "|---|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
+awk -F, 'NR > 1 && $1 == "undergrowth" { k = $3 "|" $5 "x" $6; t[k, $7] = $12; row[k, $7] = $0; keys[k] = 1 }
+    END { for (k in keys) { split(k, a, "|")
+            n = split("on screen_on", vs, " ")
+            for (i = 1; i <= n; i++) { v = vs[i]; if (!((k, v) in row)) continue
+                split(row[k, v], c, ","); off = v == "on" ? "off" : "screen_off"
+                printf "| %s | %s | %s | %.3f | %.3f | %.3f | %.3f | %.3f | %.1f | %.3f | %d | %.0f |\n",
+                    a[1], a[2], v, c[12], t[k, off], c[12] - t[k, off], c[36], c[37], c[39], c[38], c[40], c[41] / 1024 } } }' "$O/render.csv" | sort
+echo
+
 echo "## Screen-space shading (group shading: forward vs screen, same frames)"
 echo
 echo "Per pass: GPU medians of the depth pass (geometry or ray cast), the classification and the compute shading.  Layers per pixel evaluated / needed and samples per pixel come from one counting frame (abi.h SPLAT_COUNT) after the timed ones; efficiency = needed / evaluated.  Error: against the forward image of the same frame."

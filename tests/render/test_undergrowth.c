@@ -111,7 +111,7 @@ int main(int argc, char **argv)
     CHECK(p.ug.nslots == 1 && p.ug.nblocks == 2, "pack undergrowth: %d slots, %d blocks",
           p.ug.nslots, p.ug.nblocks);
     CHECK(bp.ug.nslots == 0, "the bare pack has undergrowth");
-    rt_camera cam = { .position = { 64, 100, 64 }, .look = { 64, 0, 64.01 } };
+    rt_camera cam = { .position = { 64, 60, 64 }, .look = { 64, 0, 64.01 } };
     rt_ug_instance *a = malloc(sizeof *a * MAXI), *b = malloc(sizeof *b * MAXI);
     rt_renderer *r1 = renderer(&dev, &p, false), *r2 = renderer(&dev, &p, false);
     if (!a || !b || !r1 || !r2)

@@ -165,7 +165,9 @@ static void test_obj_cube(void **state)
             snprintf(c, sizeof c, "%c/%c/%c", *p, *p, *p);
             strcat(f, c);
         } else {
-            strncat(f, p, 1);
+            size_t n = strlen(f);
+            f[n] = *p;
+            f[n + 1] = 0;
         }
     }
     snprintf(text, sizeof text, "%s%s%s", cube_v, vn, f);
