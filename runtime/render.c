@@ -170,7 +170,8 @@ static bool make_targets(rt_renderer *r, rt_error *e)
                          VK_IMAGE_ASPECT_COLOR_BIT, &r->color, e) ||
         !rt_image_create(d, (uint32_t)w, (uint32_t)h, 1, false, 1, VK_FORMAT_D32_SFLOAT,
                          VK_IMAGE_USAGE_DEPTH_STENCIL_ATTACHMENT_BIT |
-                         (screen ? VK_IMAGE_USAGE_SAMPLED_BIT : 0), VK_IMAGE_ASPECT_DEPTH_BIT,
+                         (screen ? VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT : 0),
+                         VK_IMAGE_ASPECT_DEPTH_BIT,
                          &r->depth, e))
         return false;
     if (!make_pass(d, 1, true, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, &r->rp.main, e))
@@ -425,9 +426,6 @@ static bool make_commands(rt_renderer *r, rt_error *e)
  * cut them). */
 static bool use_raycast(const rt_renderer *r)
 {
-    /* undergrowth is depth-tested against the terrain's depth attachment */
-    if (r->p->ug.nslots > 0 && !r->desc.no_undergrowth)
-        return false;
     if (r->desc.screen_depth == RT_DEPTH_RAYCAST)
         return true;
     return r->desc.screen_depth == RT_DEPTH_AUTO && !r->p->holes &&
@@ -1145,6 +1143,8 @@ static bool draw_frame(rt_renderer *r, const rt_camera *c, rt_frame_stats *st, r
                      : record_forward(r, cb, c, &vp, &area, variant, &binds, e);
     if (!ok)
         return false;
+    if (ug && screen && rt_screen_raycasting(r->screen))
+        rt_screen_depth_out(r->screen, cb, &r->depth);
     if (ug)
         rt_ug_draw(r->ug, cb, screen, r->set0, r->set1, &vp, &area);
     if (r->timestamps)

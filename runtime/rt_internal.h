@@ -390,6 +390,11 @@ bool rt_screen_create(rt_device *d, const rt_pack *p, const rt_pipelines *pl,
  * (screen.c) instead of the geometry pass. */
 bool rt_screen_raycasting(const rt_screen *s);
 void rt_screen_raycast(rt_screen *s, VkCommandBuffer cb, VkDescriptorSet set0);
+/* After the shading, when ray casting: the ray-cast depth copied into
+ * `depth` (D32, through a buffer: a colour image cannot be copied into a
+ * depth one), left SHADER_READ_ONLY_OPTIMAL as the geometry pass leaves
+ * it, for the passes that depth-test against the terrain (undergrowth). */
+void rt_screen_depth_out(rt_screen *s, VkCommandBuffer cb, const rt_image *depth);
 void rt_screen_destroy(rt_screen *s);
 /* The geometry pass: depth only, ends in SHADER_READ_ONLY_OPTIMAL. */
 VkRenderPass rt_screen_depth_pass(const rt_screen *s, VkFramebuffer *fb);

@@ -47,6 +47,7 @@ struct rt_screen {
     bool                  raycast;           /* depth by ray casting          */
     VkPipeline            raycaster;
     rt_image              maxmip, rdepth;    /* pyramid; R32F depth           */
+    rt_buffer             depth_copy;        /* rdepth on its way to a D32    */
     VkSampler             mip_sampler;       /* every level (texelFetch)      */
     int                   mip_levels;
     bool                  rdepth_ready;      /* in GENERAL layout             */
@@ -692,8 +693,12 @@ bool rt_screen_create(rt_device *d, const rt_pack *p, const rt_pipelines *pl,
     if (raycast &&
         (!make_maxmip(s, e) ||
          !rt_image_create(d, color->width, color->height, 1, false, 1, VK_FORMAT_R32_SFLOAT,
-                          VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT,
-                          VK_IMAGE_ASPECT_COLOR_BIT, &s->rdepth, e)))
+                          VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_SAMPLED_BIT |
+                              VK_IMAGE_USAGE_TRANSFER_SRC_BIT,
+                          VK_IMAGE_ASPECT_COLOR_BIT, &s->rdepth, e) ||
+         !rt_buffer_create(d, (VkDeviceSize)color->width * color->height * 4,
+                           VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                           false, &s->depth_copy, e)))
         return false;
     if (!make_depth_pass(s, depth, e) || !make_compute(s, pl, nearest, e))
         return false;
@@ -738,6 +743,7 @@ void rt_screen_destroy(rt_screen *s)
         if (s->mip_sampler)
             vkDestroySampler(d->dev, s->mip_sampler, NULL);
         rt_image_destroy(d, &s->rdepth);
+        rt_buffer_destroy(d, &s->depth_copy);
         if (s->layout)
             vkDestroyPipelineLayout(d->dev, s->layout, NULL);
         if (s->pool)
@@ -785,6 +791,55 @@ void rt_screen_raycast(rt_screen *s, VkCommandBuffer cb, VkDescriptorSet set0)
                          VK_IMAGE_LAYOUT_GENERAL, VK_ACCESS_SHADER_WRITE_BIT,
                          VK_ACCESS_SHADER_READ_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
                          VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT);
+}
+
+static void depth_barrier(VkCommandBuffer cb, VkImage img, VkImageLayout from, VkImageLayout to,
+                          VkAccessFlags sa, VkAccessFlags da, VkPipelineStageFlags src,
+                          VkPipelineStageFlags dst)
+{
+    VkImageMemoryBarrier b = {
+        .sType = VK_STRUCTURE_TYPE_IMAGE_MEMORY_BARRIER,
+        .srcAccessMask = sa, .dstAccessMask = da, .oldLayout = from, .newLayout = to,
+        .srcQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED,
+        .dstQueueFamilyIndex = VK_QUEUE_FAMILY_IGNORED,
+        .image = img, .subresourceRange = { VK_IMAGE_ASPECT_DEPTH_BIT, 0, 1, 0, 1 },
+    };
+    vkCmdPipelineBarrier(cb, src, dst, 0, 0, NULL, 0, NULL, 1, &b);
+}
+
+void rt_screen_depth_out(rt_screen *s, VkCommandBuffer cb, const rt_image *depth)
+{
+    rt_cmd_image_barrier(cb, s->rdepth.img, 0, 1, 1, VK_IMAGE_LAYOUT_GENERAL,
+                         VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_ACCESS_SHADER_WRITE_BIT,
+                         VK_ACCESS_TRANSFER_READ_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+                         VK_PIPELINE_STAGE_TRANSFER_BIT);
+    VkBufferImageCopy c = {
+        .imageSubresource = { VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1 },
+        .imageExtent = { s->rdepth.width, s->rdepth.height, 1 },
+    };
+    vkCmdCopyImageToBuffer(cb, s->rdepth.img, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+                           s->depth_copy.buf, 1, &c);
+    rt_cmd_image_barrier(cb, s->rdepth.img, 0, 1, 1, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+                         VK_IMAGE_LAYOUT_GENERAL, VK_ACCESS_TRANSFER_READ_BIT, 0,
+                         VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT);
+    VkMemoryBarrier mb = { .sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER,
+                           .srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT,
+                           .dstAccessMask = VK_ACCESS_TRANSFER_READ_BIT };
+    vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, 0,
+                         1, &mb, 0, NULL, 0, NULL);
+    depth_barrier(cb, depth->img, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+                  0, VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT,
+                  VK_PIPELINE_STAGE_TRANSFER_BIT);
+    c.imageSubresource.aspectMask = VK_IMAGE_ASPECT_DEPTH_BIT;
+    vkCmdCopyBufferToImage(cb, s->depth_copy.buf, depth->img, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+                           1, &c);
+    depth_barrier(cb, depth->img, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+                  VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, VK_ACCESS_TRANSFER_WRITE_BIT,
+                  VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_READ_BIT |
+                      VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT,
+                  VK_PIPELINE_STAGE_TRANSFER_BIT,
+                  VK_PIPELINE_STAGE_EARLY_FRAGMENT_TESTS_BIT |
+                      VK_PIPELINE_STAGE_LATE_FRAGMENT_TESTS_BIT);
 }
 
 void rt_screen_begin(rt_screen *s, VkCommandBuffer cb, bool count)

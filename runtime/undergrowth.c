@@ -68,12 +68,17 @@ struct rt_ug {
     double                radius;
     ug_cell              *cells;
     int                  *order;               /* draw order, front to back  */
-    rt_buffer             masks, inst, args, blocks, vbuf, ibuf, frame;
+    /* device-local: masks, instances, draw arguments (the GPU writes
+     * them and reads them every frame); host-visible: args_host (the
+     * arguments copied back after a generation, for the counts), blocks,
+     * meshes, the mask pass's frame block */
+    rt_buffer             masks, inst, args, args_host, blocks, vbuf, ibuf, frame;
     VkDescriptorSetLayout set_terrain;         /* set 0 of the mask pass     */
     VkDescriptorSetLayout set_mask, set_gen, set_draw;
     VkPipelineLayout      mask_layout, gen_layout, draw_layout;
     VkPipeline           *mask_pipes;          /* per combination            */
-    VkPipeline            gen_pipe, draw_pipe;
+    VkPipeline            gen_pipe;
+    VkPipeline            draw_pipe[2];        /* opaque (early depth), cut out */
     VkDescriptorPool      dpool;
     VkDescriptorSet       set0, mask_set, gen_set, draw_set;
     VkRenderPass          pass_att, pass_ro;   /* depth in attachment / read */
@@ -212,10 +217,10 @@ static const char draw_frag_main[] =
     "layout(location = 5) in vec2 g_uv;\n"
     "layout(location = 6) flat in uint g_flags;\n"
     "void main() {\n"
-    "    if ((g_flags & 1u) != 0u) {   /* a leaf cut from the quad */\n"
-    "        float x = abs(g_uv.x * 2.0 - 1.0);\n"
-    "        if (x > 0.9 * sin(clamp(g_uv.y, 0.0, 1.0) * 3.14159)) discard;\n"
-    "    }\n"
+    "#ifdef UG_CUTOUT\n"
+    "    float x = abs(g_uv.x * 2.0 - 1.0);   /* a leaf cut from the quad */\n"
+    "    if (x > 0.9 * sin(clamp(g_uv.y, 0.0, 1.0) * 3.14159)) discard;\n"
+    "#endif\n"
     "    float dist = length(v_rel);\n"
     "    vec3 v = dist > 0.0 ? -v_rel / dist : vec3(0.0, 1.0, 0.0);\n"
     "    vec3 n = normalize(g_normal);\n"
@@ -335,11 +340,14 @@ static bool make_pass(rt_device *d, VkImageLayout depth_in, VkRenderPass *out, r
     return true;
 }
 
-static bool draw_pipeline(rt_ug *u, rt_error *e)
+/* The draw pipeline of opaque meshes (depth tested before shading: blades
+ * hidden behind nearer ones cost no lighting) or of cut-out ones (the
+ * fragment shader discards, so the test waits for it). */
+static bool draw_pipeline(rt_ug *u, bool cutout, rt_error *e)
 {
     rt_device *d = u->d;
     size_t nv = strlen(SPLAT_GLSL_TERRAIN) + strlen(draw_vert_main) + 32;
-    size_t nf = strlen(SPLAT_GLSL_PRELUDE) + strlen(draw_frag_main) + 32;
+    size_t nf = strlen(SPLAT_GLSL_PRELUDE) + strlen(draw_frag_main) + 96;
     char *vs = malloc(nv), *fs = malloc(nf);
     if (!vs || !fs) {
         free(vs);
@@ -347,7 +355,9 @@ static bool draw_pipeline(rt_ug *u, rt_error *e)
         return rt_fail(e, RT_E_VULKAN, "undergrowth", "out of memory");
     }
     snprintf(vs, nv, "#version 450\n%s%s", SPLAT_GLSL_TERRAIN, draw_vert_main);
-    snprintf(fs, nf, "#version 450\n%s%s", SPLAT_GLSL_PRELUDE, draw_frag_main);
+    snprintf(fs, nf, "#version 450\n%s%s%s",
+             cutout ? "#define UG_CUTOUT 1\n" : "layout(early_fragment_tests) in;\n",
+             SPLAT_GLSL_PRELUDE, draw_frag_main);
     VkShaderModule vm = VK_NULL_HANDLE, fm = VK_NULL_HANDLE;
     bool ok = module(d, vs, VK_SHADER_STAGE_VERTEX_BIT, "undergrowth.vert", &vm, e) &&
               module(d, fs, VK_SHADER_STAGE_FRAGMENT_BIT, "undergrowth.frag", &fm, e);
@@ -410,7 +420,8 @@ static bool draw_pipeline(rt_ug *u, rt_error *e)
             .pMultisampleState = &ms, .pDepthStencilState = &ds, .pColorBlendState = &cb,
             .pDynamicState = &dy, .layout = u->draw_layout, .renderPass = u->pass_att,
         };
-        VkResult r = vkCreateGraphicsPipelines(d->dev, VK_NULL_HANDLE, 1, &ci, NULL, &u->draw_pipe);
+        VkResult r = vkCreateGraphicsPipelines(d->dev, VK_NULL_HANDLE, 1, &ci, NULL,
+                                               &u->draw_pipe[cutout]);
         if (r != VK_SUCCESS)
             ok = rt_fail(e, RT_E_VULKAN, "vkCreateGraphicsPipelines", rt_vk_result_name(r));
     }
@@ -566,7 +577,10 @@ static bool make_buffers(rt_ug *u, rt_error *e)
         !rt_buffer_create(d, inst_bytes + 32, st | VK_BUFFER_USAGE_TRANSFER_SRC_BIT, false,
                           &u->inst, e) ||
         !rt_buffer_create(d, (VkDeviceSize)u->pool * u->nblocks * 20,
-                          st | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT, true, &u->args, e) ||
+                          st | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT |
+                              VK_BUFFER_USAGE_TRANSFER_SRC_BIT, false, &u->args, e) ||
+        !rt_buffer_create(d, (VkDeviceSize)u->pool * u->nblocks * 20,
+                          VK_BUFFER_USAGE_TRANSFER_DST_BIT, true, &u->args_host, e) ||
         !rt_buffer_create(d, (VkDeviceSize)u->nblocks * 48, st, true, &u->blocks, e) ||
         !rt_buffer_create(d, (VkDeviceSize)pu->nvertices * 32, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT,
                           true, &u->vbuf, e) ||
@@ -578,7 +592,7 @@ static bool make_buffers(rt_ug *u, rt_error *e)
     memcpy(u->vbuf.map, pu->vertices, (size_t)pu->nvertices * 32);
     memcpy(u->ibuf.map, pu->indices, (size_t)pu->nindices * 4);
     fill_blocks(u, u->blocks.map);
-    memset(u->args.map, 0, (size_t)u->args.size);
+    memset(u->args_host.map, 0, (size_t)u->args_host.size);
     return true;
 }
 
@@ -618,7 +632,7 @@ bool rt_ug_create(rt_device *d, const rt_pack *p, rt_pipelines *pl, const rt_qua
         !make_pass(d, VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL, &u->pass_att, e) ||
         !make_pass(d, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, &u->pass_ro, e) ||
         !compute_pipe(d, u->gen_layout, gen_glsl, "undergrowth scatter", &u->gen_pipe, e) ||
-        !draw_pipeline(u, e))
+        !draw_pipeline(u, false, e) || !draw_pipeline(u, true, e))
         return false;
     VkImageView views[2] = { t->color->view, t->depth->view };
     VkFramebufferCreateInfo fci = {
@@ -640,8 +654,8 @@ void rt_ug_destroy(rt_ug *u)
     for (int i = 0; u->mask_pipes && i <= u->p->ncombos; i++)
         if (u->mask_pipes[i])
             vkDestroyPipeline(d->dev, u->mask_pipes[i], NULL);
-    VkPipeline pipes[2] = { u->gen_pipe, u->draw_pipe };
-    for (int i = 0; i < 2; i++)
+    VkPipeline pipes[3] = { u->gen_pipe, u->draw_pipe[0], u->draw_pipe[1] };
+    for (int i = 0; i < 3; i++)
         if (pipes[i])
             vkDestroyPipeline(d->dev, pipes[i], NULL);
     VkPipelineLayout pls[3] = { u->mask_layout, u->gen_layout, u->draw_layout };
@@ -662,7 +676,8 @@ void rt_ug_destroy(rt_ug *u)
         vkDestroyRenderPass(d->dev, u->pass_ro, NULL);
     if (u->qpool)
         vkDestroyQueryPool(d->dev, u->qpool, NULL);
-    rt_buffer *bufs[] = { &u->masks, &u->inst, &u->args, &u->blocks, &u->vbuf, &u->ibuf, &u->frame };
+    rt_buffer *bufs[] = { &u->masks, &u->inst, &u->args, &u->args_host, &u->blocks, &u->vbuf,
+                          &u->ibuf, &u->frame };
     for (size_t i = 0; i < sizeof bufs / sizeof *bufs; i++)
         rt_buffer_destroy(d, bufs[i]);
     free(u->mask_pipes);
@@ -856,15 +871,17 @@ static bool record_masks(rt_ug *u, VkCommandBuffer cb, const ug_cell *cl, int sl
 
 /* The draw arguments of a slot's blocks (instance counts 0 until its
  * scatter pass writes them). */
-static void reset_args(rt_ug *u, int slot)
+static void reset_args(rt_ug *u, VkCommandBuffer cb, int slot)
 {
-    uint32_t *a = (uint32_t *)u->args.map + (size_t)slot * u->nblocks * 5;
+    uint32_t a[5 * 64];
     for (int b = 0; b < u->nblocks; b++) {
         const rt_pack_ug_mesh *m = &u->p->ug.meshes[u->p->ug.blocks[b].mesh];
         uint32_t v[5] = { m->nidx, 0, m->first_index, m->first_vertex,
                           (uint32_t)slot * u->cap + u->block_base[b] };
         memcpy(a + 5 * b, v, sizeof v);
     }
+    vkCmdUpdateBuffer(cb, u->args.buf, (VkDeviceSize)slot * u->nblocks * 20,
+                      (VkDeviceSize)u->nblocks * 20, a);
 }
 
 bool rt_ug_generate(rt_ug *u, VkCommandBuffer cb, const rt_camera *c, const splat_frame *fr,
@@ -893,7 +910,7 @@ bool rt_ug_generate(rt_ug *u, VkCommandBuffer cb, const rt_camera *c, const spla
         VkDeviceSize per = (VkDeviceSize)TEXELS * TEXELS * (u->nw + 2) * 4;
         for (int i = 0; i < n; i++) {
             vkCmdFillBuffer(cb, u->masks.buf, per * (VkDeviceSize)todo[i], per, 0);
-            reset_args(u, todo[i]);
+            reset_args(u, cb, todo[i]);
         }
         barrier(cb, VK_PIPELINE_STAGE_TRANSFER_BIT | VK_PIPELINE_STAGE_DRAW_INDIRECT_BIT |
                     VK_PIPELINE_STAGE_VERTEX_SHADER_BIT,
@@ -927,9 +944,14 @@ bool rt_ug_generate(rt_ug *u, VkCommandBuffer cb, const rt_camera *c, const spla
         }
         barrier(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
                 VK_PIPELINE_STAGE_DRAW_INDIRECT_BIT | VK_PIPELINE_STAGE_VERTEX_SHADER_BIT |
-                    VK_PIPELINE_STAGE_HOST_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT,
+                    VK_PIPELINE_STAGE_TRANSFER_BIT,
                 VK_ACCESS_INDIRECT_COMMAND_READ_BIT | VK_ACCESS_SHADER_READ_BIT |
-                    VK_ACCESS_HOST_READ_BIT | VK_ACCESS_TRANSFER_READ_BIT);
+                    VK_ACCESS_TRANSFER_READ_BIT);
+        /* the counts, for the stats and the tests (read after the frame) */
+        VkBufferCopy all = { 0, 0, u->args.size };
+        vkCmdCopyBuffer(cb, u->args.buf, u->args_host.buf, 1, &all);
+        barrier(cb, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
+                VK_PIPELINE_STAGE_HOST_BIT, VK_ACCESS_HOST_READ_BIT);
     }
     if (u->qpool)
         vkCmdWriteTimestamp(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, u->qpool, 1);
@@ -951,7 +973,6 @@ void rt_ug_draw(rt_ug *u, VkCommandBuffer cb, bool depth_read_only, VkDescriptor
     vkCmdBeginRenderPass(cb, &rb, VK_SUBPASS_CONTENTS_INLINE);
     vkCmdSetViewport(cb, 0, 1, vp);
     vkCmdSetScissor(cb, 0, 1, area);
-    vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_GRAPHICS, u->draw_pipe);
     VkDescriptorSet sets[3] = { set0, set1, u->draw_set };
     vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_GRAPHICS, u->draw_layout, 0, 3, sets, 0, NULL);
     splat_push push = { .patch_xz = { (float)u->radius, 0, 0, 0 } };
@@ -960,13 +981,18 @@ void rt_ug_draw(rt_ug *u, VkCommandBuffer cb, bool depth_read_only, VkDescriptor
     VkDeviceSize zero = 0;
     vkCmdBindVertexBuffers(cb, 0, 1, &u->vbuf.buf, &zero);
     vkCmdBindIndexBuffer(cb, u->ibuf.buf, 0, VK_INDEX_TYPE_UINT32);
-    for (int i = 0; i < u->pool; i++) {   /* front to back */
-        int k = u->order[i];
-        if (u->cells[k].state != CELL_READY || !u->cells[k].visible)
-            continue;
-        VkDeviceSize at = (VkDeviceSize)k * u->nblocks * 20;
-        for (int b = 0; b < u->nblocks; b++)
-            vkCmdDrawIndexedIndirect(cb, u->args.buf, at + 20 * (VkDeviceSize)b, 1, 20);
+    const rt_pack_ug *pu = &u->p->ug;
+    for (int cut = 0; cut < 2; cut++) {   /* opaque first: they hide the rest */
+        vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_GRAPHICS, u->draw_pipe[cut]);
+        for (int i = 0; i < u->pool; i++) {   /* front to back */
+            int k = u->order[i];
+            if (u->cells[k].state != CELL_READY || !u->cells[k].visible)
+                continue;
+            VkDeviceSize at = (VkDeviceSize)k * u->nblocks * 20;
+            for (int b = 0; b < u->nblocks; b++)
+                if ((int)(pu->meshes[pu->blocks[b].mesh].flags & 1u) == cut)
+                    vkCmdDrawIndexedIndirect(cb, u->args.buf, at + 20 * (VkDeviceSize)b, 1, 20);
+        }
     }
     vkCmdEndRenderPass(cb);
     if (u->qpool)
@@ -980,7 +1006,7 @@ void rt_ug_read_stats(rt_ug *u, rt_ug_stats *st)
     if (!u)
         return;
     st->generated = u->generated;
-    const uint32_t *a = u->args.map;
+    const uint32_t *a = u->args_host.map;
     for (int i = 0; i < u->pool; i++) {
         if (u->cells[i].state != CELL_READY)
             continue;
@@ -1010,7 +1036,7 @@ int rt_ug_read_cell(rt_ug *u, int ix, int iz, rt_ug_instance *out, int max, rt_e
     if (!cl || cl->state != CELL_READY)
         return 0;
     int slot = (int)(cl - u->cells);
-    const uint32_t *a = (const uint32_t *)u->args.map + (size_t)slot * u->nblocks * 5;
+    const uint32_t *a = (const uint32_t *)u->args_host.map + (size_t)slot * u->nblocks * 5;
     rt_buffer st;
     if (!rt_buffer_create(u->d, (VkDeviceSize)u->cap * 32, VK_BUFFER_USAGE_TRANSFER_DST_BIT, true,
                           &st, e))
