@@ -20,7 +20,10 @@ JOBS=$(nproc 2>/dev/null || echo 2)
 "$VIEW" out/colorado.pack --headless -o out/demo.png --size "$SIZE" --camera-preset "$CAMERA"
 "$VIEW" out/colorado.pack --headless -o out/demo_combos.png --size "$SIZE" \
     --camera-preset "$CAMERA" --view combos
+# on the ground, where the undergrowth grows (none from the air)
+"$VIEW" out/colorado.pack --headless -o out/demo_meadow.png --size "$SIZE" --camera-preset meadow
 echo
-echo "pictures:  out/demo.png  out/demo_combos.png  (camera preset '$CAMERA')"
+echo "pictures:  out/demo.png  out/demo_combos.png  (camera preset '$CAMERA'),"
+echo "           out/demo_meadow.png  (preset 'meadow': undergrowth)"
 echo "viewer:    $VIEW out/colorado.pack --camera-preset $CAMERA"
-echo "other presets: valley overview blanca spanish_peaks pivots trinidad (SPLAT_DEMO_CAMERA=...)"
+echo "other presets: valley overview blanca spanish_peaks pivots trinidad meadow (SPLAT_DEMO_CAMERA=...)"

@@ -129,6 +129,7 @@ struct rt_pack;
 typedef enum rt_shader_role {
     RT_ROLE_VERTEX, RT_ROLE_COMPOSITE, RT_ROLE_REFERENCE,
     RT_ROLE_COMPUTE,      /* the compute variants (*.comp.spv, abi.h)       */
+    RT_ROLE_UNDERGROWTH,  /* undergrowth mask shaders (*.ug.comp, abi.h)    */
     RT_ROLE_COUNT,
 } rt_shader_role;
 

@@ -218,8 +218,9 @@ static const char draw_frag_main[] =
     "layout(location = 6) flat in uint g_flags;\n"
     "void main() {\n"
     "#ifdef UG_CUTOUT\n"
-    "    float x = abs(g_uv.x * 2.0 - 1.0);   /* a leaf cut from the quad */\n"
-    "    if (x > 0.9 * sin(clamp(g_uv.y, 0.0, 1.0) * 3.14159)) discard;\n"
+    "    /* a frond cut from the quad: a lens-shaped outline, chevron leaflets */\n"
+    "    float x = abs(g_uv.x * 2.0 - 1.0), t = clamp(g_uv.y, 0.0, 1.0);\n"
+    "    if (x > 0.9 * sin(t * 3.14159) || (x > 0.08 && fract(t * 7.0 - x * 2.5) > 0.6)) discard;\n"
     "#endif\n"
     "    float dist = length(v_rel);\n"
     "    vec3 v = dist > 0.0 ? -v_rel / dist : vec3(0.0, 1.0, 0.0);\n"
@@ -257,11 +258,13 @@ static bool pipe_layout(rt_device *d, const VkDescriptorSetLayout *sets, uint32_
 }
 
 static bool module(rt_device *d, const char *glsl, VkShaderStageFlagBits stage,
-                   const char *name, VkShaderModule *out, rt_error *e)
+                   const char *name, const rt_interface *check, VkShaderModule *out,
+                   rt_error *e)
 {
     uint32_t *w = NULL;
     size_t n = 0;
-    bool ok = rt_glsl_compile(glsl, stage, name, &w, &n, e) && rt_spirv_validate(w, n, name, e);
+    bool ok = rt_glsl_compile(glsl, stage, name, &w, &n, e) && rt_spirv_validate(w, n, name, e) &&
+              (!check || rt_spirv_check(w, n, name, check, e));
     if (ok) {
         VkShaderModuleCreateInfo ci = {
             .sType = VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO,
@@ -275,11 +278,14 @@ static bool module(rt_device *d, const char *glsl, VkShaderStageFlagBits stage,
     return ok;
 }
 
+/* A compute pipeline from GLSL; `check`: a pack's shader, checked against
+ * that interface before the driver sees it. */
 static bool compute_pipe(rt_device *d, VkPipelineLayout layout, const char *glsl,
-                         const char *name, VkPipeline *out, rt_error *e)
+                         const char *name, const rt_interface *check, VkPipeline *out,
+                         rt_error *e)
 {
     VkShaderModule m;
-    if (!module(d, glsl, VK_SHADER_STAGE_COMPUTE_BIT, name, &m, e))
+    if (!module(d, glsl, VK_SHADER_STAGE_COMPUTE_BIT, name, check, &m, e))
         return false;
     VkComputePipelineCreateInfo ci = {
         .sType = VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO,
@@ -359,8 +365,8 @@ static bool draw_pipeline(rt_ug *u, bool cutout, rt_error *e)
              cutout ? "#define UG_CUTOUT 1\n" : "layout(early_fragment_tests) in;\n",
              SPLAT_GLSL_PRELUDE, draw_frag_main);
     VkShaderModule vm = VK_NULL_HANDLE, fm = VK_NULL_HANDLE;
-    bool ok = module(d, vs, VK_SHADER_STAGE_VERTEX_BIT, "undergrowth.vert", &vm, e) &&
-              module(d, fs, VK_SHADER_STAGE_FRAGMENT_BIT, "undergrowth.frag", &fm, e);
+    bool ok = module(d, vs, VK_SHADER_STAGE_VERTEX_BIT, "undergrowth.vert", NULL, &vm, e) &&
+              module(d, fs, VK_SHADER_STAGE_FRAGMENT_BIT, "undergrowth.frag", NULL, &fm, e);
     free(vs);
     free(fs);
     if (ok) {
@@ -631,7 +637,7 @@ bool rt_ug_create(rt_device *d, const rt_pack *p, rt_pipelines *pl, const rt_qua
         !make_sets(u, t->set0, t->height, t->nearest, e) ||
         !make_pass(d, VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL, &u->pass_att, e) ||
         !make_pass(d, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, &u->pass_ro, e) ||
-        !compute_pipe(d, u->gen_layout, gen_glsl, "undergrowth scatter", &u->gen_pipe, e) ||
+        !compute_pipe(d, u->gen_layout, gen_glsl, "undergrowth scatter", NULL, &u->gen_pipe, e) ||
         !draw_pipeline(u, false, e) || !draw_pipeline(u, true, e))
         return false;
     VkImageView views[2] = { t->color->view, t->depth->view };
@@ -814,7 +820,12 @@ static bool mask_pipeline(rt_ug *u, int combo, VkPipeline *out, rt_error *e)
             *out = VK_NULL_HANDLE;   /* grows nothing: the texels stay 0 */
             return true;
         }
-        if (!compute_pipe(u->d, u->mask_layout, glsl, name, &u->mask_pipes[combo], e))
+        rt_interface in;
+        if (!rt_interface_for(u->p, RT_ROLE_UNDERGROWTH, &in))
+            return rt_fail(e, RT_E_VULKAN, "undergrowth", "out of memory");
+        bool ok = compute_pipe(u->d, u->mask_layout, glsl, name, &in, &u->mask_pipes[combo], e);
+        rt_interface_free(&in);
+        if (!ok)
             return false;
     }
     *out = u->mask_pipes[combo];
@@ -953,8 +964,8 @@ bool rt_ug_generate(rt_ug *u, VkCommandBuffer cb, const rt_camera *c, const spla
         barrier(cb, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
                 VK_PIPELINE_STAGE_HOST_BIT, VK_ACCESS_HOST_READ_BIT);
     }
-    if (u->qpool)
-        vkCmdWriteTimestamp(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, u->qpool, 1);
+    if (u->qpool)   /* bottom of pipe: when everything before has finished */
+        vkCmdWriteTimestamp(cb, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, u->qpool, 1);
     u->generated = n;
     return true;
 }
@@ -963,8 +974,8 @@ void rt_ug_draw(rt_ug *u, VkCommandBuffer cb, bool depth_read_only, VkDescriptor
                 VkDescriptorSet set1, const VkViewport *vp, const VkRect2D *area)
 {
     u->drawn = true;
-    if (u->qpool)
-        vkCmdWriteTimestamp(cb, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, u->qpool, 2);
+    if (u->qpool)   /* after the terrain has finished, not when it started */
+        vkCmdWriteTimestamp(cb, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, u->qpool, 2);
     VkRenderPassBeginInfo rb = {
         .sType = VK_STRUCTURE_TYPE_RENDER_PASS_BEGIN_INFO,
         .renderPass = depth_read_only ? u->pass_ro : u->pass_att, .framebuffer = u->fb,

@@ -155,11 +155,18 @@ static void test_compute_role(void **state)
     snprintf(shaders, sizeof shaders, "%s/shaders", compute_dir);
     DIR *dir = opendir(shaders);
     assert_non_null(dir);
-    int ncomp = 0;
+    int ncomp = 0, nug = 0;
     struct dirent *ent;
     while ((ent = readdir(dir)) != NULL) {
         size_t len = strlen(ent->d_name);
-        if (len > 9 && !strcmp(ent->d_name + len - 9, ".comp.spv")) {
+        if (len > 12 && !strcmp(ent->d_name + len - 12, ".ug.comp.spv")) {
+            /* undergrowth masks: their own role (set 2), not compute shading */
+            if (!fits(&p, ent->d_name, RT_ROLE_UNDERGROWTH, &e))
+                fail_msg("%s", e.msg);
+            assert_false(fits(&p, ent->d_name, RT_ROLE_COMPUTE, &e));
+            rt_error_clear(&e);
+            nug++;
+        } else if (len > 9 && !strcmp(ent->d_name + len - 9, ".comp.spv")) {
             if (!fits(&p, ent->d_name, RT_ROLE_COMPUTE, &e))
                 fail_msg("%s", e.msg);
             assert_false(fits(&p, ent->d_name, RT_ROLE_COMPOSITE, &e));
@@ -169,7 +176,12 @@ static void test_compute_role(void **state)
         }
     }
     closedir(dir);
-    printf("  %d compute variants fit the compute role\n", ncomp);
+    printf("  %d compute variants fit the compute role, %d undergrowth mask shaders theirs\n",
+           ncomp, nug);
+    int want_ug = 0;
+    for (int i = 0; i < p.ncombos; i++)
+        want_ug += p.combos[i].ug_compute != NULL;
+    assert_int_equal(nug, want_ug);
     assert_int_equal(ncomp, p.ncombos + 1);   /* every composite and the uber */
     assert_false(fits(&p, "0000.spv", RT_ROLE_COMPUTE, &e));
     assert_non_null(strstr(e.msg, "no compute entry point"));
