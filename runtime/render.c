@@ -1143,9 +1143,10 @@ static bool draw_frame(rt_renderer *r, const rt_camera *c, rt_frame_stats *st, r
                      : record_forward(r, cb, c, &vp, &area, variant, &binds, e);
     if (!ok)
         return false;
-    if (ug && screen && rt_screen_raycasting(r->screen))
+    bool ug_draw = ug && rt_ug_visible(r->ug);
+    if (ug_draw && screen && rt_screen_raycasting(r->screen))
         rt_screen_depth_out(r->screen, cb, &r->depth);
-    if (ug)
+    if (ug_draw)
         rt_ug_draw(r->ug, cb, screen, r->set0, r->set1, &vp, &area);
     if (r->timestamps)
         vkCmdWriteTimestamp(cb, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, r->qpool, 3);

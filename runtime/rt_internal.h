@@ -438,6 +438,9 @@ void rt_ug_destroy(rt_ug *u);
  * `budget` pending ones (<= 0: all), frustum first, near first. */
 bool rt_ug_generate(rt_ug *u, VkCommandBuffer cb, const rt_camera *c, const splat_frame *fr,
                     VkDescriptorSet set1, int budget, rt_error *e);
+/* Whether a generated cell is in the frustum (else nothing to draw: the
+ * pass and, on the screen path, the depth copy are left out). */
+bool rt_ug_visible(const rt_ug *u);
 /* After the terrain: the instances of the visible cells, front to back;
  * depth_read_only: the depth was left SHADER_READ_ONLY (screen path). */
 void rt_ug_draw(rt_ug *u, VkCommandBuffer cb, bool depth_read_only, VkDescriptorSet set0,

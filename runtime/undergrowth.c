@@ -970,6 +970,14 @@ bool rt_ug_generate(rt_ug *u, VkCommandBuffer cb, const rt_camera *c, const spla
     return true;
 }
 
+bool rt_ug_visible(const rt_ug *u)
+{
+    for (int i = 0; u && i < u->pool; i++)
+        if (u->cells[i].state == CELL_READY && u->cells[i].visible)
+            return true;
+    return false;
+}
+
 void rt_ug_draw(rt_ug *u, VkCommandBuffer cb, bool depth_read_only, VkDescriptorSet set0,
                 VkDescriptorSet set1, const VkViewport *vp, const VkRect2D *area)
 {
