@@ -136,5 +136,8 @@ if(TARGET splatrt AND TARGET splatview)
       set_tests_properties(render.${t} PROPERTIES LABELS render TIMEOUT 600
                            ENVIRONMENT "SPLAT_VALIDATE=1")
     endforeach()
+    # the undergrowth's cells, GPU passes and pack sections under the
+    # sanitizers too
+    set_tests_properties(render.undergrowth PROPERTIES LABELS "render;asan")
   endif()
 endif()

@@ -16,6 +16,8 @@
  *     per cell within 3 sigma of its own spread;
  *   - a second renderer (another run) gives byte-identical instances in
  *     every cell, and so does a camera 40 m away in the cells both share;
+ *   - hot reload to the same scene with a quarter of the grass density
+ *     regenerates every cell, with a quarter of the grass;
  *   - a crater (burnt's mask 1 inside) leaves fewer than 2 % of the
  *     instances that stood in its inner disc;
  *   - with rd.no_undergrowth the picture is byte for byte the picture of
@@ -33,13 +35,19 @@
 enum { N = 129, W = 256, H = 192, CELLS = 8, MAXI = 4096 };
 static const double WEIGHT = 128.0 / 255.0;
 
-static bool write_scene(const char *dir, const char *name, bool undergrowth)
+/* grass: the grass block's density (0: no undergrowth blocks at all) */
+static bool write_scene(const char *dir, const char *name, double grass)
 {
     char *sg = join(dir, name);
     FILE *f = fopen(sg, "w");
     free(sg);
     if (!f)
         return false;
+    char blocks[256] = "";
+    if (grass > 0)
+        snprintf(blocks, sizeof blocks,
+                 "    undergrowth grass { density = %g, scale = 0.8 1.2 }\n"
+                 "    undergrowth stone { density = 0.1, align = normal }\n", grass);
     fprintf(f, "import \"nodes/compositors.sg\"\nimport \"nodes/masks.sg\"\n"
                "material ground {\n    out albedo = vec3(0.30, 0.25, 0.20)\n}\n"
                "material meadow {\n    out mask = 0.5\n    out albedo = vec3(0.2, 0.4, 0.1)\n%s}\n"
@@ -48,8 +56,7 @@ static bool write_scene(const char *dir, const char *name, bool undergrowth)
                "scene meadow {\n    heightfield = \"flat.png\"\n    size = 128 128\n"
                "    max_height = 10\n    materials = [ground, meadow, burnt]\n    cell = 16\n"
                "    destruction { origin = 0 0, size = 128 128, cell = 16 }\n}\n",
-            undergrowth ? "    undergrowth grass { density = 2, scale = 0.8 1.2 }\n"
-                          "    undergrowth stone { density = 0.1, align = normal }\n" : "");
+            blocks);
     return fclose(f) == 0;
 }
 
@@ -59,7 +66,8 @@ static bool write_inputs(const char *dir)
     char *png = join(dir, "flat.png");
     bool ok = stbi_write_png(png, N, N, 1, hf, N) != 0;
     free(png);
-    return ok && write_scene(dir, "meadow.sg", true) && write_scene(dir, "bare.sg", false);
+    return ok && write_scene(dir, "meadow.sg", 2.0) && write_scene(dir, "bare.sg", 0) &&
+           write_scene(dir, "sparse.sg", 0.5);
 }
 
 static rt_renderer *renderer(rt_device *dev, const rt_pack *p, bool off)
@@ -179,7 +187,35 @@ int main(int argc, char **argv)
             }
     }
     printf("identical cells: %d of %d (two runs, then a camera 40 m away)\n", same, cells);
+
+    /* hot reload (rt_renderer_swap_pack): the grass at a quarter of the
+     * density, every cell generated again */
+    char *ssg = join(dir, "sparse.sg"), *spackdir = join(dir, "sparse.pack");
+    rt_pack sp;
+    bool loaded = build_pack_ok(ssg, spackdir) && rt_pack_load(&sp, spackdir, &e);
+    CHECK(loaded, "sparse pack: %s", e.msg ? e.msg : "does not build");
+    rt_error_clear(&e);
+    if (loaded) {
+        CHECK(rt_renderer_swap_pack(r2, &sp, &e), "swap: %s", e.msg ? e.msg : "?");
+        rt_error_clear(&e);
+        CHECK(rt_renderer_frame(r2, &cam, &st, &e), "frame: %s", e.msg ? e.msg : "?");
+        long grass = 0;
+        for (int iz = 0; iz < CELLS; iz++)
+            for (int ix = 0; ix < CELLS; ix++)
+                grass += count(b, cell_of(r2, ix, iz, b), 0, 0, 0, 1e9);
+        double want = sum[0] / 4.0;   /* density 0.5 instead of 2 */
+        printf("hot reload: %d cells generated again, grass %ld (a quarter of before: %.0f)\n",
+               st.undergrowth.generated, grass, want);
+        CHECK(st.undergrowth.generated == CELLS * CELLS, "reload regenerated %d cells",
+              st.undergrowth.generated);
+        CHECK(fabs(grass - want) < 0.1 * want, "grass after the reload: %ld, want about %.0f",
+              grass, want);
+    }
     rt_renderer_destroy(r2);
+    if (loaded)
+        rt_pack_free(&sp);
+    free(ssg);
+    free(spackdir);
 
     /* a crater: burnt covers its inner disc, the meadow's instances go */
     const double cx = 40, cz = 40, radius = 12, inner = 0.4 * radius;
