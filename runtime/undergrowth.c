@@ -35,6 +35,15 @@
 #define CELL    16.0                 /* metres per cell side                */
 #define TEXELS  SPLAT_UG_TEXELS      /* mask texels per cell side           */
 #define MAX_INSTANCE_BYTES ((VkDeviceSize)256 << 20)
+/* Distance LOD: beyond LOD_NEAR metres a cell draws the fraction
+ * (LOD_NEAR / d)^2 of its instances (at least LOD_MIN), each scaled by
+ * 1 / sqrt(fraction) (at most LOD_GROW): about as many instances per
+ * pixel at every distance, and the same cover (a far tiny triangle costs
+ * a whole quad of fragments; the H100 paid 0.25 us per instance drawn). */
+#define LOD_NEAR 14.0
+#define LOD_MIN  0.08
+#define LOD_GROW 3.0
+#define LOD_GROW_S "3.0"
 
 enum { CELL_FREE, CELL_PENDING, CELL_READY };
 
@@ -53,7 +62,7 @@ typedef struct ug_push {
     uint32_t slot, nw, cap, mask_base;
     float    terrain[4];      /* size x, size z, max height, offset       */
     int32_t  hf[2];
-    uint32_t pad[2];
+    uint32_t nblocks, pad;
 } ug_push;
 
 struct rt_ug {
@@ -73,14 +82,16 @@ struct rt_ug {
      * arguments copied back after a generation, for the counts), blocks,
      * meshes, the mask pass's frame block */
     rt_buffer             masks, inst, args, args_host, blocks, vbuf, ibuf, frame;
+    rt_buffer             draw_args;           /* args with the LOD's counts */
+    rt_buffer             lod;                 /* per slot: fraction drawn   */
     VkDescriptorSetLayout set_terrain;         /* set 0 of the mask pass     */
-    VkDescriptorSetLayout set_mask, set_gen, set_draw;
-    VkPipelineLayout      mask_layout, gen_layout, draw_layout;
+    VkDescriptorSetLayout set_mask, set_gen, set_draw, set_lod;
+    VkPipelineLayout      mask_layout, gen_layout, draw_layout, lod_layout;
     VkPipeline           *mask_pipes;          /* per combination            */
-    VkPipeline            gen_pipe;
+    VkPipeline            gen_pipe, lod_pipe;
     VkPipeline            draw_pipe[2];        /* opaque (early depth), cut out */
     VkDescriptorPool      dpool;
-    VkDescriptorSet       set0, mask_set, gen_set, draw_set;
+    VkDescriptorSet       set0, mask_set, gen_set, draw_set, lod_set;
     VkRenderPass          pass_att, pass_ro;   /* depth in attachment / read */
     VkFramebuffer         fb;
     VkQueryPool           qpool;               /* VK_NULL_HANDLE: no timestamps */
@@ -101,7 +112,7 @@ static const char gen_glsl[] =
     "layout(set = 0, binding = 4) uniform sampler2D u_height;\n"
     "layout(push_constant, std430) uniform P {\n"
     "    vec2 origin; ivec2 cell; uint slot, nw, cap, mask_base;\n"
-    "    vec4 terrain; ivec2 hf;\n"
+    "    vec4 terrain; ivec2 hf; uint nblocks;\n"
     "} u_p;\n"
     "shared uint s_scan[64];\n"
     "uint hash(uint x) {\n"
@@ -135,8 +146,12 @@ static const char gen_glsl[] =
     "        bool ok = false;\n"
     "        Inst it;\n"
     "        if (k < total) {\n"
-    "            uint s = hash(seed0 ^ hash(k));\n"
-    "            vec2 g = vec2(float(k % n), float(k / n));\n"
+    /* candidates in a lattice order (stride coprime with the count), so
+     * that every prefix of the kept instances spreads over the cell: the
+     * draw's distance LOD keeps a prefix */
+    "            uint q = (k * uint(b2.w)) % total;\n"
+    "            uint s = hash(seed0 ^ hash(q));\n"
+    "            vec2 g = vec2(float(q % n), float(q / n));\n"
     "            vec2 l = (g + vec2(rnd(s), rnd(s))) * step;\n"
     "            ivec2 tx = min(ivec2(l * (64.0 / 16.0)), ivec2(63));\n"
     "            uint at = u_p.mask_base + uint(tx.y * 64 + tx.x) * (u_p.nw + 2u);\n"
@@ -164,7 +179,24 @@ static const char gen_glsl[] =
     "        run += s_scan[63];\n"
     "        barrier();\n"
     "    }\n"
-    "    if (lid == 0u) u_args.a[(u_p.slot * uint(u_blocks.b[2].w) + b) * 5u + 1u] = run;\n"
+    "    if (lid == 0u) u_args.a[(u_p.slot * u_p.nblocks + b) * 5u + 1u] = run;\n"
+    "}\n";
+
+/* The LOD pass, every frame: the draw arguments from the generated ones,
+ * each cell's instance count times its fraction (a prefix: the scatter
+ * pass keeps instances in a lattice order that spreads every prefix). */
+static const char lod_glsl[] =
+    "#version 450\n"
+    "layout(local_size_x = 64) in;\n"
+    "layout(set = 0, binding = 0, std430) readonly buffer A { uint a[]; } u_args;\n"
+    "layout(set = 0, binding = 1, std430) writeonly buffer D { uint a[]; } u_draw;\n"
+    "layout(set = 0, binding = 2, std430) readonly buffer F { float f[]; } u_lod;\n"
+    "layout(push_constant, std430) uniform P { uint n, nblocks; } u_p;\n"
+    "void main() {\n"
+    "    uint i = gl_GlobalInvocationID.x;\n"
+    "    if (i >= u_p.n) return;\n"
+    "    for (uint k = 0u; k < 5u; k++) u_draw.a[5u * i + k] = u_args.a[5u * i + k];\n"
+    "    u_draw.a[5u * i + 1u] = uint(ceil(float(u_args.a[5u * i + 1u]) * u_lod.f[i / u_p.nblocks]));\n"
     "}\n";
 
 /* The draw pass: SPLAT_GLSL_TERRAIN (frame block) + this vertex main; the
@@ -174,6 +206,7 @@ static const char draw_vert_main[] =
     "struct Inst { vec4 p; uvec4 q; };\n"
     "layout(set = 2, binding = 0, std430) readonly buffer B { vec4 b[]; } u_blocks;\n"
     "layout(set = 2, binding = 1, std430) readonly buffer I { Inst v[]; } u_inst;\n"
+    "layout(set = 2, binding = 2, std430) readonly buffer F { float f[]; } u_lod;\n"
     "layout(location = 0) in vec3 a_pos;\n"
     "layout(location = 1) in vec3 a_nrm;\n"
     "layout(location = 2) in vec2 a_uv;\n"
@@ -192,7 +225,9 @@ static const char draw_vert_main[] =
     "    float a = uintBitsToFloat(it.q.z), c = cos(a), s = sin(a);\n"
     "    /* shrink away over the last quarter of the radius (push patch_xz.x) */\n"
     "    float r = u_push.patch_xz.x, d = length(it.p.xz - u_frame.camera.xz);\n"
-    "    vec3 p = a_pos * it.p.w * clamp((r - d) / (0.25 * r), 0.0, 1.0);\n"
+    "    /* the LOD's growth (u_push.info.x: instances per cell) */\n"
+    "    float grow = min(inversesqrt(u_lod.f[uint(gl_InstanceIndex) / u_push.info.x]), " LOD_GROW_S ");\n"
+    "    vec3 p = a_pos * it.p.w * grow * clamp((r - d) / (0.25 * r), 0.0, 1.0);\n"
     "    p = vec3(c * p.x + s * p.z, p.y, -s * p.x + c * p.z);\n"
     "    vec3 m = vec3(c * a_nrm.x + s * a_nrm.z, a_nrm.y, -s * a_nrm.x + c * a_nrm.z);\n"
     "    if ((flags & 4u) != 0u) {   /* aligned to the terrain normal */\n"
@@ -438,10 +473,20 @@ static bool draw_pipeline(rt_ug *u, bool cutout, rt_error *e)
     return ok;
 }
 
+static uint32_t gcd(uint32_t a, uint32_t b)
+{
+    while (b) {
+        uint32_t t = a % b;
+        a = b;
+        b = t;
+    }
+    return a;
+}
+
 /* The block table (set 0 binding 3 of the scatter pass, set 2 binding 0
  * of the draw): per block three vec4s, (density, scale lo, scale hi,
  * blend), (colour, slot), (candidates per side, first instance in the
- * cell, flags, 0); block 0's last is the block count. */
+ * cell, flags, the stride of the candidates' lattice order). */
 static void fill_blocks(rt_ug *u, float *b)
 {
     const rt_pack_ug *pu = &u->p->ug;
@@ -454,13 +499,15 @@ static void fill_blocks(rt_ug *u, float *b)
         u->block_base[i] = at;
         at += n * n;
         unsigned flags = pu->meshes[k->mesh].flags | (k->align_normal ? 4u : 0u);
+        uint32_t stride = (uint32_t)(0.618034 * n * n);
+        while (stride > 1 && gcd(stride, n * n) != 1)
+            stride++;
         float v[12] = { (float)k->density, (float)k->scale[0], (float)k->scale[1],
                         (float)k->blend, (float)k->color[0], (float)k->color[1],
                         (float)k->color[2], (float)k->slot, (float)n, (float)u->block_base[i],
-                        (float)flags, 0.0f };
+                        (float)flags, (float)(stride ? stride : 1) };
         memcpy(b + 12 * i, v, sizeof v);
     }
-    b[11] = (float)u->nblocks;   /* block 0's last: the block count */
     u->cap = at;
 }
 
@@ -469,26 +516,28 @@ static bool make_sets(rt_ug *u, VkDescriptorSet set0_src, const rt_image *height
 {
     rt_device *d = u->d;
     VkDescriptorPoolSize sizes[3] = {
-        { VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 8 },
+        { VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 12 },
         { VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 16 },
         { VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 2 },
     };
     VkDescriptorPoolCreateInfo pci = {
         .sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO,
-        .maxSets = 4, .poolSizeCount = 3, .pPoolSizes = sizes,
+        .maxSets = 5, .poolSizeCount = 3, .pPoolSizes = sizes,
     };
     RT_VK(e, vkCreateDescriptorPool(d->dev, &pci, NULL, &u->dpool));
-    VkDescriptorSetLayout layouts[4] = { u->set_terrain, u->set_mask, u->set_gen, u->set_draw };
-    VkDescriptorSet sets[4];
+    VkDescriptorSetLayout layouts[5] = { u->set_terrain, u->set_mask, u->set_gen, u->set_draw,
+                                         u->set_lod };
+    VkDescriptorSet sets[5];
     VkDescriptorSetAllocateInfo ai = {
         .sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO,
-        .descriptorPool = u->dpool, .descriptorSetCount = 4, .pSetLayouts = layouts,
+        .descriptorPool = u->dpool, .descriptorSetCount = 5, .pSetLayouts = layouts,
     };
     RT_VK(e, vkAllocateDescriptorSets(d->dev, &ai, sets));
     u->set0 = sets[0];
     u->mask_set = sets[1];
     u->gen_set = sets[2];
     u->draw_set = sets[3];
+    u->lod_set = sets[4];
     /* set 0 of the mask pass: the terrain's, but the frame block whose
      * camera is the origin (abi.h "undergrowth masks") */
     static const uint32_t terrain[] = {
@@ -507,6 +556,8 @@ static bool make_sets(rt_ug *u, VkDescriptorSet set0_src, const rt_image *height
     VkDescriptorBufferInfo ib = { u->inst.buf, 0, VK_WHOLE_SIZE };
     VkDescriptorBufferInfo ab = { u->args.buf, 0, VK_WHOLE_SIZE };
     VkDescriptorBufferInfo bb = { u->blocks.buf, 0, VK_WHOLE_SIZE };
+    VkDescriptorBufferInfo db = { u->draw_args.buf, 0, VK_WHOLE_SIZE };
+    VkDescriptorBufferInfo lb = { u->lod.buf, 0, VK_WHOLE_SIZE };
     VkDescriptorImageInfo hi = { nearest, height->view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL };
     const VkDescriptorType sb = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
 #define W(set_, b_, type_, img_, buf_) \
@@ -520,6 +571,9 @@ static bool make_sets(rt_ug *u, VkDescriptorSet set0_src, const rt_image *height
         W(u->gen_set, 2, sb, NULL, &ab), W(u->gen_set, 3, sb, NULL, &bb),
         W(u->gen_set, 4, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, &hi, NULL),
         W(u->draw_set, 0, sb, NULL, &bb), W(u->draw_set, 1, sb, NULL, &ib),
+        W(u->draw_set, 2, sb, NULL, &lb),
+        W(u->lod_set, 0, sb, NULL, &ab), W(u->lod_set, 1, sb, NULL, &db),
+        W(u->lod_set, 2, sb, NULL, &lb),
     };
 #undef W
     vkUpdateDescriptorSets(d->dev, sizeof w / sizeof *w, w, N, cp);
@@ -552,15 +606,20 @@ static bool make_layouts(rt_ug *u, rt_error *e)
     };
     VkDescriptorSetLayoutBinding draw[] = {
         { 0, sb, 1, VK_SHADER_STAGE_VERTEX_BIT, NULL }, { 1, sb, 1, VK_SHADER_STAGE_VERTEX_BIT, NULL },
+        { 2, sb, 1, VK_SHADER_STAGE_VERTEX_BIT, NULL },
+    };
+    VkDescriptorSetLayoutBinding lod[] = {
+        { 0, sb, 1, cs, NULL }, { 1, sb, 1, cs, NULL }, { 2, sb, 1, cs, NULL },
     };
     if (!set_layout(d, terrain, sizeof terrain / sizeof *terrain, &u->set_terrain, e) ||
         !set_layout(d, mask, 1, &u->set_mask, e) || !set_layout(d, gen, 5, &u->set_gen, e) ||
-        !set_layout(d, draw, 2, &u->set_draw, e))
+        !set_layout(d, draw, 3, &u->set_draw, e) || !set_layout(d, lod, 3, &u->set_lod, e))
         return false;
     VkDescriptorSetLayout ms[3] = { u->set_terrain, u->pl->set_material, u->set_mask };
     VkDescriptorSetLayout ds[3] = { u->pl->set_terrain, u->pl->set_material, u->set_draw };
     return pipe_layout(d, ms, 3, cs, sizeof(splat_push), &u->mask_layout, e) &&
            pipe_layout(d, &u->set_gen, 1, cs, sizeof(ug_push), &u->gen_layout, e) &&
+           pipe_layout(d, &u->set_lod, 1, cs, 8, &u->lod_layout, e) &&
            pipe_layout(d, ds, 3, VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT,
                        sizeof(splat_push), &u->draw_layout, e);
 }
@@ -587,6 +646,9 @@ static bool make_buffers(rt_ug *u, rt_error *e)
                               VK_BUFFER_USAGE_TRANSFER_SRC_BIT, false, &u->args, e) ||
         !rt_buffer_create(d, (VkDeviceSize)u->pool * u->nblocks * 20,
                           VK_BUFFER_USAGE_TRANSFER_DST_BIT, true, &u->args_host, e) ||
+        !rt_buffer_create(d, (VkDeviceSize)u->pool * u->nblocks * 20,
+                          st | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT, false, &u->draw_args, e) ||
+        !rt_buffer_create(d, (VkDeviceSize)u->pool * 4, st, true, &u->lod, e) ||
         !rt_buffer_create(d, (VkDeviceSize)u->nblocks * 48, st, true, &u->blocks, e) ||
         !rt_buffer_create(d, (VkDeviceSize)pu->nvertices * 32, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT,
                           true, &u->vbuf, e) ||
@@ -599,6 +661,8 @@ static bool make_buffers(rt_ug *u, rt_error *e)
     memcpy(u->ibuf.map, pu->indices, (size_t)pu->nindices * 4);
     fill_blocks(u, u->blocks.map);
     memset(u->args_host.map, 0, (size_t)u->args_host.size);
+    for (int i = 0; i < u->pool; i++)
+        ((float *)u->lod.map)[i] = 1.0f;
     return true;
 }
 
@@ -638,6 +702,7 @@ bool rt_ug_create(rt_device *d, const rt_pack *p, rt_pipelines *pl, const rt_qua
         !make_pass(d, VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL, &u->pass_att, e) ||
         !make_pass(d, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, &u->pass_ro, e) ||
         !compute_pipe(d, u->gen_layout, gen_glsl, "undergrowth scatter", NULL, &u->gen_pipe, e) ||
+        !compute_pipe(d, u->lod_layout, lod_glsl, "undergrowth lod", NULL, &u->lod_pipe, e) ||
         !draw_pipeline(u, false, e) || !draw_pipeline(u, true, e))
         return false;
     VkImageView views[2] = { t->color->view, t->depth->view };
@@ -660,16 +725,17 @@ void rt_ug_destroy(rt_ug *u)
     for (int i = 0; u->mask_pipes && i <= u->p->ncombos; i++)
         if (u->mask_pipes[i])
             vkDestroyPipeline(d->dev, u->mask_pipes[i], NULL);
-    VkPipeline pipes[3] = { u->gen_pipe, u->draw_pipe[0], u->draw_pipe[1] };
-    for (int i = 0; i < 3; i++)
+    VkPipeline pipes[4] = { u->gen_pipe, u->lod_pipe, u->draw_pipe[0], u->draw_pipe[1] };
+    for (int i = 0; i < 4; i++)
         if (pipes[i])
             vkDestroyPipeline(d->dev, pipes[i], NULL);
-    VkPipelineLayout pls[3] = { u->mask_layout, u->gen_layout, u->draw_layout };
-    for (int i = 0; i < 3; i++)
+    VkPipelineLayout pls[4] = { u->mask_layout, u->gen_layout, u->draw_layout, u->lod_layout };
+    for (int i = 0; i < 4; i++)
         if (pls[i])
             vkDestroyPipelineLayout(d->dev, pls[i], NULL);
-    VkDescriptorSetLayout sls[4] = { u->set_terrain, u->set_mask, u->set_gen, u->set_draw };
-    for (int i = 0; i < 4; i++)
+    VkDescriptorSetLayout sls[5] = { u->set_terrain, u->set_mask, u->set_gen, u->set_draw,
+                                     u->set_lod };
+    for (int i = 0; i < 5; i++)
         if (sls[i])
             vkDestroyDescriptorSetLayout(d->dev, sls[i], NULL);
     if (u->dpool)
@@ -682,8 +748,8 @@ void rt_ug_destroy(rt_ug *u)
         vkDestroyRenderPass(d->dev, u->pass_ro, NULL);
     if (u->qpool)
         vkDestroyQueryPool(d->dev, u->qpool, NULL);
-    rt_buffer *bufs[] = { &u->masks, &u->inst, &u->args, &u->args_host, &u->blocks, &u->vbuf,
-                          &u->ibuf, &u->frame };
+    rt_buffer *bufs[] = { &u->masks, &u->inst, &u->args, &u->args_host, &u->draw_args, &u->lod,
+                          &u->blocks, &u->vbuf, &u->ibuf, &u->frame };
     for (size_t i = 0; i < sizeof bufs / sizeof *bufs; i++)
         rt_buffer_destroy(d, bufs[i]);
     free(u->mask_pipes);
@@ -784,6 +850,9 @@ static void allocate(rt_ug *u, const rt_camera *c, const float view_proj[16])
         double lo[3] = { cl->ix * CELL - cx, hmin - c->position[1] - 2, cl->iz * CELL - cz };
         double hi[3] = { lo[0] + CELL, hmax - c->position[1] + 8, lo[2] + CELL };
         cl->visible = !box_outside(view_proj, lo, hi);
+        double near = cl->dist - CELL * 0.7071;   /* the cell's nearest point, about */
+        double f = near > LOD_NEAR ? (LOD_NEAR / near) * (LOD_NEAR / near) : 1.0;
+        ((float *)u->lod.map)[i] = (float)(f > LOD_MIN ? f : LOD_MIN);
     }
     for (int i = 1; i < u->pool; i++)   /* insertion sort: a few hundred cells */
         for (int j = i; j > 0 && before(&u->cells[u->order[j]], &u->cells[u->order[j - 1]]); j--) {
@@ -947,7 +1016,7 @@ bool rt_ug_generate(rt_ug *u, VkCommandBuffer cb, const rt_camera *c, const spla
                 .mask_base = (uint32_t)todo[i] * TEXELS * TEXELS * (uint32_t)(u->nw + 2),
                 .terrain = { (float)p->size[0], (float)p->size[1], (float)p->max_height,
                              (float)p->height_offset },
-                .hf = { p->hf_width, p->hf_height },
+                .hf = { p->hf_width, p->hf_height }, .nblocks = (uint32_t)u->nblocks,
             };
             vkCmdPushConstants(cb, u->gen_layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof push, &push);
             vkCmdDispatch(cb, (uint32_t)u->nblocks, 1, 1);
@@ -964,6 +1033,15 @@ bool rt_ug_generate(rt_ug *u, VkCommandBuffer cb, const rt_camera *c, const spla
         barrier(cb, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
                 VK_PIPELINE_STAGE_HOST_BIT, VK_ACCESS_HOST_READ_BIT);
     }
+    /* every frame: this camera's LOD of every cell's arguments */
+    uint32_t pc[2] = { (uint32_t)(u->pool * u->nblocks), (uint32_t)u->nblocks };
+    vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, u->lod_pipe);
+    vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, u->lod_layout, 0, 1, &u->lod_set,
+                            0, NULL);
+    vkCmdPushConstants(cb, u->lod_layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof pc, pc);
+    vkCmdDispatch(cb, (pc[0] + 63) / 64, 1, 1);
+    barrier(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
+            VK_PIPELINE_STAGE_DRAW_INDIRECT_BIT, VK_ACCESS_INDIRECT_COMMAND_READ_BIT);
     if (u->qpool)   /* bottom of pipe: when everything before has finished */
         vkCmdWriteTimestamp(cb, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, u->qpool, 1);
     u->generated = n;
@@ -994,7 +1072,7 @@ void rt_ug_draw(rt_ug *u, VkCommandBuffer cb, bool depth_read_only, VkDescriptor
     vkCmdSetScissor(cb, 0, 1, area);
     VkDescriptorSet sets[3] = { set0, set1, u->draw_set };
     vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_GRAPHICS, u->draw_layout, 0, 3, sets, 0, NULL);
-    splat_push push = { .patch_xz = { (float)u->radius, 0, 0, 0 } };
+    splat_push push = { .patch_xz = { (float)u->radius, 0, 0, 0 }, .info = { u->cap, 0, 0, 0 } };
     vkCmdPushConstants(cb, u->draw_layout, VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT,
                        0, sizeof push, &push);
     VkDeviceSize zero = 0;
@@ -1010,7 +1088,7 @@ void rt_ug_draw(rt_ug *u, VkCommandBuffer cb, bool depth_read_only, VkDescriptor
             VkDeviceSize at = (VkDeviceSize)k * u->nblocks * 20;
             for (int b = 0; b < u->nblocks; b++)
                 if ((int)(pu->meshes[pu->blocks[b].mesh].flags & 1u) == cut)
-                    vkCmdDrawIndexedIndirect(cb, u->args.buf, at + 20 * (VkDeviceSize)b, 1, 20);
+                    vkCmdDrawIndexedIndirect(cb, u->draw_args.buf, at + 20 * (VkDeviceSize)b, 1, 20);
         }
     }
     vkCmdEndRenderPass(cb);
