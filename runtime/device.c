@@ -437,6 +437,18 @@ void rt_image_destroy(rt_device *d, rt_image *img)
     memset(img, 0, sizeof *img);
 }
 
+bool rt_set_layout(rt_device *d, const VkDescriptorSetLayoutBinding *b, uint32_t n,
+                   VkDescriptorSetLayout *out, rt_error *e)
+{
+    VkDescriptorSetLayoutCreateInfo ci = {
+        .sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO,
+        .bindingCount = n,
+        .pBindings = b,
+    };
+    RT_VK(e, vkCreateDescriptorSetLayout(d->dev, &ci, NULL, out));
+    return true;
+}
+
 bool rt_format_supports(rt_device *d, VkFormat f, VkFormatFeatureFlags need)
 {
     VkFormatProperties fp;

@@ -166,18 +166,6 @@ static void save_cache(rt_device *d, rt_pipelines *pl)
 
 /* ---- layouts ------------------------------------------------------------- */
 
-static bool make_set_layout(rt_device *d, const VkDescriptorSetLayoutBinding *b,
-                            uint32_t n, VkDescriptorSetLayout *out, rt_error *e)
-{
-    VkDescriptorSetLayoutCreateInfo ci = {
-        .sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO,
-        .bindingCount = n,
-        .pBindings = b,
-    };
-    RT_VK(e, vkCreateDescriptorSetLayout(d->dev, &ci, NULL, out));
-    return true;
-}
-
 static bool make_layouts(rt_device *d, int ntextures, rt_pipelines *pl, rt_error *e)
 {
     const VkShaderStageFlags cs = VK_SHADER_STAGE_COMPUTE_BIT;
@@ -202,7 +190,7 @@ static bool make_layouts(rt_device *d, int ntextures, rt_pipelines *pl, rt_error
         { SPLAT_BIND_TILES, sbuf, 1, cs, NULL },
         { SPLAT_BIND_COUNTERS, sbuf, 1, cs, NULL },
     };
-    if (!make_set_layout(d, terrain, sizeof terrain / sizeof *terrain, &pl->set_terrain, e))
+    if (!rt_set_layout(d, terrain, sizeof terrain / sizeof *terrain, &pl->set_terrain, e))
         return false;
     VkDescriptorSetLayoutBinding *mat = calloc((size_t)ntextures + 1, sizeof *mat);
     if (!mat)
@@ -210,12 +198,12 @@ static bool make_layouts(rt_device *d, int ntextures, rt_pipelines *pl, rt_error
     mat[0] = (VkDescriptorSetLayoutBinding){ SPLAT_BIND_PARAMS, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 1, fs, NULL };
     for (int i = 0; i < ntextures; i++)
         mat[i + 1] = (VkDescriptorSetLayoutBinding){ (uint32_t)(SPLAT_BIND_TEXTURE0 + i), smp, 1, fs, NULL };
-    bool ok = make_set_layout(d, mat, (uint32_t)ntextures + 1, &pl->set_material, e);
+    bool ok = rt_set_layout(d, mat, (uint32_t)ntextures + 1, &pl->set_material, e);
     free(mat);
     VkDescriptorSetLayoutBinding res[] = {
         { 0, smp, 1, fs, NULL }, { 1, smp, 1, fs, NULL }, { 2, smp, 1, fs, NULL },
     };
-    if (!ok || !make_set_layout(d, res, 3, &pl->set_resolve, e))
+    if (!ok || !rt_set_layout(d, res, 3, &pl->set_resolve, e))
         return false;
     VkPushConstantRange push = { vf, 0, sizeof(splat_push) };
     VkDescriptorSetLayout sets[3] = { pl->set_terrain, pl->set_material, pl->set_resolve };

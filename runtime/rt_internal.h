@@ -58,6 +58,9 @@ void rt_cmd_image_barrier(VkCommandBuffer cb, VkImage img, uint32_t mip, uint32_
                           VkAccessFlags src_access, VkAccessFlags dst_access,
                           VkPipelineStageFlags src, VkPipelineStageFlags dst);
 bool rt_format_supports(rt_device *d, VkFormat f, VkFormatFeatureFlags need);
+/* A descriptor set layout of these bindings. */
+bool rt_set_layout(rt_device *d, const VkDescriptorSetLayoutBinding *b, uint32_t n,
+                   VkDescriptorSetLayout *out, rt_error *e);
 /* The sampler address mode of an ir_wrap (ir.h IR_WRAPS). */
 VkSamplerAddressMode rt_sampler_wrap(int ir_wrap);
 
@@ -71,6 +74,16 @@ bool rt_glsl_compile(const char *glsl, VkShaderStageFlagBits stage,
 /* SPIRV-Tools validation for Vulkan 1.2; message in e on failure. */
 bool rt_spirv_validate(const uint32_t *words, size_t nwords, const char *name,
                        rt_error *e);
+struct rt_interface;
+/* The runtime's GLSL to a shader module: glslang, spirv-val, and when
+ * `check` is given (a pack's shader) rt_spirv_check against it. */
+bool rt_glsl_module(rt_device *d, const char *glsl, VkShaderStageFlagBits stage,
+                    const char *name, const struct rt_interface *check, VkShaderModule *out,
+                    rt_error *e);
+/* A compute pipeline over `layout` from GLSL (rt_glsl_module). */
+bool rt_glsl_compute_pipeline(rt_device *d, VkPipelineCache cache, VkPipelineLayout layout,
+                              const char *glsl, const char *name,
+                              const struct rt_interface *check, VkPipeline *out, rt_error *e);
 
 /* ---- spirv_check.c: a pack shader against what it is bound to --------- */
 

@@ -511,33 +511,9 @@ static bool own_pipeline(rt_screen *s, const rt_pipelines *pl, const char *head,
     if (!src)
         return rt_fail(e, RT_E_VULKAN, name, "out of memory");
     snprintf(src, n, "#version 450\n%s%s%s%s", head, SPLAT_GLSL_TERRAIN, SPLAT_GLSL_SKY, body);
-    uint32_t *words = NULL;
-    size_t nw = 0;
-    bool ok = rt_glsl_compile(src, VK_SHADER_STAGE_COMPUTE_BIT, name, &words, &nw, e);
+    bool ok = rt_glsl_compute_pipeline(d, pl->cache, s->layout, src, name, NULL, out, e);
     free(src);
-    if (!ok)
-        return false;
-    VkShaderModuleCreateInfo mi = {
-        .sType = VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO,
-        .codeSize = nw * 4,
-        .pCode = words,
-    };
-    VkShaderModule m;
-    VkResult r = vkCreateShaderModule(d->dev, &mi, NULL, &m);
-    free(words);
-    if (r != VK_SUCCESS)
-        return rt_fail(e, RT_E_VULKAN, "vkCreateShaderModule", rt_vk_result_name(r));
-    VkComputePipelineCreateInfo ci = {
-        .sType = VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO,
-        .stage = { .sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO,
-                   .stage = VK_SHADER_STAGE_COMPUTE_BIT, .module = m, .pName = "main" },
-        .layout = s->layout,
-    };
-    r = vkCreateComputePipelines(d->dev, pl->cache, 1, &ci, NULL, out);
-    vkDestroyShaderModule(d->dev, m, NULL);
-    if (r != VK_SUCCESS)
-        return rt_fail(e, RT_E_VULKAN, "vkCreateComputePipelines", rt_vk_result_name(r));
-    return true;
+    return ok;
 }
 
 /* Whether the classification may append through subgroup operations. */

@@ -40,3 +40,44 @@ bool rt_spirv_validate(const uint32_t *words, size_t nwords, const char *name,
     free(log);
     return true;
 }
+
+bool rt_glsl_module(rt_device *d, const char *glsl, VkShaderStageFlagBits stage,
+                    const char *name, const rt_interface *check, VkShaderModule *out,
+                    rt_error *e)
+{
+    uint32_t *w = NULL;
+    size_t n = 0;
+    bool ok = rt_glsl_compile(glsl, stage, name, &w, &n, e) && rt_spirv_validate(w, n, name, e) &&
+              (!check || rt_spirv_check(w, n, name, check, e));
+    if (ok) {
+        VkShaderModuleCreateInfo ci = {
+            .sType = VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO,
+            .codeSize = n * 4, .pCode = w,
+        };
+        VkResult r = vkCreateShaderModule(d->dev, &ci, NULL, out);
+        if (r != VK_SUCCESS)
+            ok = rt_fail(e, RT_E_VULKAN, "vkCreateShaderModule", rt_vk_result_name(r));
+    }
+    free(w);
+    return ok;
+}
+
+bool rt_glsl_compute_pipeline(rt_device *d, VkPipelineCache cache, VkPipelineLayout layout,
+                              const char *glsl, const char *name, const rt_interface *check,
+                              VkPipeline *out, rt_error *e)
+{
+    VkShaderModule m;
+    if (!rt_glsl_module(d, glsl, VK_SHADER_STAGE_COMPUTE_BIT, name, check, &m, e))
+        return false;
+    VkComputePipelineCreateInfo ci = {
+        .sType = VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO,
+        .stage = { .sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO,
+                   .stage = VK_SHADER_STAGE_COMPUTE_BIT, .module = m, .pName = "main" },
+        .layout = layout,
+    };
+    VkResult r = vkCreateComputePipelines(d->dev, cache, 1, &ci, NULL, out);
+    vkDestroyShaderModule(d->dev, m, NULL);
+    if (r != VK_SUCCESS)
+        return rt_fail(e, RT_E_VULKAN, "vkCreateComputePipelines", rt_vk_result_name(r));
+    return true;
+}

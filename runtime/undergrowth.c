@@ -267,17 +267,6 @@ static const char draw_frag_main[] =
 
 /* ---- creation ----------------------------------------------------------------- */
 
-static bool set_layout(rt_device *d, const VkDescriptorSetLayoutBinding *b, uint32_t n,
-                       VkDescriptorSetLayout *out, rt_error *e)
-{
-    VkDescriptorSetLayoutCreateInfo ci = {
-        .sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO,
-        .bindingCount = n, .pBindings = b,
-    };
-    RT_VK(e, vkCreateDescriptorSetLayout(d->dev, &ci, NULL, out));
-    return true;
-}
-
 static bool pipe_layout(rt_device *d, const VkDescriptorSetLayout *sets, uint32_t n,
                         VkShaderStageFlags stages, uint32_t push, VkPipelineLayout *out,
                         rt_error *e)
@@ -289,49 +278,6 @@ static bool pipe_layout(rt_device *d, const VkDescriptorSetLayout *sets, uint32_
         .pushConstantRangeCount = 1, .pPushConstantRanges = &pr,
     };
     RT_VK(e, vkCreatePipelineLayout(d->dev, &ci, NULL, out));
-    return true;
-}
-
-static bool module(rt_device *d, const char *glsl, VkShaderStageFlagBits stage,
-                   const char *name, const rt_interface *check, VkShaderModule *out,
-                   rt_error *e)
-{
-    uint32_t *w = NULL;
-    size_t n = 0;
-    bool ok = rt_glsl_compile(glsl, stage, name, &w, &n, e) && rt_spirv_validate(w, n, name, e) &&
-              (!check || rt_spirv_check(w, n, name, check, e));
-    if (ok) {
-        VkShaderModuleCreateInfo ci = {
-            .sType = VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO,
-            .codeSize = n * 4, .pCode = w,
-        };
-        VkResult r = vkCreateShaderModule(d->dev, &ci, NULL, out);
-        if (r != VK_SUCCESS)
-            ok = rt_fail(e, RT_E_VULKAN, "vkCreateShaderModule", rt_vk_result_name(r));
-    }
-    free(w);
-    return ok;
-}
-
-/* A compute pipeline from GLSL; `check`: a pack's shader, checked against
- * that interface before the driver sees it. */
-static bool compute_pipe(rt_device *d, VkPipelineLayout layout, const char *glsl,
-                         const char *name, const rt_interface *check, VkPipeline *out,
-                         rt_error *e)
-{
-    VkShaderModule m;
-    if (!module(d, glsl, VK_SHADER_STAGE_COMPUTE_BIT, name, check, &m, e))
-        return false;
-    VkComputePipelineCreateInfo ci = {
-        .sType = VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO,
-        .stage = { .sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO,
-                   .stage = VK_SHADER_STAGE_COMPUTE_BIT, .module = m, .pName = "main" },
-        .layout = layout,
-    };
-    VkResult r = vkCreateComputePipelines(d->dev, VK_NULL_HANDLE, 1, &ci, NULL, out);
-    vkDestroyShaderModule(d->dev, m, NULL);
-    if (r != VK_SUCCESS)
-        return rt_fail(e, RT_E_VULKAN, "vkCreateComputePipelines", rt_vk_result_name(r));
     return true;
 }
 
@@ -400,8 +346,8 @@ static bool draw_pipeline(rt_ug *u, bool cutout, rt_error *e)
              cutout ? "#define UG_CUTOUT 1\n" : "layout(early_fragment_tests) in;\n",
              SPLAT_GLSL_PRELUDE, draw_frag_main);
     VkShaderModule vm = VK_NULL_HANDLE, fm = VK_NULL_HANDLE;
-    bool ok = module(d, vs, VK_SHADER_STAGE_VERTEX_BIT, "undergrowth.vert", NULL, &vm, e) &&
-              module(d, fs, VK_SHADER_STAGE_FRAGMENT_BIT, "undergrowth.frag", NULL, &fm, e);
+    bool ok = rt_glsl_module(d, vs, VK_SHADER_STAGE_VERTEX_BIT, "undergrowth.vert", NULL, &vm, e) &&
+              rt_glsl_module(d, fs, VK_SHADER_STAGE_FRAGMENT_BIT, "undergrowth.frag", NULL, &fm, e);
     free(vs);
     free(fs);
     if (ok) {
@@ -611,9 +557,9 @@ static bool make_layouts(rt_ug *u, rt_error *e)
     VkDescriptorSetLayoutBinding lod[] = {
         { 0, sb, 1, cs, NULL }, { 1, sb, 1, cs, NULL }, { 2, sb, 1, cs, NULL },
     };
-    if (!set_layout(d, terrain, sizeof terrain / sizeof *terrain, &u->set_terrain, e) ||
-        !set_layout(d, mask, 1, &u->set_mask, e) || !set_layout(d, gen, 5, &u->set_gen, e) ||
-        !set_layout(d, draw, 3, &u->set_draw, e) || !set_layout(d, lod, 3, &u->set_lod, e))
+    if (!rt_set_layout(d, terrain, sizeof terrain / sizeof *terrain, &u->set_terrain, e) ||
+        !rt_set_layout(d, mask, 1, &u->set_mask, e) || !rt_set_layout(d, gen, 5, &u->set_gen, e) ||
+        !rt_set_layout(d, draw, 3, &u->set_draw, e) || !rt_set_layout(d, lod, 3, &u->set_lod, e))
         return false;
     VkDescriptorSetLayout ms[3] = { u->set_terrain, u->pl->set_material, u->set_mask };
     VkDescriptorSetLayout ds[3] = { u->pl->set_terrain, u->pl->set_material, u->set_draw };
@@ -701,8 +647,8 @@ bool rt_ug_create(rt_device *d, const rt_pack *p, rt_pipelines *pl, const rt_qua
         !make_sets(u, t->set0, t->height, t->nearest, e) ||
         !make_pass(d, VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL, &u->pass_att, e) ||
         !make_pass(d, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, &u->pass_ro, e) ||
-        !compute_pipe(d, u->gen_layout, gen_glsl, "undergrowth scatter", NULL, &u->gen_pipe, e) ||
-        !compute_pipe(d, u->lod_layout, lod_glsl, "undergrowth lod", NULL, &u->lod_pipe, e) ||
+        !rt_glsl_compute_pipeline(d, VK_NULL_HANDLE, u->gen_layout, gen_glsl, "undergrowth scatter", NULL, &u->gen_pipe, e) ||
+        !rt_glsl_compute_pipeline(d, VK_NULL_HANDLE, u->lod_layout, lod_glsl, "undergrowth lod", NULL, &u->lod_pipe, e) ||
         !draw_pipeline(u, false, e) || !draw_pipeline(u, true, e))
         return false;
     VkImageView views[2] = { t->color->view, t->depth->view };
@@ -892,7 +838,8 @@ static bool mask_pipeline(rt_ug *u, int combo, VkPipeline *out, rt_error *e)
         rt_interface in;
         if (!rt_interface_for(u->p, RT_ROLE_UNDERGROWTH, &in))
             return rt_fail(e, RT_E_VULKAN, "undergrowth", "out of memory");
-        bool ok = compute_pipe(u->d, u->mask_layout, glsl, name, &in, &u->mask_pipes[combo], e);
+        bool ok = rt_glsl_compute_pipeline(u->d, u->pl->cache, u->mask_layout, glsl, name, &in,
+                                           &u->mask_pipes[combo], e);
         rt_interface_free(&in);
         if (!ok)
             return false;
