@@ -179,17 +179,95 @@ static void stone(builder *b)
     }
 }
 
-bool splat_mesh_builtin(const char *name, splat_mesh *m)
+/* The far versions (mesh.h splat_mesh_builtin_far): what a distant clump
+ * needs is its cover, not its shape; the undergrowth's draws cost per
+ * triangle (each one shades at least a 2x2 quad), so they keep the cover
+ * with a sixth of the triangles. */
+
+/* grass far: 4 blades, 90 degrees apart (jittered as the near ones), each
+ * one tapered quad from root to tip (2 triangles, no bend), three times
+ * as wide: about the near clump's side area. */
+static void grass_far(builder *b)
 {
-    static void (*const make[])(builder *) = { grass, plant, stone };
+    for (int k = 0; k < 4; k++) {
+        double f = frac(k * 0.6180339887), g = frac(k * 0.7548776662 + 0.3);
+        double ang = k * (2 * PI / 4) + (f - 0.5) * 0.4;
+        double out[2] = { cos(ang), sin(ang) };
+        double twist = ang + PI / 2 + (g - 0.5) * 0.8;
+        double side[2] = { cos(twist), sin(twist) };
+        double r = 0.02 + 0.06 * g, h = 0.35 + 0.15 * f, lean = 0.06 + 0.08 * g;
+        double n[3] = { 0.3 * out[0], 1, 0.3 * out[1] };
+        uint32_t row[2][2];
+        for (int i = 0; i < 2; i++) {
+            double w = 0.045 * (1 - 0.8 * i), o = r + lean * i;
+            for (int j = 0; j < 2; j++) {
+                double s = j ? w : -w;
+                double p[3] = { out[0] * o + side[0] * s, h * i, out[1] * o + side[1] * s };
+                row[i][j] = vert(b, p, n, j, i);
+            }
+        }
+        tri(b, row[0][0], row[0][1], row[1][0]);
+        tri(b, row[1][0], row[0][1], row[1][1]);
+    }
+}
+
+/* stone far: 5 faces from a ring of 5 points just under the ground to a
+ * top point, flat normals. */
+static void stone_far(builder *b)
+{
+    static const double top[3] = { 0.02, 0.18, -0.01 };
+    double e[5][3];
+    for (int i = 0; i < 5; i++) {
+        double a = (i * 72 + 15) * PI / 180, r = i & 1 ? 0.19 : 0.22;
+        e[i][0] = r * cos(a);
+        e[i][1] = -0.02;   /* in the ground, as the near one's bottom */
+        e[i][2] = r * sin(a);
+    }
+    for (int i = 0; i < 5; i++) {
+        const double *p0 = e[i], *p1 = e[(i + 1) % 5];
+        double a[3], c[3], n[3], mid[3];
+        for (int k = 0; k < 3; k++) {
+            a[k] = p1[k] - p0[k];
+            c[k] = top[k] - p0[k];
+            mid[k] = (p0[k] + p1[k] + top[k]) / 3 - (k == 1 ? 0.07 : 0);
+        }
+        cross(a, c, n);
+        bool flip = n[0] * mid[0] + n[1] * mid[1] + n[2] * mid[2] < 0;
+        if (flip)   /* outward normals, counter-clockwise seen from outside */
+            for (int k = 0; k < 3; k++)
+                n[k] = -n[k];
+        /* uv.y as the near stone's: height over its 0.25 m */
+        uint32_t v0 = vert(b, p0, n, 0.5, 0.12), v1 = vert(b, p1, n, 0.5, 0.12);
+        uint32_t vt = vert(b, top, n, 0.5, (top[1] + 0.05) / 0.25);
+        if (flip)
+            tri(b, v0, vt, v1);
+        else
+            tri(b, v0, v1, vt);
+    }
+}
+
+static bool build(const char *name, void (*const make[])(builder *), splat_mesh *m)
+{
     memset(m, 0, sizeof *m);
     for (int i = 0; splat_mesh_builtins[i]; i++)
-        if (!strcmp(name, splat_mesh_builtins[i])) {
+        if (!strcmp(name, splat_mesh_builtins[i]) && make[i]) {
             builder b = { m, 0, 0 };
             make[i](&b);
             return true;
         }
     return false;
+}
+
+bool splat_mesh_builtin(const char *name, splat_mesh *m)
+{
+    static void (*const make[])(builder *) = { grass, plant, stone };
+    return build(name, make, m);
+}
+
+bool splat_mesh_builtin_far(const char *name, splat_mesh *m)
+{
+    static void (*const make[])(builder *) = { grass_far, NULL, stone_far };
+    return build(name, make, m);
 }
 
 void splat_mesh_free(splat_mesh *m)

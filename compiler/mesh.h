@@ -45,6 +45,12 @@ typedef struct splat_mesh {
 extern const char *const splat_mesh_builtins[];
 /* Build built-in mesh `name` into *m; false for an unknown name. */
 bool splat_mesh_builtin(const char *name, splat_mesh *m);
+/* Its far version, drawn beyond the runtime's LOD distance where a clump
+ * covers a few pixels: the same cover from a sixth of the triangles
+ * ("grass": 4 wide single-quad blades, 8 triangles instead of 48;
+ * "stone": 5 faces instead of 24).  False where there is none ("plant",
+ * 4 triangles, is its own). */
+bool splat_mesh_builtin_far(const char *name, splat_mesh *m);
 /* Load an OBJ file: triangulated, identical vertices merged; normals from
  * the file or flat where it has none; uv from the file (uv.y clamped to
  * 0..1) or, where it has none, (0.5, height over the mesh's height).  No

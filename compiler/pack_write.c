@@ -423,6 +423,8 @@ static json_t *jundergrowth(const splat_ug *u)
         json_object_set_new(m, "name", json_string(u->mesh_names[i]));
         json_object_set_new(m, "vertices", json_integer(u->meshes[i].nv));
         json_object_set_new(m, "indices", json_integer(u->meshes[i].nidx));
+        if (u->far[i] >= 0)
+            json_object_set_new(m, "far", json_integer(u->far[i]));
         json_array_append_new(meshes, m);
     }
     json_object_set_new(o, "meshes", meshes);

@@ -6,11 +6,26 @@
 
 #include "util.h"
 
+/* Append mesh `m` named `name` (owned), keyed `key`; its index. */
+static int mesh_add(splat_ug *u, splat_mesh m, char *name, const char *key)
+{
+    int i = u->nmeshes++;
+    u->meshes = xrealloc(u->meshes, sizeof *u->meshes * (size_t)u->nmeshes);
+    u->mesh_names = xrealloc(u->mesh_names, sizeof *u->mesh_names * (size_t)u->nmeshes);
+    u->mesh_keys = xrealloc(u->mesh_keys, sizeof *u->mesh_keys * (size_t)u->nmeshes);
+    u->far = xrealloc(u->far, sizeof *u->far * (size_t)u->nmeshes);
+    u->meshes[i] = m;
+    u->mesh_names[i] = name;
+    u->mesh_keys[i] = key;
+    u->far[i] = -1;
+    return i;
+}
+
 static int mesh_index(splat_ug *u, const sg_undergrowth *g, sg_diags *d)
 {
     const char *key = g->obj ? g->obj : g->mesh;
     for (int i = 0; i < u->nmeshes; i++)
-        if (strcmp(u->mesh_keys[i], key) == 0)
+        if (u->mesh_keys[i] && strcmp(u->mesh_keys[i], key) == 0)
             return i;
     splat_mesh m = {0};
     if (g->obj) {
@@ -25,14 +40,14 @@ static int mesh_index(splat_ug *u, const sg_undergrowth *g, sg_diags *d)
         sg_errorf(d, g->loc, SG_E_SETTING, "unknown built-in mesh '%s'", g->mesh);
         return -1;
     }
-    int i = u->nmeshes++;
-    u->meshes = xrealloc(u->meshes, sizeof *u->meshes * (size_t)u->nmeshes);
-    u->mesh_names = xrealloc(u->mesh_names, sizeof *u->mesh_names * (size_t)u->nmeshes);
-    u->mesh_keys = xrealloc(u->mesh_keys, sizeof *u->mesh_keys * (size_t)u->nmeshes);
-    u->meshes[i] = m;
     const char *base = strrchr(key, '/');
-    u->mesh_names[i] = xstrdup(base ? base + 1 : key);
-    u->mesh_keys[i] = key;
+    int i = mesh_add(u, m, xstrdup(base ? base + 1 : key), key);
+    splat_mesh far;
+    if (!g->obj && splat_mesh_builtin_far(g->mesh, &far)) {
+        char name[64];
+        snprintf(name, sizeof name, "%s.far", g->mesh);
+        u->far[i] = mesh_add(u, far, xstrdup(name), NULL);   /* never looked up */
+    }
     return i;
 }
 
@@ -75,6 +90,7 @@ void splat_ug_free(splat_ug *u)
     free(u->meshes);
     free(u->mesh_names);
     free(u->mesh_keys);
+    free(u->far);
     free(u->blocks);
     free(u->slot_of);
     memset(u, 0, sizeof *u);

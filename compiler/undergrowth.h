@@ -24,7 +24,9 @@ typedef struct splat_ug {
     splat_ug_block *blocks;  int nblocks;
     splat_mesh    *meshes;           /* distinct: a built-in or OBJ file  */
     char         **mesh_names;       /* built-in name or the OBJ's basename */
-    const char   **mesh_keys;        /* built-in name or the OBJ's path   */
+    const char   **mesh_keys;        /* built-in name or the OBJ's path;
+                                        NULL for a far version            */
+    int           *far;              /* per mesh: its far version or -1   */
     int            nmeshes;
 } splat_ug;
 

@@ -445,10 +445,22 @@ static bool read_undergrowth(reader *r, json_t *root)
         if (ni % 3)
             return field_fail(r, where, "indices: must be a multiple of 3");
         unsigned flags = strcmp(name, "plant") == 0 ? 3u : strcmp(name, "grass") == 0 ? 2u : 0u;
+        int far = -1;
+        if (json_object_get(m, "far") &&
+            !get_int(r, m, "far", where, 0, (int)json_array_size(ms) - 1, &far))
+            return false;
         u->meshes[i] = (rt_pack_ug_mesh){ (uint32_t)nv, (uint32_t)ni, u->nvertices, u->nindices,
-                                          flags };
+                                          flags, far };
         u->nvertices += (uint32_t)nv;
         u->nindices += (uint32_t)ni;
+    }
+    for (int i = 0; i < u->nmeshes; i++) {   /* a far version is a plain mesh */
+        rt_pack_ug_mesh *m = &u->meshes[i];
+        if (m->far >= 0 && (m->far == i || u->meshes[m->far].far >= 0))
+            return field_fail(r, "undergrowth.meshes:",
+                              "far: must name another mesh that has no far version");
+        if (m->far >= 0)   /* drawn with the near mesh's pipeline and lighting */
+            u->meshes[m->far].flags = m->flags;
     }
     for (int i = 0; i < u->nblocks; i++) {
         char where[64];

@@ -231,6 +231,7 @@ typedef struct rt_pack_ug_mesh {
     uint32_t first_vertex, first_index;
     unsigned flags;        /* 1: a leaf cut from its quads (plant), 2: lit
                               with the terrain normal (grass, plant)     */
+    int      far;          /* the mesh drawn beyond the LOD distance, or -1 */
 } rt_pack_ug_mesh;
 
 typedef struct rt_pack_ug {

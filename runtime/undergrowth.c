@@ -84,6 +84,7 @@ struct rt_ug {
     rt_buffer             masks, inst, args, args_host, blocks, vbuf, ibuf, frame;
     rt_buffer             draw_args;           /* args with the LOD's counts */
     rt_buffer             lod;                 /* per slot: fraction drawn   */
+    rt_buffer             far;                 /* per block: far mesh (LOD)  */
     VkDescriptorSetLayout set_terrain;         /* set 0 of the mask pass     */
     VkDescriptorSetLayout set_mask, set_gen, set_draw, set_lod;
     VkPipelineLayout      mask_layout, gen_layout, draw_layout, lod_layout;
@@ -184,19 +185,29 @@ static const char gen_glsl[] =
 
 /* The LOD pass, every frame: the draw arguments from the generated ones,
  * each cell's instance count times its fraction (a prefix: the scatter
- * pass keeps instances in a lattice order that spreads every prefix). */
+ * pass keeps instances in a lattice order that spreads every prefix), and
+ * beyond LOD_NEAR the block's far mesh where it has one (PACK.md: index
+ * count, first index, vertex offset, and w = 1). */
 static const char lod_glsl[] =
     "#version 450\n"
     "layout(local_size_x = 64) in;\n"
     "layout(set = 0, binding = 0, std430) readonly buffer A { uint a[]; } u_args;\n"
     "layout(set = 0, binding = 1, std430) writeonly buffer D { uint a[]; } u_draw;\n"
     "layout(set = 0, binding = 2, std430) readonly buffer F { float f[]; } u_lod;\n"
+    "layout(set = 0, binding = 3, std430) readonly buffer M { uvec4 m[]; } u_far;\n"
     "layout(push_constant, std430) uniform P { uint n, nblocks; } u_p;\n"
     "void main() {\n"
     "    uint i = gl_GlobalInvocationID.x;\n"
     "    if (i >= u_p.n) return;\n"
     "    for (uint k = 0u; k < 5u; k++) u_draw.a[5u * i + k] = u_args.a[5u * i + k];\n"
-    "    u_draw.a[5u * i + 1u] = uint(ceil(float(u_args.a[5u * i + 1u]) * u_lod.f[i / u_p.nblocks]));\n"
+    "    float f = u_lod.f[i / u_p.nblocks];\n"
+    "    u_draw.a[5u * i + 1u] = uint(ceil(float(u_args.a[5u * i + 1u]) * f));\n"
+    "    uvec4 m = u_far.m[i % u_p.nblocks];   /* the block's far mesh */\n"
+    "    if (f < 1.0 && m.w != 0u) {\n"
+    "        u_draw.a[5u * i] = m.x;\n"
+    "        u_draw.a[5u * i + 2u] = m.y;\n"
+    "        u_draw.a[5u * i + 3u] = m.z;\n"
+    "    }\n"
     "}\n";
 
 /* The draw pass: SPLAT_GLSL_TERRAIN (frame block) + this vertex main; the
@@ -462,7 +473,7 @@ static bool make_sets(rt_ug *u, VkDescriptorSet set0_src, const rt_image *height
 {
     rt_device *d = u->d;
     VkDescriptorPoolSize sizes[3] = {
-        { VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 12 },
+        { VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 13 },
         { VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 16 },
         { VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 2 },
     };
@@ -504,6 +515,7 @@ static bool make_sets(rt_ug *u, VkDescriptorSet set0_src, const rt_image *height
     VkDescriptorBufferInfo bb = { u->blocks.buf, 0, VK_WHOLE_SIZE };
     VkDescriptorBufferInfo db = { u->draw_args.buf, 0, VK_WHOLE_SIZE };
     VkDescriptorBufferInfo lb = { u->lod.buf, 0, VK_WHOLE_SIZE };
+    VkDescriptorBufferInfo fm = { u->far.buf, 0, VK_WHOLE_SIZE };
     VkDescriptorImageInfo hi = { nearest, height->view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL };
     const VkDescriptorType sb = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
 #define W(set_, b_, type_, img_, buf_) \
@@ -519,7 +531,7 @@ static bool make_sets(rt_ug *u, VkDescriptorSet set0_src, const rt_image *height
         W(u->draw_set, 0, sb, NULL, &bb), W(u->draw_set, 1, sb, NULL, &ib),
         W(u->draw_set, 2, sb, NULL, &lb),
         W(u->lod_set, 0, sb, NULL, &ab), W(u->lod_set, 1, sb, NULL, &db),
-        W(u->lod_set, 2, sb, NULL, &lb),
+        W(u->lod_set, 2, sb, NULL, &lb), W(u->lod_set, 3, sb, NULL, &fm),
     };
 #undef W
     vkUpdateDescriptorSets(d->dev, sizeof w / sizeof *w, w, N, cp);
@@ -556,10 +568,11 @@ static bool make_layouts(rt_ug *u, rt_error *e)
     };
     VkDescriptorSetLayoutBinding lod[] = {
         { 0, sb, 1, cs, NULL }, { 1, sb, 1, cs, NULL }, { 2, sb, 1, cs, NULL },
+        { 3, sb, 1, cs, NULL },
     };
     if (!rt_set_layout(d, terrain, sizeof terrain / sizeof *terrain, &u->set_terrain, e) ||
         !rt_set_layout(d, mask, 1, &u->set_mask, e) || !rt_set_layout(d, gen, 5, &u->set_gen, e) ||
-        !rt_set_layout(d, draw, 3, &u->set_draw, e) || !rt_set_layout(d, lod, 3, &u->set_lod, e))
+        !rt_set_layout(d, draw, 3, &u->set_draw, e) || !rt_set_layout(d, lod, 4, &u->set_lod, e))
         return false;
     VkDescriptorSetLayout ms[3] = { u->set_terrain, u->pl->set_material, u->set_mask };
     VkDescriptorSetLayout ds[3] = { u->pl->set_terrain, u->pl->set_material, u->set_draw };
@@ -596,6 +609,7 @@ static bool make_buffers(rt_ug *u, rt_error *e)
                           st | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT, false, &u->draw_args, e) ||
         !rt_buffer_create(d, (VkDeviceSize)u->pool * 4, st, true, &u->lod, e) ||
         !rt_buffer_create(d, (VkDeviceSize)u->nblocks * 48, st, true, &u->blocks, e) ||
+        !rt_buffer_create(d, (VkDeviceSize)u->nblocks * 16, st, true, &u->far, e) ||
         !rt_buffer_create(d, (VkDeviceSize)pu->nvertices * 32, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT,
                           true, &u->vbuf, e) ||
         !rt_buffer_create(d, (VkDeviceSize)pu->nindices * 4, VK_BUFFER_USAGE_INDEX_BUFFER_BIT,
@@ -606,6 +620,12 @@ static bool make_buffers(rt_ug *u, rt_error *e)
     memcpy(u->vbuf.map, pu->vertices, (size_t)pu->nvertices * 32);
     memcpy(u->ibuf.map, pu->indices, (size_t)pu->nindices * 4);
     fill_blocks(u, u->blocks.map);
+    for (int b = 0; b < u->nblocks; b++) {
+        int f = pu->meshes[pu->blocks[b].mesh].far;
+        const rt_pack_ug_mesh *m = &pu->meshes[f >= 0 ? f : 0];
+        uint32_t v[4] = { m->nidx, m->first_index, m->first_vertex, f >= 0 };
+        memcpy((uint32_t *)u->far.map + 4 * b, v, sizeof v);
+    }
     memset(u->args_host.map, 0, (size_t)u->args_host.size);
     for (int i = 0; i < u->pool; i++)
         ((float *)u->lod.map)[i] = 1.0f;
@@ -695,7 +715,7 @@ void rt_ug_destroy(rt_ug *u)
     if (u->qpool)
         vkDestroyQueryPool(d->dev, u->qpool, NULL);
     rt_buffer *bufs[] = { &u->masks, &u->inst, &u->args, &u->args_host, &u->draw_args, &u->lod,
-                          &u->blocks, &u->vbuf, &u->ibuf, &u->frame };
+                          &u->far, &u->blocks, &u->vbuf, &u->ibuf, &u->frame };
     for (size_t i = 0; i < sizeof bufs / sizeof *bufs; i++)
         rt_buffer_destroy(d, bufs[i]);
     free(u->mask_pipes);

@@ -240,5 +240,11 @@ EOF
 case_ max_height_negative bc4 "scene: size, max_height and height_offset must be finite" <<EOF
 "$PE" set $M scene.max_height -1
 EOF
+case_ ug_far_self bc4 "undergrowth.meshes: far: must name another mesh that has no far version" <<EOF
+"$PE" set $M undergrowth.meshes.0.far 0
+EOF
+case_ ug_far_range bc4 "undergrowth.meshes\[0\].far: must be an integer in \[0, 3\]" <<EOF
+"$PE" set $M undergrowth.meshes.0.far 9
+EOF
 echo "PASS: $n corrupt packs refused"
 [ $n -ge 30 ] || fail "only $n cases"

@@ -1,5 +1,7 @@
 /* test_mesh.c — undergrowth meshes (mesh.h): every built-in is a sound
- * triangle list of the stated size, deterministic; OBJ files round-trip
+ * triangle list of the stated size, deterministic, and so are the far
+ * versions, which keep the cover with a third of the triangles or fewer;
+ * OBJ files round-trip
  * (a cube with and without normals) and broken ones give a message. */
 #include <setjmp.h>
 #include <stdarg.h>
@@ -36,6 +38,79 @@ static box check_sound(const splat_mesh *m)
         }
     }
     return b;
+}
+
+/* Flat normals, pointing out of a stone: each face's vertices share the
+ * normal, and the winding agrees. */
+static void check_flat_outward(const splat_mesh *m)
+{
+    for (uint32_t t = 0; t < m->nidx; t += 3) {
+        const float *p0 = m->v[m->idx[t]].pos, *p1 = m->v[m->idx[t + 1]].pos,
+                    *p2 = m->v[m->idx[t + 2]].pos, *nrm = m->v[m->idx[t]].nrm;
+        float a[3], c[3];
+        for (int k = 0; k < 3; k++)
+            a[k] = p1[k] - p0[k], c[k] = p2[k] - p0[k];
+        float x[3] = { a[1] * c[2] - a[2] * c[1], a[2] * c[0] - a[0] * c[2],
+                       a[0] * c[1] - a[1] * c[0] };
+        assert_true(x[0] * nrm[0] + x[1] * nrm[1] + x[2] * nrm[2] > 0);
+        assert_memory_equal(m->v[m->idx[t + 1]].nrm, nrm, sizeof m->v->nrm);
+        float mid = (p0[0] + p1[0] + p2[0]) * nrm[0] +
+                    ((p0[1] + p1[1] + p2[1]) / 3 - 0.07f) * 3 * nrm[1] +
+                    (p0[2] + p1[2] + p2[2]) * nrm[2];
+        assert_true(mid > 0);
+    }
+}
+
+/* The summed area of a mesh's triangles (its cover, seen from the side). */
+static double area(const splat_mesh *m)
+{
+    double sum = 0;
+    for (uint32_t t = 0; t < m->nidx; t += 3) {
+        const float *p0 = m->v[m->idx[t]].pos, *p1 = m->v[m->idx[t + 1]].pos,
+                    *p2 = m->v[m->idx[t + 2]].pos;
+        double a[3], c[3];
+        for (int k = 0; k < 3; k++)
+            a[k] = p1[k] - p0[k], c[k] = p2[k] - p0[k];
+        double x[3] = { a[1] * c[2] - a[2] * c[1], a[2] * c[0] - a[0] * c[2],
+                        a[0] * c[1] - a[1] * c[0] };
+        sum += 0.5 * sqrt(x[0] * x[0] + x[1] * x[1] + x[2] * x[2]);
+    }
+    return sum;
+}
+
+/* The far versions: sound, deterministic, at most a third of the near
+ * triangles, the near one's cover within 15 % and its box (grass: its
+ * height) within 5 cm;
+ * stones keep flat outward normals; plant has none. */
+static void test_far(void **state)
+{
+    static const char *const with_far[] = { "grass", "stone" };
+    for (int i = 0; i < 2; i++) {
+        splat_mesh near, far, again;
+        assert_true(splat_mesh_builtin(with_far[i], &near));
+        assert_true(splat_mesh_builtin_far(with_far[i], &far));
+        box bn = check_sound(&near), bf = check_sound(&far);
+        assert_true(splat_mesh_builtin_far(with_far[i], &again));
+        assert_int_equal(again.nv, far.nv);
+        assert_memory_equal(again.v, far.v, far.nv * sizeof *far.v);
+        splat_mesh_free(&again);
+        assert_true(3 * far.nidx <= near.nidx);
+        if (i == 0) {
+            assert_int_equal(far.nidx, 4 * 6);                  /* 4 quads */
+            assert_true(fabs(area(&far) / area(&near) - 1) < 0.15);
+        } else {
+            check_flat_outward(&far);
+        }
+        for (int k = i == 0 ? 1 : 0; k < (i == 0 ? 2 : 3); k++) {   /* grass: height */
+            assert_true(fabsf(bf.lo[k] - bn.lo[k]) < 0.05f);
+            assert_true(fabsf(bf.hi[k] - bn.hi[k]) < 0.05f);
+        }
+        splat_mesh_free(&near);
+        splat_mesh_free(&far);
+    }
+    splat_mesh m;
+    assert_false(splat_mesh_builtin_far("plant", &m));
+    assert_false(splat_mesh_builtin_far("fern", &m));
 }
 
 static void test_builtins(void **state)
@@ -76,23 +151,7 @@ static void test_builtins(void **state)
             assert_true(b.hi[1] > 0.15f && b.hi[1] <= 0.25f);
             for (int k = 0; k < 3; k += 2)
                 assert_true(b.hi[k] - b.lo[k] > 0.3f && b.hi[k] - b.lo[k] < 0.5f);
-            /* flat normals, pointing out of the stone: each face's
-             * vertices share the normal, and the winding agrees */
-            for (uint32_t t = 0; t < m.nidx; t += 3) {
-                const float *p0 = m.v[m.idx[t]].pos, *p1 = m.v[m.idx[t + 1]].pos,
-                            *p2 = m.v[m.idx[t + 2]].pos, *nrm = m.v[m.idx[t]].nrm;
-                float a[3], c[3];
-                for (int k = 0; k < 3; k++)
-                    a[k] = p1[k] - p0[k], c[k] = p2[k] - p0[k];
-                float x[3] = { a[1] * c[2] - a[2] * c[1], a[2] * c[0] - a[0] * c[2],
-                               a[0] * c[1] - a[1] * c[0] };
-                assert_true(x[0] * nrm[0] + x[1] * nrm[1] + x[2] * nrm[2] > 0);
-                assert_memory_equal(m.v[m.idx[t + 1]].nrm, nrm, sizeof m.v->nrm);
-                float mid = (p0[0] + p1[0] + p2[0]) * nrm[0] +
-                            ((p0[1] + p1[1] + p2[1]) / 3 - 0.07f) * 3 * nrm[1] +
-                            (p0[2] + p1[2] + p2[2]) * nrm[2];
-                assert_true(mid > 0);
-            }
+            check_flat_outward(&m);
         }
         splat_mesh_free(&m);
     }
@@ -229,6 +288,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_builtins),
+        cmocka_unit_test(test_far),
         cmocka_unit_test(test_obj_cube),
         cmocka_unit_test(test_obj_errors),
     };
