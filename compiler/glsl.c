@@ -150,6 +150,25 @@ int glsl_scope_count(const glsl_emitter *e, ir_op op)
     return n;
 }
 
+static void remember(glsl_emitter *e, uint32_t id, char *expr)
+{
+    e->expr[id] = expr;
+    e->level[id] = e->nscopes;
+    if (e->nemitted == e->capemitted) {
+        e->capemitted = e->capemitted ? 2 * e->capemitted : 64;
+        e->emitted = xgrow(e->emitted, sizeof(uint32_t) * (size_t)e->capemitted);
+    }
+    e->emitted[e->nemitted++] = id;
+}
+
+void glsl_bind(glsl_emitter *e, ir_ref r, const char *name)
+{
+    assert(ir_ref_ok(r) && r.id < e->nnodes && !e->expr[r.id]);
+    ir_buf b = {0};
+    ir_buf_printf(&b, "%s", name);
+    remember(e, r.id, b.s);
+}
+
 static bool is_leaf(const ir_node *n)
 {
     return n->op <= IR_OP_PAINTED || n->op == IR_OP_DINPUT;
@@ -297,13 +316,7 @@ const char *glsl_value(glsl_emitter *e, ir_ref r, const char *indent)
                       ir_type_name((ir_type)n->type), id, rhs.s);
         ir_buf name = {0};
         ir_buf_printf(&name, "v%u", id);
-        e->expr[id] = name.s;
-        e->level[id] = e->nscopes;
-        if (e->nemitted == e->capemitted) {
-            e->capemitted = e->capemitted ? 2 * e->capemitted : 64;
-            e->emitted = xgrow(e->emitted, sizeof(uint32_t) * (size_t)e->capemitted);
-        }
-        e->emitted[e->nemitted++] = id;
+        remember(e, id, name.s);
     }
     for (int k = 0; k < ntodo; k++)
         e->seen[todo[k]] = 0;
