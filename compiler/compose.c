@@ -405,7 +405,7 @@ typedef struct sched {
     int      *place;       /* per node: region, or -1 if not needed */
     int      *guard;       /* per layer: G_j                        */
     int      *surface;     /* per layer: W_j                        */
-    int     (*lazy)[3];    /* per node: its lazy side region per operand, or -1 */
+    int     (*lazy)[4];    /* per node: its lazy side region per operand, or -1 */
     int       nlazy;       /* lazy branches kept                    */
 } sched;
 
@@ -565,7 +565,7 @@ static void schedule(sched *s, const ir *ir, const splat_layer *layers, int n,
     s->nlazy = 0;
     s->lazy = xcalloc(ir->nnodes, sizeof *s->lazy);
     for (uint32_t i = 0; i < ir->nnodes; i++)
-        s->lazy[i][0] = s->lazy[i][1] = s->lazy[i][2] = -1;
+        s->lazy[i][0] = s->lazy[i][1] = s->lazy[i][2] = s->lazy[i][3] = -1;
     s->guard = xcalloc((size_t)n, sizeof *s->guard);
     s->surface = xcalloc((size_t)n, sizeof *s->surface);
     s->place = xcalloc(ir->nnodes, sizeof *s->place);
@@ -1255,6 +1255,14 @@ void splat_composite_glsl(const splat_layout *L, const splat_composite *c,
         free(plat);
         if (desc->lazy_branches)
             *desc->lazy_branches += em.s.nlazy;
+        if (desc->lazy_sides) {
+            assert(!desc->compute);
+            memset(desc->lazy_sides, 0, c->ir.nnodes);
+            for (uint32_t id = 1; id < em.ir.nnodes; id++)
+                for (int a = 0; a < 4; a++)
+                    if (em.s.lazy[id][a] >= 0)
+                        desc->lazy_sides[em.src_of[id]] |= (uint8_t)(1u << a);
+        }
         emit_placed(&em, 0, 1);
         if (desc->flat) {
             emit_layer(&em, 0, true, 1);

@@ -125,6 +125,9 @@ typedef struct splat_glsl_desc {
                                  variant): every mix/select/mul operand
                                  evaluated where its layer is            */
     int        *lazy_branches; /* non-NULL: += the lazy branches made    */
+    uint8_t    *lazy_sides;   /* non-NULL (not with compute): per node of
+                                 c->ir, bit k set where operand k became
+                                 a lazy branch (tests)                   */
 } splat_glsl_desc;
 
 /* A mix/select/mul operand side gets its own branch (compose.c "lazy
