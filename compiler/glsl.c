@@ -87,6 +87,7 @@ struct glsl_emitter {
     int        nscopes, capscopes;
     uint32_t  *work;      /* scratch for glsl_value                        */
     uint8_t   *seen;
+    uint8_t   *bound;     /* per node: its expression came from glsl_bind  */
 };
 
 glsl_emitter *glsl_emitter_new(const ir *ir, const glsl_names *names, ir_buf *out)
@@ -103,6 +104,7 @@ glsl_emitter *glsl_emitter_new(const ir *ir, const glsl_names *names, ir_buf *ou
         e->level[i] = -1;
     e->work = xalloc(sizeof(uint32_t) * ir->nnodes);
     e->seen = xalloc(ir->nnodes);
+    e->bound = xalloc(ir->nnodes);
     return e;
 }
 
@@ -118,6 +120,7 @@ void glsl_emitter_free(glsl_emitter *e)
     free(e->scope_mark);
     free(e->work);
     free(e->seen);
+    free(e->bound);
     free(e);
 }
 
@@ -137,6 +140,7 @@ void glsl_scope_pop(glsl_emitter *e)
     while (e->nemitted > mark) {
         uint32_t id = e->emitted[--e->nemitted];
         e->level[id] = -1;
+        e->bound[id] = 0;
         free(e->expr[id]);
         e->expr[id] = NULL;
     }
@@ -146,7 +150,7 @@ int glsl_scope_count(const glsl_emitter *e, ir_op op)
 {
     int from = e->nscopes ? e->scope_mark[e->nscopes - 1] : 0, n = 0;
     for (int i = from; i < e->nemitted; i++)
-        n += e->ir->nodes[e->emitted[i]].op == op;
+        n += e->ir->nodes[e->emitted[i]].op == op && !e->bound[e->emitted[i]];
     return n;
 }
 
@@ -167,6 +171,7 @@ void glsl_bind(glsl_emitter *e, ir_ref r, const char *name)
     ir_buf b = {0};
     ir_buf_printf(&b, "%s", name);
     remember(e, r.id, b.s);
+    e->bound[r.id] = 1;   /* computed (and counted) inside the closed block */
 }
 
 static bool is_leaf(const ir_node *n)

@@ -432,6 +432,16 @@ else
     pl=$(knob_pack colorado lvl2 "" "" 's|^\([ \t]*painted [a-z_]* *= *"[^"]*"\)[ \t]*$|\1 { max_level = 2 }|')
     render knob_painted colorado ground 1280x720 "dense=composite,pack=$pd" \
         "sparse_r8=composite,pack=$pr" sparse_bc4=composite "bc4_level2=composite,pack=$pl"
+    # laziness inside materials (compiler/DESIGN.md 6.1): the same pack with
+    # every mix/select/mul side evaluated eagerly (the reference) and with
+    # lazy branches (the default), forward and screen-space
+    KNOB_BUILD_ARGS="--no-lazy"
+    pe=$(knob_pack colorado eager "" "")
+    KNOB_BUILD_ARGS=""
+    for p in ground topdown; do
+        render knob_lazy colorado "$p" 1280x720 "eager=composite,pack=$pe" lazy=composite \
+            "eager_screen=screen,pack=$pe" lazy_screen=screen
+    done
 fi
 { echo "group,$(sed -n 1p "$W/render.txt")"; cat "$CSV.body"; } > "$CSV"
 rm -f "$CSV.body"

@@ -172,6 +172,15 @@ static int count(const char *s, const char *what)
     return n;
 }
 
+/* The samples the counting variant adds up over the whole shader. */
+static int samples_counted(const char *g)
+{
+    int n = 0;
+    for (const char *p = g; (p = strstr(p, "splat_count_samples(")); p++)
+        n += atoi(p + strlen("splat_count_samples("));
+    return n;
+}
+
 /* ---- the cases ----------------------------------------------------------- */
 
 static void test_cases(void **state)
@@ -226,12 +235,16 @@ static void test_cases(void **state)
     assert_int_equal(nlazy, 2);
     assert_true(count(g, "textureGrad(") >= 4);
     free(g);
-    /* --no-lazy: no lz values at all */
+    /* --no-lazy: no lz values at all; each sample counted once either way */
+    char *lz = glsl(&f, &c, true, false, NULL, NULL);
     nlazy = 0;
     g = glsl(&f, &c, false, false, NULL, &nlazy);
     compiles(g, false);
     assert_int_equal(nlazy, 0);
     assert_int_equal(count(g, "lz"), 0);
+    assert_int_equal(samples_counted(g), 5);
+    assert_int_equal(samples_counted(lz), 5);
+    free(lz);
     free(g);
     free(sides);
     splat_composite_free(&c);
