@@ -453,8 +453,8 @@ static void use_at(sched *s, ir_ref r, int region)
  *
  *     mix(a, b, t)     a when t can be 1, if (t < 1);  b when t can be 0, if (t > 0)
  *     select(c, a, b)  a if (c != 0);  b if (c == 0)
- *     mul(w, x)        x when w can be 0, if (w != 0)  (w: the operand whose
- *                      bounds hold 0, the cheaper one if both do)
+ *     mul(w, x)        x when w can be 0, if (w != 0)  (where both operands
+ *                      can be 0, the side with more work of its own)
  *
  * The bounds are the interval evaluator's over every input's domain, so a
  * weight that cannot be 0 (or 1) gets no branch.  A skipped side reads 0,
@@ -502,17 +502,10 @@ static void lazy_sides(sched *s, uint32_t id, const uint8_t *plat)
     case IR_OP_SELECT:   /* not folded: c is 0 somewhere, not everywhere */
         side[1] = side[2] = true;
         break;
-    case IR_OP_MUL: {
-        bool z0 = plat[n->arg[0].id] & PLAT_0, z1 = plat[n->arg[1].id] & PLAT_0;
-        if (z0 && z1) {   /* the cheaper operand is the weight */
-            long c0 = ir_cost(ir, &n->arg[0], 1), c1 = ir_cost(ir, &n->arg[1], 1);
-            z0 = c0 <= c1;
-            z1 = !z0;
-        }
-        side[1] = z0;
-        side[0] = z1;
+    case IR_OP_MUL:   /* both may vanish: lazy_settle keeps the dearer side */
+        side[1] = plat[n->arg[0].id] & PLAT_0;
+        side[0] = plat[n->arg[1].id] & PLAT_0;
         break;
-    }
     default:
         return;
     }
@@ -538,10 +531,29 @@ static void lazy_settle(sched *s)
             cost[s->place[i]] += ir_node_cost(s->ir, (ir_ref){i});
     for (int r = s->nregions; r-- > 1;)   /* children after their parents */
         cost[s->regions[r].parent] += cost[r];
-    int *eff = xcalloc((size_t)s->nregions, sizeof *eff);
     for (int r = 0; r < s->nregions; r++) {
         region *g = &s->regions[r];
         g->kept = g->owner && cost[r] > SPLAT_LAZY_MIN_COST;
+    }
+    /* a mul of two operands that may vanish: one is the other's weight,
+     * the side with more work of its own is skipped (a parallax step's
+     * sample, not the chain of earlier steps its `alive` weight ends) */
+    for (int r = 0; r < s->nregions; r++) {
+        region *g = &s->regions[r];
+        const ir_node *n = &s->ir->nodes[g->owner];
+        if (!g->kept || n->op != IR_OP_MUL || g->side != 0)
+            continue;
+        int o = s->lazy[g->owner][1];
+        if (o >= 0 && s->regions[o].kept) {
+            if (cost[o] > cost[r])
+                g->kept = false;
+            else
+                s->regions[o].kept = false;
+        }
+    }
+    int *eff = xcalloc((size_t)s->nregions, sizeof *eff);
+    for (int r = 0; r < s->nregions; r++) {
+        region *g = &s->regions[r];
         eff[r] = !g->owner || g->kept ? r : eff[g->parent];
         if (g->owner && !g->kept)
             s->lazy[g->owner][g->side] = -1;
