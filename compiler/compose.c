@@ -26,7 +26,9 @@
  * lowest common ancestor of its users' regions, users before operands
  * (operands have smaller ids).  Emission walks the tree and, on entering a
  * region, emits the values placed there in id order; the emitter's scopes
- * make sure a value emitted inside a block is not reused outside it.  So
+ * make sure a value emitted inside a block is not reused outside it.
+ * Lazy branches (below) add a child region per skippable operand side of
+ * a mix/select/mul, emitted just before that node.  So
  * the terrain normal that two masks need sits in the outer guard, while a
  * texture only one surface reads stays inside that surface's `if`.
  *
@@ -456,8 +458,11 @@ static void use_at(sched *s, ir_ref r, int region)
  *     mul(w, x)        x when w can be 0, if (w != 0)  (where both operands
  *                      can be 0, the side with more work of its own)
  *
- * The bounds are the interval evaluator's over every input's domain, so a
- * weight that cannot be 0 (or 1) gets no branch.  A skipped side reads 0,
+ * The weight must be able to take that value over an area (plateau_of
+ * below: clamps, steps, comparisons, painted masks, params and what they
+ * flow through), within the interval evaluator's bounds over every input's
+ * domain: a weight that cannot be 0 (or 1), or is so only at isolated
+ * points (a noise's fade), gets no branch.  A skipped side reads 0,
  * so the result equals eager evaluation wherever the operands are finite:
  * mix(0, b, 1) = b, mix(a, 0, 0) = a, 0 * w = 0 when w = 0.  Before
  * (a tri-planar tap, eager):
