@@ -121,8 +121,8 @@ static bool inputs_key(build *b)
     XXH3_128bits_reset(st);
     char head[128];
     int n = snprintf(head, sizeof head,
-                     "splatc %s\nabi %d\nflat %d\npainted %s\ncompute-spirv %d\npreview ",
-                     SPLATC_VERSION, SPLAT_ABI_VERSION, b->desc->flat,
+                     "splatc %s\nabi %d\nflat %d\nlazy %d\npainted %s\ncompute-spirv %d\npreview ",
+                     SPLATC_VERSION, SPLAT_ABI_VERSION, b->desc->flat, !b->desc->no_lazy,
                      splat_painted_format_name(b->desc->painted), b->desc->compute_spirv);
     XXH3_128bits_update(st, head, (size_t)n);
     if (b->desc->preview)   /* the name and its end */

@@ -40,6 +40,7 @@ typedef struct job {
                                  the pool (build_compose), with gdesc      */
     splat_glsl_desc gdesc;
     char      title[96];      /* gdesc.title                              */
+    int       nlazy;          /* gdesc.lazy_branches: the lazy branches made */
     char     *log;            /* compile / validation failure             */
 } job;
 

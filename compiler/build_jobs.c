@@ -186,7 +186,7 @@ static bool add_composite(build *b, job_kind kind, int index, const int *materia
         j->gdesc = (splat_glsl_desc){.flat = k == JOB_FLAT, .painted_sparse = b->sparse_ok,
                                      .painted_places = b->painted_places,
                                      .no_mask_view = k != JOB_UBER && k != JOB_UBER_COMPUTE,
-                                     .compute = compute,
+                                     .compute = compute, .no_lazy = b->desc->no_lazy,
                                      .ug_slot = k == JOB_COMBO_UG ? b->ug.slot_of : NULL};
     }
     if (info) {
@@ -237,6 +237,7 @@ bool build_compose(build *b)
     bool *pending = xcalloc((size_t)b->njobs, sizeof *pending);
     for (int i = 0; i < b->njobs; i++) {
         b->jobs[i].gdesc.title = b->jobs[i].title;
+        b->jobs[i].gdesc.lazy_branches = &b->jobs[i].nlazy;
         pending[i] = b->jobs[i].composite != NULL;
     }
     run_pool(b, emit_job, pending, b->desc->jobs);
@@ -303,6 +304,7 @@ bool build_validate(build *b)
         bool combo = j->kind == JOB_COMBO;
         st->shaders++;
         st->combos += combo;
+        st->lazy_branches += combo ? j->nlazy : 0;
         if (j->cached) {
             st->shaders_cached++;
             st->combos_cached += combo;

@@ -1,5 +1,5 @@
 /* cli_build.c — `splatc build SCENE.sg -o PACKDIR [-j N] [--stats]
- * [--cache DIR | --no-cache] [--flat] [--compute-spirv] [--painted bc4|r8|dense]
+ * [--cache DIR | --no-cache] [--flat] [--no-lazy] [--compute-spirv] [--painted bc4|r8|dense]
  * [-I DIR]... [--depfile FILE] [--preview MATERIAL] [--json]`:
  * the command-line face
  * of splat_build (build.c).  Exit status 0 on success, 1 on input errors,
@@ -22,6 +22,8 @@ static const char usage[] =
     "                 $XDG_CACHE_HOME/splatc, else ~/.cache/splatc)\n"
     "  --no-cache     neither read nor write the cache\n"
     "  --flat         also write each composite without dynamic branches\n"
+    "  --no-lazy      no lazy branches inside materials (a mix/select/mul side\n"
+    "                 is skipped where its weight is 0; compiler/DESIGN.md 6.1)\n"
     "  --compute-spirv  also compile the compute variants to SPIR-V (default:\n"
     "                 their GLSL only; the runtime compiles them on first use)\n"
     "  --painted F    painted mask storage: bc4 (default: sparse quad-tree,\n"
@@ -57,6 +59,8 @@ static void print_stats(const splat_build_stats *st, FILE *out)
             st->combos_cached, st->combos_compiled);
     fprintf(out, "shaders: %d (%d from cache, %d compiled)\n", st->shaders,
             st->shaders_cached, st->shaders_compiled);
+    fprintf(out, "lazy branches: %d in the fragment composites written\n",
+            st->lazy_branches);
 }
 
 int splat_cli_build(int argc, char **argv)
@@ -96,6 +100,8 @@ int splat_cli_build(int argc, char **argv)
             desc.no_cache = true;
         } else if (strcmp(a, "--flat") == 0) {
             desc.flat = true;
+        } else if (strcmp(a, "--no-lazy") == 0) {
+            desc.no_lazy = true;
         } else if (strcmp(a, "--compute-spirv") == 0) {
             desc.compute_spirv = true;
         } else if (strcmp(a, "--painted") == 0 && next) {

@@ -26,7 +26,9 @@
  * lowest common ancestor of its users' regions, users before operands
  * (operands have smaller ids).  Emission walks the tree and, on entering a
  * region, emits the values placed there in id order; the emitter's scopes
- * make sure a value emitted inside a block is not reused outside it.  So
+ * make sure a value emitted inside a block is not reused outside it.
+ * Lazy branches (below) add a child region per skippable operand side of
+ * a mix/select/mul, emitted just before that node.  So
  * the terrain normal that two masks need sits in the outer guard, while a
  * texture only one surface reads stays inside that surface's `if`.
  *
@@ -393,19 +395,29 @@ double splat_composite_cost(const splat_composite *c)
 
 typedef struct region {
     int parent, depth;
+    uint32_t owner;        /* lazy side: the mix/select/mul it feeds, else 0 */
+    int      side;         /* lazy side: the owner's operand index          */
+    bool     kept;         /* lazy side: worth its branch (else merged up)  */
 } region;
 
 typedef struct sched {
     const ir *ir;
     region   *regions;
-    int       nregions;
+    int       nregions, capregions;
     int      *place;       /* per node: region, or -1 if not needed */
     int      *guard;       /* per layer: G_j                        */
     int      *surface;     /* per layer: W_j                        */
+    int     (*lazy)[4];    /* per node: its lazy side region per operand, or -1 */
+    int       nlazy;       /* lazy branches kept                    */
 } sched;
 
 static int region_new(sched *s, int parent)
 {
+    if (s->nregions == s->capregions) {
+        s->capregions = s->capregions ? 2 * s->capregions : 16;
+        s->regions = xrealloc(s->regions, sizeof *s->regions * (size_t)s->capregions);
+    }
+    memset(&s->regions[s->nregions], 0, sizeof *s->regions);
     int r = s->nregions++;
     s->regions[r].parent = parent;
     s->regions[r].depth = parent < 0 ? 0 : s->regions[parent].depth + 1;
@@ -433,12 +445,144 @@ static void use_at(sched *s, ir_ref r, int region)
     *p = *p < 0 ? region : lca(s, *p, region);
 }
 
-/* Regions and uses of a composite; `flat` puts everything at the root. */
+/* ---- lazy branches (an emission rule) -------------------------------------
+ *
+ * An operand side of a `mix`, `select` or `mul` whose weight can make it
+ * not count is its own region, guarded by a quad-uniform branch, when the
+ * work only that side needs (the nodes the scheduler places in its region,
+ * in ir_cost units) is worth more than SPLAT_LAZY_MIN_COST
+ * (compiler/DESIGN.md §6.1):
+ *
+ *     mix(a, b, t)     a when t can be 1, if (t < 1);  b when t can be 0, if (t > 0)
+ *     select(c, a, b)  a if (c != 0);  b if (c == 0)
+ *     mul(w, x)        x when w can be 0, if (w != 0)  (where both operands
+ *                      can be 0, the side with more work of its own)
+ *
+ * The weight must be able to take that value over an area (plateau_of
+ * below: clamps, steps, comparisons, painted masks, params and what they
+ * flow through), within the interval evaluator's bounds over every input's
+ * domain: a weight that cannot be 0 (or 1), or is so only at isolated
+ * points (a noise's fade), gets no branch.  A skipped side reads 0,
+ * so the result equals eager evaluation wherever the operands are finite:
+ * mix(0, b, 1) = b, mix(a, 0, 0) = a, 0 * w = 0 when w = 0.  Before
+ * (a tri-planar tap, eager):
+ *
+ *     vec4 v12 = texture(u_tex_0, v11);            // x projection
+ *     vec4 v20 = v19 * v12;                        // v19 = its weight
+ *
+ * after:
+ *
+ *     vec4 lz20_1 = vec4(0.0);
+ *     if (splat_quad_any(v18 != 0.0)) {            // v19 = vec4(v18)
+ *         vec2 v11 = ...;  vec4 v12 = texture(u_tex_0, v11);
+ *         lz20_1 = v12;
+ *     }
+ *     vec4 v20 = v19 * lz20_1;
+ */
+
+/* Whether some component of `iv` (w of them) can be exactly `x`. */
+static bool can_be(const ir_iv *iv, int w, double x)
+{
+    for (int c = 0; c < w; c++)
+        if (iv[c].lo <= x && x <= iv[c].hi)
+            return true;
+    return false;
+}
+
+enum { PLAT_0 = 1, PLAT_1 = 2 };   /* plateau_of (below) */
+
+/* Node `id` (placed at s->place[id]): open a lazy side region for each
+ * operand that may be skipped (plat: plateau_of per node); its uses then
+ * go there. */
+static void lazy_sides(sched *s, uint32_t id, const uint8_t *plat)
+{
+    const ir *ir = s->ir;
+    const ir_node *n = &ir->nodes[id];
+    bool side[3] = {false, false, false};
+    switch (n->op) {
+    case IR_OP_MIX:
+        side[0] = plat[n->arg[2].id] & PLAT_1;
+        side[1] = plat[n->arg[2].id] & PLAT_0;
+        break;
+    case IR_OP_SELECT:   /* not folded: c is 0 somewhere, not everywhere */
+        side[1] = side[2] = true;
+        break;
+    case IR_OP_MUL:   /* both may vanish: lazy_settle keeps the dearer side */
+        side[1] = plat[n->arg[0].id] & PLAT_0;
+        side[0] = plat[n->arg[1].id] & PLAT_0;
+        break;
+    default:
+        return;
+    }
+    if (ir_ref_eq(n->arg[0], n->arg[1]))
+        return;
+    for (int a = 0; a < n->nargs; a++) {
+        if (!side[a])
+            continue;
+        int r = region_new(s, s->place[id]);
+        s->regions[r].owner = id;
+        s->regions[r].side = a;
+        s->lazy[id][a] = r;
+    }
+}
+
+/* Keep the lazy regions worth SPLAT_LAZY_MIN_COST; every node placed in
+ * one that is not moves to its nearest kept (or plain) ancestor. */
+static void lazy_settle(sched *s)
+{
+    long *cost = xcalloc((size_t)s->nregions, sizeof *cost);
+    for (uint32_t i = 1; i < s->ir->nnodes; i++)
+        if (s->place[i] >= 0)
+            cost[s->place[i]] += ir_node_cost(s->ir, (ir_ref){i});
+    for (int r = s->nregions; r-- > 1;)   /* children after their parents */
+        cost[s->regions[r].parent] += cost[r];
+    for (int r = 0; r < s->nregions; r++) {
+        region *g = &s->regions[r];
+        g->kept = g->owner && cost[r] > SPLAT_LAZY_MIN_COST;
+    }
+    /* a mul of two operands that may vanish: one is the other's weight,
+     * the side with more work of its own is skipped (a parallax step's
+     * sample, not the chain of earlier steps its `alive` weight ends) */
+    for (int r = 0; r < s->nregions; r++) {
+        region *g = &s->regions[r];
+        const ir_node *n = &s->ir->nodes[g->owner];
+        if (!g->kept || n->op != IR_OP_MUL || g->side != 0)
+            continue;
+        int o = s->lazy[g->owner][1];
+        if (o >= 0 && s->regions[o].kept) {
+            if (cost[o] > cost[r])
+                g->kept = false;
+            else
+                s->regions[o].kept = false;
+        }
+    }
+    int *eff = xcalloc((size_t)s->nregions, sizeof *eff);
+    for (int r = 0; r < s->nregions; r++) {
+        region *g = &s->regions[r];
+        eff[r] = !g->owner || g->kept ? r : eff[g->parent];
+        if (g->owner && !g->kept)
+            s->lazy[g->owner][g->side] = -1;
+        s->nlazy += g->kept;
+    }
+    for (uint32_t i = 1; i < s->ir->nnodes; i++)
+        if (s->place[i] >= 0)
+            s->place[i] = eff[s->place[i]];
+    free(eff);
+    free(cost);
+}
+
+/* Regions and uses of a composite; `flat` puts everything at the root;
+ * `lazy` adds the lazy side regions above. */
 static void schedule(sched *s, const ir *ir, const splat_layer *layers, int n,
-                     bool flat)
+                     bool flat, const uint8_t *lazy)
 {
     s->ir = ir;
-    s->regions = xcalloc((size_t)(2 * n + 1), sizeof *s->regions);
+    s->regions = NULL;
+    s->nregions = s->capregions = 0;
+    s->nlazy = 0;
+    s->lazy = xcalloc(ir->nnodes, sizeof *s->lazy);
+    for (uint32_t i = 0; i < ir->nnodes; i++)
+        s->lazy[i][0] = s->lazy[i][1] = s->lazy[i][2] = s->lazy[i][3] = -1;
     s->guard = xcalloc((size_t)n, sizeof *s->guard);
     s->surface = xcalloc((size_t)n, sizeof *s->surface);
     s->place = xcalloc(ir->nnodes, sizeof *s->place);
@@ -467,14 +611,19 @@ static void schedule(sched *s, const ir *ir, const splat_layer *layers, int n,
         if (s->place[i] < 0)
             continue;
         const ir_node *nd = &ir->nodes[i];
+        if (lazy && !flat)
+            lazy_sides(s, i, lazy);
         for (int a = 0; a < nd->nargs; a++)
-            use_at(s, nd->arg[a], s->place[i]);
+            use_at(s, nd->arg[a], s->lazy[i][a] >= 0 ? s->lazy[i][a] : s->place[i]);
     }
+    if (lazy && !flat)
+        lazy_settle(s);
 }
 
 static void sched_free(sched *s)
 {
     free(s->regions);
+    free(s->lazy);
     free(s->guard);
     free(s->surface);
     free(s->place);
@@ -496,6 +645,7 @@ typedef struct emit {
     ir                     ir;       /* the copy GLSL is written from       */
     splat_layer           *layers;   /* c->layers, in the copy's ids         */
     int                   *input_of; /* per param of the copy: input or -1  */
+    uint32_t              *src_of;   /* per node of the copy: its id in src */
     glsl_emitter          *e;
     ir_buf                *out;
     sched                  s;
@@ -539,6 +689,9 @@ static void emission_copy(emit *em)
         }
         map[id] = ir_node_add(dst, &n).id;
     }
+    em->src_of = xcalloc(dst->nnodes, sizeof *em->src_of);
+    for (uint32_t id = 1; id < src->nnodes; id++)
+        em->src_of[map[id]] = id;
     em->input_of = xcalloc((size_t)dst->nparams, sizeof *em->input_of);
     for (int i = 0; i < dst->nparams; i++)
         em->input_of[i] = -1;
@@ -566,6 +719,7 @@ static void emission_free(emit *em)
     ir_free(&em->ir);
     free(em->layers);
     free(em->input_of);
+    free(em->src_of);
 }
 
 /* Declare a leaf we name ourselves (an input or a painted mask). */
@@ -604,6 +758,68 @@ static char *value(emit *em, ir_ref r, int depth)
     return xstrdup(glsl_value(em->e, r, ind));
 }
 
+static void emit_placed(emit *em, int region, int depth);
+static void close_block(emit *em, int depth);
+
+/* The condition under which operand `a` of lazy node `id` counts. */
+static char *lazy_condition(emit *em, uint32_t id, int a, int depth)
+{
+    const ir_node *n = &em->ir.nodes[id];
+    ir_ref g = n->op == IR_OP_MIX ? n->arg[2] : n->op == IR_OP_SELECT ? n->arg[0]
+                                                                      : n->arg[1 - a];
+    if (ir_get(&em->ir, g)->op == IR_OP_SPLAT)   /* the scalar it repeats */
+        g = ir_get(&em->ir, g)->arg[0];
+    int w = ir_type_width(ir_typeof(&em->ir, g));
+    const char *tn = ir_type_name(ir_typeof(&em->ir, g));
+    char *x = value(em, g, depth);
+    const char *op, *fn;
+    const char *k = "0.0";
+    if (n->op == IR_OP_MIX && a == 0) {
+        op = "<", fn = "lessThan", k = "1.0";
+    } else if (n->op == IR_OP_MIX) {
+        op = ">", fn = "greaterThan";
+    } else if (n->op == IR_OP_SELECT && a == 2) {
+        op = "==", fn = "equal";
+    } else {
+        op = "!=", fn = "notEqual";
+    }
+    ir_buf b = {0};
+    if (w == 1)
+        ir_buf_printf(&b, "%s %s %s", x, op, k);
+    else
+        ir_buf_printf(&b, "any(%s(%s, %s(%s)))", fn, x, tn, k);
+    free(x);
+    return b.s;
+}
+
+/* Lazy node `id`'s kept sides: each side's region inside its branch, its
+ * value left in `lz<id>_<a>` (0 where the branch is skipped), which the
+ * node then reads. */
+static void emit_lazy(emit *em, uint32_t id, int depth)
+{
+    const ir_node *n = &em->ir.nodes[id];
+    for (int a = 0; a < n->nargs; a++) {
+        int r = em->s.lazy[id][a];
+        if (r < 0)
+            continue;
+        ir_ref x = n->arg[a];
+        const char *tn = ir_type_name(ir_typeof(&em->ir, x));
+        char name[48];
+        snprintf(name, sizeof name, "lz%u_%d", id, a);
+        char *cond = lazy_condition(em, id, a, depth);
+        ir_buf_printf(em->out, "%s%s %s = %s(0.0);\n", indent_at(em, depth), tn, name, tn);
+        ir_buf_printf(em->out, "%sif (splat_quad_any(%s)) {\n", indent_at(em, depth), cond);
+        free(cond);
+        glsl_scope_push(em->e);
+        emit_placed(em, r, depth + 1);
+        char *v = value(em, x, depth + 1);
+        ir_buf_printf(em->out, "%s%s = %s;\n", indent_at(em, depth + 1), name, v);
+        free(v);
+        close_block(em, depth);
+        glsl_bind(em->e, x, name);
+    }
+}
+
 /* Emit every value placed at `region`, operands first (id order). */
 static void emit_placed(emit *em, int region, int depth)
 {
@@ -614,6 +830,8 @@ static void emit_placed(emit *em, int region, int depth)
         if (em->s.place[i] != region || ir->nodes[i].type == IR_T_TEX)
             continue;
         declare_leaf(em, i, ind);
+        if (em->s.lazy)
+            emit_lazy(em, i, depth);
         glsl_value(em->e, (ir_ref){i}, ind);
     }
 }
@@ -932,6 +1150,87 @@ static void differentiated(const splat_composite *c, ir *dst, splat_layer *layer
     layers_from_roots(dst, layers, c->nlayers);
 }
 
+/* Plateaus: whether a value can be exactly 0 (PLAT_0) or exactly 1
+ * (PLAT_1) over an open set of pixels, not just at isolated points (a
+ * noise's fade weight is 0 only on lattice lines: a branch on it would be
+ * taken by every quad).  Clamping ops, steps, comparisons, selects, painted
+ * masks and params make plateaus; products, sums and the like carry them;
+ * anything else (an input, a texture, a sine) has none.  Always within the
+ * interval bounds. */
+static unsigned plateau_of(const ir *ir, uint32_t id, const ir_iv *iv, const uint8_t *p)
+{
+    const ir_node *n = &ir->nodes[id];
+    unsigned a = n->nargs > 0 ? p[n->arg[0].id] : 0, b = n->nargs > 1 ? p[n->arg[1].id] : 0;
+    unsigned c = n->nargs > 2 ? p[n->arg[2].id] : 0, r = 0;
+    switch (n->op) {
+    case IR_OP_CONST: case IR_OP_PARAM: case IR_OP_PAINTED:
+    case IR_OP_SATURATE: case IR_OP_CLAMP: case IR_OP_SMOOTHSTEP: case IR_OP_STEP:
+    case IR_OP_LESS:
+        r = PLAT_0 | PLAT_1;
+        break;
+    case IR_OP_SPLAT: case IR_OP_SWIZZLE: case IR_OP_POW: case IR_OP_ABS: case IR_OP_NEG:
+        r = a;
+        break;
+    case IR_OP_CONSTRUCT: case IR_OP_MIN: case IR_OP_MAX:
+        for (int i = 0; i < n->nargs; i++)
+            r |= p[n->arg[i].id];
+        break;
+    case IR_OP_SELECT:
+        r = b | c;
+        break;
+    case IR_OP_MUL:
+        r = ((a | b) & PLAT_0) | (a & b & PLAT_1);
+        break;
+    case IR_OP_DIV:
+        r = a & PLAT_0;
+        break;
+    case IR_OP_ADD:   /* 0 + 0, 1 + 0 */
+        r = (a & b & PLAT_0) | ((a & PLAT_1) && (b & PLAT_0)) * PLAT_1 |
+            ((b & PLAT_1) && (a & PLAT_0)) * PLAT_1;
+        break;
+    case IR_OP_SUB:   /* 1 - 1, 0 - 0, 1 - 0 */
+        r = ((a & b & PLAT_1) || (a & b & PLAT_0)) * PLAT_0 |
+            ((a & PLAT_1) && (b & PLAT_0)) * PLAT_1;
+        break;
+    case IR_OP_MIX:   /* mix(a, b, 0) = a, mix(a, b, 1) = b */
+        r = (a & b) | ((c & PLAT_0) ? a : 0) | ((c & PLAT_1) ? b : 0);
+        break;
+    default:
+        break;
+    }
+    int w = ir_type_width((ir_type)n->type);
+    if (!can_be(iv, w, 0.0))
+        r &= ~(unsigned)PLAT_0;
+    if (!can_be(iv, w, 1.0))
+        r &= ~(unsigned)PLAT_1;
+    return r;
+}
+
+/* Bounds of every node of the copy over the inputs' domains (params over
+ * their [lo, hi]), from the source ir, which still has its inputs; and
+ * each node's plateaus into *plat. */
+static ir_iv (*lazy_bounds(const emit *em, uint8_t **plat))[4]
+{
+    ir_ienv env;
+    memset(&env, 0, sizeof env);
+    ir_ienv_domain(&env);
+    const ir *s = em->src;
+    ir_iv (*src)[4] = xcalloc(s->nnodes, sizeof *src);
+    ir_interval_all(s, &env, src);
+    uint8_t *sp = xcalloc(s->nnodes, 1);
+    for (uint32_t id = 1; id < s->nnodes; id++)
+        sp[id] = (uint8_t)plateau_of(s, id, src[id], sp);
+    ir_iv (*iv)[4] = xcalloc(em->ir.nnodes, sizeof *iv);
+    *plat = xcalloc(em->ir.nnodes, 1);
+    for (uint32_t id = 1; id < em->ir.nnodes; id++) {
+        memcpy(iv[id], src[em->src_of[id]], sizeof iv[id]);
+        (*plat)[id] = sp[em->src_of[id]];
+    }
+    free(sp);
+    free(src);
+    return iv;
+}
+
 void splat_composite_glsl(const splat_layout *L, const splat_composite *c,
                           const splat_glsl_desc *desc, ir_buf *out)
 {
@@ -963,7 +1262,24 @@ void splat_composite_glsl(const splat_layout *L, const splat_composite *c,
                           o == SG_OUT_ALBEDO || o == SG_OUT_NORMAL ? "vec3" : "float",
                           acc_names[o],
                           o == SG_OUT_ALBEDO || o == SG_OUT_NORMAL ? "vec3(0.0)" : "0.0");
-        schedule(&em.s, &em.ir, em.layers, c->nlayers, desc->flat);
+        uint8_t *plat = NULL;
+        ir_iv (*bounds)[4] = NULL;
+        if (!desc->flat && !desc->no_lazy) {
+            bounds = lazy_bounds(&em, &plat);
+            free(bounds);   /* the plateaus are within them */
+        }
+        schedule(&em.s, &em.ir, em.layers, c->nlayers, desc->flat, plat);
+        free(plat);
+        if (desc->lazy_branches)
+            *desc->lazy_branches += em.s.nlazy;
+        if (desc->lazy_sides) {
+            assert(!desc->compute);
+            memset(desc->lazy_sides, 0, c->ir.nnodes);
+            for (uint32_t id = 1; id < em.ir.nnodes; id++)
+                for (int a = 0; a < 4; a++)
+                    if (em.s.lazy[id][a] >= 0)
+                        desc->lazy_sides[em.src_of[id]] |= (uint8_t)(1u << a);
+        }
         emit_placed(&em, 0, 1);
         if (desc->flat) {
             emit_layer(&em, 0, true, 1);

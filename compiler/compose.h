@@ -121,7 +121,21 @@ typedef struct splat_glsl_desc {
     const int  *ug_slot;      /* with compute: the undergrowth mask variant
                                  (abi.h "undergrowth masks"); per scene
                                  material its slot, -1 for none         */
+    bool        no_lazy;      /* no lazy branches (compose.c; benchmark
+                                 variant): every mix/select/mul operand
+                                 evaluated where its layer is            */
+    int        *lazy_branches; /* non-NULL: += the lazy branches made    */
+    uint8_t    *lazy_sides;   /* non-NULL (not with compute): per node of
+                                 c->ir, bit k set where operand k became
+                                 a lazy branch (tests)                   */
 } splat_glsl_desc;
+
+/* A mix/select/mul operand side gets its own branch (compose.c "lazy
+ * branches") when the work only it needs costs more than this, in ir_cost
+ * units (ir.h): one vec4 texture sample (16) with nothing around it stays
+ * eager; a sample with its uv arithmetic, or anything dearer, is skipped
+ * where its weight is 0. */
+#define SPLAT_LAZY_MIN_COST 16
 
 /* The complete Vulkan GLSL 450 fragment shader of `c`: for a composite,
  * front-to-back with every value placed in the innermost region that

@@ -87,6 +87,7 @@ struct glsl_emitter {
     int        nscopes, capscopes;
     uint32_t  *work;      /* scratch for glsl_value                        */
     uint8_t   *seen;
+    uint8_t   *bound;     /* per node: its expression came from glsl_bind  */
 };
 
 glsl_emitter *glsl_emitter_new(const ir *ir, const glsl_names *names, ir_buf *out)
@@ -103,6 +104,7 @@ glsl_emitter *glsl_emitter_new(const ir *ir, const glsl_names *names, ir_buf *ou
         e->level[i] = -1;
     e->work = xalloc(sizeof(uint32_t) * ir->nnodes);
     e->seen = xalloc(ir->nnodes);
+    e->bound = xalloc(ir->nnodes);
     return e;
 }
 
@@ -118,6 +120,7 @@ void glsl_emitter_free(glsl_emitter *e)
     free(e->scope_mark);
     free(e->work);
     free(e->seen);
+    free(e->bound);
     free(e);
 }
 
@@ -137,6 +140,7 @@ void glsl_scope_pop(glsl_emitter *e)
     while (e->nemitted > mark) {
         uint32_t id = e->emitted[--e->nemitted];
         e->level[id] = -1;
+        e->bound[id] = 0;
         free(e->expr[id]);
         e->expr[id] = NULL;
     }
@@ -146,8 +150,28 @@ int glsl_scope_count(const glsl_emitter *e, ir_op op)
 {
     int from = e->nscopes ? e->scope_mark[e->nscopes - 1] : 0, n = 0;
     for (int i = from; i < e->nemitted; i++)
-        n += e->ir->nodes[e->emitted[i]].op == op;
+        n += e->ir->nodes[e->emitted[i]].op == op && !e->bound[e->emitted[i]];
     return n;
+}
+
+static void remember(glsl_emitter *e, uint32_t id, char *expr)
+{
+    e->expr[id] = expr;
+    e->level[id] = e->nscopes;
+    if (e->nemitted == e->capemitted) {
+        e->capemitted = e->capemitted ? 2 * e->capemitted : 64;
+        e->emitted = xgrow(e->emitted, sizeof(uint32_t) * (size_t)e->capemitted);
+    }
+    e->emitted[e->nemitted++] = id;
+}
+
+void glsl_bind(glsl_emitter *e, ir_ref r, const char *name)
+{
+    assert(ir_ref_ok(r) && r.id < e->nnodes && !e->expr[r.id]);
+    ir_buf b = {0};
+    ir_buf_printf(&b, "%s", name);
+    remember(e, r.id, b.s);
+    e->bound[r.id] = 1;   /* computed (and counted) inside the closed block */
 }
 
 static bool is_leaf(const ir_node *n)
@@ -297,13 +321,7 @@ const char *glsl_value(glsl_emitter *e, ir_ref r, const char *indent)
                       ir_type_name((ir_type)n->type), id, rhs.s);
         ir_buf name = {0};
         ir_buf_printf(&name, "v%u", id);
-        e->expr[id] = name.s;
-        e->level[id] = e->nscopes;
-        if (e->nemitted == e->capemitted) {
-            e->capemitted = e->capemitted ? 2 * e->capemitted : 64;
-            e->emitted = xgrow(e->emitted, sizeof(uint32_t) * (size_t)e->capemitted);
-        }
-        e->emitted[e->nemitted++] = id;
+        remember(e, id, name.s);
     }
     for (int k = 0; k < ntodo; k++)
         e->seen[todo[k]] = 0;

@@ -596,6 +596,9 @@ void    ir_ienv_domain(ir_ienv *ienv);
  * in out[c] for each component c.  NaN-producing cases widen to
  * [-inf, +inf]. */
 void ir_interval(const ir *ir, ir_ref r, const ir_ienv *env, ir_iv out[4]);
+/* The same for every node at once: vals[id] (4 per node, ir->nnodes of
+ * them) for each id (compose.c's lazy branches ask about many). */
+void ir_interval_all(const ir *ir, const ir_ienv *env, ir_iv (*vals)[4]);
 
 /* ---- GLSL (glsl.c) ----------------------------------------------------- */
 
@@ -639,6 +642,10 @@ void          glsl_scope_pop(glsl_emitter *e);
  * shader's outermost level when none is open): e.g. the texture samples a
  * block takes, for the counting variant. */
 int           glsl_scope_count(const glsl_emitter *e, ir_op op);
+/* From now on (until the current scope is popped) `r` reads as the GLSL
+ * variable `name`, which the caller has declared: a value computed inside
+ * a block the caller closed (compose.c's lazy branches). */
+void          glsl_bind(glsl_emitter *e, ir_ref r, const char *name);
 
 /* GLSL literal for a constant of type t ("vec3(0.5, 0.5, 0.5)"), exact
  * enough to round-trip a float. */

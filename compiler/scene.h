@@ -25,6 +25,7 @@ typedef struct splat_build_desc {
     const char        *cache_dir;    /* NULL = splat_cache_default_dir()      */
     bool               no_cache;
     bool               flat;         /* also write branch-free composites     */
+    bool               no_lazy;      /* no lazy branches (compose.c)          */
     bool               compute_spirv; /* also compile the compute variants
                                         (default: their GLSL only; PACK.md) */
     splat_painted_format painted;    /* painted mask storage; default BC4     */
@@ -39,6 +40,8 @@ typedef struct splat_build_stats {
     double load, analysis, compose, glslang, validate, write; /* seconds     */
     int    combos, combos_cached, combos_compiled;  /* composite shaders     */
     int    shaders, shaders_cached, shaders_compiled; /* every module         */
+    int    lazy_branches;    /* lazy branches in the composites compiled
+                                (fragment variants; compose.c)          */
     bool   up_to_date;       /* the pack already held this build's output:
                                 nothing after `load` ran (combos = its count) */
 } splat_build_stats;

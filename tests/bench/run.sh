@@ -418,9 +418,20 @@ else
     # flank of Blanca Peak (parallax fades out beyond 300 m)
     p4=$(knob_pack colorado par4 rock "s/: *parallax8 /: parallax4 /")
     p16=$(knob_pack colorado par16 rock "s/: *parallax8 /: parallax16 /")
+    # steps by view angle and distance with an early exit (nodes/parallax.sg
+    # parallax_adaptive; rock.png is 256 texels a repeat), and 16 fixed
+    # steps without lazy branches (every step sampled)
+    pa=$(knob_pack colorado paradapt rock \
+        "s/: *parallax8 { tex = \"textures\/rock.png\"/: parallax_adaptive { texels = 256.0, tex = \"textures\/rock.png\"/")
+    KNOB_BUILD_ARGS="--no-lazy"
+    p16e=$(knob_pack colorado par16eager rock "s/: *parallax8 /: parallax16 /")
+    KNOB_BUILD_ARGS=""
     GROUND_START=45000,47087,1,0
     render knob_parallax colorado ground 1280x720 "parallax16=composite,pack=$p16" \
-        parallax8=composite "parallax4=composite,pack=$p4"
+        parallax8=composite "parallax4=composite,pack=$p4" \
+        "parallax16_eager=composite,pack=$p16e" "parallax_adaptive=composite,pack=$pa" \
+        "parallax16_screen=screen,pack=$p16" "parallax16_eager_screen=screen,pack=$p16e" \
+        "parallax_adaptive_screen=screen,pack=$pa"
     GROUND_START=""
     # painted masks: dense raster (the reference) vs sparse R8, BC4 (the
     # default) and BC4 with every mask limited to quad-tree level 2
@@ -432,6 +443,16 @@ else
     pl=$(knob_pack colorado lvl2 "" "" 's|^\([ \t]*painted [a-z_]* *= *"[^"]*"\)[ \t]*$|\1 { max_level = 2 }|')
     render knob_painted colorado ground 1280x720 "dense=composite,pack=$pd" \
         "sparse_r8=composite,pack=$pr" sparse_bc4=composite "bc4_level2=composite,pack=$pl"
+    # laziness inside materials (compiler/DESIGN.md 6.1): the same pack with
+    # every mix/select/mul side evaluated eagerly (the reference) and with
+    # lazy branches (the default), forward and screen-space
+    KNOB_BUILD_ARGS="--no-lazy"
+    pe=$(knob_pack colorado eager "" "")
+    KNOB_BUILD_ARGS=""
+    for p in ground topdown; do
+        render knob_lazy colorado "$p" 1280x720 "eager=composite,pack=$pe" lazy=composite \
+            "eager_screen=screen,pack=$pe" lazy_screen=screen
+    done
 fi
 { echo "group,$(sed -n 1p "$W/render.txt")"; cat "$CSV.body"; } > "$CSV"
 rm -f "$CSV.body"

@@ -75,6 +75,15 @@ if(TARGET splatrt AND TARGET splatview)
         FIXTURES_REQUIRED ${ex}_pack ENVIRONMENT "SPLAT_VALIDATE=1")
     endwhile()
 
+    # Lazy branches: colorado's pack against the same built --no-lazy.
+    add_test(NAME render.lazy_colorado
+      COMMAND sh ${RENDER_DIR}/lazy.sh $<TARGET_FILE:splatc_cli> $<TARGET_FILE:splatview>
+              $<TARGET_FILE:imgcheck> ${RENDER_OUT}/colorado ${RENDER_OUT}/spv_cache
+              ${RENDER_OUT}/out
+      WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
+    set_tests_properties(render.lazy_colorado PROPERTIES LABELS render TIMEOUT 600
+      FIXTURES_REQUIRED colorado_pack ENVIRONMENT "SPLAT_VALIDATE=1")
+
     # The screen-space path against the forward path at every camera
     # preset (screen.sh says what each kind of scene is held to).
     add_test(NAME render.pack_notex

@@ -334,6 +334,15 @@ static void test_projection(void **state)
     NEAR(evalf(f, &e, "n.out.r", tp, 2.0), (wx * ux + wy * uy) / (wx + wy));
     /* weights sum to 1: the constant channel stays constant */
     NEAR(evalf(f, &e, "n.out.b", tp, 3.0), 0.25);
+    /* below the cutoff (0.02 by default) a weight is 0, the rest
+     * renormalised: n = (0.3, 0.954, 0) at sharpness 4 weighs x by 0.0097,
+     * so only the top-down plane is read; cutoff 0 blends both */
+    e.normal[0] = 0.3; e.normal[1] = sqrt(1 - 0.09); e.normal[2] = 0;
+    NEAR(evalf(f, &e, "n.out.r", tp, 4.0), uy);
+    const char *tp0 = "triplanar { tex = \"textures/rock.png\", scale = 2.0, sharpness = %g, "
+                      "cutoff = 0.0 }";
+    wx = pow(0.3, 4); wy = pow(1 - 0.09, 2);
+    NEAR(evalf(f, &e, "n.out.r", tp0, 4.0), (wx * ux + wy * uy) / (wx + wy));
 }
 
 /* A normal map of one constant texel. */

@@ -160,6 +160,60 @@ static void test_against_loop(void **state)
             }
 }
 
+/* parallax_adaptive's uv (texels per repeat `texels`, 1 texel a step). */
+static void eval_adaptive(height_fn h, double texels, const double uv0[2],
+                          const double off[2], double out[2])
+{
+    char node[256];
+    snprintf(node, sizeof node,
+             "parallax_adaptive { tex = \"textures/rock.png\", uv = terrain.uv, "
+             "offset = vec2(%.17g, %.17g), texels = %.17g }", off[0], off[1], texels);
+    lowered l;
+    lower(&l, node, "px.out.x", "px.out.y");
+    ir_env e;
+    memset(&e, 0, sizeof e);
+    e.uv[0] = uv0[0];
+    e.uv[1] = uv0[1];
+    e.sample = sample_h;
+    e.sample_user = &h;
+    double x[4], y[4];
+    ir_eval(&l.ir, ir_find_root(&l.ir, "t.mask"), &e, x);
+    ir_eval(&l.ir, ir_find_root(&l.ir, "t.height"), &e, y);
+    out[0] = x[0];
+    out[1] = y[0];
+    lowered_free(&l);
+}
+
+/* Steps by the ray's length in texels: the loop with N = clamp(ceil(|offset|
+ * * texels), 1, 16) (the unrolled 16 steps, those from N on dead). */
+static void test_adaptive_against_loop(void **state)
+{
+    (void)state;
+    const height_fn hs[] = { h_step, h_wave, h_ramp, h_low, h_high };
+    const double rays[][4] = {
+        { 0.0, 0.0, 1.0, 0.0 }, { 0.1, 0.3, 0.35, -0.2 }, { 0.7, 0.2, -0.6, 0.45 },
+        { 0.25, 0.75, 0.05, 0.02 }, { 0.5, 0.5, 0.0, 0.0 },
+    };
+    const double texels[] = { 2.0, 9.0, 30.0, 256.0 };
+    int seen[17] = {0};
+    for (size_t h = 0; h < sizeof hs / sizeof hs[0]; h++)
+        for (size_t r = 0; r < sizeof rays / sizeof rays[0]; r++)
+            for (size_t i = 0; i < sizeof texels / sizeof texels[0]; i++) {
+                const double *o = rays[r] + 2;
+                int n = (int)fmin(16, fmax(1, ceil(hypot(o[0], o[1]) * texels[i])));
+                seen[n] = 1;
+                double got[2], want[2];
+                eval_adaptive(hs[h], texels[i], rays[r], o, got);
+                loop_uv(hs[h], n, rays[r], o, want);
+                for (int c = 0; c < 2; c++)
+                    if (!(fabs(got[c] - want[c]) <= 1e-12))
+                        fail_msg("h %zu ray %zu texels %g (N %d): uv[%d] = %.17g, loop %.17g",
+                                 h, r, texels[i], n, c, got[c], want[c]);
+            }
+    /* the rays cover 1 step, a few, and the full 16 */
+    assert_true(seen[1] && seen[2] && seen[9] && seen[16]);
+}
+
 /* Bounds: whatever the texture, the uv lies between uv0 and uv0 + offset. */
 static void test_intervals(void **state)
 {
@@ -275,6 +329,7 @@ int main(void)
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_hand_steps),
         cmocka_unit_test(test_against_loop),
+        cmocka_unit_test(test_adaptive_against_loop),
         cmocka_unit_test(test_intervals),
         cmocka_unit_test(test_offset),
         cmocka_unit_test(test_rock_uses_parallax),
