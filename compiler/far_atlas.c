@@ -4,32 +4,34 @@
  * heightfield's own density, colorado 73.5 x 92.6 m), covering the terrain
  * uv square; its leaf cells' blocks lie where the quadtree's leaf cells
  * lie, so a node's part of the atlas is the rectangle of its cells.  Each
- * texel holds the composite of the combination of the leaf cell its centre
- * falls in (the pack's combos.bin level 0; the forward and screen paths
- * shade that cell with it or an equal superset), without lighting:
- * "composite.albedo / .normal / .roughness" (compose.h).
+ * texel holds the mean of the composite at 2 x 2 points spread over it
+ * (FAR_SS: a box filter over the texel), each point shaded by the
+ * combination of the leaf cell it falls in (the pack's combos.bin level
+ * 0; the forward and screen paths shade that cell with it or an equal
+ * superset), without lighting: "composite.albedo / .normal / .roughness"
+ * (compose.h).
  *
  * How: on the CPU, in double, with the compiler's own reference evaluator
  * (ir_eval_node over the composite's IR in id order, every root at once),
  * there being no device at build time.  The inputs are the fragment
- * stage's at the texel centre: height and normal from the heightfield
+ * stage's at each point: height and normal from the heightfield
  * (splat_terrain_height / _normal, the ABI's twins), painted masks
- * bilinear from the dense rasters, destruction 0, params at their
- * defaults; view.distance FAR_ATLAS_BAKE_DISTANCE and the view straight
- * down.  Textures are filtered as a GPU filters them at that footprint: the
- * composite is differentiated (ir_differentiate, as for the compute stage)
- * with the atlas texel as the pixel step, and every sample_grad picks its
- * level from its gradients (trilinear over a box-filtered chain in linear
- * space, or the texture's stored mip files: PACK.md), so a 4 m rock
- * texture reads as its mean, not as aliased texels.
+ * bilinear from the dense rasters (a placed mask is read as covering the
+ * whole terrain: not yet right for placed masks), destruction 0, params at
+ * their defaults; view.distance FAR_ATLAS_BAKE_DISTANCE and the view
+ * straight down.  Textures are filtered as a GPU filters them at that
+ * footprint: the composite is differentiated (ir_differentiate, as for the
+ * compute stage) with the point spacing as the pixel step, and every
+ * sample_grad picks its level from its gradients (trilinear over a
+ * box-filtered chain in linear space, or the texture's stored mip files:
+ * PACK.md), so a 4 m rock texture reads as its mean, not as aliased texels.
  *
  * Then a box-filtered mip chain (normals renormalised) and BC1 (sRGB) /
- * BC5 / BC4 blocks by stb_dxt.  Cost: colorado (2401 x 1201 texels, 17
- * combinations) in about a minute of CPU on two threads; it scales with
- * the texel count, so N = 2 is a quarter of that.
+ * BC5 / BC4 blocks by stb_dxt.  Cost: proportional to texels x 4 points
+ * (tests/bench/RESULTS.md "Shading LOD: far atlas" has colorado's).
  *
- * Not baked: craters (the runtime does not use the atlas once the terrain
- * is destroyed: runtime/DESIGN.md) and param edits (a rebuild). */
+ * Not baked: craters (the runtime never uses the atlas over the
+ * destructible area: runtime/DESIGN.md) and param edits (a rebuild). */
 #include "build.h"
 #include "far_atlas.h"
 
@@ -215,85 +217,113 @@ static void sample_grad(void *user, int texture, const double uv[2], const doubl
         rgba[c] = a[c] * (1 - f) + b[c] * f;
 }
 
-/* One row of atlas texels. */
-static void bake_row(far_bake *fb, int z, double (*vals)[4], uint32_t cap)
+/* The composite at heightfield uv (u, v), with a pixel step of (sx, sz)
+ * metres for the texture gradients: albedo, unit normal, roughness.  False
+ * where the leaf cell is all hole (never drawn). */
+static bool eval_point(far_bake *fb, double u, double v, double sx, double sz,
+                       double (*vals)[4], double al[3], double nrm[3], double *ro)
 {
     build *b = fb->b;
     const splat_terrain *t = &b->scene.terrain;
     const splat_analysis *a = &b->analysis;
     const splat_scene *s = &b->scene;
-    (void)cap;
+    int cx = (int)(u * t->width) / a->cell_texels, cz = (int)(v * t->height) / a->cell_texels;
+    cx = cx < 0 ? 0 : cx < a->cells_x ? cx : a->cells_x - 1;
+    cz = cz < 0 ? 0 : cz < a->cells_z ? cz : a->cells_z - 1;
+    int id = a->levels[0].ids[(size_t)cz * a->cells_x + cx];
+    if (id >= a->ncombos)
+        return false;
+    const splat_composite *c = &fb->comp[id];
+    far_sampler smp = {fb, id};
+    double painted[256] = {0};
+    for (int k = 0; k < c->ir.npainted && k < 256; k++) {
+        int sp = fb->painted_of[id][k];
+        if (sp < 0 || !s->painted || !s->painted[sp])
+            continue;
+        int pw = s->painted_size[sp][0], ph = s->painted_size[sp][1];
+        double fx = u * pw - 0.5, fy = v * ph - 0.5;
+        int x0 = (int)floor(fx), y0 = (int)floor(fy);
+        double ax = fx - x0, ay = fy - y0, acc = 0;
+        for (int dy = 0; dy < 2; dy++)
+            for (int dx = 0; dx < 2; dx++) {
+                int px = x0 + dx < 0 ? 0 : x0 + dx >= pw ? pw - 1 : x0 + dx;
+                int py = y0 + dy < 0 ? 0 : y0 + dy >= ph ? ph - 1 : y0 + dy;
+                acc += s->painted[sp][(size_t)py * pw + px] / 255.0 * (dx ? ax : 1 - ax) *
+                       (dy ? ay : 1 - ay);
+            }
+        painted[k] = acc;
+    }
+    ir_env env;
+    memset(&env, 0, sizeof env);
+    env.height = splat_terrain_height(t, u, v);
+    splat_terrain_normal(t, u, v, env.normal);
+    env.slope = 1.0 - env.normal[1];
+    env.position[0] = u * t->size[0];
+    env.position[1] = env.height;
+    env.position[2] = v * t->size[1];
+    env.uv[0] = u;
+    env.uv[1] = v;
+    env.view_distance = FAR_ATLAS_BAKE_DISTANCE;
+    env.view_direction[1] = 1.0;
+    env.painted = painted;
+    env.sample_grad = sample_grad;
+    env.sample_user = &smp;
+    /* one step right / down, on the terrain's tangent plane */
+    double ny = env.normal[1] > 0.05 ? env.normal[1] : 0.05;
+    double dhx = -sx * env.normal[0] / ny, dhz = -sz * env.normal[2] / ny;
+    double *px = env.d_input[0][IR_IN_POSITION], *pz = env.d_input[1][IR_IN_POSITION];
+    px[0] = sx; px[1] = dhx;
+    pz[1] = dhz; pz[2] = sz;
+    env.d_input[0][IR_IN_HEIGHT][0] = dhx;
+    env.d_input[1][IR_IN_HEIGHT][0] = dhz;
+    env.d_input[0][IR_IN_UV][0] = sx / t->size[0];
+    env.d_input[1][IR_IN_UV][1] = sz / t->size[1];
+    for (uint32_t n = 1; n < c->ir.nnodes; n++)
+        ir_eval_node(&c->ir, n, &env, vals);
+    const double *A = vals[fb->roots[id][0].id], *N = vals[fb->roots[id][1].id];
+    const double *R = vals[fb->roots[id][2].id];
+    double len = sqrt(N[0] * N[0] + N[1] * N[1] + N[2] * N[2]);
+    for (int k = 0; k < 3; k++) {
+        al[k] = A[k] < 0 ? 0 : A[k] > 1 ? 1 : A[k];
+        nrm[k] = len > 0 ? N[k] / len : k == 1;
+    }
+    *ro = R[0] < 0 ? 0 : R[0] > 1 ? 1 : R[0];
+    return true;
+}
+
+/* One row of atlas texels: each the mean of FAR_SS x FAR_SS points spread
+ * over it (a box filter of the composite over the texel, which is what a
+ * far pixel covering the texel should show; one point at the centre would
+ * keep the composite's aliasing: a peak's texel centre has a flat normal). */
+enum { FAR_SS = 2 };
+
+static void bake_row(far_bake *fb, int z, double (*vals)[4])
+{
+    const splat_terrain *t = &fb->b->scene.terrain;
+    double sx = t->size[0] / fb->W / FAR_SS, sz = t->size[1] / fb->H / FAR_SS;
     for (int x = 0; x < fb->W; x++) {
         size_t i = (size_t)z * fb->W + x;
-        double u = (x + 0.5) / fb->W, v = (z + 0.5) / fb->H;
-        int cx = (int)(u * t->width) / a->cell_texels, cz = (int)(v * t->height) / a->cell_texels;
-        cx = cx < a->cells_x ? cx : a->cells_x - 1;
-        cz = cz < a->cells_z ? cz : a->cells_z - 1;
-        int id = a->levels[0].ids[(size_t)cz * a->cells_x + cx];
-        if (id >= a->ncombos) {   /* all hole: never drawn */
-            fb->albedo[3 * i] = fb->albedo[3 * i + 1] = fb->albedo[3 * i + 2] = 0.0f;
-            fb->normal[3 * i] = fb->normal[3 * i + 2] = 0.0f;
-            fb->normal[3 * i + 1] = 1.0f;
-            fb->rough[i] = 1.0f;
-            continue;
-        }
-        const splat_composite *c = &fb->comp[id];
-        far_sampler smp = {fb, id};
-        double painted[256] = {0};
-        for (int k = 0; k < c->ir.npainted && k < 256; k++) {
-            int sp = fb->painted_of[id][k];
-            if (sp < 0 || !s->painted || !s->painted[sp])
+        double al[3] = {0}, no[3] = {0}, ro = 0;
+        int n = 0;
+        for (int k = 0; k < FAR_SS * FAR_SS; k++) {
+            double u = (x + (k % FAR_SS + 0.5) / FAR_SS) / fb->W;
+            double v = (z + (k / FAR_SS + 0.5) / FAR_SS) / fb->H;
+            double a1[3], n1[3], r1;
+            if (!eval_point(fb, u, v, sx, sz, vals, a1, n1, &r1))
                 continue;
-            int pw = s->painted_size[sp][0], ph = s->painted_size[sp][1];
-            double fx = u * pw - 0.5, fy = v * ph - 0.5;
-            int x0 = (int)floor(fx), y0 = (int)floor(fy);
-            double ax = fx - x0, ay = fy - y0, acc = 0;
-            for (int dy = 0; dy < 2; dy++)
-                for (int dx = 0; dx < 2; dx++) {
-                    int px = x0 + dx < 0 ? 0 : x0 + dx >= pw ? pw - 1 : x0 + dx;
-                    int py = y0 + dy < 0 ? 0 : y0 + dy >= ph ? ph - 1 : y0 + dy;
-                    acc += s->painted[sp][(size_t)py * pw + px] / 255.0 * (dx ? ax : 1 - ax) *
-                           (dy ? ay : 1 - ay);
-                }
-            painted[k] = acc;
+            for (int c = 0; c < 3; c++) {
+                al[c] += a1[c];
+                no[c] += n1[c];
+            }
+            ro += r1;
+            n++;
         }
-        ir_env env;
-        memset(&env, 0, sizeof env);
-        double step_x = t->size[0] / fb->W, step_z = t->size[1] / fb->H;
-        env.height = splat_terrain_height(t, u, v);
-        splat_terrain_normal(t, u, v, env.normal);
-        env.slope = 1.0 - env.normal[1];
-        env.position[0] = u * t->size[0];
-        env.position[1] = env.height;
-        env.position[2] = v * t->size[1];
-        env.uv[0] = u;
-        env.uv[1] = v;
-        env.view_distance = FAR_ATLAS_BAKE_DISTANCE;
-        env.view_direction[1] = 1.0;
-        env.painted = painted;
-        env.sample_grad = sample_grad;
-        env.sample_user = &smp;
-        /* one atlas texel right / down, on the terrain's tangent plane */
-        double ny = env.normal[1] > 0.05 ? env.normal[1] : 0.05;
-        double dhx = -step_x * env.normal[0] / ny, dhz = -step_z * env.normal[2] / ny;
-        double *px = env.d_input[0][IR_IN_POSITION], *pz = env.d_input[1][IR_IN_POSITION];
-        px[0] = step_x; px[1] = dhx;
-        pz[1] = dhz; pz[2] = step_z;
-        env.d_input[0][IR_IN_HEIGHT][0] = dhx;
-        env.d_input[1][IR_IN_HEIGHT][0] = dhz;
-        env.d_input[0][IR_IN_UV][0] = 1.0 / fb->W;
-        env.d_input[1][IR_IN_UV][1] = 1.0 / fb->H;
-        for (uint32_t n = 1; n < c->ir.nnodes; n++)
-            ir_eval_node(&c->ir, n, &env, vals);
-        const double *al = vals[fb->roots[id][0].id], *no = vals[fb->roots[id][1].id];
-        const double *ro = vals[fb->roots[id][2].id];
         double len = sqrt(no[0] * no[0] + no[1] * no[1] + no[2] * no[2]);
-        for (int k = 0; k < 3; k++) {
-            double av = al[k] < 0 ? 0 : al[k] > 1 ? 1 : al[k];
-            fb->albedo[3 * i + k] = (float)av;
-            fb->normal[3 * i + k] = (float)(len > 0 ? no[k] / len : k == 1);
+        for (int c = 0; c < 3; c++) {
+            fb->albedo[3 * i + c] = n ? (float)(al[c] / n) : 0.0f;
+            fb->normal[3 * i + c] = len > 0 ? (float)(no[c] / len) : (float)(c == 1);
         }
-        fb->rough[i] = (float)(ro[0] < 0 ? 0 : ro[0] > 1 ? 1 : ro[0]);
+        fb->rough[i] = n ? (float)(ro / n) : 1.0f;
     }
 }
 
@@ -310,7 +340,7 @@ static void *bake_worker(void *arg)
         pthread_mutex_unlock(&fb->lock);
         if (z >= fb->H)
             break;
-        bake_row(fb, z, vals, cap);
+        bake_row(fb, z, vals);
     }
     free(vals);
     return NULL;
