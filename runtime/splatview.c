@@ -1,6 +1,7 @@
 /* splatview — render a shader pack: headless to PNG (and raw floats), or in
  * a GLFW window with a fly camera and hot reload.  See usage() below. */
 #include "rt_internal.h"
+#include "far_atlas.h"
 #include "scene.h"
 #include "util.h"
 
@@ -653,6 +654,12 @@ static int headless(const opts *o)
                    cs.tiles.branches / px);
         }
         printf("shading: %s\n", st.screen ? "screen" : "forward");
+        if (pack.far.data)   /* the BC blocks as uploaded (PACK.md "Far atlas") */
+            printf("far atlas: %d x %d texels of %.1f x %.1f m, %d levels, %zu bytes; %s\n",
+                   pack.far.width, pack.far.height, pack.far.texel[0], pack.far.texel[1],
+                   pack.far.levels, pack.far.n - FAR_ATLAS_HEADER,
+                   o->far_distance > 0 && st.screen
+                       ? "screen tiles beyond --far-atlas-distance use it" : "not used");
         rt_painted_print_stats(&pack, stdout);
         if (rt_renderer_destruction(r))
             rt_destruction_print_stats(rt_renderer_destruction(r), stdout);

@@ -14,6 +14,6 @@ if(TARGET splatrt AND TARGET splatview AND TARGET splatc_cli AND TARGET splatben
       ENVIRONMENT "SPLAT_VALIDATE=1")
   endforeach()
   set_tests_properties(far.build PROPERTIES FIXTURES_SETUP far_pack)
-  set_tests_properties(far.error far.corrupt PROPERTIES FIXTURES_REQUIRED far_pack)
+  set_tests_properties(far.error PROPERTIES FIXTURES_REQUIRED far_pack)
   set_property(TEST far.corrupt APPEND PROPERTY LABELS asan)
 endif()
