@@ -119,11 +119,12 @@ static bool inputs_key(build *b)
     if (!st)
         abort();
     XXH3_128bits_reset(st);
-    char head[128];
+    char head[192];
     int n = snprintf(head, sizeof head,
-                     "splatc %s\nabi %d\nflat %d\nlazy %d\npainted %s\ncompute-spirv %d\npreview ",
+                     "splatc %s\nabi %d\nflat %d\nlazy %d\npainted %s\ncompute-spirv %d\nfar-atlas %d\npreview ",
                      SPLATC_VERSION, SPLAT_ABI_VERSION, b->desc->flat, !b->desc->no_lazy,
-                     splat_painted_format_name(b->desc->painted), b->desc->compute_spirv);
+                     splat_painted_format_name(b->desc->painted), b->desc->compute_spirv,
+                     b->desc->far_atlas);
     XXH3_128bits_update(st, head, (size_t)n);
     if (b->desc->preview)   /* the name and its end */
         XXH3_128bits_update(st, b->desc->preview, strlen(b->desc->preview) + 1);
@@ -195,6 +196,11 @@ static bool up_to_date(build *b, int *ncombos)
          shader_files(b->out, json_object_get(json_object_get(m, "uber"), "compute"),
                       b->desc->compute_spirv) &&
          has_files(b->out, json_object_get(m, "vertex"));
+    if (ok && b->desc->far_atlas > 0) {   /* the key says it was baked */
+        char *fa = xasprintf("%s/far.atlas", b->out);
+        ok = access(fa, R_OK) == 0;
+        free(fa);
+    }
     *ncombos = ok ? (int)json_array_size(combos) : 0;
     json_decref(m);
     return ok;
@@ -245,8 +251,10 @@ static bool layout(build *b)
 
 static bool write_out(build *b)
 {
-    if (b->desc->report)
+    if (b->desc->report) {
         build_report_shaders(b, b->desc->report);
+        build_report_far(b, b->desc->report);
+    }
     return build_write_pack(b);
 }
 
@@ -332,6 +340,7 @@ static bool build_finish(build *b)
     if (b->sparse_ok)
         sparse_free(&b->sparse);
     free(b->painted_places);
+    free(b->far.data);
     if (b->scene_ok)
         splat_scene_free(&b->scene);
     free(b->out);
@@ -359,6 +368,7 @@ bool splat_build(const splat_build_desc *desc, splat_build_stats *st, sg_diags *
     phase(&b, build_compose, &st->compose); /* GLSL and key per shader      */
     phase(&b, build_compile, &st->glslang); /* cache, then glslang          */
     phase(&b, build_validate, &st->validate); /* spirv-val, cache puts      */
+    phase(&b, build_far_atlas, &st->far_atlas); /* --far-atlas: the bake    */
     phase(&b, write_out, &st->write);       /* manifest, files, swap        */
     phase(&b, write_depfile, &st->write);   /* --depfile: every input       */
     return build_finish(&b);

@@ -50,6 +50,15 @@ typedef struct combo_info {
     double cost;              /* splat_composite_cost                     */
 } combo_info;
 
+/* The far atlas as the pack stores it (far_atlas.h), when --far-atlas. */
+typedef struct far_atlas_out {
+    uint8_t *data;            /* the whole far.atlas file                 */
+    size_t   n;
+    int      width, height, levels;
+    double   texel[2];        /* metres per level-0 texel, x and z        */
+    double   seconds;         /* the bake's wall time                     */
+} far_atlas_out;
+
 typedef struct build {
     const splat_build_desc *desc;
     splat_build_stats *st;
@@ -77,6 +86,7 @@ typedef struct build {
     sg_diags      *d;
     sg_loc         loc;       /* the scene file, for errors without a line */
     char          *out;       /* desc->out without trailing slashes        */
+    far_atlas_out  far;       /* --far-atlas: far_atlas.c                 */
 } build;
 
 /* Phases: each returns false on failure (with diagnostics in b->d). */
@@ -84,6 +94,13 @@ bool build_compose(build *b);    /* a job per shader, with its GLSL and key */
 bool build_compile(build *b);    /* cache lookups, glslang on the misses    */
 bool build_validate(build *b);   /* spirv-val on the compiled, cache puts   */
 void build_jobs_free(build *b);
+
+/* ---- the far atlas (far_atlas.c) ------------------------------------------ */
+
+/* With desc->far_atlas > 0: bake every texel's composite into b->far. */
+bool build_far_atlas(build *b);
+/* --stats: its size, density and bake time (nothing without an atlas). */
+void build_report_far(const build *b, FILE *out);
 
 /* ---- the pack writer (pack_write.c) -------------------------------------- */
 

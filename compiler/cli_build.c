@@ -1,6 +1,6 @@
 /* cli_build.c — `splatc build SCENE.sg -o PACKDIR [-j N] [--stats]
  * [--cache DIR | --no-cache] [--flat] [--no-lazy] [--compute-spirv] [--painted bc4|r8|dense]
- * [-I DIR]... [--depfile FILE] [--preview MATERIAL] [--json]`:
+ * [-I DIR]... [--depfile FILE] [--preview MATERIAL] [--far-atlas[=N]] [--json]`:
  * the command-line face
  * of splat_build (build.c).  Exit status 0 on success, 1 on input errors,
  * 2 on usage errors. */
@@ -35,17 +35,20 @@ static const char usage[] =
     "  --preview M    write material M's swatch pack instead: M alone on a\n"
     "                 built-in test hill under the scene's light (splatview\n"
     "                 --material renders it)\n"
+    "  --far-atlas[=N]  also bake the far atlas: each terrain texel's composited\n"
+    "                 albedo, normal and roughness, one atlas texel per N x N\n"
+    "                 heightfield texels (default 1), BC-compressed (far.atlas)\n"
     "  --json         diagnostics as JSON Lines on stderr (for editors)\n";
 
 static void print_stats(const splat_build_stats *st, FILE *out)
 {
     static const char *const names[] = {"load", "analysis", "compose+codegen",
-                                        "glslang", "validation", "write"};
+                                        "glslang", "validation", "far atlas", "write"};
     double t[] = {st->load, st->analysis, st->compose, st->glslang, st->validate,
-                  st->write};
+                  st->far_atlas, st->write};
     double total = 0;
     fprintf(out, "phase             seconds\n");
-    for (int i = 0; i < 6; i++) {
+    for (int i = 0; i < 7; i++) {
         fprintf(out, "%-16s %8.3f\n", names[i], t[i]);
         total += t[i];
     }
@@ -104,6 +107,15 @@ int splat_cli_build(int argc, char **argv)
             desc.no_lazy = true;
         } else if (strcmp(a, "--compute-spirv") == 0) {
             desc.compute_spirv = true;
+        } else if (strcmp(a, "--far-atlas") == 0 || strncmp(a, "--far-atlas=", 12) == 0) {
+            char *end;
+            long n = a[11] ? strtol(a + 12, &end, 10) : 1;
+            if (a[11] && (*end || n < 1 || n > 64)) {
+                fprintf(stderr, "splatc build: --far-atlas=N expects heightfield texels per "
+                                "atlas texel 1..64, found '%s'\n", a + 12);
+                goto done;
+            }
+            desc.far_atlas = (int)n;
         } else if (strcmp(a, "--painted") == 0 && next) {
             if (!splat_painted_format_parse(next, &desc.painted)) {
                 fprintf(stderr, "splatc build: --painted expects bc4, r8 or dense, found '%s'\n",

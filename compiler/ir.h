@@ -530,6 +530,11 @@ void ir_dump(const ir *ir, FILE *out);
 typedef void (*ir_sample_fn)(void *user, int texture, double u, double v,
                              double rgba[4]);
 
+/* The same with SAMPLE_GRAD's gradients (duv/dx, duv/dy), for a reference
+ * that filters as the GPU does (the far atlas bake, far_atlas.c). */
+typedef void (*ir_sample_grad_fn)(void *user, int texture, const double uv[2],
+                                  const double dx[2], const double dy[2], double rgba[4]);
+
 typedef struct ir_env {
     double height, slope;          /* terrain inputs at the sample point */
     double normal[3], position[3], uv[2];
@@ -543,6 +548,8 @@ typedef struct ir_env {
     double d_input[2][IR_IN_COUNT][4]; /* DINPUT leaves: screen-space
                                       derivative of each input, per axis
                                       (d/dx, d/dy); 0 when unset          */
+    ir_sample_grad_fn sample_grad; /* non-NULL: SAMPLE_GRAD calls it (with
+                                      sample_user) instead of `sample`    */
 } ir_env;
 
 /* Double-precision reference value of `r` (w = ir_type_width components). */

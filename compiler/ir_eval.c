@@ -52,7 +52,10 @@ void ir_eval_node(const ir *ir, uint32_t id, const ir_env *env, double (*vals)[4
     case IR_OP_SAMPLE_GRAD: {
         const double *uv = vals[n->arg[1].id];
         int tex = (int)ir->nodes[n->arg[0].id].imm;
-        if (env->sample) {
+        if (env->sample_grad && n->op == IR_OP_SAMPLE_GRAD) {
+            env->sample_grad(env->sample_user, tex, uv, vals[n->arg[2].id],
+                             vals[n->arg[3].id], out);
+        } else if (env->sample) {
             env->sample(env->sample_user, tex, uv[0], uv[1], out);
         } else {
             out[0] = out[1] = out[2] = 0.5;

@@ -22,6 +22,8 @@
 
 #include <stb_image.h>
 
+#include "far_atlas.h"
+
 #include "abi.h"
 #include "spv.h"
 
@@ -497,6 +499,17 @@ static json_t *manifest(build *b, char **tex_names, const char *dir)
     json_t *ug = jundergrowth(&b->ug);
     if (ug)
         json_object_set_new(m, "undergrowth", ug);
+    if (b->far.data) {   /* far_atlas.h */
+        json_t *fa = json_object();
+        json_object_set_new(fa, "file", json_string("far.atlas"));
+        json_object_set_new(fa, "width", json_integer(b->far.width));
+        json_object_set_new(fa, "height", json_integer(b->far.height));
+        json_object_set_new(fa, "levels", json_integer(b->far.levels));
+        json_object_set_new(fa, "texel", json_pack("[f, f]", b->far.texel[0], b->far.texel[1]));
+        json_object_set_new(fa, "bake_distance", json_real(FAR_ATLAS_BAKE_DISTANCE));
+        json_object_set_new(fa, "bytes", json_integer((json_int_t)b->far.n));
+        json_object_set_new(m, "far_atlas", fa);
+    }
     return m;
 }
 
@@ -576,6 +589,8 @@ static bool write_contents(build *b, const char *dir)
 
     if (ok && b->ug.nblocks > 0)
         ok = write_with(b, dir, "meshes.bin", put_meshes, &b->ug);
+    if (ok && b->far.data)
+        ok = write_file(b, dir, "far.atlas", b->far.data, b->far.n);
 
     for (int i = 0; ok && i < b->njobs; i++) {
         const job *j = &b->jobs[i];

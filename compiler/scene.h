@@ -34,10 +34,14 @@ typedef struct splat_build_desc {
                                         of every input here (build.c)     */
     const char        *preview;      /* non-NULL: this material's swatch pack
                                         instead (preview.c)               */
+    int                far_atlas;    /* > 0: bake the far atlas, one texel
+                                        per N x N heightfield texels
+                                        (far_atlas.c); 0: none            */
 } splat_build_desc;
 
 typedef struct splat_build_stats {
     double load, analysis, compose, glslang, validate, write; /* seconds     */
+    double far_atlas;        /* the far atlas bake (--far-atlas), seconds  */
     int    combos, combos_cached, combos_compiled;  /* composite shaders     */
     int    shaders, shaders_cached, shaders_compiled; /* every module         */
     int    lazy_branches;    /* lazy branches in the composites compiled

@@ -5,6 +5,7 @@
  * names the file and the field, never a crash or a validation error. */
 #include "rt_internal.h"
 #include "ir.h"
+#include "far_atlas.h"
 
 #include <errno.h>
 #include <fcntl.h>
@@ -402,6 +403,50 @@ static bool read_meshes(reader *r, const char *rel, rt_pack_ug *u)
     free(data);
     if (bad)
         return rt_fail(r->e, RT_E_PACK_FILE, r->manifest, "undergrowth.file", rel, bad);
+    return true;
+}
+
+/* "far_atlas" (optional): far.atlas, its size from the manifest's width,
+ * height and levels checked against the file's before it is read, and its
+ * header against the manifest (compiler/far_atlas.h). */
+static bool read_far(reader *r, json_t *root)
+{
+    json_t *o = get(r, root, "far_atlas", "manifest", false);
+    if (!o || json_is_null(o))
+        return true;
+    rt_pack_far *f = &r->p->far;
+    const char *file;
+    if (!get_int(r, o, "width", "far_atlas", 1, FAR_ATLAS_MAX_SIDE, &f->width) ||
+        !get_int(r, o, "height", "far_atlas", 1, FAR_ATLAS_MAX_SIDE, &f->height) ||
+        !get_int(r, o, "levels", "far_atlas", 1,
+                 far_atlas_levels_max((uint32_t)f->width, (uint32_t)f->height), &f->levels) ||
+        !get_string(r, o, "file", "far_atlas", &file))
+        return false;
+    size_t want = (size_t)far_atlas_file_bytes((uint32_t)f->width, (uint32_t)f->height,
+                                               f->levels);
+    size_t n = 0;
+    uint8_t *data = pack_file(r, "far_atlas.file", file, want, want, &n);
+    if (!data)
+        return false;
+    double tx, tz;
+    uint64_t bx, bz;
+    memcpy(&bx, data + 24, 8);   /* little-endian hosts only, as le32 */
+    memcpy(&bz, data + 32, 8);
+    memcpy(&tx, &bx, 8);
+    memcpy(&tz, &bz, 8);
+    if (memcmp(data, FAR_ATLAS_MAGIC, 8) || le32(data + 8) != FAR_ATLAS_VERSION ||
+        le32(data + 12) != (uint32_t)f->width || le32(data + 16) != (uint32_t)f->height ||
+        le32(data + 20) != (uint32_t)f->levels || !isfinite(tx) || !isfinite(tz) ||
+        !(tx > 0) || !(tz > 0)) {
+        free(data);
+        return rt_fail(r->e, RT_E_PACK_FILE, r->manifest, "far_atlas.file", file,
+                       "does not match the manifest's far_atlas (magic, version, size, levels "
+                       "or texel size)");
+    }
+    f->data = data;
+    f->n = n;
+    f->texel[0] = tx;
+    f->texel[1] = tz;
     return true;
 }
 
@@ -1160,7 +1205,8 @@ bool rt_pack_load(rt_pack *p, const char *dir, rt_error *e)
     }
     ok = read_scene(&r, root) && read_materials(&r, root) && read_params(&r, root) &&
          read_textures(&r, root) && read_painted(&r, root) && read_sites(&r, root) &&
-         read_combos(&r, root) && read_quadtree(&r, root) && read_undergrowth(&r, root);
+         read_combos(&r, root) && read_quadtree(&r, root) && read_undergrowth(&r, root) &&
+         read_far(&r, root);
     if (ok) {
         json_t *vx = get(&r, root, "vertex", "manifest", true);
         ok = vx && read_spirv(&r, vx, "vertex", &p->vertex);
@@ -1225,6 +1271,7 @@ void rt_pack_free(rt_pack *p)
     free(p->ug.meshes);
     free(p->ug.vertices);
     free(p->ug.indices);
+    free(p->far.data);
     free_spirv(&p->vertex);
     free(p->cameras);
     free(p->materials);

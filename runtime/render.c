@@ -504,6 +504,8 @@ bool rt_renderer_create(rt_device *d, const rt_pack *p, const rt_render_desc *de
         rt_renderer_destroy(r);
         return false;
     }
+    if (r->screen)
+        rt_screen_far(r->screen, r->desc.far_atlas_distance);
     r->shading = r->screen ? RT_SHADING_SCREEN : RT_SHADING_FORWARD;
     if (!make_undergrowth(r, e)) {
         rt_renderer_destroy(r);
@@ -1372,6 +1374,7 @@ bool rt_renderer_swap_pack(rt_renderer *r, const rt_pack *p, rt_error *e)
             r->screen = NULL;
             return false;
         }
+        rt_screen_far(r->screen, r->desc.far_atlas_distance);
     }
     return true;
 }

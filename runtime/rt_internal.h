@@ -428,6 +428,21 @@ bool rt_screen_dispatch(rt_screen *s, VkCommandBuffer cb, rt_pipelines *pl,
  * again), -1 on error. */
 int rt_screen_missing(rt_screen *s, rt_pipelines *pl, unsigned variant, rt_error *e);
 void rt_screen_read_stats(const rt_screen *s, rt_screen_stats *st);
+/* The far atlas (far.c): tiles whose nearest terrain pixel is at least
+ * `distance` m away (0: off), outside the destructible area, are shaded
+ * from it.  Nothing without an atlas in the pack (rt_screen_has_far). */
+void rt_screen_far(rt_screen *s, double distance);
+bool rt_screen_has_far(const rt_screen *s);
+
+/* ---- far.c: the far atlas on the device ---------------------------------- */
+
+/* The device samples BC1 sRGB, BC5 and BC4 with linear filtering. */
+bool  rt_far_supported(rt_device *d);
+/* p->far's three images with every stored level, SHADER_READ_ONLY. */
+bool  rt_far_upload(rt_device *d, const rt_pack *p, rt_image img[3], rt_error *e);
+/* The far shading compute shader (malloc'd; NULL without the über compute
+ * GLSL whose head it reuses); `count`: the counting variant. */
+char *rt_far_glsl(const rt_pack *p, bool count);
 
 /* ---- undergrowth.c: cells, generation, drawing (render.c drives it) ---- */
 

@@ -54,6 +54,13 @@ struct rt_screen {
     bool                  wide;              /* classification: a workgroup
                                                 per tile (GPUs), else an
                                                 invocation per tile (CPUs)   */
+    /* the far atlas (far.c): list ncombos + 1 when far_ok */
+    bool                  far_ok;            /* the pack has one, the device
+                                                samples BC formats          */
+    float                 far_distance;      /* m; 0: off (rt_screen_far)    */
+    rt_image              far_img[3];        /* albedo, normal, roughness    */
+    VkSampler             far_sampler;
+    VkPipeline            far_pipe[2];       /* plain, counting              */
 };
 
 /* The classification shader: SPLAT_GLSL_TERRAIN (frame block) + this. */
@@ -74,6 +81,7 @@ static const char classify_glsl[] =
     "uint mask[WORDS];\n"
     "uint last = 0xffffffffu;\n"
     "bool any_cell = false;\n"
+    "float dmin = 1e30;   /* the tile's nearest terrain pixel (m) */\n"
     "void add_cell(ivec2 c) {\n"
     "    c = clamp(c, ivec2(0), ivec2(u_info.cells_x, u_info.cells_z) - 1);\n"
     "    uint i = uint(c.y) * u_info.cells_x + uint(c.x);\n"
@@ -126,6 +134,11 @@ static const char classify_glsl[] =
     "    }\n"
     "    vec4 p = u_frame.inv_view_proj * vec4(ndc, d, 1.0);\n"
     "    vec2 local = p.xz / p.w + u_frame.camera.xz;\n"
+    /* far atlas: never over the destructible area (patch_uv), craters
+     * change what the bake saw */
+    "    dmin = min(dmin, length(p.xyz / p.w));\n"
+    "    if (all(greaterThanEqual(local, u_push.patch_uv.xy)) &&\n"
+    "        all(lessThan(local, u_push.patch_uv.zw))) dmin = 0.0;\n"
     "    vec2 cf = local / u_frame.terrain.xy * u_frame.texel.xy / float(u_info.cell_texels);\n"
     /* a pixel within 1/64 cell of an edge counts for both cells: the
      * position from depth is rounded, the analysis is per closed cell */
@@ -147,16 +160,23 @@ static const char classify_glsl[] =
     "    }\n"
     "    return u_info.ncombos;\n"
     "}\n"
+    /* a tile wholly beyond the far distance (info.y, float bits; 0: off)
+     * goes to the far atlas's list */
+    "uint pick_far() {\n"
+    "    float fd = uintBitsToFloat(u_push.info.y);\n"
+    "    return fd > 0.0 && dmin >= fd ? u_info.ncombos + 1u : pick();\n"
+    "}\n"
     "#ifdef WIDE\n"
     /* GPUs: one workgroup per tile, one invocation per pixel; the sets
      * ORed over each subgroup, then over the workgroup in shared memory */
     "layout(local_size_x = 64) in;\n"
     "shared uint s_mask[WORDS];\n"
     "shared uint s_any;\n"
+    "shared uint s_dmin;\n"
     "void main() {\n"
     "    uint li = gl_LocalInvocationIndex;\n"
     "    if (li < uint(WORDS)) s_mask[li] = 0u;\n"
-    "    if (li == 0u) s_any = 0u;\n"
+    "    if (li == 0u) { s_any = 0u; s_dmin = floatBitsToUint(1e30); }\n"
     "    for (int w = 0; w < WORDS; w++) mask[w] = 0u;\n"
     "    barrier();\n"
     "    uvec2 tile = gl_WorkGroupID.xy;\n"
@@ -167,10 +187,13 @@ static const char classify_glsl[] =
     "        if (subgroupElect() && v != 0u) atomicOr(s_mask[w], v);\n"
     "    }\n"
     "    if (subgroupAny(any_cell) && subgroupElect()) atomicOr(s_any, 1u);\n"
+    "    float dm = subgroupMin(dmin);   /* >= 0: the bits order as uints */\n"
+    "    if (subgroupElect()) atomicMin(s_dmin, floatBitsToUint(dm));\n"
     "    barrier();\n"
     "    if (li != 0u || s_any == 0u) return;   /* sky tile: skipped */\n"
     "    for (int w = 0; w < WORDS; w++) mask[w] = s_mask[w];\n"
-    "    append(pick(), tile.x | (tile.y << 16u));\n"
+    "    dmin = uintBitsToFloat(s_dmin);\n"
+    "    append(pick_far(), tile.x | (tile.y << 16u));\n"
     "}\n"
     "#else\n"
     /* CPU drivers (lavapipe): one invocation per tile, no shared memory
@@ -185,7 +208,7 @@ static const char classify_glsl[] =
     "            ivec2 px = ivec2(tile * 8u) + ivec2(x, y);\n"
     "            if (all(lessThan(px, size))) pixel(px);\n"
     "        }\n"
-    "    if (any_cell) append(pick(), tile.x | (tile.y << 16u));\n"
+    "    if (any_cell) append(pick_far(), tile.x | (tile.y << 16u));\n"
     "}\n"
     /* every invocation reaches append's subgroup loop or none past it */
     "void main() {\n"
@@ -540,12 +563,14 @@ static bool make_compute(rt_screen *s, const rt_pipelines *pl, VkSampler nearest
     rt_device *d = s->d;
     const VkDescriptorType sb = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
     const VkShaderStageFlags cs = VK_SHADER_STAGE_COMPUTE_BIT;
-    VkDescriptorSetLayoutBinding b[5] = {
+    const VkDescriptorType cis = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
+    VkDescriptorSetLayoutBinding b[8] = {
         { 0, sb, 1, cs, NULL }, { 1, sb, 1, cs, NULL }, { 2, sb, 1, cs, NULL },
-        { 3, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, cs, NULL },
-        { 4, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, cs, NULL },
+        { 3, cis, 1, cs, NULL }, { 4, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, cs, NULL },
     };
     uint32_t nb = s->raycast ? 5 : 3;
+    for (uint32_t k = 0; s->far_ok && k < 3; k++)   /* far.c's atlas, bindings 5-7 */
+        b[nb++] = (VkDescriptorSetLayoutBinding){ 5 + k, cis, 1, cs, NULL };
     VkDescriptorSetLayoutCreateInfo li = {
         .sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO,
         .bindingCount = nb,
@@ -564,13 +589,13 @@ static bool make_compute(rt_screen *s, const rt_pipelines *pl, VkSampler nearest
     RT_VK(e, vkCreatePipelineLayout(d->dev, &pi, NULL, &s->layout));
 
     VkDescriptorPoolSize sizes[3] = {
-        { sb, 3 }, { VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1 },
+        { sb, 3 }, { cis, (s->raycast ? 1 : 0) + (s->far_ok ? 3 : 0) },
         { VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1 },
     };
     VkDescriptorPoolCreateInfo dpi = {
         .sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO,
         .maxSets = 1,
-        .poolSizeCount = s->raycast ? 3 : 1,
+        .poolSizeCount = s->raycast ? 3 : s->far_ok ? 2 : 1,
         .pPoolSizes = sizes,
     };
     RT_VK(e, vkCreateDescriptorPool(d->dev, &dpi, NULL, &s->pool));
@@ -585,16 +610,21 @@ static bool make_compute(rt_screen *s, const rt_pipelines *pl, VkSampler nearest
         { s->info.buf, 0, VK_WHOLE_SIZE }, { s->tiles.buf, 0, VK_WHOLE_SIZE },
         { s->args.buf, 0, VK_WHOLE_SIZE },
     };
-    VkDescriptorImageInfo ii[2] = {
-        { s->mip_sampler, s->maxmip.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL },
-        { VK_NULL_HANDLE, s->rdepth.view, VK_IMAGE_LAYOUT_GENERAL },
+    VkDescriptorImageInfo ii[8] = {
+        [3] = { s->mip_sampler, s->maxmip.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL },
+        [4] = { VK_NULL_HANDLE, s->rdepth.view, VK_IMAGE_LAYOUT_GENERAL },
     };
-    VkWriteDescriptorSet w[5];
-    for (uint32_t i = 0; i < nb; i++)
+    for (int k = 0; s->far_ok && k < 3; k++)
+        ii[5 + k] = (VkDescriptorImageInfo){ s->far_sampler, s->far_img[k].view,
+                                             VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL };
+    VkWriteDescriptorSet w[8];
+    for (uint32_t i = 0; i < nb; i++) {
+        uint32_t at = b[i].binding;
         w[i] = (VkWriteDescriptorSet){ .sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET,
-            .dstSet = s->set, .dstBinding = i, .descriptorCount = 1,
+            .dstSet = s->set, .dstBinding = at, .descriptorCount = 1,
             .descriptorType = b[i].descriptorType,
-            .pBufferInfo = i < 3 ? &bi[i] : NULL, .pImageInfo = i >= 3 ? &ii[i - 3] : NULL };
+            .pBufferInfo = at < 3 ? &bi[at] : NULL, .pImageInfo = at >= 3 ? &ii[at] : NULL };
+    }
     vkUpdateDescriptorSets(d->dev, nb, w, 0, NULL);
 
     char head[320];
@@ -633,7 +663,8 @@ bool rt_screen_create(rt_device *d, const rt_pack *p, const rt_pipelines *pl,
     s->tiles_x = (s->width + SPLAT_TILE - 1) / SPLAT_TILE;
     s->tiles_y = (s->height + SPLAT_TILE - 1) / SPLAT_TILE;
     s->ntiles = s->tiles_x * s->tiles_y;
-    s->nlists = p->ncombos + 1;
+    s->far_ok = p->far.data && p->uber_compute && rt_far_supported(d);
+    s->nlists = p->ncombos + 1 + s->far_ok;   /* + the far atlas's list */
     s->words = (p->nmaterials + 31) / 32;
     if (s->words > MAX_WORDS)
         s->words = 0;   /* too many materials to classify: über-shader only */
@@ -676,6 +707,20 @@ bool rt_screen_create(rt_device *d, const rt_pack *p, const rt_pipelines *pl,
                            VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
                            false, &s->depth_copy, e)))
         return false;
+    if (s->far_ok) {
+        VkSamplerCreateInfo si = {
+            .sType = VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO,
+            .magFilter = VK_FILTER_LINEAR, .minFilter = VK_FILTER_LINEAR,
+            .mipmapMode = VK_SAMPLER_MIPMAP_MODE_LINEAR,
+            .addressModeU = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE,
+            .addressModeV = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE,
+            .addressModeW = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE,
+            .maxLod = VK_LOD_CLAMP_NONE,
+        };
+        RT_VK(e, vkCreateSampler(d->dev, &si, NULL, &s->far_sampler));
+        if (!rt_far_upload(d, p, s->far_img, e))
+            return false;
+    }
     if (!make_depth_pass(s, depth, e) || !make_compute(s, pl, nearest, e))
         return false;
 
@@ -715,6 +760,13 @@ void rt_screen_destroy(rt_screen *s)
             vkDestroyPipeline(d->dev, s->classify, NULL);
         if (s->raycaster)
             vkDestroyPipeline(d->dev, s->raycaster, NULL);
+        for (int k = 0; k < 2; k++)
+            if (s->far_pipe[k])
+                vkDestroyPipeline(d->dev, s->far_pipe[k], NULL);
+        for (int k = 0; k < 3; k++)
+            rt_image_destroy(d, &s->far_img[k]);
+        if (s->far_sampler)
+            vkDestroySampler(d->dev, s->far_sampler, NULL);
         rt_image_destroy(d, &s->maxmip);
         if (s->mip_sampler)
             vkDestroySampler(d->dev, s->mip_sampler, NULL);
@@ -851,6 +903,18 @@ void rt_screen_classify(rt_screen *s, VkCommandBuffer cb, VkDescriptorSet set0,
     memcpy(push.patch_xz, clear, 3 * sizeof(float));
     push.patch_xz[3] = 1.0f;
     push.info[0] = force_uber || s->words == 0;
+    /* the far atlas's distance (0: off) and the destructible area */
+    float fd = s->far_ok && !force_uber ? s->far_distance : 0.0f;
+    memcpy(&push.info[1], &fd, sizeof fd);
+    const rt_pack *p = s->p;
+    float rect[4] = { 1.0f, 1.0f, 0.0f, 0.0f };   /* empty */
+    if (p->has_destruction) {
+        rect[0] = (float)p->destr_origin[0];
+        rect[1] = (float)p->destr_origin[1];
+        rect[2] = (float)(p->destr_origin[0] + p->destr_size[0]);
+        rect[3] = (float)(p->destr_origin[1] + p->destr_size[1]);
+    }
+    memcpy(push.patch_uv, rect, sizeof rect);
     vkCmdPushConstants(cb, s->layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof push, &push);
     if (s->wide)
         vkCmdDispatch(cb, (uint32_t)s->tiles_x, (uint32_t)s->tiles_y, 1);
@@ -879,6 +943,8 @@ bool rt_screen_dispatch(rt_screen *s, VkCommandBuffer cb, rt_pipelines *pl,
     bool bound_sets = false;
     for (int k = 0; k < s->nlists; k++) {
         s->dispatched[k] = 0;
+        if (k > p->ncombos)   /* the far list, below */
+            continue;
         if (!rt_pipelines_has_compute(pl, k, variant))
             continue;
         VkPipeline pipe;
@@ -897,6 +963,31 @@ bool rt_screen_dispatch(rt_screen *s, VkCommandBuffer cb, rt_pipelines *pl,
         push.info[2] = (uint32_t)p->nmaterials;
         push.info[3] = (uint32_t)k * (uint32_t)s->ntiles;
         vkCmdPushConstants(cb, pl->compute_layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof push, &push);
+        vkCmdDispatchIndirect(cb, s->args.buf, (VkDeviceSize)k * 12);
+        s->dispatched[k] = variant + 1;
+    }
+    if (s->far_ok && s->far_distance > 0) {
+        int k = p->ncombos + 1, c = (variant & RT_CVARIANT_COUNT) != 0;
+        if (!s->far_pipe[c]) {
+            char *src = rt_far_glsl(p, c);
+            if (!src)
+                return rt_fail(e, RT_E_VULKAN, "far atlas shader", "no über compute GLSL");
+            bool ok = rt_glsl_compute_pipeline(d, pl->cache, s->layout, src, "far.comp", NULL,
+                                               &s->far_pipe[c], e);
+            free(src);
+            if (!ok)
+                return false;
+        }
+        VkDescriptorSet all[3] = { sets[0], sets[1], s->set };
+        vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, s->layout, 0, 3, all, 0, NULL);
+        vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, s->far_pipe[c]);
+        (*binds)++;
+        splat_push push;
+        memset(&push, 0, sizeof push);
+        push.info[1] = (uint32_t)k;
+        push.info[2] = (uint32_t)p->nmaterials;
+        push.info[3] = (uint32_t)k * (uint32_t)s->ntiles;
+        vkCmdPushConstants(cb, s->layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof push, &push);
         vkCmdDispatchIndirect(cb, s->args.buf, (VkDeviceSize)k * 12);
         s->dispatched[k] = variant + 1;
     }
@@ -932,7 +1023,7 @@ int rt_screen_missing(rt_screen *s, rt_pipelines *pl, unsigned variant, rt_error
     const uint32_t *args = s->readback.map;
     int made = 0;
     for (int k = 0; k < s->nlists; k++) {
-        if (args[3 * k] == 0 || s->dispatched[k] == variant + 1)
+        if (args[3 * k] == 0 || s->dispatched[k] == variant + 1 || k > s->p->ncombos)
             continue;
         VkPipeline pipe;
         if (!rt_pipelines_compute(s->d, s->p, pl, k, variant, &pipe, e))
@@ -941,6 +1032,13 @@ int rt_screen_missing(rt_screen *s, rt_pipelines *pl, unsigned variant, rt_error
     }
     return made;
 }
+
+void rt_screen_far(rt_screen *s, double distance)
+{
+    s->far_distance = distance > 0 ? (float)distance : 0.0f;
+}
+
+bool rt_screen_has_far(const rt_screen *s) { return s->far_ok; }
 
 void rt_screen_read_stats(const rt_screen *s, rt_screen_stats *st)
 {
@@ -953,7 +1051,8 @@ void rt_screen_read_stats(const rt_screen *s, rt_screen_stats *st)
         st->tiles += (int)args[3 * k];
         st->lists += args[3 * k] > 0;
     }
-    st->tiles_uber = (int)args[3 * (s->nlists - 1)];
+    st->tiles_uber = (int)args[3 * s->p->ncombos];
+    st->tiles_far = s->far_ok ? (int)args[3 * (s->p->ncombos + 1)] : 0;
     st->pixels = c.pixels;
     st->layers_evaluated = c.layers_evaluated;
     st->layers_needed = c.layers_needed;

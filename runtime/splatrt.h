@@ -244,6 +244,14 @@ typedef struct rt_pack_ug {
     uint32_t          nindices;
 } rt_pack_ug;
 
+/* The far atlas (compiler/far_atlas.h): far.atlas as read, checked. */
+typedef struct rt_pack_far {
+    uint8_t *data;             /* the whole file; NULL: the pack has none  */
+    size_t   n;
+    int      width, height, levels;
+    double   texel[2];         /* metres per level-0 texel                  */
+} rt_pack_far;
+
 typedef struct rt_pack {
     char            *dir;
     char            *name;
@@ -276,6 +284,7 @@ typedef struct rt_pack {
                                         the pack (hot reload), or NULL      */
     rt_light         light;          /* scene.light over the defaults       */
     rt_pack_ug       ug;             /* undergrowth; ug.nslots 0: none      */
+    rt_pack_far      far;            /* far atlas; far.data NULL: none      */
 } rt_pack;
 
 /* Read and check a pack, untrusted input: every file it names is a
@@ -328,6 +337,7 @@ typedef enum rt_reference {
 typedef struct rt_screen_stats {
     int      tiles, tiles_total;  /* terrain tiles shaded; all tiles         */
     int      tiles_uber;          /* tiles no combination covered            */
+    int      tiles_far;           /* tiles shaded from the far atlas         */
     int      lists;               /* combinations (and über) with tiles      */
     uint32_t pixels, layers_evaluated, layers_needed, samples;  /* counting */
     uint32_t branches, branches_uniform;   /* splat_counters (abi.h)         */
@@ -350,6 +360,9 @@ typedef struct rt_render_desc {
     bool         no_shadows;        /* the sun casts none (splatview --no-shadows) */
     bool         no_undergrowth;    /* draw no undergrowth (--no-undergrowth)  */
     double       undergrowth_radius; /* m around the camera; 0: RT_UG_RADIUS    */
+    double       far_atlas_distance; /* screen path: tiles at least this far (m)
+                                    are shaded from the pack's far atlas; 0:
+                                    off (the default)                        */
     /* any light key over the pack's (splatview --light KEY=V,...): bit k
      * of light_keys set = abi.h SPLAT_LIGHT_KEYS row k given, its values
      * in light[k]; applied after sun / exposure / fog_density above */

@@ -1,6 +1,7 @@
 /* splatview — render a shader pack: headless to PNG (and raw floats), or in
  * a GLFW window with a fly camera and hot reload.  See usage() below. */
 #include "rt_internal.h"
+#include "far_atlas.h"
 #include "scene.h"
 #include "util.h"
 
@@ -33,6 +34,9 @@ static void usage(FILE *f)
         "  --float-out FILE          also write the RGBA32F image (SPLATF32 format)\n"
         "  --param NAME=v[,v,v,v]    set a material param\n"
         "  --lod-pixels P            screen error per grid step (default 3)\n"
+        "  --far-atlas-distance D    screen path: tiles at least D m away are shaded\n"
+        "                            from the pack's far atlas (splatc build\n"
+        "                            --far-atlas); 0: off (default)\n"
         "  --sun AZ,EL               the sun: azimuth (degrees clockwise from north)\n"
         "                            and elevation, over the scene's light block\n"
         "  --exposure EV             exposure in stops (default: the scene's, or 0)\n"
@@ -102,6 +106,7 @@ typedef struct opts {
     bool no_undergrowth;
     int width, height, frames;
     double camera[3], look[3], lod_pixels;
+    double far_distance;   /* --far-atlas-distance */
     float clear[4];
     rt_reference ref;
     rt_shading shading;
@@ -258,6 +263,14 @@ static int parse_args(int argc, char **argv, opts *o)
             o->frames = atoi(v);
             if (o->frames < 1) {
                 fprintf(stderr, "splatview: --frames expects a positive count, found '%s'\n", v);
+                return 2;
+            }
+        } else if (!strcmp(a, "--far-atlas-distance")) {
+            NEED();
+            char *end;
+            o->far_distance = strtod(v, &end);
+            if (*end || !(o->far_distance >= 0) || !isfinite(o->far_distance)) {
+                fprintf(stderr, "splatview: --far-atlas-distance expects metres >= 0, found '%s'\n", v);
                 return 2;
             }
         } else if (!strcmp(a, "--lod-pixels")) {
@@ -525,7 +538,7 @@ static int headless(const opts *o)
         .no_cull = o->no_cull, .lod_pixels = o->lod_pixels, .no_shadows = o->no_shadows,
         .no_undergrowth = o->no_undergrowth,
         .destruction_pool = o->destruction_pool, .shading = o->shading,
-        .screen_depth = o->screen_depth,
+        .screen_depth = o->screen_depth, .far_atlas_distance = o->far_distance,
     };
     light_options(o, &rd);
     memcpy(rd.clear, o->clear, sizeof rd.clear);
@@ -600,8 +613,9 @@ static int headless(const opts *o)
                 summary(pass + k * o->frames, o->frames, &m, &l, &h);
                 printf("  %-18s gpu ms: median %.3f  p10 %.3f  p90 %.3f\n", names[k], m, l, h);
             }
-            printf("tiles: %d of %d shaded, %d lists, %d by the uber-shader\n", st.tiles.tiles,
-                   st.tiles.tiles_total, st.tiles.lists, st.tiles.tiles_uber);
+            printf("tiles: %d of %d shaded, %d lists, %d by the uber-shader, %d from the far "
+                   "atlas\n", st.tiles.tiles, st.tiles.tiles_total, st.tiles.lists,
+                   st.tiles.tiles_uber, st.tiles.tiles_far);
         }
         printf("quadtree cpu ms/frame: median %.4f  p10 %.4f  p90 %.4f\n", sm, sl, sh);
         if (o->no_shadows)
@@ -640,6 +654,12 @@ static int headless(const opts *o)
                    cs.tiles.branches / px);
         }
         printf("shading: %s\n", st.screen ? "screen" : "forward");
+        if (pack.far.data)   /* the BC blocks as uploaded (PACK.md "Far atlas") */
+            printf("far atlas: %d x %d texels of %.1f x %.1f m, %d levels, %zu bytes; %s\n",
+                   pack.far.width, pack.far.height, pack.far.texel[0], pack.far.texel[1],
+                   pack.far.levels, pack.far.n - FAR_ATLAS_HEADER,
+                   o->far_distance > 0 && st.screen
+                       ? "screen tiles beyond --far-atlas-distance use it" : "not used");
         rt_painted_print_stats(&pack, stdout);
         if (rt_renderer_destruction(r))
             rt_destruction_print_stats(rt_renderer_destruction(r), stdout);
@@ -735,7 +755,8 @@ int main(int argc, char **argv)
         .height = o.height ? o.height : 720, .script = o.script,
         .render = { .reference = o.ref, .pipeline_cache = o.cache, .lod_pixels = o.lod_pixels,
                     .shading = o.shading, .screen_depth = o.screen_depth,
-                    .no_shadows = o.no_shadows, .no_undergrowth = o.no_undergrowth },
+                    .no_shadows = o.no_shadows, .no_undergrowth = o.no_undergrowth,
+                    .far_atlas_distance = o.far_distance },
         .view = SPLAT_VIEW_FINAL,
     };
     memcpy(vd.render.clear, o.clear, sizeof o.clear);

@@ -354,6 +354,10 @@ if [ "$MODE" = smoke ]; then
     stoch=$(comp_pack minimal stochastic_select)
     render knobs minimal ground 320x180 composite=composite fp16=fp16 sobel=sobel \
         "stochastic=composite,pack=$stoch" lod6=composite,lod=6
+    KNOB_BUILD_ARGS="--far-atlas"
+    mf=$(knob_pack minimal far "" "")
+    KNOB_BUILD_ARGS=""
+    render knob_far minimal ground 320x180 "screen=screen,pack=$mf" "far50=screen,far=50,pack=$mf"
 else
     # (c) compositors, against the alpha composite of the same frames
     for s in minimal colorado; do
@@ -452,6 +456,19 @@ else
     for p in ground topdown; do
         render knob_lazy colorado "$p" 1280x720 "eager=composite,pack=$pe" lazy=composite \
             "eager_screen=screen,pack=$pe" lazy_screen=screen
+    done
+    # the far atlas (issue 11 part 3; splatc build --far-atlas, one texel per
+    # heightfield texel): the screen path with the tiles at least D m away
+    # shaded from the atlas, against the same pack's composites on the same
+    # frames; tiles_far says how many tiles the atlas took
+    KNOB_BUILD_ARGS="--far-atlas"
+    cf=$(knob_pack colorado far "" "")
+    KNOB_BUILD_ARGS=""
+    for p in topdown ground; do
+        render knob_far colorado "$p" 1280x720 "screen=screen,pack=$cf" \
+            "far40k=screen,far=40000,pack=$cf" "far20k=screen,far=20000,pack=$cf" \
+            "far10k=screen,far=10000,pack=$cf" "far5k=screen,far=5000,pack=$cf" \
+            "far2k=screen,far=2000,pack=$cf"
     done
 fi
 { echo "group,$(sed -n 1p "$W/render.txt")"; cat "$CSV.body"; } > "$CSV"

@@ -39,7 +39,10 @@
  *       time what they always timed), ugradius=R within R metres of the
  *       camera instead of the runtime's 96: its rows add the generation GPU ms
  *       per frame and per generated cell, the draw GPU ms per frame, the
- *       instances and the memory per cell.
+ *       instances and the memory per cell.  far=D (screen kinds) shades
+ *       tiles at least D m away from the pack's far atlas (splatc build
+ *       --far-atlas); its rows add the distance and the tiles the atlas
+ *       shaded (from the counting frame).
  *       Paths (--path): ground (2 m above the terrain looking 150 m ahead,
  *       from --start-preset NAME or --start x,z,dx,dz), topdown, grazing.
  *   splatbench upscale IN.png K OUT
@@ -192,6 +195,7 @@ typedef struct variant {
     bool         no_shadows;
     bool         ug;        /* draw the undergrowth                         */
     double       ug_radius; /* its radius (m); 0: the runtime's default     */
+    double       far;       /* screen: the far atlas's distance (m); 0: off */
     double       shadow_ms; /* CPU ms of the shadow map (the first frame)   */
     double      *ug_gen, *ug_draw; /* per timed frame, GPU ms               */
     long         ug_cells;  /* cells generated over the timed frames        */
@@ -396,6 +400,9 @@ static bool parse_variant(const char *s, const char *default_pack, variant *v)
             v->ug = true;
             v->ug_radius = atof(t + 9);
             ok = v->ug_radius > 0;
+        } else if (!strncmp(t, "far=", 4)) {
+            v->far = atof(t + 4);
+            ok = v->far > 0;
         } else if (!strncmp(t, "lod=", 4)) {
             v->lod = atof(t + 4);
             ok = v->lod > 0;
@@ -606,7 +613,7 @@ static int cmd_render(int argc, char **argv)
         rt_render_desc rd = {
             .width = width, .height = height, .lod_pixels = v[i].lod,
             .no_shadows = v[i].no_shadows, .no_undergrowth = !v[i].ug,
-            .undergrowth_radius = v[i].ug_radius,
+            .undergrowth_radius = v[i].ug_radius, .far_atlas_distance = v[i].far,
             .reference = v[i].k == K_MULTIPASS ? RT_REF_MULTIPASS
                        : v[i].k == K_UBER || v[i].k == K_SCREEN_UBER ? RT_REF_UBER : RT_REF_NONE,
             .pipeline_cache = save ? cache : NULL,
@@ -706,7 +713,7 @@ static int cmd_render(int argc, char **argv)
                      "geometry_ms,classify_ms,shade_ms,tiles,tiles_uber,layers_evaluated,"
                      "layers_needed,samples_per_px,branches_uniform_pct,shadow_map_ms,"
                      "ug_gen_med_ms,ug_gen_ms_per_cell,ug_draw_med_ms,ug_cells_per_frame,"
-                     "ug_instances,ug_bytes_per_cell\n");
+                     "ug_instances,ug_bytes_per_cell,far_distance,tiles_far\n");
     /* the device name in CSV: its commas become ';' */
     char devname[VK_MAX_PHYSICAL_DEVICE_NAME_SIZE];
     snprintf(devname, sizeof devname, "%s", dev.props.deviceName);
@@ -733,7 +740,7 @@ static int cmd_render(int argc, char **argv)
         const char *pk = strrchr(v[i].pack_dir, '/');
         fprintf(out, "\"%s\",%s,%s,%d,%d,%s,%s,%s,%g,%d,%.3f,%.3f,%.3f,%.3f,%.4f,%d,%d,"
                      "%.6g,%.6g,%.2f,%ld,%.1f,%s,%s,%.3f,%.3f,%.3f,%d,%d,%.4f,%.4f,%.3f,%.1f,"
-                     "%.2f,%.4f,%.4f,%.4f,%.2f,%ld,%zu\n",
+                     "%.2f,%.4f,%.4f,%.4f,%.2f,%ld,%zu,%g,%d\n",
                 devname, scene ? scene : v[i].base->name, pd.name, width, height,
                 v[i].label, kind_names[v[i].k], pk ? pk + 1 : v[i].pack_dir,
                 v[i].lod > 0 ? v[i].lod : 3.0, frames, gm, g10, g90, cm, sm,
@@ -747,7 +754,7 @@ static int cmd_render(int argc, char **argv)
                                     : 100.0,
                 v[i].shadow_ms, ugm, v[i].ug_cells ? gen_sum / (double)v[i].ug_cells : -1.0,
                 ugd, (double)v[i].ug_cells / frames, v[i].ug_last.instances,
-                v[i].ug_last.bytes_per_cell);
+                v[i].ug_last.bytes_per_cell, v[i].far, v[i].tiles.tiles_far);
     }
     if (csv)
         fclose(out);

@@ -1,0 +1,98 @@
+#!/bin/sh
+# tests/far/far.sh CASE SPLATC SPLATVIEW SPLATBENCH SRC OUT
+# The far atlas (compiler/far_atlas.h, runtime/far.c) on colorado:
+#   build     two builds with --far-atlas=4 give byte-identical packs
+#   error     screen path at the valley camera (320x180): per distance band
+#             [D_k, D_k+1) the tiles the atlas shades there against the same
+#             tiles shaded by their composites (images with far distance D_k
+#             and D_k+1 differ in exactly those tiles); the band's mean
+#             absolute error per colour channel must stay within BOUND and
+#             every band must have tiles; zero validation messages
+#   corrupt   on examples/minimal's pack: a truncated far.atlas, a wrong
+#             magic, levels over the chain, a manifest width that does not
+#             match the file, a symbolic link: each refused with an error
+#             naming far_atlas
+# Prints the bands as a table (the RESULTS.md rows come from it).
+set -eu
+CASE=$1 SPLATC=$2 VIEW=$3 BENCH=$4 SRC=$5 OUT=$6
+PACK=${FAR_PACK:-$OUT/colorado_far}   # FAR_PACK: measure another pack
+mkdir -p "$OUT"
+fail() { echo "FAIL: $*" >&2; exit 1; }
+
+build_pack() {   # $1: folder
+    "$SPLATC" build "$SRC/examples/colorado/scene.sg" -o "$1" --far-atlas=4 -j 2 \
+        --cache "$OUT/cache" >/dev/null
+}
+
+case $CASE in
+build)
+    rm -rf "$PACK" "$PACK.2"
+    build_pack "$PACK"
+    build_pack "$PACK.2"   # the cache is warm: only the bake runs again
+    cmp "$PACK/far.atlas" "$PACK.2/far.atlas" || fail "far.atlas differs between two builds"
+    cmp "$PACK/manifest.json" "$PACK.2/manifest.json" || fail "manifest differs"
+    grep -q '"far_atlas"' "$PACK/manifest.json" || fail "no far_atlas in the manifest"
+    # without the option: no atlas, no manifest entry
+    "$SPLATC" build "$SRC/examples/minimal/scene.sg" -o "$OUT/minimal_nofar" --cache "$OUT/cache" >/dev/null
+    [ ! -e "$OUT/minimal_nofar/far.atlas" ] || fail "far.atlas written without --far-atlas"
+    ! grep -q far_atlas "$OUT/minimal_nofar/manifest.json" || fail "far_atlas in a pack without one"
+    echo "far.atlas: $(wc -c < "$PACK/far.atlas") bytes, identical on two builds"
+    ;;
+error)
+    [ -f "$PACK/far.atlas" ] || build_pack "$PACK"
+    BOUND=${FAR_BOUND:-0.05}
+    R="--headless --shading screen --size 320x180 --camera-preset valley --no-undergrowth --stats"
+    render() {   # $1: distance -> $OUT/far_$1.f32; prints the far tiles
+        SPLAT_VALIDATE=1 "$VIEW" "$PACK" $R --far-atlas-distance "$1" -o "$OUT/far_$1.png" \
+            --float-out "$OUT/far_$1.f32" > "$OUT/far_$1.log" 2>&1 ||
+            { cat "$OUT/far_$1.log" >&2; fail "splatview at distance $1"; }
+        grep -q "validation message" "$OUT/far_$1.log" && fail "validation messages at $1"
+        sed -n 's/.*, \([0-9]*\) from the far atlas/\1/p' "$OUT/far_$1.log"
+    }
+    render 0 > /dev/null
+    BANDS="1000 2000 5000 10000 20000 40000"
+    printf "%-16s %8s %12s %10s\n" "band (m)" "tiles" "mean_abs" "max_abs"
+    prev=""; prev_tiles=0; bad=0
+    for d in $BANDS 0; do
+        tiles=0
+        [ "$d" = 0 ] || tiles=$(render "$d")
+        if [ -n "$prev" ]; then
+            # band [prev, d): images prev and d differ in its tiles only
+            n=$((prev_tiles - tiles))
+            line=$("$BENCH" compare "$OUT/far_$prev.f32" "$OUT/far_$d.f32")
+            max=$(echo "$line" | awk '{print $2}')
+            mean=$(echo "$line" | awk -v n="$n" '{ printf "%.5f", (n > 0 ? $4 * 320 * 180 / (64 * n) : 0) }')
+            hi=$([ "$d" = 0 ] && echo inf || echo "$d")
+            printf "%-16s %8d %12s %10s\n" "[$prev, $hi)" "$n" "$mean" "$max"
+            [ "$n" -gt 0 ] || { echo "band [$prev, $hi) has no tiles" >&2; bad=1; }
+            awk -v m="$mean" -v b="$BOUND" 'BEGIN { exit !(m <= b) }' ||
+                { echo "band [$prev, $hi): mean error $mean over $BOUND" >&2; bad=1; }
+        fi
+        prev=$d; prev_tiles=$tiles
+    done
+    [ $bad = 0 ] || fail "far atlas error"
+    ;;
+corrupt)
+    # its own small pack (examples/minimal), so the case is quick under ASan
+    PACK=$OUT/minimal_far
+    "$SPLATC" build "$SRC/examples/minimal/scene.sg" -o "$PACK" --far-atlas --cache "$OUT/cache" \
+        >/dev/null
+    try() {   # $1: what; the pack in $OUT/bad must be refused naming far_atlas
+        if "$VIEW" "$OUT/bad" --headless --shading screen --size 64x36 -o "$OUT/bad.png" \
+            > "$OUT/bad.log" 2>&1; then
+            fail "$1: accepted"
+        fi
+        grep -q "far_atlas" "$OUT/bad.log" || { cat "$OUT/bad.log" >&2; fail "$1: error does not name far_atlas"; }
+        echo "$1: refused: $(grep -m1 far_atlas "$OUT/bad.log")"
+    }
+    fresh() { rm -rf "$OUT/bad"; cp -r "$PACK" "$OUT/bad"; }
+    fresh; head -c 1000 "$PACK/far.atlas" > "$OUT/bad/far.atlas"; try "truncated"
+    fresh; printf 'XPLATFAR' | dd of="$OUT/bad/far.atlas" conv=notrunc 2>/dev/null; try "magic"
+    fresh; sed -i "s/\"levels\": [0-9][0-9]*/\"levels\": 99/" "$OUT/bad/manifest.json"; try "levels"
+    fresh; awk '/"far_atlas"/ { f = 1 } f && /"width"/ { sub(/[0-9]+/, "100"); f = 0 } { print }' \
+        "$PACK/manifest.json" > "$OUT/bad/manifest.json"; try "width"
+    fresh; rm "$OUT/bad/far.atlas"; ln -s "$PACK/far.atlas" "$OUT/bad/far.atlas"; try "symlink"
+    ;;
+*)
+    echo "unknown case $CASE" >&2; exit 2 ;;
+esac
