@@ -1,5 +1,6 @@
 /* cli_build.c — `splatc build SCENE.sg -o PACKDIR [-j N] [--stats]
- * [--cache DIR | --no-cache] [--flat] [--compute-spirv] [--painted bc4|r8|dense]
+ * [--cache DIR | --no-cache] [--flat] [--compute-spirv] [--no-distance-classes]
+ * [--painted bc4|r8|dense]
  * [-I DIR]... [--depfile FILE] [--preview MATERIAL] [--json]`:
  * the command-line face
  * of splat_build (build.c).  Exit status 0 on success, 1 on input errors,
@@ -24,6 +25,7 @@ static const char usage[] =
     "  --flat         also write each composite without dynamic branches\n"
     "  --compute-spirv  also compile the compute variants to SPIR-V (default:\n"
     "                 their GLSL only; the runtime compiles them on first use)\n"
+    "  --no-distance-classes  no distance class variants (compiler/distance.c)\n"
     "  --painted F    painted mask storage: bc4 (default: sparse quad-tree,\n"
     "                 BC4 atlas), r8 (sparse, R8 atlas) or dense (painted.r8)\n"
     "  -I DIR         search DIR for imports (repeatable; then $SPLATC_PATH,\n"
@@ -57,6 +59,7 @@ static void print_stats(const splat_build_stats *st, FILE *out)
             st->combos_cached, st->combos_compiled);
     fprintf(out, "shaders: %d (%d from cache, %d compiled)\n", st->shaders,
             st->shaders_cached, st->shaders_compiled);
+    fprintf(out, "distance classes: %d variants added\n", st->dclasses);
 }
 
 int splat_cli_build(int argc, char **argv)
@@ -98,6 +101,8 @@ int splat_cli_build(int argc, char **argv)
             desc.flat = true;
         } else if (strcmp(a, "--compute-spirv") == 0) {
             desc.compute_spirv = true;
+        } else if (strcmp(a, "--no-distance-classes") == 0) {
+            desc.no_dclasses = true;
         } else if (strcmp(a, "--painted") == 0 && next) {
             if (!splat_painted_format_parse(next, &desc.painted)) {
                 fprintf(stderr, "splatc build: --painted expects bc4, r8 or dense, found '%s'\n",

@@ -596,6 +596,13 @@ void    ir_ienv_domain(ir_ienv *ienv);
  * in out[c] for each component c.  NaN-producing cases widen to
  * [-inf, +inf]. */
 void ir_interval(const ir *ir, ir_ref r, const ir_ienv *env, ir_iv out[4]);
+/* The same bounds for every node at once: vals[id][c] (ir->nnodes rows). */
+void ir_interval_nodes(const ir *ir, const ir_ienv *env, ir_iv (*vals)[4]);
+/* A pass outside the pipeline (it needs a region): every value whose
+ * bounds over `env` are one finite point becomes that constant
+ * (opt_pin.c); run ir_optimize after it.  Distance classes use it
+ * (compiler/distance.c). */
+bool opt_pin(ir *ir, const ir_ienv *env);
 
 /* ---- GLSL (glsl.c) ----------------------------------------------------- */
 

@@ -118,3 +118,12 @@ void ir_interval(const ir *ir, ir_ref r, const ir_ienv *env, ir_iv out[4])
     free(vals);
     free(need);
 }
+
+void ir_interval_nodes(const ir *ir, const ir_ienv *env, ir_iv (*vals)[4])
+{
+    assert(env);
+    for (int c = 0; c < 4; c++)
+        vals[0][c] = (ir_iv){0, 0};
+    for (uint32_t id = 1; id < ir->nnodes; id++)
+        bound_node(ir, id, env, vals);
+}

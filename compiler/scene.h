@@ -28,6 +28,7 @@ typedef struct splat_build_desc {
     bool               compute_spirv; /* also compile the compute variants
                                         (default: their GLSL only; PACK.md) */
     splat_painted_format painted;    /* painted mask storage; default BC4     */
+    bool               no_dclasses;  /* no distance classes (distance.c)     */
     FILE              *report;       /* non-NULL: the analysis report here    */
     const char        *depfile;      /* non-NULL: write a Make/Ninja depfile
                                         of every input here (build.c)     */
@@ -39,6 +40,7 @@ typedef struct splat_build_stats {
     double load, analysis, compose, glslang, validate, write; /* seconds     */
     int    combos, combos_cached, combos_compiled;  /* composite shaders     */
     int    shaders, shaders_cached, shaders_compiled; /* every module         */
+    int    dclasses;         /* distance class variants added (distance.c)  */
     bool   up_to_date;       /* the pack already held this build's output:
                                 nothing after `load` ran (combos = its count) */
 } splat_build_stats;
