@@ -4,10 +4,12 @@
  *
  *   test_dclass PACKDIR   (colorado's pack, built by render.pack_colorado)
  *
- * At 20 random cameras (a fixed seed): 2 to 400 m above the ground
- * (log-uniform, so nodes and tiles fall on both sides of rock's 300 m
- * fade), anywhere over the terrain, looking 5 to 45 degrees down in any
- * direction, at 128x72, each path (forward, screen) renders the picture
+ * At 20 random cameras (a fixed seed), at 128x72: half of them 2 to 400 m
+ * above the ground (log-uniform) anywhere over the terrain, looking 5 to
+ * 45 degrees down in any direction; the other half 20 to 250 m from a
+ * random point of a leaf cell whose combination has rock on top and whose
+ * slope is over rock's ramp (bare rock), looking at it from 2 to 50 m up (rock's parallax fades out at 300 m, so nodes
+ * and tiles fall on both sides of its class boundary); each path (forward, screen) renders the picture
  * with the distance classes on and the picture with every patch / tile on
  * the über-shader (--reference uber); they must agree within 1/255 in
  * every channel of every pixel.  The classes must have been used (patches
@@ -47,6 +49,18 @@ static double ground(const rt_pack *p, double x, double z)
     return h / 65535.0 * p->max_height + p->height_offset;
 }
 
+/* 1 - n.y of Listing 1's normal at the texel under (x, z) (abi.c). */
+static double slope(const rt_pack *p, double x, double z)
+{
+    int i = (int)(x / p->size[0] * p->hf_width), j = (int)(z / p->size[1] * p->hf_height);
+#define T(a, b) ((double)p->heights[(size_t)((b) < 0 ? 0 : (b) >= p->hf_height ? p->hf_height - 1 : (b)) * \
+                 (size_t)p->hf_width + (size_t)((a) < 0 ? 0 : (a) >= p->hf_width ? p->hf_width - 1 : (a))] / 65535.0)
+    double nx = (T(i - 1, j) - T(i + 1, j)) * p->max_height / (p->size[0] / p->hf_width);
+    double nz = (T(i, j - 1) - T(i, j + 1)) * p->max_height / (p->size[1] / p->hf_height);
+#undef T
+    return 1 - 2 / sqrt(nx * nx + 4 + nz * nz);
+}
+
 static bool frame(rt_renderer *r, const rt_camera *c, rt_frame_stats *st, float *img)
 {
     rt_error e = { 0 };
@@ -70,17 +84,45 @@ int main(int argc, char **argv)
         return 1;
     }
     CHECK(p.ncombos > p.nbase, "the pack has no distance classes (%d combinations)", p.nbase);
+    /* texels whose leaf cell has rock as the top material of its
+     * combination (nothing above it is present) and whose slope is over
+     * rock's ramp (graphs/rock.sg: 0.16 .. 0.24), so bare rock: half the
+     * cameras look at one from 20 to 250 m, where the parallax is on (a
+     * class used there would show) */
+    int rock = rt_pack_material_find(&p, "rock");
+    const rt_pack_level *leaf = &p.levels[0];
+    int *texels = malloc(sizeof(int) * (size_t)p.hf_width * (size_t)p.hf_height), ntexels = 0;
+    for (int tz = 0; texels && tz < p.hf_height; tz++)
+        for (int tx = 0; tx < p.hf_width; tx++) {
+            int cx = tx / p.cell_texels, cz = tz / p.cell_texels;
+            int id = leaf->ids[(size_t)cz * (size_t)leaf->width + (size_t)cx];
+            double x = (tx + 0.5) * p.size[0] / p.hf_width, z = (tz + 0.5) * p.size[1] / p.hf_height;
+            if (id < p.nbase && p.combos[id].materials[0] == rock && slope(&p, x, z) > 0.24)
+                texels[ntexels++] = tz * p.hf_width + tx;
+        }
+    printf("%d texels of bare rock\n", ntexels);
+    CHECK(rock >= 0 && ntexels > 0, "colorado has no bare rock");
     rt_camera cams[CAMERAS];
     for (int i = 0; i < CAMERAS; i++) {
         double x = p.size[0] * (0.02 + 0.96 * rnd01()), z = p.size[1] * (0.02 + 0.96 * rnd01());
         double above = 2.0 * pow(200.0, rnd01());
         double yaw = 2 * M_PI * rnd01(), pitch = (5 + 40 * rnd01()) * M_PI / 180;
         double y = ground(&p, x, z) + above;
-        cams[i] = (rt_camera){ .position = { x, y, z },
-                               .look = { x + cos(yaw) * cos(pitch), y - sin(pitch),
-                                         z + sin(yaw) * cos(pitch) },
+        double look[3] = { x + cos(yaw) * cos(pitch), y - sin(pitch), z + sin(yaw) * cos(pitch) };
+        if (i % 2 && ntexels > 0) {   /* at bare rock */
+            int t = texels[(int)(rnd01() * ntexels) % ntexels];
+            look[0] = (t % p.hf_width + rnd01()) * p.size[0] / p.hf_width;
+            look[2] = (t / p.hf_width + rnd01()) * p.size[1] / p.hf_height;
+            look[1] = ground(&p, look[0], look[2]);
+            double d = 20 * pow(12.5, rnd01());
+            x = look[0] + d * cos(yaw);
+            z = look[2] + d * sin(yaw);
+            y = fmax(ground(&p, x, z), look[1]) + 2 + 48 * rnd01();
+        }
+        cams[i] = (rt_camera){ .position = { x, y, z }, .look = { look[0], look[1], look[2] },
                                .fovy = M_PI / 3, .znear = 0.25 };
     }
+    free(texels);
     float *a = malloc(sizeof(float) * W * H * 4), *b = malloc(sizeof(float) * W * H * 4);
     static const char *const names[2] = { "forward", "screen" };
     for (int s = 0; s < 2 && a && b; s++) {
@@ -119,9 +161,11 @@ int main(int argc, char **argv)
                     at = k / 4;
                 }
             }
-            printf("%s camera %2d (%.0f, %.0f, %.0f), %5.1f m up: classes on %d of %d %s, "
-                   "max difference to the über-shader %.3g at (%zu, %zu)\n", names[s], i,
+            printf("%s camera %2d (%.0f, %.0f, %.0f) -> (%.0f, %.0f, %.0f), %5.1f m up: "
+                   "classes on %d of %d %s, max difference to the über-shader %.3g at "
+                   "(%zu, %zu)\n", names[s], i,
                    cams[i].position[0], cams[i].position[1], cams[i].position[2],
+                   cams[i].look[0], cams[i].look[1], cams[i].look[2],
                    cams[i].position[1] - ground(&p, cams[i].position[0], cams[i].position[2]),
                    u, t, s ? "tiles" : "patches", cam_worst, at % W, at / W);
             CHECK(cam_worst <= 1.0 / 255, "%s camera %d: classes differ from the über-shader "
