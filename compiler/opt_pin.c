@@ -15,12 +15,18 @@
  * (distance.c) run it with view.distance restricted, every other input at
  * its domain.
  *
- * Before (view.distance in [300, inf]):    After:
- *   node n1 : view.distance                  node n3 : ... (n2's uses read 0.0)
- *   node n2 : saturate { x = 1 - n1 / 300 }
- *   node n3 : mul { a = depth, b = n2.out }  node n3 : mul { a = depth, b = 0.0 }
- * and fold turns n3 into 0.0, so the parallax offset is 0 and its taps fold
- * onto one sample (nodes/parallax.sg).
+ * Before (view.distance in [301, inf]):   After opt_pin, then fold and DCE:
+ *   node n1 : view.distance                  out r = 0.0
+ *   node n2 : div { a = n1.out, b = 300.0 }
+ *   node n3 : sub { a = 1.0, b = n2.out }
+ *   node n4 : saturate { x = n3.out }
+ *   node n5 : view.direction
+ *   node n6 : mul { a = n4.out, b = n5.x }
+ *   out r = n6.out
+ * (n4 is [0, 0] there, and so is n6, as view.direction is bounded: both
+ * are pinned; fold alone could not drop mul(0, x) for an x that might be
+ * NaN.)  That is nodes/parallax.sg's offset: 0 beyond `fade` metres, so
+ * its eight taps fold onto one sample (tests/unit/test_distance.c).
  */
 #include "ir.h"
 

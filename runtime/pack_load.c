@@ -930,9 +930,14 @@ static bool read_classes(reader *r, json_t *cs)
     rt_pack *p = r->p;
     int total = p->nbase;
     for (int i = 0; i < p->nbase; i++) {
-        json_t *cl = get_array(r, json_array_get(cs, (size_t)i), "classes", "combination", false);
+        char where[64];
+        snprintf(where, sizeof where, "combinations[%d]", i);
+        json_t *c = json_array_get(cs, (size_t)i);
+        json_t *cl = get_array(r, c, "classes", where, false);
+        if (!cl && json_object_get(c, "classes"))
+            return false;   /* not an array: get_array said so */
         if (cl && json_array_size(cl) > 16)
-            return field_fail(r, "combinations[].classes:", "has more than 16 entries");
+            return field_fail(r, where, "classes: has more than 16 entries");
         total += cl ? (int)json_array_size(cl) : 0;
     }
     if (total > 65534)
