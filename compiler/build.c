@@ -121,10 +121,10 @@ static bool inputs_key(build *b)
     XXH3_128bits_reset(st);
     char head[192];
     int n = snprintf(head, sizeof head,
-                     "splatc %s\nabi %d\nflat %d\nlazy %d\npainted %s\ncompute-spirv %d\nfar-atlas %d\npreview ",
+                     "splatc %s\nabi %d\nflat %d\nlazy %d\npainted %s\ncompute-spirv %d\nfar-atlas %d\ndclasses %d\npreview ",
                      SPLATC_VERSION, SPLAT_ABI_VERSION, b->desc->flat, !b->desc->no_lazy,
                      splat_painted_format_name(b->desc->painted), b->desc->compute_spirv,
-                     b->desc->far_atlas);
+                     b->desc->far_atlas, !b->desc->no_dclasses);
     XXH3_128bits_update(st, head, (size_t)n);
     if (b->desc->preview)   /* the name and its end */
         XXH3_128bits_update(st, b->desc->preview, strlen(b->desc->preview) + 1);
@@ -188,6 +188,11 @@ static bool up_to_date(build *b, int *ncombos)
         ok = has_files(b->out, c) &&
              shader_files(b->out, json_object_get(c, "compute"), b->desc->compute_spirv) &&
              (!b->desc->flat || has_files(b->out, json_object_get(c, "flat")));
+        json_t *cls = json_object_get(c, "classes");   /* distance classes */
+        for (size_t k = 0; ok && k < json_array_size(cls); k++)
+            ok = shader_files(b->out, json_array_get(cls, k), b->desc->compute_spirv) &&
+                 shader_files(b->out, json_object_get(json_array_get(cls, k), "compute"),
+                              b->desc->compute_spirv);
     }
     json_t *mats = json_object_get(m, "materials");
     for (size_t i = 0; ok && i < json_array_size(mats); i++)

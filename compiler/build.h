@@ -21,11 +21,14 @@ typedef enum job_kind {
     JOB_COMBO, JOB_FLAT, JOB_UBER, JOB_REF, JOB_VERTEX,
     JOB_COMBO_COMPUTE, JOB_UBER_COMPUTE,   /* abi.h "compute stage" */
     JOB_COMBO_UG,                          /* abi.h "undergrowth masks" */
+    JOB_CLASS, JOB_CLASS_COMPUTE,          /* a distance class of a combination
+                                              (distance.c): fragment, compute */
 } job_kind;
 
 typedef struct job {
     job_kind  kind;
     int       index;          /* combination or material                   */
+    int       dclass;         /* JOB_CLASS*: the class of combination index */
     char     *file;           /* "shaders/0003" (".frag" added for fragment
                                  shaders, ".spv" for the module)          */
     ir_buf    glsl;
@@ -48,6 +51,9 @@ typedef struct combo_info {
     int *textures, ntextures; /* layout textures used                     */
     int *params, nparams;
     double cost;              /* splat_composite_cost                     */
+    int    nclasses;          /* distance classes (distance.c)            */
+    double dlo[SPLAT_MAX_DCLASSES], dhi[SPLAT_MAX_DCLASSES]; /* their intervals */
+    double dcost[SPLAT_MAX_DCLASSES];                        /* their costs     */
 } combo_info;
 
 /* The far atlas as the pack stores it (far_atlas.h), when --far-atlas. */

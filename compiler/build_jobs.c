@@ -131,6 +131,49 @@ static void emit_job(build *b, job *j)
 
 /* ---- compose -------------------------------------------------------------- */
 
+static void keep_composite(build *b, splat_composite *pc)
+{
+    b->composites = xrealloc(b->composites, sizeof *b->composites * (size_t)(b->ncomposites + 1));
+    b->composites[b->ncomposites++] = pc;
+}
+
+/* The distance classes of combination `index` (distance.c): each a
+ * fragment and a compute job, shaders/NNNN.dK{.frag,.comp}. */
+static void add_classes(build *b, int index, const splat_composite *c, combo_info *info)
+{
+    splat_dclass *v;
+    int n = splat_distance_classes(&b->layout, c, &v, b->d);
+    for (int k = 0; k < n; k++) {
+        splat_composite *pc = xcalloc(1, sizeof *pc);
+        *pc = v[k].comp;
+        keep_composite(b, pc);
+        info->dlo[k] = v[k].lo;
+        info->dhi[k] = v[k].hi;
+        info->dcost[k] = v[k].cost;
+        for (int compute = 0; compute < 2; compute++) {
+            char *file = xasprintf(compute ? "shaders/%04d.d%d.comp" : "shaders/%04d.d%d",
+                                   index, k);
+            job *j = job_add(b, compute ? JOB_CLASS_COMPUTE : JOB_CLASS, index, file,
+                             compute ? SPV_STAGE_COMPUTE : SPV_STAGE_FRAGMENT);
+            j->dclass = k;
+            /* GLSL only, both stages, unless --compute-spirv: the runtime
+             * compiles a class on first use (PACK.md "Distance classes") */
+            j->glsl_only = !b->desc->compute_spirv;
+            snprintf(j->title, sizeof j->title,
+                     "composite of combination %d, distance class %d (%g m and %s)%s", index, k,
+                     v[k].lo == 0 ? v[k].hi : v[k].lo, v[k].lo == 0 ? "nearer" : "beyond",
+                     compute ? " (compute)" : "");
+            j->composite = pc;
+            j->gdesc = (splat_glsl_desc){.painted_sparse = b->sparse_ok,
+                                         .painted_places = b->painted_places,
+                                         .no_mask_view = true, .compute = compute != 0};
+        }
+    }
+    info->nclasses = n;
+    b->st->dclasses += n;
+    free(v);   /* the composites moved into b->composites */
+}
+
 static bool add_composite(build *b, job_kind kind, int index, const int *materials,
                           int n, bool reference, combo_info *info)
 {
@@ -141,8 +184,7 @@ static bool add_composite(build *b, job_kind kind, int index, const int *materia
         free(pc);
         return false;
     }
-    b->composites = xrealloc(b->composites, sizeof *b->composites * (size_t)(b->ncomposites + 1));
-    b->composites[b->ncomposites++] = pc;
+    keep_composite(b, pc);
     const splat_composite *c = pc;
     /* the variants of this composite: fragment, then flat (--flat) and
      * compute (composites and the über-shader) */
@@ -197,6 +239,8 @@ static bool add_composite(build *b, job_kind kind, int index, const int *materia
         info->params = xcalloc((size_t)c->nparams, sizeof *info->params);
         memcpy(info->params, c->params, (size_t)c->nparams * sizeof *c->params);
         info->cost = splat_composite_cost(c);
+        if (kind == JOB_COMBO && !b->desc->no_dclasses)
+            add_classes(b, index, c, info);
     }
     return true;
 }

@@ -1,6 +1,7 @@
 /* cli_build.c — `splatc build SCENE.sg -o PACKDIR [-j N] [--stats]
- * [--cache DIR | --no-cache] [--flat] [--no-lazy] [--compute-spirv] [--painted bc4|r8|dense]
- * [-I DIR]... [--depfile FILE] [--preview MATERIAL] [--far-atlas[=N]] [--json]`:
+ * [--cache DIR | --no-cache] [--flat] [--no-lazy] [--compute-spirv] [--no-distance-classes]
+ * [--painted bc4|r8|dense] [-I DIR]... [--depfile FILE] [--preview MATERIAL] [--far-atlas[=N]]
+ * [--json]`:
  * the command-line face
  * of splat_build (build.c).  Exit status 0 on success, 1 on input errors,
  * 2 on usage errors. */
@@ -26,6 +27,7 @@ static const char usage[] =
     "                 is skipped where its weight is 0; compiler/DESIGN.md 6.1)\n"
     "  --compute-spirv  also compile the compute variants to SPIR-V (default:\n"
     "                 their GLSL only; the runtime compiles them on first use)\n"
+    "  --no-distance-classes  no distance class variants (compiler/distance.c)\n"
     "  --painted F    painted mask storage: bc4 (default: sparse quad-tree,\n"
     "                 BC4 atlas), r8 (sparse, R8 atlas) or dense (painted.r8)\n"
     "  -I DIR         search DIR for imports (repeatable; then $SPLATC_PATH,\n"
@@ -64,6 +66,7 @@ static void print_stats(const splat_build_stats *st, FILE *out)
             st->shaders_cached, st->shaders_compiled);
     fprintf(out, "lazy branches: %d in the fragment composites written\n",
             st->lazy_branches);
+    fprintf(out, "distance classes: %d variants added\n", st->dclasses);
 }
 
 int splat_cli_build(int argc, char **argv)
@@ -116,6 +119,8 @@ int splat_cli_build(int argc, char **argv)
                 goto done;
             }
             desc.far_atlas = (int)n;
+        } else if (strcmp(a, "--no-distance-classes") == 0) {
+            desc.no_dclasses = true;
         } else if (strcmp(a, "--painted") == 0 && next) {
             if (!splat_painted_format_parse(next, &desc.painted)) {
                 fprintf(stderr, "splatc build: --painted expects bc4, r8 or dense, found '%s'\n",

@@ -1301,3 +1301,13 @@ void splat_composite_glsl(const splat_layout *L, const splat_composite *c,
         free(dlayers);
     }
 }
+
+void splat_composite_refresh(const splat_layout *L, splat_composite *c, sg_diags *d)
+{
+    layers_from_roots(&c->ir, c->layers, c->nlayers);
+    free(c->textures);
+    free(c->params);
+    c->textures = c->params = NULL;
+    c->ntextures = c->nparams = 0;
+    collect_used(L, c, d);
+}

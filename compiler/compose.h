@@ -101,6 +101,10 @@ bool splat_compose(const splat_layout *L, const splat_compose_desc *desc,
                    splat_composite *c, sg_diags *d);
 void splat_composite_free(splat_composite *c);
 
+/* After a pass rewrote c->ir (distance.c): the layers' refs found again
+ * by their root names, the textures and params used collected again. */
+void splat_composite_refresh(const splat_layout *L, splat_composite *c, sg_diags *d);
+
 /* Estimated per-pixel cost of shading with `c` when every layer runs
  * (the most a pixel pays): ir_cost over all its values, in the op table's
  * cost units (ir.h IR_OPS).  The manifest's "cost": the runtime picks the
@@ -143,5 +147,26 @@ typedef struct splat_glsl_desc {
  * `if (w > 0.0)`); for a reference, one pass under SPLAT_MULTIPASS. */
 void splat_composite_glsl(const splat_layout *L, const splat_composite *c,
                           const splat_glsl_desc *desc, ir_buf *out);
+
+/* ---- distance.c: distance classes --------------------------------------- */
+
+/* A variant of a composite valid wherever view.distance lies in [lo, hi]:
+ * its values that the interval evaluator proves constant there pinned
+ * (opt_pin.c) and folded away.  Cheaper than the composite by ir_cost. */
+typedef struct splat_dclass {
+    double          lo, hi;    /* metres; hi = INFINITY for "and beyond"    */
+    splat_composite comp;
+    double          cost;      /* splat_composite_cost(&comp)               */
+} splat_dclass;
+
+/* At most this many classes per composite. */
+enum { SPLAT_MAX_DCLASSES = 4 };
+
+/* The distance classes of composite `c` (distance.c says how the
+ * boundaries are found): *out malloc'd (NULL when none), the count
+ * returned, cheapest last within each direction. */
+int  splat_distance_classes(const splat_layout *L, const splat_composite *c,
+                            splat_dclass **out, sg_diags *d);
+void splat_dclasses_free(splat_dclass *v, int n);
 
 #endif

@@ -606,6 +606,11 @@ void ir_interval(const ir *ir, ir_ref r, const ir_ienv *env, ir_iv out[4]);
 /* The same for every node at once: vals[id] (4 per node, ir->nnodes of
  * them) for each id (compose.c's lazy branches ask about many). */
 void ir_interval_all(const ir *ir, const ir_ienv *env, ir_iv (*vals)[4]);
+/* A pass outside the pipeline (it needs a region): every value whose
+ * bounds over `env` are one finite point becomes that constant
+ * (opt_pin.c); run ir_optimize after it.  Distance classes use it
+ * (compiler/distance.c). */
+bool opt_pin(ir *ir, const ir_ienv *env);
 
 /* ---- GLSL (glsl.c) ----------------------------------------------------- */
 

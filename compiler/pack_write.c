@@ -14,6 +14,7 @@
 #include <ftw.h>
 #include <jansson.h>
 #include <limits.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -376,6 +377,44 @@ static const job *find_job(const build *b, int i, int kind)
     return NULL;
 }
 
+static const job *find_class_job(build *b, int i, int k, job_kind kind)
+{
+    for (int n = 0; n < b->njobs; n++)
+        if (b->jobs[n].index == i && b->jobs[n].kind == kind && b->jobs[n].dclass == k)
+            return &b->jobs[n];
+    return NULL;
+}
+
+/* A combination's distance classes (PACK.md "Distance classes"), or NULL. */
+static json_t *jclasses(build *b, int i)
+{
+    const combo_info *ci = &b->combos[i];
+    if (ci->nclasses == 0)
+        return NULL;
+    json_t *a = json_array();
+    for (int k = 0; k < ci->nclasses; k++) {
+        const job *fj = find_class_job(b, i, k, JOB_CLASS);
+        const job *xj = find_class_job(b, i, k, JOB_CLASS_COMPUTE);
+        json_t *o = json_object();
+        json_t *dist = json_array();
+        json_array_append_new(dist, json_real(ci->dlo[k]));
+        json_array_append_new(dist, isinf(ci->dhi[k]) ? json_null() : json_real(ci->dhi[k]));
+        json_object_set_new(o, "distance", dist);
+        char buf[160];
+        snprintf(buf, sizeof buf, "%s.frag", fj->file);
+        json_object_set_new(o, "glsl", json_string(buf));
+        if (!fj->glsl_only) {
+            snprintf(buf, sizeof buf, "%s.spv", fj->file);
+            json_object_set_new(o, "spirv", json_string(buf));
+        }
+        json_object_set_new(o, "hash", json_string(fj->key));
+        json_object_set_new(o, "cost", json_real(ci->dcost[k]));
+        json_object_set_new(o, "compute", jcompute(xj));
+        json_array_append_new(a, o);
+    }
+    return a;
+}
+
 static json_t *jcombinations(build *b)
 {
     const splat_analysis *a = &b->analysis;
@@ -404,6 +443,9 @@ static json_t *jcombinations(build *b)
         const job *uj = find_job(b, i, JOB_COMBO_UG);
         if (uj)
             json_object_set_new(o, "undergrowth", jcompute(uj));
+        json_t *cls = jclasses(b, i);
+        if (cls)
+            json_object_set_new(o, "classes", cls);
         json_array_append_new(combos, o);
     }
     return combos;

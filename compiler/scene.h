@@ -29,6 +29,7 @@ typedef struct splat_build_desc {
     bool               compute_spirv; /* also compile the compute variants
                                         (default: their GLSL only; PACK.md) */
     splat_painted_format painted;    /* painted mask storage; default BC4     */
+    bool               no_dclasses;  /* no distance classes (distance.c)     */
     FILE              *report;       /* non-NULL: the analysis report here    */
     const char        *depfile;      /* non-NULL: write a Make/Ninja depfile
                                         of every input here (build.c)     */
@@ -46,6 +47,7 @@ typedef struct splat_build_stats {
     int    shaders, shaders_cached, shaders_compiled; /* every module         */
     int    lazy_branches;    /* lazy branches in the composites compiled
                                 (fragment variants; compose.c)          */
+    int    dclasses;         /* distance class variants added (distance.c)  */
     bool   up_to_date;       /* the pack already held this build's output:
                                 nothing after `load` ran (combos = its count) */
 } splat_build_stats;

@@ -323,6 +323,8 @@ static bool read_spirv(reader *r, json_t *obj, const char *where, rt_spirv *out)
 /* {"compute": {"glsl": …}} of a combination or the über-shader: the
  * compute variant's GLSL text (PACK.md), NUL-terminated; optional (a pack
  * without it cannot be drawn by the screen-space path). */
+static bool read_glsl_at(reader *r, json_t *c, const char *w, char **out);
+
 static bool read_glsl(reader *r, json_t *obj, const char *key, const char *where, char **out)
 {
     json_t *c = get(r, obj, key, where, false);
@@ -330,6 +332,12 @@ static bool read_glsl(reader *r, json_t *obj, const char *key, const char *where
         return true;
     char w[96];
     snprintf(w, sizeof w, "%s.%s", where, key);
+    return read_glsl_at(r, c, w, out);
+}
+
+/* The text of c["glsl"] (`w` names c in errors). */
+static bool read_glsl_at(reader *r, json_t *c, const char *w, char **out)
+{
     const char *rel;
     if (!get_string(r, c, "glsl", w, &rel))
         return false;
@@ -972,6 +980,74 @@ static bool read_sites(reader *r, json_t *root)
     return true;
 }
 
+/* The combinations' distance classes (PACK.md "Distance classes"),
+ * appended to p->combos after the nbase combinations. */
+static bool read_classes(reader *r, json_t *cs)
+{
+    rt_pack *p = r->p;
+    int total = p->nbase;
+    for (int i = 0; i < p->nbase; i++) {
+        char where[64];
+        snprintf(where, sizeof where, "combinations[%d]", i);
+        json_t *c = json_array_get(cs, (size_t)i);
+        json_t *cl = get_array(r, c, "classes", where, false);
+        if (!cl && json_object_get(c, "classes"))
+            return false;   /* not an array: get_array said so */
+        if (cl && json_array_size(cl) > 16)
+            return field_fail(r, where, "classes: has more than 16 entries");
+        total += cl ? (int)json_array_size(cl) : 0;
+    }
+    if (total > 65534)
+        return field_fail(r, "combinations:", "with their classes, more than 65534 shaders");
+    if (total == p->nbase)
+        return true;
+    rt_pack_combo *all = realloc(p->combos, (size_t)total * sizeof *all);
+    if (!all)
+        return false;
+    memset(all + p->nbase, 0, (size_t)(total - p->nbase) * sizeof *all);
+    p->combos = all;
+    int n = p->nbase;
+    for (int i = 0; i < p->nbase; i++) {
+        json_t *cl = json_object_get(json_array_get(cs, (size_t)i), "classes");
+        p->combos[i].first_class = n;
+        for (size_t k = 0; k < json_array_size(cl); k++) {
+            json_t *c = json_array_get(cl, k);
+            char where[96];
+            snprintf(where, sizeof where, "combinations[%d].classes[%zu]", i, k);
+            rt_pack_combo *co = &p->combos[n];
+            p->ncombos = ++n;   /* freed with the pack from here on */
+            co->base = i;
+            co->nmaterials = p->combos[i].nmaterials;
+            co->materials = calloc((size_t)co->nmaterials + 1, sizeof *co->materials);
+            if (!co->materials)
+                return false;
+            memcpy(co->materials, p->combos[i].materials,
+                   (size_t)co->nmaterials * sizeof *co->materials);
+            json_t *dist = get_array(r, c, "distance", where, true);
+            if (!dist)
+                return false;
+            json_t *lo = json_array_get(dist, 0), *hi = json_array_get(dist, 1);
+            if (json_array_size(dist) != 2 || !json_is_number(lo) ||
+                !(json_is_number(hi) || json_is_null(hi)))
+                return field_fail(r, where, "distance: must be [lo, hi or null]");
+            co->dlo = json_number_value(lo);
+            co->dhi = json_is_null(hi) ? INFINITY : json_number_value(hi);
+            if (!(co->dlo >= 0) || !(co->dhi >= co->dlo))
+                return field_fail(r, where, "distance: must have 0 <= lo <= hi");
+            if (get(r, c, "spirv", where, false) ? !read_spirv(r, c, where, &co->spirv)
+                                                   : !read_glsl_at(r, c, where, &co->glsl))
+                return false;
+            if (!read_glsl(r, c, "compute", where, &co->compute) ||
+                !get_number(r, c, "cost", where, &co->cost))
+                return false;
+            if (!(co->cost >= 0) || co->cost > 1e12)
+                return field_fail(r, where, "cost: must be a number >= 0");
+        }
+        p->combos[i].nclasses = n - p->combos[i].first_class;
+    }
+    return true;
+}
+
 static bool read_combos(reader *r, json_t *root)
 {
     rt_pack *p = r->p;
@@ -1019,8 +1095,11 @@ static bool read_combos(reader *r, json_t *root)
                      json_number_value(cost) > 1e12))
             return field_fail(r, where, "cost: must be a number >= 0");
         co->cost = cost ? json_number_value(cost) : 0;
+        co->base = i;
+        co->dhi = INFINITY;
     }
-    return true;
+    p->nbase = p->ncombos;
+    return read_classes(r, cs);
 }
 
 bool rt_combos_parse(const uint8_t *data, size_t n, int cells_x, int cells_z,
@@ -1109,7 +1188,7 @@ static bool read_quadtree(reader *r, json_t *root)
     uint8_t *data = pack_file(r, "quadtree.file", file, 0, MAX_BINARY, &n);
     char path[1024];
     snprintf(path, sizeof path, "%s/%s", p->dir, file);
-    bool ok = data && rt_combos_parse(data, n, cx, cz, offsets, p->ncombos, p->holes != NULL,
+    bool ok = data && rt_combos_parse(data, n, cx, cz, offsets, p->nbase, p->holes != NULL,
                                       p->levels, path,
                                       r->e);
     free(data);
@@ -1260,6 +1339,7 @@ void rt_pack_free(rt_pack *p)
         free(p->combos[i].materials);
         free(p->combos[i].compute);
         free(p->combos[i].ug_compute);
+        free(p->combos[i].glsl);
         free_spirv(&p->combos[i].spirv);
     }
     for (int i = 0; i < p->nlevels && p->levels; i++)

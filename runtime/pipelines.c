@@ -368,6 +368,25 @@ bool rt_pipelines_combo(rt_device *d, const rt_pack *p, const rt_passes *rp,
     if ((variant & RT_VARIANT_WIRE) && !d->wireframe)
         return rt_fail(e, RT_E_NO_FORMAT, "draw wireframe (no fillModeNonSolid)");
     VkPipeline *slot = &pl->combo[(size_t)id * RT_VARIANTS + (variant % RT_VARIANTS)];
+    if (!*slot && !p->combos[id].spirv.words && p->combos[id].glsl) {
+        /* a distance class: GLSL in the pack, compiled, validated and
+         * checked against the composite interface here, on first use */
+        char name[64];
+        snprintf(name, sizeof name, "combination %d (distance class)", id);
+        rt_interface in;
+        if (!rt_interface_for(p, RT_ROLE_COMPOSITE, &in))
+            return rt_fail(e, RT_E_VULKAN, "pipelines", "out of memory");
+        VkShaderModule m;
+        bool ok = rt_glsl_module(d, p->combos[id].glsl, VK_SHADER_STAGE_FRAGMENT_BIT, name, &in,
+                                 &m, e);
+        rt_interface_free(&in);
+        if (!ok)
+            return false;
+        ok = make_pipeline(d, pl, pl->vertex, m, rp->main, K_OPAQUE, variant, slot, e);
+        vkDestroyShaderModule(d->dev, m, NULL);
+        if (!ok)
+            return false;
+    }
     if (!*slot && !pack_pipeline(d, pl, &p->combos[id].spirv, rp->main, K_OPAQUE, variant, slot, e))
         return false;
     *out = *slot;

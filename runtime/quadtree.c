@@ -176,6 +176,23 @@ static double box_distance(const double c[3], const double lo[3], const double h
     return sqrt(d2);
 }
 
+void rt_node_distance(const rt_quadtree *q, int level, int x, int z, const double camera[3],
+                      double *dmin, double *dmax)
+{
+    double x0, z0, sx, sz;
+    rt_node_rect(q, level, x, z, &x0, &z0, &sx, &sz);
+    size_t i = (size_t)z * (size_t)q->width[level] + (size_t)x;
+    double lo[3] = { x0, q->bounds->hmin[level][i], z0 };
+    double hi[3] = { x0 + sx, q->bounds->hmax[level][i], z0 + sz };
+    *dmin = box_distance(camera, lo, hi);
+    double far2 = 0;
+    for (int k = 0; k < 3; k++) {
+        double d = fmax(fabs(camera[k] - lo[k]), fabs(camera[k] - hi[k]));
+        far2 += d * d;
+    }
+    *dmax = sqrt(far2);
+}
+
 static bool box_visible(const frame *f, const double lo[3], const double hi[3])
 {
     const double *c = f->s->camera;

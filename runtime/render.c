@@ -948,7 +948,8 @@ static bool record_screen(rt_renderer *r, VkCommandBuffer cb, const rt_camera *c
     if (r->timestamps)
         vkCmdWriteTimestamp(cb, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, r->qpool, 1);
     rt_screen_classify(r->screen, cb, r->set0c, r->desc.clear,
-                       r->desc.reference == RT_REF_UBER || r->view == SPLAT_VIEW_MASK, binds);
+                       r->desc.reference == RT_REF_UBER || r->view == SPLAT_VIEW_MASK,
+                       r->desc.no_distance_classes, binds);
     if (r->timestamps)
         vkCmdWriteTimestamp(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, r->qpool, 2);
     VkDescriptorSet csets[2] = { r->set0c, r->set1 };
@@ -957,6 +958,27 @@ static bool record_screen(rt_renderer *r, VkCommandBuffer cb, const rt_camera *c
         return false;
     }
     return true;
+}
+
+/* Distance classes on the forward path (PACK.md): the cheapest class of
+ * combination `combo` whose interval holds the patch's whole distance
+ * range (its node's box, widened by RT_DCLASS_SLACK), else `combo`. */
+static int class_pick(const rt_pack *p, int combo, const rt_quadtree *q, const rt_patch *pt,
+                      const double camera[3])
+{
+    const rt_pack_combo *c = &p->combos[combo];
+    if (c->nclasses == 0)
+        return combo;
+    double dmin, dmax;
+    rt_node_distance(q, pt->level, pt->x, pt->z, camera, &dmin, &dmax);
+    dmin *= 1 - RT_DCLASS_SLACK;
+    dmax *= 1 + RT_DCLASS_SLACK;
+    int best = combo;
+    for (int k = c->first_class; k < c->first_class + c->nclasses; k++)
+        if (p->combos[k].dlo <= dmin && dmax <= p->combos[k].dhi &&
+            p->combos[k].cost < p->combos[best].cost)
+            best = k;
+    return best;
 }
 
 /* The quadtree selection, then the patches sorted by combination (a
@@ -973,6 +995,10 @@ static int select_and_sort(rt_renderer *r, const rt_camera *c, const splat_frame
     rt_quadtree_select(&r->qt, &sd);
     *select_ms = 1e3 * splat_now() - ts;
     int n = r->qt.npatches;
+    if (!r->desc.no_distance_classes)
+        for (int i = 0; i < n; i++)
+            r->qt.patches[i].combo = (uint16_t)class_pick(
+                r->p, r->qt.patches[i].combo, &r->qt, &r->qt.patches[i], c->position);
     memset(r->counts, 0, sizeof *r->counts * (size_t)(r->ncombos + 1));
     for (int i = 0; i < n; i++)
         r->counts[r->qt.patches[i].combo + 1]++;
@@ -1169,6 +1195,8 @@ static bool draw_frame(rt_renderer *r, const rt_camera *c, rt_frame_stats *st, r
     st->culled = r->qt.nculled;
     st->pipelines = binds;
     st->combos_in_view = in_view;
+    for (int i = 0; i < r->qt.npatches && !screen; i++)
+        st->class_patches += r->qt.patches[i].combo >= r->p->nbase;
     st->backfaces_culled = cull;
     st->select_ms = select_ms;
     st->cpu_ms = cpu_ms;

@@ -285,6 +285,18 @@ void rt_quadtree_free(rt_quadtree *q);
  * neighbours differ by at most one level, cull, pick each patch's
  * permutation.  No allocation after init. */
 void rt_quadtree_select(rt_quadtree *q, const rt_select_desc *s);
+/* Distance classes (PACK.md) are used only where a node's or tile's
+ * distance range, widened by this fraction, lies inside the class's
+ * interval: the shaders' fp32 distance (length of an interpolated or
+ * reconstructed position) differs from the runtime's by far less. */
+#define RT_DCLASS_SLACK 1e-3
+
+/* The nearest and farthest distance from `camera` (terrain-local metres)
+ * to any point of node (level, x, z): its rectangle, not clipped to the
+ * terrain, from its minimum to its maximum height (the box culling uses).
+ * Everything its patch rasterises lies inside. */
+void rt_node_distance(const rt_quadtree *q, int level, int x, int z, const double camera[3],
+                      double *dmin, double *dmax);
 /* World rectangle of a node (metres; may overhang the terrain). */
 void rt_node_rect(const rt_quadtree *q, int level, int x, int z,
                   double *x0, double *z0, double *sx, double *sz);
@@ -415,9 +427,9 @@ VkRenderPass rt_screen_depth_pass(const rt_screen *s, VkFramebuffer *fb);
 /* Before the geometry pass: reset the list counts (and the counters). */
 void rt_screen_begin(rt_screen *s, VkCommandBuffer cb, bool count);
 /* After it: the background, the classification (force_uber: every tile
- * to the über-shader's list). */
+ * to the über-shader's list; no_classes: no distance class variants). */
 void rt_screen_classify(rt_screen *s, VkCommandBuffer cb, VkDescriptorSet set0,
-                        const float clear[4], bool force_uber, int *binds);
+                        const float clear[4], bool force_uber, bool no_classes, int *binds);
 /* Then one indirect dispatch per list whose pipeline in `variant`
  * (RT_CVARIANT_*) exists; the colour image ends in TRANSFER_SRC_OPTIMAL. */
 bool rt_screen_dispatch(rt_screen *s, VkCommandBuffer cb, rt_pipelines *pl,

@@ -68,8 +68,9 @@ static const char classify_glsl[] =
     "layout(set = 0, binding = 7) uniform sampler2D u_depth;\n"
     "layout(set = 2, binding = 0, std430) readonly buffer cls_info_block {\n"
     "    uint ncombos, words, cells_x, cells_z;\n"
-    "    uint ntiles, unused, cell_texels, tiles_x;\n"
-    "    uint data[];   /* order[ncombos], masks[ncombos][words], cells[] */\n"
+    "    uint ntiles, nbase, cell_texels, tiles_x;\n"
+    "    uint data[];   /* order[ncombos], masks[ncombos][words], cells[],\n"
+    "                      distance[ncombos][2] (float bits) */\n"
     "} u_info;\n"
     "layout(set = 2, binding = 1, std430) writeonly buffer cls_tiles_block {\n"
     "    uint tiles[];\n"
@@ -81,7 +82,8 @@ static const char classify_glsl[] =
     "uint mask[WORDS];\n"
     "uint last = 0xffffffffu;\n"
     "bool any_cell = false;\n"
-    "float dmin = 1e30;   /* the tile's nearest terrain pixel (m) */\n"
+    "float dmin = 3.0e38, dmax = 0.0;   /* the tile's terrain pixels' distances */\n"
+    "float dfar = 3.0e38;   /* dmin, but 0 over the destructible area (far atlas) */\n"
     "void add_cell(ivec2 c) {\n"
     "    c = clamp(c, ivec2(0), ivec2(u_info.cells_x, u_info.cells_z) - 1);\n"
     "    uint i = uint(c.y) * u_info.cells_x + uint(c.x);\n"
@@ -133,12 +135,17 @@ static const char classify_glsl[] =
     "        return;\n"
     "    }\n"
     "    vec4 p = u_frame.inv_view_proj * vec4(ndc, d, 1.0);\n"
+    /* view.distance as the compute variants reconstruct it (abi.c
+     * splat_unproject): the same depth, the same pixel centre */
+    "    float dist = length(p.xyz / p.w);\n"
+    "    dmin = min(dmin, dist);\n"
+    "    dmax = max(dmax, dist);\n"
     "    vec2 local = p.xz / p.w + u_frame.camera.xz;\n"
     /* far atlas: never over the destructible area (patch_uv), craters
      * change what the bake saw */
-    "    dmin = min(dmin, length(p.xyz / p.w));\n"
+    "    dfar = min(dfar, dist);\n"
     "    if (all(greaterThanEqual(local, u_push.patch_uv.xy)) &&\n"
-    "        all(lessThan(local, u_push.patch_uv.zw))) dmin = 0.0;\n"
+    "        all(lessThan(local, u_push.patch_uv.zw))) dfar = 0.0;\n"
     "    vec2 cf = local / u_frame.terrain.xy * u_frame.texel.xy / float(u_info.cell_texels);\n"
     /* a pixel within 1/64 cell of an edge counts for both cells: the
      * position from depth is rounded, the analysis is per closed cell */
@@ -148,6 +155,16 @@ static const char classify_glsl[] =
     "    if (hi.y != lo.y) add_cell(ivec2(lo.x, hi.y));\n"
     "    if (hi.x != lo.x && hi.y != lo.y) add_cell(hi);\n"
     "}\n"
+    /* distance classes (c >= nbase, PACK.md): only where the tile's
+     * distances, widened by SLACK, lie inside the class's interval, and
+     * not at all with push info.z set (--no-distance-classes) */
+    "bool fits(uint c) {\n"
+    "    if (c < u_info.nbase) return true;\n"
+    "    if (u_push.info.z != 0u) return false;\n"
+    "    uint at = u_info.ncombos * (1u + u_info.words) + u_info.cells_x * u_info.cells_z + 2u * c;\n"
+    "    return dmin * (1.0 - SLACK) >= uintBitsToFloat(u_info.data[at]) &&\n"
+    "           dmax * (1.0 + SLACK) <= uintBitsToFloat(u_info.data[at + 1u]);\n"
+    "}\n"
     /* the cheapest combination whose set covers mask, else the über-shader */
     "uint pick() {\n"
     "    if (u_push.info.x != 0u || u_info.words == 0u) return u_info.ncombos;\n"
@@ -156,7 +173,7 @@ static const char classify_glsl[] =
     "        bool covers = true;\n"
     "        for (uint w = 0u; w < u_info.words && covers; w++)\n"
     "            covers = (mask[w] & ~u_info.data[u_info.ncombos + c * u_info.words + w]) == 0u;\n"
-    "        if (covers) return c;\n"
+    "        if (covers && fits(c)) return c;\n"
     "    }\n"
     "    return u_info.ncombos;\n"
     "}\n"
@@ -164,19 +181,21 @@ static const char classify_glsl[] =
      * goes to the far atlas's list */
     "uint pick_far() {\n"
     "    float fd = uintBitsToFloat(u_push.info.y);\n"
-    "    return fd > 0.0 && dmin >= fd ? u_info.ncombos + 1u : pick();\n"
+    "    return fd > 0.0 && dfar >= fd ? u_info.ncombos + 1u : pick();\n"
     "}\n"
     "#ifdef WIDE\n"
     /* GPUs: one workgroup per tile, one invocation per pixel; the sets
      * ORed over each subgroup, then over the workgroup in shared memory */
     "layout(local_size_x = 64) in;\n"
     "shared uint s_mask[WORDS];\n"
-    "shared uint s_any;\n"
-    "shared uint s_dmin;\n"
+    "shared uint s_any, s_dmin, s_dmax, s_dfar;   /* distances as bits: >= 0 orders as uint */\n"
     "void main() {\n"
     "    uint li = gl_LocalInvocationIndex;\n"
     "    if (li < uint(WORDS)) s_mask[li] = 0u;\n"
-    "    if (li == 0u) { s_any = 0u; s_dmin = floatBitsToUint(1e30); }\n"
+    "    if (li == 0u) {\n"
+    "        s_any = 0u; s_dmin = floatBitsToUint(3.0e38); s_dmax = 0u;\n"
+    "        s_dfar = floatBitsToUint(3.0e38);\n"
+    "    }\n"
     "    for (int w = 0; w < WORDS; w++) mask[w] = 0u;\n"
     "    barrier();\n"
     "    uvec2 tile = gl_WorkGroupID.xy;\n"
@@ -187,12 +206,18 @@ static const char classify_glsl[] =
     "        if (subgroupElect() && v != 0u) atomicOr(s_mask[w], v);\n"
     "    }\n"
     "    if (subgroupAny(any_cell) && subgroupElect()) atomicOr(s_any, 1u);\n"
-    "    float dm = subgroupMin(dmin);   /* >= 0: the bits order as uints */\n"
-    "    if (subgroupElect()) atomicMin(s_dmin, floatBitsToUint(dm));\n"
+    "    float a = subgroupMin(dmin), b = subgroupMax(dmax), f = subgroupMin(dfar);\n"
+    "    if (subgroupElect()) {\n"
+    "        atomicMin(s_dmin, floatBitsToUint(a));\n"
+    "        atomicMax(s_dmax, floatBitsToUint(b));\n"
+    "        atomicMin(s_dfar, floatBitsToUint(f));\n"
+    "    }\n"
     "    barrier();\n"
     "    if (li != 0u || s_any == 0u) return;   /* sky tile: skipped */\n"
     "    for (int w = 0; w < WORDS; w++) mask[w] = s_mask[w];\n"
     "    dmin = uintBitsToFloat(s_dmin);\n"
+    "    dmax = uintBitsToFloat(s_dmax);\n"
+    "    dfar = uintBitsToFloat(s_dfar);\n"
     "    append(pick_far(), tile.x | (tile.y << 16u));\n"
     "}\n"
     "#else\n"
@@ -341,7 +366,7 @@ static bool fill_info(rt_screen *s, rt_error *e)
     const rt_pack_level *leaf = &p->levels[0];
     size_t n = (size_t)p->ncombos;
     size_t cells = (size_t)leaf->width * (size_t)leaf->height;
-    size_t words = 8 + n + n * (size_t)s->words + cells;
+    size_t words = 8 + n + n * (size_t)s->words + cells + 2 * n;
     rt_buffer staging;
     if (!rt_buffer_create(s->d, words * 4, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT |
                           VK_BUFFER_USAGE_TRANSFER_DST_BIT, false, &s->info, e) ||
@@ -354,7 +379,7 @@ static bool fill_info(rt_screen *s, rt_error *e)
     u[2] = (uint32_t)leaf->width;
     u[3] = (uint32_t)leaf->height;
     u[4] = (uint32_t)s->ntiles;
-    u[5] = 0;   /* unused */
+    u[5] = (uint32_t)p->nbase;
     u[6] = (uint32_t)p->cell_texels;
     u[7] = (uint32_t)s->tiles_x;
     uint32_t *order = u + 8, *masks = order + n, *map = masks + n * (size_t)s->words;
@@ -369,6 +394,13 @@ static bool fill_info(rt_screen *s, rt_error *e)
         }
     for (size_t i = 0; i < cells; i++)
         map[i] = leaf->ids[i];
+    float *dist = (float *)(map + cells);   /* [lo, hi] per combination */
+    for (size_t i = 0; i < n; i++) {
+        /* rounded inwards: a class is never used outside its interval */
+        float lo = (float)p->combos[i].dlo, hi = (float)p->combos[i].dhi;
+        dist[2 * i] = lo < p->combos[i].dlo ? nextafterf(lo, INFINITY) : lo;
+        dist[2 * i + 1] = hi > p->combos[i].dhi ? nextafterf(hi, 0.0f) : hi;
+    }
     VkCommandBuffer cb;
     bool ok = rt_oneshot_begin(s->d, &cb, e);
     if (ok) {
@@ -633,7 +665,8 @@ static bool make_compute(rt_screen *s, const rt_pipelines *pl, VkSampler nearest
     const char *force = getenv("SPLAT_CLASSIFY");   /* tests: wide | tile */
     if (force && sub)
         s->wide = !strcmp(force, "wide");
-    snprintf(head, sizeof head, "#define WORDS %d\n%s%s", s->words > 0 ? s->words : 1,
+    snprintf(head, sizeof head, "#define WORDS %d\n#define SLACK %.9g\n%s%s",
+             s->words > 0 ? s->words : 1, RT_DCLASS_SLACK,
              sub ? "#extension GL_KHR_shader_subgroup_vote : require\n"
                    "#extension GL_KHR_shader_subgroup_ballot : require\n"
                    "#extension GL_KHR_shader_subgroup_arithmetic : require\n" : "",
@@ -886,7 +919,7 @@ void rt_screen_begin(rt_screen *s, VkCommandBuffer cb, bool count)
 }
 
 void rt_screen_classify(rt_screen *s, VkCommandBuffer cb, VkDescriptorSet set0,
-                        const float clear[4], bool force_uber, int *binds)
+                        const float clear[4], bool force_uber, bool no_classes, int *binds)
 {
     /* the colour image for storage writes: the classification writes the
      * background of empty pixels, shading the terrain's */
@@ -897,7 +930,9 @@ void rt_screen_classify(rt_screen *s, VkCommandBuffer cb, VkDescriptorSet set0,
     vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, s->layout, 0, 1, &set0, 0, NULL);
     vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, s->layout, 2, 1, &s->set, 0, NULL);
     /* abi.h's push block, read as: patch_xz the background colour,
-     * info.x 1 to send every tile to the über-shader */
+     * info.x 1 to send every tile to the über-shader, info.y the far
+     * atlas's distance (float bits), info.z 1 for no distance classes,
+     * patch_uv the destructible rectangle */
     splat_push push;
     memset(&push, 0, sizeof push);
     memcpy(push.patch_xz, clear, 3 * sizeof(float));
@@ -906,6 +941,7 @@ void rt_screen_classify(rt_screen *s, VkCommandBuffer cb, VkDescriptorSet set0,
     /* the far atlas's distance (0: off) and the destructible area */
     float fd = s->far_ok && !force_uber ? s->far_distance : 0.0f;
     memcpy(&push.info[1], &fd, sizeof fd);
+    push.info[2] = no_classes;
     const rt_pack *p = s->p;
     float rect[4] = { 1.0f, 1.0f, 0.0f, 0.0f };   /* empty */
     if (p->has_destruction) {
@@ -1050,6 +1086,8 @@ void rt_screen_read_stats(const rt_screen *s, rt_screen_stats *st)
     for (int k = 0; k < s->nlists; k++) {
         st->tiles += (int)args[3 * k];
         st->lists += args[3 * k] > 0;
+        if (k >= s->p->nbase && k < s->p->ncombos)
+            st->tiles_class += (int)args[3 * k];
     }
     st->tiles_uber = (int)args[3 * s->p->ncombos];
     st->tiles_far = s->far_ok ? (int)args[3 * (s->p->ncombos + 1)] : 0;

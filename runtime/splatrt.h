@@ -179,6 +179,15 @@ typedef struct rt_pack_combo {
     char    *compute;     /* compute variant's GLSL (PACK.md); NULL: none   */
     char    *ug_compute;  /* undergrowth mask GLSL (PACK.md); NULL: none    */
     double   cost;        /* per-pixel cost, op-table units; 0: not given   */
+    /* Distance classes (PACK.md): entries nbase.. of rt_pack.combos are
+     * the class variants, after the combinations of combos.bin; a class
+     * holds where view.distance lies in [dlo, dhi] (base ones [0, inf]).
+     * Its fragment shader comes as GLSL (spirv.words NULL), compiled on
+     * first use. */
+    int      base;        /* the combination it is a variant of (own id)    */
+    double   dlo, dhi;    /* metres; dhi INFINITY: and beyond               */
+    char    *glsl;        /* a class's fragment GLSL; NULL for the others   */
+    int      first_class, nclasses; /* a combination's classes, contiguous */
 } rt_pack_combo;
 
 typedef struct rt_pack_level {
@@ -275,7 +284,9 @@ typedef struct rt_pack {
                                         or r8), NULL: dense painted         */
     bool             has_destruction; /* scene.destruction is not null      */
     double           destr_origin[2], destr_size[2], destr_cell; /* metres */
-    rt_pack_combo   *combos;    int ncombos;
+    rt_pack_combo   *combos;    int ncombos;  /* combinations, then their
+                                                 distance classes           */
+    int              nbase;          /* combinations of combos.bin          */
     rt_spirv         uber;           /* words NULL if absent               */
     char            *uber_compute;   /* its compute GLSL; NULL if absent    */
     rt_spirv         vertex;
@@ -338,6 +349,7 @@ typedef struct rt_screen_stats {
     int      tiles, tiles_total;  /* terrain tiles shaded; all tiles         */
     int      tiles_uber;          /* tiles no combination covered            */
     int      tiles_far;           /* tiles shaded from the far atlas         */
+    int      tiles_class;         /* tiles shaded by a distance class        */
     int      lists;               /* combinations (and über) with tiles      */
     uint32_t pixels, layers_evaluated, layers_needed, samples;  /* counting */
     uint32_t branches, branches_uniform;   /* splat_counters (abi.h)         */
@@ -359,6 +371,9 @@ typedef struct rt_render_desc {
     double       sun[2], exposure, fog_density;
     bool         no_shadows;        /* the sun casts none (splatview --no-shadows) */
     bool         no_undergrowth;    /* draw no undergrowth (--no-undergrowth)  */
+    bool         no_distance_classes; /* shade with the combinations only, not
+                                       their distance classes (PACK.md;
+                                       splatview --no-distance-classes)     */
     double       undergrowth_radius; /* m around the camera; 0: RT_UG_RADIUS    */
     double       far_atlas_distance; /* screen path: tiles at least this far (m)
                                     are shaded from the pack's far atlas; 0:
@@ -392,6 +407,7 @@ typedef struct rt_ug_stats {
 
 typedef struct rt_frame_stats {
     int    patches, culled, pipelines, combos_in_view;
+    int    class_patches;     /* forward: patches shaded by a distance class */
     bool   backfaces_culled;  /* the camera was above the terrain            */
     double gpu_ms;            /* timestamps; < 0 if unsupported              */
     double select_ms;         /* CPU quadtree selection + culling            */

@@ -43,6 +43,8 @@ static void usage(FILE *f)
         "  --fog-density D           fog per metre at the fog height (0: none)\n"
         "  --no-shadows              the sun casts no terrain shadows\n"
         "  --no-undergrowth          draw no undergrowth (grass, plants, stones)\n"
+        "  --no-distance-classes     shade with the combinations only, not their\n"
+        "                            distance classes (compiler/PACK.md)\n"
         "  --light KEY=V[,V,V]       any key of the scene's light block (sun, sun_color,\n"
         "                            intensity, sky, fog_density, fog_height, exposure)\n"
         "  --clear r,g,b             background colour (linear)\n"
@@ -104,6 +106,7 @@ typedef struct opts {
     char *preview_dir;          /* where that pack is built                 */
     bool headless, stats, have_camera, have_look, no_stitch, no_cull, no_shadows;
     bool no_undergrowth;
+    bool no_distance_classes;
     int width, height, frames;
     double camera[3], look[3], lod_pixels;
     double far_distance;   /* --far-atlas-distance */
@@ -219,6 +222,8 @@ static int parse_args(int argc, char **argv, opts *o)
             o->no_shadows = true;
         } else if (!strcmp(a, "--no-undergrowth")) {
             o->no_undergrowth = true;
+        } else if (!strcmp(a, "--no-distance-classes")) {
+            o->no_distance_classes = true;
         } else if (!strcmp(a, "-o")) {
             NEED(); o->out = v;
         } else if (!strcmp(a, "--float-out")) {
@@ -537,6 +542,7 @@ static int headless(const opts *o)
         .pipeline_cache = o->cache, .no_stitch = o->no_stitch,
         .no_cull = o->no_cull, .lod_pixels = o->lod_pixels, .no_shadows = o->no_shadows,
         .no_undergrowth = o->no_undergrowth,
+        .no_distance_classes = o->no_distance_classes,
         .destruction_pool = o->destruction_pool, .shading = o->shading,
         .screen_depth = o->screen_depth, .far_atlas_distance = o->far_distance,
     };
@@ -601,6 +607,8 @@ static int headless(const opts *o)
         printf("back faces culled: %s\n", st.backfaces_culled ? "yes" : "no");
         printf("pipelines bound: %d\n", st.pipelines);
         printf("combinations in view: %d of %d\n", st.combos_in_view, pack.ncombos);
+        if (!st.screen)
+            printf("distance classes: %d of %d patches\n", st.class_patches, st.patches);
         if (gm >= 0)
             printf("gpu ms/frame: median %.3f  p10 %.3f  p90 %.3f\n", gm, gl, gh);
         else
@@ -616,6 +624,7 @@ static int headless(const opts *o)
             printf("tiles: %d of %d shaded, %d lists, %d by the uber-shader, %d from the far "
                    "atlas\n", st.tiles.tiles, st.tiles.tiles_total, st.tiles.lists,
                    st.tiles.tiles_uber, st.tiles.tiles_far);
+            printf("distance classes: %d of %d tiles\n", st.tiles.tiles_class, st.tiles.tiles);
         }
         printf("quadtree cpu ms/frame: median %.4f  p10 %.4f  p90 %.4f\n", sm, sl, sh);
         if (o->no_shadows)
@@ -756,7 +765,8 @@ int main(int argc, char **argv)
         .render = { .reference = o.ref, .pipeline_cache = o.cache, .lod_pixels = o.lod_pixels,
                     .shading = o.shading, .screen_depth = o.screen_depth,
                     .no_shadows = o.no_shadows, .no_undergrowth = o.no_undergrowth,
-                    .far_atlas_distance = o.far_distance },
+                    .far_atlas_distance = o.far_distance,
+                    .no_distance_classes = o.no_distance_classes },
         .view = SPLAT_VIEW_FINAL,
     };
     memcpy(vd.render.clear, o.clear, sizeof o.clear);

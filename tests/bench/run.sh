@@ -437,6 +437,16 @@ else
         "parallax16_screen=screen,pack=$p16" "parallax16_eager_screen=screen,pack=$p16e" \
         "parallax_adaptive_screen=screen,pack=$pa"
     GROUND_START=""
+    # distance classes (issue 11, compiler/distance.c) on and off, on both
+    # paths, against the über-shader on every tile of the same frames: the
+    # ground path up Blanca's west flank (rock's parallax fades out at
+    # 300 m: the classes drop it beyond) and top-down
+    for p in ground topdown; do
+        [ "$p" = ground ] && GROUND_START=45000,47087,1,0
+        render distclass colorado "$p" 1280x720 uber=screen_uber screen_on=screen \
+            screen_off=screen,distclass=0 forward_on=composite forward_off=composite,distclass=0
+        GROUND_START=""
+    done
     # painted masks: dense raster (the reference) vs sparse R8, BC4 (the
     # default) and BC4 with every mask limited to quad-tree level 2
     KNOB_BUILD_ARGS="--painted dense"

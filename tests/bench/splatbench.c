@@ -42,7 +42,11 @@
  *       instances and the memory per cell.  far=D (screen kinds) shades
  *       tiles at least D m away from the pack's far atlas (splatc build
  *       --far-atlas); its rows add the distance and the tiles the atlas
- *       shaded (from the counting frame).
+ *       shaded (from the counting frame).  distclass=0 shades with the
+ *       combinations only (--no-distance-classes; PACK.md "Distance
+ *       classes"), distclass=1 (the default) with their distance classes;
+ *       the kinds that recompile the composites (flat fp16 sobel analytic
+ *       lambert) always run without them.
  *       Paths (--path): ground (2 m above the terrain looking 150 m ahead,
  *       from --start-preset NAME or --start x,z,dx,dz), topdown, grazing.
  *   splatbench upscale IN.png K OUT
@@ -193,6 +197,7 @@ typedef struct variant {
     const char  *pack_dir;
     double       lod;
     bool         no_shadows;
+    bool         no_dclass; /* distclass=0                                 */
     bool         ug;        /* draw the undergrowth                         */
     double       ug_radius; /* its radius (m); 0: the runtime's default     */
     double       far;       /* screen: the far atlas's distance (m); 0: off */
@@ -315,14 +320,19 @@ static bool variant_shaders(variant *v)
     json_error_t jerr;
     json_t *m = json_load_file(path, 0, &jerr);
     json_t *combos = m ? json_object_get(m, "combinations") : NULL;
-    if (!json_is_array(combos) || (int)json_array_size(combos) != v->base->ncombos) {
+    /* the combinations only: their distance classes (entries nbase.. of
+     * combos, shared with the base pack) are left out (no_dclass) */
+    v->no_dclass = true;
+    if (!json_is_array(combos) || (int)json_array_size(combos) != v->base->nbase) {
         fprintf(stderr, "splatbench: %s: no combinations list matching the pack\n", path);
         json_decref(m);
         return false;
     }
     v->combos = xcalloc((size_t)v->base->ncombos, sizeof *v->combos);
     bool ok = true;
-    for (int i = 0; i < v->base->ncombos && ok; i++) {
+    for (int i = v->base->nbase; i < v->base->ncombos; i++)
+        v->combos[i] = v->base->combos[i];
+    for (int i = 0; i < v->base->nbase && ok; i++) {
         json_t *c = json_array_get(combos, (size_t)i);
         v->combos[i] = v->base->combos[i];
         v->combos[i].spirv.words = NULL;
@@ -365,7 +375,7 @@ static void variant_free(variant *v)
 {
     rt_renderer_destroy(v->r);
     if (v->combos)
-        for (int i = 0; i < v->base->ncombos; i++)
+        for (int i = 0; i < v->base->nbase; i++)
             free(v->combos[i].spirv.words);
     free(v->combos);
     free(v->label);
@@ -394,6 +404,8 @@ static bool parse_variant(const char *s, const char *default_pack, variant *v)
             v->pack_dir = strdup(t + 5);   /* lives as long as the process */
         } else if (!strcmp(t, "noshadow")) {
             v->no_shadows = true;
+        } else if (!strcmp(t, "distclass=0") || !strcmp(t, "distclass=1")) {
+            v->no_dclass = t[10] == '0';
         } else if (!strcmp(t, "ug")) {
             v->ug = true;
         } else if (!strncmp(t, "ugradius=", 9)) {
@@ -613,6 +625,7 @@ static int cmd_render(int argc, char **argv)
         rt_render_desc rd = {
             .width = width, .height = height, .lod_pixels = v[i].lod,
             .no_shadows = v[i].no_shadows, .no_undergrowth = !v[i].ug,
+            .no_distance_classes = v[i].no_dclass,
             .undergrowth_radius = v[i].ug_radius, .far_atlas_distance = v[i].far,
             .reference = v[i].k == K_MULTIPASS ? RT_REF_MULTIPASS
                        : v[i].k == K_UBER || v[i].k == K_SCREEN_UBER ? RT_REF_UBER : RT_REF_NONE,
@@ -713,7 +726,7 @@ static int cmd_render(int argc, char **argv)
                      "geometry_ms,classify_ms,shade_ms,tiles,tiles_uber,layers_evaluated,"
                      "layers_needed,samples_per_px,branches_uniform_pct,shadow_map_ms,"
                      "ug_gen_med_ms,ug_gen_ms_per_cell,ug_draw_med_ms,ug_cells_per_frame,"
-                     "ug_instances,ug_bytes_per_cell,far_distance,tiles_far\n");
+                     "ug_instances,ug_bytes_per_cell,far_distance,tiles_far,distclass,tiles_class\n");
     /* the device name in CSV: its commas become ';' */
     char devname[VK_MAX_PHYSICAL_DEVICE_NAME_SIZE];
     snprintf(devname, sizeof devname, "%s", dev.props.deviceName);
@@ -740,7 +753,7 @@ static int cmd_render(int argc, char **argv)
         const char *pk = strrchr(v[i].pack_dir, '/');
         fprintf(out, "\"%s\",%s,%s,%d,%d,%s,%s,%s,%g,%d,%.3f,%.3f,%.3f,%.3f,%.4f,%d,%d,"
                      "%.6g,%.6g,%.2f,%ld,%.1f,%s,%s,%.3f,%.3f,%.3f,%d,%d,%.4f,%.4f,%.3f,%.1f,"
-                     "%.2f,%.4f,%.4f,%.4f,%.2f,%ld,%zu,%g,%d\n",
+                     "%.2f,%.4f,%.4f,%.4f,%.2f,%ld,%zu,%g,%d,%d,%d\n",
                 devname, scene ? scene : v[i].base->name, pd.name, width, height,
                 v[i].label, kind_names[v[i].k], pk ? pk + 1 : v[i].pack_dir,
                 v[i].lod > 0 ? v[i].lod : 3.0, frames, gm, g10, g90, cm, sm,
@@ -754,7 +767,8 @@ static int cmd_render(int argc, char **argv)
                                     : 100.0,
                 v[i].shadow_ms, ugm, v[i].ug_cells ? gen_sum / (double)v[i].ug_cells : -1.0,
                 ugd, (double)v[i].ug_cells / frames, v[i].ug_last.instances,
-                v[i].ug_last.bytes_per_cell, v[i].far, v[i].tiles.tiles_far);
+                v[i].ug_last.bytes_per_cell, v[i].far, v[i].tiles.tiles_far, !v[i].no_dclass,
+                v[i].tiles.tiles_class);
     }
     if (csv)
         fclose(out);

@@ -145,6 +145,14 @@ if(TARGET splatrt AND TARGET splatview)
       set_tests_properties(render.${t} PROPERTIES LABELS render TIMEOUT 600
                            ENVIRONMENT "SPLAT_VALIDATE=1")
     endforeach()
+    # distance classes against the über-shader at 20 random cameras on
+    # colorado, both paths (test_dclass.c)
+    add_executable(test_dclass ${RENDER_DIR}/test_dclass.c)
+    target_link_libraries(test_dclass splatrt splatc m)
+    add_test(NAME render.dclass COMMAND test_dclass ${RENDER_OUT}/colorado
+             WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
+    set_tests_properties(render.dclass PROPERTIES LABELS render TIMEOUT 900
+                         FIXTURES_REQUIRED colorado_pack ENVIRONMENT "SPLAT_VALIDATE=1")
     # the undergrowth's cells, GPU passes and pack sections under the
     # sanitizers too
     set_tests_properties(render.undergrowth PROPERTIES LABELS "render;asan")
