@@ -46,7 +46,8 @@ static int mesh_index(splat_ug *u, const sg_undergrowth *g, sg_diags *d)
     if (!g->obj && splat_mesh_builtin_far(g->mesh, &far)) {
         char name[64];
         snprintf(name, sizeof name, "%s.far", g->mesh);
-        u->far[i] = mesh_add(u, far, xstrdup(name), NULL);   /* never looked up */
+        int f = mesh_add(u, far, xstrdup(name), NULL);   /* never looked up */
+        u->far[i] = f;   /* after the call: it moves u->far */
     }
     return i;
 }
