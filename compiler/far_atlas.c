@@ -131,20 +131,6 @@ static void tex_free(far_tex *t)
     free(t->h);
 }
 
-static int wrap_coord(int i, int n, ir_wrap w)
-{
-    switch (w) {
-    case IR_WRAP_CLAMP:
-        return i < 0 ? 0 : i >= n ? n - 1 : i;
-    case IR_WRAP_MIRROR: {
-        int m = ((i % (2 * n)) + 2 * n) % (2 * n);
-        return m < n ? m : 2 * n - 1 - m;
-    }
-    default:
-        return ((i % n) + n) % n;
-    }
-}
-
 static void tex_level(const far_tex *t, int l, double u, double v, double out[4])
 {
     int w = t->w[l], h = t->h[l];
@@ -154,15 +140,15 @@ static void tex_level(const far_tex *t, int l, double u, double v, double out[4]
         return;
     }
     if (t->filter == IR_FILTER_NEAREST) {
-        int x = wrap_coord((int)floor(u * w), w, t->wrap), y = wrap_coord((int)floor(v * h), h, t->wrap);
+        int x = ir_wrap_index((int)floor(u * w), w, t->wrap), y = ir_wrap_index((int)floor(v * h), h, t->wrap);
         for (int c = 0; c < 4; c++)
             out[c] = px[((size_t)y * w + x) * 4 + c];
         return;
     }
     double fx = u * w - 0.5, fy = v * h - 0.5;
     double x0f = floor(fx), y0f = floor(fy), ax = fx - x0f, ay = fy - y0f;
-    int x0 = wrap_coord((int)x0f, w, t->wrap), x1 = wrap_coord((int)x0f + 1, w, t->wrap);
-    int y0 = wrap_coord((int)y0f, h, t->wrap), y1 = wrap_coord((int)y0f + 1, h, t->wrap);
+    int x0 = ir_wrap_index((int)x0f, w, t->wrap), x1 = ir_wrap_index((int)x0f + 1, w, t->wrap);
+    int y0 = ir_wrap_index((int)y0f, h, t->wrap), y1 = ir_wrap_index((int)y0f + 1, h, t->wrap);
     for (int c = 0; c < 4; c++) {
         double a = px[((size_t)y0 * w + x0) * 4 + c], b = px[((size_t)y0 * w + x1) * 4 + c];
         double d = px[((size_t)y1 * w + x0) * 4 + c], e = px[((size_t)y1 * w + x1) * 4 + c];

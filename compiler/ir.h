@@ -357,6 +357,9 @@ typedef enum ir_wrap {
 } ir_wrap;
 const char *ir_filter_name(ir_filter f);
 const char *ir_wrap_name(ir_wrap w);
+/* Texel index i of a side of n texels under wrap mode w (the sampler's
+ * addressing; CPU twins of texture reads use it). */
+int ir_wrap_index(int i, int n, ir_wrap w);
 int         ir_filter_by_name(const char *name);   /* -1 if unknown */
 int         ir_wrap_by_name(const char *name);     /* -1 if unknown */
 

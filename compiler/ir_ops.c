@@ -886,6 +886,20 @@ enum { NFILTERS = sizeof filter_names / sizeof *filter_names,
 const char *ir_filter_name(ir_filter f) { return (unsigned)f < NFILTERS ? filter_names[f] : "?"; }
 const char *ir_wrap_name(ir_wrap w) { return (unsigned)w < NWRAPS ? wrap_names[w] : "?"; }
 
+int ir_wrap_index(int i, int n, ir_wrap w)
+{
+    switch (w) {
+    case IR_WRAP_CLAMP:
+        return i < 0 ? 0 : i >= n ? n - 1 : i;
+    case IR_WRAP_MIRROR: {
+        int m = ((i % (2 * n)) + 2 * n) % (2 * n);
+        return m < n ? m : 2 * n - 1 - m;
+    }
+    default:
+        return ((i % n) + n) % n;
+    }
+}
+
 int ir_filter_by_name(const char *name)
 {
     for (int i = 0; i < NFILTERS; i++)

@@ -967,6 +967,22 @@ void rt_screen_classify(rt_screen *s, VkCommandBuffer cb, VkDescriptorSet set0,
                          0, 1, &mb, 0, NULL, 0, NULL);
 }
 
+/* List k's indirect dispatch with the pipeline bound: workgroup g shades
+ * tiles[k * ntiles + g] (abi.h's push block: info.y the list, info.z the
+ * material count, info.w its first tile). */
+static void dispatch_list(rt_screen *s, VkCommandBuffer cb, VkPipelineLayout layout, int k,
+                          unsigned variant)
+{
+    splat_push push;
+    memset(&push, 0, sizeof push);
+    push.info[1] = (uint32_t)k;
+    push.info[2] = (uint32_t)s->p->nmaterials;
+    push.info[3] = (uint32_t)k * (uint32_t)s->ntiles;
+    vkCmdPushConstants(cb, layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof push, &push);
+    vkCmdDispatchIndirect(cb, s->args.buf, (VkDeviceSize)k * 12);
+    s->dispatched[k] = variant + 1;
+}
+
 bool rt_screen_dispatch(rt_screen *s, VkCommandBuffer cb, rt_pipelines *pl,
                         const VkDescriptorSet sets[2], unsigned variant, int *binds,
                         rt_error *e)
@@ -993,14 +1009,7 @@ bool rt_screen_dispatch(rt_screen *s, VkCommandBuffer cb, rt_pipelines *pl,
         }
         vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, pipe);
         (*binds)++;
-        splat_push push;
-        memset(&push, 0, sizeof push);
-        push.info[1] = (uint32_t)k;
-        push.info[2] = (uint32_t)p->nmaterials;
-        push.info[3] = (uint32_t)k * (uint32_t)s->ntiles;
-        vkCmdPushConstants(cb, pl->compute_layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof push, &push);
-        vkCmdDispatchIndirect(cb, s->args.buf, (VkDeviceSize)k * 12);
-        s->dispatched[k] = variant + 1;
+        dispatch_list(s, cb, pl->compute_layout, k, variant);
     }
     if (s->far_ok && s->far_distance > 0) {
         int k = p->ncombos + 1, c = (variant & RT_CVARIANT_COUNT) != 0;
@@ -1018,14 +1027,7 @@ bool rt_screen_dispatch(rt_screen *s, VkCommandBuffer cb, rt_pipelines *pl,
         vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, s->layout, 0, 3, all, 0, NULL);
         vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, s->far_pipe[c]);
         (*binds)++;
-        splat_push push;
-        memset(&push, 0, sizeof push);
-        push.info[1] = (uint32_t)k;
-        push.info[2] = (uint32_t)p->nmaterials;
-        push.info[3] = (uint32_t)k * (uint32_t)s->ntiles;
-        vkCmdPushConstants(cb, s->layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof push, &push);
-        vkCmdDispatchIndirect(cb, s->args.buf, (VkDeviceSize)k * 12);
-        s->dispatched[k] = variant + 1;
+        dispatch_list(s, cb, s->layout, k, variant);
     }
     rt_cmd_image_barrier(cb, s->color_img, 0, 1, 1, VK_IMAGE_LAYOUT_GENERAL,
                          VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_ACCESS_SHADER_WRITE_BIT,

@@ -150,24 +150,10 @@ static double bound(const ir *ir, uint32_t id, const ir_env *env,
 
 /* ---- the sampler's CPU twin -------------------------------------------- */
 
-static int wrap_texel(int i, int n, ir_wrap w)
-{
-    switch (w) {
-    case IR_WRAP_CLAMP:
-        return i < 0 ? 0 : i >= n ? n - 1 : i;
-    case IR_WRAP_MIRROR: {
-        int m = ((i % (2 * n)) + 2 * n) % (2 * n);
-        return m < n ? m : 2 * n - 1 - m;
-    }
-    default:
-        return ((i % n) + n) % n;
-    }
-}
-
 static const float *texel(const harness_image *im, int x, int y)
 {
-    x = wrap_texel(x, im->width, im->wrap);
-    y = wrap_texel(y, im->height, im->wrap);
+    x = ir_wrap_index(x, im->width, im->wrap);
+    y = ir_wrap_index(y, im->height, im->wrap);
     return im->rgba + ((size_t)y * (size_t)im->width + (size_t)x) * 4;
 }
 
