@@ -102,29 +102,10 @@
     "uint splat_n_evaluated = 0u, splat_n_needed = 0u, splat_n_samples = 0u;\n" \
     "uint splat_n_branches = 0u, splat_n_uniform = 0u;\n"
 
-/* After splat_finish: depth reconstruction, FC5's position derivatives,
- * the real main() around the composite's (renamed splat_main).
- *
- * Derivatives (Moore 2018, "Shading Pass Derivatives"): the plane through
- * the pixel's position with the terrain normal (Listing 1), intersected
- * with the ray from the camera (the origin of camera-relative space)
- * through the centre of the pixel to the right / below; the difference to
- * the position is what a fragment quad's dFdx / dFdy of the position
- * would be on that plane.  A ray that misses the plane (grazing, or
- * parallel) takes the far cap t = 1e4: the coarsest mips, as a quad would
- * pick next to a silhouette. */
+/* After splat_finish: depth reconstruction, FC5's position derivatives
+ * (the prelude's splat_plane_step), the real main() around the
+ * composite's (renamed splat_main). */
 #define COMPUTE_MAIN                                                        \
-    "vec3 splat_unproject(vec2 px, float depth) {\n"                        \
-    "    vec2 ndc = px / u_frame.screen.xy * 2.0 - 1.0;\n"                   \
-    "    vec4 p = u_frame.inv_view_proj * vec4(ndc, depth, 1.0);\n"         \
-    "    return p.xyz / p.w;\n"                                             \
-    "}\n"                                                                   \
-    "vec3 splat_plane_step(vec3 n, vec2 px, float depth) {\n"               \
-    "    vec3 q = splat_unproject(px, depth);\n"                            \
-    "    float t = dot(n, v_rel) / dot(n, q);\n"                            \
-    "    t = t > 0.0 ? min(t, 1e4) : 1e4;\n"                                \
-    "    return q * t - v_rel;\n"                                           \
-    "}\n"                                                                   \
     "bool splat_begin() {\n"                                                \
     "    uint t = u_tiles.tiles[u_push.info.w + gl_WorkGroupID.x];\n"       \
     "    splat_pixel = ivec2(uvec2(t & 0xffffu, t >> 16u) * 8u + gl_LocalInvocationID.xy);\n" \
@@ -136,8 +117,8 @@
     "    v_local = v_rel + u_frame.camera.xyz;\n"                           \
     "    v_uv = v_local.xz / u_frame.terrain.xy;\n"                         \
     "    splat_nrm = splat_normal_at(v_uv);\n"                              \
-    "    splat_dpdx = splat_plane_step(splat_nrm, c + vec2(1.0, 0.0), d);\n" \
-    "    splat_dpdy = splat_plane_step(splat_nrm, c + vec2(0.0, 1.0), d);\n" \
+    "    splat_dpdx = splat_plane_step(splat_nrm, v_rel, c + vec2(1.0, 0.0), d);\n" \
+    "    splat_dpdy = splat_plane_step(splat_nrm, v_rel, c + vec2(0.0, 1.0), d);\n" \
     "    return true;\n"                                                    \
     "}\n"                                                                   \
     "void splat_main();\n"                                                  \
@@ -153,6 +134,27 @@
     "    atomicAdd(u_counters.branches_uniform, splat_n_uniform);\n"        \
     "#endif\n"                                                              \
     "    imageStore(u_out, splat_pixel, o_color);\n"                        \
+    "}\n"                                                                   \
+    "#define main splat_main\n"
+
+/* A fragment shader that samples with gradients (SPLAT_GRADIENTS, which
+ * the composite defines when it has any): the normal and the position
+ * derivatives once per pixel, as compute's splat_begin does, then the
+ * composite's main (renamed splat_main).  The plane goes through the
+ * pixel's own unprojected depth, not the interpolated v_rel: the
+ * difference of two points must come from one computation (far from the
+ * origin v_rel carries the vertex stage's rounding, a fifth of a 13 cm
+ * pixel at 1,000 km in tests/world/test_far.c). */
+#define FRAGMENT_MAIN                                                       \
+    "void splat_main();\n"                                                  \
+    "void main() {\n"                                                       \
+    "    vec3 p = splat_unproject(gl_FragCoord.xy, gl_FragCoord.z);\n"      \
+    "    splat_nrm = splat_normal_at(v_uv);\n"                              \
+    "    splat_dpdx = splat_plane_step(splat_nrm, p, gl_FragCoord.xy + vec2(1.0, 0.0),\n" \
+    "                                  gl_FragCoord.z);\n"                  \
+    "    splat_dpdy = splat_plane_step(splat_nrm, p, gl_FragCoord.xy + vec2(0.0, 1.0),\n" \
+    "                                  gl_FragCoord.z);\n"                  \
+    "    splat_main();\n"                                                   \
     "}\n"                                                                   \
     "#define main splat_main\n"
 
@@ -370,11 +372,12 @@ const char SPLAT_GLSL_PRELUDE[] =
     " ? u_frame.view.x : splat_spec_view;\n"
     "}\n"
     /* A composite's branch condition, made uniform over each 2x2 quad:
-     * true for all four pixels if it holds for any.  Textures sampled
-     * inside the branch take implicit derivatives, which are undefined
-     * when only part of a quad runs it (NVIDIA then picks wrong mip levels
-     * at material borders).  Fine derivatives of a 0/1 flag are the OR
-     * with the horizontal, then the vertical neighbour; the caller is in
+     * true for all four pixels if it holds for any.  It kept implicit
+     * derivatives defined inside the branch (NVIDIA picked wrong mip
+     * levels at material borders without it); material samples take the
+     * compiler's gradients now, and it stays because a quad's lanes run
+     * together anyway.  Fine derivatives of a 0/1 flag are the OR with
+     * the horizontal, then the vertical neighbour; the caller is in
      * quad-uniform control flow by induction.  Pixels with weight 0 that
      * run the branch add 0 * surface. */
     "#if defined(SPLAT_COMPUTE) && defined(SPLAT_COUNT)\n"
@@ -408,8 +411,12 @@ const char SPLAT_GLSL_PRELUDE[] =
     "    return normalize(n);\n"
     "}\n"
     "float splat_height() { return splat_height_at(v_uv); }\n"
-    /* compute: splat_begin computed it already (for the derivatives) */
-    "#ifdef SPLAT_COMPUTE\n"
+    /* compute, and fragments with gradients: computed once per pixel
+     * before the composite (for the derivatives) */
+    "#if defined(SPLAT_COMPUTE)\n"
+    "vec3 splat_normal() { return splat_nrm; }\n"
+    "#elif defined(SPLAT_GRADIENTS)\n"
+    "vec3 splat_nrm, splat_dpdx, splat_dpdy;  /* FRAGMENT_MAIN sets them */\n"
     "vec3 splat_normal() { return splat_nrm; }\n"
     "#else\n"
     "vec3 splat_normal() { return splat_normal_at(v_uv); }\n"
@@ -431,15 +438,48 @@ const char SPLAT_GLSL_PRELUDE[] =
     "    return l > 0.0 ? -v_rel / l : vec3(0.0, 1.0, 0.0);\n"
     "}\n"
     "#endif\n"
+    /* Position derivatives (Moore 2018, "Shading Pass Derivatives"): the
+     * plane through the pixel's position with the terrain normal (Listing
+     * 1), intersected with the ray from the camera (the origin of
+     * camera-relative space) through the centre of the pixel to the right
+     * / below; the difference to the position is what a quad's dFdx / dFdy
+     * of the position would be on that plane.  A ray that misses the plane
+     * (grazing, or parallel) takes the far cap t = 1e4: the coarsest mips,
+     * as a quad would pick next to a silhouette.  Both stages use it, so
+     * the forward and screen paths pick the same mip levels (a quad's
+     * finite differences of an interpolated position differ at grazing
+     * angles and across triangle edges). */
+    "vec3 splat_unproject(vec2 px, float depth) {\n"
+    "    vec2 ndc = px / u_frame.screen.xy * 2.0 - 1.0;\n"
+    "    vec4 p = u_frame.inv_view_proj * vec4(ndc, depth, 1.0);\n"
+    "    return p.xyz / p.w;\n"
+    "}\n"
+    "vec3 splat_plane_step(vec3 n, vec3 p, vec2 px, float depth) {\n"
+    "    vec3 q = splat_unproject(px, depth);\n"
+    "    float t = dot(n, p) / dot(n, q);\n"
+    "    t = t > 0.0 ? min(t, 1e4) : 1e4;\n"
+    "    return q * t - p;\n"
+    "}\n"
     /* Screen-space derivatives of the inputs (d/dx: axis 0, d/dy: 1), the
-     * leaves ir_differentiate writes.  All follow from the position's:
-     * FC5's plane step in compute, the quad's dFdx / dFdy in fragments.
+     * leaves ir_differentiate writes.  All follow from the position's.
      * normal, slope, destruction and painted masks have derivative 0 (the
      * pass writes constants for them). */
-    "#ifdef SPLAT_COMPUTE\n"
+    /* A sample with explicit gradients (IR SAMPLE_GRAD): the level the
+     * Vulkan spec gives for textureGrad without anisotropy, log2 of the
+     * longer gradient in texels, sampled with textureLod.  The same mip
+     * as textureGrad, at the rate of a plain sample: NVIDIA runs
+     * textureGrad several times slower (H100, colorado top-down forward:
+     * 14.7 ms with textureGrad against 9.7 ms with implicit derivatives). */
+    "vec4 splat_texture_grad(sampler2D t, vec2 uv, vec2 dx, vec2 dy) {\n"
+    "    vec2 s = vec2(textureSize(t, 0));\n"
+    "    vec2 a = dx * s, b = dy * s;\n"
+    "    float r = max(max(dot(a, a), dot(b, b)), 1e-30);\n"
+    "    return textureLod(t, uv, 0.5 * log2(r));\n"
+    "}\n"
+    "#if defined(SPLAT_COMPUTE) || defined(SPLAT_GRADIENTS)\n"
     "vec3 splat_d_rel(int a) { return a == 0 ? splat_dpdx : splat_dpdy; }\n"
     "#else\n"
-    "vec3 splat_d_rel(int a) { return a == 0 ? dFdx(v_rel) : dFdy(v_rel); }\n"
+    "vec3 splat_d_rel(int a) { return vec3(0.0); }   /* no gradients taken */\n"
     "#endif\n"
     "vec3 splat_d_position(int a) { return splat_d_rel(a); }\n"
     "float splat_d_height(int a) { return splat_d_rel(a).y; }\n"
@@ -548,6 +588,8 @@ const char SPLAT_GLSL_PRELUDE[] =
     UG_MAIN
     "#elif defined(SPLAT_COMPUTE)\n"
     COMPUTE_MAIN
+    "#elif defined(SPLAT_GRADIENTS)\n"
+    FRAGMENT_MAIN
     "#endif\n";
 
 void splat_normal_filter(double hl, double hr, double hd, double hu,

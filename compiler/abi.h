@@ -86,7 +86,16 @@
  *   composite's main (renamed splat_main by a #define), and imageStores
  *   the colour splat_finish left.  Height, slope and normal then come from
  *   the heightfield (Listing 1) through the same functions as in the
- *   fragment stage.  splat_quad_any(c) is c (no quads: explicit gradients).
+ *   fragment stage.  splat_quad_any(c) is c (no quads).
+ *   Gradients (both stages): a material texture sample is
+ *   splat_texture_grad(tex, uv, duv/dx, duv/dy) (textureLod at the level
+ *   textureGrad would take), the gradients the compiler's derivatives
+ *   (ir_differentiate.c) of splat_dpdx / splat_dpdy: FC5's plane step,
+ *   the plane through the pixel with the terrain normal met by the rays
+ *   through the next pixel right / down.  Compute's main sets them from
+ *   the depth texel; a fragment composite that samples defines
+ *   SPLAT_GRADIENTS before the prelude, whose main then sets them from
+ *   gl_FragCoord (and the normal, once) before the composite's.
  *   Textures of the prelude (heightfield, painted, destruction: one mip
  *   level each) read through splat_texture0(s, uv): texture() in the
  *   fragment stage, textureLod(s, uv, 0.0) in compute.  New prelude code

@@ -46,6 +46,7 @@
 #include <string.h>
 
 #include "abi.h"
+#include "sg_internal.h"
 #include "util.h"
 
 #ifndef SPLATC_VERSION
@@ -156,19 +157,37 @@ static void builtin_alpha(ir *ir, ir_ref T, ir_ref m, ir_ref *w, ir_ref *T_next)
     *T_next = ir_op2(ir, IR_OP_SUB, T, *w);
 }
 
+/* Whether shader `name` of prog has an input port `port`. */
+static bool has_input(const sg_program *prog, const char *name, const char *port)
+{
+    int si = sg_shader_find(prog, name);
+    if (si < 0)
+        return false;
+    const sg_shader *s = prog->shaders[si];
+    for (int i = 0; i < s->nins; i++)
+        if (strcmp(s->ins[i].name, port) == 0)
+            return true;
+    return false;
+}
+
+/* The compositor inlined for one layer: T, m, h, and the material's index
+ * as `id` where the compositor declares that port (a per-material seed:
+ * nodes/stochastic.sg). */
 static bool lower_compositor(const splat_layout *L, ir *ir, ir_ref T, ir_ref m,
-                             ir_ref h, ir_ref *w, ir_ref *T_next, sg_diags *d)
+                             ir_ref h, int material, ir_ref *w, ir_ref *T_next,
+                             sg_diags *d)
 {
     if (!L->prog) {
         builtin_alpha(ir, T, m, w, T_next);
         return true;
     }
-    static const char *const in_names[] = {"T", "m", "h"};
+    static const char *const in_names[] = {"T", "m", "h", "id"};
     static const char *const out_names[] = {"weight", "T_next"};
-    ir_ref in_vals[3] = {T, m, h};
+    ir_ref in_vals[4] = {T, m, h, ir_constf(ir, material)};
     ir_ref outs[2];
     const char *name = L->compositor ? L->compositor : "linear_alpha";
-    if (!sg_lower_shader(L->prog, name, ir, in_names, in_vals, 3, out_names,
+    int nin = has_input(L->prog, name, "id") ? 4 : 3;
+    if (!sg_lower_shader(L->prog, name, ir, in_names, in_vals, nin, out_names,
                          outs, 2, d))
         return false;
     *w = outs[0];
@@ -335,7 +354,7 @@ bool splat_compose(const splat_layout *L, const splat_compose_desc *desc,
         if (desc->reference) {
             w = m;
         } else {
-            if (!lower_compositor(L, dst, T, m, s[SG_OUT_HEIGHT], &w, &T_next, d))
+            if (!lower_compositor(L, dst, T, m, s[SG_OUT_HEIGHT], k, &w, &T_next, d))
                 break;
             if (j == n - 1)
                 T_next = IR_NONE;  /* nothing below the bottom layer */
@@ -991,6 +1010,14 @@ static const char *basename_of(const char *path)
 static const char *const swizzle_of_type[IR_T_COUNT] = {
     [IR_T_FLOAT] = ".x", [IR_T_VEC2] = ".xy", [IR_T_VEC3] = ".xyz", [IR_T_VEC4] = ""};
 
+static bool has_op(const ir *ir, int op)
+{
+    for (uint32_t id = 1; id < ir->nnodes; id++)
+        if (ir->nodes[id].op == op)
+            return true;
+    return false;
+}
+
 /* Header comment and the set-1 declarations this shader uses. */
 static void emit_header(emit *em, const splat_glsl_desc *desc)
 {
@@ -1029,6 +1056,8 @@ static void emit_header(emit *em, const splat_glsl_desc *desc)
         ir_buf_printf(o, "%s", desc->painted_places);
     if (desc->compute)
         ir_buf_printf(o, "#define SPLAT_COMPUTE 1\n");
+    else if (has_op(&em->ir, IR_OP_DINPUT))
+        ir_buf_printf(o, "#define SPLAT_GRADIENTS 1\n");
     if (desc->ug_slot)
         ir_buf_printf(o, "#define SPLAT_UNDERGROWTH 1\n");
     ir_buf_printf(o, "%s", SPLAT_GLSL_PRELUDE);
@@ -1133,11 +1162,12 @@ static void emit_reference(emit *em)
         free(x[o]);
 }
 
-/* The composite with explicit texture gradients (compute: no quads): a copy
- * of its ir through ir_differentiate, then one fold and dce (the copy was
- * optimised; one round folds the derivatives' zeros and ones, and gives
- * what the whole pipeline gives on the examples at 80 % of its time);
- * layers by root name. */
+/* The composite with explicit texture gradients (every stage: compute has
+ * no quads, and the fragment stage takes the same gradients so the paths
+ * agree): a copy of its ir through ir_differentiate, then one fold and dce
+ * (the copy was optimised; one round folds the derivatives' zeros and
+ * ones, and gives what the whole pipeline gives on the examples at 80 % of
+ * its time); layers by root name. */
 static void differentiated(const splat_composite *c, ir *dst, splat_layer *layers)
 {
     ir_clone(dst, &c->ir);
@@ -1240,7 +1270,11 @@ void splat_composite_glsl(const splat_layout *L, const splat_composite *c,
     ir dir;
     splat_layer *dlayers = NULL;
     assert(!(desc->compute && c->reference));
-    if (desc->compute) {
+    /* Every stage samples with the compiler's gradients (splat_texture_grad), from
+     * the same position derivatives (abi.c "Position derivatives"): the
+     * forward, multi-pass and screen paths pick the same mip levels.  Not
+     * for the lazy-side map (tests), which is indexed by c->ir's nodes. */
+    if (!desc->lazy_sides) {
         dlayers = xcalloc((size_t)c->nlayers, sizeof *dlayers);
         differentiated(c, &dir, dlayers);
         em.src = &dir;

@@ -162,6 +162,14 @@ typedef struct splat_dclass {
 /* At most this many classes per composite. */
 enum { SPLAT_MAX_DCLASSES = 4 };
 
+/* A class is kept only if it saves at least this share of the composite's
+ * cost, and at least SPLAT_LAZY_MIN_COST units, against the composite and
+ * the class kept before it: each class is one more shader to compile on
+ * first use and one more tile list per combination in the screen path's
+ * classification (a stochastic compositor's footprint cell gave every
+ * combination two classes saving 2 %, and the pass cost 3.5x as much). */
+#define SPLAT_DCLASS_MIN_SAVING 0.05
+
 /* The distance classes of composite `c` (distance.c says how the
  * boundaries are found): *out malloc'd (NULL when none), the count
  * returned, cheapest last within each direction. */

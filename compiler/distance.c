@@ -16,8 +16,9 @@
  * classes are [b, inf] per far step and [0, b] per near step; each is the
  * composite with opt_pin over its interval, then ir_optimize.  A class is
  * kept only if ir_cost says it is cheaper than the composite and than the
- * kept class before it in its direction (a class nested in another is
- * worth its shader only if it saves more); at most SPLAT_MAX_DCLASSES.
+ * kept class before it in its direction by SPLAT_DCLASS_MIN_SAVING of the
+ * composite's cost (compose.h; a class nested in another is worth its
+ * shader only if it saves more); at most SPLAT_MAX_DCLASSES.
  *
  * The runtime uses a class for a quadtree node or screen tile only when
  * the node's or tile's whole distance range lies inside the interval
@@ -161,7 +162,8 @@ int splat_distance_classes(const splat_layout *L, const splat_composite *c,
         for (int i = 0; i < m && n < SPLAT_MAX_DCLASSES; i++) {
             double lo = dir == 0 ? fb[i] : 0, hi = dir == 0 ? INFINITY : nb[i];
             make_class(L, c, lo, hi, &v[n], d);
-            if (v[n].cost < best) {
+            double need = fmax(SPLAT_LAZY_MIN_COST, SPLAT_DCLASS_MIN_SAVING * full);
+            if (v[n].cost <= best - need) {
                 best = v[n].cost;
                 n++;
             } else {

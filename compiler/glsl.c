@@ -221,13 +221,14 @@ static char *leaf_expr(glsl_emitter *e, const ir_node *n)
 static void op_expr(glsl_emitter *e, const ir_node *n, ir_buf *b)
 {
     uint32_t id = (uint32_t)(n - e->ir->nodes);
-    if (e->names.override && e->names.override[id]) {
-        ir_buf_printf(b, "%s", e->names.override[id]);
-        return;
-    }
     const char *a[4] = {0};
     for (int i = 0; i < n->nargs; i++)
         a[i] = e->expr[n->arg[i].id];
+    const char *form = ir_opinfo_get((ir_op)n->op)->glsl;
+    if (e->names.override && e->names.override[id]) {
+        form = e->names.override[id];   /* its $k read operand k, as below */
+        goto substitute;
+    }
     const char *tn = ir_type_name((ir_type)n->type);
     int w = ir_type_width((ir_type)n->type);
     switch (n->op) {
@@ -263,7 +264,8 @@ static void op_expr(glsl_emitter *e, const ir_node *n, ir_buf *b)
         break;
     }
     /* the op table's form, $k standing for operand k */
-    for (const char *p = ir_opinfo_get((ir_op)n->op)->glsl; *p; p++) {
+substitute:
+    for (const char *p = form; *p; p++) {
         if (p[0] == '$' && p[1] >= '0' && p[1] <= '3') {
             ir_buf_printf(b, "%s", a[p[1] - '0']);
             p++;
@@ -300,9 +302,13 @@ const char *glsl_value(glsl_emitter *e, ir_ref r, const char *indent)
             continue;
         }
         todo[ntodo++] = id;
-        if (e->names.override && e->names.override[id])
-            continue;     /* written whole: its operands are not read */
+        /* an override is written whole: it reads only the operands its
+         * $k name */
+        const char *ov = e->names.override ? e->names.override[id] : NULL;
         for (int i = 0; i < n->nargs; i++) {
+            char ref[3] = {'$', (char)('0' + i), 0};
+            if (ov && !strstr(ov, ref))
+                continue;
             uint32_t a = n->arg[i].id;
             if (!e->expr[a] && !e->seen[a]) {
                 e->seen[a] = 1;

@@ -242,11 +242,12 @@ enum { IR_FIN_NO = 0, IR_FIN_YES = 1, IR_FIN_DATA = 2, IR_FIN_ARGS_BIT = 0x100 }
     /* random graph generators draw SPLAT..CROSS.  DINPUT: imm =          */                 \
     /* IR_DINPUT_IMM(input, axis), the input row's dglsl accessor;        */                 \
     /* SAMPLE_GRAD (tex, uv, duv/dx, duv/dy): the reference samples as    */                 \
-    /* SAMPLE does (level 0); LOG2: pow's rule (never drawn by the harness) */               \
+    /* SAMPLE does (level 0); LOG2: pow's rule, and .sg's log2 (never    */                 \
+    /* drawn by the harness: x <= 0 is undefined in GLSL)                 */               \
     X(DINPUT,    NULL,  0, 0, NOPORTS, "splat_d_<input>(axis)", ty_leaf, ENV, IR_FIN_NO, EXACT, 0, D0) \
-    X(SAMPLE_GRAD, NULL, 4, 0, PORTS("tex", "uv", "ddx", "ddy"), "textureGrad($0, $1, $2, $3)", \
+    X(SAMPLE_GRAD, NULL, 4, 0, PORTS("tex", "uv", "ddx", "ddy"), "splat_texture_grad($0, $1, $2, $3)", \
       ty_sample_grad, ENV, IR_FIN_DATA, SAMPLE, 4, D(sample))                               \
-    X(LOG2,      NULL,  1, IR_CWN, P1, "log2($0)", ty_same, CW(log2), IR_FIN_NO, ULP3, 4, D(log2))
+    X(LOG2,      "log2", 1, IR_CWN, P1, "log2($0)", ty_same, CW(log2), IR_FIN_NO, ULP3, 4, D(log2))
 
 /* IR_NAN_PROPAGATES: a NaN operand component gives a NaN result component
  * (the interval code short-circuits such operands to [-inf, inf]). */
@@ -639,8 +640,8 @@ typedef struct glsl_names {
     const char *const *texture;
     const char *const *painted;
     /* NULL, or per node id: a complete GLSL expression emitted for that
-     * node instead of its op, its operands left unread (precision.c's
-     * camera-relative rewrites). */
+     * node instead of its op, reading only the operands it names as $k
+     * (precision.c's camera-relative rewrites). */
     const char *const *override;
 } glsl_names;
 

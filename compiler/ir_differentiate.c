@@ -1,16 +1,18 @@
 /* ir_differentiate.c — texture gradients from the compiler: forward-mode
  * differentiation on the IR, for shaders that have no fragment quads (the
  * compute stage of screen-space shading, Moore 2018 "Shading Pass
- * Derivatives").
+ * Derivatives"), and for the fragment stage too, so both pick the same
+ * mip levels.
  *
  * What: every SAMPLE(tex, uv) becomes SAMPLE_GRAD(tex, uv, duv/dx,
- * duv/dy), which the emitter writes as textureGrad.  The gradients are IR,
+ * duv/dy), which the emitter writes as splat_texture_grad (abi.c:
+ * textureLod at textureGrad's level).  The gradients are IR,
  * built from the uv's expression by the chain rule: each op's row of the
  * op table (ir_ops.c) carries its derivative rule next to its GLSL, double
  * and interval semantics, and the leaves are
  *     terrain.position, .height, .uv, view.distance, view.direction
  *         -> DINPUT(input, axis): the prelude's splat_d_<input>(axis), from
- *            FC5's plane-ray intersection in compute (abi.h)
+ *            FC5's plane-ray intersection in both stages (abi.c)
  *     terrain.normal, .slope, .destruction, painted masks, params,
  *     constants -> 0 (normal and slope would need the heightfield's second
  *            derivatives; they weight, they do not move, texture lookups)

@@ -116,7 +116,7 @@ static bool use_ok(const ir *ir, const ir_node *u, int arg)
 {
     if (u->op == IR_OP_FLOOR || u->op == IR_OP_FRACT)
         return true;
-    if (u->op == IR_OP_SAMPLE && arg == 1) {
+    if ((u->op == IR_OP_SAMPLE || u->op == IR_OP_SAMPLE_GRAD) && arg == 1) {
         const ir_node *t = ir_get(ir, u->arg[0]);
         return t->op == IR_OP_TEXTURE && ir->textures[t->imm].wrap == IR_WRAP_REPEAT;
     }
@@ -224,6 +224,9 @@ char **splat_sites_overrides(const splat_layout *L, const ir *ir,
                 ir_buf_printf(&e, "(u_frame.world[%d].xy + floor(%s))", k, f.s);
             else if (u->op == IR_OP_FRACT)
                 ir_buf_printf(&e, "fract(%s)", f.s);
+            else if (u->op == IR_OP_SAMPLE_GRAD)   /* the gradients as they are */
+                ir_buf_printf(&e, "splat_texture_grad(%s, %s, $2, $3)",
+                              names->texture[ir_get(ir, u->arg[0])->imm], f.s);
             else
                 ir_buf_printf(&e, "texture(%s, %s)",
                               names->texture[ir_get(ir, u->arg[0])->imm], f.s);
@@ -257,7 +260,7 @@ static double feature_size(const ir *ir, const ir_node *u, const splat_site *s)
         double hi = fmax(fabs(s->value[0]), fabs(s->value[1]));
         cell = s->mul ? 1.0 / hi : lo;
     }
-    if (u->op == IR_OP_SAMPLE) {
+    if (u->op == IR_OP_SAMPLE || u->op == IR_OP_SAMPLE_GRAD) {
         int w = 256, h = 0, c = 0;
         const char *file = ir->textures[ir_get(ir, u->arg[0])->imm].file;
         if (!stbi_info(file, &w, &h, &c) || w < 1)

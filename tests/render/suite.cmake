@@ -93,7 +93,7 @@ if(TARGET splatrt AND TARGET splatview)
     set_tests_properties(render.pack_notex PROPERTIES LABELS render FIXTURES_SETUP notex_pack)
     set(SCREEN_CASES
       "colorado|textured|overview blanca valley spanish_peaks pivots trinidad"
-      "billingsley|procedural|overview ground peak"
+      "billingsley|textured|overview ground peak"
       "minimal|textured|overview"
       "notex|notex|overview low")
     foreach(sc IN LISTS SCREEN_CASES)

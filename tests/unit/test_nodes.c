@@ -613,11 +613,11 @@ static double pow2_cell(double footprint, double cell_min)
 }
 
 /* world_hash by hand: q = floor(p / cell); two chained hash_perm lookups
- * over (x, z), (y, x), (z, y), u = fract(h2 + h3 / 289). */
-static double world_hash(const double p[3], double cell)
+ * over (x, z) + seed, (y, x), (z, y), u = fract(h2 + h3 / 289). */
+static double world_hash(const double p[3], double cell, double seed)
 {
     double qx = floor(p[0] / cell), qy = floor(p[1] / cell), qz = floor(p[2] / cell);
-    double h1 = hash_perm(qx, qz);
+    double h1 = hash_perm(qx + seed, qz + seed);
     double h2 = hash_perm(qy + 289 * h1, qx + 289 * h1);
     double h3 = hash_perm(qz + 289 * h2, qy + 289 * h2);
     double s = h2 + h3 / 289;
@@ -651,7 +651,9 @@ static void test_stochastic(void **state)
     for (size_t k = 0; k < sizeof pts / sizeof pts[0]; k++) {
         memcpy(e.position, pts[k], sizeof e.position);
         double u = evalf(f, &e, "n.out", "world_hash { cell = 2.0 }");
-        NEAR(u, world_hash(pts[k], 2.0));
+        NEAR(u, world_hash(pts[k], 2.0, 0));
+        NEAR(evalf(f, &e, "n.out", "world_hash { cell = 2.0, seed = 74.0 }"),
+             world_hash(pts[k], 2.0, 74));
         assert_true(u >= 0 && u < 1);
         double inside[3] = {2 * floor(pts[k][0] / 2) + 1.9, 2 * floor(pts[k][1] / 2) + 0.1,
                             2 * floor(pts[k][2] / 2) + 1.0};
@@ -663,34 +665,52 @@ static void test_stochastic(void **state)
     e.position[0] = 1.5;                                  /* the next cell along x */
     assert_true(fabs(evalf(f, &e, "n.out", "world_hash { cell = 1.0 }") - u0) > 1e-6);
 
-    /* stochastic_select: u from the cell of distance * pixel_angle; the
-     * layer is drawn when u lies in [T - T m, T) */
+    /* stochastic_select: a Bernoulli draw u < m per layer, u from the cell
+     * of distance * pixel_angle and the layer's seed (37 id) */
     e = flat_env();
     const double pos[3] = {412.3, 95.1, 77.7};
     memcpy(e.position, pos, sizeof e.position);
     e.view_distance = 100.0;
-    double u = world_hash(pos, pow2_cell(100.0 * 0.0016, 0.05));
-    assert_true(u > 0.01 && u < 0.99);
-    const char *ss = "stochastic_select { T = %.17g, m = %.17g }";
-    /* m = 0: never drawn, coverage unchanged; m = 1 at the top: always */
-    NEAR(evalf(f, &e, "n.weight", ss, 1.0, 0.0), 0.0);
-    NEAR(evalf(f, &e, "n.T_next", ss, 1.0, 0.0), 1.0);
-    NEAR(evalf(f, &e, "n.weight", ss, 1.0, 1.0), 1.0);
-    NEAR(evalf(f, &e, "n.T_next", ss, 1.0, 1.0), 0.0);
-    /* T = 1: drawn iff u >= 1 - m */
-    double m_hit = 1 - u + 0.005, m_miss = 1 - u - 0.005;
-    NEAR(evalf(f, &e, "n.weight", ss, 1.0, m_hit), 1.0);
-    NEAR(evalf(f, &e, "n.T_next", ss, 1.0, m_hit), 0.0);
-    NEAR(evalf(f, &e, "n.weight", ss, 1.0, m_miss), 0.0);
-    NEAR(evalf(f, &e, "n.T_next", ss, 1.0, m_miss), 1.0 - m_miss);
-    /* a layer further down, reached with T <= u: never drawn */
-    double T = u * 0.9;
-    NEAR(evalf(f, &e, "n.weight", ss, T, 1.0), 0.0);
-    NEAR(evalf(f, &e, "n.T_next", ss, T, 0.5), T - T * 0.5);
-    /* T above u: drawn iff u >= T (1 - m) */
-    T = fmin(1.0, u + 0.2);
-    NEAR(evalf(f, &e, "n.weight", ss, T, 1 - u / T + 0.01), 1.0);
-    NEAR(evalf(f, &e, "n.weight", ss, T, 1 - u / T - 0.01), 0.0);
+    const double cell = pow2_cell(100.0 * 0.0016, 0.05);
+    const char *ss = "stochastic_select { T = %.17g, m = %.17g, id = %d.0 }";
+    for (int id = 0; id < 3; id++) {
+        double u = world_hash(pos, cell, 37.0 * id);
+        assert_true(u > 0.01 && u < 0.99);
+        /* m = 0: never drawn, coverage unchanged; m = 1: always */
+        NEAR(evalf(f, &e, "n.weight", ss, 1.0, 0.0, id), 0.0);
+        NEAR(evalf(f, &e, "n.T_next", ss, 1.0, 0.0, id), 1.0);
+        NEAR(evalf(f, &e, "n.weight", ss, 1.0, 1.0, id), 1.0);
+        NEAR(evalf(f, &e, "n.T_next", ss, 1.0, 1.0, id), 0.0);
+        /* 0 < m < 1: drawn iff u < m */
+        NEAR(evalf(f, &e, "n.weight", ss, 1.0, u + 0.005, id), 1.0);
+        NEAR(evalf(f, &e, "n.T_next", ss, 1.0, u + 0.005, id), 0.0);
+        NEAR(evalf(f, &e, "n.weight", ss, 1.0, u - 0.005, id), 0.0);
+        NEAR(evalf(f, &e, "n.T_next", ss, 1.0, u - 0.005, id), 1.0);
+        /* below a drawn layer (T = 0): nothing */
+        NEAR(evalf(f, &e, "n.weight", ss, 0.0, 1.0, id), 0.0);
+        NEAR(evalf(f, &e, "n.weight", ss, 0.0, u + 0.005, id), 0.0);
+    }
+    /* The draw frequencies are the alpha weights: a stack of a (id 1,
+     * m 0.3) over b (id 2, m 0.6) over the bottom draws a with p 0.3, b
+     * with 0.7 * 0.6 = 0.42, the bottom with 0.28, over 4000 cells; within
+     * 4 sigma, which also needs the two seeds' fields independent. */
+    int na = 0, nb = 0, ncells = 4000;
+    for (int k = 0; k < ncells; k++) {
+        const double q[3] = {cell * (k % 71) + 0.5 * cell, 3.0, cell * (k / 71) + 0.5 * cell};
+        bool a = world_hash(q, cell, 37.0) < 0.3;
+        bool b = !a && world_hash(q, cell, 74.0) < 0.6;
+        na += a;
+        nb += b;
+    }
+    const double pa = 0.3, pb = 0.42;
+    assert_true(fabs(na - ncells * pa) < 4 * sqrt(ncells * pa * (1 - pa)));
+    assert_true(fabs(nb - ncells * pb) < 4 * sqrt(ncells * pb * (1 - pb)));
+    /* and the graph draws what the hand-computed hash says, at a few cells */
+    for (int k = 0; k < 4; k++) {
+        const double q[3] = {cell * (7 * k + 3) + 0.25 * cell, 3.0, cell * (13 * k) + 0.75 * cell};
+        memcpy(e.position, q, sizeof e.position);
+        NEAR(evalf(f, &e, "n.weight", ss, 1.0, 0.3, 1), world_hash(q, cell, 37.0) < 0.3);
+    }
 }
 
 /* ---- noise.sg: the longer fBms ---------------------------------------------- */
