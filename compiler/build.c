@@ -18,13 +18,14 @@
  *
  * Nothing changed: right after loading, the bytes of every input (the
  * graph files the program read, the heightfield, the painted rasters, the
- * texture files) are hashed with the compiler version and options; the
- * manifest records that "inputs" key, and when the existing pack carries
+ * texture files) are hashed with the compiler version, its own executable
+ * and the options; the manifest records that "inputs" key, and when the existing pack carries
  * the same key and has all its shader files, the build stops there (with
  * --stats it still runs the analysis for the report and reads the shader
  * figures back from the pack).
  *
- * Determinism: every file is a function of the inputs only (no times, no
+ * Determinism: every file is a function of the inputs and the splatc
+ * binary only (the "inputs" key holds the binary's hash; no times, no
  * absolute paths: material sources are written relative to the scene's
  * folder); manifest keys in a fixed order, reals with 15 significant
  * digits (JSON_REAL_PRECISION).
@@ -131,6 +132,10 @@ static bool inputs_key(build *b)
     /* the ABI's GLSL too: a changed prelude is a changed compiler */
     XXH3_128bits_update(st, SPLAT_GLSL_PRELUDE, strlen(SPLAT_GLSL_PRELUDE));
     XXH3_128bits_update(st, SPLAT_GLSL_VERTEX, strlen(SPLAT_GLSL_VERTEX));
+    /* and this splatc's own bytes, where the system shows them: a compiler
+     * rebuilt from changed sources under the same version number must not
+     * call an older pack up to date (the same binary gives the same key) */
+    hash_file(st, "/proc/self/exe");
     bool ok = true;
     char **files = input_files(&b->scene);
     for (int i = 0; ok && files[i]; i++)
