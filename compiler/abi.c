@@ -80,6 +80,19 @@
     "layout(set = 0, binding = 9, std430) readonly buffer splat_tiles_block {\n" \
     "    uint tiles[];\n"                                                   \
     "} u_tiles;\n"                                                          \
+    "#endif\n"                                                              \
+    "vec3 v_rel;      /* camera-relative position (m), from depth */\n"     \
+    "vec2 v_uv;       /* heightfield uv */\n"                               \
+    "vec3 v_local;    /* terrain-local position (m) */\n"                   \
+    "vec4 o_color;    /* what main() stores into u_out */\n"                \
+    "ivec2 splat_pixel;\n"                                                  \
+    "vec3 splat_nrm;  /* the terrain normal (Listing 1) at v_uv */\n"      \
+    "vec3 splat_dpdx; /* position one pixel right, minus the position */\n" \
+    "vec3 splat_dpdy; /* position one pixel down, minus the position */\n"
+
+/* The counting variant (abi.h SPLAT_COUNT), both stages: binding 10 and
+ * this invocation's counts, added to it after the composite ran. */
+#define COUNT_DECLS                                                         \
     "#ifdef SPLAT_COUNT\n"                                                  \
     "layout(set = 0, binding = 10, std430) buffer splat_counters_block {\n" \
     "    uint pixels;\n"                                                    \
@@ -89,18 +102,18 @@
     "    uint branches;\n"                                                  \
     "    uint branches_uniform;\n"                                          \
     "} u_counters;\n"                                                       \
-    "#endif\n"                                                              \
-    "#endif\n"                                                              \
-    "vec3 v_rel;      /* camera-relative position (m), from depth */\n"     \
-    "vec2 v_uv;       /* heightfield uv */\n"                               \
-    "vec3 v_local;    /* terrain-local position (m) */\n"                   \
-    "vec4 o_color;    /* what main() stores into u_out */\n"                \
-    "ivec2 splat_pixel;\n"                                                  \
-    "vec3 splat_nrm;  /* the terrain normal (Listing 1) at v_uv */\n"      \
-    "vec3 splat_dpdx; /* position one pixel right, minus the position */\n" \
-    "vec3 splat_dpdy; /* position one pixel down, minus the position */\n"  \
     "uint splat_n_evaluated = 0u, splat_n_needed = 0u, splat_n_samples = 0u;\n" \
-    "uint splat_n_branches = 0u, splat_n_uniform = 0u;\n"
+    "uint splat_n_branches = 0u, splat_n_uniform = 0u;\n"                   \
+    "#endif\n"
+#define COUNT_ADD                                                           \
+    "#ifdef SPLAT_COUNT\n"                                                  \
+    "    atomicAdd(u_counters.pixels, 1u);\n"                               \
+    "    atomicAdd(u_counters.layers_evaluated, splat_n_evaluated);\n"      \
+    "    atomicAdd(u_counters.layers_needed, splat_n_needed);\n"            \
+    "    atomicAdd(u_counters.samples, splat_n_samples);\n"                 \
+    "    atomicAdd(u_counters.branches, splat_n_branches);\n"               \
+    "    atomicAdd(u_counters.branches_uniform, splat_n_uniform);\n"        \
+    "#endif\n"
 
 /* After splat_finish: depth reconstruction, FC5's position derivatives
  * (the prelude's splat_plane_step), the real main() around the
@@ -125,14 +138,7 @@
     "void main() {\n"                                                       \
     "    if (!splat_begin()) return;\n"                                     \
     "    splat_main();\n"                                                   \
-    "#ifdef SPLAT_COUNT\n"                                                  \
-    "    atomicAdd(u_counters.pixels, 1u);\n"                               \
-    "    atomicAdd(u_counters.layers_evaluated, splat_n_evaluated);\n"      \
-    "    atomicAdd(u_counters.layers_needed, splat_n_needed);\n"            \
-    "    atomicAdd(u_counters.samples, splat_n_samples);\n"                 \
-    "    atomicAdd(u_counters.branches, splat_n_branches);\n"               \
-    "    atomicAdd(u_counters.branches_uniform, splat_n_uniform);\n"        \
-    "#endif\n"                                                              \
+    COUNT_ADD                                                               \
     "    imageStore(u_out, splat_pixel, o_color);\n"                        \
     "}\n"                                                                   \
     "#define main splat_main\n"
@@ -148,13 +154,19 @@
 #define FRAGMENT_MAIN                                                       \
     "void splat_main();\n"                                                  \
     "void main() {\n"                                                       \
+    "#ifdef SPLAT_GRADIENTS\n"                                              \
     "    vec3 p = splat_unproject(gl_FragCoord.xy, gl_FragCoord.z);\n"      \
     "    splat_nrm = splat_normal_at(v_uv);\n"                              \
     "    splat_dpdx = splat_plane_step(splat_nrm, p, gl_FragCoord.xy + vec2(1.0, 0.0),\n" \
     "                                  gl_FragCoord.z);\n"                  \
     "    splat_dpdy = splat_plane_step(splat_nrm, p, gl_FragCoord.xy + vec2(0.0, 1.0),\n" \
     "                                  gl_FragCoord.z);\n"                  \
+    "#endif\n"                                                              \
     "    splat_main();\n"                                                   \
+    "#ifdef SPLAT_COUNT\n"                                                  \
+    "    if (gl_HelperInvocation) return;\n"                                \
+    "#endif\n"                                                              \
+    COUNT_ADD                                                               \
     "}\n"                                                                   \
     "#define main splat_main\n"
 
@@ -334,9 +346,13 @@ const char SPLAT_GLSL_VERTEX[] =
     "}\n";
 
 const char SPLAT_GLSL_PRELUDE[] =
-    /* the counting variant's branches are subgroup-uniform (abi.h) */
-    "#if defined(SPLAT_COMPUTE) && defined(SPLAT_COUNT)\n"
+    /* the counting variant's branches are subgroup-uniform (abi.h); its
+     * fragments count where the depth test let them through */
+    "#ifdef SPLAT_COUNT\n"
     "#extension GL_KHR_shader_subgroup_vote : require\n"
+    "#if !defined(SPLAT_COMPUTE)\n"
+    "layout(early_fragment_tests) in;\n"
+    "#endif\n"
     "#endif\n"
     SPLAT_GLSL_COMMON
     /* painted masks: dense layers, or the sparse quad-tree (sparse.h) */
@@ -349,6 +365,7 @@ const char SPLAT_GLSL_PRELUDE[] =
     "#endif\n"
     "layout(set = 0, binding = 3) uniform sampler2D u_destruction_atlas;\n"
     "layout(set = 0, binding = 4) uniform sampler2D u_destruction_index;\n"
+    COUNT_DECLS
     "#ifdef SPLAT_COMPUTE\n"
     COMPUTE_DECLS
     "#else\n"
@@ -380,7 +397,7 @@ const char SPLAT_GLSL_PRELUDE[] =
      * the horizontal, then the vertical neighbour; the caller is in
      * quad-uniform control flow by induction.  Pixels with weight 0 that
      * run the branch add 0 * surface. */
-    "#if defined(SPLAT_COMPUTE) && defined(SPLAT_COUNT)\n"
+    "#if defined(SPLAT_COUNT)\n"
     "bool splat_quad_any(bool c) {\n"
     "    bool a = subgroupAny(c);\n"
     "    splat_n_branches += 1u;\n"
@@ -495,7 +512,7 @@ const char SPLAT_GLSL_PRELUDE[] =
     "    return (r * dot(r, d) - d) / l;\n"
     "}\n"
     /* The counting variant's hooks (abi.h); nothing elsewhere. */
-    "#if defined(SPLAT_COMPUTE) && defined(SPLAT_COUNT)\n"
+    "#if defined(SPLAT_COUNT)\n"
     "void splat_count_layer(float w) {\n"
     "    splat_n_evaluated += 1u;\n"
     "    if (w > 0.0) splat_n_needed += 1u;\n"
@@ -528,7 +545,7 @@ const char SPLAT_GLSL_PRELUDE[] =
     "    return splat_combo_color(u_push.info.y);\n"
     "#endif\n"
     "}\n"
-    "#if defined(SPLAT_COMPUTE) && defined(SPLAT_COUNT)\n"
+    "#if defined(SPLAT_COUNT)\n"
     "vec3 splat_cost_color() { return splat_heat(float(splat_n_samples)); }\n"
     "#else\n"
     "vec3 splat_cost_color() { return splat_heat(0.0); }\n"
@@ -588,7 +605,7 @@ const char SPLAT_GLSL_PRELUDE[] =
     UG_MAIN
     "#elif defined(SPLAT_COMPUTE)\n"
     COMPUTE_MAIN
-    "#elif defined(SPLAT_GRADIENTS)\n"
+    "#elif defined(SPLAT_GRADIENTS) || defined(SPLAT_COUNT)\n"
     FRAGMENT_MAIN
     "#endif\n";
 

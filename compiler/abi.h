@@ -101,12 +101,16 @@
  *   fragment stage, textureLod(s, uv, 0.0) in compute.  New prelude code
  *   that samples must use it (compute has no implicit derivatives).
  *
- * Counting variant (SPLAT_COUNT, compute only): not stored in the pack.
- *   The runtime compiles it on first use from the pack's compute GLSL with
+ * Counting variant (SPLAT_COUNT, both stages): not stored in the pack.
+ *   The runtime compiles it on first use from the pack's GLSL (compute, or
+ *   a composite's / the über-shader's fragment GLSL) with
  *   `#define SPLAT_COUNT 1` inserted after the #version line (glslang, as
  *   runtime/shader_compile.c does for its own).  It adds binding 10 and
  *   atomically adds, per terrain pixel, the fields of splat_counters
- *   below.  Its dynamic branches are subgroup-uniform (splat_quad_any is
+ *   below.  A fragment counts once it has passed the depth test
+ *   (early_fragment_tests: the picture is the same, no shader writes
+ *   depth or discards), helper invocations never: on the forward path
+ *   "pixels" is the fragments shaded, overdraw included.  Its dynamic branches are subgroup-uniform (splat_quad_any is
  *   subgroupAny, GL_KHR_shader_subgroup_vote): a layer counts as evaluated
  *   for every pixel of a subgroup in which any pixel needs it (weight > 0),
  *   which is what the SIMD hardware pays; the picture is the same (a pixel
@@ -166,7 +170,7 @@ enum {
     SPLAT_BIND_DEPTH = 7,          /* compute only */
     SPLAT_BIND_OUT = 8,            /* compute only: rgba32f storage image */
     SPLAT_BIND_TILES = 9,          /* compute only: uint tiles[]          */
-    SPLAT_BIND_COUNTERS = 10,      /* compute, SPLAT_COUNT only           */
+    SPLAT_BIND_COUNTERS = 10,      /* fragment + compute, SPLAT_COUNT only */
     SPLAT_BIND_SHADOW = 11,        /* fragment + compute: sun visibility,
                                       R8 per heightfield texel (shadow.c) */
 

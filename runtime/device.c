@@ -264,6 +264,18 @@ bool rt_device_create(rt_device *d, const rt_device_desc *desc, rt_error *e)
     d->wireframe = have.fillModeNonSolid;
     want.textureCompressionBC = have.textureCompressionBC;   /* sparse masks */
     d->bc = have.textureCompressionBC;
+    /* the forward path's counting variant (abi.h SPLAT_COUNT) */
+    VkPhysicalDeviceSubgroupProperties sg = {
+        .sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SUBGROUP_PROPERTIES,
+    };
+    VkPhysicalDeviceProperties2 p2 = {
+        .sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_PROPERTIES_2, .pNext = &sg,
+    };
+    vkGetPhysicalDeviceProperties2(d->phys, &p2);
+    want.fragmentStoresAndAtomics = have.fragmentStoresAndAtomics;
+    d->count_fragments = have.fragmentStoresAndAtomics &&
+                         (sg.supportedStages & VK_SHADER_STAGE_FRAGMENT_BIT) &&
+                         (sg.supportedOperations & VK_SUBGROUP_FEATURE_VOTE_BIT);
     /* the shared vertex shader cuts terrain holes with a clip distance */
     if (!have.shaderClipDistance) {
         rt_device_destroy(d);
@@ -500,6 +512,14 @@ VkSamplerAddressMode rt_sampler_wrap(int ir_wrap)
     case IR_WRAP_REPEAT: break;
     }
     return VK_SAMPLER_ADDRESS_MODE_REPEAT;
+}
+
+void rt_cmd_barrier(VkCommandBuffer cb, VkPipelineStageFlags src, VkAccessFlags sa,
+                    VkPipelineStageFlags dst, VkAccessFlags da)
+{
+    VkMemoryBarrier mb = { .sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER,
+                           .srcAccessMask = sa, .dstAccessMask = da };
+    vkCmdPipelineBarrier(cb, src, dst, 0, 1, &mb, 0, NULL, 0, NULL);
 }
 
 void rt_cmd_image_barrier(VkCommandBuffer cb, VkImage img, uint32_t mip, uint32_t nmips,

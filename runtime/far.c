@@ -121,7 +121,7 @@ static const char far_main[] =
     "    vec2 nxz = textureGrad(u_far_normal, v_uv, gx, gy).rg * 2.0 - 1.0;\n"
     "    vec3 n = vec3(nxz.x, sqrt(max(1.0 - dot(nxz, nxz), 0.0)), nxz.y);\n"
     "    float rough = textureGrad(u_far_rough, v_uv, gx, gy).r;\n"
-    "    splat_n_samples = 3u;\n"
+    "    splat_count_samples(3u);\n"
     "    splat_finish(albedo, n, rough, 0.0, 1.0);\n"
     "}\n";
 

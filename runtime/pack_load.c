@@ -335,6 +335,13 @@ static bool read_glsl(reader *r, json_t *obj, const char *key, const char *where
     return read_glsl_at(r, c, w, out);
 }
 
+/* c["glsl"], the fragment GLSL beside c["spirv"]; optional (the forward
+ * path's counting variant compiles from it: abi.h SPLAT_COUNT). */
+static bool read_fragment_glsl(reader *r, json_t *c, const char *where, char **out)
+{
+    return !get(r, c, "glsl", where, false) || read_glsl_at(r, c, where, out);
+}
+
 /* The text of c["glsl"] (`w` names c in errors). */
 static bool read_glsl_at(reader *r, json_t *c, const char *w, char **out)
 {
@@ -1034,8 +1041,10 @@ static bool read_classes(reader *r, json_t *cs)
             co->dhi = json_is_null(hi) ? INFINITY : json_number_value(hi);
             if (!(co->dlo >= 0) || !(co->dhi >= co->dlo))
                 return field_fail(r, where, "distance: must have 0 <= lo <= hi");
-            if (get(r, c, "spirv", where, false) ? !read_spirv(r, c, where, &co->spirv)
-                                                   : !read_glsl_at(r, c, where, &co->glsl))
+            if (get(r, c, "spirv", where, false)
+                    ? !read_spirv(r, c, where, &co->spirv) ||
+                          !read_fragment_glsl(r, c, where, &co->glsl)
+                    : !read_glsl_at(r, c, where, &co->glsl))
                 return false;
             if (!read_glsl(r, c, "compute", where, &co->compute) ||
                 !get_number(r, c, "cost", where, &co->cost))
@@ -1087,6 +1096,7 @@ static bool read_combos(reader *r, json_t *root)
             co->materials[k] = (int)json_integer_value(m);
         }
         if (!read_spirv(r, c, where, &co->spirv) ||
+            !read_fragment_glsl(r, c, where, &co->glsl) ||
             !read_glsl(r, c, "compute", where, &co->compute) ||
             !read_glsl(r, c, "undergrowth", where, &co->ug_compute))
             return false;
@@ -1294,6 +1304,7 @@ bool rt_pack_load(rt_pack *p, const char *dir, rt_error *e)
         json_t *ub = get(&r, root, "uber", "manifest", false);
         if (ub && !json_is_null(ub))
             ok = read_spirv(&r, ub, "uber", &p->uber) &&
+                 read_fragment_glsl(&r, ub, "uber", &p->uber_glsl) &&
                  read_glsl(&r, ub, "compute", "uber", &p->uber_compute);
     }
     ok = ok && check_shaders(&r);
@@ -1347,6 +1358,7 @@ void rt_pack_free(rt_pack *p)
     free(p->holes);
     free_spirv(&p->uber);
     free(p->uber_compute);
+    free(p->uber_glsl);
     free(p->ug.blocks);
     free(p->ug.meshes);
     free(p->ug.vertices);

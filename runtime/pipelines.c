@@ -174,7 +174,8 @@ static bool make_layouts(rt_device *d, int ntextures, rt_pipelines *pl, rt_error
     const VkDescriptorType smp = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
     const VkDescriptorType sbuf = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
     /* One set 0 for both paths: the graphics passes leave the compute
-     * bindings (7-10) unwritten in their set, which they never read. */
+     * bindings (7-9) unwritten in their set, which they never read; both
+     * sets write the counters (10) for the counting variants. */
     VkDescriptorSetLayoutBinding terrain[] = {
         { SPLAT_BIND_HEIGHTFIELD, smp, 1, vf | cs, NULL },
         { SPLAT_BIND_FRAME, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 1, vf | cs, NULL },
@@ -188,7 +189,7 @@ static bool make_layouts(rt_device *d, int ntextures, rt_pipelines *pl, rt_error
         { SPLAT_BIND_DEPTH, smp, 1, cs, NULL },
         { SPLAT_BIND_OUT, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, cs, NULL },
         { SPLAT_BIND_TILES, sbuf, 1, cs, NULL },
-        { SPLAT_BIND_COUNTERS, sbuf, 1, cs, NULL },
+        { SPLAT_BIND_COUNTERS, sbuf, 1, fs, NULL },
     };
     if (!rt_set_layout(d, terrain, sizeof terrain / sizeof *terrain, &pl->set_terrain, e))
         return false;
@@ -361,6 +362,57 @@ static bool pack_pipeline(rt_device *d, rt_pipelines *pl, const rt_spirv *fs,
     return ok;
 }
 
+/* The pack's GLSL with `#define SPLAT_COUNT 1` after its #version line
+ * (abi.h: the counting variant is never stored). */
+static char *with_count_define(const char *glsl)
+{
+    const char *nl = strchr(glsl, '\n');
+    size_t head = nl ? (size_t)(nl - glsl) + 1 : 0, n = strlen(glsl);
+    static const char def[] = "#define SPLAT_COUNT 1\n";
+    char *s = malloc(n + sizeof def);
+    if (!s)
+        return NULL;
+    memcpy(s, glsl, head);
+    memcpy(s + head, def, sizeof def - 1);
+    memcpy(s + head + sizeof def - 1, glsl + head, n - head + 1);
+    return s;
+}
+
+/* A composite's fragment pipeline from the pack's GLSL, compiled,
+ * validated and checked against the composite interface here, on first
+ * use: a distance class without SPIR-V, and every counting variant. */
+static bool glsl_pipeline(rt_device *d, const rt_pack *p, rt_pipelines *pl,
+                          const rt_passes *rp, const char *glsl, const char *name,
+                          unsigned variant, VkPipeline *slot, rt_error *e)
+{
+    bool count = (variant & RT_VARIANT_COUNT) != 0;
+    if (count && !d->count_fragments)
+        return rt_fail(e, RT_E_NO_FORMAT, "count on the forward path (fragmentStoresAndAtomics "
+                       "and subgroup votes in fragment shaders)");
+    if (!glsl) {
+        char what[160];
+        snprintf(what, sizeof what, "the pack has no fragment GLSL of %s", name);
+        return rt_fail(e, RT_E_PACK_FIELD, p->dir, what);
+    }
+    char *src = count ? with_count_define(glsl) : NULL;
+    if (count && !src)
+        return rt_fail(e, RT_E_VULKAN, "pipelines", "out of memory");
+    rt_interface in;
+    if (!rt_interface_for(p, RT_ROLE_COMPOSITE, &in)) {
+        free(src);
+        return rt_fail(e, RT_E_VULKAN, "pipelines", "out of memory");
+    }
+    VkShaderModule m;
+    bool ok = rt_glsl_module(d, src ? src : glsl, VK_SHADER_STAGE_FRAGMENT_BIT, name, &in, &m, e);
+    rt_interface_free(&in);
+    free(src);
+    if (!ok)
+        return false;
+    ok = make_pipeline(d, pl, pl->vertex, m, rp->main, K_OPAQUE, variant, slot, e);
+    vkDestroyShaderModule(d->dev, m, NULL);
+    return ok;
+}
+
 bool rt_pipelines_combo(rt_device *d, const rt_pack *p, const rt_passes *rp,
                         rt_pipelines *pl, int id, unsigned variant, VkPipeline *out,
                         rt_error *e)
@@ -368,23 +420,12 @@ bool rt_pipelines_combo(rt_device *d, const rt_pack *p, const rt_passes *rp,
     if ((variant & RT_VARIANT_WIRE) && !d->wireframe)
         return rt_fail(e, RT_E_NO_FORMAT, "draw wireframe (no fillModeNonSolid)");
     VkPipeline *slot = &pl->combo[(size_t)id * RT_VARIANTS + (variant % RT_VARIANTS)];
-    if (!*slot && !p->combos[id].spirv.words && p->combos[id].glsl) {
-        /* a distance class: GLSL in the pack, compiled, validated and
-         * checked against the composite interface here, on first use */
+    if (!*slot && (!p->combos[id].spirv.words || (variant & RT_VARIANT_COUNT))) {
+        /* a distance class (GLSL alone in the pack), or the counting variant */
         char name[64];
-        snprintf(name, sizeof name, "combination %d (distance class)", id);
-        rt_interface in;
-        if (!rt_interface_for(p, RT_ROLE_COMPOSITE, &in))
-            return rt_fail(e, RT_E_VULKAN, "pipelines", "out of memory");
-        VkShaderModule m;
-        bool ok = rt_glsl_module(d, p->combos[id].glsl, VK_SHADER_STAGE_FRAGMENT_BIT, name, &in,
-                                 &m, e);
-        rt_interface_free(&in);
-        if (!ok)
-            return false;
-        ok = make_pipeline(d, pl, pl->vertex, m, rp->main, K_OPAQUE, variant, slot, e);
-        vkDestroyShaderModule(d->dev, m, NULL);
-        if (!ok)
+        snprintf(name, sizeof name, "combination %d (%s)", id,
+                 p->combos[id].spirv.words ? "counting" : "distance class");
+        if (!glsl_pipeline(d, p, pl, rp, p->combos[id].glsl, name, variant, slot, e))
             return false;
     }
     if (!*slot && !pack_pipeline(d, pl, &p->combos[id].spirv, rp->main, K_OPAQUE, variant, slot, e))
@@ -402,6 +443,9 @@ bool rt_pipelines_uber(rt_device *d, const rt_pack *p, const rt_passes *rp,
     if (!p->uber.words)
         return rt_fail(e, RT_E_PACK_FIELD, p->dir, "the pack has no uber shader");
     VkPipeline *slot = &pl->uber[variant % RT_VARIANTS];
+    if (!*slot && (variant & RT_VARIANT_COUNT) &&
+        !glsl_pipeline(d, p, pl, rp, p->uber_glsl, "uber (counting)", variant, slot, e))
+        return false;
     if (!*slot && !pack_pipeline(d, pl, &p->uber, rp->main, K_OPAQUE, variant, slot, e))
         return false;
     *out = *slot;
@@ -422,22 +466,6 @@ bool rt_pipelines_ref(rt_device *d, const rt_pack *p, const rt_passes *rp,
 }
 
 /* ---- compute shading (screen-space path) --------------------------------- */
-
-/* The pack's compute GLSL with `#define SPLAT_COUNT 1` after its #version
- * line (abi.h: the counting variant is never stored). */
-static char *with_count_define(const char *glsl)
-{
-    const char *nl = strchr(glsl, '\n');
-    size_t head = nl ? (size_t)(nl - glsl) + 1 : 0, n = strlen(glsl);
-    static const char def[] = "#define SPLAT_COUNT 1\n";
-    char *s = malloc(n + sizeof def);
-    if (!s)
-        return NULL;
-    memcpy(s, glsl, head);
-    memcpy(s + head, def, sizeof def - 1);
-    memcpy(s + head + sizeof def - 1, glsl + head, n - head + 1);
-    return s;
-}
 
 bool rt_pipelines_has_compute(const rt_pipelines *pl, int id, unsigned variant)
 {

@@ -36,6 +36,8 @@ struct rt_renderer {
     rt_buffer         vbuf, ibuf;
     uint32_t          perm_first[RT_PERMS], perm_count[RT_PERMS];
     rt_buffer         frame_ubo, params_ubo, readback;
+    rt_buffer         counters;        /* forward counting variant: device  */
+    rt_buffer         counters_host;   /* its copy for the host             */
     rt_image         *tex;
     VkSampler        *tex_smp;
     int               ntex;
@@ -58,7 +60,7 @@ struct rt_renderer {
     splat_view        view;
     int               view_material;
     bool              wireframe;
-    bool              counting;        /* screen: counting variant (stats)  */
+    bool              counting;        /* counting variant (stats)          */
     rt_shading        shading;         /* the path in use                   */
     double            lod_distance;
 };
@@ -281,6 +283,14 @@ static bool make_descriptors(rt_renderer *r, rt_error *e)
         !rt_buffer_create(d, p->params_size, VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, true,
                           &r->params_ubo, e))
         return false;
+    /* the forward path's counters (abi.h SPLAT_COUNT) */
+    if (!rt_buffer_create(d, sizeof(splat_counters), VK_BUFFER_USAGE_STORAGE_BUFFER_BIT |
+                          VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
+                          false, &r->counters, e) ||
+        !rt_buffer_create(d, sizeof(splat_counters), VK_BUFFER_USAGE_TRANSFER_DST_BIT, true,
+                          &r->counters_host, e))
+        return false;
+    memset(r->counters_host.map, 0, sizeof(splat_counters));
     memset(r->params_ubo.map, 0, p->params_size);
     for (int i = 0; i < p->nparams; i++)
         memcpy((uint8_t *)r->params_ubo.map + p->params[i].offset, p->params[i].value, 16);
@@ -289,7 +299,7 @@ static bool make_descriptors(rt_renderer *r, rt_error *e)
         { VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 3 },
         { VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 2 * 10 + (uint32_t)r->ntex + 3 },
         { VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1 },
-        { VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 2 },
+        { VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 3 },
     };
     VkDescriptorPoolCreateInfo pci = {
         .sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO,
@@ -328,6 +338,7 @@ static bool make_descriptors(rt_renderer *r, rt_error *e)
     }
     VkDescriptorBufferInfo fb = { r->frame_ubo.buf, 0, sizeof(splat_frame) };
     VkDescriptorBufferInfo pb = { r->params_ubo.buf, 0, p->params_size };
+    VkDescriptorBufferInfo cb = { r->counters.buf, 0, sizeof(splat_counters) };
     img[0] = (VkDescriptorImageInfo){ t->linear_clamp, t->height.view, ro };
     img[1] = (VkDescriptorImageInfo){ t->linear_clamp, t->painted.view, ro };
     img[2] = (VkDescriptorImageInfo){ t->linear_clamp, t->destr_atlas.view, ro };
@@ -353,6 +364,7 @@ static bool make_descriptors(rt_renderer *r, rt_error *e)
     W(r->set0, SPLAT_BIND_HOLES, smp, &img[9], NULL);
     img[10] = (VkDescriptorImageInfo){ t->linear_clamp, t->shadow.view, ro };
     W(r->set0, SPLAT_BIND_SHADOW, smp, &img[10], NULL);
+    W(r->set0, SPLAT_BIND_COUNTERS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, NULL, &cb);
     W(r->set1, SPLAT_BIND_PARAMS, ubo, NULL, &pb);
     for (int i = 0; i < r->ntex; i++) {
         timg[i] = (VkDescriptorImageInfo){ r->tex_smp[i], r->tex[i].view, ro };
@@ -556,6 +568,8 @@ void rt_renderer_destroy(rt_renderer *r)
         rt_buffer_destroy(d, &r->frame_ubo);
         rt_buffer_destroy(d, &r->params_ubo);
         rt_buffer_destroy(d, &r->readback);
+        rt_buffer_destroy(d, &r->counters);
+        rt_buffer_destroy(d, &r->counters_host);
         rt_destruction_destroy(r->destr);
         rt_terrain_destroy(d, &r->terrain);
     }
@@ -1057,6 +1071,25 @@ static bool record_multipass(rt_renderer *r, VkCommandBuffer cb, const rt_camera
     return true;
 }
 
+/* The forward path's counters: zeroed before the pass, copied back after. */
+static void count_begin(rt_renderer *r, VkCommandBuffer cb)
+{
+    vkCmdFillBuffer(cb, r->counters.buf, 0, sizeof(splat_counters), 0);
+    rt_cmd_barrier(cb, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
+                   VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT,
+                   VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
+}
+
+static void count_end(rt_renderer *r, VkCommandBuffer cb)
+{
+    rt_cmd_barrier(cb, VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
+                   VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_READ_BIT);
+    VkBufferCopy c = { 0, 0, sizeof(splat_counters) };
+    vkCmdCopyBuffer(cb, r->counters.buf, r->counters_host.buf, 1, &c);
+    rt_cmd_barrier(cb, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
+                   VK_PIPELINE_STAGE_HOST_BIT, VK_ACCESS_HOST_READ_BIT);
+}
+
 /* The forward path: each group of patches with its composite (or every
  * patch with the über-shader: --reference uber, and the MASK view, which
  * composites do not carry: compiler/build_jobs.c). */
@@ -1073,6 +1106,8 @@ static bool record_forward(rt_renderer *r, VkCommandBuffer cb, const rt_camera *
         .renderPass = r->rp.main, .framebuffer = r->fb_main,
         .renderArea = *area, .clearValueCount = 2, .pClearValues = clears,
     };
+    if (variant & RT_VARIANT_COUNT)
+        count_begin(r, cb);
     begin_terrain_pass(r, cb, &rb, vp, sets);
     int n = r->qt.npatches;
     if (r->desc.reference == RT_REF_UBER || r->view == SPLAT_VIEW_MASK) {
@@ -1105,6 +1140,8 @@ static bool record_forward(rt_renderer *r, VkCommandBuffer cb, const rt_camera *
         vkCmdDraw(cb, 3, 1, 0, 0);
     }
     vkCmdEndRenderPass(cb);
+    if (variant & RT_VARIANT_COUNT)
+        count_end(r, cb);
     return true;
 }
 
@@ -1160,11 +1197,14 @@ static bool draw_frame(rt_renderer *r, const rt_camera *c, rt_frame_stats *st, r
     if (ug && !rt_ug_generate(r->ug, cb, c, fr, r->set1, 0, e))
         return abandon_frame(cb);
     bool cull = !r->desc.no_cull && camera_above_terrain(r, c);
-    unsigned variant = (r->wireframe ? RT_VARIANT_WIRE : 0) |
-                       (r->view != SPLAT_VIEW_FINAL ? RT_VARIANT_DEBUG : 0) |
-                       (cull ? RT_VARIANT_CULL : 0);
     bool screen = r->screen && r->shading == RT_SHADING_SCREEN &&
                   r->desc.reference != RT_REF_MULTIPASS && !r->wireframe;
+    /* the multi-pass reference has no counting variant */
+    bool count = (r->counting || r->view == SPLAT_VIEW_COST) && !screen &&
+                 r->d->count_fragments && r->desc.reference != RT_REF_MULTIPASS;
+    unsigned variant = (r->wireframe ? RT_VARIANT_WIRE : 0) |
+                       (r->view != SPLAT_VIEW_FINAL ? RT_VARIANT_DEBUG : 0) |
+                       (cull ? RT_VARIANT_CULL : 0) | (count ? RT_VARIANT_COUNT : 0);
     bool ok = screen ? record_screen(r, cb, c, &vp, &area, cull, &binds, e)
             : r->desc.reference == RT_REF_MULTIPASS
                      ? record_multipass(r, cb, c, &vp, &area, cull, &binds, e)
@@ -1203,6 +1243,8 @@ static bool draw_frame(rt_renderer *r, const rt_camera *c, rt_frame_stats *st, r
     st->screen = screen;
     if (screen)
         rt_screen_read_stats(r->screen, &st->tiles);
+    else if (count)
+        rt_counters_read(r->counters_host.map, &st->tiles);
     rt_ug_read_stats(ug ? r->ug : NULL, &st->undergrowth);
     return read_times(r, screen, st, e);
 }

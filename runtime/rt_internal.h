@@ -51,6 +51,10 @@ bool rt_image_upload_levels(rt_device *d, rt_image *img, const uint8_t *const *l
 /* One-time command buffer helpers (load time only). */
 bool rt_oneshot_begin(rt_device *d, VkCommandBuffer *cb, rt_error *e);
 bool rt_oneshot_end(rt_device *d, VkCommandBuffer cb, rt_error *e);
+/* Record a global memory barrier: `sa` writes of stages `src` made
+ * visible to `da` accesses of stages `dst`. */
+void rt_cmd_barrier(VkCommandBuffer cb, VkPipelineStageFlags src, VkAccessFlags sa,
+                    VkPipelineStageFlags dst, VkAccessFlags da);
 /* Record a layout transition of mips [mip, mip + nmips) of the first
  * `layers` layers of a colour image. */
 void rt_cmd_image_barrier(VkCommandBuffer cb, VkImage img, uint32_t mip, uint32_t nmips,
@@ -315,7 +319,10 @@ enum {
                               above the terrain (render.c), where it hides
                               nothing visible (a few ridge pixels change
                               where depth rounding let a back face win)     */
-    RT_VARIANTS      = 8,
+    RT_VARIANT_COUNT = 8,  /* the counting variant (abi.h SPLAT_COUNT),
+                              compiled from the pack's fragment GLSL; needs
+                              rt_device.count_fragments                     */
+    RT_VARIANTS      = 16,
 };
 
 typedef struct rt_pipelines {
@@ -440,6 +447,9 @@ bool rt_screen_dispatch(rt_screen *s, VkCommandBuffer cb, rt_pipelines *pl,
  * again), -1 on error. */
 int rt_screen_missing(rt_screen *s, rt_pipelines *pl, unsigned variant, rt_error *e);
 void rt_screen_read_stats(const rt_screen *s, rt_screen_stats *st);
+/* The counting variant's splat_counters (abi.h, any alignment) into the
+ * stats' counting fields; both paths. */
+void rt_counters_read(const void *counters, rt_screen_stats *st);
 /* The far atlas (far.c): tiles whose nearest terrain pixel is at least
  * `distance` m away (0: off), outside the destructible area, are shaded
  * from it.  Nothing without an atlas in the pack (rt_screen_has_far). */

@@ -883,11 +883,8 @@ void rt_screen_depth_out(rt_screen *s, VkCommandBuffer cb, const rt_image *depth
     rt_cmd_image_barrier(cb, s->rdepth.img, 0, 1, 1, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
                          VK_IMAGE_LAYOUT_GENERAL, VK_ACCESS_TRANSFER_READ_BIT, 0,
                          VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT);
-    VkMemoryBarrier mb = { .sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER,
-                           .srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT,
-                           .dstAccessMask = VK_ACCESS_TRANSFER_READ_BIT };
-    vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, 0,
-                         1, &mb, 0, NULL, 0, NULL);
+    rt_cmd_barrier(cb, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
+                   VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_READ_BIT);
     depth_barrier(cb, depth->img, VK_IMAGE_LAYOUT_UNDEFINED, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
                   0, VK_ACCESS_TRANSFER_WRITE_BIT, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT,
                   VK_PIPELINE_STAGE_TRANSFER_BIT);
@@ -909,13 +906,9 @@ void rt_screen_begin(rt_screen *s, VkCommandBuffer cb, bool count)
     vkCmdCopyBuffer(cb, s->args_reset.buf, s->args.buf, 1, &c);
     if (count)
         vkCmdFillBuffer(cb, s->counters.buf, 0, sizeof(splat_counters), 0);
-    VkMemoryBarrier mb = {
-        .sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER,
-        .srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT,
-        .dstAccessMask = VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT,
-    };
-    vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
-                         0, 1, &mb, 0, NULL, 0, NULL);
+    rt_cmd_barrier(cb, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
+                   VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+                   VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
 }
 
 void rt_screen_classify(rt_screen *s, VkCommandBuffer cb, VkDescriptorSet set0,
@@ -957,14 +950,9 @@ void rt_screen_classify(rt_screen *s, VkCommandBuffer cb, VkDescriptorSet set0,
     else
         vkCmdDispatch(cb, (uint32_t)(s->ntiles + 63) / 64, 1, 1);
     (*binds)++;
-    VkMemoryBarrier mb = {
-        .sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER,
-        .srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT,
-        .dstAccessMask = VK_ACCESS_INDIRECT_COMMAND_READ_BIT | VK_ACCESS_SHADER_READ_BIT,
-    };
-    vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
-                         VK_PIPELINE_STAGE_DRAW_INDIRECT_BIT | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
-                         0, 1, &mb, 0, NULL, 0, NULL);
+    rt_cmd_barrier(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
+                   VK_PIPELINE_STAGE_DRAW_INDIRECT_BIT | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+                   VK_ACCESS_INDIRECT_COMMAND_READ_BIT | VK_ACCESS_SHADER_READ_BIT);
 }
 
 /* List k's indirect dispatch with the pipeline bound: workgroup g shades
@@ -1035,24 +1023,14 @@ bool rt_screen_dispatch(rt_screen *s, VkCommandBuffer cb, rt_pipelines *pl,
                          VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
                          VK_PIPELINE_STAGE_TRANSFER_BIT | VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT);
     /* the list counts and counters back to the host */
-    VkMemoryBarrier tb = {
-        .sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER,
-        .srcAccessMask = VK_ACCESS_SHADER_WRITE_BIT,
-        .dstAccessMask = VK_ACCESS_TRANSFER_READ_BIT,
-    };
-    vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
-                         0, 1, &tb, 0, NULL, 0, NULL);
+    rt_cmd_barrier(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
+                   VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_READ_BIT);
     VkBufferCopy ca = { 0, 0, (VkDeviceSize)s->nlists * 12 };
     VkBufferCopy cc = { 0, (VkDeviceSize)s->nlists * 12, sizeof(splat_counters) };
     vkCmdCopyBuffer(cb, s->args.buf, s->readback.buf, 1, &ca);
     vkCmdCopyBuffer(cb, s->counters.buf, s->readback.buf, 1, &cc);
-    VkMemoryBarrier hb = {
-        .sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER,
-        .srcAccessMask = VK_ACCESS_TRANSFER_WRITE_BIT,
-        .dstAccessMask = VK_ACCESS_HOST_READ_BIT,
-    };
-    vkCmdPipelineBarrier(cb, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_PIPELINE_STAGE_HOST_BIT,
-                         0, 1, &hb, 0, NULL, 0, NULL);
+    rt_cmd_barrier(cb, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
+                   VK_PIPELINE_STAGE_HOST_BIT, VK_ACCESS_HOST_READ_BIT);
     return true;
 }
 
@@ -1081,8 +1059,6 @@ bool rt_screen_has_far(const rt_screen *s) { return s->far_ok; }
 void rt_screen_read_stats(const rt_screen *s, rt_screen_stats *st)
 {
     const uint32_t *args = s->readback.map;
-    splat_counters c;
-    memcpy(&c, args + 3 * s->nlists, sizeof c);
     memset(st, 0, sizeof *st);
     st->tiles_total = s->ntiles;
     for (int k = 0; k < s->nlists; k++) {
@@ -1093,6 +1069,13 @@ void rt_screen_read_stats(const rt_screen *s, rt_screen_stats *st)
     }
     st->tiles_uber = (int)args[3 * s->p->ncombos];
     st->tiles_far = s->far_ok ? (int)args[3 * (s->p->ncombos + 1)] : 0;
+    rt_counters_read(args + 3 * s->nlists, st);
+}
+
+void rt_counters_read(const void *counters, rt_screen_stats *st)
+{
+    splat_counters c;
+    memcpy(&c, counters, sizeof c);
     st->pixels = c.pixels;
     st->layers_evaluated = c.layers_evaluated;
     st->layers_needed = c.layers_needed;

@@ -87,6 +87,9 @@ typedef struct rt_device {
     VkCommandPool            pool;       /* resettable command buffers      */
     bool                     wireframe;  /* fillModeNonSolid enabled        */
     bool                     bc;         /* textureCompressionBC enabled    */
+    bool                     count_fragments; /* fragmentStoresAndAtomics and
+                                            fragment subgroup votes: the
+                                            forward counting variant       */
     bool                     validating;
     int                      messages;   /* validation warnings + errors    */
 } rt_device;
@@ -182,11 +185,13 @@ typedef struct rt_pack_combo {
     /* Distance classes (PACK.md): entries nbase.. of rt_pack.combos are
      * the class variants, after the combinations of combos.bin; a class
      * holds where view.distance lies in [dlo, dhi] (base ones [0, inf]).
-     * Its fragment shader comes as GLSL (spirv.words NULL), compiled on
-     * first use. */
+     * Its fragment shader may come as GLSL alone (spirv.words NULL),
+     * compiled on first use. */
     int      base;        /* the combination it is a variant of (own id)    */
     double   dlo, dhi;    /* metres; dhi INFINITY: and beyond               */
-    char    *glsl;        /* a class's fragment GLSL; NULL for the others   */
+    char    *glsl;        /* fragment GLSL (the counting variant's source;
+                             a class's only shader without "spirv"); NULL:
+                             absent                                        */
     int      first_class, nclasses; /* a combination's classes, contiguous */
 } rt_pack_combo;
 
@@ -288,6 +293,7 @@ typedef struct rt_pack {
                                                  distance classes           */
     int              nbase;          /* combinations of combos.bin          */
     rt_spirv         uber;           /* words NULL if absent               */
+    char            *uber_glsl;      /* its fragment GLSL; NULL if absent   */
     char            *uber_compute;   /* its compute GLSL; NULL if absent    */
     rt_spirv         vertex;
     rt_pack_level   *levels;    int nlevels;
@@ -351,7 +357,9 @@ typedef struct rt_screen_stats {
     int      tiles_far;           /* tiles shaded from the far atlas         */
     int      tiles_class;         /* tiles shaded by a distance class        */
     int      lists;               /* combinations (and über) with tiles      */
-    uint32_t pixels, layers_evaluated, layers_needed, samples;  /* counting */
+    /* Counting frames (rt_renderer_set_counting, the cost view), both
+     * paths; on the forward path "pixels" are the fragments shaded. */
+    uint32_t pixels, layers_evaluated, layers_needed, samples;
     uint32_t branches, branches_uniform;   /* splat_counters (abi.h)         */
 } rt_screen_stats;
 
@@ -415,7 +423,7 @@ typedef struct rt_frame_stats {
     double pass_ms[3];        /* screen: geometry, classification, shading
                                  GPU ms (timestamps; < 0 if unsupported)     */
     bool   screen;            /* drawn by the screen-space path              */
-    rt_screen_stats tiles;    /* its tiles and counters (screen only)        */
+    rt_screen_stats tiles;    /* its tiles (screen only) and counters        */
     int    redraws;           /* frames drawn again after compiling pipelines */
     double shadow_ms;         /* CPU ms of a new shadow map (the sun moved or
                                  a crater changed heights); 0: none needed  */
@@ -449,8 +457,10 @@ int  rt_renderer_undergrowth_cell(rt_renderer *r, int ix, int iz, rt_ug_instance
 /* Terrain shadows on or off (rt_render_desc.no_shadows; the viewer's H). */
 void rt_renderer_set_shadows(rt_renderer *r, bool on);
 const rt_light *rt_renderer_light(const rt_renderer *r);
-/* Screen-space path: frames with the counting variant of the shaders
- * (abi.h SPLAT_COUNT), whose counters rt_frame_stats.tiles carries. */
+/* Frames with the counting variant of the shaders (abi.h SPLAT_COUNT),
+ * whose counters rt_frame_stats.tiles carries: the screen path's compute
+ * shaders, or the forward path's composites and über-shader (needs
+ * rt_device.count_fragments; not the multi-pass reference). */
 void rt_renderer_set_counting(rt_renderer *r, bool on);
 /* Switch paths; screen needs a renderer created with RT_SHADING_SCREEN
  * (false otherwise). */

@@ -645,7 +645,7 @@ static int headless(const opts *o)
             printf("undergrowth: off\n");
         }
         printf("cpu ms/frame (record): median %.3f  p10 %.3f  p90 %.3f\n", cm, cl, ch);
-        if (st.screen) {
+        if (st.screen || (dev.count_fragments && o->ref != RT_REF_MULTIPASS)) {
             /* one more frame with the counting variant (not timed) */
             rt_renderer_set_counting(r, true);
             rt_frame_stats cs;

@@ -868,14 +868,6 @@ static bool mask_pipeline(rt_ug *u, int combo, VkPipeline *out, rt_error *e)
     return true;
 }
 
-static void barrier(VkCommandBuffer cb, VkPipelineStageFlags src, VkAccessFlags sa,
-                    VkPipelineStageFlags dst, VkAccessFlags da)
-{
-    VkMemoryBarrier mb = { .sType = VK_STRUCTURE_TYPE_MEMORY_BARRIER,
-                           .srcAccessMask = sa, .dstAccessMask = da };
-    vkCmdPipelineBarrier(cb, src, dst, 0, 1, &mb, 0, NULL, 0, NULL);
-}
-
 /* The mask dispatches of cell `cl` in pool slot `slot`: one per leaf cell
  * it overlaps, clipped to that leaf. */
 static bool record_masks(rt_ug *u, VkCommandBuffer cb, const ug_cell *cl, int slot,
@@ -959,17 +951,17 @@ bool rt_ug_generate(rt_ug *u, VkCommandBuffer cb, const rt_camera *c, const spla
             vkCmdFillBuffer(cb, u->masks.buf, per * (VkDeviceSize)todo[i], per, 0);
             reset_args(u, cb, todo[i]);
         }
-        barrier(cb, VK_PIPELINE_STAGE_TRANSFER_BIT | VK_PIPELINE_STAGE_DRAW_INDIRECT_BIT |
-                    VK_PIPELINE_STAGE_VERTEX_SHADER_BIT,
-                VK_ACCESS_TRANSFER_WRITE_BIT | VK_ACCESS_INDIRECT_COMMAND_READ_BIT |
-                    VK_ACCESS_SHADER_READ_BIT,
-                VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
-                VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_SHADER_READ_BIT);
+        rt_cmd_barrier(cb, VK_PIPELINE_STAGE_TRANSFER_BIT | VK_PIPELINE_STAGE_DRAW_INDIRECT_BIT |
+                           VK_PIPELINE_STAGE_VERTEX_SHADER_BIT,
+                       VK_ACCESS_TRANSFER_WRITE_BIT | VK_ACCESS_INDIRECT_COMMAND_READ_BIT |
+                           VK_ACCESS_SHADER_READ_BIT,
+                       VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+                       VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_SHADER_READ_BIT);
         for (int i = 0; i < n; i++)
             if (!record_masks(u, cb, &u->cells[todo[i]], todo[i], set1, e))
                 return false;
-        barrier(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
-                VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT);
+        rt_cmd_barrier(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
+                       VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT);
         vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, u->gen_pipe);
         vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, u->gen_layout, 0, 1,
                                 &u->gen_set, 0, NULL);
@@ -989,16 +981,16 @@ bool rt_ug_generate(rt_ug *u, VkCommandBuffer cb, const rt_camera *c, const spla
             vkCmdDispatch(cb, (uint32_t)u->nblocks, 1, 1);
             u->cells[todo[i]].state = CELL_READY;
         }
-        barrier(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
-                VK_PIPELINE_STAGE_DRAW_INDIRECT_BIT | VK_PIPELINE_STAGE_VERTEX_SHADER_BIT |
-                    VK_PIPELINE_STAGE_TRANSFER_BIT,
-                VK_ACCESS_INDIRECT_COMMAND_READ_BIT | VK_ACCESS_SHADER_READ_BIT |
-                    VK_ACCESS_TRANSFER_READ_BIT);
+        rt_cmd_barrier(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
+                       VK_PIPELINE_STAGE_DRAW_INDIRECT_BIT | VK_PIPELINE_STAGE_VERTEX_SHADER_BIT |
+                           VK_PIPELINE_STAGE_TRANSFER_BIT,
+                       VK_ACCESS_INDIRECT_COMMAND_READ_BIT | VK_ACCESS_SHADER_READ_BIT |
+                           VK_ACCESS_TRANSFER_READ_BIT);
         /* the counts, for the stats and the tests (read after the frame) */
         VkBufferCopy all = { 0, 0, u->args.size };
         vkCmdCopyBuffer(cb, u->args.buf, u->args_host.buf, 1, &all);
-        barrier(cb, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
-                VK_PIPELINE_STAGE_HOST_BIT, VK_ACCESS_HOST_READ_BIT);
+        rt_cmd_barrier(cb, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
+                       VK_PIPELINE_STAGE_HOST_BIT, VK_ACCESS_HOST_READ_BIT);
     }
     /* every frame: this camera's LOD of every cell's arguments */
     uint32_t pc[2] = { (uint32_t)(u->pool * u->nblocks), (uint32_t)u->nblocks };
@@ -1007,8 +999,8 @@ bool rt_ug_generate(rt_ug *u, VkCommandBuffer cb, const rt_camera *c, const spla
                             0, NULL);
     vkCmdPushConstants(cb, u->lod_layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof pc, pc);
     vkCmdDispatch(cb, (pc[0] + 63) / 64, 1, 1);
-    barrier(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
-            VK_PIPELINE_STAGE_DRAW_INDIRECT_BIT, VK_ACCESS_INDIRECT_COMMAND_READ_BIT);
+    rt_cmd_barrier(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
+                   VK_PIPELINE_STAGE_DRAW_INDIRECT_BIT, VK_ACCESS_INDIRECT_COMMAND_READ_BIT);
     if (u->qpool)   /* bottom of pipe: when everything before has finished */
         vkCmdWriteTimestamp(cb, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, u->qpool, 1);
     u->generated = n;

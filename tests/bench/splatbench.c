@@ -25,9 +25,10 @@
  *                     baseline the GGX sun and the shadows are timed against
  *         screen      screen-space shading (--shading screen): depth pass,
  *                     tile classification, compute composites; its rows
- *                     add the three passes' GPU medians and, from one
- *                     counting frame after the timed ones, layers
- *                     evaluated / needed and samples per pixel
+ *                     add the three passes' GPU medians
+ *       Rows of screen, composite and uber add, from one counting frame
+ *       after the timed ones (abi.h SPLAT_COUNT), layers evaluated /
+ *       needed and samples per pixel (forward: per fragment shaded).
  *         screen_uber the same with every tile on the über-shader
  *         screen_raster, screen_raycast   the screen path with its depth
  *                     from the patches drawn depth only, or ray cast in
@@ -694,9 +695,11 @@ static int cmd_render(int argc, char **argv)
         }
     }
 
-    /* one counting frame per screen variant, after the timed ones */
+    /* one counting frame per variant the pack's GLSL shades (the screen
+     * kinds, composite and uber), after the timed ones */
     for (int i = 0; i < nspecs; i++) {
-        if (!IS_SCREEN(v[i].k))
+        if (!IS_SCREEN(v[i].k) && !(dev.count_fragments &&
+                                    (v[i].k == K_COMPOSITE || v[i].k == K_UBER)))
             continue;
         rt_camera cam;
         rt_frame_stats st;

@@ -27,9 +27,12 @@
 # With CRATER=R (a pack with a destructible area): at the first preset, a
 # crater of radius R where the view's centre ray meets the terrain, then
 # screen vs forward as above, and the crater must change the picture.
-# Then, at the first preset: the tiles and cost views render, --stats
-# prints the per-pass times and the counting lines with needed <=
-# evaluated.
+# Then, at the first preset: the tiles and cost views render (the cost
+# view on both paths), --stats prints the per-pass times and the counting
+# lines with needed <= evaluated on both paths, and the two paths' layers
+# needed per pixel agree within 5 % (the same pixels and weights, counted
+# by two different shaders; the forward path counts fragments, so
+# overdraw the depth test let through counts too).
 set -u
 SV=$1 IC=$2 PACK=$3 OUT=$4/screen_$(basename "$3") KIND=$5
 shift 5
@@ -85,6 +88,21 @@ for line in "  depth" "classification" "shading (compute)" "tiles:" \
             "layers per pixel: evaluated" "texture samples per pixel:" "shading: screen"; do
     grep -q "$line" "$OUT/stats.txt" || fail "--stats lacks '$line'"
 done
-sed -n 's/^layers per pixel: evaluated \([0-9.]*\), needed \([0-9.]*\).*/\1 \2/p' "$OUT/stats.txt" |
-    awk '{ exit !($2 > 0 && $2 <= $1 + 1e-9) }' || fail "layers needed must be > 0 and <= evaluated"
+run "$PACK" --headless $SIZE $c --view cost -o "$OUT/cost.f.png"
+"$IC" nonuniform "$OUT/cost.f.png" || fail "the forward path's cost view is uniform"
+run "$PACK" --headless $SIZE $c --stats --frames 2 > "$OUT/stats.f.txt"
+cat "$OUT/stats.f.txt"
+for line in "layers per pixel: evaluated" "texture samples per pixel:" "shading: forward"; do
+    grep -q "$line" "$OUT/stats.f.txt" || fail "forward --stats lacks '$line'"
+done
+layers() {
+    sed -n 's/^layers per pixel: evaluated \([0-9.]*\), needed \([0-9.]*\).*/\1 \2/p' "$1"
+}
+for f in stats stats.f; do
+    layers "$OUT/$f.txt" | awk '{ exit !($2 > 0 && $2 <= $1 + 1e-9) }' ||
+        fail "$f: layers needed must be > 0 and <= evaluated"
+done
+echo "$(layers "$OUT/stats.txt") $(layers "$OUT/stats.f.txt")" |
+    awk '{ d = $2 - $4; if (d < 0) d = -d; exit !(d <= 0.05 * $2) }' ||
+    fail "screen and forward count different layers needed per pixel"
 echo "ok"
