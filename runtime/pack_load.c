@@ -335,11 +335,32 @@ static bool read_glsl(reader *r, json_t *obj, const char *key, const char *where
     return read_glsl_at(r, c, w, out);
 }
 
-/* c["glsl"], the fragment GLSL beside c["spirv"]; optional (the forward
- * path's counting variant compiles from it: abi.h SPLAT_COUNT). */
-static bool read_fragment_glsl(reader *r, json_t *c, const char *where, char **out)
+/* c["glsl"], the fragment GLSL beside c["spirv"]: optional, and only its
+ * path is kept (the forward path's counting variant reads it on first use:
+ * rt_pack_read_glsl). */
+static bool read_fragment_glsl(reader *r, json_t *c, const char *where, char **path)
 {
-    return !get(r, c, "glsl", where, false) || read_glsl_at(r, c, where, out);
+    const char *rel;
+    if (!get(r, c, "glsl", where, false))
+        return true;
+    if (!get_string(r, c, "glsl", where, &rel))
+        return false;
+    *path = xstrdup(rel);
+    return true;
+}
+
+/* The file's bytes as GLSL text: NUL-terminated, no NUL inside; NULL with
+ * `why` set if not.  Takes `data` (n bytes, one spare byte allocated). */
+static char *glsl_text(uint8_t *data, size_t n, char *why, size_t nwhy)
+{
+    char *text = (char *)data;
+    text[n] = '\0';
+    if (strlen(text) != n) {
+        snprintf(why, nwhy, "holds a NUL byte: not GLSL text");
+        free(text);
+        return NULL;
+    }
+    return text;
 }
 
 /* The text of c["glsl"] (`w` names c in errors). */
@@ -348,24 +369,36 @@ static bool read_glsl_at(reader *r, json_t *c, const char *w, char **out)
     const char *rel;
     if (!get_string(r, c, "glsl", w, &rel))
         return false;
-    char field[128];
+    char field[128], why[96];
     snprintf(field, sizeof field, "%s.glsl", w);
     size_t n = 0;
     uint8_t *data = pack_file(r, field, rel, 0, MAX_SPIRV, &n);
     if (!data)
         return false;
-    char *text = realloc(data, n + 1);
-    if (!text) {
-        free(data);
-        return field_fail(r, field, "does not fit in memory");
-    }
-    text[n] = '\0';
-    if (strlen(text) != n) {
-        free(text);
-        return field_fail(r, field, "holds a NUL byte: not GLSL text");
-    }
-    *out = text;
+    if (!(*out = glsl_text(data, n, why, sizeof why)))
+        return field_fail(r, field, why);
     return true;
+}
+
+char *rt_pack_read_glsl(const rt_pack *p, const char *field, const char *rel, rt_error *e)
+{
+    char why[256];
+    size_t n = 0;
+    uint8_t *data = NULL;
+    int dirfd = open(p->dir, O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+    if (dirfd < 0) {
+        snprintf(why, sizeof why, "cannot open the pack folder (%s)", strerror(errno));
+    } else {
+        data = rt_pack_read_file(dirfd, rel, MAX_SPIRV, &n, why, sizeof why);
+        close(dirfd);
+    }
+    char *text = data ? glsl_text(data, n, why, sizeof why) : NULL;
+    if (!text) {
+        char manifest[512];
+        snprintf(manifest, sizeof manifest, "%s/manifest.json", p->dir);
+        rt_fail(e, RT_E_PACK_FILE, manifest, field, rel, why);
+    }
+    return text;
 }
 
 /* ---- sections ------------------------------------------------------------ */
@@ -1043,7 +1076,7 @@ static bool read_classes(reader *r, json_t *cs)
                 return field_fail(r, where, "distance: must have 0 <= lo <= hi");
             if (get(r, c, "spirv", where, false)
                     ? !read_spirv(r, c, where, &co->spirv) ||
-                          !read_fragment_glsl(r, c, where, &co->glsl)
+                          !read_fragment_glsl(r, c, where, &co->frag_path)
                     : !read_glsl_at(r, c, where, &co->glsl))
                 return false;
             if (!read_glsl(r, c, "compute", where, &co->compute) ||
@@ -1096,7 +1129,7 @@ static bool read_combos(reader *r, json_t *root)
             co->materials[k] = (int)json_integer_value(m);
         }
         if (!read_spirv(r, c, where, &co->spirv) ||
-            !read_fragment_glsl(r, c, where, &co->glsl) ||
+            !read_fragment_glsl(r, c, where, &co->frag_path) ||
             !read_glsl(r, c, "compute", where, &co->compute) ||
             !read_glsl(r, c, "undergrowth", where, &co->ug_compute))
             return false;
@@ -1304,7 +1337,7 @@ bool rt_pack_load(rt_pack *p, const char *dir, rt_error *e)
         json_t *ub = get(&r, root, "uber", "manifest", false);
         if (ub && !json_is_null(ub))
             ok = read_spirv(&r, ub, "uber", &p->uber) &&
-                 read_fragment_glsl(&r, ub, "uber", &p->uber_glsl) &&
+                 read_fragment_glsl(&r, ub, "uber", &p->uber_frag_path) &&
                  read_glsl(&r, ub, "compute", "uber", &p->uber_compute);
     }
     ok = ok && check_shaders(&r);
@@ -1351,6 +1384,7 @@ void rt_pack_free(rt_pack *p)
         free(p->combos[i].compute);
         free(p->combos[i].ug_compute);
         free(p->combos[i].glsl);
+        free(p->combos[i].frag_path);
         free_spirv(&p->combos[i].spirv);
     }
     for (int i = 0; i < p->nlevels && p->levels; i++)
@@ -1358,7 +1392,7 @@ void rt_pack_free(rt_pack *p)
     free(p->holes);
     free_spirv(&p->uber);
     free(p->uber_compute);
-    free(p->uber_glsl);
+    free(p->uber_frag_path);
     free(p->ug.blocks);
     free(p->ug.meshes);
     free(p->ug.vertices);

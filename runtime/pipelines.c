@@ -378,34 +378,39 @@ static char *with_count_define(const char *glsl)
     return s;
 }
 
-/* A composite's fragment pipeline from the pack's GLSL, compiled,
- * validated and checked against the composite interface here, on first
- * use: a distance class without SPIR-V, and every counting variant. */
+/* A composite's fragment pipeline from the pack's GLSL (`glsl`, else read
+ * from the pack's file `path`), compiled, validated and checked against
+ * the composite interface here, on first use: a distance class without
+ * SPIR-V, and every counting variant. */
 static bool glsl_pipeline(rt_device *d, const rt_pack *p, rt_pipelines *pl,
-                          const rt_passes *rp, const char *glsl, const char *name,
-                          unsigned variant, VkPipeline *slot, rt_error *e)
+                          const rt_passes *rp, const char *glsl, const char *field,
+                          const char *path, const char *name, unsigned variant,
+                          VkPipeline *slot, rt_error *e)
 {
     bool count = (variant & RT_VARIANT_COUNT) != 0;
     if (count && !d->count_fragments)
         return rt_fail(e, RT_E_NO_FORMAT, "count on the forward path (fragmentStoresAndAtomics "
                        "and subgroup votes in fragment shaders)");
+    char *text = NULL;
+    if (!glsl && path && !(glsl = text = rt_pack_read_glsl(p, field, path, e)))
+        return false;
     if (!glsl) {
         char what[160];
         snprintf(what, sizeof what, "the pack has no fragment GLSL of %s", name);
         return rt_fail(e, RT_E_PACK_FIELD, p->dir, what);
     }
     char *src = count ? with_count_define(glsl) : NULL;
-    if (count && !src)
-        return rt_fail(e, RT_E_VULKAN, "pipelines", "out of memory");
     rt_interface in;
-    if (!rt_interface_for(p, RT_ROLE_COMPOSITE, &in)) {
+    if ((count && !src) || !rt_interface_for(p, RT_ROLE_COMPOSITE, &in)) {
         free(src);
+        free(text);
         return rt_fail(e, RT_E_VULKAN, "pipelines", "out of memory");
     }
     VkShaderModule m;
     bool ok = rt_glsl_module(d, src ? src : glsl, VK_SHADER_STAGE_FRAGMENT_BIT, name, &in, &m, e);
     rt_interface_free(&in);
     free(src);
+    free(text);
     if (!ok)
         return false;
     ok = make_pipeline(d, pl, pl->vertex, m, rp->main, K_OPAQUE, variant, slot, e);
@@ -422,10 +427,17 @@ bool rt_pipelines_combo(rt_device *d, const rt_pack *p, const rt_passes *rp,
     VkPipeline *slot = &pl->combo[(size_t)id * RT_VARIANTS + (variant % RT_VARIANTS)];
     if (!*slot && (!p->combos[id].spirv.words || (variant & RT_VARIANT_COUNT))) {
         /* a distance class (GLSL alone in the pack), or the counting variant */
-        char name[64];
+        char name[64], field[64];
         snprintf(name, sizeof name, "combination %d (%s)", id,
                  p->combos[id].spirv.words ? "counting" : "distance class");
-        if (!glsl_pipeline(d, p, pl, rp, p->combos[id].glsl, name, variant, slot, e))
+        const rt_pack_combo *c = &p->combos[id], *b = &p->combos[c->base];
+        if (id >= p->nbase)   /* a distance class, as the manifest nests it */
+            snprintf(field, sizeof field, "combinations[%d].classes[%d].glsl", c->base,
+                     id - b->first_class);
+        else
+            snprintf(field, sizeof field, "combinations[%d].glsl", id);
+        if (!glsl_pipeline(d, p, pl, rp, p->combos[id].glsl, field, p->combos[id].frag_path,
+                           name, variant, slot, e))
             return false;
     }
     if (!*slot && !pack_pipeline(d, pl, &p->combos[id].spirv, rp->main, K_OPAQUE, variant, slot, e))
@@ -444,7 +456,8 @@ bool rt_pipelines_uber(rt_device *d, const rt_pack *p, const rt_passes *rp,
         return rt_fail(e, RT_E_PACK_FIELD, p->dir, "the pack has no uber shader");
     VkPipeline *slot = &pl->uber[variant % RT_VARIANTS];
     if (!*slot && (variant & RT_VARIANT_COUNT) &&
-        !glsl_pipeline(d, p, pl, rp, p->uber_glsl, "uber (counting)", variant, slot, e))
+        !glsl_pipeline(d, p, pl, rp, NULL, "uber.glsl", p->uber_frag_path, "uber (counting)",
+                       variant, slot, e))
         return false;
     if (!*slot && !pack_pipeline(d, pl, &p->uber, rp->main, K_OPAQUE, variant, slot, e))
         return false;

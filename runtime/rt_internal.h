@@ -172,6 +172,9 @@ int      rt_pack_open_file(int dirfd, const char *rel, char *why, size_t nwhy);
  * `max` bytes (bounded reads; NUL appended, not counted in *n). */
 uint8_t *rt_pack_read_file(int dirfd, const char *rel, size_t max, size_t *n, char *why,
                            size_t nwhy);
+/* The GLSL text at `rel` in p's folder (the manifest's `field`), read now
+ * under the same checks (malloc'd); NULL with `e` set if it cannot be. */
+char    *rt_pack_read_glsl(const rt_pack *p, const char *field, const char *rel, rt_error *e);
 /* combos.bin (PACK.md) of `n` bytes: the rt_level_count(cells_x, cells_z)
  * levels, level L (cells halved L times, rounding up) at offsets[L]; every
  * level inside the file and every id below ncombos, checked before each

@@ -189,9 +189,10 @@ typedef struct rt_pack_combo {
      * compiled on first use. */
     int      base;        /* the combination it is a variant of (own id)    */
     double   dlo, dhi;    /* metres; dhi INFINITY: and beyond               */
-    char    *glsl;        /* fragment GLSL (the counting variant's source;
-                             a class's only shader without "spirv"); NULL:
-                             absent                                        */
+    char    *glsl;        /* a class's fragment GLSL; NULL for the others   */
+    char    *frag_path;   /* "glsl" beside "spirv": the forward counting
+                             variant's source, read on first use
+                             (rt_pack_read_glsl); NULL: absent              */
     int      first_class, nclasses; /* a combination's classes, contiguous */
 } rt_pack_combo;
 
@@ -293,7 +294,8 @@ typedef struct rt_pack {
                                                  distance classes           */
     int              nbase;          /* combinations of combos.bin          */
     rt_spirv         uber;           /* words NULL if absent               */
-    char            *uber_glsl;      /* its fragment GLSL; NULL if absent   */
+    char            *uber_frag_path; /* its fragment GLSL ("glsl"); NULL if
+                                        absent: read on first use          */
     char            *uber_compute;   /* its compute GLSL; NULL if absent    */
     rt_spirv         vertex;
     rt_pack_level   *levels;    int nlevels;
