@@ -18,8 +18,10 @@ mkdir -p out
 JOBS=$(nproc 2>/dev/null || echo 2)
 "$SPLATC" build examples/colorado/scene.sg -o out/colorado.pack -j "$JOBS" --stats
 "$VIEW" out/colorado.pack --headless -o out/demo.png --size "$SIZE" --camera-preset "$CAMERA"
+# the combination of each patch, as the paper's figure draws it (the
+# default screen path would show each 8x8 tile's choice)
 "$VIEW" out/colorado.pack --headless -o out/demo_combos.png --size "$SIZE" \
-    --camera-preset "$CAMERA" --view combos
+    --camera-preset "$CAMERA" --view combos --shading forward
 # on the ground, where the undergrowth grows (none from the air)
 "$VIEW" out/colorado.pack --headless -o out/demo_meadow.png --size "$SIZE" --camera-preset meadow
 echo

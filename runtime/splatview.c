@@ -29,7 +29,10 @@ static void usage(FILE *f)
         "  --reference multipass|uber   the multi-pass alpha reference or the uber-shader\n"
         "  --shading forward|screen  forward: each patch shaded by its composite;\n"
         "                            screen: depth pass, 8x8 tiles classified by\n"
-        "                            combination, shaded in compute (default forward)\n"
+        "                            combination, shaded in compute (default: screen\n"
+        "                            where the pack has compute variants and no\n"
+        "                            --reference multipass, else forward;\n"
+        "                            $SPLAT_SHADING=forward|screen sets it)\n"
         "  --screen-depth auto|raster|raycast   the screen path's depth: the patches\n"
         "                            drawn depth only, or the heightfield ray cast in\n"
         "                            compute (auto: ray cast on GPUs without holes)\n"
@@ -115,6 +118,7 @@ typedef struct opts {
     float clear[4];
     rt_reference ref;
     rt_shading shading;
+    bool shading_set;      /* --shading given; else screen where the pack can */
     rt_screen_depth screen_depth;
     const char *params[64];
     int nparams;
@@ -317,9 +321,9 @@ static int parse_args(int argc, char **argv, opts *o)
         } else if (!strcmp(a, "--shading")) {
             NEED();
             if (!strcmp(v, "forward"))
-                o->shading = RT_SHADING_FORWARD;
+                o->shading = RT_SHADING_FORWARD, o->shading_set = true;
             else if (!strcmp(v, "screen"))
-                o->shading = RT_SHADING_SCREEN;
+                o->shading = RT_SHADING_SCREEN, o->shading_set = true;
             else {
                 fprintf(stderr, "splatview: --shading expects forward or screen, found '%s'\n", v);
                 return 2;
@@ -548,6 +552,15 @@ static int headless(const opts *o)
         .destruction_pool = o->destruction_pool, .shading = o->shading,
         .screen_depth = o->screen_depth, .far_atlas_distance = o->far_distance,
     };
+    /* the default: $SPLAT_SHADING (forward|screen), else the screen-space
+     * path wherever the pack has its compute variants (faster on both
+     * devices: tests/bench/RESULTS.md) */
+    const char *env = getenv("SPLAT_SHADING");
+    if (!o->shading_set && env && (!strcmp(env, "forward") || !strcmp(env, "screen")))
+        rd.shading = !strcmp(env, "screen") ? RT_SHADING_SCREEN : RT_SHADING_FORWARD;
+    else if (!o->shading_set)
+        rd.shading = pack.uber_compute && o->ref != RT_REF_MULTIPASS ? RT_SHADING_SCREEN
+                                                                     : RT_SHADING_FORWARD;
     light_options(o, &rd);
     memcpy(rd.clear, o->clear, sizeof rd.clear);
     if (!rt_renderer_create(&dev, &pack, &rd, &r, &e) || !apply_params(o, r, &e) ||

@@ -247,15 +247,16 @@ case_ ug_far_range bc4 "undergrowth.meshes\[0\].far: must be an integer in \[0, 
 "$PE" set $M undergrowth.meshes.0.far 9
 EOF
 # The fragment GLSL the forward counting variant reads when first needed
-# (the cost view): the same checks then, and the pack still draws without it.
+# (the cost view on the forward path): the same checks then, and the pack
+# still draws without it.
 P="$OUT/c/frag_symlink"
 rm -rf "$P" && cp -r "$OUT/bc4" "$P" || fail "frag_symlink: copy"
 for f in "$P"/shaders/[0-9][0-9][0-9][0-9].frag "$P/shaders/uber.frag"; do
     rm "$f" && ln -s ../../../outside.txt "$f" || fail "frag_symlink: the corruption itself failed"
 done
-"$SV" "$P" --headless --size 32x32 -o "$P.png" > "$P.log" 2>&1 ||
+"$SV" "$P" --headless --size 32x32 --shading forward -o "$P.png" > "$P.log" 2>&1 ||
     fail "frag_symlink: the final view needs no fragment GLSL (exit $?)"
-timeout 20 "$SV" "$P" --headless --size 32x32 --view cost -o "$P.cost.png" > "$P.cost.log" 2>&1
+timeout 20 "$SV" "$P" --headless --size 32x32 --shading forward --view cost -o "$P.cost.png" > "$P.cost.log" 2>&1
 rc=$?
 n=$((n + 1))
 echo "[$n] frag_symlink: exit $rc: $(head -c 300 "$P.cost.log" | tr '\n' ' ')"

@@ -18,6 +18,9 @@ set -u
 case_=$1 SV=$2 IC=$3 PACK=$4 OUT=$5/example_$1
 mkdir -p "$OUT"
 export SPLAT_VALIDATE=1
+# the forward path (the references compare against it); screen.sh tests
+# the screen path
+export SPLAT_SHADING=forward
 export SPLAT_PIPELINE_CACHE="$OUT/pipelines.bin"
 fail() { echo "FAIL: $*"; exit 1; }
 run() { echo "+ splatview $*"; "$SV" "$@" || fail "splatview $* (exit $?)"; }

@@ -44,7 +44,7 @@ run() { echo "+ splatview $*"; "$SV" "$@" || fail "splatview $* (exit $?)"; }
 SIZE="--size 320x180"
 for cam in "$@"; do
     c="--camera-preset $cam"
-    run "$PACK" --headless $SIZE $c --float-out "$OUT/$cam.f.f32"
+    run "$PACK" --headless $SIZE $c --shading forward --float-out "$OUT/$cam.f.f32"
     run "$PACK" --headless $SIZE $c --shading screen --float-out "$OUT/$cam.s.f32"
     run "$PACK" --headless $SIZE $c --shading screen --reference uber --float-out "$OUT/$cam.u.f32"
     case $KIND in
@@ -70,7 +70,8 @@ run "$PACK" --headless $SIZE $c --shading screen --screen-depth raster --lod-pix
 "$IC" close "$OUT/full.f32" "$OUT/ray.f32" 0.0157 0.999 60 ||
     fail "ray-cast depth and the full-detail geometry pass's differ (above)"
 if [ -n "${CRATER:-}" ]; then
-    run "$PACK" --headless $SIZE $c --crater-at-view "$CRATER" --float-out "$OUT/crater.f.f32"
+    run "$PACK" --headless $SIZE $c --crater-at-view "$CRATER" --shading forward \
+        --float-out "$OUT/crater.f.f32"
     run "$PACK" --headless $SIZE $c --crater-at-view "$CRATER" --shading screen \
         --float-out "$OUT/crater.s.f32"
     "$IC" close "$OUT/crater.f.f32" "$OUT/crater.s.f32" 0.0157 0.999 45 ||
@@ -88,9 +89,9 @@ for line in "  depth" "classification" "shading (compute)" "tiles:" \
             "layers per pixel: evaluated" "texture samples per pixel:" "shading: screen"; do
     grep -q "$line" "$OUT/stats.txt" || fail "--stats lacks '$line'"
 done
-run "$PACK" --headless $SIZE $c --view cost -o "$OUT/cost.f.png"
+run "$PACK" --headless $SIZE $c --shading forward --view cost -o "$OUT/cost.f.png"
 "$IC" nonuniform "$OUT/cost.f.png" || fail "the forward path's cost view is uniform"
-run "$PACK" --headless $SIZE $c --stats --frames 2 > "$OUT/stats.f.txt"
+run "$PACK" --headless $SIZE $c --shading forward --stats --frames 2 > "$OUT/stats.f.txt"
 cat "$OUT/stats.f.txt"
 for line in "layers per pixel: evaluated" "texture samples per pixel:" "shading: forward"; do
     grep -q "$line" "$OUT/stats.f.txt" || fail "forward --stats lacks '$line'"
