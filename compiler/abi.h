@@ -110,7 +110,8 @@
  *   below.  A fragment counts once it has passed the depth test
  *   (early_fragment_tests: the picture is the same, no shader writes
  *   depth or discards), helper invocations never: on the forward path
- *   "pixels" is the fragments shaded, overdraw included.  Its dynamic branches are subgroup-uniform (splat_quad_any is
+ *   "pixels" is the fragments shaded, overdraw included.  Its dynamic
+ *   branches are subgroup-uniform in both stages (splat_quad_any is
  *   subgroupAny, GL_KHR_shader_subgroup_vote): a layer counts as evaluated
  *   for every pixel of a subgroup in which any pixel needs it (weight > 0),
  *   which is what the SIMD hardware pays; the picture is the same (a pixel
