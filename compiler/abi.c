@@ -71,7 +71,11 @@
 
 /* Bindings 7-10 and the globals that stand for the fragment varyings. */
 #define COMPUTE_DECLS                                                       \
+    "#ifdef SPLAT_SORT\n"                                                   \
+    "layout(local_size_x = SPLAT_SORT_LANES) in;\n"                         \
+    "#else\n"                                                               \
     "layout(local_size_x = 8, local_size_y = 8) in;\n"                      \
+    "#endif\n"                                                              \
     "#ifdef SPLAT_UNDERGROWTH\n"                                            \
     UG_DECLS                                                                \
     "#else\n"                                                               \
@@ -115,13 +119,80 @@
     "    atomicAdd(u_counters.branches_uniform, splat_n_uniform);\n"        \
     "#endif\n"
 
+/* The sorted variant's main (abi.h SPLAT_SORT): each invocation takes a
+ * pixel of its workgroup's SPLAT_SORT_TILES tiles and runs the composite
+ * with splat_sorting set, which only collects the pixel's layer set; a
+ * counting sort by that set in shared memory (per-key counts, their
+ * exclusive prefix sum over the subgroups, a scatter); then invocation i
+ * shades the i-th pixel of that order, so a subgroup's lanes mostly need
+ * the same layers.  Pixels without terrain take key SORT_KEYS, which is
+ * never scattered: they are off the end of the order. */
+#define SORT_KEYS 256    /* SPLAT_SORT_KEYS, as text; <= the lanes (4 tiles) */
+#define SORT_TILES_MIN 4 /* SPLAT_SORT_TILES_MIN, as text */
+_Static_assert(SORT_KEYS == SPLAT_SORT_KEYS && SORT_TILES_MIN == SPLAT_SORT_TILES_MIN &&
+               SORT_KEYS <= 64 * SORT_TILES_MIN,
+               "the sorted variant's sizes (abi.h)");
+#define SORT_MAIN                                                           \
+    "shared uint s_sort_n[" SPLAT_STR(SORT_KEYS) " + 1];   /* per key */\n" \
+    "shared uint s_sort_part[SPLAT_SORT_LANES];   /* per subgroup */\n"     \
+    "shared uint s_sort_px[SPLAT_SORT_LANES];\n"                            \
+    "void main() {\n"                                                       \
+    "    uint li = gl_LocalInvocationIndex;\n"                              \
+    "    uint t = u_tiles.tiles[u_push.info.w + gl_WorkGroupID.x * uint(SPLAT_SORT_TILES)\n" \
+    "                           + li / 64u];\n"                             \
+    "    ivec2 px = splat_tile_pixel(t, uvec2(li & 7u, (li >> 3u) & 7u));\n" \
+    "    if (li < " SPLAT_STR(SORT_KEYS) "u) s_sort_n[li] = 0u;\n"          \
+    "    if (li == 0u) s_sort_n[" SPLAT_STR(SORT_KEYS) "] = 0u;\n"          \
+    "    barrier();\n"                                                      \
+    "    uint key = " SPLAT_STR(SORT_KEYS) "u;   /* no terrain: past every key */\n" \
+    "    if (splat_begin_at(px)) {\n"                                       \
+    "        splat_sorting = true;\n"                                       \
+    "        splat_main();\n"                                               \
+    "        splat_sorting = false;\n"                                      \
+    "        uint b = splat_layer_bits;\n"                                  \
+    "        b ^= b >> 16u;\n"                                              \
+    "        key = (b ^ (b >> 8u)) & 255u;\n"                               \
+    "    }\n"                                                               \
+    "#ifdef SPLAT_COUNT\n"   /* the first run's work, its layers excepted */ \
+    "    atomicAdd(u_counters.samples, splat_n_samples);\n"                 \
+    "    atomicAdd(u_counters.branches, splat_n_branches);\n"               \
+    "    atomicAdd(u_counters.branches_uniform, splat_n_uniform);\n"        \
+    "    splat_n_samples = 0u;\n"                                           \
+    "    splat_n_branches = 0u;\n"                                          \
+    "    splat_n_uniform = 0u;\n"                                           \
+    "#endif\n"                                                              \
+    "    uint rank = atomicAdd(s_sort_n[key], 1u);\n"                       \
+    "    barrier();\n"                                                      \
+    "    uint n = li < " SPLAT_STR(SORT_KEYS) "u ? s_sort_n[li] : 0u;\n"    \
+    "    uint below = subgroupExclusiveAdd(n);\n"                           \
+    "    if (gl_SubgroupInvocationID == gl_SubgroupSize - 1u)\n"            \
+    "        s_sort_part[gl_SubgroupID] = below + n;\n"                     \
+    "    barrier();\n"                                                      \
+    "    uint total = 0u;\n"                                                \
+    "    for (uint k = 0u; k < gl_NumSubgroups; k++) {\n"                   \
+    "        if (k == gl_SubgroupID) below += total;\n"                     \
+    "        total += s_sort_part[k];\n"                                    \
+    "    }\n"                                                               \
+    "    if (li < " SPLAT_STR(SORT_KEYS) "u)\n"                             \
+    "        s_sort_n[li] = below;   /* every count was read before the barrier */\n" \
+    "    barrier();\n"                                                      \
+    "    if (key < " SPLAT_STR(SORT_KEYS) "u)\n"                            \
+    "        s_sort_px[s_sort_n[key] + rank] = uint(px.x) | (uint(px.y) << 16u);\n" \
+    "    barrier();\n"                                                      \
+    "    if (li >= total) return;\n"                                        \
+    "    uint q = s_sort_px[li];\n"                                         \
+    "    splat_begin_at(ivec2(q & 0xffffu, q >> 16u));\n"                   \
+    "    splat_main();\n"                                                   \
+    COUNT_ADD                                                               \
+    "    imageStore(u_out, splat_pixel, o_color);\n"                        \
+    "}\n"
+
 /* After splat_finish: depth reconstruction, FC5's position derivatives
  * (the prelude's splat_plane_step), the real main() around the
  * composite's (renamed splat_main). */
 #define COMPUTE_MAIN                                                        \
-    "bool splat_begin() {\n"                                                \
-    "    uint t = u_tiles.tiles[u_push.info.w + gl_WorkGroupID.x];\n"       \
-    "    splat_pixel = ivec2(uvec2(t & 0xffffu, t >> 16u) * 8u + gl_LocalInvocationID.xy);\n" \
+    "bool splat_begin_at(ivec2 px) {\n"                                     \
+    "    splat_pixel = px;\n"                                               \
     "    if (any(greaterThanEqual(splat_pixel, ivec2(u_frame.screen.xy)))) return false;\n" \
     "    float d = texelFetch(u_depth, splat_pixel, 0).r;\n"                \
     "    if (d == u_frame.screen.z) return false;\n"                        \
@@ -134,13 +205,21 @@
     "    splat_dpdy = splat_plane_step(splat_nrm, v_rel, c + vec2(0.0, 1.0), d);\n" \
     "    return true;\n"                                                    \
     "}\n"                                                                   \
+    "ivec2 splat_tile_pixel(uint t, uvec2 q) {\n"                           \
+    "    return ivec2(uvec2(t & 0xffffu, t >> 16u) * 8u + q);\n"            \
+    "}\n"                                                                   \
     "void splat_main();\n"                                                  \
+    "#ifdef SPLAT_SORT\n"                                                   \
+    SORT_MAIN                                                               \
+    "#else\n"                                                               \
     "void main() {\n"                                                       \
-    "    if (!splat_begin()) return;\n"                                     \
+    "    uint t = u_tiles.tiles[u_push.info.w + gl_WorkGroupID.x];\n"       \
+    "    if (!splat_begin_at(splat_tile_pixel(t, gl_LocalInvocationID.xy))) return;\n" \
     "    splat_main();\n"                                                   \
     COUNT_ADD                                                               \
     "    imageStore(u_out, splat_pixel, o_color);\n"                        \
     "}\n"                                                                   \
+    "#endif\n"                                                              \
     "#define main splat_main\n"
 
 /* A fragment shader that samples with gradients (SPLAT_GRADIENTS, which
@@ -354,6 +433,13 @@ const char SPLAT_GLSL_PRELUDE[] =
     "layout(early_fragment_tests) in;\n"
     "#endif\n"
     "#endif\n"
+    "#ifdef SPLAT_SORT\n"
+    "#extension GL_KHR_shader_subgroup_arithmetic : require\n"
+    "#ifndef SPLAT_SORT_TILES\n"
+    "#define SPLAT_SORT_TILES " SPLAT_STR(SORT_TILES_MIN) "\n"
+    "#endif\n"
+    "#define SPLAT_SORT_LANES (64 * SPLAT_SORT_TILES)\n"
+    "#endif\n"
     SPLAT_GLSL_COMMON
     /* painted masks: dense layers, or the sparse quad-tree (sparse.h) */
     "#ifdef SPLAT_PAINTED_SPARSE\n"
@@ -413,6 +499,25 @@ const char SPLAT_GLSL_PRELUDE[] =
     "    f = max(f, abs(dFdyFine(f)));\n"
     "    return f > 0.0;\n"
     "}\n"
+    "#endif\n"
+    /* A composite's layer j: its surface block runs where this is true
+     * (abi.h SPLAT_SORT: the sort's first run only collects the layers) */
+    "#ifdef SPLAT_SORT\n"
+    "bool splat_sorting = false;\n"
+    "uint splat_layer_bits = 0u;\n"
+    "bool splat_surface(uint j, bool c) {\n"
+    "    if (!splat_sorting) return splat_quad_any(c);\n"
+    "    if (c) splat_layer_bits |= 1u << (j & 31u);\n"
+    "    return false;\n"
+    "}\n"
+    "bool splat_opaque(uint j) {\n"
+    "    if (!splat_sorting) return true;\n"
+    "    splat_layer_bits |= 1u << (j & 31u);\n"
+    "    return false;\n"
+    "}\n"
+    "#else\n"
+    "#define splat_surface(j, c) splat_quad_any(c)\n"
+    "#define splat_opaque(j) true\n"
     "#endif\n"
     /* Listing 1 (Andersson 2007), with the texel aspect in metres. */
     "vec3 splat_normal_at(vec2 uv) {\n"
@@ -538,7 +643,7 @@ const char SPLAT_GLSL_PRELUDE[] =
     "vec3 splat_combo_color(uint id);\n"
     "vec3 splat_tile_color() {\n"
     "#ifdef SPLAT_COMPUTE\n"
-    "    uvec2 q = gl_LocalInvocationID.xy;\n"
+    "    uvec2 q = uvec2(splat_pixel) & 7u;\n"
     "    bool edge = q.x == 0u || q.y == 0u;\n"
     "    return splat_combo_color(u_push.info.y) * (edge ? 0.6 : 1.0);\n"
     "#else\n"
@@ -584,6 +689,9 @@ const char SPLAT_GLSL_PRELUDE[] =
     COMBO_COLOR_TEXT
     "void splat_finish(vec3 albedo, vec3 normal, float rough, float height,\n"
     "                  float coverage) {\n"
+    "#ifdef SPLAT_SORT\n"
+    "    if (splat_sorting) return;\n"
+    "#endif\n"
     "    float dist = splat_view_distance();\n"
     "#if defined(SPLAT_UNDERGROWTH)\n"
     "    splat_ug_albedo = albedo;\n"

@@ -101,6 +101,31 @@
  *   fragment stage, textureLod(s, uv, 0.0) in compute.  New prelude code
  *   that samples must use it (compute has no implicit derivatives).
  *
+ * Sorted variant (SPLAT_SORT, compute only): not stored in the pack
+ *   either; the runtime inserts `#define SPLAT_SORT 1` as for SPLAT_COUNT
+ *   (the two combine), and may define SPLAT_SORT_TILES, from
+ *   SPLAT_SORT_TILES_MIN (the default) to _MAX.  A workgroup of 64 *
+ *   SPLAT_SORT_TILES invocations takes SPLAT_SORT_TILES consecutive
+ *   entries of tiles[] (workgroup g: tiles[info.w + g.x * SPLAT_SORT_TILES
+ *   + i]; an entry of 0xffffffff is padding and shades nothing) and runs
+ *   the composite twice per pixel.
+ *   First with splat_sorting set: the composite's layer branches are
+ *   written as splat_surface(j, w > 0.0) (layer j of the composite,
+ *   front to back) and, for an opaque layer, splat_opaque(j); with
+ *   splat_sorting they record bit j in splat_layer_bits and return false,
+ *   so no surface runs, only the masks and the coverage guards, and
+ *   splat_finish returns at once.  The pixels are then counting-sorted in
+ *   shared memory by their layer set (folded to 8 bits: SPLAT_SORT_KEYS),
+ *   and the second run shades pixel number gl_LocalInvocationIndex of that
+ *   order, so the lanes of a subgroup need the same layers and skip the
+ *   same surfaces.  The picture is the same (each pixel is computed as in
+ *   the plain variant); the sort only decides which lane computes it.
+ *   Needs GL_KHR_shader_subgroup_arithmetic and _vote (the runtime
+ *   checks).  Counting: layers count in the second run only (the first
+ *   runs no surface); samples and branches of both runs count.
+ *   Elsewhere splat_surface(j, c) is splat_quad_any(c) and
+ *   splat_opaque(j) is true.
+ *
  * Counting variant (SPLAT_COUNT, both stages): not stored in the pack.
  *   The runtime compiles it on first use from the pack's GLSL (compute, or
  *   a composite's / the über-shader's fragment GLSL) with
@@ -147,7 +172,8 @@
 
 #include <stdint.h>
 
-#define SPLAT_ABI_VERSION 3   /* 2: splat_frame.light; 3: GGX lighting, screen.w */
+#define SPLAT_ABI_VERSION 4   /* 2: splat_frame.light; 3: GGX lighting, screen.w;
+                                 4: splat_surface / splat_opaque, SPLAT_SORT */
 
 /* Undergrowth masks (above): texels per cell side, undergrowth-bearing
  * materials at most (4 per word), the fixed view distance (m). */
@@ -176,6 +202,9 @@ enum {
                                       R8 per heightfield texel (shadow.c) */
 
     SPLAT_TILE = 8,                /* compute: pixels per tile side = local size */
+    SPLAT_SORT_TILES_MIN = 4,      /* compute, SPLAT_SORT: tiles per workgroup: */
+    SPLAT_SORT_TILES_MAX = 16,     /* GLSL's default and the most (1024 lanes)   */
+    SPLAT_SORT_KEYS = 256,         /* SPLAT_SORT: layer-set keys (8 bits) */
 
     SPLAT_BIND_PARAMS = 0,
     SPLAT_BIND_TEXTURE0 = 1,   /* texture i at binding 1 + i */

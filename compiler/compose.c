@@ -866,19 +866,28 @@ static bool is_const(const ir *ir, ir_ref r, double *v)
 }
 
 /* Open a block guarded by `cond > 0.0`: a plain block if it is a positive
- * constant; false (nothing opened) if it is a constant <= 0. */
-static bool open_guard(emit *em, ir_ref cond, int depth)
+ * constant; false (nothing opened) if it is a constant <= 0.  `layer` >= 0:
+ * the block is that layer's surface (abi.h splat_surface / splat_opaque,
+ * which the sorted variant's first run skips); -1: a coverage guard. */
+static bool open_guard(emit *em, ir_ref cond, int depth, int layer)
 {
     double v;
     if (is_const(&em->ir, cond, &v)) {
         if (!(v > 0.0))
             return false;
-        ir_buf_printf(em->out, "%s{\n", indent_at(em, depth));
+        if (layer >= 0)
+            ir_buf_printf(em->out, "%sif (splat_opaque(%du)) {\n", indent_at(em, depth), layer);
+        else
+            ir_buf_printf(em->out, "%s{\n", indent_at(em, depth));
     } else {
         char *x = value(em, cond, depth);
         /* quad-uniform, so implicit texture derivatives stay defined */
-        ir_buf_printf(em->out, "%sif (splat_quad_any(%s > 0.0)) {\n",
-                      indent_at(em, depth), x);
+        if (layer >= 0)
+            ir_buf_printf(em->out, "%sif (splat_surface(%du, %s > 0.0)) {\n",
+                          indent_at(em, depth), layer, x);
+        else
+            ir_buf_printf(em->out, "%sif (splat_quad_any(%s > 0.0)) {\n",
+                          indent_at(em, depth), x);
         free(x);
     }
     glsl_scope_push(em->e);
@@ -934,12 +943,12 @@ static void emit_layer(emit *em, int j, bool flat, int depth)
     if (flat) {
         emit_accumulate(em, l, depth);
     } else if (ir_ref_eq(l->weight, l->T)) {  /* opaque: w = T, already > 0 */
-        ir_buf_printf(em->out, "%s{\n", indent_at(em, depth));
+        ir_buf_printf(em->out, "%sif (splat_opaque(%du)) {\n", indent_at(em, depth), j);
         glsl_scope_push(em->e);
         emit_placed(em, em->s.surface[j], depth + 1);
         emit_accumulate(em, l, depth + 1);
         close_block(em, depth);
-    } else if (open_guard(em, l->weight, depth)) {
+    } else if (open_guard(em, l->weight, depth, j)) {
         emit_placed(em, em->s.surface[j], depth + 1);
         emit_accumulate(em, l, depth + 1);
         close_block(em, depth);
@@ -948,7 +957,7 @@ static void emit_layer(emit *em, int j, bool flat, int depth)
         return;
     if (flat) {
         emit_layer(em, j + 1, flat, depth);
-    } else if (open_guard(em, l->T_next, depth)) {
+    } else if (open_guard(em, l->T_next, depth, -1)) {
         emit_layer(em, j + 1, flat, depth + 1);
         close_block(em, depth);
     }
@@ -1317,7 +1326,7 @@ void splat_composite_glsl(const splat_layout *L, const splat_composite *c,
         emit_placed(&em, 0, 1);
         if (desc->flat) {
             emit_layer(&em, 0, true, 1);
-        } else if (open_guard(&em, em.layers[0].T, 1)) {
+        } else if (open_guard(&em, em.layers[0].T, 1, -1)) {
             emit_layer(&em, 0, false, 2);
             close_block(&em, 1);
         }

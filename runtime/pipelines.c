@@ -362,19 +362,18 @@ static bool pack_pipeline(rt_device *d, rt_pipelines *pl, const rt_spirv *fs,
     return ok;
 }
 
-/* The pack's GLSL with `#define SPLAT_COUNT 1` after its #version line
- * (abi.h: the counting variant is never stored). */
-static char *with_count_define(const char *glsl)
+/* The pack's GLSL with `defs` (lines of #define) after its #version line
+ * (abi.h: the counting and sorted variants are never stored). */
+static char *with_defines(const char *glsl, const char *defs)
 {
     const char *nl = strchr(glsl, '\n');
-    size_t head = nl ? (size_t)(nl - glsl) + 1 : 0, n = strlen(glsl);
-    static const char def[] = "#define SPLAT_COUNT 1\n";
-    char *s = malloc(n + sizeof def);
+    size_t head = nl ? (size_t)(nl - glsl) + 1 : 0, n = strlen(glsl), nd = strlen(defs);
+    char *s = malloc(n + nd + 1);
     if (!s)
         return NULL;
     memcpy(s, glsl, head);
-    memcpy(s + head, def, sizeof def - 1);
-    memcpy(s + head + sizeof def - 1, glsl + head, n - head + 1);
+    memcpy(s + head, defs, nd);
+    memcpy(s + head + nd, glsl + head, n - head + 1);
     return s;
 }
 
@@ -399,7 +398,7 @@ static bool glsl_pipeline(rt_device *d, const rt_pack *p, rt_pipelines *pl,
         snprintf(what, sizeof what, "the pack has no fragment GLSL of %s", name);
         return rt_fail(e, RT_E_PACK_FIELD, p->dir, what);
     }
-    char *src = count ? with_count_define(glsl) : NULL;
+    char *src = count ? with_defines(glsl, "#define SPLAT_COUNT 1\n") : NULL;
     rt_interface in;
     if ((count && !src) || !rt_interface_for(p, RT_ROLE_COMPOSITE, &in)) {
         free(src);
@@ -508,8 +507,14 @@ bool rt_pipelines_compute(rt_device *d, const rt_pack *p, rt_pipelines *pl, int 
                  "this splatc for --shading screen", name);
         return rt_fail(e, RT_E_PACK_FIELD, p->dir, what);
     }
-    char *src = (variant & RT_CVARIANT_COUNT) ? with_count_define(glsl) : NULL;
-    if ((variant & RT_CVARIANT_COUNT) && !src)
+    char defs[96] = "", sort[64] = "";
+    if (variant & RT_CVARIANT_SORT)
+        snprintf(sort, sizeof sort, "#define SPLAT_SORT 1\n#define SPLAT_SORT_TILES %d\n",
+                 pl->sort_tiles);
+    snprintf(defs, sizeof defs, "%s%s", (variant & RT_CVARIANT_COUNT) ? "#define SPLAT_COUNT 1\n" : "",
+             sort);
+    char *src = defs[0] ? with_defines(glsl, defs) : NULL;
+    if (defs[0] && !src)
         return rt_fail(e, RT_E_VULKAN, "pipelines", "out of memory");
     uint32_t *words = NULL;
     size_t n = 0;

@@ -512,12 +512,14 @@ bool rt_renderer_create(rt_device *d, const rt_pack *p, const rt_render_desc *de
         !make_commands(r, e) ||
         (r->set0c && !rt_screen_create(d, p, &r->pl, &r->color, &r->depth,
                                        r->terrain.nearest_clamp, r->set0c, use_raycast(r),
-                                       &r->screen, e))) {
+                                       r->desc.pixel_sort, r->desc.sort_tiles, &r->screen, e))) {
         rt_renderer_destroy(r);
         return false;
     }
-    if (r->screen)
+    if (r->screen) {
         rt_screen_far(r->screen, r->desc.far_atlas_distance);
+        r->pl.sort_tiles = rt_screen_sort_tiles(r->screen);
+    }
     r->shading = r->screen ? RT_SHADING_SCREEN : RT_SHADING_FORWARD;
     if (!make_undergrowth(r, e)) {
         rt_renderer_destroy(r);
@@ -923,7 +925,8 @@ static bool abandon_frame(VkCommandBuffer cb)
 static unsigned compute_variant(const rt_renderer *r)
 {
     return (r->view != SPLAT_VIEW_FINAL ? RT_CVARIANT_DEBUG : 0) |
-           (r->counting || r->view == SPLAT_VIEW_COST ? RT_CVARIANT_COUNT : 0);
+           (r->counting || r->view == SPLAT_VIEW_COST ? RT_CVARIANT_COUNT : 0) |
+           (r->screen && rt_screen_sorting(r->screen) ? RT_CVARIANT_SORT : 0);
 }
 
 /* The screen-space path (screen.c): the geometry pass draws the patches
@@ -1241,6 +1244,7 @@ static bool draw_frame(rt_renderer *r, const rt_camera *c, rt_frame_stats *st, r
     st->select_ms = select_ms;
     st->cpu_ms = cpu_ms;
     st->screen = screen;
+    st->sorted = screen && rt_screen_sorting(r->screen);
     if (screen)
         rt_screen_read_stats(r->screen, &st->tiles);
     else if (count)
@@ -1439,12 +1443,14 @@ bool rt_renderer_swap_pack(rt_renderer *r, const rt_pack *p, rt_error *e)
         rt_screen_destroy(r->screen);
         r->screen = NULL;
         if (!rt_screen_create(r->d, p, &r->pl, &r->color, &r->depth, r->terrain.nearest_clamp,
-                              r->set0c, use_raycast(r), &r->screen, e)) {
+                              r->set0c, use_raycast(r), r->desc.pixel_sort, r->desc.sort_tiles,
+                              &r->screen, e)) {
             rt_screen_destroy(r->screen);
             r->screen = NULL;
             return false;
         }
         rt_screen_far(r->screen, r->desc.far_atlas_distance);
+        r->pl.sort_tiles = rt_screen_sort_tiles(r->screen);
     }
     return true;
 }

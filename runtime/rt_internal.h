@@ -346,6 +346,7 @@ typedef struct rt_pipelines {
     VkPipeline            resolve;
     VkPipeline            sky;           /* the analytic sky, forward path  */
     VkPipelineLayout      compute_layout;/* sets 0, 1 + splat_push (compute) */
+    int                   sort_tiles;    /* RT_CVARIANT_SORT: SPLAT_SORT_TILES */
     VkPipeline           *compute;       /* RT_CVARIANTS per combination, the
                                             über-shader's last              */
     VkPipeline            depth[2];      /* geometry pass, [RT_VARIANT_CULL] */
@@ -355,7 +356,8 @@ typedef struct rt_pipelines {
 enum {
     RT_CVARIANT_DEBUG = 1,  /* any debug view (else specialised to final)   */
     RT_CVARIANT_COUNT = 2,  /* the counting variant (abi.h SPLAT_COUNT)      */
-    RT_CVARIANTS      = 4,
+    RT_CVARIANT_SORT  = 4,  /* the sorted variant (abi.h SPLAT_SORT)         */
+    RT_CVARIANTS      = 8,
 };
 
 /* Render passes the pipelines are made for (render.c creates them). */
@@ -421,10 +423,16 @@ typedef struct rt_screen rt_screen;
  * even on failure (free with rt_screen_destroy). */
 bool rt_screen_create(rt_device *d, const rt_pack *p, const rt_pipelines *pl,
                       const rt_image *color, const rt_image *depth, VkSampler nearest,
-                      VkDescriptorSet set0, bool raycast, rt_screen **out, rt_error *e);
+                      VkDescriptorSet set0, bool raycast, rt_pixel_sort sort, int sort_tiles,
+                      rt_screen **out, rt_error *e);
 /* raycast: the depth comes from ray casting the heightfield in compute
  * (screen.c) instead of the geometry pass. */
 bool rt_screen_raycasting(const rt_screen *s);
+/* Whether the shading dispatches take the sorted variant (RT_CVARIANT_SORT),
+ * as `sort` and the device allow. */
+bool rt_screen_sorting(const rt_screen *s);
+/* Tiles per sorting workgroup (abi.h SPLAT_SORT_TILES); 0 when not sorting. */
+int rt_screen_sort_tiles(const rt_screen *s);
 void rt_screen_raycast(rt_screen *s, VkCommandBuffer cb, VkDescriptorSet set0);
 /* After the shading, when ray casting: the ray-cast depth copied into
  * `depth` (D32, through a buffer: a colour image cannot be copied into a

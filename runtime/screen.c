@@ -8,9 +8,13 @@
  * count; then one indirect dispatch per list runs that composite's compute
  * variant (abi.h "compute stage"), which lights and writes the pixels.
  *
- * Lists live in one buffer, a region of `ntiles` entries per list (list
- * k at k * ntiles; k = ncombos is the über-shader's), so one pass with one
- * atomic per tile builds them, no prefix sum.  Pipelines are compiled on
+ * Lists live in one buffer, a region of `stride` entries per list (list
+ * k at k * stride; k = ncombos is the über-shader's; stride is the tile
+ * count rounded up to SPLAT_SORT_TILES_MAX), so one pass with one atomic per
+ * tile builds them, no prefix sum.  With pixel sorting (abi.h SPLAT_SORT,
+ * rt_pixel_sort) a workgroup shades sort_tiles (4 to 16) tiles of a list:
+ * a one-workgroup pass after the classification pads each list to that
+ * multiple and writes the grouped dispatch sizes beside the counts.  Pipelines are compiled on
  * first use: a list that gets tiles but has no pipeline yet is compiled
  * after the frame and the frame is drawn again (rt_screen_missing), so a
  * returned frame is always complete and the steady state reads back only
@@ -27,6 +31,10 @@ struct rt_screen {
     rt_device            *d;
     const rt_pack        *p;
     int                   width, height, tiles_x, tiles_y, ntiles;
+    int                   stride;            /* entries per list             */
+    bool                  sort;              /* pixels sorted (SPLAT_SORT)   */
+    int                   sort_tiles;        /* tiles per sorting workgroup  */
+    VkPipeline            group;             /* pads lists, grouped args     */
     int                   nlists;            /* ncombos + 1 (über)          */
     int                   words;             /* material set words; 0: every
                                                 tile goes to the über list  */
@@ -242,6 +250,31 @@ static const char classify_glsl[] =
     "}\n"
     "#endif\n";
 
+/* Pixel sorting's list pass (one invocation per list): pad list k with
+ * empty entries (0xffffffff) to a multiple of G tiles and write its
+ * grouped dispatch size at args[3 * (nlists + k)]; info.x = nlists. */
+static const char group_glsl[] =
+    "layout(local_size_x = 64) in;\n"
+    "layout(set = 2, binding = 0, std430) readonly buffer cls_info_block {\n"
+    "    uint ncombos, words, cells_x, cells_z;\n"
+    "    uint stride;\n"
+    "} u_info;\n"
+    "layout(set = 2, binding = 1, std430) writeonly buffer cls_tiles_block {\n"
+    "    uint tiles[];\n"
+    "} u_lists;\n"
+    "layout(set = 2, binding = 2, std430) buffer cls_args_block {\n"
+    "    uint args[];\n"
+    "} u_args;\n"
+    "void main() {\n"
+    "    uint k = gl_GlobalInvocationID.x, nlists = u_push.info.x;\n"
+    "    if (k >= nlists) return;\n"
+    "    uint n = u_args.args[3u * k], g = (n + G - 1u) / G;\n"
+    "    u_args.args[3u * (nlists + k)] = g;\n"
+    "    u_args.args[3u * (nlists + k) + 1u] = 1u;\n"
+    "    u_args.args[3u * (nlists + k) + 2u] = 1u;\n"
+    "    for (uint i = n; i < g * G; i++) u_lists.tiles[k * u_info.stride + i] = 0xffffffffu;\n"
+    "}\n";
+
 /* Depth by ray casting (Tevs et al. 2008, "Maximum mipmaps"): the ray
  * through each pixel centre walks a pyramid of maximum heights from the
  * top level down, skipping cells it passes above, and at the finest level
@@ -378,7 +411,7 @@ static bool fill_info(rt_screen *s, rt_error *e)
     u[1] = (uint32_t)s->words;
     u[2] = (uint32_t)leaf->width;
     u[3] = (uint32_t)leaf->height;
-    u[4] = (uint32_t)s->ntiles;
+    u[4] = (uint32_t)s->stride;   /* the list stride; >= the tile count */
     u[5] = (uint32_t)p->nbase;
     u[6] = (uint32_t)p->cell_texels;
     u[7] = (uint32_t)s->tiles_x;
@@ -674,14 +707,18 @@ static bool make_compute(rt_screen *s, const rt_pipelines *pl, VkSampler nearest
     char rhead[128];
     snprintf(rhead, sizeof rhead, "#define TOP %d\n#define PW %u\n#define PH %u\n",
              s->mip_levels - 1, s->maxmip.width, s->maxmip.height);
+    char ghead[64];
+    snprintf(ghead, sizeof ghead, "#define G %du\n", s->sort_tiles);
     return own_pipeline(s, pl, head, classify_glsl, "classify.comp", &s->classify, e) &&
+           (!s->sort || own_pipeline(s, pl, ghead, group_glsl, "group.comp", &s->group, e)) &&
            (!s->raycast ||
             own_pipeline(s, pl, rhead, raycast_glsl, "raycast.comp", &s->raycaster, e));
 }
 
 bool rt_screen_create(rt_device *d, const rt_pack *p, const rt_pipelines *pl,
                       const rt_image *color, const rt_image *depth, VkSampler nearest,
-                      VkDescriptorSet set0, bool raycast, rt_screen **out, rt_error *e)
+                      VkDescriptorSet set0, bool raycast, rt_pixel_sort sort, int sort_tiles,
+                      rt_screen **out, rt_error *e)
 {
     *out = NULL;
     rt_screen *s = calloc(1, sizeof *s);
@@ -696,6 +733,19 @@ bool rt_screen_create(rt_device *d, const rt_pack *p, const rt_pipelines *pl,
     s->tiles_x = (s->width + SPLAT_TILE - 1) / SPLAT_TILE;
     s->tiles_y = (s->height + SPLAT_TILE - 1) / SPLAT_TILE;
     s->ntiles = s->tiles_x * s->tiles_y;
+    /* every list padded to the largest group (SPLAT_SORT_TILES_MAX) */
+    s->stride = (s->ntiles + SPLAT_SORT_TILES_MAX - 1) / SPLAT_SORT_TILES_MAX * SPLAT_SORT_TILES_MAX;
+    int most = SPLAT_SORT_TILES_MAX;   /* power of two, within the device's limits */
+    while (most >= SPLAT_SORT_TILES_MIN &&
+           ((uint32_t)most * 64 > d->props.limits.maxComputeWorkGroupInvocations ||
+            (uint32_t)most * 64 > d->props.limits.maxComputeWorkGroupSize[0]))
+        most /= 2;
+    s->sort_tiles = sort_tiles > 0 ? sort_tiles : most;
+    bool can_sort = can_aggregate(d) && s->sort_tiles >= SPLAT_SORT_TILES_MIN &&
+                    s->sort_tiles <= most && (s->sort_tiles & (s->sort_tiles - 1)) == 0;
+    s->sort = sort == RT_SORT_ON && can_sort;
+    if (!s->sort)
+        s->sort_tiles = 0;
     s->far_ok = p->far.data && p->uber_compute && rt_far_supported(d);
     s->nlists = p->ncombos + 1 + s->far_ok;   /* + the far atlas's list */
     s->words = (p->nmaterials + 31) / 32;
@@ -705,14 +755,14 @@ bool rt_screen_create(rt_device *d, const rt_pack *p, const rt_pipelines *pl,
     *out = s;
     if (!s->dispatched)
         return rt_fail(e, RT_E_VULKAN, "screen-space shading", "out of memory");
-    VkDeviceSize list_bytes = (VkDeviceSize)s->nlists * (VkDeviceSize)s->ntiles * 4;
+    VkDeviceSize list_bytes = (VkDeviceSize)s->nlists * (VkDeviceSize)s->stride * 4;
     if (list_bytes > d->props.limits.maxStorageBufferRange)
         return rt_fail(e, RT_E_PACK_LIMIT, p->dir, "the tile lists (combinations x tiles x 4 bytes)",
                        (unsigned long long)list_bytes, "maxStorageBufferRange",
                        (unsigned long long)d->props.limits.maxStorageBufferRange);
     const VkBufferUsageFlags sb = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
     if (!rt_buffer_create(d, list_bytes, sb, false, &s->tiles, e) ||
-        !rt_buffer_create(d, (VkDeviceSize)s->nlists * 12,
+        !rt_buffer_create(d, (VkDeviceSize)s->nlists * 24,   /* counts, grouped */
                           sb | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT |
                           VK_BUFFER_USAGE_TRANSFER_SRC_BIT, false, &s->args, e) ||
         !rt_buffer_create(d, (VkDeviceSize)s->nlists * 12, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, true,
@@ -793,6 +843,8 @@ void rt_screen_destroy(rt_screen *s)
             vkDestroyPipeline(d->dev, s->classify, NULL);
         if (s->raycaster)
             vkDestroyPipeline(d->dev, s->raycaster, NULL);
+        if (s->group)
+            vkDestroyPipeline(d->dev, s->group, NULL);
         for (int k = 0; k < 2; k++)
             if (s->far_pipe[k])
                 vkDestroyPipeline(d->dev, s->far_pipe[k], NULL);
@@ -833,6 +885,10 @@ VkRenderPass rt_screen_depth_pass(const rt_screen *s, VkFramebuffer *fb)
 }
 
 bool rt_screen_raycasting(const rt_screen *s) { return s->raycast; }
+
+bool rt_screen_sorting(const rt_screen *s) { return s->sort; }
+
+int rt_screen_sort_tiles(const rt_screen *s) { return s->sort_tiles; }
 
 void rt_screen_raycast(rt_screen *s, VkCommandBuffer cb, VkDescriptorSet set0)
 {
@@ -953,21 +1009,33 @@ void rt_screen_classify(rt_screen *s, VkCommandBuffer cb, VkDescriptorSet set0,
     rt_cmd_barrier(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
                    VK_PIPELINE_STAGE_DRAW_INDIRECT_BIT | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
                    VK_ACCESS_INDIRECT_COMMAND_READ_BIT | VK_ACCESS_SHADER_READ_BIT);
+    if (!s->sort)
+        return;
+    vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, s->group);
+    memset(&push, 0, sizeof push);
+    push.info[0] = (uint32_t)s->nlists;
+    vkCmdPushConstants(cb, s->layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof push, &push);
+    vkCmdDispatch(cb, (uint32_t)(s->nlists + 63) / 64, 1, 1);
+    (*binds)++;
+    rt_cmd_barrier(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
+                   VK_PIPELINE_STAGE_DRAW_INDIRECT_BIT | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+                   VK_ACCESS_INDIRECT_COMMAND_READ_BIT | VK_ACCESS_SHADER_READ_BIT);
 }
 
 /* List k's indirect dispatch with the pipeline bound: workgroup g shades
- * tiles[k * ntiles + g] (abi.h's push block: info.y the list, info.z the
+ * tiles[k * stride + g], or sort_tiles of them from there times g
+ * with `grouped` (abi.h's push block: info.y the list, info.z the
  * material count, info.w its first tile). */
 static void dispatch_list(rt_screen *s, VkCommandBuffer cb, VkPipelineLayout layout, int k,
-                          unsigned variant)
+                          unsigned variant, bool grouped)
 {
     splat_push push;
     memset(&push, 0, sizeof push);
     push.info[1] = (uint32_t)k;
     push.info[2] = (uint32_t)s->p->nmaterials;
-    push.info[3] = (uint32_t)k * (uint32_t)s->ntiles;
+    push.info[3] = (uint32_t)k * (uint32_t)s->stride;
     vkCmdPushConstants(cb, layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof push, &push);
-    vkCmdDispatchIndirect(cb, s->args.buf, (VkDeviceSize)k * 12);
+    vkCmdDispatchIndirect(cb, s->args.buf, (VkDeviceSize)(grouped ? s->nlists + k : k) * 12);
     s->dispatched[k] = variant + 1;
 }
 
@@ -997,7 +1065,7 @@ bool rt_screen_dispatch(rt_screen *s, VkCommandBuffer cb, rt_pipelines *pl,
         }
         vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, pipe);
         (*binds)++;
-        dispatch_list(s, cb, pl->compute_layout, k, variant);
+        dispatch_list(s, cb, pl->compute_layout, k, variant, (variant & RT_CVARIANT_SORT) != 0);
     }
     if (s->far_ok && s->far_distance > 0) {
         int k = p->ncombos + 1, c = (variant & RT_CVARIANT_COUNT) != 0;
@@ -1015,7 +1083,7 @@ bool rt_screen_dispatch(rt_screen *s, VkCommandBuffer cb, rt_pipelines *pl,
         vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, s->layout, 0, 3, all, 0, NULL);
         vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, s->far_pipe[c]);
         (*binds)++;
-        dispatch_list(s, cb, s->layout, k, variant);
+        dispatch_list(s, cb, s->layout, k, variant, false);
     }
     rt_cmd_image_barrier(cb, s->color_img, 0, 1, 1, VK_IMAGE_LAYOUT_GENERAL,
                          VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_ACCESS_SHADER_WRITE_BIT,

@@ -346,6 +346,18 @@ typedef enum rt_screen_depth {
     RT_DEPTH_RAYCAST,    /* maximum-mipmap ray casting in compute          */
 } rt_screen_depth;
 
+/* The screen path's shading order within a workgroup (abi.h SPLAT_SORT).
+ * Off by default: sorting raises the layers' SIMD efficiency (colorado
+ * top-down on an H100: 56 -> 84 %) but its first, masks-only run costs
+ * more than the surfaces it saves there and on lavapipe
+ * (tests/bench/RESULTS.md "Pixels sorted by layer set"). */
+typedef enum rt_pixel_sort {
+    RT_SORT_OFF = 0,     /* each workgroup shades one tile in pixel order  */
+    RT_SORT_ON,          /* sort_tiles tiles per workgroup, pixels sorted by
+                            the layers they need before shading; needs
+                            subgroup arithmetic in compute (else off)    */
+} rt_pixel_sort;
+
 typedef enum rt_reference {
     RT_REF_NONE = 0,      /* per-combination composites                     */
     RT_REF_MULTIPASS,     /* one blended pass per material + resolve        */
@@ -376,6 +388,9 @@ typedef struct rt_render_desc {
     int          destruction_pool;  /* destruction tiles; 0: RT_DESTR_POOL_DEFAULT */
     rt_shading   shading;           /* forward (default) or screen-space      */
     rt_screen_depth screen_depth;   /* screen path: where its depth comes from */
+    rt_pixel_sort pixel_sort;       /* screen path: pixels sorted by layer set */
+    int          sort_tiles;        /* tiles a sorting workgroup takes (4, 8
+                                       or 16); 0: the most the device allows */
     /* lighting over the pack's (splatview --sun, --exposure, --fog-density) */
     bool         sun_set, exposure_set, fog_set;
     double       sun[2], exposure, fog_density;
@@ -425,6 +440,7 @@ typedef struct rt_frame_stats {
     double pass_ms[3];        /* screen: geometry, classification, shading
                                  GPU ms (timestamps; < 0 if unsupported)     */
     bool   screen;            /* drawn by the screen-space path              */
+    bool   sorted;            /* its pixels sorted by layer set (rt_pixel_sort) */
     rt_screen_stats tiles;    /* its tiles (screen only) and counters        */
     int    redraws;           /* frames drawn again after compiling pipelines */
     double shadow_ms;         /* CPU ms of a new shadow map (the sun moved or

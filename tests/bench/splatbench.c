@@ -46,6 +46,10 @@
  *       shaded (from the counting frame).  distclass=0 shades with the
  *       combinations only (--no-distance-classes; PACK.md "Distance
  *       classes"), distclass=1 (the default) with their distance classes;
+ *       sort=on|off (screen kinds) sorts each workgroup's pixels by the
+ *       layers they need before shading (rt_pixel_sort; default off),
+ *       sort=N on with N tiles per workgroup (4, 8 or 16; on: the most
+ *       the device allows, 16 on GPUs and lavapipe);
  *       the kinds that recompile the composites (flat fp16 sobel analytic
  *       lambert) always run without them.
  *       Paths (--path): ground (2 m above the terrain looking 150 m ahead,
@@ -198,6 +202,8 @@ typedef struct variant {
     const char  *pack_dir;
     double       lod;
     bool         no_shadows;
+    rt_pixel_sort sort;
+    int          sort_tiles;
     bool         no_dclass; /* distclass=0                                 */
     bool         ug;        /* draw the undergrowth                         */
     double       ug_radius; /* its radius (m); 0: the runtime's default     */
@@ -407,6 +413,12 @@ static bool parse_variant(const char *s, const char *default_pack, variant *v)
             v->no_shadows = true;
         } else if (!strcmp(t, "distclass=0") || !strcmp(t, "distclass=1")) {
             v->no_dclass = t[10] == '0';
+        } else if (!strcmp(t, "sort=on") || !strcmp(t, "sort=off")) {
+            v->sort = t[6] == 'n' ? RT_SORT_ON : RT_SORT_OFF;
+        } else if (!strncmp(t, "sort=", 5)) {   /* sort=N: on, N tiles per workgroup */
+            v->sort = RT_SORT_ON;
+            v->sort_tiles = atoi(t + 5);
+            ok = v->sort_tiles > 0;
         } else if (!strcmp(t, "ug")) {
             v->ug = true;
         } else if (!strncmp(t, "ugradius=", 9)) {
@@ -626,7 +638,8 @@ static int cmd_render(int argc, char **argv)
         rt_render_desc rd = {
             .width = width, .height = height, .lod_pixels = v[i].lod,
             .no_shadows = v[i].no_shadows, .no_undergrowth = !v[i].ug,
-            .no_distance_classes = v[i].no_dclass,
+            .no_distance_classes = v[i].no_dclass, .pixel_sort = v[i].sort,
+            .sort_tiles = v[i].sort_tiles,
             .undergrowth_radius = v[i].ug_radius, .far_atlas_distance = v[i].far,
             .reference = v[i].k == K_MULTIPASS ? RT_REF_MULTIPASS
                        : v[i].k == K_UBER || v[i].k == K_SCREEN_UBER ? RT_REF_UBER : RT_REF_NONE,

@@ -27,6 +27,8 @@
 # With CRATER=R (a pack with a destructible area): at the first preset, a
 # crater of radius R where the view's centre ray meets the terrain, then
 # screen vs forward as above, and the crater must change the picture.
+# Pixel sorting (--pixel-sort on against off) at the first preset: the
+# same picture to the bit, the same layers needed, no more evaluated.
 # Then, at the first preset: the tiles and cost views render (the cost
 # view on both paths), --stats prints the per-pass times and the counting
 # lines with needed <= evaluated on both paths, and the two paths' layers
@@ -64,6 +66,25 @@ c="--camera-preset $1"
 # picture as the one CPU drivers run (an invocation per tile)
 SPLAT_CLASSIFY=wide run "$PACK" --headless $SIZE $c --shading screen --float-out "$OUT/wide.f32"
 "$IC" diff "$OUT/$1.s.f32" "$OUT/wide.f32" 0 || fail "the two classifications differ"
+# pixel sorting (abi.h SPLAT_SORT; off unless asked): the
+# same picture to the bit, as each pixel is computed the same whichever
+# lane computes it; the same layers needed per pixel, and no more
+# evaluated than unsorted (2 % slack: a subgroup straddling two keys)
+for so in off on; do
+    run "$PACK" --headless $SIZE $c --shading screen --pixel-sort $so --float-out "$OUT/sort_$so.f32"
+    run "$PACK" --headless $SIZE $c --shading screen --pixel-sort $so --stats --frames 1 \
+        > "$OUT/sort_$so.txt"
+done
+"$IC" diff "$OUT/sort_off.f32" "$OUT/sort_on.f32" 0 || fail "sorting the pixels changed the picture"
+grep -q "shading: screen, pixels sorted by layer set" "$OUT/sort_on.txt" ||
+    fail "--pixel-sort on: --stats does not say the pixels were sorted"
+sorted_layers() {
+    sed -n 's/^layers per pixel: evaluated \([0-9.]*\), needed \([0-9.]*\).*/\1 \2/p' "$1"
+}
+echo "sorted: $(sorted_layers "$OUT/sort_on.txt"), unsorted: $(sorted_layers "$OUT/sort_off.txt")"
+echo "$(sorted_layers "$OUT/sort_on.txt") $(sorted_layers "$OUT/sort_off.txt")" |
+    awk '{ exit !($2 == $4 && $1 <= 1.02 * $3) }' ||
+    fail "sorted: layers needed must equal unsorted's, evaluated not exceed it"
 run "$PACK" --headless $SIZE $c --shading screen --screen-depth raycast --float-out "$OUT/ray.f32"
 run "$PACK" --headless $SIZE $c --shading screen --screen-depth raster --lod-pixels 0.01 \
     --float-out "$OUT/full.f32"

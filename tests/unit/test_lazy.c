@@ -215,7 +215,9 @@ static void test_cases(void **state)
     char *g = glsl(&f, &c, true, false, sides, &nlazy);
     compiles(g, false);
     assert_int_equal(nlazy, 2);
-    assert_int_equal(count(g, "if (splat_quad_any(v"), 2 + 2); /* + the layers' guards */
+    /* + the layers' guards: the coverage guard and the top's surface */
+    assert_int_equal(count(g, "if (splat_quad_any(v"), 2 + 1);
+    assert_int_equal(count(g, "if (splat_surface(0u, v"), 1);   /* layer 0: the top */
     /* the two guards of the mix: t < 1 for a, t > 0 for b */
     assert_int_equal(count(g, " < 1.0)) {"), 1);
     assert_int_equal(count(g, " > 0.0)) {"), 1 + 2);
