@@ -317,15 +317,16 @@ for s in $SCENES; do
     done
 done
 # (e) screen-space shading against forward on the same frames: the
-# runtime's choice of depth for the device (screen), both depths, and the
-# über-shader on every tile (the classification's soundness reference)
+# runtime's choice of depth for the device (screen), both depths, the
+# pixels sorted by layer set (--pixel-sort on), and the über-shader on
+# every tile (the classification's soundness reference)
 for s in $SCENES; do
     for size in $SIZES; do
         for p in $PATHS; do
             [ "$size" = 1920x1080 ] && [ "$MODE" = full ] && [ "$p" != ground ] && continue
             render shading "$s" "$p" "$size" forward=composite screen=screen \
                 screen_raster=screen_raster screen_raycast=screen_raycast \
-                screen_uber=screen_uber
+                screen_sorted=screen,sort=on screen_uber=screen_uber
         done
     done
 done

@@ -151,6 +151,7 @@ awk -F, -v dev="$dev" '
     NR > 1 && $1 == "shading" {
         k = $3 "|" $4 "|" $5 "x" $6; t[k, $7] = $12; keys[k] = 1
         if ($7 == "screen") { ev[k] = $31; nd[k] = $32 }
+        if ($7 == "screen_sorted" && $31 > 0) sev[k] = $31
         if ($8 == "composite" && $31 > 0) { fev[k] = $31; fnd[k] = $32 }
         if ($7 == "screen_uber") su[k] = $12
     }
@@ -169,7 +170,7 @@ awk -F, -v dev="$dev" '
                 printf "| shading target: lavapipe colorado 1280x720 >= 10 fps, screen (%s) | %.1f fps | %s |\n", a[2], 1000 / s, verdict(1000 / s >= 10)
             }
             if (a[1] == "colorado" && a[2] != "ground" && ev[k] > 0)
-                printf "| shading target: efficiency >= 80 %% (colorado %s %s) | %.0f %% (%.2f of %.2f layers)%s | %s |\n", a[2], a[3], 100 * nd[k] / ev[k], nd[k], ev[k], (k in fev) ? sprintf("; forward %.0f %%", 100 * fnd[k] / fev[k]) : "", verdict(nd[k] / ev[k] >= 0.8)
+                printf "| shading target: efficiency >= 80 %% (colorado %s %s) | %.0f %% (%.2f of %.2f layers)%s%s | %s |\n", a[2], a[3], 100 * nd[k] / ev[k], nd[k], ev[k], (k in fev) ? sprintf("; forward %.0f %%", 100 * fnd[k] / fev[k]) : "", (k in sev) ? sprintf("; pixels sorted %.0f %%", 100 * nd[k] / sev[k]) : "", verdict(nd[k] / ev[k] >= 0.8 || ((k in sev) && nd[k] / sev[k] >= 0.8)))
         }
     }' "$O/render.csv" | sort
 echo
