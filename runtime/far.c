@@ -1,7 +1,9 @@
 /* far.c — the far atlas on the device (compiler/far_atlas.h): its three
- * BC images with their stored mip chains, and the far shading shader of
- * the screen path (screen.c sends tiles wholly beyond the far distance to
- * it).  The shader is the compute prelude (abi.h "compute stage") around a
+ * BC images with their stored mip chains (one upload, read by both
+ * paths), and the far shading shader: the screen path sends tiles wholly
+ * beyond the far distance to its compute variant (screen.c), the forward
+ * path draws quadtree patches wholly beyond it with its fragment variant
+ * (render.c).  The shader is the prelude of the stage (abi.h) around a
  * main that reads albedo, normal and roughness from the atlas with the
  * pixel's own gradients (FC5's plane-through-the-pixel derivatives, as the
  * composites take theirs) and calls splat_finish: the same lighting, fog
@@ -29,7 +31,20 @@ bool rt_far_supported(rt_device *d)
     return true;
 }
 
-bool rt_far_upload(rt_device *d, const rt_pack *p, rt_image img[3], rt_error *e)
+struct rt_far {
+    rt_device            *d;
+    rt_image              img[3];        /* albedo, normal, roughness        */
+    VkSampler             sampler;
+    /* the forward path's: set 2 = bindings 5-7, sets 0-1 and the push
+     * range as the composites' layout (rt_pipelines.layout) */
+    VkDescriptorSetLayout set_layout;
+    VkDescriptorPool      pool;
+    VkDescriptorSet       set;
+    VkPipelineLayout      layout;
+    VkPipeline            pipe[RT_VARIANTS];
+};
+
+static bool upload(rt_device *d, const rt_pack *p, rt_image img[3], rt_error *e)
 {
     const rt_pack_far *f = &p->far;
     uint32_t w = (uint32_t)f->width, h = (uint32_t)f->height;
@@ -101,7 +116,8 @@ bool rt_far_upload(rt_device *d, const rt_pack *p, rt_image img[3], rt_error *e)
                                  VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
                                  VK_ACCESS_TRANSFER_WRITE_BIT, VK_ACCESS_SHADER_READ_BIT,
                                  VK_PIPELINE_STAGE_TRANSFER_BIT,
-                                 VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT);
+                                 VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT |
+                                     VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT);
         }
         ok = rt_oneshot_end(d, cb, e);
     }
@@ -110,7 +126,8 @@ bool rt_far_upload(rt_device *d, const rt_pack *p, rt_image img[3], rt_error *e)
     return ok;
 }
 
-/* Set 2 bindings 5-7 of the screen path's layout (screen.c). */
+/* Set 2 bindings 5-7: the screen path's set (screen.c), the forward
+ * path's own (rt_far_create). */
 static const char far_main[] =
     "layout(set = 2, binding = 5) uniform sampler2D u_far_albedo;\n"
     "layout(set = 2, binding = 6) uniform sampler2D u_far_normal;\n"
@@ -125,21 +142,145 @@ static const char far_main[] =
     "    splat_finish(albedo, n, rough, 0.0, 1.0);\n"
     "}\n";
 
-char *rt_far_glsl(const rt_pack *p, bool count)
+/* `uber` (an über-shader's GLSL of the stage) cut at the prelude: its
+ * head (its defines: painted storage and places) before the prelude, so
+ * set 0 is declared as the composites do, then `defs`, the prelude and
+ * far_main. */
+static char *far_source(const char *uber, const char *defs)
 {
-    /* the über-shader's head (its defines: painted storage and places)
-     * before the prelude, so set 0 is declared as the composites do */
-    const char *u = p->uber_compute, *v = u ? strstr(u, "#version 450\n") : NULL;
+    const char *v = uber ? strstr(uber, "#version 450\n") : NULL;
     const char *at = v ? strstr(v, SPLAT_GLSL_PRELUDE) : NULL;
     if (!at)
         return NULL;
     v += strlen("#version 450\n");
     size_t head = (size_t)(at - v);
-    size_t n = 64 + head + strlen(SPLAT_GLSL_PRELUDE) + sizeof far_main;
+    size_t n = 64 + strlen(defs) + head + strlen(SPLAT_GLSL_PRELUDE) + sizeof far_main;
     char *s = malloc(n);
     if (!s)
         return NULL;
-    snprintf(s, n, "#version 450\n%s%.*s%s%s", count ? "#define SPLAT_COUNT 1\n" : "", (int)head,
-             v, SPLAT_GLSL_PRELUDE, far_main);
+    snprintf(s, n, "#version 450\n%.*s%s%s%s", (int)head, v, defs, SPLAT_GLSL_PRELUDE, far_main);
     return s;
+}
+
+char *rt_far_glsl(const rt_pack *p, bool count)
+{
+    return far_source(p->uber_compute, count ? "#define SPLAT_COUNT 1\n" : "");
+}
+
+bool rt_far_create(rt_device *d, const rt_pack *p, const rt_pipelines *pl, rt_far **out,
+                   rt_error *e)
+{
+    *out = NULL;
+    if (!p->far.data || !rt_far_supported(d))
+        return true;
+    rt_far *f = calloc(1, sizeof *f);
+    if (!f)
+        return rt_fail(e, RT_E_VULKAN, "far atlas", "out of memory");
+    f->d = d;
+    *out = f;
+    VkSamplerCreateInfo si = {
+        .sType = VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO,
+        .magFilter = VK_FILTER_LINEAR, .minFilter = VK_FILTER_LINEAR,
+        .mipmapMode = VK_SAMPLER_MIPMAP_MODE_LINEAR,
+        .addressModeU = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE,
+        .addressModeV = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE,
+        .addressModeW = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE,
+        .maxLod = VK_LOD_CLAMP_NONE,
+    };
+    RT_VK(e, vkCreateSampler(d->dev, &si, NULL, &f->sampler));
+    if (!upload(d, p, f->img, e))
+        return false;
+    const VkDescriptorType cis = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
+    VkDescriptorSetLayoutBinding b[3];
+    VkDescriptorImageInfo ii[3];
+    VkWriteDescriptorSet w[3];
+    for (uint32_t k = 0; k < 3; k++) {
+        b[k] = (VkDescriptorSetLayoutBinding){ 5 + k, cis, 1, VK_SHADER_STAGE_FRAGMENT_BIT, NULL };
+        ii[k] = rt_far_image_info(f, (int)k);
+    }
+    if (!rt_set_layout(d, b, 3, &f->set_layout, e))
+        return false;
+    VkDescriptorPoolSize size = { cis, 3 };
+    VkDescriptorPoolCreateInfo dpi = {
+        .sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO,
+        .maxSets = 1, .poolSizeCount = 1, .pPoolSizes = &size,
+    };
+    RT_VK(e, vkCreateDescriptorPool(d->dev, &dpi, NULL, &f->pool));
+    VkDescriptorSetAllocateInfo ai = {
+        .sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO,
+        .descriptorPool = f->pool, .descriptorSetCount = 1, .pSetLayouts = &f->set_layout,
+    };
+    RT_VK(e, vkAllocateDescriptorSets(d->dev, &ai, &f->set));
+    for (uint32_t k = 0; k < 3; k++)
+        w[k] = (VkWriteDescriptorSet){ .sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET,
+            .dstSet = f->set, .dstBinding = 5 + k, .descriptorCount = 1,
+            .descriptorType = cis, .pImageInfo = &ii[k] };
+    vkUpdateDescriptorSets(d->dev, 3, w, 0, NULL);
+    VkDescriptorSetLayout sets[3] = { pl->set_terrain, pl->set_material, f->set_layout };
+    VkPushConstantRange push = { VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0,
+                                 sizeof(splat_push) };
+    VkPipelineLayoutCreateInfo li = {
+        .sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO,
+        .setLayoutCount = 3, .pSetLayouts = sets,
+        .pushConstantRangeCount = 1, .pPushConstantRanges = &push,
+    };
+    RT_VK(e, vkCreatePipelineLayout(d->dev, &li, NULL, &f->layout));
+    return true;
+}
+
+VkDescriptorImageInfo rt_far_image_info(const rt_far *f, int k)
+{
+    return (VkDescriptorImageInfo){ f->sampler, f->img[k].view,
+                                    VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL };
+}
+
+bool rt_far_bind_forward(rt_far *f, const rt_pack *p, const rt_passes *rp, rt_pipelines *pl,
+                         VkCommandBuffer cb, unsigned variant, rt_error *e)
+{
+    VkPipeline *slot = &f->pipe[variant % RT_VARIANTS];
+    if (!*slot) {
+        if (!p->uber_frag_path)
+            return rt_fail(e, RT_E_PACK_FIELD, p->dir,
+                           "the pack has no fragment GLSL of the uber-shader");
+        char *uber = rt_pack_read_glsl(p, "uber.glsl", p->uber_frag_path, e);
+        if (!uber)
+            return false;
+        /* the gradients' main (abi.c FRAGMENT_MAIN) sets splat_dpdx/y */
+        char defs[96];
+        snprintf(defs, sizeof defs, "%s#ifndef SPLAT_GRADIENTS\n#define SPLAT_GRADIENTS 1\n#endif\n",
+                 (variant & RT_VARIANT_COUNT) ? "#define SPLAT_COUNT 1\n" : "");
+        char *src = far_source(uber, defs);
+        free(uber);
+        if (!src)
+            return rt_fail(e, RT_E_VULKAN, "far atlas shader", "no prelude in the uber GLSL");
+        bool ok = rt_pipelines_glsl_fragment(f->d, pl, rp, f->layout, src, "far.frag", variant,
+                                             slot, e);
+        free(src);
+        if (!ok)
+            return false;
+    }
+    vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_GRAPHICS, *slot);
+    vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_GRAPHICS, f->layout, 2, 1, &f->set, 0, NULL);
+    return true;
+}
+
+void rt_far_destroy(rt_far *f)
+{
+    if (!f)
+        return;
+    rt_device *d = f->d;
+    for (int k = 0; k < RT_VARIANTS; k++)
+        if (f->pipe[k])
+            vkDestroyPipeline(d->dev, f->pipe[k], NULL);
+    if (f->layout)
+        vkDestroyPipelineLayout(d->dev, f->layout, NULL);
+    if (f->pool)
+        vkDestroyDescriptorPool(d->dev, f->pool, NULL);
+    if (f->set_layout)
+        vkDestroyDescriptorSetLayout(d->dev, f->set_layout, NULL);
+    for (int k = 0; k < 3; k++)
+        rt_image_destroy(d, &f->img[k]);
+    if (f->sampler)
+        vkDestroySampler(d->dev, f->sampler, NULL);
+    free(f);
 }

@@ -248,9 +248,10 @@ typedef enum kind {
     K_SKY,          /* fullscreen, depth EQUAL the clear value, no write      */
 } kind;
 
-static bool make_pipeline(rt_device *d, rt_pipelines *pl, VkShaderModule vs,
-                          VkShaderModule fs, VkRenderPass pass, kind k,
-                          unsigned variant, VkPipeline *out, rt_error *e)
+/* `layout`: VK_NULL_HANDLE for the pipelines' own (resolve or terrain). */
+static bool make_pipeline_in(rt_device *d, rt_pipelines *pl, VkPipelineLayout layout,
+                             VkShaderModule vs, VkShaderModule fs, VkRenderPass pass, kind k,
+                             unsigned variant, VkPipeline *out, rt_error *e)
 {
     /* Not RT_VARIANT_DEBUG: the fragment shader specialised to the final
      * view (abi.h SPLAT_SPEC_VIEW), so the driver drops the debug views'
@@ -342,11 +343,18 @@ static bool make_pipeline(rt_device *d, rt_pipelines *pl, VkShaderModule vs,
         .pDepthStencilState = &ds,
         .pColorBlendState = &cb,
         .pDynamicState = &dy,
-        .layout = k == K_RESOLVE ? pl->resolve_layout : pl->layout,
+        .layout = layout ? layout : k == K_RESOLVE ? pl->resolve_layout : pl->layout,
         .renderPass = pass,
     };
     RT_VK(e, vkCreateGraphicsPipelines(d->dev, pl->cache, 1, &ci, NULL, out));
     return true;
+}
+
+static bool make_pipeline(rt_device *d, rt_pipelines *pl, VkShaderModule vs,
+                          VkShaderModule fs, VkRenderPass pass, kind k,
+                          unsigned variant, VkPipeline *out, rt_error *e)
+{
+    return make_pipeline_in(d, pl, VK_NULL_HANDLE, vs, fs, pass, k, variant, out, e);
 }
 
 /* A pipeline from a pack module over the shared vertex shader. */
@@ -413,6 +421,23 @@ static bool glsl_pipeline(rt_device *d, const rt_pack *p, rt_pipelines *pl,
     if (!ok)
         return false;
     ok = make_pipeline(d, pl, pl->vertex, m, rp->main, K_OPAQUE, variant, slot, e);
+    vkDestroyShaderModule(d->dev, m, NULL);
+    return ok;
+}
+
+bool rt_pipelines_glsl_fragment(rt_device *d, rt_pipelines *pl, const rt_passes *rp,
+                                VkPipelineLayout layout, const char *glsl, const char *name,
+                                unsigned variant, VkPipeline *out, rt_error *e)
+{
+    if ((variant & RT_VARIANT_COUNT) && !d->count_fragments)
+        return rt_fail(e, RT_E_NO_FORMAT, "count on the forward path (fragmentStoresAndAtomics "
+                       "and subgroup votes in fragment shaders)");
+    if ((variant & RT_VARIANT_WIRE) && !d->wireframe)
+        return rt_fail(e, RT_E_NO_FORMAT, "draw wireframe (no fillModeNonSolid)");
+    VkShaderModule m;
+    if (!rt_glsl_module(d, glsl, VK_SHADER_STAGE_FRAGMENT_BIT, name, NULL, &m, e))
+        return false;
+    bool ok = make_pipeline_in(d, pl, layout, pl->vertex, m, rp->main, K_OPAQUE, variant, out, e);
     vkDestroyShaderModule(d->dev, m, NULL);
     return ok;
 }

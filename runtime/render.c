@@ -49,6 +49,8 @@ struct rt_renderer {
     VkDescriptorSet   set0, set1, set2;
     VkDescriptorSet   set0c;           /* set 0 with the compute bindings   */
     rt_screen        *screen;          /* NULL: forward shading only        */
+    rt_far           *far;             /* NULL: no far atlas (far.c)        */
+    int               far_patches;     /* forward: the last group, far.c's  */
     rt_ug            *ug;              /* NULL: no undergrowth (undergrowth.c) */
     bool              ug_off;          /* not drawn (the viewer's U)        */
     VkCommandBuffer   cb;
@@ -56,7 +58,7 @@ struct rt_renderer {
     VkQueryPool       qpool;
     bool              timestamps;
     rt_patch         *sorted;          /* patches grouped by combination    */
-    int              *counts;          /* ncombos + 1                       */
+    int              *counts;          /* ncombos + 2 (+ the far group)     */
     splat_view        view;
     int               view_material;
     bool              wireframe;
@@ -487,7 +489,7 @@ bool rt_renderer_create(rt_device *d, const rt_pack *p, const rt_render_desc *de
     r->ncombos = p->ncombos;
     r->combo_ids = calloc((size_t)p->nlevels, sizeof *r->combo_ids);
     r->sorted = malloc(sizeof *r->sorted * (size_t)(p->levels[0].width * p->levels[0].height));
-    r->counts = calloc((size_t)p->ncombos + 1, sizeof *r->counts);
+    r->counts = calloc((size_t)p->ncombos + 2, sizeof *r->counts);
     if (!r->combo_ids || !r->sorted || !r->counts ||
         !rt_bounds_build(&r->bounds, p->heights, p->hf_width, p->hf_height, p->cell_texels,
                          p->max_height, p->height_offset) ||
@@ -509,9 +511,9 @@ bool rt_renderer_create(rt_device *d, const rt_pack *p, const rt_render_desc *de
         !rt_pipelines_create(d, p, &r->rp, r->desc.reference, r->desc.pipeline_cache,
                              p->ntextures, &r->pl, e) ||
         !make_geometry(r, e) || !make_textures(r, e) || !make_descriptors(r, e) ||
-        !make_commands(r, e) ||
+        !make_commands(r, e) || !rt_far_create(d, p, &r->pl, &r->far, e) ||
         (r->set0c && !rt_screen_create(d, p, &r->pl, &r->color, &r->depth,
-                                       r->terrain.nearest_clamp, r->set0c, use_raycast(r),
+                                       r->terrain.nearest_clamp, r->set0c, r->far, use_raycast(r),
                                        r->desc.pixel_sort, r->desc.sort_tiles, &r->screen, e))) {
         rt_renderer_destroy(r);
         return false;
@@ -539,6 +541,7 @@ void rt_renderer_destroy(rt_renderer *r)
         vkDeviceWaitIdle(d->dev);
         rt_ug_destroy(r->ug);
         rt_screen_destroy(r->screen);
+        rt_far_destroy(r->far);
         rt_pipelines_destroy(d, &r->pl);
         if (r->fence)
             vkDestroyFence(d->dev, r->fence, NULL);
@@ -998,11 +1001,30 @@ static int class_pick(const rt_pack *p, int combo, const rt_quadtree *q, const r
     return best;
 }
 
+/* The far atlas on the forward path (far.c): a patch whose node's box is
+ * wholly at least `distance` away and misses the destructible area
+ * (craters change what the bake saw), as the screen path's tiles. */
+static bool patch_far(const rt_renderer *r, const rt_patch *pt, const double camera[3],
+                      double distance)
+{
+    double dmin, dmax, x0, z0, sx, sz;
+    rt_node_distance(&r->qt, pt->level, pt->x, pt->z, camera, &dmin, &dmax);
+    if (dmin < distance)
+        return false;
+    const rt_pack *p = r->p;
+    if (!p->has_destruction)
+        return true;
+    rt_node_rect(&r->qt, pt->level, pt->x, pt->z, &x0, &z0, &sx, &sz);
+    return x0 + sx <= p->destr_origin[0] || p->destr_origin[0] + p->destr_size[0] <= x0 ||
+           z0 + sz <= p->destr_origin[1] || p->destr_origin[1] + p->destr_size[1] <= z0;
+}
+
 /* The quadtree selection, then the patches sorted by combination (a
  * counting sort: one pipeline bind per group); returns how many
  * combinations are in view.  Afterwards counts[k] ends group k, which
- * starts at counts[k-1] (0 for k = 0). */
-static int select_and_sort(rt_renderer *r, const rt_camera *c, const splat_frame *fr,
+ * starts at counts[k-1] (0 for k = 0); with `far`, group ncombos holds
+ * the patches shaded from the far atlas (r->far_patches of them). */
+static int select_and_sort(rt_renderer *r, const rt_camera *c, const splat_frame *fr, bool far,
                            double *select_ms)
 {
     rt_select_desc sd = { .lod_distance = r->lod_distance, .cull = true };
@@ -1016,12 +1038,16 @@ static int select_and_sort(rt_renderer *r, const rt_camera *c, const splat_frame
         for (int i = 0; i < n; i++)
             r->qt.patches[i].combo = (uint16_t)class_pick(
                 r->p, r->qt.patches[i].combo, &r->qt, &r->qt.patches[i], c->position);
-    memset(r->counts, 0, sizeof *r->counts * (size_t)(r->ncombos + 1));
+    for (int i = 0; far && i < n; i++)
+        if (patch_far(r, &r->qt.patches[i], c->position, r->desc.far_atlas_distance))
+            r->qt.patches[i].combo = (uint16_t)r->ncombos;
+    memset(r->counts, 0, sizeof *r->counts * (size_t)(r->ncombos + 2));
     for (int i = 0; i < n; i++)
         r->counts[r->qt.patches[i].combo + 1]++;
+    r->far_patches = r->counts[r->ncombos + 1];
     int in_view = 0;
-    for (int k = 0; k < r->ncombos; k++) {
-        in_view += r->counts[k + 1] > 0;
+    for (int k = 0; k <= r->ncombos; k++) {
+        in_view += k < r->ncombos && r->counts[k + 1] > 0;
         r->counts[k + 1] += r->counts[k];
     }
     for (int i = 0; i < n; i++)
@@ -1136,6 +1162,12 @@ static bool record_forward(rt_renderer *r, VkCommandBuffer cb, const rt_camera *
             }
             start = end;
         }
+        if (r->far_patches > 0) {   /* the far group, last (select_and_sort) */
+            if (!rt_far_bind_forward(r->far, r->p, &r->rp, &r->pl, cb, variant, e))
+                return abandon_frame(cb);
+            (*binds)++;
+            draw_patches(r, cb, c, r->sorted + start, r->far_patches);
+        }
     }
     if (sky_drawn(r)) {   /* where no terrain wrote depth */
         vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_GRAPHICS, r->pl.sky);
@@ -1180,7 +1212,13 @@ static bool draw_frame(rt_renderer *r, const rt_camera *c, rt_frame_stats *st, r
     double t0 = 1e3 * splat_now(), select_ms;
     splat_frame *fr = r->frame_ubo.map;
     fill_frame(r, c, fr);
-    int in_view = select_and_sort(r, c, fr, &select_ms);
+    bool screen = r->screen && r->shading == RT_SHADING_SCREEN &&
+                  r->desc.reference != RT_REF_MULTIPASS && !r->wireframe;
+    /* the far atlas on the forward path: composites only (not the
+     * references, not the mask view, which the über-shader draws) */
+    bool far = !screen && r->far && r->desc.far_atlas_distance > 0 &&
+               r->desc.reference == RT_REF_NONE && r->view != SPLAT_VIEW_MASK;
+    int in_view = select_and_sort(r, c, fr, far, &select_ms);
 
     VkCommandBuffer cb = r->cb;
     RT_VK(e, vkResetCommandBuffer(cb, 0));
@@ -1200,8 +1238,6 @@ static bool draw_frame(rt_renderer *r, const rt_camera *c, rt_frame_stats *st, r
     if (ug && !rt_ug_generate(r->ug, cb, c, fr, r->set1, 0, e))
         return abandon_frame(cb);
     bool cull = !r->desc.no_cull && camera_above_terrain(r, c);
-    bool screen = r->screen && r->shading == RT_SHADING_SCREEN &&
-                  r->desc.reference != RT_REF_MULTIPASS && !r->wireframe;
     /* the multi-pass reference has no counting variant */
     bool count = (r->counting || r->view == SPLAT_VIEW_COST) && !screen &&
                  r->d->count_fragments && r->desc.reference != RT_REF_MULTIPASS;
@@ -1239,7 +1275,9 @@ static bool draw_frame(rt_renderer *r, const rt_camera *c, rt_frame_stats *st, r
     st->pipelines = binds;
     st->combos_in_view = in_view;
     for (int i = 0; i < r->qt.npatches && !screen; i++)
-        st->class_patches += r->qt.patches[i].combo >= r->p->nbase;
+        st->class_patches += r->qt.patches[i].combo >= r->p->nbase &&
+                             r->qt.patches[i].combo < r->ncombos;
+    st->far_patches = screen ? 0 : r->far_patches;
     st->backfaces_culled = cull;
     st->select_ms = select_ms;
     st->cpu_ms = cpu_ms;
@@ -1415,7 +1453,7 @@ bool rt_renderer_swap_pack(rt_renderer *r, const rt_pack *p, rt_error *e)
                  "parameters, not the data uploaded at start)", why);
         return rt_fail(e, RT_E_RELOAD, msg);
     }
-    int *counts = calloc((size_t)p->ncombos + 1, sizeof *counts);
+    int *counts = calloc((size_t)p->ncombos + 2, sizeof *counts);
     if (!counts)
         return rt_fail(e, RT_E_RELOAD, "out of memory");
     vkDeviceWaitIdle(r->d->dev);
@@ -1438,13 +1476,23 @@ bool rt_renderer_swap_pack(rt_renderer *r, const rt_pack *p, rt_error *e)
     r->ug = NULL;
     if (!make_undergrowth(r, e))
         return false;
-    if (r->screen) {
+    /* the far atlas is the pack's bake (a reload's pack has none until
+     * the next --far-atlas build); the screen path borrows it */
+    bool had_screen = r->screen != NULL;
+    rt_screen_destroy(r->screen);
+    r->screen = NULL;
+    rt_far_destroy(r->far);
+    r->far = NULL;
+    if (!rt_far_create(r->d, p, &r->pl, &r->far, e)) {
+        rt_far_destroy(r->far);
+        r->far = NULL;
+        return false;
+    }
+    if (had_screen) {
         /* the classification's combination map and sets are the pack's */
-        rt_screen_destroy(r->screen);
-        r->screen = NULL;
         if (!rt_screen_create(r->d, p, &r->pl, &r->color, &r->depth, r->terrain.nearest_clamp,
-                              r->set0c, use_raycast(r), r->desc.pixel_sort, r->desc.sort_tiles,
-                              &r->screen, e)) {
+                              r->set0c, r->far, use_raycast(r), r->desc.pixel_sort,
+                              r->desc.sort_tiles, &r->screen, e)) {
             rt_screen_destroy(r->screen);
             r->screen = NULL;
             return false;

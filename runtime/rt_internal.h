@@ -377,6 +377,11 @@ bool rt_pipelines_create(rt_device *d, const rt_pack *p, const rt_passes *rp,
                          int ntextures, rt_pipelines *pl, rt_error *e);
 /* The pipeline of combination `id` in `variant` (RT_VARIANT_* bits), made
  * now if it does not exist yet. */
+/* A main-pass fragment pipeline from `glsl` over the terrain's vertex
+ * shader, in `layout` (sets 0-1 and the push range as pl->layout's). */
+bool rt_pipelines_glsl_fragment(rt_device *d, rt_pipelines *pl, const rt_passes *rp,
+                                VkPipelineLayout layout, const char *glsl, const char *name,
+                                unsigned variant, VkPipeline *out, rt_error *e);
 bool rt_pipelines_combo(rt_device *d, const rt_pack *p, const rt_passes *rp,
                         rt_pipelines *pl, int id, unsigned variant, VkPipeline *out,
                         rt_error *e);
@@ -416,15 +421,17 @@ double rt_camera_fovy(const rt_camera *c);
 /* ---- screen.c: screen-space shading (render.c drives it) -------------- */
 
 typedef struct rt_screen rt_screen;
+typedef struct rt_far rt_far;   /* far.c */
 
 
 /* Buffers, the depth-only pass over `depth`, the classification pipeline;
- * writes set 0's compute bindings (abi.h 7-10) into `set0`.  *out is set
- * even on failure (free with rt_screen_destroy). */
+ * writes set 0's compute bindings (abi.h 7-10) into `set0`.  `far`: the
+ * far atlas (NULL: none), which must outlive the screen.  *out is set even
+ * on failure (free with rt_screen_destroy). */
 bool rt_screen_create(rt_device *d, const rt_pack *p, const rt_pipelines *pl,
                       const rt_image *color, const rt_image *depth, VkSampler nearest,
-                      VkDescriptorSet set0, bool raycast, rt_pixel_sort sort, int sort_tiles,
-                      rt_screen **out, rt_error *e);
+                      VkDescriptorSet set0, const rt_far *far, bool raycast,
+                      rt_pixel_sort sort, int sort_tiles, rt_screen **out, rt_error *e);
 /* raycast: the depth comes from ray casting the heightfield in compute
  * (screen.c) instead of the geometry pass. */
 bool rt_screen_raycasting(const rt_screen *s);
@@ -471,11 +478,21 @@ bool rt_screen_has_far(const rt_screen *s);
 
 /* The device samples BC1 sRGB, BC5 and BC4 with linear filtering. */
 bool  rt_far_supported(rt_device *d);
-/* p->far's three images with every stored level, SHADER_READ_ONLY. */
-bool  rt_far_upload(rt_device *d, const rt_pack *p, rt_image img[3], rt_error *e);
+/* p->far's three images (every stored level, SHADER_READ_ONLY) and the
+ * forward path's set and layout; *out stays NULL without an atlas in the
+ * pack or without the BC formats. */
+bool  rt_far_create(rt_device *d, const rt_pack *p, const rt_pipelines *pl, rt_far **out,
+                    rt_error *e);
+void  rt_far_destroy(rt_far *f);
+/* Image k (0 albedo, 1 normal, 2 roughness) with the atlas's sampler. */
+VkDescriptorImageInfo rt_far_image_info(const rt_far *f, int k);
 /* The far shading compute shader (malloc'd; NULL without the über compute
  * GLSL whose head it reuses); `count`: the counting variant. */
 char *rt_far_glsl(const rt_pack *p, bool count);
+/* Forward path, inside the main pass: binds the far shading fragment
+ * pipeline of `variant` (made on first use) and its set 2. */
+bool  rt_far_bind_forward(rt_far *f, const rt_pack *p, const rt_passes *rp, rt_pipelines *pl,
+                          VkCommandBuffer cb, unsigned variant, rt_error *e);
 
 /* ---- undergrowth.c: cells, generation, drawing (render.c drives it) ---- */
 

@@ -66,8 +66,7 @@ struct rt_screen {
     bool                  far_ok;            /* the pack has one, the device
                                                 samples BC formats          */
     float                 far_distance;      /* m; 0: off (rt_screen_far)    */
-    rt_image              far_img[3];        /* albedo, normal, roughness    */
-    VkSampler             far_sampler;
+    const rt_far         *far;               /* the renderer's               */
     VkPipeline            far_pipe[2];       /* plain, counting              */
 };
 
@@ -698,8 +697,7 @@ static bool make_compute(rt_screen *s, const rt_pipelines *pl, VkSampler nearest
         [4] = { VK_NULL_HANDLE, s->rdepth.view, VK_IMAGE_LAYOUT_GENERAL },
     };
     for (int k = 0; s->far_ok && k < 3; k++)
-        ii[5 + k] = (VkDescriptorImageInfo){ s->far_sampler, s->far_img[k].view,
-                                             VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL };
+        ii[5 + k] = rt_far_image_info(s->far, k);
     VkWriteDescriptorSet w[8];
     for (uint32_t i = 0; i < nb; i++) {
         uint32_t at = b[i].binding;
@@ -735,8 +733,8 @@ static bool make_compute(rt_screen *s, const rt_pipelines *pl, VkSampler nearest
 
 bool rt_screen_create(rt_device *d, const rt_pack *p, const rt_pipelines *pl,
                       const rt_image *color, const rt_image *depth, VkSampler nearest,
-                      VkDescriptorSet set0, bool raycast, rt_pixel_sort sort, int sort_tiles,
-                      rt_screen **out, rt_error *e)
+                      VkDescriptorSet set0, const rt_far *far, bool raycast,
+                      rt_pixel_sort sort, int sort_tiles, rt_screen **out, rt_error *e)
 {
     *out = NULL;
     rt_screen *s = calloc(1, sizeof *s);
@@ -764,7 +762,8 @@ bool rt_screen_create(rt_device *d, const rt_pack *p, const rt_pipelines *pl,
     s->sort = sort == RT_SORT_ON && can_sort;
     if (!s->sort)
         s->sort_tiles = 0;
-    s->far_ok = p->far.data && p->uber_compute && rt_far_supported(d);
+    s->far = far;
+    s->far_ok = far && p->uber_compute;
     s->nlists = p->ncombos + 1 + s->far_ok;   /* + the far atlas's list */
     s->words = (p->nmaterials + 31) / 32;
     if (s->words > MAX_WORDS)
@@ -808,20 +807,6 @@ bool rt_screen_create(rt_device *d, const rt_pack *p, const rt_pipelines *pl,
                            VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
                            false, &s->depth_copy, e)))
         return false;
-    if (s->far_ok) {
-        VkSamplerCreateInfo si = {
-            .sType = VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO,
-            .magFilter = VK_FILTER_LINEAR, .minFilter = VK_FILTER_LINEAR,
-            .mipmapMode = VK_SAMPLER_MIPMAP_MODE_LINEAR,
-            .addressModeU = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE,
-            .addressModeV = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE,
-            .addressModeW = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE,
-            .maxLod = VK_LOD_CLAMP_NONE,
-        };
-        RT_VK(e, vkCreateSampler(d->dev, &si, NULL, &s->far_sampler));
-        if (!rt_far_upload(d, p, s->far_img, e))
-            return false;
-    }
     if (!make_depth_pass(s, depth, e) || !make_compute(s, pl, nearest, e))
         return false;
 
@@ -866,10 +851,6 @@ void rt_screen_destroy(rt_screen *s)
         for (int k = 0; k < 2; k++)
             if (s->far_pipe[k])
                 vkDestroyPipeline(d->dev, s->far_pipe[k], NULL);
-        for (int k = 0; k < 3; k++)
-            rt_image_destroy(d, &s->far_img[k]);
-        if (s->far_sampler)
-            vkDestroySampler(d->dev, s->far_sampler, NULL);
         rt_image_destroy(d, &s->maxmip);
         if (s->mip_sampler)
             vkDestroySampler(d->dev, s->mip_sampler, NULL);

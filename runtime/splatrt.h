@@ -400,9 +400,9 @@ typedef struct rt_render_desc {
                                        their distance classes (PACK.md;
                                        splatview --no-distance-classes)     */
     double       undergrowth_radius; /* m around the camera; 0: RT_UG_RADIUS    */
-    double       far_atlas_distance; /* screen path: tiles at least this far (m)
-                                    are shaded from the pack's far atlas; 0:
-                                    off (the default)                        */
+    double       far_atlas_distance; /* screen tiles, forward patches at least
+                                    this far (m) are shaded from the pack's
+                                    far atlas; 0: off (the default)          */
     /* any light key over the pack's (splatview --light KEY=V,...): bit k
      * of light_keys set = abi.h SPLAT_LIGHT_KEYS row k given, its values
      * in light[k]; applied after sun / exposure / fog_density above */
@@ -433,6 +433,7 @@ typedef struct rt_ug_stats {
 typedef struct rt_frame_stats {
     int    patches, culled, pipelines, combos_in_view;
     int    class_patches;     /* forward: patches shaded by a distance class */
+    int    far_patches;       /* forward: patches shaded from the far atlas  */
     bool   backfaces_culled;  /* the camera was above the terrain            */
     double gpu_ms;            /* timestamps; < 0 if unsupported              */
     double select_ms;         /* CPU quadtree selection + culling            */

@@ -44,9 +44,9 @@ static void usage(FILE *f)
         "  --float-out FILE          also write the RGBA32F image (SPLATF32 format)\n"
         "  --param NAME=v[,v,v,v]    set a material param\n"
         "  --lod-pixels P            screen error per grid step (default 3)\n"
-        "  --far-atlas-distance D    screen path: tiles at least D m away are shaded\n"
-        "                            from the pack's far atlas (splatc build\n"
-        "                            --far-atlas); 0: off (default)\n"
+        "  --far-atlas-distance D    screen tiles and forward patches wholly at least\n"
+        "                            D m away are shaded from the pack's far atlas\n"
+        "                            (splatc build --far-atlas); 0: off (default)\n"
         "  --sun AZ,EL               the sun: azimuth (degrees clockwise from north)\n"
         "                            and elevation, over the scene's light block\n"
         "  --exposure EV             exposure in stops (default: the scene's, or 0)\n"
@@ -638,8 +638,10 @@ static int headless(const opts *o)
         printf("back faces culled: %s\n", st.backfaces_culled ? "yes" : "no");
         printf("pipelines bound: %d\n", st.pipelines);
         printf("combinations in view: %d of %d\n", st.combos_in_view, pack.ncombos);
-        if (!st.screen)
+        if (!st.screen) {
             printf("distance classes: %d of %d patches\n", st.class_patches, st.patches);
+            printf("far atlas: %d of %d patches\n", st.far_patches, st.patches);
+        }
         if (gm >= 0)
             printf("gpu ms/frame: median %.3f  p10 %.3f  p90 %.3f\n", gm, gl, gh);
         else
@@ -699,8 +701,9 @@ static int headless(const opts *o)
             printf("far atlas: %d x %d texels of %.1f x %.1f m, %d levels, %zu bytes; %s\n",
                    pack.far.width, pack.far.height, pack.far.texel[0], pack.far.texel[1],
                    pack.far.levels, pack.far.n - FAR_ATLAS_HEADER,
-                   o->far_distance > 0 && st.screen
-                       ? "screen tiles beyond --far-atlas-distance use it" : "not used");
+                   o->far_distance <= 0 ? "not used"
+                   : st.screen ? "screen tiles beyond --far-atlas-distance use it"
+                               : "forward patches beyond --far-atlas-distance use it");
         rt_painted_print_stats(&pack, stdout);
         if (rt_renderer_destruction(r))
             rt_destruction_print_stats(rt_renderer_destruction(r), stdout);

@@ -471,11 +471,14 @@ else
     # the far atlas (issue 11 part 3; splatc build --far-atlas, one texel per
     # heightfield texel): the screen path with the tiles at least D m away
     # shaded from the atlas, against the same pack's composites on the same
-    # frames; tiles_far says how many tiles the atlas took
+    # frames; tiles_far says how many tiles the atlas took; the same on the
+    # forward path (tiles_far: patches wholly beyond D)
     KNOB_BUILD_ARGS="--far-atlas"
     cf=$(knob_pack colorado far "" "")
     KNOB_BUILD_ARGS=""
     for p in topdown ground; do
+        render knob_far colorado "$p" 1280x720 "forward=composite,pack=$cf" \
+            "forward10k=composite,far=10000,pack=$cf" "forward5k=composite,far=5000,pack=$cf"
         render knob_far colorado "$p" 1280x720 "screen=screen,pack=$cf" \
             "far40k=screen,far=40000,pack=$cf" "far20k=screen,far=20000,pack=$cf" \
             "far10k=screen,far=10000,pack=$cf" "far5k=screen,far=5000,pack=$cf" \

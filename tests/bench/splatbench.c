@@ -40,10 +40,11 @@
  *       time what they always timed), ugradius=R within R metres of the
  *       camera instead of the runtime's 96: its rows add the generation GPU ms
  *       per frame and per generated cell, the draw GPU ms per frame, the
- *       instances and the memory per cell.  far=D (screen kinds) shades
- *       tiles at least D m away from the pack's far atlas (splatc build
- *       --far-atlas); its rows add the distance and the tiles the atlas
- *       shaded (from the counting frame).  distclass=0 shades with the
+ *       instances and the memory per cell.  far=D shades screen tiles
+ *       (screen kinds) or quadtree patches (composite) at least D m away
+ *       from the pack's far atlas (splatc build --far-atlas); its rows add
+ *       the distance and the tiles (patches) the atlas shaded (from the
+ *       counting frame).  distclass=0 shades with the
  *       combinations only (--no-distance-classes; PACK.md "Distance
  *       classes"), distclass=1 (the default) with their distance classes;
  *       sort=on|off (screen kinds) sorts each workgroup's pixels by the
@@ -722,6 +723,8 @@ static int cmd_render(int argc, char **argv)
         if (!rt_renderer_frame(v[i].r, &cam, &st, &e))
             goto done;
         v[i].tiles = st.tiles;
+        if (!st.screen)   /* forward: the far column counts patches */
+            v[i].tiles.tiles_far = st.far_patches;
     }
 
     FILE *out = stdout;

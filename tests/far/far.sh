@@ -8,6 +8,14 @@
 #             and D_k+1 differ in exactly those tiles); the band's mean
 #             absolute error per colour channel must stay within BOUND and
 #             every band must have tiles; zero validation messages
+#   forward   the forward path at the valley camera (320x180): with
+#             --far-atlas-distance 5000 some patches, not all, are shaded
+#             from the atlas (--stats), fewer texture samples per pixel than
+#             without; its picture within FWD_PSNR dB of the screen path's
+#             at the same distance (both shade the far terrain from the atlas;
+#             they differ only where a tile and a patch disagree about
+#             being wholly beyond it) and its mean error against the
+#             composites within BOUND; zero validation messages
 #   corrupt   on examples/minimal's pack: a truncated far.atlas, a wrong
 #             magic, levels over the chain, a manifest width that does not
 #             match the file, a symbolic link: each refused with an error
@@ -71,6 +79,36 @@ error)
         prev=$d; prev_tiles=$tiles
     done
     [ $bad = 0 ] || fail "far atlas error"
+    ;;
+forward)
+    [ -f "$PACK/far.atlas" ] || build_pack "$PACK"
+    BOUND=${FAR_BOUND:-0.05}
+    R="--headless --size 320x180 --camera-preset valley --no-undergrowth --stats"
+    shade() {   # $1: path, $2: distance -> $OUT/fwd_$1_$2.f32 and .log
+        SPLAT_VALIDATE=1 "$VIEW" "$PACK" $R --shading "$1" --far-atlas-distance "$2" \
+            -o "$OUT/fwd_$1_$2.png" --float-out "$OUT/fwd_$1_$2.f32" > "$OUT/fwd_$1_$2.log" 2>&1 ||
+            { cat "$OUT/fwd_$1_$2.log" >&2; fail "splatview $1 at distance $2"; }
+        ! grep -q "validation message" "$OUT/fwd_$1_$2.log" || fail "validation messages ($1, $2)"
+    }
+    shade forward 0; shade forward 5000; shade screen 5000
+    far=$(sed -n 's/^far atlas: \([0-9]*\) of \([0-9]*\) patches$/\1 \2/p' "$OUT/fwd_forward_5000.log")
+    none=$(sed -n 's/^far atlas: \([0-9]*\) of [0-9]* patches$/\1/p' "$OUT/fwd_forward_0.log")
+    [ -n "$far" ] && [ "$none" = 0 ] || fail "no far patch count in --stats (or patches at distance 0)"
+    set -- $far
+    [ "$1" -gt 0 ] && [ "$1" -lt "$2" ] || fail "far patches $1 of $2: expected some, not all"
+    spp() { sed -n 's/^texture samples per pixel: //p' "$OUT/fwd_forward_$1.log"; }
+    awk -v a="$(spp 5000)" -v b="$(spp 0)" 'BEGIN { exit !(a < b) }' ||
+        fail "samples per pixel $(spp 5000) with the atlas, $(spp 0) without"
+    vs_screen=$("$BENCH" compare "$OUT/fwd_forward_5000.f32" "$OUT/fwd_screen_5000.f32")
+    vs_full=$("$BENCH" compare "$OUT/fwd_forward_5000.f32" "$OUT/fwd_forward_0.f32")
+    echo "far patches: $1 of $2; samples per pixel $(spp 0) -> $(spp 5000)"
+    echo "forward with the atlas vs screen with the atlas: $vs_screen"
+    echo "forward with the atlas vs forward composites:   $vs_full"
+    psnr=$(echo "$vs_screen" | awk '{print $6}')
+    awk -v p="$psnr" -v m="${FWD_PSNR:-40}" 'BEGIN { exit !(p >= m) }' ||
+        fail "forward vs screen far shading: $psnr dB < ${FWD_PSNR:-40}"
+    mean=$(echo "$vs_full" | awk '{print $4}')
+    awk -v m="$mean" -v b="$BOUND" 'BEGIN { exit !(m <= b) }' || fail "mean error $mean over $BOUND"
     ;;
 corrupt)
     # its own small pack (examples/minimal), so the case is quick under ASan
