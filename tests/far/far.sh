@@ -15,7 +15,9 @@
 #             at the same distance (both shade the far terrain from the atlas;
 #             they differ only where a tile and a patch disagree about
 #             being wholly beyond it) and its mean error against the
-#             composites within BOUND; zero validation messages
+#             composites within BOUND; at the trinidad camera (over the
+#             destructible area) with D = 1 m some patches are still not
+#             far: those over the destructible area; zero validation messages
 #   corrupt   on examples/minimal's pack: a truncated far.atlas, a wrong
 #             magic, levels over the chain, a manifest width that does not
 #             match the file, a symbolic link: each refused with an error
@@ -109,6 +111,12 @@ forward)
         fail "forward vs screen far shading: $psnr dB < ${FWD_PSNR:-40}"
     mean=$(echo "$vs_full" | awk '{print $4}')
     awk -v m="$mean" -v b="$BOUND" 'BEGIN { exit !(m <= b) }' || fail "mean error $mean over $BOUND"
+    # every patch is beyond 1 m; only the destructible area's stay composites
+    R="--headless --size 320x180 --camera-preset trinidad --no-undergrowth --stats"
+    shade forward 1
+    set -- $(sed -n 's/^far atlas: \([0-9]*\) of \([0-9]*\) patches$/\1 \2/p' "$OUT/fwd_forward_1.log")
+    echo "trinidad, D = 1 m: $1 of $2 patches far"
+    [ "$1" -gt 0 ] && [ "$1" -lt "$2" ] || fail "trinidad at 1 m: $1 of $2 patches far"
     ;;
 corrupt)
     # its own small pack (examples/minimal), so the case is quick under ASan
