@@ -572,6 +572,9 @@ static int headless(const opts *o)
      * path wherever the pack has its compute variants (faster on both
      * devices: tests/bench/RESULTS.md) */
     const char *env = getenv("SPLAT_SHADING");
+    if (!o->shading_set && env && *env && strcmp(env, "forward") && strcmp(env, "screen"))
+        fprintf(stderr, "splatview: warning: SPLAT_SHADING='%s' is neither forward nor screen; "
+                "ignored\n", env);
     if (!o->shading_set && env && (!strcmp(env, "forward") || !strcmp(env, "screen")))
         rd.shading = !strcmp(env, "screen") ? RT_SHADING_SCREEN : RT_SHADING_FORWARD;
     else if (!o->shading_set)
