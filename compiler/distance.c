@@ -154,23 +154,44 @@ int splat_distance_classes(const splat_layout *L, const splat_composite *c,
     int nn = near_steps(ir, vals, nb, MAXB);
     free(vals);
     double full = splat_composite_cost(c);
+    double need = fmax(SPLAT_LAZY_MIN_COST, SPLAT_DCLASS_MIN_SAVING * full);
     splat_dclass *v = xcalloc(SPLAT_MAX_DCLASSES, sizeof *v);
+    double fcost[MAXB], ncost[MAXB];   /* each step's class, kept or not */
     int n = 0;
     for (int dir = 0; dir < 2; dir++) {
         double best = full;
         int m = dir == 0 ? nf : nn;
-        for (int i = 0; i < m && n < SPLAT_MAX_DCLASSES; i++) {
+        for (int i = 0; i < m; i++) {
+            splat_dclass t;
             double lo = dir == 0 ? fb[i] : 0, hi = dir == 0 ? INFINITY : nb[i];
-            make_class(L, c, lo, hi, &v[n], d);
-            double need = fmax(SPLAT_LAZY_MIN_COST, SPLAT_DCLASS_MIN_SAVING * full);
-            if (v[n].cost <= best - need) {
-                best = v[n].cost;
-                n++;
+            make_class(L, c, lo, hi, &t, d);
+            (dir == 0 ? fcost : ncost)[i] = t.cost;
+            if (n < SPLAT_MAX_DCLASSES && t.cost <= best - need) {
+                best = t.cost;
+                v[n++] = t;
             } else {
-                splat_composite_free(&v[n].comp);
+                splat_composite_free(&t.comp);
             }
         }
     }
+    /* mid classes [fb[i], nb[j]]: what fades out nearer than fb[i] and
+     * what fades in farther than nb[j] both pinned; worth their shader
+     * only if cheaper than either side's class and every kept class
+     * holding their interval */
+    for (int i = 0; i < nf; i++)
+        for (int j = 0; j < nn && n < SPLAT_MAX_DCLASSES; j++) {
+            if (!(fb[i] < nb[j]))
+                continue;
+            double bound = fmin(full, fmin(fcost[i], ncost[j]));
+            for (int k = 0; k < n; k++)
+                if (v[k].lo <= fb[i] && nb[j] <= v[k].hi)
+                    bound = fmin(bound, v[k].cost);
+            make_class(L, c, fb[i], nb[j], &v[n], d);
+            if (v[n].cost <= bound - need)
+                n++;
+            else
+                splat_composite_free(&v[n].comp);
+        }
     if (n == 0) {
         free(v);
         return 0;

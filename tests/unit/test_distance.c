@@ -12,7 +12,8 @@
  * of the full composite in the double reference (ir_eval); and the check
  * can fail: nearer than the class's interval the two differ somewhere.
  * Every class variant's GLSL (fragment and compute) passes glslang and
- * spirv-val.
+ * spirv-val.  A mid class ([a, b], both ends finite) on a scene whose
+ * detail fades in as well as out (tests/scene/distance_mid.sg).
  *
  * Runs from the repository root (CTest's working directory). */
 #include <setjmp.h>
@@ -90,12 +91,12 @@ typedef struct fixture {
     splat_layout L;
 } fixture;
 
-static int setup(void **state)
+static int load(void **state, const char *scene)
 {
     fixture *f = calloc(1, sizeof *f);
     sg_diags d;
     sg_diags_init(&d);
-    bool ok = splat_scene_load(&f->s, "examples/colorado/scene.sg", search, &d) &&
+    bool ok = splat_scene_load(&f->s, scene, search, &d) &&
               splat_layout_from_scene(&f->L, &f->s, &d);
     sg_diags_print(&d, stderr);
     sg_diags_free(&d);
@@ -103,6 +104,10 @@ static int setup(void **state)
     *state = f;
     return 0;
 }
+
+static int setup(void **state) { return load(state, "examples/colorado/scene.sg"); }
+
+static int setup_mid(void **state) { return load(state, "tests/scene/distance_mid.sg"); }
 
 static int teardown(void **state)
 {
@@ -326,6 +331,43 @@ static void test_colorado_uber(void **state)
     free(all);
 }
 
+/* near / mid / far (tests/scene/distance_mid.sg): detail fading out by
+ * 300 m and detail fading in from 1 km give a mid class [300, 1000] with
+ * both pinned, cheaper than every other class holding its interval,
+ * equal to the composite inside it and not outside it on either side. */
+static void test_mid_class(void **state)
+{
+    fixture *f = *state;
+    int mats[] = {material(f, "fades")};
+    splat_composite full;
+    compose(f, mats, 1, &full);
+    splat_dclass *v;
+    sg_diags d;
+    sg_diags_init(&d);
+    int nc = splat_distance_classes(&f->L, &full, &v, &d);
+    assert_int_equal(d.nerrors, 0);
+    sg_diags_free(&d);
+    int mid = -1;
+    for (int k = 0; k < nc; k++)
+        if (fabs(v[k].lo - 300.0) < 0.1 && fabs(v[k].hi - 1000.0) < 0.1)
+            mid = k;
+    assert_true(mid >= 0);
+    for (int k = 0; k < nc; k++)
+        if (k != mid && v[k].lo <= v[mid].lo && v[mid].hi <= v[k].hi)
+            assert_true(v[mid].cost < v[k].cost);
+    assert_true(v[mid].cost < splat_composite_cost(&full));
+    uint64_t rng = 0x6a09e667f3bcc909ull;
+    assert_int_equal(compare(f, &full, &v[mid].comp, v[mid].lo, v[mid].hi, 400, true, &rng), 0);
+    assert_true(compare(f, &full, &v[mid].comp, 0.05 * v[mid].lo, 0.5 * v[mid].lo, 200, false,
+                        &rng) > 0);
+    assert_true(compare(f, &full, &v[mid].comp, 1.5 * v[mid].hi, 3.0 * v[mid].hi, 200, false,
+                        &rng) > 0);
+    compiles(&f->L, &v[mid].comp, false);
+    compiles(&f->L, &v[mid].comp, true);
+    splat_dclasses_free(v, nc);
+    splat_composite_free(&full);
+}
+
 /* A composite that never reads view.distance has no classes. */
 static void test_no_distance(void **state)
 {
@@ -349,6 +391,7 @@ int main(void)
         cmocka_unit_test_setup_teardown(test_colorado_rock, setup, teardown),
         cmocka_unit_test_setup_teardown(test_colorado_uber, setup, teardown),
         cmocka_unit_test_setup_teardown(test_no_distance, setup, teardown),
+        cmocka_unit_test_setup_teardown(test_mid_class, setup_mid, teardown),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
