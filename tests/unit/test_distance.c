@@ -278,16 +278,24 @@ static void compiles(const splat_layout *L, const splat_composite *c, bool compu
     ir_buf_free(&glsl);
 }
 
+/* The composite of `mats` into *full and its classes into *v; how many. */
+static int classes_of(fixture *f, const int *mats, int n, splat_composite *full,
+                      splat_dclass **v)
+{
+    compose(f, mats, n, full);
+    sg_diags d;
+    sg_diags_init(&d);
+    int nc = splat_distance_classes(&f->L, full, v, &d);
+    assert_int_equal(d.nerrors, 0);
+    sg_diags_free(&d);
+    return nc;
+}
+
 static void check_classes(fixture *f, const int *mats, int n, uint64_t seed, bool glsl)
 {
     splat_composite full;
-    compose(f, mats, n, &full);
     splat_dclass *v;
-    sg_diags d;
-    sg_diags_init(&d);
-    int nc = splat_distance_classes(&f->L, &full, &v, &d);
-    assert_int_equal(d.nerrors, 0);
-    sg_diags_free(&d);
+    int nc = classes_of(f, mats, n, &full, &v);
     assert_true(nc >= 1);
     double cost = splat_composite_cost(&full);
     bool fade_class = false;
@@ -340,13 +348,8 @@ static void test_mid_class(void **state)
     fixture *f = *state;
     int mats[] = {material(f, "fades")};
     splat_composite full;
-    compose(f, mats, 1, &full);
     splat_dclass *v;
-    sg_diags d;
-    sg_diags_init(&d);
-    int nc = splat_distance_classes(&f->L, &full, &v, &d);
-    assert_int_equal(d.nerrors, 0);
-    sg_diags_free(&d);
+    int nc = classes_of(f, mats, 1, &full, &v);
     int mid = -1;
     for (int k = 0; k < nc; k++)
         if (fabs(v[k].lo - 300.0) < 0.1 && fabs(v[k].hi - 1000.0) < 0.1)
