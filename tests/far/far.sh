@@ -18,6 +18,10 @@
 #             composites within BOUND; at the trinidad camera (over the
 #             destructible area) with D = 1 m some patches are still not
 #             far: those over the destructible area; zero validation messages
+#   small     examples/minimal's pack with its atlas (quick: in the ASan
+#             run): forward and screen at D = 600 m both shade some, not
+#             all, of the terrain from the atlas, within FWD_PSNR dB of
+#             each other; zero validation messages
 #   corrupt   on examples/minimal's pack: a truncated far.atlas, a wrong
 #             magic, levels over the chain, a manifest width that does not
 #             match the file, a symbolic link: each refused with an error
@@ -117,6 +121,27 @@ forward)
     set -- $(sed -n 's/^far atlas: \([0-9]*\) of \([0-9]*\) patches$/\1 \2/p' "$OUT/fwd_forward_1.log")
     echo "trinidad, D = 1 m: $1 of $2 patches far"
     [ "$1" -gt 0 ] && [ "$1" -lt "$2" ] || fail "trinidad at 1 m: $1 of $2 patches far"
+    ;;
+small)
+    PACK=$OUT/minimal_far_small
+    "$SPLATC" build "$SRC/examples/minimal/scene.sg" -o "$PACK" --far-atlas --cache "$OUT/cache" \
+        >/dev/null
+    for sh in forward screen; do
+        SPLAT_VALIDATE=1 "$VIEW" "$PACK" --headless --size 160x90 --shading $sh \
+            --far-atlas-distance 600 --stats --float-out "$OUT/small_$sh.f32" \
+            -o "$OUT/small_$sh.png" > "$OUT/small_$sh.log" 2>&1 ||
+            { cat "$OUT/small_$sh.log" >&2; fail "splatview $sh"; }
+        ! grep -q "validation message" "$OUT/small_$sh.log" || fail "validation messages ($sh)"
+    done
+    set -- $(sed -n 's/^far atlas: \([0-9]*\) of \([0-9]*\) patches$/\1 \2/p' "$OUT/small_forward.log")
+    [ -n "${2:-}" ] && [ "$1" -gt 0 ] && [ "$1" -lt "$2" ] || fail "forward far patches: ${1:-?} of ${2:-?}"
+    tiles=$(sed -n 's/.*, \([0-9]*\) from the far atlas/\1/p' "$OUT/small_screen.log")
+    [ "${tiles:-0}" -gt 0 ] || fail "no screen tile from the far atlas"
+    line=$("$BENCH" compare "$OUT/small_forward.f32" "$OUT/small_screen.f32")
+    echo "forward: $1 of $2 patches far; screen: $tiles tiles far; forward vs screen: $line"
+    psnr=$(echo "$line" | awk '{print $6}')
+    awk -v p="$psnr" -v m="${FWD_PSNR:-40}" 'BEGIN { exit !(p >= m) }' ||
+        fail "forward vs screen far shading: $psnr dB < ${FWD_PSNR:-40}"
     ;;
 corrupt)
     # its own small pack (examples/minimal), so the case is quick under ASan
