@@ -21,7 +21,8 @@ static const VkFormat far_formats[3] = {
 };
 static const int far_block[3] = {8, 16, 8};
 
-bool rt_far_supported(rt_device *d)
+/* The device samples BC1 sRGB, BC5 and BC4 with linear filtering. */
+static bool far_supported(rt_device *d)
 {
     for (int i = 0; i < 3; i++)
         if (!rt_format_supports(d, far_formats[i], VK_FORMAT_FEATURE_SAMPLED_IMAGE_BIT |
@@ -171,7 +172,7 @@ bool rt_far_create(rt_device *d, const rt_pack *p, const rt_pipelines *pl, rt_fa
                    rt_error *e)
 {
     *out = NULL;
-    if (!p->far.data || !rt_far_supported(d))
+    if (!p->far.data || !far_supported(d))
         return true;
     rt_far *f = calloc(1, sizeof *f);
     if (!f)

@@ -385,6 +385,34 @@ static char *with_defines(const char *glsl, const char *defs)
     return s;
 }
 
+/* Whether the device draws `variant`: wireframe needs fillModeNonSolid,
+ * the counting variant fragment stores and subgroup votes. */
+static bool variant_supported(const rt_device *d, unsigned variant, rt_error *e)
+{
+    if ((variant & RT_VARIANT_WIRE) && !d->wireframe)
+        return rt_fail(e, RT_E_NO_FORMAT, "draw wireframe (no fillModeNonSolid)");
+    if ((variant & RT_VARIANT_COUNT) && !d->count_fragments)
+        return rt_fail(e, RT_E_NO_FORMAT, "count on the forward path (fragmentStoresAndAtomics "
+                       "and subgroup votes in fragment shaders)");
+    return true;
+}
+
+/* A main-pass pipeline over the terrain's vertex shader from fragment
+ * GLSL: compiled, validated, checked against `check` (NULL: not), in
+ * `layout` (VK_NULL_HANDLE: the terrain's). */
+static bool fragment_pipeline(rt_device *d, rt_pipelines *pl, const rt_passes *rp,
+                              VkPipelineLayout layout, const char *glsl, const char *name,
+                              const rt_interface *check, unsigned variant, VkPipeline *out,
+                              rt_error *e)
+{
+    VkShaderModule m;
+    if (!rt_glsl_module(d, glsl, VK_SHADER_STAGE_FRAGMENT_BIT, name, check, &m, e))
+        return false;
+    bool ok = make_pipeline_in(d, pl, layout, pl->vertex, m, rp->main, K_OPAQUE, variant, out, e);
+    vkDestroyShaderModule(d->dev, m, NULL);
+    return ok;
+}
+
 /* A composite's fragment pipeline from the pack's GLSL (`glsl`, else read
  * from the pack's file `path`), compiled, validated and checked against
  * the composite interface here, on first use: a distance class without
@@ -395,9 +423,8 @@ static bool glsl_pipeline(rt_device *d, const rt_pack *p, rt_pipelines *pl,
                           VkPipeline *slot, rt_error *e)
 {
     bool count = (variant & RT_VARIANT_COUNT) != 0;
-    if (count && !d->count_fragments)
-        return rt_fail(e, RT_E_NO_FORMAT, "count on the forward path (fragmentStoresAndAtomics "
-                       "and subgroup votes in fragment shaders)");
+    if (!variant_supported(d, variant, e))
+        return false;
     char *text = NULL;
     if (!glsl && path && !(glsl = text = rt_pack_read_glsl(p, field, path, e)))
         return false;
@@ -413,15 +440,11 @@ static bool glsl_pipeline(rt_device *d, const rt_pack *p, rt_pipelines *pl,
         free(text);
         return rt_fail(e, RT_E_VULKAN, "pipelines", "out of memory");
     }
-    VkShaderModule m;
-    bool ok = rt_glsl_module(d, src ? src : glsl, VK_SHADER_STAGE_FRAGMENT_BIT, name, &in, &m, e);
+    bool ok = fragment_pipeline(d, pl, rp, VK_NULL_HANDLE, src ? src : glsl, name, &in, variant,
+                                slot, e);
     rt_interface_free(&in);
     free(src);
     free(text);
-    if (!ok)
-        return false;
-    ok = make_pipeline(d, pl, pl->vertex, m, rp->main, K_OPAQUE, variant, slot, e);
-    vkDestroyShaderModule(d->dev, m, NULL);
     return ok;
 }
 
@@ -429,25 +452,16 @@ bool rt_pipelines_glsl_fragment(rt_device *d, rt_pipelines *pl, const rt_passes 
                                 VkPipelineLayout layout, const char *glsl, const char *name,
                                 unsigned variant, VkPipeline *out, rt_error *e)
 {
-    if ((variant & RT_VARIANT_COUNT) && !d->count_fragments)
-        return rt_fail(e, RT_E_NO_FORMAT, "count on the forward path (fragmentStoresAndAtomics "
-                       "and subgroup votes in fragment shaders)");
-    if ((variant & RT_VARIANT_WIRE) && !d->wireframe)
-        return rt_fail(e, RT_E_NO_FORMAT, "draw wireframe (no fillModeNonSolid)");
-    VkShaderModule m;
-    if (!rt_glsl_module(d, glsl, VK_SHADER_STAGE_FRAGMENT_BIT, name, NULL, &m, e))
-        return false;
-    bool ok = make_pipeline_in(d, pl, layout, pl->vertex, m, rp->main, K_OPAQUE, variant, out, e);
-    vkDestroyShaderModule(d->dev, m, NULL);
-    return ok;
+    return variant_supported(d, variant, e) &&
+           fragment_pipeline(d, pl, rp, layout, glsl, name, NULL, variant, out, e);
 }
 
 bool rt_pipelines_combo(rt_device *d, const rt_pack *p, const rt_passes *rp,
                         rt_pipelines *pl, int id, unsigned variant, VkPipeline *out,
                         rt_error *e)
 {
-    if ((variant & RT_VARIANT_WIRE) && !d->wireframe)
-        return rt_fail(e, RT_E_NO_FORMAT, "draw wireframe (no fillModeNonSolid)");
+    if (!variant_supported(d, variant, e))
+        return false;
     VkPipeline *slot = &pl->combo[(size_t)id * RT_VARIANTS + (variant % RT_VARIANTS)];
     if (!*slot && (!p->combos[id].spirv.words || (variant & RT_VARIANT_COUNT))) {
         /* a distance class (GLSL alone in the pack), or the counting variant */
@@ -474,8 +488,8 @@ bool rt_pipelines_uber(rt_device *d, const rt_pack *p, const rt_passes *rp,
                        rt_pipelines *pl, unsigned variant, VkPipeline *out,
                        rt_error *e)
 {
-    if ((variant & RT_VARIANT_WIRE) && !d->wireframe)
-        return rt_fail(e, RT_E_NO_FORMAT, "draw wireframe (no fillModeNonSolid)");
+    if (!variant_supported(d, variant, e))
+        return false;
     if (!p->uber.words)
         return rt_fail(e, RT_E_PACK_FIELD, p->dir, "the pack has no uber shader");
     VkPipeline *slot = &pl->uber[variant % RT_VARIANTS];

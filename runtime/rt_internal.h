@@ -476,11 +476,10 @@ bool rt_screen_has_far(const rt_screen *s);
 
 /* ---- far.c: the far atlas on the device ---------------------------------- */
 
-/* The device samples BC1 sRGB, BC5 and BC4 with linear filtering. */
-bool  rt_far_supported(rt_device *d);
 /* p->far's three images (every stored level, SHADER_READ_ONLY) and the
  * forward path's set and layout; *out stays NULL without an atlas in the
- * pack or without the BC formats. */
+ * pack or where the device does not sample BC1 sRGB, BC5 and BC4 with
+ * linear filtering. */
 bool  rt_far_create(rt_device *d, const rt_pack *p, const rt_pipelines *pl, rt_far **out,
                     rt_error *e);
 void  rt_far_destroy(rt_far *f);

@@ -188,9 +188,9 @@ static const char classify_glsl[] =
     "}\n"
     /* a tile wholly beyond the far distance (info.y, float bits; 0: off)
      * goes to the far atlas's list */
-    "uint pick_far() {\n"
+    "bool far_tile() {\n"
     "    float fd = uintBitsToFloat(u_push.info.y);\n"
-    "    return fd > 0.0 && dfar >= fd ? u_info.ncombos + 1u : pick();\n"
+    "    return fd > 0.0 && dfar >= fd;\n"
     "}\n"
     "#ifdef WIDE\n"
     /* GPUs: one workgroup per tile, one invocation per pixel; the sets
@@ -241,8 +241,7 @@ static const char classify_glsl[] =
     "    dmin = uintBitsToFloat(s_dmin);\n"
     "    dmax = uintBitsToFloat(s_dmax);\n"
     "    dfar = uintBitsToFloat(s_dfar);\n"
-    "    float fd = uintBitsToFloat(u_push.info.y);\n"
-    "    uint list = fd > 0.0 && dfar >= fd ? u_info.ncombos + 1u : pick_wide(li);\n"
+    "    uint list = far_tile() ? u_info.ncombos + 1u : pick_wide(li);\n"
     "    if (li == 0u) append(list, tile.x | (tile.y << 16u));\n"
     "}\n"
     "#else\n"
@@ -258,7 +257,7 @@ static const char classify_glsl[] =
     "            ivec2 px = ivec2(tile * 8u) + ivec2(x, y);\n"
     "            if (all(lessThan(px, size))) pixel(px);\n"
     "        }\n"
-    "    if (any_cell) append(pick_far(), tile.x | (tile.y << 16u));\n"
+    "    if (any_cell) append(far_tile() ? u_info.ncombos + 1u : pick(), tile.x | (tile.y << 16u));\n"
     "}\n"
     /* every invocation reaches append's subgroup loop or none past it */
     "void main() {\n"
