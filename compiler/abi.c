@@ -1,5 +1,6 @@
 /* abi.c — the shared GLSL text of the shader ABI (see abi.h). */
 #include "abi.h"
+#include "far_atlas.h"
 #include "sparse.h"
 
 #include <math.h>
@@ -69,6 +70,51 @@
     "}\n"                                                                   \
     "#define main splat_main\n"
 
+/* The far atlas bake variant (SPLAT_FAR_BAKE, with SPLAT_COMPUTE; abi.h
+ * "far atlas bake"): one invocation per bake point of a rectangle of the
+ * point grid, point (i, j) at ((i, j) + 0.5) * patch_xz.xy terrain-local
+ * metres, seen from straight above at FAR_ATLAS_BAKE_DISTANCE as the CPU
+ * reference sees it (far_atlas.c eval_point), one point step as the pixel
+ * step of the texture gradients.  Writes the composite's albedo, unit
+ * normal and roughness, clamped, and 1 (a point shaded) into u_far.v. */
+#define FAR_DECLS                                                           \
+    "layout(set = 2, binding = 0, std430) writeonly buffer splat_far_block {\n" \
+    "    float v[];\n"                                                      \
+    "} u_far;\n"                                                            \
+    "vec3 splat_far_albedo, splat_far_normal;\n"                            \
+    "float splat_far_rough;\n"
+
+#define FAR_MAIN                                                            \
+    "void splat_main();\n"                                                  \
+    "void main() {\n"                                                       \
+    "    if (any(greaterThanEqual(gl_GlobalInvocationID.xy, u_push.info.zw))) return;\n" \
+    "    uvec2 q = u_push.info.xy + gl_GlobalInvocationID.xy;\n"            \
+    "    splat_pixel = ivec2(q);\n"                                         \
+    "    vec2 step = u_push.patch_xz.xy;\n"                                 \
+    "    vec2 xz = (vec2(q) + 0.5) * step;\n"                               \
+    "    v_uv = xz / u_frame.terrain.xy;\n"                                 \
+    "    v_local = vec3(xz.x, splat_height_at(v_uv), xz.y);\n"              \
+    "    v_rel = v_local;   /* the frame's camera is the origin */\n"      \
+    "    splat_nrm = splat_normal_at(v_uv);\n"                              \
+    "    float ny = max(splat_nrm.y, 0.05);\n"                              \
+    "    splat_dpdx = vec3(step.x, -step.x * splat_nrm.x / ny, 0.0);\n"     \
+    "    splat_dpdy = vec3(0.0, -step.y * splat_nrm.z / ny, step.y);\n"     \
+    "    splat_far_albedo = vec3(0.0);\n"                                   \
+    "    splat_far_normal = vec3(0.0, 1.0, 0.0);\n"                         \
+    "    splat_far_rough = 1.0;\n"                                          \
+    "    splat_main();\n"                                                   \
+    "    uint at = ((q.y - u_push.info.y + uint(u_push.patch_xz.w)) * uint(u_push.patch_xz.z)\n" \
+    "               + q.x) * 8u;\n"                                          \
+    "    float l = length(splat_far_normal);\n"                             \
+    "    vec3 n = l > 0.0 ? splat_far_normal / l : vec3(0.0, 1.0, 0.0);\n"  \
+    "    vec3 a = clamp(splat_far_albedo, 0.0, 1.0);\n"                     \
+    "    u_far.v[at] = a.r; u_far.v[at + 1u] = a.g; u_far.v[at + 2u] = a.b;\n" \
+    "    u_far.v[at + 3u] = n.x; u_far.v[at + 4u] = n.y; u_far.v[at + 5u] = n.z;\n" \
+    "    u_far.v[at + 6u] = clamp(splat_far_rough, 0.0, 1.0);\n"            \
+    "    u_far.v[at + 7u] = 1.0;\n"                                         \
+    "}\n"                                                                   \
+    "#define main splat_main\n"
+
 /* Bindings 7-10 and the globals that stand for the fragment varyings. */
 #define COMPUTE_DECLS                                                       \
     "#ifdef SPLAT_SORT\n"                                                   \
@@ -76,8 +122,10 @@
     "#else\n"                                                               \
     "layout(local_size_x = 8, local_size_y = 8) in;\n"                      \
     "#endif\n"                                                              \
-    "#ifdef SPLAT_UNDERGROWTH\n"                                            \
+    "#if defined(SPLAT_UNDERGROWTH)\n"                                      \
     UG_DECLS                                                                \
+    "#elif defined(SPLAT_FAR_BAKE)\n"                                       \
+    FAR_DECLS                                                               \
     "#else\n"                                                               \
     "layout(set = 0, binding = 7) uniform sampler2D u_depth;\n"             \
     "layout(set = 0, binding = 8, rgba32f) uniform writeonly image2D u_out;\n" \
@@ -551,6 +599,10 @@ const char SPLAT_GLSL_PRELUDE[] =
     "#ifdef SPLAT_UNDERGROWTH\n"
     "float splat_view_distance() { return " SPLAT_STR(SPLAT_UG_DISTANCE) "; }\n"
     "vec3 splat_view_direction() { return vec3(0.0, 1.0, 0.0); }\n"
+    /* the far atlas bake: as the CPU reference (far_atlas.c) sees it */
+    "#elif defined(SPLAT_FAR_BAKE)\n"
+    "float splat_view_distance() { return " SPLAT_STR(FAR_ATLAS_BAKE_DISTANCE) "; }\n"
+    "vec3 splat_view_direction() { return vec3(0.0, 1.0, 0.0); }\n"
     "#else\n"
     "float splat_view_distance() { return length(v_rel); }\n"
     /* v_rel = surface - camera (terrain-local axes), so surface -> camera
@@ -606,6 +658,10 @@ const char SPLAT_GLSL_PRELUDE[] =
     "vec3 splat_d_position(int a) { return splat_d_rel(a); }\n"
     "float splat_d_height(int a) { return splat_d_rel(a).y; }\n"
     "vec2 splat_d_uv(int a) { return splat_d_rel(a).xz / u_frame.terrain.xy; }\n"
+    "#ifdef SPLAT_FAR_BAKE\n"   /* the reference's view does not move */
+    "float splat_d_view_distance(int a) { return 0.0; }\n"
+    "vec3 splat_d_view_direction(int a) { return vec3(0.0); }\n"
+    "#else\n"
     "float splat_d_view_distance(int a) {\n"
     "    float l = length(v_rel);\n"
     "    return l > 0.0 ? dot(v_rel, splat_d_rel(a)) / l : 0.0;\n"
@@ -616,6 +672,7 @@ const char SPLAT_GLSL_PRELUDE[] =
     "    vec3 r = v_rel / l, d = splat_d_rel(a);\n"
     "    return (r * dot(r, d) - d) / l;\n"
     "}\n"
+    "#endif\n"
     /* The counting variant's hooks (abi.h); nothing elsewhere. */
     "#if defined(SPLAT_COUNT)\n"
     "void splat_count_layer(float w) {\n"
@@ -695,6 +752,10 @@ const char SPLAT_GLSL_PRELUDE[] =
     "    float dist = splat_view_distance();\n"
     "#if defined(SPLAT_UNDERGROWTH)\n"
     "    splat_ug_albedo = albedo;\n"
+    "#elif defined(SPLAT_FAR_BAKE)\n"
+    "    splat_far_albedo = albedo;\n"
+    "    splat_far_normal = normal;\n"
+    "    splat_far_rough = rough;\n"
     "#elif defined(SPLAT_MULTIPASS)\n"
     "    o_albedo = vec4(albedo, coverage);\n"
     "    o_normal = vec4(normal, coverage);\n"
@@ -711,6 +772,8 @@ const char SPLAT_GLSL_PRELUDE[] =
     "}\n"
     "#if defined(SPLAT_UNDERGROWTH)\n"
     UG_MAIN
+    "#elif defined(SPLAT_FAR_BAKE)\n"
+    FAR_MAIN
     "#elif defined(SPLAT_COMPUTE)\n"
     COMPUTE_MAIN
     "#elif defined(SPLAT_GRADIENTS) || defined(SPLAT_COUNT)\n"

@@ -166,6 +166,22 @@
  * word s / 4, component s % 4: the weight after the compositor, so a
  * covered layer grows nothing), then packSnorm4x8(terrain normal, 0),
  * then packUnorm4x8(composite albedo, 1).
+ *
+ * ---- far atlas bake (splatc build --far-bake, far_atlas.h) --
+ * Any combination's compute variant with `#define SPLAT_FAR_BAKE 1` too
+ * bakes far atlas points on the device.  One invocation per point of the
+ * rectangle info.xy (first point) + [0, info.zw) of the bake's point grid
+ * (8x8 workgroups), point (i, j) at ((i, j) + 0.5) * patch_xz.xy
+ * terrain-local metres (patch_xz.xy: the point spacing), the leaf cell
+ * whose combination this is.  Height, normal, painted and destruction
+ * masks as in the fragment stage; view.distance FAR_ATLAS_BAKE_DISTANCE,
+ * the view straight down and its derivatives 0, the point spacing as the
+ * pixel step: the CPU reference's inputs (far_atlas.c); the runtime binds
+ * a frame block whose camera and world sites are the origin, as for the
+ * undergrowth masks.  Set 2 binding 0:
+ * buffer splat_far_block { float v[]; } (std430), 8 floats per point at
+ * ((j - info.y + patch_xz.w) * patch_xz.z + i) * 8: albedo rgb and
+ * roughness clamped to [0, 1], the unit normal, then 1 (a point shaded).
  */
 #ifndef SPLAT_ABI_H
 #define SPLAT_ABI_H

@@ -120,12 +120,14 @@ static bool inputs_key(build *b)
     if (!st)
         abort();
     XXH3_128bits_reset(st);
-    char head[192];
+    char head[256];
+    static const char *const bakes[] = {"auto", "cpu", "gpu"};
     int n = snprintf(head, sizeof head,
-                     "splatc %s\nabi %d\nflat %d\nlazy %d\npainted %s\ncompute-spirv %d\nfar-atlas %d\ndclasses %d\npreview ",
+                     "splatc %s\nabi %d\nflat %d\nlazy %d\npainted %s\ncompute-spirv %d\nfar-atlas %d %s\ndclasses %d\npreview ",
                      SPLATC_VERSION, SPLAT_ABI_VERSION, b->desc->flat, !b->desc->no_lazy,
                      splat_painted_format_name(b->desc->painted), b->desc->compute_spirv,
-                     b->desc->far_atlas, !b->desc->no_dclasses);
+                     b->desc->far_atlas, b->desc->far_atlas > 0 ? bakes[b->desc->far_bake] : "-",
+                     !b->desc->no_dclasses);
     XXH3_128bits_update(st, head, (size_t)n);
     if (b->desc->preview)   /* the name and its end */
         XXH3_128bits_update(st, b->desc->preview, strlen(b->desc->preview) + 1);
@@ -261,11 +263,18 @@ static bool layout(build *b)
 
 static bool write_out(build *b)
 {
-    if (b->desc->report) {
+    if (b->desc->report)
         build_report_shaders(b, b->desc->report);
-        build_report_far(b, b->desc->report);
+    bool device = b->far.pending;
+    bool ok = build_write_pack(b);
+    if (device) {   /* the device bake ran inside: count it as the bake's */
+        b->st->far_atlas += b->far.seconds;
+        b->st->write -= b->far.seconds;
     }
-    return build_write_pack(b);
+    b->st->far_on_device = b->far.on_device;
+    if (b->desc->report)
+        build_report_far(b, b->desc->report);
+    return ok;
 }
 
 /* A Make/Ninja path: spaces, '#' and '\\' before them escaped, '$' doubled. */

@@ -63,6 +63,9 @@ typedef struct far_atlas_out {
     int      width, height, levels;
     double   texel[2];        /* metres per level-0 texel, x and z        */
     double   seconds;         /* the bake's wall time                     */
+    bool     pending;         /* for the device: build_write_pack bakes it */
+    bool     on_device;       /* baked by desc->far_device                */
+    char     cpu_why[256];    /* auto, baked on the CPU: why not a device */
 } far_atlas_out;
 
 typedef struct build {
@@ -103,8 +106,13 @@ void build_jobs_free(build *b);
 
 /* ---- the far atlas (far_atlas.c) ------------------------------------------ */
 
-/* With desc->far_atlas > 0: bake every texel's composite into b->far. */
+/* With desc->far_atlas > 0: bake every texel's composite into b->far,
+ * on the CPU; with a device bake (desc->far_device, far_bake not CPU)
+ * only mark it pending. */
 bool build_far_atlas(build *b);
+/* The pending device bake, from the pack written in `dir` (complete but
+ * for the atlas); auto falls back to the CPU where the device cannot. */
+bool build_far_atlas_device(build *b, const char *dir);
 /* --stats: its size, density and bake time (nothing without an atlas). */
 void build_report_far(const build *b, FILE *out);
 

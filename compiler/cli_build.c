@@ -1,7 +1,7 @@
 /* cli_build.c — `splatc build SCENE.sg -o PACKDIR [-j N] [--stats]
  * [--cache DIR | --no-cache] [--flat] [--no-lazy] [--compute-spirv] [--no-distance-classes]
  * [--painted bc4|r8|dense] [-I DIR]... [--depfile FILE] [--preview MATERIAL] [--far-atlas[=N]]
- * [--json]`:
+ * [--far-bake auto|cpu|gpu] [--json]`:
  * the command-line face
  * of splat_build (build.c).  Exit status 0 on success, 1 on input errors,
  * 2 on usage errors. */
@@ -12,6 +12,10 @@
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+
+#ifdef SPLATC_DEVICE_BAKE   /* the runtime is built: it bakes on a device */
+#include "splatrt.h"
+#endif
 
 static const char usage[] =
     "usage: splatc build SCENE.sg -o PACKDIR [options]\n"
@@ -40,6 +44,9 @@ static const char usage[] =
     "  --far-atlas[=N]  also bake the far atlas: each terrain texel's composited\n"
     "                 albedo, normal and roughness, one atlas texel per N x N\n"
     "                 heightfield texels (default 1), BC-compressed (far.atlas)\n"
+    "  --far-bake W   where to bake it: gpu (the Vulkan device; an error where\n"
+    "                 there is none), cpu (the compiler's double reference) or\n"
+    "                 auto (default: a GPU if there is one, else the CPU)\n"
     "  --json         diagnostics as JSON Lines on stderr (for editors)\n";
 
 static void print_stats(const splat_build_stats *st, FILE *out)
@@ -119,6 +126,18 @@ int splat_cli_build(int argc, char **argv)
                 goto done;
             }
             desc.far_atlas = (int)n;
+        } else if (strcmp(a, "--far-bake") == 0 && next) {
+            static const char *const modes[] = {"auto", "cpu", "gpu"};
+            int m = 0;
+            while (m < 3 && strcmp(next, modes[m]))
+                m++;
+            if (m == 3) {
+                fprintf(stderr, "splatc build: --far-bake expects auto, cpu or gpu, found '%s'\n",
+                        next);
+                goto done;
+            }
+            desc.far_bake = (splat_far_bake)m;
+            i++;
         } else if (strcmp(a, "--no-distance-classes") == 0) {
             desc.no_dclasses = true;
         } else if (strcmp(a, "--painted") == 0 && next) {
@@ -162,6 +181,10 @@ int splat_cli_build(int argc, char **argv)
     search = splat_search_path(include, ninclude, desc.scene);
     desc.search_paths = (const char *const *)search;
     desc.report = stats ? stdout : NULL;
+#ifdef SPLATC_DEVICE_BAKE
+    desc.far_device = rt_far_bake_device;
+    desc.far_device_user = &desc.far_bake;
+#endif
 
     sg_diags d;
     sg_diags_init(&d);

@@ -11,9 +11,15 @@
  * superset), without lighting: "composite.albedo / .normal / .roughness"
  * (compose.h).
  *
- * How: on the CPU, in double, with the compiler's own reference evaluator
- * (ir_eval_node over the composite's IR in id order, every root at once),
- * there being no device at build time.  The inputs are the fragment
+ * How (`--far-bake cpu`, and auto without a GPU): on the CPU, in double,
+ * with the compiler's own reference evaluator (ir_eval_node over the
+ * composite's IR in id order, every root at once).  `--far-bake gpu` (and
+ * auto with one) shades the same points with the same inputs on the
+ * device instead: the splatc program links the runtime and hands its
+ * device bake in desc->far_device (runtime/far_bake.c, abi.h "far atlas
+ * bake"), which reads the pack written so far, before the swap; this
+ * library stays free of Vulkan.  Both bakes reduce their points to texels
+ * with far_atlas_reduce and share the mips and blocks below.  The inputs are the fragment
  * stage's at each point: height and normal from the heightfield
  * (splat_terrain_height / _normal, the ABI's twins), painted masks
  * bilinear from the dense rasters (a placed mask is read as covering the
@@ -277,40 +283,33 @@ static bool eval_point(far_bake *fb, double u, double v, double sx, double sz,
     return true;
 }
 
-/* One row of atlas texels: each the mean of FAR_SS x FAR_SS points spread
- * over it (a box filter of the composite over the texel, which is what a
- * far pixel covering the texel should show; one point at the centre would
- * keep the composite's aliasing: a peak's texel centre has a flat normal). */
-enum { FAR_SS = 2 };
+/* One row of atlas texels, from its FAR_ATLAS_SS rows of points (each
+ * texel the mean of the composite at FAR_ATLAS_SS^2 points spread over
+ * it: a box filter over the texel, which is what a far pixel covering the
+ * texel should show; one point at the centre would keep the composite's
+ * aliasing: a peak's texel centre has a flat normal). */
+enum { FAR_SS = FAR_ATLAS_SS };
 
-static void bake_row(far_bake *fb, int z, double (*vals)[4])
+static void bake_row(far_bake *fb, int z, double (*vals)[4], float *pts)
 {
     const splat_terrain *t = &fb->b->scene.terrain;
-    double sx = t->size[0] / fb->W / FAR_SS, sz = t->size[1] / fb->H / FAR_SS;
-    for (int x = 0; x < fb->W; x++) {
-        size_t i = (size_t)z * fb->W + x;
-        double al[3] = {0}, no[3] = {0}, ro = 0;
-        int n = 0;
-        for (int k = 0; k < FAR_SS * FAR_SS; k++) {
-            double u = (x + (k % FAR_SS + 0.5) / FAR_SS) / fb->W;
-            double v = (z + (k / FAR_SS + 0.5) / FAR_SS) / fb->H;
-            double a1[3], n1[3], r1;
-            if (!eval_point(fb, u, v, sx, sz, vals, a1, n1, &r1))
-                continue;
+    int nx = FAR_SS * fb->W;
+    double sx = t->size[0] / nx, sz = t->size[1] / (FAR_SS * fb->H);
+    for (int r = 0; r < FAR_SS; r++)
+        for (int i = 0; i < nx; i++) {
+            double u = (i + 0.5) / nx, v = (FAR_SS * z + r + 0.5) / (FAR_SS * fb->H);
+            double al[3], no[3], ro;
+            float *p = pts + ((size_t)r * nx + i) * 8;
+            bool shaded = eval_point(fb, u, v, sx, sz, vals, al, no, &ro);
             for (int c = 0; c < 3; c++) {
-                al[c] += a1[c];
-                no[c] += n1[c];
+                p[c] = shaded ? (float)al[c] : 0.0f;
+                p[3 + c] = shaded ? (float)no[c] : 0.0f;
             }
-            ro += r1;
-            n++;
+            p[6] = shaded ? (float)ro : 0.0f;
+            p[7] = shaded ? 1.0f : 0.0f;
         }
-        double len = sqrt(no[0] * no[0] + no[1] * no[1] + no[2] * no[2]);
-        for (int c = 0; c < 3; c++) {
-            fb->albedo[3 * i + c] = n ? (float)(al[c] / n) : 0.0f;
-            fb->normal[3 * i + c] = len > 0 ? (float)(no[c] / len) : (float)(c == 1);
-        }
-        fb->rough[i] = n ? (float)(ro / n) : 1.0f;
-    }
+    size_t i = (size_t)z * fb->W;
+    far_atlas_reduce(pts, fb->W, fb->albedo + 3 * i, fb->normal + 3 * i, fb->rough + i);
 }
 
 static void *bake_worker(void *arg)
@@ -320,14 +319,16 @@ static void *bake_worker(void *arg)
     for (int k = 0; k < fb->b->analysis.ncombos; k++)
         cap = fb->comp[k].ir.nnodes > cap ? fb->comp[k].ir.nnodes : cap;
     double (*vals)[4] = xcalloc(cap + 1, sizeof *vals);
+    float *pts = xmalloc((size_t)FAR_SS * FAR_SS * fb->W * 8 * sizeof *pts);
     for (;;) {
         pthread_mutex_lock(&fb->lock);
         int z = fb->next_row++;
         pthread_mutex_unlock(&fb->lock);
         if (z >= fb->H)
             break;
-        bake_row(fb, z, vals);
+        bake_row(fb, z, vals, pts);
     }
+    free(pts);
     free(vals);
     return NULL;
 }
@@ -430,22 +431,88 @@ static void put_f64(ir_buf *o, double v)
 
 /* ---- the phase ---------------------------------------------------------------- */
 
-bool build_far_atlas(build *b)
+/* The mip chain of level 0 (fb's arrays) and its blocks, into b->far. */
+static void encode_atlas(build *b, const far_bake *fb)
 {
-    if (b->desc->far_atlas <= 0)
-        return true;
-    double t0 = splat_now();
     const splat_terrain *t = &b->scene.terrain;
-    const splat_analysis *a = &b->analysis;
-    int n = b->desc->far_atlas;
-    far_bake fb = {.b = b};
-    fb.W = (t->width + n - 1) / n;
-    fb.H = (t->height + n - 1) / n;
-    if (fb.W > FAR_ATLAS_MAX_SIDE || fb.H > FAR_ATLAS_MAX_SIDE) {
-        sg_errorf(b->d, b->loc, SG_E_OVER_LIMIT, "far atlas of %d x %d texels is over %d a side",
-                  fb.W, fb.H, FAR_ATLAS_MAX_SIDE);
-        return false;
+    ir_buf o = {0};
+    app(&o, FAR_ATLAS_MAGIC, 8);
+    int levels = far_atlas_levels_max((uint32_t)fb->W, (uint32_t)fb->H);
+    put_u32(&o, FAR_ATLAS_VERSION);
+    put_u32(&o, (uint32_t)fb->W);
+    put_u32(&o, (uint32_t)fb->H);
+    put_u32(&o, (uint32_t)levels);
+    put_f64(&o, t->size[0] / fb->W);
+    put_f64(&o, t->size[1] / fb->H);
+    float *al = fb->albedo, *no = fb->normal, *ro = fb->rough;
+    int w = fb->W, h = fb->H;
+    for (int l = 0; l < levels; l++) {
+        if (l > 0) {
+            int dw = w >> 1 ? w >> 1 : 1, dh = h >> 1 ? h >> 1 : 1;
+            float *nal = xmalloc((size_t)dw * dh * 3 * sizeof *nal);
+            float *nno = xmalloc((size_t)dw * dh * 3 * sizeof *nno);
+            float *nro = xmalloc((size_t)dw * dh * sizeof *nro);
+            halve(al, w, h, 3, nal, dw, dh);
+            halve(no, w, h, 3, nno, dw, dh);
+            halve(ro, w, h, 1, nro, dw, dh);
+            for (size_t i = 0; i < (size_t)dw * dh; i++) {
+                double len = sqrt(nno[3 * i] * nno[3 * i] + nno[3 * i + 1] * nno[3 * i + 1] +
+                                  nno[3 * i + 2] * nno[3 * i + 2]);
+                for (int c = 0; c < 3; c++)
+                    nno[3 * i + c] = len > 0 ? (float)(nno[3 * i + c] / len) : c == 1;
+            }
+            if (al != fb->albedo) {
+                free(al);
+                free(no);
+                free(ro);
+            }
+            al = nal, no = nno, ro = nro, w = dw, h = dh;
+        }
+        encode_level(&o, al, no, ro, w, h);
     }
+    if (al != fb->albedo) {
+        free(al);
+        free(no);
+        free(ro);
+    }
+    b->far.data = (uint8_t *)o.s;
+    b->far.n = o.len;
+    b->far.width = fb->W;
+    b->far.height = fb->H;
+    b->far.levels = levels;
+    b->far.texel[0] = t->size[0] / fb->W;
+    b->far.texel[1] = t->size[1] / fb->H;
+}
+
+/* The atlas's level-0 size for desc->far_atlas; false past the limit. */
+static bool atlas_size(build *b, int *w, int *h)
+{
+    const splat_terrain *t = &b->scene.terrain;
+    int n = b->desc->far_atlas;
+    *w = (t->width + n - 1) / n;
+    *h = (t->height + n - 1) / n;
+    if (*w <= FAR_ATLAS_MAX_SIDE && *h <= FAR_ATLAS_MAX_SIDE)
+        return true;
+    sg_errorf(b->d, b->loc, SG_E_OVER_LIMIT, "far atlas of %d x %d texels is over %d a side",
+              *w, *h, FAR_ATLAS_MAX_SIDE);
+    return false;
+}
+
+static void alloc_level0(far_bake *fb)
+{
+    size_t texels = (size_t)fb->W * fb->H;
+    fb->albedo = xmalloc(texels * 3 * sizeof(float));
+    fb->normal = xmalloc(texels * 3 * sizeof(float));
+    fb->rough = xmalloc(texels * sizeof(float));
+}
+
+/* The CPU reference bake, then the blocks. */
+static bool bake_on_cpu(build *b)
+{
+    const splat_analysis *a = &b->analysis;
+    far_bake fb = {.b = b};
+    if (!atlas_size(b, &fb.W, &fb.H))
+        return false;
     int nt = b->layout.ntextures;
     fb.tex = xcalloc((size_t)nt + 1, sizeof *fb.tex);
     fb.tex_ok = xcalloc((size_t)nt + 1, sizeof *fb.tex_ok);
@@ -482,10 +549,7 @@ bool build_far_atlas(build *b)
         }
     }
     if (ok) {
-        size_t texels = (size_t)fb.W * fb.H;
-        fb.albedo = xmalloc(texels * 3 * sizeof(float));
-        fb.normal = xmalloc(texels * 3 * sizeof(float));
-        fb.rough = xmalloc(texels * sizeof(float));
+        alloc_level0(&fb);
         pthread_mutex_init(&fb.lock, NULL);
         int nth = b->desc->jobs > 1 ? b->desc->jobs : 1;
         pthread_t th[64];
@@ -497,55 +561,7 @@ bool build_far_atlas(build *b)
         for (int i = 0; i < started; i++)
             pthread_join(th[i], NULL);
         pthread_mutex_destroy(&fb.lock);
-
-        /* the mip chain and its blocks */
-        ir_buf o = {0};
-        app(&o, FAR_ATLAS_MAGIC, 8);
-        int levels = far_atlas_levels_max((uint32_t)fb.W, (uint32_t)fb.H);
-        put_u32(&o, FAR_ATLAS_VERSION);
-        put_u32(&o, (uint32_t)fb.W);
-        put_u32(&o, (uint32_t)fb.H);
-        put_u32(&o, (uint32_t)levels);
-        put_f64(&o, t->size[0] / fb.W);
-        put_f64(&o, t->size[1] / fb.H);
-        float *al = fb.albedo, *no = fb.normal, *ro = fb.rough;
-        int w = fb.W, h = fb.H;
-        for (int l = 0; l < levels; l++) {
-            if (l > 0) {
-                int dw = w >> 1 ? w >> 1 : 1, dh = h >> 1 ? h >> 1 : 1;
-                float *nal = xmalloc((size_t)dw * dh * 3 * sizeof *nal);
-                float *nno = xmalloc((size_t)dw * dh * 3 * sizeof *nno);
-                float *nro = xmalloc((size_t)dw * dh * sizeof *nro);
-                halve(al, w, h, 3, nal, dw, dh);
-                halve(no, w, h, 3, nno, dw, dh);
-                halve(ro, w, h, 1, nro, dw, dh);
-                for (size_t i = 0; i < (size_t)dw * dh; i++) {
-                    double len = sqrt(nno[3 * i] * nno[3 * i] + nno[3 * i + 1] * nno[3 * i + 1] +
-                                      nno[3 * i + 2] * nno[3 * i + 2]);
-                    for (int c = 0; c < 3; c++)
-                        nno[3 * i + c] = len > 0 ? (float)(nno[3 * i + c] / len) : c == 1;
-                }
-                if (al != fb.albedo) {
-                    free(al);
-                    free(no);
-                    free(ro);
-                }
-                al = nal, no = nno, ro = nro, w = dw, h = dh;
-            }
-            encode_level(&o, al, no, ro, w, h);
-        }
-        if (al != fb.albedo) {
-            free(al);
-            free(no);
-            free(ro);
-        }
-        b->far.data = (uint8_t *)o.s;
-        b->far.n = o.len;
-        b->far.width = fb.W;
-        b->far.height = fb.H;
-        b->far.levels = levels;
-        b->far.texel[0] = t->size[0] / fb.W;
-        b->far.texel[1] = t->size[1] / fb.H;
+        encode_atlas(b, &fb);
     }
     for (int k = 0; k < nc; k++) {
         if (fb.comp[k].layers || fb.comp[k].ir.nnodes)
@@ -565,6 +581,55 @@ bool build_far_atlas(build *b)
     free(fb.albedo);
     free(fb.normal);
     free(fb.rough);
+    return ok;
+}
+
+bool build_far_atlas(build *b)
+{
+    if (b->desc->far_atlas <= 0)
+        return true;
+    int w, h;
+    if (!atlas_size(b, &w, &h))
+        return false;
+    if (b->desc->far_bake != SPLAT_FAR_BAKE_CPU && b->desc->far_device) {
+        b->far.pending = true;   /* the pack first: the device reads it */
+        return true;
+    }
+    if (b->desc->far_bake == SPLAT_FAR_BAKE_GPU) {
+        sg_errorf(b->d, b->loc, SG_E_NO_DEVICE, "--far-bake gpu: this splatc was built "
+                  "without the runtime, so it has no device to bake on");
+        return false;
+    }
+    double t0 = splat_now();
+    bool ok = bake_on_cpu(b);
+    b->far.seconds = splat_now() - t0;
+    return ok;
+}
+
+bool build_far_atlas_device(build *b, const char *dir)
+{
+    double t0 = splat_now();
+    far_bake fb = {.b = b};
+    bool ok = atlas_size(b, &fb.W, &fb.H);
+    if (ok) {
+        alloc_level0(&fb);
+        char msg[sizeof b->far.cpu_why] = "";
+        b->far.on_device = b->desc->far_device(b->desc->far_device_user, dir, fb.W, fb.H,
+                                               fb.albedo, fb.normal, fb.rough, msg, sizeof msg);
+        if (b->far.on_device) {
+            encode_atlas(b, &fb);
+        } else if (b->desc->far_bake == SPLAT_FAR_BAKE_GPU) {
+            sg_errorf(b->d, b->loc, SG_E_NO_DEVICE, "--far-bake gpu: %s", msg);
+            ok = false;
+        } else {   /* auto: the CPU reference */
+            snprintf(b->far.cpu_why, sizeof b->far.cpu_why, "%s", msg);
+            ok = bake_on_cpu(b);
+        }
+    }
+    free(fb.albedo);
+    free(fb.normal);
+    free(fb.rough);
+    b->far.pending = false;
     b->far.seconds = splat_now() - t0;
     return ok;
 }
@@ -575,7 +640,10 @@ void build_report_far(const build *b, FILE *out)
         return;
     fprintf(out, "far atlas: %d x %d texels (%.1f x %.1f m each), %d levels, %zu bytes "
             "(BC1 albedo + BC5 normal + BC4 roughness; RGBA8 + RG8 + R8 would be %.0f), "
-            "baked in %.2f s\n", b->far.width, b->far.height, b->far.texel[0], b->far.texel[1],
-            b->far.levels, b->far.n, (double)b->far.width * b->far.height * 7.0 * 4.0 / 3.0,
-            b->far.seconds);
+            "baked in %.2f s on the %s\n", b->far.width, b->far.height, b->far.texel[0],
+            b->far.texel[1], b->far.levels, b->far.n,
+            (double)b->far.width * b->far.height * 7.0 * 4.0 / 3.0, b->far.seconds,
+            b->far.on_device ? "device" : "CPU");
+    if (b->far.cpu_why[0])
+        fprintf(out, "far atlas: not baked on a device: %s\n", b->far.cpu_why);
 }

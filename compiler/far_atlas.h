@@ -24,6 +24,25 @@
  * view straight down (view.direction (0, 1, 0)). */
 #define FAR_ATLAS_BAKE_DISTANCE 2000.0
 
+/* Where `splatc build --far-bake` bakes it: the CPU reference
+ * (far_atlas.c), the device (runtime/far_bake.c), or auto: a GPU when
+ * the CLI finds one, else the CPU (a CPU's Vulkan device, lavapipe, is
+ * not taken for a GPU). */
+typedef enum splat_far_bake {
+    SPLAT_FAR_BAKE_AUTO, SPLAT_FAR_BAKE_CPU, SPLAT_FAR_BAKE_GPU,
+} splat_far_bake;
+
+/* Points per texel side: each texel is the mean of FAR_ATLAS_SS^2 points
+ * spread over it (a box filter of the composite over the texel). */
+#define FAR_ATLAS_SS 2
+
+/* One texel row of w texels from its FAR_ATLAS_SS rows of w *
+ * FAR_ATLAS_SS points, 8 floats each (albedo rgb, unit normal, roughness,
+ * 1 where the point was shaded, 0 over a hole): the mean albedo and
+ * roughness and the renormalised mean normal of the shaded points (a
+ * texel of none: albedo 0, normal up, roughness 1).  Both bakes. */
+void far_atlas_reduce(const float *points, int w, float *albedo, float *normal, float *rough);
+
 static inline int far_atlas_levels_max(uint32_t w, uint32_t h)
 {
     int n = 1;

@@ -570,6 +570,25 @@ static bool write_sparse(build *b, const char *dir)
     return write_with(b, dir, "painted.sparse", put_sparse, &b->sparse);
 }
 
+static bool write_manifest(build *b, const char *dir)
+{
+    char **tex_names = texture_names(b);
+    json_t *m = manifest(b, tex_names, dir);
+    for (int i = 0; i < b->layout.ntextures; i++)
+        free(tex_names[i]);
+    free(tex_names);
+    char *text = json_dumps(m, JSON_INDENT(2) | JSON_PRESERVE_ORDER | JSON_REAL_PRECISION(15));
+    json_decref(m);
+    if (!text)
+        abort();
+    size_t n = strlen(text);
+    char *withnl = xasprintf("%s\n", text);
+    free(text);
+    bool ok = write_file(b, dir, "manifest.json", withnl, n + 1);
+    free(withnl);
+    return ok;
+}
+
 static bool write_contents(build *b, const char *dir)
 {
     const splat_scene *s = &b->scene;
@@ -661,23 +680,10 @@ static bool write_contents(build *b, const char *dir)
             free(to);
         }
     }
-    if (ok) {
-        json_t *m = manifest(b, tex_names, dir);
-        char *text = json_dumps(m, JSON_INDENT(2) | JSON_PRESERVE_ORDER |
-                                       JSON_REAL_PRECISION(15));
-        json_decref(m);
-        if (!text)
-            abort();
-        size_t n = strlen(text);
-        char *withnl = xasprintf("%s\n", text);
-        free(text);
-        ok = write_file(b, dir, "manifest.json", withnl, n + 1);
-        free(withnl);
-    }
     for (int i = 0; i < b->layout.ntextures; i++)
         free(tex_names[i]);
     free(tex_names);
-    return ok;
+    return ok && write_manifest(b, dir);
 }
 
 static int rm_entry(const char *path, const struct stat *sb, int flag, struct FTW *ftw)
@@ -733,6 +739,11 @@ bool build_write_pack(build *b)
     }
     chmod(tmp, 0755);
     bool ok = write_contents(b, tmp);
+    /* the device bake reads the pack written so far, then the atlas and
+     * the manifest naming it join it, all before the swap */
+    if (ok && b->far.pending)
+        ok = build_far_atlas_device(b, tmp) && b->far.data &&
+             write_file(b, tmp, "far.atlas", b->far.data, b->far.n) && write_manifest(b, tmp);
     if (ok && exists) {
         /* Swap old and new in one step where the file system can. */
         if (renameat2(AT_FDCWD, tmp, AT_FDCWD, out, RENAME_EXCHANGE) == 0) {

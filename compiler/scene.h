@@ -14,6 +14,7 @@
 
 #include "cache.h"
 #include "compose.h"
+#include "far_atlas.h"
 
 /* ---- build.c: `splatc build`, the shader pack (PACK.md) ---------------- */
 
@@ -38,11 +39,20 @@ typedef struct splat_build_desc {
     int                far_atlas;    /* > 0: bake the far atlas, one texel
                                         per N x N heightfield texels
                                         (far_atlas.c); 0: none            */
+    splat_far_bake     far_bake;     /* where it is baked (far_atlas.h)     */
+    /* The device bake (far_bake != CPU; the CLI sets it where the runtime
+     * is built): w x h texels of albedo (3 floats), normal (3) and
+     * roughness (1) from the pack written in `pack_dir` (complete but for
+     * the far atlas); false with a message in `msg`: no device there. */
+    bool (*far_device)(void *user, const char *pack_dir, int w, int h, float *albedo,
+                       float *normal, float *rough, char *msg, size_t nmsg);
+    void              *far_device_user;
 } splat_build_desc;
 
 typedef struct splat_build_stats {
     double load, analysis, compose, glslang, validate, write; /* seconds     */
     double far_atlas;        /* the far atlas bake (--far-atlas), seconds  */
+    bool   far_on_device;    /* it was baked by desc->far_device           */
     int    combos, combos_cached, combos_compiled;  /* composite shaders     */
     int    shaders, shaders_cached, shaders_compiled; /* every module         */
     int    lazy_branches;    /* lazy branches in the composites compiled

@@ -58,6 +58,7 @@ typedef struct sg_loc {
     X(OVER_LIMIT,    "%s")      /* over a pack or device limit (PACK.md)   */ \
     X(EMPTY_TERRAIN, "%s")      /* holes cover the whole terrain           */ \
     X(NOT_A_PACK,    "%s")      /* the output folder is not a shader pack  */ \
+    X(NO_DEVICE,     "%s")      /* --far-bake gpu and no device to bake on */ \
     X(OUT_OF_MEMORY, "%s")                                                  \
     X(INTERNAL,      "internal compiler error: %s")
 

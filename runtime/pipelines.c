@@ -370,9 +370,7 @@ static bool pack_pipeline(rt_device *d, rt_pipelines *pl, const rt_spirv *fs,
     return ok;
 }
 
-/* The pack's GLSL with `defs` (lines of #define) after its #version line
- * (abi.h: the counting and sorted variants are never stored). */
-static char *with_defines(const char *glsl, const char *defs)
+char *rt_glsl_with_defines(const char *glsl, const char *defs)
 {
     const char *nl = strchr(glsl, '\n');
     size_t head = nl ? (size_t)(nl - glsl) + 1 : 0, n = strlen(glsl), nd = strlen(defs);
@@ -433,7 +431,7 @@ static bool glsl_pipeline(rt_device *d, const rt_pack *p, rt_pipelines *pl,
         snprintf(what, sizeof what, "the pack has no fragment GLSL of %s", name);
         return rt_fail(e, RT_E_PACK_FIELD, p->dir, what);
     }
-    char *src = count ? with_defines(glsl, "#define SPLAT_COUNT 1\n") : NULL;
+    char *src = count ? rt_glsl_with_defines(glsl, "#define SPLAT_COUNT 1\n") : NULL;
     rt_interface in;
     if ((count && !src) || !rt_interface_for(p, RT_ROLE_COMPOSITE, &in)) {
         free(src);
@@ -552,7 +550,7 @@ bool rt_pipelines_compute(rt_device *d, const rt_pack *p, rt_pipelines *pl, int 
                  pl->sort_tiles);
     snprintf(defs, sizeof defs, "%s%s", (variant & RT_CVARIANT_COUNT) ? "#define SPLAT_COUNT 1\n" : "",
              sort);
-    char *src = defs[0] ? with_defines(glsl, defs) : NULL;
+    char *src = defs[0] ? rt_glsl_with_defines(glsl, defs) : NULL;
     if (defs[0] && !src)
         return rt_fail(e, RT_E_VULKAN, "pipelines", "out of memory");
     uint32_t *words = NULL;
@@ -730,4 +728,43 @@ void rt_pipelines_destroy(rt_device *d, rt_pipelines *pl)
     free(pl->ref);
     free(pl->cache_path);
     memset(pl, 0, sizeof *pl);
+}
+
+/* ---- set 0 of the terrain bakes (undergrowth masks, far atlas) ---------- */
+
+/* The terrain's bindings, without the screen path's (7-10), which a
+ * bake neither declares nor has to fill. */
+static const uint32_t terrain_bindings[] = {
+    SPLAT_BIND_HEIGHTFIELD, SPLAT_BIND_PAINTED, SPLAT_BIND_DESTRUCTION_ATLAS,
+    SPLAT_BIND_DESTRUCTION_INDEX, SPLAT_BIND_PAINTED_INDEX, SPLAT_BIND_PAINTED_LEVEL,
+    SPLAT_BIND_HOLES, SPLAT_BIND_SHADOW,
+};
+enum { NTERRAIN = sizeof terrain_bindings / sizeof *terrain_bindings };
+
+bool rt_terrain_compute_layout(rt_device *d, VkDescriptorSetLayout *out, rt_error *e)
+{
+    VkDescriptorSetLayoutBinding b[NTERRAIN + 1];
+    for (int i = 0; i < NTERRAIN; i++)
+        b[i] = (VkDescriptorSetLayoutBinding){ terrain_bindings[i],
+            VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, VK_SHADER_STAGE_COMPUTE_BIT, NULL };
+    b[NTERRAIN] = (VkDescriptorSetLayoutBinding){ SPLAT_BIND_FRAME,
+        VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, NULL };
+    return rt_set_layout(d, b, NTERRAIN + 1, out, e);
+}
+
+void rt_terrain_compute_set(rt_device *d, VkDescriptorSet src, VkDescriptorSet dst,
+                            VkBuffer frame)
+{
+    VkCopyDescriptorSet cp[NTERRAIN];
+    for (int i = 0; i < NTERRAIN; i++)
+        cp[i] = (VkCopyDescriptorSet){ .sType = VK_STRUCTURE_TYPE_COPY_DESCRIPTOR_SET,
+            .srcSet = src, .srcBinding = terrain_bindings[i], .dstSet = dst,
+            .dstBinding = terrain_bindings[i], .descriptorCount = 1 };
+    VkDescriptorBufferInfo fb = { frame, 0, sizeof(splat_frame) };
+    VkWriteDescriptorSet w = {
+        .sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = dst,
+        .dstBinding = SPLAT_BIND_FRAME, .descriptorCount = 1,
+        .descriptorType = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, .pBufferInfo = &fb,
+    };
+    vkUpdateDescriptorSets(d->dev, 1, &w, NTERRAIN, cp);
 }

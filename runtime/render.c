@@ -1557,6 +1557,21 @@ bool rt_renderer_pick(const rt_renderer *r, const double o[3], const double dir[
     return rt_heightfield_pick(rt_renderer_heights(r), r->p, o, dir, hit);
 }
 
+bool rt_renderer_bake_far(rt_renderer *r, int w, int h, float *albedo, float *normal,
+                          float *rough, rt_far_bake_stats *st, rt_error *e)
+{
+    rt_camera c;
+    rt_default_camera(r->p, &c);
+    splat_frame fr;
+    fill_frame(r, &c, &fr);
+    /* seen from the origin (abi.h "far atlas bake"), no craters */
+    memset(fr.camera, 0, sizeof fr.camera);
+    memset(fr.world, 0, sizeof fr.world);
+    memset(fr.destruction, 0, sizeof fr.destruction);
+    return rt_far_bake(r->d, r->p, &r->pl, r->set0, r->set1, &fr, w, h, albedo, normal, rough,
+                       st, e);
+}
+
 bool rt_renderer_read_heights(rt_renderer *r, uint16_t *out, rt_error *e)
 {
     return rt_destruction_wait(r->destr, e) && rt_read_r16(r->d, &r->terrain.height, out, e);

@@ -89,6 +89,17 @@ bool rt_glsl_compute_pipeline(rt_device *d, VkPipelineCache cache, VkPipelineLay
                               const char *glsl, const char *name,
                               const struct rt_interface *check, VkPipeline *out, rt_error *e);
 
+/* The pack's GLSL with `defs` (lines of #define) after its #version line
+ * (abi.h: the counting, sorted and bake variants are never stored);
+ * malloc'd, NULL when out of memory (pipelines.c). */
+char *rt_glsl_with_defines(const char *glsl, const char *defs);
+/* Set 0 of a terrain bake (undergrowth masks, far atlas; compute stage):
+ * the terrain's bindings without the screen path's, copied from the
+ * graphics set 0 `src`, and a frame block of the bake's own (pipelines.c). */
+bool rt_terrain_compute_layout(rt_device *d, VkDescriptorSetLayout *out, rt_error *e);
+void rt_terrain_compute_set(rt_device *d, VkDescriptorSet src, VkDescriptorSet dst,
+                            VkBuffer frame);
+
 /* ---- spirv_check.c: a pack shader against what it is bound to --------- */
 
 typedef enum rt_res {
@@ -147,6 +158,7 @@ typedef enum rt_shader_role {
     RT_ROLE_VERTEX, RT_ROLE_COMPOSITE, RT_ROLE_REFERENCE,
     RT_ROLE_COMPUTE,      /* the compute variants (*.comp.spv, abi.h)       */
     RT_ROLE_UNDERGROWTH,  /* undergrowth mask shaders (*.ug.comp, abi.h)    */
+    RT_ROLE_FAR_BAKE,     /* far atlas bake variants (abi.h, far_bake.c)    */
     RT_ROLE_COUNT,
 } rt_shader_role;
 
@@ -498,6 +510,16 @@ bool  rt_far_bind_forward(rt_far *f, const rt_pack *p, const rt_passes *rp, rt_p
 typedef struct rt_ug rt_ug;
 
 /* What the draw pass renders into and reads. */
+/* ---- far_bake.c: the far atlas baked on the device -------------------- */
+
+/* w x h texels of the far atlas (abi.h "far atlas bake"; far_atlas_reduce
+ * of 2 x 2 points each) into albedo (3 floats a texel), normal (3) and
+ * roughness (1), row-major; set0 / set1 the renderer's graphics sets,
+ * `frame` a frame block whose camera and world sites are the origin. */
+bool rt_far_bake(rt_device *d, const rt_pack *p, rt_pipelines *pl, VkDescriptorSet set0,
+                 VkDescriptorSet set1, const splat_frame *frame, int w, int h, float *albedo,
+                 float *normal, float *rough, rt_far_bake_stats *st, rt_error *e);
+
 typedef struct rt_ug_targets {
     const rt_image *color, *depth, *height;
     int             width, height_px;

@@ -64,6 +64,7 @@ static const char *const role_names[RT_ROLE_COUNT] = {
     [RT_ROLE_REFERENCE] = "a multi-pass reference fragment shader",
     [RT_ROLE_COMPUTE] = "a compute shading shader",
     [RT_ROLE_UNDERGROWTH] = "an undergrowth mask shader",
+    [RT_ROLE_FAR_BAKE] = "a far atlas bake shader",
 };
 
 bool rt_interface_for(const rt_pack *p, rt_shader_role role, rt_interface *out)
@@ -80,7 +81,8 @@ bool rt_interface_for(const rt_pack *p, rt_shader_role role, rt_interface *out)
     for (int i = 0; i < p->ntextures; i++)
         b[k++] = (rt_binding_rule){ SPLAT_SET_MATERIAL, (uint32_t)(SPLAT_BIND_TEXTURE0 + i),
                                     RT_RES_SAMPLED, RT_IMAGE_2D, false, RT_FLOAT, 0, FS, RT_PAINTED_ANY };
-    if (role == RT_ROLE_UNDERGROWTH)   /* abi.h "undergrowth masks": the output */
+    /* abi.h "undergrowth masks" and "far atlas bake": the output */
+    if (role == RT_ROLE_UNDERGROWTH || role == RT_ROLE_FAR_BAKE)
         b[k++] = (rt_binding_rule){ 2, 0, RT_RES_STORAGE_BUFFER, 0, false, 0, 0, CS,
                                     RT_PAINTED_ANY };
     out->what = role_names[role];
@@ -95,7 +97,8 @@ bool rt_interface_for(const rt_pack *p, rt_shader_role role, rt_interface *out)
         out->outputs = abi_varyings;
         out->noutputs = 3;
         out->outputs_exact = true;
-    } else if (role == RT_ROLE_COMPUTE || role == RT_ROLE_UNDERGROWTH) {
+    } else if (role == RT_ROLE_COMPUTE || role == RT_ROLE_UNDERGROWTH ||
+               role == RT_ROLE_FAR_BAKE) {
         out->stage = VK_SHADER_STAGE_COMPUTE_BIT;   /* no stage inputs or outputs */
         out->spec_ids = abi_spec_ids;
         out->nspec = 1;

@@ -530,6 +530,23 @@ bool rt_renderer_crater_at_pixel(rt_renderer *r, const rt_camera *c, double px, 
                                  rt_error *e);
 /* The GPU heightfield read back (tests): W*H texels. */
 bool rt_renderer_read_heights(rt_renderer *r, uint16_t *out, rt_error *e);
+/* The far atlas baked on this device (`splatc build --far-bake`; abi.h
+ * "far atlas bake", far_bake.c): w x h texels over the terrain, each the
+ * mean of its 2 x 2 points as compiler/far_atlas.c's CPU bake makes it,
+ * into albedo (3 floats a texel), unit normal (3) and roughness (1),
+ * row-major.  Uses the pack's parameters at their defaults and no craters.
+ * st (may be NULL): where the time went. */
+typedef struct rt_far_bake_stats {
+    int    combos;        /* combinations compiled (those the leaf cells name) */
+    double compile_s;     /* their pipelines, on all cores                  */
+    double shade_s;       /* dispatches, read back and texels               */
+} rt_far_bake_stats;
+bool rt_renderer_bake_far(rt_renderer *r, int w, int h, float *albedo, float *normal,
+                          float *rough, rt_far_bake_stats *st, rt_error *e);
+/* `splatc build --far-bake`'s device (compiler/scene.h far_device; user:
+ * a splat_far_bake): rt_renderer_bake_far on the pack in pack_dir. */
+bool rt_far_bake_device(void *user, const char *pack_dir, int w, int h, float *albedo,
+                        float *normal, float *rough, char *msg, size_t nmsg);
 bool rt_parse_view(const char *s, const rt_pack *p, splat_view *view,
                    int *material, rt_error *e);
 

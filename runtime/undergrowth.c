@@ -497,18 +497,7 @@ static bool make_sets(rt_ug *u, VkDescriptorSet set0_src, const rt_image *height
     u->lod_set = sets[4];
     /* set 0 of the mask pass: the terrain's, but the frame block whose
      * camera is the origin (abi.h "undergrowth masks") */
-    static const uint32_t terrain[] = {
-        SPLAT_BIND_HEIGHTFIELD, SPLAT_BIND_PAINTED, SPLAT_BIND_DESTRUCTION_ATLAS,
-        SPLAT_BIND_DESTRUCTION_INDEX, SPLAT_BIND_PAINTED_INDEX, SPLAT_BIND_PAINTED_LEVEL,
-        SPLAT_BIND_HOLES, SPLAT_BIND_SHADOW,
-    };
-    enum { N = sizeof terrain / sizeof *terrain };
-    VkCopyDescriptorSet cp[N];
-    for (int i = 0; i < N; i++)
-        cp[i] = (VkCopyDescriptorSet){ .sType = VK_STRUCTURE_TYPE_COPY_DESCRIPTOR_SET,
-            .srcSet = set0_src, .srcBinding = terrain[i], .dstSet = u->set0,
-            .dstBinding = terrain[i], .descriptorCount = 1 };
-    VkDescriptorBufferInfo fb = { u->frame.buf, 0, sizeof(splat_frame) };
+    rt_terrain_compute_set(d, set0_src, u->set0, u->frame.buf);
     VkDescriptorBufferInfo mb = { u->masks.buf, 0, VK_WHOLE_SIZE };
     VkDescriptorBufferInfo ib = { u->inst.buf, 0, VK_WHOLE_SIZE };
     VkDescriptorBufferInfo ab = { u->args.buf, 0, VK_WHOLE_SIZE };
@@ -523,7 +512,6 @@ static bool make_sets(rt_ug *u, VkDescriptorSet set0_src, const rt_image *height
         .dstSet = set_, .dstBinding = b_, .descriptorCount = 1, .descriptorType = type_, \
         .pImageInfo = img_, .pBufferInfo = buf_ }
     VkWriteDescriptorSet w[] = {
-        W(u->set0, SPLAT_BIND_FRAME, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, NULL, &fb),
         W(u->mask_set, 0, sb, NULL, &mb),
         W(u->gen_set, 0, sb, NULL, &mb), W(u->gen_set, 1, sb, NULL, &ib),
         W(u->gen_set, 2, sb, NULL, &ab), W(u->gen_set, 3, sb, NULL, &bb),
@@ -534,7 +522,7 @@ static bool make_sets(rt_ug *u, VkDescriptorSet set0_src, const rt_image *height
         W(u->lod_set, 2, sb, NULL, &lb), W(u->lod_set, 3, sb, NULL, &fm),
     };
 #undef W
-    vkUpdateDescriptorSets(d->dev, sizeof w / sizeof *w, w, N, cp);
+    vkUpdateDescriptorSets(d->dev, sizeof w / sizeof *w, w, 0, NULL);
     return true;
 }
 
@@ -543,20 +531,6 @@ static bool make_layouts(rt_ug *u, rt_error *e)
     rt_device *d = u->d;
     const VkShaderStageFlags cs = VK_SHADER_STAGE_COMPUTE_BIT;
     const VkDescriptorType sb = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
-    /* the terrain's set 0 without the screen path's bindings (7-10),
-     * which the mask pass neither declares nor has to fill */
-    const VkDescriptorType smp = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
-    VkDescriptorSetLayoutBinding terrain[] = {
-        { SPLAT_BIND_HEIGHTFIELD, smp, 1, cs, NULL },
-        { SPLAT_BIND_FRAME, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 1, cs, NULL },
-        { SPLAT_BIND_PAINTED, smp, 1, cs, NULL },
-        { SPLAT_BIND_DESTRUCTION_ATLAS, smp, 1, cs, NULL },
-        { SPLAT_BIND_DESTRUCTION_INDEX, smp, 1, cs, NULL },
-        { SPLAT_BIND_PAINTED_INDEX, smp, 1, cs, NULL },
-        { SPLAT_BIND_PAINTED_LEVEL, smp, 1, cs, NULL },
-        { SPLAT_BIND_HOLES, smp, 1, cs, NULL },
-        { SPLAT_BIND_SHADOW, smp, 1, cs, NULL },
-    };
     VkDescriptorSetLayoutBinding mask[] = { { 0, sb, 1, cs, NULL } };
     VkDescriptorSetLayoutBinding gen[] = {
         { 0, sb, 1, cs, NULL }, { 1, sb, 1, cs, NULL }, { 2, sb, 1, cs, NULL },
@@ -570,7 +544,7 @@ static bool make_layouts(rt_ug *u, rt_error *e)
         { 0, sb, 1, cs, NULL }, { 1, sb, 1, cs, NULL }, { 2, sb, 1, cs, NULL },
         { 3, sb, 1, cs, NULL },
     };
-    if (!rt_set_layout(d, terrain, sizeof terrain / sizeof *terrain, &u->set_terrain, e) ||
+    if (!rt_terrain_compute_layout(d, &u->set_terrain, e) ||
         !rt_set_layout(d, mask, 1, &u->set_mask, e) || !rt_set_layout(d, gen, 5, &u->set_gen, e) ||
         !rt_set_layout(d, draw, 3, &u->set_draw, e) || !rt_set_layout(d, lod, 4, &u->set_lod, e))
         return false;

@@ -937,8 +937,109 @@ done:
     return status;
 }
 
+/* splatbench far-bake --pack P [--far-atlas N] [--runs K] [--out PREFIX]:
+ * the far atlas baked on the device (runtime/far_bake.c) from pack P, one
+ * texel per N x N heightfield texels, K times (the first compiles with a
+ * cold pipeline cache of its own, the later ones hit it): per run the
+ * combinations compiled and the seconds of compiling and of shading.
+ * --out writes the last run's level 0 for `splatbench compare`:
+ * PREFIX.albedo.f32 (albedo rgb, roughness) and PREFIX.normal.f32 (xyz, 1). */
+static int cmd_far_bake(int argc, char **argv)
+{
+    const char *pack_dir = NULL, *out = NULL;
+    int n = 1, runs = 1;
+    for (int i = 2; i < argc; i++) {
+        const char *a = argv[i], *next = i + 1 < argc ? argv[i + 1] : NULL;
+        if (!strcmp(a, "--pack") && next)
+            pack_dir = argv[++i];
+        else if (!strcmp(a, "--far-atlas") && next)
+            n = atoi(argv[++i]);
+        else if (!strcmp(a, "--runs") && next)
+            runs = atoi(argv[++i]);
+        else if (!strcmp(a, "--out") && next)
+            out = argv[++i];
+        else {
+            fprintf(stderr, "usage: splatbench far-bake --pack P [--far-atlas N] [--runs K] "
+                            "[--out PREFIX]\n");
+            return 2;
+        }
+    }
+    if (!pack_dir || n < 1 || n > 64 || runs < 1) {
+        fprintf(stderr, "splatbench far-bake: --pack, N in 1..64 and K >= 1 needed\n");
+        return 2;
+    }
+    rt_error e = {0};
+    rt_pack p;
+    rt_device dev;
+    rt_renderer *r = NULL;
+    bool have_pack = false, have_dev = false;
+    int status = 1;
+    float *al = NULL, *no = NULL, *ro = NULL, *img = NULL;
+    char cache[64];
+    snprintf(cache, sizeof cache, "/tmp/splatbench-farbake-%d.bin", (int)getpid());
+    remove(cache);
+    if (!(have_pack = rt_pack_load(&p, pack_dir, &e)) ||
+        !(have_dev = rt_device_create(&dev, NULL, &e)))
+        goto done;
+    int w = (p.hf_width + n - 1) / n, h = (p.hf_height + n - 1) / n;
+    size_t texels = (size_t)w * (size_t)h;
+    al = xcalloc(texels * 3, sizeof *al);
+    no = xcalloc(texels * 3, sizeof *no);
+    ro = xcalloc(texels, sizeof *ro);
+    printf("device %s, far atlas %d x %d texels (N = %d)\n", dev.props.deviceName, w, h, n);
+    printf("run,combos,compile_s,shade_s,total_s\n");
+    for (int k = 0; k < runs; k++) {
+        rt_render_desc rd = { .width = 8, .height = 8, .no_undergrowth = true, .no_shadows = true,
+                              .pipeline_cache = cache };
+        rt_far_bake_stats st;
+        if (!rt_renderer_create(&dev, &p, &rd, &r, &e) ||
+            !rt_renderer_bake_far(r, w, h, al, no, ro, &st, &e))
+            goto done;
+        rt_renderer_destroy(r);   /* saves the pipeline cache */
+        r = NULL;
+        printf("%d,%d,%.3f,%.3f,%.3f\n", k + 1, st.combos, st.compile_s, st.shade_s,
+               st.compile_s + st.shade_s);
+    }
+    if (out) {
+        img = xcalloc(texels * 4, sizeof *img);
+        char path[4096];
+        for (size_t i = 0; i < texels; i++) {
+            memcpy(img + 4 * i, al + 3 * i, 3 * sizeof *img);
+            img[4 * i + 3] = ro[i];
+        }
+        snprintf(path, sizeof path, "%s.albedo.f32", out);
+        if (!rt_write_float(path, img, w, h, &e))
+            goto done;
+        for (size_t i = 0; i < texels; i++) {
+            memcpy(img + 4 * i, no + 3 * i, 3 * sizeof *img);
+            img[4 * i + 3] = 1.0f;
+        }
+        snprintf(path, sizeof path, "%s.normal.f32", out);
+        if (!rt_write_float(path, img, w, h, &e))
+            goto done;
+    }
+    status = 0;
+done:
+    if (e.msg)
+        fprintf(stderr, "splatbench: %s\n", e.msg);
+    rt_error_clear(&e);
+    rt_renderer_destroy(r);
+    if (have_dev)
+        rt_device_destroy(&dev);
+    if (have_pack)
+        rt_pack_free(&p);
+    remove(cache);
+    free(al);
+    free(no);
+    free(ro);
+    free(img);
+    return status;
+}
+
 int main(int argc, char **argv)
 {
+    if (argc >= 2 && !strcmp(argv[1], "far-bake"))
+        return cmd_far_bake(argc, argv);
     if (argc >= 2 && !strcmp(argv[1], "render"))
         return cmd_render(argc, argv);
     if (argc >= 2 && !strcmp(argv[1], "upscale"))
@@ -947,6 +1048,6 @@ int main(int argc, char **argv)
         return cmd_compare(argc, argv);
     if (argc >= 2 && !strcmp(argv[1], "analytic-hf"))
         return cmd_analytic_hf(argc, argv);
-    fprintf(stderr, "usage: splatbench render|upscale|compare ... (see tests/bench/splatbench.c)\n");
+    fprintf(stderr, "usage: splatbench render|upscale|compare|far-bake ... (see tests/bench/splatbench.c)\n");
     return 2;
 }

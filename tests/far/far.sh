@@ -22,6 +22,16 @@
 #             run): forward and screen at D = 600 m both shade some, not
 #             all, of the terrain from the atlas, within FWD_PSNR dB of
 #             each other; zero validation messages
+#   device    the atlas baked on the device (--far-bake gpu, lavapipe here;
+#             runtime/far_bake.c) against the CPU reference's (the build
+#             case's pack): the screen path at the valley camera with the
+#             far tiles beyond 1 km, both pictures (final and albedo views)
+#             within DEV_PSNR dB; zero
+#             validation messages in the bake and the renders
+#   device_small  the same on examples/minimal (quick: in the ASan run),
+#             and: two device bakes byte-identical, auto on a CPU's device
+#             bakes on the CPU (byte-identical to --far-bake cpu, its reason
+#             in --stats), a bad --far-bake refused
 #   corrupt   on examples/minimal's pack: a truncated far.atlas, a wrong
 #             magic, levels over the chain, a manifest width that does not
 #             match the file, a symbolic link: each refused with an error
@@ -32,6 +42,10 @@ CASE=$1 SPLATC=$2 VIEW=$3 BENCH=$4 SRC=$5 OUT=$6
 PACK=${FAR_PACK:-$OUT/colorado_far}   # FAR_PACK: measure another pack
 mkdir -p "$OUT"
 fail() { echo "FAIL: $*" >&2; exit 1; }
+need_psnr() {   # $1: a `splatbench compare` line, $2: least dB, $3: what
+    psnr=$(echo "$1" | awk '{print $6}')
+    awk -v p="$psnr" -v m="$2" 'BEGIN { exit !(p >= m) }' || fail "$3: $psnr dB < $2"
+}
 
 build_pack() {   # $1: folder
     "$SPLATC" build "$SRC/examples/colorado/scene.sg" -o "$1" --far-atlas=4 -j 2 \
@@ -110,9 +124,7 @@ forward)
     echo "far patches: $1 of $2; samples per pixel $(spp 0) -> $(spp 5000)"
     echo "forward with the atlas vs screen with the atlas: $vs_screen"
     echo "forward with the atlas vs forward composites:   $vs_full"
-    psnr=$(echo "$vs_screen" | awk '{print $6}')
-    awk -v p="$psnr" -v m="${FWD_PSNR:-40}" 'BEGIN { exit !(p >= m) }' ||
-        fail "forward vs screen far shading: $psnr dB < ${FWD_PSNR:-40}"
+    need_psnr "$vs_screen" "${FWD_PSNR:-40}" "forward vs screen far shading"
     mean=$(echo "$vs_full" | awk '{print $4}')
     awk -v m="$mean" -v b="$BOUND" 'BEGIN { exit !(m <= b) }' || fail "mean error $mean over $BOUND"
     # every patch is beyond 1 m; only the destructible area's stay composites
@@ -139,9 +151,64 @@ small)
     [ "${tiles:-0}" -gt 0 ] || fail "no screen tile from the far atlas"
     line=$("$BENCH" compare "$OUT/small_forward.f32" "$OUT/small_screen.f32")
     echo "forward: $1 of $2 patches far; screen: $tiles tiles far; forward vs screen: $line"
-    psnr=$(echo "$line" | awk '{print $6}')
-    awk -v p="$psnr" -v m="${FWD_PSNR:-40}" 'BEGIN { exit !(p >= m) }' ||
-        fail "forward vs screen far shading: $psnr dB < ${FWD_PSNR:-40}"
+    need_psnr "$line" "${FWD_PSNR:-40}" "forward vs screen far shading"
+    ;;
+device|device_small)
+    # $1 scene, $2 pack folder prefix, $3 --far-atlas=N, $4 camera preset, $5 size, $6 distance
+    if [ "$CASE" = device ]; then
+        set -- colorado "$OUT/colorado_dev" 4 valley 320x180 1000
+        DEV_PSNR=${DEV_PSNR:-40}   # measured 46.3; red bake = green: 37.2
+        CPU_PACK=$PACK
+        [ -f "$CPU_PACK/far.atlas" ] || build_pack "$CPU_PACK"
+    else
+        set -- minimal "$OUT/minimal_dev" 1 overview 160x90 600
+        DEV_PSNR=${DEV_PSNR:-45}   # measured 47.8 (albedo); red bake = green: 41.8
+        CPU_PACK=$2_cpu
+        "$SPLATC" build "$SRC/examples/minimal/scene.sg" -o "$CPU_PACK" --far-atlas=$3 \
+            --far-bake cpu --cache "$OUT/cache" > /dev/null
+    fi
+    GPU_PACK=$2_gpu
+    bake() {   # $1 folder, $2 mode, $3 log
+        rm -rf "$1"
+        SPLAT_VALIDATE=1 "$SPLATC" build "$SRC/examples/$SCENE/scene.sg" -o "$1" \
+            --far-atlas=$N --far-bake "$2" -j 2 --cache "$OUT/cache" --stats > "$3" 2>&1 ||
+            { cat "$3" >&2; fail "--far-bake $2"; }
+    }
+    SCENE=$1 N=$3
+    bake "$GPU_PACK" gpu "$OUT/dev_$1.log"
+    grep -q "^far atlas: .* on the device$" "$OUT/dev_$1.log" || fail "not baked on the device"
+    grep "^far atlas: " "$OUT/dev_$1.log"
+    for v in final albedo; do
+        for k in cpu gpu; do
+            eval pk=\$$(echo $k | tr a-z A-Z)_PACK
+            f=$OUT/dev_$1_${v}_$k
+            SPLAT_VALIDATE=1 "$VIEW" "$pk" --headless --shading screen --size "$5" --view $v \
+                --camera-preset "$4" --no-undergrowth --far-atlas-distance "$6" --stats \
+                --float-out "$f.f32" -o "$f.png" > "$f.log" 2>&1 ||
+                { cat "$f.log" >&2; fail "splatview $k $v"; }
+            ! grep -q "validation message" "$f.log" || fail "validation messages ($k $v)"
+        done
+        tiles=$(sed -n 's/.*, \([0-9]*\) from the far atlas/\1/p' "$f.log")
+        [ "${tiles:-0}" -gt 0 ] || fail "no screen tile from the far atlas"
+        line=$("$BENCH" compare "$OUT/dev_$1_${v}_cpu.f32" "$OUT/dev_$1_${v}_gpu.f32")
+        echo "$1, view $v: $tiles tiles from the atlas; CPU-baked vs device-baked: $line"
+        need_psnr "$line" "$DEV_PSNR" "view $v: device bake vs CPU bake"
+    done
+    if [ "$CASE" = device_small ]; then
+        bake "$GPU_PACK.2" gpu "$OUT/dev_again.log"
+        cmp "$GPU_PACK/far.atlas" "$GPU_PACK.2/far.atlas" || fail "two device bakes differ"
+        bake "$2_auto" auto "$OUT/dev_auto.log"
+        grep -q "^far atlas: not baked on a device: .*is a CPU" "$OUT/dev_auto.log" ||
+            { cat "$OUT/dev_auto.log" >&2; fail "auto on lavapipe: no reason given"; }
+        cmp "$CPU_PACK/far.atlas" "$2_auto/far.atlas" || fail "auto on lavapipe differs from cpu"
+        if "$SPLATC" build "$SRC/examples/minimal/scene.sg" -o "$OUT/dev_bad" --far-atlas \
+            --far-bake fast > "$OUT/dev_bad.log" 2>&1; then
+            fail "--far-bake fast accepted"
+        fi
+        grep -q "expects auto, cpu or gpu" "$OUT/dev_bad.log" || fail "--far-bake fast: no message"
+        [ ! -e "$OUT/dev_bad" ] || fail "--far-bake fast wrote a pack"
+        echo "two device bakes identical; auto baked on the CPU here: $(grep 'not baked' "$OUT/dev_auto.log")"
+    fi
     ;;
 corrupt)
     # its own small pack (examples/minimal), so the case is quick under ASan

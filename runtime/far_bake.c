@@ -1,0 +1,379 @@
+/* far_bake.c — the far atlas baked on the device (`splatc build
+ * --far-bake`; abi.h "far atlas bake").
+ *
+ * The compiler's CPU bake (compiler/far_atlas.c) evaluates every atlas
+ * point with its double reference evaluator.  Here each combination's
+ * compute variant, with SPLAT_FAR_BAKE defined, shades the same points on
+ * the device with the same inputs: the bake grid is the atlas's 2 x 2
+ * points per texel, each point shaded by the combination of the leaf cell
+ * it falls in (the CPU's rule, evaluated here on the CPU so both pick the
+ * same cell), one dispatch per leaf cell and band of rows.  The points
+ * come back in bands of at most BAND_BYTES, and far_atlas_reduce (the
+ * compiler's) makes the texels of them, as the CPU bake does: the mip
+ * chain and the BC blocks stay the compiler's.
+ *
+ * Set 0 is the terrain's (the renderer's bindings copied) with a frame
+ * block of its own whose camera and world sites are the origin and whose
+ * destructible area is empty; set 1 the renderer's materials; set 2 the
+ * points. */
+#include "rt_internal.h"
+#include "far_atlas.h"
+#include "util.h"   /* splat_now */
+
+#include <math.h>
+#include <pthread.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#define BAND_BYTES ((VkDeviceSize)32 << 20)
+#define POINT_FLOATS 8
+
+typedef struct far_baker {
+    rt_device            *d;
+    const rt_pack        *p;
+    rt_pipelines         *pl;
+    VkDescriptorSetLayout set_terrain, set_out;
+    VkPipelineLayout      layout;
+    VkPipeline           *pipes;        /* per base combination, on first use */
+    VkDescriptorPool      dpool;
+    VkDescriptorSet       set0, set_points;
+    rt_buffer             frame, points;
+} far_baker;
+
+static bool bake_pipeline(far_baker *fb, int combo, VkPipeline *out, rt_error *e)
+{
+    if (!fb->pipes[combo]) {
+        const char *glsl = fb->p->combos[combo].compute;
+        char name[64];
+        snprintf(name, sizeof name, "combination %d (far atlas bake)", combo);
+        if (!glsl) {
+            char what[160];
+            snprintf(what, sizeof what, "the pack has no compute variant of %s", name);
+            return rt_fail(e, RT_E_PACK_FIELD, fb->p->dir, what);
+        }
+        char *src = rt_glsl_with_defines(glsl, "#define SPLAT_FAR_BAKE 1\n");
+        rt_interface in;
+        if (!src || !rt_interface_for(fb->p, RT_ROLE_FAR_BAKE, &in)) {
+            free(src);
+            return rt_fail(e, RT_E_VULKAN, "far atlas bake", "out of memory");
+        }
+        bool ok = rt_glsl_compute_pipeline(fb->d, fb->pl->cache, fb->layout, src, name, &in,
+                                           &fb->pipes[combo], e);
+        rt_interface_free(&in);
+        free(src);
+        if (!ok)
+            return false;
+    }
+    *out = fb->pipes[combo];
+    return true;
+}
+
+/* Every combination the leaf cells name, compiled on all cores first
+ * (glslang, validation and the driver's compiler per combination: most
+ * of a bake's time; vkCreateComputePipelines and the pipeline cache are
+ * free-threaded). */
+typedef struct compile_jobs {
+    far_baker      *fb;
+    const int      *combos;
+    int             n, next;
+    pthread_mutex_t lock;
+    rt_error        e;     /* the first failure */
+} compile_jobs;
+
+static void *compile_worker(void *arg)
+{
+    compile_jobs *j = arg;
+    for (;;) {
+        pthread_mutex_lock(&j->lock);
+        int k = j->e.id == RT_OK && j->next < j->n ? j->next++ : -1;
+        pthread_mutex_unlock(&j->lock);
+        if (k < 0)
+            return NULL;
+        rt_error e = {0};
+        VkPipeline pipe;
+        if (!bake_pipeline(j->fb, j->combos[k], &pipe, &e)) {
+            pthread_mutex_lock(&j->lock);
+            if (j->e.id == RT_OK)
+                j->e = e;
+            else
+                rt_error_clear(&e);
+            pthread_mutex_unlock(&j->lock);
+        }
+    }
+}
+
+static bool compile_all(far_baker *fb, int *ncombos, rt_error *e)
+{
+    const rt_pack_level *L0 = &fb->p->levels[0];
+    int *combos = malloc(((size_t)fb->p->nbase + 1) * sizeof *combos), n = 0;
+    bool *seen = calloc((size_t)fb->p->nbase + 1, 1);
+    if (!combos || !seen) {
+        free(combos);
+        free(seen);
+        return rt_fail(e, RT_E_VULKAN, "far atlas bake", "out of memory");
+    }
+    for (size_t i = 0; i < (size_t)L0->width * (size_t)L0->height; i++) {
+        unsigned id = L0->ids[i];
+        if (id != SPLAT_COMBO_HOLE && (int)id < fb->p->nbase && !seen[id]) {
+            seen[id] = true;
+            combos[n++] = (int)id;
+        }
+    }
+    compile_jobs j = { .fb = fb, .combos = combos, .n = n };
+    *ncombos = n;
+    pthread_mutex_init(&j.lock, NULL);
+    long cores = sysconf(_SC_NPROCESSORS_ONLN);
+    int nth = cores > 1 ? (cores < 16 ? (int)cores : 16) : 1;
+    pthread_t th[16];
+    int started = 0;
+    for (int i = 1; i < nth; i++)
+        if (pthread_create(&th[started], NULL, compile_worker, &j) == 0)
+            started++;
+    compile_worker(&j);
+    for (int i = 0; i < started; i++)
+        pthread_join(th[i], NULL);
+    pthread_mutex_destroy(&j.lock);
+    free(combos);
+    free(seen);
+    if (j.e.id == RT_OK)
+        return true;
+    *e = j.e;
+    return false;
+}
+
+static bool make_baker(far_baker *fb, VkDescriptorSet set0_src, const splat_frame *frame,
+                       VkDeviceSize band_bytes, rt_error *e)
+{
+    rt_device *d = fb->d;
+    fb->pipes = calloc((size_t)fb->p->nbase + 1, sizeof *fb->pipes);
+    if (!fb->pipes)
+        return rt_fail(e, RT_E_VULKAN, "far atlas bake", "out of memory");
+    VkDescriptorSetLayoutBinding out = { 0, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1,
+                                         VK_SHADER_STAGE_COMPUTE_BIT, NULL };
+    if (!rt_terrain_compute_layout(d, &fb->set_terrain, e) ||
+        !rt_set_layout(d, &out, 1, &fb->set_out, e))
+        return false;
+    VkDescriptorSetLayout sets[3] = { fb->set_terrain, fb->pl->set_material, fb->set_out };
+    VkPushConstantRange pr = { VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(splat_push) };
+    VkPipelineLayoutCreateInfo lci = {
+        .sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO,
+        .setLayoutCount = 3, .pSetLayouts = sets,
+        .pushConstantRangeCount = 1, .pPushConstantRanges = &pr,
+    };
+    RT_VK(e, vkCreatePipelineLayout(d->dev, &lci, NULL, &fb->layout));
+    if (!rt_buffer_create(d, sizeof(splat_frame), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, true,
+                          &fb->frame, e) ||
+        !rt_buffer_create(d, band_bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT |
+                          VK_BUFFER_USAGE_TRANSFER_DST_BIT, true, &fb->points, e))
+        return false;
+    memcpy(fb->frame.map, frame, sizeof *frame);
+    VkDescriptorPoolSize sizes[3] = {
+        { VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1 },
+        { VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 16 },
+        { VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 1 },
+    };
+    VkDescriptorPoolCreateInfo pci = {
+        .sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO,
+        .maxSets = 2, .poolSizeCount = 3, .pPoolSizes = sizes,
+    };
+    RT_VK(e, vkCreateDescriptorPool(d->dev, &pci, NULL, &fb->dpool));
+    VkDescriptorSetLayout ls[2] = { fb->set_terrain, fb->set_out };
+    VkDescriptorSet ds[2];
+    VkDescriptorSetAllocateInfo ai = {
+        .sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO,
+        .descriptorPool = fb->dpool, .descriptorSetCount = 2, .pSetLayouts = ls,
+    };
+    RT_VK(e, vkAllocateDescriptorSets(d->dev, &ai, ds));
+    fb->set0 = ds[0];
+    fb->set_points = ds[1];
+    rt_terrain_compute_set(d, set0_src, fb->set0, fb->frame.buf);
+    VkDescriptorBufferInfo pb = { fb->points.buf, 0, VK_WHOLE_SIZE };
+    VkWriteDescriptorSet w = {
+        .sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = fb->set_points,
+        .dstBinding = 0, .descriptorCount = 1,
+        .descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, .pBufferInfo = &pb,
+    };
+    vkUpdateDescriptorSets(d->dev, 1, &w, 0, NULL);
+    return true;
+}
+
+static void destroy_baker(far_baker *fb)
+{
+    rt_device *d = fb->d;
+    for (int k = 0; fb->pipes && k < fb->p->nbase; k++)
+        if (fb->pipes[k])
+            vkDestroyPipeline(d->dev, fb->pipes[k], NULL);
+    free(fb->pipes);
+    if (fb->dpool)
+        vkDestroyDescriptorPool(d->dev, fb->dpool, NULL);
+    if (fb->layout)
+        vkDestroyPipelineLayout(d->dev, fb->layout, NULL);
+    if (fb->set_terrain)
+        vkDestroyDescriptorSetLayout(d->dev, fb->set_terrain, NULL);
+    if (fb->set_out)
+        vkDestroyDescriptorSetLayout(d->dev, fb->set_out, NULL);
+    rt_buffer_destroy(d, &fb->points);
+    rt_buffer_destroy(d, &fb->frame);
+}
+
+/* The leaf cell of each point column (row) of a grid of n points over
+ * `texels` heightfield texels: far_atlas.c's rule, in double. */
+static int *cells_of(int n, int texels, int cell_texels, int cells)
+{
+    int *c = malloc((size_t)n * sizeof *c);
+    for (int i = 0; c && i < n; i++) {
+        int k = (int)((i + 0.5) / n * texels) / cell_texels;
+        c[i] = k < 0 ? 0 : k < cells ? k : cells - 1;
+    }
+    return c;
+}
+
+/* Record the dispatches of point rows [j0, j1) into the band buffer. */
+static bool record_band(far_baker *fb, VkCommandBuffer cb, const int *cx, const int *cz, int nx,
+                        int j0, int j1, const float step[2], rt_error *e)
+{
+    const rt_pack_level *L0 = &fb->p->levels[0];
+    for (int ja = j0; ja < j1;) {
+        int jb = ja;
+        while (jb < j1 && cz[jb] == cz[ja])
+            jb++;
+        for (int ia = 0; ia < nx;) {
+            int ib = ia;
+            while (ib < nx && cx[ib] == cx[ia])
+                ib++;
+            unsigned id = L0->ids[(size_t)cz[ja] * (size_t)L0->width + (size_t)cx[ia]];
+            if (id != SPLAT_COMBO_HOLE && (int)id < fb->p->nbase) {
+                VkPipeline pipe = VK_NULL_HANDLE;
+                if (!bake_pipeline(fb, (int)id, &pipe, e))
+                    return false;
+                vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, pipe);
+                splat_push push = {
+                    .patch_xz = { step[0], step[1], (float)nx, (float)(ja - j0) },
+                    .info = { (uint32_t)ia, (uint32_t)ja, (uint32_t)(ib - ia), (uint32_t)(jb - ja) },
+                };
+                vkCmdPushConstants(cb, fb->layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof push,
+                                   &push);
+                vkCmdDispatch(cb, (uint32_t)(ib - ia + 7) / 8, (uint32_t)(jb - ja + 7) / 8, 1);
+            }
+            ia = ib;
+        }
+        ja = jb;
+    }
+    return true;
+}
+
+bool rt_far_bake(rt_device *d, const rt_pack *p, rt_pipelines *pl, VkDescriptorSet set0,
+                 VkDescriptorSet set1, const splat_frame *frame, int w, int h, float *albedo,
+                 float *normal, float *rough, rt_far_bake_stats *st, rt_error *e)
+{
+    rt_far_bake_stats ignored;
+    st = st ? st : &ignored;
+    memset(st, 0, sizeof *st);
+    if (w < 1 || h < 1 || w > FAR_ATLAS_MAX_SIDE || h > FAR_ATLAS_MAX_SIDE)
+        return rt_fail(e, RT_E_PACK_LIMIT, p->dir, "far atlas side (texels)",
+                       (unsigned long long)(w > h ? w : h), "the far atlas's limit",
+                       (unsigned long long)FAR_ATLAS_MAX_SIDE);
+    int nx = 2 * w, nz = 2 * h;   /* FAR_ATLAS_SS points per texel side */
+    VkDeviceSize row = (VkDeviceSize)nx * POINT_FLOATS * sizeof(float);
+    VkDeviceSize limit = d->props.limits.maxStorageBufferRange < BAND_BYTES
+                             ? d->props.limits.maxStorageBufferRange : BAND_BYTES;
+    int band = (int)(limit / row) & ~1;   /* whole texel rows */
+    if (band < 2)
+        return rt_fail(e, RT_E_PACK_LIMIT, p->dir, "far atlas bake row (bytes)",
+                       (unsigned long long)(2 * row), "the device's storage buffer range",
+                       (unsigned long long)limit);
+    band = band < nz ? band : nz;
+    const rt_pack_level *L0 = &p->levels[0];
+    int *cx = cells_of(nx, p->hf_width, p->cell_texels, L0->width);
+    int *cz = cells_of(nz, p->hf_height, p->cell_texels, L0->height);
+    far_baker fb = { .d = d, .p = p, .pl = pl };
+    double t0 = splat_now();
+    bool ok = cx && cz ? make_baker(&fb, set0, frame, (VkDeviceSize)band * row, e) &&
+                             compile_all(&fb, &st->combos, e)
+                       : rt_fail(e, RT_E_VULKAN, "far atlas bake", "out of memory");
+    double t1 = splat_now();
+    st->compile_s = t1 - t0;
+    float step[2] = { (float)(p->size[0] / nx), (float)(p->size[1] / nz) };
+    for (int j0 = 0; ok && j0 < nz; j0 += band) {
+        int j1 = j0 + band < nz ? j0 + band : nz;
+        VkCommandBuffer cb;
+        ok = rt_oneshot_begin(d, &cb, e);
+        if (!ok)
+            break;
+        vkCmdFillBuffer(cb, fb.points.buf, 0, VK_WHOLE_SIZE, 0);
+        rt_cmd_barrier(cb, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
+                       VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT);
+        VkDescriptorSet sets[3] = { fb.set0, set1, fb.set_points };
+        vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, fb.layout, 0, 3, sets, 0, NULL);
+        ok = record_band(&fb, cb, cx, cz, nx, j0, j1, step, e);
+        rt_cmd_barrier(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
+                       VK_PIPELINE_STAGE_HOST_BIT, VK_ACCESS_HOST_READ_BIT);
+        ok = rt_oneshot_end(d, cb, e) && ok;
+        for (int z = j0 / 2; ok && z < j1 / 2; z++)
+            far_atlas_reduce((const float *)fb.points.map + (size_t)(2 * z - j0) * nx * POINT_FLOATS,
+                             w, albedo + (size_t)z * w * 3, normal + (size_t)z * w * 3,
+                             rough + (size_t)z * w);
+    }
+    st->shade_s = splat_now() - t1;
+    destroy_baker(&fb);
+    free(cx);
+    free(cz);
+    return ok;
+}
+
+/* ---- splatc build's device (compiler/scene.h far_device) ------------------ */
+
+/* Linked into the splatc program where the runtime is built (libsplatc
+ * stays free of Vulkan).  It opens the pack the build has written so far
+ * (no far atlas yet) on the Vulkan device splatview would pick
+ * (SPLAT_DEVICE picks another; with SPLAT_VALIDATE=1 any validation
+ * message fails the bake).  For auto a CPU's device (lavapipe) does not
+ * count: the compiler's CPU reference bakes instead. */
+static bool fail_msg(rt_error *e, char *msg, size_t nmsg, const char *what)
+{
+    snprintf(msg, nmsg, "%s: %s", what, e->msg ? e->msg : "failed");
+    rt_error_clear(e);
+    return false;
+}
+
+bool rt_far_bake_device(void *user, const char *pack_dir, int w, int h, float *albedo,
+                       float *normal, float *rough, char *msg, size_t nmsg)
+{
+    splat_far_bake mode = *(const splat_far_bake *)user;
+    rt_error e = {0};
+    rt_device d = {0};
+    rt_device_desc dd = {0};
+    if (!rt_device_create(&d, &dd, &e))
+        return fail_msg(&e, msg, nmsg, "no Vulkan device");
+    bool ok = false;
+    if (mode == SPLAT_FAR_BAKE_AUTO && d.props.deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU) {
+        snprintf(msg, nmsg, "the Vulkan device, %s, is a CPU", d.props.deviceName);
+        rt_device_destroy(&d);
+        return false;
+    }
+    rt_pack p;
+    if (!rt_pack_load(&p, pack_dir, &e)) {
+        fail_msg(&e, msg, nmsg, "the pack");
+        rt_device_destroy(&d);
+        return false;
+    }
+    rt_render_desc rd = { .width = 8, .height = 8, .no_undergrowth = true, .no_shadows = true };
+    rt_renderer *r = NULL;
+    if (!rt_renderer_create(&d, &p, &rd, &r, &e))
+        fail_msg(&e, msg, nmsg, d.props.deviceName);
+    else if (!rt_renderer_bake_far(r, w, h, albedo, normal, rough, NULL, &e))
+        fail_msg(&e, msg, nmsg, d.props.deviceName);
+    else
+        ok = true;
+    rt_renderer_destroy(r);
+    rt_pack_free(&p);
+    int messages = rt_device_messages(&d);
+    rt_device_destroy(&d);
+    if (ok && messages > 0) {
+        snprintf(msg, nmsg, "%d validation messages while baking", messages);
+        ok = false;
+    }
+    return ok;
+}
