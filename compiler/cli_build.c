@@ -46,7 +46,8 @@ static const char usage[] =
     "                 heightfield texels (default 1), BC-compressed (far.atlas)\n"
     "  --far-bake W   where to bake it: gpu (the Vulkan device; an error where\n"
     "                 there is none), cpu (the compiler's double reference) or\n"
-    "                 auto (default: a GPU if there is one, else the CPU)\n"
+    "                 auto (default: a GPU if there is one, else the CPU;\n"
+    "                 $SPLAT_FAR_BAKE sets the default)\n"
     "  --json         diagnostics as JSON Lines on stderr (for editors)\n";
 
 static void print_stats(const splat_build_stats *st, FILE *out)
@@ -79,6 +80,12 @@ static void print_stats(const splat_build_stats *st, FILE *out)
 int splat_cli_build(int argc, char **argv)
 {
     splat_build_desc desc = {.jobs = 1};
+    const char *bake_env = getenv("SPLAT_FAR_BAKE");   /* --far-bake's default */
+    if (bake_env && *bake_env && !splat_far_bake_parse(bake_env, &desc.far_bake)) {
+        fprintf(stderr, "splatc build: SPLAT_FAR_BAKE expects auto, cpu or gpu, found '%s'\n",
+                bake_env);
+        return 2;
+    }
     bool stats = false, json = false;
     const char **include = xcalloc((size_t)argc + 1, sizeof *include);
     int ninclude = 0;
@@ -127,16 +134,11 @@ int splat_cli_build(int argc, char **argv)
             }
             desc.far_atlas = (int)n;
         } else if (strcmp(a, "--far-bake") == 0 && next) {
-            static const char *const modes[] = {"auto", "cpu", "gpu"};
-            int m = 0;
-            while (m < 3 && strcmp(next, modes[m]))
-                m++;
-            if (m == 3) {
+            if (!splat_far_bake_parse(next, &desc.far_bake)) {
                 fprintf(stderr, "splatc build: --far-bake expects auto, cpu or gpu, found '%s'\n",
                         next);
                 goto done;
             }
-            desc.far_bake = (splat_far_bake)m;
             i++;
         } else if (strcmp(a, "--no-distance-classes") == 0) {
             desc.no_dclasses = true;
@@ -182,8 +184,9 @@ int splat_cli_build(int argc, char **argv)
     desc.search_paths = (const char *const *)search;
     desc.report = stats ? stdout : NULL;
 #ifdef SPLATC_DEVICE_BAKE
+    rt_far_bake_host host = { .mode = desc.far_bake };
     desc.far_device = rt_far_bake_device;
-    desc.far_device_user = &desc.far_bake;
+    desc.far_device_user = &host;
 #endif
 
     sg_diags d;

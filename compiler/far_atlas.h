@@ -13,8 +13,10 @@
 #ifndef SPLAT_FAR_ATLAS_H
 #define SPLAT_FAR_ATLAS_H
 
+#include <stdbool.h>
 #include <stddef.h>
 #include <stdint.h>
+#include <string.h>
 
 #define FAR_ATLAS_MAGIC      "SPLATFAR"
 #define FAR_ATLAS_VERSION    1u
@@ -31,6 +33,18 @@
 typedef enum splat_far_bake {
     SPLAT_FAR_BAKE_AUTO, SPLAT_FAR_BAKE_CPU, SPLAT_FAR_BAKE_GPU,
 } splat_far_bake;
+
+/* "auto", "cpu" or "gpu" (--far-bake, $SPLAT_FAR_BAKE); false otherwise. */
+static inline bool splat_far_bake_parse(const char *s, splat_far_bake *out)
+{
+    static const char *const names[] = {"auto", "cpu", "gpu"};
+    for (int m = 0; s && m < 3; m++)
+        if (!strcmp(s, names[m])) {
+            *out = (splat_far_bake)m;
+            return true;
+        }
+    return false;
+}
 
 /* Points per texel side: each texel is the mean of FAR_ATLAS_SS^2 points
  * spread over it (a box filter of the composite over the texel). */

@@ -11,7 +11,8 @@ set(SPLAT_PUBLIC_HEADERS
   ${PROJECT_SOURCE_DIR}/compiler/cache.h ${PROJECT_SOURCE_DIR}/compiler/mesh.h
   ${PROJECT_SOURCE_DIR}/compiler/sparse.h ${PROJECT_SOURCE_DIR}/compiler/shader.h
   ${PROJECT_SOURCE_DIR}/compiler/spv.h ${PROJECT_SOURCE_DIR}/compiler/texgen.h
-  ${PROJECT_SOURCE_DIR}/compiler/util.h ${PROJECT_SOURCE_DIR}/runtime/splatrt.h)
+  ${PROJECT_SOURCE_DIR}/compiler/util.h ${PROJECT_SOURCE_DIR}/compiler/far_atlas.h
+  ${PROJECT_SOURCE_DIR}/runtime/splatrt.h)
 
 install(TARGETS splatc_cli splatview RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
 install(TARGETS splatc splatrt EXPORT splatcTargets

@@ -339,38 +339,39 @@ static bool fail_msg(rt_error *e, char *msg, size_t nmsg, const char *what)
 }
 
 bool rt_far_bake_device(void *user, const char *pack_dir, int w, int h, float *albedo,
-                       float *normal, float *rough, char *msg, size_t nmsg)
+                        float *normal, float *rough, char *msg, size_t nmsg)
 {
-    splat_far_bake mode = *(const splat_far_bake *)user;
+    const rt_far_bake_host *host = user;
     rt_error e = {0};
-    rt_device d = {0};
+    rt_device own = {0}, *d = host->device;
     rt_device_desc dd = {0};
-    if (!rt_device_create(&d, &dd, &e))
-        return fail_msg(&e, msg, nmsg, "no Vulkan device");
+    if (!d) {
+        if (!rt_device_create(&own, &dd, &e))
+            return fail_msg(&e, msg, nmsg, "no Vulkan device");
+        d = &own;
+    }
     bool ok = false;
-    if (mode == SPLAT_FAR_BAKE_AUTO && d.props.deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU) {
-        snprintf(msg, nmsg, "the Vulkan device, %s, is a CPU", d.props.deviceName);
-        rt_device_destroy(&d);
-        return false;
-    }
+    int before = rt_device_messages(d);
     rt_pack p;
-    if (!rt_pack_load(&p, pack_dir, &e)) {
-        fail_msg(&e, msg, nmsg, "the pack");
-        rt_device_destroy(&d);
-        return false;
-    }
-    rt_render_desc rd = { .width = 8, .height = 8, .no_undergrowth = true, .no_shadows = true };
     rt_renderer *r = NULL;
-    if (!rt_renderer_create(&d, &p, &rd, &r, &e))
-        fail_msg(&e, msg, nmsg, d.props.deviceName);
-    else if (!rt_renderer_bake_far(r, w, h, albedo, normal, rough, NULL, &e))
-        fail_msg(&e, msg, nmsg, d.props.deviceName);
-    else
-        ok = true;
-    rt_renderer_destroy(r);
-    rt_pack_free(&p);
-    int messages = rt_device_messages(&d);
-    rt_device_destroy(&d);
+    if (host->mode == SPLAT_FAR_BAKE_AUTO && d->props.deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU) {
+        snprintf(msg, nmsg, "the Vulkan device, %s, is a CPU", d->props.deviceName);
+    } else if (!rt_pack_load(&p, pack_dir, &e)) {
+        fail_msg(&e, msg, nmsg, "the pack");
+    } else {
+        rt_render_desc rd = { .width = 8, .height = 8, .no_undergrowth = true, .no_shadows = true };
+        if (!rt_renderer_create(d, &p, &rd, &r, &e))
+            fail_msg(&e, msg, nmsg, d->props.deviceName);
+        else if (!rt_renderer_bake_far(r, w, h, albedo, normal, rough, NULL, &e))
+            fail_msg(&e, msg, nmsg, d->props.deviceName);
+        else
+            ok = true;
+        rt_renderer_destroy(r);
+        rt_pack_free(&p);
+    }
+    int messages = rt_device_messages(d) - before;
+    if (d == &own)
+        rt_device_destroy(&own);
     if (ok && messages > 0) {
         snprintf(msg, nmsg, "%d validation messages while baking", messages);
         ok = false;

@@ -23,6 +23,7 @@
 #include <vulkan/vulkan.h>
 
 #include "abi.h"
+#include "far_atlas.h"
 #include "sparse.h"
 
 /* ---- errors (device.c) -------------------------------------------------
@@ -544,7 +545,12 @@ typedef struct rt_far_bake_stats {
 bool rt_renderer_bake_far(rt_renderer *r, int w, int h, float *albedo, float *normal,
                           float *rough, rt_far_bake_stats *st, rt_error *e);
 /* `splatc build --far-bake`'s device (compiler/scene.h far_device; user:
- * a splat_far_bake): rt_renderer_bake_far on the pack in pack_dir. */
+ * an rt_far_bake_host): rt_renderer_bake_far on the pack in pack_dir, on
+ * host->device (the viewer's, for a hot reload) or on one of its own. */
+typedef struct rt_far_bake_host {
+    splat_far_bake mode;      /* auto: a CPU's device declines            */
+    rt_device     *device;    /* NULL: create one (splatc)                */
+} rt_far_bake_host;
 bool rt_far_bake_device(void *user, const char *pack_dir, int w, int h, float *albedo,
                         float *normal, float *rough, char *msg, size_t nmsg);
 bool rt_parse_view(const char *s, const rt_pack *p, splat_view *view,

@@ -302,8 +302,20 @@ static void watch_scene(viewer *v)
     sg_diags_free(&d);
 }
 
+/* The --far-atlas=N a pack's atlas was baked with (0: none). */
+static int far_atlas_n(const rt_pack *p)
+{
+    for (int n = 1; p->far.data && n <= 64; n++)
+        if ((p->hf_width + n - 1) / n == p->far.width && (p->hf_height + n - 1) / n == p->far.height)
+            return n;
+    return 0;
+}
+
 /* Rebuild the pack in process and swap pipelines; errors leave the old
- * pack drawing and are shown in the console and the title. */
+ * pack drawing and are shown in the console and the title.  A far atlas
+ * is rebaked on the viewer's device where that is a GPU (or where
+ * $SPLAT_FAR_BAKE asks: gpu, or cpu for the compiler's reference), else
+ * dropped: on a CPU the bake takes longer than an edit should wait. */
 static void reload(viewer *v)
 {
     char **paths = splat_search_path(v->desc->include, v->desc->ninclude, v->scene);
@@ -312,6 +324,18 @@ static void reload(viewer *v)
     splat_build_desc bd = { .scene = v->scene, .out = v->desc->pack_dir,
                             .search_paths = (const char *const *)paths, .jobs = 2,
                             .preview = v->desc->preview };
+    rt_far_bake_host host = { .mode = SPLAT_FAR_BAKE_AUTO, .device = &v->dev };
+    bool asked = splat_far_bake_parse(getenv("SPLAT_FAR_BAKE"), &host.mode);
+    int far_n = v->desc->preview ? 0 : far_atlas_n(v->pack);
+    if (far_n && (asked || v->dev.props.deviceType != VK_PHYSICAL_DEVICE_TYPE_CPU)) {
+        bd.far_atlas = far_n;
+        bd.far_bake = host.mode;
+        bd.far_device = rt_far_bake_device;
+        bd.far_device_user = &host;
+    } else if (far_n) {
+        fprintf(stderr, "splatview: hot reload: the far atlas is dropped (%s is a CPU; "
+                "SPLAT_FAR_BAKE=gpu or cpu rebakes it)\n", v->dev.props.deviceName);
+    }
     splat_build_stats bs;
     double t0 = splat_now();
     bool ok = splat_build(&bd, &bs, &d);
@@ -342,8 +366,10 @@ static void reload(viewer *v)
     free(v->pack);
     v->pack = np;
     v->reloads++;
-    snprintf(v->status, sizeof v->status, "reloaded in %.0f ms (%d compiled)",
-             (splat_now() - t0) * 1e3, bs.shaders_compiled);
+    snprintf(v->status, sizeof v->status, "reloaded in %.0f ms (%d compiled%s)",
+             (splat_now() - t0) * 1e3, bs.shaders_compiled,
+             bd.far_atlas ? bs.far_on_device ? ", far atlas baked on the device"
+                                             : ", far atlas baked on the CPU" : "");
     fprintf(stderr, "splatview: %s\n", v->status);
 }
 

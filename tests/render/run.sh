@@ -219,6 +219,29 @@ hot_reload)
     grep -q "reloaded" "$OUT/viewer.log" || fail "no reload"
     cmp -s "$OUT/a.png" "$OUT/b.png" && fail "the picture did not change after the edit"
     ;;
+hot_reload_far)
+    # a pack with a far atlas keeps it across a hot reload, rebaked on the
+    # viewer's own device (SPLAT_FAR_BAKE=gpu: lavapipe is a CPU's device,
+    # where auto drops the atlas); the edit changes the atlas
+    command -v xvfb-run > /dev/null || { echo "SKIP: no xvfb-run"; exit 77; }
+    minimal_copy
+    "$SPLATC" build "$SCENE" -o "$OUT/pack" --far-atlas --far-bake cpu --no-cache > /dev/null ||
+        fail "splatc build"
+    cp "$OUT/pack/far.atlas" "$OUT/far_before.atlas"
+    export SPLAT_FAR_BAKE=gpu
+    viewer_until_shot "$OUT/a.png" "$OUT/viewer.log" "$OUT/pack" --size 320x200 \
+        --camera-preset overview --far-atlas-distance 600 \
+        --script "frames=3;screenshot=$OUT/a.png;wait_reload=150;frames=2;screenshot=$OUT/b.png;quit"
+    unset SPLAT_FAR_BAKE
+    sed -i 's/vec3(0.55, 0.47, 0.22)/vec3(0.9, 0.05, 0.05)/' "$SCENE"
+    viewer_done "$OUT/viewer.log"
+    grep -q "reloaded in .*far atlas baked on the device" "$OUT/viewer.log" ||
+        fail "the far atlas was not rebaked on the device"
+    grep -q '"far_atlas"' "$OUT/pack/manifest.json" || fail "the reloaded pack lost its far atlas"
+    cmp -s "$OUT/far_before.atlas" "$OUT/pack/far.atlas" && fail "the far atlas did not change"
+    grep -q "validation message" "$OUT/viewer.log" && fail "validation messages"
+    cmp -s "$OUT/a.png" "$OUT/b.png" && fail "the picture did not change after the edit"
+    ;;
 preview)
     # splatview --material: one material of a copy of examples/minimal alone
     # on the built-in test hill (splatc build --preview), headless, then in

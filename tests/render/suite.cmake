@@ -42,8 +42,9 @@ if(TARGET splatrt AND TARGET splatview)
     set_tests_properties(render.real_minimal PROPERTIES LABELS "render;asan"
       FIXTURES_REQUIRED minimal_pack ENVIRONMENT "SPLAT_VALIDATE=1" TIMEOUT 300)
     # hot reload of an edited scene; _search: imports found only through
-    # -I or $SPLATC_PATH, as splatc build finds them
-    foreach(case hot_reload hot_reload_search preview)
+    # -I or $SPLATC_PATH, as splatc build finds them; _far: the far atlas
+    # rebaked on the viewer's device
+    foreach(case hot_reload hot_reload_search hot_reload_far preview)
       add_test(NAME render.${case}
         COMMAND sh ${RENDER_DIR}/run.sh ${case} $<TARGET_FILE:splatview>
                 $<TARGET_FILE:imgcheck> ${RENDER_OUT}/minimal ${RENDER_OUT}/out)
