@@ -31,7 +31,8 @@
 #   device_small  the same on examples/minimal (quick: in the ASan run),
 #             and: two device bakes byte-identical, auto on a CPU's device
 #             bakes on the CPU (byte-identical to --far-bake cpu, its reason
-#             in --stats), a bad --far-bake refused
+#             in --stats), a bad --far-bake refused; with no Vulkan driver,
+#             gpu an error that keeps the old pack, auto the CPU
 #   corrupt   on examples/minimal's pack: a truncated far.atlas, a wrong
 #             magic, levels over the chain, a manifest width that does not
 #             match the file, a symbolic link: each refused with an error
@@ -207,7 +208,25 @@ device|device_small)
         fi
         grep -q "expects auto, cpu or gpu" "$OUT/dev_bad.log" || fail "--far-bake fast: no message"
         [ ! -e "$OUT/dev_bad" ] || fail "--far-bake fast wrote a pack"
+        # no device at all: gpu is an error that leaves the old pack as it was,
+        # auto bakes on the CPU and says why
+        cp "$CPU_PACK/manifest.json" "$OUT/dev_manifest.before"
+        if VK_DRIVER_FILES=/nonexistent.json VK_ICD_FILENAMES=/nonexistent.json "$SPLATC" build \
+            "$SRC/examples/minimal/scene.sg" -o "$CPU_PACK" --far-atlas --far-bake gpu --no-cache \
+            > "$OUT/dev_nodev.log" 2>&1; then
+            fail "--far-bake gpu without a device succeeded"
+        fi
+        grep -q "error: --far-bake gpu: no Vulkan device" "$OUT/dev_nodev.log" ||
+            { cat "$OUT/dev_nodev.log" >&2; fail "--far-bake gpu without a device: no message"; }
+        cmp -s "$OUT/dev_manifest.before" "$CPU_PACK/manifest.json" || fail "the failed build touched the pack"
+        ! ls -d "$CPU_PACK".tmp-* > /dev/null 2>&1 || fail "a temporary folder was left behind"
+        VK_DRIVER_FILES=/nonexistent.json VK_ICD_FILENAMES=/nonexistent.json "$SPLATC" build \
+            "$SRC/examples/minimal/scene.sg" -o "$OUT/dev_nodev" --far-atlas --no-cache --stats \
+            > "$OUT/dev_nodev.log" 2>&1 || fail "auto without a device"
+        grep -q "^far atlas: not baked on a device: no Vulkan device" "$OUT/dev_nodev.log" ||
+            fail "auto without a device: no reason given"
         echo "two device bakes identical; auto baked on the CPU here: $(grep 'not baked' "$OUT/dev_auto.log")"
+        echo "without a device: gpu refused, the pack kept; auto on the CPU"
     fi
     ;;
 corrupt)
