@@ -275,14 +275,17 @@ bool rt_far_bake(rt_device *d, const rt_pack *p, rt_pipelines *pl, VkDescriptorS
         return rt_fail(e, RT_E_PACK_LIMIT, p->dir, "far atlas side (texels)",
                        (unsigned long long)(w > h ? w : h), "the far atlas's limit",
                        (unsigned long long)FAR_ATLAS_MAX_SIDE);
-    int nx = 2 * w, nz = 2 * h;   /* FAR_ATLAS_SS points per texel side */
+    if (p->cell_texels < 1)
+        return rt_fail(e, RT_E_PACK_FIELD, p->dir, "a leaf cell of no texels");
+    enum { SS = FAR_ATLAS_SS };   /* points per texel side */
+    int nx = SS * w, nz = SS * h;
     VkDeviceSize row = (VkDeviceSize)nx * POINT_FLOATS * sizeof(float);
     VkDeviceSize limit = d->props.limits.maxStorageBufferRange < BAND_BYTES
                              ? d->props.limits.maxStorageBufferRange : BAND_BYTES;
-    int band = (int)(limit / row) & ~1;   /* whole texel rows */
-    if (band < 2)
+    int band = (int)(limit / row) / SS * SS;   /* whole texel rows */
+    if (band < SS)
         return rt_fail(e, RT_E_PACK_LIMIT, p->dir, "far atlas bake row (bytes)",
-                       (unsigned long long)(2 * row), "the device's storage buffer range",
+                       (unsigned long long)(SS * row), "the device's storage buffer range",
                        (unsigned long long)limit);
     band = band < nz ? band : nz;
     const rt_pack_level *L0 = &p->levels[0];
@@ -310,9 +313,12 @@ bool rt_far_bake(rt_device *d, const rt_pack *p, rt_pipelines *pl, VkDescriptorS
         ok = record_band(&fb, cb, cx, cz, nx, j0, j1, step, e);
         rt_cmd_barrier(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
                        VK_PIPELINE_STAGE_HOST_BIT, VK_ACCESS_HOST_READ_BIT);
-        ok = rt_oneshot_end(d, cb, e) && ok;
-        for (int z = j0 / 2; ok && z < j1 / 2; z++)
-            far_atlas_reduce((const float *)fb.points.map + (size_t)(2 * z - j0) * nx * POINT_FLOATS,
+        rt_error scratch = {0};   /* after a recording error: keep that one */
+        bool ended = rt_oneshot_end(d, cb, ok ? e : &scratch);
+        rt_error_clear(&scratch);
+        ok = ok && ended;
+        for (int z = j0 / SS; ok && z < j1 / SS; z++)
+            far_atlas_reduce((const float *)fb.points.map + (size_t)(SS * z - j0) * nx * POINT_FLOATS,
                              w, albedo + (size_t)z * w * 3, normal + (size_t)z * w * 3,
                              rough + (size_t)z * w);
     }
