@@ -488,6 +488,27 @@ fi
 { echo "group,$(sed -n 1p "$W/render.txt")"; cat "$CSV.body"; } > "$CSV"
 rm -f "$CSV.body"
 
+# ---- the far atlas's bake: the CPU reference against the device ------------------
+# (splatc build --far-bake cpu, its --stats phase; splatbench far-bake, the
+# device's pipelines and shading) on the same machine, one run each
+far_bake() {   # SCENE N
+    rm -rf "$W/farbake_cpu"
+    s=$("$SPLATC" build "examples/$1/scene.sg" -o "$W/farbake_cpu" --far-atlas="$2" --far-bake cpu \
+        -j 2 --cache "$W/cache-$1" --stats | sed -n 's/^far atlas  *\([0-9.]*\)$/\1/p')
+    echo "$1,$2,cpu,,,$s"
+    "$BENCH" far-bake --pack "$W/$1" --far-atlas "$2" --runs 1 |
+        awk -F, -v s="$1" -v n="$2" 'NR > 2 { print s "," n ",device," $2 "," $3 "," $5 }'
+}
+{
+    echo "scene,far_atlas_n,bake,combos,compile_s,total_s"
+    if [ "$MODE" = smoke ]; then
+        far_bake minimal 1
+    else
+        far_bake colorado 4
+        far_bake colorado 1
+    fi
+} > "$OUT/far_bake.csv"
+
 # ---- figures printed by tests: sparse masks, quadtree selection -----------------
 : > "$OUT/sparse.txt"
 : > "$OUT/quadtree.txt"

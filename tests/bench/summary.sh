@@ -187,6 +187,17 @@ awk -F, 'NR > 1 {
         printf "| %s | %s | %s | %sx%s | %s | %.2f (%.2f-%.2f) | %.3f | %.2f | %.3g | %.3g | %.1f | %s |\n",
             $1, $3, $4, $5, $6, $7, $12, $13, $14, $15, (ref[k] > 0 ? $12 / ref[k] : 0), $19, $20, $21, $22 }' "$O/render.csv"
 echo
+if [ -s "$O/far_bake.csv" ]; then
+    echo "## Far atlas bake: the CPU reference against the device (seconds)"
+    echo
+    echo "| scene | N | CPU reference | device: combinations, compile, total | CPU / device |"
+    echo "|---|---:|---:|---|---:|"
+    awk -F, 'NR > 1 && $3 == "cpu" { cpu[$1 "," $2] = $6 }
+        NR > 1 && $3 == "device" { k = $1 "," $2
+            printf "| %s | %s | %.2f | %s, %.2f, %.2f | %.2fx |\n", $1, $2, cpu[k], $4, $5, $6,
+                ($6 > 0 ? cpu[k] / $6 : 0) }' "$O/far_bake.csv"
+    echo
+fi
 if [ -s "$O/sparse.txt" ]; then
     echo "## Sparse painted masks (tests/sparse/gpu_sparse on this device)"
     echo
