@@ -22,8 +22,8 @@
  * with far_atlas_reduce and share the mips and blocks below.  The inputs are the fragment
  * stage's at each point: height and normal from the heightfield
  * (splat_terrain_height / _normal, the ABI's twins), painted masks
- * bilinear from the dense rasters (a placed mask is read as covering the
- * whole terrain: not yet right for placed masks), destruction 0, params at
+ * bilinear from the dense rasters (a placed mask over its own rectangle,
+ * 0 outside, as the runtime reads it), destruction 0, params at
  * their defaults; view.distance FAR_ATLAS_BAKE_DISTANCE and the view
  * straight down.  Textures are filtered as a GPU filters them at that
  * footprint: the composite is differentiated (ir_differentiate, as for the
@@ -233,7 +233,15 @@ static bool eval_point(far_bake *fb, double u, double v, double sx, double sz,
         if (sp < 0 || !s->painted || !s->painted[sp])
             continue;
         int pw = s->painted_size[sp][0], ph = s->painted_size[sp][1];
-        double fx = u * pw - 0.5, fy = v * ph - 0.5;
+        double mu = u, mv = v;   /* the mask's own uv */
+        const sg_scene_painted *pm = &s->desc->painted[sp];
+        if (pm->place_loc.line > 0) {   /* placed: its rectangle, 0 outside (abi.c) */
+            mu = (u * t->size[0] - pm->origin[0]) / pm->place[0];
+            mv = (v * t->size[1] - pm->origin[1]) / pm->place[1];
+            if (!(mu >= 0 && mu <= 1 && mv >= 0 && mv <= 1))
+                continue;
+        }
+        double fx = mu * pw - 0.5, fy = mv * ph - 0.5;
         int x0 = (int)floor(fx), y0 = (int)floor(fy);
         double ax = fx - x0, ay = fy - y0, acc = 0;
         for (int dy = 0; dy < 2; dy++)

@@ -32,7 +32,8 @@
 #             and: two device bakes byte-identical, auto on a CPU's device
 #             bakes on the CPU (byte-identical to --far-bake cpu, its reason
 #             in --stats), a bad --far-bake refused; with no Vulkan driver,
-#             gpu an error that keeps the old pack, auto the CPU
+#             gpu an error that keeps the old pack, auto the CPU; a placed
+#             painted mask baked alike on both
 #   corrupt   on examples/minimal's pack: a truncated far.atlas, a wrong
 #             magic, levels over the chain, a manifest width that does not
 #             match the file, a symbolic link: each refused with an error
@@ -227,6 +228,28 @@ device|device_small)
             fail "auto without a device: no reason given"
         echo "two device bakes identical; auto baked on the CPU here: $(grep 'not baked' "$OUT/dev_auto.log")"
         echo "without a device: gpu refused, the pack kept; auto on the CPU"
+        # a placed painted mask (its own rectangle, 0 outside): both bakes
+        # read it as the runtime does
+        P=$OUT/placed_src
+        rm -rf "$P" && mkdir -p "$P/examples"
+        cp -r "$SRC/examples/minimal" "$P/examples/" && cp -r "$SRC/graphs" "$SRC/nodes" "$P/" ||
+            fail "copy"
+        sed -i 's|painted fields = "fields.png"|painted fields = "fields.png" { origin = 200 300, size = 500 400 }|' \
+            "$P/examples/minimal/scene.sg"
+        grep -q "origin = 200 300" "$P/examples/minimal/scene.sg" || fail "the scene edit"
+        for k in cpu gpu; do
+            rm -rf "$OUT/placed_$k"
+            SPLAT_VALIDATE=1 "$SPLATC" build "$P/examples/minimal/scene.sg" -o "$OUT/placed_$k" \
+                --far-atlas --far-bake $k --no-cache > "$OUT/placed_$k.log" 2>&1 ||
+                { cat "$OUT/placed_$k.log" >&2; fail "placed: --far-bake $k"; }
+            SPLAT_VALIDATE=1 "$VIEW" "$OUT/placed_$k" --headless --shading screen --size 160x90 \
+                --view albedo --camera-preset overview --no-undergrowth --far-atlas-distance 600 \
+                --float-out "$OUT/placed_$k.f32" -o "$OUT/placed_$k.png" > "$OUT/placed_v$k.log" 2>&1 ||
+                { cat "$OUT/placed_v$k.log" >&2; fail "placed: splatview $k"; }
+        done
+        line=$("$BENCH" compare "$OUT/placed_cpu.f32" "$OUT/placed_gpu.f32")
+        echo "placed mask, albedo view: CPU-baked vs device-baked: $line"
+        need_psnr "$line" "$DEV_PSNR" "placed mask: device bake vs CPU bake"
     fi
     ;;
 corrupt)
