@@ -55,6 +55,13 @@
  *       lambert) always run without them.
  *       Paths (--path): ground (2 m above the terrain looking 150 m ahead,
  *       from --start-preset NAME or --start x,z,dx,dz), topdown, grazing.
+ *       --warmup N (default 1) untimed frames at the path's start first;
+ *       --warmup path: every frame of the path once, untimed, so nothing a
+ *       view needs is made or JIT-compiled inside a timed frame (llvmpipe
+ *       compiles shader variants when a draw or dispatch first needs them,
+ *       inside the GPU timestamps).
+ *   splatbench far-bake --pack P [--far-atlas N] [--runs K] [--out PREFIX]
+ *       the far atlas baked on the device (cmd_far_bake says more).
  *   splatbench upscale IN.png K OUT
  *       K times the texels per side, bilinear: a 16-bit PNG becomes raw
  *       little-endian R16 (OUT), an 8-bit one an 8-bit PNG (nearest).
@@ -562,7 +569,7 @@ static int cmd_render(int argc, char **argv)
         else if (!strcmp(a, "--scene")) scene = next;
         else if (!strcmp(a, "--save")) save = next;
         else if (!strcmp(a, "--frames")) frames = atoi(next);
-        else if (!strcmp(a, "--warmup")) warmup = atoi(next);
+        else if (!strcmp(a, "--warmup")) warmup = !strcmp(next, "path") ? -1 : atoi(next);
         else if (!strcmp(a, "--size")) {
             if (sscanf(next, "%dx%d", &width, &height) != 2 || width <= 0 || height <= 0) {
                 fprintf(stderr, "splatbench render: --size expects WxH\n");
@@ -573,7 +580,7 @@ static int cmd_render(int argc, char **argv)
             return 2;
         }
     }
-    if (nspecs == 0 || frames < 1 || warmup < 0) {
+    if (nspecs == 0 || frames < 1 || warmup < -1) {
         fprintf(stderr, "splatbench render: needs --variant LABEL=KIND... and --frames >= 1\n");
         return 2;
     }
@@ -667,8 +674,8 @@ static int cmd_render(int argc, char **argv)
         /* warm-up frames: pipelines are made (and JIT-compiled) on first use */
         rt_camera cam;
         rt_frame_stats st;
-        for (int w = 0; w < warmup; w++) {
-            if (!path_camera(&v[i].view, &pd, 0, frames, &cam))
+        for (int w = 0; w < (warmup < 0 ? frames : warmup); w++) {
+            if (!path_camera(&v[i].view, &pd, warmup < 0 ? w : 0, frames, &cam))
                 goto done;
             if (!rt_renderer_frame(v[i].r, &cam, &st, &e))
                 goto done;
