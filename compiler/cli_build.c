@@ -46,7 +46,9 @@ static const char usage[] =
     "                 heightfield texels (default 1), BC-compressed (far.atlas)\n"
     "  --far-bake W   where to bake it: gpu (the Vulkan device; an error where\n"
     "                 there is none), cpu (the compiler's double reference) or\n"
-    "                 auto (default: a GPU if there is one, else the CPU;\n"
+    "                 auto (default: a GPU if there is one, a CPU's device\n"
+    "                 (lavapipe) for atlases of 10,000 texels a combination\n"
+    "                 and more, else the CPU;\n"
     "                 $SPLAT_FAR_BAKE sets the default)\n"
     "  --json         diagnostics as JSON Lines on stderr (for editors)\n";
 

@@ -28,8 +28,9 @@
 
 /* Where `splatc build --far-bake` bakes it: the CPU reference
  * (far_atlas.c), the device (runtime/far_bake.c), or auto: a GPU when
- * the CLI finds one, else the CPU (a CPU's Vulkan device, lavapipe, is
- * not taken for a GPU). */
+ * the CLI finds one; a CPU's Vulkan device (lavapipe) where the atlas has
+ * enough texels per combination to pay for its shader compiles
+ * (runtime/far_bake.c cpu_device_pays); else the CPU reference. */
 typedef enum splat_far_bake {
     SPLAT_FAR_BAKE_AUTO, SPLAT_FAR_BAKE_CPU, SPLAT_FAR_BAKE_GPU,
 } splat_far_bake;

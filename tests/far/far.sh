@@ -29,9 +29,11 @@
 #             within DEV_PSNR dB; zero
 #             validation messages in the bake and the renders
 #   device_small  the same on examples/minimal (quick: in the ASan run),
-#             and: two device bakes byte-identical, auto on a CPU's device
-#             bakes on the CPU (byte-identical to --far-bake cpu, its reason
-#             in --stats), a bad --far-bake refused; with no Vulkan driver,
+#             and: two device bakes byte-identical; auto on a CPU's device
+#             bakes there at N = 1 (22,000 texels a combination: byte-
+#             identical to --far-bake gpu) and on the CPU at N = 4 (1,400:
+#             byte-identical to --far-bake cpu, its reason in --stats); a
+#             bad --far-bake refused; with no Vulkan driver,
 #             gpu an error that keeps the old pack, auto the CPU; a placed
 #             painted mask baked alike on both
 #   corrupt   on examples/minimal's pack: a truncated far.atlas, a wrong
@@ -199,10 +201,18 @@ device|device_small)
     if [ "$CASE" = device_small ]; then
         bake "$GPU_PACK.2" gpu "$OUT/dev_again.log"
         cmp "$GPU_PACK/far.atlas" "$GPU_PACK.2/far.atlas" || fail "two device bakes differ"
+        # auto on lavapipe: the device where the atlas pays for its compiles
+        bake "$2_auto" auto "$OUT/dev_auto1.log"
+        grep -q "^far atlas: .* on the device$" "$OUT/dev_auto1.log" ||
+            { cat "$OUT/dev_auto1.log" >&2; fail "auto at N = 1 on lavapipe: not on the device"; }
+        cmp "$GPU_PACK/far.atlas" "$2_auto/far.atlas" || fail "auto at N = 1 differs from gpu"
+        N=4
         bake "$2_auto" auto "$OUT/dev_auto.log"
-        grep -q "^far atlas: not baked on a device: .*is a CPU" "$OUT/dev_auto.log" ||
-            { cat "$OUT/dev_auto.log" >&2; fail "auto on lavapipe: no reason given"; }
-        cmp "$CPU_PACK/far.atlas" "$2_auto/far.atlas" || fail "auto on lavapipe differs from cpu"
+        bake "$2_cpu4" cpu "$OUT/dev_cpu4.log"
+        N=$3
+        grep -q "^far atlas: not baked on a device: .*is a CPU, and .* texels a combination" \
+            "$OUT/dev_auto.log" || { cat "$OUT/dev_auto.log" >&2; fail "auto at N = 4: no reason given"; }
+        cmp "$2_cpu4/far.atlas" "$2_auto/far.atlas" || fail "auto at N = 4 differs from cpu"
         if "$SPLATC" build "$SRC/examples/minimal/scene.sg" -o "$OUT/dev_bad" --far-atlas \
             --far-bake fast > "$OUT/dev_bad.log" 2>&1; then
             fail "--far-bake fast accepted"
@@ -221,12 +231,13 @@ device|device_small)
             { cat "$OUT/dev_nodev.log" >&2; fail "--far-bake gpu without a device: no message"; }
         cmp -s "$OUT/dev_manifest.before" "$CPU_PACK/manifest.json" || fail "the failed build touched the pack"
         ! ls -d "$CPU_PACK".tmp-* > /dev/null 2>&1 || fail "a temporary folder was left behind"
+        rm -rf "$OUT/dev_nodev"   # else up to date from an earlier run: no bake, no reason
         VK_DRIVER_FILES=/nonexistent.json VK_ICD_FILENAMES=/nonexistent.json "$SPLATC" build \
             "$SRC/examples/minimal/scene.sg" -o "$OUT/dev_nodev" --far-atlas --no-cache --stats \
             > "$OUT/dev_nodev.log" 2>&1 || fail "auto without a device"
         grep -q "^far atlas: not baked on a device: no Vulkan device" "$OUT/dev_nodev.log" ||
             fail "auto without a device: no reason given"
-        echo "two device bakes identical; auto baked on the CPU here: $(grep 'not baked' "$OUT/dev_auto.log")"
+        echo "two device bakes identical; auto: N = 1 on the device, N = 4 $(grep 'not baked' "$OUT/dev_auto.log")"
         echo "without a device: gpu refused, the pack kept; auto on the CPU"
         # a placed painted mask (its own rectangle, 0 outside): both bakes
         # read it as the runtime does
