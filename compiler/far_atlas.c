@@ -619,14 +619,20 @@ bool build_far_atlas_device(build *b, const char *dir)
     double t0 = splat_now();
     far_bake fb = {.b = b};
     bool ok = atlas_size(b, &fb.W, &fb.H);
+    char msg[sizeof b->far.cpu_why] = "";
     if (ok) {
         alloc_level0(&fb);
-        char msg[sizeof b->far.cpu_why] = "";
         b->far.on_device = b->desc->far_device(b->desc->far_device_user, dir, fb.W, fb.H,
                                                fb.albedo, fb.normal, fb.rough, msg, sizeof msg);
-        if (b->far.on_device) {
+        if (b->far.on_device)
             encode_atlas(b, &fb);
-        } else if (b->desc->far_bake == SPLAT_FAR_BAKE_GPU) {
+    }
+    /* level 0's floats go before a CPU bake allocates its own */
+    free(fb.albedo);
+    free(fb.normal);
+    free(fb.rough);
+    if (ok && !b->far.on_device) {
+        if (b->desc->far_bake == SPLAT_FAR_BAKE_GPU) {
             sg_errorf(b->d, b->loc, SG_E_NO_DEVICE, "--far-bake gpu: %s", msg);
             ok = false;
         } else {   /* auto: the CPU reference */
@@ -634,9 +640,6 @@ bool build_far_atlas_device(build *b, const char *dir)
             ok = bake_on_cpu(b);
         }
     }
-    free(fb.albedo);
-    free(fb.normal);
-    free(fb.rough);
     b->far.pending = false;
     b->far.seconds = splat_now() - t0;
     return ok;

@@ -261,6 +261,17 @@ comp_pack() {  # SCENE COMPOSITOR -> pack dir
     "$SPLATC" build "$d/scene.sg" -o "$W/$1_$2" -j 2 --cache "$W/cache-$1" >/dev/null
     echo "$W/$1_$2"
 }
+# cliffs_pack COMPOSITOR OUT -> OUT: tests/bench/cliffs (Far Cry 5's dear
+# cliff surfaces over cheap masks) on colorado's terrain, with COMPOSITOR
+cliffs_pack() {
+    R=$W/mirror-cliffs
+    mirror "$R"
+    cp "$REPO/tests/bench/cliffs/cliffs.sg" "$R/graphs/cliffs.sg"
+    d=$(mirror_scene "$R" colorado cliffs)
+    sed -e "s/compositor *= *[a-z_]*/compositor = $1/" "$REPO/tests/bench/cliffs/scene.sg" > "$d/scene.sg"
+    "$SPLATC" build "$d/scene.sg" -o "$2" -j 2 --cache "$W/cache-cliffs" -I "$R" >/dev/null
+    echo "$2"
+}
 # graph knob variants: one graph file with a node type replaced
 KNOB_BUILD_ARGS=""
 # knob_pack SCENE LABEL GRAPH GRAPH-SED [SCENE-SED] -> pack dir: the scene
@@ -374,6 +385,18 @@ else
     st=$(comp_pack billingsley stochastic_select)
     render compositor billingsley ground 1280x720 ref=multipass max_height=composite \
         "stochastic=composite,pack=$st"
+    # Far Cry 5's case for stochastic selection (seed 004): surfaces of 7
+    # samples over masks that share one tap, on colorado's terrain; the
+    # ground path up Blanca's west flank, where the cliffs blend, and top-down
+    cliffs_pack linear_alpha "$W/cliffs" >/dev/null
+    cst=$(cliffs_pack stochastic_select "$W/cliffs_stochastic")
+    for p in ground topdown; do
+        [ "$p" = ground ] && GROUND_START=45000,47087,1,0
+        render compositor_cliffs cliffs "$p" 1280x720 linear_alpha=composite \
+            "stochastic=composite,pack=$cst" linear_alpha_screen=screen \
+            "stochastic_screen=screen,pack=$cst"
+        GROUND_START=""
+    done
     # (d) knobs: arithmetic precision, normal filter, LOD threshold (the
     # ground path; LOD against the finest threshold measured)
     render knob_precision colorado ground 1280x720 fp32=composite fp16=fp16
