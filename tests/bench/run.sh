@@ -370,6 +370,13 @@ if [ "$MODE" = smoke ]; then
     mf=$(knob_pack minimal far "" "")
     KNOB_BUILD_ARGS=""
     render knob_far minimal ground 320x180 "screen=screen,pack=$mf" "far50=screen,far=50,pack=$mf"
+    # the cliffs stack still compiles under both compositors (a full run
+    # renders it: group compositor_cliffs)
+    cliffs_pack linear_alpha "$W/cliffs" >/dev/null
+    cliffs_pack stochastic_select "$W/cliffs_stochastic" >/dev/null
+    if cmp -s "$W/cliffs/manifest.json" "$W/cliffs_stochastic/manifest.json"; then
+        echo "run.sh: the cliffs stack's compositor did not change its pack" >&2; exit 1
+    fi
 else
     # (c) compositors, against the alpha composite of the same frames
     for s in minimal colorado; do
