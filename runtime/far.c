@@ -202,16 +202,8 @@ bool rt_far_create(rt_device *d, const rt_pack *p, const rt_pipelines *pl, rt_fa
     if (!rt_set_layout(d, b, 3, &f->set_layout, e))
         return false;
     VkDescriptorPoolSize size = { cis, 3 };
-    VkDescriptorPoolCreateInfo dpi = {
-        .sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO,
-        .maxSets = 1, .poolSizeCount = 1, .pPoolSizes = &size,
-    };
-    RT_VK(e, vkCreateDescriptorPool(d->dev, &dpi, NULL, &f->pool));
-    VkDescriptorSetAllocateInfo ai = {
-        .sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO,
-        .descriptorPool = f->pool, .descriptorSetCount = 1, .pSetLayouts = &f->set_layout,
-    };
-    RT_VK(e, vkAllocateDescriptorSets(d->dev, &ai, &f->set));
+    if (!rt_descriptor_sets(d, &size, 1, &f->set_layout, 1, &f->pool, &f->set, e))
+        return false;
     for (uint32_t k = 0; k < 3; k++)
         w[k] = (VkWriteDescriptorSet){ .sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET,
             .dstSet = f->set, .dstBinding = 5 + k, .descriptorCount = 1,

@@ -104,34 +104,35 @@ static void *compile_worker(void *arg)
     }
 }
 
-/* The combinations the leaf cells name, each once, into combos (nbase
- * entries); how many, or -1 when out of memory. */
-static int named_combos(const rt_pack *p, int *combos)
+/* The combinations the leaf cells name, each once (*n of them), or NULL
+ * when out of memory. */
+static int *named_combos(const rt_pack *p, int *n)
 {
     const rt_pack_level *L0 = &p->levels[0];
+    int *combos = malloc(((size_t)p->nbase + 1) * sizeof *combos);
     bool *seen = calloc((size_t)p->nbase + 1, 1);
-    if (!seen)
-        return -1;
-    int n = 0;
-    for (size_t i = 0; i < (size_t)L0->width * (size_t)L0->height; i++) {
+    *n = 0;
+    for (size_t i = 0; combos && seen && i < (size_t)L0->width * (size_t)L0->height; i++) {
         unsigned id = L0->ids[i];
         if (id != SPLAT_COMBO_HOLE && (int)id < p->nbase && !seen[id]) {
             seen[id] = true;
-            combos[n++] = (int)id;
+            combos[(*n)++] = (int)id;
         }
     }
+    if (!seen) {
+        free(combos);
+        combos = NULL;
+    }
     free(seen);
-    return n;
+    return combos;
 }
 
 static bool compile_all(far_baker *fb, int *ncombos, rt_error *e)
 {
-    int *combos = malloc(((size_t)fb->p->nbase + 1) * sizeof *combos);
-    int n = combos ? named_combos(fb->p, combos) : -1;
-    if (n < 0) {
-        free(combos);
+    int n;
+    int *combos = named_combos(fb->p, &n);
+    if (!combos)
         return rt_fail(e, RT_E_VULKAN, "far atlas bake", "out of memory");
-    }
     compile_jobs j = { .fb = fb, .combos = combos, .n = n };
     *ncombos = n;
     pthread_mutex_init(&j.lock, NULL);
@@ -184,18 +185,10 @@ static bool make_baker(far_baker *fb, VkDescriptorSet set0_src, const splat_fram
         { VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 16 },
         { VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 1 },
     };
-    VkDescriptorPoolCreateInfo pci = {
-        .sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO,
-        .maxSets = 2, .poolSizeCount = 3, .pPoolSizes = sizes,
-    };
-    RT_VK(e, vkCreateDescriptorPool(d->dev, &pci, NULL, &fb->dpool));
     VkDescriptorSetLayout ls[2] = { fb->set_terrain, fb->set_out };
     VkDescriptorSet ds[2];
-    VkDescriptorSetAllocateInfo ai = {
-        .sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO,
-        .descriptorPool = fb->dpool, .descriptorSetCount = 2, .pSetLayouts = ls,
-    };
-    RT_VK(e, vkAllocateDescriptorSets(d->dev, &ai, ds));
+    if (!rt_descriptor_sets(d, sizes, 3, ls, 2, &fb->dpool, ds, e))
+        return false;
     fb->set0 = ds[0];
     fb->set_points = ds[1];
     rt_terrain_compute_set(d, set0_src, fb->set0, fb->frame.buf);
@@ -365,9 +358,8 @@ static bool fail_msg(rt_error *e, char *msg, size_t nmsg, const char *what)
 static bool cpu_device_pays(const rt_pack *p, int w, int h, const rt_device *d, char *msg,
                             size_t nmsg)
 {
-    int *combos = malloc(((size_t)p->nbase + 1) * sizeof *combos);
-    int n = combos ? named_combos(p, combos) : -1;
-    free(combos);
+    int n;
+    free(named_combos(p, &n));
     double per = n > 0 ? (double)w * h / n : 0;
     if (per >= CPU_DEVICE_TEXELS)
         return true;

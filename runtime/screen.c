@@ -673,20 +673,9 @@ static bool make_compute(rt_screen *s, const rt_pipelines *pl, VkSampler nearest
         { sb, 3 }, { cis, (s->raycast ? 1 : 0) + (s->far_ok ? 3 : 0) },
         { VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1 },
     };
-    VkDescriptorPoolCreateInfo dpi = {
-        .sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO,
-        .maxSets = 1,
-        .poolSizeCount = s->raycast ? 3 : s->far_ok ? 2 : 1,
-        .pPoolSizes = sizes,
-    };
-    RT_VK(e, vkCreateDescriptorPool(d->dev, &dpi, NULL, &s->pool));
-    VkDescriptorSetAllocateInfo ai = {
-        .sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO,
-        .descriptorPool = s->pool,
-        .descriptorSetCount = 1,
-        .pSetLayouts = &s->set_layout,
-    };
-    RT_VK(e, vkAllocateDescriptorSets(d->dev, &ai, &s->set));
+    if (!rt_descriptor_sets(d, sizes, s->raycast ? 3 : s->far_ok ? 2 : 1, &s->set_layout, 1,
+                            &s->pool, &s->set, e))
+        return false;
     VkDescriptorBufferInfo bi[3] = {
         { s->info.buf, 0, VK_WHOLE_SIZE }, { s->tiles.buf, 0, VK_WHOLE_SIZE },
         { s->args.buf, 0, VK_WHOLE_SIZE },

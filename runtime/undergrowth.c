@@ -477,19 +477,11 @@ static bool make_sets(rt_ug *u, VkDescriptorSet set0_src, const rt_image *height
         { VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 16 },
         { VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 2 },
     };
-    VkDescriptorPoolCreateInfo pci = {
-        .sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO,
-        .maxSets = 5, .poolSizeCount = 3, .pPoolSizes = sizes,
-    };
-    RT_VK(e, vkCreateDescriptorPool(d->dev, &pci, NULL, &u->dpool));
     VkDescriptorSetLayout layouts[5] = { u->set_terrain, u->set_mask, u->set_gen, u->set_draw,
                                          u->set_lod };
     VkDescriptorSet sets[5];
-    VkDescriptorSetAllocateInfo ai = {
-        .sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO,
-        .descriptorPool = u->dpool, .descriptorSetCount = 5, .pSetLayouts = layouts,
-    };
-    RT_VK(e, vkAllocateDescriptorSets(d->dev, &ai, sets));
+    if (!rt_descriptor_sets(d, sizes, 3, layouts, 5, &u->dpool, sets, e))
+        return false;
     u->set0 = sets[0];
     u->mask_set = sets[1];
     u->gen_set = sets[2];

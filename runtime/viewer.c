@@ -514,16 +514,8 @@ static bool make_tonemap(viewer *v, rt_error *e)
     };
     RT_VK(e, vkCreateSampler(d->dev, &si, NULL, &v->sampler));
     VkDescriptorPoolSize ps = { VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1 };
-    VkDescriptorPoolCreateInfo pci = {
-        .sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO, .maxSets = 1,
-        .poolSizeCount = 1, .pPoolSizes = &ps,
-    };
-    RT_VK(e, vkCreateDescriptorPool(d->dev, &pci, NULL, &v->dpool));
-    VkDescriptorSetAllocateInfo ai = {
-        .sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO,
-        .descriptorPool = v->dpool, .descriptorSetCount = 1, .pSetLayouts = &v->set_layout,
-    };
-    RT_VK(e, vkAllocateDescriptorSets(d->dev, &ai, &v->set));
+    if (!rt_descriptor_sets(d, &ps, 1, &v->set_layout, 1, &v->dpool, &v->set, e))
+        return false;
     VkDescriptorImageInfo ii = { v->sampler, rt_renderer_target(v->r)->view,
                                  VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL };
     VkWriteDescriptorSet w = {
