@@ -21,11 +21,9 @@
 #include "util.h"   /* splat_now */
 
 #include <math.h>
-#include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
-#include <unistd.h>
 
 #define BAND_BYTES ((VkDeviceSize)32 << 20)
 #define POINT_FLOATS 8
@@ -70,38 +68,17 @@ static bool bake_pipeline(far_baker *fb, int combo, VkPipeline *out, rt_error *e
     return true;
 }
 
-/* Every combination the leaf cells name, compiled on all cores first
- * (glslang, validation and the driver's compiler per combination: most
- * of a bake's time; vkCreateComputePipelines and the pipeline cache are
- * free-threaded). */
+/* One job of compile_all: the k-th combination the leaf cells name. */
 typedef struct compile_jobs {
-    far_baker      *fb;
-    const int      *combos;
-    int             n, next;
-    pthread_mutex_t lock;
-    rt_error        e;     /* the first failure */
+    far_baker *fb;
+    const int *combos;
 } compile_jobs;
 
-static void *compile_worker(void *arg)
+static bool compile_one(void *ctx, int k, rt_error *e)
 {
-    compile_jobs *j = arg;
-    for (;;) {
-        pthread_mutex_lock(&j->lock);
-        int k = j->e.id == RT_OK && j->next < j->n ? j->next++ : -1;
-        pthread_mutex_unlock(&j->lock);
-        if (k < 0)
-            return NULL;
-        rt_error e = {0};
-        VkPipeline pipe;
-        if (!bake_pipeline(j->fb, j->combos[k], &pipe, &e)) {
-            pthread_mutex_lock(&j->lock);
-            if (j->e.id == RT_OK)
-                j->e = e;
-            else
-                rt_error_clear(&e);
-            pthread_mutex_unlock(&j->lock);
-        }
-    }
+    compile_jobs *j = ctx;
+    VkPipeline pipe;
+    return bake_pipeline(j->fb, j->combos[k], &pipe, e);
 }
 
 /* The combinations the leaf cells name, each once (*n of them), or NULL
@@ -133,25 +110,13 @@ static bool compile_all(far_baker *fb, int *ncombos, rt_error *e)
     int *combos = named_combos(fb->p, &n);
     if (!combos)
         return rt_fail(e, RT_E_VULKAN, "far atlas bake", "out of memory");
-    compile_jobs j = { .fb = fb, .combos = combos, .n = n };
+    compile_jobs j = { .fb = fb, .combos = combos };
     *ncombos = n;
-    pthread_mutex_init(&j.lock, NULL);
-    long cores = sysconf(_SC_NPROCESSORS_ONLN);
-    int nth = cores > 1 ? (cores < 16 ? (int)cores : 16) : 1;
-    pthread_t th[16];
-    int started = 0;
-    for (int i = 1; i < nth; i++)
-        if (pthread_create(&th[started], NULL, compile_worker, &j) == 0)
-            started++;
-    compile_worker(&j);
-    for (int i = 0; i < started; i++)
-        pthread_join(th[i], NULL);
-    pthread_mutex_destroy(&j.lock);
+    /* most of a bake's time: glslang, validation and the driver's compiler
+     * per combination, on all cores (jobs.c) */
+    bool ok = rt_parallel(n, compile_one, &j, e);
     free(combos);
-    if (j.e.id == RT_OK)
-        return true;
-    *e = j.e;
-    return false;
+    return ok;
 }
 
 static bool make_baker(far_baker *fb, VkDescriptorSet set0_src, const splat_frame *frame,

@@ -11,6 +11,9 @@
 #include <string.h>
 #include <sys/stat.h>
 
+#include "cache.h"
+#include "spv.h"
+
 /* The resolve pass of the multi-pass reference: a fullscreen triangle that
  * reads the three blended targets and applies the same lighting as the
  * single-pass shaders (splat_finish), so both give the same image. */
@@ -522,6 +525,36 @@ bool rt_pipelines_has_compute(const rt_pipelines *pl, int id, unsigned variant)
            pl->compute[(size_t)id * RT_CVARIANTS + (variant % RT_CVARIANTS)] != VK_NULL_HANDLE;
 }
 
+/* The SPIR-V of a compute variant's GLSL `text`: from the SPIR-V cache
+ * (cache.h) when the compiler (splatc build --compute-spirv) or an earlier
+ * run compiled it, else glslang and spirv-val, stored for the next run.
+ * The cache holds only validated modules, each under a checksum; the
+ * runtime's own entries have a key of their own (stage RT_STAGE_COMPUTE),
+ * so a build never takes a module the runtime compiled. */
+#define RT_STAGE_COMPUTE (16 + SPV_STAGE_COMPUTE)
+
+static bool compute_spirv(rt_pipelines *pl, const char *text, const char *name,
+                          uint32_t **words, size_t *n, rt_error *e)
+{
+    char built[SPLAT_KEY_CHARS + 1], own[SPLAT_KEY_CHARS + 1];
+    splat_shader_key(text, SPV_STAGE_COMPUTE, built);
+    splat_shader_key(text, RT_STAGE_COMPUTE, own);
+    if (splat_cache_get(&pl->spv_cache, built, words, n) ||
+        splat_cache_get(&pl->spv_cache, own, words, n)) {
+        atomic_fetch_add(&pl->spirv_cached, 1);
+        return true;
+    }
+    if (!rt_glsl_compile(text, VK_SHADER_STAGE_COMPUTE_BIT, name, words, n, e) ||
+        !rt_spirv_validate(*words, *n, name, e)) {
+        free(*words);
+        *words = NULL;
+        return false;
+    }
+    atomic_fetch_add(&pl->spirv_compiled, 1);
+    splat_cache_put(&pl->spv_cache, own, *words, *n);   /* failure: only slower next time */
+    return true;
+}
+
 bool rt_pipelines_compute(rt_device *d, const rt_pack *p, rt_pipelines *pl, int id,
                           unsigned variant, VkPipeline *out, rt_error *e)
 {
@@ -557,8 +590,7 @@ bool rt_pipelines_compute(rt_device *d, const rt_pack *p, rt_pipelines *pl, int 
     size_t n = 0;
     rt_interface in;
     bool have_in = false;
-    bool ok = rt_glsl_compile(src ? src : glsl, VK_SHADER_STAGE_COMPUTE_BIT, name, &words, &n, e) &&
-              rt_spirv_validate(words, n, name, e);
+    bool ok = compute_spirv(pl, src ? src : glsl, name, &words, &n, e);
     free(src);
     if (ok) {
         have_in = rt_interface_for(p, RT_ROLE_COMPUTE, &in);
@@ -663,6 +695,7 @@ bool rt_pipelines_create(rt_device *d, const rt_pack *p, const rt_passes *rp,
                          int ntextures, rt_pipelines *pl, rt_error *e)
 {
     memset(pl, 0, sizeof *pl);
+    splat_cache_open(&pl->spv_cache, NULL);   /* disabled when it cannot be made */
     if (!make_layouts(d, ntextures, pl, e) || !open_cache(d, pl, cache_path, e) ||
         !make_module(d, p->vertex.words, p->vertex.nwords, &pl->vertex, e))
         return false;
@@ -691,6 +724,7 @@ bool rt_pipelines_create(rt_device *d, const rt_pack *p, const rt_passes *rp,
 
 void rt_pipelines_destroy(rt_device *d, rt_pipelines *pl)
 {
+    splat_cache_close(&pl->spv_cache);
     if (!d->dev)
         return;
     if (pl->cache) {

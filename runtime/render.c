@@ -1332,14 +1332,20 @@ bool rt_renderer_frame(rt_renderer *r, const rt_camera *c, rt_frame_stats *st, r
     double shadow_ms;
     if (!update_shadow(r, &shadow_ms, e))
         return false;
+    double compile_ms = 0;
     for (int redraws = 0;; redraws++) {
         if (!draw_frame(r, c, st, e))
             return false;
         st->redraws = redraws;
         st->shadow_ms = shadow_ms;
+        st->compile_ms = compile_ms;
+        st->spirv_cached = atomic_load(&r->pl.spirv_cached);
+        st->spirv_compiled = atomic_load(&r->pl.spirv_compiled);
         if (!st->screen)
             return true;
+        double t0 = splat_now();
         int made = rt_screen_missing(r->screen, &r->pl, compute_variant(r), e);
+        compile_ms += 1e3 * (splat_now() - t0);
         if (made < 0)
             return false;
         if (made == 0)

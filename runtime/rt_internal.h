@@ -11,6 +11,9 @@
 #define SPLAT_RT_INTERNAL_H
 
 #include "splatrt.h"
+#include "cache.h"
+
+#include <stdatomic.h>
 
 /* ---- errors (device.c) ------------------------------------------------- */
 
@@ -93,6 +96,16 @@ bool rt_glsl_module(rt_device *d, const char *glsl, VkShaderStageFlagBits stage,
 bool rt_glsl_compute_pipeline(rt_device *d, VkPipelineCache cache, VkPipelineLayout layout,
                               const char *glsl, const char *name,
                               const struct rt_interface *check, VkPipeline *out, rt_error *e);
+
+/* ---- jobs.c: independent jobs on every core ------------------------- */
+
+/* Job k of n; false with *e set stops the jobs not yet started. */
+typedef bool (*rt_job_fn)(void *ctx, int k, rt_error *e);
+/* Run fn for k = 0..n-1 on min(cores, 16, n) threads, the caller's among
+ * them; false with the first failure in *e. */
+bool rt_parallel(int n, rt_job_fn fn, void *ctx, rt_error *e);
+/* The threads rt_parallel would use for n jobs. */
+int  rt_job_threads(int n);
 
 /* The pack's GLSL with `defs` (lines of #define) after its #version line
  * (abi.h: the counting, sorted and bake variants are never stored);
@@ -367,6 +380,9 @@ typedef struct rt_pipelines {
     VkPipeline           *compute;       /* RT_CVARIANTS per combination, the
                                             über-shader's last              */
     VkPipeline            depth[2];      /* geometry pass, [RT_VARIANT_CULL] */
+    splat_cache           spv_cache;     /* compute variants' SPIR-V (cache.h) */
+    atomic_int            spirv_cached;  /* compute modules found there      */
+    atomic_int            spirv_compiled;/* ... and compiled with glslang    */
 } rt_pipelines;
 
 /* Variants of a compute shading pipeline (screen-space path), as bits. */

@@ -1089,19 +1089,37 @@ bool rt_screen_dispatch(rt_screen *s, VkCommandBuffer cb, rt_pipelines *pl,
     return true;
 }
 
+/* One job of rt_screen_missing: the pipeline of list lists[k]. */
+typedef struct missing_jobs {
+    rt_screen    *s;
+    rt_pipelines *pl;
+    unsigned      variant;
+    const int    *lists;
+} missing_jobs;
+
+static bool make_missing(void *ctx, int k, rt_error *e)
+{
+    missing_jobs *j = ctx;
+    VkPipeline pipe;
+    return rt_pipelines_compute(j->s->d, j->s->p, j->pl, j->lists[k], j->variant, &pipe, e);
+}
+
 int rt_screen_missing(rt_screen *s, rt_pipelines *pl, unsigned variant, rt_error *e)
 {
     const uint32_t *args = s->readback.map;
-    int made = 0;
-    for (int k = 0; k < s->nlists; k++) {
-        if (args[3 * k] == 0 || s->dispatched[k] == variant + 1 || k > s->p->ncombos)
-            continue;
-        VkPipeline pipe;
-        if (!rt_pipelines_compute(s->d, s->p, pl, k, variant, &pipe, e))
-            return -1;
-        made++;
+    int *lists = malloc((size_t)s->nlists * sizeof *lists), made = 0;
+    if (!lists) {
+        rt_fail(e, RT_E_VULKAN, "screen-space shading", "out of memory");
+        return -1;
     }
-    return made;
+    for (int k = 0; k < s->nlists; k++)
+        if (args[3 * k] != 0 && s->dispatched[k] != variant + 1 && k <= s->p->ncombos)
+            lists[made++] = k;
+    /* each list's slot is its own: compiled on all cores (jobs.c) */
+    missing_jobs j = { s, pl, variant, lists };
+    bool ok = rt_parallel(made, make_missing, &j, e);
+    free(lists);
+    return ok ? made : -1;
 }
 
 void rt_screen_far(rt_screen *s, double distance)

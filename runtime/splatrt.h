@@ -445,6 +445,9 @@ typedef struct rt_frame_stats {
     bool   sorted;            /* its pixels sorted by layer set (rt_pixel_sort) */
     rt_screen_stats tiles;    /* its tiles (screen only) and counters        */
     int    redraws;           /* frames drawn again after compiling pipelines */
+    double compile_ms;        /* wall ms of this call making those pipelines */
+    int    spirv_cached;      /* compute modules so far from the SPIR-V cache */
+    int    spirv_compiled;    /* ... and compiled from GLSL (glslang)        */
     double shadow_ms;         /* CPU ms of a new shadow map (the sun moved or
                                  a crater changed heights); 0: none needed  */
     rt_ug_stats undergrowth;  /* cells, instances, generation and draw     */

@@ -598,6 +598,7 @@ static int headless(const opts *o)
     double shadow_ms = 0;   /* the first frame makes the shadow map */
     double ug_gen_ms = 0;   /* and generates the undergrowth's cells */
     int ug_generated = 0;
+    double compile_ms = 0;
     /* the cost view needs the counting variant's counters */
     rt_renderer_set_counting(r, view == SPLAT_VIEW_COST);
     for (int f = 0; f < o->frames; f++) {
@@ -605,6 +606,7 @@ static int headless(const opts *o)
             goto done;
         gpu[f] = st.gpu_ms;
         shadow_ms += st.shadow_ms;
+        compile_ms += st.compile_ms;
         sel[f] = st.select_ms;
         cpu[f] = st.cpu_ms;
         for (int k = 0; k < 3; k++)
@@ -640,6 +642,10 @@ static int headless(const opts *o)
         printf("patches drawn: %d  culled: %d\n", st.patches, st.culled);
         printf("back faces culled: %s\n", st.backfaces_culled ? "yes" : "no");
         printf("pipelines bound: %d\n", st.pipelines);
+        if (st.screen)
+            printf("compute modules: %d from the SPIR-V cache, %d compiled from GLSL; "
+                   "%.1f ms making pipelines between frames\n", st.spirv_cached,
+                   st.spirv_compiled, compile_ms);
         printf("combinations in view: %d of %d\n", st.combos_in_view, pack.ncombos);
         if (!st.screen) {
             printf("distance classes: %d of %d patches\n", st.class_patches, st.patches);

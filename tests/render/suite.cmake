@@ -112,6 +112,12 @@ if(TARGET splatrt AND TARGET splatview)
         set_property(TEST render.screen_${pk} APPEND PROPERTY LABELS asan)
       endif()
     endforeach()
+    # the SPIR-V and pipeline caches across runs (spirv_cache.sh)
+    add_test(NAME render.spirv_cache
+      COMMAND sh ${RENDER_DIR}/spirv_cache.sh $<TARGET_FILE:splatview> ${RENDER_OUT}/minimal
+              ${RENDER_OUT}/out)
+    set_tests_properties(render.spirv_cache PROPERTIES LABELS "render;asan" TIMEOUT 300
+      FIXTURES_REQUIRED minimal_pack)
     # SPLAT_VALIDATE=1 without the validation layer: a loud failure
     add_test(NAME render.no_validation_layer
       COMMAND sh ${RENDER_DIR}/no_layer.sh $<TARGET_FILE:splatview> ${RENDER_OUT}/minimal
