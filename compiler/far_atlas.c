@@ -34,7 +34,7 @@
  *
  * Then a box-filtered mip chain (normals renormalised) and BC1 (sRGB) /
  * BC5 / BC4 blocks by stb_dxt.  Cost: proportional to texels x 4 points
- * (tests/bench/RESULTS.md "Shading LOD: far atlas" has colorado's).
+ * (tests/bench/HISTORY.md "Shading LOD: far atlas" has colorado's).
  *
  * Not baked: craters (the runtime never uses the atlas over the
  * destructible area: runtime/DESIGN.md) and param edits (a rebuild). */

@@ -315,7 +315,7 @@ static bool fail_msg(rt_error *e, char *msg, size_t nmsg, const char *what)
 /* Auto on a CPU's device (lavapipe): llvmpipe JIT-compiles each
  * combination on its first dispatch (about 0.22 s cold on the project's
  * VM), then shades a texel in about 1.7 us against the CPU reference's
- * 23 us (tests/bench/RESULTS.md "The far atlas baked on the device"):
+ * 23 us (tests/bench/HISTORY.md "The far atlas baked on the device"):
  * the device pays from about CPU_DEVICE_TEXELS texels per combination.
  * Both costs scale with the same cores, so the ratio travels. */
 #define CPU_DEVICE_TEXELS 10000.0

@@ -351,7 +351,7 @@ typedef enum rt_screen_depth {
  * Off by default: sorting raises the layers' SIMD efficiency (colorado
  * top-down on an H100: 56 -> 84 %) but its first, masks-only run costs
  * more than the surfaces it saves there and on lavapipe
- * (tests/bench/RESULTS.md "Pixels sorted by layer set"). */
+ * (tests/bench/HISTORY.md "Pixels sorted by layer set"). */
 typedef enum rt_pixel_sort {
     RT_SORT_OFF = 0,     /* each workgroup shades one tile in pixel order  */
     RT_SORT_ON,          /* sort_tiles tiles per workgroup, pixels sorted by

@@ -7,7 +7,7 @@
 # Vulkan loader, SPIRV-Cross), under DEST/lib, and the example packs
 # under DEST/packs (built here; run from the repository root).  DEST should be an ignored folder of the
 # repository (build-h100/ is, through /build*/) so it can be carried.
-# On the device, from the repository root (see tests/bench/RESULTS.md):
+# On the device, from the repository root (see tests/bench/HISTORY.md, "NVIDIA GPU through the device tool"):
 #   export LD_LIBRARY_PATH=$PWD/DEST/lib:$LD_LIBRARY_PATH
 #   export VK_DRIVER_FILES=/usr/local/nvidia/share/vulkan/icd.d/nvidia_icd.json
 #   sh tests/bench/run.sh DEST --quick --out $OUT/bench

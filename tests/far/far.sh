@@ -40,7 +40,7 @@
 #             magic, levels over the chain, a manifest width that does not
 #             match the file, a symbolic link: each refused with an error
 #             naming far_atlas
-# Prints the bands as a table (the RESULTS.md rows come from it).
+# Prints the bands as a table (the tests/bench/HISTORY.md rows come from it).
 set -eu
 CASE=$1 SPLATC=$2 VIEW=$3 BENCH=$4 SRC=$5 OUT=$6
 PACK=${FAR_PACK:-$OUT/colorado_far}   # FAR_PACK: measure another pack

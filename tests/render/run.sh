@@ -9,7 +9,7 @@
 #   composite vs multi-pass 1e-5: both render into RGBA32F and compute the
 #     same sums in another order and another pass (blending of fp32 values
 #     in the multi-pass case); they agree to 2.4e-7 on lavapipe and 3.6e-7
-#     on an H200 (tests/bench/RESULTS.md).  1e-5 is ~40 fp32 ulps of 1.0:
+#     on an H200 (tests/bench/HISTORY.md).  1e-5 is ~40 fp32 ulps of 1.0:
 #     a compositor error of even 1/255 on one pixel fails.  No driver tested
 #     needs more; one that does gets 1e-4 here, named, with its measurement.
 #     Under the GGX sun (view dependent: a highlight's slope turns those
