@@ -457,6 +457,12 @@ bool rt_pipelines_glsl_fragment(rt_device *d, rt_pipelines *pl, const rt_passes 
            fragment_pipeline(d, pl, rp, layout, glsl, name, NULL, variant, out, e);
 }
 
+bool rt_pipelines_has_combo(const rt_pipelines *pl, int id, unsigned variant)
+{
+    return pl->combo && id >= 0 && id < pl->ncombos &&
+           pl->combo[(size_t)id * RT_VARIANTS + (variant % RT_VARIANTS)] != VK_NULL_HANDLE;
+}
+
 bool rt_pipelines_combo(rt_device *d, const rt_pack *p, const rt_passes *rp,
                         rt_pipelines *pl, int id, unsigned variant, VkPipeline *out,
                         rt_error *e)

@@ -1119,6 +1119,40 @@ static void count_end(rt_renderer *r, VkCommandBuffer cb)
                    VK_PIPELINE_STAGE_HOST_BIT, VK_ACCESS_HOST_READ_BIT);
 }
 
+/* One job of make_forward_pipelines: the composite of combination ids[k]. */
+typedef struct combo_jobs {
+    rt_renderer *r;
+    unsigned     variant;
+    const int   *ids;
+} combo_jobs;
+
+static bool make_combo(void *ctx, int k, rt_error *e)
+{
+    combo_jobs *j = ctx;
+    VkPipeline pipe;
+    return rt_pipelines_combo(j->r->d, j->r->p, &j->r->rp, &j->r->pl, j->ids[k], j->variant,
+                              &pipe, e);
+}
+
+/* The composites this frame draws that are not made yet, made first on all
+ * cores (jobs.c; each has its own slot), so a cold view pays glslang and
+ * the driver's compiler in parallel rather than one after the other. */
+static bool make_forward_pipelines(rt_renderer *r, unsigned variant, rt_error *e)
+{
+    int *ids = malloc(((size_t)r->ncombos + 1) * sizeof *ids), n = 0, start = 0;
+    if (!ids)
+        return rt_fail(e, RT_E_VULKAN, "forward path", "out of memory");
+    for (int k = 0; k < r->ncombos; k++) {
+        if (r->counts[k] > start && !rt_pipelines_has_combo(&r->pl, k, variant))
+            ids[n++] = k;
+        start = r->counts[k];
+    }
+    combo_jobs j = { r, variant, ids };
+    bool ok = rt_parallel(n, make_combo, &j, e);
+    free(ids);
+    return ok;
+}
+
 /* The forward path: each group of patches with its composite (or every
  * patch with the über-shader: --reference uber, and the MASK view, which
  * composites do not carry: compiler/build_jobs.c). */
@@ -1135,11 +1169,14 @@ static bool record_forward(rt_renderer *r, VkCommandBuffer cb, const rt_camera *
         .renderPass = r->rp.main, .framebuffer = r->fb_main,
         .renderArea = *area, .clearValueCount = 2, .pClearValues = clears,
     };
+    bool composites = r->desc.reference != RT_REF_UBER && r->view != SPLAT_VIEW_MASK;
+    if (composites && !make_forward_pipelines(r, variant, e))
+        return abandon_frame(cb);
     if (variant & RT_VARIANT_COUNT)
         count_begin(r, cb);
     begin_terrain_pass(r, cb, &rb, vp, sets);
     int n = r->qt.npatches;
-    if (r->desc.reference == RT_REF_UBER || r->view == SPLAT_VIEW_MASK) {
+    if (!composites) {
         if (n > 0) {
             VkPipeline pipe;
             if (!rt_pipelines_uber(r->d, r->p, &r->rp, &r->pl, variant, &pipe, e))

@@ -415,6 +415,8 @@ bool rt_pipelines_create(rt_device *d, const rt_pack *p, const rt_passes *rp,
 bool rt_pipelines_glsl_fragment(rt_device *d, rt_pipelines *pl, const rt_passes *rp,
                                 VkPipelineLayout layout, const char *glsl, const char *name,
                                 unsigned variant, VkPipeline *out, rt_error *e);
+/* Whether combination id's pipeline of `variant` is made already. */
+bool rt_pipelines_has_combo(const rt_pipelines *pl, int id, unsigned variant);
 bool rt_pipelines_combo(rt_device *d, const rt_pack *p, const rt_passes *rp,
                         rt_pipelines *pl, int id, unsigned variant, VkPipeline *out,
                         rt_error *e);
