@@ -525,10 +525,10 @@ bool rt_pipelines_ref(rt_device *d, const rt_pack *p, const rt_passes *rp,
 
 /* ---- compute shading (screen-space path) --------------------------------- */
 
-bool rt_pipelines_has_compute(const rt_pipelines *pl, int id, unsigned variant)
+bool rt_pipelines_has_compute(rt_pipelines *pl, int id, unsigned variant)
 {
     return pl->compute && id >= 0 && id <= pl->ncombos &&
-           pl->compute[(size_t)id * RT_CVARIANTS + (variant % RT_CVARIANTS)] != VK_NULL_HANDLE;
+           rt_async_slot(pl, (size_t)id * RT_CVARIANTS + (variant % RT_CVARIANTS)) != VK_NULL_HANDLE;
 }
 
 /* The SPIR-V of a compute variant's GLSL `text`: from the SPIR-V cache
@@ -566,11 +566,20 @@ bool rt_pipelines_compute(rt_device *d, const rt_pack *p, rt_pipelines *pl, int 
 {
     if (id < 0 || id > pl->ncombos)
         return rt_fail(e, RT_E_PACK_FIELD, p->dir, "compute pipeline of an unknown combination");
-    VkPipeline *slot = &pl->compute[(size_t)id * RT_CVARIANTS + (variant % RT_CVARIANTS)];
-    if (*slot) {
-        *out = *slot;
+    size_t slot = (size_t)id * RT_CVARIANTS + (variant % RT_CVARIANTS);
+    if ((*out = rt_async_slot(pl, slot)))
         return true;
-    }
+    VkPipeline pipe;
+    if (!rt_pipelines_compute_make(d, p, pl, id, variant, &pipe, e))
+        return false;
+    *out = rt_async_publish(d, pl, slot, pipe);
+    return true;
+}
+
+bool rt_pipelines_compute_make(rt_device *d, const rt_pack *p, rt_pipelines *pl, int id,
+                               unsigned variant, VkPipeline *out, rt_error *e)
+{
+    *out = VK_NULL_HANDLE;
     const char *glsl = id < p->ncombos ? p->combos[id].compute : p->uber_compute;
     char name[64];
     if (id < p->ncombos)
@@ -617,7 +626,7 @@ bool rt_pipelines_compute(rt_device *d, const rt_pack *p, rt_pipelines *pl, int 
                        .pSpecializationInfo = (variant & RT_CVARIANT_DEBUG) ? NULL : &spec },
             .layout = pl->compute_layout,
         };
-        VkResult r = vkCreateComputePipelines(d->dev, pl->cache, 1, &ci, NULL, slot);
+        VkResult r = vkCreateComputePipelines(d->dev, pl->cache, 1, &ci, NULL, out);
         if (r != VK_SUCCESS)
             ok = rt_fail(e, RT_E_VULKAN, "vkCreateComputePipelines", rt_vk_result_name(r));
         vkDestroyShaderModule(d->dev, m, NULL);
@@ -625,8 +634,6 @@ bool rt_pipelines_compute(rt_device *d, const rt_pack *p, rt_pipelines *pl, int 
         ok = false;
     }
     free(words);
-    if (ok)
-        *out = *slot;
     return ok;
 }
 
@@ -643,6 +650,7 @@ bool rt_pipelines_depth(rt_device *d, rt_pipelines *pl, VkRenderPass pass, bool 
 
 static void destroy_combos(rt_device *d, rt_pipelines *pl)
 {
+    rt_async_stop(pl);   /* no worker writes a slot from here on */
     for (size_t i = 0; pl->combo && i < (size_t)pl->ncombos * RT_VARIANTS; i++)
         if (pl->combo[i])
             vkDestroyPipeline(d->dev, pl->combo[i], NULL);
@@ -730,6 +738,7 @@ bool rt_pipelines_create(rt_device *d, const rt_pack *p, const rt_passes *rp,
 
 void rt_pipelines_destroy(rt_device *d, rt_pipelines *pl)
 {
+    rt_async_stop(pl);   /* the workers use the pipeline cache */
     splat_cache_close(&pl->spv_cache);
     if (!d->dev)
         return;

@@ -518,6 +518,10 @@ bool rt_renderer_create(rt_device *d, const rt_pack *p, const rt_render_desc *de
         rt_renderer_destroy(r);
         return false;
     }
+    if (r->screen && r->desc.async_pipelines && !rt_async_start(d, p, &r->pl, e)) {
+        rt_renderer_destroy(r);
+        return false;
+    }
     if (r->screen) {
         rt_screen_far(r->screen, r->desc.far_atlas_distance);
         r->pl.sort_tiles = rt_screen_sort_tiles(r->screen);
@@ -973,7 +977,7 @@ static bool record_screen(rt_renderer *r, VkCommandBuffer cb, const rt_camera *c
     if (r->timestamps)
         vkCmdWriteTimestamp(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, r->qpool, 2);
     VkDescriptorSet csets[2] = { r->set0c, r->set1 };
-    if (!rt_screen_dispatch(r->screen, cb, &r->pl, csets, cv, binds, e)) {
+    if (!rt_screen_dispatch(r->screen, cb, &r->pl, csets, cv, r->pl.async != NULL, binds, e)) {
         vkEndCommandBuffer(cb);
         return false;
     }
@@ -1378,11 +1382,14 @@ bool rt_renderer_frame(rt_renderer *r, const rt_camera *c, rt_frame_stats *st, r
         st->compile_ms = compile_ms;
         st->spirv_cached = atomic_load(&r->pl.spirv_cached);
         st->spirv_compiled = atomic_load(&r->pl.spirv_compiled);
+        if (rt_async_failed(&r->pl, e))
+            return false;
         if (!st->screen)
             return true;
         double t0 = splat_now();
         int made = rt_screen_missing(r->screen, &r->pl, compute_variant(r), e);
         compile_ms += 1e3 * (splat_now() - t0);
+        st->pipelines_pending = rt_async_pending(&r->pl);
         if (made < 0)
             return false;
         if (made == 0)
@@ -1500,7 +1507,10 @@ bool rt_renderer_swap_pack(rt_renderer *r, const rt_pack *p, rt_error *e)
     if (!counts)
         return rt_fail(e, RT_E_RELOAD, "out of memory");
     vkDeviceWaitIdle(r->d->dev);
-    if (!rt_pipelines_reset_combos(r->d, p, &r->pl, e)) {
+    /* the workers stop with the old pack's pipelines; new ones for the new */
+    bool async = r->pl.async != NULL;
+    if (!rt_pipelines_reset_combos(r->d, p, &r->pl, e) ||
+        (async && !rt_async_start(r->d, p, &r->pl, e))) {
         free(counts);
         return false;
     }

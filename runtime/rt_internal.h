@@ -381,6 +381,7 @@ typedef struct rt_pipelines {
                                             über-shader's last              */
     VkPipeline            depth[2];      /* geometry pass, [RT_VARIANT_CULL] */
     splat_cache           spv_cache;     /* compute variants' SPIR-V (cache.h) */
+    struct rt_async      *async;         /* workers (async_compile.c) or NULL */
     atomic_int            spirv_cached;  /* compute modules found there      */
     atomic_int            spirv_compiled;/* ... and compiled with glslang    */
 } rt_pipelines;
@@ -429,6 +430,28 @@ bool rt_pipelines_uber(rt_device *d, const rt_pack *p, const rt_passes *rp,
 bool rt_pipelines_ref(rt_device *d, const rt_pack *p, const rt_passes *rp,
                       rt_pipelines *pl, int m, bool cull, VkPipeline *out,
                       rt_error *e);
+/* rt_pipelines_compute's pipeline (below) made and returned in *out, its
+ * slot left alone: for the workers of async_compile.c. */
+bool rt_pipelines_compute_make(rt_device *d, const rt_pack *p, rt_pipelines *pl, int id,
+                               unsigned variant, VkPipeline *out, rt_error *e);
+
+/* ---- async_compile.c: compute pipelines made on worker threads -------- */
+
+/* Workers for pl (pl->async); rt_async_stop joins them (destroy_combos
+ * does, before a pack swap or the end) and drops what is still queued. */
+bool       rt_async_start(rt_device *d, const rt_pack *p, rt_pipelines *pl, rt_error *e);
+void       rt_async_stop(rt_pipelines *pl);
+/* Queue combination id's pipeline of `variant` unless made or queued. */
+void       rt_async_request(rt_pipelines *pl, int id, unsigned variant);
+/* Queued or being made. */
+int        rt_async_pending(rt_pipelines *pl);
+/* A worker's failure, handed over once (true, *e set). */
+bool       rt_async_failed(rt_pipelines *pl, rt_error *e);
+/* A compute slot read, and one filled (a pipeline made twice is destroyed;
+ * returns what the slot holds), under the workers' lock while they run. */
+VkPipeline rt_async_slot(rt_pipelines *pl, size_t slot);
+VkPipeline rt_async_publish(rt_device *d, rt_pipelines *pl, size_t slot, VkPipeline pipe);
+
 /* The compute shading pipeline of combination `id` (p->ncombos: the
  * über-shader) in `variant` (RT_CVARIANT_* bits), compiled from the pack's
  * compute GLSL on first use (PACK.md): glslang, spirv-val, the interface
@@ -440,7 +463,7 @@ bool rt_pipelines_compute(rt_device *d, const rt_pack *p, rt_pipelines *pl, int 
 bool rt_pipelines_depth(rt_device *d, rt_pipelines *pl, VkRenderPass pass, bool cull,
                         VkPipeline *out, rt_error *e);
 /* Whether that pipeline exists already. */
-bool rt_pipelines_has_compute(const rt_pipelines *pl, int id, unsigned variant);
+bool rt_pipelines_has_compute(rt_pipelines *pl, int id, unsigned variant);
 /* Drop every combination pipeline (hot reload: the next frames make those
  * of the new pack); the array is resized to p->ncombos. */
 bool rt_pipelines_reset_combos(rt_device *d, const rt_pack *p, rt_pipelines *pl,
@@ -493,11 +516,12 @@ void rt_screen_classify(rt_screen *s, VkCommandBuffer cb, VkDescriptorSet set0,
 /* Then one indirect dispatch per list whose pipeline in `variant`
  * (RT_CVARIANT_*) exists; the colour image ends in TRANSFER_SRC_OPTIMAL. */
 bool rt_screen_dispatch(rt_screen *s, VkCommandBuffer cb, rt_pipelines *pl,
-                        const VkDescriptorSet sets[2], unsigned variant, int *binds,
-                        rt_error *e);
+                        const VkDescriptorSet sets[2], unsigned variant, bool stand_in,
+                        int *binds, rt_error *e);
 /* After the frame completed: compiles the pipelines of lists that got
  * tiles but were not dispatched; returns how many (> 0: draw the frame
- * again), -1 on error. */
+ * again), -1 on error.  Lists the über-shader stood in for are queued on
+ * the workers instead (rt_async_request), not counted. */
 int rt_screen_missing(rt_screen *s, rt_pipelines *pl, unsigned variant, rt_error *e);
 void rt_screen_read_stats(const rt_screen *s, rt_screen_stats *st);
 /* The counting variant's splat_counters (abi.h, any alignment) into the

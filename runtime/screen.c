@@ -51,6 +51,9 @@ struct rt_screen {
      * readback (args and counters copied back after the frame) */
     rt_buffer             info, tiles, args, args_reset, counters, readback;
     unsigned             *dispatched;        /* per list: variant + 1 drawn  */
+    unsigned char        *stand_in;          /* per list: drawn by the über-
+                                                shader while its pipeline is
+                                                made (async_compile.c)      */
     VkImage               color_img;
     bool                  raycast;           /* depth by ray casting          */
     VkPipeline            raycaster;
@@ -757,8 +760,9 @@ bool rt_screen_create(rt_device *d, const rt_pack *p, const rt_pipelines *pl,
     if (s->words > MAX_WORDS)
         s->words = 0;   /* too many materials to classify: über-shader only */
     s->dispatched = calloc((size_t)s->nlists, sizeof *s->dispatched);
+    s->stand_in = calloc((size_t)s->nlists, 1);
     *out = s;
-    if (!s->dispatched)
+    if (!s->dispatched || !s->stand_in)
         return rt_fail(e, RT_E_VULKAN, "screen-space shading", "out of memory");
     VkDeviceSize list_bytes = (VkDeviceSize)s->nlists * (VkDeviceSize)s->stride * 4;
     if (list_bytes > d->props.limits.maxStorageBufferRange)
@@ -862,6 +866,7 @@ void rt_screen_destroy(rt_screen *s)
         rt_buffer_destroy(d, &s->readback);
     }
     free(s->dispatched);
+    free(s->stand_in);
     free(s);
 }
 
@@ -1027,24 +1032,28 @@ static void dispatch_list(rt_screen *s, VkCommandBuffer cb, VkPipelineLayout lay
 }
 
 bool rt_screen_dispatch(rt_screen *s, VkCommandBuffer cb, rt_pipelines *pl,
-                        const VkDescriptorSet sets[2], unsigned variant, int *binds,
-                        rt_error *e)
+                        const VkDescriptorSet sets[2], unsigned variant, bool stand_in,
+                        int *binds, rt_error *e)
 {
     rt_device *d = s->d;
     const rt_pack *p = s->p;
 
     /* one indirect dispatch per list whose pipeline exists (the others
-     * are found empty or compiled after the frame: rt_screen_missing) */
+     * are found empty or compiled after the frame: rt_screen_missing);
+     * with stand_in, the others by the über-shader's pipeline meanwhile */
     bool bound_sets = false;
     for (int k = 0; k < s->nlists; k++) {
         s->dispatched[k] = 0;
+        s->stand_in[k] = 0;
         if (k > p->ncombos)   /* the far list, below */
             continue;
-        if (!rt_pipelines_has_compute(pl, k, variant))
+        bool have = rt_pipelines_has_compute(pl, k, variant);
+        if (!have && !stand_in)
             continue;
         VkPipeline pipe;
-        if (!rt_pipelines_compute(d, p, pl, k, variant, &pipe, e))
+        if (!rt_pipelines_compute(d, p, pl, have ? k : p->ncombos, variant, &pipe, e))
             return false;
+        s->stand_in[k] = !have;
         if (!bound_sets) {
             vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, pl->compute_layout, 0, 2,
                                     sets, 0, NULL);
@@ -1112,9 +1121,14 @@ int rt_screen_missing(rt_screen *s, rt_pipelines *pl, unsigned variant, rt_error
         rt_fail(e, RT_E_VULKAN, "screen-space shading", "out of memory");
         return -1;
     }
-    for (int k = 0; k < s->nlists; k++)
-        if (args[3 * k] != 0 && s->dispatched[k] != variant + 1 && k <= s->p->ncombos)
+    for (int k = 0; k < s->nlists && k <= s->p->ncombos; k++) {
+        if (args[3 * k] == 0)
+            continue;
+        if (s->stand_in[k])   /* drawn meanwhile: made on the workers */
+            rt_async_request(pl, k, variant);
+        else if (s->dispatched[k] != variant + 1)
             lists[made++] = k;
+    }
     /* each list's slot is its own: compiled on all cores (jobs.c) */
     missing_jobs j = { s, pl, variant, lists };
     bool ok = rt_parallel(made, make_missing, &j, e);
@@ -1137,6 +1151,8 @@ void rt_screen_read_stats(const rt_screen *s, rt_screen_stats *st)
     for (int k = 0; k < s->nlists; k++) {
         st->tiles += (int)args[3 * k];
         st->lists += args[3 * k] > 0;
+        if (s->stand_in[k])
+            st->tiles_stand_in += (int)args[3 * k];
         if (k >= s->p->nbase && k < s->p->ncombos)
             st->tiles_class += (int)args[3 * k];
     }

@@ -371,6 +371,9 @@ typedef struct rt_screen_stats {
     int      tiles_uber;          /* tiles no combination covered            */
     int      tiles_far;           /* tiles shaded from the far atlas         */
     int      tiles_class;         /* tiles shaded by a distance class        */
+    int      tiles_stand_in;      /* tiles the über-shader shaded while their
+                                     combination's pipeline was being made
+                                     (rt_render_desc.async_pipelines)       */
     int      lists;               /* combinations (and über) with tiles      */
     /* Counting frames (rt_renderer_set_counting, the cost view), both
      * paths; on the forward path "pixels" are the fragments shaded. */
@@ -400,6 +403,10 @@ typedef struct rt_render_desc {
     bool         no_distance_classes; /* shade with the combinations only, not
                                        their distance classes (PACK.md;
                                        splatview --no-distance-classes)     */
+    bool         async_pipelines;   /* screen path: compute pipelines made on
+                                       worker threads, the über-shader's
+                                       drawing their tiles meanwhile (the
+                                       viewer's default; headless waits)   */
     double       undergrowth_radius; /* m around the camera; 0: RT_UG_RADIUS    */
     double       far_atlas_distance; /* screen tiles, forward patches at least
                                     this far (m) are shaded from the pack's
@@ -448,6 +455,7 @@ typedef struct rt_frame_stats {
     double compile_ms;        /* wall ms of this call making those pipelines */
     int    spirv_cached;      /* compute modules so far from the SPIR-V cache */
     int    spirv_compiled;    /* ... and compiled from GLSL (glslang)        */
+    int    pipelines_pending; /* being made on workers after this frame     */
     double shadow_ms;         /* CPU ms of a new shadow map (the sun moved or
                                  a crater changed heights); 0: none needed  */
     rt_ug_stats undergrowth;  /* cells, instances, generation and draw     */

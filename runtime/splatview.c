@@ -53,6 +53,10 @@ static void usage(FILE *f)
         "  --fog-density D           fog per metre at the fog height (0: none)\n"
         "  --no-shadows              the sun casts no terrain shadows\n"
         "  --no-undergrowth          draw no undergrowth (grass, plants, stones)\n"
+        "  --async-pipelines on|off  screen path: make compute pipelines on worker\n"
+        "                            threads, the uber-shader drawing their tiles\n"
+        "                            meanwhile (default: on in the window, off\n"
+        "                            headless, which waits for every pipeline)\n"
         "  --no-distance-classes     shade with the combinations only, not their\n"
         "                            distance classes (compiler/PACK.md)\n"
         "  --light KEY=V[,V,V]       any key of the scene's light block (sun, sun_color,\n"
@@ -117,6 +121,7 @@ typedef struct opts {
     bool headless, stats, have_camera, have_look, no_stitch, no_cull, no_shadows;
     bool no_undergrowth;
     bool no_distance_classes;
+    int async_pipelines;   /* --async-pipelines: 1 on, 0 off, -1 default */
     int width, height, frames;
     double camera[3], look[3], lod_pixels;
     double far_distance;   /* --far-atlas-distance */
@@ -215,6 +220,7 @@ static int parse_args(int argc, char **argv, opts *o)
 {
     memset(o, 0, sizeof *o);
     o->frames = 1;
+    o->async_pipelines = -1;
     for (int i = 1; i < argc; i++) {
         const char *a = argv[i];
         const char *v = i + 1 < argc ? argv[i + 1] : NULL;
@@ -236,6 +242,13 @@ static int parse_args(int argc, char **argv, opts *o)
             o->no_undergrowth = true;
         } else if (!strcmp(a, "--no-distance-classes")) {
             o->no_distance_classes = true;
+        } else if (!strcmp(a, "--async-pipelines")) {
+            NEED();
+            if (strcmp(v, "on") && strcmp(v, "off")) {
+                fprintf(stderr, "splatview: --async-pipelines takes on or off, not '%s'\n", v);
+                return 2;
+            }
+            o->async_pipelines = !strcmp(v, "on");
         } else if (!strcmp(a, "-o")) {
             NEED(); o->out = v;
         } else if (!strcmp(a, "--float-out")) {
@@ -565,6 +578,7 @@ static int headless(const opts *o)
         .no_cull = o->no_cull, .lod_pixels = o->lod_pixels, .no_shadows = o->no_shadows,
         .no_undergrowth = o->no_undergrowth,
         .no_distance_classes = o->no_distance_classes,
+        .async_pipelines = o->async_pipelines == 1,
         .destruction_pool = o->destruction_pool, .shading = o->shading,
         .screen_depth = o->screen_depth, .pixel_sort = o->pixel_sort, .far_atlas_distance = o->far_distance,
     };
@@ -667,6 +681,8 @@ static int headless(const opts *o)
                    "atlas\n", st.tiles.tiles, st.tiles.tiles_total, st.tiles.lists,
                    st.tiles.tiles_uber, st.tiles.tiles_far);
             printf("distance classes: %d of %d tiles\n", st.tiles.tiles_class, st.tiles.tiles);
+            printf("pipelines pending: %d (tiles the uber-shader stood in for: %d)\n",
+                   st.pipelines_pending, st.tiles.tiles_stand_in);
         }
         printf("quadtree cpu ms/frame: median %.4f  p10 %.4f  p90 %.4f\n", sm, sl, sh);
         if (o->no_shadows)
@@ -810,7 +826,8 @@ int main(int argc, char **argv)
                     .shading = o.shading, .screen_depth = o.screen_depth, .pixel_sort = o.pixel_sort,
                     .no_shadows = o.no_shadows, .no_undergrowth = o.no_undergrowth,
                     .far_atlas_distance = o.far_distance,
-                    .no_distance_classes = o.no_distance_classes },
+                    .no_distance_classes = o.no_distance_classes,
+                    .async_pipelines = o.async_pipelines != 0 },
         .view = SPLAT_VIEW_FINAL,
     };
     memcpy(vd.render.clear, o.clear, sizeof o.clear);

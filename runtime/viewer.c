@@ -702,12 +702,14 @@ static bool frame(viewer *v, const char *shot, double *last, rt_error *e)
     static double shown;
     if (t - shown > 0.25) {
         shown = t;
-        char title[512];
+        char title[512], pending[48] = "";
+        if (st.pipelines_pending > 0)   /* their tiles on the über-shader meanwhile */
+            snprintf(pending, sizeof pending, " (%d shaders compiling)", st.pipelines_pending);
         snprintf(title, sizeof title,
-                 "splatview %s | %s%s | %s | %.1f ms/frame (gpu %.1f) | %d patches, %d pipelines | %s",
+                 "splatview %s | %s%s | %s | %.1f ms/frame (gpu %.1f) | %d patches, %d pipelines%s | %s",
                  v->pack->name, rt_view_name(v->view), v->wire ? " wire" : "",
                  st.screen ? "screen" : "forward", dt * 1e3,
-                 st.gpu_ms, st.patches, st.pipelines, v->status);
+                 st.gpu_ms, st.patches, st.pipelines, pending, v->status);
         glfwSetWindowTitle(v->win, title);
     }
     return true;

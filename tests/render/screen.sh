@@ -62,6 +62,18 @@ for cam in "$@"; do
         fail "$cam: classification changed the picture (composites vs über-shader)"
 done
 c="--camera-preset $1"
+# pipelines made on workers (--async-pipelines on): the first frame has
+# none but the über-shader's, which stands in for every list with tiles;
+# its picture is the final one within 1/255 (the soundness bound above)
+SPLATC_CACHE="$OUT/async_cache" run "$PACK" --headless $SIZE $c --shading screen \
+    --async-pipelines on --frames 1 --stats --float-out "$OUT/async.f32" > "$OUT/async.log"
+cat "$OUT/async.log"
+tiles=$(sed -n 's/^tiles: \([0-9]*\) of .*/\1/p' "$OUT/async.log")
+stood=$(sed -n 's/^pipelines pending: [0-9]* (tiles the uber-shader stood in for: \([0-9]*\))/\1/p' "$OUT/async.log")
+[ -n "$tiles" ] && [ "$tiles" -gt 0 ] && [ "$stood" = "$tiles" ] ||
+    fail "async: expected the über-shader to stand in for all $tiles tiles, got '$stood'"
+"$IC" diff "$OUT/$1.s.f32" "$OUT/async.f32" 0.0039 ||
+    fail "the picture with pipelines pending differs from the final one by more than 1/255"
 # the classification GPUs run (a workgroup per tile), forced here: the same
 # picture as the one CPU drivers run (an invocation per tile)
 SPLAT_CLASSIFY=wide run "$PACK" --headless $SIZE $c --shading screen --float-out "$OUT/wide.f32"
