@@ -5,12 +5,15 @@
 # cache, the driver's own: Mesa's and NVIDIA's), then again with the caches
 # the first run left.  One line per run:
 #   LABEL PATH KIND cold|warm SECONDS
+# KINDS (default "screen screen,async composite") picks splatbench kinds;
+# screen,async is the first picture with the über-shader standing in for
+# pipelines still being made.
 set -u
 SB=$1 PACK=$2 SIZE=$3 LABEL=$4 P=${5:-topdown}
 TMP=$(mktemp -d)
 trap 'rm -rf "$TMP"' EXIT
 TIMEFORMAT=%R
-for kind in screen composite; do
+for kind in ${KINDS:-screen screen,async composite}; do
     rm -rf "$TMP/c"
     mkdir -p "$TMP/c"
     for run in cold warm; do

@@ -47,6 +47,8 @@
  *       counting frame).  distclass=0 shades with the
  *       combinations only (--no-distance-classes; PACK.md "Distance
  *       classes"), distclass=1 (the default) with their distance classes;
+ *       async (screen kinds) makes compute pipelines on worker threads,
+ *       the über-shader shading their tiles meanwhile (first pictures);
  *       sort=on|off (screen kinds) sorts each workgroup's pixels by the
  *       layers they need before shading (rt_pixel_sort; default off),
  *       sort=N on with N tiles per workgroup (4, 8 or 16; on: the most
@@ -213,6 +215,8 @@ typedef struct variant {
     rt_pixel_sort sort;
     int          sort_tiles;
     bool         no_dclass; /* distclass=0                                 */
+    bool         async;     /* async: pipelines made on workers, the über-
+                               shader standing in (screen kinds)          */
     bool         ug;        /* draw the undergrowth                         */
     double       ug_radius; /* its radius (m); 0: the runtime's default     */
     double       far;       /* screen: the far atlas's distance (m); 0: off */
@@ -419,6 +423,8 @@ static bool parse_variant(const char *s, const char *default_pack, variant *v)
             v->pack_dir = strdup(t + 5);   /* lives as long as the process */
         } else if (!strcmp(t, "noshadow")) {
             v->no_shadows = true;
+        } else if (!strcmp(t, "async")) {
+            v->async = true;
         } else if (!strcmp(t, "distclass=0") || !strcmp(t, "distclass=1")) {
             v->no_dclass = t[10] == '0';
         } else if (!strcmp(t, "sort=on") || !strcmp(t, "sort=off")) {
@@ -647,6 +653,7 @@ static int cmd_render(int argc, char **argv)
             .width = width, .height = height, .lod_pixels = v[i].lod,
             .no_shadows = v[i].no_shadows, .no_undergrowth = !v[i].ug,
             .no_distance_classes = v[i].no_dclass, .pixel_sort = v[i].sort,
+            .async_pipelines = v[i].async,
             .sort_tiles = v[i].sort_tiles,
             .undergrowth_radius = v[i].ug_radius, .far_atlas_distance = v[i].far,
             .reference = v[i].k == K_MULTIPASS ? RT_REF_MULTIPASS
