@@ -15,6 +15,7 @@
 #include <string.h>
 
 #include "abi.h"
+#include "progress.h"
 #include "spv.h"
 
 static job *job_add(build *b, job_kind kind, int index, char *file, int stage)
@@ -42,6 +43,7 @@ typedef struct pool {
                                  short ones fill the tail                 */
     int             next;
     pthread_mutex_t lock;
+    splat_progress  progress; /* under lock                               */
 } pool;
 
 static const build *sort_build;  /* qsort has no context argument */
@@ -72,12 +74,20 @@ static void *pool_worker(void *arg)
         if (i < 0)
             return NULL;
         p->fn(p->b, &p->b->jobs[i]);
+        pthread_mutex_lock(&p->lock);
+        splat_progress_step(&p->progress);
+        pthread_mutex_unlock(&p->lock);
     }
 }
 
-static void run_pool(build *b, void (*fn)(build *, job *), bool *pending, int threads)
+static void run_pool(build *b, const char *phase, void (*fn)(build *, job *), bool *pending,
+                     int threads)
 {
     pool p = {.b = b, .fn = fn, .pending = pending};
+    int n = 0;
+    for (int i = 0; i < b->njobs; i++)
+        n += pending[i];
+    splat_progress_begin(&p.progress, phase, n);
     p.order = xcalloc((size_t)b->njobs, sizeof *p.order);
     for (int i = 0; i < b->njobs; i++)
         p.order[i] = i;
@@ -98,6 +108,7 @@ static void run_pool(build *b, void (*fn)(build *, job *), bool *pending, int th
         pthread_join(t[i], NULL);
     free(t);
     free(p.order);
+    splat_progress_end(&p.progress);
     pthread_mutex_destroy(&p.lock);
 }
 
@@ -263,17 +274,21 @@ bool build_compose(build *b)
     const splat_analysis *a = &b->analysis;
     int nm = b->scene.nmaterials;
     b->combos = xcalloc((size_t)a->ncombos, sizeof *b->combos);
-    for (int i = 0; i < a->ncombos; i++)
-        if (!add_composite(b, JOB_COMBO, i, a->combos[i].materials,
-                           a->combos[i].nmaterials, false, &b->combos[i]))
-            return false;
+    splat_progress pr;
+    splat_progress_begin(&pr, "compose", a->ncombos + 1 + nm);
+    bool ok = true;
+    for (int i = 0; ok && i < a->ncombos; i++, splat_progress_step(&pr))
+        ok = add_composite(b, JOB_COMBO, i, a->combos[i].materials, a->combos[i].nmaterials,
+                           false, &b->combos[i]);
     int *all = xcalloc((size_t)nm, sizeof *all);
     for (int k = 0; k < nm; k++)
         all[k] = nm - 1 - k;
-    bool ok = add_composite(b, JOB_UBER, 0, all, nm, false, NULL);
+    ok = ok && add_composite(b, JOB_UBER, 0, all, nm, false, NULL);
+    splat_progress_step(&pr);
     free(all);
-    for (int k = 0; ok && k < nm; k++)
+    for (int k = 0; ok && k < nm; k++, splat_progress_step(&pr))
         ok = add_composite(b, JOB_REF, k, &k, 1, true, NULL);
+    splat_progress_end(&pr);
     if (!ok)
         return false;
     /* the GLSL of every variant, on the pool (composing itself lowers the
@@ -284,7 +299,7 @@ bool build_compose(build *b)
         b->jobs[i].gdesc.lazy_branches = &b->jobs[i].nlazy;
         pending[i] = b->jobs[i].composite != NULL;
     }
-    run_pool(b, emit_job, pending, b->desc->jobs);
+    run_pool(b, "glsl", emit_job, pending, b->desc->jobs);
     free(pending);
     composites_free(b);
     job *v = job_add(b, JOB_VERTEX, 0, xasprintf("shaders/terrain.vert"), SPV_STAGE_VERTEX);
@@ -308,7 +323,7 @@ bool build_compile(build *b)
                     splat_cache_get(&b->cache, j->key, &j->words, &j->nwords);
         pending[i] = !j->cached && !j->glsl_only;
     }
-    run_pool(b, compile_job, pending, b->desc->jobs);
+    run_pool(b, "glslang", compile_job, pending, b->desc->jobs);
     free(pending);
     return true;
 }
@@ -331,7 +346,7 @@ bool build_validate(build *b)
     bool *pending = xcalloc((size_t)b->njobs, sizeof *pending);
     for (int i = 0; i < b->njobs; i++)
         pending[i] = !b->jobs[i].cached && !b->jobs[i].glsl_only;
-    run_pool(b, validate_job, pending, b->desc->jobs);
+    run_pool(b, "spirv-val", validate_job, pending, b->desc->jobs);
     free(pending);
     bool ok = true;
     for (int i = 0; i < b->njobs; i++) {
