@@ -23,6 +23,9 @@ typedef struct reader {
     rt_pack    *p;
     rt_error   *e;
     int         dirfd;      /* the pack folder: every file opened under it */
+    rt_spirv  **unchecked;  /* modules read, validated at the end on all
+                               cores (validate_all)                      */
+    int         nunchecked, capunchecked;
 } reader;
 
 /* Files bigger than these are refused before they are read. */
@@ -315,9 +318,55 @@ static bool read_spirv(reader *r, json_t *obj, const char *where, rt_spirv *out)
     }
     out->words = (uint32_t *)data;
     out->nwords = n / 4;
+    if (r->nunchecked == r->capunchecked) {
+        int cap = r->capunchecked ? 2 * r->capunchecked : 64;
+        rt_spirv **u = realloc(r->unchecked, (size_t)cap * sizeof *u);
+        if (!u)
+            return false;
+        r->unchecked = u;
+        r->capunchecked = cap;
+    }
+    r->unchecked[r->nunchecked++] = out;
+    return true;
+}
+
+/* One job of validate_all: spirv-val on module k, its failure in errs[k]. */
+typedef struct validate_jobs {
+    reader    *r;
+    rt_error  *errs;
+} validate_jobs;
+
+static bool validate_one(void *ctx, int k, rt_error *e)
+{
+    validate_jobs *j = ctx;
+    const rt_spirv *s = j->r->unchecked[k];
     char path[512];
-    snprintf(path, sizeof path, "%s/%s", r->p->dir, rel);
-    return rt_spirv_validate(out->words, out->nwords, path, r->e);
+    snprintf(path, sizeof path, "%s/%s", j->r->p->dir, s->path);
+    (void)e;   /* every module is validated: the first failure by index is reported */
+    rt_spirv_validate(s->words, s->nwords, path, &j->errs[k]);
+    return true;
+}
+
+/* Every module read, validated before any reaches the driver: spirv-val
+ * on all cores (jobs.c), the failure reported that of the first module in
+ * manifest order, so the message does not depend on the threads. */
+static bool validate_all(reader *r)
+{
+    rt_error *errs = calloc((size_t)r->nunchecked + 1, sizeof *errs);
+    if (!errs)
+        return false;
+    validate_jobs j = { r, errs };
+    bool ok = rt_parallel(r->nunchecked, validate_one, &j, r->e);
+    for (int k = 0; k < r->nunchecked; k++) {
+        if (ok && errs[k].id != RT_OK) {
+            *r->e = errs[k];
+            ok = false;
+        } else {
+            rt_error_clear(&errs[k]);
+        }
+    }
+    free(errs);
+    return ok;
 }
 
 /* {"compute": {"glsl": …}} of a combination or the über-shader: the
@@ -1340,8 +1389,9 @@ bool rt_pack_load(rt_pack *p, const char *dir, rt_error *e)
                  read_fragment_glsl(&r, ub, "uber", &p->uber_frag_path) &&
                  read_glsl(&r, ub, "compute", "uber", &p->uber_compute);
     }
-    ok = ok && check_shaders(&r);
+    ok = ok && validate_all(&r) && check_shaders(&r);
 done:
+    free(r.unchecked);
     if (r.dirfd >= 0)
         close(r.dirfd);
     json_decref(root);

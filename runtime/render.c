@@ -1174,8 +1174,10 @@ static bool record_forward(rt_renderer *r, VkCommandBuffer cb, const rt_camera *
         .renderArea = *area, .clearValueCount = 2, .pClearValues = clears,
     };
     bool composites = r->desc.reference != RT_REF_UBER && r->view != SPLAT_VIEW_MASK;
-    if (composites && !make_forward_pipelines(r, variant, e))
-        return abandon_frame(cb);
+    if (composites && !make_forward_pipelines(r, variant, e)) {
+        vkEndCommandBuffer(cb);   /* no pass begun yet */
+        return false;
+    }
     if (variant & RT_VARIANT_COUNT)
         count_begin(r, cb);
     begin_terrain_pass(r, cb, &rb, vp, sets);
