@@ -17,9 +17,6 @@
 
 /* ---- errors (device.c) ------------------------------------------------- */
 
-/* Record an error (printf arguments for the id's format); returns false so
- * that `return rt_fail(e, RT_E_IO, ...)` reads naturally.  `e` may be NULL. */
-bool        rt_fail(rt_error *e, rt_error_id id, ...);
 const char *rt_vk_result_name(VkResult r);
 
 /* Check a VkResult at run time (never only inside assert). */
@@ -225,8 +222,6 @@ bool rt_painted_read(rt_pack *p, const char *manifest, const char *file,
  * RGBA8UI 2D arrays. */
 bool rt_painted_upload(rt_device *d, const rt_pack *p, rt_image *atlas,
                        rt_image *index, rt_image *level, rt_error *e);
-/* Print the bytes of each mask representation next to dense. */
-void rt_painted_print_stats(const rt_pack *p, FILE *out);
 
 /* ---- terrain_upload.c: heightfield on the GPU, node height bounds ----- */
 
@@ -615,7 +610,6 @@ bool rt_destruction_crater(rt_destruction *ds, const rt_crater *c, rt_crater_sta
                            rt_error *e);
 /* Wait until the last crater's commands are done. */
 bool rt_destruction_wait(rt_destruction *ds, rt_error *e);
-void rt_destruction_print_stats(const rt_destruction *ds, FILE *out);
 bool   rt_read_r16(rt_device *d, const rt_image *img, uint16_t *out, rt_error *e);
 
 /* ---- shadow.c: the sun-visibility map ---------------------------------- */

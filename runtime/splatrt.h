@@ -60,6 +60,9 @@ typedef struct rt_error {
 } rt_error;
 
 void        rt_error_clear(rt_error *e);
+/* Record an error (printf arguments for the id's format); returns false so
+ * that `return rt_fail(e, RT_E_IO, ...)` reads naturally.  `e` may be NULL. */
+bool        rt_fail(rt_error *e, rt_error_id id, ...);
 
 /* ---- device.c: instance, device, memory -------------------------------- */
 
@@ -319,6 +322,8 @@ bool rt_pack_load(rt_pack *p, const char *dir, rt_error *e);
  * it is created; RT_E_PACK_LIMIT naming the limit. */
 bool rt_pack_check_device(const rt_pack *p, const rt_device *d, rt_error *e);
 void rt_pack_free(rt_pack *p);
+/* Print the bytes of each painted mask representation next to dense. */
+void rt_painted_print_stats(const rt_pack *p, FILE *out);
 int  rt_pack_material_find(const rt_pack *p, const char *name);   /* -1 */
 int  rt_pack_camera_find(const rt_pack *p, const char *name);     /* -1 */
 
@@ -529,6 +534,8 @@ bool rt_renderer_crater(rt_renderer *r, const rt_crater *c, rt_crater_stats *st,
                         rt_error *e);
 /* NULL when the pack has no destructible area. */
 rt_destruction *rt_renderer_destruction(rt_renderer *r);
+/* The destruction mask's memory: this area, and the slides' configuration. */
+void rt_destruction_print_stats(const rt_destruction *ds, FILE *out);
 /* The heightfield as the renderer has it now (craters included). */
 const uint16_t *rt_renderer_heights(const rt_renderer *r);
 /* Where the ray from `o` along `dir` first meets the terrain (CPU march
