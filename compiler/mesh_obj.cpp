@@ -35,18 +35,15 @@ extern "C" bool splat_obj_read(const char *path, splat_obj_corners *c, char **er
 {
     *c = splat_obj_corners{};
     *err = nullptr;
-    struct stat st;
-    if (stat(path, &st))
-        return fail(err, strerror(errno));
-    if (!S_ISREG(st.st_mode))
-        return fail(err, "not a regular file");
-    std::ifstream f(path, std::ios::binary);
-    if (!f)
-        return fail(err, strerror(errno ? errno : EIO));
-    std::stringstream text;
-    text << f.rdbuf();
-    if (f.bad())
-        return fail(err, strerror(errno ? errno : EIO));
+    // only regular files of bounded size (util.h): a FIFO or /dev/zero
+    // must not hang the compiler
+    char why[256];
+    size_t len = 0;
+    char *bytes = splat_input_read(path, SPLAT_MAX_MESH_BYTES, &len, why, sizeof why);
+    if (!bytes)
+        return fail(err, why);
+    std::stringstream text(std::string(bytes, len));
+    free(bytes);
 
     tinyobj::attrib_t a;
     std::vector<tinyobj::shape_t> shapes;

@@ -71,9 +71,10 @@ static bool write_file(build *b, const char *dir, const char *name, const void *
 
 static bool copy_file(build *b, const char *from, const char *dir, const char *name)
 {
-    FILE *f = fopen(from, "rb");
+    char why[256];
+    FILE *f = splat_input_fopen(from, SPLAT_MAX_IMAGE_BYTES, why, sizeof why);
     if (!f) {
-        sg_error(b->d, b->loc, SG_E_IO, from, strerror(errno));
+        sg_error(b->d, b->loc, SG_E_IO, from, why);
         return false;
     }
     size_t cap = 1 << 16, n = 0;
@@ -193,33 +194,26 @@ char *build_mip_path(const char *path, int k)
 int build_mip_count(const char *src)
 {
     /* never more than the texture has below its base (PACK.md "Limits") */
-    int w = 0, h = 0, comp, levels = 0;
-    if (stbi_info(src, &w, &h, &comp))
+    long long w = 0, h = 0;
+    int comp, levels = 0;
+    bool is16;
+    char why[256];
+    FILE *f = splat_input_fopen(src, SPLAT_MAX_IMAGE_BYTES, why, sizeof why);
+    if (f && splat_image_info(f, &w, &h, &comp, &is16))
         while ((w > h ? w : h) >> (levels + 1))
             levels++;
+    if (f)
+        fclose(f);
     int k = 0;
     for (;;) {
         char *p = build_mip_path(src, k + 1);
         struct stat st;
-        bool there = stat(p, &st) == 0 && S_ISREG(st.st_mode);
+        bool there = stat(p, &st) == 0 && S_ISREG(st.st_mode);   /* stat: no open */
         free(p);
         if (!there || k >= levels)
             return k;
         k++;
     }
-}
-
-/* A texture within the pack limit (abi.h): one image on the GPU. */
-static bool texture_fits(build *b, const char *src)
-{
-    int w, h, comp;
-    if (!stbi_info(src, &w, &h, &comp) || (w <= SPLAT_MAX_TEXTURE && h <= SPLAT_MAX_TEXTURE))
-        return true;   /* unreadable images are the runtime's error (it names the file) */
-    char msg[512];
-    snprintf(msg, sizeof msg, "texture '%s' is %d x %d texels, over the pack limit of %d "
-             "per side", src, w, h, SPLAT_MAX_TEXTURE);
-    sg_error(b->d, b->loc, SG_E_OVER_LIMIT, msg);
-    return false;
 }
 
 /* ---- manifest.json, one function per section (PACK.md) -------------------- */
@@ -672,7 +666,7 @@ static bool write_contents(build *b, const char *dir)
             first &= strcmp(tex_names[k], tex_names[i]) != 0;
         const char *src = b->layout.src->textures[b->layout.textures[i]].file;
         if (first)
-            ok = texture_fits(b, src) && copy_file(b, src, dir, tex_names[i]);
+            ok = copy_file(b, src, dir, tex_names[i]);   /* checked: scene.c */
         for (int k = 1, n = first ? build_mip_count(src) : 0; ok && k <= n; k++) {
             char *from = build_mip_path(src, k), *to = build_mip_path(tex_names[i], k);
             ok = copy_file(b, from, dir, to);

@@ -1214,43 +1214,6 @@ typedef struct loader {
     int         depth;
 } loader;
 
-static char *read_all(const char *path, size_t *len, const char **err)
-{
-    FILE *f = fopen(path, "rb");
-    if (!f) {
-        *err = strerror(errno);
-        return NULL;
-    }
-    /* only regular files: an import of /dev/zero or a FIFO must not hang */
-    struct stat st;
-    if (fstat(fileno(f), &st) || !S_ISREG(st.st_mode)) {
-        *err = "not a regular file";
-        fclose(f);
-        return NULL;
-    }
-    size_t cap = 4096, n = 0;
-    char *buf = xmalloc(cap + 1);
-    for (;;) {
-        size_t got = fread(buf + n, 1, cap - n, f);
-        n += got;
-        if (n < cap) {
-            if (ferror(f)) {
-                *err = strerror(errno ? errno : EIO);
-                fclose(f);
-                free(buf);
-                return NULL;
-            }
-            break;
-        }
-        cap *= 2;
-        buf = xrealloc(buf, cap + 1);
-    }
-    fclose(f);
-    buf[n] = 0;
-    *len = n;
-    return buf;
-}
-
 /* Lex, parse and load the imports of `path` (text given, or read). */
 static int load_file(loader *l, const char *path, const char *text, size_t len,
                      sg_loc from, bool is_import)
@@ -1288,8 +1251,9 @@ static int load_file(loader *l, const char *path, const char *text, size_t len,
     }
     char *owned = NULL;
     if (!text) {
-        const char *err = NULL;
-        owned = read_all(path, &len, &err);
+        /* only regular files: an import of /dev/zero or a FIFO must not hang */
+        char err[256];
+        owned = splat_input_read(path, SPLAT_MAX_GRAPH_BYTES, &len, err, sizeof err);
         if (!owned) {
             free(rp);
             if (is_import)
@@ -1404,6 +1368,14 @@ sg_loc sg_material_loc(const sg_program *p, int i)
 {
     return p->shaders[p->materials[i]]->loc;
 }
+sg_loc sg_texture_loc(const sg_program *p, const char *file)
+{
+    for (int i = 0; i < p->ntextures; i++)
+        if (p->textures[i]->file && !strcmp(p->textures[i]->file, file))
+            return p->textures[i]->loc;
+    return (sg_loc){ 0 };
+}
+
 int sg_material_find(const sg_program *p, const char *name)
 {
     for (int i = 0; i < p->nmaterials; i++)

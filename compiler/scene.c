@@ -90,41 +90,37 @@ static uint8_t *load_mask(const char *name, const char *file, int *pw, int *ph,
         return px;
     }
     int fw, fh, comp;
-    if (!stbi_info(file, &fw, &fh, &comp)) {
-        FILE *f = fopen(file, "rb");
-        if (!f) {
-            sg_error(d, loc, SG_E_IO, file, strerror(errno));
-        } else {
-            fclose(f);
-            sg_error(d, loc, SG_E_IO, file, "not a PNG image");
-        }
+    bool is16;
+    FILE *f = splat_png_open("painted mask", file, &fw, &fh, &comp, &is16, loc, d);
+    if (!f)
         return NULL;
-    }
-    if (comp != 1 || stbi_is_16_bit(file)) {
+    if (comp != 1 || is16) {
+        fclose(f);
         sg_errorf(d, loc, SG_E_RASTER, "painted mask '%s' ('%s') must be an 8-bit "
                     "greyscale image, found %d channels of %d bits", name, file,
-                    comp, stbi_is_16_bit(file) ? 16 : 8);
+                    comp, is16 ? 16 : 8);
         return NULL;
     }
     if (any) {
         *pw = w = fw;
         *ph = h = fh;
     } else if (fw != w || fh != h) {
+        fclose(f);
         sg_errorf(d, loc, SG_E_RASTER, "painted mask '%s' ('%s') is %d x %d texels; the "
                     "heightfield is %d x %d (or place it: { origin = X Z, size = W H })",
                     name, file, fw, fh, w, h);
         return NULL;
     }
-    if (!splat_raster_check_size("painted mask", file, fw, fh, loc, d))
-        return NULL;
     int lw, lh, lc;
-    uint8_t *px = stbi_load(file, &lw, &lh, &lc, 1);
-    if (!px) {
+    uint8_t *px = stbi_load_from_file(f, &lw, &lh, &lc, 1);
+    fclose(f);
+    if (!px || lw != w || lh != h) {
         /* the header read, the data did not */
-        char why[160];
-        snprintf(why, sizeof why, "truncated or corrupt PNG (stb_image: %s)",
+        char msg[160];
+        snprintf(msg, sizeof msg, "truncated or corrupt PNG (stb_image: %s)",
                  stbi_failure_reason());
-        sg_error(d, loc, SG_E_IO, file, why);
+        sg_error(d, loc, SG_E_IO, file, msg);
+        stbi_image_free(px);
         return NULL;
     }
     /* Own the pixels with malloc so splat_scene_free needs no stb. */
@@ -186,6 +182,8 @@ static bool load_painted(splat_scene *s, sg_diags *d)
 
 /* ---- materials ---------------------------------------------------------- */
 
+static bool check_textures(splat_scene *s, const int *first_material, sg_diags *d);
+
 static bool lower_materials(splat_scene *s, sg_diags *d)
 {
     const sg_scene *sc = s->desc;
@@ -194,9 +192,15 @@ static bool lower_materials(splat_scene *s, sg_diags *d)
         (void)k;   /* == i: names are unique (check_scene) */
     }
     bool ok = true;
+    int *first_material = NULL;   /* per texture: the material that first samples it */
     for (int i = 0; i < sc->nmaterials; i++) {
-        int before = s->ir.npainted;
-        if (!sg_lower_material(s->prog, sc->materials[i], &s->ir, d)) {
+        int before = s->ir.npainted, tex_before = s->ir.ntextures;
+        bool lowered = sg_lower_material(s->prog, sc->materials[i], &s->ir, d);
+        first_material = xrealloc(first_material, ((size_t)s->ir.ntextures + 1) *
+                                                      sizeof *first_material);
+        for (int k = tex_before; k < s->ir.ntextures; k++)
+            first_material[k] = i;
+        if (!lowered) {
             ok = false;
             continue;
         }
@@ -213,6 +217,58 @@ static bool lower_materials(splat_scene *s, sg_diags *d)
             if (m >= 0)
                 sg_note(d, sg_material_loc(s->prog, m), "material '%s' is "
                         "defined here", sc->materials[i]);
+            ok = false;
+        }
+    }
+    ok = ok && check_textures(s, first_material, d);
+    free(first_material);
+    return ok;
+}
+
+/* ---- textures ------------------------------------------------------------ */
+
+/* Every texture the materials sample, checked once here so that nothing
+ * later (precision.c, far_atlas.c, the pack writer, the runtime) meets a
+ * FIFO, a device or an image over the pack limit: a regular file within
+ * SPLAT_MAX_IMAGE_BYTES, an image stb_image decodes, at most
+ * SPLAT_MAX_TEXTURE texels a side (the header's size, read from the PNG
+ * itself when stb_image refuses it).  Errors at the `texture`
+ * declaration, or at the scene's material that samples an inline one. */
+static bool check_textures(splat_scene *s, const int *first_material, sg_diags *d)
+{
+    const sg_scene *sc = s->desc;
+    bool ok = true;
+    for (int i = 0; i < s->ir.ntextures; i++) {
+        const char *file = s->ir.textures[i].file;
+        sg_loc loc = sg_texture_loc(s->prog, file);
+        if (loc.line == 0) {
+            int m = first_material[i];
+            loc = sc->material_locs && m >= 0 ? sg_loc_or(sc->material_locs[m], sc->loc)
+                                              : sc->loc;
+        }
+        char why[256];
+        FILE *f = splat_input_fopen(file, SPLAT_MAX_IMAGE_BYTES, why, sizeof why);
+        if (!f) {
+            sg_errorf(d, loc, SG_E_IO, "cannot read texture '%s': %s", file, why);
+            ok = false;
+            continue;
+        }
+        long long w, h;
+        int comp;
+        bool is16;
+        bool image = splat_image_info(f, &w, &h, &comp, &is16);
+        fclose(f);
+        if (!image) {
+            sg_errorf(d, loc, SG_E_IO, "cannot read texture '%s': not an image "
+                      "(PNG, JPEG, TGA, BMP, …)", file);
+            ok = false;
+        } else if (w < 1 || h < 1 || w > SPLAT_MAX_TEXTURE || h > SPLAT_MAX_TEXTURE) {
+            sg_errorf(d, loc, SG_E_OVER_LIMIT, "texture '%s' is %lld x %lld texels, over "
+                      "the pack limit of %d per side", file, w, h, SPLAT_MAX_TEXTURE);
+            ok = false;
+        } else if (comp == 0) {
+            sg_errorf(d, loc, SG_E_IO, "cannot read texture '%s': stb_image does not "
+                      "decode its %lld x %lld header", file, w, h);
             ok = false;
         }
     }

@@ -6,6 +6,7 @@
 
 #include <stdbool.h>
 #include <stdint.h>
+#include <stdio.h>
 
 #include "abi.h"
 #include "ir.h"
@@ -33,6 +34,19 @@ typedef struct splat_terrain {
  * before allocating. */
 bool splat_raster_check_size(const char *what, const char *path, long long w,
                              long long h, sg_loc loc, sg_diags *d);
+
+/* An image's header, read from an open file (left at its start): what
+ * stb_image says, or, for a PNG whose header stb_image refuses (a size it
+ * will not decode, such as 100000 x 100000), the IHDR's own width and
+ * height with *comp = 0, so the caller's limit check still sees the real
+ * size.  False when the file is no image stb_image reads. */
+bool splat_image_info(FILE *f, long long *w, long long *h, int *comp, bool *is16);
+/* A PNG raster opened as an untrusted input (util.h splat_input_fopen),
+ * its header read (splat_image_info) and its size checked
+ * (splat_raster_check_size, `what` names it); the file at its start, or
+ * NULL with the error at loc. */
+FILE *splat_png_open(const char *what, const char *path, int *w, int *h, int *comp,
+                     bool *is16, sg_loc loc, sg_diags *d);
 
 /* Load 16-bit PNG, 8-bit PNG (scaled to 16 bits) or raw little-endian R16
  * (width and height given).  Errors at `loc`. */

@@ -267,7 +267,10 @@ static void test_obj_errors(void **state)
     assert_string_equal(err, "No such file or directory");
     free(err);
     assert_false(splat_mesh_obj(dir, &m, &err));          /* a folder */
-    assert_string_equal(err, "not a regular file");
+    assert_string_equal(err, "not a regular file: it is a folder");
+    free(err);
+    assert_false(splat_mesh_obj("/dev/zero", &m, &err));  /* would never end */
+    assert_string_equal(err, "not a regular file: it is a character device");
     free(err);
 }
 

@@ -1,0 +1,129 @@
+#!/bin/sh
+# hostile.sh SPLATC CASE — hostile inputs to `splatc build` (issue 34), run
+# from the repository root by CTest (tests/hostile/suite.cmake), one CASE
+# per test.  Every command runs under `timeout`, so a hang fails the test
+# instead of stalling it; every refusal must be a located error
+# (FILE:LINE:COL: error:) with exit status 1 and no pack written.
+#   special  a FIFO, a character device (/dev/null), a folder, a unix
+#            socket and a symbolic link to /dev/zero as the heightfield
+#            (PNG and GDAL), an import, a texture, a painted mask (PNG and
+#            GDAL) and an OBJ mesh
+set -u
+SPLATC=$1
+CASE=$2
+TMP=$(mktemp -d "${TMPDIR:-/tmp}/splatc_hostile.XXXXXX")
+trap 'rm -rf "$TMP"' EXIT
+fails=0
+SECONDS_MAX=30     # a refusal takes well under a second; a hang is killed
+
+fail() { echo "FAIL: $*"; fails=$((fails + 1)); }
+
+# The base scene: a 16x16 heightfield, a texture, a painted mask, an OBJ
+# mesh, all regular files, in folder $1.  It builds.
+base_scene() {
+    d=$1
+    mkdir -p "$d"
+    cp tests/scene/hf16.png "$d/hf16.png" && cp tests/scene/mask.png "$d/mask.png" &&
+        cp tests/scene/mask8x8.png "$d/tex.png" || fail "copy fixtures"
+    printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n' > "$d/m.obj"
+    printf 'material lib_unused { out albedo = vec3(0.5, 0.5, 0.5) }\n' > "$d/lib.sg"
+    cat > "$d/scene.sg" <<'SG'
+import "nodes/compositors.sg"
+import "lib.sg"
+texture rock { file = "tex.png" }
+material base {
+    node uv : terrain.uv
+    node t : sample { tex = rock, uv = uv.out }
+    out albedo = t.rgb
+    undergrowth "m.obj" { density = 1 }
+}
+material west_paint {
+    node p : painted { mask = "west" }
+    out mask   = p.out
+    out albedo = vec3(0.6, 0.5, 0.2)
+}
+scene s {
+    heightfield = "hf16.png"
+    size = 64 32
+    max_height = 50
+    materials = [base, west_paint]
+    painted west = "mask.png"
+}
+SG
+}
+
+# build_fails DIR LINE WHAT: `splatc build DIR/scene.sg` exits 1 within
+# SECONDS_MAX with an error located at DIR/scene.sg:LINE, writes no pack,
+# and no sanitizer speaks.
+build_fails() {
+    dir=$1 line=$2 what=$3
+    start=$(date +%s)
+    timeout "$SECONDS_MAX" "$SPLATC" build "$dir/scene.sg" -o "$dir/pack" -I . \
+        > "$dir/out" 2> "$dir/err"
+    got=$?
+    took=$(( $(date +%s) - start ))
+    if [ "$got" != 1 ]; then
+        fail "$what: exit $got after ${took}s, expected 1"; sed 's/^/    /' "$dir/err" | head -10
+        return
+    fi
+    grep -q "^$dir/scene.sg:$line:[0-9]*: error: " "$dir/err" ||
+        { fail "$what: no error at scene.sg:$line"; sed 's/^/    /' "$dir/err" | head -10; }
+    if grep -q "Sanitizer" "$dir/err"; then
+        fail "$what: sanitizer report"; grep -A5 Sanitizer "$dir/err" | head -20
+    fi
+    [ -e "$dir/pack" ] && fail "$what: a failed build wrote a pack"
+    [ "$took" -le 10 ] || fail "$what: took ${took}s"
+}
+
+# make_special KIND PATH: replace PATH by a special file of KIND; false
+# when this machine cannot make one.
+make_special() {
+    rm -rf "$2"
+    case $1 in
+    fifo)    mkfifo "$2" ;;
+    chardev) ln -s /dev/null "$2" ;;
+    zero)    ln -s /dev/zero "$2" ;;
+    folder)  mkdir "$2" ;;
+    socket)  command -v python3 > /dev/null &&
+             python3 -c 'import socket, sys; socket.socket(socket.AF_UNIX).bind(sys.argv[1])' "$2" ;;
+    esac
+}
+
+case $CASE in
+special)
+    base_scene "$TMP/ok"
+    timeout 120 "$SPLATC" build "$TMP/ok/scene.sg" -o "$TMP/ok/pack" -I . > /dev/null 2> "$TMP/ok/err" ||
+        { fail "the base scene does not build"; cat "$TMP/ok/err"; }
+    n=0
+    for kind in fifo chardev zero folder socket; do
+        # slot: file name in the scene, the line that names it, a sed
+        # edit of the scene that uses it (GDAL variants rename the file)
+        for slot in hf hf_gdal import texture mask mask_gdal mesh; do
+            d="$TMP/$kind.$slot"
+            base_scene "$d"
+            case $slot in
+            hf)        file=hf16.png  line=16 ;;
+            hf_gdal)   file=hf.tif    line=16; sed -i -e 's/"hf16.png"/"hf.tif"/' -e '/max_height/d' "$d/scene.sg" ;;
+            import)    file=lib.sg    line=2 ;;
+            texture)   file=tex.png   line=3 ;;
+            mask)      file=mask.png  line=20 ;;
+            mask_gdal) file=mask.tif  line=20; sed -i 's/"mask.png"/"mask.tif"/' "$d/scene.sg" ;;
+            mesh)      file=m.obj     line=8 ;;
+            esac
+            if ! make_special "$kind" "$d/$file"; then
+                echo "skip: cannot make a $kind here"
+                continue
+            fi
+            n=$((n + 1))
+            build_fails "$d" "$line" "$kind as $slot"
+        done
+    done
+    echo "$n special-file cases"
+    [ "$n" -ge 28 ] || fail "only $n cases ran"
+    ;;
+*)
+    echo "unknown case $CASE"; exit 2 ;;
+esac
+
+[ "$fails" = 0 ] || { echo "$fails failure(s)"; exit 1; }
+echo "ok"
