@@ -20,9 +20,6 @@
 extern "C" {
 #endif
 
-/* Largest mesh an undergrowth block may name (sg_load reports OVER_LIMIT). */
-#define SPLAT_MESH_MAX_VERTICES 65536
-#define SPLAT_MESH_MAX_INDICES  196608
 
 /* ---- mesh.c ---------------------------------------------------------------- */
 
@@ -54,7 +51,7 @@ bool splat_mesh_builtin_far(const char *name, splat_mesh *m);
 /* Load an OBJ file: triangulated, identical vertices merged; normals from
  * the file or flat where it has none; uv from the file (uv.y clamped to
  * 0..1) or, where it has none, (0.5, height over the mesh's height).  No
- * size limits here (SPLAT_MESH_MAX_*: the caller's).  False with a
+ * size limits here (abi.h SPLAT_MAX_MESH_*: the caller's).  False with a
  * malloc'd message in *err (a missing file: strerror's text). */
 bool splat_mesh_obj(const char *path, splat_mesh *m, char **err);
 void splat_mesh_free(splat_mesh *m);

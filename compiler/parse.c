@@ -579,10 +579,23 @@ static void check_obj(parser *ps, const char *path, sg_loc at)
         free(err);
         return;
     }
-    if (m.nv > SPLAT_MESH_MAX_VERTICES || m.nidx > SPLAT_MESH_MAX_INDICES)
+    if (m.nv > SPLAT_MAX_MESH_VERTICES || m.nidx > SPLAT_MAX_MESH_INDICES)
         sg_errorf(ps->d, at, SG_E_OVER_LIMIT, "mesh '%s' has %u vertices and %u indices; "
                   "an undergrowth mesh may have at most %d and %d", path, m.nv, m.nidx,
-                  SPLAT_MESH_MAX_VERTICES, SPLAT_MESH_MAX_INDICES);
+                  SPLAT_MAX_MESH_VERTICES, SPLAT_MAX_MESH_INDICES);
+    /* meshes.bin's floats as the runtime's loader bounds them (abi.h) */
+    for (uint32_t i = 0; i < m.nv; i++) {
+        const splat_mesh_vertex *x = &m.v[i];
+        const float v[5] = { x->pos[0], x->pos[1], x->pos[2], x->uv[0], x->uv[1] };
+        for (int k = 0; k < 5; k++)
+            if (!(fabsf(v[k]) <= (float)SPLAT_MAX_MESH_VALUE)) {
+                sg_errorf(ps->d, at, SG_E_OVER_LIMIT, "mesh '%s' has a vertex %s of %g; the "
+                          "pack limit is %g either way (metres at scale 1, and uv)", path,
+                          k < 3 ? "coordinate" : "uv", (double)v[k], SPLAT_MAX_MESH_VALUE);
+                splat_mesh_free(&m);
+                return;
+            }
+    }
     splat_mesh_free(&m);
 }
 

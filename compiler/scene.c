@@ -183,6 +183,7 @@ static bool load_painted(splat_scene *s, sg_diags *d)
 /* ---- materials ---------------------------------------------------------- */
 
 static bool check_textures(splat_scene *s, const int *first_material, sg_diags *d);
+static bool check_extent(const splat_scene *s, sg_diags *d);
 
 static bool lower_materials(splat_scene *s, sg_diags *d)
 {
@@ -275,6 +276,36 @@ static bool check_textures(splat_scene *s, const int *first_material, sg_diags *
     return ok;
 }
 
+/* ---- the terrain's values ------------------------------------------------ */
+
+/* The loaded terrain's size and heights within the pack limits (abi.h
+ * SPLAT_MAX_EXTENT), finite: a GDAL raster brings its own (a Float64
+ * band at +-1.7e308 spans an infinite max_height), and the manifest must
+ * hold numbers the runtime accepts.  Errors at the heightfield. */
+static bool check_extent(const splat_scene *s, sg_diags *d)
+{
+    const splat_terrain *t = &s->terrain;
+    const sg_scene *sc = s->desc;
+    sg_loc loc = sg_loc_or(sc->heightfield_loc, sc->loc);
+    if (!(t->size[0] > 0 && t->size[0] <= SPLAT_MAX_EXTENT && t->size[1] > 0 &&
+          t->size[1] <= SPLAT_MAX_EXTENT)) {
+        sg_errorf(d, loc, SG_E_OVER_LIMIT, "heightfield '%s' gives a world size of %g x %g m; "
+                  "the pack limit is %g m a side", sc->heightfield, t->size[0], t->size[1],
+                  SPLAT_MAX_EXTENT);
+        return false;
+    }
+    double lo = t->height_offset, hi = t->height_offset + t->max_height;
+    if (!(t->max_height >= 0 && t->max_height <= SPLAT_MAX_EXTENT &&
+          fabs(t->height_offset) <= SPLAT_MAX_EXTENT && fabs(hi) <= SPLAT_MAX_EXTENT)) {
+        sg_errorf(d, loc, SG_E_OVER_LIMIT, "heightfield '%s' has heights from %g to %g m "
+                  "(max_height %g, height_offset %g); the pack limit is finite heights "
+                  "within %g m of 0", sc->heightfield, lo, hi, t->max_height,
+                  t->height_offset, SPLAT_MAX_EXTENT);
+        return false;
+    }
+    return true;
+}
+
 /* ---- the scene ---------------------------------------------------------- */
 
 bool splat_scene_load(splat_scene *s, const char *path,
@@ -311,6 +342,8 @@ bool splat_scene_load(splat_scene *s, const char *path,
     if (!splat_terrain_load(&s->terrain, sc->heightfield, sc->hf_format,
                             sc->hf_width, sc->hf_height,
                             sg_loc_or(sc->heightfield_loc, sc->loc), d))
+        goto fail;
+    if (!check_extent(s, d))
         goto fail;
     if (sc->hf_format != SG_HF_R16 &&
         !sg_scene_cells_fit(sc, s->terrain.width, s->terrain.height, d))

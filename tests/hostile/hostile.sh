@@ -8,6 +8,10 @@
 #            socket and a symbolic link to /dev/zero as the heightfield
 #            (PNG and GDAL), an import, a texture, a painted mask (PNG and
 #            GDAL) and an OBJ mesh
+#   limits   values the runtime would refuse, refused at build time: a
+#            texture whose header says 100000 x 100000, an OBJ vertex at
+#            5000 m, undergrowth densities over the instance buffer,
+#            max_height 1e300 (GDAL rasters at +-1.7e308: world.test_gdal)
 set -u
 SPLATC=$1
 CASE=$2
@@ -120,6 +124,34 @@ special)
     done
     echo "$n special-file cases"
     [ "$n" -ge 28 ] || fail "only $n cases ran"
+    ;;
+limits)
+    # a PNG header claiming 100000 x 100000 (stb_image refuses to say so)
+    d="$TMP/lying_png"; base_scene "$d"
+    printf '\211PNG\r\n\032\n\000\000\000\015IHDR\000\001\206\240\000\001\206\240\010\000\000\000\000\000\000\000\000' \
+        > "$d/tex.png"
+    build_fails "$d" 3 "texture header of 100000 x 100000"
+    grep -q "100000 x 100000 texels, over the pack limit of 16384" "$d/err" ||
+        fail "lying header: the message does not give the header's size"
+    # an OBJ vertex at 5000 m (the runtime allows 1000)
+    d="$TMP/far_vertex"; base_scene "$d"
+    printf 'v 0 0 0\nv 5000 0 0\nv 0 1 0\nf 1 2 3\n' > "$d/m.obj"
+    build_fails "$d" 8 "OBJ vertex at 5000 m"
+    # two blocks at density 64: 128 per m^2, over the instance buffer every
+    # device holds (about 83 per m^2); the error at the second block
+    d="$TMP/density"; base_scene "$d"
+    sed -i '8s/.*/    undergrowth grass { density = 64 } undergrowth stone { density = 64 }/' "$d/scene.sg"
+    build_fails "$d" 8 "total undergrowth density 128"
+    grep -q "128 MiB every device holds" "$d/err" || fail "density: the message lacks the limit"
+    # one block at 64 fits
+    d="$TMP/density_ok"; base_scene "$d"
+    sed -i '8s/.*/    undergrowth grass { density = 64 }/' "$d/scene.sg"
+    timeout 120 "$SPLATC" build "$d/scene.sg" -o "$d/pack" -I . > /dev/null 2> "$d/err" ||
+        { fail "density 64 alone does not build"; cat "$d/err"; }
+    # max_height far past any terrain
+    d="$TMP/max_height"; base_scene "$d"
+    sed -i 's/max_height = 50/max_height = 1e300/' "$d/scene.sg"
+    build_fails "$d" 18 "max_height 1e300"
     ;;
 *)
     echo "unknown case $CASE"; exit 2 ;;
