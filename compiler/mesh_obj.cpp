@@ -2,9 +2,9 @@
 // tinyobjloader (Debian's libtinyobjloader, float build).
 //
 // C++ only because tinyobjloader is a C++ library.  Keep this file to this
-// one function: merging vertices, normals and uv are mesh.c's.  The file is
-// read here (regular files only, as the .sg loader does: a FIFO must not
-// hang the compiler) and parsed from memory, with no material reader, so
+// one function: reading the file (bounded, regular files only), checking
+// its text against the limits, merging vertices, normals and uv are
+// mesh.c's.  The text is parsed from memory, with no material reader, so
 // an OBJ's `mtllib` never opens another file.
 #include "mesh.h"
 
@@ -12,12 +12,9 @@
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
-#include <fstream>
 #include <sstream>
 #include <string>
 #include <vector>
-
-#include <sys/stat.h>
 
 #include <tiny_obj_loader.h>
 
@@ -31,19 +28,12 @@ static bool fail(char **err, const std::string &msg)
     return false;
 }
 
-extern "C" bool splat_obj_read(const char *path, splat_obj_corners *c, char **err)
+extern "C" bool splat_obj_parse(const char *bytes, size_t len, splat_obj_corners *c,
+                                char **err)
 {
     *c = splat_obj_corners{};
     *err = nullptr;
-    // only regular files of bounded size (util.h): a FIFO or /dev/zero
-    // must not hang the compiler
-    char why[256];
-    size_t len = 0;
-    char *bytes = splat_input_read(path, SPLAT_MAX_MESH_BYTES, &len, why, sizeof why);
-    if (!bytes)
-        return fail(err, why);
     std::stringstream text(std::string(bytes, len));
-    free(bytes);
 
     tinyobj::attrib_t a;
     std::vector<tinyobj::shape_t> shapes;

@@ -12,6 +12,9 @@
 #            texture whose header says 100000 x 100000, an OBJ vertex at
 #            5000 m, undergrowth densities over the instance buffer,
 #            max_height 1e300 (GDAL rasters at +-1.7e308: world.test_gdal)
+#   mesh     OBJ files refused before tinyobjloader: `v nan`, a face of
+#            100000 corners, a file over 64 MiB (sparse: nothing is read);
+#            the rest of the text checks are unit.test_mesh's
 set -u
 SPLATC=$1
 CASE=$2
@@ -152,6 +155,23 @@ limits)
     d="$TMP/max_height"; base_scene "$d"
     sed -i 's/max_height = 50/max_height = 1e300/' "$d/scene.sg"
     build_fails "$d" 18 "max_height 1e300"
+    ;;
+mesh)
+    d="$TMP/nan"; base_scene "$d"
+    printf 'v nan 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n' > "$d/m.obj"
+    build_fails "$d" 8 "v nan"
+    grep -q "line 1: 'v' value 'nan' is not a finite number" "$d/err" ||
+        fail "v nan: the message lacks the OBJ line"
+    d="$TMP/face"; base_scene "$d"
+    { printf 'v 0 0 0\nv 1 0 0\nv 0 1 0\nf'
+      i=0; while [ $i -lt 1000 ]; do printf ' 1 2 3 1 2 3 1 2 3 1 2 3 1 2 3 1 2 3 1 2 3 1 2 3 1 2 3 1 2 3 1 2 3 1 2 3 1 2 3 1 2 3 1 2 3 1 2 3 1 2 3 1 2 3 1 2 3 1 2 3 1 2 3 1 2 3 1 2 3 1 2 3 1 2 3 1 2 3 1 2 3 1 2 3 1 2 3 1 2 3 1 2 3 1 2 3 1 2 3 1 2 3 1 2 3 1'; i=$((i + 1)); done
+      printf '\n'; } > "$d/m.obj"
+    build_fails "$d" 8 "a face of 100000 corners"
+    grep -q "a face of more than 1024 corners" "$d/err" || fail "face: wrong message"
+    d="$TMP/huge"; base_scene "$d"
+    truncate -s 65M "$d/m.obj" || fail "truncate"
+    build_fails "$d" 8 "a 65 MiB OBJ file"
+    grep -q "over the limit of 67108864" "$d/err" || fail "huge OBJ: wrong message"
     ;;
 *)
     echo "unknown case $CASE"; exit 2 ;;
