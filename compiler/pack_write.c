@@ -763,6 +763,9 @@ bool build_write_pack(build *b)
     if (ok && b->far.pending)
         ok = build_far_atlas_device(b, tmp) && b->far.data &&
              write_file(b, tmp, "far.atlas", b->far.data, b->far.n) && write_manifest(b, tmp);
+    /* everything is written before the swap, the depfile included: a
+     * depfile that cannot be written leaves the old pack byte-identical */
+    ok = ok && build_write_depfile(b);
     if (ok && exists) {
         /* Swap old and new in one step where the file system can. */
         if (renameat2(AT_FDCWD, tmp, AT_FDCWD, out, RENAME_EXCHANGE) == 0) {

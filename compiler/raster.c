@@ -385,6 +385,17 @@ done:
 
 /* ---- painted masks ------------------------------------------------------ */
 
+bool splat_raster_size(const char *what, const char *path, int *w, int *h,
+                       sg_loc loc, sg_diags *d)
+{
+    GDALDatasetH ds = open_raster(path, loc, d);
+    if (!ds) return false;
+    *w = GDALGetRasterXSize(ds);
+    *h = GDALGetRasterYSize(ds);
+    GDALClose(ds);
+    return splat_raster_check_size(what, path, *w, *h, loc, d);
+}
+
 uint8_t *splat_raster_mask(const char *what, const char *path, int *out_w,
                            int *out_h, sg_loc loc, sg_diags *d)
 {

@@ -65,51 +65,70 @@ static bool is_png(const char *file)
     return dot && strcmp(dot, ".png") == 0;
 }
 
+/* splatc's bound on the painted masks it holds (the decoded rasters: one
+ * byte a texel), checked on the headers before any data is decoded:
+ * eight full-size 16384^2 masks.  Placed masks that no material reads are
+ * not decoded at all (load_painted). */
+#define MAX_PAINTED_BYTES ((unsigned long long)2 << 30)
+
 /* An 8-bit greyscale raster of exactly *w x *h texels (any size, returned
  * in *w, *h, when *w is 0), or NULL (error at loc): a PNG through
- * stb_image, anything else through GDAL (raster.c). */
+ * stb_image, anything else through GDAL (raster.c).  With !decode only
+ * the header is read and checked (*w, *h as found) and the raster
+ * returned is a single texel of 0. */
 static uint8_t *load_mask(const char *name, const char *file, int *pw, int *ph,
-                          sg_loc loc, sg_diags *d)
+                          bool decode, sg_loc loc, sg_diags *d)
 {
     bool any = *pw == 0;
-    int w = *pw, h = *ph;
+    int w = *pw, h = *ph, fw = 0, fh = 0;
+    char what[160];
+    snprintf(what, sizeof what, "painted mask '%s'", name);
+    FILE *f = NULL;
     if (!is_png(file)) {
-        char what[160];
-        snprintf(what, sizeof what, "painted mask '%s'", name);
-        int fw = 0, fh = 0;
-        uint8_t *px = splat_raster_mask(what, file, &fw, &fh, loc, d);
-        if (px && any) {
-            *pw = fw;
-            *ph = fh;
-        } else if (px && (fw != w || fh != h)) {
-            sg_errorf(d, loc, SG_E_RASTER, "painted mask '%s' ('%s') is %d x %d texels; the "
-                        "heightfield is %d x %d", name, file, fw, fh, w, h);
-            free(px);
-            px = NULL;
+        if (!splat_raster_size(what, file, &fw, &fh, loc, d))
+            return NULL;
+    } else {
+        int comp;
+        bool is16;
+        f = splat_png_open(what, file, &fw, &fh, &comp, &is16, loc, d);
+        if (!f)
+            return NULL;
+        if (comp != 1 || is16) {
+            fclose(f);
+            sg_errorf(d, loc, SG_E_RASTER, "painted mask '%s' ('%s') must be an 8-bit "
+                        "greyscale image, found %d channels of %d bits", name, file,
+                        comp, is16 ? 16 : 8);
+            return NULL;
         }
-        return px;
-    }
-    int fw, fh, comp;
-    bool is16;
-    FILE *f = splat_png_open("painted mask", file, &fw, &fh, &comp, &is16, loc, d);
-    if (!f)
-        return NULL;
-    if (comp != 1 || is16) {
-        fclose(f);
-        sg_errorf(d, loc, SG_E_RASTER, "painted mask '%s' ('%s') must be an 8-bit "
-                    "greyscale image, found %d channels of %d bits", name, file,
-                    comp, is16 ? 16 : 8);
-        return NULL;
     }
     if (any) {
-        *pw = w = fw;
-        *ph = h = fh;
+        w = fw;
+        h = fh;
     } else if (fw != w || fh != h) {
-        fclose(f);
+        if (f)
+            fclose(f);
         sg_errorf(d, loc, SG_E_RASTER, "painted mask '%s' ('%s') is %d x %d texels; the "
                     "heightfield is %d x %d (or place it: { origin = X Z, size = W H })",
                     name, file, fw, fh, w, h);
         return NULL;
+    }
+    *pw = w;
+    *ph = h;
+    if (!decode) {
+        if (f)
+            fclose(f);
+        return xcalloc(1, 1);
+    }
+    size_t n = (size_t)w * (size_t)h;
+    if (!f) {
+        int gw = 0, gh = 0;
+        uint8_t *px = splat_raster_mask(what, file, &gw, &gh, loc, d);
+        if (px && (gw != w || gh != h)) {   /* changed since the probe */
+            sg_error(d, loc, SG_E_IO, file, "changed while it was read");
+            free(px);
+            px = NULL;
+        }
+        return px;
     }
     int lw, lh, lc;
     uint8_t *px = stbi_load_from_file(f, &lw, &lh, &lc, 1);
@@ -124,7 +143,6 @@ static uint8_t *load_mask(const char *name, const char *file, int *pw, int *ph,
         return NULL;
     }
     /* Own the pixels with malloc so splat_scene_free needs no stb. */
-    size_t n = (size_t)w * (size_t)h;
     uint8_t *out = malloc(n);
     if (out) memcpy(out, px, n);
     else sg_error(d, loc, SG_E_OUT_OF_MEMORY, "painted mask does not fit in memory");
@@ -141,7 +159,7 @@ static bool load_holes(splat_scene *s, sg_diags *d)
     sg_loc loc = sg_loc_or(sc->holes_loc, sc->loc);
     if (sc->holes) {
         int w = t->width, h = t->height;
-        uint8_t *m = load_mask("holes", sc->holes, &w, &h, loc, d);
+        uint8_t *m = load_mask("holes", sc->holes, &w, &h, true, loc, d);
         if (!m) return false;
         size_t n = (size_t)t->width * (size_t)t->height;
         for (size_t i = 0; i < n; i++)
@@ -156,27 +174,68 @@ static bool load_holes(splat_scene *s, sg_diags *d)
     return true;
 }
 
+/* The scene's painted masks, after the materials are lowered.  First
+ * every header is read and checked; a placed mask that no material reads
+ * (no OP_PAINTED node names it) stays at that: a single texel of 0 stands
+ * for it in the pack.  The rest must fit MAX_PAINTED_BYTES together
+ * before any is decoded. */
 static bool load_painted(splat_scene *s, sg_diags *d)
 {
     const sg_scene *sc = s->desc;
     if (sc->npainted == 0) return true;
     s->painted = calloc((size_t)sc->npainted, sizeof *s->painted);
     s->painted_size = calloc((size_t)sc->npainted, sizeof *s->painted_size);
-    if (!s->painted || !s->painted_size) {
+    uint8_t *decode = calloc((size_t)sc->npainted, 1);
+    if (!s->painted || !s->painted_size || !decode) {
+        free(decode);
         sg_error(d, sc->loc, SG_E_OUT_OF_MEMORY, "painted masks do not fit in memory");
         return false;
     }
+    /* ir.painted[i] is scene mask i (lower_materials adds them first) */
+    for (uint32_t id = 1; id < s->ir.nnodes; id++) {
+        const ir_node *n = &s->ir.nodes[id];
+        if (n->op == IR_OP_PAINTED && n->imm < (uint32_t)sc->npainted)
+            decode[n->imm] = 1;
+    }
+    unsigned long long total = 0;
     bool ok = true;
-    for (int i = 0; i < sc->npainted; i++) {
+    for (int i = 0; i < sc->npainted; i++) {       /* the headers */
         const sg_scene_painted *pm = &sc->painted[i];
         int *wh = s->painted_size[i];
         bool placed = pm->place_loc.line > 0;
+        decode[i] |= !placed;
         wh[0] = placed ? 0 : s->terrain.width;
         wh[1] = placed ? 0 : s->terrain.height;
-        s->painted[i] = load_mask(pm->name, pm->file, &wh[0], &wh[1],
-                                  sg_loc_or(pm->loc, sc->loc), d);
-        ok &= s->painted[i] != NULL;
+        sg_loc loc = sg_loc_or(pm->loc, sc->loc);
+        s->painted[i] = load_mask(pm->name, pm->file, &wh[0], &wh[1], false, loc, d);
+        if (!s->painted[i]) {
+            ok = false;
+            continue;
+        }
+        if (!decode[i]) {
+            wh[0] = wh[1] = 1;
+            continue;
+        }
+        total += (unsigned long long)wh[0] * (unsigned long long)wh[1];
+        if (ok && total > MAX_PAINTED_BYTES) {
+            sg_errorf(d, loc, SG_E_OVER_LIMIT, "with painted mask '%s' (%d x %d texels) the "
+                      "painted masks that materials read would take %llu MiB, over "
+                      "splatc's bound of %llu MiB; use fewer or smaller masks, or place "
+                      "them over the area they cover", pm->name, wh[0], wh[1], total >> 20,
+                      MAX_PAINTED_BYTES >> 20);
+            ok = false;
+        }
     }
+    for (int i = 0; ok && i < sc->npainted; i++) {  /* the data */
+        if (!decode[i])
+            continue;
+        const sg_scene_painted *pm = &sc->painted[i];
+        free(s->painted[i]);
+        s->painted[i] = load_mask(pm->name, pm->file, &s->painted_size[i][0],
+                                  &s->painted_size[i][1], true, sg_loc_or(pm->loc, sc->loc), d);
+        ok = s->painted[i] != NULL;
+    }
+    free(decode);
     return ok;
 }
 
@@ -348,7 +407,7 @@ bool splat_scene_load(splat_scene *s, const char *path,
     if (sc->hf_format != SG_HF_R16 &&
         !sg_scene_cells_fit(sc, s->terrain.width, s->terrain.height, d))
         goto fail;
-    if (!load_holes(s, d) || !load_painted(s, d) || !lower_materials(s, d) ||
+    if (!load_holes(s, d) || !lower_materials(s, d) || !load_painted(s, d) ||
         d->nerrors > errors)
         goto fail;
     if (!splat_compositor_check(s->prog, sc->compositor ? sc->compositor : "linear_alpha",

@@ -68,6 +68,10 @@ int  splat_terrain_hole(const splat_terrain *t, int x, int z);
  * Conversions are reported as notes at `loc`. */
 bool splat_raster_heightfield(splat_terrain *t, const char *path, bool size_given,
                               sg_loc loc, sg_diags *d);
+/* A raster's size in texels, checked against the pack limit, without
+ * reading its data; false with the error at loc. */
+bool splat_raster_size(const char *what, const char *path, int *w, int *h,
+                       sg_loc loc, sg_diags *d);
 /* An 8-bit mask (band 1) of any size, malloc'd; `what` names it in
  * errors ("painted mask 'road'").  NULL on error. */
 uint8_t *splat_raster_mask(const char *what, const char *path, int *w, int *h,

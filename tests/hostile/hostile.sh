@@ -15,9 +15,18 @@
 #   mesh     OBJ files refused before tinyobjloader: `v nan`, a face of
 #            100000 corners, a file over 64 MiB (sparse: nothing is read);
 #            the rest of the text checks are unit.test_mesh's
+#   masks    40 placed 16384^2 masks from one small PNG (BIG_PNG writes it),
+#            one read by a material: builds, decoding that one only (max
+#            RSS under 1 GB where /usr/bin/time measures it, unless
+#            SANITIZE); 9 read ones: refused from their headers (over
+#            splatc's 2 GiB bound) before any is decoded
+#   depfile  an unwritable --depfile over an existing pack: the build fails
+#            and the old pack stays byte-identical
 set -u
 SPLATC=$1
 CASE=$2
+BIG_PNG=${3:-}          # masks: tests/hostile/big_png
+SANITIZE=${4:-OFF}      # masks: ON under ASan (no memory bound then)
 TMP=$(mktemp -d "${TMPDIR:-/tmp}/splatc_hostile.XXXXXX")
 trap 'rm -rf "$TMP"' EXIT
 fails=0
@@ -172,6 +181,72 @@ mesh)
     truncate -s 65M "$d/m.obj" || fail "truncate"
     build_fails "$d" 8 "a 65 MiB OBJ file"
     grep -q "over the limit of 67108864" "$d/err" || fail "huge OBJ: wrong message"
+    ;;
+masks)
+    d="$TMP/masks"; base_scene "$d"
+    "$BIG_PNG" "$d/big.png" 16384 || fail "big_png"
+    # mask 'west' (read by west_paint) and 39 others nobody reads, all
+    # placed 16384^2 rasters over the terrain
+    places=""
+    i=0; while [ $i -lt 39 ]; do
+        places="$places    painted unused$i = \"big.png\" { origin = 0 0, size = 64 32 }\n"
+        i=$((i + 1)); done
+    sed -i "s|    painted west = \"mask.png\"|${places}    painted west = \"big.png\" { origin = 0 0, size = 64 32 }|" "$d/scene.sg"
+    [ "$(grep -c 'big.png' "$d/scene.sg")" = 40 ] || fail "masks: the scene has not 40 masks"
+    if [ -x /usr/bin/time ]; then
+        timeout 300 /usr/bin/time -f '%M' -o "$d/rss" "$SPLATC" build "$d/scene.sg" -o "$d/pack" \
+            -I . > /dev/null 2> "$d/err" || { fail "40 placed masks, 1 read: no pack"; cat "$d/err"; }
+        kb=$(tail -1 "$d/rss")
+        echo "40 placed 16384^2 masks, 1 read: max RSS $((kb / 1024)) MiB"
+        [ "$SANITIZE" = ON ] || [ "$kb" -lt 1048576 ] || fail "masks: max RSS ${kb} KiB, over 1 GiB"
+    else
+        timeout 300 "$SPLATC" build "$d/scene.sg" -o "$d/pack" -I . > /dev/null 2> "$d/err" ||
+            { fail "40 placed masks, 1 read: no pack"; cat "$d/err"; }
+    fi
+    # nine read masks of 16384^2: 2304 MiB, refused at the ninth
+    d="$TMP/masks_read"; base_scene "$d"
+    "$BIG_PNG" "$d/big.png" 16384 || fail "big_png"
+    i=0; places=""
+    while [ $i -lt 9 ]; do
+        places="$places    painted m$i = \"big.png\" { origin = 0 0, size = 64 32 }\n"
+        i=$((i + 1)); done
+    # one material reading the nine (summed), appended to the scene file
+    {
+        printf 'material nine {\n'
+        i=0; while [ $i -lt 9 ]; do printf '    node p%d : painted { mask = "m%d" }\n' $i $i; i=$((i + 1)); done
+        printf '    node s : add { a = p0.out, b = p1.out }\n'
+        i=2; prev=s; while [ $i -lt 9 ]; do printf '    node s%d : add { a = %s.out, b = p%d.out }\n' $i $prev $i; prev=s$i; i=$((i + 1)); done
+        printf '    out mask = %s.out\n}\n' $prev
+    } > "$d/nine.sg"
+    sed -i -e "s|    painted west = \"mask.png\"|${places}    painted west = \"mask.png\"|" \
+           -e 's|materials = \[base, west_paint\]|materials = [base, west_paint, nine]|' \
+           -e '2a import "nine.sg"' "$d/scene.sg"
+    line=$(grep -n 'painted m8 ' "$d/scene.sg" | cut -d: -f1)
+    build_fails "$d" "$line" "nine read 16384^2 masks"
+    grep -q "over splatc's bound of 2048 MiB" "$d/err" || fail "masks: wrong message"
+    ;;
+depfile)
+    d="$TMP/dep"; base_scene "$d"
+    timeout 120 "$SPLATC" build "$d/scene.sg" -o "$d/pack" -I . > /dev/null 2> "$d/err" ||
+        { fail "first build"; cat "$d/err"; }
+    cp -r "$d/pack" "$TMP/pack.before" || fail "copy the pack"
+    # a change, so the rebuild writes a new pack; the depfile's folder is
+    # missing, so the depfile cannot be written
+    sed -i 's/max_height = 50/max_height = 60/' "$d/scene.sg"
+    timeout 120 "$SPLATC" build "$d/scene.sg" -o "$d/pack" -I . --depfile "$d/no/such/dir/pack.d" \
+        > /dev/null 2> "$d/err"
+    got=$?
+    [ "$got" = 1 ] || fail "unwritable depfile: exit $got, expected 1"
+    grep -q "pack.d" "$d/err" || fail "unwritable depfile: the error does not name it"
+    if diff -r "$TMP/pack.before" "$d/pack" > "$TMP/diff"; then :; else
+        fail "unwritable depfile: the old pack changed"; head -5 "$TMP/diff"; fi
+    ls "$d" | grep -q 'tmp-' && fail "unwritable depfile: a temporary folder is left"
+    # and with a writable one the same rebuild replaces the pack
+    timeout 120 "$SPLATC" build "$d/scene.sg" -o "$d/pack" -I . --depfile "$d/pack.d" \
+        > /dev/null 2> "$d/err" || { fail "rebuild with a depfile"; cat "$d/err"; }
+    if cmp -s "$TMP/pack.before/manifest.json" "$d/pack/manifest.json"; then
+        fail "the rebuild did not replace the pack"; fi
+    [ -s "$d/pack.d" ] || fail "no depfile written"
     ;;
 *)
     echo "unknown case $CASE"; exit 2 ;;
