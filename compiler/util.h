@@ -64,6 +64,8 @@ bool splat_write_atomic(const char *path, const void *data, size_t n);
 #define SPLAT_MAX_MESH_BYTES   ((unsigned long long)64 << 20)   /* OBJ files  */
 #define SPLAT_MAX_IMAGE_BYTES  ((unsigned long long)1 << 30)    /* PNG, …     */
 #define SPLAT_MAX_RASTER_BYTES ((unsigned long long)4 << 30)    /* GDAL, R16  */
+#define SPLAT_MAX_SPIRV_BYTES  ((unsigned long long)64 << 20)   /* the SPIR-V
+                                  cache's entries, an existing pack's shaders */
 
 /* Open `path` for reading as an untrusted input, the one way every input
  * is opened: open(2) with O_RDONLY | O_NONBLOCK | O_CLOEXEC (a FIFO's open
