@@ -22,7 +22,7 @@ static int chunk(FILE *f, const char *type, const uint8_t *data, uint32_t n)
     uLong crc = crc32(crc32(0, (const Bytef *)type, 4), data, n);
     uint8_t tail[4];
     put32(tail, (uint32_t)crc);
-    return fwrite(head, 1, 8, f) == 8 && fwrite(data, 1, n, f) == n &&
+    return fwrite(head, 1, 8, f) == 8 && (n == 0 || fwrite(data, 1, n, f) == n) &&
            fwrite(tail, 1, 4, f) == 4;
 }
 
@@ -60,6 +60,7 @@ int main(int argc, char **argv)
     }
     deflateEnd(&z);
     free(row);
-    ok = ok && chunk(f, "IEND", NULL, 0);
+    static const uint8_t none[1];
+    ok = ok && chunk(f, "IEND", none, 0);
     return fclose(f) == 0 && ok ? 0 : 1;
 }
