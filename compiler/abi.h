@@ -186,6 +186,7 @@
 #ifndef SPLAT_ABI_H
 #define SPLAT_ABI_H
 
+#include <math.h>
 #include <stdint.h>
 
 #define SPLAT_ABI_VERSION 4   /* 2: splat_frame.light; 3: GGX lighting, screen.w;
@@ -243,7 +244,49 @@ enum {
                                        layers fit every device)             */
     SPLAT_MAX_DESTRUCTION_CELLS = 1024, /* destruction grid cells per side  */
     SPLAT_MAX_TEXTURES = 64,        /* textures of a scene (set 1 bindings)  */
+    SPLAT_MAX_MESH_VERTICES = 65536,  /* vertices of one undergrowth mesh    */
+    SPLAT_MAX_MESH_INDICES = 196608,  /* indices of one (a triangle list)     */
+    SPLAT_MAX_UG_BLOCKS = 64,       /* undergrowth blocks of a pack          */
 };
+
+/* Values of a pack, bounded on both sides (PACK.md "Limits"); every
+ * number in the manifest and meshes.bin is finite, too. */
+#define SPLAT_MAX_EXTENT 1.0e8      /* |size|, |max_height|, |height_offset|
+                                       (m): exact enough as floats on the
+                                       GPU, and far past any planet      */
+#define SPLAT_MAX_MESH_VALUE 1000.0 /* |each float of a mesh vertex|:
+                                       position (m), normal, uv          */
+#define SPLAT_MAX_UG_DENSITY 64.0   /* instances per m^2 of one block     */
+
+/* The undergrowth's instance buffer (runtime/undergrowth.c): a pool of
+ * cells SPLAT_UG_CELL metres wide, every cell within the radius around
+ * the camera (SPLAT_UG_RADIUS unless the viewer asks for another), each
+ * with room for every block's candidates (a jittered grid of
+ * splat_ug_candidates(density) points), SPLAT_UG_INSTANCE_BYTES each.
+ * The runtime refuses a buffer over the device's maxStorageBufferRange
+ * or SPLAT_UG_MAX_INSTANCE_BYTES; splatc refuses a scene whose buffer at
+ * the default radius is over SPLAT_UG_PACK_INSTANCE_BYTES, Vulkan's
+ * minimum maxStorageBufferRange (lavapipe's), so that every pack's
+ * undergrowth fits every device: about 83 instances per m^2 in all. */
+#define SPLAT_UG_CELL 16.0
+#define SPLAT_UG_RADIUS 96.0
+#define SPLAT_UG_INSTANCE_BYTES 32u
+#define SPLAT_UG_MAX_INSTANCE_BYTES ((uint64_t)256 << 20)
+#define SPLAT_UG_PACK_INSTANCE_BYTES ((uint64_t)128 << 20)
+
+/* Candidates per cell of a block of `density` (a square grid, enough
+ * that each is kept with probability density * cell^2 / n^2 <= 1). */
+static inline uint32_t splat_ug_candidates(double density)
+{
+    uint32_t n = (uint32_t)ceil(sqrt(density * SPLAT_UG_CELL * SPLAT_UG_CELL));
+    return n * n;
+}
+/* Cells of the pool for a radius (m): a square of them around the camera. */
+static inline uint32_t splat_ug_pool(double radius)
+{
+    uint32_t side = (uint32_t)ceil(2 * radius / SPLAT_UG_CELL) + 2;
+    return side * side;
+}
 
 /* Periodic sites of terrain.position (compiler/precision.c): at most this
  * many per pack, each a vec4 of splat_frame.world. */

@@ -53,7 +53,10 @@
 
 static bool hash_file(XXH3_state_t *st, const char *path)
 {
-    FILE *f = fopen(path, "rb");
+    /* a regular file of bounded size: a texture linked to /dev/zero must
+     * not spin here (util.h) */
+    char why[256];
+    FILE *f = splat_input_fopen(path, SPLAT_MAX_RASTER_BYTES, why, sizeof why);
     if (!f)
         return false;
     char buf[1 << 16];
@@ -287,10 +290,10 @@ static void dep_path(ir_buf *o, const char *p)
     }
 }
 
-/* --depfile: "PACKDIR/manifest.json: every input", written atomically
- * after the pack is (or is found) up to date, so Make and Ninja rebuild
- * the pack when any file it was made from changes. */
-static bool write_depfile(build *b)
+/* --depfile: "PACKDIR/manifest.json: every input", so Make and Ninja
+ * rebuild the pack when any file it was made from changes (build.h: the
+ * pack writer calls it before its swap). */
+bool build_write_depfile(build *b)
 {
     if (!b->desc->depfile)
         return true;
@@ -379,7 +382,7 @@ bool splat_build(const splat_build_desc *desc, splat_build_stats *st, sg_diags *
 
     phase(&b, load, &st->load);             /* parse, check, lower, rasters */
     if (unchanged(&b)) {
-        phase(&b, write_depfile, &st->write);
+        phase(&b, build_write_depfile, &st->write);
         return build_finish(&b);
     }
     phase(&b, analyse, &st->analysis);      /* painted masks, combinations  */
@@ -388,7 +391,6 @@ bool splat_build(const splat_build_desc *desc, splat_build_stats *st, sg_diags *
     phase(&b, build_compile, &st->glslang); /* cache, then glslang          */
     phase(&b, build_validate, &st->validate); /* spirv-val, cache puts      */
     phase(&b, build_far_atlas, &st->far_atlas); /* --far-atlas: the bake    */
-    phase(&b, write_out, &st->write);       /* manifest, files, swap        */
-    phase(&b, write_depfile, &st->write);   /* --depfile: every input       */
+    phase(&b, write_out, &st->write);       /* manifest, files, depfile, swap */
     return build_finish(&b);
 }

@@ -116,8 +116,18 @@ bool build_far_atlas_device(build *b, const char *dir);
 /* --stats: its size, density and bake time (nothing without an atlas). */
 void build_report_far(const build *b, FILE *out);
 
+/* ---- the depfile (build.c) ------------------------------------------------ */
+
+/* --depfile (if given): "PACKDIR/manifest.json: every input", written
+ * atomically.  build_write_pack calls it after the new pack is complete
+ * and before the swap, so a depfile that cannot be written leaves the old
+ * pack as it was; an up-to-date build writes it alone. */
+bool build_write_depfile(build *b);
+
 /* ---- the pack writer (pack_write.c) -------------------------------------- */
 
+/* Write the pack into a temporary folder beside b->out, then the depfile,
+ * then swap it in; on any failure the old pack (if any) stays as it was. */
 bool build_write_pack(build *b);
 /* A texture's k-th mip file ("rock.mip1.png") and how many it has. */
 char *build_mip_path(const char *path, int k);

@@ -82,7 +82,8 @@ static int pack_spirv_instructions(const build *b, const char *rel)
     if (!rel)
         return -1;
     char *path = xasprintf("%s/%s", b->out, rel);
-    FILE *f = fopen(path, "rb");
+    char why[256];   /* the pack is read as any input: no FIFO hangs here */
+    FILE *f = splat_input_fopen(path, SPLAT_MAX_SPIRV_BYTES, why, sizeof why);
     free(path);
     if (!f)
         return -1;

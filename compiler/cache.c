@@ -118,7 +118,8 @@ bool splat_cache_get(const splat_cache *c, const char *key, uint32_t **words,
     if (!c->dir)
         return false;
     char *path = entry_path(c, key, false);
-    FILE *f = fopen(path, "rb");
+    char why[256];   /* a regular file of bounded size, or a miss */
+    FILE *f = splat_input_fopen(path, SPLAT_MAX_SPIRV_BYTES, why, sizeof why);
     free(path);
     if (!f)
         return false;

@@ -67,7 +67,12 @@ static double srgb_to_linear(double c)
 static float *load_rgba(const char *path, bool srgb, int *w, int *h)
 {
     int n;
-    stbi_uc *px = stbi_load(path, w, h, &n, 4);
+    char why[256];
+    FILE *file = splat_input_fopen(path, SPLAT_MAX_IMAGE_BYTES, why, sizeof why);
+    if (!file)
+        return NULL;
+    stbi_uc *px = stbi_load_from_file(file, w, h, &n, 4);
+    fclose(file);
     if (!px)
         return NULL;
     size_t count = (size_t)*w * (size_t)*h * 4;

@@ -10,11 +10,14 @@
 #include "mesh.h"
 
 #include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include <xxhash.h>
 
+#include "abi.h"
 #include "util.h"
 
 const char *const splat_mesh_builtins[] = { "grass", "plant", "stone", NULL };
@@ -296,11 +299,99 @@ static uint32_t merge(splat_mesh *m, uint32_t *slots, uint32_t mask, const splat
     }
 }
 
+/* The next whitespace-separated word of line [*p, end), or NULL. */
+static const char *word(const char **p, const char *end, size_t *n)
+{
+    const char *s = *p;
+    while (s < end && (*s == ' ' || *s == '\t' || *s == '\r'))
+        s++;
+    const char *e = s;
+    while (e < end && *e != ' ' && *e != '\t' && *e != '\r')
+        e++;
+    *p = e;
+    *n = (size_t)(e - s);
+    return e > s ? s : NULL;
+}
+
+static bool scan_fail(char **err, size_t line, const char *fmt, ...)
+    __attribute__((format(printf, 3, 4)));
+static bool scan_fail(char **err, size_t line, const char *fmt, ...)
+{
+    char msg[256];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(msg, sizeof msg, fmt, ap);
+    va_end(ap);
+    *err = xasprintf("line %zu: %s", line, msg);
+    return false;
+}
+
+bool splat_obj_scan(const char *text, size_t len, char **err)
+{
+    const char *end = text + len;
+    size_t line = 0, count[3] = { 0 }, indices = 0;
+    static const char *const kinds[3] = { "v", "vn", "vt" };
+    for (const char *p = text; p < end; ) {
+        const char *eol = memchr(p, '\n', (size_t)(end - p));
+        if (!eol)
+            eol = end;
+        line++;
+        const char *at = p;
+        p = eol + 1;
+        size_t n;
+        const char *kw = word(&at, eol, &n);
+        if (!kw || kw[0] == '#')
+            continue;
+        int kind = n == 1 && kw[0] == 'v' ? 0 : n == 2 && kw[0] == 'v' && kw[1] == 'n' ? 1
+                 : n == 2 && kw[0] == 'v' && kw[1] == 't' ? 2 : -1;
+        if (kind >= 0) {
+            if (++count[kind] > SPLAT_MAX_MESH_INDICES)
+                return scan_fail(err, line, "more than %d '%s' lines (no mesh within the "
+                                 "limit of %d indices can use them)", SPLAT_MAX_MESH_INDICES,
+                                 kinds[kind], SPLAT_MAX_MESH_INDICES);
+            const char *w;
+            for (int k = 0; (w = word(&at, eol, &n)) != NULL; k++) {
+                char num[64];
+                snprintf(num, sizeof num, "%.*s", (int)(n < 63 ? n : 63), w);
+                double x = strtod(num, NULL);
+                if (!isfinite(x))
+                    return scan_fail(err, line, "'%s' value '%s' is not a finite number",
+                                     kinds[kind], num);
+                if (kind == 0 && k < 3 && !(fabs(x) <= SPLAT_MAX_MESH_VALUE))
+                    return scan_fail(err, line, "vertex coordinate %s is beyond the pack "
+                                     "limit of %g m either way", num, SPLAT_MAX_MESH_VALUE);
+            }
+        } else if (n == 1 && kw[0] == 'f') {
+            size_t corners = 0;
+            while (word(&at, eol, &n))
+                if (++corners > SPLAT_OBJ_MAX_FACE_CORNERS)
+                    return scan_fail(err, line, "a face of more than %d corners",
+                                     SPLAT_OBJ_MAX_FACE_CORNERS);
+            if (corners >= 3 && (indices += 3 * (corners - 2)) > SPLAT_MAX_MESH_INDICES)
+                return scan_fail(err, line, "the faces so far make more than %d indices, "
+                                 "the limit of an undergrowth mesh", SPLAT_MAX_MESH_INDICES);
+        }
+    }
+    return true;
+}
+
 bool splat_mesh_obj(const char *path, splat_mesh *m, char **err)
 {
     memset(m, 0, sizeof *m);
+    *err = NULL;
+    /* only regular files of bounded size (util.h): a FIFO or /dev/zero
+     * must not hang the compiler */
+    char why[256];
+    size_t len = 0;
+    char *text = splat_input_read(path, SPLAT_MAX_MESH_BYTES, &len, why, sizeof why);
+    if (!text) {
+        *err = xstrdup(why);
+        return false;
+    }
     splat_obj_corners c;
-    if (!splat_obj_read(path, &c, err))
+    bool ok = splat_obj_scan(text, len, err) && splat_obj_parse(text, len, &c, err);
+    free(text);
+    if (!ok)
         return false;
     float ylo = INFINITY, yhi = -INFINITY;
     for (uint32_t i = 0; i < c.n; i++) {

@@ -14,15 +14,13 @@
 #define SPLAT_MESH_H
 
 #include <stdbool.h>
+#include <stddef.h>
 #include <stdint.h>
 
 #ifdef __cplusplus
 extern "C" {
 #endif
 
-/* Largest mesh an undergrowth block may name (sg_load reports OVER_LIMIT). */
-#define SPLAT_MESH_MAX_VERTICES 65536
-#define SPLAT_MESH_MAX_INDICES  196608
 
 /* ---- mesh.c ---------------------------------------------------------------- */
 
@@ -53,22 +51,40 @@ bool splat_mesh_builtin(const char *name, splat_mesh *m);
 bool splat_mesh_builtin_far(const char *name, splat_mesh *m);
 /* Load an OBJ file: triangulated, identical vertices merged; normals from
  * the file or flat where it has none; uv from the file (uv.y clamped to
- * 0..1) or, where it has none, (0.5, height over the mesh's height).  No
- * size limits here (SPLAT_MESH_MAX_*: the caller's).  False with a
- * malloc'd message in *err (a missing file: strerror's text). */
+ * 0..1) or, where it has none, (0.5, height over the mesh's height).
+ * Before tinyobjloader sees it, the file is read as an untrusted input
+ * (util.h: a regular file of at most SPLAT_MAX_MESH_BYTES) and its text
+ * is checked line by line (splat_obj_scan).  The merged mesh's own limits
+ * (abi.h SPLAT_MAX_MESH_*) are the caller's.  False with a malloc'd
+ * message in *err (a missing file: strerror's text; a bad line:
+ * "line N: ..."). */
 bool splat_mesh_obj(const char *path, splat_mesh *m, char **err);
 void splat_mesh_free(splat_mesh *m);
 
+/* The most corners of one OBJ face: tinyobjloader triangulates a polygon
+ * in time quadratic in its corners (100000 took 30 s), and no mesh within
+ * the index limit needs a face this large. */
+#define SPLAT_OBJ_MAX_FACE_CORNERS 1024
+/* Check an OBJ file's text before it is parsed, so that nothing the limits
+ * refuse is ever built: every number of a `v`, `vn` or `vt` line finite
+ * (strtod reads "nan" and "inf", which tinyobjloader reads as 0), a `v`
+ * coordinate within SPLAT_MAX_MESH_VALUE, at most SPLAT_MAX_MESH_INDICES
+ * of each of `v`, `vn` and `vt` (no mesh within the limits can use more),
+ * faces of at most SPLAT_OBJ_MAX_FACE_CORNERS corners, and the faces'
+ * triangles within SPLAT_MAX_MESH_INDICES indices.  False with a
+ * malloc'd "line N: ..." in *err. */
+bool splat_obj_scan(const char *text, size_t len, char **err);
+
 /* ---- mesh_obj.cpp ---------------------------------------------------------- */
 
-/* An OBJ file's triangles as corners (3 per triangle), all malloc'd: pos
+/* An OBJ text's triangles as corners (3 per triangle), all malloc'd: pos
  * 3 floats a corner; nrm 3 (all 0 where the file gives none); uv 2 (NaN
- * where the file gives none).  Only regular files; `mtllib` is ignored. */
+ * where the file gives none).  `mtllib` is ignored. */
 typedef struct splat_obj_corners {
     float   *pos, *nrm, *uv;
     uint32_t n;
 } splat_obj_corners;
-bool splat_obj_read(const char *path, splat_obj_corners *c, char **err);
+bool splat_obj_parse(const char *text, size_t len, splat_obj_corners *c, char **err);
 
 #ifdef __cplusplus
 }

@@ -2,9 +2,9 @@
 // tinyobjloader (Debian's libtinyobjloader, float build).
 //
 // C++ only because tinyobjloader is a C++ library.  Keep this file to this
-// one function: merging vertices, normals and uv are mesh.c's.  The file is
-// read here (regular files only, as the .sg loader does: a FIFO must not
-// hang the compiler) and parsed from memory, with no material reader, so
+// one function: reading the file (bounded, regular files only), checking
+// its text against the limits, merging vertices, normals and uv are
+// mesh.c's.  The text is parsed from memory, with no material reader, so
 // an OBJ's `mtllib` never opens another file.
 #include "mesh.h"
 
@@ -12,12 +12,9 @@
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
-#include <fstream>
 #include <sstream>
 #include <string>
 #include <vector>
-
-#include <sys/stat.h>
 
 #include <tiny_obj_loader.h>
 
@@ -31,22 +28,12 @@ static bool fail(char **err, const std::string &msg)
     return false;
 }
 
-extern "C" bool splat_obj_read(const char *path, splat_obj_corners *c, char **err)
+extern "C" bool splat_obj_parse(const char *bytes, size_t len, splat_obj_corners *c,
+                                char **err)
 {
     *c = splat_obj_corners{};
     *err = nullptr;
-    struct stat st;
-    if (stat(path, &st))
-        return fail(err, strerror(errno));
-    if (!S_ISREG(st.st_mode))
-        return fail(err, "not a regular file");
-    std::ifstream f(path, std::ios::binary);
-    if (!f)
-        return fail(err, strerror(errno ? errno : EIO));
-    std::stringstream text;
-    text << f.rdbuf();
-    if (f.bad())
-        return fail(err, strerror(errno ? errno : EIO));
+    std::stringstream text(std::string(bytes, len));
 
     tinyobj::attrib_t a;
     std::vector<tinyobj::shape_t> shapes;

@@ -71,9 +71,10 @@ static bool write_file(build *b, const char *dir, const char *name, const void *
 
 static bool copy_file(build *b, const char *from, const char *dir, const char *name)
 {
-    FILE *f = fopen(from, "rb");
+    char why[256];
+    FILE *f = splat_input_fopen(from, SPLAT_MAX_IMAGE_BYTES, why, sizeof why);
     if (!f) {
-        sg_error(b->d, b->loc, SG_E_IO, from, strerror(errno));
+        sg_error(b->d, b->loc, SG_E_IO, from, why);
         return false;
     }
     size_t cap = 1 << 16, n = 0;
@@ -106,11 +107,28 @@ static uint8_t *le16(const uint16_t *v, size_t n)
     return out;
 }
 
+/* Every number of the manifest goes through jreal: JSON has no NaN or
+ * infinity (json_real returns NULL for them and the key would silently go
+ * missing), and a pack that builds must load.  A non-finite value is
+ * counted here (per thread: builds may run side by side in one process)
+ * and write_manifest fails the build; the checks before (scene.c's
+ * limits, the settings' ranges) name the value and its place first. */
+static _Thread_local int nonfinite;
+
+static json_t *jreal(double v)
+{
+    if (!isfinite(v)) {
+        nonfinite++;
+        v = 0;
+    }
+    return json_real(v);
+}
+
 static json_t *jreals(const double *v, int n)
 {
     json_t *a = json_array();
     for (int i = 0; i < n; i++)
-        json_array_append_new(a, json_real(v[i]));
+        json_array_append_new(a, jreal(v[i]));
     return a;
 }
 
@@ -193,33 +211,26 @@ char *build_mip_path(const char *path, int k)
 int build_mip_count(const char *src)
 {
     /* never more than the texture has below its base (PACK.md "Limits") */
-    int w = 0, h = 0, comp, levels = 0;
-    if (stbi_info(src, &w, &h, &comp))
+    long long w = 0, h = 0;
+    int comp, levels = 0;
+    bool is16;
+    char why[256];
+    FILE *f = splat_input_fopen(src, SPLAT_MAX_IMAGE_BYTES, why, sizeof why);
+    if (f && splat_image_info(f, &w, &h, &comp, &is16))
         while ((w > h ? w : h) >> (levels + 1))
             levels++;
+    if (f)
+        fclose(f);
     int k = 0;
     for (;;) {
         char *p = build_mip_path(src, k + 1);
         struct stat st;
-        bool there = stat(p, &st) == 0 && S_ISREG(st.st_mode);
+        bool there = stat(p, &st) == 0 && S_ISREG(st.st_mode);   /* stat: no open */
         free(p);
         if (!there || k >= levels)
             return k;
         k++;
     }
-}
-
-/* A texture within the pack limit (abi.h): one image on the GPU. */
-static bool texture_fits(build *b, const char *src)
-{
-    int w, h, comp;
-    if (!stbi_info(src, &w, &h, &comp) || (w <= SPLAT_MAX_TEXTURE && h <= SPLAT_MAX_TEXTURE))
-        return true;   /* unreadable images are the runtime's error (it names the file) */
-    char msg[512];
-    snprintf(msg, sizeof msg, "texture '%s' is %d x %d texels, over the pack limit of %d "
-             "per side", src, w, h, SPLAT_MAX_TEXTURE);
-    sg_error(b->d, b->loc, SG_E_OVER_LIMIT, msg);
-    return false;
 }
 
 /* ---- manifest.json, one function per section (PACK.md) -------------------- */
@@ -242,8 +253,8 @@ static json_t *jscene(build *b, const char *dir)
         json_object_set_new(hf, "holes", json_string("holes.r8"));
     json_object_set_new(scene, "heightfield", hf);
     json_object_set_new(scene, "size", jreals(s->terrain.size, 2));
-    json_object_set_new(scene, "max_height", json_real(s->terrain.max_height));
-    json_object_set_new(scene, "height_offset", json_real(s->terrain.height_offset));
+    json_object_set_new(scene, "max_height", jreal(s->terrain.max_height));
+    json_object_set_new(scene, "height_offset", jreal(s->terrain.height_offset));
     json_object_set_new(scene, "cell_texels", json_integer(b->analysis.cell_texels));
     json_t *cams = json_array();
     for (int i = 0; i < sc->ncameras; i++) {
@@ -259,7 +270,7 @@ static json_t *jscene(build *b, const char *dir)
         for (int k = 0; k < SPLAT_LIGHT_COUNT; k++) {
             const splat_light_key *lk = &splat_light_keys[k];
             if (sc->light.given & 1u << k)
-                json_object_set_new(l, lk->key, lk->n == 1 ? json_real(sc->light.v[k][0])
+                json_object_set_new(l, lk->key, lk->n == 1 ? jreal(sc->light.v[k][0])
                                                            : jreals(sc->light.v[k], lk->n));
         }
         json_object_set_new(scene, "light", l);
@@ -268,7 +279,7 @@ static json_t *jscene(build *b, const char *dir)
         json_t *dd = json_object();
         json_object_set_new(dd, "origin", jreals(sc->destruction_origin, 2));
         json_object_set_new(dd, "size", jreals(sc->destruction_size, 2));
-        json_object_set_new(dd, "cell_size", json_real(sc->destruction_cell));
+        json_object_set_new(dd, "cell_size", jreal(sc->destruction_cell));
         json_object_set_new(scene, "destruction", dd);
     } else {
         json_object_set_new(scene, "destruction", json_null());
@@ -310,8 +321,8 @@ static json_t *jparams(const splat_layout *L)
         json_object_set_new(o, "name", json_string(p->name));
         json_object_set_new(o, "type", json_string(tnames[p->type] ? tnames[p->type] : "float"));
         json_object_set_new(o, "default", jreals(p->def, 4));
-        json_object_set_new(o, "min", json_real(p->lo));
-        json_object_set_new(o, "max", json_real(p->hi));
+        json_object_set_new(o, "min", jreal(p->lo));
+        json_object_set_new(o, "max", jreal(p->hi));
         json_object_set_new(o, "offset", json_integer(16 * i));
         json_array_append_new(params, o);
     }
@@ -397,8 +408,8 @@ static json_t *jclasses(build *b, int i)
         const job *xj = find_class_job(b, i, k, JOB_CLASS_COMPUTE);
         json_t *o = json_object();
         json_t *dist = json_array();
-        json_array_append_new(dist, json_real(ci->dlo[k]));
-        json_array_append_new(dist, isinf(ci->dhi[k]) ? json_null() : json_real(ci->dhi[k]));
+        json_array_append_new(dist, jreal(ci->dlo[k]));
+        json_array_append_new(dist, isinf(ci->dhi[k]) ? json_null() : jreal(ci->dhi[k]));
         json_object_set_new(o, "distance", dist);
         char buf[160];
         snprintf(buf, sizeof buf, "%s.frag", fj->file);
@@ -408,7 +419,7 @@ static json_t *jclasses(build *b, int i)
             json_object_set_new(o, "spirv", json_string(buf));
         }
         json_object_set_new(o, "hash", json_string(fj->key));
-        json_object_set_new(o, "cost", json_real(ci->dcost[k]));
+        json_object_set_new(o, "cost", jreal(ci->dcost[k]));
         json_object_set_new(o, "compute", jcompute(xj));
         json_array_append_new(a, o);
     }
@@ -438,7 +449,7 @@ static json_t *jcombinations(build *b)
         json_object_set_new(o, "cells", json_integer(a->combos[i].ncells));
         json_object_set_new(o, "nodes", json_integer(a->combos[i].nnodes));
         json_object_set_new(o, "hash", json_string(cj->key));
-        json_object_set_new(o, "cost", json_real(b->combos[i].cost));
+        json_object_set_new(o, "cost", jreal(b->combos[i].cost));
         json_object_set_new(o, "compute", jcompute(xj));
         const job *uj = find_job(b, i, JOB_COMBO_UG);
         if (uj)
@@ -479,10 +490,10 @@ static json_t *jundergrowth(const splat_ug *u)
         json_object_set_new(m, "material", json_integer(k->material));
         json_object_set_new(m, "slot", json_integer(k->slot));
         json_object_set_new(m, "mesh", json_integer(k->mesh));
-        json_object_set_new(m, "density", json_real(k->u->density));
+        json_object_set_new(m, "density", jreal(k->u->density));
         json_object_set_new(m, "scale", jreals(k->u->scale, 2));
         json_object_set_new(m, "align", json_string(k->u->align_normal ? "normal" : "upright"));
-        json_object_set_new(m, "blend", json_real(k->u->blend));
+        json_object_set_new(m, "blend", jreal(k->u->blend));
         json_object_set_new(m, "color", jreals(k->u->color, 3));
         json_array_append_new(blocks, m);
     }
@@ -548,7 +559,7 @@ static json_t *manifest(build *b, char **tex_names, const char *dir)
         json_object_set_new(fa, "height", json_integer(b->far.height));
         json_object_set_new(fa, "levels", json_integer(b->far.levels));
         json_object_set_new(fa, "texel", json_pack("[f, f]", b->far.texel[0], b->far.texel[1]));
-        json_object_set_new(fa, "bake_distance", json_real(FAR_ATLAS_BAKE_DISTANCE));
+        json_object_set_new(fa, "bake_distance", jreal(FAR_ATLAS_BAKE_DISTANCE));
         json_object_set_new(fa, "bytes", json_integer((json_int_t)b->far.n));
         json_object_set_new(m, "far_atlas", fa);
     }
@@ -573,10 +584,18 @@ static bool write_sparse(build *b, const char *dir)
 static bool write_manifest(build *b, const char *dir)
 {
     char **tex_names = texture_names(b);
+    nonfinite = 0;
     json_t *m = manifest(b, tex_names, dir);
     for (int i = 0; i < b->layout.ntextures; i++)
         free(tex_names[i]);
     free(tex_names);
+    if (nonfinite > 0) {
+        json_decref(m);
+        sg_errorf(b->d, b->loc, SG_E_OVER_LIMIT, "the manifest would hold %d number%s "
+                  "that %s not finite (NaN or infinity); the runtime refuses such a pack",
+                  nonfinite, nonfinite == 1 ? "" : "s", nonfinite == 1 ? "is" : "are");
+        return false;
+    }
     char *text = json_dumps(m, JSON_INDENT(2) | JSON_PRESERVE_ORDER | JSON_REAL_PRECISION(15));
     json_decref(m);
     if (!text)
@@ -672,7 +691,7 @@ static bool write_contents(build *b, const char *dir)
             first &= strcmp(tex_names[k], tex_names[i]) != 0;
         const char *src = b->layout.src->textures[b->layout.textures[i]].file;
         if (first)
-            ok = texture_fits(b, src) && copy_file(b, src, dir, tex_names[i]);
+            ok = copy_file(b, src, dir, tex_names[i]);   /* checked: scene.c */
         for (int k = 1, n = first ? build_mip_count(src) : 0; ok && k <= n; k++) {
             char *from = build_mip_path(src, k), *to = build_mip_path(tex_names[i], k);
             ok = copy_file(b, from, dir, to);
@@ -744,6 +763,9 @@ bool build_write_pack(build *b)
     if (ok && b->far.pending)
         ok = build_far_atlas_device(b, tmp) && b->far.data &&
              write_file(b, tmp, "far.atlas", b->far.data, b->far.n) && write_manifest(b, tmp);
+    /* everything is written before the swap, the depfile included: a
+     * depfile that cannot be written leaves the old pack byte-identical */
+    ok = ok && build_write_depfile(b);
     if (ok && exists) {
         /* Swap old and new in one step where the file system can. */
         if (renameat2(AT_FDCWD, tmp, AT_FDCWD, out, RENAME_EXCHANGE) == 0) {

@@ -579,10 +579,23 @@ static void check_obj(parser *ps, const char *path, sg_loc at)
         free(err);
         return;
     }
-    if (m.nv > SPLAT_MESH_MAX_VERTICES || m.nidx > SPLAT_MESH_MAX_INDICES)
+    if (m.nv > SPLAT_MAX_MESH_VERTICES || m.nidx > SPLAT_MAX_MESH_INDICES)
         sg_errorf(ps->d, at, SG_E_OVER_LIMIT, "mesh '%s' has %u vertices and %u indices; "
                   "an undergrowth mesh may have at most %d and %d", path, m.nv, m.nidx,
-                  SPLAT_MESH_MAX_VERTICES, SPLAT_MESH_MAX_INDICES);
+                  SPLAT_MAX_MESH_VERTICES, SPLAT_MAX_MESH_INDICES);
+    /* meshes.bin's floats as the runtime's loader bounds them (abi.h) */
+    for (uint32_t i = 0; i < m.nv; i++) {
+        const splat_mesh_vertex *x = &m.v[i];
+        const float v[5] = { x->pos[0], x->pos[1], x->pos[2], x->uv[0], x->uv[1] };
+        for (int k = 0; k < 5; k++)
+            if (!(fabsf(v[k]) <= (float)SPLAT_MAX_MESH_VALUE)) {
+                sg_errorf(ps->d, at, SG_E_OVER_LIMIT, "mesh '%s' has a vertex %s of %g; the "
+                          "pack limit is %g either way (metres at scale 1, and uv)", path,
+                          k < 3 ? "coordinate" : "uv", (double)v[k], SPLAT_MAX_MESH_VALUE);
+                splat_mesh_free(&m);
+                return;
+            }
+    }
     splat_mesh_free(&m);
 }
 
@@ -1214,43 +1227,6 @@ typedef struct loader {
     int         depth;
 } loader;
 
-static char *read_all(const char *path, size_t *len, const char **err)
-{
-    FILE *f = fopen(path, "rb");
-    if (!f) {
-        *err = strerror(errno);
-        return NULL;
-    }
-    /* only regular files: an import of /dev/zero or a FIFO must not hang */
-    struct stat st;
-    if (fstat(fileno(f), &st) || !S_ISREG(st.st_mode)) {
-        *err = "not a regular file";
-        fclose(f);
-        return NULL;
-    }
-    size_t cap = 4096, n = 0;
-    char *buf = xmalloc(cap + 1);
-    for (;;) {
-        size_t got = fread(buf + n, 1, cap - n, f);
-        n += got;
-        if (n < cap) {
-            if (ferror(f)) {
-                *err = strerror(errno ? errno : EIO);
-                fclose(f);
-                free(buf);
-                return NULL;
-            }
-            break;
-        }
-        cap *= 2;
-        buf = xrealloc(buf, cap + 1);
-    }
-    fclose(f);
-    buf[n] = 0;
-    *len = n;
-    return buf;
-}
-
 /* Lex, parse and load the imports of `path` (text given, or read). */
 static int load_file(loader *l, const char *path, const char *text, size_t len,
                      sg_loc from, bool is_import)
@@ -1288,8 +1264,9 @@ static int load_file(loader *l, const char *path, const char *text, size_t len,
     }
     char *owned = NULL;
     if (!text) {
-        const char *err = NULL;
-        owned = read_all(path, &len, &err);
+        /* only regular files: an import of /dev/zero or a FIFO must not hang */
+        char err[256];
+        owned = splat_input_read(path, SPLAT_MAX_GRAPH_BYTES, &len, err, sizeof err);
         if (!owned) {
             free(rp);
             if (is_import)
@@ -1404,6 +1381,14 @@ sg_loc sg_material_loc(const sg_program *p, int i)
 {
     return p->shaders[p->materials[i]]->loc;
 }
+sg_loc sg_texture_loc(const sg_program *p, const char *file)
+{
+    for (int i = 0; i < p->ntextures; i++)
+        if (p->textures[i]->file && !strcmp(p->textures[i]->file, file))
+            return p->textures[i]->loc;
+    return (sg_loc){ 0 };
+}
+
 int sg_material_find(const sg_program *p, const char *name)
 {
     for (int i = 0; i < p->nmaterials; i++)

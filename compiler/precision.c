@@ -39,6 +39,7 @@
 #include <stb_image.h>
 
 #include "abi.h"
+#include "util.h"
 
 /* Maps of a composite's emission copy (compose.c): its params to layout
  * slots, and to the terrain input a param stands for (composites read
@@ -261,10 +262,16 @@ static double feature_size(const ir *ir, const ir_node *u, const splat_site *s)
         cell = s->mul ? 1.0 / hi : lo;
     }
     if (u->op == IR_OP_SAMPLE || u->op == IR_OP_SAMPLE_GRAD) {
-        int w = 256, h = 0, c = 0;
+        long long w = 256, h = 0;
+        int c = 0;
+        bool is16;
         const char *file = ir->textures[ir_get(ir, u->arg[0])->imm].file;
-        if (!stbi_info(file, &w, &h, &c) || w < 1)
+        char why[256];
+        FILE *f = splat_input_fopen(file, SPLAT_MAX_IMAGE_BYTES, why, sizeof why);
+        if (!f || !splat_image_info(f, &w, &h, &c, &is16) || w < 1)
             w = 256;
+        if (f)
+            fclose(f);
         cell /= w;
     }
     return cell;

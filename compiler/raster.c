@@ -34,6 +34,7 @@
 #include "terrain.h"
 
 #include "abi.h"
+#include "util.h"
 
 #include <errno.h>
 #include <math.h>
@@ -83,12 +84,12 @@ static void gdal_error(const char *path, const char *fallback, sg_loc loc,
 /* Open `path` with the allowed drivers, or NULL (error at loc). */
 static GDALDatasetH open_raster(const char *path, sg_loc loc, sg_diags *d)
 {
-    FILE *f = fopen(path, "rb");
-    if (!f) {
-        sg_error(d, loc, SG_E_IO, path, strerror(errno));
+    /* a FIFO, a device or a folder never reaches GDAL (util.h) */
+    char why[256];
+    if (!splat_input_check(path, SPLAT_MAX_RASTER_BYTES, why, sizeof why)) {
+        sg_error(d, loc, SG_E_IO, path, why);
         return NULL;
     }
-    fclose(f);
     pthread_once(&gdal_once, gdal_init);
     CPLErrorReset();
     CPLPushErrorHandler(CPLQuietErrorHandler);
@@ -383,6 +384,17 @@ done:
 }
 
 /* ---- painted masks ------------------------------------------------------ */
+
+bool splat_raster_size(const char *what, const char *path, int *w, int *h,
+                       sg_loc loc, sg_diags *d)
+{
+    GDALDatasetH ds = open_raster(path, loc, d);
+    if (!ds) return false;
+    *w = GDALGetRasterXSize(ds);
+    *h = GDALGetRasterYSize(ds);
+    GDALClose(ds);
+    return splat_raster_check_size(what, path, *w, *h, loc, d);
+}
 
 uint8_t *splat_raster_mask(const char *what, const char *path, int *out_w,
                            int *out_h, sg_loc loc, sg_diags *d)

@@ -65,70 +65,84 @@ static bool is_png(const char *file)
     return dot && strcmp(dot, ".png") == 0;
 }
 
+/* splatc's bound on the painted masks it holds (the decoded rasters: one
+ * byte a texel), checked on the headers before any data is decoded:
+ * eight full-size 16384^2 masks.  Placed masks that no material reads are
+ * not decoded at all (load_painted). */
+#define MAX_PAINTED_BYTES ((unsigned long long)2 << 30)
+
 /* An 8-bit greyscale raster of exactly *w x *h texels (any size, returned
  * in *w, *h, when *w is 0), or NULL (error at loc): a PNG through
- * stb_image, anything else through GDAL (raster.c). */
+ * stb_image, anything else through GDAL (raster.c).  With !decode only
+ * the header is read and checked (*w, *h as found) and the raster
+ * returned is a single texel of 0. */
 static uint8_t *load_mask(const char *name, const char *file, int *pw, int *ph,
-                          sg_loc loc, sg_diags *d)
+                          bool decode, sg_loc loc, sg_diags *d)
 {
     bool any = *pw == 0;
-    int w = *pw, h = *ph;
+    int w = *pw, h = *ph, fw = 0, fh = 0;
+    char what[160];
+    snprintf(what, sizeof what, "painted mask '%s'", name);
+    FILE *f = NULL;
     if (!is_png(file)) {
-        char what[160];
-        snprintf(what, sizeof what, "painted mask '%s'", name);
-        int fw = 0, fh = 0;
-        uint8_t *px = splat_raster_mask(what, file, &fw, &fh, loc, d);
-        if (px && any) {
-            *pw = fw;
-            *ph = fh;
-        } else if (px && (fw != w || fh != h)) {
-            sg_errorf(d, loc, SG_E_RASTER, "painted mask '%s' ('%s') is %d x %d texels; the "
-                        "heightfield is %d x %d", name, file, fw, fh, w, h);
-            free(px);
-            px = NULL;
-        }
-        return px;
-    }
-    int fw, fh, comp;
-    if (!stbi_info(file, &fw, &fh, &comp)) {
-        FILE *f = fopen(file, "rb");
-        if (!f) {
-            sg_error(d, loc, SG_E_IO, file, strerror(errno));
-        } else {
+        if (!splat_raster_size(what, file, &fw, &fh, loc, d))
+            return NULL;
+    } else {
+        int comp;
+        bool is16;
+        f = splat_png_open(what, file, &fw, &fh, &comp, &is16, loc, d);
+        if (!f)
+            return NULL;
+        if (comp != 1 || is16) {
             fclose(f);
-            sg_error(d, loc, SG_E_IO, file, "not a PNG image");
+            sg_errorf(d, loc, SG_E_RASTER, "painted mask '%s' ('%s') must be an 8-bit "
+                        "greyscale image, found %d channels of %d bits", name, file,
+                        comp, is16 ? 16 : 8);
+            return NULL;
         }
-        return NULL;
-    }
-    if (comp != 1 || stbi_is_16_bit(file)) {
-        sg_errorf(d, loc, SG_E_RASTER, "painted mask '%s' ('%s') must be an 8-bit "
-                    "greyscale image, found %d channels of %d bits", name, file,
-                    comp, stbi_is_16_bit(file) ? 16 : 8);
-        return NULL;
     }
     if (any) {
-        *pw = w = fw;
-        *ph = h = fh;
+        w = fw;
+        h = fh;
     } else if (fw != w || fh != h) {
+        if (f)
+            fclose(f);
         sg_errorf(d, loc, SG_E_RASTER, "painted mask '%s' ('%s') is %d x %d texels; the "
                     "heightfield is %d x %d (or place it: { origin = X Z, size = W H })",
                     name, file, fw, fh, w, h);
         return NULL;
     }
-    if (!splat_raster_check_size("painted mask", file, fw, fh, loc, d))
-        return NULL;
+    *pw = w;
+    *ph = h;
+    if (!decode) {
+        if (f)
+            fclose(f);
+        return xcalloc(1, 1);
+    }
+    size_t n = (size_t)w * (size_t)h;
+    if (!f) {
+        int gw = 0, gh = 0;
+        uint8_t *px = splat_raster_mask(what, file, &gw, &gh, loc, d);
+        if (px && (gw != w || gh != h)) {   /* changed since the probe */
+            sg_error(d, loc, SG_E_IO, file, "changed while it was read");
+            free(px);
+            px = NULL;
+        }
+        return px;
+    }
     int lw, lh, lc;
-    uint8_t *px = stbi_load(file, &lw, &lh, &lc, 1);
-    if (!px) {
+    uint8_t *px = stbi_load_from_file(f, &lw, &lh, &lc, 1);
+    fclose(f);
+    if (!px || lw != w || lh != h) {
         /* the header read, the data did not */
-        char why[160];
-        snprintf(why, sizeof why, "truncated or corrupt PNG (stb_image: %s)",
+        char msg[160];
+        snprintf(msg, sizeof msg, "truncated or corrupt PNG (stb_image: %s)",
                  stbi_failure_reason());
-        sg_error(d, loc, SG_E_IO, file, why);
+        sg_error(d, loc, SG_E_IO, file, msg);
+        stbi_image_free(px);
         return NULL;
     }
     /* Own the pixels with malloc so splat_scene_free needs no stb. */
-    size_t n = (size_t)w * (size_t)h;
     uint8_t *out = malloc(n);
     if (out) memcpy(out, px, n);
     else sg_error(d, loc, SG_E_OUT_OF_MEMORY, "painted mask does not fit in memory");
@@ -145,7 +159,7 @@ static bool load_holes(splat_scene *s, sg_diags *d)
     sg_loc loc = sg_loc_or(sc->holes_loc, sc->loc);
     if (sc->holes) {
         int w = t->width, h = t->height;
-        uint8_t *m = load_mask("holes", sc->holes, &w, &h, loc, d);
+        uint8_t *m = load_mask("holes", sc->holes, &w, &h, true, loc, d);
         if (!m) return false;
         size_t n = (size_t)t->width * (size_t)t->height;
         for (size_t i = 0; i < n; i++)
@@ -160,31 +174,75 @@ static bool load_holes(splat_scene *s, sg_diags *d)
     return true;
 }
 
+/* The scene's painted masks, after the materials are lowered.  First
+ * every header is read and checked; a placed mask that no material reads
+ * (no OP_PAINTED node names it) stays at that: a single texel of 0 stands
+ * for it in the pack.  The rest must fit MAX_PAINTED_BYTES together
+ * before any is decoded. */
 static bool load_painted(splat_scene *s, sg_diags *d)
 {
     const sg_scene *sc = s->desc;
     if (sc->npainted == 0) return true;
     s->painted = calloc((size_t)sc->npainted, sizeof *s->painted);
     s->painted_size = calloc((size_t)sc->npainted, sizeof *s->painted_size);
-    if (!s->painted || !s->painted_size) {
+    uint8_t *decode = calloc((size_t)sc->npainted, 1);
+    if (!s->painted || !s->painted_size || !decode) {
+        free(decode);
         sg_error(d, sc->loc, SG_E_OUT_OF_MEMORY, "painted masks do not fit in memory");
         return false;
     }
+    /* ir.painted[i] is scene mask i (lower_materials adds them first) */
+    for (uint32_t id = 1; id < s->ir.nnodes; id++) {
+        const ir_node *n = &s->ir.nodes[id];
+        if (n->op == IR_OP_PAINTED && n->imm < (uint32_t)sc->npainted)
+            decode[n->imm] = 1;
+    }
+    unsigned long long total = 0;
     bool ok = true;
-    for (int i = 0; i < sc->npainted; i++) {
+    for (int i = 0; i < sc->npainted; i++) {       /* the headers */
         const sg_scene_painted *pm = &sc->painted[i];
         int *wh = s->painted_size[i];
         bool placed = pm->place_loc.line > 0;
+        decode[i] |= !placed;
         wh[0] = placed ? 0 : s->terrain.width;
         wh[1] = placed ? 0 : s->terrain.height;
-        s->painted[i] = load_mask(pm->name, pm->file, &wh[0], &wh[1],
-                                  sg_loc_or(pm->loc, sc->loc), d);
-        ok &= s->painted[i] != NULL;
+        sg_loc loc = sg_loc_or(pm->loc, sc->loc);
+        s->painted[i] = load_mask(pm->name, pm->file, &wh[0], &wh[1], false, loc, d);
+        if (!s->painted[i]) {
+            ok = false;
+            continue;
+        }
+        if (!decode[i]) {
+            wh[0] = wh[1] = 1;
+            continue;
+        }
+        total += (unsigned long long)wh[0] * (unsigned long long)wh[1];
+        if (ok && total > MAX_PAINTED_BYTES) {
+            sg_errorf(d, loc, SG_E_OVER_LIMIT, "with painted mask '%s' (%d x %d texels) the "
+                      "painted masks that materials read would take %llu MiB, over "
+                      "splatc's bound of %llu MiB; use fewer or smaller masks, or place "
+                      "them over the area they cover", pm->name, wh[0], wh[1], total >> 20,
+                      MAX_PAINTED_BYTES >> 20);
+            ok = false;
+        }
     }
+    for (int i = 0; ok && i < sc->npainted; i++) {  /* the data */
+        if (!decode[i])
+            continue;
+        const sg_scene_painted *pm = &sc->painted[i];
+        free(s->painted[i]);
+        s->painted[i] = load_mask(pm->name, pm->file, &s->painted_size[i][0],
+                                  &s->painted_size[i][1], true, sg_loc_or(pm->loc, sc->loc), d);
+        ok = s->painted[i] != NULL;
+    }
+    free(decode);
     return ok;
 }
 
 /* ---- materials ---------------------------------------------------------- */
+
+static bool check_textures(splat_scene *s, const int *first_material, sg_diags *d);
+static bool check_extent(const splat_scene *s, sg_diags *d);
 
 static bool lower_materials(splat_scene *s, sg_diags *d)
 {
@@ -194,9 +252,15 @@ static bool lower_materials(splat_scene *s, sg_diags *d)
         (void)k;   /* == i: names are unique (check_scene) */
     }
     bool ok = true;
+    int *first_material = NULL;   /* per texture: the material that first samples it */
     for (int i = 0; i < sc->nmaterials; i++) {
-        int before = s->ir.npainted;
-        if (!sg_lower_material(s->prog, sc->materials[i], &s->ir, d)) {
+        int before = s->ir.npainted, tex_before = s->ir.ntextures;
+        bool lowered = sg_lower_material(s->prog, sc->materials[i], &s->ir, d);
+        first_material = xrealloc(first_material, ((size_t)s->ir.ntextures + 1) *
+                                                      sizeof *first_material);
+        for (int k = tex_before; k < s->ir.ntextures; k++)
+            first_material[k] = i;
+        if (!lowered) {
             ok = false;
             continue;
         }
@@ -216,7 +280,89 @@ static bool lower_materials(splat_scene *s, sg_diags *d)
             ok = false;
         }
     }
+    ok = ok && check_textures(s, first_material, d);
+    free(first_material);
     return ok;
+}
+
+/* ---- textures ------------------------------------------------------------ */
+
+/* Every texture the materials sample, checked once here so that nothing
+ * later (precision.c, far_atlas.c, the pack writer, the runtime) meets a
+ * FIFO, a device or an image over the pack limit: a regular file within
+ * SPLAT_MAX_IMAGE_BYTES, an image stb_image decodes, at most
+ * SPLAT_MAX_TEXTURE texels a side (the header's size, read from the PNG
+ * itself when stb_image refuses it).  Errors at the `texture`
+ * declaration, or at the scene's material that samples an inline one. */
+static bool check_textures(splat_scene *s, const int *first_material, sg_diags *d)
+{
+    const sg_scene *sc = s->desc;
+    bool ok = true;
+    for (int i = 0; i < s->ir.ntextures; i++) {
+        const char *file = s->ir.textures[i].file;
+        sg_loc loc = sg_texture_loc(s->prog, file);
+        if (loc.line == 0) {
+            int m = first_material[i];
+            loc = sc->material_locs && m >= 0 ? sg_loc_or(sc->material_locs[m], sc->loc)
+                                              : sc->loc;
+        }
+        char why[256];
+        FILE *f = splat_input_fopen(file, SPLAT_MAX_IMAGE_BYTES, why, sizeof why);
+        if (!f) {
+            sg_errorf(d, loc, SG_E_IO, "cannot read texture '%s': %s", file, why);
+            ok = false;
+            continue;
+        }
+        long long w, h;
+        int comp;
+        bool is16;
+        bool image = splat_image_info(f, &w, &h, &comp, &is16);
+        fclose(f);
+        if (!image) {
+            sg_errorf(d, loc, SG_E_IO, "cannot read texture '%s': not an image "
+                      "(PNG, JPEG, TGA, BMP, …)", file);
+            ok = false;
+        } else if (w < 1 || h < 1 || w > SPLAT_MAX_TEXTURE || h > SPLAT_MAX_TEXTURE) {
+            sg_errorf(d, loc, SG_E_OVER_LIMIT, "texture '%s' is %lld x %lld texels, over "
+                      "the pack limit of %d per side", file, w, h, SPLAT_MAX_TEXTURE);
+            ok = false;
+        } else if (comp == 0) {
+            sg_errorf(d, loc, SG_E_IO, "cannot read texture '%s': stb_image does not "
+                      "decode its %lld x %lld header", file, w, h);
+            ok = false;
+        }
+    }
+    return ok;
+}
+
+/* ---- the terrain's values ------------------------------------------------ */
+
+/* The loaded terrain's size and heights within the pack limits (abi.h
+ * SPLAT_MAX_EXTENT), finite: a GDAL raster brings its own (a Float64
+ * band at +-1.7e308 spans an infinite max_height), and the manifest must
+ * hold numbers the runtime accepts.  Errors at the heightfield. */
+static bool check_extent(const splat_scene *s, sg_diags *d)
+{
+    const splat_terrain *t = &s->terrain;
+    const sg_scene *sc = s->desc;
+    sg_loc loc = sg_loc_or(sc->heightfield_loc, sc->loc);
+    if (!(t->size[0] > 0 && t->size[0] <= SPLAT_MAX_EXTENT && t->size[1] > 0 &&
+          t->size[1] <= SPLAT_MAX_EXTENT)) {
+        sg_errorf(d, loc, SG_E_OVER_LIMIT, "heightfield '%s' gives a world size of %g x %g m; "
+                  "the pack limit is %g m a side", sc->heightfield, t->size[0], t->size[1],
+                  SPLAT_MAX_EXTENT);
+        return false;
+    }
+    double lo = t->height_offset, hi = t->height_offset + t->max_height;
+    if (!(t->max_height >= 0 && t->max_height <= SPLAT_MAX_EXTENT &&
+          fabs(t->height_offset) <= SPLAT_MAX_EXTENT && fabs(hi) <= SPLAT_MAX_EXTENT)) {
+        sg_errorf(d, loc, SG_E_OVER_LIMIT, "heightfield '%s' has heights from %g to %g m "
+                  "(max_height %g, height_offset %g); the pack limit is finite heights "
+                  "within %g m of 0", sc->heightfield, lo, hi, t->max_height,
+                  t->height_offset, SPLAT_MAX_EXTENT);
+        return false;
+    }
+    return true;
 }
 
 /* ---- the scene ---------------------------------------------------------- */
@@ -256,10 +402,12 @@ bool splat_scene_load(splat_scene *s, const char *path,
                             sc->hf_width, sc->hf_height,
                             sg_loc_or(sc->heightfield_loc, sc->loc), d))
         goto fail;
+    if (!check_extent(s, d))
+        goto fail;
     if (sc->hf_format != SG_HF_R16 &&
         !sg_scene_cells_fit(sc, s->terrain.width, s->terrain.height, d))
         goto fail;
-    if (!load_holes(s, d) || !load_painted(s, d) || !lower_materials(s, d) ||
+    if (!load_holes(s, d) || !lower_materials(s, d) || !load_painted(s, d) ||
         d->nerrors > errors)
         goto fail;
     if (!splat_compositor_check(s->prog, sc->compositor ? sc->compositor : "linear_alpha",

@@ -57,15 +57,22 @@ static void check_terrain(const sg_scene *sc, sg_diags *d)
     if (gdal && sc->height_offset_loc.line > 0)
         sg_errorf(d, sc->height_offset_loc, SG_E_SETTING, "height_offset comes from the "
                     "heights stored in '%s' (a GDAL raster); remove it", sc->heightfield);
+    /* finite and within the pack limit (abi.h SPLAT_MAX_EXTENT); what a
+     * GDAL raster brings is checked once loaded (scene.c) */
     if (sc->size_loc.line > 0 && !(sc->size[0] > 0 && sc->size[1] > 0 &&
-                                   isfinite(sc->size[0]) && isfinite(sc->size[1])))
-        sg_errorf(d, sc->size_loc, SG_E_SETTING, "world size must be positive (x and z "
-                    "metres)");
-    if (sc->max_height_loc.line > 0 && !(sc->max_height >= 0 && isfinite(sc->max_height)))
-        sg_errorf(d, sc->max_height_loc, SG_E_SETTING, "max_height must not be negative");
-    if (!isfinite(sc->height_offset))
+                                   sc->size[0] <= SPLAT_MAX_EXTENT &&
+                                   sc->size[1] <= SPLAT_MAX_EXTENT))
+        sg_errorf(d, sc->size_loc, SG_E_SETTING, "world size must be positive and at most "
+                    "%g m (x and z metres), found %g %g", SPLAT_MAX_EXTENT, sc->size[0],
+                    sc->size[1]);
+    if (sc->max_height_loc.line > 0 && !(sc->max_height >= 0 &&
+                                         sc->max_height <= SPLAT_MAX_EXTENT))
+        sg_errorf(d, sc->max_height_loc, SG_E_SETTING, "max_height must be in [0, %g] m, "
+                    "found %g", SPLAT_MAX_EXTENT, sc->max_height);
+    if (!(fabs(sc->height_offset) <= SPLAT_MAX_EXTENT))
         sg_errorf(d, sg_loc_or(sc->height_offset_loc, sc->loc), SG_E_SETTING, "height_offset "
-                    "must be finite, found %g", sc->height_offset);
+                    "must be finite and at most %g m either way, found %g", SPLAT_MAX_EXTENT,
+                    sc->height_offset);
     if (!is_pow2(sc->cell_texels) || sc->cell_texels > 4096)
         sg_errorf(d, sg_loc_or(sc->cell_texels_loc, sc->loc), SG_E_SETTING, "cell must be a "
                     "power of two from 1 to 4096 heightfield texels");

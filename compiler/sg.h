@@ -140,6 +140,9 @@ int         sg_material_count(const sg_program *p);
 const char *sg_material_name(const sg_program *p, int i);
 sg_loc      sg_material_loc(const sg_program *p, int i);
 int         sg_material_find(const sg_program *p, const char *name); /* -1 */
+/* Where a `texture` declaration names file `file` (as resolved: the IR's
+ * ir_texture.file); loc.line 0 if none does (an inline texture). */
+sg_loc      sg_texture_loc(const sg_program *p, const char *file);
 
 /* A material's `undergrowth` block (seed 000 §5.5): instances of a mesh
  * scattered where the material's composited weight says (DESIGN.md §3).

@@ -828,9 +828,10 @@ bool sparse_load_raster(const char *path, int width, int height,
 {
     *texels = NULL;
     int w, h, comp;
-    FILE *f = fopen(path, "rb");
+    char why[256];
+    FILE *f = splat_input_fopen(path, SPLAT_MAX_IMAGE_BYTES, why, sizeof why);
     if (!f)
-        return fail(err, SPARSE_E_IO, path, strerror(errno));
+        return fail(err, SPARSE_E_IO, path, why);
     if (!stbi_info_from_file(f, &w, &h, &comp)) {
         fclose(f);
         return fail(err, SPARSE_E_IO, path, stbi_failure_reason());

@@ -37,10 +37,12 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include <stb_image.h>
 
 #include "abi.h"
+#include "util.h"
 
 #define SUBTEXEL_EPS (1.0 / 256.0 + 1.0 / 4096.0)
 #define UNORM16_EPS  (1.0 / 65536.0)
@@ -48,22 +50,66 @@
 
 /* ---- loading ------------------------------------------------------------ */
 
+bool splat_image_info(FILE *f, long long *w, long long *h, int *comp, bool *is16)
+{
+    int iw, ih, ic;
+    *w = *h = 0;
+    *comp = 0;
+    *is16 = false;
+    if (stbi_info_from_file(f, &iw, &ih, &ic)) {
+        *w = iw;
+        *h = ih;
+        *comp = ic;
+        *is16 = stbi_is_16_bit_from_file(f) != 0;
+        return true;
+    }
+    /* PNG signature, IHDR length 13 and type, then width, height (big-endian) */
+    static const uint8_t sig[16] = { 0x89, 'P', 'N', 'G', '\r', '\n', 0x1a, '\n',
+                                     0, 0, 0, 13, 'I', 'H', 'D', 'R' };
+    uint8_t head[24];
+    long pos = ftell(f);
+    size_t got = fread(head, 1, sizeof head, f);
+    fseek(f, pos, SEEK_SET);
+    if (got != sizeof head || memcmp(head, sig, sizeof sig) != 0)
+        return false;
+    *w = (long long)head[16] << 24 | head[17] << 16 | head[18] << 8 | head[19];
+    *h = (long long)head[20] << 24 | head[21] << 16 | head[22] << 8 | head[23];
+    return true;
+}
+
+FILE *splat_png_open(const char *what, const char *path, int *w, int *h, int *comp,
+                     bool *is16, sg_loc loc, sg_diags *d)
+{
+    char why[256];
+    FILE *f = splat_input_fopen(path, SPLAT_MAX_IMAGE_BYTES, why, sizeof why);
+    if (!f) {
+        sg_error(d, loc, SG_E_IO, path, why);
+        return NULL;
+    }
+    long long lw, lh;
+    if (!splat_image_info(f, &lw, &lh, comp, is16)) {
+        fclose(f);
+        sg_error(d, loc, SG_E_IO, path, "not a PNG image");
+        return NULL;
+    }
+    if (!splat_raster_check_size(what, path, lw, lh, loc, d)) {
+        fclose(f);
+        return NULL;
+    }
+    *w = (int)lw;
+    *h = (int)lh;
+    return f;
+}
+
 static bool load_png(splat_terrain *t, const char *path, sg_loc loc, sg_diags *d)
 {
     int w, h, comp;
-    if (!stbi_info(path, &w, &h, &comp)) {
-        FILE *f = fopen(path, "rb");
-        if (!f) {
-            sg_error(d, loc, SG_E_IO, path, strerror(errno));
-        } else {
-            fclose(f);
-            sg_error(d, loc, SG_E_IO, path, "not a PNG image");
-        }
-        return false;
-    }
-    if (!splat_raster_check_size("heightfield", path, w, h, loc, d))
+    bool is16;
+    FILE *f = splat_png_open("heightfield", path, &w, &h, &comp, &is16, loc, d);
+    if (!f)
         return false;
     if (comp != 1) {
+        fclose(f);
         char msg[256];
         snprintf(msg, sizeof msg, "heightfield '%s' has %d channels; expected a "
                  "greyscale image (1 channel, 8 or 16 bits)", path, comp);
@@ -73,32 +119,35 @@ static bool load_png(splat_terrain *t, const char *path, sg_loc loc, sg_diags *d
     size_t n = (size_t)w * (size_t)h;
     t->texels = malloc(n * sizeof *t->texels);
     if (!t->texels) {
+        fclose(f);
         sg_error(d, loc, SG_E_OUT_OF_MEMORY, "heightfield does not fit in memory");
         return false;
     }
     int lw, lh, lc;
-    if (stbi_is_16_bit(path)) {
-        stbi_us *px = stbi_load_16(path, &lw, &lh, &lc, 1);
-        if (!px) goto fail;
+    if (is16) {
+        stbi_us *px = stbi_load_from_file_16(f, &lw, &lh, &lc, 1);
+        if (!px || lw != w || lh != h) { stbi_image_free(px); goto fail; }
         memcpy(t->texels, px, n * sizeof *t->texels);
         stbi_image_free(px);
     } else {
-        stbi_uc *px = stbi_load(path, &lw, &lh, &lc, 1);
-        if (!px) goto fail;
+        stbi_uc *px = stbi_load_from_file(f, &lw, &lh, &lc, 1);
+        if (!px || lw != w || lh != h) { stbi_image_free(px); goto fail; }
         for (size_t i = 0; i < n; i++)
             t->texels[i] = (uint16_t)(px[i] * 257u);   /* 255 -> 65535 */
         stbi_image_free(px);
     }
+    fclose(f);
     t->width = w;
     t->height = h;
     return true;
 fail:
+    fclose(f);
     {
         /* the header read, the data did not */
-        char why[160];
-        snprintf(why, sizeof why, "truncated or corrupt PNG (stb_image: %s)",
+        char msg[160];
+        snprintf(msg, sizeof msg, "truncated or corrupt PNG (stb_image: %s)",
                  stbi_failure_reason());
-        sg_error(d, loc, SG_E_IO, path, why);
+        sg_error(d, loc, SG_E_IO, path, msg);
     }
     free(t->texels);
     t->texels = NULL;
@@ -117,26 +166,20 @@ static bool load_r16(splat_terrain *t, const char *path, int w, int h,
     }
     if (!splat_raster_check_size("heightfield", path, w, h, loc, d))
         return false;
-    FILE *f = fopen(path, "rb");
-    if (!f) {
-        sg_error(d, loc, SG_E_IO, path, strerror(errno));
+    char why[256];
+    unsigned long long len;
+    int fd = splat_input_open(path, SPLAT_MAX_RASTER_BYTES, &len, why, sizeof why);
+    if (fd < 0) {
+        sg_error(d, loc, SG_E_IO, path, why);
         return false;
     }
     size_t n = (size_t)w * (size_t)h;
-    long len = -1;
-    if (fseek(f, 0, SEEK_END) == 0)
-        len = ftell(f);
-    if (len < 0 || fseek(f, 0, SEEK_SET) != 0) {
-        sg_error(d, loc, SG_E_IO, path, "cannot determine its size");
-        fclose(f);
-        return false;
-    }
-    if ((unsigned long)len != n * 2) {
-        snprintf(msg, sizeof msg, "raw heightfield '%s' is %ld bytes; "
+    if (len != n * 2) {
+        snprintf(msg, sizeof msg, "raw heightfield '%s' is %llu bytes; "
                  "heightfield_size = %d %d needs %zu (16-bit little-endian)",
                  path, len, w, h, n * 2);
         sg_error(d, loc, SG_E_RASTER, msg);
-        fclose(f);
+        close(fd);
         return false;
     }
     uint8_t *raw = malloc(n * 2);
@@ -145,12 +188,20 @@ static bool load_r16(splat_terrain *t, const char *path, int w, int h,
         free(raw);
         free(t->texels);
         t->texels = NULL;
-        fclose(f);
+        close(fd);
         sg_error(d, loc, SG_E_OUT_OF_MEMORY, "heightfield does not fit in memory");
         return false;
     }
-    size_t got = fread(raw, 1, n * 2, f);
-    fclose(f);
+    size_t got = 0;
+    while (got < n * 2) {
+        ssize_t r = read(fd, raw + got, n * 2 - got);
+        if (r < 0 && errno == EINTR)
+            continue;
+        if (r <= 0)
+            break;
+        got += (size_t)r;
+    }
+    close(fd);
     if (got != n * 2) {
         sg_error(d, loc, SG_E_IO, path, "short read");
         free(raw);

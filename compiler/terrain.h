@@ -6,6 +6,7 @@
 
 #include <stdbool.h>
 #include <stdint.h>
+#include <stdio.h>
 
 #include "abi.h"
 #include "ir.h"
@@ -34,6 +35,19 @@ typedef struct splat_terrain {
 bool splat_raster_check_size(const char *what, const char *path, long long w,
                              long long h, sg_loc loc, sg_diags *d);
 
+/* An image's header, read from an open file (left at its start): what
+ * stb_image says, or, for a PNG whose header stb_image refuses (a size it
+ * will not decode, such as 100000 x 100000), the IHDR's own width and
+ * height with *comp = 0, so the caller's limit check still sees the real
+ * size.  False when the file is no image stb_image reads. */
+bool splat_image_info(FILE *f, long long *w, long long *h, int *comp, bool *is16);
+/* A PNG raster opened as an untrusted input (util.h splat_input_fopen),
+ * its header read (splat_image_info) and its size checked
+ * (splat_raster_check_size, `what` names it); the file at its start, or
+ * NULL with the error at loc. */
+FILE *splat_png_open(const char *what, const char *path, int *w, int *h, int *comp,
+                     bool *is16, sg_loc loc, sg_diags *d);
+
 /* Load 16-bit PNG, 8-bit PNG (scaled to 16 bits) or raw little-endian R16
  * (width and height given).  Errors at `loc`. */
 bool splat_terrain_load(splat_terrain *t, const char *path, sg_hf_format fmt,
@@ -54,6 +68,10 @@ int  splat_terrain_hole(const splat_terrain *t, int x, int z);
  * Conversions are reported as notes at `loc`. */
 bool splat_raster_heightfield(splat_terrain *t, const char *path, bool size_given,
                               sg_loc loc, sg_diags *d);
+/* A raster's size in texels, checked against the pack limit, without
+ * reading its data; false with the error at loc. */
+bool splat_raster_size(const char *what, const char *path, int *w, int *h,
+                       sg_loc loc, sg_diags *d);
 /* An 8-bit mask (band 1) of any size, malloc'd; `what` names it in
  * errors ("painted mask 'road'").  NULL on error. */
 uint8_t *splat_raster_mask(const char *what, const char *path, int *w, int *h,

@@ -52,6 +52,32 @@ static int mesh_index(splat_ug *u, const sg_undergrowth *g, sg_diags *d)
     return i;
 }
 
+/* The runtime's instance buffer at the default radius within what every
+ * device holds (abi.h SPLAT_UG_PACK_INSTANCE_BYTES): the blocks' densities
+ * add up, so the error is at the block that goes over, with the total. */
+static bool check_instances(const splat_ug *u, sg_diags *d)
+{
+    uint64_t per_cell = 0, pool = splat_ug_pool(SPLAT_UG_RADIUS);
+    double total = 0;
+    for (int b = 0; b < u->nblocks; b++) {
+        const sg_undergrowth *g = u->blocks[b].u;
+        per_cell += splat_ug_candidates(g->density);
+        total += g->density;
+        uint64_t bytes = pool * per_cell * SPLAT_UG_INSTANCE_BYTES;
+        if (bytes > SPLAT_UG_PACK_INSTANCE_BYTES) {
+            sg_errorf(d, g->loc, SG_E_OVER_LIMIT, "the scene's undergrowth densities add up "
+                      "to %g instances per m^2 here; the runtime's instance buffer would be "
+                      "%llu MiB, over the %llu MiB every device holds (about %.0f per m^2 "
+                      "in all)", total, (unsigned long long)(bytes >> 20),
+                      (unsigned long long)(SPLAT_UG_PACK_INSTANCE_BYTES >> 20),
+                      (double)SPLAT_UG_PACK_INSTANCE_BYTES /
+                          ((double)pool * SPLAT_UG_INSTANCE_BYTES * SPLAT_UG_CELL * SPLAT_UG_CELL));
+            return false;
+        }
+    }
+    return true;
+}
+
 bool splat_ug_init(splat_ug *u, const splat_scene *s, sg_diags *d)
 {
     memset(u, 0, sizeof *u);
@@ -79,7 +105,7 @@ bool splat_ug_init(splat_ug *u, const splat_scene *s, sg_diags *d)
                 .material = i, .slot = u->slot_of[i], .mesh = mesh, .u = g};
         }
     }
-    return true;
+    return check_instances(u, d);
 }
 
 void splat_ug_free(splat_ug *u)

@@ -265,3 +265,107 @@ bool splat_make_dirs(const char *path)
     free(p);
     return ok;
 }
+
+/* ---- inputs ------------------------------------------------------------- */
+
+static const char *file_kind(mode_t m)
+{
+    return S_ISFIFO(m) ? "a FIFO (named pipe)" : S_ISCHR(m) ? "a character device"
+         : S_ISBLK(m) ? "a block device" : S_ISDIR(m) ? "a folder"
+         : S_ISSOCK(m) ? "a socket" : "not a plain file";
+}
+
+int splat_input_open(const char *path, unsigned long long max_bytes,
+                     unsigned long long *size, char *why, size_t nwhy)
+{
+    *size = 0;
+    int fd;
+    do
+        fd = open(path, O_RDONLY | O_NONBLOCK | O_CLOEXEC | O_NOCTTY);
+    while (fd < 0 && errno == EINTR);
+    if (fd < 0) {
+        snprintf(why, nwhy, "%s", strerror(errno));
+        return -1;
+    }
+    struct stat st;
+    if (fstat(fd, &st) != 0) {
+        snprintf(why, nwhy, "%s", strerror(errno));
+        close(fd);
+        return -1;
+    }
+    if (!S_ISREG(st.st_mode)) {
+        snprintf(why, nwhy, "not a regular file: it is %s", file_kind(st.st_mode));
+        close(fd);
+        return -1;
+    }
+    if (st.st_size < 0 || (unsigned long long)st.st_size > max_bytes) {
+        snprintf(why, nwhy, "is %lld bytes, over the limit of %llu for this kind of input",
+                 (long long)st.st_size, max_bytes);
+        close(fd);
+        return -1;
+    }
+    int fl = fcntl(fd, F_GETFL);
+    if (fl < 0 || fcntl(fd, F_SETFL, fl & ~O_NONBLOCK) != 0) {
+        snprintf(why, nwhy, "%s", strerror(errno));
+        close(fd);
+        return -1;
+    }
+    *size = (unsigned long long)st.st_size;
+    return fd;
+}
+
+FILE *splat_input_fopen(const char *path, unsigned long long max_bytes,
+                        char *why, size_t nwhy)
+{
+    unsigned long long size;
+    int fd = splat_input_open(path, max_bytes, &size, why, nwhy);
+    if (fd < 0)
+        return NULL;
+    FILE *f = fdopen(fd, "rb");
+    if (!f) {
+        snprintf(why, nwhy, "%s", strerror(errno));
+        close(fd);
+    }
+    return f;
+}
+
+bool splat_input_check(const char *path, unsigned long long max_bytes,
+                       char *why, size_t nwhy)
+{
+    unsigned long long size;
+    int fd = splat_input_open(path, max_bytes, &size, why, nwhy);
+    if (fd < 0)
+        return false;
+    close(fd);
+    return true;
+}
+
+char *splat_input_read(const char *path, unsigned long long max_bytes, size_t *len,
+                       char *why, size_t nwhy)
+{
+    *len = 0;
+    unsigned long long size;
+    int fd = splat_input_open(path, max_bytes, &size, why, nwhy);
+    if (fd < 0)
+        return NULL;
+    char *buf = xmalloc((size_t)size + 1);
+    size_t n = 0;
+    while (n < size) {
+        ssize_t got = read(fd, buf + n, (size_t)size - n);
+        if (got < 0 && errno == EINTR)
+            continue;
+        if (got < 0) {
+            snprintf(why, nwhy, "%s", strerror(errno));
+            close(fd);
+            free(buf);
+            return NULL;
+        }
+        if (got == 0)
+            break;              /* shrank meanwhile: what is there */
+        n += (size_t)got;
+    }
+    close(fd);
+    buf[n] = 0;
+    *len = n;
+    return buf;
+}

@@ -12,6 +12,7 @@
 
 #include <stdbool.h>
 #include <stddef.h>
+#include <stdio.h>
 
 void *xmalloc(size_t size);
 void *xcalloc(size_t n, size_t size);          /* n == 0 gives a valid block */
@@ -52,5 +53,42 @@ bool  splat_make_dirs(const char *path);
  * (PATH.tmp-XXXXXX, mode 0666 & ~umask), renamed over it; readers never
  * see half a file, and on failure nothing is left.  False with errno set. */
 bool splat_write_atomic(const char *path, const void *data, size_t n);
+
+/* ---- inputs: every file a scene names is untrusted ------------------------ */
+
+/* Size bounds of the inputs, checked on the open descriptor before a byte
+ * is read (and before GDAL, stb_image or tinyobjloader see the file).
+ * They bound runaway files, not honest ones: a 16384^2 RGBA PNG stored
+ * uncompressed is 1 GiB, a Float64 GeoTIFF of 16384^2 texels 2 GiB. */
+#define SPLAT_MAX_GRAPH_BYTES  ((unsigned long long)16 << 20)   /* .sg files  */
+#define SPLAT_MAX_MESH_BYTES   ((unsigned long long)64 << 20)   /* OBJ files  */
+#define SPLAT_MAX_IMAGE_BYTES  ((unsigned long long)1 << 30)    /* PNG, …     */
+#define SPLAT_MAX_RASTER_BYTES ((unsigned long long)4 << 30)    /* GDAL, R16  */
+#define SPLAT_MAX_SPIRV_BYTES  ((unsigned long long)64 << 20)   /* the SPIR-V
+                                  cache's entries, an existing pack's shaders */
+
+/* Open `path` for reading as an untrusted input, the one way every input
+ * is opened: open(2) with O_RDONLY | O_NONBLOCK | O_CLOEXEC (a FIFO's open
+ * never waits for a writer), then fstat on that descriptor: anything but
+ * a regular file (a FIFO, a character or block device, a folder, a
+ * socket; a symbolic link counts as what it points to, so a link to
+ * /dev/zero is a character device) or a file over `max_bytes` is refused.
+ * O_NONBLOCK is then cleared.  The descriptor, its size in *size; -1 with
+ * the reason in why[nwhy] ("No such file or directory", "not a regular
+ * file: it is a FIFO (named pipe)", "is N bytes, over the limit of M"). */
+int   splat_input_open(const char *path, unsigned long long max_bytes,
+                       unsigned long long *size, char *why, size_t nwhy);
+/* The same, as a FILE * ("rb"). */
+FILE *splat_input_fopen(const char *path, unsigned long long max_bytes,
+                        char *why, size_t nwhy);
+/* Checked, then closed: for libraries that open the path themselves
+ * (GDAL), after the check. */
+bool  splat_input_check(const char *path, unsigned long long max_bytes,
+                        char *why, size_t nwhy);
+/* The whole file, at most its fstat size (a file that grows while read
+ * is cut there), NUL-terminated, malloc'd, its length in *len; NULL with
+ * the reason in why. */
+char *splat_input_read(const char *path, unsigned long long max_bytes, size_t *len,
+                       char *why, size_t nwhy);
 
 #endif

@@ -486,7 +486,7 @@ static bool read_meshes(reader *r, const char *rel, rt_pack_ug *u)
             uint32_t w = le32(at);
             float f;
             memcpy(&f, &w, 4);
-            if (!isfinite(f) || fabsf(f) > 1e3f)
+            if (!isfinite(f) || fabsf(f) > (float)SPLAT_MAX_MESH_VALUE)
                 bad = "holds a vertex value that is not finite or over 1000";
             u->vertices[8 * (size_t)m->first_vertex + k] = f;
         }
@@ -566,7 +566,7 @@ static bool read_undergrowth(reader *r, json_t *root)
         return false;
     if (json_array_size(ms) < 1 || json_array_size(ms) > 64)
         return field_fail(r, "undergrowth.meshes:", "must have 1 to 64 entries");
-    if (json_array_size(bs) < 1 || json_array_size(bs) > 64)
+    if (json_array_size(bs) < 1 || json_array_size(bs) > SPLAT_MAX_UG_BLOCKS)
         return field_fail(r, "undergrowth.blocks:", "must have 1 to 64 entries");
     u->nmeshes = (int)json_array_size(ms);
     u->nblocks = (int)json_array_size(bs);
@@ -580,8 +580,8 @@ static bool read_undergrowth(reader *r, json_t *root)
         json_t *m = json_array_get(ms, (size_t)i);
         int nv, ni;
         const char *name;
-        if (!get_int(r, m, "vertices", where, 1, 65536, &nv) ||
-            !get_int(r, m, "indices", where, 3, 196608, &ni) ||
+        if (!get_int(r, m, "vertices", where, 1, SPLAT_MAX_MESH_VERTICES, &nv) ||
+            !get_int(r, m, "indices", where, 3, SPLAT_MAX_MESH_INDICES, &ni) ||
             !get_string(r, m, "name", where, &name))
             return false;
         if (ni % 3)
@@ -619,7 +619,7 @@ static bool read_undergrowth(reader *r, json_t *root)
             !get_vec(r, b, "color", where, 3, k->color) ||
             !get_string(r, b, "align", where, &align))
             return false;
-        if (!(k->density > 0 && k->density <= 64))
+        if (!(k->density > 0 && k->density <= SPLAT_MAX_UG_DENSITY))
             return field_fail(r, where, "density: must be in (0, 64]");
         if (!(k->scale[0] > 0 && k->scale[0] <= k->scale[1] && k->scale[1] <= 100))
             return field_fail(r, where, "scale: must be 0 < lo <= hi <= 100");
@@ -702,10 +702,11 @@ static bool read_scene(reader *r, json_t *root)
                  cells, SPLAT_MAX_CELLS);
         return field_fail(r, "scene.cell_texels:", what);
     }
-    if (!isfinite(p->size[0]) || !isfinite(p->size[1]) || !isfinite(p->max_height) ||
-        !isfinite(p->height_offset) || p->max_height < 0)
+    if (!(p->size[0] <= SPLAT_MAX_EXTENT) || !(p->size[1] <= SPLAT_MAX_EXTENT) ||
+        !(p->max_height >= 0 && p->max_height <= SPLAT_MAX_EXTENT) ||
+        !(fabs(p->height_offset) <= SPLAT_MAX_EXTENT))
         return field_fail(r, "scene:", "size, max_height and height_offset must be finite "
-                          "(max_height >= 0)");
+                          "and at most 1e8 m (max_height >= 0)");
 
     size_t texels = (size_t)p->hf_width * (size_t)p->hf_height;
     uint8_t *raw = pack_file(r, "scene.heightfield.file", file, texels * 2, 0, NULL);

@@ -32,9 +32,9 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define CELL    16.0                 /* metres per cell side                */
+#define CELL    SPLAT_UG_CELL        /* metres per cell side (abi.h)        */
 #define TEXELS  SPLAT_UG_TEXELS      /* mask texels per cell side           */
-#define MAX_INSTANCE_BYTES ((VkDeviceSize)256 << 20)
+_Static_assert(RT_UG_RADIUS == SPLAT_UG_RADIUS, "splatc checks packs at the default radius");
 /* Distance LOD: beyond LOD_NEAR metres a cell draws the fraction
  * (LOD_NEAR / d)^2 of its instances (at least LOD_MIN), each scaled by
  * 1 / sqrt(fraction) (at most LOD_GROW): about as many instances per
@@ -451,10 +451,10 @@ static void fill_blocks(rt_ug *u, float *b)
     for (int i = 0; i < u->nblocks; i++) {
         const rt_pack_ug_block *k = &pu->blocks[i];
         /* enough candidates that keep = density * 256 / n^2 <= 1 */
-        uint32_t n = (uint32_t)ceil(sqrt(k->density * CELL * CELL));
+        uint32_t nn = splat_ug_candidates(k->density), n = (uint32_t)lround(sqrt(nn));
         u->block_grid[i] = n;
         u->block_base[i] = at;
-        at += n * n;
+        at += nn;
         unsigned flags = pu->meshes[k->mesh].flags | (k->align_normal ? 4u : 0u);
         uint32_t stride = (uint32_t)(0.618034 * n * n);
         while (stride > 1 && gcd(stride, n * n) != 1)
@@ -555,14 +555,20 @@ static bool make_buffers(rt_ug *u, rt_error *e)
     const rt_pack_ug *pu = &u->p->ug;
     const VkBufferUsageFlags st = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
     VkDeviceSize mask_bytes = (VkDeviceSize)u->pool * TEXELS * TEXELS * (u->nw + 2) * 4;
-    VkDeviceSize inst_bytes = (VkDeviceSize)u->pool * u->cap * 32;
-    if (inst_bytes > MAX_INSTANCE_BYTES || inst_bytes > d->props.limits.maxStorageBufferRange ||
-        mask_bytes > d->props.limits.maxStorageBufferRange)
+    VkDeviceSize inst_bytes = (VkDeviceSize)u->pool * u->cap * SPLAT_UG_INSTANCE_BYTES;
+    VkDeviceSize range = d->props.limits.maxStorageBufferRange;
+    VkDeviceSize inst_max = range < SPLAT_UG_MAX_INSTANCE_BYTES ? range : SPLAT_UG_MAX_INSTANCE_BYTES;
+    if (inst_bytes > inst_max)
         return rt_fail(e, RT_E_PACK_LIMIT, u->p->dir, "undergrowth's instance buffer (bytes)",
-                       (unsigned long long)inst_bytes, "the device's storage buffer range or 256 MiB",
-                       (unsigned long long)(MAX_INSTANCE_BYTES < d->props.limits.maxStorageBufferRange
-                                                ? MAX_INSTANCE_BYTES
-                                                : d->props.limits.maxStorageBufferRange));
+                       (unsigned long long)inst_bytes,
+                       range < SPLAT_UG_MAX_INSTANCE_BYTES
+                           ? "the device's maxStorageBufferRange"
+                           : "the runtime's instance buffer limit (abi.h)",
+                       (unsigned long long)inst_max);
+    if (mask_bytes > range)
+        return rt_fail(e, RT_E_PACK_LIMIT, u->p->dir, "undergrowth's mask buffer (bytes)",
+                       (unsigned long long)mask_bytes, "the device's maxStorageBufferRange",
+                       (unsigned long long)range);
     if (!rt_buffer_create(d, mask_bytes, st | VK_BUFFER_USAGE_TRANSFER_DST_BIT, false, &u->masks, e) ||
         !rt_buffer_create(d, inst_bytes + 32, st | VK_BUFFER_USAGE_TRANSFER_SRC_BIT, false,
                           &u->inst, e) ||
@@ -613,8 +619,7 @@ bool rt_ug_create(rt_device *d, const rt_pack *p, rt_pipelines *pl, const rt_qua
     u->pl = pl;
     u->qt = qt;
     u->radius = radius > 0 ? radius : RT_UG_RADIUS;
-    int side = (int)ceil(2 * u->radius / CELL) + 2;
-    u->pool = side * side;
+    u->pool = (int)splat_ug_pool(u->radius);
     u->nblocks = p->ug.nblocks;
     u->nw = (p->ug.nslots + 3) / 4;
     u->cells = calloc((size_t)u->pool, sizeof *u->cells);

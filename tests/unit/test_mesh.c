@@ -12,6 +12,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 #include <unistd.h>
 
 #include "mesh.h"
@@ -251,6 +252,20 @@ static void test_obj_errors(void **state)
         { "points.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\n", "no triangles" },
         { "range.obj", "v 0 0 0\nv 1 0 0\nf 1 2 3\n", "a face refers to" },
         { "zero.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n", "not an OBJ file" },
+        /* non-finite text, which tinyobjloader reads as 0, and values the
+         * runtime refuses: refused with their line before parsing */
+        { "nan.obj", "v nan 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n",
+          "line 1: 'v' value 'nan' is not a finite number" },
+        { "inf.obj", "v 0 0 0\n# a comment\nv 1 -inf 0\nv 0 1 0\nf 1 2 3\n",
+          "line 3: 'v' value '-inf' is not a finite number" },
+        { "big.obj", "v 0 0 0\nv 1e999 0 0\nv 0 1 0\nf 1 2 3\n",
+          "line 2: 'v' value '1e999' is not a finite number" },
+        { "vn.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvn 0 NaN 1\nf 1//1 2//1 3//1\n",
+          "line 4: 'vn' value 'NaN' is not a finite number" },
+        { "vt.obj", "v 0 0 0\nv 1 0 0\nv 0 1 0\nvt infinity 0\nf 1/1 2/1 3/1\n",
+          "line 4: 'vt' value 'infinity' is not a finite number" },
+        { "far.obj", "v 0 0 0\nv 5000 0 0\nv 0 1 0\nf 1 2 3\n",
+          "line 2: vertex coordinate 5000 is beyond the pack limit of 1000 m" },
     };
     for (size_t i = 0; i < sizeof bad / sizeof bad[0]; i++) {
         assert_false(splat_mesh_obj(write_file(bad[i].name, bad[i].text), &m, &err));
@@ -267,8 +282,57 @@ static void test_obj_errors(void **state)
     assert_string_equal(err, "No such file or directory");
     free(err);
     assert_false(splat_mesh_obj(dir, &m, &err));          /* a folder */
-    assert_string_equal(err, "not a regular file");
+    assert_string_equal(err, "not a regular file: it is a folder");
     free(err);
+    assert_false(splat_mesh_obj("/dev/zero", &m, &err));  /* would never end */
+    assert_string_equal(err, "not a regular file: it is a character device");
+    free(err);
+}
+
+/* The limits are checked on the text, before tinyobjloader parses or
+ * triangulates anything: one face of 100000 corners (30 s of
+ * triangulation before), more triangles than the index limit, more `v`
+ * lines than any mesh within it can use.  Each is refused at once. */
+static void test_obj_limits(void **state)
+{
+    (void)state;
+    splat_mesh m;
+    char *err = NULL;
+    enum { CORNERS = 100000 };
+    size_t cap = (size_t)CORNERS * 24 + 64, n = 0;
+    char *text = malloc(cap);
+    assert_non_null(text);
+    /* one face of 100000 corners */
+    n = (size_t)snprintf(text, cap, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf");
+    for (int i = 0; i < CORNERS; i++)
+        n += (size_t)snprintf(text + n, cap - n, " %d", 1 + i % 3);
+    snprintf(text + n, cap - n, "\n");
+    double t0 = (double)clock() / CLOCKS_PER_SEC;
+    assert_false(splat_mesh_obj(write_file("face.obj", text), &m, &err));
+    assert_true((double)clock() / CLOCKS_PER_SEC - t0 < 1.0);
+    assert_non_null(strstr(err, "line 4: a face of more than 1024 corners"));
+    free(err);
+    /* a face of 1024 corners is within the limit */
+    n = (size_t)snprintf(text, cap, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf");
+    for (int i = 0; i < 1024; i++)
+        n += (size_t)snprintf(text + n, cap - n, " %d", 1 + i % 3);
+    snprintf(text + n, cap - n, "\n");
+    assert_true(splat_obj_scan(text, strlen(text), &err));
+    /* 65537 triangles: 196611 indices */
+    n = (size_t)snprintf(text, cap, "v 0 0 0\nv 1 0 0\nv 0 1 0\n");
+    for (int i = 0; i < 65537; i++)
+        n += (size_t)snprintf(text + n, cap - n, "f 1 2 3\n");
+    assert_false(splat_mesh_obj(write_file("faces.obj", text), &m, &err));
+    assert_non_null(strstr(err, "line 65540: the faces so far make more than 196608 indices"));
+    free(err);
+    /* 196609 positions */
+    n = 0;
+    for (int i = 0; i < 196609; i++)
+        n += (size_t)snprintf(text + n, cap - n, "v 0 0 0\n");
+    assert_false(splat_obj_scan(text, n, &err));
+    assert_non_null(strstr(err, "line 196609: more than 196608 'v' lines"));
+    free(err);
+    free(text);
 }
 
 static int setup(void **state)
@@ -291,6 +355,7 @@ int main(void)
         cmocka_unit_test(test_far),
         cmocka_unit_test(test_obj_cube),
         cmocka_unit_test(test_obj_errors),
+        cmocka_unit_test(test_obj_limits),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }

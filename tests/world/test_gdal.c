@@ -238,6 +238,12 @@ static void test_errors(void **state)
     write_tif("allnd.tif", 2, 2, GDT_Float32, all, 26913, gt, &nd);
     write_tif("m3.tif", 3, 3, GDT_Byte, m, 0, NULL, NULL);
     write_tif("m16.tif", 2, 2, GDT_UInt16, v, 0, NULL, NULL);
+    /* values at their ends: Float64 heights at +-1.7e308 (a span no float
+     * holds) and 1e9 m texels; both would leave the manifest non-finite or
+     * out of the runtime's range (abi.h SPLAT_MAX_EXTENT) */
+    double ends[4] = { -1.7e308, 1.7e308, 0, 1 }, wide[6] = { 0, 1e9, 0, 0, 0, -1e9 };
+    write_tif("ends.tif", 2, 2, GDT_Float64, ends, 0, gt, NULL);
+    write_tif("wide.tif", 2, 2, GDT_Float32, v, 0, wide, NULL);
     write_text("junk.tif", "this is not a raster\n");
     /* a VRT (which could name any file) is not opened */
     write_text("x.vrt", "<VRTDataset rasterXSize=\"2\" rasterYSize=\"2\">"
@@ -250,6 +256,8 @@ static void test_errors(void **state)
         const char *text;
     } cases[] = {
         { "rot.tif", "", SG_E_RASTER, "rotated" },
+        { "ends.tif", "", SG_E_OVER_LIMIT, "the pack limit is finite heights" },
+        { "wide.tif", "", SG_E_OVER_LIMIT, "gives a world size of 2e+09 x 2e+09 m" },
         { "nogt.tif", "", SG_E_RASTER, "no geotransform" },
         { "allnd.tif", "", SG_E_RASTER, "no valid height" },
         { "junk.tif", "", SG_E_IO, "not a raster GDAL reads" },
