@@ -87,6 +87,21 @@ static void expected(parser *ps, const char *what)
              sg_tok_describe(t, buf, sizeof buf));
 }
 
+/* "did you mean" for a misspelt setting `key` among `keys` (NULL-ended),
+ * on the diagnostic just reported. */
+static void hint_key(parser *ps, const sg_token *key, const char *const *keys)
+{
+    if (key->kind != SG_TK_IDENT)
+        return;
+    char word[64];
+    snprintf(word, sizeof word, "%.*s", key->len, key->start);
+    sg_suggest sg;
+    sg_suggest_init(&sg, word);
+    for (int i = 0; keys[i]; i++)
+        sg_suggest_offer(&sg, keys[i]);
+    sg_hint_suggest(ps->d, sg_suggest_best(&sg));
+}
+
 static bool accept(parser *ps, sg_tok_kind k)
 {
     if (cur(ps)->kind != k)
@@ -493,6 +508,8 @@ static bool ug_stmt(parser *ps, void *user)
     if (k == UG_NKEYS) {
         sg_errorf(ps->d, kloc, SG_E_BAD_OPTION, "unknown undergrowth setting '%.*s' "
                   "(expected density, scale, align, blend or color)", key->len, key->start);
+        static const char *const keys[] = { "density", "scale", "align", "blend", "color", NULL };
+        hint_key(ps, key, keys);
         /* skip its value (vec3(…) whole), then to ',', '}' or the next line */
         next(ps);
         sg_value v;
@@ -755,6 +772,8 @@ static void add_texture_setting(parser *ps, void *user, sg_token *key, sg_value 
         snprintf(msg, sizeof msg, "unknown texture setting '%.*s' "
                  "(expected file, filter, mip, wrap or srgb)", key->len, key->start);
         sg_error(ps->d, loc_of(ps, key), SG_E_BAD_OPTION, msg);
+        static const char *const keys[] = { "file", "filter", "mip", "wrap", "srgb", NULL };
+        hint_key(ps, key, keys);
     }
 }
 
@@ -864,6 +883,9 @@ static bool painted_stmt(parser *ps, void *user)
         if (ok) *(size ? &pm->place_loc : &pm->origin_loc) = kloc;
     } else {
         expected(ps, keys);
+        static const char *const names[] = { "max_level", "max_error", "near", "origin",
+                                             "size", NULL };
+        hint_key(ps, key, names);
         return false;
     }
     if (ok)
@@ -903,6 +925,9 @@ static bool sub_stmt(parser *ps, void *user)
         ok = expect(ps, SG_TK_EQ, "'='") && parse_number(ps, &sc->destruction_cell);
     } else {
         expected(ps, b->cam ? "'position', 'look' or '}'" : "'origin', 'size', 'cell' or '}'");
+        static const char *const cam[] = { "position", "look", NULL };
+        static const char *const des[] = { "origin", "size", "cell", NULL };
+        hint_key(ps, key, b->cam ? cam : des);
         return false;
     }
     if (ok)
@@ -922,6 +947,11 @@ static bool light_stmt(parser *ps, void *user)
     if (key->kind != SG_TK_IDENT || k == SPLAT_LIGHT_COUNT) {
         expected(ps, "'sun', 'sun_color', 'intensity', 'sky', 'fog_density', "
                      "'fog_height', 'exposure' or '}'");
+        const char *keys[SPLAT_LIGHT_COUNT + 1];
+        for (int i = 0; i < SPLAT_LIGHT_COUNT; i++)
+            keys[i] = splat_light_keys[i].key;
+        keys[SPLAT_LIGHT_COUNT] = NULL;
+        hint_key(ps, key, keys);
         return false;
     }
     l->loc[k] = loc_of(ps, key);
@@ -1130,6 +1160,11 @@ static bool scene_stmt(parser *ps, void *user)
              "a scene setting (heightfield, heightfield_size, size, max_height, "
              "height_offset, materials, compositor, painted, destruction, cell, camera, light)",
              sg_tok_describe(key, buf, sizeof buf));
+    static const char *const keys[] = { "heightfield", "heightfield_size", "size",
+                                        "max_height", "height_offset", "materials",
+                                        "compositor", "painted", "destruction", "cell",
+                                        "camera", "light", NULL };
+    hint_key(ps, key, keys);
     return false;
 }
 

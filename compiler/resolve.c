@@ -129,6 +129,70 @@ static const char *path_text(const sg_value *v, char *buf, size_t n)
     return buf;
 }
 
+/* ---- did you mean ---------------------------------------------------------- */
+
+/* The node type `word` may have meant: terrain and view inputs, painted,
+ * the built-in ops, the program's shaders. */
+static const char *near_node_type(checker *c, const char *word)
+{
+    sg_suggest sg;
+    sg_suggest_init(&sg, word);
+    for (int i = 0; i < IR_IN_COUNT; i++)
+        sg_suggest_offer(&sg, ir_input_get((ir_input_kind)i)->name);
+    sg_suggest_offer(&sg, "painted");
+    for (int i = 0; i < IR_OP_COUNT; i++)
+        sg_suggest_offer(&sg, ir_opinfo_get((ir_op)i)->name);
+    for (int i = 0; i < c->p->nshaders; i++)
+        if (!c->p->shaders[i]->is_material)
+            sg_suggest_offer(&sg, c->p->shaders[i]->name);
+    return sg_suggest_best(&sg);
+}
+
+static const char *near_port(const sg_port *ports, int n, const char *word)
+{
+    sg_suggest sg;
+    sg_suggest_init(&sg, word);
+    for (int i = 0; i < n; i++)
+        sg_suggest_offer(&sg, ports[i].name);
+    return sg_suggest_best(&sg);
+}
+
+/* A name in scope that `word` may have meant: the shader's inputs,
+ * params and nodes, the program's textures, the terrain and view inputs
+ * (for "terrain.positon", only those). */
+static const char *near_name(checker *c, const char *word, bool allow_locals)
+{
+    sg_suggest sg;
+    sg_suggest_init(&sg, word);
+    bool dotted = strchr(word, '.') != NULL;
+    if (!dotted) {
+        const sg_shader *s = c->s;
+        for (int i = 0; s && i < s->nins; i++)
+            sg_suggest_offer(&sg, s->ins[i].name);
+        for (int i = 0; s && i < s->nparams; i++)
+            sg_suggest_offer(&sg, s->params[i].name);
+        for (int i = 0; s && allow_locals && i < s->nnodes; i++)
+            sg_suggest_offer(&sg, s->nodes[i].name);
+        for (int i = 0; i < c->p->ntextures; i++)
+            sg_suggest_offer(&sg, c->p->textures[i]->name);
+    }
+    for (int i = 0; i < IR_IN_COUNT; i++)
+        sg_suggest_offer(&sg, ir_input_get((ir_input_kind)i)->name);
+    return sg_suggest_best(&sg);
+}
+
+/* "take the first N components with '.rgb'" for a value one swizzle away
+ * from the type wanted (a wider vector into a narrower port). */
+static void hint_swizzle(checker *c, const sg_value *v, ir_type want)
+{
+    static const char *const take[] = { NULL, ".x", ".xy", ".rgb" };
+    int ww = ir_type_width(want), hw = ir_type_width(v->type);
+    if (v->kind != SG_V_PATH || ww < 1 || ww > 3 || hw <= ww)
+        return;
+    sg_hint(c->d, "write '%s' after it to take its first %d component%s", take[ww], ww,
+            ww == 1 ? "" : "s");
+}
+
 /* Output port index of node `n` called `port`, or -1. */
 static int node_port(checker *c, const sg_node *n, const char *port)
 {
@@ -194,6 +258,15 @@ static bool resolve_path(checker *c, sg_value *v, bool allow_locals)
                 v->index = node_port(c, n, "out") >= 0 ? node_port(c, n, "out") : 0;
             } else {
                 sg_error(c->d, v->loc, SG_E_UNKNOWN_PORT, n->name, "output", v->parts[1]);
+                if (n->kind == SG_NODE_INSTANCE) {
+                    const sg_shader *callee = c->p->shaders[n->shader];
+                    sg_hint_suggest(c->d, near_port(callee->outs, callee->nouts, v->parts[1]));
+                } else {
+                    sg_suggest sg;
+                    sg_suggest_init(&sg, v->parts[1]);
+                    sg_suggest_offer(&sg, "out");
+                    sg_hint_suggest(c->d, sg_suggest_best(&sg));
+                }
                 return false;
             }
         }
@@ -210,6 +283,7 @@ static bool resolve_path(checker *c, sg_value *v, bool allow_locals)
         int in = ir_input_by_name(buf);
         if (in < 0) {
             sg_error(c->d, v->loc, SG_E_UNKNOWN_NAME, buf);
+            sg_hint_suggest(c->d, near_name(c, buf, allow_locals));
             return false;
         }
         v->ref = SG_REF_INPUT;
@@ -224,6 +298,7 @@ static bool resolve_path(checker *c, sg_value *v, bool allow_locals)
             sg_error(c->d, v->loc, SG_E_BAD_DEFAULT, msg);
         } else {
             sg_error(c->d, v->loc, SG_E_UNKNOWN_NAME, path_text(v, buf, sizeof buf));
+            sg_hint_suggest(c->d, near_name(c, first, allow_locals));
         }
         return false;
     }
@@ -297,6 +372,11 @@ static void check_op(checker *c, sg_node *n)
                 k = j;
         if (k < 0) {
             sg_error(c->d, b->loc, SG_E_UNKNOWN_PORT, n->type, "input", b->port);
+            sg_suggest sg;
+            sg_suggest_init(&sg, b->port);
+            for (int j = 0; j < nargs; j++)
+                sg_suggest_offer(&sg, info->ports[j]);
+            sg_hint_suggest(c->d, sg_suggest_best(&sg));
             bad = unknown = true;
             continue;
         }
@@ -350,6 +430,7 @@ static void check_op(checker *c, sg_node *n)
                          n->name, n->type);
                 sg_error(c->d, slot[j]->val.loc, SG_E_TYPE_MISMATCH, what,
                          ir_type_name(cand[k]), ir_type_name(args[j]));
+                hint_swizzle(c, &slot[j]->val, cand[k]);
                 return;
             }
         }
@@ -388,6 +469,7 @@ static void check_instance(checker *c, sg_node *n)
                 k = j;
         if (k < 0) {
             sg_error(c->d, b->loc, SG_E_UNKNOWN_PORT, n->type, "input", b->port);
+            sg_hint_suggest(c->d, near_port(callee->ins, callee->nins, b->port));
             unknown = true;
             continue;
         }
@@ -404,6 +486,7 @@ static void check_instance(checker *c, sg_node *n)
             snprintf(what, sizeof what, "input '%s' of '%s' (%s)", b->port, n->name, n->type);
             sg_error(c->d, b->val.loc, SG_E_TYPE_MISMATCH, what,
                      ir_type_name(callee->ins[k].type), ir_type_name(b->val.type));
+            hint_swizzle(c, &b->val, callee->ins[k].type);
         }
     }
     for (int j = 0; j < callee->nins; j++)
@@ -420,6 +503,10 @@ static void check_painted(checker *c, sg_node *n)
         sg_binding *b = &n->args[i];
         if (strcmp(b->port, "mask")) {
             sg_error(c->d, b->loc, SG_E_UNKNOWN_PORT, "painted", "input", b->port);
+            sg_suggest sg;
+            sg_suggest_init(&sg, b->port);
+            sg_suggest_offer(&sg, "mask");
+            sg_hint_suggest(c->d, sg_suggest_best(&sg));
             continue;
         }
         if (have) {
@@ -599,6 +686,7 @@ static void resolve_node_type(checker *c, sg_node *n)
         return;
     }
     sg_error(c->d, n->type_loc, SG_E_UNKNOWN_NODE, n->type);
+    sg_hint_suggest(c->d, near_node_type(c, n->type));
 }
 
 /* Defaults of inputs and params: constants (params: numbers only),
@@ -709,6 +797,11 @@ static void check_shader(checker *c, sg_shader *s)
                     o->output = k;
             if (o->output < 0) {
                 sg_error(c->d, o->loc, SG_E_BAD_OUTPUT, o->name);
+                sg_suggest sg;
+                sg_suggest_init(&sg, o->name);
+                for (int k = 0; k < SG_OUT_COUNT; k++)
+                    sg_suggest_offer(&sg, sg_output_names[k]);
+                sg_hint_suggest(c->d, sg_suggest_best(&sg));
                 continue;
             }
             want = output_types[o->output];
@@ -733,6 +826,7 @@ static void check_shader(checker *c, sg_shader *s)
             snprintf(what, sizeof what, "output '%s'", o->name);
             sg_error(c->d, v->loc, SG_E_TYPE_MISMATCH, what, ir_type_name(want),
                      ir_type_name(v->type));
+            hint_swizzle(c, v, want);
         }
     }
     s->ok = c->d->nerrors == errors;
@@ -822,6 +916,11 @@ static void check_scene(checker *c)
                 sg_error(c->d, sc->material_locs[i], SG_E_BAD_REFERENCE, msg);
             } else {
                 sg_error(c->d, sc->material_locs[i], SG_E_UNKNOWN_NAME, sc->materials[i]);
+                sg_suggest sg;
+                sg_suggest_init(&sg, sc->materials[i]);
+                for (int k = 0; k < p->nmaterials; k++)
+                    sg_suggest_offer(&sg, p->shaders[p->materials[k]]->name);
+                sg_hint_suggest(c->d, sg_suggest_best(&sg));
             }
         }
     if (sg_shader_find(p, sc->compositor) < 0) {
@@ -829,6 +928,12 @@ static void check_scene(checker *c)
         snprintf(msg, sizeof msg, "compositor '%s' is not a shader of this program "
                  "(import \"nodes/compositors.sg\"?)", sc->compositor);
         sg_error(c->d, sc->compositor_loc, SG_E_UNDECLARED, msg);
+        sg_suggest sg;
+        sg_suggest_init(&sg, sc->compositor);
+        for (int k = 0; k < p->nshaders; k++)
+            if (!p->shaders[k]->is_material)
+                sg_suggest_offer(&sg, p->shaders[k]->name);
+        sg_hint_suggest(c->d, sg_suggest_best(&sg));
     }
 }
 

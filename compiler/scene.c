@@ -44,6 +44,11 @@ static void check_materials(sg_program *p, const sg_scene *sc, sg_diags *d)
                                        : sc->loc;
         if (sg_material_find(p, sc->materials[i]) < 0) {
             sg_error(d, loc, SG_E_UNKNOWN_NAME, sc->materials[i]);
+            sg_suggest sg;
+            sg_suggest_init(&sg, sc->materials[i]);
+            for (int k = 0; k < sg_material_count(p); k++)
+                sg_suggest_offer(&sg, sg_material_name(p, k));
+            sg_hint_suggest(d, sg_suggest_best(&sg));
             continue;
         }
         for (int j = 0; j < i; j++) {

@@ -77,6 +77,7 @@ typedef struct sg_diag {
     sg_error_id  id;
     char        *msg;
     char        *src_line;  /* the source line at loc (for the caret), or NULL */
+    char        *suggestion; /* "did you mean" replacement (sg_hint_suggest), or NULL */
 } sg_diag;
 
 typedef struct sg_diags {
@@ -85,6 +86,7 @@ typedef struct sg_diags {
     int      nerrors;
     int      ndropped;  /* diagnostics counted but not stored (too many) */
     struct sg_sources *sources; /* source texts for carets (diag.c)      */
+    bool     last_dropped; /* the latest diagnostic was only counted     */
 } sg_diags;
 
 void sg_diags_init(sg_diags *d);
@@ -104,11 +106,37 @@ void sg_note(sg_diags *d, sg_loc loc, const char *fmt, ...)
 /* A warning: printed like an error, but the input is accepted. */
 void sg_warning(sg_diags *d, sg_loc loc, const char *fmt, ...)
     __attribute__((format(printf, 3, 4)));
+/* Append "; <text>" to the latest diagnostic's message (a hint on how to
+ * fix it); nothing if it was dropped or there is none. */
+void sg_hint(sg_diags *d, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+/* Append "; did you mean 'word'?" and record `word` as the latest
+ * diagnostic's suggestion (JSON "suggestion"); nothing if word is NULL. */
+void sg_hint_suggest(sg_diags *d, const char *word);
+
+/* "Did you mean": offer the names a misspelt `word` could have meant, one
+ * by one; sg_suggest_best is the nearest by edit distance (Damerau-
+ * Levenshtein: a swap of neighbours costs 1, a change of case 0; one name
+ * starting with the other, "out" for "output", just passes), or NULL
+ * when none is within about a third of the word's length.  The first of
+ * equally near names wins, so the result depends only on the order of
+ * the offers.  A name is not copied: it must outlive the sg_suggest. */
+typedef struct sg_suggest {
+    const char *word;
+    const char *best;
+    int         dist;
+} sg_suggest;
+void        sg_suggest_init(sg_suggest *s, const char *word);
+void        sg_suggest_offer(sg_suggest *s, const char *name);
+const char *sg_suggest_best(const sg_suggest *s);
+/* Edit distance of a and b as sg_suggest counts it (capped at 64). */
+int         sg_edit_distance(const char *a, const char *b);
+
 /* GCC style: "file:line:col: error: msg", the source line, a caret. */
 void sg_diags_print(const sg_diags *d, FILE *out);
 /* The same diagnostics for editors, one JSON object per line (JSON Lines):
  * {"file": …, "line": N, "column": N, "severity": "error", "id":
- * "UNKNOWN_NODE", "message": …}; file is null and line/column 0 where
+ * "UNKNOWN_NODE", "message": …} and, where the message says "did you
+ * mean", "suggestion": the name; file is null and line/column 0 where
  * unknown; a last {"dropped": N} line if some were not stored. */
 void sg_diags_print_json(const sg_diags *d, FILE *out);
 /* The id's name as in SG_ERRORS ("UNKNOWN_NODE"). */

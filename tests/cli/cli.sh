@@ -13,6 +13,10 @@
 #   preview    `splatc build --preview M`: M alone on the 257^2 test hill,
 #              camera `swatch`, no fog; deterministic; an unknown material
 #              is a located error and writes nothing
+#   teach      diagnostics that teach: "did you mean" in text and in
+#              --json ("suggestion"), failed imports list their search
+#              path, each file's errors once in `check A B`, a missing
+#              texture located at its declaration, -o checked first
 #   malformed  empty file, binary garbage, truncated files, 10 MB inputs,
 #              10000-deep instance nesting: exit 1 with a diagnostic, no crash
 #              or hang
@@ -196,6 +200,17 @@ depfile)
         > /dev/null || { fail "--json: no UNKNOWN_NODE at 2:14"; cat "$TMP/err"; }
     jq -e -s 'length >= 1 and all(.[]; has("file") and has("severity") and has("message"))' \
         "$TMP/err" > /dev/null || fail "--json: not JSON Lines of diagnostics"
+    ;;
+teach)
+    # did you mean, in the text and as a JSON "suggestion"
+    printf 'import "nodes/masks.sg"\nmaterial m {\n    node r : slope_rmap { lo = 0.3 }\n    out mask = r.out\n}\n' > "$TMP/typo.sg"
+    run 1 "$SPLATC" check "$TMP/typo.sg"
+    grep -q "^$TMP/typo.sg:3:14: error: unknown node type 'slope_rmap'; did you mean 'slope_ramp'?" \
+        "$TMP/err" || { fail "no suggestion in text"; cat "$TMP/err"; }
+    run 1 "$SPLATC" build "$TMP/typo.sg" -o "$TMP/typopack" --json
+    jq -e 'select(.id == "UNKNOWN_NODE" and .line == 3 and .column == 14 and
+                  .suggestion == "slope_ramp")' "$TMP/err" > /dev/null ||
+        { fail "--json: no suggestion"; cat "$TMP/err"; }
     ;;
 preview)
     run 0 "$SPLATC" build examples/minimal/scene.sg -o "$TMP/sw" --preview rock --no-cache
