@@ -17,6 +17,9 @@
 #              --json ("suggestion"), failed imports list their search
 #              path, each file's errors once in `check A B`, a missing
 #              texture located at its declaration, -o checked first
+#   teach_param  splatview --param (SPLATVIEW in the environment): a name
+#              without its material suggests MATERIAL.NAME, a value outside
+#              the param's declared range is refused
 #   malformed  empty file, binary garbage, truncated files, 10 MB inputs,
 #              10000-deep instance nesting: exit 1 with a diagnostic, no crash
 #              or hang
@@ -211,6 +214,18 @@ teach)
     jq -e 'select(.id == "UNKNOWN_NODE" and .line == 3 and .column == 14 and
                   .suggestion == "slope_ramp")' "$TMP/err" > /dev/null ||
         { fail "--json: no suggestion"; cat "$TMP/err"; }
+    ;;
+teach_param)
+    SPLATVIEW=${SPLATVIEW:?SPLATVIEW must name splatview}
+    run 0 "$SPLATC" build examples/minimal/scene.sg -o "$TMP/pack"
+    run 1 "$SPLATVIEW" "$TMP/pack" --headless -o "$TMP/a.png" --param tiling=1
+    grep -q "no param named 'tiling'; did you mean 'grass.tiling'?" "$TMP/err" ||
+        { fail "--param tiling: no suggestion"; cat "$TMP/err"; }
+    run 1 "$SPLATVIEW" "$TMP/pack" --headless -o "$TMP/a.png" --param grass.tiling=5
+    grep -q "param 'grass.tiling' = 5 is outside its declared range \[0.05, 2\]" "$TMP/err" ||
+        { fail "--param out of range accepted"; cat "$TMP/err"; }
+    [ -e "$TMP/a.png" ] && fail "a refused --param wrote a picture"
+    run 0 "$SPLATVIEW" "$TMP/pack" --headless -o "$TMP/a.png" --param grass.tiling=1
     ;;
 preview)
     run 0 "$SPLATC" build examples/minimal/scene.sg -o "$TMP/sw" --preview rock --no-cache

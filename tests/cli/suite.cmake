@@ -8,3 +8,10 @@ if(TARGET splatc_cli)
     set_tests_properties(cli.${case} PROPERTIES LABELS cli TIMEOUT 600)
   endforeach()
 endif()
+if(TARGET splatc_cli AND TARGET splatview)
+  add_test(NAME cli.teach_param
+           COMMAND sh ${CMAKE_CURRENT_LIST_DIR}/cli.sh $<TARGET_FILE:splatc_cli> teach_param
+           WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
+  set_tests_properties(cli.teach_param PROPERTIES LABELS "cli;render" TIMEOUT 600
+                       ENVIRONMENT "SPLATVIEW=$<TARGET_FILE:splatview>;SPLAT_VALIDATE=1")
+endif()
