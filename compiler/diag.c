@@ -121,9 +121,43 @@ static const char *find_line(sg_diags *d, const char *file, int line, size_t *n)
     return src->text + start;
 }
 
+/* A stored diagnostic equal to this one (its message perhaps with a hint
+ * appended), for sg_diags.unique. */
+static bool stored(const sg_diags *d, sg_loc loc, sg_severity sev, const char *msg)
+{
+    size_t n = strlen(msg);
+    for (int i = 0; i < d->n; i++) {
+        const sg_diag *g = &d->items[i];
+        if (g->severity == sev && g->loc.line == loc.line && g->loc.col == loc.col &&
+            (g->loc.file == loc.file || (g->loc.file && loc.file &&
+                                         !strcmp(g->loc.file, loc.file))) &&
+            !strncmp(g->msg, msg, n) && (g->msg[n] == 0 || g->msg[n] == ';'))
+            return true;
+    }
+    return false;
+}
+
 static void add(sg_diags *d, sg_loc loc, sg_severity sev, sg_error_id id,
                 const char *fmt, va_list ap)
 {
+    if (d->unique) {
+        va_list ap3;
+        va_copy(ap3, ap);
+        int len = vsnprintf(NULL, 0, fmt, ap3);
+        va_end(ap3);
+        char *msg = xmalloc((size_t)(len > 0 ? len : 0) + 1);
+        va_copy(ap3, ap);
+        vsnprintf(msg, (size_t)(len > 0 ? len : 0) + 1, fmt, ap3);
+        va_end(ap3);
+        bool dup = stored(d, loc, sev, msg);
+        free(msg);
+        if (dup) {
+            if (sev == SG_ERROR)
+                d->nerrors++;   /* still an error of this load */
+            d->last_dropped = true;
+            return;
+        }
+    }
     if (sev == SG_ERROR)
         d->nerrors++;
     if (d->n >= SG_MAX_STORED_DIAGS) {
@@ -272,7 +306,9 @@ void sg_suggest_init(sg_suggest *s, const char *word)
 static int limit_for(const char *word)
 {
     int len = (int)strlen(word);
-    return len < 5 ? 1 : (len + 1) / 3;   /* 1 up to 4 letters, 2 up to 7 ... */
+    /* none for 1 or 2 letters ('c' is as near 'a' as 'b'), 1 up to 4,
+     * 2 up to 7, ... */
+    return len < 3 ? 0 : len < 5 ? 1 : (len + 1) / 3;
 }
 
 /* One name the other starts with ("output" and "out"), both 3 letters or
@@ -394,8 +430,16 @@ void sg_diags_print_json(const sg_diags *d, FILE *out)
 
 void sg_diags_print(const sg_diags *d, FILE *out)
 {
+    sg_diags_print_from(d, 0, out);
+    if (d->ndropped)
+        fprintf(out, "splatc: note: %d more diagnostic%s not shown\n",
+                d->ndropped, d->ndropped == 1 ? "" : "s");
+}
+
+void sg_diags_print_from(const sg_diags *d, int from, FILE *out)
+{
     static const char *const sev[] = { "error", "warning", "note" };
-    for (int i = 0; i < d->n; i++) {
+    for (int i = from < 0 ? 0 : from; i < d->n; i++) {
         const sg_diag *g = &d->items[i];
         if (g->loc.file && g->loc.line > 0)
             fprintf(out, "%s:%d:%d: ", g->loc.file, g->loc.line, g->loc.col);
@@ -407,7 +451,4 @@ void sg_diags_print(const sg_diags *d, FILE *out)
         if (g->src_line)
             print_excerpt(out, g->loc.line, g->src_line, g->loc.col);
     }
-    if (d->ndropped)
-        fprintf(out, "splatc: note: %d more diagnostic%s not shown\n",
-                d->ndropped, d->ndropped == 1 ? "" : "s");
 }

@@ -220,15 +220,25 @@ static int cmd_check(int argc, char **argv)
     int st = parse_options(argc, argv, "", &o);
     if (st == EXIT_OK && o.nfiles == 0)
         st = usage_error("%s needs at least one FILE", "check");
+    /* one list for all the files, so an error in a file that several of
+     * them import is printed once */
+    sg_diags d;
+    sg_diags_init(&d);
+    d.unique = true;
     for (int i = 0; st != EXIT_USAGE && i < o.nfiles; i++) {
-        sg_diags d;
-        sg_diags_init(&d);
-        sg_program *p = load(o.files[i], &o, &d);
-        if (!p)
+        int from = d.n, errors = d.nerrors;
+        char **paths = splat_search_path(o.include, o.ninclude, o.files[i]);
+        sg_program *p = sg_load(o.files[i], (const char *const *)paths, &d);
+        splat_search_path_free(paths);
+        sg_diags_print_from(&d, from, stderr);
+        if (!p || d.nerrors > errors)
             st = EXIT_INPUT;
         sg_free(p);
-        sg_diags_free(&d);
     }
+    if (d.ndropped)
+        fprintf(stderr, "splatc: note: %d more diagnostic%s not shown\n", d.ndropped,
+                d.ndropped == 1 ? "" : "s");
+    sg_diags_free(&d);
     options_free(&o);
     return st;
 }

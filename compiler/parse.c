@@ -1249,6 +1249,45 @@ typedef struct loader {
     int         depth;
 } loader;
 
+/* Search folder s is the importing file's folder or an earlier one. */
+static bool seen_before(const sg_program *p, const char *dir, int s)
+{
+    if (!strcmp(p->search[s], dir))
+        return true;
+    for (int k = 0; k < s; k++)
+        if (!strcmp(p->search[k], p->search[s]))
+            return true;
+    return false;
+}
+
+/* An import found nowhere: the folders searched, in order, and how to add
+ * one.  The errors that only follow from it (names it would have defined)
+ * are left out by resolve (p->failed_imports). */
+static void missing_import(loader *l, const sg_file *f, const sg_import *im)
+{
+    sg_program *p = l->p;
+    size_t n = 256 + strlen(f->dir);
+    for (int s = 0; s < p->nsearch; s++)
+        n += strlen(p->search[s]) + 6;
+    char *msg = xmalloc(n);
+    size_t o = (size_t)snprintf(msg, n, "not found in '%s' (the importing file's folder)",
+                                f->dir);
+    /* each folder once, as given (the scene's folder often comes twice) */
+    int last = -1;
+    for (int s = 0; s < p->nsearch; s++)
+        if (!seen_before(p, f->dir, s))
+            last = s;
+    for (int s = 0; s < p->nsearch; s++)
+        if (!seen_before(p, f->dir, s))
+            o += (size_t)snprintf(msg + o, n - o, "%s'%s'", s == last ? " or " : ", ",
+                                  p->search[s]);
+    snprintf(msg + o, n - o, "; add the folder that holds it with -I DIR or "
+             "SPLATC_PATH=DIR[:DIR...]");
+    sg_error(l->d, im->loc, SG_E_MISSING_IMPORT, im->path, msg);
+    free(msg);
+    p->failed_imports++;
+}
+
 static char *read_all(const char *path, size_t *len, const char **err)
 {
     FILE *f = fopen(path, "rb");
@@ -1327,8 +1366,10 @@ static int load_file(loader *l, const char *path, const char *text, size_t len,
         owned = read_all(path, &len, &err);
         if (!owned) {
             free(rp);
-            if (is_import)
+            if (is_import) {
                 sg_error(l->d, from, SG_E_MISSING_IMPORT, path, err);
+                p->failed_imports++;
+            }
             else
                 sg_error(l->d, from, SG_E_IO, path, err);
             return -1;
@@ -1368,9 +1409,7 @@ static int load_file(loader *l, const char *path, const char *text, size_t len,
         }
         if (!found) {
             free(cand);
-            sg_error(l->d, imports[i].loc, SG_E_MISSING_IMPORT, imports[i].path,
-                     p->nsearch ? "not found next to the importing file or in the search paths"
-                                : "not found next to the importing file");
+            missing_import(l, f, &imports[i]);
             continue;
         }
         load_file(l, cand, NULL, 0, imports[i].loc, true);

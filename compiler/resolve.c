@@ -72,7 +72,20 @@ typedef struct checker {
     sg_diags   *d;
     sg_shader  *s;        /* current scope                                */
     sg_map      locals;   /* name -> (index << 2) | local kind            */
+    int         suppressed; /* unknown names left unreported in this scope:
+                               an import failed, they may be its (parse.c) */
 } checker;
+
+/* An unknown global name (node type, texture, material, compositor) is
+ * most likely one of a failed import's: leave it out, the import's error
+ * says what to do.  The scope is then not ok, though no error is added. */
+static bool after_failed_import(checker *c)
+{
+    if (c->p->failed_imports == 0)
+        return false;
+    c->suppressed++;
+    return true;
+}
 
 enum { L_NODE, L_IN, L_PARAM };
 
@@ -296,7 +309,7 @@ static bool resolve_path(checker *c, sg_value *v, bool allow_locals)
             snprintf(msg, sizeof msg, "a default value cannot use '%s': only constants, "
                      "textures and terrain inputs", first);
             sg_error(c->d, v->loc, SG_E_BAD_DEFAULT, msg);
-        } else {
+        } else if (!after_failed_import(c)) {
             sg_error(c->d, v->loc, SG_E_UNKNOWN_NAME, path_text(v, buf, sizeof buf));
             sg_hint_suggest(c->d, near_name(c, first, allow_locals));
         }
@@ -685,6 +698,8 @@ static void resolve_node_type(checker *c, sg_node *n)
         n->shader = g >> 1;
         return;
     }
+    if (after_failed_import(c))
+        return;
     sg_error(c->d, n->type_loc, SG_E_UNKNOWN_NODE, n->type);
     sg_hint_suggest(c->d, near_node_type(c, n->type));
 }
@@ -720,6 +735,7 @@ static void check_default(checker *c, sg_port *port, bool is_param)
 static void check_shader(checker *c, sg_shader *s)
 {
     int errors = c->d->nerrors;
+    c->suppressed = 0;
     declare_locals(c, s);
     for (int i = 0; i < s->nins; i++)
         if (s->ins[i].has_value)
@@ -829,7 +845,7 @@ static void check_shader(checker *c, sg_shader *s)
             hint_swizzle(c, v, want);
         }
     }
-    s->ok = c->d->nerrors == errors;
+    s->ok = c->d->nerrors == errors && c->suppressed == 0;
 }
 
 /* ---- the program ---------------------------------------------------------- */
@@ -914,7 +930,7 @@ static void check_scene(checker *c)
                 char msg[300];
                 snprintf(msg, sizeof msg, "'%s' is not a material", sc->materials[i]);
                 sg_error(c->d, sc->material_locs[i], SG_E_BAD_REFERENCE, msg);
-            } else {
+            } else if (!after_failed_import(c)) {
                 sg_error(c->d, sc->material_locs[i], SG_E_UNKNOWN_NAME, sc->materials[i]);
                 sg_suggest sg;
                 sg_suggest_init(&sg, sc->materials[i]);
@@ -923,7 +939,7 @@ static void check_scene(checker *c)
                 sg_hint_suggest(c->d, sg_suggest_best(&sg));
             }
         }
-    if (sg_shader_find(p, sc->compositor) < 0) {
+    if (sg_shader_find(p, sc->compositor) < 0 && !after_failed_import(c)) {
         char msg[300];
         snprintf(msg, sizeof msg, "compositor '%s' is not a shader of this program "
                  "(import \"nodes/compositors.sg\"?)", sc->compositor);
@@ -939,7 +955,7 @@ static void check_scene(checker *c)
 
 void sg_resolve(sg_program *p, sg_diags *d)
 {
-    checker c = { p, d, NULL, { 0 } };
+    checker c = { p, d, NULL, { 0 }, 0 };
     declare_globals(&c);
     for (int i = 0; i < p->nshaders; i++)
         check_shader(&c, p->shaders[i]);

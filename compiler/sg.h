@@ -86,7 +86,11 @@ typedef struct sg_diags {
     int      nerrors;
     int      ndropped;  /* diagnostics counted but not stored (too many) */
     struct sg_sources *sources; /* source texts for carets (diag.c)      */
-    bool     last_dropped; /* the latest diagnostic was only counted     */
+    bool     last_dropped; /* the latest diagnostic was not stored        */
+    bool     unique;    /* do not store a diagnostic equal to one stored
+                           (it still counts in nerrors): one list for
+                           several loads of files that share imports
+                           (`splatc check A B` prints each error once)    */
 } sg_diags;
 
 void sg_diags_init(sg_diags *d);
@@ -117,9 +121,10 @@ void sg_hint_suggest(sg_diags *d, const char *word);
  * by one; sg_suggest_best is the nearest by edit distance (Damerau-
  * Levenshtein: a swap of neighbours costs 1, a change of case 0; one name
  * starting with the other, "out" for "output", just passes), or NULL
- * when none is within about a third of the word's length.  The first of
- * equally near names wins, so the result depends only on the order of
- * the offers.  A name is not copied: it must outlive the sg_suggest. */
+ * when none is within about a third of the word's length (none at all
+ * for words of 1 or 2 letters).  The first of equally near names wins, so
+ * the result depends only on the order of the offers.  A name is not
+ * copied: it must outlive the sg_suggest. */
 typedef struct sg_suggest {
     const char *word;
     const char *best;
@@ -133,6 +138,8 @@ int         sg_edit_distance(const char *a, const char *b);
 
 /* GCC style: "file:line:col: error: msg", the source line, a caret. */
 void sg_diags_print(const sg_diags *d, FILE *out);
+/* The same for the diagnostics from index `from` on (no "not shown" line). */
+void sg_diags_print_from(const sg_diags *d, int from, FILE *out);
 /* The same diagnostics for editors, one JSON object per line (JSON Lines):
  * {"file": …, "line": N, "column": N, "severity": "error", "id":
  * "UNKNOWN_NODE", "message": …} and, where the message says "did you

@@ -215,6 +215,8 @@ struct sg_program {
     char      **search;  int nsearch;
     int         load_errors; /* errors while loading and checking       */
     int         nug_materials; /* materials with undergrowth blocks     */
+    int         failed_imports; /* imports not found: resolve leaves out the
+                                   unknown names that follow from them   */
 };
 
 /* ---- parse.c ------------------------------------------------------------ */

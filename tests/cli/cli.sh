@@ -214,6 +214,21 @@ teach)
     jq -e 'select(.id == "UNKNOWN_NODE" and .line == 3 and .column == 14 and
                   .suggestion == "slope_ramp")' "$TMP/err" > /dev/null ||
         { fail "--json: no suggestion"; cat "$TMP/err"; }
+    # a failed import: the folders searched, how to add one, no follow-on errors
+    mkdir -p "$TMP/fresh"
+    printf 'import "lib/mine.sg"\nmaterial m {\n    node r : my_ramp { x = terrain.slope }\n    out mask = r.out\n}\n' > "$TMP/fresh/a.sg"
+    run 1 "$SPLATC" check "$TMP/fresh/a.sg"
+    grep -q "^$TMP/fresh/a.sg:1:8: error: cannot import 'lib/mine.sg': not found in '$TMP/fresh' (the importing file's folder).*'\.'.*; add the folder that holds it with -I DIR or SPLATC_PATH=DIR\[:DIR...\]" \
+        "$TMP/err" || { fail "failed import: no search list"; cat "$TMP/err"; }
+    [ "$(grep -c 'error:' "$TMP/err")" = 1 ] || { fail "failed import: follow-on errors"; cat "$TMP/err"; }
+    # each file's errors once in `check A B` (both import the broken lib)
+    mkdir -p "$TMP/fresh/lib"
+    printf 'shader my_ramp {\n    in float x\n    node q : quux { }\n    out float out = x\n}\n' > "$TMP/fresh/lib/mine.sg"
+    cp "$TMP/fresh/a.sg" "$TMP/fresh/b.sg"
+    run 1 "$SPLATC" check "$TMP/fresh/a.sg" "$TMP/fresh/b.sg"
+    [ "$(grep -c "lib/mine.sg:3:14: error: unknown node type 'quux'" "$TMP/err")" = 1 ] ||
+        { fail "check A B: an imported file's error not printed exactly once"; cat "$TMP/err"; }
+    run 1 "$SPLATC" check "$TMP/fresh/b.sg"
     ;;
 teach_param)
     SPLATVIEW=${SPLATVIEW:?SPLATVIEW must name splatview}
