@@ -230,6 +230,8 @@ static int cmd_check(int argc, char **argv)
         char **paths = splat_search_path(o.include, o.ninclude, o.files[i]);
         sg_program *p = sg_load(o.files[i], (const char *const *)paths, &d);
         splat_search_path_free(paths);
+        if (p && d.nerrors == errors)
+            sg_check_texture_files(p, &d);   /* what `build` would read */
         sg_diags_print_from(&d, from, stderr);
         if (!p || d.nerrors > errors)
             st = EXIT_INPUT;

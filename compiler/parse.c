@@ -745,6 +745,7 @@ static void add_texture_setting(parser *ps, void *user, sg_token *key, sg_value 
         else {
             char *path = splat_path_join(ps->f->dir, v->str);
             t->file = sg_strdup(ps->a, path);
+            t->file_loc = v->loc;
             free(path);
         }
     } else if (is_kw(key, "filter") || is_kw(key, "mip")) {

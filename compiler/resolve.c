@@ -25,8 +25,12 @@
 #include "sg_internal.h"
 #include "util.h"
 
+#include <errno.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
+
+#include <stb_image.h>
 
 const char *const sg_output_names[SG_OUT_COUNT] = {
 #define X(id, name, type) name,
@@ -962,4 +966,101 @@ void sg_resolve(sg_program *p, sg_diags *d)
     sg_map_free(&c.locals);
     check_nesting(&c);
     check_scene(&c);
+}
+
+/* ---- texture files ----------------------------------------------------------- */
+
+typedef void (*tex_fn)(void *user, const char *file, sg_loc loc);
+
+/* Every texture file named in the program, with where: declarations,
+ * then inline strings on node ports and input defaults, in file order. */
+static void each_texture_file(const sg_program *p, tex_fn fn, void *user)
+{
+    for (int i = 0; i < p->ntextures; i++) {
+        const sg_texdecl *t = p->textures[i];
+        if (t->file && *t->file)
+            fn(user, t->file, t->file_loc.line > 0 ? t->file_loc : t->loc);
+    }
+    for (int i = 0; i < p->nshaders; i++) {
+        const sg_shader *s = p->shaders[i];
+        const char *dir = p->files[s->file]->dir;
+        for (int k = 0; k < s->nins; k++)
+            if (s->ins[k].has_value && s->ins[k].value.kind == SG_V_STRING &&
+                s->ins[k].type == IR_T_TEX) {
+                char *path = splat_path_join(dir, s->ins[k].value.str);
+                fn(user, path, s->ins[k].value.loc);
+                free(path);
+            }
+        for (int k = 0; k < s->nnodes; k++) {
+            const sg_node *n = &s->nodes[k];
+            if (n->kind == SG_NODE_PAINTED)
+                continue;
+            for (int a = 0; a < n->nargs; a++)
+                if (n->args[a].val.kind == SG_V_STRING) {
+                    char *path = splat_path_join(dir, n->args[a].val.str);
+                    fn(user, path, n->args[a].val.loc);
+                    free(path);
+                }
+        }
+    }
+}
+
+typedef struct tex_find { const char *file; sg_loc loc; } tex_find;
+
+static void find_file(void *user, const char *file, sg_loc loc)
+{
+    tex_find *f = user;
+    if (f->loc.line == 0 && !strcmp(f->file, file))
+        f->loc = loc;
+}
+
+sg_loc sg_texture_file_loc(const sg_program *p, const char *file)
+{
+    tex_find f = { file, { NULL, 0, 0 } };
+    each_texture_file(p, find_file, &f);
+    return f.loc;
+}
+
+typedef struct tex_check {
+    sg_diags *d;
+    sg_map    seen;
+    char    **keys;
+    int       nkeys, cap;
+    bool      ok;
+} tex_check;
+
+static void check_file(void *user, const char *file, sg_loc loc)
+{
+    tex_check *c = user;
+    if (sg_map_get(&c->seen, file) >= 0)
+        return;
+    if (c->nkeys == c->cap) {
+        c->cap = c->cap ? 2 * c->cap : 16;
+        c->keys = xrealloc(c->keys, (size_t)c->cap * sizeof *c->keys);
+    }
+    c->keys[c->nkeys] = xstrdup(file);
+    sg_map_put(&c->seen, c->keys[c->nkeys++], 0);
+    struct stat st;
+    int w, h, comp;
+    if (stat(file, &st) != 0) {
+        sg_error(c->d, loc, SG_E_IO, file, strerror(errno));
+        c->ok = false;
+    } else if (!S_ISREG(st.st_mode)) {
+        sg_error(c->d, loc, SG_E_IO, file, "not a regular file");
+        c->ok = false;
+    } else if (!stbi_info(file, &w, &h, &comp)) {
+        sg_error(c->d, loc, SG_E_IO, file, "not an image (PNG, JPEG, TGA or BMP)");
+        c->ok = false;
+    }
+}
+
+bool sg_check_texture_files(const sg_program *p, sg_diags *d)
+{
+    tex_check c = { d, { 0 }, NULL, 0, 0, true };
+    each_texture_file(p, check_file, &c);
+    sg_map_free(&c.seen);
+    for (int i = 0; i < c.nkeys; i++)
+        free(c.keys[i]);
+    free(c.keys);
+    return c.ok;
 }

@@ -62,6 +62,32 @@ static void check_materials(sg_program *p, const sg_scene *sc, sg_diags *d)
     }
 }
 
+/* The stack's texture files, before any work: each readable and an image,
+ * else an error at the string that names it (in whichever file that is). */
+static bool check_textures(const splat_scene *s, sg_diags *d)
+{
+    bool ok = true;
+    for (int i = 0; i < s->ir.ntextures; i++) {
+        const char *file = s->ir.textures[i].file;
+        bool first = true;
+        for (int k = 0; k < i; k++)
+            first &= strcmp(s->ir.textures[k].file, file) != 0;
+        if (!first)
+            continue;
+        sg_loc loc = sg_loc_or(sg_texture_file_loc(s->prog, file), s->desc->loc);
+        struct stat st;
+        int w, h, comp;
+        if (stat(file, &st) != 0) {
+            sg_error(d, loc, SG_E_IO, file, strerror(errno));
+            ok = false;
+        } else if (!S_ISREG(st.st_mode) || !stbi_info(file, &w, &h, &comp)) {
+            sg_error(d, loc, SG_E_IO, file, "not an image (PNG, JPEG, TGA or BMP)");
+            ok = false;
+        }
+    }
+    return ok;
+}
+
 /* ---- rasters ------------------------------------------------------------ */
 
 static bool is_png(const char *file)
@@ -265,7 +291,7 @@ bool splat_scene_load(splat_scene *s, const char *path,
         !sg_scene_cells_fit(sc, s->terrain.width, s->terrain.height, d))
         goto fail;
     if (!load_holes(s, d) || !load_painted(s, d) || !lower_materials(s, d) ||
-        d->nerrors > errors)
+        !check_textures(s, d) || d->nerrors > errors)
         goto fail;
     if (!splat_compositor_check(s->prog, sc->compositor ? sc->compositor : "linear_alpha",
                                 sg_loc_or(sc->compositor_loc, sc->loc), d))

@@ -165,6 +165,15 @@ sg_program *sg_load(const char *path, const char *const *search_paths,
 /* Same, from memory (`name` is used in diagnostics and for imports). */
 sg_program *sg_load_string(const char *name, const char *text,
                            const char *const *search_paths, sg_diags *d);
+/* Where texture file `file` (a path as in ir_texture.file) is named: the
+ * string of its `texture { file = "…" }` or of an inline texture on a
+ * port, the first such; line 0 if none. */
+sg_loc sg_texture_file_loc(const sg_program *p, const char *file);
+/* Every texture file the program names (declared or inline), each once:
+ * readable and an image, else IO at the string naming it.  False if one
+ * is not.  sg_load does not look at files (a graph library may name
+ * textures its user never builds); `splatc check` and scene loading do. */
+bool sg_check_texture_files(const sg_program *p, sg_diags *d);
 void        sg_free(sg_program *p);
 
 /* Every file the program read (for hot reload and cache keys). */

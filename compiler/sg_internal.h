@@ -195,6 +195,7 @@ typedef struct sg_texdecl {
     char      *name;
     sg_loc     loc;
     char      *file;        /* resolved relative to the declaring file    */
+    sg_loc     file_loc;    /* the `file = "…"` string (else loc)          */
     ir_filter  filter, mip;
     ir_wrap    wrap;
     bool       srgb;

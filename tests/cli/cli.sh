@@ -229,6 +229,21 @@ teach)
     [ "$(grep -c "lib/mine.sg:3:14: error: unknown node type 'quux'" "$TMP/err")" = 1 ] ||
         { fail "check A B: an imported file's error not printed exactly once"; cat "$TMP/err"; }
     run 1 "$SPLATC" check "$TMP/fresh/b.sg"
+    # a missing texture: at its declaration (in the file that declares it),
+    # by check as by build, and build stops before writing anything
+    mkdir -p "$TMP/tex"
+    cp examples/minimal/heightfield.png "$TMP/tex/"
+    printf 'texture rocks { file = "textures/rocks.png" }\nmaterial rock {\n    node s : sample { tex = rocks, uv = terrain.uv }\n    out albedo = s.rgb\n}\n' > "$TMP/tex/materials.sg"
+    printf 'import "nodes/compositors.sg"\nimport "materials.sg"\nscene s {\n    heightfield = "heightfield.png"\n    size = 1024 1024\n    max_height = 160\n    materials = [rock]\n}\n' > "$TMP/tex/scene.sg"
+    run 1 "$SPLATC" check "$TMP/tex/scene.sg"
+    grep -q "^$TMP/tex/materials.sg:1:24: error: cannot read '$TMP/tex/textures/rocks.png': No such file or directory" \
+        "$TMP/err" || { fail "check: missing texture not located at its declaration"; cat "$TMP/err"; }
+    run 1 "$SPLATC" build "$TMP/tex/scene.sg" -o "$TMP/tex/pack"
+    grep -q "^$TMP/tex/materials.sg:1:24: error: cannot read '$TMP/tex/textures/rocks.png'" \
+        "$TMP/err" || { fail "build: missing texture not located at its declaration"; cat "$TMP/err"; }
+    [ -e "$TMP/tex/pack" ] && fail "build with a missing texture wrote a pack"
+    mkdir -p "$TMP/tex/textures" && cp graphs/textures/rock.png "$TMP/tex/textures/rocks.png"
+    run 0 "$SPLATC" check "$TMP/tex/scene.sg"
     ;;
 teach_param)
     SPLATVIEW=${SPLATVIEW:?SPLATVIEW must name splatview}

@@ -6,7 +6,9 @@
  *
  * in the order the compiler reports them.  A file with no `expect` line
  * must load without errors and every one of its materials must lower to
- * valid IR.  Usage: golden FILE.sg [--print] (from the repository root;
+ * valid IR.  A file with a `# golden: texture files` line also has its
+ * texture files checked (sg_check_texture_files, as `splatc check` does).
+ * Usage: golden FILE.sg [--print] (from the repository root;
  * --print shows what the compiler says, in the expect format). */
 #include "sg.h"
 
@@ -59,6 +61,7 @@ int main(int argc, char **argv)
         fprintf(stderr, "golden: cannot read %s\n", path);
         return 2;
     }
+    bool texture_files = strstr(text, "# golden: texture files") != NULL;
     /* the expectations */
     char **want = NULL;
     int nwant = 0;
@@ -73,6 +76,8 @@ int main(int argc, char **argv)
     sg_diags d;
     sg_diags_init(&d);
     sg_program *p = sg_load(path, search, &d);
+    if (p && texture_files && d.nerrors == 0)
+        sg_check_texture_files(p, &d);
     int failures = 0;
     if (print) {
         for (int i = 0; i < d.n; i++) {
