@@ -377,6 +377,7 @@ bool splat_build(const splat_build_desc *desc, splat_build_stats *st, sg_diags *
     for (size_t n = strlen(b.out); n > 1 && b.out[n - 1] == '/'; n--)
         b.out[n - 1] = 0;
 
+    phase(&b, build_check_out, &st->load);  /* -o can be written, first    */
     phase(&b, load, &st->load);             /* parse, check, lower, rasters */
     if (unchanged(&b)) {
         phase(&b, write_depfile, &st->write);

@@ -119,6 +119,10 @@ void build_report_far(const build *b, FILE *out);
 /* ---- the pack writer (pack_write.c) -------------------------------------- */
 
 bool build_write_pack(build *b);
+/* Before any work: the output's parent folder exists and takes new
+ * entries, and the output is absent, a folder or a pack (what
+ * build_write_pack will refuse, it refuses first). */
+bool build_check_out(build *b);
 /* A texture's k-th mip file ("rock.mip1.png") and how many it has. */
 char *build_mip_path(const char *path, int k);
 int   build_mip_count(const char *src);

@@ -725,6 +725,39 @@ static bool replaceable(build *b, const char *path, bool *exists)
     return false;
 }
 
+bool build_check_out(build *b)
+{
+    const char *out = b->out;
+    sg_loc none = { NULL, 0, 0 };
+    char *parent = splat_path_dir(out);
+    struct stat sb;
+    bool ok = true;
+    if (stat(parent, &sb) != 0) {
+        char why[PATH_MAX + 96];
+        snprintf(why, sizeof why, "its folder '%s' does not exist (create it first: "
+                 "mkdir -p '%s')", parent, parent);
+        sg_error(b->d, none, SG_E_WRITE, out, why);
+        ok = false;
+    } else if (!S_ISDIR(sb.st_mode)) {
+        char why[PATH_MAX + 64];
+        snprintf(why, sizeof why, "'%s' is not a folder", parent);
+        sg_error(b->d, none, SG_E_WRITE, out, why);
+        ok = false;
+    } else if (access(parent, W_OK | X_OK) != 0) {
+        char why[PATH_MAX + 64];
+        snprintf(why, sizeof why, "folder '%s': %s", parent, strerror(errno));
+        sg_error(b->d, none, SG_E_WRITE, out, why);
+        ok = false;
+    } else if (lstat(out, &sb) == 0 && !S_ISDIR(sb.st_mode)) {
+        char msg[PATH_MAX + 64];
+        snprintf(msg, sizeof msg, "refusing to replace '%s': it is not a shader pack", out);
+        sg_error(b->d, b->loc, SG_E_NOT_A_PACK, msg);
+        ok = false;
+    }
+    free(parent);
+    return ok;
+}
+
 bool build_write_pack(build *b)
 {
     const char *out = b->out;

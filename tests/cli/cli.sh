@@ -244,6 +244,14 @@ teach)
     [ -e "$TMP/tex/pack" ] && fail "build with a missing texture wrote a pack"
     mkdir -p "$TMP/tex/textures" && cp graphs/textures/rock.png "$TMP/tex/textures/rocks.png"
     run 0 "$SPLATC" check "$TMP/tex/scene.sg"
+    # -o into a folder that does not exist: refused before any work (the
+    # scene's own errors and the --stats report never come)
+    run 1 "$SPLATC" build "$TMP/typo.sg" -o "$TMP/no/such/pack" --stats
+    grep -q "^splatc: error: cannot write '$TMP/no/such/pack': its folder '$TMP/no/such' does not exist" \
+        "$TMP/err" || { fail "-o: missing parent not reported"; cat "$TMP/err"; }
+    grep -q "slope_rmap" "$TMP/err" && fail "-o: the scene was loaded before -o was checked"
+    [ -s "$TMP/out" ] && fail "-o: a report was printed"
+    [ -e "$TMP/no" ] && fail "-o: a folder was made"
     ;;
 teach_param)
     SPLATVIEW=${SPLATVIEW:?SPLATVIEW must name splatview}
