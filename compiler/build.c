@@ -228,8 +228,14 @@ static bool load(build *b)
         splat_scene_free(&b->scene);
         b->scene_ok = false;
     }
-    if (b->scene_ok)   /* here, so an up-to-date build warns the same */
+    if (b->scene_ok) {   /* here, so an up-to-date build warns the same */
         splat_sites_warn(&b->scene, b->d);   /* precision.c */
+        ir_ienv region;                      /* lint.c, over this terrain */
+        memset(&region, 0, sizeof region);
+        splat_terrain_ranges(&b->scene.terrain, 0, 0, b->scene.terrain.width,
+                             b->scene.terrain.height, &region);
+        sg_lint(b->scene.prog, &region, b->d);
+    }
     return b->scene_ok;
 }
 

@@ -232,6 +232,8 @@ static int cmd_check(int argc, char **argv)
         splat_search_path_free(paths);
         if (p && d.nerrors == errors)
             sg_check_texture_files(p, &d);   /* what `build` would read */
+        if (p && d.nerrors == errors)
+            sg_lint(p, NULL, &d);            /* over every input's domain */
         sg_diags_print_from(&d, from, stderr);
         if (!p || d.nerrors > errors)
             st = EXIT_INPUT;

@@ -733,6 +733,20 @@ static void check_default(checker *c, sg_port *port, bool is_param)
         snprintf(msg, sizeof msg, "range of param '%s' is empty (%g > %g)", port->name,
                  port->lo, port->hi);
         sg_error(c->d, v->loc, SG_E_EMPTY_RANGE, msg);
+    } else if (is_param && port->has_range && port->lo < port->hi) {
+        /* the interval analysis (and the pack's culling) assume the param
+         * stays in its range, the default included (lo == hi: fixed at
+         * its default, as the IR dump writes a param with no range) */
+        int w = v->kind == SG_V_VEC ? v->width : 1;
+        for (int k = 0; k < w; k++)
+            if (!(v->num[k] >= port->lo && v->num[k] <= port->hi)) {
+                char msg[300];
+                snprintf(msg, sizeof msg, "the default %g of param '%s' is outside its "
+                         "range [%g, %g] (the compiler assumes the param stays in it)",
+                         v->num[k], port->name, port->lo, port->hi);
+                sg_error(c->d, v->loc, SG_E_BAD_DEFAULT, msg);
+                break;
+            }
     }
 }
 

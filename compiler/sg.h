@@ -165,6 +165,12 @@ sg_program *sg_load(const char *path, const char *const *search_paths,
 /* Same, from memory (`name` is used in diagnostics and for imports). */
 sg_program *sg_load_string(const char *name, const char *text,
                            const char *const *search_paths, sg_diags *d);
+/* Warnings about what builds but cannot be meant (lint.c): a mask whose
+ * bounds over `region` leave [0, 1], an output that can be NaN or
+ * infinite, a constant lo >= hi on a ramp-like node.  `region`: the
+ * terrain's input bounds (params and painted unset), NULL for every
+ * input's domain.  Nothing for a program with errors. */
+void sg_lint(sg_program *p, const ir_ienv *region, sg_diags *d);
 /* Where texture file `file` (a path as in ir_texture.file) is named: the
  * string of its `texture { file = "…" }` or of an inline texture on a
  * port, the first such; line 0 if none. */

@@ -252,6 +252,16 @@ teach)
     grep -q "slope_rmap" "$TMP/err" && fail "-o: the scene was loaded before -o was checked"
     [ -s "$TMP/out" ] && fail "-o: a report was printed"
     [ -e "$TMP/no" ] && fail "-o: a folder was made"
+    # interval warnings in a build: the mask's bounds over this terrain
+    mkdir -p "$TMP/tall"
+    cp examples/minimal/heightfield.png "$TMP/tall/"
+    printf 'import "nodes/compositors.sg"\nmaterial grass { out albedo = vec3(0.2, 0.4, 0.1) }\nmaterial rock { out mask = terrain.height }\nscene s {\n    heightfield = "heightfield.png"\n    size = 1024 1024\n    max_height = 500\n    materials = [grass, rock]\n}\n' > "$TMP/tall/scene.sg"
+    run 0 "$SPLATC" build "$TMP/tall/scene.sg" -o "$TMP/tall/pack"
+    grep -q "^$TMP/tall/scene.sg:3:21: warning: the mask of material 'rock' takes values in \[78.39[0-9]*, 420.3[0-9]*\]" \
+        "$TMP/err" || { fail "build: no mask warning with the terrain's bounds"; cat "$TMP/err"; }
+    run 0 "$SPLATC" check "$TMP/tall/scene.sg"
+    grep -q "^$TMP/tall/scene.sg:3:21: warning: the mask of material 'rock' takes values in \[-inf, inf\]" \
+        "$TMP/err" || { fail "check: no mask warning"; cat "$TMP/err"; }
     ;;
 teach_param)
     SPLATVIEW=${SPLATVIEW:?SPLATVIEW must name splatview}
