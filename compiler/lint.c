@@ -295,3 +295,48 @@ void sg_lint(sg_program *p, const ir_ienv *region, sg_diags *d)
     for (int i = 0; i < p->nmaterials; i++)
         lint_outputs(p, p->shaders[p->materials[i]], region, d);
 }
+
+/* ---- the node behind an IR fact ------------------------------------------- */
+
+/* Does value v read terrain input `input` ("terrain.position")? */
+static bool reads_input(const sg_value *v, int input)
+{
+    return v->kind == SG_V_PATH && v->ref == SG_REF_INPUT && v->index == input;
+}
+
+static bool find_reader(const sg_program *p, const sg_shader *s, const char *op, int input,
+                        int depth, sg_loc *loc, char *what, size_t n)
+{
+    if (depth > SG_MAX_DEPTH)
+        return false;
+    for (int pass = 0; pass < 2; pass++)   /* op nodes here first, then inside instances */
+        for (int i = 0; i < s->nnodes; i++) {
+            const sg_node *nd = &s->nodes[i];
+            if (pass == 0 && (!op || (nd->kind == SG_NODE_OP && !strcmp(nd->type, op)))) {
+                for (int a = 0; a < nd->nargs; a++)
+                    if (reads_input(&nd->args[a].val, input)) {
+                        *loc = nd->loc;
+                        snprintf(what, n, "node '%s' (%s)%s%s", nd->name, nd->type,
+                                 s->is_material ? "" : " of shader ",
+                                 s->is_material ? "" : s->name);
+                        return true;
+                    }
+            } else if (pass == 1 && nd->kind == SG_NODE_INSTANCE &&
+                       find_reader(p, p->shaders[nd->shader], op, input, depth + 1, loc,
+                                   what, n)) {
+                return true;
+            }
+        }
+    return false;
+}
+
+bool sg_node_reading_input(const sg_program *p, const char *material, const char *op,
+                           int input, sg_loc *loc, char *what, size_t n)
+{
+    int mi = sg_material_find(p, material);
+    if (mi < 0)
+        return false;
+    const sg_shader *s = p->shaders[p->materials[mi]];
+    return find_reader(p, s, op, input, 0, loc, what, n) ||
+           (op && find_reader(p, s, NULL, input, 0, loc, what, n));
+}

@@ -171,6 +171,13 @@ sg_program *sg_load_string(const char *name, const char *text,
  * terrain's input bounds (params and painted unset), NULL for every
  * input's domain.  Nothing for a program with errors. */
 void sg_lint(sg_program *p, const ir_ienv *region, sg_diags *d);
+/* The node of `material` (or of a shader it instantiates, looked at
+ * after its own nodes) of built-in op `op` (NULL: any) that reads terrain
+ * input `input` (ir_input_kind) directly; its location and "node 'uv'
+ * (mul)" or "node 'uv' (mul) of shader S" in `what`.  Falls back to any
+ * node reading the input when none of `op` does.  False if none. */
+bool sg_node_reading_input(const sg_program *p, const char *material, const char *op,
+                           int input, sg_loc *loc, char *what, size_t n);
 /* Where texture file `file` (a path as in ir_texture.file) is named: the
  * string of its `texture { file = "…" }` or of an inline texture on a
  * port, the first such; line 0 if none. */
