@@ -214,7 +214,15 @@ void sg_warning(sg_diags *d, sg_loc loc, const char *fmt, ...)
 {
     va_list ap;
     va_start(ap, fmt);
-    add(d, loc, SG_WARNING, SG_E_INTERNAL, fmt, ap);
+    add(d, loc, SG_WARNING, SG_E_WARNING, fmt, ap);
+    va_end(ap);
+}
+
+void sg_warning_id(sg_diags *d, sg_loc loc, sg_error_id id, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    add(d, loc, SG_WARNING, id, fmt, ap);
     va_end(ap);
 }
 
@@ -407,8 +415,15 @@ static void json_string(FILE *out, const char *s)
 
 void sg_diags_print_json(const sg_diags *d, FILE *out)
 {
+    sg_diags_print_json_from(d, 0, out);
+    if (d->ndropped)
+        fprintf(out, "{\"dropped\": %d}\n", d->ndropped);
+}
+
+void sg_diags_print_json_from(const sg_diags *d, int from, FILE *out)
+{
     static const char *const sev[] = { "error", "warning", "note" };
-    for (int i = 0; i < d->n; i++) {
+    for (int i = from < 0 ? 0 : from; i < d->n; i++) {
         const sg_diag *g = &d->items[i];
         fputs("{\"file\": ", out);
         json_string(out, g->loc.file);
@@ -424,8 +439,6 @@ void sg_diags_print_json(const sg_diags *d, FILE *out)
         }
         fputs("}\n", out);
     }
-    if (d->ndropped)
-        fprintf(out, "{\"dropped\": %d}\n", d->ndropped);
 }
 
 void sg_diags_print(const sg_diags *d, FILE *out)

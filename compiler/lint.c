@@ -200,7 +200,7 @@ static void lint_outputs(sg_program *p, const sg_shader *s, const ir_ienv *regio
         double w;
         if ((b.lo < -1e-6 || b.hi > 1 + 1e-6) && ir.npainted <= 64 &&
             mask_witness(&ir, ir.roots[r].ref, &env, &w))
-            sg_warning(d, o->loc, "the mask of material '%s' takes values in [%g, %g] "
+            sg_warning_id(d, o->loc, SG_E_W_MASK_RANGE, "the mask of material '%s' takes values in [%g, %g] "
                        "(%g at one point), outside [0, 1]: it is clamped there (bring it "
                        "into [0, 1] with ramp, remap or saturate)", s->name, b.lo, b.hi, w);
     }
@@ -232,7 +232,7 @@ static void lint_outputs(sg_program *p, const sg_shader *s, const ir_ienv *regio
             len += (size_t)snprintf(ops + len, sizeof ops - len, "%s[%g, %g]", k ? ", " : "",
                                     a[0].lo, a[0].hi);
         }
-        sg_warning(d, o->loc, "output '%s' of material '%s' can be NaN or infinite: its "
+        sg_warning_id(d, o->loc, SG_E_W_NAN, "output '%s' of material '%s' can be NaN or infinite: its "
                    "'%s' can make one from operands in %s", o->name, s->name,
                    op ? op : "internal op", ops);
     }
@@ -278,7 +278,7 @@ static void lint_ranges(const sg_program *p, const sg_shader *s, sg_diags *d)
             if (!const_input(p, n, pairs[k][0], &lo) || !const_input(p, n, pairs[k][1], &hi))
                 continue;
             if (lo >= hi)
-                sg_warning(d, n->loc, "'%s' (%s) has %s = %g >= %s = %g: no ramp between "
+                sg_warning_id(d, n->loc, SG_E_W_LO_HI, "'%s' (%s) has %s = %g >= %s = %g: no ramp between "
                            "them, at most a hard step (for a falling ramp, swap them and "
                            "take 1 - the result)", n->name, n->type, pairs[k][0], lo,
                            pairs[k][1], hi);

@@ -1,6 +1,6 @@
 /* main.c — the splatc command line.
  *
- *   splatc check FILE...                       parse and type-check
+ *   splatc check FILE... [--json]              parse and type-check
  *   splatc glsl  FILE -m MAT [-o OUT.frag] [--stage fragment|compute]
  *                                              shader of one material
  *   splatc spirv FILE -m MAT -o OUT.spv [--stage …]  the same, compiled and validated
@@ -37,7 +37,9 @@ enum { EXIT_OK = 0, EXIT_INPUT = 1, EXIT_USAGE = 2 };
 static const char usage_text[] =
     "usage: splatc COMMAND [options]\n"
     "commands:\n"
-    "  check FILE...                      parse and type-check graph files\n"
+    "  check FILE... [--json]             parse and type-check graph files, their texture\n"
+    "                                     files and their masks' bounds (--json: the\n"
+    "                                     diagnostics as JSON Lines, for editors)\n"
     "  glsl  FILE -m MATERIAL [-o OUT]    Vulkan GLSL 450 fragment shader of a material\n"
     "  spirv FILE -m MATERIAL -o OUT.spv  the same compiled to SPIR-V and validated\n"
     "        --stage fragment|compute     (glsl, spirv) the fragment shader (default) or\n"
@@ -59,7 +61,8 @@ static const char usage_text[] =
     "  build SCENE.sg -o PACKDIR ...      compile a scene into a shader pack (build --help)\n"
     "  texgen --out DIR ...               write the example textures (texgen --help)\n"
     "options:\n"
-    "  -I DIR       also search DIR for imports (repeatable)\n"
+    "  -I DIR       also search DIR for imports (repeatable; SPLATC_PATH=DIR:DIR...\n"
+    "               in the environment does the same)\n"
     "  --help       this text\n"
     "  --version    the compiler version\n"
     "exit status: 0 ok, 1 errors in the input, 2 usage errors\n";
@@ -83,6 +86,7 @@ typedef struct options {
     const char  *at;
     const char  *stage;   /* --stage fragment|compute (glsl, spirv) */
     bool         interval;
+    bool         json;    /* --json (check): diagnostics as JSON Lines */
     const char **include; int ninclude;
 } options;
 
@@ -118,6 +122,9 @@ static int parse_options(int argc, char **argv, const char *allowed, options *o)
             continue;
         } else if (!strcmp(a, "--interval") && strstr(allowed, "@")) {
             o->interval = true;
+            continue;
+        } else if (!strcmp(a, "--json") && strstr(allowed, "J")) {
+            o->json = true;
             continue;
         } else if (a[0] == '-' && a[1]) {
             return usage_error("unknown option '%s' for this command", a);
@@ -217,7 +224,7 @@ static int write_output(const char *path, const void *data, size_t len)
 static int cmd_check(int argc, char **argv)
 {
     options o;
-    int st = parse_options(argc, argv, "", &o);
+    int st = parse_options(argc, argv, "J", &o);
     if (st == EXIT_OK && o.nfiles == 0)
         st = usage_error("%s needs at least one FILE", "check");
     /* one list for all the files, so an error in a file that several of
@@ -234,12 +241,17 @@ static int cmd_check(int argc, char **argv)
             sg_check_texture_files(p, &d);   /* what `build` would read */
         if (p && d.nerrors == errors)
             sg_lint(p, NULL, &d);            /* over every input's domain */
-        sg_diags_print_from(&d, from, stderr);
+        if (o.json)
+            sg_diags_print_json_from(&d, from, stderr);
+        else
+            sg_diags_print_from(&d, from, stderr);
         if (!p || d.nerrors > errors)
             st = EXIT_INPUT;
         sg_free(p);
     }
-    if (d.ndropped)
+    if (d.ndropped && o.json)
+        fprintf(stderr, "{\"dropped\": %d}\n", d.ndropped);
+    else if (d.ndropped)
         fprintf(stderr, "splatc: note: %d more diagnostic%s not shown\n", d.ndropped,
                 d.ndropped == 1 ? "" : "s");
     sg_diags_free(&d);

@@ -353,13 +353,13 @@ void splat_sites_warn(const splat_scene *s, sg_diags *d)
             const char *op = strcmp(what, "an internal op") ? what : NULL;
             if (sg_node_reading_input(s->prog, sc->materials[m], op, IR_IN_POSITION, &loc,
                                       node, sizeof node))
-                sg_warning(d, loc, "%s of material '%s' reads terrain.position through "
+                sg_warning_id(d, loc, SG_E_W_PRECISION, "%s of material '%s' reads terrain.position through "
                            "'%s', which splatc cannot make camera-relative: its fp32 "
                            "rounding passes a quarter texel about %.0f km from the origin, "
                            "and this terrain reaches %.0f km", node, sc->materials[m], what,
                            worst / 1000.0, reach / 1000.0);
             else
-                sg_warning(d, loc, "material '%s' reads terrain.position through '%s', "
+                sg_warning_id(d, loc, SG_E_W_PRECISION, "material '%s' reads terrain.position through '%s', "
                            "which splatc cannot make camera-relative: its fp32 rounding "
                            "passes a quarter texel about %.0f km from the origin, and this "
                            "terrain reaches %.0f km", sc->materials[m], what, worst / 1000.0,

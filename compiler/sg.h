@@ -60,6 +60,12 @@ typedef struct sg_loc {
     X(NOT_A_PACK,    "%s")      /* the output folder is not a shader pack  */ \
     X(NO_DEVICE,     "%s")      /* --far-bake gpu and no device to bake on */ \
     X(OUT_OF_MEMORY, "%s")                                                  \
+    /* warnings (the input is accepted) */                                  \
+    X(W_MASK_RANGE,  "%s")      /* a mask's values leave [0, 1] (lint.c)   */ \
+    X(W_NAN,         "%s")      /* an output can be NaN or infinite        */ \
+    X(W_LO_HI,       "%s")      /* a constant lo >= hi on a ramp-like node */ \
+    X(W_PRECISION,   "%s")      /* position in fp32 past a quarter texel   */ \
+    X(WARNING,       "%s")      /* any other warning                       */ \
     X(INTERNAL,      "internal compiler error: %s")
 
 typedef enum sg_error_id {
@@ -107,9 +113,12 @@ void sg_errorf(sg_diags *d, sg_loc loc, sg_error_id id, const char *fmt, ...)
     __attribute__((format(printf, 4, 5)));
 void sg_note(sg_diags *d, sg_loc loc, const char *fmt, ...)
     __attribute__((format(printf, 3, 4)));
-/* A warning: printed like an error, but the input is accepted. */
+/* A warning: printed like an error, but the input is accepted (id
+ * SG_E_WARNING; sg_warning_id for one of the W_ ids). */
 void sg_warning(sg_diags *d, sg_loc loc, const char *fmt, ...)
     __attribute__((format(printf, 3, 4)));
+void sg_warning_id(sg_diags *d, sg_loc loc, sg_error_id id, const char *fmt, ...)
+    __attribute__((format(printf, 4, 5)));
 /* Append "; <text>" to the latest diagnostic's message (a hint on how to
  * fix it); nothing if it was dropped or there is none. */
 void sg_hint(sg_diags *d, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
@@ -146,6 +155,8 @@ void sg_diags_print_from(const sg_diags *d, int from, FILE *out);
  * mean", "suggestion": the name; file is null and line/column 0 where
  * unknown; a last {"dropped": N} line if some were not stored. */
 void sg_diags_print_json(const sg_diags *d, FILE *out);
+/* The same from index `from` on (no "dropped" line). */
+void sg_diags_print_json_from(const sg_diags *d, int from, FILE *out);
 /* The id's name as in SG_ERRORS ("UNKNOWN_NODE"). */
 const char *sg_error_name(sg_error_id id);
 /* Make `text` the source of `path` for the caret lines of later

@@ -211,9 +211,19 @@ teach)
     grep -q "^$TMP/typo.sg:3:14: error: unknown node type 'slope_rmap'; did you mean 'slope_ramp'?" \
         "$TMP/err" || { fail "no suggestion in text"; cat "$TMP/err"; }
     run 1 "$SPLATC" build "$TMP/typo.sg" -o "$TMP/typopack" --json
-    jq -e 'select(.id == "UNKNOWN_NODE" and .line == 3 and .column == 14 and
+    jq -e -s 'any(.[]; .id == "UNKNOWN_NODE" and .line == 3 and .column == 14 and
                   .suggestion == "slope_ramp")' "$TMP/err" > /dev/null ||
         { fail "--json: no suggestion"; cat "$TMP/err"; }
+    run 1 "$SPLATC" check --json "$TMP/typo.sg" tests/golden/lint.sg
+    jq -e -s 'any(.[]; .id == "UNKNOWN_NODE" and .line == 3 and .column == 14 and
+                  .suggestion == "slope_ramp")' "$TMP/err" > /dev/null ||
+        { fail "check --json: no suggestion"; cat "$TMP/err"; }
+    jq -e -s 'any(.[]; .severity == "warning" and .id == "W_MASK_RANGE" and
+                  .file == "tests/golden/lint.sg" and .line == 8 and
+                  (.message | test("mask of material .tall.")))' "$TMP/err" > /dev/null ||
+        { fail "check --json: no lint warning"; cat "$TMP/err"; }
+    jq -e -s 'length >= 2 and all(.[]; has("file") and has("severity") and has("message"))' \
+        "$TMP/err" > /dev/null || fail "check --json: not JSON Lines of diagnostics"
     # a failed import: the folders searched, how to add one, no follow-on errors
     mkdir -p "$TMP/fresh"
     printf 'import "lib/mine.sg"\nmaterial m {\n    node r : my_ramp { x = terrain.slope }\n    out mask = r.out\n}\n' > "$TMP/fresh/a.sg"
