@@ -182,9 +182,16 @@ static int load_material(const options *o, const char *cmd, ir *ir, sg_program *
         fprintf(stderr, "%s: error: no material '%s' (", o->files[0], o->material);
         if (!sg_material_count(p))
             fputs("the file declares none", stderr);
-        for (int i = 0; i < sg_material_count(p); i++)
+        sg_suggest sg;
+        sg_suggest_init(&sg, o->material);
+        for (int i = 0; i < sg_material_count(p); i++) {
             fprintf(stderr, "%s%s", i ? ", " : "materials: ", sg_material_name(p, i));
-        fputs(")\n", stderr);
+            sg_suggest_offer(&sg, sg_material_name(p, i));
+        }
+        fputs(")", stderr);
+        if (sg_suggest_best(&sg))
+            fprintf(stderr, "; did you mean '%s'?", sg_suggest_best(&sg));
+        fputc('\n', stderr);
         sg_free(p);
         sg_diags_free(&d);
         return EXIT_INPUT;

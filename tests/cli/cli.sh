@@ -214,6 +214,9 @@ teach)
     jq -e -s 'any(.[]; .id == "UNKNOWN_NODE" and .line == 3 and .column == 14 and
                   .suggestion == "slope_ramp")' "$TMP/err" > /dev/null ||
         { fail "--json: no suggestion"; cat "$TMP/err"; }
+    run 1 "$SPLATC" glsl graphs/cliff.sg -m clif
+    grep -q "no material 'clif' (materials: cliff); did you mean 'cliff'?" "$TMP/err" ||
+        { fail "-m: no suggestion"; cat "$TMP/err"; }
     run 1 "$SPLATC" check --json "$TMP/typo.sg" tests/golden/lint.sg
     jq -e -s 'any(.[]; .id == "UNKNOWN_NODE" and .line == 3 and .column == 14 and
                   .suggestion == "slope_ramp")' "$TMP/err" > /dev/null ||
