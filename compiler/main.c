@@ -9,6 +9,7 @@
  *   splatc eval  FILE -m MAT [--output NAME] [--interval] --at KEY=V,...
  *   splatc build SCENE.sg -o PACK ...          (cli_build.c)
  *   splatc texgen --out DIR ...                (cli_texgen.c)
+ *   splatc init DIR                            a starter project (cli_init.c)
  *
  * Exit status: 0 success, 1 input errors (diagnostics on stderr), 2 usage.
  * Files are written atomically (OUT.tmp-XXXXXX, then rename): on an error
@@ -60,6 +61,8 @@ static const char usage_text[] =
     "                                     direction is always -1:1)\n"
     "  build SCENE.sg -o PACKDIR ...      compile a scene into a shader pack (build --help)\n"
     "  texgen --out DIR ...               write the example textures (texgen --help)\n"
+    "  init  DIR                          a starter project: scene.sg, heightfield.png,\n"
+    "                                     README.md (builds and renders as it stands)\n"
     "options:\n"
     "  -I DIR       also search DIR for imports (repeatable; SPLATC_PATH=DIR:DIR...\n"
     "               in the environment does the same)\n"
@@ -734,6 +737,7 @@ static const struct { const char *name; command_fn run; } commands[] = {
     { "eval",   cmd_eval },
     { "build",  splat_cli_build },
     { "texgen", splat_cli_texgen },
+    { "init",   splat_cli_init },
 };
 
 /* General options may come before the command (`splatc -I DIR check F`):
@@ -761,12 +765,13 @@ int main(int argc, char **argv)
     for (size_t i = 0; i < sizeof commands / sizeof commands[0]; i++)
         if (!strcmp(cmd, commands[i].name)) {
             for (int j = first + 1; j < argc; j++)
-                if (!strcmp(argv[j], "--help") && strcmp(cmd, "build") && strcmp(cmd, "texgen")) {
+                if (!strcmp(argv[j], "--help") && strcmp(cmd, "build") && strcmp(cmd, "texgen") &&
+                    strcmp(cmd, "init")) {
                     fputs(usage_text, stdout);
                     return EXIT_OK;
                 }
             /* argv for the command: its name, the general options, the rest */
-            bool keep = strcmp(cmd, "texgen") != 0;
+            bool keep = strcmp(cmd, "texgen") != 0 && strcmp(cmd, "init") != 0;
             char **av = calloc((size_t)argc + 1, sizeof *av);
             if (!av)
                 return EXIT_USAGE;

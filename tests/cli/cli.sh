@@ -20,6 +20,10 @@
 #   teach_param  splatview --param (SPLATVIEW in the environment): a name
 #              without its material suggests MATERIAL.NAME, a value outside
 #              the param's declared range is refused
+#   init       `splatc init DIR` from a folder outside the repository: the
+#              project builds and renders as it stands (SPLATVIEW, IMGCHECK
+#              in the environment), its picture is not mostly fog (luma
+#              contrast), a second init into it is refused
 #   malformed  empty file, binary garbage, truncated files, 10 MB inputs,
 #              10000-deep instance nesting: exit 1 with a diagnostic, no crash
 #              or hang
@@ -287,6 +291,32 @@ teach_param)
         { fail "--param out of range accepted"; cat "$TMP/err"; }
     [ -e "$TMP/a.png" ] && fail "a refused --param wrote a picture"
     run 0 "$SPLATVIEW" "$TMP/pack" --headless -o "$TMP/a.png" --param grass.tiling=1
+    ;;
+init)
+    SPLATVIEW=${SPLATVIEW:?SPLATVIEW must name splatview}
+    IMGCHECK=${IMGCHECK:?IMGCHECK must name imgcheck}
+    mkdir -p "$TMP/elsewhere"
+    cd "$TMP/elsewhere" || exit 1
+    run 0 "$SPLATC" init "$TMP/x"
+    for f in scene.sg heightfield.png README.md; do
+        [ -s "$TMP/x/$f" ] || fail "init wrote no $f"
+    done
+    [ "$(wc -l < "$TMP/x/README.md")" = 5 ] || fail "README.md is not five lines"
+    run 0 "$SPLATC" build "$TMP/x/scene.sg" -o "$TMP/x/pack"
+    [ -s "$TMP/err" ] && { fail "the starter project builds with diagnostics"; cat "$TMP/err"; }
+    run 0 "$SPLATVIEW" "$TMP/x/pack" --headless -o x.png
+    [ -s x.png ] || fail "no picture"
+    run 0 "$IMGCHECK" contrast x.png 0.08
+    cat "$TMP/out"
+    # a relative DIR, and no second init over a project
+    run 0 "$SPLATC" init y
+    [ -s y/scene.sg ] || fail "init y wrote nothing"
+    run 1 "$SPLATC" init "$TMP/x"
+    grep -q "cannot write '$TMP/x': it exists and is not an empty folder" "$TMP/err" ||
+        { fail "init over a project: no refusal"; cat "$TMP/err"; }
+    run 1 "$SPLATC" init "$TMP/no/such/x"
+    ls "$TMP" | grep -q "tmp-" && fail "temporary folders left in $TMP"
+    cd - > /dev/null || exit 1
     ;;
 preview)
     run 0 "$SPLATC" build examples/minimal/scene.sg -o "$TMP/sw" --preview rock --no-cache
