@@ -234,6 +234,15 @@ static json_t *jscene(build *b, const char *dir)
     char *scene_src = splat_path_relative_real(dir, b->desc->scene);
     json_object_set_new(scene, "source", json_string(scene_src));
     free(scene_src);
+    if (b->desc->pack_search && b->desc->pack_search[0]) {
+        json_t *search = json_array();
+        for (int i = 0; b->desc->pack_search[i]; i++) {
+            char *rel = splat_path_relative_real(dir, b->desc->pack_search[i]);
+            json_array_append_new(search, json_string(rel));
+            free(rel);
+        }
+        json_object_set_new(scene, "search", search);
+    }
     json_t *hf = json_object();
     json_object_set_new(hf, "file", json_string("heightfield.r16"));
     json_object_set_new(hf, "width", json_integer(s->terrain.width));

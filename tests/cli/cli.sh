@@ -291,6 +291,18 @@ teach_param)
         { fail "--param out of range accepted"; cat "$TMP/err"; }
     [ -e "$TMP/a.png" ] && fail "a refused --param wrote a picture"
     run 0 "$SPLATVIEW" "$TMP/pack" --headless -o "$TMP/a.png" --param grass.tiling=1
+    # the pack records the folders -I added (relative to it): a swatch
+    # finds the same imports with no -I, from another folder
+    mkdir -p "$TMP/lib" "$TMP/proj" "$TMP/else"
+    printf 'shader half {\n    in float x\n    node m : mul { a = x, b = 0.5 }\n    out float out = m.out\n}\n' > "$TMP/lib/half.sg"
+    cp examples/minimal/heightfield.png "$TMP/proj/"
+    printf 'import "nodes/compositors.sg"\nimport "half.sg"\nmaterial ground { out albedo = vec3(0.3, 0.4, 0.2) }\nmaterial steep {\n    node s : terrain.slope\n    node k : half { x = s.out }\n    out mask = k.out\n}\nscene s {\n    heightfield = "heightfield.png"\n    size = 1024 1024\n    max_height = 160\n    materials = [ground, steep]\n}\n' > "$TMP/proj/scene.sg"
+    run 0 "$SPLATC" build "$TMP/proj/scene.sg" -o "$TMP/proj/pack" -I "$TMP/lib"
+    jq -e '.scene.search == ["../../lib"]' "$TMP/proj/pack/manifest.json" > /dev/null ||
+        fail "manifest scene.search: $(jq -c .scene.search "$TMP/proj/pack/manifest.json")"
+    ( cd "$TMP/else" && SPLATC_PATH= "$SPLATVIEW" "$TMP/proj/pack" --material steep --headless \
+          -o swatch.png > "$TMP/out" 2> "$TMP/err" ) || { fail "swatch without -I"; cat "$TMP/err"; }
+    [ -s "$TMP/else/swatch.png" ] || fail "no swatch"
     ;;
 init)
     SPLATVIEW=${SPLATVIEW:?SPLATVIEW must name splatview}
