@@ -10,6 +10,7 @@
  *   splatc build SCENE.sg -o PACK ...          (cli_build.c)
  *   splatc texgen --out DIR ...                (cli_texgen.c)
  *   splatc init DIR                            a starter project (cli_init.c)
+ *   splatc doc [-o FILE]                       the language reference (cli_doc.c)
  *
  * Exit status: 0 success, 1 input errors (diagnostics on stderr), 2 usage.
  * Files are written atomically (OUT.tmp-XXXXXX, then rename): on an error
@@ -63,6 +64,8 @@ static const char usage_text[] =
     "  texgen --out DIR ...               write the example textures (texgen --help)\n"
     "  init  DIR                          a starter project: scene.sg, heightfield.png,\n"
     "                                     README.md (builds and renders as it stands)\n"
+    "  doc   [-o FILE]                    the language reference (docs/language.md) from\n"
+    "                                     the compiler's tables and the node library\n"
     "options:\n"
     "  -I DIR       also search DIR for imports (repeatable; SPLATC_PATH=DIR:DIR...\n"
     "               in the environment does the same)\n"
@@ -738,6 +741,7 @@ static const struct { const char *name; command_fn run; } commands[] = {
     { "build",  splat_cli_build },
     { "texgen", splat_cli_texgen },
     { "init",   splat_cli_init },
+    { "doc",    splat_cli_doc },
 };
 
 /* General options may come before the command (`splatc -I DIR check F`):
@@ -766,12 +770,13 @@ int main(int argc, char **argv)
         if (!strcmp(cmd, commands[i].name)) {
             for (int j = first + 1; j < argc; j++)
                 if (!strcmp(argv[j], "--help") && strcmp(cmd, "build") && strcmp(cmd, "texgen") &&
-                    strcmp(cmd, "init")) {
+                    strcmp(cmd, "init") && strcmp(cmd, "doc")) {
                     fputs(usage_text, stdout);
                     return EXIT_OK;
                 }
             /* argv for the command: its name, the general options, the rest */
-            bool keep = strcmp(cmd, "texgen") != 0 && strcmp(cmd, "init") != 0;
+            bool keep = strcmp(cmd, "texgen") != 0 && strcmp(cmd, "init") != 0 &&
+                        strcmp(cmd, "doc") != 0;
             char **av = calloc((size_t)argc + 1, sizeof *av);
             if (!av)
                 return EXIT_USAGE;

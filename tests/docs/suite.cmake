@@ -9,3 +9,14 @@ if(TARGET splatc_cli AND TARGET splatview)
   set_tests_properties(docs.getting_started PROPERTIES LABELS "docs;render" TIMEOUT 600
                        ENVIRONMENT "SPLAT_VALIDATE=1")
 endif()
+# docs/language.md is `splatc doc`'s output: an op, input, output, light key
+# or node-library shader added without regenerating it fails here
+# (regenerate: build/compiler/splatc doc -o docs/language.md).
+if(TARGET splatc_cli)
+  add_test(NAME docs.language
+           COMMAND sh -c "'$<TARGET_FILE:splatc_cli>' doc > '${CMAKE_CURRENT_BINARY_DIR}/language.md' && \
+diff -u docs/language.md '${CMAKE_CURRENT_BINARY_DIR}/language.md' || \
+{ echo 'FAIL: docs/language.md is out of date: run splatc doc -o docs/language.md'; exit 1; }"
+           WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
+  set_tests_properties(docs.language PROPERTIES LABELS docs)
+endif()
