@@ -64,7 +64,7 @@ static void types_of(const ir_opinfo *in, char *buf, size_t n)
         ir_type args[4];
         char ops[96] = "";
         size_t k = 0;
-        for (int i = 0; i < na; i++) {
+        for (int i = 0; i < na && k < sizeof ops; i++) {
             args[i] = !strcmp(in->ports[i], "tex") ? IR_T_TEX
                     : !strcmp(in->ports[i], "uv") ? IR_T_VEC2 : ir_type_vec(w);
             k += (size_t)snprintf(ops + k, sizeof ops - k, "%s%s", i ? ", " : "",
@@ -78,7 +78,8 @@ static void types_of(const ir_opinfo *in, char *buf, size_t n)
         if (!strcmp(one, last))
             continue;   /* sample: the same for every width */
         snprintf(last, sizeof last, "%s", one);
-        o += (size_t)snprintf(buf + o, n - o, "%s%s", o ? "; " : "", one);
+        if (o < n)
+            o += (size_t)snprintf(buf + o, n - o, "%s%s", o ? "; " : "", one);
     }
 }
 
@@ -127,7 +128,7 @@ static void inputs_table(FILE *out)
         const ir_input_info *in = ir_input_get((ir_input_kind)k);
         char range[160] = "";
         size_t o = 0;
-        for (int c = 0; c < ir_type_width(in->type); c++) {
+        for (int c = 0; c < ir_type_width(in->type) && o < sizeof range; c++) {
             char lo[32], hi[32];
             fmt_bound(in->domain[c].lo, lo, sizeof lo);
             fmt_bound(in->domain[c].hi, hi, sizeof hi);
@@ -241,15 +242,16 @@ static void value_text(const sg_value *v, char *buf, size_t n)
         snprintf(buf, n, "%g", v->num[0]);
     else if (v->kind == SG_V_VEC) {
         size_t o = (size_t)snprintf(buf, n, "vec%d(", v->width);
-        for (int i = 0; i < v->width; i++)
+        for (int i = 0; i < v->width && o < n; i++)
             o += (size_t)snprintf(buf + o, n - o, "%s%g", i ? ", " : "", v->num[i]);
-        snprintf(buf + o, n - o, ")");
+        if (o < n)
+            snprintf(buf + o, n - o, ")");
     } else if (v->kind == SG_V_STRING)
         snprintf(buf, n, "\"%s\"", v->str);
     else if (v->kind == SG_V_PATH) {
         size_t o = 0;
         buf[0] = 0;
-        for (int i = 0; i < v->nparts; i++)
+        for (int i = 0; i < v->nparts && o < n; i++)
             o += (size_t)snprintf(buf + o, n - o, "%s%s", i ? "." : "", v->parts[i]);
     } else
         buf[0] = 0;
@@ -296,7 +298,7 @@ static bool nodes_tables(FILE *out, const char *data, const char *nodes)
                     continue;   /* this file's own shaders */
                 char ins[1024] = "", outs[512] = "", what[1024];
                 size_t o = 0;
-                for (int k = 0; k < s->nins; k++) {
+                for (int k = 0; k < s->nins && o < sizeof ins; k++) {
                     char v[128] = "";
                     if (s->ins[k].has_value)
                         value_text(&s->ins[k].value, v, sizeof v);
@@ -305,7 +307,7 @@ static bool nodes_tables(FILE *out, const char *data, const char *nodes)
                                           s->ins[k].name, *v ? " = " : "", v);
                 }
                 o = 0;
-                for (int k = 0; k < s->nouts; k++)
+                for (int k = 0; k < s->nouts && o < sizeof outs; k++)
                     o += (size_t)snprintf(outs + o, sizeof outs - o, "%s%s `%s`", k ? ", " : "",
                                           ir_type_name(s->outs[k].type), s->outs[k].name);
                 comment_above(p->files[0]->text, s->loc.line, what, sizeof what);
