@@ -89,13 +89,7 @@ int splat_cli_build(int argc, char **argv)
         return 2;
     }
     bool stats = false, json = false;
-    /* -I folders, then room for SPLATC_PATH's (recorded in the pack) */
-    const char *env_path = getenv("SPLATC_PATH");
-    size_t nenv = 1;
-    for (const char *c = env_path; c && *c; c++)
-        nenv += *c == ':';
-    const char **include = xcalloc((size_t)argc + nenv + 1, sizeof *include);
-    char *env_copy = NULL;
+    const char **include = xcalloc((size_t)argc + 1, sizeof *include);
     int ninclude = 0;
     char **search = NULL;
     int status = 2;
@@ -190,14 +184,9 @@ int splat_cli_build(int argc, char **argv)
     }
     search = splat_search_path(include, ninclude, desc.scene);
     desc.search_paths = (const char *const *)search;
-    /* what the user added: -I, then SPLATC_PATH (the pack records them) */
-    env_copy = env_path ? xstrdup(env_path) : NULL;
-    char *save = NULL;
-    int nuser = ninclude;
-    for (char *t = env_copy ? strtok_r(env_copy, ":", &save) : NULL; t;
-         t = strtok_r(NULL, ":", &save))
-        include[nuser++] = t;
-    include[nuser] = NULL;
+    /* the -I folders, which the pack records (SPLATC_PATH is the
+     * environment's, which splatview reads itself) */
+    include[ninclude] = NULL;
     desc.pack_search = include;
     /* the report is held until the diagnostics are out, so a warning never
      * lands inside its tables (stdout and stderr share a terminal) */
@@ -238,6 +227,5 @@ int splat_cli_build(int argc, char **argv)
 done:
     splat_search_path_free(search);
     free(include);
-    free(env_copy);
     return status;
 }
