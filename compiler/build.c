@@ -231,8 +231,14 @@ static bool load(build *b)
         splat_scene_free(&b->scene);
         b->scene_ok = false;
     }
-    if (b->scene_ok)   /* here, so an up-to-date build warns the same */
+    if (b->scene_ok) {   /* here, so an up-to-date build warns the same */
         splat_sites_warn(&b->scene, b->d);   /* precision.c */
+        ir_ienv region;                      /* lint.c, over this terrain */
+        memset(&region, 0, sizeof region);
+        splat_terrain_ranges(&b->scene.terrain, 0, 0, b->scene.terrain.width,
+                             b->scene.terrain.height, &region);
+        sg_lint(b->scene.prog, &region, b->d);
+    }
     return b->scene_ok;
 }
 
@@ -380,6 +386,7 @@ bool splat_build(const splat_build_desc *desc, splat_build_stats *st, sg_diags *
     for (size_t n = strlen(b.out); n > 1 && b.out[n - 1] == '/'; n--)
         b.out[n - 1] = 0;
 
+    phase(&b, build_check_out, &st->load);  /* -o can be written, first    */
     phase(&b, load, &st->load);             /* parse, check, lower, rasters */
     if (unchanged(&b)) {
         phase(&b, build_write_depfile, &st->write);

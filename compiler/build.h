@@ -129,6 +129,10 @@ bool build_write_depfile(build *b);
 /* Write the pack into a temporary folder beside b->out, then the depfile,
  * then swap it in; on any failure the old pack (if any) stays as it was. */
 bool build_write_pack(build *b);
+/* Before any work: the output's parent folder exists and takes new
+ * entries, and the output is absent, a folder or a pack (what
+ * build_write_pack will refuse, it refuses first). */
+bool build_check_out(build *b);
 /* A texture's k-th mip file ("rock.mip1.png") and how many it has. */
 char *build_mip_path(const char *path, int k);
 int   build_mip_count(const char *src);

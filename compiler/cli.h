@@ -10,5 +10,7 @@
 int splat_cli_build(int argc, char **argv);
 /* `splatc texgen --out DIR [--seed N] [--size N] [--all-mips]` (cli_texgen.c) */
 int splat_cli_texgen(int argc, char **argv);
+int splat_cli_init(int argc, char **argv);    /* cli_init.c: splatc init DIR */
+int splat_cli_doc(int argc, char **argv);     /* cli_doc.c: splatc doc [-o FILE] */
 
 #endif

@@ -184,7 +184,21 @@ int splat_cli_build(int argc, char **argv)
     }
     search = splat_search_path(include, ninclude, desc.scene);
     desc.search_paths = (const char *const *)search;
-    desc.report = stats ? stdout : NULL;
+    /* the -I folders, which the pack records (SPLATC_PATH is the
+     * environment's, which splatview reads itself) */
+    include[ninclude] = NULL;
+    desc.pack_search = include;
+    /* the report is held until the diagnostics are out, so a warning never
+     * lands inside its tables (stdout and stderr share a terminal) */
+    char *report = NULL;
+    size_t report_len = 0;
+    FILE *report_f = stats ? open_memstream(&report, &report_len) : NULL;
+    if (stats && !report_f) {
+        fprintf(stderr, "splatc build: out of memory\n");
+        status = 1;
+        goto done;
+    }
+    desc.report = report_f;
 #ifdef SPLATC_DEVICE_BAKE
     rt_far_bake_host host = { .mode = desc.far_bake };
     desc.far_device = rt_far_bake_device;
@@ -200,6 +214,13 @@ int splat_cli_build(int argc, char **argv)
     else
         sg_diags_print(&d, stderr);
     sg_diags_free(&d);
+    fflush(stderr);
+    if (report_f) {
+        fclose(report_f);
+        if (ok)
+            fwrite(report, 1, report_len, stdout);
+        free(report);
+    }
     if (ok && stats)
         print_stats(&st, stdout);
     status = ok ? 0 : 1;

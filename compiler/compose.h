@@ -40,7 +40,9 @@ char **splat_sites_overrides(const splat_layout *L, const ir *ir,
                              const glsl_names *names);
 void   splat_sites_overrides_free(const ir *ir, char **ov);
 /* A warning per material whose terrain.position uses stay absolute fp32,
- * with the distance at which their error passes a quarter texel. */
+ * with the distance at which their error passes a quarter texel, where
+ * the scene's terrain reaches that far from the origin; at the node that
+ * reads position (sg_node_reading_input), else at the material. */
 struct splat_scene;
 void   splat_sites_warn(const struct splat_scene *s, sg_diags *d);
 

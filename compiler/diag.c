@@ -48,6 +48,7 @@ void sg_diags_free(sg_diags *d)
     for (int i = 0; i < d->n; i++) {
         free(d->items[i].msg);
         free(d->items[i].src_line);
+        free(d->items[i].suggestion);
         free((char *)d->items[i].loc.file);
     }
     free(d->items);
@@ -120,15 +121,51 @@ static const char *find_line(sg_diags *d, const char *file, int line, size_t *n)
     return src->text + start;
 }
 
+/* A stored diagnostic equal to this one (its message perhaps with a hint
+ * appended), for sg_diags.unique. */
+static bool stored(const sg_diags *d, sg_loc loc, sg_severity sev, const char *msg)
+{
+    size_t n = strlen(msg);
+    for (int i = 0; i < d->n; i++) {
+        const sg_diag *g = &d->items[i];
+        if (g->severity == sev && g->loc.line == loc.line && g->loc.col == loc.col &&
+            (g->loc.file == loc.file || (g->loc.file && loc.file &&
+                                         !strcmp(g->loc.file, loc.file))) &&
+            !strncmp(g->msg, msg, n) && (g->msg[n] == 0 || g->msg[n] == ';'))
+            return true;
+    }
+    return false;
+}
+
 static void add(sg_diags *d, sg_loc loc, sg_severity sev, sg_error_id id,
                 const char *fmt, va_list ap)
 {
+    if (d->unique) {
+        va_list ap3;
+        va_copy(ap3, ap);
+        int len = vsnprintf(NULL, 0, fmt, ap3);
+        va_end(ap3);
+        char *msg = xmalloc((size_t)(len > 0 ? len : 0) + 1);
+        va_copy(ap3, ap);
+        vsnprintf(msg, (size_t)(len > 0 ? len : 0) + 1, fmt, ap3);
+        va_end(ap3);
+        bool dup = stored(d, loc, sev, msg);
+        free(msg);
+        if (dup) {
+            if (sev == SG_ERROR)
+                d->nerrors++;   /* still an error of this load */
+            d->last_dropped = true;
+            return;
+        }
+    }
     if (sev == SG_ERROR)
         d->nerrors++;
     if (d->n >= SG_MAX_STORED_DIAGS) {
         d->ndropped++;
+        d->last_dropped = true;
         return;
     }
+    d->last_dropped = false;
     if (d->n == d->cap) {
         d->cap = d->cap ? d->cap * 2 : 16;
         d->items = xrealloc(d->items, (size_t)d->cap * sizeof *d->items);
@@ -147,6 +184,7 @@ static void add(sg_diags *d, sg_loc loc, sg_severity sev, sg_error_id id,
     g->id = id;
     g->msg = msg;
     g->src_line = NULL;
+    g->suggestion = NULL;
     size_t n;
     const char *line = find_line(d, loc.file, loc.line, &n);
     if (line) {
@@ -176,7 +214,15 @@ void sg_warning(sg_diags *d, sg_loc loc, const char *fmt, ...)
 {
     va_list ap;
     va_start(ap, fmt);
-    add(d, loc, SG_WARNING, SG_E_INTERNAL, fmt, ap);
+    add(d, loc, SG_WARNING, SG_E_WARNING, fmt, ap);
+    va_end(ap);
+}
+
+void sg_warning_id(sg_diags *d, sg_loc loc, sg_error_id id, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    add(d, loc, SG_WARNING, id, fmt, ap);
     va_end(ap);
 }
 
@@ -186,6 +232,125 @@ void sg_note(sg_diags *d, sg_loc loc, const char *fmt, ...)
     va_start(ap, fmt);
     add(d, loc, SG_NOTE, SG_E_INTERNAL, fmt, ap);
     va_end(ap);
+}
+
+void sg_hint(sg_diags *d, const char *fmt, ...)
+{
+    if (d->n == 0 || d->last_dropped)
+        return;
+    sg_diag *g = &d->items[d->n - 1];
+    va_list ap, ap2;
+    va_start(ap, fmt);
+    va_copy(ap2, ap);
+    int len = vsnprintf(NULL, 0, fmt, ap);
+    va_end(ap);
+    if (len < 0)
+        len = 0;
+    size_t old = strlen(g->msg);
+    g->msg = xrealloc(g->msg, old + 2 + (size_t)len + 1);
+    memcpy(g->msg + old, "; ", 2);
+    vsnprintf(g->msg + old + 2, (size_t)len + 1, fmt, ap2);
+    va_end(ap2);
+}
+
+void sg_hint_suggest(sg_diags *d, const char *word)
+{
+    if (!word || d->n == 0 || d->last_dropped)
+        return;
+    sg_hint(d, "did you mean '%s'?", word);
+    sg_diag *g = &d->items[d->n - 1];
+    free(g->suggestion);
+    g->suggestion = xstrdup(word);
+}
+
+/* ---- did you mean ------------------------------------------------------- */
+
+#define EDIT_MAX 64
+
+static int lower(int c)
+{
+    return c >= 'A' && c <= 'Z' ? c + 32 : c;
+}
+
+int sg_edit_distance(const char *a, const char *b)
+{
+    int n = (int)strlen(a), m = (int)strlen(b);
+    if (n > EDIT_MAX || m > EDIT_MAX)
+        return EDIT_MAX;
+    /* three rows of the optimal-string-alignment table */
+    int rows[3][EDIT_MAX + 1];
+    int *pp = rows[0], *prev = rows[1], *cur = rows[2];
+    for (int j = 0; j <= m; j++)
+        prev[j] = j;
+    for (int i = 1; i <= n; i++) {
+        cur[0] = i;
+        for (int j = 1; j <= m; j++) {
+            int cost = lower(a[i - 1]) != lower(b[j - 1]);
+            int v = prev[j - 1] + cost;
+            if (prev[j] + 1 < v)
+                v = prev[j] + 1;
+            if (cur[j - 1] + 1 < v)
+                v = cur[j - 1] + 1;
+            if (i > 1 && j > 1 && lower(a[i - 1]) == lower(b[j - 2]) &&
+                lower(a[i - 2]) == lower(b[j - 1]) && pp[j - 2] + 1 < v)
+                v = pp[j - 2] + 1;
+            cur[j] = v;
+        }
+        int *t = pp;
+        pp = prev;
+        prev = cur;
+        cur = t;
+    }
+    return prev[m];
+}
+
+void sg_suggest_init(sg_suggest *s, const char *word)
+{
+    s->word = word;
+    s->best = NULL;
+    s->dist = EDIT_MAX + 1;
+}
+
+static int limit_for(const char *word)
+{
+    int len = (int)strlen(word);
+    /* none for 1 or 2 letters ('c' is as near 'a' as 'b'), 1 up to 4,
+     * 2 up to 7, ... */
+    return len < 3 ? 0 : len < 5 ? 1 : (len + 1) / 3;
+}
+
+/* One name the other starts with ("output" and "out"), both 3 letters or
+ * more: near enough, but behind any name within the limit. */
+static bool prefix_of(const char *a, const char *b)
+{
+    size_t na = strlen(a), nb = strlen(b), n = na < nb ? na : nb;
+    if (n < 3)
+        return false;
+    for (size_t i = 0; i < n; i++)
+        if (lower(a[i]) != lower(b[i]))
+            return false;
+    return true;
+}
+
+void sg_suggest_offer(sg_suggest *s, const char *name)
+{
+    if (!name || !s->word || !strcmp(name, s->word))
+        return;
+    int dist = sg_edit_distance(s->word, name);
+    int limit = limit_for(s->word);
+    if (dist > limit && prefix_of(s->word, name))
+        dist = limit;
+    if (dist < s->dist) {
+        s->dist = dist;
+        s->best = name;
+    }
+}
+
+const char *sg_suggest_best(const sg_suggest *s)
+{
+    if (!s->best)
+        return NULL;
+    return s->dist <= limit_for(s->word) ? s->best : NULL;
 }
 
 /* The line, shortened to a window around the caret, with non-printable
@@ -250,8 +415,15 @@ static void json_string(FILE *out, const char *s)
 
 void sg_diags_print_json(const sg_diags *d, FILE *out)
 {
+    sg_diags_print_json_from(d, 0, out);
+    if (d->ndropped)
+        fprintf(out, "{\"dropped\": %d}\n", d->ndropped);
+}
+
+void sg_diags_print_json_from(const sg_diags *d, int from, FILE *out)
+{
     static const char *const sev[] = { "error", "warning", "note" };
-    for (int i = 0; i < d->n; i++) {
+    for (int i = from < 0 ? 0 : from; i < d->n; i++) {
         const sg_diag *g = &d->items[i];
         fputs("{\"file\": ", out);
         json_string(out, g->loc.file);
@@ -261,16 +433,26 @@ void sg_diags_print_json(const sg_diags *d, FILE *out)
         json_string(out, g->severity == SG_NOTE ? NULL : sg_error_name(g->id));
         fputs(", \"message\": ", out);
         json_string(out, g->msg);
+        if (g->suggestion) {
+            fputs(", \"suggestion\": ", out);
+            json_string(out, g->suggestion);
+        }
         fputs("}\n", out);
     }
-    if (d->ndropped)
-        fprintf(out, "{\"dropped\": %d}\n", d->ndropped);
 }
 
 void sg_diags_print(const sg_diags *d, FILE *out)
 {
+    sg_diags_print_from(d, 0, out);
+    if (d->ndropped)
+        fprintf(out, "splatc: note: %d more diagnostic%s not shown\n",
+                d->ndropped, d->ndropped == 1 ? "" : "s");
+}
+
+void sg_diags_print_from(const sg_diags *d, int from, FILE *out)
+{
     static const char *const sev[] = { "error", "warning", "note" };
-    for (int i = 0; i < d->n; i++) {
+    for (int i = from < 0 ? 0 : from; i < d->n; i++) {
         const sg_diag *g = &d->items[i];
         if (g->loc.file && g->loc.line > 0)
             fprintf(out, "%s:%d:%d: ", g->loc.file, g->loc.line, g->loc.col);
@@ -282,7 +464,4 @@ void sg_diags_print(const sg_diags *d, FILE *out)
         if (g->src_line)
             print_excerpt(out, g->loc.line, g->src_line, g->loc.col);
     }
-    if (d->ndropped)
-        fprintf(out, "splatc: note: %d more diagnostic%s not shown\n",
-                d->ndropped, d->ndropped == 1 ? "" : "s");
 }

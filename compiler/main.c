@@ -1,6 +1,6 @@
 /* main.c — the splatc command line.
  *
- *   splatc check FILE...                       parse and type-check
+ *   splatc check FILE... [--json]              parse and type-check
  *   splatc glsl  FILE -m MAT [-o OUT.frag] [--stage fragment|compute]
  *                                              shader of one material
  *   splatc spirv FILE -m MAT -o OUT.spv [--stage …]  the same, compiled and validated
@@ -9,6 +9,8 @@
  *   splatc eval  FILE -m MAT [--output NAME] [--interval] --at KEY=V,...
  *   splatc build SCENE.sg -o PACK ...          (cli_build.c)
  *   splatc texgen --out DIR ...                (cli_texgen.c)
+ *   splatc init DIR                            a starter project (cli_init.c)
+ *   splatc doc [-o FILE]                       the language reference (cli_doc.c)
  *
  * Exit status: 0 success, 1 input errors (diagnostics on stderr), 2 usage.
  * Files are written atomically (OUT.tmp-XXXXXX, then rename): on an error
@@ -37,7 +39,9 @@ enum { EXIT_OK = 0, EXIT_INPUT = 1, EXIT_USAGE = 2 };
 static const char usage_text[] =
     "usage: splatc COMMAND [options]\n"
     "commands:\n"
-    "  check FILE...                      parse and type-check graph files\n"
+    "  check FILE... [--json]             parse and type-check graph files, their texture\n"
+    "                                     files and their masks' bounds (--json: the\n"
+    "                                     diagnostics as JSON Lines, for editors)\n"
     "  glsl  FILE -m MATERIAL [-o OUT]    Vulkan GLSL 450 fragment shader of a material\n"
     "  spirv FILE -m MATERIAL -o OUT.spv  the same compiled to SPIR-V and validated\n"
     "        --stage fragment|compute     (glsl, spirv) the fragment shader (default) or\n"
@@ -58,8 +62,13 @@ static const char usage_text[] =
     "                                     direction is always -1:1)\n"
     "  build SCENE.sg -o PACKDIR ...      compile a scene into a shader pack (build --help)\n"
     "  texgen --out DIR ...               write the example textures (texgen --help)\n"
+    "  init  DIR                          a starter project: scene.sg, heightfield.png,\n"
+    "                                     README.md (builds and renders as it stands)\n"
+    "  doc   [-o FILE]                    the language reference (docs/language.md) from\n"
+    "                                     the compiler's tables and the node library\n"
     "options:\n"
-    "  -I DIR       also search DIR for imports (repeatable)\n"
+    "  -I DIR       also search DIR for imports (repeatable; SPLATC_PATH=DIR:DIR...\n"
+    "               in the environment does the same)\n"
     "  --help       this text\n"
     "  --version    the compiler version\n"
     "exit status: 0 ok, 1 errors in the input, 2 usage errors\n";
@@ -83,6 +92,7 @@ typedef struct options {
     const char  *at;
     const char  *stage;   /* --stage fragment|compute (glsl, spirv) */
     bool         interval;
+    bool         json;    /* --json (check): diagnostics as JSON Lines */
     const char **include; int ninclude;
 } options;
 
@@ -118,6 +128,9 @@ static int parse_options(int argc, char **argv, const char *allowed, options *o)
             continue;
         } else if (!strcmp(a, "--interval") && strstr(allowed, "@")) {
             o->interval = true;
+            continue;
+        } else if (!strcmp(a, "--json") && strstr(allowed, "J")) {
+            o->json = true;
             continue;
         } else if (a[0] == '-' && a[1]) {
             return usage_error("unknown option '%s' for this command", a);
@@ -175,9 +188,16 @@ static int load_material(const options *o, const char *cmd, ir *ir, sg_program *
         fprintf(stderr, "%s: error: no material '%s' (", o->files[0], o->material);
         if (!sg_material_count(p))
             fputs("the file declares none", stderr);
-        for (int i = 0; i < sg_material_count(p); i++)
+        sg_suggest sg;
+        sg_suggest_init(&sg, o->material);
+        for (int i = 0; i < sg_material_count(p); i++) {
             fprintf(stderr, "%s%s", i ? ", " : "materials: ", sg_material_name(p, i));
-        fputs(")\n", stderr);
+            sg_suggest_offer(&sg, sg_material_name(p, i));
+        }
+        fputs(")", stderr);
+        if (sg_suggest_best(&sg))
+            fprintf(stderr, "; did you mean '%s'?", sg_suggest_best(&sg));
+        fputc('\n', stderr);
         sg_free(p);
         sg_diags_free(&d);
         return EXIT_INPUT;
@@ -217,18 +237,37 @@ static int write_output(const char *path, const void *data, size_t len)
 static int cmd_check(int argc, char **argv)
 {
     options o;
-    int st = parse_options(argc, argv, "", &o);
+    int st = parse_options(argc, argv, "J", &o);
     if (st == EXIT_OK && o.nfiles == 0)
         st = usage_error("%s needs at least one FILE", "check");
+    /* one list for all the files, so an error in a file that several of
+     * them import is printed once */
+    sg_diags d;
+    sg_diags_init(&d);
+    d.unique = true;
     for (int i = 0; st != EXIT_USAGE && i < o.nfiles; i++) {
-        sg_diags d;
-        sg_diags_init(&d);
-        sg_program *p = load(o.files[i], &o, &d);
-        if (!p)
+        int from = d.n, errors = d.nerrors;
+        char **paths = splat_search_path(o.include, o.ninclude, o.files[i]);
+        sg_program *p = sg_load(o.files[i], (const char *const *)paths, &d);
+        splat_search_path_free(paths);
+        if (p && d.nerrors == errors)
+            sg_check_texture_files(p, &d);   /* what `build` would read */
+        if (p && d.nerrors == errors)
+            sg_lint(p, NULL, &d);            /* over every input's domain */
+        if (o.json)
+            sg_diags_print_json_from(&d, from, stderr);
+        else
+            sg_diags_print_from(&d, from, stderr);
+        if (!p || d.nerrors > errors)
             st = EXIT_INPUT;
         sg_free(p);
-        sg_diags_free(&d);
     }
+    if (d.ndropped && o.json)
+        fprintf(stderr, "{\"dropped\": %d}\n", d.ndropped);
+    else if (d.ndropped)
+        fprintf(stderr, "splatc: note: %d more diagnostic%s not shown\n", d.ndropped,
+                d.ndropped == 1 ? "" : "s");
+    sg_diags_free(&d);
     options_free(&o);
     return st;
 }
@@ -701,6 +740,8 @@ static const struct { const char *name; command_fn run; } commands[] = {
     { "eval",   cmd_eval },
     { "build",  splat_cli_build },
     { "texgen", splat_cli_texgen },
+    { "init",   splat_cli_init },
+    { "doc",    splat_cli_doc },
 };
 
 /* General options may come before the command (`splatc -I DIR check F`):
@@ -728,12 +769,14 @@ int main(int argc, char **argv)
     for (size_t i = 0; i < sizeof commands / sizeof commands[0]; i++)
         if (!strcmp(cmd, commands[i].name)) {
             for (int j = first + 1; j < argc; j++)
-                if (!strcmp(argv[j], "--help") && strcmp(cmd, "build") && strcmp(cmd, "texgen")) {
+                if (!strcmp(argv[j], "--help") && strcmp(cmd, "build") && strcmp(cmd, "texgen") &&
+                    strcmp(cmd, "init") && strcmp(cmd, "doc")) {
                     fputs(usage_text, stdout);
                     return EXIT_OK;
                 }
             /* argv for the command: its name, the general options, the rest */
-            bool keep = strcmp(cmd, "texgen") != 0;
+            bool keep = strcmp(cmd, "texgen") != 0 && strcmp(cmd, "init") != 0 &&
+                        strcmp(cmd, "doc") != 0;
             char **av = calloc((size_t)argc + 1, sizeof *av);
             if (!av)
                 return EXIT_USAGE;

@@ -245,6 +245,15 @@ static json_t *jscene(build *b, const char *dir)
     char *scene_src = splat_path_relative_real(dir, b->desc->scene);
     json_object_set_new(scene, "source", json_string(scene_src));
     free(scene_src);
+    if (b->desc->pack_search && b->desc->pack_search[0]) {
+        json_t *search = json_array();
+        for (int i = 0; b->desc->pack_search[i]; i++) {
+            char *rel = splat_path_relative_real(dir, b->desc->pack_search[i]);
+            json_array_append_new(search, json_string(rel));
+            free(rel);
+        }
+        json_object_set_new(scene, "search", search);
+    }
     json_t *hf = json_object();
     json_object_set_new(hf, "file", json_string("heightfield.r16"));
     json_object_set_new(hf, "width", json_integer(s->terrain.width));
@@ -742,6 +751,39 @@ static bool replaceable(build *b, const char *path, bool *exists)
     snprintf(msg, sizeof msg, "refusing to replace '%s': it is not a shader pack", path);
     sg_error(b->d, b->loc, SG_E_NOT_A_PACK, msg);
     return false;
+}
+
+bool build_check_out(build *b)
+{
+    const char *out = b->out;
+    sg_loc none = { NULL, 0, 0 };
+    char *parent = splat_path_dir(out);
+    struct stat sb;
+    bool ok = true;
+    if (stat(parent, &sb) != 0) {
+        char why[PATH_MAX + 96];
+        snprintf(why, sizeof why, "its folder '%s' does not exist (create it first: "
+                 "mkdir -p '%s')", parent, parent);
+        sg_error(b->d, none, SG_E_WRITE, out, why);
+        ok = false;
+    } else if (!S_ISDIR(sb.st_mode)) {
+        char why[PATH_MAX + 64];
+        snprintf(why, sizeof why, "'%s' is not a folder", parent);
+        sg_error(b->d, none, SG_E_WRITE, out, why);
+        ok = false;
+    } else if (access(parent, W_OK | X_OK) != 0) {
+        char why[PATH_MAX + 64];
+        snprintf(why, sizeof why, "folder '%s': %s", parent, strerror(errno));
+        sg_error(b->d, none, SG_E_WRITE, out, why);
+        ok = false;
+    } else if (lstat(out, &sb) == 0 && !S_ISDIR(sb.st_mode)) {
+        char msg[PATH_MAX + 64];
+        snprintf(msg, sizeof msg, "refusing to replace '%s': it is not a shader pack", out);
+        sg_error(b->d, b->loc, SG_E_NOT_A_PACK, msg);
+        ok = false;
+    }
+    free(parent);
+    return ok;
 }
 
 bool build_write_pack(build *b)

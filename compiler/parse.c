@@ -87,6 +87,21 @@ static void expected(parser *ps, const char *what)
              sg_tok_describe(t, buf, sizeof buf));
 }
 
+/* "did you mean" for a misspelt setting `key` among `keys` (NULL-ended),
+ * on the diagnostic just reported. */
+static void hint_key(parser *ps, const sg_token *key, const char *const *keys)
+{
+    if (key->kind != SG_TK_IDENT)
+        return;
+    char word[64];
+    snprintf(word, sizeof word, "%.*s", key->len, key->start);
+    sg_suggest sg;
+    sg_suggest_init(&sg, word);
+    for (int i = 0; keys[i]; i++)
+        sg_suggest_offer(&sg, keys[i]);
+    sg_hint_suggest(ps->d, sg_suggest_best(&sg));
+}
+
 static bool accept(parser *ps, sg_tok_kind k)
 {
     if (cur(ps)->kind != k)
@@ -493,6 +508,8 @@ static bool ug_stmt(parser *ps, void *user)
     if (k == UG_NKEYS) {
         sg_errorf(ps->d, kloc, SG_E_BAD_OPTION, "unknown undergrowth setting '%.*s' "
                   "(expected density, scale, align, blend or color)", key->len, key->start);
+        static const char *const keys[] = { "density", "scale", "align", "blend", "color", NULL };
+        hint_key(ps, key, keys);
         /* skip its value (vec3(…) whole), then to ',', '}' or the next line */
         next(ps);
         sg_value v;
@@ -741,6 +758,7 @@ static void add_texture_setting(parser *ps, void *user, sg_token *key, sg_value 
         else {
             char *path = splat_path_join(ps->f->dir, v->str);
             t->file = sg_strdup(ps->a, path);
+            t->file_loc = v->loc;
             free(path);
         }
     } else if (is_kw(key, "filter") || is_kw(key, "mip")) {
@@ -768,6 +786,8 @@ static void add_texture_setting(parser *ps, void *user, sg_token *key, sg_value 
         snprintf(msg, sizeof msg, "unknown texture setting '%.*s' "
                  "(expected file, filter, mip, wrap or srgb)", key->len, key->start);
         sg_error(ps->d, loc_of(ps, key), SG_E_BAD_OPTION, msg);
+        static const char *const keys[] = { "file", "filter", "mip", "wrap", "srgb", NULL };
+        hint_key(ps, key, keys);
     }
 }
 
@@ -877,6 +897,9 @@ static bool painted_stmt(parser *ps, void *user)
         if (ok) *(size ? &pm->place_loc : &pm->origin_loc) = kloc;
     } else {
         expected(ps, keys);
+        static const char *const names[] = { "max_level", "max_error", "near", "origin",
+                                             "size", NULL };
+        hint_key(ps, key, names);
         return false;
     }
     if (ok)
@@ -916,6 +939,9 @@ static bool sub_stmt(parser *ps, void *user)
         ok = expect(ps, SG_TK_EQ, "'='") && parse_number(ps, &sc->destruction_cell);
     } else {
         expected(ps, b->cam ? "'position', 'look' or '}'" : "'origin', 'size', 'cell' or '}'");
+        static const char *const cam[] = { "position", "look", NULL };
+        static const char *const des[] = { "origin", "size", "cell", NULL };
+        hint_key(ps, key, b->cam ? cam : des);
         return false;
     }
     if (ok)
@@ -935,6 +961,11 @@ static bool light_stmt(parser *ps, void *user)
     if (key->kind != SG_TK_IDENT || k == SPLAT_LIGHT_COUNT) {
         expected(ps, "'sun', 'sun_color', 'intensity', 'sky', 'fog_density', "
                      "'fog_height', 'exposure' or '}'");
+        const char *keys[SPLAT_LIGHT_COUNT + 1];
+        for (int i = 0; i < SPLAT_LIGHT_COUNT; i++)
+            keys[i] = splat_light_keys[i].key;
+        keys[SPLAT_LIGHT_COUNT] = NULL;
+        hint_key(ps, key, keys);
         return false;
     }
     l->loc[k] = loc_of(ps, key);
@@ -1143,6 +1174,11 @@ static bool scene_stmt(parser *ps, void *user)
              "a scene setting (heightfield, heightfield_size, size, max_height, "
              "height_offset, materials, compositor, painted, destruction, cell, camera, light)",
              sg_tok_describe(key, buf, sizeof buf));
+    static const char *const keys[] = { "heightfield", "heightfield_size", "size",
+                                        "max_height", "height_offset", "materials",
+                                        "compositor", "painted", "destruction", "cell",
+                                        "camera", "light", NULL };
+    hint_key(ps, key, keys);
     return false;
 }
 
@@ -1227,6 +1263,45 @@ typedef struct loader {
     int         depth;
 } loader;
 
+/* Search folder s is the importing file's folder or an earlier one. */
+static bool seen_before(const sg_program *p, const char *dir, int s)
+{
+    if (!strcmp(p->search[s], dir))
+        return true;
+    for (int k = 0; k < s; k++)
+        if (!strcmp(p->search[k], p->search[s]))
+            return true;
+    return false;
+}
+
+/* An import found nowhere: the folders searched, in order, and how to add
+ * one.  The errors that only follow from it (names it would have defined)
+ * are left out by resolve (p->failed_imports). */
+static void missing_import(loader *l, const sg_file *f, const sg_import *im)
+{
+    sg_program *p = l->p;
+    size_t n = 256 + strlen(f->dir);
+    for (int s = 0; s < p->nsearch; s++)
+        n += strlen(p->search[s]) + 6;
+    char *msg = xmalloc(n);
+    size_t o = (size_t)snprintf(msg, n, "not found in '%s' (the importing file's folder)",
+                                f->dir);
+    /* each folder once, as given (the scene's folder often comes twice) */
+    int last = -1;
+    for (int s = 0; s < p->nsearch; s++)
+        if (!seen_before(p, f->dir, s))
+            last = s;
+    for (int s = 0; s < p->nsearch; s++)
+        if (!seen_before(p, f->dir, s))
+            o += (size_t)snprintf(msg + o, n - o, "%s'%s'", s == last ? " or " : ", ",
+                                  p->search[s]);
+    snprintf(msg + o, n - o, "; add the folder that holds it with -I DIR or "
+             "SPLATC_PATH=DIR[:DIR...]");
+    sg_error(l->d, im->loc, SG_E_MISSING_IMPORT, im->path, msg);
+    free(msg);
+    p->failed_imports++;
+}
+
 /* Lex, parse and load the imports of `path` (text given, or read). */
 static int load_file(loader *l, const char *path, const char *text, size_t len,
                      sg_loc from, bool is_import)
@@ -1269,8 +1344,10 @@ static int load_file(loader *l, const char *path, const char *text, size_t len,
         owned = splat_input_read(path, SPLAT_MAX_GRAPH_BYTES, &len, err, sizeof err);
         if (!owned) {
             free(rp);
-            if (is_import)
+            if (is_import) {
                 sg_error(l->d, from, SG_E_MISSING_IMPORT, path, err);
+                p->failed_imports++;
+            }
             else
                 sg_error(l->d, from, SG_E_IO, path, err);
             return -1;
@@ -1310,9 +1387,7 @@ static int load_file(loader *l, const char *path, const char *text, size_t len,
         }
         if (!found) {
             free(cand);
-            sg_error(l->d, imports[i].loc, SG_E_MISSING_IMPORT, imports[i].path,
-                     p->nsearch ? "not found next to the importing file or in the search paths"
-                                : "not found next to the importing file");
+            missing_import(l, f, &imports[i]);
             continue;
         }
         load_file(l, cand, NULL, 0, imports[i].loc, true);
@@ -1380,13 +1455,6 @@ const char *sg_material_name(const sg_program *p, int i)
 sg_loc sg_material_loc(const sg_program *p, int i)
 {
     return p->shaders[p->materials[i]]->loc;
-}
-sg_loc sg_texture_loc(const sg_program *p, const char *file)
-{
-    for (int i = 0; i < p->ntextures; i++)
-        if (p->textures[i]->file && !strcmp(p->textures[i]->file, file))
-            return p->textures[i]->loc;
-    return (sg_loc){ 0 };
 }
 
 int sg_material_find(const sg_program *p, const char *name)

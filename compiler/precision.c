@@ -23,7 +23,9 @@
  * material, with the distance from the origin at which fp32's rounding of
  * position passes a quarter of the texel (or noise cell, or metre) it
  * feeds: 2^22 times that size (fp32 keeps 24 bits; half an ulp at
- * distance D is about D / 2^24).
+ * distance D is about D / 2^24), but only where the scene's terrain
+ * reaches that distance (a 2 km terrain never meets a 12 000 km limit),
+ * and at the node that reads position.
  *
  * Sites are collected once from every material (splat_sites_find, on the
  * layout's source ir), in node order, so their numbers are the same in
@@ -288,6 +290,16 @@ void splat_sites_warn(const splat_scene *s, sg_diags *d)
         return;
     }
     const sg_scene *sc = s->desc;
+    /* the farthest a point of this terrain is from the origin */
+    ir_ienv region;
+    memset(&region, 0, sizeof region);
+    splat_terrain_ranges(&s->terrain, 0, 0, s->terrain.width, s->terrain.height, &region);
+    double reach = 0;
+    for (int c = 0; c < 3; c++) {
+        double far = fmax(fabs(region.position[c].lo), fabs(region.position[c].hi));
+        reach += far * far;
+    }
+    reach = sqrt(reach);
     for (int m = 0; m < sc->nmaterials; m++) {
         memset(live, 0, ir->nnodes);
         size_t plen = strlen(sc->materials[m]);
@@ -340,13 +352,25 @@ void splat_sites_warn(const splat_scene *s, sg_diags *d)
                 }
             }
         }
-        if (what) {
+        /* only where this scene's terrain reaches that far from the origin */
+        if (what && worst <= reach) {
             int mi = sg_material_find(s->prog, sc->materials[m]);
             sg_loc loc = mi >= 0 ? sg_material_loc(s->prog, mi) : sc->loc;
-            sg_warning(d, loc, "material '%s' reads terrain.position through '%s', "
-                       "which splatc cannot make camera-relative: its fp32 rounding "
-                       "passes a quarter texel about %.0f km from the origin",
-                       sc->materials[m], what, worst / 1000.0);
+            char node[256] = "";
+            const char *op = strcmp(what, "an internal op") ? what : NULL;
+            if (sg_node_reading_input(s->prog, sc->materials[m], op, IR_IN_POSITION, &loc,
+                                      node, sizeof node))
+                sg_warning_id(d, loc, SG_E_W_PRECISION, "%s of material '%s' reads terrain.position through "
+                           "'%s', which splatc cannot make camera-relative: its fp32 "
+                           "rounding passes a quarter texel about %.0f km from the origin, "
+                           "and this terrain reaches %.0f km", node, sc->materials[m], what,
+                           worst / 1000.0, reach / 1000.0);
+            else
+                sg_warning_id(d, loc, SG_E_W_PRECISION, "material '%s' reads terrain.position through '%s', "
+                           "which splatc cannot make camera-relative: its fp32 rounding "
+                           "passes a quarter texel about %.0f km from the origin, and this "
+                           "terrain reaches %.0f km", sc->materials[m], what, worst / 1000.0,
+                           reach / 1000.0);
         }
     }
     free(live);

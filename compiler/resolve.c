@@ -25,8 +25,12 @@
 #include "sg_internal.h"
 #include "util.h"
 
+#include <errno.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
+
+#include <stb_image.h>
 
 const char *const sg_output_names[SG_OUT_COUNT] = {
 #define X(id, name, type) name,
@@ -72,7 +76,20 @@ typedef struct checker {
     sg_diags   *d;
     sg_shader  *s;        /* current scope                                */
     sg_map      locals;   /* name -> (index << 2) | local kind            */
+    int         suppressed; /* unknown names left unreported in this scope:
+                               an import failed, they may be its (parse.c) */
 } checker;
+
+/* An unknown global name (node type, texture, material, compositor) is
+ * most likely one of a failed import's: leave it out, the import's error
+ * says what to do.  The scope is then not ok, though no error is added. */
+static bool after_failed_import(checker *c)
+{
+    if (c->p->failed_imports == 0)
+        return false;
+    c->suppressed++;
+    return true;
+}
 
 enum { L_NODE, L_IN, L_PARAM };
 
@@ -127,6 +144,70 @@ static const char *path_text(const sg_value *v, char *buf, size_t n)
     for (int i = 0; i < v->nparts && o < n; i++)
         o += (size_t)snprintf(buf + o, n - o, "%s%s", i ? "." : "", v->parts[i]);
     return buf;
+}
+
+/* ---- did you mean ---------------------------------------------------------- */
+
+/* The node type `word` may have meant: terrain and view inputs, painted,
+ * the built-in ops, the program's shaders. */
+static const char *near_node_type(checker *c, const char *word)
+{
+    sg_suggest sg;
+    sg_suggest_init(&sg, word);
+    for (int i = 0; i < IR_IN_COUNT; i++)
+        sg_suggest_offer(&sg, ir_input_get((ir_input_kind)i)->name);
+    sg_suggest_offer(&sg, "painted");
+    for (int i = 0; i < IR_OP_COUNT; i++)
+        sg_suggest_offer(&sg, ir_opinfo_get((ir_op)i)->name);
+    for (int i = 0; i < c->p->nshaders; i++)
+        if (!c->p->shaders[i]->is_material)
+            sg_suggest_offer(&sg, c->p->shaders[i]->name);
+    return sg_suggest_best(&sg);
+}
+
+static const char *near_port(const sg_port *ports, int n, const char *word)
+{
+    sg_suggest sg;
+    sg_suggest_init(&sg, word);
+    for (int i = 0; i < n; i++)
+        sg_suggest_offer(&sg, ports[i].name);
+    return sg_suggest_best(&sg);
+}
+
+/* A name in scope that `word` may have meant: the shader's inputs,
+ * params and nodes, the program's textures, the terrain and view inputs
+ * (for "terrain.positon", only those). */
+static const char *near_name(checker *c, const char *word, bool allow_locals)
+{
+    sg_suggest sg;
+    sg_suggest_init(&sg, word);
+    bool dotted = strchr(word, '.') != NULL;
+    if (!dotted) {
+        const sg_shader *s = c->s;
+        for (int i = 0; s && i < s->nins; i++)
+            sg_suggest_offer(&sg, s->ins[i].name);
+        for (int i = 0; s && i < s->nparams; i++)
+            sg_suggest_offer(&sg, s->params[i].name);
+        for (int i = 0; s && allow_locals && i < s->nnodes; i++)
+            sg_suggest_offer(&sg, s->nodes[i].name);
+        for (int i = 0; i < c->p->ntextures; i++)
+            sg_suggest_offer(&sg, c->p->textures[i]->name);
+    }
+    for (int i = 0; i < IR_IN_COUNT; i++)
+        sg_suggest_offer(&sg, ir_input_get((ir_input_kind)i)->name);
+    return sg_suggest_best(&sg);
+}
+
+/* "take the first N components with '.rgb'" for a value one swizzle away
+ * from the type wanted (a wider vector into a narrower port). */
+static void hint_swizzle(checker *c, const sg_value *v, ir_type want)
+{
+    static const char *const take[] = { NULL, ".x", ".xy", ".rgb" };
+    int ww = ir_type_width(want), hw = ir_type_width(v->type);
+    if (v->kind != SG_V_PATH || ww < 1 || ww > 3 || hw <= ww)
+        return;
+    sg_hint(c->d, "write '%s' after it to take its first %d component%s", take[ww], ww,
+            ww == 1 ? "" : "s");
 }
 
 /* Output port index of node `n` called `port`, or -1. */
@@ -194,6 +275,15 @@ static bool resolve_path(checker *c, sg_value *v, bool allow_locals)
                 v->index = node_port(c, n, "out") >= 0 ? node_port(c, n, "out") : 0;
             } else {
                 sg_error(c->d, v->loc, SG_E_UNKNOWN_PORT, n->name, "output", v->parts[1]);
+                if (n->kind == SG_NODE_INSTANCE) {
+                    const sg_shader *callee = c->p->shaders[n->shader];
+                    sg_hint_suggest(c->d, near_port(callee->outs, callee->nouts, v->parts[1]));
+                } else {
+                    sg_suggest sg;
+                    sg_suggest_init(&sg, v->parts[1]);
+                    sg_suggest_offer(&sg, "out");
+                    sg_hint_suggest(c->d, sg_suggest_best(&sg));
+                }
                 return false;
             }
         }
@@ -210,6 +300,7 @@ static bool resolve_path(checker *c, sg_value *v, bool allow_locals)
         int in = ir_input_by_name(buf);
         if (in < 0) {
             sg_error(c->d, v->loc, SG_E_UNKNOWN_NAME, buf);
+            sg_hint_suggest(c->d, near_name(c, buf, allow_locals));
             return false;
         }
         v->ref = SG_REF_INPUT;
@@ -222,8 +313,9 @@ static bool resolve_path(checker *c, sg_value *v, bool allow_locals)
             snprintf(msg, sizeof msg, "a default value cannot use '%s': only constants, "
                      "textures and terrain inputs", first);
             sg_error(c->d, v->loc, SG_E_BAD_DEFAULT, msg);
-        } else {
+        } else if (!after_failed_import(c)) {
             sg_error(c->d, v->loc, SG_E_UNKNOWN_NAME, path_text(v, buf, sizeof buf));
+            sg_hint_suggest(c->d, near_name(c, first, allow_locals));
         }
         return false;
     }
@@ -297,6 +389,11 @@ static void check_op(checker *c, sg_node *n)
                 k = j;
         if (k < 0) {
             sg_error(c->d, b->loc, SG_E_UNKNOWN_PORT, n->type, "input", b->port);
+            sg_suggest sg;
+            sg_suggest_init(&sg, b->port);
+            for (int j = 0; j < nargs; j++)
+                sg_suggest_offer(&sg, info->ports[j]);
+            sg_hint_suggest(c->d, sg_suggest_best(&sg));
             bad = unknown = true;
             continue;
         }
@@ -350,6 +447,7 @@ static void check_op(checker *c, sg_node *n)
                          n->name, n->type);
                 sg_error(c->d, slot[j]->val.loc, SG_E_TYPE_MISMATCH, what,
                          ir_type_name(cand[k]), ir_type_name(args[j]));
+                hint_swizzle(c, &slot[j]->val, cand[k]);
                 return;
             }
         }
@@ -388,6 +486,7 @@ static void check_instance(checker *c, sg_node *n)
                 k = j;
         if (k < 0) {
             sg_error(c->d, b->loc, SG_E_UNKNOWN_PORT, n->type, "input", b->port);
+            sg_hint_suggest(c->d, near_port(callee->ins, callee->nins, b->port));
             unknown = true;
             continue;
         }
@@ -404,6 +503,7 @@ static void check_instance(checker *c, sg_node *n)
             snprintf(what, sizeof what, "input '%s' of '%s' (%s)", b->port, n->name, n->type);
             sg_error(c->d, b->val.loc, SG_E_TYPE_MISMATCH, what,
                      ir_type_name(callee->ins[k].type), ir_type_name(b->val.type));
+            hint_swizzle(c, &b->val, callee->ins[k].type);
         }
     }
     for (int j = 0; j < callee->nins; j++)
@@ -420,6 +520,10 @@ static void check_painted(checker *c, sg_node *n)
         sg_binding *b = &n->args[i];
         if (strcmp(b->port, "mask")) {
             sg_error(c->d, b->loc, SG_E_UNKNOWN_PORT, "painted", "input", b->port);
+            sg_suggest sg;
+            sg_suggest_init(&sg, b->port);
+            sg_suggest_offer(&sg, "mask");
+            sg_hint_suggest(c->d, sg_suggest_best(&sg));
             continue;
         }
         if (have) {
@@ -598,7 +702,10 @@ static void resolve_node_type(checker *c, sg_node *n)
         n->shader = g >> 1;
         return;
     }
+    if (after_failed_import(c))
+        return;
     sg_error(c->d, n->type_loc, SG_E_UNKNOWN_NODE, n->type);
+    sg_hint_suggest(c->d, near_node_type(c, n->type));
 }
 
 /* Defaults of inputs and params: constants (params: numbers only),
@@ -626,12 +733,27 @@ static void check_default(checker *c, sg_port *port, bool is_param)
         snprintf(msg, sizeof msg, "range of param '%s' is empty (%g > %g)", port->name,
                  port->lo, port->hi);
         sg_error(c->d, v->loc, SG_E_EMPTY_RANGE, msg);
+    } else if (is_param && port->has_range && port->lo < port->hi) {
+        /* the interval analysis (and the pack's culling) assume the param
+         * stays in its range, the default included (lo == hi: fixed at
+         * its default, as the IR dump writes a param with no range) */
+        int w = v->kind == SG_V_VEC ? v->width : 1;
+        for (int k = 0; k < w; k++)
+            if (!(v->num[k] >= port->lo && v->num[k] <= port->hi)) {
+                char msg[300];
+                snprintf(msg, sizeof msg, "the default %g of param '%s' is outside its "
+                         "range [%g, %g] (the compiler assumes the param stays in it)",
+                         v->num[k], port->name, port->lo, port->hi);
+                sg_error(c->d, v->loc, SG_E_BAD_DEFAULT, msg);
+                break;
+            }
     }
 }
 
 static void check_shader(checker *c, sg_shader *s)
 {
     int errors = c->d->nerrors;
+    c->suppressed = 0;
     declare_locals(c, s);
     for (int i = 0; i < s->nins; i++)
         if (s->ins[i].has_value)
@@ -709,6 +831,11 @@ static void check_shader(checker *c, sg_shader *s)
                     o->output = k;
             if (o->output < 0) {
                 sg_error(c->d, o->loc, SG_E_BAD_OUTPUT, o->name);
+                sg_suggest sg;
+                sg_suggest_init(&sg, o->name);
+                for (int k = 0; k < SG_OUT_COUNT; k++)
+                    sg_suggest_offer(&sg, sg_output_names[k]);
+                sg_hint_suggest(c->d, sg_suggest_best(&sg));
                 continue;
             }
             want = output_types[o->output];
@@ -733,9 +860,10 @@ static void check_shader(checker *c, sg_shader *s)
             snprintf(what, sizeof what, "output '%s'", o->name);
             sg_error(c->d, v->loc, SG_E_TYPE_MISMATCH, what, ir_type_name(want),
                      ir_type_name(v->type));
+            hint_swizzle(c, v, want);
         }
     }
-    s->ok = c->d->nerrors == errors;
+    s->ok = c->d->nerrors == errors && c->suppressed == 0;
 }
 
 /* ---- the program ---------------------------------------------------------- */
@@ -820,25 +948,135 @@ static void check_scene(checker *c)
                 char msg[300];
                 snprintf(msg, sizeof msg, "'%s' is not a material", sc->materials[i]);
                 sg_error(c->d, sc->material_locs[i], SG_E_BAD_REFERENCE, msg);
-            } else {
+            } else if (!after_failed_import(c)) {
                 sg_error(c->d, sc->material_locs[i], SG_E_UNKNOWN_NAME, sc->materials[i]);
+                sg_suggest sg;
+                sg_suggest_init(&sg, sc->materials[i]);
+                for (int k = 0; k < p->nmaterials; k++)
+                    sg_suggest_offer(&sg, p->shaders[p->materials[k]]->name);
+                sg_hint_suggest(c->d, sg_suggest_best(&sg));
             }
         }
-    if (sg_shader_find(p, sc->compositor) < 0) {
+    if (sg_shader_find(p, sc->compositor) < 0 && !after_failed_import(c)) {
         char msg[300];
         snprintf(msg, sizeof msg, "compositor '%s' is not a shader of this program "
                  "(import \"nodes/compositors.sg\"?)", sc->compositor);
         sg_error(c->d, sc->compositor_loc, SG_E_UNDECLARED, msg);
+        sg_suggest sg;
+        sg_suggest_init(&sg, sc->compositor);
+        for (int k = 0; k < p->nshaders; k++)
+            if (!p->shaders[k]->is_material)
+                sg_suggest_offer(&sg, p->shaders[k]->name);
+        sg_hint_suggest(c->d, sg_suggest_best(&sg));
     }
 }
 
 void sg_resolve(sg_program *p, sg_diags *d)
 {
-    checker c = { p, d, NULL, { 0 } };
+    checker c = { p, d, NULL, { 0 }, 0 };
     declare_globals(&c);
     for (int i = 0; i < p->nshaders; i++)
         check_shader(&c, p->shaders[i]);
     sg_map_free(&c.locals);
     check_nesting(&c);
     check_scene(&c);
+}
+
+/* ---- texture files ----------------------------------------------------------- */
+
+typedef void (*tex_fn)(void *user, const char *file, sg_loc loc);
+
+/* Every texture file named in the program, with where: declarations,
+ * then inline strings on node ports and input defaults, in file order. */
+static void each_texture_file(const sg_program *p, tex_fn fn, void *user)
+{
+    for (int i = 0; i < p->ntextures; i++) {
+        const sg_texdecl *t = p->textures[i];
+        if (t->file && *t->file)
+            fn(user, t->file, t->file_loc.line > 0 ? t->file_loc : t->loc);
+    }
+    for (int i = 0; i < p->nshaders; i++) {
+        const sg_shader *s = p->shaders[i];
+        const char *dir = p->files[s->file]->dir;
+        for (int k = 0; k < s->nins; k++)
+            if (s->ins[k].has_value && s->ins[k].value.kind == SG_V_STRING &&
+                s->ins[k].type == IR_T_TEX) {
+                char *path = splat_path_join(dir, s->ins[k].value.str);
+                fn(user, path, s->ins[k].value.loc);
+                free(path);
+            }
+        for (int k = 0; k < s->nnodes; k++) {
+            const sg_node *n = &s->nodes[k];
+            if (n->kind == SG_NODE_PAINTED)
+                continue;
+            for (int a = 0; a < n->nargs; a++)
+                if (n->args[a].val.kind == SG_V_STRING) {
+                    char *path = splat_path_join(dir, n->args[a].val.str);
+                    fn(user, path, n->args[a].val.loc);
+                    free(path);
+                }
+        }
+    }
+}
+
+typedef struct tex_find { const char *file; sg_loc loc; } tex_find;
+
+static void find_file(void *user, const char *file, sg_loc loc)
+{
+    tex_find *f = user;
+    if (f->loc.line == 0 && !strcmp(f->file, file))
+        f->loc = loc;
+}
+
+sg_loc sg_texture_file_loc(const sg_program *p, const char *file)
+{
+    tex_find f = { file, { NULL, 0, 0 } };
+    each_texture_file(p, find_file, &f);
+    return f.loc;
+}
+
+typedef struct tex_check {
+    sg_diags *d;
+    sg_map    seen;
+    char    **keys;
+    int       nkeys, cap;
+    bool      ok;
+} tex_check;
+
+static void check_file(void *user, const char *file, sg_loc loc)
+{
+    tex_check *c = user;
+    if (sg_map_get(&c->seen, file) >= 0)
+        return;
+    if (c->nkeys == c->cap) {
+        c->cap = c->cap ? 2 * c->cap : 16;
+        c->keys = xrealloc(c->keys, (size_t)c->cap * sizeof *c->keys);
+    }
+    c->keys[c->nkeys] = xstrdup(file);
+    sg_map_put(&c->seen, c->keys[c->nkeys++], 0);
+    /* opened as every input is (util.h): a FIFO or device is refused, not read */
+    char why[256];
+    int w, h, comp;
+    FILE *f = splat_input_fopen(file, SPLAT_MAX_IMAGE_BYTES, why, sizeof why);
+    if (!f) {
+        sg_error(c->d, loc, SG_E_IO, file, why);
+        c->ok = false;
+        return;
+    }
+    if (!stbi_info_from_file(f, &w, &h, &comp)) {
+        sg_error(c->d, loc, SG_E_IO, file, "not an image (PNG, JPEG, TGA or BMP)");
+        c->ok = false;
+    }
+    fclose(f);
+}
+
+bool sg_check_texture_files(const sg_program *p, sg_diags *d)
+{
+    tex_check c = { d, { 0 }, NULL, 0, 0, true };
+    each_texture_file(p, check_file, &c);
+    sg_map_free(&c.seen);
+    for (int i = 0; i < c.nkeys; i++)
+        free(c.keys[i]);
+    free(c.keys);
+    return c.ok;
 }

@@ -44,6 +44,11 @@ static void check_materials(sg_program *p, const sg_scene *sc, sg_diags *d)
                                        : sc->loc;
         if (sg_material_find(p, sc->materials[i]) < 0) {
             sg_error(d, loc, SG_E_UNKNOWN_NAME, sc->materials[i]);
+            sg_suggest sg;
+            sg_suggest_init(&sg, sc->materials[i]);
+            for (int k = 0; k < sg_material_count(p); k++)
+                sg_suggest_offer(&sg, sg_material_name(p, k));
+            sg_hint_suggest(d, sg_suggest_best(&sg));
             continue;
         }
         for (int j = 0; j < i; j++) {
@@ -56,6 +61,7 @@ static void check_materials(sg_program *p, const sg_scene *sc, sg_diags *d)
         }
     }
 }
+
 
 /* ---- rasters ------------------------------------------------------------ */
 
@@ -300,7 +306,7 @@ static bool check_textures(splat_scene *s, const int *first_material, sg_diags *
     bool ok = true;
     for (int i = 0; i < s->ir.ntextures; i++) {
         const char *file = s->ir.textures[i].file;
-        sg_loc loc = sg_texture_loc(s->prog, file);
+        sg_loc loc = sg_texture_file_loc(s->prog, file);
         if (loc.line == 0) {
             int m = first_material[i];
             loc = sc->material_locs && m >= 0 ? sg_loc_or(sc->material_locs[m], sc->loc)

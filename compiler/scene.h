@@ -22,6 +22,12 @@ typedef struct splat_build_desc {
     const char        *scene;        /* scene.sg                              */
     const char        *out;          /* PACKDIR                               */
     const char *const *search_paths; /* for imports (NULL-terminated) or NULL */
+    const char *const *pack_search;  /* the folders -I added (NULL-
+                                        terminated) or NULL: the manifest's
+                                        scene.search, relative to the pack,
+                                        so swatches and hot reload find the
+                                        same imports (SPLATC_PATH is the
+                                        environment's: splatview reads it) */
     int                jobs;         /* glslang threads; 0 = 1                */
     const char        *cache_dir;    /* NULL = splat_cache_default_dir()      */
     bool               no_cache;

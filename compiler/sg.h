@@ -60,6 +60,12 @@ typedef struct sg_loc {
     X(NOT_A_PACK,    "%s")      /* the output folder is not a shader pack  */ \
     X(NO_DEVICE,     "%s")      /* --far-bake gpu and no device to bake on */ \
     X(OUT_OF_MEMORY, "%s")                                                  \
+    /* warnings (the input is accepted) */                                  \
+    X(W_MASK_RANGE,  "%s")      /* a mask's values leave [0, 1] (lint.c)   */ \
+    X(W_NAN,         "%s")      /* an output can be NaN or infinite        */ \
+    X(W_LO_HI,       "%s")      /* a constant lo >= hi on a ramp-like node */ \
+    X(W_PRECISION,   "%s")      /* position in fp32 past a quarter texel   */ \
+    X(WARNING,       "%s")      /* any other warning                       */ \
     X(INTERNAL,      "internal compiler error: %s")
 
 typedef enum sg_error_id {
@@ -77,6 +83,7 @@ typedef struct sg_diag {
     sg_error_id  id;
     char        *msg;
     char        *src_line;  /* the source line at loc (for the caret), or NULL */
+    char        *suggestion; /* "did you mean" replacement (sg_hint_suggest), or NULL */
 } sg_diag;
 
 typedef struct sg_diags {
@@ -85,6 +92,11 @@ typedef struct sg_diags {
     int      nerrors;
     int      ndropped;  /* diagnostics counted but not stored (too many) */
     struct sg_sources *sources; /* source texts for carets (diag.c)      */
+    bool     last_dropped; /* the latest diagnostic was not stored        */
+    bool     unique;    /* do not store a diagnostic equal to one stored
+                           (it still counts in nerrors): one list for
+                           several loads of files that share imports
+                           (`splatc check A B` prints each error once)    */
 } sg_diags;
 
 void sg_diags_init(sg_diags *d);
@@ -101,16 +113,50 @@ void sg_errorf(sg_diags *d, sg_loc loc, sg_error_id id, const char *fmt, ...)
     __attribute__((format(printf, 4, 5)));
 void sg_note(sg_diags *d, sg_loc loc, const char *fmt, ...)
     __attribute__((format(printf, 3, 4)));
-/* A warning: printed like an error, but the input is accepted. */
+/* A warning: printed like an error, but the input is accepted (id
+ * SG_E_WARNING; sg_warning_id for one of the W_ ids). */
 void sg_warning(sg_diags *d, sg_loc loc, const char *fmt, ...)
     __attribute__((format(printf, 3, 4)));
+void sg_warning_id(sg_diags *d, sg_loc loc, sg_error_id id, const char *fmt, ...)
+    __attribute__((format(printf, 4, 5)));
+/* Append "; <text>" to the latest diagnostic's message (a hint on how to
+ * fix it); nothing if it was dropped or there is none. */
+void sg_hint(sg_diags *d, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+/* Append "; did you mean 'word'?" and record `word` as the latest
+ * diagnostic's suggestion (JSON "suggestion"); nothing if word is NULL. */
+void sg_hint_suggest(sg_diags *d, const char *word);
+
+/* "Did you mean": offer the names a misspelt `word` could have meant, one
+ * by one; sg_suggest_best is the nearest by edit distance (Damerau-
+ * Levenshtein: a swap of neighbours costs 1, a change of case 0; one name
+ * starting with the other, "out" for "output", just passes), or NULL
+ * when none is within about a third of the word's length (none at all
+ * for words of 1 or 2 letters).  The first of equally near names wins, so
+ * the result depends only on the order of the offers.  A name is not
+ * copied: it must outlive the sg_suggest. */
+typedef struct sg_suggest {
+    const char *word;
+    const char *best;
+    int         dist;
+} sg_suggest;
+void        sg_suggest_init(sg_suggest *s, const char *word);
+void        sg_suggest_offer(sg_suggest *s, const char *name);
+const char *sg_suggest_best(const sg_suggest *s);
+/* Edit distance of a and b as sg_suggest counts it (capped at 64). */
+int         sg_edit_distance(const char *a, const char *b);
+
 /* GCC style: "file:line:col: error: msg", the source line, a caret. */
 void sg_diags_print(const sg_diags *d, FILE *out);
+/* The same for the diagnostics from index `from` on (no "not shown" line). */
+void sg_diags_print_from(const sg_diags *d, int from, FILE *out);
 /* The same diagnostics for editors, one JSON object per line (JSON Lines):
  * {"file": …, "line": N, "column": N, "severity": "error", "id":
- * "UNKNOWN_NODE", "message": …}; file is null and line/column 0 where
+ * "UNKNOWN_NODE", "message": …} and, where the message says "did you
+ * mean", "suggestion": the name; file is null and line/column 0 where
  * unknown; a last {"dropped": N} line if some were not stored. */
 void sg_diags_print_json(const sg_diags *d, FILE *out);
+/* The same from index `from` on (no "dropped" line). */
+void sg_diags_print_json_from(const sg_diags *d, int from, FILE *out);
 /* The id's name as in SG_ERRORS ("UNKNOWN_NODE"). */
 const char *sg_error_name(sg_error_id id);
 /* Make `text` the source of `path` for the caret lines of later
@@ -130,6 +176,28 @@ sg_program *sg_load(const char *path, const char *const *search_paths,
 /* Same, from memory (`name` is used in diagnostics and for imports). */
 sg_program *sg_load_string(const char *name, const char *text,
                            const char *const *search_paths, sg_diags *d);
+/* Warnings about what builds but cannot be meant (lint.c): a mask whose
+ * bounds over `region` leave [0, 1], an output that can be NaN or
+ * infinite, a constant lo >= hi on a ramp-like node.  `region`: the
+ * terrain's input bounds (params and painted unset), NULL for every
+ * input's domain.  Nothing for a program with errors. */
+void sg_lint(sg_program *p, const ir_ienv *region, sg_diags *d);
+/* The node of `material` (or of a shader it instantiates, looked at
+ * after its own nodes) of built-in op `op` (NULL: any) that reads terrain
+ * input `input` (ir_input_kind) directly; its location and "node 'uv'
+ * (mul)" or "node 'uv' (mul) of shader S" in `what`.  Falls back to any
+ * node reading the input when none of `op` does.  False if none. */
+bool sg_node_reading_input(const sg_program *p, const char *material, const char *op,
+                           int input, sg_loc *loc, char *what, size_t n);
+/* Where texture file `file` (a path as in ir_texture.file) is named: the
+ * string of its `texture { file = "…" }` or of an inline texture on a
+ * port, the first such; line 0 if none. */
+sg_loc sg_texture_file_loc(const sg_program *p, const char *file);
+/* Every texture file the program names (declared or inline), each once:
+ * readable and an image, else IO at the string naming it.  False if one
+ * is not.  sg_load does not look at files (a graph library may name
+ * textures its user never builds); `splatc check` and scene loading do. */
+bool sg_check_texture_files(const sg_program *p, sg_diags *d);
 void        sg_free(sg_program *p);
 
 /* Every file the program read (for hot reload and cache keys). */
@@ -140,9 +208,6 @@ int         sg_material_count(const sg_program *p);
 const char *sg_material_name(const sg_program *p, int i);
 sg_loc      sg_material_loc(const sg_program *p, int i);
 int         sg_material_find(const sg_program *p, const char *name); /* -1 */
-/* Where a `texture` declaration names file `file` (as resolved: the IR's
- * ir_texture.file); loc.line 0 if none does (an inline texture). */
-sg_loc      sg_texture_loc(const sg_program *p, const char *file);
 
 /* A material's `undergrowth` block (seed 000 §5.5): instances of a mesh
  * scattered where the material's composited weight says (DESIGN.md §3).

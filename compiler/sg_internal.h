@@ -195,6 +195,7 @@ typedef struct sg_texdecl {
     char      *name;
     sg_loc     loc;
     char      *file;        /* resolved relative to the declaring file    */
+    sg_loc     file_loc;    /* the `file = "…"` string (else loc)          */
     ir_filter  filter, mip;
     ir_wrap    wrap;
     bool       srgb;
@@ -215,6 +216,8 @@ struct sg_program {
     char      **search;  int nsearch;
     int         load_errors; /* errors while loading and checking       */
     int         nug_materials; /* materials with undergrowth blocks     */
+    int         failed_imports; /* imports not found: resolve leaves out the
+                                   unknown names that follow from them   */
 };
 
 /* ---- parse.c ------------------------------------------------------------ */

@@ -838,6 +838,18 @@ static bool read_params(reader *r, json_t *root)
             return field_fail(r, where, "offset must be a multiple of 16");
         p->params[i].name = xstrdup(name);
         p->params[i].offset = (uint32_t)off;
+        /* optional: the type's width and the declared range */
+        json_t *ty = json_object_get(q, "type");
+        const char *tn = json_is_string(ty) ? json_string_value(ty) : "";
+        p->params[i].width = !strcmp(tn, "float") ? 1 : !strcmp(tn, "vec2") ? 2
+                           : !strcmp(tn, "vec3") ? 3 : 4;
+        json_t *mn = json_object_get(q, "min"), *mx = json_object_get(q, "max");
+        if (json_is_number(mn) && json_is_number(mx) &&
+            json_number_value(mn) < json_number_value(mx)) {
+            p->params[i].has_range = true;
+            p->params[i].min = json_number_value(mn);
+            p->params[i].max = json_number_value(mx);
+        }
         for (int k = 0; k < 4; k++)
             p->params[i].value[k] = (float)def[k];
     }

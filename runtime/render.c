@@ -10,6 +10,7 @@
  * combination, a uniform write into mapped memory and one command buffer. */
 #include "rt_internal.h"
 #include "util.h"
+#include "sg.h"     /* sg_suggest: "did you mean" for --param */
 
 #include <math.h>
 #include <stdlib.h>
@@ -681,16 +682,63 @@ void rt_renderer_set_wireframe(rt_renderer *r, bool on)
     r->wireframe = on;
 }
 
+/* A param by its full name ("snowcap.snowline"), or, failing that, by the
+ * name after its material's ("snowline") when one material has it. */
+static int find_param(const rt_pack *p, const char *name, int *nsuffix)
+{
+    int found = -1;
+    *nsuffix = 0;
+    for (int i = 0; i < p->nparams; i++)
+        if (!strcmp(p->params[i].name, name))
+            return i;
+    for (int i = 0; i < p->nparams; i++) {
+        const char *dot = strchr(p->params[i].name, '.');
+        if (dot && !strcmp(dot + 1, name)) {
+            found = i;
+            (*nsuffix)++;
+        }
+    }
+    return -1 - found;   /* <= -1: not found; -1 - index of a short match */
+}
+
 bool rt_renderer_set_param(rt_renderer *r, const char *name, const float value[4], rt_error *e)
 {
-    for (int i = 0; i < r->p->nparams; i++)
-        if (!strcmp(r->p->params[i].name, name)) {
-            memcpy((uint8_t *)r->params_ubo.map + r->p->params[i].offset, value, 16);
-            rt_ug_invalidate(r->ug, NULL);   /* the masks may have changed */
-            return true;
-        }
-    char what[256];
-    snprintf(what, sizeof what, "no param named '%s'", name);
+    char what[512];
+    int nsuffix;
+    int i = find_param(r->p, name, &nsuffix);
+    if (i >= 0) {
+        const rt_pack_param *pp = &r->p->params[i];
+        for (int k = 0; pp->has_range && k < pp->width; k++)
+            if (!(value[k] >= pp->min && value[k] <= pp->max)) {
+                /* the pack's combinations were culled for values in the range */
+                snprintf(what, sizeof what, "param '%s' = %g is outside its declared range "
+                         "[%g, %g] (the pack was analysed for that range; widen `range` in "
+                         "the material and rebuild)", name, (double)value[k], pp->min, pp->max);
+                return rt_fail(e, RT_E_PACK_FIELD, r->p->dir, what);
+            }
+        memcpy((uint8_t *)r->params_ubo.map + pp->offset, value, 16);
+        rt_ug_invalidate(r->ug, NULL);   /* the masks may have changed */
+        return true;
+    }
+    const char *near = NULL;
+    if (nsuffix == 1) {
+        near = r->p->params[-1 - i].name;
+    } else {
+        sg_suggest sg;
+        sg_suggest_init(&sg, name);
+        for (int k = 0; k < r->p->nparams; k++)
+            sg_suggest_offer(&sg, r->p->params[k].name);
+        near = sg_suggest_best(&sg);
+    }
+    if (near)
+        snprintf(what, sizeof what, "no param named '%s'; did you mean '%s'?", name, near);
+    else if (nsuffix > 1)
+        snprintf(what, sizeof what, "no param named '%s' (%d materials have one: write "
+                 "MATERIAL.%s)", name, nsuffix, name);
+    else
+        snprintf(what, sizeof what, "no param named '%s' (the pack has %d param%s%s%s)", name,
+                 r->p->nparams, r->p->nparams == 1 ? "" : "s",
+                 r->p->nparams ? ", e.g. " : "", r->p->nparams ? r->p->params[0].name : "");
     return rt_fail(e, RT_E_PACK_FIELD, r->p->dir, what);
 }
 

@@ -164,6 +164,10 @@ typedef struct rt_pack_param {
     char  *name;
     float  value[4];      /* default                                       */
     uint32_t offset;      /* bytes into the params block                    */
+    int    width;         /* components (manifest "type"; 4 if absent)      */
+    bool   has_range;     /* "min" < "max" given: the declared range, which
+                             the pack's analysis assumed                    */
+    double min, max;
 } rt_pack_param;
 
 typedef struct rt_pack_texture {

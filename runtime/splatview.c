@@ -5,6 +5,7 @@
 #include "scene.h"
 #include "util.h"
 
+#include <jansson.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -809,12 +810,31 @@ static int build_preview(opts *o)
     return 0;
 }
 
+/* The folders the pack was built with (manifest scene.search, relative to
+ * the pack: splatc build's -I and SPLATC_PATH) join -I's, after them, so a
+ * swatch (--material) and hot reload find the imports the build found.
+ * The strings live as long as the process. */
+static void pack_search(opts *o)
+{
+    char *mf = splat_path_join(o->pack, "manifest.json");
+    json_t *m = json_load_file(mf, 0, NULL);
+    free(mf);
+    json_t *search = json_object_get(json_object_get(m, "scene"), "search");
+    for (size_t i = 0; i < json_array_size(search) && o->ninclude < 64; i++) {
+        json_t *d = json_array_get(search, i);
+        if (json_is_string(d))
+            o->include[o->ninclude++] = splat_path_join(o->pack, json_string_value(d));
+    }
+    json_decref(m);
+}
+
 int main(int argc, char **argv)
 {
     opts o;
     int rc = parse_args(argc, argv, &o);
     if (rc)
         return rc;
+    pack_search(&o);
     if (o.material && (rc = build_preview(&o)) != 0)
         return rc;
     if (o.headless)

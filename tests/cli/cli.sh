@@ -13,6 +13,17 @@
 #   preview    `splatc build --preview M`: M alone on the 257^2 test hill,
 #              camera `swatch`, no fog; deterministic; an unknown material
 #              is a located error and writes nothing
+#   teach      diagnostics that teach: "did you mean" in text and in
+#              --json ("suggestion"), failed imports list their search
+#              path, each file's errors once in `check A B`, a missing
+#              texture located at its declaration, -o checked first
+#   teach_param  splatview --param (SPLATVIEW in the environment): a name
+#              without its material suggests MATERIAL.NAME, a value outside
+#              the param's declared range is refused
+#   init       `splatc init DIR` from a folder outside the repository: the
+#              project builds and renders as it stands (SPLATVIEW, IMGCHECK
+#              in the environment), its picture is not mostly fog (luma
+#              contrast), a second init into it is refused
 #   malformed  empty file, binary garbage, truncated files, 10 MB inputs,
 #              10000-deep instance nesting: exit 1 with a diagnostic, no crash
 #              or hang
@@ -196,6 +207,128 @@ depfile)
         > /dev/null || { fail "--json: no UNKNOWN_NODE at 2:14"; cat "$TMP/err"; }
     jq -e -s 'length >= 1 and all(.[]; has("file") and has("severity") and has("message"))' \
         "$TMP/err" > /dev/null || fail "--json: not JSON Lines of diagnostics"
+    ;;
+teach)
+    # did you mean, in the text and as a JSON "suggestion"
+    printf 'import "nodes/masks.sg"\nmaterial m {\n    node r : slope_rmap { lo = 0.3 }\n    out mask = r.out\n}\n' > "$TMP/typo.sg"
+    run 1 "$SPLATC" check "$TMP/typo.sg"
+    grep -q "^$TMP/typo.sg:3:14: error: unknown node type 'slope_rmap'; did you mean 'slope_ramp'?" \
+        "$TMP/err" || { fail "no suggestion in text"; cat "$TMP/err"; }
+    run 1 "$SPLATC" build "$TMP/typo.sg" -o "$TMP/typopack" --json
+    jq -e -s 'any(.[]; .id == "UNKNOWN_NODE" and .line == 3 and .column == 14 and
+                  .suggestion == "slope_ramp")' "$TMP/err" > /dev/null ||
+        { fail "--json: no suggestion"; cat "$TMP/err"; }
+    run 1 "$SPLATC" glsl graphs/cliff.sg -m clif
+    grep -q "no material 'clif' (materials: cliff); did you mean 'cliff'?" "$TMP/err" ||
+        { fail "-m: no suggestion"; cat "$TMP/err"; }
+    run 1 "$SPLATC" check --json "$TMP/typo.sg" tests/golden/lint.sg
+    jq -e -s 'any(.[]; .id == "UNKNOWN_NODE" and .line == 3 and .column == 14 and
+                  .suggestion == "slope_ramp")' "$TMP/err" > /dev/null ||
+        { fail "check --json: no suggestion"; cat "$TMP/err"; }
+    jq -e -s 'any(.[]; .severity == "warning" and .id == "W_MASK_RANGE" and
+                  .file == "tests/golden/lint.sg" and .line == 8 and
+                  (.message | test("mask of material .tall.")))' "$TMP/err" > /dev/null ||
+        { fail "check --json: no lint warning"; cat "$TMP/err"; }
+    jq -e -s 'length >= 2 and all(.[]; has("file") and has("severity") and has("message"))' \
+        "$TMP/err" > /dev/null || fail "check --json: not JSON Lines of diagnostics"
+    # a failed import: the folders searched, how to add one, no follow-on errors
+    mkdir -p "$TMP/fresh"
+    printf 'import "lib/mine.sg"\nmaterial m {\n    node r : my_ramp { x = terrain.slope }\n    out mask = r.out\n}\n' > "$TMP/fresh/a.sg"
+    run 1 "$SPLATC" check "$TMP/fresh/a.sg"
+    grep -q "^$TMP/fresh/a.sg:1:8: error: cannot import 'lib/mine.sg': not found in '$TMP/fresh' (the importing file's folder).*'\.'.*; add the folder that holds it with -I DIR or SPLATC_PATH=DIR\[:DIR...\]" \
+        "$TMP/err" || { fail "failed import: no search list"; cat "$TMP/err"; }
+    [ "$(grep -c 'error:' "$TMP/err")" = 1 ] || { fail "failed import: follow-on errors"; cat "$TMP/err"; }
+    # each file's errors once in `check A B` (both import the broken lib)
+    mkdir -p "$TMP/fresh/lib"
+    printf 'shader my_ramp {\n    in float x\n    node q : quux { }\n    out float out = x\n}\n' > "$TMP/fresh/lib/mine.sg"
+    cp "$TMP/fresh/a.sg" "$TMP/fresh/b.sg"
+    run 1 "$SPLATC" check "$TMP/fresh/a.sg" "$TMP/fresh/b.sg"
+    [ "$(grep -c "lib/mine.sg:3:14: error: unknown node type 'quux'" "$TMP/err")" = 1 ] ||
+        { fail "check A B: an imported file's error not printed exactly once"; cat "$TMP/err"; }
+    run 1 "$SPLATC" check "$TMP/fresh/b.sg"
+    # a missing texture: at its declaration (in the file that declares it),
+    # by check as by build, and build stops before writing anything
+    mkdir -p "$TMP/tex"
+    cp examples/minimal/heightfield.png "$TMP/tex/"
+    printf 'texture rocks { file = "textures/rocks.png" }\nmaterial rock {\n    node s : sample { tex = rocks, uv = terrain.uv }\n    out albedo = s.rgb\n}\n' > "$TMP/tex/materials.sg"
+    printf 'import "nodes/compositors.sg"\nimport "materials.sg"\nscene s {\n    heightfield = "heightfield.png"\n    size = 1024 1024\n    max_height = 160\n    materials = [rock]\n}\n' > "$TMP/tex/scene.sg"
+    run 1 "$SPLATC" check "$TMP/tex/scene.sg"
+    grep -q "^$TMP/tex/materials.sg:1:24: error: cannot read '$TMP/tex/textures/rocks.png': No such file or directory" \
+        "$TMP/err" || { fail "check: missing texture not located at its declaration"; cat "$TMP/err"; }
+    run 1 "$SPLATC" build "$TMP/tex/scene.sg" -o "$TMP/tex/pack"
+    grep -q "^$TMP/tex/materials.sg:1:24: error: cannot read texture '$TMP/tex/textures/rocks.png'" \
+        "$TMP/err" || { fail "build: missing texture not located at its declaration"; cat "$TMP/err"; }
+    [ -e "$TMP/tex/pack" ] && fail "build with a missing texture wrote a pack"
+    mkdir -p "$TMP/tex/textures" && cp graphs/textures/rock.png "$TMP/tex/textures/rocks.png"
+    run 0 "$SPLATC" check "$TMP/tex/scene.sg"
+    # -o into a folder that does not exist: refused before any work (the
+    # scene's own errors and the --stats report never come)
+    run 1 "$SPLATC" build "$TMP/typo.sg" -o "$TMP/no/such/pack" --stats
+    grep -q "^splatc: error: cannot write '$TMP/no/such/pack': its folder '$TMP/no/such' does not exist" \
+        "$TMP/err" || { fail "-o: missing parent not reported"; cat "$TMP/err"; }
+    grep -q "slope_rmap" "$TMP/err" && fail "-o: the scene was loaded before -o was checked"
+    [ -s "$TMP/out" ] && fail "-o: a report was printed"
+    [ -e "$TMP/no" ] && fail "-o: a folder was made"
+    # interval warnings in a build: the mask's bounds over this terrain
+    mkdir -p "$TMP/tall"
+    cp examples/minimal/heightfield.png "$TMP/tall/"
+    printf 'import "nodes/compositors.sg"\nmaterial grass { out albedo = vec3(0.2, 0.4, 0.1) }\nmaterial rock { out mask = terrain.height }\nscene s {\n    heightfield = "heightfield.png"\n    size = 1024 1024\n    max_height = 500\n    materials = [grass, rock]\n}\n' > "$TMP/tall/scene.sg"
+    run 0 "$SPLATC" build "$TMP/tall/scene.sg" -o "$TMP/tall/pack"
+    grep -q "^$TMP/tall/scene.sg:3:21: warning: the mask of material 'rock' takes values in \[78.39[0-9]*, 420.3[0-9]*\]" \
+        "$TMP/err" || { fail "build: no mask warning with the terrain's bounds"; cat "$TMP/err"; }
+    run 0 "$SPLATC" check "$TMP/tall/scene.sg"
+    grep -q "^$TMP/tall/scene.sg:3:21: warning: the mask of material 'rock' takes values in \[-inf, inf\]" \
+        "$TMP/err" || { fail "check: no mask warning"; cat "$TMP/err"; }
+    ;;
+teach_param)
+    SPLATVIEW=${SPLATVIEW:?SPLATVIEW must name splatview}
+    run 0 "$SPLATC" build examples/minimal/scene.sg -o "$TMP/pack"
+    run 1 "$SPLATVIEW" "$TMP/pack" --headless -o "$TMP/a.png" --param tiling=1
+    grep -q "no param named 'tiling'; did you mean 'grass.tiling'?" "$TMP/err" ||
+        { fail "--param tiling: no suggestion"; cat "$TMP/err"; }
+    run 1 "$SPLATVIEW" "$TMP/pack" --headless -o "$TMP/a.png" --param grass.tiling=5
+    grep -q "param 'grass.tiling' = 5 is outside its declared range \[0.05, 2\]" "$TMP/err" ||
+        { fail "--param out of range accepted"; cat "$TMP/err"; }
+    [ -e "$TMP/a.png" ] && fail "a refused --param wrote a picture"
+    run 0 "$SPLATVIEW" "$TMP/pack" --headless -o "$TMP/a.png" --param grass.tiling=1
+    # the pack records the folders -I added (relative to it): a swatch
+    # finds the same imports with no -I, from another folder
+    mkdir -p "$TMP/lib" "$TMP/proj" "$TMP/else"
+    printf 'shader half {\n    in float x\n    node m : mul { a = x, b = 0.5 }\n    out float out = m.out\n}\n' > "$TMP/lib/half.sg"
+    cp examples/minimal/heightfield.png "$TMP/proj/"
+    printf 'import "nodes/compositors.sg"\nimport "half.sg"\nmaterial ground { out albedo = vec3(0.3, 0.4, 0.2) }\nmaterial steep {\n    node s : terrain.slope\n    node k : half { x = s.out }\n    out mask = k.out\n}\nscene s {\n    heightfield = "heightfield.png"\n    size = 1024 1024\n    max_height = 160\n    materials = [ground, steep]\n}\n' > "$TMP/proj/scene.sg"
+    run 0 "$SPLATC" build "$TMP/proj/scene.sg" -o "$TMP/proj/pack" -I "$TMP/lib"
+    jq -e '.scene.search == ["../../lib"]' "$TMP/proj/pack/manifest.json" > /dev/null ||
+        fail "manifest scene.search: $(jq -c .scene.search "$TMP/proj/pack/manifest.json")"
+    ( cd "$TMP/else" && SPLATC_PATH= "$SPLATVIEW" "$TMP/proj/pack" --material steep --headless \
+          -o swatch.png > "$TMP/out" 2> "$TMP/err" ) || { fail "swatch without -I"; cat "$TMP/err"; }
+    [ -s "$TMP/else/swatch.png" ] || fail "no swatch"
+    ;;
+init)
+    SPLATVIEW=${SPLATVIEW:?SPLATVIEW must name splatview}
+    IMGCHECK=${IMGCHECK:?IMGCHECK must name imgcheck}
+    mkdir -p "$TMP/elsewhere"
+    cd "$TMP/elsewhere" || exit 1
+    run 0 "$SPLATC" init "$TMP/x"
+    for f in scene.sg heightfield.png README.md; do
+        [ -s "$TMP/x/$f" ] || fail "init wrote no $f"
+    done
+    [ "$(wc -l < "$TMP/x/README.md")" = 5 ] || fail "README.md is not five lines"
+    run 0 "$SPLATC" build "$TMP/x/scene.sg" -o "$TMP/x/pack"
+    [ -s "$TMP/err" ] && { fail "the starter project builds with diagnostics"; cat "$TMP/err"; }
+    run 0 "$SPLATVIEW" "$TMP/x/pack" --headless -o x.png
+    [ -s x.png ] || fail "no picture"
+    run 0 "$IMGCHECK" contrast x.png 0.08
+    cat "$TMP/out"
+    # a relative DIR, and no second init over a project
+    run 0 "$SPLATC" init y
+    [ -s y/scene.sg ] || fail "init y wrote nothing"
+    run 1 "$SPLATC" init "$TMP/x"
+    grep -q "cannot write '$TMP/x': it exists and is not an empty folder" "$TMP/err" ||
+        { fail "init over a project: no refusal"; cat "$TMP/err"; }
+    run 1 "$SPLATC" init "$TMP/no/such/x"
+    ls "$TMP" | grep -q "tmp-" && fail "temporary folders left in $TMP"
+    cd - > /dev/null || exit 1
     ;;
 preview)
     run 0 "$SPLATC" build examples/minimal/scene.sg -o "$TMP/sw" --preview rock --no-cache

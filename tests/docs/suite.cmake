@@ -10,3 +10,26 @@ set_tests_properties(docs.links PROPERTIES LABELS unit TIMEOUT 60)
 add_test(NAME docs.internal_includes
   COMMAND sh ${CMAKE_CURRENT_LIST_DIR}/internal_includes.sh ${PROJECT_SOURCE_DIR})
 set_tests_properties(docs.internal_includes PROPERTIES LABELS unit)
+
+# Documentation tests: docs/getting-started.md followed verbatim (its ```sh
+# blocks, in an empty folder outside the repository, with the built tools
+# on PATH); fails if any step fails.
+if(TARGET splatc_cli AND TARGET splatview)
+  add_test(NAME docs.getting_started
+           COMMAND sh ${CMAKE_CURRENT_LIST_DIR}/getting_started.sh
+                   ${PROJECT_SOURCE_DIR}/docs/getting-started.md
+                   $<TARGET_FILE_DIR:splatview> $<TARGET_FILE_DIR:splatc_cli>)
+  set_tests_properties(docs.getting_started PROPERTIES LABELS "docs;render" TIMEOUT 600
+                       ENVIRONMENT "SPLAT_VALIDATE=1")
+endif()
+# docs/language.md is `splatc doc`'s output: an op, input, output, light key
+# or node-library shader added without regenerating it fails here
+# (regenerate: build/compiler/splatc doc -o docs/language.md).
+if(TARGET splatc_cli)
+  add_test(NAME docs.language
+           COMMAND sh -c "'$<TARGET_FILE:splatc_cli>' doc > '${CMAKE_CURRENT_BINARY_DIR}/language.md' && \
+diff -u docs/language.md '${CMAKE_CURRENT_BINARY_DIR}/language.md' || \
+{ echo 'FAIL: docs/language.md is out of date: run splatc doc -o docs/language.md'; exit 1; }"
+           WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
+  set_tests_properties(docs.language PROPERTIES LABELS docs)
+endif()

@@ -6,7 +6,11 @@
  *
  * in the order the compiler reports them.  A file with no `expect` line
  * must load without errors and every one of its materials must lower to
- * valid IR.  Usage: golden FILE.sg [--print] (from the repository root;
+ * valid IR.  A file with a `# golden: texture files` line also has its
+ * texture files checked (sg_check_texture_files, as `splatc check` does),
+ * one with `# golden: lint` the warnings of sg_lint over every input's
+ * domain (as `splatc check` has).
+ * Usage: golden FILE.sg [--print] (from the repository root;
  * --print shows what the compiler says, in the expect format). */
 #include "sg.h"
 
@@ -59,6 +63,8 @@ int main(int argc, char **argv)
         fprintf(stderr, "golden: cannot read %s\n", path);
         return 2;
     }
+    bool texture_files = strstr(text, "# golden: texture files") != NULL;
+    bool lint = strstr(text, "# golden: lint") != NULL;
     /* the expectations */
     char **want = NULL;
     int nwant = 0;
@@ -73,6 +79,10 @@ int main(int argc, char **argv)
     sg_diags d;
     sg_diags_init(&d);
     sg_program *p = sg_load(path, search, &d);
+    if (p && texture_files && d.nerrors == 0)
+        sg_check_texture_files(p, &d);
+    if (p && lint && d.nerrors == 0)
+        sg_lint(p, NULL, &d);
     int failures = 0;
     if (print) {
         for (int i = 0; i < d.n; i++) {
@@ -92,12 +102,16 @@ int main(int argc, char **argv)
             }
             free(got);
         }
-        if (d.nerrors != nwant && d.n == nwant) {
-            fprintf(stderr, "%s: %d errors counted, %d expected\n", path, d.nerrors, nwant);
+        int nwant_errors = 0;
+        for (int i = 0; i < nwant; i++)
+            nwant_errors += strstr(want[i], ": error: ") != NULL;
+        if (d.nerrors != nwant_errors && d.n == nwant) {
+            fprintf(stderr, "%s: %d errors counted, %d expected\n", path, d.nerrors,
+                    nwant_errors);
             failures++;
         }
     }
-    if (!print && nwant == 0 && p && d.nerrors == 0) {
+    if (!print && d.nerrors == 0 && p && (nwant == 0 || lint)) {
         /* a good file: every material lowers to valid IR */
         for (int i = 0; i < sg_material_count(p); i++) {
             ir ir;

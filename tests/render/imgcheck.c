@@ -13,6 +13,10 @@
  *   imgcheck near A.f32 r,g,b TOL MAX    the share of pixels whose RGB is
  *                                        within TOL of (r, g, b) (floats);
  *                                        exit 1 if it is over MAX (0..1)
+ *   imgcheck contrast IMG.png MIN        the spread of luma (Rec. 709, 0..1)
+ *                                        between its 5th and 95th percentile;
+ *                                        exit 1 if under MIN (a picture that
+ *                                        is mostly fog or sky has little)
  */
 #include "rt_internal.h"
 
@@ -53,6 +57,35 @@ int main(int argc, char **argv)
         return 2;
     }
     const char *cmd = argv[1];
+    if (!strcmp(cmd, "contrast")) {
+        int w, h;
+        double min;
+        if (argc != 4 || sscanf(argv[3], "%lf", &min) != 1) {
+            fprintf(stderr, "usage: imgcheck contrast IMG.png MIN\n");
+            return 2;
+        }
+        uint8_t *px = load(argv[2], &w, &h);
+        if (!px)
+            return 2;
+        size_t n = (size_t)w * (size_t)h, hist[256] = { 0 };
+        for (size_t i = 0; i < n; i++) {
+            double y = 0.2126 * px[4 * i] + 0.7152 * px[4 * i + 1] + 0.0722 * px[4 * i + 2];
+            hist[(int)(y + 0.5) > 255 ? 255 : (int)(y + 0.5)]++;
+        }
+        stbi_image_free(px);
+        int p5 = -1, p95 = -1;
+        size_t acc = 0;
+        for (int v = 0; v < 256; v++) {
+            acc += hist[v];
+            if (p5 < 0 && acc * 20 >= n)
+                p5 = v;
+            if (p95 < 0 && acc * 20 >= n * 19)
+                p95 = v;
+        }
+        double spread = (p95 - p5) / 255.0;
+        printf("luma p5 %.3f p95 %.3f spread %.3f\n", p5 / 255.0, p95 / 255.0, spread);
+        return spread >= min ? 0 : 1;
+    }
     if (!strcmp(cmd, "near")) {
         rt_error e = { 0 };
         float *a = NULL;

@@ -57,12 +57,46 @@ static void test_unknown_names(void **state)
     expect_one("material m {\n  node a : abs { x = wetness }\n}\n", SG_E_UNKNOWN_NAME, 2, 22,
                "unknown name 'wetness'");
     expect_one("material m {\n  node a : abs { x = terrain.hieght }\n}\n", SG_E_UNKNOWN_NAME,
-               2, 22, "unknown name 'terrain.hieght'");
+               2, 22, "unknown name 'terrain.hieght'; did you mean 'terrain.height'?");
     expect_one("material m {\n  out colour = 1\n}\n", SG_E_BAD_OUTPUT, 2, 7, NULL);
     expect_one("material m {\n  node s : terrain.slope\n  out mask = s.out.q\n}\n",
                SG_E_BAD_SWIZZLE, 3, 14, NULL);
     expect_one("material a { }\nmaterial m {\n  node x : a\n}\n", SG_E_BAD_REFERENCE, 3, 12,
                "'a' is a material; only shaders can be instantiated as nodes");
+}
+
+/* "did you mean": the distance, the limit, ties and prefixes. */
+static void test_suggest(void **state)
+{
+    assert_int_equal(sg_edit_distance("ramp", "ramp"), 0);
+    assert_int_equal(sg_edit_distance("slope_rmap", "slope_ramp"), 1);  /* a swap */
+    assert_int_equal(sg_edit_distance("inlo", "in_lo"), 1);
+    assert_int_equal(sg_edit_distance("Ramp", "ramp"), 0);              /* case */
+    assert_int_equal(sg_edit_distance("", "abc"), 3);
+    assert_int_equal(sg_edit_distance("kitten", "sitting"), 3);
+    sg_suggest sg;
+    sg_suggest_init(&sg, "positon");
+    sg_suggest_offer(&sg, "normal");
+    sg_suggest_offer(&sg, "position");
+    sg_suggest_offer(&sg, "positions");
+    assert_string_equal(sg_suggest_best(&sg), "position");
+    sg_suggest_init(&sg, "quux");            /* nothing near */
+    sg_suggest_offer(&sg, "mix");
+    sg_suggest_offer(&sg, "abs");
+    assert_null(sg_suggest_best(&sg));
+    sg_suggest_init(&sg, "c");               /* too short to guess */
+    sg_suggest_offer(&sg, "a");
+    assert_null(sg_suggest_best(&sg));
+    sg_suggest_init(&sg, "output");          /* a prefix passes */
+    sg_suggest_offer(&sg, "out");
+    assert_string_equal(sg_suggest_best(&sg), "out");
+    sg_suggest_init(&sg, "e2");              /* not itself, first of a tie */
+    sg_suggest_offer(&sg, "e2");
+    assert_null(sg_suggest_best(&sg));
+    sg_suggest_init(&sg, "lox");
+    sg_suggest_offer(&sg, "lo");
+    sg_suggest_offer(&sg, "lx");
+    assert_string_equal(sg_suggest_best(&sg), "lo");
 }
 
 static void test_types(void **state)
@@ -218,6 +252,7 @@ int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_unknown_names),
+        cmocka_unit_test(test_suggest),
         cmocka_unit_test(test_types),
         cmocka_unit_test(test_missing_and_duplicate),
         cmocka_unit_test(test_cycles),
