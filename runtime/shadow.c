@@ -43,7 +43,6 @@ typedef struct march {
     const rt_bounds *b;
     double dir[2], rise;    /* horizontal unit direction; rise per metre    */
     double leaf[2];         /* a quadtree leaf's size in metres             */
-    double top;             /* highest height of the terrain                */
 } march;
 
 /* Distance along the ray from (x, z) to where it leaves the cell (cx, cz)
@@ -63,10 +62,12 @@ static double cell_exit(const march *m, double x, double z, int cx, int cz, cons
 }
 
 /* How far the ray at (x, z), height `ray`, t along, may skip: the exit of
- * the largest quadtree node around it whose highest point lies below the
- * ray by more than the sun's radius all the way (the ray only rises, so
- * (ray - hmax) / (t + exit) bounds its clearance there); 0: none. */
-static double skip(const march *m, double x, double z, double ray, double t)
+ * the largest quadtree node around it whose samples cannot lower the
+ * lowest clearance below `thr` (min(lowest so far, tan of the sun's
+ * radius): the ray only rises, so past t a sample's clearance is at least
+ * (ray - hmax) / (t + exit) where that is positive, (ray - hmax) / t
+ * where it is not); 0: none. */
+static double skip(const march *m, double x, double z, double ray, double t, double thr)
 {
     const rt_bounds *b = m->b;
     double best = 0, size[2] = { m->leaf[0], m->leaf[1] };
@@ -76,29 +77,34 @@ static double skip(const march *m, double x, double z, double ray, double t)
         cz = cz < b->height[L] ? cz : b->height[L] - 1;
         double hmax = b->hmax[L][(size_t)cz * (size_t)b->width[L] + (size_t)cx];
         double exit = cell_exit(m, x, z, cx, cz, size);
-        if (!(ray - hmax > SUN_TAN * (t + exit)))
+        if (!(ray - hmax > thr * (thr >= 0 ? t + exit : t)))
             break;
         best = exit;
     }
     return best;
 }
 
+/* The samples lie at t = k step, k = 1, 2, ... whatever is skipped, and
+ * a skip passes over only samples that cannot lower the result (skip), so
+ * the map is the same over any bound of the heights: the GPU march
+ * (shadow_gpu.c) skips over a pyramid of texel maxima and makes this map. */
 static uint8_t visibility(const march *m, double x0, double z0, double y0, double step)
 {
     const rt_pack *p = m->p;
     double lowest = INFINITY;   /* tan of the lowest clearance */
-    for (double t = step; lowest > -SUN_TAN;) {
+    for (double k = 1; lowest > -SUN_TAN;) {
+        double t = k * step;
         double x = x0 + m->dir[0] * t, z = z0 + m->dir[1] * t, ray = y0 + m->rise * t;
-        if (x < 0 || z < 0 || x > p->size[0] || z > p->size[1] || ray > m->top)
+        if (x < 0 || z < 0 || x > p->size[0] || z > p->size[1])
             break;
-        double jump = skip(m, x, z, ray, t);
+        double jump = skip(m, x, z, ray, t, fmin(lowest, SUN_TAN));
         if (jump > 0) {
-            t += fmax(jump, step * 0.5) + 1e-9;
+            k = fmax(k + 1, floor((t + jump) / step) + 1);
             continue;
         }
         double h = rt_height_at(m->heights, p, x, z);
         lowest = fmin(lowest, (ray - h) / t);
-        t += step;
+        k++;
     }
     double v = isinf(lowest) ? 1.0 : 0.5 + lowest / (2.0 * SUN_TAN);
     v = v < 0 ? 0 : v > 1 ? 1 : v;
@@ -172,7 +178,6 @@ void rt_shadow_map(const uint16_t *heights, const rt_pack *p, const rt_bounds *b
         .heights = heights, .p = p, .b = b,
         .dir = { sun[0] / flat, sun[2] / flat }, .rise = sun[1] / flat,
         .leaf = { sx * p->cell_texels, sz * p->cell_texels },
-        .top = b->hmax[b->nlevels - 1][0],
     };
     /* rows split over the CPU's cores; each texel's march is independent */
     enum { MAX_THREADS = 32 };

@@ -359,6 +359,14 @@ typedef enum rt_pixel_sort {
                             subgroup arithmetic in compute (else off)    */
 } rt_pixel_sort;
 
+/* Where the terrain's shadow map is marched (shadow.c, shadow_gpu.c); the
+ * two maps agree within 1/255 (render.shadow_gpu). */
+typedef enum rt_shadow_path {
+    RT_SHADOW_AUTO = 0,  /* on the device; $SPLAT_SHADOW=cpu|gpu overrides */
+    RT_SHADOW_GPU,       /* a compute pass over a pyramid of maxima        */
+    RT_SHADOW_CPU,       /* the reference march, rows over the CPU's cores */
+} rt_shadow_path;
+
 typedef enum rt_reference {
     RT_REF_NONE = 0,      /* per-combination composites                     */
     RT_REF_MULTIPASS,     /* one blended pass per material + resolve        */
@@ -396,6 +404,8 @@ typedef struct rt_render_desc {
     bool         sun_set, exposure_set, fog_set;
     double       sun[2], exposure, fog_density;
     bool         no_shadows;        /* the sun casts none (splatview --no-shadows) */
+    rt_shadow_path shadow;          /* where the shadow map is marched
+                                       (splatview --shadow cpu|gpu)         */
     bool         no_undergrowth;    /* draw no undergrowth (--no-undergrowth)  */
     bool         no_distance_classes; /* shade with the combinations only, not
                                        their distance classes (PACK.md;
@@ -445,8 +455,11 @@ typedef struct rt_frame_stats {
     bool   sorted;            /* its pixels sorted by layer set (rt_pixel_sort) */
     rt_screen_stats tiles;    /* its tiles (screen only) and counters        */
     int    redraws;           /* frames drawn again after compiling pipelines */
-    double shadow_ms;         /* CPU ms of a new shadow map (the sun moved or
-                                 a crater changed heights); 0: none needed  */
+    double shadow_ms;         /* wall ms of a new shadow map (the sun moved or
+                                 a crater changed heights), marched on the
+                                 CPU or submitted to the device and waited
+                                 for; 0: none needed                        */
+    bool   shadow_gpu;        /* the map is marched on the device          */
     rt_ug_stats undergrowth;  /* cells, instances, generation and draw     */
 } rt_frame_stats;
 

@@ -52,6 +52,10 @@ static void usage(FILE *f)
         "  --exposure EV             exposure in stops (default: the scene's, or 0)\n"
         "  --fog-density D           fog per metre at the fog height (0: none)\n"
         "  --no-shadows              the sun casts no terrain shadows\n"
+        "  --shadow gpu|cpu          where the shadow map is marched when the sun\n"
+        "                            moves or a crater lands: a compute pass (the\n"
+        "                            default; $SPLAT_SHADOW=cpu|gpu sets it) or the\n"
+        "                            CPU reference\n"
         "  --no-undergrowth          draw no undergrowth (grass, plants, stones)\n"
         "  --no-distance-classes     shade with the combinations only, not their\n"
         "                            distance classes (compiler/PACK.md)\n"
@@ -125,6 +129,7 @@ typedef struct opts {
     rt_shading shading;
     bool shading_set;      /* --shading given; else screen where the pack can */
     rt_screen_depth screen_depth;
+    rt_shadow_path shadow;
     rt_pixel_sort pixel_sort;
     const char *params[64];
     int nparams;
@@ -332,6 +337,16 @@ static int parse_args(int argc, char **argv, opts *o)
                 o->shading = RT_SHADING_SCREEN, o->shading_set = true;
             else {
                 fprintf(stderr, "splatview: --shading expects forward or screen, found '%s'\n", v);
+                return 2;
+            }
+        } else if (!strcmp(a, "--shadow")) {
+            NEED();
+            if (!strcmp(v, "gpu"))
+                o->shadow = RT_SHADOW_GPU;
+            else if (!strcmp(v, "cpu"))
+                o->shadow = RT_SHADOW_CPU;
+            else {
+                fprintf(stderr, "splatview: --shadow expects gpu or cpu, found '%s'\n", v);
                 return 2;
             }
         } else if (!strcmp(a, "--screen-depth")) {
@@ -563,6 +578,7 @@ static int headless(const opts *o)
         .width = o->width, .height = o->height, .reference = o->ref,
         .pipeline_cache = o->cache, .no_stitch = o->no_stitch,
         .no_cull = o->no_cull, .lod_pixels = o->lod_pixels, .no_shadows = o->no_shadows,
+        .shadow = o->shadow,
         .no_undergrowth = o->no_undergrowth,
         .no_distance_classes = o->no_distance_classes,
         .destruction_pool = o->destruction_pool, .shading = o->shading,
@@ -666,8 +682,8 @@ static int headless(const opts *o)
         if (o->no_shadows)
             printf("shadow map: off\n");
         else
-            printf("shadow map cpu ms: %.2f (when the sun moves or a crater lands; "
-                   "per frame a texture tap)\n", shadow_ms);
+            printf("shadow map %s ms: %.2f (when the sun moves or a crater lands; "
+                   "per frame a texture tap)\n", st.shadow_gpu ? "gpu" : "cpu", shadow_ms);
         if (pack.ug.nslots > 0 && !o->no_undergrowth && view == SPLAT_VIEW_FINAL) {
             double um, ul, uh;
             summary(ug_draw, o->frames, &um, &ul, &uh);
@@ -802,7 +818,8 @@ int main(int argc, char **argv)
         .height = o.height ? o.height : 720, .script = o.script,
         .render = { .reference = o.ref, .pipeline_cache = o.cache, .lod_pixels = o.lod_pixels,
                     .shading = o.shading, .screen_depth = o.screen_depth, .pixel_sort = o.pixel_sort,
-                    .no_shadows = o.no_shadows, .no_undergrowth = o.no_undergrowth,
+                    .no_shadows = o.no_shadows, .shadow = o.shadow,
+                    .no_undergrowth = o.no_undergrowth,
                     .far_atlas_distance = o.far_distance,
                     .no_distance_classes = o.no_distance_classes },
         .view = SPLAT_VIEW_FINAL,

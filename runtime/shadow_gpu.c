@@ -1,0 +1,407 @@
+/* shadow_gpu.c — the sun-visibility map (shadow.c) marched on the device.
+ *
+ * One compute invocation makes four consecutive texels of the map (one
+ * uint of a storage buffer holding the W x H bytes row by row), marching
+ * from each texel centre towards the sun exactly as shadow.c does: the
+ * samples at t = k step (half the smaller texel side), the terrain read
+ * bilinearly between texel centres from the terrain's own R16 heightfield
+ * (so craters, which lower it in place, are followed), the clearance's
+ * tangent (ray - h) / t, the visibility 0.5 + lowest / (2 tan r).  It skips
+ * over a pyramid of maximum heights built like the ray caster's
+ * (screen.c make_maxmip: R32F, padded to a multiple of 256 texels, 8
+ * levels of the largest of four), trying the levels from the finest up
+ * at each sample as shadow.c does over the quadtree, and stops once the
+ * ray can no longer lower the result anywhere on the terrain.  Level 0
+ * differs from the ray caster's: per quad between texel edges it holds the
+ * highest of the 3 x 3 texels the bilinear surface there reads, not the
+ * highest mesh corner (a peak texel stands above the four corner means
+ * around it, so the ray caster's bound is not one for the bilinear
+ * surface).  Heights are raw R16 units in the pyramid; craters only lower
+ * the terrain, so it stays a bound without being rebuilt.
+ *
+ * The skipping passes only over samples that cannot lower the lowest
+ * clearance (shadow.c skip), so the result does not depend on the bound
+ * used: in exact arithmetic the two maps are equal.  In floats the march
+ * works relative to its start texel (integer texel plus a float offset,
+ * heights as differences of raw units), so the 176 km colorado keeps
+ * millimetre positions; the map equals the CPU's to within 1/255
+ * (render.shadow_gpu holds it).
+ *
+ * An update is one command buffer: the crater uploads' transfer writes
+ * made visible to the compute reads, the dispatch (a crater: only the
+ * rows of its rectangle, the texels outside it kept from the buffer), the
+ * buffer copied into the sampled R8 map after the last frame's reads. */
+#include "rt_internal.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define SUN_TAN 0.0047   /* shadow.c's: tan of the sun's angular radius */
+#define LEVELS 8         /* the pyramid's levels above the finest        */
+
+struct rt_shadow_gpu {
+    rt_device            *d;
+    int                   W, H;       /* the heightfield's texels          */
+    double                size[2];    /* its metres (a hot reload's pack
+                                         keeps them: render.c)             */
+    double                max_height;
+    rt_image              bound;      /* R32F pyramid of raw maxima        */
+    float                 top;        /* highest raw height                */
+    VkSampler             nearest;    /* every level (texelFetch)          */
+    rt_buffer             map;        /* W x H bytes, in uints             */
+    rt_buffer             readback;   /* host copy for rt_shadow_gpu_read  */
+    VkDescriptorSetLayout set_layout;
+    VkPipelineLayout      layout;
+    VkDescriptorPool      pool;
+    VkDescriptorSet       set;
+    VkPipeline            pipe;
+    bool                  made;       /* the buffer holds a whole map      */
+};
+
+/* The push block of march_glsl. */
+typedef struct march_push {
+    float    d[2];         /* texels per metre along the sun's direction */
+    float    rise, step;   /* metres up per metre; metres per sample     */
+    float    kh, eps;      /* metres per raw unit; the start's lift (m)  */
+    float    tan_r, top;   /* tan of the sun's radius; highest raw       */
+    int32_t  rect[4];      /* texels made: x0 z0 x1 z1, end exclusive    */
+    int32_t  size[2];      /* W H                                        */
+    uint32_t first, count; /* uints of the buffer this dispatch makes    */
+} march_push;
+
+static const char march_glsl[] =
+    "#version 450\n"
+    "layout(local_size_x = 64) in;\n"
+    "layout(set = 0, binding = 0) uniform sampler2D u_height;\n"
+    "layout(set = 0, binding = 1) uniform sampler2D u_bound;\n"
+    "layout(set = 0, binding = 2, std430) buffer map_block { uint words[]; } u_map;\n"
+    "layout(push_constant) uniform push_block {\n"
+    "    vec2 d; float rise, step;\n"
+    "    float kh, eps, tan_r, top;\n"
+    "    ivec4 rect;\n"
+    "    ivec2 size; uint first, count;\n"
+    "} u;\n"
+    "float raw(ivec2 k) {\n"
+    "    k = clamp(k, ivec2(0), u.size - 1);\n"
+    "    return round(texelFetch(u_height, k, 0).r * 65535.0);\n"
+    "}\n"
+    /* bilinear between texel centres at texel base's centre + o (texels),
+     * in raw units: shadow.c's rt_height_at */
+    "float height(ivec2 base, vec2 o) {\n"
+    "    vec2 f = floor(o), w = o - f;\n"
+    "    ivec2 k = base + ivec2(f);\n"
+    "    float a = raw(k), b = raw(k + ivec2(1, 0));\n"
+    "    float c = raw(k + ivec2(0, 1)), e = raw(k + ivec2(1, 1));\n"
+    "    return (a * (1.0 - w.x) + b * w.x) * (1.0 - w.y) + (c * (1.0 - w.x) + e * w.x) * w.y;\n"
+    "}\n"
+    /* distance along the ray from texel-space p to the exit of the box
+     * [lo, hi] (texels) */
+    "float box_exit(vec2 p, vec2 lo, vec2 hi) {\n"
+    "    float t = 1e30;\n"
+    "    if (u.d.x > 0.0) t = min(t, (hi.x - p.x) / u.d.x);\n"
+    "    if (u.d.x < 0.0) t = min(t, (lo.x - p.x) / u.d.x);\n"
+    "    if (u.d.y > 0.0) t = min(t, (hi.y - p.y) / u.d.y);\n"
+    "    if (u.d.y < 0.0) t = min(t, (lo.y - p.y) / u.d.y);\n"
+    "    return max(t, 0.0);\n"
+    "}\n"
+    /* no sample past t can lower the lowest clearance below thr where the
+     * highest height ahead is hmax (raw) and the box is left at t + exit */
+    "bool clear_of(float above, float t, float exit, float thr) {\n"
+    "    return above > thr * (thr >= 0.0 ? t + exit : t);\n"
+    "}\n"
+    "uint visibility(ivec2 base) {\n"
+    "    float h0 = raw(base);\n"
+    "    float lowest = 1e30;\n"
+    "    float k = 1.0;\n"
+    "    vec2 size = vec2(u.size);\n"
+    "    while (lowest > -u.tan_r) {\n"
+    "        float t = k * u.step;\n"
+    "        vec2 o = u.d * t;\n"
+    "        vec2 p = vec2(base) + 0.5 + o;   /* texels from the terrain's corner */\n"
+    "        if (any(lessThan(p, vec2(0.0))) || any(greaterThan(p, size))) break;\n"
+    "        float ray = u.eps + u.rise * t;   /* metres above the start */\n"
+    "        float thr = min(lowest, u.tan_r);\n"
+    /* the whole terrain below the ray: done */
+    "        if (clear_of(ray - (u.top - h0) * u.kh, t, box_exit(p, vec2(0.0), size), thr))\n"
+    "            break;\n"
+    "        float best = 0.0;\n"
+    "        for (int L = 0; L <= LEVELS; L++) {\n"
+    "            float s = float(1 << L);\n"
+    "            ivec2 c = clamp(ivec2(floor(p / s)), ivec2(0), textureSize(u_bound, L) - 1);\n"
+    "            float hmax = texelFetch(u_bound, c, L).r;\n"
+    "            float exit = box_exit(p, vec2(c) * s, vec2(c + 1) * s);\n"
+    "            if (!clear_of(ray - (hmax - h0) * u.kh, t, exit, thr)) break;\n"
+    "            best = exit;\n"
+    "        }\n"
+    "        if (best > 0.0) {\n"
+    "            k = max(k + 1.0, floor((t + best) / u.step) + 1.0);\n"
+    "            continue;\n"
+    "        }\n"
+    "        float h = height(base, o);\n"
+    "        lowest = min(lowest, (ray - (h - h0) * u.kh) / t);\n"
+    "        k += 1.0;\n"
+    "    }\n"
+    "    float v = lowest >= 1e30 ? 1.0 : clamp(0.5 + lowest / (2.0 * u.tan_r), 0.0, 1.0);\n"
+    "    return uint(roundEven(v * 255.0));\n"
+    "}\n"
+    "void main() {\n"
+    "    uint g = gl_GlobalInvocationID.x;\n"
+    "    if (g >= u.count) return;\n"
+    "    uint w = u.first + g, word = u_map.words[w], n = uint(u.size.x * u.size.y);\n"
+    "    for (uint b = 0u; b < 4u; b++) {\n"
+    "        uint idx = 4u * w + b;\n"
+    "        if (idx >= n) break;\n"
+    "        ivec2 px = ivec2(idx % uint(u.size.x), idx / uint(u.size.x));\n"
+    "        if (any(lessThan(px, u.rect.xy)) || any(greaterThanEqual(px, u.rect.zw))) continue;\n"
+    "        word = (word & ~(0xffu << (8u * b))) | (visibility(px) << (8u * b));\n"
+    "    }\n"
+    "    u_map.words[w] = word;\n"
+    "}\n";
+
+/* The highest raw height of the bilinear surface over each quad between
+ * texel edges (its 3 x 3 texels), then the largest of four per level. */
+static bool make_bound(rt_shadow_gpu *s, const rt_pack *p, const uint16_t *heights,
+                       rt_error *e)
+{
+    int W = p->hf_width, H = p->hf_height, K = LEVELS;
+    int PW = ((W + (1 << K) - 1) >> K) << K, PH = ((H + (1 << K) - 1) >> K) << K;
+    if ((uint32_t)PW > s->d->props.limits.maxImageDimension2D ||
+        (uint32_t)PH > s->d->props.limits.maxImageDimension2D)
+        return rt_fail(e, RT_E_PACK_LIMIT, p->dir, "the shadow march's height pyramid width",
+                       (unsigned long long)(PW > PH ? PW : PH), "maxImageDimension2D",
+                       (unsigned long long)s->d->props.limits.maxImageDimension2D);
+    size_t total = 0;
+    for (int k = 0; k <= K; k++)
+        total += (size_t)(PW >> k) * (size_t)(PH >> k);
+    float *all = malloc(total * sizeof *all);
+    const uint8_t *levels[LEVELS + 1];
+    if (!all) {
+        return rt_fail(e, RT_E_VULKAN, "shadow march", "out of memory");
+    }
+    float *l0 = all;
+    unsigned top = 0;
+    for (int j = 0; j < PH; j++) {
+        for (int i = 0; i < PW; i++) {
+            unsigned m = 0;
+            for (int dz = -1; dz <= 1 && i < W && j < H; dz++) {
+                int z = j + dz < 0 ? 0 : j + dz >= H ? H - 1 : j + dz;
+                for (int dx = -1; dx <= 1; dx++) {
+                    int x = i + dx < 0 ? 0 : i + dx >= W ? W - 1 : i + dx;
+                    unsigned v = heights[(size_t)z * (size_t)W + (size_t)x];
+                    m = v > m ? v : m;
+                }
+            }
+            top = m > top ? m : top;
+            l0[(size_t)j * (size_t)PW + (size_t)i] = (float)m;   /* padding: 0, off the terrain */
+        }
+    }
+    s->top = (float)top;
+    levels[0] = (const uint8_t *)l0;
+    float *prev = l0;
+    for (int k = 1; k <= K; k++) {
+        int w = PW >> k, h = PH >> k, pw = PW >> (k - 1);
+        float *cur = prev + (size_t)pw * (size_t)(PH >> (k - 1));
+        for (int j = 0; j < h; j++)
+            for (int i = 0; i < w; i++) {
+                const float *q = prev + (size_t)(2 * j) * (size_t)pw + (size_t)(2 * i);
+                float m = fmaxf(fmaxf(q[0], q[1]), fmaxf(q[pw], q[pw + 1]));
+                cur[(size_t)j * (size_t)w + (size_t)i] = m;
+            }
+        levels[k] = (const uint8_t *)cur;
+        prev = cur;
+    }
+    bool ok = rt_image_create(s->d, (uint32_t)PW, (uint32_t)PH, 1, false, (uint32_t)K + 1,
+                              VK_FORMAT_R32_SFLOAT,
+                              VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT,
+                              VK_IMAGE_ASPECT_COLOR_BIT, &s->bound, e) &&
+              rt_image_upload_levels(s->d, &s->bound, levels, e);
+    free(all);
+    return ok;
+}
+
+bool rt_shadow_gpu_create(rt_device *d, const rt_pack *p, const uint16_t *heights,
+                          const rt_image *height, VkPipelineCache cache, rt_shadow_gpu **out,
+                          rt_error *e)
+{
+    rt_shadow_gpu *s = calloc(1, sizeof *s);
+    *out = s;
+    if (!s)
+        return rt_fail(e, RT_E_VULKAN, "shadow march", "out of memory");
+    s->d = d;
+    s->W = p->hf_width;
+    s->H = p->hf_height;
+    s->size[0] = p->size[0];
+    s->size[1] = p->size[1];
+    s->max_height = p->max_height;
+    size_t n = (size_t)p->hf_width * (size_t)p->hf_height, words = (n + 3) / 4;
+    if (!make_bound(s, p, heights, e) ||
+        !rt_buffer_create(d, words * 4, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT |
+                          VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                          false, &s->map, e))
+        return false;
+    VkSamplerCreateInfo si = {
+        .sType = VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO,
+        .magFilter = VK_FILTER_NEAREST, .minFilter = VK_FILTER_NEAREST,
+        .mipmapMode = VK_SAMPLER_MIPMAP_MODE_NEAREST,
+        .addressModeU = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE,
+        .addressModeV = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE,
+        .addressModeW = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE,
+        .maxLod = VK_LOD_CLAMP_NONE,
+    };
+    RT_VK(e, vkCreateSampler(d->dev, &si, NULL, &s->nearest));
+    const VkShaderStageFlags cs = VK_SHADER_STAGE_COMPUTE_BIT;
+    const VkDescriptorType cis = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
+    const VkDescriptorType sb = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+    VkDescriptorSetLayoutBinding b[3] = {
+        { 0, cis, 1, cs, NULL }, { 1, cis, 1, cs, NULL }, { 2, sb, 1, cs, NULL },
+    };
+    if (!rt_set_layout(d, b, 3, &s->set_layout, e))
+        return false;
+    VkPushConstantRange push = { cs, 0, sizeof(march_push) };
+    VkPipelineLayoutCreateInfo pi = {
+        .sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO,
+        .setLayoutCount = 1,
+        .pSetLayouts = &s->set_layout,
+        .pushConstantRangeCount = 1,
+        .pPushConstantRanges = &push,
+    };
+    RT_VK(e, vkCreatePipelineLayout(d->dev, &pi, NULL, &s->layout));
+    VkDescriptorPoolSize sizes[2] = { { cis, 2 }, { sb, 1 } };
+    if (!rt_descriptor_sets(d, sizes, 2, &s->set_layout, 1, &s->pool, &s->set, e))
+        return false;
+    VkDescriptorImageInfo ii[2] = {
+        { s->nearest, height->view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL },
+        { s->nearest, s->bound.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL },
+    };
+    VkDescriptorBufferInfo bi = { s->map.buf, 0, VK_WHOLE_SIZE };
+    VkWriteDescriptorSet w[3];
+    for (uint32_t i = 0; i < 3; i++)
+        w[i] = (VkWriteDescriptorSet){ .sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET,
+            .dstSet = s->set, .dstBinding = i, .descriptorCount = 1,
+            .descriptorType = b[i].descriptorType,
+            .pImageInfo = i < 2 ? &ii[i] : NULL, .pBufferInfo = i == 2 ? &bi : NULL };
+    vkUpdateDescriptorSets(d->dev, 3, w, 0, NULL);
+    char *src = malloc(sizeof march_glsl + 64);
+    if (!src)
+        return rt_fail(e, RT_E_VULKAN, "shadow march", "out of memory");
+    /* #define after the #version line */
+    const char *nl = strchr(march_glsl, '\n') + 1;
+    snprintf(src, sizeof march_glsl + 64, "%.*s#define LEVELS %d\n%s", (int)(nl - march_glsl),
+             march_glsl, LEVELS, nl);
+    bool ok = rt_glsl_compute_pipeline(d, cache, s->layout, src, "shadow.comp", NULL, &s->pipe, e);
+    free(src);
+    return ok;
+}
+
+void rt_shadow_gpu_destroy(rt_shadow_gpu *s)
+{
+    if (!s)
+        return;
+    rt_device *d = s->d;
+    if (d->dev) {
+        if (s->pipe)
+            vkDestroyPipeline(d->dev, s->pipe, NULL);
+        if (s->layout)
+            vkDestroyPipelineLayout(d->dev, s->layout, NULL);
+        if (s->pool)
+            vkDestroyDescriptorPool(d->dev, s->pool, NULL);
+        if (s->set_layout)
+            vkDestroyDescriptorSetLayout(d->dev, s->set_layout, NULL);
+        if (s->nearest)
+            vkDestroySampler(d->dev, s->nearest, NULL);
+        rt_image_destroy(d, &s->bound);
+        rt_buffer_destroy(d, &s->map);
+        rt_buffer_destroy(d, &s->readback);
+    }
+    free(s);
+}
+
+bool rt_shadow_gpu_map(rt_shadow_gpu *s, const double sun[3], const int rect[4], rt_image *shadow,
+                       rt_error *e)
+{
+    int W = s->W, H = s->H;
+    double flat = sqrt(sun[0] * sun[0] + sun[2] * sun[2]);
+    bool constant = sun[1] <= -SUN_TAN * flat || flat < 1e-9;   /* below the horizon, or overhead */
+    if (!rect || constant)
+        rect = NULL;
+    else if (!s->made)
+        return rt_fail(e, RT_E_VULKAN, "shadow march", "a part of a map never made whole");
+    int i0 = rect ? rect[0] : 0, j0 = rect ? rect[1] : 0;
+    int i1 = rect ? rect[2] : W, j1 = rect ? rect[3] : H;
+    if (i0 >= i1 || j0 >= j1)
+        return true;
+    VkCommandBuffer cb;
+    if (!rt_oneshot_begin(s->d, &cb, e))
+        return false;
+    /* craters upload heights by transfers; the last update's copy read
+     * the buffer this one writes */
+    rt_cmd_barrier(cb, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
+                   VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT,
+                   VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT |
+                       VK_ACCESS_TRANSFER_WRITE_BIT);
+    if (constant) {
+        vkCmdFillBuffer(cb, s->map.buf, 0, VK_WHOLE_SIZE, sun[1] > 0 ? 0xffffffffu : 0u);
+    } else {
+        double sx = s->size[0] / W, sz = s->size[1] / H;
+        march_push push = {
+            .d = { (float)(sun[0] / flat / sx), (float)(sun[2] / flat / sz) },
+            .rise = (float)(sun[1] / flat), .step = (float)(0.5 * fmin(sx, sz)),
+            .kh = (float)(s->max_height / 65535.0), .eps = (float)(1e-4 * (s->max_height + 1.0)),
+            .tan_r = (float)SUN_TAN, .top = s->top,
+            .rect = { i0, j0, i1, j1 }, .size = { W, H },
+        };
+        size_t first = (size_t)j0 * (size_t)W / 4, end = ((size_t)j1 * (size_t)W + 3) / 4;
+        push.first = (uint32_t)first;
+        push.count = (uint32_t)(end - first);
+        vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, s->pipe);
+        vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, s->layout, 0, 1, &s->set, 0,
+                                NULL);
+        vkCmdPushConstants(cb, s->layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof push, &push);
+        vkCmdDispatch(cb, (push.count + 63) / 64, 1, 1);
+    }
+    rt_cmd_barrier(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT,
+                   VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT,
+                   VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_READ_BIT);
+    /* the map: every frame's shaders read it until now */
+    const VkPipelineStageFlags shaders = VK_PIPELINE_STAGE_VERTEX_SHADER_BIT |
+        VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT;
+    rt_cmd_image_barrier(cb, shadow->img, 0, 1, 1, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+                         VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_ACCESS_SHADER_READ_BIT,
+                         VK_ACCESS_TRANSFER_WRITE_BIT, shaders, VK_PIPELINE_STAGE_TRANSFER_BIT);
+    VkBufferImageCopy copy = {
+        .imageSubresource = { VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1 },
+        .imageExtent = { (uint32_t)W, (uint32_t)H, 1 },
+    };
+    vkCmdCopyBufferToImage(cb, s->map.buf, shadow->img, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1,
+                           &copy);
+    rt_cmd_image_barrier(cb, shadow->img, 0, 1, 1, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+                         VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, VK_ACCESS_TRANSFER_WRITE_BIT,
+                         VK_ACCESS_SHADER_READ_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT, shaders);
+    if (!rt_oneshot_end(s->d, cb, e))
+        return false;
+    s->made = true;
+    return true;
+}
+
+bool rt_shadow_gpu_read(rt_shadow_gpu *s, uint8_t *out, rt_error *e)
+{
+    size_t n = (size_t)s->W * (size_t)s->H, bytes = (n + 3) / 4 * 4;
+    if (!s->readback.buf &&
+        !rt_buffer_create(s->d, bytes, VK_BUFFER_USAGE_TRANSFER_DST_BIT, true, &s->readback, e))
+        return false;
+    VkCommandBuffer cb;
+    if (!rt_oneshot_begin(s->d, &cb, e))
+        return false;
+    rt_cmd_barrier(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT,
+                   VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT,
+                   VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_READ_BIT);
+    VkBufferCopy c = { 0, 0, bytes };
+    vkCmdCopyBuffer(cb, s->map.buf, s->readback.buf, 1, &c);
+    rt_cmd_barrier(cb, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
+                   VK_PIPELINE_STAGE_HOST_BIT, VK_ACCESS_HOST_READ_BIT);
+    if (!rt_oneshot_end(s->d, cb, e))
+        return false;
+    memcpy(out, s->readback.map, n);
+    return true;
+}
