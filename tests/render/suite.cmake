@@ -146,6 +146,15 @@ if(TARGET splatrt AND TARGET splatview)
       set_tests_properties(render.${t} PROPERTIES LABELS render TIMEOUT 600
                            ENVIRONMENT "SPLAT_VALIDATE=1")
     endforeach()
+    # the shadow map marched on the device against the CPU reference within
+    # 1/255: three suns and a crater (test_shadow_gpu.c)
+    add_executable(test_shadow_gpu ${RENDER_DIR}/test_shadow_gpu.c)
+    target_link_libraries(test_shadow_gpu splatrt splatc m)
+    file(MAKE_DIRECTORY ${RENDER_OUT}/shadow_gpu)
+    add_test(NAME render.shadow_gpu COMMAND test_shadow_gpu ${RENDER_OUT}/shadow_gpu
+             WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
+    set_tests_properties(render.shadow_gpu PROPERTIES LABELS "render;gpu" TIMEOUT 600
+                         ENVIRONMENT "SPLAT_VALIDATE=1")
     # distance classes against the über-shader at 20 random cameras on
     # colorado, both paths (test_dclass.c)
     add_executable(test_dclass ${RENDER_DIR}/test_dclass.c)
