@@ -624,6 +624,9 @@ typedef struct rt_viewer_desc {
     int         width, height;
     const char *script;       /* "frames=30;screenshot=out.png;quit" or NULL  */
     rt_render_desc render;
+    bool        shading_set;  /* render.shading asked for; else the screen
+                                 path where the pack has compute variants
+                                 and no multi-pass reference, as headless */
     bool        have_camera;  /* camera below is set; else preset/default   */
     rt_camera   camera;
     const char *preset;       /* manifest camera name or NULL               */

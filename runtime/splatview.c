@@ -548,6 +548,28 @@ static rt_tonemap tonemap_for(splat_view v)
     return rt_view_tonemap(v);
 }
 
+/* The shading path asked for: --shading, else $SPLAT_SHADING
+ * (forward|screen); false: neither, and the default is the screen-space
+ * path wherever the pack has its compute variants and no --reference
+ * multipass (faster on both devices: tests/bench/RESULTS.md), in the
+ * window as headless. */
+static bool shading_chosen(const opts *o, rt_shading *out)
+{
+    if (o->shading_set) {
+        *out = o->shading;
+        return true;
+    }
+    const char *env = getenv("SPLAT_SHADING");
+    if (env && (!strcmp(env, "forward") || !strcmp(env, "screen"))) {
+        *out = !strcmp(env, "screen") ? RT_SHADING_SCREEN : RT_SHADING_FORWARD;
+        return true;
+    }
+    if (env && *env)
+        fprintf(stderr, "splatview: warning: SPLAT_SHADING='%s' is neither forward nor screen; "
+                "ignored\n", env);
+    return false;
+}
+
 static int headless(const opts *o)
 {
     rt_error e = { 0 };
@@ -584,16 +606,7 @@ static int headless(const opts *o)
         .destruction_pool = o->destruction_pool, .shading = o->shading,
         .screen_depth = o->screen_depth, .pixel_sort = o->pixel_sort, .far_atlas_distance = o->far_distance,
     };
-    /* the default: $SPLAT_SHADING (forward|screen), else the screen-space
-     * path wherever the pack has its compute variants (faster on both
-     * devices: tests/bench/RESULTS.md) */
-    const char *env = getenv("SPLAT_SHADING");
-    if (!o->shading_set && env && *env && strcmp(env, "forward") && strcmp(env, "screen"))
-        fprintf(stderr, "splatview: warning: SPLAT_SHADING='%s' is neither forward nor screen; "
-                "ignored\n", env);
-    if (!o->shading_set && env && (!strcmp(env, "forward") || !strcmp(env, "screen")))
-        rd.shading = !strcmp(env, "screen") ? RT_SHADING_SCREEN : RT_SHADING_FORWARD;
-    else if (!o->shading_set)
+    if (!shading_chosen(o, &rd.shading))
         rd.shading = pack.uber_compute && o->ref != RT_REF_MULTIPASS ? RT_SHADING_SCREEN
                                                                      : RT_SHADING_FORWARD;
     light_options(o, &rd);
@@ -825,6 +838,7 @@ int main(int argc, char **argv)
         .view = SPLAT_VIEW_FINAL,
     };
     memcpy(vd.render.clear, o.clear, sizeof o.clear);
+    vd.shading_set = shading_chosen(&o, &vd.render.shading);
     light_options(&o, &vd.render);
     vd.have_camera = o.have_camera || o.preset;
     if (o.have_camera) {
