@@ -1317,6 +1317,9 @@ static bool update_shadow(rt_renderer *r, double *ms, rt_error *e)
         return true;
     const rt_pack *p = r->p;
     size_t n = (size_t)p->hf_width * (size_t)p->hf_height;
+    /* both paths wait for the queue (an upload, a one-time submission):
+     * the last frame's work is not the map's time */
+    RT_VK(e, vkQueueWaitIdle(r->d->queue));
     double t0 = splat_now();
     if (r->shadow_on_gpu) {
         if (!r->shadow_gpu &&

@@ -46,9 +46,12 @@ struct rt_shadow_gpu {
     double                size[2];    /* its metres (a hot reload's pack
                                          keeps them: render.c)             */
     double                max_height;
-    rt_image              bound;      /* R32F pyramid of raw maxima        */
+    int                   PW, PH;     /* the pyramid's padded level 0      */
+    uint32_t              offset[LEVELS + 1];   /* floats to each level    */
+    rt_buffer             bound;      /* the pyramid of raw maxima (float) */
     float                 top;        /* highest raw height                */
-    VkSampler             nearest;    /* every level (texelFetch)          */
+    const rt_image       *height;     /* the terrain's R16 heightfield     */
+    rt_buffer             heights;    /* its copy the march reads          */
     rt_buffer             map;        /* W x H bytes, in uints             */
     rt_buffer             readback;   /* host copy for rt_shadow_gpu_read  */
     VkDescriptorSetLayout set_layout;
@@ -68,23 +71,27 @@ typedef struct march_push {
     int32_t  rect[4];      /* texels made: x0 z0 x1 z1, end exclusive    */
     int32_t  size[2];      /* W H                                        */
     uint32_t first, count; /* uints of the buffer this dispatch makes    */
+    float    inv[2];       /* 1 / d (1e30 where d is 0): metres per texel */
 } march_push;
 
 static const char march_glsl[] =
-    "#version 450\n"
     "layout(local_size_x = 64) in;\n"
-    "layout(set = 0, binding = 0) uniform sampler2D u_height;\n"
-    "layout(set = 0, binding = 1) uniform sampler2D u_bound;\n"
+    "layout(set = 0, binding = 0, std430) readonly buffer height_block { uint h[]; } u_height;\n"
+    "layout(set = 0, binding = 1, std430) readonly buffer bound_block { float b[]; } u_bound;\n"
     "layout(set = 0, binding = 2, std430) buffer map_block { uint words[]; } u_map;\n"
     "layout(push_constant) uniform push_block {\n"
     "    vec2 d; float rise, step;\n"
     "    float kh, eps, tan_r, top;\n"
     "    ivec4 rect;\n"
     "    ivec2 size; uint first, count;\n"
+    "    vec2 inv;   /* 1 / d, 1e30 where d is 0 */\n"
     "} u;\n"
+    /* texel k of the heightfield, raw units, clamped to the edge (two R16
+     * texels a word, as the image's bytes lie) */
     "float raw(ivec2 k) {\n"
     "    k = clamp(k, ivec2(0), u.size - 1);\n"
-    "    return round(texelFetch(u_height, k, 0).r * 65535.0);\n"
+    "    uint i = uint(k.y) * uint(u.size.x) + uint(k.x);\n"
+    "    return float((u_height.h[i >> 1u] >> (16u * (i & 1u))) & 0xffffu);\n"
     "}\n"
     /* bilinear between texel centres at texel base's centre + o (texels),
      * in raw units: shadow.c's rt_height_at */
@@ -98,23 +105,33 @@ static const char march_glsl[] =
     /* distance along the ray from texel-space p to the exit of the box
      * [lo, hi] (texels) */
     "float box_exit(vec2 p, vec2 lo, vec2 hi) {\n"
-    "    float t = 1e30;\n"
-    "    if (u.d.x > 0.0) t = min(t, (hi.x - p.x) / u.d.x);\n"
-    "    if (u.d.x < 0.0) t = min(t, (lo.x - p.x) / u.d.x);\n"
-    "    if (u.d.y > 0.0) t = min(t, (hi.y - p.y) / u.d.y);\n"
-    "    if (u.d.y < 0.0) t = min(t, (lo.y - p.y) / u.d.y);\n"
-    "    return max(t, 0.0);\n"
+    "    vec2 e = (mix(lo, hi, greaterThan(u.d, vec2(0.0))) - p) * u.inv;\n"
+    "    e = mix(e, vec2(1e30), equal(u.d, vec2(0.0)));\n"
+    "    return max(min(e.x, e.y), 0.0);\n"
     "}\n"
     /* no sample past t can lower the lowest clearance below thr where the
-     * highest height ahead is hmax (raw) and the box is left at t + exit */
+     * ray is `above` the highest height ahead (m) and leaves it at t + exit */
     "bool clear_of(float above, float t, float exit, float thr) {\n"
     "    return above > thr * (thr >= 0.0 ? t + exit : t);\n"
+    "}\n"
+    /* the pyramid's cell of level L around p: whether the march may skip
+     * it (thr as clear_of), its exit, and its height above the start */
+    "bool level_clear(int L, vec2 p, float ray, float h0, float t, float thr, out float exit,\n"
+    "                 out float above) {\n"
+    "    int s = 1 << L;\n"
+    "    ivec2 n = ivec2(PW >> L, PH >> L);\n"
+    "    ivec2 c = clamp(ivec2(floor(p / float(s))), ivec2(0), n - 1);\n"
+    "    float hmax = u_bound.b[uint(OFFSETS[L]) + uint(c.y) * uint(n.x) + uint(c.x)];\n"
+    "    exit = box_exit(p, vec2(c * s), vec2((c + 1) * s));\n"
+    "    above = ray - (hmax - h0) * u.kh;\n"
+    "    return clear_of(above, t, exit, thr);\n"
     "}\n"
     "uint visibility(ivec2 base) {\n"
     "    float h0 = raw(base);\n"
     "    float lowest = 1e30;\n"
     "    float k = 1.0;\n"
     "    vec2 size = vec2(u.size);\n"
+    "    int hint = 0;   /* the level the last skip took */\n"
     "    while (lowest > -u.tan_r) {\n"
     "        float t = k * u.step;\n"
     "        vec2 o = u.d * t;\n"
@@ -125,21 +142,36 @@ static const char march_glsl[] =
     /* the whole terrain below the ray: done */
     "        if (clear_of(ray - (u.top - h0) * u.kh, t, box_exit(p, vec2(0.0), size), thr))\n"
     "            break;\n"
-    "        float best = 0.0;\n"
-    "        for (int L = 0; L <= LEVELS; L++) {\n"
-    "            float s = float(1 << L);\n"
-    "            ivec2 c = clamp(ivec2(floor(p / s)), ivec2(0), textureSize(u_bound, L) - 1);\n"
-    "            float hmax = texelFetch(u_bound, c, L).r;\n"
-    "            float exit = box_exit(p, vec2(c) * s, vec2(c + 1) * s);\n"
-    "            if (!clear_of(ray - (hmax - h0) * u.kh, t, exit, thr)) break;\n"
+    /* the highest level whose cell may be skipped (those that may are
+     * the levels up to one: a parent's cell is higher and longer),
+     * searched from the last skip's level */
+    "        float best = 0.0, exit, above, above0 = -1e30;\n"
+    "        int L = hint;\n"
+    "        if (level_clear(L, p, ray, h0, t, thr, exit, above)) {\n"
     "            best = exit;\n"
+    "            while (L < LEVELS && level_clear(L + 1, p, ray, h0, t, thr, exit, above)) {\n"
+    "                L++;\n"
+    "                best = exit;\n"
+    "            }\n"
+    "        } else {\n"
+    "            if (L == 0) above0 = above;\n"
+    "            while (--L >= 0) {\n"
+    "                bool ok = level_clear(L, p, ray, h0, t, thr, exit, above);\n"
+    "                if (L == 0) above0 = above;\n"
+    "                if (ok) { best = exit; break; }\n"
+    "            }\n"
     "        }\n"
     "        if (best > 0.0) {\n"
+    "            hint = L;\n"
     "            k = max(k + 1.0, floor((t + best) / u.step) + 1.0);\n"
     "            continue;\n"
     "        }\n"
-    "        float h = height(base, o);\n"
-    "        lowest = min(lowest, (ray - (h - h0) * u.kh) / t);\n"
+    "        hint = 0;\n"
+    /* a sample the quad's bound says cannot lower the lowest: not read */
+    "        if (above0 < lowest * t) {\n"
+    "            float h = height(base, o);\n"
+    "            lowest = min(lowest, (ray - (h - h0) * u.kh) / t);\n"
+    "        }\n"
     "        k += 1.0;\n"
     "    }\n"
     "    float v = lowest >= 1e30 ? 1.0 : clamp(0.5 + lowest / (2.0 * u.tan_r), 0.0, 1.0);\n"
@@ -160,30 +192,28 @@ static const char march_glsl[] =
     "}\n";
 
 /* The highest raw height of the bilinear surface over each quad between
- * texel edges (its 3 x 3 texels), then the largest of four per level. */
-static bool make_bound(rt_shadow_gpu *s, const rt_pack *p, const uint16_t *heights,
-                       rt_error *e)
+ * texel edges (its 3 x 3 texels), then the largest of four per level,
+ * into s->bound. */
+static bool make_bound(rt_shadow_gpu *s, const uint16_t *heights, rt_error *e)
 {
-    int W = p->hf_width, H = p->hf_height, K = LEVELS;
+    int W = s->W, H = s->H, K = LEVELS;
     int PW = ((W + (1 << K) - 1) >> K) << K, PH = ((H + (1 << K) - 1) >> K) << K;
-    if ((uint32_t)PW > s->d->props.limits.maxImageDimension2D ||
-        (uint32_t)PH > s->d->props.limits.maxImageDimension2D)
-        return rt_fail(e, RT_E_PACK_LIMIT, p->dir, "the shadow march's height pyramid width",
-                       (unsigned long long)(PW > PH ? PW : PH), "maxImageDimension2D",
-                       (unsigned long long)s->d->props.limits.maxImageDimension2D);
+    s->PW = PW;
+    s->PH = PH;
     size_t total = 0;
-    for (int k = 0; k <= K; k++)
+    for (int k = 0; k <= K; k++) {
+        s->offset[k] = (uint32_t)total;
         total += (size_t)(PW >> k) * (size_t)(PH >> k);
-    float *all = malloc(total * sizeof *all);
-    const uint8_t *levels[LEVELS + 1];
-    if (!all) {
-        return rt_fail(e, RT_E_VULKAN, "shadow march", "out of memory");
     }
-    float *l0 = all;
+    rt_buffer staging;
+    VkDeviceSize bytes = (VkDeviceSize)total * sizeof(float);
+    if (!rt_buffer_create(s->d, bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, true, &staging, e))
+        return false;
+    float *l0 = staging.map;
     unsigned top = 0;
-    for (int j = 0; j < PH; j++) {
+    for (int j = 0; j < PH; j++)
         for (int i = 0; i < PW; i++) {
-            unsigned m = 0;
+            unsigned m = 0;   /* padding: 0, off the terrain */
             for (int dz = -1; dz <= 1 && i < W && j < H; dz++) {
                 int z = j + dz < 0 ? 0 : j + dz >= H ? H - 1 : j + dz;
                 for (int dx = -1; dx <= 1; dx++) {
@@ -193,30 +223,30 @@ static bool make_bound(rt_shadow_gpu *s, const rt_pack *p, const uint16_t *heigh
                 }
             }
             top = m > top ? m : top;
-            l0[(size_t)j * (size_t)PW + (size_t)i] = (float)m;   /* padding: 0, off the terrain */
+            l0[(size_t)j * (size_t)PW + (size_t)i] = (float)m;
         }
-    }
     s->top = (float)top;
-    levels[0] = (const uint8_t *)l0;
-    float *prev = l0;
     for (int k = 1; k <= K; k++) {
         int w = PW >> k, h = PH >> k, pw = PW >> (k - 1);
-        float *cur = prev + (size_t)pw * (size_t)(PH >> (k - 1));
+        const float *prev = l0 + s->offset[k - 1];
+        float *cur = l0 + s->offset[k];
         for (int j = 0; j < h; j++)
             for (int i = 0; i < w; i++) {
                 const float *q = prev + (size_t)(2 * j) * (size_t)pw + (size_t)(2 * i);
-                float m = fmaxf(fmaxf(q[0], q[1]), fmaxf(q[pw], q[pw + 1]));
-                cur[(size_t)j * (size_t)w + (size_t)i] = m;
+                cur[(size_t)j * (size_t)w + (size_t)i] =
+                    fmaxf(fmaxf(q[0], q[1]), fmaxf(q[pw], q[pw + 1]));
             }
-        levels[k] = (const uint8_t *)cur;
-        prev = cur;
     }
-    bool ok = rt_image_create(s->d, (uint32_t)PW, (uint32_t)PH, 1, false, (uint32_t)K + 1,
-                              VK_FORMAT_R32_SFLOAT,
-                              VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT,
-                              VK_IMAGE_ASPECT_COLOR_BIT, &s->bound, e) &&
-              rt_image_upload_levels(s->d, &s->bound, levels, e);
-    free(all);
+    VkCommandBuffer cb;
+    bool ok = rt_buffer_create(s->d, bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT |
+                               VK_BUFFER_USAGE_TRANSFER_DST_BIT, false, &s->bound, e) &&
+              rt_oneshot_begin(s->d, &cb, e);
+    if (ok) {
+        VkBufferCopy c = { 0, 0, bytes };
+        vkCmdCopyBuffer(cb, staging.buf, s->bound.buf, 1, &c);
+        ok = rt_oneshot_end(s->d, cb, e);
+    }
+    rt_buffer_destroy(s->d, &staging);
     return ok;
 }
 
@@ -234,27 +264,19 @@ bool rt_shadow_gpu_create(rt_device *d, const rt_pack *p, const uint16_t *height
     s->size[0] = p->size[0];
     s->size[1] = p->size[1];
     s->max_height = p->max_height;
+    s->height = height;
     size_t n = (size_t)p->hf_width * (size_t)p->hf_height, words = (n + 3) / 4;
-    if (!make_bound(s, p, heights, e) ||
-        !rt_buffer_create(d, words * 4, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT |
-                          VK_BUFFER_USAGE_TRANSFER_SRC_BIT | VK_BUFFER_USAGE_TRANSFER_DST_BIT,
-                          false, &s->map, e))
+    const VkBufferUsageFlags sb = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
+    if (!make_bound(s, heights, e) ||
+        !rt_buffer_create(d, (n * 2 + 3) / 4 * 4, sb | VK_BUFFER_USAGE_TRANSFER_DST_BIT, false,
+                          &s->heights, e) ||
+        !rt_buffer_create(d, words * 4, sb | VK_BUFFER_USAGE_TRANSFER_SRC_BIT |
+                          VK_BUFFER_USAGE_TRANSFER_DST_BIT, false, &s->map, e))
         return false;
-    VkSamplerCreateInfo si = {
-        .sType = VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO,
-        .magFilter = VK_FILTER_NEAREST, .minFilter = VK_FILTER_NEAREST,
-        .mipmapMode = VK_SAMPLER_MIPMAP_MODE_NEAREST,
-        .addressModeU = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE,
-        .addressModeV = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE,
-        .addressModeW = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE,
-        .maxLod = VK_LOD_CLAMP_NONE,
-    };
-    RT_VK(e, vkCreateSampler(d->dev, &si, NULL, &s->nearest));
     const VkShaderStageFlags cs = VK_SHADER_STAGE_COMPUTE_BIT;
-    const VkDescriptorType cis = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
-    const VkDescriptorType sb = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+    const VkDescriptorType sbt = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
     VkDescriptorSetLayoutBinding b[3] = {
-        { 0, cis, 1, cs, NULL }, { 1, cis, 1, cs, NULL }, { 2, sb, 1, cs, NULL },
+        { 0, sbt, 1, cs, NULL }, { 1, sbt, 1, cs, NULL }, { 2, sbt, 1, cs, NULL },
     };
     if (!rt_set_layout(d, b, 3, &s->set_layout, e))
         return false;
@@ -267,28 +289,32 @@ bool rt_shadow_gpu_create(rt_device *d, const rt_pack *p, const uint16_t *height
         .pPushConstantRanges = &push,
     };
     RT_VK(e, vkCreatePipelineLayout(d->dev, &pi, NULL, &s->layout));
-    VkDescriptorPoolSize sizes[2] = { { cis, 2 }, { sb, 1 } };
-    if (!rt_descriptor_sets(d, sizes, 2, &s->set_layout, 1, &s->pool, &s->set, e))
+    VkDescriptorPoolSize sizes[1] = { { sbt, 3 } };
+    if (!rt_descriptor_sets(d, sizes, 1, &s->set_layout, 1, &s->pool, &s->set, e))
         return false;
-    VkDescriptorImageInfo ii[2] = {
-        { s->nearest, height->view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL },
-        { s->nearest, s->bound.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL },
+    VkDescriptorBufferInfo bi[3] = {
+        { s->heights.buf, 0, VK_WHOLE_SIZE }, { s->bound.buf, 0, VK_WHOLE_SIZE },
+        { s->map.buf, 0, VK_WHOLE_SIZE },
     };
-    VkDescriptorBufferInfo bi = { s->map.buf, 0, VK_WHOLE_SIZE };
     VkWriteDescriptorSet w[3];
     for (uint32_t i = 0; i < 3; i++)
         w[i] = (VkWriteDescriptorSet){ .sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET,
             .dstSet = s->set, .dstBinding = i, .descriptorCount = 1,
-            .descriptorType = b[i].descriptorType,
-            .pImageInfo = i < 2 ? &ii[i] : NULL, .pBufferInfo = i == 2 ? &bi : NULL };
+            .descriptorType = sbt, .pBufferInfo = &bi[i] };
     vkUpdateDescriptorSets(d->dev, 3, w, 0, NULL);
-    char *src = malloc(sizeof march_glsl + 64);
+    /* the pyramid's shape as constants */
+    char head[512];
+    int at = snprintf(head, sizeof head, "#version 450\n#define LEVELS %d\n#define PW %d\n"
+                      "#define PH %d\nconst int OFFSETS[%d] = int[](", LEVELS, s->PW, s->PH,
+                      LEVELS + 1);
+    for (int k = 0; k <= LEVELS; k++)
+        at += snprintf(head + at, sizeof head - (size_t)at, "%s%u", k ? ", " : "", s->offset[k]);
+    snprintf(head + at, sizeof head - (size_t)at, ");\n");
+    char *src = malloc(strlen(head) + sizeof march_glsl);
     if (!src)
         return rt_fail(e, RT_E_VULKAN, "shadow march", "out of memory");
-    /* #define after the #version line */
-    const char *nl = strchr(march_glsl, '\n') + 1;
-    snprintf(src, sizeof march_glsl + 64, "%.*s#define LEVELS %d\n%s", (int)(nl - march_glsl),
-             march_glsl, LEVELS, nl);
+    strcpy(src, head);
+    strcat(src, march_glsl);
     bool ok = rt_glsl_compute_pipeline(d, cache, s->layout, src, "shadow.comp", NULL, &s->pipe, e);
     free(src);
     return ok;
@@ -308,9 +334,8 @@ void rt_shadow_gpu_destroy(rt_shadow_gpu *s)
             vkDestroyDescriptorPool(d->dev, s->pool, NULL);
         if (s->set_layout)
             vkDestroyDescriptorSetLayout(d->dev, s->set_layout, NULL);
-        if (s->nearest)
-            vkDestroySampler(d->dev, s->nearest, NULL);
-        rt_image_destroy(d, &s->bound);
+        rt_buffer_destroy(d, &s->bound);
+        rt_buffer_destroy(d, &s->heights);
         rt_buffer_destroy(d, &s->map);
         rt_buffer_destroy(d, &s->readback);
     }
@@ -334,8 +359,27 @@ bool rt_shadow_gpu_map(rt_shadow_gpu *s, const double sun[3], const int rect[4],
     VkCommandBuffer cb;
     if (!rt_oneshot_begin(s->d, &cb, e))
         return false;
-    /* craters upload heights by transfers; the last update's copy read
-     * the buffer this one writes */
+    /* the heights as craters left them (their uploads are transfers, the
+     * frames' vertex, fragment and compute stages read the image), copied
+     * where the march reads them; the last update's reads and copy of the
+     * buffers this one writes are done */
+    const VkPipelineStageFlags shaders = VK_PIPELINE_STAGE_VERTEX_SHADER_BIT |
+        VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT;
+    rt_cmd_image_barrier(cb, s->height->img, 0, 1, 1, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+                         VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_ACCESS_TRANSFER_WRITE_BIT,
+                         VK_ACCESS_TRANSFER_READ_BIT,
+                         VK_PIPELINE_STAGE_TRANSFER_BIT | shaders, VK_PIPELINE_STAGE_TRANSFER_BIT);
+    rt_cmd_barrier(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT, 0,
+                   VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT, 0);
+    VkBufferImageCopy hc = {
+        .imageSubresource = { VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1 },
+        .imageExtent = { (uint32_t)W, (uint32_t)H, 1 },
+    };
+    vkCmdCopyImageToBuffer(cb, s->height->img, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+                           s->heights.buf, 1, &hc);
+    rt_cmd_image_barrier(cb, s->height->img, 0, 1, 1, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+                         VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, 0, VK_ACCESS_SHADER_READ_BIT,
+                         VK_PIPELINE_STAGE_TRANSFER_BIT, shaders);
     rt_cmd_barrier(cb, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
                    VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT,
                    VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT |
@@ -351,6 +395,8 @@ bool rt_shadow_gpu_map(rt_shadow_gpu *s, const double sun[3], const int rect[4],
             .tan_r = (float)SUN_TAN, .top = s->top,
             .rect = { i0, j0, i1, j1 }, .size = { W, H },
         };
+        for (int a = 0; a < 2; a++)
+            push.inv[a] = push.d[a] != 0 ? 1.0f / push.d[a] : 1e30f;
         size_t first = (size_t)j0 * (size_t)W / 4, end = ((size_t)j1 * (size_t)W + 3) / 4;
         push.first = (uint32_t)first;
         push.count = (uint32_t)(end - first);
@@ -364,8 +410,6 @@ bool rt_shadow_gpu_map(rt_shadow_gpu *s, const double sun[3], const int rect[4],
                    VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT,
                    VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_READ_BIT);
     /* the map: every frame's shaders read it until now */
-    const VkPipelineStageFlags shaders = VK_PIPELINE_STAGE_VERTEX_SHADER_BIT |
-        VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT;
     rt_cmd_image_barrier(cb, shadow->img, 0, 1, 1, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
                          VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, VK_ACCESS_SHADER_READ_BIT,
                          VK_ACCESS_TRANSFER_WRITE_BIT, shaders, VK_PIPELINE_STAGE_TRANSFER_BIT);
