@@ -1330,8 +1330,8 @@ static bool update_shadow(rt_renderer *r, double *ms, rt_error *e)
             return false;
         }
         t0 = splat_now();   /* the pyramid and the pipeline are made once */
-        if (!rt_shadow_gpu_map(r->shadow_gpu, sun, full ? NULL : r->shadow_rect,
-                               &r->terrain.shadow, e))
+        if (!rt_shadow_gpu_map(r->shadow_gpu, sun, r->bounds.hmax[r->bounds.nlevels - 1][0],
+                               full ? NULL : r->shadow_rect, &r->terrain.shadow, e))
             return false;
         *ms = 1e3 * (splat_now() - t0);
     } else {

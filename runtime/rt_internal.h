@@ -602,9 +602,10 @@ bool rt_shadow_gpu_create(rt_device *d, const rt_pack *p, const uint16_t *height
 void rt_shadow_gpu_destroy(rt_shadow_gpu *s);
 /* rt_shadow_map on the device into `shadow` (the R8 map, SHADER_READ_ONLY
  * before and after): the texels of rect (NULL: all; a part only once a
- * whole map was made); waits until done. */
-bool rt_shadow_gpu_map(rt_shadow_gpu *s, const double sun[3], const int rect[4], rt_image *shadow,
-                       rt_error *e);
+ * whole map was made), `top` the terrain's highest height (m: the
+ * quadtree bounds' top, where the CPU march ends); waits until done. */
+bool rt_shadow_gpu_map(rt_shadow_gpu *s, const double sun[3], double top, const int rect[4],
+                       rt_image *shadow, rt_error *e);
 /* The last map (hf_width x hf_height bytes) back to the host. */
 bool rt_shadow_gpu_read(rt_shadow_gpu *s, uint8_t *out, rt_error *e);
 

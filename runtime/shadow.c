@@ -43,6 +43,7 @@ typedef struct march {
     const rt_bounds *b;
     double dir[2], rise;    /* horizontal unit direction; rise per metre    */
     double leaf[2];         /* a quadtree leaf's size in metres             */
+    double top;             /* highest height of the terrain                */
 } march;
 
 /* Distance along the ray from (x, z) to where it leaves the cell (cx, cz)
@@ -87,7 +88,9 @@ static double skip(const march *m, double x, double z, double ray, double t, dou
 /* The samples lie at t = k step, k = 1, 2, ... whatever is skipped, and
  * a skip passes over only samples that cannot lower the result (skip), so
  * the map is the same over any bound of the heights: the GPU march
- * (shadow_gpu.c) skips over a pyramid of texel maxima and makes this map. */
+ * (shadow_gpu.c) skips over a pyramid of texel maxima and makes this map.
+ * The march ends off the terrain or above its highest point (the top of
+ * the quadtree's bounds, which craters keep current). */
 static uint8_t visibility(const march *m, double x0, double z0, double y0, double step)
 {
     const rt_pack *p = m->p;
@@ -95,7 +98,7 @@ static uint8_t visibility(const march *m, double x0, double z0, double y0, doubl
     for (double k = 1; lowest > -SUN_TAN;) {
         double t = k * step;
         double x = x0 + m->dir[0] * t, z = z0 + m->dir[1] * t, ray = y0 + m->rise * t;
-        if (x < 0 || z < 0 || x > p->size[0] || z > p->size[1])
+        if (x < 0 || z < 0 || x > p->size[0] || z > p->size[1] || ray > m->top)
             break;
         double jump = skip(m, x, z, ray, t, fmin(lowest, SUN_TAN));
         if (jump > 0) {
@@ -178,6 +181,7 @@ void rt_shadow_map(const uint16_t *heights, const rt_pack *p, const rt_bounds *b
         .heights = heights, .p = p, .b = b,
         .dir = { sun[0] / flat, sun[2] / flat }, .rise = sun[1] / flat,
         .leaf = { sx * p->cell_texels, sz * p->cell_texels },
+        .top = b->hmax[b->nlevels - 1][0],
     };
     /* rows split over the CPU's cores; each texel's march is independent */
     enum { MAX_THREADS = 32 };

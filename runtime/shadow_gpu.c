@@ -45,11 +45,10 @@ struct rt_shadow_gpu {
     int                   W, H;       /* the heightfield's texels          */
     double                size[2];    /* its metres (a hot reload's pack
                                          keeps them: render.c)             */
-    double                max_height;
+    double                max_height, hoffset;   /* metres per 65535; at 0 */
     int                   PW, PH;     /* the pyramid's padded level 0      */
     uint32_t              offset[LEVELS + 1];   /* floats to each level    */
     rt_buffer             bound;      /* the pyramid of raw maxima (float) */
-    float                 top;        /* highest raw height                */
     const rt_image       *height;     /* the terrain's R16 heightfield     */
     rt_buffer             heights;    /* its copy the march reads          */
     rt_buffer             map;        /* W x H bytes, in uints             */
@@ -67,7 +66,7 @@ typedef struct march_push {
     float    d[2];         /* texels per metre along the sun's direction */
     float    rise, step;   /* metres up per metre; metres per sample     */
     float    kh, eps;      /* metres per raw unit; the start's lift (m)  */
-    float    tan_r, top;   /* tan of the sun's radius; highest raw       */
+    float    tan_r, top;   /* tan of the sun's radius; highest (raw)     */
     int32_t  rect[4];      /* texels made: x0 z0 x1 z1, end exclusive    */
     int32_t  size[2];      /* W H                                        */
     uint32_t first, count; /* uints of the buffer this dispatch makes    */
@@ -138,6 +137,7 @@ static const char march_glsl[] =
     "        vec2 p = vec2(base) + 0.5 + o;   /* texels from the terrain's corner */\n"
     "        if (any(lessThan(p, vec2(0.0))) || any(greaterThan(p, size))) break;\n"
     "        float ray = u.eps + u.rise * t;   /* metres above the start */\n"
+    "        if (ray > (u.top - h0) * u.kh) break;   /* above the terrain: shadow.c's end */\n"
     "        float thr = min(lowest, u.tan_r);\n"
     /* the whole terrain below the ray: done */
     "        if (clear_of(ray - (u.top - h0) * u.kh, t, box_exit(p, vec2(0.0), size), thr))\n"
@@ -210,7 +210,6 @@ static bool make_bound(rt_shadow_gpu *s, const uint16_t *heights, rt_error *e)
     if (!rt_buffer_create(s->d, bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, true, &staging, e))
         return false;
     float *l0 = staging.map;
-    unsigned top = 0;
     for (int j = 0; j < PH; j++)
         for (int i = 0; i < PW; i++) {
             unsigned m = 0;   /* padding: 0, off the terrain */
@@ -222,10 +221,8 @@ static bool make_bound(rt_shadow_gpu *s, const uint16_t *heights, rt_error *e)
                     m = v > m ? v : m;
                 }
             }
-            top = m > top ? m : top;
             l0[(size_t)j * (size_t)PW + (size_t)i] = (float)m;
         }
-    s->top = (float)top;
     for (int k = 1; k <= K; k++) {
         int w = PW >> k, h = PH >> k, pw = PW >> (k - 1);
         const float *prev = l0 + s->offset[k - 1];
@@ -264,6 +261,7 @@ bool rt_shadow_gpu_create(rt_device *d, const rt_pack *p, const uint16_t *height
     s->size[0] = p->size[0];
     s->size[1] = p->size[1];
     s->max_height = p->max_height;
+    s->hoffset = p->height_offset;
     s->height = height;
     size_t n = (size_t)p->hf_width * (size_t)p->hf_height, words = (n + 3) / 4;
     const VkBufferUsageFlags sb = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
@@ -342,8 +340,8 @@ void rt_shadow_gpu_destroy(rt_shadow_gpu *s)
     free(s);
 }
 
-bool rt_shadow_gpu_map(rt_shadow_gpu *s, const double sun[3], const int rect[4], rt_image *shadow,
-                       rt_error *e)
+bool rt_shadow_gpu_map(rt_shadow_gpu *s, const double sun[3], double top, const int rect[4],
+                       rt_image *shadow, rt_error *e)
 {
     int W = s->W, H = s->H;
     double flat = sqrt(sun[0] * sun[0] + sun[2] * sun[2]);
@@ -392,7 +390,8 @@ bool rt_shadow_gpu_map(rt_shadow_gpu *s, const double sun[3], const int rect[4],
             .d = { (float)(sun[0] / flat / sx), (float)(sun[2] / flat / sz) },
             .rise = (float)(sun[1] / flat), .step = (float)(0.5 * fmin(sx, sz)),
             .kh = (float)(s->max_height / 65535.0), .eps = (float)(1e-4 * (s->max_height + 1.0)),
-            .tan_r = (float)SUN_TAN, .top = s->top,
+            .tan_r = (float)SUN_TAN,
+            .top = s->max_height > 0 ? (float)((top - s->hoffset) / (s->max_height / 65535.0)) : 0.0f,
             .rect = { i0, j0, i1, j1 }, .size = { W, H },
         };
         for (int a = 0; a < 2; a++)
