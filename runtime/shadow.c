@@ -3,12 +3,13 @@
  * the prelude's splat_light samples bilinearly at the shaded point and
  * multiplies the sun term by (every shading path alike).
  *
- * Each texel centre marches towards the sun over the heightfield: half a
- * texel a step, the terrain read as the shaders read it (bilinear between
- * texel centres, rt_height_at), stepping over every quadtree node whose
- * maximum height (rt_bounds, which craters keep current) lies safely below
- * the ray, and stopping once the ray is above the whole terrain or off it.
- * The visibility is the fraction of the sun's disc (0.27 degrees of
+ * Each texel centre marches towards the sun over the heightfield: samples
+ * every half texel (t = k step, k = 1, 2, ...), the terrain read as the
+ * shaders read it (bilinear between texel centres, rt_height_at), stepping
+ * over every quadtree node whose maximum height (rt_bounds, which craters
+ * keep current) lies so far below the ray that no sample in it could lower
+ * the result, and stopping once the ray is above the whole terrain or off
+ * it.  The visibility is the fraction of the sun's disc (0.27 degrees of
  * radius) above the horizon the march found: 0.5 + m / (2 tan r), clamped,
  * with m the lowest clearance angle's tangent along the ray.
  *
@@ -17,15 +18,20 @@
  * texels (rt_shadow_crater_rect; render.shadow checks the result equals
  * the whole map made again).
  *
- * Why a map marched on the CPU, not a per-pixel march nor a horizon map:
- * the sun and the heights change only on an event (the viewer's sun keys,
- * a light override, a crater), so a frame pays one texture tap per pixel
- * and nothing else; the CPU has the heights and bounds destruction keeps,
- * and its result is exact and the same on every device (rows split over
- * the CPU's cores).  A horizon map
- * would store many directions to make turning the sun free, at many times
- * the memory, for an event that is rare.  The cost of an update is in the
- * benchmark (bench_shadow: milliseconds per map on colorado). */
+ * This is the reference: the renderer marches the same samples on the
+ * device by default (shadow_gpu.c, over a pyramid of texel maxima instead
+ * of the quadtree: the skips pass only over samples that cannot change the
+ * result, so the bound used does not change the map; render.shadow_gpu
+ * holds the two within 1/255), and here with rt_render_desc.shadow
+ * RT_SHADOW_CPU (splatview --shadow cpu, SPLAT_SHADOW=cpu).
+ *
+ * Why a map, not a per-pixel march nor a horizon map: the sun and the
+ * heights change only on an event (the viewer's sun keys, a light
+ * override, a crater), so a frame pays one texture tap per pixel and
+ * nothing else.  A horizon map would store many directions to make turning
+ * the sun free, at many times the memory, for an event that is rare.  The
+ * cost of an update is in the benchmark (splatbench shadow: the CPU and
+ * the device's march on colorado, side by side). */
 #include "rt_internal.h"
 
 #include <math.h>

@@ -4,20 +4,23 @@
  * uint of a storage buffer holding the W x H bytes row by row), marching
  * from each texel centre towards the sun exactly as shadow.c does: the
  * samples at t = k step (half the smaller texel side), the terrain read
- * bilinearly between texel centres from the terrain's own R16 heightfield
- * (so craters, which lower it in place, are followed), the clearance's
- * tangent (ray - h) / t, the visibility 0.5 + lowest / (2 tan r).  It skips
- * over a pyramid of maximum heights built like the ray caster's
- * (screen.c make_maxmip: R32F, padded to a multiple of 256 texels, 8
- * levels of the largest of four), trying the levels from the finest up
- * at each sample as shadow.c does over the quadtree, and stops once the
- * ray can no longer lower the result anywhere on the terrain.  Level 0
- * differs from the ray caster's: per quad between texel edges it holds the
- * highest of the 3 x 3 texels the bilinear surface there reads, not the
- * highest mesh corner (a peak texel stands above the four corner means
- * around it, so the ray caster's bound is not one for the bilinear
- * surface).  Heights are raw R16 units in the pyramid; craters only lower
- * the terrain, so it stays a bound without being rebuilt.
+ * bilinearly between texel centres from a copy of the terrain's own R16
+ * heightfield made at each update (so craters, which lower that image in
+ * place, are followed), the clearance's tangent (ray - h) / t, the
+ * visibility 0.5 + lowest / (2 tan r), the end off the terrain or above
+ * its highest point.  It skips over a pyramid of maximum heights shaped
+ * like the ray caster's (screen.c make_maxmip: padded to a multiple of
+ * 256 texels, 8 levels of the largest of four; here a storage buffer of
+ * raw R16 units), one cell a step: a cell the ray clears is skipped and
+ * its parent looked at next, one it does not clear sends the march to its
+ * child at the same sample, and at level 0 the sample is taken (all lanes
+ * run the same code; searching every level at every step was twice as
+ * slow on lavapipe).  Level 0 differs from the ray caster's: per quad
+ * between texel edges it holds the highest of the 3 x 3 texels the
+ * bilinear surface there reads, not the highest mesh corner (a peak
+ * texel stands above the four corner means around it, so the ray caster's
+ * bound is not one for the bilinear surface).  Craters only lower the
+ * terrain, so the pyramid stays a bound without being rebuilt.
  *
  * The skipping passes only over samples that cannot lower the lowest
  * clearance (shadow.c skip), so the result does not depend on the bound
@@ -28,9 +31,10 @@
  * (render.shadow_gpu holds it).
  *
  * An update is one command buffer: the crater uploads' transfer writes
- * made visible to the compute reads, the dispatch (a crater: only the
- * rows of its rectangle, the texels outside it kept from the buffer), the
- * buffer copied into the sampled R8 map after the last frame's reads. */
+ * made visible to the copy of the heights, the dispatch (a crater: only
+ * the rows of its rectangle, the texels outside it kept from the buffer),
+ * the buffer copied into the sampled R8 map after the last frame's
+ * reads. */
 #include "rt_internal.h"
 
 #include <math.h>
