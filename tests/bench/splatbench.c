@@ -219,7 +219,7 @@ typedef struct variant {
     bool         ug;        /* draw the undergrowth                         */
     double       ug_radius; /* its radius (m); 0: the runtime's default     */
     double       far;       /* screen: the far atlas's distance (m); 0: off */
-    double       shadow_ms; /* CPU ms of the shadow map (the first frame)   */
+    double       shadow_ms; /* ms of the shadow map (the first frame)       */
     double      *ug_gen, *ug_draw; /* per timed frame, GPU ms               */
     long         ug_cells;  /* cells generated over the timed frames        */
     rt_ug_stats  ug_last;   /* the last frame's                             */

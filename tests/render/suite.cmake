@@ -159,7 +159,7 @@ if(TARGET splatrt AND TARGET splatview)
     file(MAKE_DIRECTORY ${RENDER_OUT}/shadow_gpu)
     add_test(NAME render.shadow_gpu COMMAND test_shadow_gpu ${RENDER_OUT}/shadow_gpu
              WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
-    set_tests_properties(render.shadow_gpu PROPERTIES LABELS "render;gpu" TIMEOUT 600
+    set_tests_properties(render.shadow_gpu PROPERTIES LABELS "render;gpu;asan" TIMEOUT 600
                          ENVIRONMENT "SPLAT_VALIDATE=1")
     # distance classes against the über-shader at 20 random cameras on
     # colorado, both paths (test_dclass.c)
