@@ -26,6 +26,7 @@ struct rt_renderer {
     int               shadow_rect[4];  /* texels craters changed since      */
     uint8_t          *shadow_map;      /* the CPU copy of the last map      */
     bool              shadow_on_gpu;   /* marched by shadow_gpu              */
+    bool              shadow_auto;     /* the path was not asked for         */
     rt_shadow_gpu    *shadow_gpu;      /* made at the first GPU map          */
     bool              default_clear;   /* no background given: the sky      */
     double            shadow_sun[3];   /* the sun the map was made for      */
@@ -477,6 +478,7 @@ bool rt_renderer_create(rt_device *d, const rt_pack *p, const rt_render_desc *de
     r->desc = *desc;
     pack_light(r, p);
     const char *sh = getenv("SPLAT_SHADOW");   /* cpu | gpu over the default */
+    r->shadow_auto = r->desc.shadow == RT_SHADOW_AUTO && !sh;
     if (r->desc.shadow == RT_SHADOW_AUTO)
         r->desc.shadow = sh && !strcmp(sh, "cpu") ? RT_SHADOW_CPU : RT_SHADOW_GPU;
     r->shadow_on_gpu = r->desc.shadow == RT_SHADOW_GPU;
@@ -1327,7 +1329,13 @@ static bool update_shadow(rt_renderer *r, double *ms, rt_error *e)
                                   r->pl.cache, &r->shadow_gpu, e)) {
             rt_shadow_gpu_destroy(r->shadow_gpu);
             r->shadow_gpu = NULL;
-            return false;
+            if (!r->shadow_auto || e->id != RT_E_PACK_LIMIT)
+                return false;
+            /* a heightfield over the device's storage buffer limit: the
+             * CPU march, unless the device's was asked for */
+            rt_error_clear(e);
+            r->shadow_on_gpu = false;
+            return update_shadow(r, ms, e);
         }
         t0 = splat_now();   /* the pyramid and the pipeline are made once */
         if (!rt_shadow_gpu_map(r->shadow_gpu, sun, r->bounds.hmax[r->bounds.nlevels - 1][0],

@@ -197,6 +197,10 @@ static bool make_bound(rt_shadow_gpu *s, const uint16_t *heights, rt_error *e)
     }
     rt_buffer staging;
     VkDeviceSize bytes = (VkDeviceSize)total * sizeof(float);
+    if (bytes > s->d->props.limits.maxStorageBufferRange)
+        return rt_fail(e, RT_E_PACK_LIMIT, "shadow march", "its height pyramid (bytes)",
+                       (unsigned long long)bytes, "maxStorageBufferRange",
+                       (unsigned long long)s->d->props.limits.maxStorageBufferRange);
     if (!rt_buffer_create(s->d, bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, true, &staging, e))
         return false;
     float *l0 = staging.map;
