@@ -1300,9 +1300,6 @@ static bool draw_frame(rt_renderer *r, const rt_camera *c, rt_frame_stats *st, r
     return read_times(r, screen, st, e);
 }
 
-/* A frame; on the screen-space path, drawn again while lists got tiles
- * whose pipelines did not exist yet (compiled in between): at most once
- * per variant in practice, since the classification is deterministic. */
 /* A new shadow map when the sun moved, or its texels a crater may have
  * changed since the last: marched on the device (shadow_gpu.c) or the CPU
  * (shadow.c, the reference); its wall time in *ms (0: none was needed). */
@@ -1376,6 +1373,9 @@ void rt_renderer_shadow_reference(rt_renderer *r, uint8_t *out)
     rt_shadow_map(rt_renderer_heights(r), r->p, &r->bounds, sun, NULL, out);
 }
 
+/* A frame; on the screen-space path, drawn again while lists got tiles
+ * whose pipelines did not exist yet (compiled in between): at most once
+ * per variant in practice, since the classification is deterministic. */
 bool rt_renderer_frame(rt_renderer *r, const rt_camera *c, rt_frame_stats *st, rt_error *e)
 {
     rt_frame_stats local;
