@@ -26,6 +26,9 @@ struct rt_renderer {
     bool              shadow_stale;    /* the whole map is to be made       */
     int               shadow_rect[4];  /* texels craters changed since      */
     uint8_t          *shadow_map;      /* the CPU copy of the last map      */
+    bool              shadow_on_gpu;   /* marched by shadow_gpu              */
+    bool              shadow_auto;     /* the path was not asked for         */
+    rt_shadow_gpu    *shadow_gpu;      /* made at the first GPU map          */
     bool              default_clear;   /* no background given: the sky      */
     double            shadow_sun[3];   /* the sun the map was made for      */
     rt_terrain_gpu    terrain;
@@ -475,6 +478,11 @@ bool rt_renderer_create(rt_device *d, const rt_pack *p, const rt_render_desc *de
     r->p = p;
     r->desc = *desc;
     pack_light(r, p);
+    const char *sh = getenv("SPLAT_SHADOW");   /* cpu | gpu over the default */
+    r->shadow_auto = r->desc.shadow == RT_SHADOW_AUTO && !sh;
+    if (r->desc.shadow == RT_SHADOW_AUTO)
+        r->desc.shadow = sh && !strcmp(sh, "cpu") ? RT_SHADOW_CPU : RT_SHADOW_GPU;
+    r->shadow_on_gpu = r->desc.shadow == RT_SHADOW_GPU;
     if (r->desc.width <= 0)
         r->desc.width = 1280;
     if (r->desc.height <= 0)
@@ -544,6 +552,7 @@ void rt_renderer_destroy(rt_renderer *r)
     rt_device *d = r->d;
     if (d->dev) {
         vkDeviceWaitIdle(d->dev);
+        rt_shadow_gpu_destroy(r->shadow_gpu);
         rt_ug_destroy(r->ug);
         rt_screen_destroy(r->screen);
         rt_far_destroy(r->far);
@@ -1382,12 +1391,9 @@ static bool draw_frame(rt_renderer *r, const rt_camera *c, rt_frame_stats *st, r
     return read_times(r, screen, st, e);
 }
 
-/* A frame; on the screen-space path, drawn again while lists got tiles
- * whose pipelines did not exist yet (compiled in between): at most once
- * per variant in practice, since the classification is deterministic. */
-/* A new shadow map (shadow.c) when the sun moved, or its texels a crater
- * may have changed since the last; its CPU time in *ms (0: none was
- * needed). */
+/* A new shadow map when the sun moved, or its texels a crater may have
+ * changed since the last: marched on the device (shadow_gpu.c) or the CPU
+ * (shadow.c, the reference); its wall time in *ms (0: none was needed). */
 static bool update_shadow(rt_renderer *r, double *ms, rt_error *e)
 {
     *ms = 0;
@@ -1395,26 +1401,72 @@ static bool update_shadow(rt_renderer *r, double *ms, rt_error *e)
     rt_light_sun_dir(&r->light, sun);
     if (r->desc.no_shadows)
         return true;
-    bool full = r->shadow_stale || !r->shadow_map || memcmp(sun, r->shadow_sun, sizeof sun);
+    bool full = r->shadow_stale || memcmp(sun, r->shadow_sun, sizeof sun);
     bool part = r->shadow_rect[0] < r->shadow_rect[2] && r->shadow_rect[1] < r->shadow_rect[3];
     if (!full && !part)
         return true;
     const rt_pack *p = r->p;
     size_t n = (size_t)p->hf_width * (size_t)p->hf_height;
-    if (!r->shadow_map && !(r->shadow_map = malloc(n)))
-        return rt_fail(e, RT_E_VULKAN, "shadow map", "out of memory");
+    /* both paths wait for the queue (an upload, a one-time submission):
+     * the last frame's work is not the map's time */
+    RT_VK(e, vkQueueWaitIdle(r->d->queue));
     double t0 = splat_now();
-    rt_shadow_map(rt_renderer_heights(r), p, &r->bounds, sun, full ? NULL : r->shadow_rect,
-                  r->shadow_map);
-    *ms = 1e3 * (splat_now() - t0);
-    if (!rt_image_upload(r->d, &r->terrain.shadow, r->shadow_map, n, e))
-        return false;
+    if (r->shadow_on_gpu) {
+        if (!r->shadow_gpu &&
+            !rt_shadow_gpu_create(r->d, p, rt_renderer_heights(r), &r->terrain.height,
+                                  r->pl.cache, &r->shadow_gpu, e)) {
+            rt_shadow_gpu_destroy(r->shadow_gpu);
+            r->shadow_gpu = NULL;
+            if (!r->shadow_auto || e->id != RT_E_PACK_LIMIT)
+                return false;
+            /* a heightfield over the device's storage buffer limit: the
+             * CPU march, unless the device's was asked for */
+            rt_error_clear(e);
+            r->shadow_on_gpu = false;
+            return update_shadow(r, ms, e);
+        }
+        t0 = splat_now();   /* the pyramid and the pipeline are made once */
+        if (!rt_shadow_gpu_map(r->shadow_gpu, sun, r->bounds.hmax[r->bounds.nlevels - 1][0],
+                               full ? NULL : r->shadow_rect, &r->terrain.shadow, e))
+            return false;
+        *ms = 1e3 * (splat_now() - t0);
+    } else {
+        if (!r->shadow_map && !(r->shadow_map = malloc(n)))
+            return rt_fail(e, RT_E_VULKAN, "shadow map", "out of memory");
+        rt_shadow_map(rt_renderer_heights(r), p, &r->bounds, sun, full ? NULL : r->shadow_rect,
+                      r->shadow_map);
+        *ms = 1e3 * (splat_now() - t0);
+        if (!rt_image_upload(r->d, &r->terrain.shadow, r->shadow_map, n, e))
+            return false;
+    }
     memcpy(r->shadow_sun, sun, sizeof sun);
     r->shadow_stale = false;
     memset(r->shadow_rect, 0, sizeof r->shadow_rect);
     return true;
 }
 
+bool rt_renderer_shadow_read(rt_renderer *r, uint8_t *out, rt_error *e)
+{
+    size_t n = (size_t)r->p->hf_width * (size_t)r->p->hf_height;
+    if (r->shadow_on_gpu && r->shadow_gpu)
+        return rt_shadow_gpu_read(r->shadow_gpu, out, e);
+    if (!r->shadow_on_gpu && r->shadow_map) {
+        memcpy(out, r->shadow_map, n);
+        return true;
+    }
+    return rt_fail(e, RT_E_VULKAN, "shadow map", "none made yet");
+}
+
+void rt_renderer_shadow_reference(rt_renderer *r, uint8_t *out)
+{
+    double sun[3];
+    rt_light_sun_dir(&r->light, sun);
+    rt_shadow_map(rt_renderer_heights(r), r->p, &r->bounds, sun, NULL, out);
+}
+
+/* A frame; on the screen-space path, drawn again while lists got tiles
+ * whose pipelines did not exist yet (compiled in between): at most once
+ * per variant in practice, since the classification is deterministic. */
 bool rt_renderer_frame(rt_renderer *r, const rt_camera *c, rt_frame_stats *st, rt_error *e)
 {
     rt_frame_stats local;
@@ -1434,6 +1486,7 @@ bool rt_renderer_frame(rt_renderer *r, const rt_camera *c, rt_frame_stats *st, r
         st->spirv_compiled = atomic_load(&r->pl.spirv_compiled);
         if (rt_async_failed(&r->pl, e))
             return false;
+        st->shadow_gpu = r->shadow_on_gpu;
         if (!st->screen)
             return true;
         double t0 = splat_now();

@@ -626,6 +626,34 @@ void rt_shadow_map(const uint16_t *heights, const rt_pack *p, const rt_bounds *b
 bool rt_shadow_crater_rect(const rt_pack *p, const rt_bounds *b, const double sun[3],
                            double x, double z, double radius, int rect[4]);
 
+/* ---- shadow_gpu.c: the sun-visibility map marched on the device ------- */
+
+typedef struct rt_shadow_gpu rt_shadow_gpu;
+/* The march's pyramid (from `heights`, the current ones: craters only
+ * lower them later), map buffer and pipeline; it reads the terrain's R16
+ * `height` image (SHADER_READ_ONLY) at every update. */
+bool rt_shadow_gpu_create(rt_device *d, const rt_pack *p, const uint16_t *heights,
+                          const rt_image *height, VkPipelineCache cache, rt_shadow_gpu **out,
+                          rt_error *e);
+void rt_shadow_gpu_destroy(rt_shadow_gpu *s);
+/* rt_shadow_map on the device into `shadow` (the R8 map, SHADER_READ_ONLY
+ * before and after): the texels of rect (NULL: all; a part only once a
+ * whole map was made), `top` the terrain's highest height (m: the
+ * quadtree bounds' top, where the CPU march ends); waits until done. */
+bool rt_shadow_gpu_map(rt_shadow_gpu *s, const double sun[3], double top, const int rect[4],
+                       rt_image *shadow, rt_error *e);
+/* The last map (hf_width x hf_height bytes) back to the host. */
+bool rt_shadow_gpu_read(rt_shadow_gpu *s, uint8_t *out, rt_error *e);
+
+/* ---- render.c: the renderer's shadow map, for tests -------------------- */
+
+/* The map the renderer made last (its CPU copy, or read back from the
+ * device) into out (hf_width x hf_height); false with e set on failure. */
+bool rt_renderer_shadow_read(rt_renderer *r, uint8_t *out, rt_error *e);
+/* The CPU reference (rt_shadow_map, whole) for the renderer's sun and
+ * current heights. */
+void rt_renderer_shadow_reference(rt_renderer *r, uint8_t *out);
+
 /* ---- light.c: the frame's lighting fields ------------------------------ */
 
 /* The frame's sun, sky, fog and exposure; fog towards `background`. */

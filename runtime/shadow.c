@@ -3,12 +3,13 @@
  * the prelude's splat_light samples bilinearly at the shaded point and
  * multiplies the sun term by (every shading path alike).
  *
- * Each texel centre marches towards the sun over the heightfield: half a
- * texel a step, the terrain read as the shaders read it (bilinear between
- * texel centres, rt_height_at), stepping over every quadtree node whose
- * maximum height (rt_bounds, which craters keep current) lies safely below
- * the ray, and stopping once the ray is above the whole terrain or off it.
- * The visibility is the fraction of the sun's disc (0.27 degrees of
+ * Each texel centre marches towards the sun over the heightfield: samples
+ * every half texel (t = k step, k = 1, 2, ...), the terrain read as the
+ * shaders read it (bilinear between texel centres, rt_height_at), stepping
+ * over every quadtree node whose maximum height (rt_bounds, which craters
+ * keep current) lies so far below the ray that no sample in it could lower
+ * the result, and stopping once the ray is above the whole terrain or off
+ * it.  The visibility is the fraction of the sun's disc (0.27 degrees of
  * radius) above the horizon the march found: 0.5 + m / (2 tan r), clamped,
  * with m the lowest clearance angle's tangent along the ray.
  *
@@ -17,15 +18,20 @@
  * texels (rt_shadow_crater_rect; render.shadow checks the result equals
  * the whole map made again).
  *
- * Why a map marched on the CPU, not a per-pixel march nor a horizon map:
- * the sun and the heights change only on an event (the viewer's sun keys,
- * a light override, a crater), so a frame pays one texture tap per pixel
- * and nothing else; the CPU has the heights and bounds destruction keeps,
- * and its result is exact and the same on every device (rows split over
- * the CPU's cores).  A horizon map
- * would store many directions to make turning the sun free, at many times
- * the memory, for an event that is rare.  The cost of an update is in the
- * benchmark (bench_shadow: milliseconds per map on colorado). */
+ * This is the reference: the renderer marches the same samples on the
+ * device by default (shadow_gpu.c, over a pyramid of texel maxima instead
+ * of the quadtree: the skips pass only over samples that cannot change the
+ * result, so the bound used does not change the map; render.shadow_gpu
+ * holds the two within 1/255), and here with rt_render_desc.shadow
+ * RT_SHADOW_CPU (splatview --shadow cpu, SPLAT_SHADOW=cpu).
+ *
+ * Why a map, not a per-pixel march nor a horizon map: the sun and the
+ * heights change only on an event (the viewer's sun keys, a light
+ * override, a crater), so a frame pays one texture tap per pixel and
+ * nothing else.  A horizon map would store many directions to make turning
+ * the sun free, at many times the memory, for an event that is rare.  The
+ * cost of an update is in the benchmark (splatbench shadow: the CPU and
+ * the device's march on colorado, side by side). */
 #include "rt_internal.h"
 
 #include <math.h>
@@ -63,10 +69,12 @@ static double cell_exit(const march *m, double x, double z, int cx, int cz, cons
 }
 
 /* How far the ray at (x, z), height `ray`, t along, may skip: the exit of
- * the largest quadtree node around it whose highest point lies below the
- * ray by more than the sun's radius all the way (the ray only rises, so
- * (ray - hmax) / (t + exit) bounds its clearance there); 0: none. */
-static double skip(const march *m, double x, double z, double ray, double t)
+ * the largest quadtree node around it whose samples cannot lower the
+ * lowest clearance below `thr` (min(lowest so far, tan of the sun's
+ * radius): the ray only rises, so past t a sample's clearance is at least
+ * (ray - hmax) / (t + exit) where that is positive, (ray - hmax) / t
+ * where it is not); 0: none. */
+static double skip(const march *m, double x, double z, double ray, double t, double thr)
 {
     const rt_bounds *b = m->b;
     double best = 0, size[2] = { m->leaf[0], m->leaf[1] };
@@ -76,29 +84,36 @@ static double skip(const march *m, double x, double z, double ray, double t)
         cz = cz < b->height[L] ? cz : b->height[L] - 1;
         double hmax = b->hmax[L][(size_t)cz * (size_t)b->width[L] + (size_t)cx];
         double exit = cell_exit(m, x, z, cx, cz, size);
-        if (!(ray - hmax > SUN_TAN * (t + exit)))
+        if (!(ray - hmax > thr * (thr >= 0 ? t + exit : t)))
             break;
         best = exit;
     }
     return best;
 }
 
+/* The samples lie at t = k step, k = 1, 2, ... whatever is skipped, and
+ * a skip passes over only samples that cannot lower the result (skip), so
+ * the map is the same over any bound of the heights: the GPU march
+ * (shadow_gpu.c) skips over a pyramid of texel maxima and makes this map.
+ * The march ends off the terrain or above its highest point (the top of
+ * the quadtree's bounds, which craters keep current). */
 static uint8_t visibility(const march *m, double x0, double z0, double y0, double step)
 {
     const rt_pack *p = m->p;
     double lowest = INFINITY;   /* tan of the lowest clearance */
-    for (double t = step; lowest > -SUN_TAN;) {
+    for (double k = 1; lowest > -SUN_TAN;) {
+        double t = k * step;
         double x = x0 + m->dir[0] * t, z = z0 + m->dir[1] * t, ray = y0 + m->rise * t;
         if (x < 0 || z < 0 || x > p->size[0] || z > p->size[1] || ray > m->top)
             break;
-        double jump = skip(m, x, z, ray, t);
+        double jump = skip(m, x, z, ray, t, fmin(lowest, SUN_TAN));
         if (jump > 0) {
-            t += fmax(jump, step * 0.5) + 1e-9;
+            k = fmax(k + 1, floor((t + jump) / step) + 1);
             continue;
         }
         double h = rt_height_at(m->heights, p, x, z);
         lowest = fmin(lowest, (ray - h) / t);
-        t += step;
+        k++;
     }
     double v = isinf(lowest) ? 1.0 : 0.5 + lowest / (2.0 * SUN_TAN);
     v = v < 0 ? 0 : v > 1 ? 1 : v;

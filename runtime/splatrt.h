@@ -368,6 +368,14 @@ typedef enum rt_pixel_sort {
                             subgroup arithmetic in compute (else off)    */
 } rt_pixel_sort;
 
+/* Where the terrain's shadow map is marched (shadow.c, shadow_gpu.c); the
+ * two maps agree within 1/255 (render.shadow_gpu). */
+typedef enum rt_shadow_path {
+    RT_SHADOW_AUTO = 0,  /* on the device; $SPLAT_SHADOW=cpu|gpu overrides */
+    RT_SHADOW_GPU,       /* a compute pass over a pyramid of maxima        */
+    RT_SHADOW_CPU,       /* the reference march, rows over the CPU's cores */
+} rt_shadow_path;
+
 typedef enum rt_reference {
     RT_REF_NONE = 0,      /* per-combination composites                     */
     RT_REF_MULTIPASS,     /* one blended pass per material + resolve        */
@@ -408,6 +416,8 @@ typedef struct rt_render_desc {
     bool         sun_set, exposure_set, fog_set;
     double       sun[2], exposure, fog_density;
     bool         no_shadows;        /* the sun casts none (splatview --no-shadows) */
+    rt_shadow_path shadow;          /* where the shadow map is marched
+                                       (splatview --shadow cpu|gpu)         */
     bool         no_undergrowth;    /* draw no undergrowth (--no-undergrowth)  */
     bool         no_distance_classes; /* shade with the combinations only, not
                                        their distance classes (PACK.md;
@@ -465,8 +475,11 @@ typedef struct rt_frame_stats {
     int    spirv_cached;      /* compute modules so far from the SPIR-V cache */
     int    spirv_compiled;    /* ... and compiled from GLSL (glslang)        */
     int    pipelines_pending; /* being made on workers after this frame     */
-    double shadow_ms;         /* CPU ms of a new shadow map (the sun moved or
-                                 a crater changed heights); 0: none needed  */
+    double shadow_ms;         /* wall ms of a new shadow map (the sun moved or
+                                 a crater changed heights), marched on the
+                                 CPU or submitted to the device and waited
+                                 for; 0: none needed                        */
+    bool   shadow_gpu;        /* the map is marched on the device          */
     rt_ug_stats undergrowth;  /* cells, instances, generation and draw     */
 } rt_frame_stats;
 
@@ -633,6 +646,9 @@ typedef struct rt_viewer_desc {
     int         width, height;
     const char *script;       /* "frames=30;screenshot=out.png;quit" or NULL  */
     rt_render_desc render;
+    bool        shading_set;  /* render.shading asked for; else the screen
+                                 path where the pack has compute variants
+                                 and no multi-pass reference, as headless */
     bool        have_camera;  /* camera below is set; else preset/default   */
     rt_camera   camera;
     const char *preset;       /* manifest camera name or NULL               */

@@ -53,6 +53,10 @@ static void usage(FILE *f)
         "  --exposure EV             exposure in stops (default: the scene's, or 0)\n"
         "  --fog-density D           fog per metre at the fog height (0: none)\n"
         "  --no-shadows              the sun casts no terrain shadows\n"
+        "  --shadow gpu|cpu          where the shadow map is marched when the sun\n"
+        "                            moves or a crater lands: a compute pass (the\n"
+        "                            default; $SPLAT_SHADOW=cpu|gpu sets it) or the\n"
+        "                            CPU reference\n"
         "  --no-undergrowth          draw no undergrowth (grass, plants, stones)\n"
         "  --async-pipelines on|off  screen path: make compute pipelines on worker\n"
         "                            threads, the uber-shader drawing their tiles\n"
@@ -131,6 +135,7 @@ typedef struct opts {
     rt_shading shading;
     bool shading_set;      /* --shading given; else screen where the pack can */
     rt_screen_depth screen_depth;
+    rt_shadow_path shadow;
     rt_pixel_sort pixel_sort;
     const char *params[64];
     int nparams;
@@ -348,6 +353,16 @@ static int parse_args(int argc, char **argv, opts *o)
                 fprintf(stderr, "splatview: --shading expects forward or screen, found '%s'\n", v);
                 return 2;
             }
+        } else if (!strcmp(a, "--shadow")) {
+            NEED();
+            if (!strcmp(v, "gpu"))
+                o->shadow = RT_SHADOW_GPU;
+            else if (!strcmp(v, "cpu"))
+                o->shadow = RT_SHADOW_CPU;
+            else {
+                fprintf(stderr, "splatview: --shadow expects gpu or cpu, found '%s'\n", v);
+                return 2;
+            }
         } else if (!strcmp(a, "--screen-depth")) {
             NEED();
             if (!strcmp(v, "auto"))
@@ -547,6 +562,28 @@ static rt_tonemap tonemap_for(splat_view v)
     return rt_view_tonemap(v);
 }
 
+/* The shading path asked for: --shading, else $SPLAT_SHADING
+ * (forward|screen); false: neither, and the default is the screen-space
+ * path wherever the pack has its compute variants and no --reference
+ * multipass (faster on both devices: tests/bench/RESULTS.md), in the
+ * window as headless. */
+static bool shading_chosen(const opts *o, rt_shading *out)
+{
+    if (o->shading_set) {
+        *out = o->shading;
+        return true;
+    }
+    const char *env = getenv("SPLAT_SHADING");
+    if (env && (!strcmp(env, "forward") || !strcmp(env, "screen"))) {
+        *out = !strcmp(env, "screen") ? RT_SHADING_SCREEN : RT_SHADING_FORWARD;
+        return true;
+    }
+    if (env && *env)
+        fprintf(stderr, "splatview: warning: SPLAT_SHADING='%s' is neither forward nor screen; "
+                "ignored\n", env);
+    return false;
+}
+
 static int headless(const opts *o)
 {
     rt_error e = { 0 };
@@ -577,22 +614,14 @@ static int headless(const opts *o)
         .width = o->width, .height = o->height, .reference = o->ref,
         .pipeline_cache = o->cache, .no_stitch = o->no_stitch,
         .no_cull = o->no_cull, .lod_pixels = o->lod_pixels, .no_shadows = o->no_shadows,
+        .shadow = o->shadow,
         .no_undergrowth = o->no_undergrowth,
         .no_distance_classes = o->no_distance_classes,
         .async_pipelines = o->async_pipelines == 1,
         .destruction_pool = o->destruction_pool, .shading = o->shading,
         .screen_depth = o->screen_depth, .pixel_sort = o->pixel_sort, .far_atlas_distance = o->far_distance,
     };
-    /* the default: $SPLAT_SHADING (forward|screen), else the screen-space
-     * path wherever the pack has its compute variants (faster on both
-     * devices: tests/bench/RESULTS.md) */
-    const char *env = getenv("SPLAT_SHADING");
-    if (!o->shading_set && env && *env && strcmp(env, "forward") && strcmp(env, "screen"))
-        fprintf(stderr, "splatview: warning: SPLAT_SHADING='%s' is neither forward nor screen; "
-                "ignored\n", env);
-    if (!o->shading_set && env && (!strcmp(env, "forward") || !strcmp(env, "screen")))
-        rd.shading = !strcmp(env, "screen") ? RT_SHADING_SCREEN : RT_SHADING_FORWARD;
-    else if (!o->shading_set)
+    if (!shading_chosen(o, &rd.shading))
         rd.shading = pack.uber_compute && o->ref != RT_REF_MULTIPASS ? RT_SHADING_SCREEN
                                                                      : RT_SHADING_FORWARD;
     light_options(o, &rd);
@@ -689,8 +718,8 @@ static int headless(const opts *o)
         if (o->no_shadows)
             printf("shadow map: off\n");
         else
-            printf("shadow map cpu ms: %.2f (when the sun moves or a crater lands; "
-                   "per frame a texture tap)\n", shadow_ms);
+            printf("shadow map %s ms: %.2f (when the sun moves or a crater lands; "
+                   "per frame a texture tap)\n", st.shadow_gpu ? "gpu" : "cpu", shadow_ms);
         if (pack.ug.nslots > 0 && !o->no_undergrowth && view == SPLAT_VIEW_FINAL) {
             double um, ul, uh;
             summary(ug_draw, o->frames, &um, &ul, &uh);
@@ -844,13 +873,15 @@ int main(int argc, char **argv)
         .height = o.height ? o.height : 720, .script = o.script,
         .render = { .reference = o.ref, .pipeline_cache = o.cache, .lod_pixels = o.lod_pixels,
                     .shading = o.shading, .screen_depth = o.screen_depth, .pixel_sort = o.pixel_sort,
-                    .no_shadows = o.no_shadows, .no_undergrowth = o.no_undergrowth,
+                    .no_shadows = o.no_shadows, .shadow = o.shadow,
+                    .no_undergrowth = o.no_undergrowth,
                     .far_atlas_distance = o.far_distance,
                     .no_distance_classes = o.no_distance_classes,
                     .async_pipelines = o.async_pipelines != 0 },
         .view = SPLAT_VIEW_FINAL,
     };
     memcpy(vd.render.clear, o.clear, sizeof o.clear);
+    vd.shading_set = shading_chosen(&o, &vd.render.shading);
     light_options(&o, &vd.render);
     vd.have_camera = o.have_camera || o.preset;
     if (o.have_camera) {

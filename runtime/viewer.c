@@ -894,7 +894,7 @@ int rt_viewer_run(const rt_viewer_desc *desc)
     rd.width = (int)v->extent.width;
     rd.height = (int)v->extent.height;
     /* Screen-capable whenever the pack has compute variants, so the G key
-     * can switch paths; forward unless --shading screen asked for it. */
+     * can switch paths. */
     rd.shading = v->pack->uber_compute ? RT_SHADING_SCREEN : RT_SHADING_FORWARD;
     bool made = rt_renderer_create(&v->dev, v->pack, &rd, &v->r, &e);
     if (!made && rd.shading == RT_SHADING_SCREEN && desc->render.shading != RT_SHADING_SCREEN) {
@@ -904,7 +904,15 @@ int rt_viewer_run(const rt_viewer_desc *desc)
     }
     if (!made || !make_tonemap(v, &e))
         goto done;
-    rt_renderer_set_shading(v->r, desc->render.shading);
+    /* the path asked for, else screen where the pack can (splatview's
+     * headless default) */
+    rt_shading want = desc->render.shading;
+    if (!desc->shading_set)
+        want = v->pack->uber_compute && desc->render.reference != RT_REF_MULTIPASS
+                   ? RT_SHADING_SCREEN : RT_SHADING_FORWARD;
+    rt_renderer_set_shading(v->r, want);
+    printf("splatview: %s shading\n",
+           rt_renderer_shading(v->r) == RT_SHADING_SCREEN ? "screen-space" : "forward");
     rt_renderer_set_view(v->r, v->view, v->material);
     /* the scene to watch: --scene, else the manifest's scene.source */
     char scene_buf[2048];

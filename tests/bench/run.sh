@@ -539,6 +539,24 @@ far_bake() {   # SCENE N
     fi
 } > "$OUT/far_bake.csv"
 
+# ---- the shadow map: the CPU reference against the device --------------------------
+# (splatbench shadow: the two marches interleaved, the sun turned a little
+# between maps so each is made whole; medians of wall ms per map)
+shadow_map() {   # SCENE RUNS
+    "$BENCH" shadow --pack "$W/$1" --runs "$2" > "$W/shadow.txt"
+    sed -n 's/^shadow map \([a-z]*\) ms: median \([0-9.]*\)  p10 \([0-9.]*\)  p90 \([0-9.]*\)$/\1,\2,\3,\4/p' \
+        "$W/shadow.txt" | sed "s/^/$1,/"
+}
+{
+    echo "scene,march,median_ms,p10_ms,p90_ms"
+    if [ "$MODE" = smoke ]; then
+        shadow_map minimal 2
+    else
+        shadow_map colorado 5
+        shadow_map minimal 5
+    fi
+} > "$OUT/shadow.csv"
+
 # ---- figures printed by tests: sparse masks, quadtree selection -----------------
 : > "$OUT/sparse.txt"
 : > "$OUT/quadtree.txt"

@@ -64,6 +64,9 @@
  *       inside the GPU timestamps).
  *   splatbench far-bake --pack P [--far-atlas N] [--runs K] [--out PREFIX]
  *       the far atlas baked on the device (cmd_far_bake says more).
+ *   splatbench shadow --pack P [--runs K] [--sun AZ,EL]
+ *       the shadow map marched on the CPU and on the device, side by side
+ *       (cmd_shadow says more).
  *   splatbench upscale IN.png K OUT
  *       K times the texels per side, bilinear: a 16-bit PNG becomes raw
  *       little-endian R16 (OUT), an 8-bit one an 8-bit PNG (nearest).
@@ -220,7 +223,7 @@ typedef struct variant {
     bool         ug;        /* draw the undergrowth                         */
     double       ug_radius; /* its radius (m); 0: the runtime's default     */
     double       far;       /* screen: the far atlas's distance (m); 0: off */
-    double       shadow_ms; /* CPU ms of the shadow map (the first frame)   */
+    double       shadow_ms; /* ms of the shadow map (the first frame)       */
     double      *ug_gen, *ug_draw; /* per timed frame, GPU ms               */
     long         ug_cells;  /* cells generated over the timed frames        */
     rt_ug_stats  ug_last;   /* the last frame's                             */
@@ -1050,10 +1053,124 @@ done:
     return status;
 }
 
+/* splatbench shadow --pack P [--runs K] [--sun AZ,EL]: the terrain's
+ * shadow map marched on the CPU (shadow.c, the reference) and on the
+ * device (shadow_gpu.c), side by side: K maps each, the two paths
+ * interleaved (map k of the CPU, then of the device, so a change of machine
+ * load hits both), the sun turned by 0.01 degree between maps so each is
+ * made whole.  Prints one CSV row per map, then per path the median, p10
+ * and p90 wall milliseconds, the ratio of the medians, and the largest
+ * difference of the last two maps (1/255). */
+static int cmd_shadow(int argc, char **argv)
+{
+    const char *pack_dir = NULL;
+    int runs = 5;
+    double sun[2] = { 144, 21 };
+    bool sun_set = false;
+    for (int i = 2; i < argc; i++) {
+        const char *a = argv[i], *next = i + 1 < argc ? argv[i + 1] : NULL;
+        if (!strcmp(a, "--pack") && next)
+            pack_dir = argv[++i];
+        else if (!strcmp(a, "--runs") && next)
+            runs = atoi(argv[++i]);
+        else if (!strcmp(a, "--sun") && next && sscanf(argv[++i], "%lf,%lf", &sun[0], &sun[1]) == 2)
+            sun_set = true;
+        else {
+            fprintf(stderr, "usage: splatbench shadow --pack P [--runs K] [--sun AZ,EL]\n");
+            return 2;
+        }
+    }
+    if (!pack_dir || runs < 1) {
+        fprintf(stderr, "splatbench shadow: --pack and K >= 1 needed\n");
+        return 2;
+    }
+    rt_error e = {0};
+    rt_pack p;
+    rt_device dev;
+    rt_renderer *r[2] = { NULL, NULL };
+    bool have_pack = false, have_dev = false;
+    int status = 1;
+    double *ms = NULL;
+    uint8_t *map[2] = { NULL, NULL };
+    static const char *const names[2] = { "cpu", "gpu" };
+    if (!(have_pack = rt_pack_load(&p, pack_dir, &e)) ||
+        !(have_dev = rt_device_create(&dev, NULL, &e)))
+        goto done;
+    size_t n = (size_t)p.hf_width * (size_t)p.hf_height;
+    ms = xcalloc((size_t)runs * 2, sizeof *ms);
+    map[0] = xcalloc(n, 1);
+    map[1] = xcalloc(n, 1);
+    for (int k = 0; k < 2; k++) {
+        rt_render_desc rd = { .width = 8, .height = 8, .no_undergrowth = true,
+                              .shading = RT_SHADING_FORWARD,
+                              .shadow = k ? RT_SHADOW_GPU : RT_SHADOW_CPU };
+        if (!rt_renderer_create(&dev, &p, &rd, &r[k], &e))
+            goto done;
+    }
+    rt_light l = *rt_renderer_light(r[0]);
+    if (sun_set)
+        memcpy(l.sun, sun, sizeof sun);
+    printf("device %s, heightfield %d x %d, sun %g/%g, %d maps per path\n", dev.props.deviceName,
+           p.hf_width, p.hf_height, l.sun[0], l.sun[1], runs);
+    rt_camera cam;
+    rt_default_camera(&p, &cam);
+    /* an untimed map each: the device's pyramid and pipeline are made,
+     * llvmpipe compiles the shader at its first dispatch */
+    for (int k = 0; k < 2; k++) {
+        rt_renderer_set_light(r[k], &l);
+        if (!rt_renderer_frame(r[k], &cam, NULL, &e))
+            goto done;
+    }
+    printf("run,path,ms\n");
+    for (int i = 0; i < runs; i++) {
+        l.sun[0] += 0.01;
+        for (int k = 0; k < 2; k++) {
+            rt_frame_stats st;
+            rt_renderer_set_light(r[k], &l);
+            if (!rt_renderer_frame(r[k], &cam, &st, &e))
+                goto done;
+            ms[k * runs + i] = st.shadow_ms;
+            printf("%d,%s,%.2f\n", i + 1, names[k], st.shadow_ms);
+        }
+    }
+    int worst = 0;
+    for (int k = 0; k < 2; k++)
+        if (!rt_renderer_shadow_read(r[k], map[k], &e))
+            goto done;
+    for (size_t i = 0; i < n; i++) {
+        int d = abs((int)map[0][i] - (int)map[1][i]);
+        worst = d > worst ? d : worst;
+    }
+    double med[2], lo[2], hi[2];
+    for (int k = 0; k < 2; k++) {
+        percentiles(ms + k * runs, runs, &med[k], &lo[k], &hi[k]);
+        printf("shadow map %s ms: median %.1f  p10 %.1f  p90 %.1f\n", names[k], med[k], lo[k],
+               hi[k]);
+    }
+    printf("shadow map cpu / gpu: %.2fx; largest difference %d/255\n", med[0] / med[1], worst);
+    status = 0;
+done:
+    if (e.msg)
+        fprintf(stderr, "splatbench: %s\n", e.msg);
+    rt_error_clear(&e);
+    rt_renderer_destroy(r[0]);
+    rt_renderer_destroy(r[1]);
+    if (have_dev)
+        rt_device_destroy(&dev);
+    if (have_pack)
+        rt_pack_free(&p);
+    free(ms);
+    free(map[0]);
+    free(map[1]);
+    return status;
+}
+
 int main(int argc, char **argv)
 {
     if (argc >= 2 && !strcmp(argv[1], "far-bake"))
         return cmd_far_bake(argc, argv);
+    if (argc >= 2 && !strcmp(argv[1], "shadow"))
+        return cmd_shadow(argc, argv);
     if (argc >= 2 && !strcmp(argv[1], "render"))
         return cmd_render(argc, argv);
     if (argc >= 2 && !strcmp(argv[1], "upscale"))
@@ -1062,6 +1179,6 @@ int main(int argc, char **argv)
         return cmd_compare(argc, argv);
     if (argc >= 2 && !strcmp(argv[1], "analytic-hf"))
         return cmd_analytic_hf(argc, argv);
-    fprintf(stderr, "usage: splatbench render|upscale|compare|far-bake ... (see tests/bench/splatbench.c)\n");
+    fprintf(stderr, "usage: splatbench render|upscale|compare|far-bake|shadow ... (see tests/bench/splatbench.c)\n");
     return 2;
 }

@@ -198,6 +198,17 @@ if [ -s "$O/far_bake.csv" ]; then
                 ($6 > 0 ? cpu[k] / $6 : 0) }' "$O/far_bake.csv"
     echo
 fi
+if [ -s "$O/shadow.csv" ]; then
+    echo "## Shadow map: the CPU reference against the device (wall ms per map, medians)"
+    echo
+    echo "| scene | CPU (p10-p90) | device (p10-p90) | CPU / device |"
+    echo "|---|---:|---:|---:|"
+    awk -F, 'NR > 1 { m[$1 "," $2] = $3; r[$1 "," $2] = $4 "-" $5; s[$1] = 1 }
+        END { for (k in s) printf "| %s | %.1f (%s) | %.1f (%s) | %.2fx |\n", k, m[k ",cpu"],
+              r[k ",cpu"], m[k ",gpu"], r[k ",gpu"],
+              (m[k ",gpu"] > 0 ? m[k ",cpu"] / m[k ",gpu"] : 0) }' "$O/shadow.csv"
+    echo
+fi
 if [ -s "$O/sparse.txt" ]; then
     echo "## Sparse painted masks (tests/sparse/gpu_sparse on this device)"
     echo

@@ -158,7 +158,8 @@ viewer)
     command -v xvfb-run > /dev/null || { echo "SKIP: no xvfb-run"; exit 77; }
     rm -f "$OUT/shot.png"
     rm -f "$OUT/after.png"
-    xvfb-run -a -s "-screen 0 640x480x24" "$SV" "$PACK" --size 320x200 \
+    # the window's own default path (not the SPLAT_SHADING above)
+    env -u SPLAT_SHADING xvfb-run -a -s "-screen 0 640x480x24" "$SV" "$PACK" --size 320x200 \
         --script "frames=10;view=combos;frames=5;screenshot=$OUT/shot.png;key=Q;screenshot=$OUT/after.png" \
         > "$OUT/viewer.log" 2>&1
     rc=$?
@@ -166,6 +167,12 @@ viewer)
     [ $rc = 0 ] || fail "viewer exit $rc"
     "$IC" nonuniform "$OUT/shot.png" || fail "viewer screenshot is uniform"
     [ -e "$OUT/after.png" ] && fail "the viewer went on after the Q key"
+    # the window's path is headless's: screen-space where the pack has
+    # compute variants (issue 33)
+    want=forward
+    [ -e "$PACK/shaders/uber.comp" ] && want=screen-space
+    grep -q "^splatview: $want shading" "$OUT/viewer.log" ||
+        fail "the window did not open on the $want path"
     ;;
 hot_reload_search)
     # hot reload resolves imports as `splatc build` does: a scene outside

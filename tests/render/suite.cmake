@@ -41,6 +41,12 @@ if(TARGET splatrt AND TARGET splatview)
               $<TARGET_FILE:imgcheck> ${RENDER_OUT}/minimal ${RENDER_OUT}/out)
     set_tests_properties(render.real_minimal PROPERTIES LABELS "render;asan"
       FIXTURES_REQUIRED minimal_pack ENVIRONMENT "SPLAT_VALIDATE=1" TIMEOUT 300)
+    # the window on a pack with compute variants: the screen-space path
+    add_test(NAME render.viewer_minimal
+      COMMAND sh ${RENDER_DIR}/run.sh viewer $<TARGET_FILE:splatview>
+              $<TARGET_FILE:imgcheck> ${RENDER_OUT}/minimal ${RENDER_OUT}/out_viewer_minimal)
+    set_tests_properties(render.viewer_minimal PROPERTIES LABELS render SKIP_RETURN_CODE 77
+      FIXTURES_REQUIRED minimal_pack ENVIRONMENT "SPLAT_VALIDATE=1" TIMEOUT 300)
     # hot reload of an edited scene; _search: imports found only through
     # -I or $SPLATC_PATH, as splatc build finds them; _far: the far atlas
     # rebaked on the viewer's device
@@ -152,6 +158,15 @@ if(TARGET splatrt AND TARGET splatview)
       set_tests_properties(render.${t} PROPERTIES LABELS render TIMEOUT 600
                            ENVIRONMENT "SPLAT_VALIDATE=1")
     endforeach()
+    # the shadow map marched on the device against the CPU reference within
+    # 1/255: three suns and a crater (test_shadow_gpu.c)
+    add_executable(test_shadow_gpu ${RENDER_DIR}/test_shadow_gpu.c)
+    target_link_libraries(test_shadow_gpu splatrt splatc m)
+    file(MAKE_DIRECTORY ${RENDER_OUT}/shadow_gpu)
+    add_test(NAME render.shadow_gpu COMMAND test_shadow_gpu ${RENDER_OUT}/shadow_gpu
+             WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
+    set_tests_properties(render.shadow_gpu PROPERTIES LABELS "render;gpu;asan" TIMEOUT 600
+                         ENVIRONMENT "SPLAT_VALIDATE=1")
     # distance classes against the über-shader at 20 random cameras on
     # colorado, both paths (test_dclass.c)
     add_executable(test_dclass ${RENDER_DIR}/test_dclass.c)
