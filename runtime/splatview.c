@@ -55,6 +55,9 @@ static void usage(FILE *f)
         "  --no-undergrowth          draw no undergrowth (grass, plants, stones)\n"
         "  --no-distance-classes     shade with the combinations only, not their\n"
         "                            distance classes (compiler/PACK.md)\n"
+        "  --uncovered uber|split    forward coarse patches no compiled combination\n"
+        "                            covers: drawn with the uber-shader (default) or\n"
+        "                            split down to nodes that have one\n"
         "  --light KEY=V[,V,V]       any key of the scene's light block (sun, sun_color,\n"
         "                            intensity, sky, fog_density, fog_height, exposure)\n"
         "  --clear r,g,b             background colour (linear)\n"
@@ -117,6 +120,7 @@ typedef struct opts {
     bool headless, stats, have_camera, have_look, no_stitch, no_cull, no_shadows;
     bool no_undergrowth;
     bool no_distance_classes;
+    bool split_uncovered;
     int width, height, frames;
     double camera[3], look[3], lod_pixels;
     double far_distance;   /* --far-atlas-distance */
@@ -236,6 +240,14 @@ static int parse_args(int argc, char **argv, opts *o)
             o->no_undergrowth = true;
         } else if (!strcmp(a, "--no-distance-classes")) {
             o->no_distance_classes = true;
+        } else if (!strcmp(a, "--uncovered")) {
+            NEED();
+            if (!strcmp(v, "split") || !strcmp(v, "uber")) {
+                o->split_uncovered = !strcmp(v, "split");
+            } else {
+                fprintf(stderr, "splatview: --uncovered expects split or uber, found '%s'\n", v);
+                return 2;
+            }
         } else if (!strcmp(a, "-o")) {
             NEED(); o->out = v;
         } else if (!strcmp(a, "--float-out")) {
@@ -565,6 +577,7 @@ static int headless(const opts *o)
         .no_cull = o->no_cull, .lod_pixels = o->lod_pixels, .no_shadows = o->no_shadows,
         .no_undergrowth = o->no_undergrowth,
         .no_distance_classes = o->no_distance_classes,
+        .split_uncovered = o->split_uncovered,
         .destruction_pool = o->destruction_pool, .shading = o->shading,
         .screen_depth = o->screen_depth, .pixel_sort = o->pixel_sort, .far_atlas_distance = o->far_distance,
     };
@@ -644,6 +657,9 @@ static int headless(const opts *o)
         if (!st.screen) {
             printf("distance classes: %d of %d patches\n", st.class_patches, st.patches);
             printf("far atlas: %d of %d patches\n", st.far_patches, st.patches);
+            printf("uber-shader fallback: %d of %d patches (no compiled combination "
+                   "covers their node)\n", st.uber_patches, st.patches);
+            printf("uncovered nodes split: %d\n", st.split_uncovered);
         }
         if (gm >= 0)
             printf("gpu ms/frame: median %.3f  p10 %.3f  p90 %.3f\n", gm, gl, gh);
@@ -804,7 +820,8 @@ int main(int argc, char **argv)
                     .shading = o.shading, .screen_depth = o.screen_depth, .pixel_sort = o.pixel_sort,
                     .no_shadows = o.no_shadows, .no_undergrowth = o.no_undergrowth,
                     .far_atlas_distance = o.far_distance,
-                    .no_distance_classes = o.no_distance_classes },
+                    .no_distance_classes = o.no_distance_classes,
+                    .split_uncovered = o.split_uncovered },
         .view = SPLAT_VIEW_FINAL,
     };
     memcpy(vd.render.clear, o.clear, sizeof o.clear);
