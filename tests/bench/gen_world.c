@@ -32,7 +32,7 @@
 static int usage(void)
 {
     fprintf(stderr, "usage: gen_world OUTDIR BIOMES MATERIALS [SIZE [CELL]]\n"
-                    "  BIOMES 1..64, MATERIALS 1..64 per biome (BIOMES x MATERIALS <= 255),\n"
+                    "  BIOMES 1..64, MATERIALS 1..64 per biome (BIOMES x MATERIALS <= 511),\n"
                     "  SIZE 64..4096 texels (default 512), CELL leaf cell texels (default 16)\n");
     return 2;
 }
@@ -76,7 +76,7 @@ int main(int argc, char **argv)
     const char *dir = argv[1];
     int B = atoi(argv[2]), M = atoi(argv[3]);
     int N = argc > 4 ? atoi(argv[4]) : 512, cell = argc > 5 ? atoi(argv[5]) : 16;
-    if (B < 1 || B > 64 || M < 1 || M > 64 || B * M > 255 || N < 64 || N > 4096 ||
+    if (B < 1 || B > 64 || M < 1 || M > 64 || B * M > 511 || N < 64 || N > 4096 ||
         cell < 1 || (cell & (cell - 1)) || cell > N)
         return usage();
     const double metres = 4.0 * N, max_height = 0.25 * metres;

@@ -11,7 +11,7 @@
 #include "abi.h"
 #include "structure.h"
 
-enum { WORDS = 4 };                   /* 256 materials */
+enum { WORDS = 8 };                   /* 512 materials */
 typedef struct mset { uint64_t w[WORDS]; } mset;
 
 static mset set_of(const splat_combo *c)

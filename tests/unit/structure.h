@@ -14,7 +14,7 @@
  *   - every coarse node: SPLAT_COMBO_HOLE where all its cells are holes, else
  *     the smallest of a's combinations covering the union of its leaf cells'
  *     sets (ref's), or SPLAT_COMBO_UBER where none covers it.
- * Scenes of up to 256 materials. */
+ * Scenes of up to 512 materials. */
 #ifndef SPLAT_TEST_STRUCTURE_H
 #define SPLAT_TEST_STRUCTURE_H
 
