@@ -34,13 +34,15 @@
  * Merging (splat_analyze_merged, `splatc build --max-combinations P`):
  * with P > 0 and more leaf combinations than P, clusters of leaf
  * combinations are merged greedily, each step the pair whose union adds
- * the fewest layers over the cells it shades: merging A and B costs
- * (|A u B| - |A|) cells(A) + (|A u B| - |B|) cells(B) cell-layers, the
- * masks those cells evaluate for layers that are absent there (mostly
- * skipped: w = 0), against one pipeline and one dispatch fewer.  Each
- * cluster's union is compiled and its leaf cells point at it.  A subset
- * merged into its superset is the cheapest case: {snow} into {snow,
- * dirt, grass} costs 2 layers per snow cell.
+ * the least work over the cells it shades: merging A and B costs
+ * cells(A) W(B \ A) + cells(B) W(A \ B), where W sums each layer's
+ * weight, 1 + the ir_cost of its mask: what those cells evaluate for
+ * layers that are absent there (the mask, to find w = 0; the surface is
+ * skipped), against one pipeline and one dispatch fewer.  Weighing by
+ * the mask's cost keeps layers whose masks sample textures out of
+ * supersets first.  Each cluster's union is compiled and its leaf cells
+ * point at it.  A subset merged into its superset is the cheapest case:
+ * {snow} into {snow, dirt, grass} costs W(dirt) + W(grass) per snow cell.
  *
  * Example: stack [grass, dirt, cliff] (bottom first), cliff opaque on a steep
  * cell, dirt partial on a sloped one:
@@ -415,13 +417,6 @@ static bool bits_subset(const uint64_t *a, const uint64_t *b, int words)
     return true;
 }
 
-static int bits_count(const uint64_t *bits, int words)
-{
-    int n = 0;
-    for (int w = 0; w < words; w++) n += __builtin_popcountll(bits[w]);
-    return n;
-}
-
 /* The smallest compiled combination whose members hold `u` (fewest
  * materials, then the lowest id), or -1; *exact: it is `u` itself. */
 static int cover(const combo_set *cs, const uint64_t *u, bool *exact)
@@ -484,8 +479,9 @@ static void analyze_level(combo_set *cs, int L, uint64_t **bits)
 /* Clusters of leaf combinations, merged greedily (the file's comment). */
 typedef struct merger {
     int        n, words;
+    const int64_t *weight; /* per scene material: its layer's cost where
+                              it is absent (1 + its mask's ir_cost)       */
     uint64_t  *u;          /* n * words: each cluster's union            */
-    int       *size;       /* materials in the union                      */
     int64_t   *cells;      /* leaf cells the cluster shades               */
     int       *parent;     /* union-find: the cluster a combination is in */
     bool      *alive;
@@ -493,13 +489,23 @@ typedef struct merger {
     int64_t   *bestd;      /* and that merge's cost                       */
 } merger;
 
-/* Cell-layers merging clusters i and j adds. */
+/* The weight of the materials in `a` but not in `b`. */
+static int64_t extra(const merger *m, const uint64_t *a, const uint64_t *b)
+{
+    int64_t sum = 0;
+    for (int w = 0; w < m->words; w++)
+        for (uint64_t x = a[w] & ~b[w]; x; x &= x - 1)
+            sum += m->weight[64 * w + __builtin_ctzll(x)];
+    return sum;
+}
+
+/* What merging clusters i and j adds: each cluster's cells evaluate the
+ * other's layers that it lacks (their masks, mostly to find w = 0), in
+ * weight units per cell. */
 static int64_t merge_cost(const merger *m, int i, int j)
 {
     const uint64_t *a = m->u + (size_t)i * m->words, *b = m->u + (size_t)j * m->words;
-    int n = 0;
-    for (int w = 0; w < m->words; w++) n += __builtin_popcountll(a[w] | b[w]);
-    return (int64_t)(n - m->size[i]) * m->cells[i] + (int64_t)(n - m->size[j]) * m->cells[j];
+    return extra(m, b, a) * m->cells[i] + extra(m, a, b) * m->cells[j];
 }
 
 static void rescan(merger *m, int i)
@@ -525,21 +531,20 @@ static int find(int *parent, int i)
  * them by the clusters' unions (ids by first occurrence in level 0) and
  * point level 0 at them.  The leaf member bits (`cells`) are left as they
  * are: coarse nodes cover their exact leaves' union. */
-static bool merge(combo_set *cs, int max, const splat_scene *s, sg_diags *d)
+static bool merge(combo_set *cs, int max, const int64_t *weight, const splat_scene *s,
+                  sg_diags *d)
 {
     splat_analysis *a = cs->a;
     int n = a->ncombos, words = cs->words;
-    merger m = { .n = n, .words = words };
+    merger m = { .n = n, .words = words, .weight = weight };
     m.u = xcalloc((size_t)n * words, sizeof *m.u);
     memcpy(m.u, cs->keys, (size_t)n * words * sizeof *m.u);
-    m.size = xcalloc((size_t)n, sizeof *m.size);
     m.cells = xcalloc((size_t)n, sizeof *m.cells);
     m.parent = xcalloc((size_t)n, sizeof *m.parent);
     m.alive = xcalloc((size_t)n, sizeof *m.alive);
     m.best = xcalloc((size_t)n, sizeof *m.best);
     m.bestd = xcalloc((size_t)n, sizeof *m.bestd);
     for (int i = 0; i < n; i++) {
-        m.size[i] = a->combos[i].nmaterials;
         m.cells[i] = a->combos[i].ncells;
         m.parent[i] = i;
         m.alive[i] = true;
@@ -553,7 +558,6 @@ static bool merge(combo_set *cs, int max, const splat_scene *s, sg_diags *d)
         uint64_t *ui = m.u + (size_t)i * words;
         const uint64_t *uj = m.u + (size_t)j * words;
         for (int w = 0; w < words; w++) ui[w] |= uj[w];
-        m.size[i] = bits_count(ui, words);
         m.cells[i] += m.cells[j];
         m.alive[j] = false;
         m.parent[j] = i;
@@ -603,7 +607,6 @@ static bool merge(combo_set *cs, int max, const splat_scene *s, sg_diags *d)
     free(leaf);
     free(to);
     free(m.u);
-    free(m.size);
     free(m.cells);
     free(m.parent);
     free(m.alive);
@@ -651,8 +654,14 @@ bool splat_analyze_merged(const splat_scene *s, int max_combos, splat_analysis *
     for (int i = 0; i < a->ncombos; i++)
         if (a->combos[i].nmaterials > a->leaf_largest)
             a->leaf_largest = a->combos[i].nmaterials;
-    if (ok && max_combos > 0 && a->ncombos > max_combos)
-        ok = merge(&cs, max_combos, s, d);
+    if (ok && max_combos > 0 && a->ncombos > max_combos) {
+        /* a layer's cost where it is absent: its guard and its mask */
+        int64_t *weight = xcalloc((size_t)(n ? n : 1), sizeof *weight);
+        for (int m = 0; m < n; m++)
+            weight[m] = 1 + (m > 0 ? ir_cost(&mir, &masks[m], 1) : 0);
+        ok = merge(&cs, max_combos, weight, s, d);
+        free(weight);
+    }
     for (int L = 1; ok && L < a->nlevels; L++)
         analyze_level(&cs, L, &bits);
     for (int i = 0; i < a->ncombos; i++)
