@@ -394,7 +394,7 @@ typedef struct rt_passes {
 /* Layouts, the pipeline cache and the resolve pass for RT_REF_MULTIPASS;
  * checks that the shaders `ref` needs are in the pack.  Combination,
  * über-shader and reference pipelines are made on first use
- * (rt_pipelines_combo/uber/ref): a view of colorado needs 20 of its 166,
+ * (rt_pipelines_combo/uber/ref): a view of colorado needs 13-20 of its 137,
  * and lavapipe compiles each in tens of milliseconds or more. */
 bool rt_pipelines_create(rt_device *d, const rt_pack *p, const rt_passes *rp,
                          rt_reference ref, const char *cache_path,
