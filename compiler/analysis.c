@@ -63,7 +63,11 @@
  * Cost: each cell's terrain and painted ranges are O(its footprint), so the
  * whole analysis is linear in texels; masks are bounded once per cell and
  * material (not per texel), on an ir holding only the masks, and only down
- * to the cell's first opaque material.
+ * to the cell's first opaque material.  Covering a coarse node scans the
+ * compiled combinations (after an exact lookup); merging n leaf
+ * combinations computes n^2 pair costs once, then per merge step O(n) and
+ * a rescan of each cluster whose cheapest partner was merged (at 257
+ * materials, 315 combinations: well under a second).
  */
 #include "analysis.h"
 #include "util.h"
