@@ -67,7 +67,8 @@
  * compiled combinations (after an exact lookup); merging n leaf
  * combinations computes n^2 pair costs once, then per merge step O(n) and
  * a rescan of each cluster whose cheapest partner was merged (at 257
- * materials, 315 combinations: well under a second).
+ * materials, 315 combinations merged to 64: 2 s of wall time on the
+ * loaded 2-core VM, against 0.5 s for the rest of the analysis).
  */
 #include "analysis.h"
 #include "util.h"
