@@ -1034,9 +1034,9 @@ static bool patch_far(const rt_renderer *r, const rt_patch *pt, const double cam
 static int select_and_sort(rt_renderer *r, const rt_camera *c, const splat_frame *fr, bool far,
                            bool split, double *select_ms)
 {
-    /* coarse nodes without a combination: the über-shader draws them
-     * (select_and_sort's last group) unless split_uncovered splits them
-     * (but for those the far atlas takes) */
+    /* coarse nodes without a combination: the über-shader draws them (the
+     * last group below), or with `split` they are split down to covered
+     * nodes, except those far enough for the far atlas */
     rt_select_desc sd = { .lod_distance = r->lod_distance, .cull = true,
                           .split_uncovered = split,
                           .uncovered_far = far ? r->desc.far_atlas_distance : 0.0 };
@@ -1050,7 +1050,7 @@ static int select_and_sort(rt_renderer *r, const rt_camera *c, const splat_frame
         for (int i = 0; i < n; i++)
             if (r->qt.patches[i].combo < r->ncombos)
                 r->qt.patches[i].combo = (uint16_t)class_pick(
-                r->p, r->qt.patches[i].combo, &r->qt, &r->qt.patches[i], c->position);
+                    r->p, r->qt.patches[i].combo, &r->qt, &r->qt.patches[i], c->position);
     for (int i = 0; far && i < n; i++)
         if (patch_far(r, &r->qt.patches[i], c->position, r->desc.far_atlas_distance))
             r->qt.patches[i].combo = (uint16_t)r->ncombos;
