@@ -295,6 +295,11 @@ static inline uint32_t splat_ug_pool(double radius)
 /* combos.bin id of a quadtree node that is all hole (PACK.md): it has no
  * combination and is not drawn. */
 #define SPLAT_COMBO_HOLE 0xFFFFu
+/* combos.bin id of a coarse quadtree node (level >= 1) that no compiled
+ * combination covers (PACK.md "combos.bin"): compositions come from leaf
+ * cells only, so the runtime shades it from the far atlas where it may,
+ * else with the über-shader, and counts it (--stats). */
+#define SPLAT_COMBO_UBER 0xFFFEu
 
 /* Specialization constant of every fragment shader that includes the
  * prelude: constant_id SPLAT_SPEC_VIEW, a uint, default

@@ -15,20 +15,39 @@
  * combination is the present materials down to the first opaque one (the
  * bottom material counts as mask 1: always present and opaque).
  *
- * Quadtree nodes above the leaves (level L+1 halves each side, rounding up,
- * until one node remains) take the union of their children: a material is
- * in the node's combination if it is in any child's.  With "present" read as
- * "in the child's combination" that is PACK.md's rule (present if present in
- * any child, opaque only if opaque in all): a child's combination ends at its
- * first opaque material, so a material opaque in every child is the lowest
- * of every child's combination and nothing below it is in the union.  It is
- * sound: on a child's fragments, materials of the union that the child lacks
- * are either absent there (w = 0) or below its opaque one (T = 0).
+ * Only leaf cells make combinations: no pixel needs more than the materials
+ * that overlap in its own leaf cell, so a coarse quadtree node's union is
+ * never compiled (at 256 materials such unions were 317 of 1,140
+ * combinations, the largest with 252 layers; issue 29).  A coarse node
+ * (level L+1 halves each side, rounding up, until one node remains) gets
+ * the union of its leaves' member sets, a material in it if in any leaf's
+ * combination, and is drawn with the smallest compiled combination whose
+ * set holds that union (fewest materials, then the lowest id); where none
+ * does it gets SPLAT_COMBO_UBER and the runtime shades it from the far
+ * atlas or with the über-shader.  A superset is sound on every fragment:
+ * a material of the superset that a leaf's combination lacks is either
+ * absent there (w = 0) or below the leaf's first opaque material (T = 0),
+ * and the superset's bottom layer, whose mask the composite takes as 1, is
+ * either that leaf's own opaque end or below it.  The screen path picks
+ * its tiles' combinations by the same rule (runtime/screen.c).
+ *
+ * Merging (splat_analyze_merged, `splatc build --max-combinations P`):
+ * with P > 0 and more leaf combinations than P, clusters of leaf
+ * combinations are merged greedily, each step the pair whose union adds
+ * the least work over the cells it shades: merging A and B costs
+ * cells(A) W(B \ A) + cells(B) W(A \ B), where W sums each layer's
+ * weight, 1 + the ir_cost of its mask: what those cells evaluate for
+ * layers that are absent there (the mask, to find w = 0; the surface is
+ * skipped), against one pipeline and one dispatch fewer.  Weighing by
+ * the mask's cost keeps layers whose masks sample textures out of
+ * supersets first.  Each cluster's union is compiled and its leaf cells
+ * point at it.  A subset merged into its superset is the cheapest case:
+ * {snow} into {snow, dirt, grass} costs W(dirt) + W(grass) per snow cell.
  *
  * Example: stack [grass, dirt, cliff] (bottom first), cliff opaque on a steep
  * cell, dirt partial on a sloped one:
  *     leaf A: {cliff}            leaf B: {dirt, grass}
- *     parent: {cliff, dirt, grass}
+ *     parent: union {cliff, dirt, grass}, compiled by no leaf: über-shader
  *
  * Holes (scene.h, terrain.holes): a cell whose texels and one-texel ring
  * are all hole is drawn nowhere (the vertex shader clips every vertex that
@@ -38,13 +57,18 @@
  * usual: its hole texels hold heights filled in from their neighbours
  * (terrain.c), which the filters near the hole's edge really read.
  *
- * Combination ids follow first occurrence: level 0 row-major, then each
- * higher level, so the same scene always gives the same ids.
+ * Combination ids follow first occurrence in level 0, row-major, so the
+ * same scene always gives the same ids.
  *
  * Cost: each cell's terrain and painted ranges are O(its footprint), so the
  * whole analysis is linear in texels; masks are bounded once per cell and
  * material (not per texel), on an ir holding only the masks, and only down
- * to the cell's first opaque material.
+ * to the cell's first opaque material.  Covering a coarse node scans the
+ * compiled combinations (after an exact lookup); merging n leaf
+ * combinations computes n^2 pair costs once, then per merge step O(n) and
+ * a rescan of each cluster whose cheapest partner was merged (at 257
+ * materials, 315 combinations merged to 64: 2 s of wall time on the
+ * loaded 2-core VM, against 0.5 s for the rest of the analysis).
  */
 #include "analysis.h"
 #include "util.h"
@@ -96,6 +120,21 @@ static bool set_grow(combo_set *cs)
     return true;
 }
 
+/* The id of the combination with members `bits`, or -1. */
+static int set_lookup(const combo_set *cs, const uint64_t *bits)
+{
+    if (!cs->capslots) return -1;
+    uint64_t h = hash_bits(bits, cs->words);
+    size_t k = h & (size_t)(cs->capslots - 1);
+    size_t bytes = (size_t)cs->words * sizeof *bits;
+    while (cs->slots[k]) {
+        int i = cs->slots[k] - 1;
+        if (memcmp(cs->keys + (size_t)i * cs->words, bits, bytes) == 0) return i;
+        k = (k + 1) & (size_t)(cs->capslots - 1);
+    }
+    return -1;
+}
+
 /* The id of the combination with members `bits`, added if new; -1 on
  * allocation failure. */
 static int set_intern(combo_set *cs, const uint64_t *bits, int nmaterials)
@@ -144,9 +183,9 @@ static int intern_checked(combo_set *cs, const uint64_t *bits, int nmaterials,
     int id = set_intern(cs, bits, nmaterials);
     if (id < 0) {
         sg_error(d, sc->loc, SG_E_OUT_OF_MEMORY, "out of memory in the analysis");
-    } else if (id >= (int)SPLAT_COMBO_HOLE) {
+    } else if (id >= (int)SPLAT_COMBO_UBER) {
         sg_error(d, sc->loc, SG_E_OVER_LIMIT,
-                 "the scene has more than 65535 material combinations");
+                 "the scene has more than 65534 material combinations");
         id = -1;
     }
     return id;
@@ -376,19 +415,42 @@ static bool analyze_cells(const block_ctx *bc, combo_set *cs, uint64_t *bits, sg
     return true;
 }
 
+static bool bits_subset(const uint64_t *a, const uint64_t *b, int words)
+{
+    for (int w = 0; w < words; w++)
+        if (a[w] & ~b[w]) return false;
+    return true;
+}
+
+/* The smallest compiled combination whose members hold `u` (fewest
+ * materials, then the lowest id), or -1; *exact: it is `u` itself. */
+static int cover(const combo_set *cs, const uint64_t *u, bool *exact)
+{
+    int id = set_lookup(cs, u);
+    *exact = id >= 0;
+    if (id >= 0) return id;
+    const splat_analysis *a = cs->a;
+    int best = -1;
+    for (int i = 0; i < a->ncombos; i++)
+        if ((best < 0 || a->combos[i].nmaterials < a->combos[best].nmaterials) &&
+            bits_subset(u, cs->keys + (size_t)i * cs->words, cs->words))
+            best = i;
+    return best;
+}
+
 /* Level L from level L - 1: each node the union of its (up to four)
- * children's bits, which *bits holds and is replaced by level L's. */
-static bool analyze_level(const splat_scene *s, combo_set *cs, int L, uint64_t **bits,
-                          sg_diags *d)
+ * children's bits, which *bits holds and is replaced by level L's; its id
+ * the compiled combination that covers the union (cover), else
+ * SPLAT_COMBO_UBER.  Nothing is interned here: no node-only unions. */
+static void analyze_level(combo_set *cs, int L, uint64_t **bits)
 {
     splat_analysis *a = cs->a;
     const splat_level *below = &a->levels[L - 1];
     splat_level *lv = &a->levels[L];
     size_t nn = (size_t)lv->width * (size_t)lv->height;
     uint64_t *up = xcalloc(nn * (size_t)cs->words, sizeof *up);
-    bool ok = true;
-    for (int z = 0; ok && z < lv->height; z++)
-        for (int x = 0; ok && x < lv->width; x++) {
+    for (int z = 0; z < lv->height; z++)
+        for (int x = 0; x < lv->width; x++) {
             uint64_t *node = up + ((size_t)z * lv->width + x) * cs->words;
             for (int dz = 0; dz < 2; dz++)
                 for (int dx = 0; dx < 2; dx++) {
@@ -397,23 +459,174 @@ static bool analyze_level(const splat_scene *s, combo_set *cs, int L, uint64_t *
                     const uint64_t *child = *bits + ((size_t)bz * below->width + bx) * cs->words;
                     for (int w = 0; w < cs->words; w++) node[w] |= child[w];
                 }
+            uint16_t *id = &lv->ids[(size_t)z * lv->width + x];
             if (bits_empty(node, cs->words)) {    /* every child a hole */
-                lv->ids[(size_t)z * lv->width + x] = SPLAT_COMBO_HOLE;
+                *id = SPLAT_COMBO_HOLE;
                 continue;
             }
-            int id = intern_checked(cs, node, s->nmaterials, s->desc, d);
-            ok = id >= 0;
-            if (ok) {
-                lv->ids[(size_t)z * lv->width + x] = (uint16_t)id;
-                a->combos[id].nnodes++;
+            bool exact;
+            int c = cover(cs, node, &exact);
+            if (c < 0) {
+                *id = SPLAT_COMBO_UBER;
+                a->uber_nodes++;
+                continue;
             }
+            *id = (uint16_t)c;
+            a->combos[c].nnodes++;
+            a->cover_nodes += !exact;
         }
     free(*bits);
     *bits = up;
+}
+
+/* ---- merging ------------------------------------------------------------- */
+
+/* Clusters of leaf combinations, merged greedily (the file's comment). */
+typedef struct merger {
+    int        n, words;
+    const int64_t *weight; /* per scene material: its layer's cost where
+                              it is absent (1 + its mask's ir_cost)       */
+    uint64_t  *u;          /* n * words: each cluster's union            */
+    int64_t   *cells;      /* leaf cells the cluster shades               */
+    int       *parent;     /* union-find: the cluster a combination is in */
+    bool      *alive;
+    int       *best;       /* each cluster's cheapest partner             */
+    int64_t   *bestd;      /* and that merge's cost                       */
+} merger;
+
+/* The weight of the materials in `a` but not in `b`. */
+static int64_t extra(const merger *m, const uint64_t *a, const uint64_t *b)
+{
+    int64_t sum = 0;
+    for (int w = 0; w < m->words; w++)
+        for (uint64_t x = a[w] & ~b[w]; x; x &= x - 1)
+            sum += m->weight[64 * w + __builtin_ctzll(x)];
+    return sum;
+}
+
+/* What merging clusters i and j adds: each cluster's cells evaluate the
+ * other's layers that it lacks (their masks, mostly to find w = 0), in
+ * weight units per cell. */
+static int64_t merge_cost(const merger *m, int i, int j)
+{
+    const uint64_t *a = m->u + (size_t)i * m->words, *b = m->u + (size_t)j * m->words;
+    return extra(m, b, a) * m->cells[i] + extra(m, a, b) * m->cells[j];
+}
+
+static void rescan(merger *m, int i)
+{
+    m->best[i] = -1;
+    for (int j = 0; j < m->n; j++) {
+        if (j == i || !m->alive[j]) continue;
+        int64_t c = merge_cost(m, i, j);
+        if (m->best[i] < 0 || c < m->bestd[i]) {
+            m->best[i] = j;
+            m->bestd[i] = c;
+        }
+    }
+}
+
+static int find(int *parent, int i)
+{
+    while (parent[i] != i) i = parent[i] = parent[parent[i]];
+    return i;
+}
+
+/* Merge cs's leaf combinations into at most `max` clusters, then replace
+ * them by the clusters' unions (ids by first occurrence in level 0) and
+ * point level 0 at them.  The leaf member bits (`cells`) are left as they
+ * are: coarse nodes cover their exact leaves' union. */
+static bool merge(combo_set *cs, int max, const int64_t *weight, const splat_scene *s,
+                  sg_diags *d)
+{
+    splat_analysis *a = cs->a;
+    int n = a->ncombos, words = cs->words;
+    merger m = { .n = n, .words = words, .weight = weight };
+    m.u = xcalloc((size_t)n * words, sizeof *m.u);
+    memcpy(m.u, cs->keys, (size_t)n * words * sizeof *m.u);
+    m.cells = xcalloc((size_t)n, sizeof *m.cells);
+    m.parent = xcalloc((size_t)n, sizeof *m.parent);
+    m.alive = xcalloc((size_t)n, sizeof *m.alive);
+    m.best = xcalloc((size_t)n, sizeof *m.best);
+    m.bestd = xcalloc((size_t)n, sizeof *m.bestd);
+    for (int i = 0; i < n; i++) {
+        m.cells[i] = a->combos[i].ncells;
+        m.parent[i] = i;
+        m.alive[i] = true;
+    }
+    for (int i = 0; i < n; i++) rescan(&m, i);
+    for (int left = n; left > max; left--) {
+        int r = -1;
+        for (int i = 0; i < n; i++)
+            if (m.alive[i] && m.best[i] >= 0 && (r < 0 || m.bestd[i] < m.bestd[r])) r = i;
+        int i = r < m.best[r] ? r : m.best[r], j = r < m.best[r] ? m.best[r] : r;
+        uint64_t *ui = m.u + (size_t)i * words;
+        const uint64_t *uj = m.u + (size_t)j * words;
+        for (int w = 0; w < words; w++) ui[w] |= uj[w];
+        m.cells[i] += m.cells[j];
+        m.alive[j] = false;
+        m.parent[j] = i;
+        rescan(&m, i);
+        for (int k = 0; k < n; k++) {
+            if (!m.alive[k] || k == i) continue;
+            if (m.best[k] == i || m.best[k] == j) {
+                rescan(&m, k);
+                continue;
+            }
+            int64_t c = merge_cost(&m, k, i);
+            if (c < m.bestd[k] || (c == m.bestd[k] && i < m.best[k])) {
+                m.best[k] = i;
+                m.bestd[k] = c;
+            }
+        }
+    }
+
+    /* The clusters' unions become the combinations. */
+    splat_combo *leaf = a->combos;
+    a->combos = NULL;
+    a->ncombos = 0;
+    free(cs->keys);
+    free(cs->slots);
+    cs->keys = NULL;
+    cs->slots = NULL;
+    cs->capslots = cs->capcombos = 0;
+    int *to = xcalloc((size_t)n, sizeof *to);
+    for (int i = 0; i < n; i++) to[i] = -1;
+    bool ok = true;
+    splat_level *l0 = &a->levels[0];
+    for (size_t c = 0; ok && c < (size_t)l0->width * l0->height; c++) {
+        int old = l0->ids[c];
+        if (old == (int)SPLAT_COMBO_HOLE) continue;
+        int root = find(m.parent, old);
+        if (to[root] < 0) {
+            to[root] = intern_checked(cs, m.u + (size_t)root * words, s->nmaterials,
+                                      s->desc, d);
+            ok = to[root] >= 0;
+            if (!ok) break;
+        }
+        l0->ids[c] = (uint16_t)to[root];
+        a->combos[to[root]].ncells++;
+        a->combos[to[root]].nnodes++;
+    }
+    for (int i = 0; i < n; i++) free(leaf[i].materials);
+    free(leaf);
+    free(to);
+    free(m.u);
+    free(m.cells);
+    free(m.parent);
+    free(m.alive);
+    free(m.best);
+    free(m.bestd);
     return ok;
 }
 
 bool splat_analyze(const splat_scene *s, splat_analysis *a, sg_diags *d)
+{
+    return splat_analyze_merged(s, 0, a, d);
+}
+
+bool splat_analyze_merged(const splat_scene *s, int max_combos, splat_analysis *a,
+                          sg_diags *d)
 {
     double t0 = splat_now();
     memset(a, 0, sizeof *a);
@@ -441,8 +654,21 @@ bool splat_analyze(const splat_scene *s, splat_analysis *a, sg_diags *d)
                      .painted = painted, .texel_x = t->size[0] / t->width,
                      .texel_z = t->size[1] / t->height };
     ok = ok && analyze_cells(&bc, &cs, bits, d);
+    a->nleaf = a->ncombos;
+    a->max_combos = max_combos > 0 ? max_combos : 0;
+    for (int i = 0; i < a->ncombos; i++)
+        if (a->combos[i].nmaterials > a->leaf_largest)
+            a->leaf_largest = a->combos[i].nmaterials;
+    if (ok && max_combos > 0 && a->ncombos > max_combos) {
+        /* a layer's cost where it is absent: its guard and its mask */
+        int64_t *weight = xcalloc((size_t)(n ? n : 1), sizeof *weight);
+        for (int m = 0; m < n; m++)
+            weight[m] = 1 + (m > 0 ? ir_cost(&mir, &masks[m], 1) : 0);
+        ok = merge(&cs, max_combos, weight, s, d);
+        free(weight);
+    }
     for (int L = 1; ok && L < a->nlevels; L++)
-        ok = analyze_level(s, &cs, L, &bits, d);
+        analyze_level(&cs, L, &bits);
     for (int i = 0; i < a->ncombos; i++)
         if (a->combos[i].nmaterials > a->largest)
             a->largest = a->combos[i].nmaterials;
@@ -478,18 +704,24 @@ void splat_analysis_free(splat_analysis *a)
 void splat_analysis_report(const splat_scene *s, const splat_analysis *a, FILE *out)
 {
     const sg_scene *sc = s->desc;
-    int leaf = 0;
-    for (int i = 0; i < a->ncombos; i++)
-        leaf += a->combos[i].ncells > 0;
     fprintf(out, "scene '%s': %d materials, heightfield %d x %d texels, "
             "%g x %g m\n", sc->name, s->nmaterials, s->terrain.width,
             s->terrain.height, s->terrain.size[0], s->terrain.size[1]);
     fprintf(out, "cells: %d x %d = %d of %d x %d texels, %d quadtree levels\n",
             a->cells_x, a->cells_z, a->cells_x * a->cells_z, a->cell_texels,
             a->cell_texels, a->nlevels);
-    fprintf(out, "combinations: %d in leaf cells, %d with quadtree nodes "
-            "(naive all subsets: %.0f)\n", leaf, a->ncombos, a->naive_subsets);
-    fprintf(out, "largest combination: %d materials\n", a->largest);
+    fprintf(out, "combinations: %d in leaf cells, %d compiled", a->nleaf, a->ncombos);
+    if (a->max_combos > 0)
+        fprintf(out, " (merged to at most %d)", a->max_combos);
+    fprintf(out, " (naive all subsets: %.0f)\n", a->naive_subsets);
+    fprintf(out, "largest combination: %d materials (largest leaf-cell overlap: %d)\n",
+            a->largest, a->leaf_largest);
+    int coarse = 0;
+    for (int L = 1; L < a->nlevels; L++)
+        coarse += a->levels[L].width * a->levels[L].height;
+    fprintf(out, "coarse quadtree nodes: %d, %d drawn by a compiled superset of their "
+            "union, %d by the uber-shader (no combination covers them)\n", coarse,
+            a->cover_nodes, a->uber_nodes);
     if (s->terrain.holes)
         fprintf(out, "holes: %d cells entirely hole (no combination)\n", a->hole_cells);
     fprintf(out, "  id  cells  nodes  materials (top first)\n");

@@ -126,11 +126,11 @@ static bool inputs_key(build *b)
     char head[256];
     static const char *const bakes[] = {"auto", "cpu", "gpu"};
     int n = snprintf(head, sizeof head,
-                     "splatc %s\nabi %d\nflat %d\nlazy %d\npainted %s\ncompute-spirv %d\nfar-atlas %d %s\ndclasses %d\npreview ",
+                     "splatc %s\nabi %d\nflat %d\nlazy %d\npainted %s\ncompute-spirv %d\nfar-atlas %d %s\ndclasses %d\nmax-combinations %d\npreview ",
                      SPLATC_VERSION, SPLAT_ABI_VERSION, b->desc->flat, !b->desc->no_lazy,
                      splat_painted_format_name(b->desc->painted), b->desc->compute_spirv,
                      b->desc->far_atlas, b->desc->far_atlas > 0 ? bakes[b->desc->far_bake] : "-",
-                     !b->desc->no_dclasses);
+                     !b->desc->no_dclasses, b->desc->max_combos);
     XXH3_128bits_update(st, head, (size_t)n);
     if (b->desc->preview)   /* the name and its end */
         XXH3_128bits_update(st, b->desc->preview, strlen(b->desc->preview) + 1);
@@ -255,7 +255,13 @@ static bool analyse(build *b)
         b->scene.sparse = &b->sparse;
         b->painted_places = sparse_glsl_places(&b->sparse);
     }
-    b->analysis_ok = splat_analyze(&b->scene, &b->analysis, b->d);
+    b->analysis_ok = splat_analyze_merged(&b->scene, b->desc->max_combos, &b->analysis, b->d);
+    if (b->analysis_ok) {
+        b->st->combos_found = b->analysis.nleaf;
+        b->st->largest = b->analysis.largest;
+        b->st->leaf_largest = b->analysis.leaf_largest;
+        b->st->uber_nodes = b->analysis.uber_nodes;
+    }
     if (b->analysis_ok && b->desc->report) {
         splat_analysis_report(&b->scene, &b->analysis, b->desc->report);
         build_report_painted(b, b->desc->report);

@@ -1,5 +1,6 @@
 /* cli_build.c — `splatc build SCENE.sg -o PACKDIR [-j N] [--stats]
  * [--cache DIR | --no-cache] [--flat] [--no-lazy] [--compute-spirv] [--no-distance-classes]
+ * [--max-combinations P]
  * [--painted bc4|r8|dense] [-I DIR]... [--depfile FILE] [--preview MATERIAL] [--far-atlas[=N]]
  * [--far-bake auto|cpu|gpu] [--json]`:
  * the command-line face
@@ -32,6 +33,9 @@ static const char usage[] =
     "  --compute-spirv  also compile the compute variants to SPIR-V (default:\n"
     "                 their GLSL only; the runtime compiles them on first use)\n"
     "  --no-distance-classes  no distance class variants (compiler/distance.c)\n"
+    "  --max-combinations P  cover the leaf cells' combinations with at most P\n"
+    "                 supersets, merging those that add the fewest layers\n"
+    "                 (compiler/analysis.c; default 0: no merging)\n"
     "  --painted F    painted mask storage: bc4 (default: sparse quad-tree,\n"
     "                 BC4 atlas), r8 (sparse, R8 atlas) or dense (painted.r8)\n"
     "  -I DIR         search DIR for imports (repeatable; then $SPLATC_PATH,\n"
@@ -72,6 +76,10 @@ static void print_stats(const splat_build_stats *st, FILE *out)
     }
     fprintf(out, "combinations: %d (%d from cache, %d compiled)\n", st->combos,
             st->combos_cached, st->combos_compiled);
+    fprintf(out, "combinations found in leaf cells: %d, pipelines built: %d "
+            "(largest composite %d layers, largest leaf-cell overlap %d; "
+            "%d coarse nodes left to the uber-shader)\n", st->combos_found, st->combos,
+            st->largest, st->leaf_largest, st->uber_nodes);
     fprintf(out, "shaders: %d (%d from cache, %d compiled)\n", st->shaders,
             st->shaders_cached, st->shaders_compiled);
     fprintf(out, "lazy branches: %d in the fragment composites written\n",
@@ -141,6 +149,16 @@ int splat_cli_build(int argc, char **argv)
                         next);
                 goto done;
             }
+            i++;
+        } else if (strcmp(a, "--max-combinations") == 0 && next) {
+            char *end;
+            long n = strtol(next, &end, 10);
+            if (*end || !*next || n < 0 || n > 65534) {
+                fprintf(stderr, "splatc build: --max-combinations expects a count 0..65534 "
+                                "(0: no merging), found '%s'\n", next);
+                goto done;
+            }
+            desc.max_combos = (int)n;
             i++;
         } else if (strcmp(a, "--no-distance-classes") == 0) {
             desc.no_dclasses = true;

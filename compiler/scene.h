@@ -37,6 +37,9 @@ typedef struct splat_build_desc {
                                         (default: their GLSL only; PACK.md) */
     splat_painted_format painted;    /* painted mask storage; default BC4     */
     bool               no_dclasses;  /* no distance classes (distance.c)     */
+    int                max_combos;   /* > 0: cover the leaf-cell combinations
+                                        with at most this many supersets
+                                        (analysis.c "merging"); 0: none    */
     FILE              *report;       /* non-NULL: the analysis report here    */
     const char        *depfile;      /* non-NULL: write a Make/Ninja depfile
                                         of every input here (build.c)     */
@@ -60,6 +63,11 @@ typedef struct splat_build_stats {
     double far_atlas;        /* the far atlas bake (--far-atlas), seconds  */
     bool   far_on_device;    /* it was baked by desc->far_device           */
     int    combos, combos_cached, combos_compiled;  /* composite shaders     */
+    int    combos_found;     /* distinct leaf-cell combinations the analysis
+                                found (combos: those built, after merging) */
+    int    largest, leaf_largest; /* most layers in a composite built, and
+                                in one leaf cell                         */
+    int    uber_nodes;       /* coarse quadtree nodes no combination covers */
     int    shaders, shaders_cached, shaders_compiled; /* every module         */
     int    lazy_branches;    /* lazy branches in the composites compiled
                                 (fragment variants; compose.c)          */

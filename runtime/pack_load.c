@@ -1228,8 +1228,11 @@ bool rt_combos_parse(const uint8_t *data, size_t n, int cells_x, int cells_z,
             return rt_fail(e, RT_E_PACK_FIELD, path, "does not fit in memory");
         for (size_t i = 0; i < nodes; i++) {
             pl->ids[i] = (uint16_t)(data[off + 2 * i] | data[off + 2 * i + 1] << 8);
-            /* a node all hole (PACK.md) only where the terrain has holes */
-            if (pl->ids[i] >= ncombos && !(pl->ids[i] == SPLAT_COMBO_HOLE && holes)) {
+            /* a node all hole (PACK.md) only where the terrain has holes;
+             * a coarse node without a combination (über-shaded) above the
+             * leaves only */
+            if (pl->ids[i] >= ncombos && !(pl->ids[i] == SPLAT_COMBO_HOLE && holes) &&
+                !(pl->ids[i] == SPLAT_COMBO_UBER && L > 0)) {
                 char at[160];
                 snprintf(at, sizeof at, "level %d node (%zu, %zu)", L, i % (size_t)w,
                          i / (size_t)w);

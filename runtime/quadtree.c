@@ -6,7 +6,11 @@
  *
  * Per frame, with no allocation:
  *   1. split top-down: a node splits while the camera is closer than
- *      lod_distance * node size (3D distance to the node's box);
+ *      lod_distance * node size (3D distance to the node's box), or, with
+ *      split_uncovered, while the pack has no combination for it
+ *      (SPLAT_COMBO_UBER: the compiler composes leaf cells' combinations
+ *      only) and it is nearer than uncovered_far, so that every patch
+ *      drawn has a composite; leaves always have one;
  *   2. restrict bottom-up: if a node at level K is split, the edge
  *      neighbours of its parent (level K+1) are split too.  Then a drawn
  *      patch at level L never touches one at level <= L-2: such a patch Q
@@ -215,9 +219,17 @@ static void split_down(frame *f, int L, int x, int z)
     double lo[3], hi[3];
     node_box(q, L, x, z, lo, hi);
     double size = fmax(hi[0] - lo[0], hi[2] - lo[2]);
-    if (box_distance(f->s->camera, lo, hi) >= f->s->lod_distance * size)
-        return;
-    q->split[L][(size_t)z * (size_t)q->width[L] + (size_t)x] = 1;
+    double dist = box_distance(f->s->camera, lo, hi);
+    size_t i = (size_t)z * (size_t)q->width[L] + (size_t)x;
+    if (dist >= f->s->lod_distance * size) {
+        bool uncovered = f->s->split_uncovered && q->combo_ids &&
+                         q->combo_ids[L][i] == SPLAT_COMBO_UBER &&
+                         !(f->s->uncovered_far > 0 && dist >= f->s->uncovered_far);
+        if (!uncovered)
+            return;
+        q->nsplit_uncovered++;
+    }
+    q->split[L][i] = 1;
     for (int c = 0; c < 4; c++) {
         int cx = 2 * x + (c & 1), cz = 2 * z + (c >> 1);
         if (cx < q->width[L - 1] && cz < q->height[L - 1])
@@ -323,10 +335,11 @@ void rt_quadtree_select(rt_quadtree *q, const rt_select_desc *s)
     for (int L = 0; L < q->nlevels; L++)
         memset(q->split[L], 0, (size_t)q->width[L] * (size_t)q->height[L]);
     int top = q->nlevels - 1;
-    split_down(&f, top, 0, 0);
-    restrict_levels(q);
     q->npatches = 0;
     q->nculled = 0;
     q->nholes = 0;
+    q->nsplit_uncovered = 0;
+    split_down(&f, top, 0, 0);
+    restrict_levels(q);
     emit(&f, top, 0, 0);
 }

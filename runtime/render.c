@@ -54,7 +54,10 @@ struct rt_renderer {
     VkDescriptorSet   set0c;           /* set 0 with the compute bindings   */
     rt_screen        *screen;          /* NULL: forward shading only        */
     rt_far           *far;             /* NULL: no far atlas (far.c)        */
-    int               far_patches;     /* forward: the last group, far.c's  */
+    int               far_patches;     /* forward: the far group, far.c's   */
+    int               uber_patches;    /* forward: the last group, nodes no
+                                          compiled combination covers
+                                          (SPLAT_COMBO_UBER), über-shaded  */
     rt_ug            *ug;              /* NULL: no undergrowth (undergrowth.c) */
     bool              ug_off;          /* not drawn (the viewer's U)        */
     VkCommandBuffer   cb;
@@ -62,7 +65,8 @@ struct rt_renderer {
     VkQueryPool       qpool;
     bool              timestamps;
     rt_patch         *sorted;          /* patches grouped by combination    */
-    int              *counts;          /* ncombos + 2 (+ the far group)     */
+    int              *counts;          /* ncombos + 3: the groups, the far
+                                          group and the über group          */
     splat_view        view;
     int               view_material;
     bool              wireframe;
@@ -498,7 +502,7 @@ bool rt_renderer_create(rt_device *d, const rt_pack *p, const rt_render_desc *de
     r->ncombos = p->ncombos;
     r->combo_ids = calloc((size_t)p->nlevels, sizeof *r->combo_ids);
     r->sorted = malloc(sizeof *r->sorted * (size_t)(p->levels[0].width * p->levels[0].height));
-    r->counts = calloc((size_t)p->ncombos + 2, sizeof *r->counts);
+    r->counts = calloc((size_t)p->ncombos + 3, sizeof *r->counts);
     if (!r->combo_ids || !r->sorted || !r->counts ||
         !rt_bounds_build(&r->bounds, p->heights, p->hf_width, p->hf_height, p->cell_texels,
                          p->max_height, p->height_offset) ||
@@ -1084,11 +1088,19 @@ static bool patch_far(const rt_renderer *r, const rt_patch *pt, const double cam
  * counting sort: one pipeline bind per group); returns how many
  * combinations are in view.  Afterwards counts[k] ends group k, which
  * starts at counts[k-1] (0 for k = 0); with `far`, group ncombos holds
- * the patches shaded from the far atlas (r->far_patches of them). */
+ * the patches shaded from the far atlas (r->far_patches of them), and
+ * group ncombos + 1 the coarse patches that no compiled combination
+ * covers (SPLAT_COMBO_UBER: the pack compiles leaf cells' combinations
+ * only), drawn with the über-shader (r->uber_patches of them). */
 static int select_and_sort(rt_renderer *r, const rt_camera *c, const splat_frame *fr, bool far,
-                           double *select_ms)
+                           bool split, double *select_ms)
 {
-    rt_select_desc sd = { .lod_distance = r->lod_distance, .cull = true };
+    /* coarse nodes without a combination: the über-shader draws them (the
+     * last group below), or with `split` they are split down to covered
+     * nodes, except those far enough for the far atlas */
+    rt_select_desc sd = { .lod_distance = r->lod_distance, .cull = true,
+                          .split_uncovered = split,
+                          .uncovered_far = far ? r->desc.far_atlas_distance : 0.0 };
     memcpy(sd.camera, c->position, sizeof sd.camera);
     memcpy(sd.view_proj, fr->view_proj, sizeof sd.view_proj);
     double ts = 1e3 * splat_now();
@@ -1097,17 +1109,22 @@ static int select_and_sort(rt_renderer *r, const rt_camera *c, const splat_frame
     int n = r->qt.npatches;
     if (!r->desc.no_distance_classes)
         for (int i = 0; i < n; i++)
-            r->qt.patches[i].combo = (uint16_t)class_pick(
-                r->p, r->qt.patches[i].combo, &r->qt, &r->qt.patches[i], c->position);
+            if (r->qt.patches[i].combo < r->ncombos)
+                r->qt.patches[i].combo = (uint16_t)class_pick(
+                    r->p, r->qt.patches[i].combo, &r->qt, &r->qt.patches[i], c->position);
     for (int i = 0; far && i < n; i++)
         if (patch_far(r, &r->qt.patches[i], c->position, r->desc.far_atlas_distance))
             r->qt.patches[i].combo = (uint16_t)r->ncombos;
-    memset(r->counts, 0, sizeof *r->counts * (size_t)(r->ncombos + 2));
+    for (int i = 0; i < n; i++)
+        if (r->qt.patches[i].combo == SPLAT_COMBO_UBER)
+            r->qt.patches[i].combo = (uint16_t)(r->ncombos + 1);
+    memset(r->counts, 0, sizeof *r->counts * (size_t)(r->ncombos + 3));
     for (int i = 0; i < n; i++)
         r->counts[r->qt.patches[i].combo + 1]++;
     r->far_patches = r->counts[r->ncombos + 1];
+    r->uber_patches = r->counts[r->ncombos + 2];
     int in_view = 0;
-    for (int k = 0; k <= r->ncombos; k++) {
+    for (int k = 0; k <= r->ncombos + 1; k++) {
         in_view += k < r->ncombos && r->counts[k + 1] > 0;
         r->counts[k + 1] += r->counts[k];
     }
@@ -1262,11 +1279,20 @@ static bool record_forward(rt_renderer *r, VkCommandBuffer cb, const rt_camera *
             }
             start = end;
         }
-        if (r->far_patches > 0) {   /* the far group, last (select_and_sort) */
+        if (r->far_patches > 0) {   /* the far group (select_and_sort) */
             if (!rt_far_bind_forward(r->far, r->p, &r->rp, &r->pl, cb, variant, e))
                 return abandon_frame(cb);
             (*binds)++;
             draw_patches(r, cb, c, r->sorted + start, r->far_patches);
+        }
+        start += r->far_patches;
+        if (r->uber_patches > 0) {  /* no combination covers them: last */
+            VkPipeline pipe;
+            if (!rt_pipelines_uber(r->d, r->p, &r->rp, &r->pl, variant, &pipe, e))
+                return abandon_frame(cb);
+            vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_GRAPHICS, pipe);
+            (*binds)++;
+            draw_patches(r, cb, c, r->sorted + start, r->uber_patches);
         }
     }
     if (sky_drawn(r)) {   /* where no terrain wrote depth */
@@ -1318,7 +1344,10 @@ static bool draw_frame(rt_renderer *r, const rt_camera *c, rt_frame_stats *st, r
      * references, not the mask view, which the über-shader draws) */
     bool far = !screen && r->far && r->desc.far_atlas_distance > 0 &&
                r->desc.reference == RT_REF_NONE && r->view != SPLAT_VIEW_MASK;
-    int in_view = select_and_sort(r, c, fr, far, &select_ms);
+    /* split_uncovered is the forward path's: the screen path classifies
+     * its tiles from leaf cells whatever the patches */
+    int in_view = select_and_sort(r, c, fr, far, !screen && r->desc.split_uncovered,
+                                  &select_ms);
 
     VkCommandBuffer cb = r->cb;
     RT_VK(e, vkResetCommandBuffer(cb, 0));
@@ -1378,6 +1407,8 @@ static bool draw_frame(rt_renderer *r, const rt_camera *c, rt_frame_stats *st, r
         st->class_patches += r->qt.patches[i].combo >= r->p->nbase &&
                              r->qt.patches[i].combo < r->ncombos;
     st->far_patches = screen ? 0 : r->far_patches;
+    st->uber_patches = screen ? 0 : r->uber_patches;
+    st->split_uncovered = r->qt.nsplit_uncovered;
     st->backfaces_culled = cull;
     st->select_ms = select_ms;
     st->cpu_ms = cpu_ms;
@@ -1606,7 +1637,7 @@ bool rt_renderer_swap_pack(rt_renderer *r, const rt_pack *p, rt_error *e)
                  "parameters, not the data uploaded at start)", why);
         return rt_fail(e, RT_E_RELOAD, msg);
     }
-    int *counts = calloc((size_t)p->ncombos + 2, sizeof *counts);
+    int *counts = calloc((size_t)p->ncombos + 3, sizeof *counts);
     if (!counts)
         return rt_fail(e, RT_E_RELOAD, "out of memory");
     vkDeviceWaitIdle(r->d->dev);

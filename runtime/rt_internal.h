@@ -206,7 +206,7 @@ char    *rt_pack_read_glsl(const rt_pack *p, const char *field, const char *rel,
  * levels, level L (cells halved L times, rounding up) at offsets[L]; every
  * level inside the file and every id below ncombos, checked before each
  * level is allocated (SPLAT_COMBO_HOLE is also accepted when `holes`: the
- * pack has a holes raster).  Fills levels[0..nlevels); errors name `path`. */
+ * pack has a holes raster; SPLAT_COMBO_UBER above level 0).  Fills levels[0..nlevels); errors name `path`. */
 bool rt_combos_parse(const uint8_t *data, size_t n, int cells_x, int cells_z,
                      const int64_t *offsets, int ncombos, bool holes,
                      rt_pack_level *levels, const char *path, rt_error *e);
@@ -294,6 +294,11 @@ typedef struct rt_select_desc {
     double lod_distance;       /* split while distance < this * node size   */
     bool   cull;               /* frustum culling (default on by caller)   */
     int    max_level_bias;     /* tests: 0                                   */
+    bool   split_uncovered;    /* split coarse nodes that no compiled
+                                  combination covers (SPLAT_COMBO_UBER),
+                                  down to nodes that have one             */
+    double uncovered_far;      /* > 0: except nodes at least this far (m):
+                                  the far atlas shades them               */
 } rt_select_desc;
 
 typedef struct rt_quadtree {
@@ -305,6 +310,8 @@ typedef struct rt_quadtree {
     const uint16_t *const *combo_ids; /* per level (pack); NULL: all 0     */
     uint8_t  **split;             /* per level scratch, reused every frame   */
     rt_patch  *patches;           /* the selection (drawn patches)           */
+    int        nsplit_uncovered;  /* nodes split only because no compiled
+                                     combination covers them (last select) */
     int        npatches, cap;
     int        nculled;           /* leaves dropped by the frustum           */
     int        nholes;            /* nodes not drawn: all hole (PACK.md)     */
@@ -399,7 +406,7 @@ typedef struct rt_passes {
 /* Layouts, the pipeline cache and the resolve pass for RT_REF_MULTIPASS;
  * checks that the shaders `ref` needs are in the pack.  Combination,
  * über-shader and reference pipelines are made on first use
- * (rt_pipelines_combo/uber/ref): a view of colorado needs 20 of its 166,
+ * (rt_pipelines_combo/uber/ref): a view of colorado needs 13-20 of its 137,
  * and lavapipe compiles each in tens of milliseconds or more. */
 bool rt_pipelines_create(rt_device *d, const rt_pack *p, const rt_passes *rp,
                          rt_reference ref, const char *cache_path,

@@ -427,6 +427,13 @@ typedef struct rt_render_desc {
                                        drawing their tiles meanwhile (the
                                        viewer's default; headless waits)   */
     double       undergrowth_radius; /* m around the camera; 0: RT_UG_RADIUS    */
+    bool         split_uncovered;   /* forward: coarse quadtree nodes that
+                                       no compiled combination covers (the
+                                       pack composes leaf cells only) are
+                                       split down to nodes that have one;
+                                       default: drawn with the über-shader,
+                                       the same picture with the same
+                                       geometry (splatview --uncovered split) */
     double       far_atlas_distance; /* screen tiles, forward patches at least
                                     this far (m) are shaded from the pack's
                                     far atlas; 0: off (the default)          */
@@ -461,6 +468,10 @@ typedef struct rt_frame_stats {
     int    patches, culled, pipelines, combos_in_view;
     int    class_patches;     /* forward: patches shaded by a distance class */
     int    far_patches;       /* forward: patches shaded from the far atlas  */
+    int    uber_patches;      /* forward: coarse patches no compiled
+                                 combination covers, über-shaded (a fallback) */
+    int    split_uncovered;   /* quadtree nodes split only because no
+                                 compiled combination covers them          */
     bool   backfaces_culled;  /* the camera was above the terrain            */
     double gpu_ms;            /* timestamps; < 0 if unsupported              */
     double select_ms;         /* CPU quadtree selection + culling            */

@@ -64,6 +64,9 @@ static void usage(FILE *f)
         "                            headless, which waits for every pipeline)\n"
         "  --no-distance-classes     shade with the combinations only, not their\n"
         "                            distance classes (compiler/PACK.md)\n"
+        "  --uncovered uber|split    forward coarse patches no compiled combination\n"
+        "                            covers: drawn with the uber-shader (default) or\n"
+        "                            split down to nodes that have one\n"
         "  --light KEY=V[,V,V]       any key of the scene's light block (sun, sun_color,\n"
         "                            intensity, sky, fog_density, fog_height, exposure)\n"
         "  --clear r,g,b             background colour (linear)\n"
@@ -127,6 +130,7 @@ typedef struct opts {
     bool no_undergrowth;
     bool no_distance_classes;
     int async_pipelines;   /* --async-pipelines: 1 on, 0 off, -1 default */
+    bool split_uncovered;
     int width, height, frames;
     double camera[3], look[3], lod_pixels;
     double far_distance;   /* --far-atlas-distance */
@@ -255,6 +259,14 @@ static int parse_args(int argc, char **argv, opts *o)
                 return 2;
             }
             o->async_pipelines = !strcmp(v, "on");
+        } else if (!strcmp(a, "--uncovered")) {
+            NEED();
+            if (!strcmp(v, "split") || !strcmp(v, "uber")) {
+                o->split_uncovered = !strcmp(v, "split");
+            } else {
+                fprintf(stderr, "splatview: --uncovered expects split or uber, found '%s'\n", v);
+                return 2;
+            }
         } else if (!strcmp(a, "-o")) {
             NEED(); o->out = v;
         } else if (!strcmp(a, "--float-out")) {
@@ -618,6 +630,7 @@ static int headless(const opts *o)
         .no_undergrowth = o->no_undergrowth,
         .no_distance_classes = o->no_distance_classes,
         .async_pipelines = o->async_pipelines == 1,
+        .split_uncovered = o->split_uncovered,
         .destruction_pool = o->destruction_pool, .shading = o->shading,
         .screen_depth = o->screen_depth, .pixel_sort = o->pixel_sort, .far_atlas_distance = o->far_distance,
     };
@@ -694,6 +707,9 @@ static int headless(const opts *o)
         if (!st.screen) {
             printf("distance classes: %d of %d patches\n", st.class_patches, st.patches);
             printf("far atlas: %d of %d patches\n", st.far_patches, st.patches);
+            printf("uber-shader fallback: %d of %d patches (no compiled combination "
+                   "covers their node)\n", st.uber_patches, st.patches);
+            printf("uncovered nodes split: %d\n", st.split_uncovered);
         }
         if (gm >= 0)
             printf("gpu ms/frame: median %.3f  p10 %.3f  p90 %.3f\n", gm, gl, gh);
@@ -877,7 +893,8 @@ int main(int argc, char **argv)
                     .no_undergrowth = o.no_undergrowth,
                     .far_atlas_distance = o.far_distance,
                     .no_distance_classes = o.no_distance_classes,
-                    .async_pipelines = o.async_pipelines != 0 },
+                    .async_pipelines = o.async_pipelines != 0,
+                    .split_uncovered = o.split_uncovered },
         .view = SPLAT_VIEW_FINAL,
     };
     memcpy(vd.render.clear, o.clear, sizeof o.clear);

@@ -12,3 +12,34 @@ if(TARGET splatrt AND TARGET splatview AND TARGET splatc_cli)
     WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
   set_tests_properties(bench.smoke PROPERTIES LABELS bench TIMEOUT 600)
 endif()
+
+# The scaled-down synthetic world (gen_world.c: B biomes x M materials with
+# painted biome masks on an fBm heightfield; issue 29), 4 x 8 + 1 = 33
+# materials, more than colorado's 15: test_world.c asserts the analysis's
+# structure on it (combinations from leaf cells only, none a coarse node's
+# union, the largest within the largest leaf overlap, merging covering every
+# leaf within its bound, sound at random points), then world.sh builds its
+# pack with --max-combinations and reads the build report.
+if(TARGET splatc)
+  add_executable(gen_world ${CMAKE_CURRENT_LIST_DIR}/gen_world.c)
+  target_link_libraries(gen_world splatc m)
+  if(TARGET splat_unit_helpers)
+    add_executable(test_world ${CMAKE_CURRENT_LIST_DIR}/test_world.c)
+    target_link_libraries(test_world splatc splat_unit_helpers PkgConfig::CMOCKA m)
+    set(WORLD_OUT ${CMAKE_BINARY_DIR}/tests/bench/world)
+    add_test(NAME bench.world_gen
+      COMMAND sh -c "rm -rf '${WORLD_OUT}' && mkdir -p '${WORLD_OUT}' && '$<TARGET_FILE:gen_world>' '${WORLD_OUT}' 4 8 512 16")
+    set_tests_properties(bench.world_gen PROPERTIES LABELS unit FIXTURES_SETUP world_scene)
+    add_test(NAME bench.world_structure COMMAND test_world ${WORLD_OUT}
+             WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
+    set_tests_properties(bench.world_structure PROPERTIES LABELS unit
+                         FIXTURES_REQUIRED world_scene TIMEOUT 300)
+    if(TARGET splatc_cli)
+      add_test(NAME bench.world_merge
+        COMMAND sh ${CMAKE_CURRENT_LIST_DIR}/world.sh $<TARGET_FILE:splatc_cli> ${WORLD_OUT}
+        WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
+      set_tests_properties(bench.world_merge PROPERTIES LABELS cli
+                           FIXTURES_REQUIRED world_scene TIMEOUT 600)
+    endif()
+  endif()
+endif()

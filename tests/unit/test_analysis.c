@@ -1,8 +1,10 @@
 /* test_analysis.c — the scene analysis (compiler/analysis.c): soundness on
  * thin slivers (a narrow slope band, a single painted texel), opaque upper
- * materials dropping lower ones, the quadtree's union semantics, the
- * destructible area, deterministic ids, and a randomised check that every
- * sample point's true combination is inside its cell's.
+ * materials dropping lower ones, combinations from leaf cells only (a
+ * coarse node gets the smallest compiled cover of its union or the
+ * über-shader, never a composite of its own), merging into at most P
+ * supersets, the destructible area, deterministic ids, and a randomised
+ * check that every sample point's true combination is inside its cell's.
  *
  * Scenes are built by hand: a heightfield in memory, an sg_scene filled in
  * directly and material masks built with the IR builder, so each test
@@ -18,7 +20,9 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "abi.h"
 #include "points.h"
+#include "structure.h"
 #include "scene.h"
 
 /* ---- fixtures ------------------------------------------------------------ */
@@ -143,6 +147,42 @@ static bool combo_has(const splat_combo *c, int m)
     for (int i = 0; i < c->nmaterials; i++)
         if (c->materials[i] == m) return true;
     return false;
+}
+
+static void analyze_merged(fixture *f, int max, splat_analysis *a)
+{
+    sg_diags d;
+    sg_diags_init(&d);
+    bool ok = splat_analyze_merged(&f->s, max, a, &d);
+    if (!ok) sg_diags_print(&d, stderr);
+    assert_true(ok);
+    assert_int_equal(d.nerrors, 0);
+    sg_diags_free(&d);
+}
+
+/* check_structure of f unmerged and merged to 1, 2, ... nleaf - 1 (at most
+ * `steps` bounds): every leaf covered, the count within the bound.
+ * Returns the unmerged analysis's über nodes. */
+static int check_all_bounds(fixture *f, int steps)
+{
+    splat_analysis ref;
+    analyze(f, &ref);
+    int uber = structure_check(&ref, &ref, 0).uber;
+    int n = ref.ncombos, stride = n / steps > 1 ? n / steps : 1;
+    for (int max = 1; max < n; max += stride) {
+        splat_analysis m;
+        analyze_merged(f, max, &m);
+        structure_check(&ref, &m, max);
+        assert_true(m.largest >= ref.largest);
+        splat_analysis_free(&m);
+    }
+    splat_analysis m;                               /* a bound above the count */
+    analyze_merged(f, n + 5, &m);
+    assert_int_equal(m.ncombos, n);
+    structure_check(&ref, &m, 0);
+    splat_analysis_free(&m);
+    splat_analysis_free(&ref);
+    return uber;
 }
 
 /* ---- slivers ------------------------------------------------------------- */
@@ -280,34 +320,91 @@ static void test_quadtree_union(void **state)
     }
     const int snow[] = { 2, -1 }, low[] = { 1, 0, -1 }, all[] = { 2, 1, 0, -1 };
     /* Level 1 node (0, 0) = low cells only; (2, 0) = cell 4: snow only;
-     * (1, 0) = cells 2, 3: the union of {snow, dirt, grass} and {snow}. */
+     * (1, 0) = cells 2, 3: the union of {snow, dirt, grass} and {snow},
+     * which is cell 2's own combination, so no node needs one of its own. */
     assert_true(combo_is(combo_at(&a, 1, 0, 0), low));
     assert_true(combo_is(combo_at(&a, 1, 2, 0), snow));
     assert_true(combo_is(combo_at(&a, 1, 1, 0), all));
     assert_true(combo_is(combo_at(&a, 3, 0, 0), all));
-    /* Every node is exactly the union of its children. */
-    for (int L = 1; L < a.nlevels; L++) {
-        const splat_level *lv = &a.levels[L], *below = &a.levels[L - 1];
-        for (int z = 0; z < lv->height; z++)
-            for (int x = 0; x < lv->width; x++) {
-                const splat_combo *node = combo_at(&a, L, x, z);
-                bool in_child[8] = { false };
-                for (int dz = 0; dz < 2; dz++)
-                    for (int dx = 0; dx < 2; dx++) {
-                        if (2 * x + dx >= below->width || 2 * z + dz >= below->height)
-                            continue;
-                        const splat_combo *c = combo_at(&a, L - 1, 2 * x + dx, 2 * z + dz);
-                        for (int i = 0; i < c->nmaterials; i++) {
-                            assert_true(combo_has(node, c->materials[i]));
-                            in_child[c->materials[i]] = true;
-                        }
-                    }
-                for (int i = 0; i < node->nmaterials; i++)
-                    assert_true(in_child[node->materials[i]]);
-                for (int i = 1; i < node->nmaterials; i++)   /* top first */
-                    assert_true(node->materials[i - 1] > node->materials[i]);
-            }
+    assert_int_equal(a.ncombos, 3);
+    assert_int_equal(structure_check(&a, &a, 0).uber, 0);
+    splat_analysis_free(&a);
+    fixture_free(f);
+}
+
+/* Four cells in a row, painted: rock opaque in cell 0, rock over grass in
+ * cell 1 (its footprint ring reads cell 0's rock), grass alone in cell 2,
+ * field over grass in cell 3.  Each level-1 node's union is a leaf's
+ * combination, but the root's, {rock, field, grass}, is no leaf's: it is
+ * not compiled, the root gets SPLAT_COMBO_UBER.  Merged to two, every
+ * leaf's set is inside its superset; merged to one, that superset covers
+ * the root as well. */
+static fixture *strip_scene(void)
+{
+    const char *names[] = { "grass", "field", "rock" };
+    fixture *f = fixture_new(32, 8, 8, 3, names);
+    uint8_t *fields = fixture_painted(f, "fields");
+    uint8_t *rocks = fixture_painted(f, "rocks");
+    for (int z = 0; z < 8; z++) {
+        for (int x = 0; x <= 8; x++) rocks[z * 32 + x] = 255;
+        for (int x = 26; x < 32; x++) fields[z * 32 + x] = 128;
     }
+    ir *ir = &f->s.ir;
+    set_mask(f, "field", ir_painted_ref(ir, 0));
+    set_mask(f, "rock", ir_painted_ref(ir, 1));
+    return f;
+}
+
+static void test_coarse_union_not_compiled(void **state)
+{
+    fixture *f = strip_scene();
+    splat_analysis a;
+    analyze(f, &a);
+    const int rock[] = { 2, -1 }, rock_grass[] = { 2, 0, -1 }, grass[] = { 0, -1 },
+              field[] = { 1, 0, -1 };
+    assert_true(combo_is(combo_at(&a, 0, 0, 0), rock));
+    assert_true(combo_is(combo_at(&a, 0, 1, 0), rock_grass));
+    assert_true(combo_is(combo_at(&a, 0, 2, 0), grass));
+    assert_true(combo_is(combo_at(&a, 0, 3, 0), field));
+    assert_int_equal(a.nlevels, 3);
+    assert_true(combo_is(combo_at(&a, 1, 0, 0), rock_grass));
+    assert_true(combo_is(combo_at(&a, 1, 1, 0), field));
+    assert_int_equal(a.levels[2].ids[0], SPLAT_COMBO_UBER);
+    assert_int_equal(a.ncombos, 4);
+    assert_int_equal(a.largest, 2);               /* not the root's 3 */
+    assert_int_equal(a.uber_nodes, 1);
+    structure_counts sc = structure_check(&a, &a, 0);
+    assert_int_equal(sc.uber, 1);
+    assert_int_equal(sc.unions, 1);           /* the root: compiled before issue 29 */
+    assert_int_equal(sc.largest, 3);
+
+    /* Merged to two: the cheapest merges first ({rock} into {rock, grass}
+     * costs one layer on one cell), never more than two pipelines. */
+    splat_analysis m;
+    analyze_merged(f, 2, &m);
+    assert_int_equal(m.nleaf, 4);
+    assert_int_equal(m.ncombos, 2);
+    assert_true(combo_is(combo_at(&m, 0, 0, 0), rock_grass));
+    assert_true(combo_is(combo_at(&m, 0, 3, 0), field));
+    assert_int_equal(structure_check(&a, &m, 2).uber, 1);
+    splat_analysis_free(&m);
+    /* Merged to one: {rock, field, grass} everywhere, the root covered. */
+    analyze_merged(f, 1, &m);
+    assert_int_equal(m.ncombos, 1);
+    assert_int_equal(m.levels[2].ids[0], 0);
+    assert_int_equal(structure_check(&a, &m, 1).uber, 0);
+    splat_analysis_free(&m);
+
+    char *text = NULL;
+    size_t len = 0;
+    FILE *out = open_memstream(&text, &len);
+    assert_non_null(out);
+    splat_analysis_report(&f->s, &a, out);
+    fclose(out);
+    assert_non_null(strstr(text, "combinations: 4 in leaf cells, 4 compiled"));
+    assert_non_null(strstr(text, "largest combination: 2 materials (largest leaf-cell overlap: 2)"));
+    assert_non_null(strstr(text, "0 drawn by a compiled superset of their union, 1 by the uber-shader"));
+    free(text);
     splat_analysis_free(&a);
     fixture_free(f);
 }
@@ -370,16 +467,19 @@ static void test_deterministic_first_occurrence_ids(void **state)
         assert_memory_equal(a.combos[i].materials, b.combos[i].materials,
                             sizeof(int) * a.combos[i].nmaterials);
     }
-    /* Ids appear in order of first occurrence, level 0 row-major first. */
+    /* Ids appear in order of first occurrence in level 0, row-major; the
+     * coarse levels name only those (or no combination). */
     int next = 0;
-    for (int L = 0; L < a.nlevels; L++) {
-        const splat_level *lv = &a.levels[L];
-        for (int i = 0; i < lv->width * lv->height; i++) {
-            assert_true(lv->ids[i] <= next);
-            if (lv->ids[i] == next) next++;
-        }
+    const splat_level *l0 = &a.levels[0];
+    for (int i = 0; i < l0->width * l0->height; i++) {
+        assert_true(l0->ids[i] <= next);
+        if (l0->ids[i] == next) next++;
     }
     assert_int_equal(next, a.ncombos);
+    for (int L = 1; L < a.nlevels; L++)
+        for (int i = 0; i < a.levels[L].width * a.levels[L].height; i++)
+            assert_true(a.levels[L].ids[i] < a.ncombos ||
+                        a.levels[L].ids[i] == SPLAT_COMBO_UBER);
     /* All distinct. */
     for (int i = 0; i < a.ncombos; i++)
         for (int j = 0; j < i; j++)
@@ -472,6 +572,8 @@ static void test_random_points_inside_cell_combination(void **state)
         }
     assert_true(dropped > 0);                  /* and the analysis prunes */
     splat_analysis_free(&a);
+    /* leaf-only combinations and every merge bound, on a scene with some */
+    check_all_bounds(f, 6);
     fixture_free(f);
 }
 
@@ -482,6 +584,7 @@ int main(void)
         cmocka_unit_test(test_single_painted_texel_kept),
         cmocka_unit_test(test_opaque_upper_drops_lower),
         cmocka_unit_test(test_quadtree_union),
+        cmocka_unit_test(test_coarse_union_not_compiled),
         cmocka_unit_test(test_destruction_area),
         cmocka_unit_test(test_deterministic_first_occurrence_ids),
         cmocka_unit_test(test_random_points_inside_cell_combination),

@@ -1,0 +1,186 @@
+/* gen_world.c — a synthetic studio-style world for the scale tests and
+ * the benchmark (issue 29): B biomes of M materials each over one base,
+ * on an fBm heightfield, each biome's materials confined to it by a
+ * painted biome mask.
+ *
+ *   gen_world OUTDIR BIOMES MATERIALS [SIZE [CELL]]
+ *
+ * writes OUTDIR/scene.sg, OUTDIR/heightfield.png (SIZE x SIZE texels,
+ * 16-bit, default 512) and OUTDIR/biome_K.png (8-bit masks, one per biome).
+ * The biomes are the cells of a jittered grid (nearest centre), each mask
+ * 255 inside its biome and falling to 0 over a 24-texel band across the
+ * border, so leaf cells on a border hold two or three biomes' materials and
+ * coarse quadtree nodes the union of many (the node-only unions issue 29
+ * removes).  Material i of biome b (stack order: base, then biome 0's
+ * materials bottom to top, then biome 1's, ...): i = 0 is the biome's
+ * ground (its mask alone), the others the mask times a slope, height or
+ * noise-free facing rule with thresholds spread over i, so within a biome
+ * the materials overlap as a real stack does.  Colours are ALU tints (no
+ * textures: the structure tests compile nothing, and the 64-texture limit
+ * is another part of the issue).  Deterministic: same arguments, same
+ * bytes. */
+#include <math.h>
+#include <stdarg.h>
+#include <stdbool.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "texgen.h"
+
+static int usage(void)
+{
+    fprintf(stderr, "usage: gen_world OUTDIR BIOMES MATERIALS [SIZE [CELL]]\n"
+                    "  BIOMES 1..64, MATERIALS 1..64 per biome (BIOMES x MATERIALS <= 511),\n"
+                    "  SIZE 64..4096 texels (default 512), CELL leaf cell texels (default 16)\n");
+    return 2;
+}
+
+static bool write_text(const char *path, const char *text)
+{
+    FILE *f = fopen(path, "w");
+    if (!f || fputs(text, f) < 0 || fclose(f) != 0) {
+        fprintf(stderr, "gen_world: cannot write %s\n", path);
+        return false;
+    }
+    return true;
+}
+
+/* Appends printf output to a growing buffer. */
+typedef struct text { char *s; size_t n, cap; } text;
+
+static void put(text *t, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+static void put(text *t, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    int need = vsnprintf(NULL, 0, fmt, ap);
+    va_end(ap);
+    if (t->n + (size_t)need + 1 > t->cap) {
+        t->cap = (t->n + (size_t)need + 1) * 2;
+        t->s = realloc(t->s, t->cap);
+        if (!t->s) abort();
+    }
+    va_start(ap, fmt);
+    vsnprintf(t->s + t->n, (size_t)need + 1, fmt, ap);
+    va_end(ap);
+    t->n += (size_t)need;
+}
+
+static double unit(uint32_t h) { return (h & 0xFFFFFF) / 16777216.0; }
+
+int main(int argc, char **argv)
+{
+    if (argc < 4 || argc > 6) return usage();
+    const char *dir = argv[1];
+    int B = atoi(argv[2]), M = atoi(argv[3]);
+    int N = argc > 4 ? atoi(argv[4]) : 512, cell = argc > 5 ? atoi(argv[5]) : 16;
+    if (B < 1 || B > 64 || M < 1 || M > 64 || B * M > 511 || N < 64 || N > 4096 ||
+        cell < 1 || (cell & (cell - 1)) || cell > N)
+        return usage();
+    const double metres = 4.0 * N, max_height = 0.25 * metres;
+
+    /* heightfield: fBm, ridged a little so slopes vary */
+    uint16_t *hf = malloc((size_t)N * N * sizeof *hf);
+    if (!hf) return 1;
+    for (int z = 0; z < N; z++)
+        for (int x = 0; x < N; x++) {
+            double v = texgen_fbm((x + 0.5) / N * 4, (z + 0.5) / N * 4, 4, 4, 6, 0.5, 29u);
+            double h = 0.5 + 0.9 * v;
+            h = h < 0 ? 0 : h > 1 ? 1 : h;
+            hf[(size_t)z * N + x] = (uint16_t)lrint(h * 65535.0);
+        }
+    char path[4096], *err = NULL;
+    snprintf(path, sizeof path, "%s/heightfield.png", dir);
+    if (!texgen_write_png16(path, N, N, hf, &err)) {
+        fprintf(stderr, "gen_world: %s: %s\n", path, err ? err : "cannot write");
+        return 1;
+    }
+    free(hf);
+
+    /* biome centres on a jittered g x g grid (g = ceil(sqrt(B))) */
+    int g = (int)ceil(sqrt((double)B));
+    double *cx = malloc((size_t)B * sizeof *cx), *cz = malloc((size_t)B * sizeof *cz);
+    for (int b = 0; b < B; b++) {
+        int gx = b % g, gz = b / g;
+        cx[b] = (gx + 0.2 + 0.6 * unit(texgen_hash(gx, gz, 1))) * N / g;
+        cz[b] = (gz + 0.2 + 0.6 * unit(texgen_hash(gx, gz, 2))) * N / g;
+    }
+    texgen_image mask;
+    if (!texgen_image_alloc(&mask, N, N, 1)) return 1;
+    const double band = 24.0;
+    for (int b = 0; b < B; b++) {
+        for (int z = 0; z < N; z++)
+            for (int x = 0; x < N; x++) {
+                double own = hypot(x + 0.5 - cx[b], z + 0.5 - cz[b]), other = INFINITY;
+                for (int k = 0; k < B; k++)
+                    if (k != b) other = fmin(other, hypot(x + 0.5 - cx[k], z + 0.5 - cz[k]));
+                /* the distance to the bisector, signed: > 0 inside */
+                double v = B == 1 ? 1.0 : 0.5 + (other - own) / band;
+                v = v < 0 ? 0 : v > 1 ? 1 : v;
+                mask.pixels[(size_t)z * N + x] = (uint8_t)lrint(v * 255.0);
+            }
+        snprintf(path, sizeof path, "%s/biome_%d.png", dir, b);
+        if (!texgen_write_png(path, &mask, &err)) {
+            fprintf(stderr, "gen_world: %s: %s\n", path, err ? err : "cannot write");
+            return 1;
+        }
+    }
+    texgen_image_free(&mask);
+
+    /* the scene */
+    text t = { 0 };
+    put(&t, "# gen_world %s %d %d %d %d: %d biomes x %d materials over a base "
+            "(tests/bench/gen_world.c)\n", dir, B, M, N, cell, B, M);
+    put(&t, "import \"nodes/compositors.sg\"\nimport \"nodes/masks.sg\"\n\n");
+    put(&t, "material base {\n    out mask      = 1.0\n    out albedo    = vec3(0.30, 0.28, 0.25)\n"
+            "    out roughness = 0.9\n}\n\n");
+    for (int b = 0; b < B; b++)
+        for (int i = 0; i < M; i++) {
+            uint32_t h = texgen_hash(b, i, 7);
+            double r = 0.15 + 0.6 * unit(h), gr = 0.15 + 0.6 * unit(h >> 3 ^ 0x9e3779b9u),
+                   bl = 0.1 + 0.5 * unit(h * 2654435761u);
+            put(&t, "material b%d_m%d {\n    node p : painted { mask = \"biome_%d\" }\n", b, i, b);
+            double f = M > 1 ? (double)(i - 1) / (M - 1) : 0;   /* spread over i */
+            if (i == 0) {
+                put(&t, "    out mask      = p.out\n");
+            } else {
+                switch (i % 3) {
+                case 0:   /* steep ground */
+                    put(&t, "    node r : slope_ramp { lo = %.3f, hi = %.3f }\n", 0.05 + 0.35 * f,
+                        0.12 + 0.35 * f);
+                    break;
+                case 1:   /* a height band */
+                    put(&t, "    node r : height_ramp { lo = %.1f, hi = %.1f }\n",
+                        max_height * (0.2 + 0.6 * f), max_height * (0.25 + 0.6 * f));
+                    break;
+                default:  /* flat ground below a height */
+                    put(&t, "    node s : slope_ramp { lo = %.3f, hi = %.3f }\n"
+                            "    node r : sub { a = 1.0, b = s.out }\n", 0.02 + 0.1 * f, 0.08 + 0.1 * f);
+                    break;
+                }
+                put(&t, "    node k : mul { a = p.out, b = r.out }\n    out mask      = k.out\n");
+            }
+            put(&t, "    out albedo    = vec3(%.3f, %.3f, %.3f)\n    out roughness = %.2f\n}\n\n",
+                r, gr, bl, 0.5 + 0.4 * unit(h >> 7));
+        }
+    put(&t, "scene world_%dx%d {\n    heightfield = \"heightfield.png\"\n", B, M);
+    put(&t, "    size = %.0f %.0f\n    max_height = %.0f\n    cell = %d\n", metres, metres,
+        max_height, cell);
+    put(&t, "    compositor = linear_alpha\n    materials = [base");
+    for (int b = 0; b < B; b++)
+        for (int i = 0; i < M; i++) put(&t, ", b%d_m%d", b, i);
+    put(&t, "]\n");
+    for (int b = 0; b < B; b++) put(&t, "    painted biome_%d = \"biome_%d.png\"\n", b, b);
+    put(&t, "    camera overview { position = %.0f %.0f %.0f, look = %.0f 0 %.0f }\n}\n",
+        -0.2 * metres, 0.8 * metres, -0.2 * metres, 0.5 * metres, 0.5 * metres);
+    snprintf(path, sizeof path, "%s/scene.sg", dir);
+    bool ok = write_text(path, t.s);
+    free(t.s);
+    free(cx);
+    free(cz);
+    if (ok) printf("gen_world: %s: %d materials (%d biomes x %d + base), %d x %d texels\n",
+                   dir, B * M + 1, B, M, N, N);
+    return ok ? 0 : 1;
+}
