@@ -18,13 +18,21 @@
 #include <jansson.h>
 #include <stb_image.h>
 
+/* A module read but not validated yet: its words stay where the pack's
+ * rt_spirv keeps them (that struct may move as arrays grow; they do not). */
+struct unchecked {
+    const uint32_t *words;
+    size_t          nwords;
+    char           *path;   /* pack-relative, owned */
+};
+
 typedef struct reader {
     const char *manifest;   /* path, for messages */
     rt_pack    *p;
     rt_error   *e;
     int         dirfd;      /* the pack folder: every file opened under it */
-    rt_spirv  **unchecked;  /* modules read, validated at the end on all
-                               cores (validate_all)                      */
+    struct unchecked *unchecked; /* modules read, validated at the end on
+                               all cores (validate_all)                  */
     int         nunchecked, capunchecked;
 } reader;
 
@@ -320,13 +328,13 @@ static bool read_spirv(reader *r, json_t *obj, const char *where, rt_spirv *out)
     out->nwords = n / 4;
     if (r->nunchecked == r->capunchecked) {
         int cap = r->capunchecked ? 2 * r->capunchecked : 64;
-        rt_spirv **u = realloc(r->unchecked, (size_t)cap * sizeof *u);
+        struct unchecked *u = realloc(r->unchecked, (size_t)cap * sizeof *u);
         if (!u)
             return false;
         r->unchecked = u;
         r->capunchecked = cap;
     }
-    r->unchecked[r->nunchecked++] = out;
+    r->unchecked[r->nunchecked++] = (struct unchecked){ out->words, out->nwords, xstrdup(rel) };
     return true;
 }
 
@@ -339,7 +347,7 @@ typedef struct validate_jobs {
 static bool validate_one(void *ctx, int k, rt_error *e)
 {
     validate_jobs *j = ctx;
-    const rt_spirv *s = j->r->unchecked[k];
+    const struct unchecked *s = &j->r->unchecked[k];
     char path[512];
     snprintf(path, sizeof path, "%s/%s", j->r->p->dir, s->path);
     (void)e;   /* every module is validated: the first failure by index is reported */
@@ -1407,6 +1415,8 @@ bool rt_pack_load(rt_pack *p, const char *dir, rt_error *e)
     }
     ok = ok && validate_all(&r) && check_shaders(&r);
 done:
+    for (int k = 0; k < r.nunchecked; k++)
+        free(r.unchecked[k].path);
     free(r.unchecked);
     if (r.dirfd >= 0)
         close(r.dirfd);

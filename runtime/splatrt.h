@@ -455,7 +455,8 @@ typedef struct rt_ug_instance {
 } rt_ug_instance;
 
 /* Undergrowth of a frame (runtime/undergrowth.c). */
-#define RT_UG_RADIUS 96.0     /* default radius of the cells around the camera */
+#define RT_UG_RADIUS SPLAT_UG_RADIUS /* default radius of the cells around the camera
+                                        (abi.h: splatc checks packs at it) */
 typedef struct rt_ug_stats {
     int    cells;             /* cells allocated around the camera          */
     int    generated;         /* of them, generated in this frame           */

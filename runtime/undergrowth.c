@@ -34,7 +34,6 @@
 
 #define CELL    SPLAT_UG_CELL        /* metres per cell side (abi.h)        */
 #define TEXELS  SPLAT_UG_TEXELS      /* mask texels per cell side           */
-_Static_assert(RT_UG_RADIUS == SPLAT_UG_RADIUS, "splatc checks packs at the default radius");
 /* Distance LOD: beyond LOD_NEAR metres a cell draws the fraction
  * (LOD_NEAR / d)^2 of its instances (at least LOD_MIN), each scaled by
  * 1 / sqrt(fraction) (at most LOD_GROW): about as many instances per
