@@ -9,7 +9,7 @@
 set -u
 FB=$1 SECS=$2
 shift 2
-TARGETS=${*:-fuzz_parse fuzz_manifest fuzz_combos fuzz_sparse fuzz_heightfield fuzz_spirv}
+TARGETS=${*:-fuzz_parse fuzz_manifest fuzz_combos fuzz_sparse fuzz_heightfield fuzz_spirv fuzz_obj}
 ROOT=$(cd "$(dirname "$0")/../.." && pwd)
 C="$FB/corpus"
 mkdir -p "$C" && cd "$ROOT" || exit 2
@@ -39,7 +39,10 @@ mkdir -p "$C/fuzz_combos" "$C/fuzz_heightfield" "$C/fuzz_spirv"
 [ -n "$(ls -A "$C/fuzz_heightfield")" ] || {
     { printf '\000'; cat tests/scene/hf16.png; } > "$C/fuzz_heightfield/png"
     { printf '\001\020\000\020\000'; cat tests/scene/hf.r16; } > "$C/fuzz_heightfield/r16"
-    { printf '\002\020\000\020\000'; cat tests/scene/mask.png; } > "$C/fuzz_heightfield/mask"; }
+    { printf '\002\020\000\020\000'; cat tests/scene/mask.png; } > "$C/fuzz_heightfield/mask"
+    printf '\003ncols 4\nnrows 3\nxllcorner 0\nyllcorner 0\ncellsize 10\nNODATA_value -9999\n1 2 3 4\n5 6 -9999 8\n9 10 11 12\n' \
+        > "$C/fuzz_heightfield/gdal_asc"; }
+seed fuzz_obj tests/golden/inc/*.obj
 [ -n "$(ls -A "$C/fuzz_spirv")" ] || for f in "$PACK"/shaders/*.spv; do
     { printf '\001'; cat "$f"; } > "$C/fuzz_spirv/$(basename "$f")"; done
 rc=0

@@ -6,14 +6,16 @@
 #   fuzz_manifest     the pack loader, manifest.json (rt_pack_load)
 #   fuzz_combos       combos.bin (rt_combos_parse)
 #   fuzz_sparse       painted.sparse (sparse_read)
-#   fuzz_heightfield  PNG / raw heightfields and painted rasters
+#   fuzz_heightfield  PNG / raw / GDAL heightfields and painted rasters
+#   fuzz_obj          the undergrowth's OBJ reader (scan, parse, triangulate)
 #   fuzz_spirv        spirv-val + the SPIRV-Cross interface check
 # run.sh runs each for a given time from seeds made of the project's files.
 #
 # In every other build, fuzz.smoke builds those targets with clang in
 # BUILD/fuzz and runs each for a few seconds; it is skipped (exit 77) where
 # clang's libFuzzer runtime is missing.
-set(FUZZ_TARGETS fuzz_parse fuzz_manifest fuzz_combos fuzz_sparse fuzz_heightfield fuzz_spirv)
+set(FUZZ_TARGETS fuzz_parse fuzz_manifest fuzz_combos fuzz_sparse fuzz_heightfield fuzz_spirv
+                 fuzz_obj)
 if(SPLAT_FUZZ)
   if(NOT CMAKE_C_COMPILER_ID MATCHES "Clang")
     message(FATAL_ERROR "SPLAT_FUZZ=ON needs clang (CC=clang cmake ...)")
@@ -31,6 +33,8 @@ if(SPLAT_FUZZ)
     add_executable(${t} ${CMAKE_CURRENT_LIST_DIR}/${t}.c)
     target_link_libraries(${t} splatrt)
   endforeach()
+  add_executable(fuzz_obj ${CMAKE_CURRENT_LIST_DIR}/fuzz_obj.c)
+  target_link_libraries(fuzz_obj splatc)
   foreach(t ${FUZZ_TARGETS})
     target_link_options(${t} PRIVATE -fsanitize=fuzzer)
     set_target_properties(${t} PROPERTIES LINKER_LANGUAGE C)
