@@ -58,6 +58,9 @@ static void usage(FILE *f)
         "                            default; $SPLAT_SHADOW=cpu|gpu sets it) or the\n"
         "                            CPU reference\n"
         "  --no-undergrowth          draw no undergrowth (grass, plants, stones)\n"
+        "  --check                   load the pack and set up a renderer on the\n"
+        "                            device, draw nothing: exit 0 if the runtime\n"
+        "                            takes the pack\n"
         "  --async-pipelines on|off  screen path: make compute pipelines on worker\n"
         "                            threads, the uber-shader drawing their tiles\n"
         "                            meanwhile (default: on in the window, off\n"
@@ -129,6 +132,7 @@ typedef struct opts {
     bool headless, stats, have_camera, have_look, no_stitch, no_cull, no_shadows;
     bool no_undergrowth;
     bool no_distance_classes;
+    bool check;            /* --check: load and set up, draw nothing       */
     int async_pipelines;   /* --async-pipelines: 1 on, 0 off, -1 default */
     bool split_uncovered;
     int width, height, frames;
@@ -240,6 +244,8 @@ static int parse_args(int argc, char **argv, opts *o)
             exit(0);
         } else if (!strcmp(a, "--headless")) {
             o->headless = true;
+        } else if (!strcmp(a, "--check")) {
+            o->check = o->headless = true;
         } else if (!strcmp(a, "--stats")) {
             o->stats = true;
         } else if (!strcmp(a, "--no-stitch")) {
@@ -480,7 +486,7 @@ static int parse_args(int argc, char **argv, opts *o)
         fprintf(stderr, "splatview: --camera and --look go together\n");
         return 2;
     }
-    if (o->headless && !o->out && !o->float_out && !o->stats) {
+    if (o->headless && !o->out && !o->float_out && !o->stats && !o->check) {
         fprintf(stderr, "splatview: --headless needs -o OUT.png, --float-out or --stats\n");
         return 2;
     }
@@ -642,6 +648,12 @@ static int headless(const opts *o)
     if (!rt_renderer_create(&dev, &pack, &rd, &r, &e) || !apply_params(o, r, &e) ||
         !apply_craters(o, r, &cam, &e))
         goto done;
+    if (o->check) {   /* the pack loads and a renderer stands on this device */
+        printf("%s: loads (%d combinations, %d materials, %s path)\n", o->pack, pack.ncombos,
+               pack.nmaterials, rd.shading == RT_SHADING_SCREEN ? "screen" : "forward");
+        status = 0;
+        goto done;
+    }
     rt_renderer_set_view(r, view, material);
     int W = o->width > 0 ? o->width : 1280, H = o->height > 0 ? o->height : 720;
     gpu = calloc((size_t)o->frames * 7, sizeof *gpu);
