@@ -62,6 +62,18 @@ for cam in "$@"; do
         fail "$cam: classification changed the picture (composites vs über-shader)"
 done
 c="--camera-preset $1"
+# pipelines follow the view: the compute modules this process made (from
+# the SPIR-V cache or compiled) are at most one per list that got tiles,
+# and the über-shader's, not one per combination of the pack
+run "$PACK" --headless $SIZE $c --shading screen --stats > "$OUT/made.log"
+lists=$(sed -n 's/^tiles: .* shaded, \([0-9]*\) lists.*/\1/p' "$OUT/made.log")
+made=$(sed -n 's/^compute modules: \([0-9]*\) from the SPIR-V cache, \([0-9]*\) compiled.*/\1 \2/p' "$OUT/made.log")
+[ -n "$lists" ] && [ -n "$made" ] || fail "no tiles or compute modules line in --stats"
+set -- $made "$@"
+[ $(($1 + $2)) -le $((lists + 1)) ] ||
+    fail "$(($1 + $2)) compute pipelines made for $lists lists in view"
+echo "pipelines follow the view: $(($1 + $2)) made for $lists lists with tiles"
+shift 2
 # pipelines made on workers (--async-pipelines on): the first frame has
 # none but the über-shader's, which stands in for every list with tiles;
 # its picture is the final one within 1/255 (the soundness bound above)
