@@ -129,6 +129,7 @@ typedef struct opts {
     const char *pack, *out, *float_out, *preset, *view, *cache, *scene, *script;
     const char *material;       /* --material M: its swatch pack instead    */
     char *preview_dir;          /* where that pack is built                 */
+    char *owned_scene;          /* the scene path build_preview allocated   */
     bool headless, stats, have_camera, have_look, no_stitch, no_cull, no_shadows;
     bool no_undergrowth;
     bool no_distance_classes;
@@ -832,8 +833,9 @@ static int build_preview(opts *o)
                             "give --scene FILE\n");
             return 1;
         }
-        o->scene = scene;   /* for hot reload; lives as long as the process */
+        o->scene = scene;   /* for hot reload */
     }
+    o->owned_scene = scene;   /* freed by main */
     char *abs = splat_path_absolute(scene), *cache = splat_cache_default_dir();
     const char *key = abs ? abs : scene;   /* one folder per scene file */
     unsigned long long h = (unsigned long long)XXH3_64bits(key, strlen(key));
@@ -885,17 +887,10 @@ static void pack_search(opts *o)
     json_decref(m);
 }
 
-int main(int argc, char **argv)
+/* The viewer window with the options parsed (rt_viewer_run). */
+static int window(const opts *o_)
 {
-    opts o;
-    int rc = parse_args(argc, argv, &o);
-    if (rc)
-        return rc;
-    pack_search(&o);
-    if (o.material && (rc = build_preview(&o)) != 0)
-        return rc;
-    if (o.headless)
-        return headless(&o);
+    opts o = *o_;
     rt_viewer_desc vd = {
         .pack_dir = o.pack, .scene = o.scene, .width = o.width ? o.width : 1280,
         .height = o.height ? o.height : 720, .script = o.script,
@@ -923,4 +918,18 @@ int main(int argc, char **argv)
     vd.ninclude = o.ninclude;
     vd.preview = o.material;
     return rt_viewer_run(&vd);
+}
+
+int main(int argc, char **argv)
+{
+    opts o;
+    int rc = parse_args(argc, argv, &o);
+    if (rc)
+        return rc;
+    pack_search(&o);
+    if (!o.material || (rc = build_preview(&o)) == 0)
+        rc = o.headless ? headless(&o) : window(&o);
+    free(o.preview_dir);
+    free(o.owned_scene);
+    return rc;
 }
