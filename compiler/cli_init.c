@@ -84,35 +84,13 @@ static const char readme_text[] =
     "Look around live, reloading as you edit scene.sg: `splatview pack --scene scene.sg`\n"
     "The language, the node library and the viewer: docs/getting-started.md in splatc.\n";
 
-/* A hash of two integers to [0, 1). */
-static double hash01(int x, int z)
-{
-    uint32_t h = (uint32_t)x * 0x8da6b343u ^ (uint32_t)z * 0xd8163841u;
-    h ^= h >> 13;
-    h *= 0x85ebca6bu;
-    h ^= h >> 16;
-    return (h & 0xffffff) / 16777216.0;
-}
-
-static double value_noise(double x, double z, double cell)
-{
-    double fx = x / cell, fz = z / cell;
-    int ix = (int)floor(fx), iz = (int)floor(fz);
-    double ax = fx - ix, az = fz - iz;
-    ax = ax * ax * (3 - 2 * ax);
-    az = az * az * (3 - 2 * az);
-    double a = hash01(ix, iz) + (hash01(ix + 1, iz) - hash01(ix, iz)) * ax;
-    double b = hash01(ix, iz + 1) + (hash01(ix + 1, iz + 1) - hash01(ix, iz + 1)) * ax;
-    return a + (b - a) * az;
-}
-
 /* Height in metres (0 .. 180): rolling hills, a ridge across the north
  * with steep flanks and a snowy crest. */
 static double height_at(int x, int z)
 {
     double u = x / (double)(HF_N - 1), v = z / (double)(HF_N - 1);
     double h = 25 + 12 * sin(u * 6.0 + 0.4) * cos(v * 5.0 - 0.3) +
-               14 * value_noise(x, z, 16) + 5 * value_noise(x, z, 5);
+               14 * texgen_value_noise(x, z, 16) + 5 * texgen_value_noise(x, z, 5);
     double ridge = 0.32 + 0.08 * sin(u * 7.0);          /* the crest line, in v */
     double d = fabs(v - ridge) / 0.11;
     h += 130 * exp(-d * d) * (0.75 + 0.25 * sin(u * 9.0 + 1.0));

@@ -67,6 +67,28 @@ uint32_t texgen_hash(int32_t x, int32_t y, uint32_t seed)
     return h;
 }
 
+/* A hash of two integers to [0, 1) (texgen_value_noise's lattice values). */
+static double hash01(int x, int z)
+{
+    uint32_t h = (uint32_t)x * 0x8da6b343u ^ (uint32_t)z * 0xd8163841u;
+    h ^= h >> 13;
+    h *= 0x85ebca6bu;
+    h ^= h >> 16;
+    return (h & 0xffffff) / 16777216.0;
+}
+
+double texgen_value_noise(double x, double z, double cell)
+{
+    double fx = x / cell, fz = z / cell;
+    int ix = (int)floor(fx), iz = (int)floor(fz);
+    double ax = fx - ix, az = fz - iz;
+    ax = ax * ax * (3 - 2 * ax);
+    az = az * az * (3 - 2 * az);
+    double a = hash01(ix, iz) + (hash01(ix + 1, iz) - hash01(ix, iz)) * ax;
+    double b = hash01(ix, iz + 1) + (hash01(ix + 1, iz + 1) - hash01(ix, iz + 1)) * ax;
+    return a + (b - a) * az;
+}
+
 static uint32_t hash_str(const char *s)
 {
     uint32_t h = 2166136261u;                      /* FNV-1a */

@@ -36,6 +36,11 @@
 /* 32-bit integer hash of (x, y, seed); a pure function. */
 uint32_t texgen_hash(int32_t x, int32_t y, uint32_t seed);
 
+/* Smooth value noise at (x, y), a lattice every `cell` units: values of an
+ * integer hash in [0, 1) blended with smoothstep weights (the examples'
+ * generated heightfields: examples/minimal, splatc init); not tileable. */
+double texgen_value_noise(double x, double y, double cell);
+
 /* Perlin-style 2D gradient noise at (x, y) in lattice units, periodic with
  * px cells in x and py cells in y; unit gradients, quintic fade.  Range
  * about [-0.71, 0.71].  The lattice is shifted by a seed-dependent fraction

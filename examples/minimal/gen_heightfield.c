@@ -23,36 +23,13 @@
 
 enum { N = 257 };
 
-/* A hash of two integers to [0, 1). */
-static double hash01(int x, int z)
-{
-    uint32_t h = (uint32_t)x * 0x8da6b343u ^ (uint32_t)z * 0xd8163841u;
-    h ^= h >> 13;
-    h *= 0x85ebca6bu;
-    h ^= h >> 16;
-    return (h & 0xffffff) / 16777216.0;
-}
-
-/* Smooth value noise with a lattice every `cell` texels. */
-static double value_noise(double x, double z, double cell)
-{
-    double fx = x / cell, fz = z / cell;
-    int ix = (int)floor(fx), iz = (int)floor(fz);
-    double ax = fx - ix, az = fz - iz;
-    ax = ax * ax * (3 - 2 * ax);
-    az = az * az * (3 - 2 * az);
-    double a = hash01(ix, iz) + (hash01(ix + 1, iz) - hash01(ix, iz)) * ax;
-    double b = hash01(ix, iz + 1) + (hash01(ix + 1, iz + 1) - hash01(ix, iz + 1)) * ax;
-    return a + (b - a) * az;
-}
-
 /* Height in metres (0 .. 160) at texel (x, z). */
 static double height_at(int x, int z)
 {
     double u = x / (double)(N - 1), v = z / (double)(N - 1);
     double h = 40 + 18 * sin(u * 5.1 + 0.3) * cos(v * 4.3 - 0.2)
                   + 9 * sin(u * 11.7 + v * 7.9)
-                  + 16 * value_noise(x, z, 32) + 6 * value_noise(x, z, 9);
+                  + 16 * texgen_value_noise(x, z, 32) + 6 * texgen_value_noise(x, z, 9);
     /* The cliff: a curved line x = 170 + 20 sin(...) texels; the east side
      * is 60 m higher, reached over about two texels. */
     double edge = 170 + 20 * sin(v * 3.0);
