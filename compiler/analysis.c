@@ -120,19 +120,23 @@ static bool set_grow(combo_set *cs)
     return true;
 }
 
+/* The slot of the combination with members `bits`, or the empty slot
+ * where it would go (linear probing; the table is never full). */
+static size_t set_probe(const combo_set *cs, const uint64_t *bits)
+{
+    size_t k = hash_bits(bits, cs->words) & (size_t)(cs->capslots - 1);
+    size_t bytes = (size_t)cs->words * sizeof *bits;
+    while (cs->slots[k] &&
+           memcmp(cs->keys + (size_t)(cs->slots[k] - 1) * cs->words, bits, bytes) != 0)
+        k = (k + 1) & (size_t)(cs->capslots - 1);
+    return k;
+}
+
 /* The id of the combination with members `bits`, or -1. */
 static int set_lookup(const combo_set *cs, const uint64_t *bits)
 {
     if (!cs->capslots) return -1;
-    uint64_t h = hash_bits(bits, cs->words);
-    size_t k = h & (size_t)(cs->capslots - 1);
-    size_t bytes = (size_t)cs->words * sizeof *bits;
-    while (cs->slots[k]) {
-        int i = cs->slots[k] - 1;
-        if (memcmp(cs->keys + (size_t)i * cs->words, bits, bytes) == 0) return i;
-        k = (k + 1) & (size_t)(cs->capslots - 1);
-    }
-    return -1;
+    return cs->slots[set_probe(cs, bits)] - 1;
 }
 
 /* The id of the combination with members `bits`, added if new; -1 on
@@ -141,14 +145,8 @@ static int set_intern(combo_set *cs, const uint64_t *bits, int nmaterials)
 {
     splat_analysis *a = cs->a;
     if ((a->ncombos + 1) * 2 > cs->capslots && !set_grow(cs)) return -1;
-    uint64_t h = hash_bits(bits, cs->words);
-    size_t k = h & (size_t)(cs->capslots - 1);
-    size_t bytes = (size_t)cs->words * sizeof *bits;
-    while (cs->slots[k]) {
-        int i = cs->slots[k] - 1;
-        if (memcmp(cs->keys + (size_t)i * cs->words, bits, bytes) == 0) return i;
-        k = (k + 1) & (size_t)(cs->capslots - 1);
-    }
+    size_t k = set_probe(cs, bits), bytes = (size_t)cs->words * sizeof *bits;
+    if (cs->slots[k]) return cs->slots[k] - 1;
     if (a->ncombos == cs->capcombos) {
         int cap = cs->capcombos ? cs->capcombos * 2 : 16;
         uint64_t *keys = realloc(cs->keys, (size_t)cap * bytes);
