@@ -457,6 +457,34 @@ bool rt_pipelines_glsl_fragment(rt_device *d, rt_pipelines *pl, const rt_passes 
            fragment_pipeline(d, pl, rp, layout, glsl, name, NULL, variant, out, e);
 }
 
+/* One job of rt_pipelines_make: the pipeline of combination ids[k]. */
+typedef struct make_jobs {
+    rt_device       *d;
+    const rt_pack   *p;
+    const rt_passes *rp;
+    rt_pipelines    *pl;
+    bool             compute;
+    const int       *ids;
+    unsigned         variant;
+} make_jobs;
+
+static bool make_one(void *ctx, int k, rt_error *e)
+{
+    const make_jobs *j = ctx;
+    VkPipeline pipe;
+    return j->compute ? rt_pipelines_compute(j->d, j->p, j->pl, j->ids[k], j->variant, &pipe, e)
+                      : rt_pipelines_combo(j->d, j->p, j->rp, j->pl, j->ids[k], j->variant,
+                                           &pipe, e);
+}
+
+bool rt_pipelines_make(rt_device *d, const rt_pack *p, const rt_passes *rp, rt_pipelines *pl,
+                       bool compute, const int *ids, int n, unsigned variant, rt_error *e)
+{
+    /* each combination's slot is its own: made on all cores (jobs.c) */
+    make_jobs j = { d, p, rp, pl, compute, ids, variant };
+    return rt_parallel(n, make_one, &j, e);
+}
+
 bool rt_pipelines_has_combo(const rt_pipelines *pl, int id, unsigned variant)
 {
     return pl->combo && id >= 0 && id < pl->ncombos &&

@@ -1197,36 +1197,24 @@ static void count_end(rt_renderer *r, VkCommandBuffer cb)
                    VK_PIPELINE_STAGE_HOST_BIT, VK_ACCESS_HOST_READ_BIT);
 }
 
-/* One job of make_forward_pipelines: the composite of combination ids[k]. */
-typedef struct combo_jobs {
-    rt_renderer *r;
-    unsigned     variant;
-    const int   *ids;
-} combo_jobs;
-
-static bool make_combo(void *ctx, int k, rt_error *e)
-{
-    combo_jobs *j = ctx;
-    VkPipeline pipe;
-    return rt_pipelines_combo(j->r->d, j->r->p, &j->r->rp, &j->r->pl, j->ids[k], j->variant,
-                              &pipe, e);
-}
-
 /* The composites this frame draws that are not made yet, made first on all
  * cores (jobs.c; each has its own slot), so a cold view pays glslang and
  * the driver's compiler in parallel rather than one after the other. */
 static bool make_forward_pipelines(rt_renderer *r, unsigned variant, rt_error *e)
 {
-    int *ids = malloc(((size_t)r->ncombos + 1) * sizeof *ids), n = 0, start = 0;
+    int n = 0, start = 0;
+    for (int k = 0; k < r->ncombos; start = r->counts[k++])
+        n += r->counts[k] > start && !rt_pipelines_has_combo(&r->pl, k, variant);
+    if (n == 0)   /* the usual frame: nothing to make, nothing allocated */
+        return true;
+    int *ids = malloc((size_t)n * sizeof *ids);
     if (!ids)
         return rt_fail(e, RT_E_VULKAN, "forward path", "out of memory");
-    for (int k = 0; k < r->ncombos; k++) {
+    n = start = 0;
+    for (int k = 0; k < r->ncombos; start = r->counts[k++])
         if (r->counts[k] > start && !rt_pipelines_has_combo(&r->pl, k, variant))
             ids[n++] = k;
-        start = r->counts[k];
-    }
-    combo_jobs j = { r, variant, ids };
-    bool ok = rt_parallel(n, make_combo, &j, e);
+    bool ok = rt_pipelines_make(r->d, r->p, &r->rp, &r->pl, false, ids, n, variant, e);
     free(ids);
     return ok;
 }

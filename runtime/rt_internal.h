@@ -418,6 +418,10 @@ bool rt_pipelines_create(rt_device *d, const rt_pack *p, const rt_passes *rp,
 bool rt_pipelines_glsl_fragment(rt_device *d, rt_pipelines *pl, const rt_passes *rp,
                                 VkPipelineLayout layout, const char *glsl, const char *name,
                                 unsigned variant, VkPipeline *out, rt_error *e);
+/* The pipelines of combinations ids[0..n) in `variant`, made at once on
+ * all cores: compute (screen path; rp unused) or composites (forward). */
+bool rt_pipelines_make(rt_device *d, const rt_pack *p, const rt_passes *rp, rt_pipelines *pl,
+                       bool compute, const int *ids, int n, unsigned variant, rt_error *e);
 /* Whether combination id's pipeline of `variant` is made already. */
 bool rt_pipelines_has_combo(const rt_pipelines *pl, int id, unsigned variant);
 bool rt_pipelines_combo(rt_device *d, const rt_pack *p, const rt_passes *rp,

@@ -1098,21 +1098,6 @@ bool rt_screen_dispatch(rt_screen *s, VkCommandBuffer cb, rt_pipelines *pl,
     return true;
 }
 
-/* One job of rt_screen_missing: the pipeline of list lists[k]. */
-typedef struct missing_jobs {
-    rt_screen    *s;
-    rt_pipelines *pl;
-    unsigned      variant;
-    const int    *lists;
-} missing_jobs;
-
-static bool make_missing(void *ctx, int k, rt_error *e)
-{
-    missing_jobs *j = ctx;
-    VkPipeline pipe;
-    return rt_pipelines_compute(j->s->d, j->s->p, j->pl, j->lists[k], j->variant, &pipe, e);
-}
-
 int rt_screen_missing(rt_screen *s, rt_pipelines *pl, unsigned variant, rt_error *e)
 {
     const uint32_t *args = s->readback.map;
@@ -1129,9 +1114,7 @@ int rt_screen_missing(rt_screen *s, rt_pipelines *pl, unsigned variant, rt_error
         else if (s->dispatched[k] != variant + 1)
             lists[made++] = k;
     }
-    /* each list's slot is its own: compiled on all cores (jobs.c) */
-    missing_jobs j = { s, pl, variant, lists };
-    bool ok = rt_parallel(made, make_missing, &j, e);
+    bool ok = rt_pipelines_make(s->d, s->p, NULL, pl, true, lists, made, variant, e);
     free(lists);
     return ok ? made : -1;
 }
