@@ -38,7 +38,7 @@ ASAN_ENV := ASAN_OPTIONS=detect_leaks=1:abort_on_error=0:strict_string_checks=1:
             UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
             $(if $(LVP_SO),LD_PRELOAD=$(LVP_SO))
 
-.PHONY: all deps configure build test test-asan demo bench bench-smoke fuzz clean
+.PHONY: all deps configure build test test-asan demo gallery bench bench-smoke fuzz clean
 
 all: build
 
@@ -78,6 +78,11 @@ demo: build
 	@if [ ! -f examples/demo.sh ]; then \
 	  echo "make demo: examples/demo.sh is missing"; exit 1; fi
 	@sh examples/demo.sh $(BUILD)
+
+# colorado and billingsley from six camera presets each into docs/gallery
+# (docs/gallery/before holds the pictures issue 31 started from)
+gallery: build
+	@sh tests/gallery.sh $(BUILD) docs/gallery
 
 bench: build
 	@if [ ! -f tests/bench/run.sh ]; then \

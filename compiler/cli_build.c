@@ -111,16 +111,19 @@ int splat_cli_build(int argc, char **argv)
         } else if (strcmp(a, "-o") == 0 && next) {
             desc.out = next;
             i++;
-        } else if (strcmp(a, "-j") == 0 && next) {
+        } else if (strncmp(a, "-j", 2) == 0 && (a[2] || next)) {
+            /* -j N or -jN, as make takes it */
+            const char *v = a[2] ? a + 2 : next;
             char *end;
-            long n = strtol(next, &end, 10);
+            long n = strtol(v, &end, 10);
             if (*end || n < 1 || n > 256) {
                 fprintf(stderr, "splatc build: -j expects a thread count 1..256, found '%s'\n",
-                        next);
+                        v);
                 goto done;
             }
             desc.jobs = (int)n;
-            i++;
+            if (!a[2])
+                i++;
         } else if (strcmp(a, "--stats") == 0) {
             stats = true;
         } else if (strcmp(a, "--cache") == 0 && next) {

@@ -108,6 +108,11 @@ status)
     run 2 "$SPLATC" -I "$TMP/lib"
     run 2 "$SPLATC" -I
     run 2 "$SPLATC" -I "$TMP/lib" frobnicate
+    # -j N and -jN both, as make takes them; a bad count is a usage error
+    run 0 "$SPLATC" build examples/minimal/scene.sg -o "$TMP/pj" -j2
+    [ -f "$TMP/pj/manifest.json" ] || fail "build -j2 wrote no pack"
+    run 2 "$SPLATC" build examples/minimal/scene.sg -o "$TMP/pj0" -j0
+    [ -e "$TMP/pj0" ] && fail "build -j0 wrote a pack"
     # errors are file:line:col with the source line and a caret
     run 1 "$SPLATC" check tests/golden/unknown_node.sg
     grep -q "^tests/golden/unknown_node.sg:5:14: error: unknown node type 'rampp'" "$TMP/err" ||
