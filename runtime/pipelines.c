@@ -5,6 +5,7 @@
  * ABI's splat_light), the über-shader pipeline, and a pipeline cache kept
  * on disk between runs. */
 #include "rt_internal.h"
+#include "util.h"   /* splat_write_atomic */
 
 #include <errno.h>
 #include <stdlib.h>
@@ -148,22 +149,10 @@ static void save_cache(rt_device *d, rt_pipelines *pl)
     uint8_t *data = malloc(n);
     if (!data)
         return;
-    if (vkGetPipelineCacheData(d->dev, pl->cache, &n, data) == VK_SUCCESS) {
-        /* Written beside and renamed: readers never see half a file. */
-        size_t len = strlen(pl->cache_path) + 16;
-        char *tmp = malloc(len);
-        if (tmp) {
-            snprintf(tmp, len, "%s.tmp%d", pl->cache_path, (int)(n & 0xffff));
-            FILE *f = fopen(tmp, "wb");
-            if (f) {
-                bool ok = fwrite(data, 1, n, f) == n;
-                ok = fclose(f) == 0 && ok;
-                if (!ok || rename(tmp, pl->cache_path) != 0)
-                    remove(tmp);
-            }
-            free(tmp);
-        }
-    }
+    /* a unique temporary beside it, renamed: readers never see half a file,
+     * and two processes saving at once never write into one temporary */
+    if (vkGetPipelineCacheData(d->dev, pl->cache, &n, data) == VK_SUCCESS)
+        (void)splat_write_atomic(pl->cache_path, data, n);
     free(data);
 }
 
