@@ -1180,9 +1180,9 @@ static void emit_reference(emit *em)
 static void differentiated(const splat_composite *c, ir *dst, splat_layer *layers)
 {
     ir_clone(dst, &c->ir);
-    if (ir_differentiate(dst)) {
-        opt_fold(dst);
-        opt_dce(dst);
+    if (ir_pass_run(dst, "differentiate", NULL)) {
+        ir_pass_run(dst, "fold", NULL);
+        ir_pass_run(dst, "dce", NULL);
     }
     for (int j = 0; j < c->nlayers; j++)
         layers[j].material = c->layers[j].material;

@@ -131,7 +131,7 @@ static void make_class(const splat_layout *L, const splat_composite *c, double l
     v->reference = c->reference;
     ir_ienv env;
     region(&env, lo, hi);
-    opt_pin(&v->ir, &env);
+    ir_pass_run(&v->ir, "pin", &env);
     ir_optimize(&v->ir, NULL);
     splat_composite_refresh(L, v, d);
     out->cost = splat_composite_cost(v);

@@ -544,7 +544,7 @@ static bool bake_on_cpu(build *b)
         if (!ok)
             break;
         ir *ir = &fb.comp[k].ir;
-        if (ir_differentiate(ir))
+        if (ir_pass_run(ir, "differentiate", NULL))
             ir_optimize(ir, NULL);
         static const char *names[3] = {"composite.albedo", "composite.normal",
                                        "composite.roughness"};

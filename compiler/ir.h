@@ -471,13 +471,22 @@ bool opt_dedup(ir *ir);  /* merge textures with equal file + sampler  */
 typedef ir_ref (*ir_rewrite_fn)(ir *dst, const ir_node *n, void *user);
 bool ir_rebuild(ir *ir, ir_rewrite_fn fn, void *user);
 
-typedef bool (*ir_pass_fn)(ir *ir);
-typedef struct ir_pass { const char *name; ir_pass_fn run; } ir_pass;
-extern const ir_pass ir_passes[];   /* in pipeline order, NULL-terminated */
+/* Every transformation of an ir is a pass of this table, so each is
+ * named and the validator runs after each (when built with
+ * SPLAT_VALIDATE_IR, as every build of this project is).  The pipeline's
+ * passes (dedup, fold, dce: `pipeline`) run to a fixed point in
+ * ir_optimize; the others run on their own through ir_pass_run:
+ * differentiate (explicit texture gradients) and pin (constants over a
+ * region: `arg` is its const ir_ienv *).  run returns progress. */
+typedef bool (*ir_pass_fn)(ir *ir, const void *arg);
+typedef struct ir_pass { const char *name; ir_pass_fn run; bool pipeline; } ir_pass;
+extern const ir_pass ir_passes[];   /* the pipeline's in order, then the rest; NULL-ended */
+const ir_pass *ir_pass_find(const char *name);   /* NULL if none */
+/* Run one pass by name (a name not in the table is a compiler bug). */
+bool ir_pass_run(ir *ir, const char *name, const void *arg);
 
-/* Run the passes to a fixed point; with `stop_after` (a pass name) stop
- * after that pass's first run (for `splatc dump --after`).  Validates after
- * every pass when built with SPLAT_VALIDATE_IR (debug builds). */
+/* Run the pipeline's passes to a fixed point; with `stop_after` (a pass
+ * name) stop after that pass's first run (for `splatc dump --after`). */
 void ir_optimize(ir *ir, const char *stop_after);
 
 /* ---- derivatives (ir_differentiate.c) ---------------------------------- */

@@ -429,11 +429,12 @@ static int cmd_dump(int argc, char **argv)
     if (st == EXIT_OK && o.after && strcmp(o.after, "lower")) {
         bool known = false;
         for (const ir_pass *ps = ir_passes; ps->name; ps++)
-            known |= !strcmp(ps->name, o.after);
+            known |= ps->pipeline && !strcmp(ps->name, o.after);
         if (!known) {
             fprintf(stderr, "splatc: unknown pass '%s'; passes: lower", o.after);
             for (const ir_pass *ps = ir_passes; ps->name; ps++)
-                fprintf(stderr, " %s", ps->name);
+                if (ps->pipeline)
+                    fprintf(stderr, " %s", ps->name);
             fputc('\n', stderr);
             st = EXIT_USAGE;
         }

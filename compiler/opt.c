@@ -5,7 +5,8 @@
  *     fold    constant folding and safe algebraic identities
  *     dce     drop unreachable nodes and unused params/textures/painted
  * CSE needs no pass: the builder hash-conses every node, so a rebuild
- * merges whatever the other passes made identical.
+ * merges whatever the other passes made identical.  The table also names
+ * the passes run on their own (ir_pass_run): differentiate and pin.
  */
 #include "ir.h"
 
@@ -13,12 +14,28 @@
 #include <stdlib.h>
 #include <string.h>
 
+static bool run_dedup(ir *ir, const void *arg) { (void)arg; return opt_dedup(ir); }
+static bool run_fold(ir *ir, const void *arg) { (void)arg; return opt_fold(ir); }
+static bool run_dce(ir *ir, const void *arg) { (void)arg; return opt_dce(ir); }
+static bool run_differentiate(ir *ir, const void *arg) { (void)arg; return ir_differentiate(ir); }
+static bool run_pin(ir *ir, const void *arg) { return opt_pin(ir, arg); }
+
 const ir_pass ir_passes[] = {
-    {"dedup", opt_dedup},
-    {"fold", opt_fold},
-    {"dce", opt_dce},
-    {NULL, NULL},
+    {"dedup", run_dedup, true},
+    {"fold", run_fold, true},
+    {"dce", run_dce, true},
+    {"differentiate", run_differentiate, false},
+    {"pin", run_pin, false},
+    {NULL, NULL, false},
 };
+
+const ir_pass *ir_pass_find(const char *name)
+{
+    for (const ir_pass *p = ir_passes; p->name; p++)
+        if (!strcmp(p->name, name))
+            return p;
+    return NULL;
+}
 
 static bool rebuild_once(ir *ir, ir_rewrite_fn fn, void *user, bool *dead_left)
 {
@@ -108,6 +125,28 @@ static void validate_after(const ir *ir, const char *pass)
 }
 #endif
 
+static bool run_validated(ir *ir, const ir_pass *p, const void *arg)
+{
+    bool progress = p->run(ir, arg);
+#ifdef SPLAT_VALIDATE_IR
+    validate_after(ir, p->name);
+#endif
+    return progress;
+}
+
+bool ir_pass_run(ir *ir, const char *name, const void *arg)
+{
+    const ir_pass *p = ir_pass_find(name);
+    if (!p) {
+        fprintf(stderr, "splatc: internal compiler error: no pass '%s'\n", name);
+        abort();
+    }
+#ifdef SPLAT_VALIDATE_IR
+    validate_after(ir, "(input)");
+#endif
+    return run_validated(ir, p, arg);
+}
+
 void ir_optimize(ir *ir, const char *stop_after)
 {
 #ifdef SPLAT_VALIDATE_IR
@@ -116,10 +155,9 @@ void ir_optimize(ir *ir, const char *stop_after)
     for (int round = 0;; round++) {
         bool progress = false;
         for (const ir_pass *p = ir_passes; p->name; p++) {
-            progress |= p->run(ir);
-#ifdef SPLAT_VALIDATE_IR
-            validate_after(ir, p->name);
-#endif
+            if (!p->pipeline)
+                continue;
+            progress |= run_validated(ir, p, NULL);
             if (stop_after && strcmp(stop_after, p->name) == 0)
                 return;
         }

@@ -159,7 +159,7 @@ void glsl_material_shader_stage(const ir *ir, const char *material, bool compute
     /* no quads in compute: explicit gradients (ir_differentiate) */
     struct ir d;
     ir_clone(&d, ir);
-    if (ir_differentiate(&d))
+    if (ir_pass_run(&d, "differentiate", NULL))
         ir_optimize(&d, NULL);
     material_shader(&d, material, true, out);
     ir_free(&d);

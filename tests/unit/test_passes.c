@@ -216,7 +216,8 @@ static void test_optimize_fixed_point_and_stop_after(void **state)
     assert_int_equal(root_node(&ir, "r")->op, IR_OP_INPUT);
     assert_int_equal(ir.nnodes, 2);
     for (const ir_pass *p = ir_passes; p->name; p++)
-        assert_false(p->run(&ir));                               /* at its fixed point */
+        if (p->pipeline)
+            assert_false(p->run(&ir, NULL));                     /* at its fixed point */
     ir_free(&ir);
 }
 
@@ -259,6 +260,39 @@ static void test_dump(void **state)
     ir_free(&ir);
 }
 
+/* Every transformation is in the table (issue 32): the pipeline's three in
+ * order, then differentiate and pin, each run by name through ir_pass_run. */
+static void test_pass_table(void **state)
+{
+    (void)state;
+    static const char *names[] = {"dedup", "fold", "dce", "differentiate", "pin"};
+    int n = 0;
+    for (const ir_pass *p = ir_passes; p->name; p++, n++) {
+        assert_true(n < 5);
+        assert_string_equal(p->name, names[n]);
+        assert_int_equal(p->pipeline, n < 3);
+        assert_ptr_equal(ir_pass_find(p->name), p);
+    }
+    assert_int_equal(n, 5);
+    assert_null(ir_pass_find("cse"));
+
+    /* pin through the table: h pinned to 2 over [2, 2] folds h * 3 to 6 */
+    ir ir;
+    ir_init(&ir);
+    ir_ref h = ir_input(&ir, IR_IN_HEIGHT);
+    ir_set_root(&ir, "r", ir_op2(&ir, IR_OP_MUL, h, ir_constf(&ir, 3.0)));
+    ir_ienv env;
+    memset(&env, 0, sizeof env);
+    ir_ienv_domain(&env);
+    env.height = (ir_iv){2.0, 2.0};
+    assert_true(ir_pass_run(&ir, "pin", &env));
+    ir_optimize(&ir, NULL);
+    assert_int_equal(root_node(&ir, "r")->op, IR_OP_CONST);
+    /* differentiate through the table: no sample, no progress */
+    assert_false(ir_pass_run(&ir, "differentiate", NULL));
+    ir_free(&ir);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -270,6 +304,7 @@ int main(void)
         cmocka_unit_test(test_dedup),
         cmocka_unit_test(test_optimize_fixed_point_and_stop_after),
         cmocka_unit_test(test_dump),
+        cmocka_unit_test(test_pass_table),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
