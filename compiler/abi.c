@@ -650,6 +650,13 @@ const char SPLAT_GLSL_PRELUDE[] =
     "    float r = max(max(dot(a, a), dot(b, b)), 1e-30);\n"
     "    return textureLod(t, uv, 0.5 * log2(r));\n"
     "}\n"
+    /* the same on a layer of a texture array: uvl = (uv, layer) */
+    "vec4 splat_texture_grad(sampler2DArray t, vec3 uvl, vec2 dx, vec2 dy) {\n"
+    "    vec2 s = vec2(textureSize(t, 0).xy);\n"
+    "    vec2 a = dx * s, b = dy * s;\n"
+    "    float r = max(max(dot(a, a), dot(b, b)), 1e-30);\n"
+    "    return textureLod(t, uvl, 0.5 * log2(r));\n"
+    "}\n"
     "#if defined(SPLAT_COMPUTE) || defined(SPLAT_GRADIENTS)\n"
     "vec3 splat_d_rel(int a) { return a == 0 ? splat_dpdx : splat_dpdy; }\n"
     "#else\n"

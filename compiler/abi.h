@@ -44,7 +44,10 @@
  * Descriptor set 1 ("material"), one for the whole pack:
  *   binding 0  uniform block   splat_params: every param of the scene, one
  *                              vec4 slot each, in manifest order
- *   binding 1+i sampler2D      the scene's texture resource i (manifest order)
+ *   binding 1+a sampler2DArray texture array a: the scene's textures of one
+ *                              size, mip files and sampler state, one layer
+ *                              each (manifest textures[i].array / .layer);
+ *                              RGBA8, UNORM or SRGB
  * Push constants (vertex and fragment stages): struct splat_push.
  *
  * Vertex input: location 0, vec2 (R32G32_SFLOAT): the grid position 0..1
@@ -189,8 +192,9 @@
 #include <math.h>
 #include <stdint.h>
 
-#define SPLAT_ABI_VERSION 4   /* 2: splat_frame.light; 3: GGX lighting, screen.w;
-                                 4: splat_surface / splat_opaque, SPLAT_SORT */
+#define SPLAT_ABI_VERSION 5   /* 2: splat_frame.light; 3: GGX lighting, screen.w;
+                                 4: splat_surface / splat_opaque, SPLAT_SORT;
+                                 5: set 1's textures are sampler2DArray layers */
 
 /* Undergrowth masks (above): texels per cell side, undergrowth-bearing
  * materials at most (4 per word), the fixed view distance (m). */
@@ -243,7 +247,12 @@ enum {
                                        maxImageArrayLayers: a dense pack's
                                        layers fit every device)             */
     SPLAT_MAX_DESTRUCTION_CELLS = 1024, /* destruction grid cells per side  */
-    SPLAT_MAX_TEXTURES = 64,        /* textures of a scene (set 1 bindings)  */
+    SPLAT_MAX_TEXTURES = 4096,      /* textures of a scene (array layers)    */
+    SPLAT_MAX_TEXTURE_ARRAYS = 20,  /* set 1 texture arrays (bindings): with
+                                       the 9 sampler bindings of set 0, within
+                                       the 32 samplers a stage lavapipe has */
+    SPLAT_MAX_ARRAY_LAYERS = 256,   /* textures in one array (Vulkan's
+                                       guaranteed maxImageArrayLayers)       */
     SPLAT_MAX_MESH_VERTICES = 65536,  /* vertices of one undergrowth mesh    */
     SPLAT_MAX_MESH_INDICES = 196608,  /* indices of one (a triangle list)     */
     SPLAT_MAX_UG_BLOCKS = 64,       /* undergrowth blocks of a pack          */

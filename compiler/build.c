@@ -269,10 +269,51 @@ static bool analyse(build *b)
     return b->analysis_ok;
 }
 
+/* The layout's textures into arrays (abi.h set 1) by size, mip files and
+ * sampler state; scene.c has checked every file is a readable image. */
+static bool group_textures(build *b)
+{
+    splat_layout *L = &b->layout;
+    int n = L->ntextures;
+    int *w = xcalloc((size_t)n + 1, sizeof *w), *h = xcalloc((size_t)n + 1, sizeof *h);
+    int *mips = xcalloc((size_t)n + 1, sizeof *mips);
+    for (int t = 0; t < n; t++) {
+        const char *file = L->src->textures[L->textures[t]].file;
+        char why[256];
+        FILE *f = splat_input_fopen(file, SPLAT_MAX_IMAGE_BYTES, why, sizeof why);
+        long long iw = 0, ih = 0;
+        int comp;
+        bool is16;
+        if (f && splat_image_info(f, &iw, &ih, &comp, &is16))
+            w[t] = (int)iw, h[t] = (int)ih;
+        if (f)
+            fclose(f);
+        mips[t] = build_mip_count(file);
+    }
+    splat_layout_group_textures(L, w, h, mips);
+    free(w);
+    free(h);
+    free(mips);
+    sg_loc at = b->scene.desc->loc;
+    if (n > SPLAT_MAX_TEXTURES) {
+        sg_errorf(b->d, at, SG_E_OVER_LIMIT, "the scene's materials sample %d textures, "
+                  "over the pack limit of %d", n, SPLAT_MAX_TEXTURES);
+        return false;
+    }
+    if (L->narrays > SPLAT_MAX_TEXTURE_ARRAYS) {
+        sg_errorf(b->d, at, SG_E_OVER_LIMIT, "the scene's %d textures need %d texture arrays "
+                  "(one per size, mip files and sampler state), over the pack limit of %d: "
+                  "use fewer sizes or sampler settings", n, L->narrays,
+                  SPLAT_MAX_TEXTURE_ARRAYS);
+        return false;
+    }
+    return true;
+}
+
 static bool layout(build *b)
 {
     b->layout_ok = splat_layout_from_scene(&b->layout, &b->scene, b->d);
-    b->ug_ok = b->layout_ok && splat_ug_init(&b->ug, &b->scene, b->d);
+    b->ug_ok = b->layout_ok && group_textures(b) && splat_ug_init(&b->ug, &b->scene, b->d);
     return b->ug_ok;
 }
 

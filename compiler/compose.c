@@ -34,7 +34,7 @@
  *
  * Example (grass below cliff): the composite of [cliff, grass] reads
  *     float v4 = ...cliff mask...;            // G_0 (T_0 = 1: a plain block)
- *     if (v4 > 0.0) { v9 = texture(u_tex_1, ...); s_albedo += v4 * v9.rgb; }
+ *     if (v4 > 0.0) { v9 = texture(u_texa_0, vec3(..., 1.0)); s_albedo += v4 * v9.rgb; }
  *     float v5 = 1.0 - v4;
  *     if (v5 > 0.0) { ...grass surface...; s_albedo += v5 * ...; }
  */
@@ -90,6 +90,11 @@ bool splat_layout_init(splat_layout *L, const ir *src, sg_program *prog,
         }
         L->texture_of[i] = t;
     }
+    L->tex_array = xcalloc((size_t)L->ntextures + 1, sizeof *L->tex_array);
+    L->tex_layer = xcalloc((size_t)L->ntextures + 1, sizeof *L->tex_layer);
+    for (int t = 0; t < L->ntextures; t++)
+        L->tex_array[t] = t;
+    L->narrays = L->ntextures;
     for (int i = 0; i < nmaterials; i++) {
         char name[512];
         snprintf(name, sizeof name, "%s.mask", materials[i]);
@@ -120,12 +125,39 @@ bool splat_layout_from_scene(splat_layout *L, const splat_scene *s, sg_diags *d)
     return ok;
 }
 
+void splat_layout_group_textures(splat_layout *L, const int *w, const int *h, const int *mips)
+{
+    int *first = xcalloc((size_t)L->ntextures + 1, sizeof *first);   /* array -> a texture */
+    int *layers = xcalloc((size_t)L->ntextures + 1, sizeof *layers);
+    L->narrays = 0;
+    for (int t = 0; t < L->ntextures; t++) {
+        const ir_texture *x = &L->src->textures[L->textures[t]];
+        int a = 0;
+        for (; a < L->narrays; a++) {
+            int u = first[a];
+            const ir_texture *y = &L->src->textures[L->textures[u]];
+            if (w[u] == w[t] && h[u] == h[t] && mips[u] == mips[t] && x->filter == y->filter &&
+                x->mip == y->mip && x->wrap == y->wrap && x->srgb == y->srgb &&
+                layers[a] < SPLAT_MAX_ARRAY_LAYERS)
+                break;
+        }
+        if (a == L->narrays)
+            first[L->narrays++] = t;
+        L->tex_array[t] = a;
+        L->tex_layer[t] = layers[a]++;
+    }
+    free(first);
+    free(layers);
+}
+
 void splat_layout_free(splat_layout *L)
 {
     free(L->materials);
     free(L->painted);
     free(L->texture_of);
     free(L->textures);
+    free(L->tex_array);
+    free(L->tex_layer);
     memset(L, 0, sizeof *L);
 }
 
@@ -486,14 +518,14 @@ static void use_at(sched *s, ir_ref r, int region)
  * mix(0, b, 1) = b, mix(a, 0, 0) = a, 0 * w = 0 when w = 0.  Before
  * (a tri-planar tap, eager):
  *
- *     vec4 v12 = texture(u_tex_0, v11);            // x projection
+ *     vec4 v12 = texture(u_texa_0, vec3(v11, 0.0));            // x projection
  *     vec4 v20 = v19 * v12;                        // v19 = its weight
  *
  * after:
  *
  *     vec4 lz20_1 = vec4(0.0);
  *     if (splat_quad_any(v18 != 0.0)) {            // v19 = vec4(v18)
- *         vec2 v11 = ...;  vec4 v12 = texture(u_tex_0, v11);
+ *         vec2 v11 = ...;  vec4 v12 = texture(u_texa_0, vec3(v11, 0.0));
  *         lz20_1 = v12;
  *     }
  *     vec4 v20 = v19 * lz20_1;
@@ -1050,11 +1082,13 @@ static void emit_header(emit *em, const splat_glsl_desc *desc)
                       ir_type_name(L->src->params[c->params[i]].type),
                       L->src->params[c->params[i]].name);
     for (int i = 0; i < c->ntextures; i++) {
-        const ir_texture *t = &L->src->textures[L->textures[c->textures[i]]];
-        ir_buf_printf(o, " * set %d binding %d: u_tex_%d = %s (%s, mip %s, %s%s)\n",
-                      SPLAT_SET_MATERIAL, SPLAT_BIND_TEXTURE0 + c->textures[i],
-                      c->textures[i], basename_of(t->file), ir_filter_name(t->filter),
-                      ir_filter_name(t->mip), ir_wrap_name(t->wrap), t->srgb ? ", sRGB" : "");
+        int x = c->textures[i];
+        const ir_texture *t = &L->src->textures[L->textures[x]];
+        ir_buf_printf(o, " * set %d binding %d: u_texa_%d layer %d = %s (%s, mip %s, %s%s)\n",
+                      SPLAT_SET_MATERIAL, SPLAT_BIND_TEXTURE0 + L->tex_array[x],
+                      L->tex_array[x], L->tex_layer[x], basename_of(t->file),
+                      ir_filter_name(t->filter), ir_filter_name(t->mip), ir_wrap_name(t->wrap),
+                      t->srgb ? ", sRGB" : "");
     }
     ir_buf_printf(o, " */\n");
     if (c->reference)
@@ -1073,15 +1107,21 @@ static void emit_header(emit *em, const splat_glsl_desc *desc)
     ir_buf_printf(o, "layout(set = %d, binding = %d, std140) uniform splat_params_block {\n"
                      "    vec4 slot[%d];\n} u_params;\n",
                   SPLAT_SET_MATERIAL, SPLAT_BIND_PARAMS, L->nparams > 0 ? L->nparams : 1);
-    for (int i = 0; i < c->ntextures; i++)
-        ir_buf_printf(o, "layout(set = %d, binding = %d) uniform sampler2D u_tex_%d;\n",
-                      SPLAT_SET_MATERIAL, SPLAT_BIND_TEXTURE0 + c->textures[i],
-                      c->textures[i]);
+    /* each array this composite reads, once (its textures' order) */
+    for (int i = 0; i < c->ntextures; i++) {
+        int a = L->tex_array[c->textures[i]], seen = 0;
+        for (int j = 0; j < i; j++)
+            seen |= L->tex_array[c->textures[j]] == a;
+        if (!seen)
+            ir_buf_printf(o, "layout(set = %d, binding = %d) uniform sampler2DArray u_texa_%d;\n",
+                          SPLAT_SET_MATERIAL, SPLAT_BIND_TEXTURE0 + a, a);
+    }
 }
 
 /* How the composite's param/texture/painted tables read in GLSL. */
 typedef struct names {
     char      **param, **texture, **painted;
+    int        *texture_layer;
     int         nparam, ntexture, npainted;
     char      **override;   /* precision.c's camera-relative forms       */
     const ir   *ir;
@@ -1112,10 +1152,13 @@ static void names_init(names *nm, const splat_layout *L, const ir *ir,
     }
     nm->ntexture = ir->ntextures;
     nm->texture = xcalloc((size_t)ir->ntextures, sizeof *nm->texture);
+    nm->texture_layer = xcalloc((size_t)ir->ntextures + 1, sizeof *nm->texture_layer);
     for (int i = 0; i < ir->ntextures; i++) {
+        int t = splat_layout_texture(L, &ir->textures[i]);
         char buf[32];
-        snprintf(buf, sizeof buf, "u_tex_%d", splat_layout_texture(L, &ir->textures[i]));
+        snprintf(buf, sizeof buf, "u_texa_%d", L->tex_array[t]);
         nm->texture[i] = xstrdup(buf);
+        nm->texture_layer[i] = L->tex_layer[t];
     }
     nm->npainted = ir->npainted;
     nm->painted = xcalloc((size_t)ir->npainted, sizeof *nm->painted);
@@ -1130,6 +1173,7 @@ static void names_init(names *nm, const splat_layout *L, const ir *ir,
     }
     nm->g.param = (const char *const *)nm->param;
     nm->g.texture = (const char *const *)nm->texture;
+    nm->g.texture_layer = nm->texture_layer;
     nm->g.painted = (const char *const *)nm->painted;
     nm->ir = ir;
     nm->override = splat_sites_overrides(L, ir, param_of, input_of, &nm->g);
@@ -1151,6 +1195,7 @@ static void names_free(names *nm)
         free(nm->painted[i]);
     free(nm->param);
     free(nm->texture);
+    free(nm->texture_layer);
     free(nm->painted);
     splat_sites_overrides_free(nm->ir, nm->override);
 }

@@ -23,6 +23,12 @@ typedef struct splat_layout {
     int           *texture_of; /* src texture index -> layout texture index   */
     int           *textures;   /* layout texture -> its first src texture     */
     int            ntextures;
+    /* Texture arrays (abi.h set 1): layout texture t is layer tex_layer[t]
+     * of array tex_array[t], bound at SPLAT_BIND_TEXTURE0 + tex_array[t].
+     * splat_layout_init gives each texture an array of its own;
+     * splat_layout_group_textures shares arrays. */
+    int           *tex_array, *tex_layer;
+    int            narrays;
     int            nparams;    /* = src->nparams; slot i = src param i        */
     /* every material's precise sites, u_frame.world[k] (precision.c) */
     splat_site     sites[SPLAT_WORLD_SITES];
@@ -60,6 +66,11 @@ bool splat_layout_from_scene(splat_layout *L, const splat_scene *s, sg_diags *d)
  * scene's compositor. */
 bool splat_compositor_check(sg_program *prog, const char *name, sg_loc at, sg_diags *d);
 void splat_layout_free(splat_layout *L);
+/* Share texture arrays: layout textures of one size (w[t] x h[t]), one
+ * count of their own mip files (mips[t]) and one sampler state (filter,
+ * mip filter, wrap, sRGB) become layers of one array, in first-use order
+ * (deterministic), at most SPLAT_MAX_ARRAY_LAYERS to an array. */
+void splat_layout_group_textures(splat_layout *L, const int *w, const int *h, const int *mips);
 /* Index of the layout texture equal (file + sampler state) to `t`, or -1. */
 int  splat_layout_texture(const splat_layout *L, const ir_texture *t);
 

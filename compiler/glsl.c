@@ -225,6 +225,13 @@ static void op_expr(glsl_emitter *e, const ir_node *n, ir_buf *b)
     for (int i = 0; i < n->nargs; i++)
         a[i] = e->expr[n->arg[i].id];
     const char *form = ir_opinfo_get((ir_op)n->op)->glsl;
+    char *layered = NULL;   /* vec3(uv, layer) for a texture array */
+    if ((n->op == IR_OP_SAMPLE || n->op == IR_OP_SAMPLE_GRAD) && e->names.texture_layer) {
+        const ir_node *t = &e->ir->nodes[n->arg[0].id];
+        ir_buf l = {0};
+        ir_buf_printf(&l, "vec3(%s, %d.0)", a[1], e->names.texture_layer[t->imm]);
+        a[1] = layered = l.s;
+    }
     if (e->names.override && e->names.override[id]) {
         form = e->names.override[id];   /* its $k read operand k, as below */
         goto substitute;
@@ -273,6 +280,7 @@ substitute:
             ir_buf_printf(b, "%c", *p);
         }
     }
+    free(layered);
 }
 
 static int cmp_id(const void *x, const void *y)

@@ -647,6 +647,10 @@ void ir_buf_free(ir_buf *b);
 typedef struct glsl_names {
     const char *const *param;
     const char *const *texture;
+    /* NULL: each texture is a sampler2D; else texture i is layer
+     * texture_layer[i] of the sampler2DArray texture[i] names, and its
+     * samples read vec3(uv, layer) (the pack's texture arrays, abi.h) */
+    const int *texture_layer;
     const char *const *painted;
     /* NULL, or per node id: a complete GLSL expression emitted for that
      * node instead of its op, reading only the operands it names as $k

@@ -345,7 +345,8 @@ static json_t *jtextures(const splat_layout *L, char **tex_names)
         const ir_texture *t = &L->src->textures[L->textures[i]];
         json_t *o = json_object();
         json_object_set_new(o, "file", json_string(tex_names[i]));
-        json_object_set_new(o, "binding", json_integer(SPLAT_BIND_TEXTURE0 + i));
+        json_object_set_new(o, "binding", json_integer(SPLAT_BIND_TEXTURE0 + L->tex_array[i]));
+        json_object_set_new(o, "layer", json_integer(L->tex_layer[i]));
         json_object_set_new(o, "filter", json_string(ir_filter_name(t->filter)));
         json_object_set_new(o, "mip", json_string(ir_filter_name(t->mip)));
         json_object_set_new(o, "wrap", json_string(ir_wrap_name(t->wrap)));

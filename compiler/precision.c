@@ -227,12 +227,21 @@ char **splat_sites_overrides(const splat_layout *L, const ir *ir,
                 ir_buf_printf(&e, "(u_frame.world[%d].xy + floor(%s))", k, f.s);
             else if (u->op == IR_OP_FRACT)
                 ir_buf_printf(&e, "fract(%s)", f.s);
-            else if (u->op == IR_OP_SAMPLE_GRAD)   /* the gradients as they are */
-                ir_buf_printf(&e, "splat_texture_grad(%s, %s, $2, $3)",
-                              names->texture[ir_get(ir, u->arg[0])->imm], f.s);
-            else
-                ir_buf_printf(&e, "texture(%s, %s)",
-                              names->texture[ir_get(ir, u->arg[0])->imm], f.s);
+            else {
+                /* a texture array's layer goes with the uv (abi.h set 1) */
+                uint32_t t = ir_get(ir, u->arg[0])->imm;
+                ir_buf uv = {0};
+                if (names->texture_layer)
+                    ir_buf_printf(&uv, "vec3(%s, %d.0)", f.s, names->texture_layer[t]);
+                else
+                    ir_buf_printf(&uv, "%s", f.s);
+                if (u->op == IR_OP_SAMPLE_GRAD)   /* the gradients as they are */
+                    ir_buf_printf(&e, "splat_texture_grad(%s, %s, $2, $3)", names->texture[t],
+                                  uv.s);
+                else
+                    ir_buf_printf(&e, "texture(%s, %s)", names->texture[t], uv.s);
+                ir_buf_free(&uv);
+            }
             ov[i] = e.s;
             ir_buf_free(&f);
             ir_buf_free(&scale);

@@ -614,14 +614,16 @@ bool rt_image_upload(rt_device *d, rt_image *img, const void *data,
 bool rt_image_upload_levels(rt_device *d, rt_image *img, const uint8_t *const *levels,
                             rt_error *e)
 {
-    /* one staging buffer holding every level, one copy region per level */
+    /* one staging buffer holding every level of every layer, one copy
+     * region per level and layer */
     size_t total = 0;
     for (uint32_t m = 0; m < img->mips; m++) {
         size_t w = img->width >> m ? img->width >> m : 1;
         size_t h = img->height >> m ? img->height >> m : 1;
-        total += w * h * 4;
+        total += w * h * 4 * img->layers;
     }
-    VkBufferImageCopy *regions = calloc(img->mips, sizeof *regions);
+    uint32_t nregions = img->mips * img->layers;
+    VkBufferImageCopy *regions = calloc(nregions, sizeof *regions);
     if (!regions)
         return rt_fail(e, RT_E_VULKAN, "mip upload", "out of memory");
     rt_buffer staging;
@@ -630,26 +632,27 @@ bool rt_image_upload_levels(rt_device *d, rt_image *img, const uint8_t *const *l
         return false;
     }
     size_t off = 0;
-    for (uint32_t m = 0; m < img->mips; m++) {
-        uint32_t w = img->width >> m ? img->width >> m : 1;
-        uint32_t h = img->height >> m ? img->height >> m : 1;
-        memcpy((uint8_t *)staging.map + off, levels[m], (size_t)w * h * 4);
-        regions[m] = (VkBufferImageCopy){
-            .bufferOffset = off,
-            .imageSubresource = { VK_IMAGE_ASPECT_COLOR_BIT, m, 0, 1 },
-            .imageExtent = { w, h, 1 },
-        };
-        off += (size_t)w * h * 4;
-    }
+    for (uint32_t l = 0; l < img->layers; l++)
+        for (uint32_t m = 0; m < img->mips; m++) {
+            uint32_t w = img->width >> m ? img->width >> m : 1;
+            uint32_t h = img->height >> m ? img->height >> m : 1;
+            memcpy((uint8_t *)staging.map + off, levels[l * img->mips + m], (size_t)w * h * 4);
+            regions[l * img->mips + m] = (VkBufferImageCopy){
+                .bufferOffset = off,
+                .imageSubresource = { VK_IMAGE_ASPECT_COLOR_BIT, m, l, 1 },
+                .imageExtent = { w, h, 1 },
+            };
+            off += (size_t)w * h * 4;
+        }
     VkCommandBuffer cb;
     bool ok = rt_oneshot_begin(d, &cb, e);
     if (ok) {
-        rt_cmd_image_barrier(cb, img->img, 0, img->mips, 1, VK_IMAGE_LAYOUT_UNDEFINED,
+        rt_cmd_image_barrier(cb, img->img, 0, img->mips, img->layers, VK_IMAGE_LAYOUT_UNDEFINED,
                 VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 0, VK_ACCESS_TRANSFER_WRITE_BIT,
                 VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT);
         vkCmdCopyBufferToImage(cb, staging.buf, img->img, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
-                               img->mips, regions);
-        rt_cmd_image_barrier(cb, img->img, 0, img->mips, 1, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
+                               nregions, regions);
+        rt_cmd_image_barrier(cb, img->img, 0, img->mips, img->layers, VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL,
                 VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, VK_ACCESS_TRANSFER_WRITE_BIT,
                 VK_ACCESS_SHADER_READ_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
                 VK_PIPELINE_STAGE_VERTEX_SHADER_BIT | VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT);

@@ -936,6 +936,52 @@ static bool read_mips(reader *r, json_t *t, const char *where, rt_pack_texture *
     return true;
 }
 
+/* The textures' arrays (binding 1 + a, layer l): the bindings dense from
+ * 1, each array's layers dense from 0, one texture a layer, and its
+ * textures alike in size, mip levels and sampler state. */
+static bool texture_arrays(reader *r)
+{
+    rt_pack *p = r->p;
+    for (int i = 0; i < p->ntextures; i++) {
+        int a = (int)p->textures[i].binding - SPLAT_BIND_TEXTURE0;
+        if (a + 1 > p->narrays)
+            p->narrays = a + 1;
+    }
+    p->arrays = calloc((size_t)p->narrays + 1, sizeof *p->arrays);
+    if (!p->arrays)
+        return field_fail(r, "textures:", "out of memory");
+    for (int a = 0; a < p->narrays; a++) {
+        rt_pack_array *A = &p->arrays[a];
+        for (int i = 0; i < p->ntextures; i++)
+            if ((int)p->textures[i].binding == SPLAT_BIND_TEXTURE0 + a)
+                A->nlayers++;
+        char where[64];
+        snprintf(where, sizeof where, "textures (binding %d)", SPLAT_BIND_TEXTURE0 + a);
+        if (!A->nlayers)
+            return field_fail(r, where, "no texture has this binding: the bindings must be dense");
+        A->textures = calloc((size_t)A->nlayers, sizeof *A->textures);
+        if (!A->textures)
+            return field_fail(r, "textures:", "out of memory");
+        for (int l = 0; l < A->nlayers; l++)
+            A->textures[l] = -1;
+        for (int i = 0; i < p->ntextures; i++) {
+            const rt_pack_texture *t = &p->textures[i];
+            if ((int)t->binding != SPLAT_BIND_TEXTURE0 + a)
+                continue;
+            if (t->layer >= A->nlayers || A->textures[t->layer] >= 0)
+                return field_fail(r, where, "its layers must be 0, 1, … once each");
+            A->textures[t->layer] = i;
+            const rt_pack_texture *u = &p->textures[A->textures[0] >= 0 ? A->textures[0] : i];
+            if (t->width != u->width || t->height != u->height || t->nmips != u->nmips ||
+                t->linear != u->linear || t->mip_linear != u->mip_linear ||
+                t->srgb != u->srgb || t->wrap != u->wrap)
+                return field_fail(r, where, "its textures differ in size, mip levels or "
+                                  "sampler state");
+        }
+    }
+    return true;
+}
+
 static bool read_textures(reader *r, json_t *root)
 {
     rt_pack *p = r->p;
@@ -959,12 +1005,15 @@ static bool read_textures(reader *r, json_t *root)
         char where[64];
         snprintf(where, sizeof where, "textures[%d]", i);
         const char *file, *filter = "linear", *mip = "linear", *wrap = "repeat";
-        int binding;
+        int binding, layer = 0;
         if (!get_string(r, t, "file", where, &file) ||
-            !get_int(r, t, "binding", where, 1, 1 << 16, &binding))
+            !get_int(r, t, "binding", where, SPLAT_BIND_TEXTURE0,
+                     SPLAT_BIND_TEXTURE0 + SPLAT_MAX_TEXTURE_ARRAYS - 1, &binding))
             return false;
-        if (binding != SPLAT_BIND_TEXTURE0 + i)
-            return field_fail(r, where, "binding must be 1 + its index");
+        if (get(r, t, "layer", where, false) &&
+            !get_int(r, t, "layer", where, 0, SPLAT_MAX_ARRAY_LAYERS - 1, &layer))
+            return false;
+        tx->layer = layer;
         if (get(r, t, "filter", where, false) && !get_string(r, t, "filter", where, &filter))
             return false;
         if (get(r, t, "mip", where, false) && !get_string(r, t, "mip", where, &mip))
@@ -1005,7 +1054,7 @@ static bool read_textures(reader *r, json_t *root)
         if (get(r, t, "mips", where, false) && !read_mips(r, t, where, tx))
             return false;
     }
-    return true;
+    return texture_arrays(r);
 }
 
 static bool read_painted(reader *r, json_t *root)
@@ -1455,6 +1504,8 @@ void rt_pack_free(rt_pack *p)
             stbi_image_free(p->textures[i].mips[k]);
         free(p->textures[i].mips);
     }
+    for (int a = 0; a < p->narrays && p->arrays; a++)
+        free(p->arrays[a].textures);
     for (int i = 0; i < p->ncombos && p->combos; i++) {
         free(p->combos[i].materials);
         free(p->combos[i].compute);
@@ -1479,6 +1530,7 @@ void rt_pack_free(rt_pack *p)
     free(p->materials);
     free(p->params);
     free(p->textures);
+    free(p->arrays);
     free(p->combos);
     free(p->levels);
     free(p->painted);
@@ -1558,11 +1610,17 @@ bool rt_pack_check_device(const rt_pack *p, const rt_device *d, rt_error *e)
                    "maxImageDimension2D", dim, e))
             return false;
     }
-    /* fragment stage: set 0's six samplers and set 1's textures */
-    uint64_t samplers = 6 + (uint64_t)p->ntextures;
-    return limit(p, "the fragment stage's sampler count (6 + textures)", samplers,
+    for (int a = 0; a < p->narrays; a++) {
+        char what[96];
+        snprintf(what, sizeof what, "texture array %d's layer count", a);
+        if (!limit(p, what, (uint64_t)p->arrays[a].nlayers, "maxImageArrayLayers", layers, e))
+            return false;
+    }
+    /* fragment stage: set 0's six samplers and set 1's texture arrays */
+    uint64_t samplers = 6 + (uint64_t)p->narrays;
+    return limit(p, "the fragment stage's sampler count (6 + texture arrays)", samplers,
                  "maxPerStageDescriptorSamplers", L->maxPerStageDescriptorSamplers, e) &&
-           limit(p, "the fragment stage's sampled image count (6 + textures)", samplers,
+           limit(p, "the fragment stage's sampled image count (6 + texture arrays)", samplers,
                  "maxPerStageDescriptorSampledImages", L->maxPerStageDescriptorSampledImages, e) &&
            limit(p, "params_size", p->params_size, "maxUniformBufferRange",
                  L->maxUniformBufferRange, e) &&

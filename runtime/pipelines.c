@@ -158,7 +158,7 @@ static void save_cache(rt_device *d, rt_pipelines *pl)
 
 /* ---- layouts ------------------------------------------------------------- */
 
-static bool make_layouts(rt_device *d, int ntextures, rt_pipelines *pl, rt_error *e)
+static bool make_layouts(rt_device *d, int ntextures /* arrays */, rt_pipelines *pl, rt_error *e)
 {
     const VkShaderStageFlags cs = VK_SHADER_STAGE_COMPUTE_BIT;
     const VkShaderStageFlags vf = VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT;

@@ -227,17 +227,21 @@ static bool make_geometry(rt_renderer *r, rt_error *e)
     return true;
 }
 
+/* One image and sampler per texture array (abi.h set 1): its textures'
+ * levels, one layer each; pack_load.c checked they are alike. */
 static bool make_textures(rt_renderer *r, rt_error *e)
 {
     rt_device *d = r->d;
     const rt_pack *p = r->p;
-    r->ntex = p->ntextures;
+    r->ntex = p->narrays;
     r->tex = calloc((size_t)r->ntex + 1, sizeof *r->tex);
     r->tex_smp = calloc((size_t)r->ntex + 1, sizeof *r->tex_smp);
     if (!r->tex || !r->tex_smp)
         return rt_fail(e, RT_E_VULKAN, "textures", "out of memory");
-    for (int i = 0; i < r->ntex; i++) {
-        const rt_pack_texture *t = &p->textures[i];
+    for (int a = 0; a < r->ntex; a++) {
+        const rt_pack_array *A = &p->arrays[a];
+        const rt_pack_texture *t = &p->textures[A->textures[0]];
+        uint32_t nl = (uint32_t)A->nlayers;
         VkFormat f = t->srgb ? VK_FORMAT_R8G8B8A8_SRGB : VK_FORMAT_R8G8B8A8_UNORM;
         uint32_t mips = 1;
         if (t->nmips > 0) {
@@ -249,22 +253,32 @@ static bool make_textures(rt_renderer *r, rt_error *e)
             for (int s = t->width > t->height ? t->width : t->height; s > 1; s /= 2)
                 mips++;
         }
-        if (!rt_image_create(d, (uint32_t)t->width, (uint32_t)t->height, 1, false, mips, f,
+        if (!rt_image_create(d, (uint32_t)t->width, (uint32_t)t->height, nl, true, mips, f,
                              VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT |
-                             VK_IMAGE_USAGE_TRANSFER_SRC_BIT, VK_IMAGE_ASPECT_COLOR_BIT, &r->tex[i], e))
+                             VK_IMAGE_USAGE_TRANSFER_SRC_BIT, VK_IMAGE_ASPECT_COLOR_BIT, &r->tex[a], e))
             return false;
         bool up;
         if (t->nmips > 0) {
-            const uint8_t **levels = calloc(mips, sizeof *levels);
+            const uint8_t **levels = calloc((size_t)mips * nl, sizeof *levels);
             if (!levels)
                 return rt_fail(e, RT_E_VULKAN, "textures", "out of memory");
-            levels[0] = t->rgba;
-            for (int k = 0; k < t->nmips; k++)
-                levels[1 + k] = t->mips[k];
-            up = rt_image_upload_levels(d, &r->tex[i], levels, e);
+            for (uint32_t l = 0; l < nl; l++) {
+                const rt_pack_texture *x = &p->textures[A->textures[l]];
+                levels[l * mips] = x->rgba;
+                for (int k = 0; k < x->nmips; k++)
+                    levels[l * mips + 1 + (uint32_t)k] = x->mips[k];
+            }
+            up = rt_image_upload_levels(d, &r->tex[a], levels, e);
             free(levels);
         } else {
-            up = rt_image_upload(d, &r->tex[i], t->rgba, (size_t)t->width * (size_t)t->height * 4, e);
+            size_t one = (size_t)t->width * (size_t)t->height * 4;
+            uint8_t *all = nl == 1 ? NULL : malloc(one * nl);
+            if (nl > 1 && !all)
+                return rt_fail(e, RT_E_VULKAN, "textures", "out of memory");
+            for (uint32_t l = 0; l < nl && all; l++)
+                memcpy(all + one * l, p->textures[A->textures[l]].rgba, one);
+            up = rt_image_upload(d, &r->tex[a], all ? all : t->rgba, one * nl, e);
+            free(all);
         }
         if (!up)
             return false;
@@ -279,7 +293,7 @@ static bool make_textures(rt_renderer *r, rt_error *e)
             .addressModeW = t->wrap,
             .maxLod = (float)mips,
         };
-        RT_VK(e, vkCreateSampler(d->dev, &ci, NULL, &r->tex_smp[i]));
+        RT_VK(e, vkCreateSampler(d->dev, &ci, NULL, &r->tex_smp[a]));
     }
     return true;
 }
@@ -522,7 +536,7 @@ bool rt_renderer_create(rt_device *d, const rt_pack *p, const rt_render_desc *de
                                &r->destr, e) ||
         !make_targets(r, e) ||
         !rt_pipelines_create(d, p, &r->rp, r->desc.reference, r->desc.pipeline_cache,
-                             p->ntextures, &r->pl, e) ||
+                             p->narrays, &r->pl, e) ||
         !make_geometry(r, e) || !make_textures(r, e) || !make_descriptors(r, e) ||
         !make_commands(r, e) || !rt_far_create(d, p, &r->pl, &r->far, e) ||
         (r->set0c && !rt_screen_create(d, p, &r->pl, &r->color, &r->depth,
@@ -1577,7 +1591,8 @@ static const char *reload_refused(const rt_pack *o, const rt_pack *p)
         return "the number of textures changed";
     for (int i = 0; i < p->ntextures; i++) {
         const rt_pack_texture *a = &o->textures[i], *b = &p->textures[i];
-        bool same = a->width == b->width && a->height == b->height && a->linear == b->linear &&
+        bool same = a->binding == b->binding && a->layer == b->layer &&
+                    a->width == b->width && a->height == b->height && a->linear == b->linear &&
                     a->mip_linear == b->mip_linear && a->srgb == b->srgb && a->wrap == b->wrap &&
                     a->nmips == b->nmips &&
                     same_bytes(a->rgba, b->rgba, (size_t)a->width * a->height * 4);

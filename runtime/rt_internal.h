@@ -43,7 +43,8 @@ void rt_image_destroy(rt_device *d, rt_image *img);
  * SHADER_READ_ONLY_OPTIMAL.  Blocks until done (load time only). */
 bool rt_image_upload(rt_device *d, rt_image *img, const void *data,
                      size_t bytes, rt_error *e);
-/* Upload every mip level of a one-layer RGBA8 image from `levels[m]`
+/* Upload every mip level of every layer of an RGBA8 image from
+ * `levels[layer * mips + m]`
  * (tightly packed, max(1, w >> m) x max(1, h >> m)) instead of blitting:
  * for mips that must not be box-filtered.  Leaves SHADER_READ_ONLY. */
 bool rt_image_upload_levels(rt_device *d, rt_image *img, const uint8_t *const *levels,

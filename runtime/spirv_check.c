@@ -70,7 +70,7 @@ static const char *const role_names[RT_ROLE_COUNT] = {
 bool rt_interface_for(const rt_pack *p, rt_shader_role role, rt_interface *out)
 {
     memset(out, 0, sizeof *out);
-    int n = rt_abi_nbindings + 2 + p->ntextures;
+    int n = rt_abi_nbindings + 2 + p->narrays;
     rt_binding_rule *b = calloc((size_t)n, sizeof *b);
     if (!b)
         return false;
@@ -78,9 +78,9 @@ bool rt_interface_for(const rt_pack *p, rt_shader_role role, rt_interface *out)
     int k = rt_abi_nbindings;
     b[k++] = (rt_binding_rule){ SPLAT_SET_MATERIAL, SPLAT_BIND_PARAMS, RT_RES_UNIFORM, 0, false,
                                 0, p->params_size, FS, RT_PAINTED_ANY };
-    for (int i = 0; i < p->ntextures; i++)
+    for (int i = 0; i < p->narrays; i++)   /* the texture arrays: sampler2DArray */
         b[k++] = (rt_binding_rule){ SPLAT_SET_MATERIAL, (uint32_t)(SPLAT_BIND_TEXTURE0 + i),
-                                    RT_RES_SAMPLED, RT_IMAGE_2D, false, RT_FLOAT, 0, FS, RT_PAINTED_ANY };
+                                    RT_RES_SAMPLED, RT_IMAGE_2D, true, RT_FLOAT, 0, FS, RT_PAINTED_ANY };
     /* abi.h "undergrowth masks" and "far atlas bake": the output */
     if (role == RT_ROLE_UNDERGROWTH || role == RT_ROLE_FAR_BAKE)
         b[k++] = (rt_binding_rule){ 2, 0, RT_RES_STORAGE_BUFFER, 0, false, 0, 0, CS,

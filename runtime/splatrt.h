@@ -172,7 +172,8 @@ typedef struct rt_pack_param {
 
 typedef struct rt_pack_texture {
     char    *file;
-    uint32_t binding;
+    uint32_t binding;     /* 1 + its texture array (abi.h set 1)           */
+    int      layer;       /* its layer in that array                       */
     bool     linear, mip_linear, srgb;
     VkSamplerAddressMode wrap;
     uint8_t *rgba;        /* decoded RGBA8                                 */
@@ -182,6 +183,13 @@ typedef struct rt_pack_texture {
                              max(1, h >> k)); NULL: the runtime blits them */
     int      nmips;
 } rt_pack_texture;
+
+/* A texture array of set 1: textures of one size, mip count and sampler
+ * state, textures[layer] = the index of the texture at that layer. */
+typedef struct rt_pack_array {
+    int     *textures;
+    int      nlayers;
+} rt_pack_array;
 
 typedef struct rt_pack_combo {
     int     *materials;   /* scene indices, top first                       */
@@ -291,6 +299,7 @@ typedef struct rt_pack {
     rt_pack_param   *params;    int nparams;
     uint32_t         params_size;
     rt_pack_texture *textures;  int ntextures;
+    rt_pack_array   *arrays;    int narrays;     /* binding 1 + index    */
     int              npainted;
     uint8_t         *painted;        /* npainted * W * H, NULL if none or
                                         sparse                             */

@@ -81,8 +81,17 @@ static void test_minimal(void **state)
     refused(&p, &d, "the painted index's layer count is 1", "maxImageArrayLayers (0)");
 
     roomy(&d);
-    d.props.limits.maxPerStageDescriptorSamplers = 8;   /* 6 + 3 textures */
-    refused(&p, &d, "sampler count (6 + textures) is 9", "maxPerStageDescriptorSamplers (8)");
+    /* 6 + the texture arrays (one per size, mip levels and sampler state) */
+    assert_true(p.narrays >= 1 && p.narrays <= p.ntextures);
+    d.props.limits.maxPerStageDescriptorSamplers = (uint32_t)(5 + p.narrays);
+    char want[64], lim[64];
+    snprintf(want, sizeof want, "sampler count (6 + texture arrays) is %d", 6 + p.narrays);
+    snprintf(lim, sizeof lim, "maxPerStageDescriptorSamplers (%d)", 5 + p.narrays);
+    refused(&p, &d, want, lim);
+    roomy(&d);
+    d.props.limits.maxImageArrayLayers = (uint32_t)p.arrays[0].nlayers - 1;
+    if (p.arrays[0].nlayers > 1 && (p.sparse ? p.sparse->layers : 0) < p.arrays[0].nlayers)
+        refused(&p, &d, "texture array 0's layer count", "maxImageArrayLayers");
 
     roomy(&d);
     d.props.limits.maxUniformBufferRange = 16;

@@ -38,7 +38,7 @@ static const char *const material_glsl[NMAT] = {
     "}\n",
     "float mask_1() { return smoothstep(110.0, 150.0, splat_height()); }\n"
     "void surf_1(out vec3 a, out vec3 n, out float r, out float h) {\n"
-    "    vec3 t = textureGrad(u_tex0, g_detail_uv, g_detail_dx, g_detail_dy).rgb;\n"
+    "    vec3 t = textureGrad(u_tex0, vec3(g_detail_uv, 0.0), g_detail_dx, g_detail_dy).rgb;\n"
     "    a = t * u_params.p[0].rgb;\n"
     "    n = splat_normal(); r = 0.7; h = t.r;\n"
     "}\n",
@@ -51,7 +51,7 @@ static const char *const material_glsl[NMAT] = {
 
 static const char common_glsl[] =
     "layout(set = 1, binding = 0, std140) uniform splat_params_block { vec4 p[1]; } u_params;\n"
-    "layout(set = 1, binding = 1) uniform sampler2D u_tex0;\n"
+    "layout(set = 1, binding = 1) uniform sampler2DArray u_tex0;\n"
     /* gradients taken in uniform control flow, used inside branches */
     "vec2 g_detail_uv, g_detail_dx, g_detail_dy;\n"
     "void detail_setup() {\n"

@@ -347,11 +347,11 @@ static void test_dedup_and_normal_once(void **state)
     assert_int_equal(c.ir.ntextures, 2);
     assert_int_equal(c.ntextures, 2);
     char *g = glsl_of(f, &c, false);
-    assert_int_equal(count(g, "uniform sampler2D u_tex_"), 2);
-    assert_int_equal(count(g, "uniform sampler2D u_tex_0;"), 1);
+    assert_int_equal(count(g, "uniform sampler2DArray u_texa_"), 2);
+    assert_int_equal(count(g, "uniform sampler2DArray u_texa_0;"), 1);
     /* the rock sample at the same uv is one node: sampled once */
     const char *body = composite_body(g);
-    assert_int_equal(count(body, "splat_texture_grad(u_tex_0"), 1);
+    assert_int_equal(count(body, "splat_texture_grad(u_texa_0"), 1);
     /* the terrain normal: three materials use it, computed once */
     assert_int_equal(count(body, "splat_normal()"), 1);
     free(g);
@@ -369,7 +369,7 @@ static void test_placement(void **state)
 
     /* snow's detail texture feeds only snow's surface: inside the
      * `if (w > 0.0)` block that accumulates it */
-    const char *use = strstr(body, "splat_texture_grad(u_tex_1");
+    const char *use = strstr(body, "splat_texture_grad(u_texa_1");
     assert_non_null(use);
     size_t hl, end;
     const char *hdr = enclosing(body, (size_t)(use - body), &hl, &end);
@@ -396,7 +396,7 @@ static void test_placement(void **state)
 
     /* the rock sample serves cliff's and base's surfaces, not snow's: it is
      * under cliff's coverage guard but not inside cliff's surface block */
-    use = strstr(body, "splat_texture_grad(u_tex_0");
+    use = strstr(body, "splat_texture_grad(u_texa_0");
     assert_non_null(use);
     hdr = enclosing(body, (size_t)(use - body), &hl, &end);
     assert_non_null(hdr);
