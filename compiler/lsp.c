@@ -300,6 +300,8 @@ static int handle(lsp_server *s, json_t *msg)
     json_t *id = json_object_get(msg, "id");
     json_t *method = json_object_get(msg, "method");
     json_t *params = json_object_get(msg, "params");
+    if (json_is_null(params))
+        params = NULL;                      /* some clients send null for none */
     if (id && !json_is_integer(id) && !json_is_string(id)) {
         respond_error(s, NULL, LSP_INVALID_REQUEST, "an id must be a number or a string");
         return -1;

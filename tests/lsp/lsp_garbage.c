@@ -209,7 +209,11 @@ static void random_session(server *s, const char *dir)
     char *uri = file_uri(path);
     static const char *const methods[] = { "textDocument/completion", "textDocument/hover",
                                            "textDocument/definition" };
-    for (int round = 0; round < 60; round++) {
+    /* LSP_GARBAGE_ROUNDS and LSP_GARBAGE_SEED (environment) for a longer run */
+    int rounds = getenv("LSP_GARBAGE_ROUNDS") ? atoi(getenv("LSP_GARBAGE_ROUNDS")) : 60;
+    if (getenv("LSP_GARBAGE_SEED"))
+        rng ^= strtoull(getenv("LSP_GARBAGE_SEED"), NULL, 0) * 0x9E3779B97F4A7C15ull + 1;
+    for (int round = 0; round < rounds; round++) {
         char *text = random_doc();
         if (round == 0)
             open_doc(s, uri, text);
@@ -281,8 +285,14 @@ int main(int argc, char **argv)
     requests(&s);
     random_session(&s, argv[2]);
     mutations(&s);
-    json_t *r = request(&s, "shutdown", NULL);
-    CHECK(r && json_object_get(r, "result"), "shutdown after the garbage");
+    /* "params": null, as some clients send it, is no params */
+    send_json(&s, json_pack("{s:s, s:i, s:s, s:n}", "jsonrpc", "2.0", "id", 7, "method",
+                            "shutdown", "params"));
+    json_t *id = json_integer(7);
+    json_t *r = response(&s, id);
+    json_decref(id);
+    CHECK(r && json_is_null(json_object_get(r, "result")) && !json_object_get(r, "error"),
+          "shutdown (params null) after the garbage");
     json_decref(r);
     int st = finish(&s, true);
     CHECK(st == 0, "exit after shutdown: status %d", st);
