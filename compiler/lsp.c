@@ -139,7 +139,7 @@ static json_t *on_initialize(lsp_server *s, json_t *params, failure *f)
         if (json_is_string(e) && !strcmp(json_string_value(e), "utf-8"))
             s->utf8 = true;
     s->initialized = true;
-    return json_pack("{s:{s:s, s:{s:b, s:i}, s:{s:[s, s, s, s], s:b}, s:b, s:b},"
+    return json_pack("{s:{s:s, s:{s:b, s:i}, s:{s:[s, s, s, s], s:b}, s:b, s:b, s:b},"
                      " s:{s:s, s:s}}",
                      "capabilities",
                      "positionEncoding", s->utf8 ? "utf-8" : "utf-16",
@@ -148,6 +148,7 @@ static json_t *on_initialize(lsp_server *s, json_t *params, failure *f)
                      "resolveProvider", 0,
                      "hoverProvider", 1,
                      "definitionProvider", 1,
+                     "codeActionProvider", 1,
                      "serverInfo", "name", "splatc", "version", SPLATC_VERSION);
 }
 
@@ -271,6 +272,20 @@ static json_t *on_definition(lsp_server *s, json_t *params, failure *f)
     return d ? lsp_definition(s, d, at) : f->code ? NULL : json_null();
 }
 
+static json_t *on_code_action(lsp_server *s, json_t *params, failure *f)
+{
+    const char *uri = NULL;
+    json_t *diags = NULL;
+    if (json_unpack(params, "{s:{s:s}, s:{s:o}}", "textDocument", "uri", &uri, "context",
+                    "diagnostics", &diags) || !json_is_array(diags))
+        return fail(f, LSP_INVALID_PARAMS, "expected textDocument.uri and context.diagnostics");
+    lsp_doc *d = doc_by_uri(s, uri);
+    if (!d)
+        return json_array();
+    fresh(s, d);
+    return lsp_code_actions(s, d, diags);
+}
+
 /* ---- dispatch ----------------------------------------------------------------------- */
 
 typedef json_t *(*request_fn)(lsp_server *s, json_t *params, failure *f);
@@ -282,6 +297,7 @@ static const struct { const char *method; request_fn run; } requests[] = {
     { "textDocument/completion", on_completion },
     { "textDocument/hover",      on_hover },
     { "textDocument/definition", on_definition },
+    { "textDocument/codeAction", on_code_action },
 };
 
 static const struct { const char *method; notification_fn run; } notifications[] = {

@@ -5,7 +5,8 @@
  * What it answers (LSP 3.17): initialize / initialized / shutdown / exit;
  * textDocument/didOpen, didChange (full or ranged edits), didClose;
  * publishDiagnostics (the checks of `splatc check`, on the editor's
- * unsaved texts); completion; hover; definition.
+ * unsaved texts); completion; hover; definition; codeAction (the "did
+ * you mean" of a diagnostic as a quick fix).
  *
  * Positions: the front end counts 1-based lines and 1-based byte columns;
  * LSP counts 0-based lines and, unless the client offers "utf-8" in
@@ -15,7 +16,7 @@
  *
  * Sections: lsp.c (the loop, lifecycle, documents, dispatch), lsp_io.c
  * (Content-Length framing), lsp_text.c (URIs, paths, positions),
- * lsp_diag.c (analysis and diagnostics), lsp_complete.c (completion),
+ * lsp_diag.c (analysis, diagnostics and their quick fixes), lsp_complete.c (completion),
  * lsp_nav.c (hover and definition).
  */
 #ifndef SPLAT_LSP_H
@@ -123,6 +124,9 @@ json_t *lsp_location(lsp_server *s, const sg_file *f, int line, int col);
 void lsp_analyse(lsp_server *s, lsp_doc *doc);
 /* An empty diagnostics list for doc (on close). */
 void lsp_clear_diagnostics(lsp_server *s, const char *uri);
+/* CodeAction[] for the client's `diagnostics` of doc: a quick fix for each
+ * one with a "did you mean" (data.suggestion) that puts the name in. */
+json_t *lsp_code_actions(lsp_server *s, lsp_doc *doc, json_t *diagnostics);
 
 /* ---- lsp_complete.c ---------------------------------------------------- */
 

@@ -134,3 +134,86 @@ void lsp_analyse(lsp_server *s, lsp_doc *doc)
     publish(s, doc->uri, list);
     sg_diags_free(&d);
 }
+
+/* ---- quick fixes ------------------------------------------------------------ */
+
+static bool name_char(char c)
+{
+    return (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '_';
+}
+
+/* The replacement of "did you mean" `word` for the name at byte a: the
+ * first parts of the dotted name there if word has as many dots
+ * (terrain.positon -> terrain.position), else the one part nearest to it
+ * (n.outt -> n.out).  False if there is no name at a. */
+static bool fix_span(const lsp_doc *doc, size_t a, const char *word, size_t *from, size_t *to)
+{
+    size_t starts[8], ends[8];
+    int n = 0;
+    size_t p = a;
+    while (n < 8 && p < doc->len && name_char(doc->text[p])) {
+        starts[n] = p;
+        while (p < doc->len && name_char(doc->text[p]))
+            p++;
+        ends[n++] = p;
+        if (p + 1 < doc->len && doc->text[p] == '.' && name_char(doc->text[p + 1]))
+            p++;
+        else
+            break;
+    }
+    if (!n)
+        return false;
+    int dots = 0;
+    for (const char *c = word; *c; c++)
+        dots += *c == '.';
+    if (dots > 0) {
+        if (dots >= n)
+            return false;
+        *from = starts[0];
+        *to = ends[dots];
+        return true;
+    }
+    int best = 0, best_d = 1 << 30;
+    for (int i = 0; i < n; i++) {
+        char part[128];
+        snprintf(part, sizeof part, "%.*s", (int)(ends[i] - starts[i]), doc->text + starts[i]);
+        int d = sg_edit_distance(part, word);
+        if (d < best_d)
+            best_d = d, best = i;
+    }
+    *from = starts[best];
+    *to = ends[best];
+    return true;
+}
+
+json_t *lsp_code_actions(lsp_server *s, lsp_doc *doc, json_t *diagnostics)
+{
+    json_t *out = json_array();
+    size_t i;
+    json_t *d;
+    json_array_foreach(diagnostics, i, d) {
+        const char *word = json_string_value(json_object_get(json_object_get(d, "data"),
+                                                             "suggestion"));
+        json_int_t line, ch;
+        if (!word || json_unpack(d, "{s:{s:{s:I, s:I}}}", "range", "start", "line", &line,
+                                 "character", &ch) ||
+            line < 0 || ch < 0 || line > INT32_MAX || ch > INT32_MAX)
+            continue;
+        size_t a = lsp_offset(s, doc->text, doc->len, (int)line, (int)ch), from, to;
+        if (!fix_span(doc, a, word, &from, &to))
+            continue;
+        if (to - from == strlen(word) && !memcmp(doc->text + from, word, to - from))
+            continue;                       /* already fixed */
+        char title[160];
+        snprintf(title, sizeof title, "Change to '%s'", word);
+        json_t *edit = json_pack("{s:{s:o, s:o}, s:s}", "range", "start",
+                                 lsp_position_at(s, doc->text, doc->len, from), "end",
+                                 lsp_position_at(s, doc->text, doc->len, to), "newText", word);
+        json_t *changes = json_object();
+        json_object_set_new(changes, doc->uri, json_pack("[o]", edit));
+        json_array_append_new(out, json_pack("{s:s, s:s, s:[O], s:b, s:{s:o}}", "title", title,
+                                             "kind", "quickfix", "diagnostics", d,
+                                             "isPreferred", 1, "edit", "changes", changes));
+    }
+    return out;
+}

@@ -8,7 +8,7 @@
  * yet), `out ` in a material, in a scene (keys; materials in `[`); hover
  * on a port (type, default, doc comment) and on a terrain input;
  * definition of an imported shader (lib.sg's line), a scene's material, a
- * node and an import; an unsaved edit to the imported file (what the
+ * node and an import; quick fixes of "did you mean"s; an unsaved edit to the imported file (what the
  * document sees, an error in it shown on the import line); UTF-16 columns
  * after non-ASCII text; a clean document's empty list; shutdown (null)
  * and exit (status 0). */
@@ -82,6 +82,7 @@ static const char utf16_text[] =
     "material u {\n"
     "    node t : sample { tex = \"\xc3\xa9\xf0\x9f\x98\x80.png\", uv = nope }\n"
     "    out albedo = t.rgb\n"
+    "    out roughness = terrain.slpe.x\n"                 /* 3: a quick fix of two parts */
     "}\n";
 
 /* The diagnostic of `list` whose message contains `part`, or NULL. */
@@ -105,6 +106,24 @@ static void check_range(json_t *range, int l0, int c0, int l1, int c1, const cha
     CHECK(ok && a == l0 && b == c0 && c == l1 && d == c1,
           "%s: range %d:%d-%d:%d, expected %d:%d-%d:%d", what, (int)a, (int)b, (int)c, (int)d,
           l0, c0, l1, c1);
+}
+
+/* The quick fix codeAction offers for diagnostic d of uri: its edit's
+ * range is checked, its new text returned (malloc'd; "" if none). */
+static char *quick_fix(server *s, const char *uri, json_t *d, int l0, int c0, int l1, int c1)
+{
+    json_t *r = request(s, "textDocument/codeAction",
+                        json_pack("{s:{s:s}, s:O, s:{s:[O]}}", "textDocument", "uri", uri,
+                                  "range", json_object_get(d, "range"), "context",
+                                  "diagnostics", d));
+    json_t *action = json_array_get(json_object_get(r, "result"), 0);
+    json_t *edit = json_array_get(json_object_get(json_object_get(json_object_get(action, "edit"),
+                                                                  "changes"), uri), 0);
+    CHECK(edit, "no quick fix for '%s'", json_string_value(json_object_get(d, "message")));
+    check_range(json_object_get(edit, "range"), l0, c0, l1, c1, "quick fix");
+    char *text = strdup(json_string_value(json_object_get(edit, "newText")) ?: "");
+    json_decref(r);
+    return text;
 }
 
 static const char *hover_text(json_t *r)
@@ -141,6 +160,9 @@ static void diagnostics_and_initialize(server *s, const char *uri)
         CHECK(!strcmp(json_string_value(json_object_get(json_object_get(d, "data"),
                                                         "suggestion")) ?: "", "ramp"),
               "rampp: data.suggestion");
+        char *fix = quick_fix(s, uri, d, 6, 13, 6, 18);
+        CHECK(!strcmp(fix, "ramp"), "quick fix for rampp: '%s'", fix);
+        free(fix);
     }
     CHECK(json_array_size(list) == 1, "didOpen: %zu diagnostics, expected only rampp's",
           json_array_size(list));
@@ -259,6 +281,13 @@ static void utf16_and_clean(server *s, const char *uri, const char *u_uri)
     int bytes = (int)(strstr(line, "nope") - line);
     if (d)   /* é: 2 bytes, 1 unit; the emoji: 4 bytes, 2 units */
         check_range(json_object_get(d, "range"), 1, bytes - 3, 1, bytes + 1, "after UTF-8");
+    d = find_diag(json_object_get(s->diags, u_uri), "terrain.slpe");
+    CHECK(d, "no diagnostic for terrain.slpe");
+    if (d) {   /* terrain.slpe of terrain.slpe.x, not the swizzle */
+        char *fix = quick_fix(s, u_uri, d, 3, 20, 3, 32);
+        CHECK(!strcmp(fix, "terrain.slope"), "quick fix for terrain.slpe: '%s'", fix);
+        free(fix);
+    }
     change_doc(s, uri, 7, clean_text);
     json_t *list = diagnostics(s, uri);
     CHECK(json_is_array(list) && json_array_size(list) == 0,
