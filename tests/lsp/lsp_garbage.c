@@ -5,7 +5,8 @@
  * with a ParseError whose id is null; a JSON value that is not a request
  * with InvalidRequest; a body over the limit is skipped and answered; a
  * request before initialize is ServerNotInitialized, an unknown one
- * MethodNotFound, one with bad params InvalidParams.  Then, from a fixed
+ * MethodNotFound, one with bad params InvalidParams; negotiated utf-8
+ * positions count bytes.  Then, from a fixed
  * seed, random documents (tokens of the language, stray bytes, unclosed
  * blocks) opened and edited with random ranged edits, with completion,
  * hover and definition at random places; and valid messages with random
@@ -122,6 +123,29 @@ static void framing(server *s)
     const char *lf = "Content-Length: 8\n\n[1, 2.5]";
     send_raw(s, lf, strlen(lf));
     expect_error(s, -32600, true, "a message with \\n line ends");
+}
+
+/* Negotiated utf-8: columns are bytes (after a 2-byte and a 4-byte character). */
+static void utf8_columns(server *s, const char *dir)
+{
+    static const char text[] =
+        "material u {\n"
+        "    node t : sample { tex = \"\xc3\xa9\xf0\x9f\x98\x80.png\", uv = nope }\n"
+        "}\n";
+    char path[4096];
+    snprintf(path, sizeof path, "%s/unsaved_utf8.sg", dir);
+    char *uri = file_uri(path);
+    open_doc(s, uri, text);
+    json_t *list = diagnostics(s, uri), *d;
+    size_t i;
+    int bytes = (int)(strstr(text, "nope") - strstr(text, "    node")), got = -1;
+    json_array_foreach(list, i, d)
+        if (strstr(json_string_value(json_object_get(d, "message")) ?: "", "'nope'"))
+            got = (int)json_integer_value(json_object_get(json_object_get(
+                json_object_get(d, "range"), "start"), "character"));
+    CHECK(got == bytes, "utf-8 columns: 'nope' at %d, expected byte %d", got, bytes);
+    notify(s, "textDocument/didClose", json_pack("{s:{s:s}}", "textDocument", "uri", uri));
+    free(uri);
 }
 
 static void requests(server *s)
@@ -283,6 +307,7 @@ int main(int argc, char **argv)
     start(&s, argv[1]);
     framing(&s);
     requests(&s);
+    utf8_columns(&s, argv[2]);
     random_session(&s, argv[2]);
     mutations(&s);
     /* "params": null, as some clients send it, is no params */
