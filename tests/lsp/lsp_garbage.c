@@ -6,13 +6,13 @@
  * with InvalidRequest; a body over the limit is skipped and answered; a
  * request before initialize is ServerNotInitialized, an unknown one
  * MethodNotFound, one with bad params InvalidParams; negotiated utf-8
- * positions count bytes.  Then, from a fixed
- * seed, random documents (tokens of the language, stray bytes, unclosed
- * blocks) opened and edited with random ranged edits, with completion,
- * hover and definition at random places; and valid messages with random
- * bytes changed.  The server must answer every request and, after
- * shutdown, exit with 0.  Last, two servers whose input ends without
- * `exit` (one inside a body) must end with status 1. */
+ * positions count bytes.  Then, from a fixed seed, random documents
+ * (tokens of the language, stray bytes, unclosed blocks) opened and edited
+ * with random ranged edits, with completion, hover and definition at
+ * random places; and valid messages with random bytes changed.  The server
+ * must answer every request and, after shutdown, exit with 0.  Last, two
+ * servers whose input ends without `exit` (one inside a body) must end
+ * with status 1. */
 #include "client.h"
 
 #include <stdint.h>
