@@ -16,8 +16,8 @@
  *
  * Sections: lsp.c (the loop, lifecycle, documents, dispatch), lsp_io.c
  * (Content-Length framing), lsp_text.c (URIs, paths, positions),
- * lsp_diag.c (analysis, diagnostics and their quick fixes), lsp_complete.c (completion),
- * lsp_nav.c (hover and definition).
+ * lsp_diag.c (analysis, diagnostics and their quick fixes),
+ * lsp_complete.c (completion), lsp_nav.c (hover and definition).
  */
 #ifndef SPLAT_LSP_H
 #define SPLAT_LSP_H
@@ -94,7 +94,8 @@ bool lsp_write(FILE *out, const json_t *msg);
 /* ---- lsp_text.c: URIs, paths, positions -------------------------------- */
 
 /* The path of a file:// URI (percent-decoded), malloc'd; other schemes
- * are returned whole (an untitled buffer is analysed under that name). */
+ * are returned whole (lsp_canonical then puts an untitled buffer in the
+ * current folder, where its imports are looked for). */
 char *lsp_uri_path(const char *uri);
 /* file:// URI of a path (made absolute, percent-encoded), malloc'd. */
 char *lsp_path_uri(const char *path);
@@ -105,8 +106,7 @@ char *lsp_canonical(const char *path);
 /* Byte offset in text of LSP position (line, character); clamped to the
  * line's end and the text's end. */
 size_t lsp_offset(const lsp_server *s, const char *text, size_t len, int line, int character);
-/* The LSP position {line, character} of byte `offset`, and of the front
- * end's (1-based line, 1-based byte column). */
+/* The LSP position {line, character} of byte `offset`. */
 json_t *lsp_position_at(const lsp_server *s, const char *text, size_t len, size_t offset);
 /* Byte offset of the front end's (line, col), clamped to the line. */
 size_t lsp_loc_offset(const char *text, size_t len, int line, int col);
@@ -116,7 +116,7 @@ json_t *lsp_range_at(const lsp_server *s, const char *text, size_t len, int line
 /* {uri, range} of a front-end location in file f of a program. */
 json_t *lsp_location(lsp_server *s, const sg_file *f, int line, int col);
 
-/* ---- lsp_diag.c: analysis and diagnostics ------------------------------ */
+/* ---- lsp_diag.c: analysis, diagnostics, quick fixes --------------------- */
 
 /* Load doc (imports through the compiler's search path, open documents
  * over the files on disk), run `splatc check`'s checks, keep the program
