@@ -1380,6 +1380,8 @@ static int load_file(loader *l, const char *path, const char *text, size_t len,
     free(dir);
     f->key = sg_strdup(&p->arena, key);
     f->from = from;
+    if (!is_import)
+        f->from.file = f->path;   /* the caller's string need not outlive the load */
     free(rp);
     f->text = sg_alloc(&p->arena, len + 1);
     memcpy(f->text, text, len);
