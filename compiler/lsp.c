@@ -17,6 +17,7 @@
 #include "lsp.h"
 #include "util.h"
 
+#include <signal.h>
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
@@ -399,6 +400,7 @@ int splat_cli_lsp(int argc, char **argv)
     }
     s.out = stdout;
     s.in = lsp_reader_new(STDIN_FILENO);
+    signal(SIGPIPE, SIG_IGN);   /* a client gone: a failed write, then the end of input */
     int status = -1;
     while (status < 0) {
         char *body = NULL, err[160];
