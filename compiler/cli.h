@@ -12,5 +12,6 @@ int splat_cli_build(int argc, char **argv);
 int splat_cli_texgen(int argc, char **argv);
 int splat_cli_init(int argc, char **argv);    /* cli_init.c: splatc init DIR */
 int splat_cli_doc(int argc, char **argv);     /* cli_doc.c: splatc doc [-o FILE] */
+int splat_cli_lsp(int argc, char **argv);     /* lsp.c: splatc lsp [-I DIR]... */
 
 #endif

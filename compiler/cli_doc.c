@@ -209,52 +209,14 @@ static int cmp_str(const void *a, const void *b)
     return strcmp(*(char *const *)a, *(char *const *)b);
 }
 
-/* The `#` lines right above line `line` of `text`, joined. */
-static void comment_above(const char *text, int line, char *buf, size_t n)
+/* The `#` lines right above line `line` of f (sg_doc_comment), with '|'
+ * made '/' for the table. */
+static void comment_above(const sg_file *f, int line, char *buf, size_t n)
 {
-    const char *starts[4096];
-    int nl = 0;
-    starts[nl++] = text;
-    for (const char *c = text; *c && nl < 4096; c++)
-        if (*c == '\n')
-            starts[nl++] = c + 1;
-    int first = line - 1;
-    while (first - 1 >= 0 && first - 1 < nl && starts[first - 1][0] == '#')
-        first--;
-    size_t o = 0;
-    buf[0] = 0;
-    for (int l = first; l < line - 1 && l < nl && o < n; l++) {
-        const char *s = starts[l] + 1;
-        while (*s == ' ')
-            s++;
-        const char *e = strchr(s, '\n');
-        int len = e ? (int)(e - s) : (int)strlen(s);
-        o += (size_t)snprintf(buf + o, n - o, "%s%.*s", o ? " " : "", len, s);
-    }
+    sg_doc_comment(f, line, false, buf, n);
     for (char *c = buf; *c; c++)
         if (*c == '|')
             *c = '/';
-}
-
-static void value_text(const sg_value *v, char *buf, size_t n)
-{
-    if (v->kind == SG_V_NUMBER)
-        snprintf(buf, n, "%g", v->num[0]);
-    else if (v->kind == SG_V_VEC) {
-        size_t o = (size_t)snprintf(buf, n, "vec%d(", v->width);
-        for (int i = 0; i < v->width && o < n; i++)
-            o += (size_t)snprintf(buf + o, n - o, "%s%g", i ? ", " : "", v->num[i]);
-        if (o < n)
-            snprintf(buf + o, n - o, ")");
-    } else if (v->kind == SG_V_STRING)
-        snprintf(buf, n, "\"%s\"", v->str);
-    else if (v->kind == SG_V_PATH) {
-        size_t o = 0;
-        buf[0] = 0;
-        for (int i = 0; i < v->nparts && o < n; i++)
-            o += (size_t)snprintf(buf + o, n - o, "%s%s", i ? "." : "", v->parts[i]);
-    } else
-        buf[0] = 0;
 }
 
 static bool nodes_tables(FILE *out, const char *data, const char *nodes)
@@ -301,7 +263,7 @@ static bool nodes_tables(FILE *out, const char *data, const char *nodes)
                 for (int k = 0; k < s->nins && o < sizeof ins; k++) {
                     char v[128] = "";
                     if (s->ins[k].has_value)
-                        value_text(&s->ins[k].value, v, sizeof v);
+                        sg_value_text(&s->ins[k].value, v, sizeof v);
                     o += (size_t)snprintf(ins + o, sizeof ins - o, "%s%s `%s`%s%s",
                                           k ? ", " : "", ir_type_name(s->ins[k].type),
                                           s->ins[k].name, *v ? " = " : "", v);
@@ -310,7 +272,7 @@ static bool nodes_tables(FILE *out, const char *data, const char *nodes)
                 for (int k = 0; k < s->nouts && o < sizeof outs; k++)
                     o += (size_t)snprintf(outs + o, sizeof outs - o, "%s%s `%s`", k ? ", " : "",
                                           ir_type_name(s->outs[k].type), s->outs[k].name);
-                comment_above(p->files[0]->text, s->loc.line, what, sizeof what);
+                comment_above(p->files[0], s->loc.line, what, sizeof what);
                 fprintf(out, "| `%s` | %s | %s | %s |\n", s->name, ins, outs, what);
             }
         }

@@ -11,6 +11,7 @@
  *   splatc texgen --out DIR ...                (cli_texgen.c)
  *   splatc init DIR                            a starter project (cli_init.c)
  *   splatc doc [-o FILE]                       the language reference (cli_doc.c)
+ *   splatc lsp [-I DIR]...                     a language server for editors (lsp.c)
  *
  * Exit status: 0 success, 1 input errors (diagnostics on stderr), 2 usage.
  * Files are written atomically (OUT.tmp-XXXXXX, then rename): on an error
@@ -66,6 +67,8 @@ static const char usage_text[] =
     "                                     README.md (builds and renders as it stands)\n"
     "  doc   [-o FILE]                    the language reference (docs/language.md) from\n"
     "                                     the compiler's tables and the node library\n"
+    "  lsp                                a Language Server Protocol server on stdin and\n"
+    "                                     stdout, for editors (docs/editors.md)\n"
     "options:\n"
     "  -I DIR       also search DIR for imports (repeatable; SPLATC_PATH=DIR:DIR...\n"
     "               in the environment does the same)\n"
@@ -251,9 +254,7 @@ static int cmd_check(int argc, char **argv)
         sg_program *p = sg_load(o.files[i], (const char *const *)paths, &d);
         splat_search_path_free(paths);
         if (p && d.nerrors == errors)
-            sg_check_texture_files(p, &d);   /* what `build` would read */
-        if (p && d.nerrors == errors)
-            sg_lint(p, NULL, &d);            /* over every input's domain */
+            sg_check(p, &d);   /* texture files, then the masks' bounds */
         if (o.json)
             sg_diags_print_json_from(&d, from, stderr);
         else
@@ -743,6 +744,7 @@ static const struct { const char *name; command_fn run; } commands[] = {
     { "texgen", splat_cli_texgen },
     { "init",   splat_cli_init },
     { "doc",    splat_cli_doc },
+    { "lsp",    splat_cli_lsp },
 };
 
 /* General options may come before the command (`splatc -I DIR check F`):
@@ -771,7 +773,7 @@ int main(int argc, char **argv)
         if (!strcmp(cmd, commands[i].name)) {
             for (int j = first + 1; j < argc; j++)
                 if (!strcmp(argv[j], "--help") && strcmp(cmd, "build") && strcmp(cmd, "texgen") &&
-                    strcmp(cmd, "init") && strcmp(cmd, "doc")) {
+                    strcmp(cmd, "init") && strcmp(cmd, "doc") && strcmp(cmd, "lsp")) {
                     fputs(usage_text, stdout);
                     return EXIT_OK;
                 }

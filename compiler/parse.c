@@ -467,7 +467,19 @@ static void parse_block_in(parser *ps, const char *what, stmt_fn stmt, void *use
 
 /* ---- undergrowth ----------------------------------------------------------- */
 
-static const char *const ug_keys[] = { "density", "scale", "align", "blend", "color" };
+/* The keys of each settings block, NULL-ended (sg_internal.h): the parser's
+ * "did you mean" lists, and what an editor completes (lsp_complete.c). */
+const char *const sg_ug_keys[] = { "density", "scale", "align", "blend", "color", NULL };
+const char *const sg_texture_keys[] = { "file", "filter", "mip", "wrap", "srgb", NULL };
+const char *const sg_scene_keys[] = { "heightfield", "heightfield_size", "size",
+                                      "max_height", "height_offset", "materials",
+                                      "compositor", "painted", "destruction", "cell",
+                                      "camera", "light", NULL };
+const char *const sg_painted_keys[] = { "max_level", "max_error", "near", "origin",
+                                        "size", NULL };
+const char *const sg_camera_keys[] = { "position", "look", NULL };
+const char *const sg_destruction_keys[] = { "origin", "size", "cell", NULL };
+
 enum { UG_NKEYS = 5 };
 
 typedef struct ug_parse {
@@ -503,7 +515,7 @@ static bool ug_stmt(parser *ps, void *user)
     }
     sg_loc kloc = loc_of(ps, key);
     int k = 0;
-    while (k < UG_NKEYS && !is_kw(key, ug_keys[k]))
+    while (k < UG_NKEYS && !is_kw(key, sg_ug_keys[k]))
         k++;
     if (k == UG_NKEYS) {
         sg_errorf(ps->d, kloc, SG_E_BAD_OPTION, "unknown undergrowth setting '%.*s' "
@@ -522,7 +534,7 @@ static bool ug_stmt(parser *ps, void *user)
         return true;
     }
     if (up->seen[k].line)
-        sg_error(ps->d, kloc, SG_E_DUPLICATE, "undergrowth setting", ug_keys[k],
+        sg_error(ps->d, kloc, SG_E_DUPLICATE, "undergrowth setting", sg_ug_keys[k],
                  up->seen[k].file, up->seen[k].line, up->seen[k].col);
     else
         up->seen[k] = kloc;
@@ -786,8 +798,7 @@ static void add_texture_setting(parser *ps, void *user, sg_token *key, sg_value 
         snprintf(msg, sizeof msg, "unknown texture setting '%.*s' "
                  "(expected file, filter, mip, wrap or srgb)", key->len, key->start);
         sg_error(ps->d, loc_of(ps, key), SG_E_BAD_OPTION, msg);
-        static const char *const keys[] = { "file", "filter", "mip", "wrap", "srgb", NULL };
-        hint_key(ps, key, keys);
+        hint_key(ps, key, sg_texture_keys);
     }
 }
 
@@ -897,9 +908,7 @@ static bool painted_stmt(parser *ps, void *user)
         if (ok) *(size ? &pm->place_loc : &pm->origin_loc) = kloc;
     } else {
         expected(ps, keys);
-        static const char *const names[] = { "max_level", "max_error", "near", "origin",
-                                             "size", NULL };
-        hint_key(ps, key, names);
+        hint_key(ps, key, sg_painted_keys);
         return false;
     }
     if (ok)
@@ -939,9 +948,7 @@ static bool sub_stmt(parser *ps, void *user)
         ok = expect(ps, SG_TK_EQ, "'='") && parse_number(ps, &sc->destruction_cell);
     } else {
         expected(ps, b->cam ? "'position', 'look' or '}'" : "'origin', 'size', 'cell' or '}'");
-        static const char *const cam[] = { "position", "look", NULL };
-        static const char *const des[] = { "origin", "size", "cell", NULL };
-        hint_key(ps, key, b->cam ? cam : des);
+        hint_key(ps, key, b->cam ? sg_camera_keys : sg_destruction_keys);
         return false;
     }
     if (ok)
@@ -1174,11 +1181,7 @@ static bool scene_stmt(parser *ps, void *user)
              "a scene setting (heightfield, heightfield_size, size, max_height, "
              "height_offset, materials, compositor, painted, destruction, cell, camera, light)",
              sg_tok_describe(key, buf, sizeof buf));
-    static const char *const keys[] = { "heightfield", "heightfield_size", "size",
-                                        "max_height", "height_offset", "materials",
-                                        "compositor", "painted", "destruction", "cell",
-                                        "camera", "light", NULL };
-    hint_key(ps, key, keys);
+    hint_key(ps, key, sg_scene_keys);
     return false;
 }
 
@@ -1258,6 +1261,7 @@ void sg_parse(sg_program *p, int file, sg_import **imports, int *nimports, sg_di
 typedef struct loader {
     sg_program *p;
     sg_diags   *d;
+    const sg_overlay *ov;    /* texts held in memory, or NULL              */
     sg_map      keys;        /* file key -> index                          */
     int        *stack;       /* files being loaded (import cycle check)    */
     int         depth;
@@ -1302,6 +1306,12 @@ static void missing_import(loader *l, const sg_file *f, const sg_import *im)
     p->failed_imports++;
 }
 
+/* The overlay's text for `path`, or NULL (read the disk). */
+static const char *overlay_text(const loader *l, const char *path, size_t *len)
+{
+    return l->ov && l->ov->text ? l->ov->text(l->ov->user, path, len) : NULL;
+}
+
 /* Lex, parse and load the imports of `path` (text given, or read). */
 static int load_file(loader *l, const char *path, const char *text, size_t len,
                      sg_loc from, bool is_import)
@@ -1338,6 +1348,15 @@ static int load_file(loader *l, const char *path, const char *text, size_t len,
         return -1;
     }
     char *owned = NULL;
+    if (!text && (text = overlay_text(l, path, &len)) && len > SPLAT_MAX_GRAPH_BYTES) {
+        free(rp);
+        sg_errorf(l->d, from, is_import ? SG_E_MISSING_IMPORT : SG_E_IO,
+                  is_import ? "cannot import '%s': %s" : "cannot read '%s': %s", path,
+                  "larger than the 16 MiB a graph file may have");
+        if (is_import)
+            p->failed_imports++;
+        return -1;
+    }
     if (!text) {
         /* only regular files: an import of /dev/zero or a FIFO must not hang */
         char err[256];
@@ -1360,6 +1379,9 @@ static int load_file(loader *l, const char *path, const char *text, size_t len,
     f->dir = sg_strdup(&p->arena, dir);
     free(dir);
     f->key = sg_strdup(&p->arena, key);
+    f->from = from;
+    if (!is_import)
+        f->from.file = f->path;   /* the caller's string need not outlive the load */
     free(rp);
     f->text = sg_alloc(&p->arena, len + 1);
     memcpy(f->text, text, len);
@@ -1379,11 +1401,12 @@ static int load_file(loader *l, const char *path, const char *text, size_t len,
     for (int i = 0; i < nimports; i++) {
         /* relative to the importing file, then the search paths */
         char *cand = splat_path_join(f->dir, imports[i].path);
-        bool found = access(cand, R_OK) == 0;
+        size_t olen;
+        bool found = access(cand, R_OK) == 0 || overlay_text(l, cand, &olen);
         for (int s = 0; !found && s < p->nsearch; s++) {
             free(cand);
             cand = splat_path_join(p->search[s], imports[i].path);
-            found = access(cand, R_OK) == 0;
+            found = access(cand, R_OK) == 0 || overlay_text(l, cand, &olen);
         }
         if (!found) {
             free(cand);
@@ -1398,7 +1421,8 @@ static int load_file(loader *l, const char *path, const char *text, size_t len,
 }
 
 static sg_program *load(const char *path, const char *text, size_t len,
-                        const char *const *search_paths, sg_diags *d)
+                        const char *const *search_paths, const sg_overlay *ov,
+                        sg_diags *d)
 {
     sg_program *p = calloc(1, sizeof *p);
     if (!p)
@@ -1412,7 +1436,7 @@ static sg_program *load(const char *path, const char *text, size_t len,
     p->nsearch = nsearch;
 
     int errors0 = d->nerrors;
-    loader l = { p, d, { 0 }, NULL, 0 };
+    loader l = { p, d, ov, { 0 }, NULL, 0 };
     l.stack = xmalloc(SG_MAX_DEPTH * sizeof *l.stack);
     load_file(&l, path, text, len, (sg_loc){ path, 0, 0 }, false);
     free(l.stack);
@@ -1425,13 +1449,19 @@ static sg_program *load(const char *path, const char *text, size_t len,
 
 sg_program *sg_load(const char *path, const char *const *search_paths, sg_diags *d)
 {
-    return load(path, NULL, 0, search_paths, d);
+    return load(path, NULL, 0, search_paths, NULL, d);
+}
+
+sg_program *sg_load_overlay(const char *path, const char *const *search_paths,
+                            const sg_overlay *ov, sg_diags *d)
+{
+    return load(path, NULL, 0, search_paths, ov, d);
 }
 
 sg_program *sg_load_string(const char *name, const char *text,
                            const char *const *search_paths, sg_diags *d)
 {
-    return load(name, text, strlen(text), search_paths, d);
+    return load(name, text, strlen(text), search_paths, NULL, d);
 }
 
 void sg_free(sg_program *p)

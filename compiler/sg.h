@@ -176,6 +176,19 @@ sg_program *sg_load(const char *path, const char *const *search_paths,
 /* Same, from memory (`name` is used in diagnostics and for imports). */
 sg_program *sg_load_string(const char *name, const char *text,
                            const char *const *search_paths, sg_diags *d);
+/* Texts held in memory (an editor's unsaved documents, `splatc lsp`):
+ * sg_load_overlay asks `text` for every file it would read, the root and
+ * each import candidate, before it looks at the disk; NULL means "not
+ * held, read the disk".  The text (len bytes, NUL-terminated) must stay
+ * valid until sg_load_overlay returns.  A path is asked as the loader
+ * spells it (the import joined to the importing file's folder or to a
+ * search folder), so `text` compares canonical forms. */
+typedef struct sg_overlay {
+    const char *(*text)(void *user, const char *path, size_t *len);
+    void *user;
+} sg_overlay;
+sg_program *sg_load_overlay(const char *path, const char *const *search_paths,
+                            const sg_overlay *ov, sg_diags *d);
 /* Warnings about what builds but cannot be meant (lint.c): a mask whose
  * bounds over `region` leave [0, 1], an output that can be NaN or
  * infinite, a constant lo >= hi on a ramp-like node.  `region`: the
@@ -189,6 +202,11 @@ void sg_lint(sg_program *p, const ir_ienv *region, sg_diags *d);
  * node reading the input when none of `op` does.  False if none. */
 bool sg_node_reading_input(const sg_program *p, const char *material, const char *op,
                            int input, sg_loc *loc, char *what, size_t n);
+/* The checks `splatc check` runs after sg_load (and `splatc lsp` on every
+ * change, sg_query.c): if the load had no errors, the texture files
+ * (sg_check_texture_files), then, if still none, sg_lint over every
+ * input's domain. */
+void sg_check(sg_program *p, sg_diags *d);
 /* Where texture file `file` (a path as in ir_texture.file) is named: the
  * string of its `texture { file = "…" }` or of an inline texture on a
  * port, the first such; line 0 if none. */

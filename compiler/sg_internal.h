@@ -4,7 +4,7 @@
  *
  * Sections: sg_util.c (arena, string map, paths), diag.c (diagnostics),
  * lex.c, parse.c (and loading with imports), resolve.c (names, types,
- * cycles), lower.c (AST -> IR), dot.c (Graphviz).
+ * cycles), lower.c (AST -> IR), dot.c (Graphviz), sg_query.c (doc comments).
  */
 #ifndef SPLAT_SG_INTERNAL_H
 #define SPLAT_SG_INTERNAL_H
@@ -78,6 +78,8 @@ typedef struct sg_file {
     char     *path;      /* as resolved (relative to the CWD, as given) */
     char     *dir;       /* splat_path_dir(path)                         */
     char     *key;       /* realpath for import dedup, else path         */
+    sg_loc    from;      /* the `import` that first loaded it (line 0 for
+                            the root file)                               */
     char     *text;      /* NUL-terminated copy                          */
     size_t    len;
     sg_token *toks;      /* ends with SG_TK_EOF                          */
@@ -228,6 +230,15 @@ typedef struct sg_import { char *path; sg_loc loc; } sg_import;
 void sg_parse(sg_program *p, int file, sg_import **imports, int *nimports,
               sg_diags *d);
 
+/* The keys of each settings block, NULL-ended, as the parser accepts them
+ * (its "did you mean" lists; an editor's completion, lsp_complete.c). */
+extern const char *const sg_scene_keys[];       /* scene NAME { … }           */
+extern const char *const sg_texture_keys[];     /* texture NAME { … }         */
+extern const char *const sg_painted_keys[];     /* painted NAME = "f" { … }   */
+extern const char *const sg_camera_keys[];      /* camera NAME { … }          */
+extern const char *const sg_destruction_keys[]; /* destruction { … }          */
+extern const char *const sg_ug_keys[];          /* undergrowth MESH { … }     */
+
 /* Inline texture declaration for a string literal on a texture port. */
 void sg_texdecl_defaults(sg_texdecl *t);
 
@@ -240,5 +251,16 @@ int  sg_shader_find(const sg_program *p, const char *name);
 /* Type of node output `index` of node n in shader s (IR_T_ERROR if bad). */
 ir_type sg_node_output_type(const sg_program *p, const sg_shader *s,
                             const sg_node *n, int index);
+
+/* ---- sg_query.c: what tools ask of a loaded program ----------------------- */
+
+/* The comment documenting the declaration on line `line` of f: with
+ * `trailing`, the `#` comment after the line's last token if there is one;
+ * else the run of `#` lines right above the line (indented or not), joined
+ * by spaces, each without its '#' and the blanks around.  Written to buf
+ * (NUL-terminated, cut at n); returns its length, 0 if none. */
+size_t sg_doc_comment(const sg_file *f, int line, bool trailing, char *buf, size_t n);
+/* A value as written: 0.5, vec3(1, 0, 0), "rock.png", terrain.slope. */
+void sg_value_text(const sg_value *v, char *buf, size_t n);
 
 #endif
