@@ -178,6 +178,31 @@ viewer)
     grep -q "^splatview: $want shading" "$OUT/viewer.log" ||
         fail "the window did not open on the $want path"
     ;;
+overlay)
+    # the help overlay (key H, runtime/overlay.c) drawn on the device,
+    # validation silent: headless --overlay changes only the top-left box
+    # and puts text (near-white pixels) in it; in the window H shows it and
+    # H again hides it
+    run "$PACK" --headless --size 640x360 -o "$OUT/plain.png"
+    run "$PACK" --headless --size 640x360 --overlay -o "$OUT/help.png"
+    "$IC" overlay "$OUT/plain.png" "$OUT/help.png" 480 200 1000 ||
+        fail "the overlay is not text in the top-left box alone"
+    run "$PACK" --headless --size 640x360 --view mask:rock --overlay -o "$OUT/help_mask.png"
+    "$IC" nonuniform "$OUT/help_mask.png" || fail "overlay on the mask view: uniform"
+    command -v xvfb-run > /dev/null || { echo "SKIP: no xvfb-run for the window's part"; exit 77; }
+    rm -f "$OUT"/win*.png
+    xvfb-run -a -s "-screen 0 800x600x24" "$SV" "$PACK" --size 640x360 --script \
+        "frames=5;screenshot=$OUT/win0.png;key=H;frames=2;screenshot=$OUT/win1.png;key=H;frames=2;screenshot=$OUT/win2.png" \
+        > "$OUT/window.log" 2>&1
+    rc=$?
+    cat "$OUT/window.log"
+    [ $rc = 0 ] || fail "viewer exit $rc"
+    w0=$("$IC" white "$OUT/win0.png" 480 200) && w1=$("$IC" white "$OUT/win1.png" 480 200) &&
+        w2=$("$IC" white "$OUT/win2.png" 480 200) || fail "imgcheck white"
+    echo "near-white pixels in the box: $w0 before H, $w1 with the help, $w2 after H again"
+    [ "$w1" -ge $((w0 + 1000)) ] || fail "H shows no help text in the window"
+    [ "$w2" -le $((w0 + 50)) ] || fail "H again does not hide the help"
+    ;;
 hot_reload_search)
     # hot reload resolves imports as `splatc build` does: a scene outside
     # any project whose graphs and nodes are found only through -I (first
