@@ -330,6 +330,13 @@ void rt_pack_free(rt_pack *p);
 void rt_painted_print_stats(const rt_pack *p, FILE *out);
 int  rt_pack_material_find(const rt_pack *p, const char *name);   /* -1 */
 int  rt_pack_camera_find(const rt_pack *p, const char *name);     /* -1 */
+/* The default fog density (per metre; light.c), for a scene without
+ * `light { fog_density = … }`: 0.375 / D, so the fog hides 31 % of the
+ * colour (1 - e^-0.375) at distance D, where D is the farthest any camera
+ * preset stands from the point it looks at, and at least a quarter of the
+ * terrain's larger side (the default camera's distance when there is no
+ * preset, where this is the old default 1.5 / extent). */
+double rt_light_fog_default(const rt_pack *p);
 
 /* ---- render.c: drawing ------------------------------------------------- */
 

@@ -24,7 +24,9 @@
 #   init       `splatc init DIR` from a folder outside the repository: the
 #              project builds and renders as it stands (SPLATVIEW, IMGCHECK
 #              in the environment), its picture is not mostly fog (luma
-#              contrast), a second init into it is refused
+#              contrast), nor with the default fog (its fog_density taken
+#              out; the old 1.5 / extent fails the same check), a second
+#              init into it is refused
 #   malformed  empty file, binary garbage, truncated files, 10 MB inputs,
 #              10000-deep instance nesting: exit 1 with a diagnostic, no crash
 #              or hang
@@ -361,8 +363,19 @@ init)
     [ -s "$TMP/err" ] && { fail "the starter project builds with diagnostics"; cat "$TMP/err"; }
     run 0 "$SPLATVIEW" "$TMP/x/pack" --headless -o x.png
     [ -s x.png ] || fail "no picture"
-    run 0 "$IMGCHECK" contrast x.png 0.08
+    run 0 "$IMGCHECK" contrast x.png 0.09
     cat "$TMP/out"
+    # the default fog (no fog_density: derived from the camera presets,
+    # runtime/light.c) leaves the starter readable too (measured 0.082 on
+    # lavapipe), where the old 1.5 / extent made it mostly fog (0.035)
+    sed 's/fog_density = [0-9.]*, //' "$TMP/x/scene.sg" > "$TMP/x/default_fog.sg"
+    grep -q fog_density "$TMP/x/default_fog.sg" && fail "the starter's fog_density was not removed"
+    run 0 "$SPLATC" build "$TMP/x/default_fog.sg" -o "$TMP/x/pack_df"
+    run 0 "$SPLATVIEW" "$TMP/x/pack_df" --headless -o df.png
+    run 0 "$IMGCHECK" contrast df.png 0.06
+    cat "$TMP/out"
+    run 0 "$SPLATVIEW" "$TMP/x/pack_df" --headless --fog-density 0.00146484375 -o old.png
+    run 1 "$IMGCHECK" contrast old.png 0.06
     # a relative DIR, and no second init over a project
     run 0 "$SPLATC" init y
     [ -s y/scene.sg ] || fail "init y wrote nothing"
