@@ -15,7 +15,10 @@
 #     Under the GGX sun (view dependent: a highlight's slope turns those
 #     ulps of the normal into up to 5.8e-4, on 10 of 64000 pixels of the
 #     fixture's overview) the final image is held to 1e-5 on >= 99.9 % of
-#     pixels and 1e-3 on all: a 1/255 compositor error still fails.
+#     pixels and 2e-3 on all: a 1/255 compositor error still fails.  (1e-3
+#     until the default fog followed the cameras: the overview's fog went
+#     from 7.3e-4 to 2.3e-4 per metre and the same 10 highlight pixels
+#     from 5.8e-4 to 1.34e-3 on lavapipe.)
 #   composite vs uber 1e-5: the same material code, other branching.
 #   culled vs not culled 1e-6: the same triangles front-facing; only hidden
 #     back faces are dropped, so equal up to nothing (1e-6 absorbs nothing
@@ -98,7 +101,7 @@ reference_multipass)
         run "$PACK" --headless --size 320x200 --camera-preset $cam --float-out "$OUT/c_$cam.f32"
         run "$PACK" --headless --size 320x200 --camera-preset $cam --reference multipass --float-out "$OUT/m_$cam.f32"
         "$IC" close "$OUT/c_$cam.f32" "$OUT/m_$cam.f32" 1e-5 0.999 80 &&
-            "$IC" diff "$OUT/c_$cam.f32" "$OUT/m_$cam.f32" 1e-3 || fail "multipass differs ($cam)"
+            "$IC" diff "$OUT/c_$cam.f32" "$OUT/m_$cam.f32" 2e-3 || fail "multipass differs ($cam)"
     done
     ;;
 reference_uber)
