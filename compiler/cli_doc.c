@@ -202,6 +202,17 @@ static void settings_tables(FILE *out)
         fprintf(out, "| `%s` | %d | [%s, %s] |\n", splat_light_keys[k].key,
                 splat_light_keys[k].n, lo, hi);
     }
+    /* the defaults runtime/light.c applies (rt_light_default,
+     * rt_light_fog_default): keep in step */
+    fputs("\nWithout a key, the runtime's default (runtime/light.c): `sun = 144 21`, "
+          "`intensity = 2.9`, `exposure = 0`, no `fog_height` (the same fog at every "
+          "height), and a `fog_density` derived from the cameras: 0.375 / D per metre, "
+          "where D is the farthest any `camera` preset stands from the point it looks "
+          "at, and at least a quarter of the terrain's larger side.  The fog then hides "
+          "31 % of the colour (1 - e^-0.375) at D, less nearer; a point d metres away "
+          "keeps exp(-density * d) of its colour.  Without presets this is 1.5 / the "
+          "larger side.  An explicit `fog_density` is used as given (0: no fog).\n",
+          out);
 }
 
 static int cmp_str(const void *a, const void *b)

@@ -3,8 +3,18 @@
  * One cluster per shader or material: inputs and params as ellipses on
  * the left, nodes as boxes ("name : type", constant inputs listed inside),
  * outputs as ellipses on the right, one edge per wire labelled with the
- * ports it joins.  With a material, only that material and the shaders it
- * instantiates (transitively) are drawn.  `dot -Tsvg` draws it. */
+ * ports it joins.  A node whose type is a shader (an instance) is a 3-D box
+ * naming the node, the shader and the ports its wires feed:
+ *
+ *     mk : overlay      (shader)
+ *     wired: base, blend
+ *     opacity = 0.9
+ *
+ * With a material, only that material is drawn, its instances collapsed
+ * into those boxes; with `expand` too, every shader it instantiates
+ * (transitively) is drawn as a cluster of its own, as without a material.
+ * Clusters follow the program's shader order and nodes their source order,
+ * so the same program gives the same bytes.  `dot -Tsvg` draws it. */
 #include "sg_internal.h"
 
 #include <stdlib.h>
@@ -105,8 +115,19 @@ static void write_shader(const sg_program *p, int si, FILE *out)
     }
     for (int i = 0; i < s->nnodes; i++) {
         const sg_node *n = &s->nodes[i];
-        fprintf(out, "    \"%s/%s\" [label=\"%s : ", s->name, n->name, n->name);
+        bool inst = n->kind == SG_NODE_INSTANCE;
+        fprintf(out, "    \"%s/%s\" [%slabel=\"%s : ", s->name, n->name,
+                inst ? "shape=box3d, style=filled, fillcolor=\"#eef2ff\", " : "", n->name);
         esc(out, n->type);
+        if (inst) {
+            fputs("  (shader)", out);
+            int wired = 0;
+            for (int j = 0; j < n->nargs; j++)
+                if (has_source(&n->args[j].val)) {
+                    fputs(wired++ ? ", " : "\\nwired: ", out);
+                    esc(out, n->args[j].port);
+                }
+        }
         for (int j = 0; j < n->nargs; j++) {
             const sg_value *v = &n->args[j].val;
             if (v->kind == SG_V_PATH && v->ref != SG_REF_TEXTURE && v->ref != SG_REF_INPUT)
@@ -148,7 +169,7 @@ static void write_shader(const sg_program *p, int si, FILE *out)
     fputs("  }\n", out);
 }
 
-void sg_write_dot(const sg_program *p, const char *material, FILE *out)
+void sg_write_dot(const sg_program *p, const char *material, bool expand, FILE *out)
 {
     bool *show = calloc((size_t)p->nshaders + 1, sizeof *show);
     int *stack = malloc(((size_t)p->nshaders + 1) * sizeof *stack);
@@ -161,7 +182,7 @@ void sg_write_dot(const sg_program *p, const char *material, FILE *out)
             stack[sp++] = p->materials[mi];
             show[p->materials[mi]] = true;
         }
-        while (sp) {
+        while (expand && sp) {
             const sg_shader *s = p->shaders[stack[--sp]];
             for (int i = 0; i < s->nnodes; i++)
                 if (s->nodes[i].kind == SG_NODE_INSTANCE && !show[s->nodes[i].shader]) {

@@ -4,7 +4,7 @@
  *   splatc glsl  FILE -m MAT [-o OUT.frag] [--stage fragment|compute]
  *                                              shader of one material
  *   splatc spirv FILE -m MAT -o OUT.spv [--stage …]  the same, compiled and validated
- *   splatc dot   FILE [-m MAT] [-o OUT.dot]    Graphviz of the graphs
+ *   splatc dot   FILE [-m MAT [--expand]] [-o OUT.dot]  Graphviz of the graphs
  *   splatc dump  FILE -m MAT [--after PASS]    the IR in .sg form
  *   splatc eval  FILE -m MAT [--output NAME] [--interval] --at KEY=V,...
  *   splatc build SCENE.sg -o PACK ...          (cli_build.c)
@@ -47,7 +47,10 @@ static const char usage_text[] =
     "  spirv FILE -m MATERIAL -o OUT.spv  the same compiled to SPIR-V and validated\n"
     "        --stage fragment|compute     (glsl, spirv) the fragment shader (default) or\n"
     "                                     the compute variant (screen-space shading)\n"
-    "  dot   FILE [-m MATERIAL] [-o OUT]  Graphviz DOT of the graphs (dot -Tsvg draws it)\n"
+    "  dot   FILE [-m MATERIAL] [-o OUT]  Graphviz DOT of the graphs (dot -Tsvg draws it);\n"
+    "        --expand                     with -m, each shader node is one box naming its\n"
+    "                                     type and wired ports; --expand draws the inside\n"
+    "                                     of every shader it instantiates too\n"
     "  dump  FILE -m MATERIAL [--after PASS]\n"
     "                                     the material's IR in .sg form, after the whole\n"
     "                                     pipeline or after PASS (lower = no pass)\n"
@@ -96,6 +99,7 @@ typedef struct options {
     const char  *stage;   /* --stage fragment|compute (glsl, spirv) */
     bool         interval;
     bool         json;    /* --json (check): diagnostics as JSON Lines */
+    bool         expand;  /* --expand (dot): draw the instanced shaders' insides */
     const char **include; int ninclude;
 } options;
 
@@ -134,6 +138,9 @@ static int parse_options(int argc, char **argv, const char *allowed, options *o)
             continue;
         } else if (!strcmp(a, "--json") && strstr(allowed, "J")) {
             o->json = true;
+            continue;
+        } else if (!strcmp(a, "--expand") && strstr(allowed, "X")) {
+            o->expand = true;
             continue;
         } else if (a[0] == '-' && a[1]) {
             return usage_error("unknown option '%s' for this command", a);
@@ -365,17 +372,17 @@ static int emit_to(const char *path, void (*emit)(void *user, FILE *f), void *us
     return st;
 }
 
-typedef struct dot_job { sg_program *p; const char *material; } dot_job;
+typedef struct dot_job { sg_program *p; const char *material; bool expand; } dot_job;
 static void emit_dot(void *user, FILE *f)
 {
     dot_job *j = user;
-    sg_write_dot(j->p, j->material, f);
+    sg_write_dot(j->p, j->material, j->expand, f);
 }
 
 static int cmd_dot(int argc, char **argv)
 {
     options o;
-    int st = parse_options(argc, argv, "mo", &o);
+    int st = parse_options(argc, argv, "moX", &o);
     if (st == EXIT_OK && o.nfiles != 1)
         st = usage_error("%s needs exactly one FILE", "dot");
     if (st == EXIT_OK) {
@@ -388,7 +395,7 @@ static int cmd_dot(int argc, char **argv)
             fprintf(stderr, "%s: error: no material '%s'\n", o.files[0], o.material);
             st = EXIT_INPUT;
         } else {
-            dot_job j = { p, o.material };
+            dot_job j = { p, o.material, o.expand };
             st = emit_to(o.out, emit_dot, &j);
         }
         sg_free(p);

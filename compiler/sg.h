@@ -283,8 +283,11 @@ typedef enum sg_output {
 } sg_output;
 extern const char *const sg_output_names[SG_OUT_COUNT];
 
-/* Graphviz DOT of the program's graphs (of one material if non-NULL). */
-void sg_write_dot(const sg_program *p, const char *material, FILE *out);
+/* Graphviz DOT of the program's graphs, or of one material if `material`
+ * is non-NULL: its shader nodes are then boxes naming the shader and its
+ * wired ports, and with `expand` the shaders it instantiates (transitively)
+ * are drawn as clusters of their own too. */
+void sg_write_dot(const sg_program *p, const char *material, bool expand, FILE *out);
 
 /* ---- scenes ------------------------------------------------------------ */
 

@@ -6,13 +6,18 @@
  *
  * Defaults, for any scene: a sun 21 degrees up in the south-east (azimuth
  * 144, clockwise from north = -z), warm, irradiance 2.9 (times pi: a white
- * surface facing it shows 2.9 before the tone map); a blue sky; fog of
- * 1.5 / the terrain's extent per metre, towards the background colour,
- * the same at every height unless the scene gives a fog_height (then it
- * halves every 0.17 x max_height above it); exposure 0 EV.  These are
- * the values the runtime always used: a lighter default fog shows the
- * screen path's mip-selection differences on far terrain past the
- * tolerances its tests hold (runtime/DESIGN.md).
+ * surface facing it shows 2.9 before the tone map); a blue sky; fog
+ * towards the background colour that hides 31 % of the colour at the
+ * distance the scene's cameras look from (rt_light_fog_default), the same
+ * at every height unless the scene gives a fog_height (then it halves
+ * every 0.17 x max_height above it); exposure 0 EV.
+ *
+ * The fog follows the cameras, not the terrain's extent alone: a 1 km
+ * terrain seen from 1.4 km away was 88 % fog at 1.5 / extent.  It is never
+ * denser than that old default (a quarter of the extent is the shortest D
+ * taken), which is what scenes without presets keep: a lighter fog there
+ * shows the screen path's mip-selection differences on far terrain past
+ * the tolerances its tests hold (runtime/DESIGN.md).
  */
 #include "rt_internal.h"
 
@@ -33,6 +38,22 @@ void rt_light_default(rt_light *l)
     };
 }
 
+double rt_light_fog_default(const rt_pack *p)
+{
+    double ext = p->size[0] > p->size[1] ? p->size[0] : p->size[1];
+    double d = 0.25 * ext;   /* rt_default_camera's distance without presets */
+    for (int i = 0; i < p->ncameras; i++) {
+        double s = 0;
+        for (int k = 0; k < 3; k++) {
+            double t = p->cameras[i].look[k] - p->cameras[i].position[k];
+            s += t * t;
+        }
+        if (sqrt(s) > d)
+            d = sqrt(s);
+    }
+    return d > 0 ? 0.375 / d : 0.0;
+}
+
 void rt_light_sun_dir(const rt_light *l, double dir[3])
 {
     double az = l->sun[0] * M_PI / 180.0, el = l->sun[1] * M_PI / 180.0;
@@ -46,8 +67,7 @@ void rt_light_frame(const rt_light *l, const rt_pack *p, const float background[
 {
     double dir[3];
     rt_light_sun_dir(l, dir);
-    double ext = p->size[0] > p->size[1] ? p->size[0] : p->size[1];
-    double density = isnan(l->fog_density) ? 1.5 / ext : l->fog_density;
+    double density = isnan(l->fog_density) ? rt_light_fog_default(p) : l->fog_density;
     double base = isnan(l->fog_height) ? p->height_offset : l->fog_height;
     /* with a fog height: halving every 0.17 max_height above it (k = ln 2
      * / (0.17 max_height)); without, the same density everywhere */

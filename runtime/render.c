@@ -634,9 +634,10 @@ void rt_default_camera(const rt_pack *p, rt_camera *c)
         return;
     }
     /* Else from the south (z large: row 0 is north), 30 degrees down onto
-     * the centre from a quarter of the extent: the distance fog (density
-     * 1.5 / extent, frame_ubo below) hides about 30 % there and less in
-     * front, where a camera seeing the whole terrain would see mostly fog.
+     * the centre from a quarter of the extent: the default fog without
+     * presets (1.5 / extent, rt_light_fog_default) hides about 31 % there
+     * and less in front, where a camera seeing the whole terrain would see
+     * mostly fog.
      * Never below the highest point. */
     double sx = p->size[0], sz = p->size[1], ext = sx > sz ? sx : sz;
     double top = p->height_offset + p->max_height, d = 0.25 * ext;

@@ -666,6 +666,19 @@ bool rt_renderer_shadow_read(rt_renderer *r, uint8_t *out, rt_error *e);
  * current heights. */
 void rt_renderer_shadow_reference(rt_renderer *r, uint8_t *out);
 
+/* ---- overlay.c: the viewer's on-screen help (key H) -------------------- */
+
+typedef struct rt_overlay rt_overlay;   /* rt_overlay_info, rt_overlay_text: splatrt.h */
+/* The overlay's pipeline for subpass 0 of `pass` (one colour attachment,
+ * display-encoded UNORM).  On failure *out may still be set: destroy it. */
+bool rt_overlay_create(rt_device *d, VkRenderPass pass, rt_overlay **out, rt_error *e);
+void rt_overlay_destroy(rt_overlay *o);
+/* Lay `text` out in a box at the top left of a w x h target into the
+ * overlay's vertex buffer (waits for the device when it must grow). */
+bool rt_overlay_layout(rt_overlay *o, const char *text, uint32_t w, uint32_t h, rt_error *e);
+/* Draw it, inside the render pass the overlay was made for. */
+void rt_overlay_record(rt_overlay *o, VkCommandBuffer cb, uint32_t w, uint32_t h);
+
 /* ---- light.c: the frame's lighting fields ------------------------------ */
 
 /* The frame's sun, sky, fog and exposure; fog towards `background`. */

@@ -339,6 +339,13 @@ void rt_pack_free(rt_pack *p);
 void rt_painted_print_stats(const rt_pack *p, FILE *out);
 int  rt_pack_material_find(const rt_pack *p, const char *name);   /* -1 */
 int  rt_pack_camera_find(const rt_pack *p, const char *name);     /* -1 */
+/* The default fog density (per metre; light.c), for a scene without
+ * `light { fog_density = … }`: 0.375 / D, so the fog hides 31 % of the
+ * colour (1 - e^-0.375) at distance D, where D is the farthest any camera
+ * preset stands from the point it looks at, and at least a quarter of the
+ * terrain's larger side (the default camera's distance when there is no
+ * preset, where this is the old default 1.5 / extent). */
+double rt_light_fog_default(const rt_pack *p);
 
 /* ---- render.c: drawing ------------------------------------------------- */
 
@@ -563,6 +570,24 @@ const char *rt_view_name(splat_view v);
 rt_tonemap  rt_view_tonemap(splat_view v);
 int         rt_view_by_key(int key);
 void        rt_view_list(char *buf, size_t n);
+/* The viewer's on-screen help (key H; overlay.c). */
+typedef struct rt_overlay_info {
+    const char *pack;       /* the pack's name                              */
+    splat_view  view;
+    const char *material;   /* the mask view's material, or NULL            */
+    bool        screen;     /* screen-space path (else forward)            */
+    bool        wire;
+    double      frame_ms;   /* <= 0: not shown (headless: no frame rate)    */
+    int         pending;    /* pipelines still compiling (rt_frame_stats)   */
+    const char *status;     /* the viewer's last status line, or NULL       */
+} rt_overlay_info;
+/* The overlay's text: the state on top, then every key. */
+void rt_overlay_text(const rt_overlay_info *in, char *buf, size_t n);
+/* Draw `text` onto a tone-mapped w x h RGBA8 picture, on the device (the
+ * same pipeline as the window; `splatview --headless --overlay`). */
+bool rt_overlay_draw_rgba8(rt_device *d, const char *text, uint8_t *rgba, int w, int h,
+                           rt_error *e);
+
 /* Craters (destruction.c) on the renderer's terrain: a pack without a
  * destructible area answers RT_CRATER_OUTSIDE. */
 typedef struct rt_crater rt_crater;

@@ -24,6 +24,8 @@ static void usage(FILE *f)
         "                            (default: the preset 'overview', else the first)\n"
         "  --view V                  %s\n"
         "  --frames N                render N frames (stats over them)\n"
+        "  --overlay                 headless: draw the window's help overlay (key H)\n"
+        "                            onto the PNG, as the window shows it\n"
         "  --stats                   patches, pipelines, GPU and CPU times, device;\n"
         "                            layers and texture samples per pixel from one\n"
         "                            counting frame (both paths, not multipass)\n"
@@ -130,6 +132,7 @@ typedef struct opts {
     const char *material;       /* --material M: its swatch pack instead    */
     char *preview_dir;          /* where that pack is built                 */
     char *owned_scene;          /* the scene path build_preview allocated   */
+    bool overlay;
     bool headless, stats, have_camera, have_look, no_stitch, no_cull, no_shadows;
     bool no_undergrowth;
     bool no_distance_classes;
@@ -249,6 +252,8 @@ static int parse_args(int argc, char **argv, opts *o)
             o->check = o->headless = true;
         } else if (!strcmp(a, "--stats")) {
             o->stats = true;
+        } else if (!strcmp(a, "--overlay")) {
+            o->overlay = true;
         } else if (!strcmp(a, "--no-stitch")) {
             o->no_stitch = true;
         } else if (!strcmp(a, "--no-cull")) {
@@ -696,6 +701,17 @@ static int headless(const opts *o)
             goto done;
         if (o->out) {
             rt_tonemap_rgba8(rgba, W, H, tonemap_for(view), png);
+            if (o->overlay) {   /* no frame rate: the picture stays reproducible */
+                char text[2048];
+                rt_overlay_info in = {
+                    .pack = pack.name, .view = view, .screen = st.screen,
+                    .material = view == SPLAT_VIEW_MASK ? pack.materials[material].name : NULL,
+                    .pending = st.pipelines_pending, .status = "headless",
+                };
+                rt_overlay_text(&in, text, sizeof text);
+                if (!rt_overlay_draw_rgba8(&dev, text, png, W, H, &e))
+                    goto done;
+            }
             if (!rt_write_png(o->out, png, W, H, &e))
                 goto done;
         }

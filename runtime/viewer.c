@@ -9,7 +9,10 @@
  * held looks around, wheel changes speed, 1 final, 2 combinations, 3 LOD,
  * 4 normal, 5 slope, 6 albedo, 7 mask (again: next material), 8 tiles,
  * 9 cost, F wireframe, G forward / screen-space shading, R rebuild now,
- * Q/Escape quit, left click: a crater there (destruction.c).
+ * J/L/I/K the sun, +/- exposure, O shadows, U undergrowth, H the on-screen
+ * help (overlay.c: these keys, the view, path, frame rate and shaders
+ * still compiling), Q/Escape quit, left click: a crater there
+ * (destruction.c).
  *
  * --script runs without a person: "frames=N" renders N frames,
  * "view=NAME", "key=K" acts as if K was pressed, "screenshot=FILE" writes
@@ -87,6 +90,9 @@ typedef struct viewer {
     VkSemaphore    acquired, rendered;
     VkFence        fence;
     rt_buffer      shot;
+    rt_overlay    *overlay;      /* the help (H), drawn after the tone map */
+    bool           help;
+    double         frame_ms;     /* smoothed, for the help                  */
     /* camera and state */
     rt_camera      cam;
     double         yaw, pitch, speed;
@@ -183,6 +189,8 @@ static void key_action(viewer *v, int key)
         snprintf(v->status, sizeof v->status, "undergrowth %s",
                  v->no_undergrowth ? "off" : "on");
     } else if (key == GLFW_KEY_H) {
+        v->help = !v->help;
+    } else if (key == GLFW_KEY_O) {
         v->no_shadows = !v->no_shadows;
         rt_renderer_set_shadows(v->r, !v->no_shadows);
         snprintf(v->status, sizeof v->status, "shadows %s", v->no_shadows ? "off" : "on");
@@ -631,6 +639,8 @@ static bool present(viewer *v, const char *shot, rt_error *e)
     uint32_t mode = (uint32_t)rt_view_tonemap(v->view);
     vkCmdPushConstants(cb, v->layout, VK_SHADER_STAGE_FRAGMENT_BIT, 0, 4, &mode);
     vkCmdDraw(cb, 3, 1, 0, 0);
+    if (v->help)
+        rt_overlay_record(v->overlay, cb, v->extent.width, v->extent.height);
     vkCmdEndRenderPass(cb);
     if (shot) {
         rt_cmd_image_barrier(cb, v->images[idx], 0, 1, 1, VK_IMAGE_LAYOUT_PRESENT_SRC_KHR,
@@ -697,7 +707,22 @@ static bool frame(viewer *v, const char *shot, double *last, rt_error *e)
     move_camera(v, dt > 0.25 ? 0.25 : dt);
     check_files(v);
     rt_frame_stats st;
-    if (!rt_renderer_frame(v->r, &v->cam, &st, e) || !present(v, shot, e))
+    if (!rt_renderer_frame(v->r, &v->cam, &st, e))
+        return false;
+    v->frame_ms = v->frame_ms > 0 ? 0.9 * v->frame_ms + 100.0 * dt : 1e3 * dt;
+    if (v->help) {
+        char text[2048];
+        rt_overlay_info in = {
+            .pack = v->pack->name, .view = v->view, .wire = v->wire,
+            .material = v->view == SPLAT_VIEW_MASK ? v->pack->materials[v->material].name : NULL,
+            .screen = st.screen, .frame_ms = v->frame_ms, .pending = st.pipelines_pending,
+            .status = v->status,
+        };
+        rt_overlay_text(&in, text, sizeof text);
+        if (!rt_overlay_layout(v->overlay, text, v->extent.width, v->extent.height, e))
+            return false;
+    }
+    if (!present(v, shot, e))
         return false;
     static double shown;
     if (t - shown > 0.25) {
@@ -789,6 +814,8 @@ static void teardown(viewer *v)
         vkDeviceWaitIdle(d->dev);
         rt_renderer_destroy(v->r);
         v->r = NULL;
+        rt_overlay_destroy(v->overlay);
+        v->overlay = NULL;
         if (v->pipeline) vkDestroyPipeline(d->dev, v->pipeline, NULL);
         if (v->layout) vkDestroyPipelineLayout(d->dev, v->layout, NULL);
         if (v->set_layout) vkDestroyDescriptorSetLayout(d->dev, v->set_layout, NULL);
@@ -902,7 +929,7 @@ int rt_viewer_run(const rt_viewer_desc *desc)
         rd.shading = RT_SHADING_FORWARD;
         made = rt_renderer_create(&v->dev, v->pack, &rd, &v->r, &e);
     }
-    if (!made || !make_tonemap(v, &e))
+    if (!made || !make_tonemap(v, &e) || !rt_overlay_create(&v->dev, v->pass, &v->overlay, &e))
         goto done;
     /* the path asked for, else screen where the pack can (splatview's
      * headless default) */

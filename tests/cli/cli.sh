@@ -6,7 +6,8 @@
 #              outputs byte-identical across runs
 #   status     exit codes 0 / 1 / 2, nothing written on error
 #   eval       `splatc eval` values and --interval bounds
-#   tools      dot, dump --after, check of several files
+#   tools      dot (-m collapsed, --expand, deterministic, dot -Tsvg), dump
+#              --after, check of several files
 #   depfile    `splatc build --depfile`: every input listed (graphs,
 #              imports, rasters, textures, mips), Make-escaped, and make
 #              rebuilds exactly when one of them changes; --json diagnostics
@@ -23,7 +24,9 @@
 #   init       `splatc init DIR` from a folder outside the repository: the
 #              project builds and renders as it stands (SPLATVIEW, IMGCHECK
 #              in the environment), its picture is not mostly fog (luma
-#              contrast), a second init into it is refused
+#              contrast), nor with the default fog (its fog_density taken
+#              out; the old 1.5 / extent fails the same check), a second
+#              init into it is refused
 #   malformed  empty file, binary garbage, truncated files, 10 MB inputs,
 #              10000-deep instance nesting: exit 1 with a diagnostic, no crash
 #              or hang
@@ -159,10 +162,52 @@ tools)
     run 0 "$SPLATC" check graphs/cliff.sg graphs/grass.sg nodes/masks.sg nodes/compositors.sg
     run 1 "$SPLATC" check graphs/cliff.sg tests/golden/cycle.sg
     grep -q "cycle: a -> c -> b -> a" "$TMP/err" || fail "cycle path not shown"
-    run 0 "$SPLATC" dot graphs/cliff.sg -m cliff -o "$TMP/c.dot"
+    run 0 "$SPLATC" dot graphs/cliff.sg -m cliff --expand -o "$TMP/c.dot"
     grep -q "^digraph" "$TMP/c.dot" || fail "dot output"
-    grep -q "cluster_overlay" "$TMP/c.dot" || fail "dot lacks the instanced shader"
+    grep -q "cluster_overlay" "$TMP/c.dot" || fail "dot --expand lacks the instanced shader"
     if command -v dot >/dev/null; then run 0 dot -Tsvg "$TMP/c.dot" -o "$TMP/c.svg"; fi
+    # dot -m rock: one labelled box per shader node, none of the shaders'
+    # inside; --expand adds the inside.  The shader nodes of rock are the
+    # nodes whose type a `shader` of nodes/ declares.
+    shaders=$(sed -n 's/^shader[ \t]*\([A-Za-z_][A-Za-z0-9_]*\).*/\1/p' nodes/*.sg | sort -u)
+    inst=""
+    for pair in $(sed -n '/^material rock/,/^}/s/^ *node *\([a-z0-9_]*\) *: *\([a-z0-9_]*\).*/\1:\2/p' \
+                  graphs/rock.sg); do
+        echo "$shaders" | grep -qx "${pair#*:}" && inst="$inst ${pair%%:*}"
+    done
+    [ "$(echo $inst | wc -w)" -ge 4 ] || fail "rock has too few shader nodes to test ($inst)"
+    run 0 "$SPLATC" dot graphs/rock.sg -m rock -o "$TMP/r.dot"
+    run 0 "$SPLATC" dot graphs/rock.sg -m rock -o "$TMP/r2.dot"
+    cmp -s "$TMP/r.dot" "$TMP/r2.dot" || fail "dot output differs between runs"
+    run 0 "$SPLATC" dot graphs/rock.sg -m rock --expand -o "$TMP/rx.dot"
+    for n in $inst; do
+        grep -q "^    \"rock/$n\" \[shape=box3d.*label=\"$n : [a-z0-9_]*  (shader)" "$TMP/r.dot" ||
+            fail "dot -m rock: no labelled box for shader node $n"
+    done
+    [ "$(grep -c 'shape=box3d' "$TMP/r.dot")" = "$(echo $inst | wc -w)" ] ||
+        fail "dot -m rock: $(grep -c 'shape=box3d' "$TMP/r.dot") boxes for $(echo $inst | wc -w) shader nodes"
+    grep -q 'label="mk : overlay  (shader)\\nwired: base, blend\\nopacity = 0.9"' "$TMP/r.dot" ||
+        fail "dot -m rock: mk's box does not name its wired ports"
+    [ "$(grep -c '^  subgraph' "$TMP/r.dot")" = 1 ] || fail "dot -m rock draws more than the material"
+    grep -q '^    "overlay/' "$TMP/r.dot" && fail "dot -m rock draws overlay's inside"
+    grep -q 'cluster_overlay' "$TMP/rx.dot" || fail "dot --expand lacks overlay"
+    grep -q '^    "overlay/[a-z0-9_]*" \[label=' "$TMP/rx.dot" || fail "dot --expand lacks overlay's op nodes"
+    [ "$(grep -c '^  subgraph' "$TMP/rx.dot")" -gt "$(echo $inst | wc -w)" ] ||
+        fail "dot --expand: fewer clusters than shader nodes"
+    for f in r rx; do
+        if command -v dot >/dev/null; then
+            run 0 dot -Tsvg "$TMP/$f.dot" -o "$TMP/$f.svg"
+            grep -q "<svg" "$TMP/$f.svg" || fail "dot -Tsvg $f.dot drew nothing"
+        else
+            # well-formed: balanced braces, every edge's ends declared
+            [ "$(tr -cd '{' < "$TMP/$f.dot" | wc -c)" = "$(tr -cd '}' < "$TMP/$f.dot" | wc -c)" ] ||
+                fail "$f.dot: unbalanced braces"
+            sed -n 's/^    \("[^"]*"\) \[.*/\1/p' "$TMP/$f.dot" | sort -u > "$TMP/decl"
+            sed -n 's/^    \("[^"]*"\) -> \("[^"]*"\).*/\1\n\2/p' "$TMP/$f.dot" | sort -u |
+                comm -23 - "$TMP/decl" > "$TMP/undecl"
+            [ -s "$TMP/undecl" ] && fail "$f.dot: edges to undeclared nodes: $(head -3 "$TMP/undecl")"
+        fi
+    done
     run 0 "$SPLATC" dump graphs/cliff.sg -m cliff --after lower
     grep -q "^    out mask = " "$TMP/out" || fail "dump has no roots"
     lowered=$(wc -l < "$TMP/out")
@@ -323,8 +368,19 @@ init)
     [ -s "$TMP/err" ] && { fail "the starter project builds with diagnostics"; cat "$TMP/err"; }
     run 0 "$SPLATVIEW" "$TMP/x/pack" --headless -o x.png
     [ -s x.png ] || fail "no picture"
-    run 0 "$IMGCHECK" contrast x.png 0.08
+    run 0 "$IMGCHECK" contrast x.png 0.09
     cat "$TMP/out"
+    # the default fog (no fog_density: derived from the camera presets,
+    # runtime/light.c) leaves the starter readable too (measured 0.082 on
+    # lavapipe), where the old 1.5 / extent made it mostly fog (0.035)
+    sed 's/fog_density = [0-9.]*, //' "$TMP/x/scene.sg" > "$TMP/x/default_fog.sg"
+    grep -q fog_density "$TMP/x/default_fog.sg" && fail "the starter's fog_density was not removed"
+    run 0 "$SPLATC" build "$TMP/x/default_fog.sg" -o "$TMP/x/pack_df"
+    run 0 "$SPLATVIEW" "$TMP/x/pack_df" --headless -o df.png
+    run 0 "$IMGCHECK" contrast df.png 0.06
+    cat "$TMP/out"
+    run 0 "$SPLATVIEW" "$TMP/x/pack_df" --headless --fog-density 0.00146484375 -o old.png
+    run 1 "$IMGCHECK" contrast old.png 0.06
     # a relative DIR, and no second init over a project
     run 0 "$SPLATC" init y
     [ -s y/scene.sg ] || fail "init y wrote nothing"

@@ -17,6 +17,14 @@
  *                                        between its 5th and 95th percentile;
  *                                        exit 1 if under MIN (a picture that
  *                                        is mostly fog or sky has little)
+ *   imgcheck overlay A.png B.png BW BH MIN   B is A with the help overlay
+ *                                        (splatview --overlay): identical
+ *                                        outside the top-left BW x BH box,
+ *                                        and inside it at least MIN more
+ *                                        near-white (text) pixels than A
+ *   imgcheck white IMG.png BW BH         print the near-white pixels (all
+ *                                        channels >= 230) in the top-left
+ *                                        BW x BH box
  */
 #include "rt_internal.h"
 
@@ -57,6 +65,47 @@ int main(int argc, char **argv)
         return 2;
     }
     const char *cmd = argv[1];
+    if (!strcmp(cmd, "white") && argc == 5) {
+        int w, h, boxw = atoi(argv[3]), boxh = atoi(argv[4]);
+        uint8_t *a = load(argv[2], &w, &h);
+        if (!a)
+            return 1;
+        long n = 0;
+        for (int y = 0; y < h && y < boxh; y++)
+            for (int x = 0; x < w && x < boxw; x++) {
+                const uint8_t *p = a + 4 * ((size_t)y * w + x);
+                n += p[0] >= 230 && p[1] >= 230 && p[2] >= 230;
+            }
+        printf("%ld\n", n);
+        stbi_image_free(a);
+        return 0;
+    }
+    if (!strcmp(cmd, "overlay") && argc == 7) {
+        int aw, ah, bw, bh, boxw = atoi(argv[4]), boxh = atoi(argv[5]), min = atoi(argv[6]);
+        uint8_t *a = load(argv[2], &aw, &ah), *b = load(argv[3], &bw, &bh);
+        if (!a || !b || aw != bw || ah != bh) {
+            fprintf(stderr, "imgcheck: overlay: unreadable pictures or sizes differ\n");
+            return 1;
+        }
+        long outside = 0, white_a = 0, white_b = 0, changed = 0;
+        for (int y = 0; y < ah; y++)
+            for (int x = 0; x < aw; x++) {
+                const uint8_t *pa = a + 4 * ((size_t)y * aw + x), *pb = b + 4 * ((size_t)y * aw + x);
+                bool same = !memcmp(pa, pb, 3);
+                if (x >= boxw || y >= boxh) {
+                    outside += !same;
+                    continue;
+                }
+                changed += !same;
+                white_a += pa[0] >= 230 && pa[1] >= 230 && pa[2] >= 230;
+                white_b += pb[0] >= 230 && pb[1] >= 230 && pb[2] >= 230;
+            }
+        printf("overlay: %ld pixels changed in the %dx%d box, near-white %ld -> %ld, "
+               "%ld changed outside\n", changed, boxw, boxh, white_a, white_b, outside);
+        stbi_image_free(a);
+        stbi_image_free(b);
+        return outside == 0 && white_b - white_a >= min ? 0 : 1;
+    }
     if (!strcmp(cmd, "contrast")) {
         int w, h;
         double min;

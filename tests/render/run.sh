@@ -15,7 +15,10 @@
 #     Under the GGX sun (view dependent: a highlight's slope turns those
 #     ulps of the normal into up to 5.8e-4, on 10 of 64000 pixels of the
 #     fixture's overview) the final image is held to 1e-5 on >= 99.9 % of
-#     pixels and 1e-3 on all: a 1/255 compositor error still fails.
+#     pixels and 2e-3 on all: a 1/255 compositor error still fails.  (1e-3
+#     until the default fog followed the cameras: the overview's fog went
+#     from 7.3e-4 to 2.3e-4 per metre and the same 10 highlight pixels
+#     from 5.8e-4 to 1.34e-3 on lavapipe.)
 #   composite vs uber 1e-5: the same material code, other branching.
 #   culled vs not culled 1e-6: the same triangles front-facing; only hidden
 #     back faces are dropped, so equal up to nothing (1e-6 absorbs nothing
@@ -98,7 +101,7 @@ reference_multipass)
         run "$PACK" --headless --size 320x200 --camera-preset $cam --float-out "$OUT/c_$cam.f32"
         run "$PACK" --headless --size 320x200 --camera-preset $cam --reference multipass --float-out "$OUT/m_$cam.f32"
         "$IC" close "$OUT/c_$cam.f32" "$OUT/m_$cam.f32" 1e-5 0.999 80 &&
-            "$IC" diff "$OUT/c_$cam.f32" "$OUT/m_$cam.f32" 1e-3 || fail "multipass differs ($cam)"
+            "$IC" diff "$OUT/c_$cam.f32" "$OUT/m_$cam.f32" 2e-3 || fail "multipass differs ($cam)"
     done
     ;;
 reference_uber)
@@ -177,6 +180,31 @@ viewer)
     [ -e "$PACK/shaders/uber.comp" ] && want=screen-space
     grep -q "^splatview: $want shading" "$OUT/viewer.log" ||
         fail "the window did not open on the $want path"
+    ;;
+overlay)
+    # the help overlay (key H, runtime/overlay.c) drawn on the device,
+    # validation silent: headless --overlay changes only the top-left box
+    # and puts text (near-white pixels) in it; in the window H shows it and
+    # H again hides it
+    run "$PACK" --headless --size 640x360 -o "$OUT/plain.png"
+    run "$PACK" --headless --size 640x360 --overlay -o "$OUT/help.png"
+    "$IC" overlay "$OUT/plain.png" "$OUT/help.png" 480 200 1000 ||
+        fail "the overlay is not text in the top-left box alone"
+    run "$PACK" --headless --size 640x360 --view mask:rock --overlay -o "$OUT/help_mask.png"
+    "$IC" nonuniform "$OUT/help_mask.png" || fail "overlay on the mask view: uniform"
+    command -v xvfb-run > /dev/null || { echo "SKIP: no xvfb-run for the window's part"; exit 77; }
+    rm -f "$OUT"/win*.png
+    xvfb-run -a -s "-screen 0 800x600x24" "$SV" "$PACK" --size 640x360 --script \
+        "frames=5;screenshot=$OUT/win0.png;key=H;frames=2;screenshot=$OUT/win1.png;key=H;frames=2;screenshot=$OUT/win2.png" \
+        > "$OUT/window.log" 2>&1
+    rc=$?
+    cat "$OUT/window.log"
+    [ $rc = 0 ] || fail "viewer exit $rc"
+    w0=$("$IC" white "$OUT/win0.png" 480 200) && w1=$("$IC" white "$OUT/win1.png" 480 200) &&
+        w2=$("$IC" white "$OUT/win2.png" 480 200) || fail "imgcheck white"
+    echo "near-white pixels in the box: $w0 before H, $w1 with the help, $w2 after H again"
+    [ "$w1" -ge $((w0 + 1000)) ] || fail "H shows no help text in the window"
+    [ "$w2" -le $((w0 + 50)) ] || fail "H again does not hide the help"
     ;;
 hot_reload_search)
     # hot reload resolves imports as `splatc build` does: a scene outside

@@ -47,6 +47,12 @@ if(TARGET splatrt AND TARGET splatview)
               $<TARGET_FILE:imgcheck> ${RENDER_OUT}/minimal ${RENDER_OUT}/out_viewer_minimal)
     set_tests_properties(render.viewer_minimal PROPERTIES LABELS render SKIP_RETURN_CODE 77
       FIXTURES_REQUIRED minimal_pack ENVIRONMENT "SPLAT_VALIDATE=1" TIMEOUT 300)
+    # the help overlay (key H): headless --overlay and the window
+    add_test(NAME render.overlay
+      COMMAND sh ${RENDER_DIR}/run.sh overlay $<TARGET_FILE:splatview>
+              $<TARGET_FILE:imgcheck> ${RENDER_OUT}/minimal ${RENDER_OUT}/out)
+    set_tests_properties(render.overlay PROPERTIES LABELS render SKIP_RETURN_CODE 77
+      FIXTURES_REQUIRED minimal_pack ENVIRONMENT "SPLAT_VALIDATE=1" TIMEOUT 300)
     # hot reload of an edited scene; _search: imports found only through
     # -I or $SPLATC_PATH, as splatc build finds them; _far: the far atlas
     # rebaked on the viewer's device
