@@ -503,7 +503,13 @@ static json_t *jundergrowth(const splat_ug *u)
         json_object_set_new(m, "scale", jreals(k->u->scale, 2));
         json_object_set_new(m, "align", json_string(k->u->align_normal ? "normal" : "upright"));
         json_object_set_new(m, "blend", jreal(k->u->blend));
+        json_object_set_new(m, "root_blend", jreal(k->u->root_blend));
         json_object_set_new(m, "color", jreals(k->u->color, 3));
+        json_object_set_new(m, "lighting", json_string(k->u->light_terrain ? "terrain" : "mesh"));
+        json_object_set_new(m, "cutout", json_string(k->u->cutout ? "frond" : "none"));
+        double wind[4] = { k->u->wind_dir[0], k->u->wind_dir[1], k->u->wind, k->u->gust };
+        json_object_set_new(m, "wind", jreals(wind, 4));
+        json_object_set_new(m, "shadow", jreal(k->u->shadow));
         json_array_append_new(blocks, m);
     }
     json_object_set_new(o, "blocks", blocks);

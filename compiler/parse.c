@@ -467,8 +467,12 @@ static void parse_block_in(parser *ps, const char *what, stmt_fn stmt, void *use
 
 /* ---- undergrowth ----------------------------------------------------------- */
 
-static const char *const ug_keys[] = { "density", "scale", "align", "blend", "color" };
-enum { UG_NKEYS = 5 };
+static const char *const ug_keys[] = { "density", "scale", "align", "blend", "color",
+                                       "root_blend", "lighting", "cutout", "wind",
+                                       "wind_dir", "gust", "shadow", NULL };
+enum { UG_NKEYS = 12 };
+#define UG_KEY_LIST "density, scale, align, blend, color, root_blend, lighting, cutout, " \
+                    "wind, wind_dir, gust, shadow"
 
 typedef struct ug_parse {
     sg_undergrowth *u;
@@ -489,16 +493,39 @@ static bool ug_number(parser *ps, const char *key, double lo, double hi, bool op
     return true;   /* well-formed: parsing goes on */
 }
 
+/* One of two keywords for `key` (*x = whether the first), or SETTING. */
+static bool ug_choice(parser *ps, const char *key, const char *yes, const char *no, bool *x)
+{
+    sg_token *vt = cur(ps);
+    char buf[96];
+    if (is_kw(vt, yes) || is_kw(vt, no)) {
+        *x = is_kw(vt, yes);
+    } else {
+        if (vt->kind != SG_TK_IDENT && vt->kind != SG_TK_NUMBER && vt->kind != SG_TK_STRING) {
+            snprintf(buf, sizeof buf, "%s or %s", yes, no);
+            expected(ps, buf);
+            return false;
+        }
+        sg_errorf(ps->d, loc_of(ps, vt), SG_E_SETTING, "'%s' must be %s or %s, found %s", key,
+                  yes, no, sg_tok_describe(vt, buf, sizeof buf));
+    }
+    next(ps);
+    return true;
+}
+
 /* ug_setting = "density" "=" NUM | "scale" "=" NUM [ NUM ]
  *            | "align" "=" ("normal" | "upright") | "blend" "=" NUM
- *            | "color" "=" "vec3" "(" NUM "," NUM "," NUM ")" */
+ *            | "color" "=" "vec3" "(" NUM "," NUM "," NUM ")"
+ *            | "root_blend" "=" NUM | "lighting" "=" ("terrain" | "mesh")
+ *            | "cutout" "=" ("frond" | "none") | "wind" "=" NUM
+ *            | "wind_dir" "=" NUM NUM | "gust" "=" NUM | "shadow" "=" NUM */
 static bool ug_stmt(parser *ps, void *user)
 {
     ug_parse *up = user;
     sg_undergrowth *u = up->u;
     sg_token *key = cur(ps);
     if (key->kind != SG_TK_IDENT) {
-        expected(ps, "an undergrowth setting (density, scale, align, blend, color) or '}'");
+        expected(ps, "an undergrowth setting (" UG_KEY_LIST ") or '}'");
         return false;
     }
     sg_loc kloc = loc_of(ps, key);
@@ -507,9 +534,8 @@ static bool ug_stmt(parser *ps, void *user)
         k++;
     if (k == UG_NKEYS) {
         sg_errorf(ps->d, kloc, SG_E_BAD_OPTION, "unknown undergrowth setting '%.*s' "
-                  "(expected density, scale, align, blend or color)", key->len, key->start);
-        static const char *const keys[] = { "density", "scale", "align", "blend", "color", NULL };
-        hint_key(ps, key, keys);
+                  "(expected " UG_KEY_LIST ")", key->len, key->start);
+        hint_key(ps, key, ug_keys);
         /* skip its value (vec3(…) whole), then to ',', '}' or the next line */
         next(ps);
         sg_value v;
@@ -529,9 +555,7 @@ static bool ug_stmt(parser *ps, void *user)
     next(ps);
     if (!expect(ps, SG_TK_EQ, "'='"))
         return false;
-    sg_token *vt = cur(ps);
-    sg_loc vloc = loc_of(ps, vt);
-    char buf[96];
+    sg_loc vloc = loc_of(ps, cur(ps));
     switch (k) {
     case 0:
         if (!ug_number(ps, "density", 0, 64, true, &u->density))
@@ -548,20 +572,49 @@ static bool ug_stmt(parser *ps, void *user)
                       "<= 100, found %g %g", u->scale[0], u->scale[1]);
         break;
     case 2:
-        if (is_kw(vt, "normal") || is_kw(vt, "upright")) {
-            u->align_normal = is_kw(vt, "normal");
-        } else {
-            if (vt->kind != SG_TK_IDENT && vt->kind != SG_TK_NUMBER && vt->kind != SG_TK_STRING) {
-                expected(ps, "normal or upright");
-                return false;
-            }
-            sg_errorf(ps->d, vloc, SG_E_SETTING, "'align' must be normal or upright, found %s",
-                      sg_tok_describe(vt, buf, sizeof buf));
-        }
-        next(ps);
+        if (!ug_choice(ps, "align", "normal", "upright", &u->align_normal))
+            return false;
         break;
     case 3:
         if (!ug_number(ps, "blend", 0, 1, false, &u->blend))
+            return false;
+        break;
+    case 5:
+        if (!ug_number(ps, "root_blend", 0, 1, false, &u->root_blend))
+            return false;
+        break;
+    case 6:
+        if (!ug_choice(ps, "lighting", "terrain", "mesh", &u->light_terrain))
+            return false;
+        break;
+    case 7:
+        if (!ug_choice(ps, "cutout", "frond", "none", &u->cutout))
+            return false;
+        break;
+    case 8:
+        if (!ug_number(ps, "wind", 0, SPLAT_MAX_UG_WIND, false, &u->wind))
+            return false;
+        break;
+    case 9: {
+        double x, z;
+        if (!parse_number(ps, &x) || !parse_number(ps, &z))
+            return false;
+        double len = hypot(x, z);
+        if (!(len > 1e-6 && len <= 1e6)) {
+            sg_errorf(ps->d, vloc, SG_E_SETTING, "'wind_dir' must be X Z, a direction in the "
+                      "ground plane (not 0 0, each at most 1e6), found %g %g", x, z);
+            break;
+        }
+        u->wind_dir[0] = x / len;
+        u->wind_dir[1] = z / len;
+        break;
+    }
+    case 10:
+        if (!ug_number(ps, "gust", 0, 1, false, &u->gust))
+            return false;
+        break;
+    case 11:
+        if (!ug_number(ps, "shadow", 0, 1, false, &u->shadow))
             return false;
         break;
     case 4: {
@@ -624,7 +677,13 @@ static bool parse_undergrowth(parser *ps, sg_shader *s)
     static const double colors[][3] = {      /* per built-in mesh, then OBJ */
         { 0.16, 0.30, 0.06 }, { 0.12, 0.26, 0.05 }, { 0.35, 0.33, 0.30 }, { 0.5, 0.5, 0.5 },
     };
-    sg_undergrowth u = { .density = 1, .scale = { 1, 1 }, .blend = 0.5 };
+    /* per built-in mesh, then OBJ: lit with the terrain normal, cut out,
+     * contact shadow (defaults: each can be set in the block) */
+    static const bool terrain_lit[] = { true, true, false, false };
+    static const bool cut[] = { false, true, false, false };
+    static const double shadows[] = { 0.35, 0.3, 0.5, 0.4 };
+    sg_undergrowth u = { .density = 1, .scale = { 1, 1 }, .blend = 0.5, .root_blend = -1,
+                         .wind_dir = { 1, 0 }, .gust = 0.5 };
     u.loc = loc_of(ps, next(ps));
     sg_token *m = cur(ps);
     bool known = true;
@@ -652,12 +711,17 @@ static bool parse_undergrowth(parser *ps, sg_shader *s)
     }
     next(ps);
     memcpy(u.color, colors[kind], sizeof u.color);
+    u.light_terrain = terrain_lit[kind];
+    u.cutout = cut[kind];
+    u.shadow = shadows[kind];
     if (cur(ps)->kind == SG_TK_LBRACE) {
         ug_parse up = { &u, { { 0 } } };
         char what[160];
         snprintf(what, sizeof what, "block of undergrowth '%.*s'", m->len, m->start);
         parse_block_in(ps, what, ug_stmt, &up, true);
     }
+    if (u.root_blend < 0)
+        u.root_blend = u.blend;
     if (!known)
         return true;
     if (s->nug == SG_MAX_UNDERGROWTH) {

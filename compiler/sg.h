@@ -218,8 +218,17 @@ typedef struct sg_undergrowth {
     double density;        /* instances per m^2, (0, 64] */
     double scale[2];       /* lo, hi */
     bool   align_normal;   /* align = normal (else upright) */
-    double blend;          /* 0..1 */
+    double blend;          /* 0..1: share of the terrain's albedo (at the tip) */
+    double root_blend;     /* 0..1: that share at the root (default: blend) */
     double color[3];       /* linear */
+    bool   light_terrain;  /* lighting = terrain (else mesh): lit with the
+                              terrain normal; default: grass and plant */
+    bool   cutout;         /* cutout = frond (else none): a leaf cut from
+                              the quads; default: plant */
+    double wind;           /* sway at 1 m above the root (m), [0, SPLAT_MAX_UG_WIND] */
+    double wind_dir[2];    /* unit xz: where the wind blows to */
+    double gust;           /* 0..1: share of the sway the gusts modulate */
+    double shadow;         /* 0..1: darkening of the ground under an instance */
     sg_loc loc;            /* the `undergrowth` keyword */
 } sg_undergrowth;
 /* At most SG_MAX_UNDERGROWTH blocks per material, SG_MAX_UG_MATERIALS

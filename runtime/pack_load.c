@@ -594,13 +594,12 @@ static bool read_undergrowth(reader *r, json_t *root)
             return false;
         if (ni % 3)
             return field_fail(r, where, "indices: must be a multiple of 3");
-        unsigned flags = strcmp(name, "plant") == 0 ? 3u : strcmp(name, "grass") == 0 ? 2u : 0u;
         int far = -1;
         if (json_object_get(m, "far") &&
             !get_int(r, m, "far", where, 0, (int)json_array_size(ms) - 1, &far))
             return false;
         u->meshes[i] = (rt_pack_ug_mesh){ (uint32_t)nv, (uint32_t)ni, u->nvertices, u->nindices,
-                                          flags, far };
+                                          far };
         u->nvertices += (uint32_t)nv;
         u->nindices += (uint32_t)ni;
     }
@@ -609,15 +608,13 @@ static bool read_undergrowth(reader *r, json_t *root)
         if (m->far >= 0 && (m->far == i || u->meshes[m->far].far >= 0))
             return field_fail(r, "undergrowth.meshes:",
                               "far: must name another mesh that has no far version");
-        if (m->far >= 0)   /* drawn with the near mesh's pipeline and lighting */
-            u->meshes[m->far].flags = m->flags;
     }
     for (int i = 0; i < u->nblocks; i++) {
         char where[64];
         snprintf(where, sizeof where, "undergrowth.blocks[%d]", i);
         json_t *b = json_array_get(bs, (size_t)i);
         rt_pack_ug_block *k = &u->blocks[i];
-        const char *align;
+        const char *align, *lighting, *cutout;
         if (!get_int(r, b, "material", where, 0, r->p->nmaterials - 1, &k->material) ||
             !get_int(r, b, "slot", where, 0, u->nslots - 1, &k->slot) ||
             !get_int(r, b, "mesh", where, 0, u->nmeshes - 1, &k->mesh) ||
@@ -625,8 +622,29 @@ static bool read_undergrowth(reader *r, json_t *root)
             !get_vec(r, b, "scale", where, 2, k->scale) ||
             !get_number(r, b, "blend", where, &k->blend) ||
             !get_vec(r, b, "color", where, 3, k->color) ||
-            !get_string(r, b, "align", where, &align))
+            !get_string(r, b, "align", where, &align) ||
+            !get_number(r, b, "root_blend", where, &k->root_blend) ||
+            !get_string(r, b, "lighting", where, &lighting) ||
+            !get_string(r, b, "cutout", where, &cutout) ||
+            !get_vec(r, b, "wind", where, 4, k->wind) ||
+            !get_number(r, b, "shadow", where, &k->shadow))
             return false;
+        if (!(k->root_blend >= 0 && k->root_blend <= 1))
+            return field_fail(r, where, "root_blend: must be in [0, 1]");
+        if (!(k->shadow >= 0 && k->shadow <= 1))
+            return field_fail(r, where, "shadow: must be in [0, 1]");
+        if (!(fabs(hypot(k->wind[0], k->wind[1]) - 1) <= 1e-3))
+            return field_fail(r, where, "wind: its direction (x, z) must be a unit vector");
+        if (!(k->wind[2] >= 0 && k->wind[2] <= SPLAT_MAX_UG_WIND))
+            return field_fail(r, where, "wind: the sway must be in [0, 2]");
+        if (!(k->wind[3] >= 0 && k->wind[3] <= 1))
+            return field_fail(r, where, "wind: the gust must be in [0, 1]");
+        if (strcmp(lighting, "terrain") && strcmp(lighting, "mesh"))
+            return field_fail(r, where, "lighting: must be \"terrain\" or \"mesh\"");
+        if (strcmp(cutout, "frond") && strcmp(cutout, "none"))
+            return field_fail(r, where, "cutout: must be \"frond\" or \"none\"");
+        k->light_terrain = strcmp(lighting, "terrain") == 0;
+        k->cutout = strcmp(cutout, "frond") == 0;
         if (!(k->density > 0 && k->density <= SPLAT_MAX_UG_DENSITY))
             return field_fail(r, where, "density: must be in (0, 64]");
         if (!(k->scale[0] > 0 && k->scale[0] <= k->scale[1] && k->scale[1] <= 100))

@@ -17,14 +17,30 @@
  *      roulette on the material's weight, scale and rotation from a hash
  *      of the cell's integer position (the same instances on every run
  *      and from every camera), the root on the heightfield (bilinear as
- *      the terrain), colour blended with the terrain's albedo at the root.
+ *      the terrain), the terrain's albedo at the root.
  *      Instances are compacted by a workgroup prefix sum in candidate
  *      order, so the buffer is deterministic (no atomics), and the count
  *      goes straight into the block's indirect draw arguments.
  * Drawing is one indexed indirect draw per block and cell, cells front to
  * back, after the terrain into its colour and depth; lit by splat_light
- * (abi.c) with the terrain normal (grass, plants) or the mesh's (stones,
- * OBJ meshes).
+ * (abi.c) with the terrain normal (a block's `lighting = terrain`) or the
+ * mesh's.  In the vertex stage (ug_glsl, which the probe pass runs too):
+ *   - the distance fade: an instance at distance d from the camera stays
+ *     with probability fade(d) = 1 - smoothstep(r0, r1, d), r1 = radius -
+ *     0.75 cell (every cell holding a point nearer than r1 is allocated),
+ *     r0 = 0.6 r1; it stays while its own hash h (of its root: stable as
+ *     the camera moves) is below fade(d), and shrinks to nothing as
+ *     fade(d) comes down to h (scale clamp((fade - h) * 5, 0, 1)): the
+ *     density thins to zero before the radius, and no instance pops;
+ *   - the wind: a vertex h metres above the root moves along the block's
+ *     direction by a = sway * h^2 * (1 - gust + gust * g), g in [0, 1]
+ *     gusts: two waves (24 m at 4.2 m/s along the wind, 9.1 m at 4 m/s
+ *     slanted across it, fract() of their phases so that far from the
+ *     origin float sin stays exact), and down by min(a^2 / 2h, h / 2)
+ *     (about keeping the blade's length);
+ *   - the colour: the block's, blended with the terrain's albedo at the
+ *     root by mix(root_blend, blend, v) (v: the mesh's uv.y, 0 at the
+ *     root, 1 at the tip).
  */
 #include "rt_internal.h"
 
@@ -43,6 +59,7 @@
 #define LOD_MIN  0.08
 #define LOD_GROW 3.0
 #define LOD_GROW_S "3.0"
+#define UG_BLOCK_VEC4 5   /* vec4s per block of the block table (fill_blocks) */
 
 enum { CELL_FREE, CELL_PENDING, CELL_READY };
 
@@ -96,6 +113,15 @@ struct rt_ug {
     VkFramebuffer         fb;
     VkQueryPool           qpool;               /* VK_NULL_HANDLE: no timestamps */
     int                   generated;           /* this frame                 */
+    double                time;                /* the camera's (the wind)    */
+    float                 cam_xz[2];           /* the camera's, this frame   */
+    /* the probe pass (tests only; made on first use) */
+    VkDescriptorSetLayout probe_sl;
+    VkPipelineLayout      probe_layout;
+    VkPipeline            probe_pipe;
+    VkDescriptorPool      probe_pool;
+    VkDescriptorSet       probe_set;
+    rt_buffer             probe_out;
     bool                  drawn;
 };
 
@@ -134,7 +160,7 @@ static const char gen_glsl[] =
     "}\n"
     "void main() {\n"
     "    uint b = gl_WorkGroupID.x, lid = gl_LocalInvocationID.x;\n"
-    "    vec4 b0 = u_blocks.b[3u * b], b1 = u_blocks.b[3u * b + 1u], b2 = u_blocks.b[3u * b + 2u];\n"
+    "    vec4 b0 = u_blocks.b[5u * b], b1 = u_blocks.b[5u * b + 1u], b2 = u_blocks.b[5u * b + 2u];\n"
     "    uint n = uint(b2.x), total = n * n, base = u_p.slot * u_p.cap + uint(b2.y);\n"
     "    uint ms = uint(b1.w);\n"
     "    float keep = b0.x * " "256.0" " / float(total);\n"
@@ -162,9 +188,8 @@ static const char gen_glsl[] =
     "            vec2 xz = u_p.origin + l;\n"
     "            float sc = mix(b0.y, b0.z, rnd(s));\n"
     "            float ang = rnd(s) * 6.2831853;\n"
-    "            vec3 col = mix(b1.rgb, alb, b0.w);\n"
     "            it.p = vec4(xz.x, height_at(xz), xz.y, sc);\n"
-    "            it.q = uvec4(packSnorm4x8(vec4(nrm, 0.0)), packUnorm4x8(vec4(col, 1.0)),\n"
+    "            it.q = uvec4(packSnorm4x8(vec4(nrm, 0.0)), packUnorm4x8(vec4(alb, 1.0)),\n"
     "                         floatBitsToUint(ang), b);\n"
     "        }\n"
     "        s_scan[lid] = ok ? 1u : 0u;\n"
@@ -209,6 +234,35 @@ static const char lod_glsl[] =
     "    }\n"
     "}\n";
 
+/* The vertex stage's fade and wind (the top comment), shared by the draw
+ * and the probe pass so that the tests count what the draw keeps. */
+#define UG_GLSL_FUNCS \
+    "float ug_hash01(vec3 root) {\n" \
+    "    uint x = floatBitsToUint(root.x) * 0x9e3779b1u ^ floatBitsToUint(root.z) * 0x85ebca77u;\n" \
+    "    x ^= x >> 16; x *= 0x7feb352du; x ^= x >> 15; x *= 0x846ca68bu; x ^= x >> 16;\n" \
+    "    return float(x >> 8) * (1.0 / 16777216.0);\n" \
+    "}\n" \
+    "float ug_fade(float d, float r) {\n" \
+    "    float r1 = max(r - " UG_FADE_MARGIN_S ", 0.5 * r);\n" \
+    "    return 1.0 - smoothstep(" UG_FADE_START_S " * r1, r1, d);\n" \
+    "}\n" \
+    "float ug_fade_scale(vec3 root, float d, float r) {\n" \
+    "    return clamp((ug_fade(d, r) - ug_hash01(root)) * 5.0, 0.0, 1.0);\n" \
+    "}\n" \
+    "float ug_gust(vec2 xz, vec2 dir, float t) {\n" \
+    "    float along = dot(xz, dir), across = dot(xz, vec2(-dir.y, dir.x));\n" \
+    "    float p1 = 6.2831853 * fract(along / 24.0 - t / 5.7);\n" \
+    "    float p2 = 6.2831853 * fract(along / 9.1 + across / 37.0 - t / 2.3);\n" \
+    "    return 0.5 + 0.3 * sin(p1) + 0.2 * sin(p2);\n" \
+    "}\n" \
+    "vec3 ug_wind(vec3 root, float h, vec4 w, float t) {\n" \
+    "    h = max(h, 0.0);\n" \
+    "    float a = w.z * h * h * (1.0 - w.w + w.w * ug_gust(root.xz, w.xy, t));\n" \
+    "    return vec3(w.x * a, -min(0.5 * a * a / max(h, 1e-3), 0.5 * h), w.y * a);\n" \
+    "}\n"
+#define UG_FADE_MARGIN_S "12.0"   /* 0.75 CELL */
+#define UG_FADE_START_S "0.6"
+
 /* The draw pass: SPLAT_GLSL_TERRAIN (frame block) + this vertex main; the
  * prelude + draw_frag_main as the fragment shader (it reads v_rel, v_uv,
  * v_local at locations 0-2, as the terrain's). */
@@ -228,28 +282,34 @@ static const char draw_vert_main[] =
     "layout(location = 4) out vec3 g_normal;\n"
     "layout(location = 5) out vec2 g_uv;\n"
     "layout(location = 6) flat out uint g_flags;\n"
+    UG_GLSL_FUNCS
     "void main() {\n"
     "    Inst it = u_inst.v[gl_InstanceIndex];\n"
-    "    uint flags = uint(u_blocks.b[3u * it.q.w + 2u].z);\n"
+    "    uint bi = 5u * it.q.w;\n"
+    "    vec4 b0 = u_blocks.b[bi], b1 = u_blocks.b[bi + 1u], b4 = u_blocks.b[bi + 4u];\n"
+    "    uint flags = uint(u_blocks.b[bi + 2u].z);\n"
     "    vec3 n = normalize(unpackSnorm4x8(it.q.x).xyz + vec3(0.0, 1e-4, 0.0));\n"
     "    float a = uintBitsToFloat(it.q.z), c = cos(a), s = sin(a);\n"
-    "    /* shrink away over the last quarter of the radius (push patch_xz.x) */\n"
+    /* the distance fade (push patch_xz.x: the radius) */
     "    float r = u_push.patch_xz.x, d = length(it.p.xz - u_frame.camera.xz);\n"
-    "    /* the LOD's growth (u_push.info.x: instances per cell) */\n"
+    /* the LOD's growth (u_push.info.x: instances per cell) */
     "    float grow = min(inversesqrt(u_lod.f[uint(gl_InstanceIndex) / u_push.info.x]), " LOD_GROW_S ");\n"
-    "    vec3 p = a_pos * it.p.w * grow * clamp((r - d) / (0.25 * r), 0.0, 1.0);\n"
+    "    vec3 p = a_pos * it.p.w * grow * ug_fade_scale(it.p.xyz, d, r);\n"
     "    p = vec3(c * p.x + s * p.z, p.y, -s * p.x + c * p.z);\n"
     "    vec3 m = vec3(c * a_nrm.x + s * a_nrm.z, a_nrm.y, -s * a_nrm.x + c * a_nrm.z);\n"
-    "    if ((flags & 4u) != 0u) {   /* aligned to the terrain normal */\n"
-    "        vec3 t = normalize(cross(vec3(0.0, 0.0, 1.0), n));\n"
+    "    if ((flags & 4u) != 0u) {   /* aligned to the terrain normal: a rotation (t, n, b) */\n"
+    "        vec3 t = normalize(cross(n, vec3(0.0, 0.0, 1.0)));\n"
     "        vec3 bt = cross(t, n);\n"
-    "        p = t * p.x + n * p.y - bt * p.z;\n"
-    "        m = t * m.x + n * m.y - bt * m.z;\n"
+    "        p = t * p.x + n * p.y + bt * p.z;\n"
+    "        m = t * m.x + n * m.y + bt * m.z;\n"
     "    }\n"
+    /* the wind (block vec4 3; push patch_xz.y: the time in seconds) */
+    "    p += ug_wind(it.p.xyz, p.y, u_blocks.b[bi + 3u], u_push.patch_xz.y);\n"
     "    v_local = it.p.xyz + p;\n"
     "    v_rel = v_local - u_frame.camera.xyz;\n"
     "    v_uv = v_local.xz / u_frame.terrain.xy;\n"
-    "    g_color = unpackUnorm4x8(it.q.y).rgb;\n"
+    "    float share = mix(b4.x, b0.w, clamp(a_uv.y, 0.0, 1.0));\n"
+    "    g_color = mix(b1.rgb, unpackUnorm4x8(it.q.y).rgb, share);\n"
     "    g_normal = (flags & 2u) != 0u ? n : m;\n"
     "    g_uv = a_uv;\n"
     "    g_flags = flags;\n"
@@ -273,6 +333,48 @@ static const char draw_frag_main[] =
     "    if ((g_flags & 2u) == 0u && !gl_FrontFacing) n = -n;\n"
     "    float ao = mix(0.5, 1.0, clamp(g_uv.y, 0.0, 1.0));   /* darker at the root */\n"
     "    o_color = vec4(splat_light(g_color * ao, n, 0.9, dist, v), 1.0);\n"
+    "}\n";
+
+/* The probe pass, for the tests only (made on first use): mode 0 counts
+ * the instances the last frame's draw keeps in cell `slot`, per ring of
+ * width ring.w around the camera ring.xy (the draw's arguments after the
+ * LOD, and ug_fade_scale > 0: exactly the instances the vertex stage does
+ * not collapse) into out[ring], and all the LOD's into out[rings + ring];
+ * mode 1 evaluates ug_wind at n points (12 floats each:
+ * root, h, the block's wind vec4, then the offset and the gust written). */
+static const char probe_glsl[] =
+    "#version 450\n"
+    "layout(local_size_x = 64) in;\n"
+    "struct Inst { vec4 p; uvec4 q; };\n"
+    "layout(set = 0, binding = 0, std430) readonly buffer I { Inst v[]; } u_inst;\n"
+    "layout(set = 0, binding = 1, std430) readonly buffer A { uint a[]; } u_draw;\n"
+    "layout(set = 0, binding = 2, std430) buffer O { uint u[]; } u_out;\n"
+    "layout(push_constant, std430) uniform P { vec4 ring; uvec4 info; } u_p;\n"
+    UG_GLSL_FUNCS
+    "void main() {\n"
+    "    uint lid = gl_LocalInvocationID.x;\n"
+    "    if (u_p.info.x == 1u) {\n"
+    "        uint i = gl_GlobalInvocationID.x;\n"
+    "        if (i >= u_p.info.y) return;\n"
+    "        float v[8];\n"
+    "        for (uint k = 0u; k < 8u; k++) v[k] = uintBitsToFloat(u_out.u[12u * i + k]);\n"
+    "        vec3 o = ug_wind(vec3(v[0], v[1], v[2]), v[3], vec4(v[4], v[5], v[6], v[7]), u_p.ring.z);\n"
+    "        u_out.u[12u * i + 8u] = floatBitsToUint(o.x);\n"
+    "        u_out.u[12u * i + 9u] = floatBitsToUint(o.y);\n"
+    "        u_out.u[12u * i + 10u] = floatBitsToUint(o.z);\n"
+    "        u_out.u[12u * i + 11u] = floatBitsToUint(ug_gust(vec2(v[0], v[2]), vec2(v[4], v[5]), u_p.ring.z));\n"
+    "        return;\n"
+    "    }\n"
+    "    uint at = 5u * (u_p.info.z * u_p.info.w + gl_WorkGroupID.x);\n"
+    "    uint n = u_draw.a[at + 1u], first = u_draw.a[at + 4u];\n"
+    "    for (uint k = lid; k < n; k += 64u) {\n"
+    "        vec3 root = u_inst.v[first + k].p.xyz;\n"
+    "        float d = length(root.xz - u_p.ring.xy);\n"
+    "        uint ring = uint(d / u_p.ring.w);\n"
+    "        if (ring >= u_p.info.y) continue;\n"
+    "        atomicAdd(u_out.u[u_p.info.y + ring], 1u);\n"
+    "        if (ug_fade_scale(root, d, u_p.ring.z) > 0.0) atomicAdd(u_out.u[ring], 1u);\n"
+    "    }\n"
     "}\n";
 
 /* ---- creation ----------------------------------------------------------------- */
@@ -440,9 +542,12 @@ static uint32_t gcd(uint32_t a, uint32_t b)
 }
 
 /* The block table (set 0 binding 3 of the scatter pass, set 2 binding 0
- * of the draw): per block three vec4s, (density, scale lo, scale hi,
- * blend), (colour, slot), (candidates per side, first instance in the
- * cell, flags, the stride of the candidates' lattice order). */
+ * of the draw and the probe): per block UG_BLOCK_VEC4 vec4s, (density,
+ * scale lo, scale hi, blend), (colour, slot), (candidates per side, first
+ * instance in the cell, flags, the stride of the candidates' lattice
+ * order), (wind direction x, z, sway, gust), (root blend, shadow, 0, 0).
+ * Flags: 1 cut out (frond), 2 lit with the terrain normal, 4 aligned to
+ * the terrain normal. */
 static void fill_blocks(rt_ug *u, float *b)
 {
     const rt_pack_ug *pu = &u->p->ug;
@@ -454,15 +559,18 @@ static void fill_blocks(rt_ug *u, float *b)
         u->block_grid[i] = n;
         u->block_base[i] = at;
         at += nn;
-        unsigned flags = pu->meshes[k->mesh].flags | (k->align_normal ? 4u : 0u);
+        unsigned flags = (k->cutout ? 1u : 0u) | (k->light_terrain ? 2u : 0u) |
+                         (k->align_normal ? 4u : 0u);
         uint32_t stride = (uint32_t)(0.618034 * n * n);
         while (stride > 1 && gcd(stride, n * n) != 1)
             stride++;
-        float v[12] = { (float)k->density, (float)k->scale[0], (float)k->scale[1],
-                        (float)k->blend, (float)k->color[0], (float)k->color[1],
-                        (float)k->color[2], (float)k->slot, (float)n, (float)u->block_base[i],
-                        (float)flags, (float)(stride ? stride : 1) };
-        memcpy(b + 12 * i, v, sizeof v);
+        float v[4 * UG_BLOCK_VEC4] = {
+            (float)k->density, (float)k->scale[0], (float)k->scale[1], (float)k->blend,
+            (float)k->color[0], (float)k->color[1], (float)k->color[2], (float)k->slot,
+            (float)n, (float)u->block_base[i], (float)flags, (float)(stride ? stride : 1),
+            (float)k->wind[0], (float)k->wind[1], (float)k->wind[2], (float)k->wind[3],
+            (float)k->root_blend, (float)k->shadow, 0, 0 };
+        memcpy(b + 4 * UG_BLOCK_VEC4 * i, v, sizeof v);
     }
     u->cap = at;
 }
@@ -579,7 +687,8 @@ static bool make_buffers(rt_ug *u, rt_error *e)
         !rt_buffer_create(d, (VkDeviceSize)u->pool * u->nblocks * 20,
                           st | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT, false, &u->draw_args, e) ||
         !rt_buffer_create(d, (VkDeviceSize)u->pool * 4, st, true, &u->lod, e) ||
-        !rt_buffer_create(d, (VkDeviceSize)u->nblocks * 48, st, true, &u->blocks, e) ||
+        !rt_buffer_create(d, (VkDeviceSize)u->nblocks * 16 * UG_BLOCK_VEC4, st, true, &u->blocks,
+                          e) ||
         !rt_buffer_create(d, (VkDeviceSize)u->nblocks * 16, st, true, &u->far, e) ||
         !rt_buffer_create(d, (VkDeviceSize)pu->nvertices * 32, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT,
                           true, &u->vbuf, e) ||
@@ -628,7 +737,7 @@ bool rt_ug_create(rt_device *d, const rt_pack *p, rt_pipelines *pl, const rt_qua
     u->mask_pipes = calloc((size_t)p->ncombos + 1, sizeof *u->mask_pipes);
     if (!u->cells || !u->order || !u->block_base || !u->block_grid || !u->mask_pipes)
         return rt_fail(e, RT_E_VULKAN, "undergrowth", "out of memory");
-    fill_blocks(u, (float[12 * 64]){0});   /* u->cap before the buffers */
+    fill_blocks(u, (float[4 * UG_BLOCK_VEC4 * SPLAT_MAX_UG_BLOCKS]){0});   /* u->cap first */
     VkQueryPoolCreateInfo qi = {
         .sType = VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO,
         .queryType = VK_QUERY_TYPE_TIMESTAMP, .queryCount = 4,
@@ -688,6 +797,15 @@ void rt_ug_destroy(rt_ug *u)
                           &u->far, &u->blocks, &u->vbuf, &u->ibuf, &u->frame };
     for (size_t i = 0; i < sizeof bufs / sizeof *bufs; i++)
         rt_buffer_destroy(d, bufs[i]);
+    if (u->probe_pipe)
+        vkDestroyPipeline(d->dev, u->probe_pipe, NULL);
+    if (u->probe_layout)
+        vkDestroyPipelineLayout(d->dev, u->probe_layout, NULL);
+    if (u->probe_sl)
+        vkDestroyDescriptorSetLayout(d->dev, u->probe_sl, NULL);
+    if (u->probe_pool)
+        vkDestroyDescriptorPool(d->dev, u->probe_pool, NULL);
+    rt_buffer_destroy(d, &u->probe_out);
     free(u->mask_pipes);
     free(u->cells);
     free(u->order);
@@ -897,6 +1015,9 @@ bool rt_ug_generate(rt_ug *u, VkCommandBuffer cb, const rt_camera *c, const spla
                     VkDescriptorSet set1, int budget, rt_error *e)
 {
     u->generated = 0;
+    u->time = c->time;
+    u->cam_xz[0] = (float)c->position[0];
+    u->cam_xz[1] = (float)c->position[2];
     allocate(u, c, fr->view_proj);
     /* the mask pass's frame block: this frame's, seen from the origin */
     splat_frame *uf = u->frame.map;
@@ -1001,7 +1122,8 @@ void rt_ug_draw(rt_ug *u, VkCommandBuffer cb, bool depth_read_only, VkDescriptor
     vkCmdSetScissor(cb, 0, 1, area);
     VkDescriptorSet sets[3] = { set0, set1, u->draw_set };
     vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_GRAPHICS, u->draw_layout, 0, 3, sets, 0, NULL);
-    splat_push push = { .patch_xz = { (float)u->radius, 0, 0, 0 }, .info = { u->cap, 0, 0, 0 } };
+    splat_push push = { .patch_xz = { (float)u->radius, (float)u->time, 0, 0 },
+                        .info = { u->cap, 0, 0, 0 } };
     vkCmdPushConstants(cb, u->draw_layout, VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT,
                        0, sizeof push, &push);
     VkDeviceSize zero = 0;
@@ -1016,7 +1138,7 @@ void rt_ug_draw(rt_ug *u, VkCommandBuffer cb, bool depth_read_only, VkDescriptor
                 continue;
             VkDeviceSize at = (VkDeviceSize)k * u->nblocks * 20;
             for (int b = 0; b < u->nblocks; b++)
-                if ((int)(pu->meshes[pu->blocks[b].mesh].flags & 1u) == cut)
+                if ((int)pu->blocks[b].cutout == cut)
                     vkCmdDrawIndexedIndirect(cb, u->draw_args.buf, at + 20 * (VkDeviceSize)b, 1, 20);
         }
     }
@@ -1086,4 +1208,108 @@ int rt_ug_read_cell(rt_ug *u, int ix, int iz, rt_ug_instance *out, int max, rt_e
         }
     rt_buffer_destroy(u->d, &st);
     return n;
+}
+
+/* ---- the probe pass (tests) -------------------------------------------------------- */
+
+/* The probe's pipeline and an output buffer of at least `bytes`. */
+static bool probe_make(rt_ug *u, VkDeviceSize bytes, rt_error *e)
+{
+    rt_device *d = u->d;
+    if (!u->probe_pipe) {
+        const VkShaderStageFlags cs = VK_SHADER_STAGE_COMPUTE_BIT;
+        const VkDescriptorType sb = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+        VkDescriptorSetLayoutBinding b[] = {
+            { 0, sb, 1, cs, NULL }, { 1, sb, 1, cs, NULL }, { 2, sb, 1, cs, NULL },
+        };
+        VkDescriptorPoolSize size = { sb, 3 };
+        if (!rt_set_layout(d, b, 3, &u->probe_sl, e) ||
+            !pipe_layout(d, &u->probe_sl, 1, cs, 32, &u->probe_layout, e) ||
+            !rt_descriptor_sets(d, &size, 1, &u->probe_sl, 1, &u->probe_pool, &u->probe_set, e) ||
+            !rt_glsl_compute_pipeline(d, VK_NULL_HANDLE, u->probe_layout, probe_glsl,
+                                      "undergrowth probe", NULL, &u->probe_pipe, e))
+            return false;
+    }
+    if (u->probe_out.size < bytes) {
+        rt_buffer_destroy(d, &u->probe_out);
+        if (!rt_buffer_create(d, bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, true, &u->probe_out, e))
+            return false;
+        VkDescriptorBufferInfo bi[3] = { { u->inst.buf, 0, VK_WHOLE_SIZE },
+                                         { u->draw_args.buf, 0, VK_WHOLE_SIZE },
+                                         { u->probe_out.buf, 0, VK_WHOLE_SIZE } };
+        VkWriteDescriptorSet w[3];
+        for (int i = 0; i < 3; i++)
+            w[i] = (VkWriteDescriptorSet){ .sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET,
+                                           .dstSet = u->probe_set, .dstBinding = (uint32_t)i,
+                                           .descriptorCount = 1,
+                                           .descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
+                                           .pBufferInfo = &bi[i] };
+        vkUpdateDescriptorSets(d->dev, 3, w, 0, NULL);
+    }
+    return true;
+}
+
+typedef struct probe_push {
+    float    ring[4];     /* camera x, z; radius (mode 0) or time (1); ring width */
+    uint32_t info[4];     /* mode, rings or points, cell slot, blocks          */
+} probe_push;
+
+static bool probe_run(rt_ug *u, const probe_push *pp, const int *slots, int nslots,
+                      uint32_t groups, rt_error *e)
+{
+    VkCommandBuffer cb;
+    if (!rt_oneshot_begin(u->d, &cb, e))
+        return false;
+    vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, u->probe_pipe);
+    vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, u->probe_layout, 0, 1,
+                            &u->probe_set, 0, NULL);
+    for (int i = 0; i < (slots ? nslots : 1); i++) {
+        probe_push q = *pp;
+        if (slots)
+            q.info[2] = (uint32_t)slots[i];
+        vkCmdPushConstants(cb, u->probe_layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof q, &q);
+        vkCmdDispatch(cb, groups, 1, 1);
+    }
+    rt_cmd_barrier(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
+                   VK_PIPELINE_STAGE_HOST_BIT, VK_ACCESS_HOST_READ_BIT);
+    return rt_oneshot_end(u->d, cb, e);
+}
+
+int rt_ug_probe_rings(rt_ug *u, double width, int nrings, uint32_t *counts, rt_error *e)
+{
+    if (!u || nrings <= 0 || !(width > 0))
+        return 0;
+    if (!probe_make(u, (VkDeviceSize)nrings * 8, e))
+        return -1;
+    memset(u->probe_out.map, 0, (size_t)nrings * 8);
+    int *slots = malloc(sizeof *slots * (size_t)u->pool), n = 0;
+    if (!slots) {
+        rt_fail(e, RT_E_VULKAN, "undergrowth", "out of memory");
+        return -1;
+    }
+    for (int i = 0; i < u->pool; i++)
+        if (u->cells[i].state == CELL_READY)
+            slots[n++] = i;
+    probe_push pp = { { u->cam_xz[0], u->cam_xz[1], (float)u->radius, (float)width },
+                      { 0, (uint32_t)nrings, 0, (uint32_t)u->nblocks } };
+    bool ok = n == 0 || probe_run(u, &pp, slots, n, (uint32_t)u->nblocks, e);
+    free(slots);
+    if (!ok)
+        return -1;
+    memcpy(counts, u->probe_out.map, (size_t)nrings * 8);
+    return n;
+}
+
+bool rt_ug_probe_wind(rt_ug *u, float *points, int n, double time, rt_error *e)
+{
+    if (!u || n <= 0)
+        return true;
+    if (!probe_make(u, (VkDeviceSize)n * 48, e))
+        return false;
+    memcpy(u->probe_out.map, points, (size_t)n * 48);
+    probe_push pp = { { 0, 0, (float)time, 0 }, { 1, (uint32_t)n, 0, 0 } };
+    if (!probe_run(u, &pp, NULL, 0, ((uint32_t)n + 63) / 64, e))
+        return false;
+    memcpy(points, u->probe_out.map, (size_t)n * 48);
+    return true;
 }

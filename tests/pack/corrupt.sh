@@ -246,6 +246,21 @@ EOF
 case_ ug_far_range bc4 "undergrowth.meshes\[0\].far: must be an integer in \[0, 3\]" <<EOF
 "$PE" set $M undergrowth.meshes.0.far 9
 EOF
+case_ ug_wind_sway bc4 "undergrowth.blocks\[0\] wind: the sway must be in \[0, 2\]" <<EOF
+"$PE" set $M undergrowth.blocks.0.wind '[1, 0, 7, 0.5]'
+EOF
+case_ ug_wind_dir bc4 "undergrowth.blocks\[0\] wind: its direction (x, z) must be a unit vector" <<EOF
+"$PE" set $M undergrowth.blocks.0.wind '[3, 0, 0.5, 0.5]'
+EOF
+case_ ug_wind_length bc4 "undergrowth.blocks\[0\].wind: must have 4 numbers" <<EOF
+"$PE" set $M undergrowth.blocks.0.wind '[1, 0]'
+EOF
+case_ ug_root_blend bc4 "undergrowth.blocks\[0\] root_blend: must be in \[0, 1\]" <<EOF
+"$PE" set $M undergrowth.blocks.0.root_blend 4
+EOF
+case_ ug_lighting bc4 "undergrowth.blocks\[0\] lighting: must be \"terrain\" or \"mesh\"" <<EOF
+"$PE" set $M undergrowth.blocks.0.lighting '"sun"'
+EOF
 # The fragment GLSL the forward counting variant reads when first needed
 # (the cost view on the forward path): the same checks then, and the pack
 # still draws without it.
