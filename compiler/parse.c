@@ -682,8 +682,10 @@ static bool parse_undergrowth(parser *ps, sg_shader *s)
     static const bool terrain_lit[] = { true, true, false, false };
     static const bool cut[] = { false, true, false, false };
     static const double shadows[] = { 0.35, 0.3, 0.5, 0.4 };
-    sg_undergrowth u = { .density = 1, .scale = { 1, 1 }, .blend = 0.5, .root_blend = -1,
-                         .wind_dir = { 1, 0 }, .gust = 0.5 };
+    /* blend at the tip and at the root: a stone keeps its own colour and
+     * takes the ground's only at its foot */
+    static const double blends[][2] = { { 0.5, -1 }, { 0.5, -1 }, { 0.15, 0.5 }, { 0.5, -1 } };
+    sg_undergrowth u = { .density = 1, .scale = { 1, 1 }, .wind_dir = { 1, 0 }, .gust = 0.5 };
     u.loc = loc_of(ps, next(ps));
     sg_token *m = cur(ps);
     bool known = true;
@@ -714,13 +716,15 @@ static bool parse_undergrowth(parser *ps, sg_shader *s)
     u.light_terrain = terrain_lit[kind];
     u.cutout = cut[kind];
     u.shadow = shadows[kind];
+    u.blend = blends[kind][0];
+    u.root_blend = blends[kind][1];
     if (cur(ps)->kind == SG_TK_LBRACE) {
         ug_parse up = { &u, { { 0 } } };
         char what[160];
         snprintf(what, sizeof what, "block of undergrowth '%.*s'", m->len, m->start);
         parse_block_in(ps, what, ug_stmt, &up, true);
     }
-    if (u.root_blend < 0)
+    if (u.root_blend < 0)   /* not set: as the tip, unless a default of its own */
         u.root_blend = u.blend;
     if (!known)
         return true;

@@ -40,7 +40,9 @@
  *     (about keeping the blade's length);
  *   - the colour: the block's, blended with the terrain's albedo at the
  *     root by mix(root_blend, blend, v) (v: the mesh's uv.y, 0 at the
- *     root, 1 at the tip).
+ *     root, 1 at the tip), and wholly the terrain's (no root darkening
+ *     either) as ug_far goes from 0 at 0.35 r1 to 1 at 0.8 r1: the cover
+ *     turns into the ground it stands on before it thins out.
  */
 #include "rt_internal.h"
 
@@ -51,10 +53,12 @@
 #define CELL    SPLAT_UG_CELL        /* metres per cell side (abi.h)        */
 #define TEXELS  SPLAT_UG_TEXELS      /* mask texels per cell side           */
 /* Distance LOD: beyond LOD_NEAR metres a cell draws the fraction
- * (LOD_NEAR / d)^2 of its instances (at least LOD_MIN), each scaled by
- * 1 / sqrt(fraction) (at most LOD_GROW): about as many instances per
- * pixel at every distance, and the same cover (a far tiny triangle costs
- * a whole quad of fragments; the H100 paid 0.25 us per instance drawn). */
+ * (LOD_NEAR / d)^2 of its instances (at least LOD_MIN), each widened by
+ * 1 / sqrt(fraction) (at most LOD_GROW) but not raised: about as many
+ * instances per pixel at every distance and the same cover seen from
+ * above, without a wall of tall far clumps at a grazing view (a far tiny
+ * triangle costs a whole quad of fragments; the H100 paid 0.25 us per
+ * instance drawn). */
 #define LOD_NEAR 14.0
 #define LOD_MIN  0.08
 #define LOD_GROW 3.0
@@ -246,6 +250,10 @@ static const char lod_glsl[] =
     "    float r1 = max(r - " UG_FADE_MARGIN_S ", 0.5 * r);\n" \
     "    return 1.0 - smoothstep(" UG_FADE_START_S " * r1, r1, d);\n" \
     "}\n" \
+    "float ug_far(float d, float r) {\n" \
+    "    float r1 = max(r - " UG_FADE_MARGIN_S ", 0.5 * r);\n" \
+    "    return smoothstep(0.35 * r1, 0.8 * r1, d);\n" \
+    "}\n" \
     "float ug_fade_scale(vec3 root, float d, float r) {\n" \
     "    return clamp((ug_fade(d, r) - ug_hash01(root)) * 5.0, 0.0, 1.0);\n" \
     "}\n" \
@@ -282,6 +290,7 @@ static const char draw_vert_main[] =
     "layout(location = 4) out vec3 g_normal;\n"
     "layout(location = 5) out vec2 g_uv;\n"
     "layout(location = 6) flat out uint g_flags;\n"
+    "layout(location = 7) out float g_far;\n"
     UG_GLSL_FUNCS
     "void main() {\n"
     "    Inst it = u_inst.v[gl_InstanceIndex];\n"
@@ -294,7 +303,8 @@ static const char draw_vert_main[] =
     "    float r = u_push.patch_xz.x, d = length(it.p.xz - u_frame.camera.xz);\n"
     /* the LOD's growth (u_push.info.x: instances per cell) */
     "    float grow = min(inversesqrt(u_lod.f[uint(gl_InstanceIndex) / u_push.info.x]), " LOD_GROW_S ");\n"
-    "    vec3 p = a_pos * it.p.w * grow * ug_fade_scale(it.p.xyz, d, r);\n"
+    /* the growth widens, it does not raise: far cover, not a hedge */
+    "    vec3 p = a_pos * it.p.w * ug_fade_scale(it.p.xyz, d, r) * vec3(grow, 1.0, grow);\n"
     "    p = vec3(c * p.x + s * p.z, p.y, -s * p.x + c * p.z);\n"
     "    vec3 m = vec3(c * a_nrm.x + s * a_nrm.z, a_nrm.y, -s * a_nrm.x + c * a_nrm.z);\n"
     "    if ((flags & 4u) != 0u) {   /* aligned to the terrain normal: a rotation (t, n, b) */\n"
@@ -308,7 +318,11 @@ static const char draw_vert_main[] =
     "    v_local = it.p.xyz + p;\n"
     "    v_rel = v_local - u_frame.camera.xyz;\n"
     "    v_uv = v_local.xz / u_frame.terrain.xy;\n"
-    "    float share = mix(b4.x, b0.w, clamp(a_uv.y, 0.0, 1.0));\n"
+    /* towards the radius the colour becomes the ground's (the cover thins
+     * into the terrain it stands on, the root darkening goes with it) */
+    "    float far = ug_far(d, r);\n"
+    "    float share = mix(mix(b4.x, b0.w, clamp(a_uv.y, 0.0, 1.0)), 1.0, far);\n"
+    "    g_far = far;\n"
     "    g_color = mix(b1.rgb, unpackUnorm4x8(it.q.y).rgb, share);\n"
     "    g_normal = (flags & 2u) != 0u ? n : m;\n"
     "    g_uv = a_uv;\n"
@@ -321,6 +335,7 @@ static const char draw_frag_main[] =
     "layout(location = 4) in vec3 g_normal;\n"
     "layout(location = 5) in vec2 g_uv;\n"
     "layout(location = 6) flat in uint g_flags;\n"
+    "layout(location = 7) in float g_far;\n"
     "void main() {\n"
     "#ifdef UG_CUTOUT\n"
     "    /* a frond cut from the quad: a lens-shaped outline, chevron leaflets */\n"
@@ -331,7 +346,7 @@ static const char draw_frag_main[] =
     "    vec3 v = dist > 0.0 ? -v_rel / dist : vec3(0.0, 1.0, 0.0);\n"
     "    vec3 n = normalize(g_normal);\n"
     "    if ((g_flags & 2u) == 0u && !gl_FrontFacing) n = -n;\n"
-    "    float ao = mix(0.5, 1.0, clamp(g_uv.y, 0.0, 1.0));   /* darker at the root */\n"
+    "    float ao = mix(mix(0.5, 1.0, clamp(g_uv.y, 0.0, 1.0)), 1.0, g_far);   /* darker at the root */\n"
     "    o_color = vec4(splat_light(g_color * ao, n, 0.9, dist, v), 1.0);\n"
     "}\n";
 
