@@ -111,6 +111,8 @@ struct rt_ug {
     VkPipeline           *mask_pipes;          /* per combination            */
     VkPipeline            gen_pipe, lod_pipe;
     VkPipeline            draw_pipe[2];        /* opaque (early depth), cut out */
+    VkPipeline            shadow_pipe;         /* contact shadows (if shadows) */
+    bool                  shadows;             /* the colour target blends   */
     VkDescriptorPool      dpool;
     VkDescriptorSet       set0, mask_set, gen_set, draw_set, lod_set;
     VkRenderPass          pass_att, pass_ro;   /* depth in attachment / read */
@@ -215,7 +217,10 @@ static const char gen_glsl[] =
  * each cell's instance count times its fraction (a prefix: the scatter
  * pass keeps instances in a lattice order that spreads every prefix), and
  * beyond LOD_NEAR the block's far mesh where it has one (PACK.md: index
- * count, first index, vertex offset, and w = 1). */
+ * count, first index, vertex offset, and w = 1); after the n arguments,
+ * the contact shadows' n: the same instances drawn with the shadow quad
+ * (push qidx, qvtx), none for a block whose shadow is 0 (its second
+ * uvec4 .x). */
 static const char lod_glsl[] =
     "#version 450\n"
     "layout(local_size_x = 64) in;\n"
@@ -223,14 +228,21 @@ static const char lod_glsl[] =
     "layout(set = 0, binding = 1, std430) writeonly buffer D { uint a[]; } u_draw;\n"
     "layout(set = 0, binding = 2, std430) readonly buffer F { float f[]; } u_lod;\n"
     "layout(set = 0, binding = 3, std430) readonly buffer M { uvec4 m[]; } u_far;\n"
-    "layout(push_constant, std430) uniform P { uint n, nblocks; } u_p;\n"
+    "layout(push_constant, std430) uniform P { uint n, nblocks, qidx, qvtx; } u_p;\n"
     "void main() {\n"
     "    uint i = gl_GlobalInvocationID.x;\n"
     "    if (i >= u_p.n) return;\n"
     "    for (uint k = 0u; k < 5u; k++) u_draw.a[5u * i + k] = u_args.a[5u * i + k];\n"
     "    float f = u_lod.f[i / u_p.nblocks];\n"
-    "    u_draw.a[5u * i + 1u] = uint(ceil(float(u_args.a[5u * i + 1u]) * f));\n"
-    "    uvec4 m = u_far.m[i % u_p.nblocks];   /* the block's far mesh */\n"
+    "    uint count = uint(ceil(float(u_args.a[5u * i + 1u]) * f));\n"
+    "    u_draw.a[5u * i + 1u] = count;\n"
+    "    uint s = 5u * (u_p.n + i);\n"
+    "    u_draw.a[s] = 6u;\n"
+    "    u_draw.a[s + 1u] = u_far.m[2u * (i % u_p.nblocks) + 1u].x != 0u ? count : 0u;\n"
+    "    u_draw.a[s + 2u] = u_p.qidx;\n"
+    "    u_draw.a[s + 3u] = u_p.qvtx;\n"
+    "    u_draw.a[s + 4u] = u_args.a[5u * i + 4u];\n"
+    "    uvec4 m = u_far.m[2u * (i % u_p.nblocks)];   /* the block's far mesh */\n"
     "    if (f < 1.0 && m.w != 0u) {\n"
     "        u_draw.a[5u * i] = m.x;\n"
     "        u_draw.a[5u * i + 2u] = m.y;\n"
@@ -392,6 +404,49 @@ static const char probe_glsl[] =
     "    }\n"
     "}\n";
 
+/* Contact shadows (a block's `shadow`): before the plants, every kept
+ * instance darkens the ground under it by a disc on the terrain plane at
+ * its root, 1.3 times its footprint, 4 cm up the normal, multiplied into
+ * the colour (dst * src): shadow * (1 - smoothstep(0.2, 1, r^2)), gone
+ * with the instance (the fade's scale) and with ug_far, so overlapping
+ * discs under dense cover darken the ground the more. */
+static const char shadow_vert_main[] =
+    "struct Inst { vec4 p; uvec4 q; };\n"
+    "layout(set = 2, binding = 0, std430) readonly buffer B { vec4 b[]; } u_blocks;\n"
+    "layout(set = 2, binding = 1, std430) readonly buffer I { Inst v[]; } u_inst;\n"
+    "layout(set = 2, binding = 2, std430) readonly buffer F { float f[]; } u_lod;\n"
+    "layout(location = 0) in vec3 a_pos;\n"
+    "layout(location = 1) in vec3 a_nrm;   /* the vertex layout's; unused */\n"
+    "layout(location = 2) in vec2 a_uv;\n"
+    "out gl_PerVertex { vec4 gl_Position; };\n"
+    "layout(location = 0) out vec2 s_q;\n"
+    "layout(location = 1) out float s_a;\n"
+    UG_GLSL_FUNCS
+    "void main() {\n"
+    "    Inst it = u_inst.v[gl_InstanceIndex];\n"
+    "    vec4 b4 = u_blocks.b[5u * it.q.w + 4u];\n"
+    "    vec3 n = normalize(unpackSnorm4x8(it.q.x).xyz + vec3(0.0, 1e-4, 0.0));\n"
+    "    float r = u_push.patch_xz.x, d = length(it.p.xz - u_frame.camera.xz);\n"
+    "    float grow = min(inversesqrt(u_lod.f[uint(gl_InstanceIndex) / u_push.info.x]), " LOD_GROW_S ");\n"
+    "    float size = 1.3 * b4.z * it.p.w * grow * ug_fade_scale(it.p.xyz, d, r);\n"
+    "    vec3 t = normalize(cross(n, vec3(0.0, 0.0, 1.0))), bt = cross(t, n);\n"
+    "    vec3 p = it.p.xyz + (t * a_pos.x + bt * a_pos.z) * size + n * 0.04;\n"
+    "    s_q = a_uv * 2.0 - 1.0;\n"
+    "    s_a = b4.y * (1.0 - ug_far(d, r));\n"
+    "    gl_Position = u_frame.view_proj * vec4(p - u_frame.camera.xyz, 1.0);\n"
+    "}\n";
+
+static const char shadow_frag[] =
+    "#version 450\n"
+    "layout(early_fragment_tests) in;\n"
+    "layout(location = 0) in vec2 s_q;\n"
+    "layout(location = 1) in float s_a;\n"
+    "layout(location = 0) out vec4 o_color;\n"
+    "void main() {\n"
+    "    float a = s_a * (1.0 - smoothstep(0.2, 1.0, dot(s_q, s_q)));\n"
+    "    o_color = vec4(vec3(1.0 - a), 1.0);\n"
+    "}\n";
+
 /* ---- creation ----------------------------------------------------------------- */
 
 static bool pipe_layout(rt_device *d, const VkDescriptorSetLayout *sets, uint32_t n,
@@ -455,23 +510,29 @@ static bool make_pass(rt_device *d, VkImageLayout depth_in, VkRenderPass *out, r
 }
 
 /* The draw pipeline of opaque meshes (depth tested before shading: blades
- * hidden behind nearer ones cost no lighting) or of cut-out ones (the
- * fragment shader discards, so the test waits for it). */
-static bool draw_pipeline(rt_ug *u, bool cutout, rt_error *e)
+ * hidden behind nearer ones cost no lighting), of cut-out ones (the
+ * fragment shader discards, so the test waits for it: kind 1) or of the
+ * contact shadows (kind 2: multiplied into the colour, no depth written). */
+static bool draw_pipeline(rt_ug *u, int kind, rt_error *e)
 {
     rt_device *d = u->d;
-    size_t nv = strlen(SPLAT_GLSL_TERRAIN) + strlen(draw_vert_main) + 32;
-    size_t nf = strlen(SPLAT_GLSL_PRELUDE) + strlen(draw_frag_main) + 96;
+    bool cutout = kind == 1, shadow = kind == 2;
+    const char *vmain = shadow ? shadow_vert_main : draw_vert_main;
+    size_t nv = strlen(SPLAT_GLSL_TERRAIN) + strlen(vmain) + 32;
+    size_t nf = strlen(SPLAT_GLSL_PRELUDE) + strlen(draw_frag_main) + strlen(shadow_frag) + 96;
     char *vs = malloc(nv), *fs = malloc(nf);
     if (!vs || !fs) {
         free(vs);
         free(fs);
         return rt_fail(e, RT_E_VULKAN, "undergrowth", "out of memory");
     }
-    snprintf(vs, nv, "#version 450\n%s%s", SPLAT_GLSL_TERRAIN, draw_vert_main);
-    snprintf(fs, nf, "#version 450\n%s%s%s",
-             cutout ? "#define UG_CUTOUT 1\n" : "layout(early_fragment_tests) in;\n",
-             SPLAT_GLSL_PRELUDE, draw_frag_main);
+    snprintf(vs, nv, "#version 450\n%s%s", SPLAT_GLSL_TERRAIN, vmain);
+    if (shadow)
+        snprintf(fs, nf, "%s", shadow_frag);
+    else
+        snprintf(fs, nf, "#version 450\n%s%s%s",
+                 cutout ? "#define UG_CUTOUT 1\n" : "layout(early_fragment_tests) in;\n",
+                 SPLAT_GLSL_PRELUDE, draw_frag_main);
     VkShaderModule vm = VK_NULL_HANDLE, fm = VK_NULL_HANDLE;
     bool ok = rt_glsl_module(d, vs, VK_SHADER_STAGE_VERTEX_BIT, "undergrowth.vert", NULL, &vm, e) &&
               rt_glsl_module(d, fs, VK_SHADER_STAGE_FRAGMENT_BIT, "undergrowth.frag", NULL, &fm, e);
@@ -514,10 +575,17 @@ static bool draw_pipeline(rt_ug *u, bool cutout, rt_error *e)
         };
         VkPipelineDepthStencilStateCreateInfo ds = {   /* reversed Z */
             .sType = VK_STRUCTURE_TYPE_PIPELINE_DEPTH_STENCIL_STATE_CREATE_INFO,
-            .depthTestEnable = VK_TRUE, .depthWriteEnable = VK_TRUE,
+            .depthTestEnable = VK_TRUE, .depthWriteEnable = shadow ? VK_FALSE : VK_TRUE,
             .depthCompareOp = VK_COMPARE_OP_GREATER,
         };
         VkPipelineColorBlendAttachmentState cba = { .colorWriteMask = 0xf };
+        if (shadow)   /* dst * src: the colour darkened, its alpha kept */
+            cba = (VkPipelineColorBlendAttachmentState){
+                .blendEnable = VK_TRUE, .srcColorBlendFactor = VK_BLEND_FACTOR_ZERO,
+                .dstColorBlendFactor = VK_BLEND_FACTOR_SRC_COLOR, .colorBlendOp = VK_BLEND_OP_ADD,
+                .srcAlphaBlendFactor = VK_BLEND_FACTOR_ZERO,
+                .dstAlphaBlendFactor = VK_BLEND_FACTOR_ONE, .alphaBlendOp = VK_BLEND_OP_ADD,
+                .colorWriteMask = 0xf };
         VkPipelineColorBlendStateCreateInfo cb = {
             .sType = VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO,
             .attachmentCount = 1, .pAttachments = &cba,
@@ -535,7 +603,7 @@ static bool draw_pipeline(rt_ug *u, bool cutout, rt_error *e)
             .pDynamicState = &dy, .layout = u->draw_layout, .renderPass = u->pass_att,
         };
         VkResult r = vkCreateGraphicsPipelines(d->dev, VK_NULL_HANDLE, 1, &ci, NULL,
-                                               &u->draw_pipe[cutout]);
+                                               shadow ? &u->shadow_pipe : &u->draw_pipe[cutout]);
         if (r != VK_SUCCESS)
             ok = rt_fail(e, RT_E_VULKAN, "vkCreateGraphicsPipelines", rt_vk_result_name(r));
     }
@@ -544,6 +612,20 @@ static bool draw_pipeline(rt_ug *u, bool cutout, rt_error *e)
     if (fm)
         vkDestroyShaderModule(d->dev, fm, NULL);
     return ok;
+}
+
+/* The radius of a mesh's footprint on the ground (m at scale 1): the
+ * farthest vertex from its axis, for the contact shadow's quad. */
+static double footprint(const rt_pack_ug *pu, int mesh)
+{
+    const rt_pack_ug_mesh *m = &pu->meshes[mesh];
+    double r = 0;
+    for (uint32_t v = 0; v < m->nv; v++) {
+        const float *x = pu->vertices + 8 * (size_t)(m->first_vertex + v);
+        double h = hypot(x[0], x[2]);
+        r = h > r ? h : r;
+    }
+    return r;
 }
 
 static uint32_t gcd(uint32_t a, uint32_t b)
@@ -560,7 +642,8 @@ static uint32_t gcd(uint32_t a, uint32_t b)
  * of the draw and the probe): per block UG_BLOCK_VEC4 vec4s, (density,
  * scale lo, scale hi, blend), (colour, slot), (candidates per side, first
  * instance in the cell, flags, the stride of the candidates' lattice
- * order), (wind direction x, z, sway, gust), (root blend, shadow, 0, 0).
+ * order), (wind direction x, z, sway, gust), (root blend, shadow, the
+ * mesh's footprint radius, 0).
  * Flags: 1 cut out (frond), 2 lit with the terrain normal, 4 aligned to
  * the terrain normal. */
 static void fill_blocks(rt_ug *u, float *b)
@@ -584,7 +667,7 @@ static void fill_blocks(rt_ug *u, float *b)
             (float)k->color[0], (float)k->color[1], (float)k->color[2], (float)k->slot,
             (float)n, (float)u->block_base[i], (float)flags, (float)(stride ? stride : 1),
             (float)k->wind[0], (float)k->wind[1], (float)k->wind[2], (float)k->wind[3],
-            (float)k->root_blend, (float)k->shadow, 0, 0 };
+            (float)k->root_blend, (float)k->shadow, (float)footprint(pu, k->mesh), 0 };
         memcpy(b + 4 * UG_BLOCK_VEC4 * i, v, sizeof v);
     }
     u->cap = at;
@@ -666,7 +749,7 @@ static bool make_layouts(rt_ug *u, rt_error *e)
     VkDescriptorSetLayout ds[3] = { u->pl->set_terrain, u->pl->set_material, u->set_draw };
     return pipe_layout(d, ms, 3, cs, sizeof(splat_push), &u->mask_layout, e) &&
            pipe_layout(d, &u->set_gen, 1, cs, sizeof(ug_push), &u->gen_layout, e) &&
-           pipe_layout(d, &u->set_lod, 1, cs, 8, &u->lod_layout, e) &&
+           pipe_layout(d, &u->set_lod, 1, cs, 16, &u->lod_layout, e) &&
            pipe_layout(d, ds, 3, VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT,
                        sizeof(splat_push), &u->draw_layout, e);
 }
@@ -699,27 +782,34 @@ static bool make_buffers(rt_ug *u, rt_error *e)
                               VK_BUFFER_USAGE_TRANSFER_SRC_BIT, false, &u->args, e) ||
         !rt_buffer_create(d, (VkDeviceSize)u->pool * u->nblocks * 20,
                           VK_BUFFER_USAGE_TRANSFER_DST_BIT, true, &u->args_host, e) ||
-        !rt_buffer_create(d, (VkDeviceSize)u->pool * u->nblocks * 20,
+        !rt_buffer_create(d, (VkDeviceSize)u->pool * u->nblocks * 40,   /* + the shadows' */
                           st | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT, false, &u->draw_args, e) ||
         !rt_buffer_create(d, (VkDeviceSize)u->pool * 4, st, true, &u->lod, e) ||
         !rt_buffer_create(d, (VkDeviceSize)u->nblocks * 16 * UG_BLOCK_VEC4, st, true, &u->blocks,
                           e) ||
-        !rt_buffer_create(d, (VkDeviceSize)u->nblocks * 16, st, true, &u->far, e) ||
-        !rt_buffer_create(d, (VkDeviceSize)pu->nvertices * 32, VK_BUFFER_USAGE_VERTEX_BUFFER_BIT,
-                          true, &u->vbuf, e) ||
-        !rt_buffer_create(d, (VkDeviceSize)pu->nindices * 4, VK_BUFFER_USAGE_INDEX_BUFFER_BIT,
+        !rt_buffer_create(d, (VkDeviceSize)u->nblocks * 32, st, true, &u->far, e) ||
+        !rt_buffer_create(d, (VkDeviceSize)(pu->nvertices + 4) * 32,
+                          VK_BUFFER_USAGE_VERTEX_BUFFER_BIT, true, &u->vbuf, e) ||
+        !rt_buffer_create(d, (VkDeviceSize)(pu->nindices + 6) * 4, VK_BUFFER_USAGE_INDEX_BUFFER_BIT,
                           true, &u->ibuf, e) ||
         !rt_buffer_create(d, sizeof(splat_frame), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, true,
                           &u->frame, e))
         return false;
     memcpy(u->vbuf.map, pu->vertices, (size_t)pu->nvertices * 32);
     memcpy(u->ibuf.map, pu->indices, (size_t)pu->nindices * 4);
+    /* the contact shadow's quad after the pack's meshes: [-1, 1]^2 in x, z */
+    static const float quad[4][8] = { { -1, 0, -1, 0, 1, 0, 0, 0 }, { 1, 0, -1, 0, 1, 0, 1, 0 },
+                                      { 1, 0, 1, 0, 1, 0, 1, 1 }, { -1, 0, 1, 0, 1, 0, 0, 1 } };
+    static const uint32_t qi[6] = { 0, 1, 2, 0, 2, 3 };
+    memcpy((float *)u->vbuf.map + (size_t)pu->nvertices * 8, quad, sizeof quad);
+    memcpy((uint32_t *)u->ibuf.map + pu->nindices, qi, sizeof qi);
     fill_blocks(u, u->blocks.map);
     for (int b = 0; b < u->nblocks; b++) {
         int f = pu->meshes[pu->blocks[b].mesh].far;
         const rt_pack_ug_mesh *m = &pu->meshes[f >= 0 ? f : 0];
-        uint32_t v[4] = { m->nidx, m->first_index, m->first_vertex, f >= 0 };
-        memcpy((uint32_t *)u->far.map + 4 * b, v, sizeof v);
+        uint32_t v[8] = { m->nidx, m->first_index, m->first_vertex, f >= 0,
+                          pu->blocks[b].shadow > 0 && u->shadows, 0, 0, 0 };
+        memcpy((uint32_t *)u->far.map + 8 * b, v, sizeof v);
     }
     memset(u->args_host.map, 0, (size_t)u->args_host.size);
     for (int i = 0; i < u->pool; i++)
@@ -753,6 +843,12 @@ bool rt_ug_create(rt_device *d, const rt_pack *p, rt_pipelines *pl, const rt_qua
     if (!u->cells || !u->order || !u->block_base || !u->block_grid || !u->mask_pipes)
         return rt_fail(e, RT_E_VULKAN, "undergrowth", "out of memory");
     fill_blocks(u, (float[4 * UG_BLOCK_VEC4 * SPLAT_MAX_UG_BLOCKS]){0});   /* u->cap first */
+    /* contact shadows where the colour target blends (RGBA32F: most do) */
+    VkFormatProperties fp;
+    vkGetPhysicalDeviceFormatProperties(d->phys, VK_FORMAT_R32G32B32A32_SFLOAT, &fp);
+    for (int b = 0; b < u->nblocks; b++)
+        u->shadows |= p->ug.blocks[b].shadow > 0;
+    u->shadows &= (fp.optimalTilingFeatures & VK_FORMAT_FEATURE_COLOR_ATTACHMENT_BLEND_BIT) != 0;
     VkQueryPoolCreateInfo qi = {
         .sType = VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO,
         .queryType = VK_QUERY_TYPE_TIMESTAMP, .queryCount = 4,
@@ -763,7 +859,8 @@ bool rt_ug_create(rt_device *d, const rt_pack *p, rt_pipelines *pl, const rt_qua
         !make_pass(d, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, &u->pass_ro, e) ||
         !rt_glsl_compute_pipeline(d, VK_NULL_HANDLE, u->gen_layout, gen_glsl, "undergrowth scatter", NULL, &u->gen_pipe, e) ||
         !rt_glsl_compute_pipeline(d, VK_NULL_HANDLE, u->lod_layout, lod_glsl, "undergrowth lod", NULL, &u->lod_pipe, e) ||
-        !draw_pipeline(u, false, e) || !draw_pipeline(u, true, e))
+        !draw_pipeline(u, 0, e) || !draw_pipeline(u, 1, e) ||
+        (u->shadows && !draw_pipeline(u, 2, e)))
         return false;
     VkImageView views[2] = { t->color->view, t->depth->view };
     VkFramebufferCreateInfo fci = {
@@ -785,8 +882,9 @@ void rt_ug_destroy(rt_ug *u)
     for (int i = 0; u->mask_pipes && i <= u->p->ncombos; i++)
         if (u->mask_pipes[i])
             vkDestroyPipeline(d->dev, u->mask_pipes[i], NULL);
-    VkPipeline pipes[4] = { u->gen_pipe, u->lod_pipe, u->draw_pipe[0], u->draw_pipe[1] };
-    for (int i = 0; i < 4; i++)
+    VkPipeline pipes[5] = { u->gen_pipe, u->lod_pipe, u->draw_pipe[0], u->draw_pipe[1],
+                            u->shadow_pipe };
+    for (int i = 0; i < 5; i++)
         if (pipes[i])
             vkDestroyPipeline(d->dev, pipes[i], NULL);
     VkPipelineLayout pls[4] = { u->mask_layout, u->gen_layout, u->draw_layout, u->lod_layout };
@@ -1099,7 +1197,8 @@ bool rt_ug_generate(rt_ug *u, VkCommandBuffer cb, const rt_camera *c, const spla
                        VK_PIPELINE_STAGE_HOST_BIT, VK_ACCESS_HOST_READ_BIT);
     }
     /* every frame: this camera's LOD of every cell's arguments */
-    uint32_t pc[2] = { (uint32_t)(u->pool * u->nblocks), (uint32_t)u->nblocks };
+    uint32_t pc[4] = { (uint32_t)(u->pool * u->nblocks), (uint32_t)u->nblocks,
+                       u->p->ug.nindices, u->p->ug.nvertices };   /* the shadow quad */
     vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, u->lod_pipe);
     vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, u->lod_layout, 0, 1, &u->lod_set,
                             0, NULL);
@@ -1145,6 +1244,19 @@ void rt_ug_draw(rt_ug *u, VkCommandBuffer cb, bool depth_read_only, VkDescriptor
     vkCmdBindVertexBuffers(cb, 0, 1, &u->vbuf.buf, &zero);
     vkCmdBindIndexBuffer(cb, u->ibuf.buf, 0, VK_INDEX_TYPE_UINT32);
     const rt_pack_ug *pu = &u->p->ug;
+    if (u->shadows) {   /* under the plants: before them */
+        vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_GRAPHICS, u->shadow_pipe);
+        VkDeviceSize shadows = (VkDeviceSize)u->pool * u->nblocks * 20;
+        for (int i = 0; i < u->pool; i++) {
+            int k = u->order[i];
+            if (u->cells[k].state != CELL_READY || !u->cells[k].visible)
+                continue;
+            VkDeviceSize at = shadows + (VkDeviceSize)k * u->nblocks * 20;
+            for (int b = 0; b < u->nblocks; b++)
+                if (pu->blocks[b].shadow > 0)
+                    vkCmdDrawIndexedIndirect(cb, u->draw_args.buf, at + 20 * (VkDeviceSize)b, 1, 20);
+        }
+    }
     for (int cut = 0; cut < 2; cut++) {   /* opaque first: they hide the rest */
         vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_GRAPHICS, u->draw_pipe[cut]);
         for (int i = 0; i < u->pool; i++) {   /* front to back */

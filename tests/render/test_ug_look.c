@@ -22,7 +22,11 @@
  *     sway;
  *   - with wind 0 and with a wind the frame differs only where the
  *     undergrowth is (the wind moves the blades, not the ground), and
- *     the still picture is the same at every time. */
+ *     the still picture is the same at every time;
+ *   - contact shadows: seen from 1.6 m, the grass with its default
+ *     shadow (0.35) against `shadow = 0`: no pixel brighter, more than a
+ *     tenth of the pixels darker, by more than 0.2 and less than 0.85 at
+ *     most (overlapping discs compound: 1 - 0.65^4 = 0.82). */
 #include "rt_internal.h"
 #include "../check.h"
 
@@ -204,15 +208,18 @@ int main(int argc, char **argv)
     static uint8_t hf[N * N];
     char *png = join(dir, "flat.png");
     bool ok = stbi_write_png(png, N, N, 1, hf, N) != 0 && write_scene(dir, "still.sg", "") &&
+              write_scene(dir, "unshadowed.sg", ", shadow = 0") &&
               write_scene(dir, "windy.sg", ", wind = 1.5, wind_dir = 1 0.5, gust = 0.7");
     free(png);
     char *sg = join(dir, "still.sg"), *pk = join(dir, "still.pack");
     char *wsg = join(dir, "windy.sg"), *wpk = join(dir, "windy.pack");
-    rt_pack p, wp;
+    char *usg = join(dir, "unshadowed.sg"), *upk = join(dir, "unshadowed.pack");
+    rt_pack p, wp, up;
     rt_device dev;
     rt_error e = { 0 };
-    if (!ok || !build_pack_ok(sg, pk) || !build_pack_ok(wsg, wpk) || !rt_pack_load(&p, pk, &e) ||
-        !rt_pack_load(&wp, wpk, &e) || !rt_device_create(&dev, NULL, &e)) {
+    if (!ok || !build_pack_ok(sg, pk) || !build_pack_ok(wsg, wpk) || !build_pack_ok(usg, upk) ||
+        !rt_pack_load(&p, pk, &e) || !rt_pack_load(&wp, wpk, &e) || !rt_pack_load(&up, upk, &e) ||
+        !rt_device_create(&dev, NULL, &e)) {
         fprintf(stderr, "FAIL: setup: %s\n", e.msg ? e.msg : "the scene does not build");
         return 1;
     }
@@ -256,6 +263,38 @@ int main(int argc, char **argv)
     } else {
         CHECK(false, "frames failed");
     }
+
+    /* contact shadows: darker ground, nothing brighter */
+    rt_renderer *ur = make(&dev, &up, false);
+    rt_camera look = { .position = { 64, 1.6, 60 }, .look = { 64, 0, 64 } };
+    float *sh = r ? frame_of(r, &look, W, H) : NULL, *un = ur ? frame_of(ur, &look, W, H) : NULL;
+    if (sh && un) {
+        long darker = 0, brighter = 0;
+        double most = 0;
+        for (long i = 0; i < (long)W * H; i++) {
+            double a = sh[4 * i] + sh[4 * i + 1] + sh[4 * i + 2];
+            double b = un[4 * i] + un[4 * i + 1] + un[4 * i + 2];
+            darker += a < b * 0.995;
+            brighter += a > b * 1.0001 + 1e-6;
+            most = b > 0 && 1 - a / b > most ? 1 - a / b : most;
+        }
+        printf("contact shadows: %ld of %d pixels darker (by up to %.0f %%), %ld brighter\n",
+               darker, W * H, 100 * most, brighter);
+        CHECK(brighter == 0, "contact shadows brighten %ld pixels", brighter);
+        CHECK(darker > W * H / 10, "contact shadows darken only %ld pixels", darker);
+        CHECK(most > 0.2 && most < 0.85, "contact shadows darken by up to %.2f (shadow 0.35, "
+              "overlapping discs compound)", most);
+        write_picture(dir, "shadowed.png", sh, W, H, SPLAT_VIEW_FINAL);
+        write_picture(dir, "unshadowed.png", un, W, H, SPLAT_VIEW_FINAL);
+    } else {
+        CHECK(false, "shadow frames failed");
+    }
+    free(sh);
+    free(un);
+    rt_renderer_destroy(ur);
+    rt_pack_free(&up);
+    free(usg);
+    free(upk);
     free(still);
     free(bare);
     free(w0);
