@@ -27,7 +27,7 @@
  *     shadow (0.35) against `shadow = 0`: no pixel brighter, more than a
  *     tenth of the pixels darker, by more than 0.2 and less than 0.85 at
  *     most (overlapping discs compound: 1 - 0.65^4 = 0.82). */
-#include "rt_internal.h"
+#include "splatrt.h"
 #include "../check.h"
 
 #include <math.h>
