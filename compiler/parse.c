@@ -15,6 +15,8 @@
 #include "sg_internal.h"
 #include "util.h"
 
+#include <stb_image.h>
+
 #include <errno.h>
 #include <limits.h>
 #include <math.h>
@@ -469,10 +471,10 @@ static void parse_block_in(parser *ps, const char *what, stmt_fn stmt, void *use
 
 static const char *const ug_keys[] = { "density", "scale", "align", "blend", "color",
                                        "root_blend", "lighting", "cutout", "wind",
-                                       "wind_dir", "gust", "shadow", NULL };
-enum { UG_NKEYS = 12 };
+                                       "wind_dir", "gust", "shadow", "texture", NULL };
+enum { UG_NKEYS = 13 };
 #define UG_KEY_LIST "density, scale, align, blend, color, root_blend, lighting, cutout, " \
-                    "wind, wind_dir, gust, shadow"
+                    "wind, wind_dir, gust, shadow, texture"
 
 typedef struct ug_parse {
     sg_undergrowth *u;
@@ -513,12 +515,32 @@ static bool ug_choice(parser *ps, const char *key, const char *yes, const char *
     return true;
 }
 
+/* Check an undergrowth texture now, so its errors are located at the
+ * string: readable, an image, 1 to SPLAT_MAX_UG_TEXTURE texels a side. */
+static void check_ug_texture(parser *ps, const char *path, sg_loc at)
+{
+    char why[160];
+    FILE *f = splat_input_fopen(path, SPLAT_MAX_IMAGE_BYTES, why, sizeof why);
+    if (!f) {
+        sg_error(ps->d, at, SG_E_IO, path, why);
+        return;
+    }
+    int w, h, comp;
+    if (!stbi_info_from_file(f, &w, &h, &comp))
+        sg_error(ps->d, at, SG_E_IO, path, "not an image stb_image reads");
+    else if (w < 1 || h < 1 || w > SPLAT_MAX_UG_TEXTURE || h > SPLAT_MAX_UG_TEXTURE)
+        sg_errorf(ps->d, at, SG_E_OVER_LIMIT, "texture '%s' is %d x %d; an undergrowth texture "
+                  "may have at most %d texels a side", path, w, h, SPLAT_MAX_UG_TEXTURE);
+    fclose(f);
+}
+
 /* ug_setting = "density" "=" NUM | "scale" "=" NUM [ NUM ]
  *            | "align" "=" ("normal" | "upright") | "blend" "=" NUM
  *            | "color" "=" "vec3" "(" NUM "," NUM "," NUM ")"
  *            | "root_blend" "=" NUM | "lighting" "=" ("terrain" | "mesh")
- *            | "cutout" "=" ("frond" | "none") | "wind" "=" NUM
- *            | "wind_dir" "=" NUM NUM | "gust" "=" NUM | "shadow" "=" NUM */
+ *            | "cutout" "=" ("frond" | "alpha" | "none") | "wind" "=" NUM
+ *            | "wind_dir" "=" NUM NUM | "gust" "=" NUM | "shadow" "=" NUM
+ *            | "texture" "=" STRING */
 static bool ug_stmt(parser *ps, void *user)
 {
     ug_parse *up = user;
@@ -588,9 +610,23 @@ static bool ug_stmt(parser *ps, void *user)
             return false;
         break;
     case 7:
-        if (!ug_choice(ps, "cutout", "frond", "none", &u->cutout))
-            return false;
+    {
+        sg_token *vt = cur(ps);
+        char buf[96];
+        if (is_kw(vt, "none") || is_kw(vt, "frond") || is_kw(vt, "alpha")) {
+            u->cutout = is_kw(vt, "frond") ? SG_UG_CUT_FROND
+                      : is_kw(vt, "alpha") ? SG_UG_CUT_ALPHA : SG_UG_CUT_NONE;
+        } else {
+            if (vt->kind != SG_TK_IDENT && vt->kind != SG_TK_NUMBER && vt->kind != SG_TK_STRING) {
+                expected(ps, "none, frond or alpha");
+                return false;
+            }
+            sg_errorf(ps->d, vloc, SG_E_SETTING, "'cutout' must be none, frond or alpha, "
+                      "found %s", sg_tok_describe(vt, buf, sizeof buf));
+        }
+        next(ps);
         break;
+    }
     case 8:
         if (!ug_number(ps, "wind", 0, SPLAT_MAX_UG_WIND, false, &u->wind))
             return false;
@@ -617,6 +653,19 @@ static bool ug_stmt(parser *ps, void *user)
         if (!ug_number(ps, "shadow", 0, 1, false, &u->shadow))
             return false;
         break;
+    case 12: {
+        sg_token *vt = cur(ps);
+        if (vt->kind != SG_TK_STRING) {
+            expected(ps, "an image file in quotes");
+            return false;
+        }
+        char *path = splat_path_join(ps->f->dir, vt->str);
+        u->texture = sg_strdup(ps->a, path);
+        free(path);
+        check_ug_texture(ps, u->texture, vloc);
+        next(ps);
+        break;
+    }
     case 4: {
         sg_value v;
         if (!parse_value(ps, &v))
@@ -680,13 +729,15 @@ static bool parse_undergrowth(parser *ps, sg_shader *s)
     /* per built-in mesh, then OBJ: lit with the terrain normal, cut out,
      * contact shadow (defaults: each can be set in the block) */
     static const bool terrain_lit[] = { true, true, false, false };
-    static const bool cut[] = { false, true, false, false };
+    static const int cut[] = { SG_UG_CUT_NONE, SG_UG_CUT_FROND, SG_UG_CUT_NONE,
+                               SG_UG_CUT_NONE };
     static const double shadows[] = { 0.35, 0.3, 0.5, 0.4 };
     /* blend at the tip and at the root: a stone keeps its own colour and
      * takes the ground's only at its foot */
     static const double blends[][2] = { { 0.5, -1 }, { 0.5, -1 }, { 0.15, 0.5 }, { 0.5, -1 } };
     sg_undergrowth u = { .density = 1, .scale = { 1, 1 }, .wind_dir = { 1, 0 }, .gust = 0.5 };
     u.loc = loc_of(ps, next(ps));
+    bool seen_color = false;
     sg_token *m = cur(ps);
     bool known = true;
     int kind = 0;
@@ -723,9 +774,15 @@ static bool parse_undergrowth(parser *ps, sg_shader *s)
         char what[160];
         snprintf(what, sizeof what, "block of undergrowth '%.*s'", m->len, m->start);
         parse_block_in(ps, what, ug_stmt, &up, true);
+        seen_color = up.seen[4].line != 0;
+        if (u.cutout == SG_UG_CUT_ALPHA && !u.texture)
+            sg_errorf(ps->d, up.seen[7], SG_E_SETTING, "'cutout = alpha' needs a texture "
+                      "(texture = \"file.png\") whose alpha cuts the mesh");
     }
     if (u.root_blend < 0)   /* not set: as the tip, unless a default of its own */
         u.root_blend = u.blend;
+    if (u.texture && !seen_color)   /* the texture's own colour */
+        u.color[0] = u.color[1] = u.color[2] = 1.0;
     if (!known)
         return true;
     if (s->nug == SG_MAX_UNDERGROWTH) {

@@ -248,7 +248,9 @@ typedef struct rt_pack_ug_block {
     double   density, scale[2], blend, root_blend, color[3];
     bool     align_normal;
     bool     light_terrain;  /* lit with the terrain normal (else the mesh's) */
-    bool     cutout;         /* a leaf cut from the mesh's quads (frond)    */
+    int      cutout;         /* 0 none, 1 a leaf cut from the mesh's quads
+                                (frond), 2 the texture's alpha, dithered  */
+    int      texture;        /* index into the pack's textures, or -1       */
     double   wind[4];        /* direction x, z (unit), sway at 1 m, gust     */
     double   shadow;         /* darkening of the ground under an instance    */
 } rt_pack_ug_block;
@@ -259,8 +261,14 @@ typedef struct rt_pack_ug_mesh {
     int      far;          /* the mesh drawn beyond the LOD distance, or -1 */
 } rt_pack_ug_mesh;
 
+typedef struct rt_pack_ug_texture {
+    int      width, height;
+    uint8_t *rgba;                 /* rows top first; sRGB rgb, alpha       */
+} rt_pack_ug_texture;
+
 typedef struct rt_pack_ug {
     int               nslots;      /* 0: the pack has no undergrowth        */
+    rt_pack_ug_texture *textures; int ntextures;   /* ugtex.bin             */
     rt_pack_ug_block *blocks;  int nblocks;
     rt_pack_ug_mesh  *meshes;  int nmeshes;
     float            *vertices;    /* 8 per vertex                          */

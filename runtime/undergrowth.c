@@ -112,6 +112,8 @@ struct rt_ug {
     VkPipeline            gen_pipe, lod_pipe;
     VkPipeline            draw_pipe[2];        /* opaque (early depth), cut out */
     VkPipeline            shadow_pipe;         /* contact shadows (if shadows) */
+    rt_image              tex[SPLAT_MAX_UG_TEXTURES + 1];   /* the pack's, then white */
+    VkSampler             tex_smp;             /* trilinear, repeat          */
     bool                  shadows;             /* the colour target blends   */
     VkDescriptorPool      dpool;
     VkDescriptorSet       set0, mask_set, gen_set, draw_set, lod_set;
@@ -343,23 +345,49 @@ static const char draw_vert_main[] =
     "}\n";
 
 static const char draw_frag_main[] =
+    "layout(set = 2, binding = 3) uniform sampler2D u_ugtex[" SPLAT_STR(SPLAT_MAX_UG_TEXTURES) "];\n"
     "layout(location = 3) in vec3 g_color;\n"
     "layout(location = 4) in vec3 g_normal;\n"
     "layout(location = 5) in vec2 g_uv;\n"
     "layout(location = 6) flat in uint g_flags;\n"
     "layout(location = 7) in float g_far;\n"
+    /* constant indices: no dynamic indexing feature needed (the index is
+     * the block's, the same for a whole draw) */
+    "vec4 ug_texture(uint t, vec2 uv) {\n"
+    "    switch (t) {\n"
+    "    case 1u: return texture(u_ugtex[0], uv);\n"
+    "    case 2u: return texture(u_ugtex[1], uv);\n"
+    "    case 3u: return texture(u_ugtex[2], uv);\n"
+    "    case 4u: return texture(u_ugtex[3], uv);\n"
+    "    case 5u: return texture(u_ugtex[4], uv);\n"
+    "    case 6u: return texture(u_ugtex[5], uv);\n"
+    "    case 7u: return texture(u_ugtex[6], uv);\n"
+    "    case 8u: return texture(u_ugtex[7], uv);\n"
+    "    }\n"
+    "    return vec4(1.0);\n"
+    "}\n"
     "void main() {\n"
+    /* the texture with v up the mesh (OBJ: v = 0 at the image's bottom) */
+    "    vec4 tex = ug_texture(g_flags >> 8, vec2(g_uv.x, 1.0 - g_uv.y));\n"
     "#ifdef UG_CUTOUT\n"
-    "    /* a frond cut from the quad: a lens-shaped outline, chevron leaflets */\n"
-    "    float x = abs(g_uv.x * 2.0 - 1.0), t = clamp(g_uv.y, 0.0, 1.0);\n"
-    "    if (x > 0.9 * sin(t * 3.14159) || (x > 0.08 && fract(t * 7.0 - x * 2.5) > 0.6)) discard;\n"
+    "    if ((g_flags & 1u) != 0u) {\n"
+    "        /* a frond cut from the quad: a lens-shaped outline, chevron leaflets */\n"
+    "        float x = abs(g_uv.x * 2.0 - 1.0), t = clamp(g_uv.y, 0.0, 1.0);\n"
+    "        if (x > 0.9 * sin(t * 3.14159) || (x > 0.08 && fract(t * 7.0 - x * 2.5) > 0.6)) discard;\n"
+    "    } else {\n"
+    "        /* the texture's alpha, dithered (interleaved gradient noise): a\n"
+    "         * pixel is covered with that probability, as alpha to coverage\n"
+    "         * would with samples */\n"
+    "        float ign = fract(52.9829189 * fract(dot(gl_FragCoord.xy, vec2(0.06711056, 0.00583715))));\n"
+    "        if (tex.a <= ign) discard;\n"
+    "    }\n"
     "#endif\n"
     "    float dist = length(v_rel);\n"
     "    vec3 v = dist > 0.0 ? -v_rel / dist : vec3(0.0, 1.0, 0.0);\n"
     "    vec3 n = normalize(g_normal);\n"
     "    if ((g_flags & 2u) == 0u && !gl_FrontFacing) n = -n;\n"
     "    float ao = mix(mix(0.5, 1.0, clamp(g_uv.y, 0.0, 1.0)), 1.0, g_far);   /* darker at the root */\n"
-    "    o_color = vec4(splat_light(g_color * ao, n, 0.9, dist, v), 1.0);\n"
+    "    o_color = vec4(splat_light(g_color * tex.rgb * ao, n, 0.9, dist, v), 1.0);\n"
     "}\n";
 
 /* The probe pass, for the tests only (made on first use): mode 0 counts
@@ -645,7 +673,8 @@ static uint32_t gcd(uint32_t a, uint32_t b)
  * order), (wind direction x, z, sway, gust), (root blend, shadow, the
  * mesh's footprint radius, 0).
  * Flags: 1 cut out (frond), 2 lit with the terrain normal, 4 aligned to
- * the terrain normal. */
+ * the terrain normal, 8 cut out by the texture's alpha; bits 8 and up the
+ * texture + 1 (0: none). */
 static void fill_blocks(rt_ug *u, float *b)
 {
     const rt_pack_ug *pu = &u->p->ug;
@@ -657,8 +686,9 @@ static void fill_blocks(rt_ug *u, float *b)
         u->block_grid[i] = n;
         u->block_base[i] = at;
         at += nn;
-        unsigned flags = (k->cutout ? 1u : 0u) | (k->light_terrain ? 2u : 0u) |
-                         (k->align_normal ? 4u : 0u);
+        unsigned flags = (k->cutout == 1 ? 1u : 0u) | (k->light_terrain ? 2u : 0u) |
+                         (k->align_normal ? 4u : 0u) | (k->cutout == 2 ? 8u : 0u) |
+                         (unsigned)(k->texture + 1) << 8;
         uint32_t stride = (uint32_t)(0.618034 * n * n);
         while (stride > 1 && gcd(stride, n * n) != 1)
             stride++;
@@ -679,7 +709,7 @@ static bool make_sets(rt_ug *u, VkDescriptorSet set0_src, const rt_image *height
     rt_device *d = u->d;
     VkDescriptorPoolSize sizes[3] = {
         { VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 13 },
-        { VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 16 },
+        { VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 16 + SPLAT_MAX_UG_TEXTURES },
         { VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 2 },
     };
     VkDescriptorSetLayout layouts[5] = { u->set_terrain, u->set_mask, u->set_gen, u->set_draw,
@@ -720,6 +750,50 @@ static bool make_sets(rt_ug *u, VkDescriptorSet set0_src, const rt_image *height
     };
 #undef W
     vkUpdateDescriptorSets(d->dev, sizeof w / sizeof *w, w, 0, NULL);
+    /* the textures (every slot bound: the white one past the pack's) */
+    VkDescriptorImageInfo ti[SPLAT_MAX_UG_TEXTURES];
+    for (int i = 0; i < SPLAT_MAX_UG_TEXTURES; i++) {
+        int k = i < u->p->ug.ntextures ? i : SPLAT_MAX_UG_TEXTURES;
+        ti[i] = (VkDescriptorImageInfo){ u->tex_smp, u->tex[k].view,
+                                         VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL };
+    }
+    VkWriteDescriptorSet tw = {
+        .sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = u->draw_set, .dstBinding = 3,
+        .descriptorCount = SPLAT_MAX_UG_TEXTURES,
+        .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, .pImageInfo = ti,
+    };
+    vkUpdateDescriptorSets(d->dev, 1, &tw, 0, NULL);
+    return true;
+}
+
+/* The blocks' textures: sRGB with their mip chains, and a white texel. */
+static bool make_textures(rt_ug *u, rt_error *e)
+{
+    rt_device *d = u->d;
+    const rt_pack_ug *pu = &u->p->ug;
+    const VkImageUsageFlags use = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT |
+                                  VK_IMAGE_USAGE_TRANSFER_SRC_BIT;
+    for (int i = 0; i <= pu->ntextures; i++) {
+        static const uint8_t white[4] = { 255, 255, 255, 255 };
+        bool own = i < pu->ntextures;
+        uint32_t w = own ? (uint32_t)pu->textures[i].width : 1;
+        uint32_t h = own ? (uint32_t)pu->textures[i].height : 1, mips = 1;
+        while ((w > h ? w : h) >> mips)
+            mips++;
+        rt_image *img = &u->tex[own ? i : SPLAT_MAX_UG_TEXTURES];
+        if (!rt_image_create(d, w, h, 1, false, mips, VK_FORMAT_R8G8B8A8_SRGB, use,
+                             VK_IMAGE_ASPECT_COLOR_BIT, img, e) ||
+            !rt_image_upload(d, img, own ? pu->textures[i].rgba : white, (size_t)w * h * 4, e))
+            return false;
+    }
+    VkSamplerCreateInfo ci = {
+        .sType = VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO,
+        .magFilter = VK_FILTER_LINEAR, .minFilter = VK_FILTER_LINEAR,
+        .mipmapMode = VK_SAMPLER_MIPMAP_MODE_LINEAR,
+        .addressModeU = VK_SAMPLER_ADDRESS_MODE_REPEAT, .addressModeV = VK_SAMPLER_ADDRESS_MODE_REPEAT,
+        .addressModeW = VK_SAMPLER_ADDRESS_MODE_REPEAT, .maxLod = 16.0f,
+    };
+    RT_VK(e, vkCreateSampler(d->dev, &ci, NULL, &u->tex_smp));
     return true;
 }
 
@@ -736,6 +810,8 @@ static bool make_layouts(rt_ug *u, rt_error *e)
     VkDescriptorSetLayoutBinding draw[] = {
         { 0, sb, 1, VK_SHADER_STAGE_VERTEX_BIT, NULL }, { 1, sb, 1, VK_SHADER_STAGE_VERTEX_BIT, NULL },
         { 2, sb, 1, VK_SHADER_STAGE_VERTEX_BIT, NULL },
+        { 3, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, SPLAT_MAX_UG_TEXTURES,
+          VK_SHADER_STAGE_FRAGMENT_BIT, NULL },
     };
     VkDescriptorSetLayoutBinding lod[] = {
         { 0, sb, 1, cs, NULL }, { 1, sb, 1, cs, NULL }, { 2, sb, 1, cs, NULL },
@@ -743,7 +819,7 @@ static bool make_layouts(rt_ug *u, rt_error *e)
     };
     if (!rt_terrain_compute_layout(d, &u->set_terrain, e) ||
         !rt_set_layout(d, mask, 1, &u->set_mask, e) || !rt_set_layout(d, gen, 5, &u->set_gen, e) ||
-        !rt_set_layout(d, draw, 3, &u->set_draw, e) || !rt_set_layout(d, lod, 4, &u->set_lod, e))
+        !rt_set_layout(d, draw, 4, &u->set_draw, e) || !rt_set_layout(d, lod, 4, &u->set_lod, e))
         return false;
     VkDescriptorSetLayout ms[3] = { u->set_terrain, u->pl->set_material, u->set_mask };
     VkDescriptorSetLayout ds[3] = { u->pl->set_terrain, u->pl->set_material, u->set_draw };
@@ -853,7 +929,7 @@ bool rt_ug_create(rt_device *d, const rt_pack *p, rt_pipelines *pl, const rt_qua
         .sType = VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO,
         .queryType = VK_QUERY_TYPE_TIMESTAMP, .queryCount = 4,
     };
-    if (!make_layouts(u, e) || !make_buffers(u, e) ||
+    if (!make_layouts(u, e) || !make_buffers(u, e) || !make_textures(u, e) ||
         !make_sets(u, t->set0, t->height, t->nearest, e) ||
         !make_pass(d, VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL, &u->pass_att, e) ||
         !make_pass(d, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, &u->pass_ro, e) ||
@@ -919,6 +995,10 @@ void rt_ug_destroy(rt_ug *u)
     if (u->probe_pool)
         vkDestroyDescriptorPool(d->dev, u->probe_pool, NULL);
     rt_buffer_destroy(d, &u->probe_out);
+    for (int i = 0; i <= SPLAT_MAX_UG_TEXTURES; i++)
+        rt_image_destroy(d, &u->tex[i]);
+    if (u->tex_smp)
+        vkDestroySampler(d->dev, u->tex_smp, NULL);
     free(u->mask_pipes);
     free(u->cells);
     free(u->order);
@@ -1265,7 +1345,7 @@ void rt_ug_draw(rt_ug *u, VkCommandBuffer cb, bool depth_read_only, VkDescriptor
                 continue;
             VkDeviceSize at = (VkDeviceSize)k * u->nblocks * 20;
             for (int b = 0; b < u->nblocks; b++)
-                if ((int)pu->blocks[b].cutout == cut)
+                if ((pu->blocks[b].cutout != 0) == cut)
                     vkCmdDrawIndexedIndirect(cb, u->draw_args.buf, at + 20 * (VkDeviceSize)b, 1, 20);
         }
     }

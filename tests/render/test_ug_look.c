@@ -26,7 +26,10 @@
  *   - contact shadows: seen from 1.6 m, the grass with its default
  *     shadow (0.35) against `shadow = 0`: no pixel brighter, more than a
  *     tenth of the pixels darker, by more than 0.2 and less than 0.85 at
- *     most (overlapping discs compound: 1 - 0.65^4 = 0.82). */
+ *     most (overlapping discs compound: 1 - 0.65^4 = 0.82);
+ *   - a textured OBJ card (uv, `texture` red at alpha 0.5): opaque, the
+ *     pixels it covers are red; with `cutout = alpha` it covers half as
+ *     many (0.35 to 0.65 of them: the dithered alpha). */
 #include "splatrt.h"
 #include "../check.h"
 
@@ -87,6 +90,89 @@ static void wind(const double root[3], double h, const double w[4], double t, do
 }
 
 static double unit(void) { return rand() / (RAND_MAX + 1.0); }
+
+static rt_renderer *make(rt_device *dev, const rt_pack *p, bool off);
+
+/* An upright 1 m card with uv, a red texture at alpha 0.5, and a scene of
+ * them (cutout: "none" or "alpha"). */
+static bool write_card(const char *dir, const char *name, const char *cutout)
+{
+    char *obj = join(dir, "card.obj"), *png = join(dir, "red.png"), *sg = join(dir, name);
+    FILE *f = fopen(obj, "w");
+    bool ok = f != NULL;
+    if (f) {
+        fprintf(f, "v -0.5 0 0\nv 0.5 0 0\nv 0.5 1 0\nv -0.5 1 0\nvt 0 0\nvt 1 0\nvt 1 1\n"
+                   "vt 0 1\nvn 0 0 1\nf 1/1/1 2/2/1 3/3/1\nf 1/1/1 3/3/1 4/4/1\n");
+        ok = fclose(f) == 0;
+    }
+    uint8_t red[4 * 4 * 4];
+    for (int i = 0; i < 16; i++) {
+        red[4 * i] = 230, red[4 * i + 1] = 20, red[4 * i + 2] = 20, red[4 * i + 3] = 128;
+    }
+    ok = ok && stbi_write_png(png, 4, 4, 4, red, 16) != 0;
+    f = ok ? fopen(sg, "w") : NULL;
+    if (f) {
+        fprintf(f, "import \"nodes/compositors.sg\"\n"
+                   "material ground {\n    out albedo = vec3(0.30, 0.25, 0.20)\n}\n"
+                   "material meadow {\n    out mask = 1.0\n    out albedo = vec3(0.2, 0.4, 0.1)\n"
+                   "    undergrowth \"card.obj\" { density = 0.3, texture = \"red.png\", "
+                   "cutout = %s, blend = 0, shadow = 0 }\n}\n"
+                   "scene meadow {\n    heightfield = \"flat.png\"\n    size = 128 128\n"
+                   "    max_height = 10\n    materials = [ground, meadow]\n    cell = 16\n}\n",
+                cutout);
+        ok = fclose(f) == 0;
+    } else {
+        ok = false;
+    }
+    free(obj);
+    free(png);
+    free(sg);
+    return ok;
+}
+
+static void check_texture(rt_device *dev, const char *dir)
+{
+    rt_pack p[2];
+    long covered[2] = { 0 }, red = 0;
+    for (int k = 0; k < 2; k++) {
+        char *sg = join(dir, k ? "card_cut.sg" : "card.sg");
+        char *pk = join(dir, k ? "card_cut.pack" : "card.pack");
+        rt_error e = { 0 };
+        bool ok = write_card(dir, k ? "card_cut.sg" : "card.sg", k ? "alpha" : "none") &&
+                  build_pack_ok(sg, pk) && rt_pack_load(&p[k], pk, &e);
+        CHECK(ok, "card pack: %s", e.msg ? e.msg : "does not build");
+        rt_error_clear(&e);
+        free(sg);
+        free(pk);
+        if (!ok)
+            return;
+        CHECK(p[k].ug.ntextures == 1 && p[k].ug.textures[0].width == 4 &&
+              p[k].ug.blocks[0].texture == 0 && p[k].ug.blocks[0].cutout == (k ? 2 : 0),
+              "card pack %d: %d textures", k, p[k].ug.ntextures);
+        rt_renderer *on = make(dev, &p[k], false), *off = make(dev, &p[k], true);
+        rt_camera cam = { .position = { 64, 1.0, 50 }, .look = { 64, 0.5, 60 } };
+        float *a = on ? frame_of(on, &cam, W, H) : NULL, *b = off ? frame_of(off, &cam, W, H) : NULL;
+        for (long i = 0; a && b && i < (long)W * H; i++) {
+            bool c = memcmp(a + 4 * i, b + 4 * i, 12) != 0;
+            covered[k] += c;
+            if (c && k == 0)
+                red += a[4 * i] > 1.5 * a[4 * i + 1] && a[4 * i] > 1.5 * a[4 * i + 2];
+        }
+        if (a)
+            write_picture(dir, k ? "card_cut.png" : "card.png", a, W, H, SPLAT_VIEW_FINAL);
+        free(a);
+        free(b);
+        rt_renderer_destroy(on);
+        rt_renderer_destroy(off);
+        rt_pack_free(&p[k]);
+    }
+    double share = covered[0] ? (double)covered[1] / covered[0] : 0;
+    printf("texture: the card covers %ld pixels (%ld of them red), cut by its alpha %ld (%.2f)\n",
+           covered[0], red, covered[1], share);
+    CHECK(covered[0] > W * H / 20, "the cards cover only %ld pixels", covered[0]);
+    CHECK(red > 0.8 * covered[0], "only %ld of %ld card pixels are red", red, covered[0]);
+    CHECK(share > 0.35 && share < 0.65, "the alpha 0.5 cut-out covers %.2f of the pixels", share);
+}
 
 static rt_renderer *make(rt_device *dev, const rt_pack *p, bool off)
 {
@@ -293,6 +379,7 @@ int main(int argc, char **argv)
     free(un);
     rt_renderer_destroy(ur);
     rt_pack_free(&up);
+    check_texture(&dev, dir);
     free(usg);
     free(upk);
     free(still);
