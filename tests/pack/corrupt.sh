@@ -258,6 +258,15 @@ EOF
 case_ ug_root_blend bc4 "undergrowth.blocks\[0\] root_blend: must be in \[0, 1\]" <<EOF
 "$PE" set $M undergrowth.blocks.0.root_blend 4
 EOF
+case_ ug_texture_range bc4 "undergrowth.blocks\[0\].texture: must be an integer in \[-1, -1\]" <<EOF
+"$PE" set $M undergrowth.blocks.0.texture 3
+EOF
+case_ ug_alpha_untextured bc4 "undergrowth.blocks\[0\] cutout: \"alpha\" needs a texture" <<EOF
+"$PE" set $M undergrowth.blocks.0.cutout '"alpha"'
+EOF
+case_ ug_textures_count bc4 "undergrowth.textures: must be an array of 1 to 8 entries" <<EOF
+"$PE" set $M undergrowth.textures '[]'
+EOF
 case_ ug_lighting bc4 "undergrowth.blocks\[0\] lighting: must be \"terrain\" or \"mesh\"" <<EOF
 "$PE" set $M undergrowth.blocks.0.lighting '"sun"'
 EOF
