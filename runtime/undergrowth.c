@@ -41,8 +41,9 @@
  *   - the colour: the block's, blended with the terrain's albedo at the
  *     root by mix(root_blend, blend, v) (v: the mesh's uv.y, 0 at the
  *     root, 1 at the tip), and wholly the terrain's (no root darkening
- *     either) as ug_far goes from 0 at 0.35 r1 to 1 at 0.8 r1: the cover
- *     turns into the ground it stands on before it thins out.
+ *     either, and a mesh-lit instance's normal the terrain's) as ug_far
+ *     goes from 0 at 0.35 r1 to 1 at 0.8 r1: the cover turns into the
+ *     ground it stands on before it thins out.
  */
 #include "rt_internal.h"
 
@@ -305,6 +306,7 @@ static const char draw_vert_main[] =
     "layout(location = 5) out vec2 g_uv;\n"
     "layout(location = 6) flat out uint g_flags;\n"
     "layout(location = 7) out float g_far;\n"
+    "layout(location = 8) out vec3 g_tnormal;\n"
     UG_GLSL_FUNCS
     "void main() {\n"
     "    Inst it = u_inst.v[gl_InstanceIndex];\n"
@@ -339,6 +341,7 @@ static const char draw_vert_main[] =
     "    g_far = far;\n"
     "    g_color = mix(b1.rgb, unpackUnorm4x8(it.q.y).rgb, share);\n"
     "    g_normal = (flags & 2u) != 0u ? n : m;\n"
+    "    g_tnormal = n;\n"
     "    g_uv = a_uv;\n"
     "    g_flags = flags;\n"
     "    gl_Position = u_frame.view_proj * vec4(v_rel, 1.0);\n"
@@ -351,6 +354,7 @@ static const char draw_frag_main[] =
     "layout(location = 5) in vec2 g_uv;\n"
     "layout(location = 6) flat in uint g_flags;\n"
     "layout(location = 7) in float g_far;\n"
+    "layout(location = 8) in vec3 g_tnormal;\n"
     /* constant indices: no dynamic indexing feature needed (the index is
      * the block's, the same for a whole draw) */
     "vec4 ug_texture(uint t, vec2 uv) {\n"
@@ -386,6 +390,8 @@ static const char draw_frag_main[] =
     "    vec3 v = dist > 0.0 ? -v_rel / dist : vec3(0.0, 1.0, 0.0);\n"
     "    vec3 n = normalize(g_normal);\n"
     "    if ((g_flags & 2u) == 0u && !gl_FrontFacing) n = -n;\n"
+    /* a mesh-lit instance shades as the ground as it turns into it */
+    "    n = normalize(mix(n, normalize(g_tnormal), g_far));\n"
     "    float ao = mix(mix(0.5, 1.0, clamp(g_uv.y, 0.0, 1.0)), 1.0, g_far);   /* darker at the root */\n"
     "    o_color = vec4(splat_light(g_color * tex.rgb * ao, n, 0.9, dist, v), 1.0);\n"
     "}\n";
