@@ -266,6 +266,11 @@ enum {
 #define SPLAT_MAX_MESH_VALUE 1000.0 /* |each float of a mesh vertex|:
                                        position (m), normal, uv          */
 #define SPLAT_MAX_UG_DENSITY 64.0   /* instances per m^2 of one block     */
+#define SPLAT_MAX_UG_TEXTURE 1024   /* texels per side of an undergrowth
+                                       block's `texture`                 */
+#define SPLAT_MAX_UG_TEXTURES 8     /* distinct undergrowth textures     */
+#define SPLAT_MAX_UG_WIND 2.0       /* a block's `wind`: sway (m) at 1 m above
+                                       the root (runtime/undergrowth.c)  */
 
 /* The undergrowth's instance buffer (runtime/undergrowth.c): a pool of
  * cells SPLAT_UG_CELL metres wide, every cell within the radius around

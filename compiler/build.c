@@ -98,11 +98,15 @@ static char **input_files(const splat_scene *s)
         for (int k = 1, m = build_mip_count(s->ir.textures[i].file); k <= m; k++)
             ADD(build_mip_path(s->ir.textures[i].file, k));
     }
-    /* undergrowth meshes from OBJ files */
+    /* undergrowth meshes from OBJ files, and their textures */
     for (int m = 0; m < sg_material_count(s->prog); m++)
-        for (int k = 0; k < sg_undergrowth_count(s->prog, m); k++)
-            if (sg_undergrowth_get(s->prog, m, k)->obj)
-                ADD(xstrdup(sg_undergrowth_get(s->prog, m, k)->obj));
+        for (int k = 0; k < sg_undergrowth_count(s->prog, m); k++) {
+            const sg_undergrowth *g = sg_undergrowth_get(s->prog, m, k);
+            if (g->obj)
+                ADD(xstrdup(g->obj));
+            if (g->texture)
+                ADD(xstrdup(g->texture));
+        }
 #undef ADD
     return v;
 }

@@ -42,7 +42,7 @@ static const char intro[] =
     "| `shader NAME { in TYPE x [= default] … node … out TYPE y = value … }` | a reusable graph, instantiated as a node type |\n"
     "| `material NAME { param TYPE p = v [range lo hi] … node … out OUTPUT = value … }` | a terrain layer; outputs below; params can be set at run time within their range |\n"
     "| `node NAME : TYPE { port = value, … }` | a built-in op, a terrain input (`terrain.slope`), `painted { mask = \"NAME\" }` or a shader |\n"
-    "| `undergrowth MESH { density = …, scale = LO HI, align = normal, blend = …, color = vec3(…) }` | (materials) instanced meshes: grass, plant, stone or an OBJ file |\n"
+    "| `undergrowth MESH { density = …, scale = LO HI, align = normal, blend = …, root_blend = …, color = vec3(…), lighting = terrain, cutout = frond, texture = \"…\", wind = …, wind_dir = X Z, gust = …, shadow = … }` | (materials) instanced meshes: grass, plant, stone or an OBJ file |\n"
     "| `scene NAME { … }` | the heightfield, the material stack and the rest (keys below) |\n"
     "\n"
     "Values: numbers, `vec2(…)` to `vec4(…)`, strings (texture files, painted\n"

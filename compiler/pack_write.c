@@ -504,10 +504,29 @@ static json_t *jundergrowth(const splat_ug *u)
         json_object_set_new(m, "scale", jreals(k->u->scale, 2));
         json_object_set_new(m, "align", json_string(k->u->align_normal ? "normal" : "upright"));
         json_object_set_new(m, "blend", jreal(k->u->blend));
+        json_object_set_new(m, "root_blend", jreal(k->u->root_blend));
         json_object_set_new(m, "color", jreals(k->u->color, 3));
+        json_object_set_new(m, "lighting", json_string(k->u->light_terrain ? "terrain" : "mesh"));
+        static const char *const cuts[] = { "none", "frond", "alpha" };
+        json_object_set_new(m, "cutout", json_string(cuts[k->u->cutout]));
+        json_object_set_new(m, "texture", json_integer(k->texture));
+        double wind[4] = { k->u->wind_dir[0], k->u->wind_dir[1], k->u->wind, k->u->gust };
+        json_object_set_new(m, "wind", jreals(wind, 4));
+        json_object_set_new(m, "shadow", jreal(k->u->shadow));
         json_array_append_new(blocks, m);
     }
     json_object_set_new(o, "blocks", blocks);
+    if (u->ntextures > 0) {
+        json_t *tex = json_array();
+        for (int i = 0; i < u->ntextures; i++) {
+            json_t *t = json_object();
+            json_object_set_new(t, "width", json_integer(u->textures[i].width));
+            json_object_set_new(t, "height", json_integer(u->textures[i].height));
+            json_array_append_new(tex, t);
+        }
+        json_object_set_new(o, "textures", tex);
+        json_object_set_new(o, "texture_file", json_string("ugtex.bin"));
+    }
     return o;
 }
 
@@ -584,6 +603,11 @@ static bool put_sparse(FILE *f, const void *user)
 static bool put_meshes(FILE *f, const void *user)
 {
     return splat_ug_write_meshes(user, f);
+}
+
+static bool put_ug_textures(FILE *f, const void *user)
+{
+    return splat_ug_write_textures(user, f);
 }
 
 static bool write_sparse(build *b, const char *dir)
@@ -679,6 +703,8 @@ static bool write_contents(build *b, const char *dir)
 
     if (ok && b->ug.nblocks > 0)
         ok = write_with(b, dir, "meshes.bin", put_meshes, &b->ug);
+    if (ok && b->ug.ntextures > 0)
+        ok = write_with(b, dir, "ugtex.bin", put_ug_textures, &b->ug);
     if (ok && b->far.data)
         ok = write_file(b, dir, "far.atlas", b->far.data, b->far.n);
 

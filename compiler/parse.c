@@ -15,6 +15,8 @@
 #include "sg_internal.h"
 #include "util.h"
 
+#include <stb_image.h>
+
 #include <errno.h>
 #include <limits.h>
 #include <math.h>
@@ -469,7 +471,9 @@ static void parse_block_in(parser *ps, const char *what, stmt_fn stmt, void *use
 
 /* The keys of each settings block, NULL-ended (sg_internal.h): the parser's
  * "did you mean" lists, and what an editor completes (lsp_complete.c). */
-const char *const sg_ug_keys[] = { "density", "scale", "align", "blend", "color", NULL };
+const char *const sg_ug_keys[] = { "density", "scale", "align", "blend", "color",
+                                   "root_blend", "lighting", "cutout", "wind",
+                                   "wind_dir", "gust", "shadow", "texture", NULL };
 const char *const sg_texture_keys[] = { "file", "filter", "mip", "wrap", "srgb", NULL };
 const char *const sg_scene_keys[] = { "heightfield", "heightfield_size", "size",
                                       "max_height", "height_offset", "materials",
@@ -480,7 +484,9 @@ const char *const sg_painted_keys[] = { "max_level", "max_error", "near", "origi
 const char *const sg_camera_keys[] = { "position", "look", NULL };
 const char *const sg_destruction_keys[] = { "origin", "size", "cell", NULL };
 
-enum { UG_NKEYS = 5 };
+enum { UG_NKEYS = 13 };
+#define UG_KEY_LIST "density, scale, align, blend, color, root_blend, lighting, cutout, " \
+                    "wind, wind_dir, gust, shadow, texture"
 
 typedef struct ug_parse {
     sg_undergrowth *u;
@@ -501,16 +507,59 @@ static bool ug_number(parser *ps, const char *key, double lo, double hi, bool op
     return true;   /* well-formed: parsing goes on */
 }
 
+/* One of two keywords for `key` (*x = whether the first), or SETTING. */
+static bool ug_choice(parser *ps, const char *key, const char *yes, const char *no, bool *x)
+{
+    sg_token *vt = cur(ps);
+    char buf[96];
+    if (is_kw(vt, yes) || is_kw(vt, no)) {
+        *x = is_kw(vt, yes);
+    } else {
+        if (vt->kind != SG_TK_IDENT && vt->kind != SG_TK_NUMBER && vt->kind != SG_TK_STRING) {
+            snprintf(buf, sizeof buf, "%s or %s", yes, no);
+            expected(ps, buf);
+            return false;
+        }
+        sg_errorf(ps->d, loc_of(ps, vt), SG_E_SETTING, "'%s' must be %s or %s, found %s", key,
+                  yes, no, sg_tok_describe(vt, buf, sizeof buf));
+    }
+    next(ps);
+    return true;
+}
+
+/* Check an undergrowth texture now, so its errors are located at the
+ * string: readable, an image, 1 to SPLAT_MAX_UG_TEXTURE texels a side. */
+static void check_ug_texture(parser *ps, const char *path, sg_loc at)
+{
+    char why[160];
+    FILE *f = splat_input_fopen(path, SPLAT_MAX_IMAGE_BYTES, why, sizeof why);
+    if (!f) {
+        sg_error(ps->d, at, SG_E_IO, path, why);
+        return;
+    }
+    int w, h, comp;
+    if (!stbi_info_from_file(f, &w, &h, &comp))
+        sg_error(ps->d, at, SG_E_IO, path, "not an image stb_image reads");
+    else if (w < 1 || h < 1 || w > SPLAT_MAX_UG_TEXTURE || h > SPLAT_MAX_UG_TEXTURE)
+        sg_errorf(ps->d, at, SG_E_OVER_LIMIT, "texture '%s' is %d x %d; an undergrowth texture "
+                  "may have at most %d texels a side", path, w, h, SPLAT_MAX_UG_TEXTURE);
+    fclose(f);
+}
+
 /* ug_setting = "density" "=" NUM | "scale" "=" NUM [ NUM ]
  *            | "align" "=" ("normal" | "upright") | "blend" "=" NUM
- *            | "color" "=" "vec3" "(" NUM "," NUM "," NUM ")" */
+ *            | "color" "=" "vec3" "(" NUM "," NUM "," NUM ")"
+ *            | "root_blend" "=" NUM | "lighting" "=" ("terrain" | "mesh")
+ *            | "cutout" "=" ("frond" | "alpha" | "none") | "wind" "=" NUM
+ *            | "wind_dir" "=" NUM NUM | "gust" "=" NUM | "shadow" "=" NUM
+ *            | "texture" "=" STRING */
 static bool ug_stmt(parser *ps, void *user)
 {
     ug_parse *up = user;
     sg_undergrowth *u = up->u;
     sg_token *key = cur(ps);
     if (key->kind != SG_TK_IDENT) {
-        expected(ps, "an undergrowth setting (density, scale, align, blend, color) or '}'");
+        expected(ps, "an undergrowth setting (" UG_KEY_LIST ") or '}'");
         return false;
     }
     sg_loc kloc = loc_of(ps, key);
@@ -519,9 +568,8 @@ static bool ug_stmt(parser *ps, void *user)
         k++;
     if (k == UG_NKEYS) {
         sg_errorf(ps->d, kloc, SG_E_BAD_OPTION, "unknown undergrowth setting '%.*s' "
-                  "(expected density, scale, align, blend or color)", key->len, key->start);
-        static const char *const keys[] = { "density", "scale", "align", "blend", "color", NULL };
-        hint_key(ps, key, keys);
+                  "(expected " UG_KEY_LIST ")", key->len, key->start);
+        hint_key(ps, key, sg_ug_keys);
         /* skip its value (vec3(…) whole), then to ',', '}' or the next line */
         next(ps);
         sg_value v;
@@ -541,9 +589,7 @@ static bool ug_stmt(parser *ps, void *user)
     next(ps);
     if (!expect(ps, SG_TK_EQ, "'='"))
         return false;
-    sg_token *vt = cur(ps);
-    sg_loc vloc = loc_of(ps, vt);
-    char buf[96];
+    sg_loc vloc = loc_of(ps, cur(ps));
     switch (k) {
     case 0:
         if (!ug_number(ps, "density", 0, 64, true, &u->density))
@@ -560,22 +606,78 @@ static bool ug_stmt(parser *ps, void *user)
                       "<= 100, found %g %g", u->scale[0], u->scale[1]);
         break;
     case 2:
-        if (is_kw(vt, "normal") || is_kw(vt, "upright")) {
-            u->align_normal = is_kw(vt, "normal");
-        } else {
-            if (vt->kind != SG_TK_IDENT && vt->kind != SG_TK_NUMBER && vt->kind != SG_TK_STRING) {
-                expected(ps, "normal or upright");
-                return false;
-            }
-            sg_errorf(ps->d, vloc, SG_E_SETTING, "'align' must be normal or upright, found %s",
-                      sg_tok_describe(vt, buf, sizeof buf));
-        }
-        next(ps);
+        if (!ug_choice(ps, "align", "normal", "upright", &u->align_normal))
+            return false;
         break;
     case 3:
         if (!ug_number(ps, "blend", 0, 1, false, &u->blend))
             return false;
         break;
+    case 5:
+        if (!ug_number(ps, "root_blend", 0, 1, false, &u->root_blend))
+            return false;
+        break;
+    case 6:
+        if (!ug_choice(ps, "lighting", "terrain", "mesh", &u->light_terrain))
+            return false;
+        break;
+    case 7:
+    {
+        sg_token *vt = cur(ps);
+        char buf[96];
+        if (is_kw(vt, "none") || is_kw(vt, "frond") || is_kw(vt, "alpha")) {
+            u->cutout = is_kw(vt, "frond") ? SG_UG_CUT_FROND
+                      : is_kw(vt, "alpha") ? SG_UG_CUT_ALPHA : SG_UG_CUT_NONE;
+        } else {
+            if (vt->kind != SG_TK_IDENT && vt->kind != SG_TK_NUMBER && vt->kind != SG_TK_STRING) {
+                expected(ps, "none, frond or alpha");
+                return false;
+            }
+            sg_errorf(ps->d, vloc, SG_E_SETTING, "'cutout' must be none, frond or alpha, "
+                      "found %s", sg_tok_describe(vt, buf, sizeof buf));
+        }
+        next(ps);
+        break;
+    }
+    case 8:
+        if (!ug_number(ps, "wind", 0, SPLAT_MAX_UG_WIND, false, &u->wind))
+            return false;
+        break;
+    case 9: {
+        double x, z;
+        if (!parse_number(ps, &x) || !parse_number(ps, &z))
+            return false;
+        double len = hypot(x, z);
+        if (!(len > 1e-6 && len <= 1e6)) {
+            sg_errorf(ps->d, vloc, SG_E_SETTING, "'wind_dir' must be X Z, a direction in the "
+                      "ground plane (not 0 0, each at most 1e6), found %g %g", x, z);
+            break;
+        }
+        u->wind_dir[0] = x / len;
+        u->wind_dir[1] = z / len;
+        break;
+    }
+    case 10:
+        if (!ug_number(ps, "gust", 0, 1, false, &u->gust))
+            return false;
+        break;
+    case 11:
+        if (!ug_number(ps, "shadow", 0, 1, false, &u->shadow))
+            return false;
+        break;
+    case 12: {
+        sg_token *vt = cur(ps);
+        if (vt->kind != SG_TK_STRING) {
+            expected(ps, "an image file in quotes");
+            return false;
+        }
+        char *path = splat_path_join(ps->f->dir, vt->str);
+        u->texture = sg_strdup(ps->a, path);
+        free(path);
+        check_ug_texture(ps, u->texture, vloc);
+        next(ps);
+        break;
+    }
     case 4: {
         sg_value v;
         if (!parse_value(ps, &v))
@@ -636,8 +738,18 @@ static bool parse_undergrowth(parser *ps, sg_shader *s)
     static const double colors[][3] = {      /* per built-in mesh, then OBJ */
         { 0.16, 0.30, 0.06 }, { 0.12, 0.26, 0.05 }, { 0.35, 0.33, 0.30 }, { 0.5, 0.5, 0.5 },
     };
-    sg_undergrowth u = { .density = 1, .scale = { 1, 1 }, .blend = 0.5 };
+    /* per built-in mesh, then OBJ: lit with the terrain normal, cut out,
+     * contact shadow (defaults: each can be set in the block) */
+    static const bool terrain_lit[] = { true, true, false, false };
+    static const int cut[] = { SG_UG_CUT_NONE, SG_UG_CUT_FROND, SG_UG_CUT_NONE,
+                               SG_UG_CUT_NONE };
+    static const double shadows[] = { 0.35, 0.3, 0.5, 0.4 };
+    /* blend at the tip and at the root: a stone keeps its own colour and
+     * takes the ground's only at its foot */
+    static const double blends[][2] = { { 0.5, -1 }, { 0.5, -1 }, { 0.15, 0.5 }, { 0.5, -1 } };
+    sg_undergrowth u = { .density = 1, .scale = { 1, 1 }, .wind_dir = { 1, 0 }, .gust = 0.5 };
     u.loc = loc_of(ps, next(ps));
+    bool seen_color = false;
     sg_token *m = cur(ps);
     bool known = true;
     int kind = 0;
@@ -664,12 +776,25 @@ static bool parse_undergrowth(parser *ps, sg_shader *s)
     }
     next(ps);
     memcpy(u.color, colors[kind], sizeof u.color);
+    u.light_terrain = terrain_lit[kind];
+    u.cutout = cut[kind];
+    u.shadow = shadows[kind];
+    u.blend = blends[kind][0];
+    u.root_blend = blends[kind][1];
     if (cur(ps)->kind == SG_TK_LBRACE) {
         ug_parse up = { &u, { { 0 } } };
         char what[160];
         snprintf(what, sizeof what, "block of undergrowth '%.*s'", m->len, m->start);
         parse_block_in(ps, what, ug_stmt, &up, true);
+        seen_color = up.seen[4].line != 0;
+        if (u.cutout == SG_UG_CUT_ALPHA && !u.texture)
+            sg_errorf(ps->d, up.seen[7], SG_E_SETTING, "'cutout = alpha' needs a texture "
+                      "(texture = \"file.png\") whose alpha cuts the mesh");
     }
+    if (u.root_blend < 0)   /* not set: as the tip, unless a default of its own */
+        u.root_blend = u.blend;
+    if (u.texture && !seen_color)   /* the texture's own colour */
+        u.color[0] = u.color[1] = u.color[2] = 1.0;
     if (!known)
         return true;
     if (s->nug == SG_MAX_UNDERGROWTH) {

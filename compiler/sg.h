@@ -236,10 +236,23 @@ typedef struct sg_undergrowth {
     double density;        /* instances per m^2, (0, 64] */
     double scale[2];       /* lo, hi */
     bool   align_normal;   /* align = normal (else upright) */
-    double blend;          /* 0..1 */
+    double blend;          /* 0..1: share of the terrain's albedo (at the tip) */
+    double root_blend;     /* 0..1: that share at the root (default: blend) */
     double color[3];       /* linear */
+    bool   light_terrain;  /* lighting = terrain (else mesh): lit with the
+                              terrain normal; default: grass and plant */
+    int    cutout;         /* SG_UG_CUT_*: `cutout = none | frond | alpha`;
+                              default: frond for plant */
+    const char *texture;   /* `texture = "file"`: an image's path (resolved
+                              as the OBJ's), its rgb times the colour, its
+                              alpha the cut-out (alpha), or NULL */
+    double wind;           /* sway at 1 m above the root (m), [0, SPLAT_MAX_UG_WIND] */
+    double wind_dir[2];    /* unit xz: where the wind blows to */
+    double gust;           /* 0..1: share of the sway the gusts modulate */
+    double shadow;         /* 0..1: darkening of the ground under an instance */
     sg_loc loc;            /* the `undergrowth` keyword */
 } sg_undergrowth;
+enum { SG_UG_CUT_NONE, SG_UG_CUT_FROND, SG_UG_CUT_ALPHA };
 /* At most SG_MAX_UNDERGROWTH blocks per material, SG_MAX_UG_MATERIALS
  * undergrowth-bearing materials per program (OVER_LIMIT). */
 #define SG_MAX_UNDERGROWTH  4

@@ -4,6 +4,8 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include <stb_image.h>
+
 #include "util.h"
 
 /* Append mesh `m` named `name` (owned), keyed `key`; its index. */
@@ -50,6 +52,36 @@ static int mesh_index(splat_ug *u, const sg_undergrowth *g, sg_diags *d)
         u->far[i] = f;   /* after the call: it moves u->far */
     }
     return i;
+}
+
+/* Block g's texture index (loaded once per path), -1 without one. */
+static int texture_index(splat_ug *u, const sg_undergrowth *g, sg_diags *d)
+{
+    if (!g->texture)
+        return -1;
+    for (int i = 0; i < u->ntextures; i++)
+        if (strcmp(u->textures[i].path, g->texture) == 0)
+            return i;
+    if (u->ntextures == SPLAT_MAX_UG_TEXTURES) {
+        sg_errorf(d, g->loc, SG_E_OVER_LIMIT, "the scene's undergrowth uses more than %d "
+                  "textures", SPLAT_MAX_UG_TEXTURES);
+        return -2;
+    }
+    char why[160];
+    FILE *f = splat_input_fopen(g->texture, SPLAT_MAX_IMAGE_BYTES, why, sizeof why);
+    int w = 0, h = 0, comp;
+    uint8_t *px = f ? stbi_load_from_file(f, &w, &h, &comp, 4) : NULL;
+    if (f)
+        fclose(f);
+    if (!px || w < 1 || h < 1 || w > SPLAT_MAX_UG_TEXTURE || h > SPLAT_MAX_UG_TEXTURE) {
+        sg_errorf(d, g->loc, SG_E_IO, "cannot use texture '%s': %s", g->texture,
+                  !f ? why : !px ? "not an image stb_image reads" : "too large");
+        stbi_image_free(px);
+        return -2;
+    }
+    u->textures = xrealloc(u->textures, sizeof *u->textures * (size_t)(u->ntextures + 1));
+    u->textures[u->ntextures] = (splat_ug_texture){ g->texture, w, h, px };
+    return u->ntextures++;
 }
 
 /* The runtime's instance buffer at the default radius within what every
@@ -100,9 +132,12 @@ bool splat_ug_init(splat_ug *u, const splat_scene *s, sg_diags *d)
             int mesh = mesh_index(u, g, d);
             if (mesh < 0)
                 return false;
+            int tex = texture_index(u, g, d);
+            if (tex < -1)
+                return false;
             u->blocks = xrealloc(u->blocks, sizeof *u->blocks * (size_t)(u->nblocks + 1));
             u->blocks[u->nblocks++] = (splat_ug_block){
-                .material = i, .slot = u->slot_of[i], .mesh = mesh, .u = g};
+                .material = i, .slot = u->slot_of[i], .mesh = mesh, .u = g, .texture = tex};
         }
     }
     return check_instances(u, d);
@@ -118,6 +153,9 @@ void splat_ug_free(splat_ug *u)
     free(u->mesh_names);
     free(u->mesh_keys);
     free(u->far);
+    for (int i = 0; i < u->ntextures; i++)
+        stbi_image_free(u->textures[i].rgba);
+    free(u->textures);
     free(u->blocks);
     free(u->slot_of);
     memset(u, 0, sizeof *u);
@@ -166,6 +204,23 @@ bool splat_ug_write_meshes(const splat_ug *u, FILE *f)
         }
         for (uint32_t k = 0; ok && k < m->nidx; k++)
             ok = put_u32(f, m->idx[k]);
+    }
+    return ok;
+}
+
+/* "SPLATUGT", version 1, count; per texture its width and height; then
+ * per texture its texels, rows top first, 4 bytes each (sRGB rgb, linear
+ * alpha), all little-endian. */
+bool splat_ug_write_textures(const splat_ug *u, FILE *f)
+{
+    bool ok = fwrite("SPLATUGT", 1, 8, f) == 8 && put_u32(f, 1) &&
+              put_u32(f, (uint32_t)u->ntextures);
+    for (int i = 0; ok && i < u->ntextures; i++)
+        ok = put_u32(f, (uint32_t)u->textures[i].width) &&
+             put_u32(f, (uint32_t)u->textures[i].height);
+    for (int i = 0; ok && i < u->ntextures; i++) {
+        size_t n = (size_t)u->textures[i].width * (size_t)u->textures[i].height * 4;
+        ok = fwrite(u->textures[i].rgba, 1, n, f) == n;
     }
     return ok;
 }

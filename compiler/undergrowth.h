@@ -16,7 +16,14 @@ typedef struct splat_ug_block {
     int                   slot;      /* its mask slot                     */
     int                   mesh;      /* index into meshes                 */
     const sg_undergrowth *u;         /* owned by the scene's program      */
+    int                   texture;   /* index into textures, or -1        */
 } splat_ug_block;
+
+typedef struct splat_ug_texture {
+    const char *path;                /* the block's (owned by the program) */
+    int         width, height;
+    uint8_t    *rgba;                /* width * height * 4, sRGB + alpha  */
+} splat_ug_texture;
 
 typedef struct splat_ug {
     int            nslots;           /* undergrowth-bearing materials     */
@@ -28,6 +35,7 @@ typedef struct splat_ug {
                                         NULL for a far version            */
     int           *far;              /* per mesh: its far version or -1   */
     int            nmeshes;
+    splat_ug_texture *textures;  int ntextures;   /* distinct, <= SPLAT_MAX_UG_TEXTURES */
 } splat_ug;
 
 /* The scene's undergrowth (none: nblocks 0, slot_of all -1).  Meshes are
@@ -38,5 +46,7 @@ void splat_ug_free(splat_ug *u);
 bool splat_ug_in(const splat_ug *u, const int *materials, int n);
 /* meshes.bin (PACK.md): every mesh's vertices and indices. */
 bool splat_ug_write_meshes(const splat_ug *u, FILE *f);
+/* ugtex.bin (PACK.md): every texture's texels (only with textures). */
+bool splat_ug_write_textures(const splat_ug *u, FILE *f);
 
 #endif

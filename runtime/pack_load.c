@@ -511,6 +511,70 @@ static bool read_meshes(reader *r, const char *rel, rt_pack_ug *u)
     return true;
 }
 
+/* undergrowth.textures (optional): each one's width and height. */
+static bool read_ug_texture_sizes(reader *r, json_t *o, rt_pack_ug *u)
+{
+    json_t *ts = json_object_get(o, "textures");
+    if (!ts)
+        return true;
+    if (!json_is_array(ts) || json_array_size(ts) < 1 ||
+        json_array_size(ts) > SPLAT_MAX_UG_TEXTURES)
+        return field_fail(r, "undergrowth.textures:", "must be an array of 1 to 8 entries");
+    u->ntextures = (int)json_array_size(ts);
+    u->textures = calloc((size_t)u->ntextures, sizeof *u->textures);
+    if (!u->textures)
+        return false;
+    for (int i = 0; i < u->ntextures; i++) {
+        char where[64];
+        snprintf(where, sizeof where, "undergrowth.textures[%d]", i);
+        json_t *t = json_array_get(ts, (size_t)i);
+        if (!get_int(r, t, "width", where, 1, SPLAT_MAX_UG_TEXTURE, &u->textures[i].width) ||
+            !get_int(r, t, "height", where, 1, SPLAT_MAX_UG_TEXTURE, &u->textures[i].height))
+            return false;
+    }
+    return true;
+}
+
+/* ugtex.bin (PACK.md "Undergrowth"): its size from the manifest's sizes,
+ * checked before it is read, and its header against them. */
+static bool read_ug_textures(reader *r, json_t *o, rt_pack_ug *u)
+{
+    if (u->ntextures == 0)
+        return true;
+    const char *rel;
+    if (!get_string(r, o, "texture_file", "undergrowth", &rel))
+        return false;
+    size_t head = 16 + 8 * (size_t)u->ntextures, want = head;
+    for (int i = 0; i < u->ntextures; i++)
+        want += 4 * (size_t)u->textures[i].width * (size_t)u->textures[i].height;
+    uint8_t *data = pack_file(r, "undergrowth.texture_file", rel, want, 0, NULL);
+    if (!data)
+        return false;
+    const char *bad = NULL;
+    if (memcmp(data, "SPLATUGT", 8) || le32(data + 8) != 1 ||
+        le32(data + 12) != (uint32_t)u->ntextures)
+        bad = "does not match the manifest's textures (magic, version or count)";
+    for (int i = 0; !bad && i < u->ntextures; i++)
+        if (le32(data + 16 + 8 * i) != (uint32_t)u->textures[i].width ||
+            le32(data + 20 + 8 * i) != (uint32_t)u->textures[i].height)
+            bad = "has texture sizes other than the manifest's";
+    const uint8_t *at = data + head;
+    for (int i = 0; !bad && i < u->ntextures; i++) {
+        size_t n = 4 * (size_t)u->textures[i].width * (size_t)u->textures[i].height;
+        u->textures[i].rgba = malloc(n);
+        if (!u->textures[i].rgba) {
+            bad = "does not fit in memory";
+            break;
+        }
+        memcpy(u->textures[i].rgba, at, n);
+        at += n;
+    }
+    free(data);
+    if (bad)
+        return rt_fail(r->e, RT_E_PACK_FILE, r->manifest, "undergrowth.texture_file", rel, bad);
+    return true;
+}
+
 /* "far_atlas" (optional): far.atlas, its size from the manifest's width,
  * height and levels checked against the file's before it is read, and its
  * header against the manifest (compiler/far_atlas.h). */
@@ -576,6 +640,8 @@ static bool read_undergrowth(reader *r, json_t *root)
         return field_fail(r, "undergrowth.meshes:", "must have 1 to 64 entries");
     if (json_array_size(bs) < 1 || json_array_size(bs) > SPLAT_MAX_UG_BLOCKS)
         return field_fail(r, "undergrowth.blocks:", "must have 1 to 64 entries");
+    if (!read_ug_texture_sizes(r, o, u))
+        return false;
     u->nmeshes = (int)json_array_size(ms);
     u->nblocks = (int)json_array_size(bs);
     u->meshes = calloc((size_t)u->nmeshes, sizeof *u->meshes);
@@ -594,13 +660,12 @@ static bool read_undergrowth(reader *r, json_t *root)
             return false;
         if (ni % 3)
             return field_fail(r, where, "indices: must be a multiple of 3");
-        unsigned flags = strcmp(name, "plant") == 0 ? 3u : strcmp(name, "grass") == 0 ? 2u : 0u;
         int far = -1;
         if (json_object_get(m, "far") &&
             !get_int(r, m, "far", where, 0, (int)json_array_size(ms) - 1, &far))
             return false;
         u->meshes[i] = (rt_pack_ug_mesh){ (uint32_t)nv, (uint32_t)ni, u->nvertices, u->nindices,
-                                          flags, far };
+                                          far };
         u->nvertices += (uint32_t)nv;
         u->nindices += (uint32_t)ni;
     }
@@ -609,15 +674,13 @@ static bool read_undergrowth(reader *r, json_t *root)
         if (m->far >= 0 && (m->far == i || u->meshes[m->far].far >= 0))
             return field_fail(r, "undergrowth.meshes:",
                               "far: must name another mesh that has no far version");
-        if (m->far >= 0)   /* drawn with the near mesh's pipeline and lighting */
-            u->meshes[m->far].flags = m->flags;
     }
     for (int i = 0; i < u->nblocks; i++) {
         char where[64];
         snprintf(where, sizeof where, "undergrowth.blocks[%d]", i);
         json_t *b = json_array_get(bs, (size_t)i);
         rt_pack_ug_block *k = &u->blocks[i];
-        const char *align;
+        const char *align, *lighting, *cutout;
         if (!get_int(r, b, "material", where, 0, r->p->nmaterials - 1, &k->material) ||
             !get_int(r, b, "slot", where, 0, u->nslots - 1, &k->slot) ||
             !get_int(r, b, "mesh", where, 0, u->nmeshes - 1, &k->mesh) ||
@@ -625,8 +688,32 @@ static bool read_undergrowth(reader *r, json_t *root)
             !get_vec(r, b, "scale", where, 2, k->scale) ||
             !get_number(r, b, "blend", where, &k->blend) ||
             !get_vec(r, b, "color", where, 3, k->color) ||
-            !get_string(r, b, "align", where, &align))
+            !get_string(r, b, "align", where, &align) ||
+            !get_number(r, b, "root_blend", where, &k->root_blend) ||
+            !get_string(r, b, "lighting", where, &lighting) ||
+            !get_string(r, b, "cutout", where, &cutout) ||
+            !get_vec(r, b, "wind", where, 4, k->wind) ||
+            !get_number(r, b, "shadow", where, &k->shadow) ||
+            !get_int(r, b, "texture", where, -1, u->ntextures - 1, &k->texture))
             return false;
+        if (!(k->root_blend >= 0 && k->root_blend <= 1))
+            return field_fail(r, where, "root_blend: must be in [0, 1]");
+        if (!(k->shadow >= 0 && k->shadow <= 1))
+            return field_fail(r, where, "shadow: must be in [0, 1]");
+        if (!(fabs(hypot(k->wind[0], k->wind[1]) - 1) <= 1e-3))
+            return field_fail(r, where, "wind: its direction (x, z) must be a unit vector");
+        if (!(k->wind[2] >= 0 && k->wind[2] <= SPLAT_MAX_UG_WIND))
+            return field_fail(r, where, "wind: the sway must be in [0, 2]");
+        if (!(k->wind[3] >= 0 && k->wind[3] <= 1))
+            return field_fail(r, where, "wind: the gust must be in [0, 1]");
+        if (strcmp(lighting, "terrain") && strcmp(lighting, "mesh"))
+            return field_fail(r, where, "lighting: must be \"terrain\" or \"mesh\"");
+        if (strcmp(cutout, "frond") && strcmp(cutout, "none") && strcmp(cutout, "alpha"))
+            return field_fail(r, where, "cutout: must be \"none\", \"frond\" or \"alpha\"");
+        k->light_terrain = strcmp(lighting, "terrain") == 0;
+        k->cutout = strcmp(cutout, "frond") == 0 ? 1 : strcmp(cutout, "alpha") == 0 ? 2 : 0;
+        if (k->cutout == 2 && k->texture < 0)
+            return field_fail(r, where, "cutout: \"alpha\" needs a texture");
         if (!(k->density > 0 && k->density <= SPLAT_MAX_UG_DENSITY))
             return field_fail(r, where, "density: must be in (0, 64]");
         if (!(k->scale[0] > 0 && k->scale[0] <= k->scale[1] && k->scale[1] <= 100))
@@ -640,7 +727,7 @@ static bool read_undergrowth(reader *r, json_t *root)
             return field_fail(r, where, "align: must be \"normal\" or \"upright\"");
         k->align_normal = strcmp(align, "normal") == 0;
     }
-    return read_meshes(r, file, u);
+    return read_meshes(r, file, u) && read_ug_textures(r, o, u);
 }
 
 /* scene.light (optional, and each of its fields): over the defaults. */
@@ -1520,6 +1607,9 @@ void rt_pack_free(rt_pack *p)
     free_spirv(&p->uber);
     free(p->uber_compute);
     free(p->uber_frag_path);
+    for (int i = 0; i < p->ug.ntextures; i++)
+        free(p->ug.textures[i].rgba);
+    free(p->ug.textures);
     free(p->ug.blocks);
     free(p->ug.meshes);
     free(p->ug.vertices);

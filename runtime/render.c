@@ -1737,6 +1737,18 @@ int rt_renderer_undergrowth_cell(rt_renderer *r, int ix, int iz, rt_ug_instance 
     return rt_ug_read_cell(r->ug, ix, iz, out, max, e);
 }
 
+int rt_renderer_undergrowth_rings(rt_renderer *r, double width, int nrings, uint32_t *counts,
+                                  rt_error *e)
+{
+    return rt_ug_probe_rings(r->ug, width, nrings, counts, e);
+}
+
+bool rt_renderer_undergrowth_wind(rt_renderer *r, float *points, int n, double time,
+                                  rt_error *e)
+{
+    return r->ug ? rt_ug_probe_wind(r->ug, points, n, time, e) : false;
+}
+
 const uint16_t *rt_renderer_heights(const rt_renderer *r)
 {
     return r->destr ? rt_destruction_heights(r->destr) : r->p->heights;

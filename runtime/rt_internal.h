@@ -606,6 +606,16 @@ void rt_ug_read_stats(rt_ug *u, rt_ug_stats *st);
 /* The instances of cell (ix, iz) (its origin at 16 m times those), up to
  * max; 0 if the cell is not generated, -1 on error. */
 int  rt_ug_read_cell(rt_ug *u, int ix, int iz, rt_ug_instance *out, int max, rt_error *e);
+/* Tests: the instances the last frame's draw keeps (after the LOD and the
+ * distance fade, as the vertex stage decides), counted per ring of `width`
+ * metres around its camera: counts[k] for [k width, (k + 1) width), and
+ * counts[nrings + k] all the LOD's there, kept or not; the generated
+ * cells it counted, or -1 on error. */
+int  rt_ug_probe_rings(rt_ug *u, double width, int nrings, uint32_t *counts, rt_error *e);
+/* Tests: the vertex stage's wind at n points on the device, 12 floats
+ * each: root xyz, h (m above the root), the block's wind (direction x, z,
+ * sway, gust) in, then the offset xyz and the gust in [0, 1] out. */
+bool rt_ug_probe_wind(rt_ug *u, float *points, int n, double time, rt_error *e);
 
 /* ---- destruction.c: the renderer's side ------------------------------- */
 

@@ -253,20 +253,30 @@ const char *rt_light_check(const rt_light *l);
  * indices concatenated. */
 typedef struct rt_pack_ug_block {
     int      material, slot, mesh;
-    double   density, scale[2], blend, color[3];
+    double   density, scale[2], blend, root_blend, color[3];
     bool     align_normal;
+    bool     light_terrain;  /* lit with the terrain normal (else the mesh's) */
+    int      cutout;         /* 0 none, 1 a leaf cut from the mesh's quads
+                                (frond), 2 the texture's alpha, dithered  */
+    int      texture;        /* index into the pack's textures, or -1       */
+    double   wind[4];        /* direction x, z (unit), sway at 1 m, gust     */
+    double   shadow;         /* darkening of the ground under an instance    */
 } rt_pack_ug_block;
 
 typedef struct rt_pack_ug_mesh {
     uint32_t nv, nidx;
     uint32_t first_vertex, first_index;
-    unsigned flags;        /* 1: a leaf cut from its quads (plant), 2: lit
-                              with the terrain normal (grass, plant)     */
     int      far;          /* the mesh drawn beyond the LOD distance, or -1 */
 } rt_pack_ug_mesh;
 
+typedef struct rt_pack_ug_texture {
+    int      width, height;
+    uint8_t *rgba;                 /* rows top first; sRGB rgb, alpha       */
+} rt_pack_ug_texture;
+
 typedef struct rt_pack_ug {
     int               nslots;      /* 0: the pack has no undergrowth        */
+    rt_pack_ug_texture *textures; int ntextures;   /* ugtex.bin             */
     rt_pack_ug_block *blocks;  int nblocks;
     rt_pack_ug_mesh  *meshes;  int nmeshes;
     float            *vertices;    /* 8 per vertex                          */
@@ -352,6 +362,8 @@ double rt_light_fog_default(const rt_pack *p);
 
 typedef struct rt_camera {
     double position[3];   /* terrain-local metres                           */
+    double time;          /* seconds: animates the undergrowth's wind (0: the
+                             still picture of a headless frame)             */
     double look[3];       /* a point looked at                              */
     double fovy;          /* radians; default 60 degrees                    */
     double znear;         /* metres; default 0.25                           */
@@ -465,7 +477,7 @@ typedef struct rt_ug_instance {
     float    pos[3];      /* root, terrain-local metres                  */
     float    scale;
     uint32_t normal;      /* packSnorm4x8 of the terrain normal          */
-    uint32_t color;       /* packUnorm4x8: rgb, 1                        */
+    uint32_t color;       /* packUnorm4x8: the terrain's albedo at the root, 1 */
     float    angle;       /* radians about the up (or normal) axis       */
     uint32_t block;       /* pack undergrowth block                      */
 } rt_ug_instance;
@@ -534,6 +546,19 @@ void rt_renderer_set_undergrowth(rt_renderer *r, bool on);
  * is (16 ix, 16 iz) terrain-local metres, as generated (up to max; 0 when
  * that cell is not allocated and generated, -1 on error): for tests. */
 int  rt_renderer_undergrowth_cell(rt_renderer *r, int ix, int iz, rt_ug_instance *out, int max,
+                                  rt_error *e);
+/* For tests: the undergrowth instances the last frame drew, after the
+ * distance LOD and the distance fade (runtime/undergrowth.c), counted
+ * per ring of `width` m around its camera (counts[k]: [k, k + 1) widths;
+ * farther ones not counted), and in counts[nrings + k] the LOD's before
+ * the fade (2 nrings counts): the cells counted, -1 on error. */
+int  rt_renderer_undergrowth_rings(rt_renderer *r, double width, int nrings, uint32_t *counts,
+                                   rt_error *e);
+/* For tests: the vertex stage's wind offset on the device at n points (12
+ * floats each: root xyz, h metres above the root, a block's wind: unit
+ * direction x, z, sway, gust; out: the offset xyz, the gust in [0, 1]).
+ * false without undergrowth or on error. */
+bool rt_renderer_undergrowth_wind(rt_renderer *r, float *points, int n, double time,
                                   rt_error *e);
 /* Terrain shadows on or off (rt_render_desc.no_shadows; the viewer's H). */
 void rt_renderer_set_shadows(rt_renderer *r, bool on);

@@ -705,6 +705,7 @@ static bool frame(viewer *v, const char *shot, double *last, rt_error *e)
     *last = t;
     glfwPollEvents();
     move_camera(v, dt > 0.25 ? 0.25 : dt);
+    v->cam.time += dt > 0.25 ? 0.25 : dt;   /* the undergrowth's wind */
     check_files(v);
     rt_frame_stats st;
     if (!rt_renderer_frame(v->r, &v->cam, &st, e))

@@ -114,7 +114,7 @@ special)
     for kind in fifo chardev zero folder socket; do
         # slot: file name in the scene, the line that names it, a sed
         # edit of the scene that uses it (GDAL variants rename the file)
-        for slot in hf hf_gdal import texture mask mask_gdal mesh; do
+        for slot in hf hf_gdal import texture mask mask_gdal mesh ugtex; do
             d="$TMP/$kind.$slot"
             base_scene "$d"
             case $slot in
@@ -125,6 +125,8 @@ special)
             mask)      file=mask.png  line=20 ;;
             mask_gdal) file=mask.tif  line=20; sed -i 's/"mask.png"/"mask.tif"/' "$d/scene.sg" ;;
             mesh)      file=m.obj     line=8 ;;
+            ugtex)     file=ut.png    line=8
+                       sed -i 's/undergrowth "m.obj" { density = 1 }/undergrowth "m.obj" { density = 1, texture = "ut.png" }/' "$d/scene.sg" ;;
             esac
             if ! make_special "$kind" "$d/$file"; then
                 echo "skip: cannot make a $kind here"

@@ -246,6 +246,30 @@ EOF
 case_ ug_far_range bc4 "undergrowth.meshes\[0\].far: must be an integer in \[0, 3\]" <<EOF
 "$PE" set $M undergrowth.meshes.0.far 9
 EOF
+case_ ug_wind_sway bc4 "undergrowth.blocks\[0\] wind: the sway must be in \[0, 2\]" <<EOF
+"$PE" set $M undergrowth.blocks.0.wind '[1, 0, 7, 0.5]'
+EOF
+case_ ug_wind_dir bc4 "undergrowth.blocks\[0\] wind: its direction (x, z) must be a unit vector" <<EOF
+"$PE" set $M undergrowth.blocks.0.wind '[3, 0, 0.5, 0.5]'
+EOF
+case_ ug_wind_length bc4 "undergrowth.blocks\[0\].wind: must have 4 numbers" <<EOF
+"$PE" set $M undergrowth.blocks.0.wind '[1, 0]'
+EOF
+case_ ug_root_blend bc4 "undergrowth.blocks\[0\] root_blend: must be in \[0, 1\]" <<EOF
+"$PE" set $M undergrowth.blocks.0.root_blend 4
+EOF
+case_ ug_texture_range bc4 "undergrowth.blocks\[0\].texture: must be an integer in \[-1, -1\]" <<EOF
+"$PE" set $M undergrowth.blocks.0.texture 3
+EOF
+case_ ug_alpha_untextured bc4 "undergrowth.blocks\[0\] cutout: \"alpha\" needs a texture" <<EOF
+"$PE" set $M undergrowth.blocks.0.cutout '"alpha"'
+EOF
+case_ ug_textures_count bc4 "undergrowth.textures: must be an array of 1 to 8 entries" <<EOF
+"$PE" set $M undergrowth.textures '[]'
+EOF
+case_ ug_lighting bc4 "undergrowth.blocks\[0\] lighting: must be \"terrain\" or \"mesh\"" <<EOF
+"$PE" set $M undergrowth.blocks.0.lighting '"sun"'
+EOF
 # The fragment GLSL the forward counting variant reads when first needed
 # (the cost view on the forward path): the same checks then, and the pack
 # still draws without it.
