@@ -1,34 +1,36 @@
-/* test_far.c — shading far from the origin (compiler/precision.c) on a
- * Vulkan device (lavapipe here; SPLAT_VALIDATE=1, any validation message
- * fails).
+/* test_far.c — shading far from the origin (compiler/precision.c, the
+ * vertex lattice of abi.h splat_push) on a Vulkan device (lavapipe here;
+ * SPLAT_VALIDATE=1, any validation message fails).
  *
  *   test_far OUTDIR
  *
- * A flat scene 10,240 km wide (1024 x 1024 texels of 10 km, cell 1: the
- * patches are 10 km squares) with tests/world/far.sg's materials: a 1 m
- * top-down texture, an 8 m tri-planar one and ALU value noise of 2 m
- * cells.  Two local views, each near the origin and 100 km, 1,000 km and
- * 5,000 km away (along x and z: multiples of every period and of the
- * patch size):
- *   - "down", straight down from 30 m, inside one patch;
+ * A flat terrain 10,240 km wide (1024 x 1024 texels of 10 km) with
+ * tests/world/far.sg's materials: a 1 m top-down texture, an 8 m
+ * tri-planar one and ALU value noise of 2 m cells; cell 1 (10 km
+ * patches) and, for "coarse", cell 32 (320 km patches).  Three local
+ * views, each near the origin and 100 km, 1,000 km and 5,000 km away
+ * (along x and z: multiples of every period):
+ *   - "down", straight down from 30 m, inside one 10 km patch;
  *   - "edges", 12 m up and looking 11 degrees down over the corner (40 km,
- *     40 km) where four patches meet, so two patch edges cross the
- *     picture; the camera's coordinates are not floats (39,978.3 m), so a
- *     patch edge computed from float world positions would show.
+ *     40 km) where four 10 km patches meet, so two patch edges cross the
+ *     picture; the camera's coordinates are not floats (39,978.3 m);
+ *   - "coarse", the same over the corner (320 km, 320 km) of four 320 km
+ *     patches (the offsets are not multiples of 320 km: far away the
+ *     edges lie elsewhere).  Before the lattice its near view showed the
+ *     sky through a crack along the patch edge, 12 pixels on one line.
  * Checks:
  *   - the albedo views, forward, screen-space with rasterised depth and
  *     screen-space with ray-cast depth (the GPUs' default), against the
  *     forward one near the origin: at most 0.5 % of the pixels over
- *     8/255, and no line of differing pixels: no set of them, each within
- *     two pixels of another, spans LINE pixels or more (issue 34: seams
- *     along patch edges, 0.8 % of the pixels, all in lines);
- *   - the line detector itself, on drawn lines and on scattered noise;
+ *     8/255, and no line of differing pixels (line_pixels, is_line; issue
+ *     34: seams along patch edges, 0.8 % of the pixels, all in lines);
+ *   - the line detector itself, on drawn lines and on scattered pixels;
  *   - the noise material's mask view matches the double-precision
  *     reference (ir_eval, what `splatc eval` prints) within 1e-3 at 64
  *     pixels of each view.
- * Without the pass the 5,000 km view fails both (position's fp32 ulp
- * there is 0.5 m).  Pictures go to OUTDIR: each view, and diff_*.png (red:
- * over 8/255, grey: the difference times 16). */
+ * Without the precision pass the 5,000 km view fails both (position's
+ * fp32 ulp there is 0.5 m).  Pictures go to OUTDIR: each view, and
+ * diff_*.png (red: over 8/255, grey: the difference times 16). */
 #include "rt_internal.h"
 #include "../check.h"
 
