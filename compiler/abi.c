@@ -448,6 +448,12 @@ const char SPLAT_GLSL_TERRAIN[] = SPLAT_GLSL_COMMON;
 const char SPLAT_GLSL_LIGHTING[] = LIGHTING_TEXT;
 const char SPLAT_GLSL_SKY[] = SKY_TEXT;
 
+/* abi.h SPLAT_LATTICE, as text: a vertex of the grid (a_grid = i / 32,
+ * exact) is a whole number of lattice steps from its patch's corner */
+#define LATTICE 32
+_Static_assert(LATTICE == SPLAT_LATTICE && LATTICE == SPLAT_GRID - 1,
+               "the vertex lattice (abi.h splat_push)");
+
 const char SPLAT_GLSL_VERTEX[] =
     "#version 450\n"
     SPLAT_GLSL_COMMON
@@ -458,11 +464,15 @@ const char SPLAT_GLSL_VERTEX[] =
     "layout(location = 1) out vec2 v_uv;\n"
     "layout(location = 2) out vec3 v_local;\n"
     "void main() {\n"
-    /* patches of the quadtree may overhang the terrain: clamp to its edge */
-    "    vec2 g = min(a_grid, (1.0 - u_push.patch_uv.xy) / u_push.patch_uv.zw);\n"
-    "    vec2 uv = u_push.patch_uv.xy + g * u_push.patch_uv.zw;\n"
+    /* the vertex's lattice index (abi.h splat_push), whole and exact:
+     * shared vertices of neighbouring patches are the same number;
+     * patches of the quadtree may overhang the terrain: clamp to its edge */
+    "    vec2 edge = u_frame.texel.xy * " SPLAT_STR(LATTICE) ".0;\n"
+    "    vec2 q = min(u_push.patch_xz.xy + a_grid * u_push.patch_xz.z, edge);\n"
+    "    vec2 uv = q * (u_frame.texel.zw * (1.0 / " SPLAT_STR(LATTICE) ".0));\n"
     "    float h = splat_height_at(uv);\n"
-    "    vec2 rel_xz = u_push.patch_xz.xy + g * u_push.patch_xz.zw;\n"
+    "    vec2 step = u_frame.terrain.xy * u_frame.texel.zw * (1.0 / " SPLAT_STR(LATTICE) ".0);\n"
+    "    vec2 rel_xz = (q - u_push.patch_uv.xy) * step - u_push.patch_uv.zw;\n"
     "    vec3 rel = vec3(rel_xz.x, h - u_frame.camera.y, rel_xz.y);\n"
     "    v_rel = rel;\n"
     "    v_uv = uv;\n"

@@ -194,7 +194,8 @@
 
 #define SPLAT_ABI_VERSION 5   /* 2: splat_frame.light; 3: GGX lighting, screen.w;
                                  4: splat_surface / splat_opaque, SPLAT_SORT;
-                                 5: set 1's textures are sampler2DArray layers */
+                                 5: set 1's textures are sampler2DArray layers;
+                                    terrain vertices on the lattice (splat_push) */
 
 /* Undergrowth masks (above): texels per cell side, undergrowth-bearing
  * materials at most (4 per word), the fixed view distance (m). */
@@ -231,6 +232,7 @@ enum {
     SPLAT_BIND_TEXTURE0 = 1,   /* texture i at binding 1 + i */
 
     SPLAT_GRID = 33,           /* vertices per patch side */
+    SPLAT_LATTICE = 32,        /* vertex lattice points per texel (splat_push) */
 };
 
 /* Pack limits (compiler/PACK.md "Limits"): what every pack promises and
@@ -469,11 +471,22 @@ typedef struct splat_counters {
     uint32_t branches_uniform; /* of them, where the whole subgroup agreed    */
 } splat_counters;
 
-/* Push constants, vertex + fragment. */
+/* Push constants, vertex + fragment.  The terrain's vertex stage places
+ * every vertex on one lattice, SPLAT_LATTICE points per heightfield
+ * texel (the finest patch's grid step at cell = 1), by whole lattice
+ * index: a vertex's index is the corner's plus a_grid times the side,
+ * exact in float (at most SPLAT_MAX_HEIGHTFIELD * SPLAT_LATTICE = 2^19),
+ * so a vertex two patches share is computed from the same number by both
+ * and comes out bit-identical; camera-relative, it is (index - the
+ * camera's cell) * the lattice step - the camera's offset in that cell,
+ * the cell and offset computed in double on the CPU (issue 34: patch
+ * corners rounded to float relative to the camera left seams along the
+ * patch edges).  Other stages read these fields as abi.h says there. */
 typedef struct splat_push {
-    float    patch_xz[4];  /* xy: patch corner x, z relative to the camera
-                              (m); zw: patch size x, z (m)                  */
-    float    patch_uv[4];  /* xy: heightfield uv of the corner; zw: extent */
+    float    patch_xz[4];  /* xy: patch corner x, z (lattice index, whole);
+                              z: patch side (lattice steps); w: 0          */
+    float    patch_uv[4];  /* xy: the lattice point at or below the camera
+                              (x, z: whole); zw: camera - that point (m)   */
     uint32_t info[4];      /* x: quadtree level, y: combination id,
                               z: scene material count, w: 0              */
 } splat_push;

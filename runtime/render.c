@@ -912,22 +912,31 @@ static void fill_frame(rt_renderer *r, const rt_camera *c, splat_frame *fr)
     fr->view[1] = (uint32_t)(r->view_material > 0 ? r->view_material : 0);
 }
 
+/* A patch's push constants: its corner and side on the vertex lattice
+ * and the camera's lattice point and offset from it (abi.h splat_push),
+ * all in double here.  Every lattice index is whole, so neighbouring
+ * patches compute their shared vertices from the same numbers. */
 static void push_patch(rt_renderer *r, VkCommandBuffer cb, VkPipelineLayout layout,
                        const rt_camera *c, const rt_patch *pt)
 {
     const rt_pack *p = r->p;
-    double x0, z0, sx, sz;
-    rt_node_rect(&r->qt, pt->level, pt->x, pt->z, &x0, &z0, &sx, &sz);
+    const double texels = (double)r->qt.cell_texels * (double)(1 << pt->level);
+    const double width[2] = { (double)p->hf_width, (double)p->hf_height };
+    const double cam[2] = { c->position[0], c->position[2] };
+    const int idx[2] = { pt->x, pt->z };
     splat_push push;
-    /* corner minus camera in double: precise near the viewer in any world */
-    push.patch_xz[0] = (float)(x0 - c->position[0]);
-    push.patch_xz[1] = (float)(z0 - c->position[2]);
-    push.patch_xz[2] = (float)sx;
-    push.patch_xz[3] = (float)sz;
-    push.patch_uv[0] = (float)(x0 / p->size[0]);
-    push.patch_uv[1] = (float)(z0 / p->size[1]);
-    push.patch_uv[2] = (float)(sx / p->size[0]);
-    push.patch_uv[3] = (float)(sz / p->size[1]);
+    for (int a = 0; a < 2; a++) {
+        /* the step as the vertex stage computes it (terrain * texel /
+         * lattice, floats), so the offset and the steps agree */
+        double step = (double)((float)p->size[a] * (1.0f / (float)width[a])) / SPLAT_LATTICE;
+        /* the camera's lattice point, kept where floats hold whole numbers */
+        double at = fmin(fmax(floor(cam[a] / step), -8388608.0), 8388608.0);
+        push.patch_xz[a] = (float)(idx[a] * texels * SPLAT_LATTICE);
+        push.patch_uv[a] = (float)at;
+        push.patch_uv[2 + a] = (float)(cam[a] - at * step);
+    }
+    push.patch_xz[2] = (float)(texels * SPLAT_LATTICE);
+    push.patch_xz[3] = 0.0f;
     push.info[0] = pt->level;
     push.info[1] = pt->combo;
     push.info[2] = (uint32_t)p->nmaterials;

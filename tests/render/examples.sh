@@ -13,8 +13,8 @@
 #     combinations view shows one colour per combination in view (and one
 #     for the über-shader where it draws coarse patches no combination
 #     covers; colorado: with --uncovered split there are none);
-#   colorado: composite vs the multi-pass reference within 1/255 at the
-#     preset 'valley';
+#   colorado: composite vs the multi-pass reference at the preset 'valley',
+#     within run.sh's tolerances for the lit image;
 #   nocam: a scene without presets gets the computed view (light fog).
 set -u
 case_=$1 SV=$2 IC=$3 PACK=$4 OUT=$5/example_$1
@@ -80,7 +80,12 @@ colorado)
     cam="--camera-preset valley"
     run "$PACK" --headless $SIZE $cam --float-out "$OUT/c.f32"
     run "$PACK" --headless $SIZE $cam --reference multipass --float-out "$OUT/m.f32"
-    "$IC" diff "$OUT/c.f32" "$OUT/m.f32" 1e-5 || fail "composite and multipass differ by more than 1e-5 (run.sh says why)"
+    # run.sh's tolerances for the lit image (GGX turns ulps into up to
+    # 7e-4 on a pixel or two: 1e-5 on 99.9 %, 1e-3 on all; a compositor
+    # error of 1/255 still fails)
+    "$IC" close "$OUT/c.f32" "$OUT/m.f32" 1e-5 0.999 80 &&
+        "$IC" diff "$OUT/c.f32" "$OUT/m.f32" 1e-3 ||
+        fail "composite and multipass differ (run.sh's tolerances)"
     ;;
 billingsley)
     default_view 0.75
