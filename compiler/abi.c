@@ -619,7 +619,7 @@ const char SPLAT_GLSL_PRELUDE[] =
     "        lo[2 * q + 1] = vec4(a.zw, b.zw);  hi[2 * q + 1] = vec4(b.zw, c.zw);\n"
     "    }\n"
     "    vec4 m[6];   /* columns x-1 .. x+2 */\n"
-    "    for (int r = 0; r < 6; r++) m[r] = vec4(lo[r].yzw, hi[r].w);\n"
+    "    for (int r = 0; r < 6; r++) m[r] = vec4(lo[r].yzw, hi[r].z);\n"
     "    vec4 ha, ga, gb;\n"
     "    for (int r = 0; r < 4; r++) {\n"
     "        ha[r] = dot(wx, m[r + 1]);\n"
