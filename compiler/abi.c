@@ -42,9 +42,9 @@
     "    float step = u_push.patch_xz.z / " SPLAT_STR(SPLAT_UG_TEXELS) ".0;\n" \
     "    vec2 xz = u_push.patch_xz.xy + (vec2(splat_pixel) + 0.5) * step;\n" \
     "    v_uv = xz / u_frame.terrain.xy;\n"                                 \
-    "    v_local = vec3(xz.x, splat_height_at(v_uv), xz.y);\n"              \
+    "    splat_terrain_at(v_uv, splat_hgt, splat_nrm);\n"                   \
+    "    v_local = vec3(xz.x, splat_hgt, xz.y);\n"                          \
     "    v_rel = v_local - u_frame.camera.xyz;\n"                           \
-    "    splat_nrm = splat_normal_at(v_uv);\n"                              \
     "    float ny = max(splat_nrm.y, 0.05);\n"                              \
     "    splat_dpdx = vec3(step, -step * splat_nrm.x / ny, 0.0);\n"         \
     "    splat_dpdy = vec3(0.0, -step * splat_nrm.z / ny, step);\n"         \
@@ -93,9 +93,9 @@
     "    vec2 step = u_push.patch_xz.xy;\n"                                 \
     "    vec2 xz = (vec2(q) + 0.5) * step;\n"                               \
     "    v_uv = xz / u_frame.terrain.xy;\n"                                 \
-    "    v_local = vec3(xz.x, splat_height_at(v_uv), xz.y);\n"              \
+    "    splat_terrain_at(v_uv, splat_hgt, splat_nrm);\n"                   \
+    "    v_local = vec3(xz.x, splat_hgt, xz.y);\n"                          \
     "    v_rel = v_local;   /* the frame's camera is the origin */\n"      \
-    "    splat_nrm = splat_normal_at(v_uv);\n"                              \
     "    float ny = max(splat_nrm.y, 0.05);\n"                              \
     "    splat_dpdx = vec3(step.x, -step.x * splat_nrm.x / ny, 0.0);\n"     \
     "    splat_dpdy = vec3(0.0, -step.y * splat_nrm.z / ny, step.y);\n"     \
@@ -139,6 +139,7 @@
     "vec4 o_color;    /* what main() stores into u_out */\n"                \
     "ivec2 splat_pixel;\n"                                                  \
     "vec3 splat_nrm;  /* the terrain normal (Listing 1) at v_uv */\n"      \
+    "float splat_hgt; /* the terrain height (m) at v_uv, smooth */\n"      \
     "vec3 splat_dpdx; /* position one pixel right, minus the position */\n" \
     "vec3 splat_dpdy; /* position one pixel down, minus the position */\n"
 
@@ -248,7 +249,7 @@ _Static_assert(SORT_KEYS == SPLAT_SORT_KEYS && SORT_TILES_MIN == SPLAT_SORT_TILE
     "    v_rel = splat_unproject(c, d);\n"                                  \
     "    v_local = v_rel + u_frame.camera.xyz;\n"                           \
     "    v_uv = v_local.xz / u_frame.terrain.xy;\n"                         \
-    "    splat_nrm = splat_normal_at(v_uv);\n"                              \
+    "    splat_terrain_at(v_uv, splat_hgt, splat_nrm);\n"                   \
     "    splat_dpdx = splat_plane_step(splat_nrm, v_rel, c + vec2(1.0, 0.0), d);\n" \
     "    splat_dpdy = splat_plane_step(splat_nrm, v_rel, c + vec2(0.0, 1.0), d);\n" \
     "    return true;\n"                                                    \
@@ -283,7 +284,7 @@ _Static_assert(SORT_KEYS == SPLAT_SORT_KEYS && SORT_TILES_MIN == SPLAT_SORT_TILE
     "void main() {\n"                                                       \
     "#ifdef SPLAT_GRADIENTS\n"                                              \
     "    vec3 p = splat_unproject(gl_FragCoord.xy, gl_FragCoord.z);\n"      \
-    "    splat_nrm = splat_normal_at(v_uv);\n"                              \
+    "    splat_terrain_at(v_uv, splat_hgt, splat_nrm);\n"                   \
     "    splat_dpdx = splat_plane_step(splat_nrm, p, gl_FragCoord.xy + vec2(1.0, 0.0),\n" \
     "                                  gl_FragCoord.z);\n"                  \
     "    splat_dpdy = splat_plane_step(splat_nrm, p, gl_FragCoord.xy + vec2(0.0, 1.0),\n" \
@@ -577,29 +578,90 @@ const char SPLAT_GLSL_PRELUDE[] =
     "#define splat_surface(j, c) splat_quad_any(c)\n"
     "#define splat_opaque(j) true\n"
     "#endif\n"
-    /* Listing 1 (Andersson 2007), with the texel aspect in metres. */
-    "vec3 splat_normal_at(vec2 uv) {\n"
+    /* The shading pass's terrain inputs, smooth between texels (issue 31):
+     * the uniform cubic B-spline over the heightfield's texels (C2, and a
+     * convex combination of the 4x4 texels around uv, so the analysis's
+     * texel min / max bound it: terrain.c), and Listing 1's cross filter
+     * (Andersson 2007, with the texel aspect in metres) on that surface.
+     * H(x-1) - H(x+1) is the same B-spline over the per-texel differences
+     * h(i-1) - h(i+1), so the normal takes the 6x6 texels around uv: 9
+     * gathers, each 2x2 texels, no filtering, the weights in float (the
+     * CPU twins: terrain.c splat_terrain_height / _normal).  The mesh and
+     * its depth stay bilinear (splat_height_at). */
+    "vec4 splat_bspline_w(float t) {\n"
+    "    float s = 1.0 - t, t2 = t * t, t3 = t2 * t;\n"
+    "    return vec4(s * s * s, 3.0 * t3 - 6.0 * t2 + 4.0,\n"
+    "                -3.0 * t3 + 3.0 * t2 + 3.0 * t + 1.0, t3) * (1.0 / 6.0);\n"
+    "}\n"
+    /* texels (k.x, k.y) .. (k.x+1, k.y+1), row k.y in .xy, row k.y+1 in
+     * .zw; gathered at their shared corner, so rounding picks no other */
+    "vec4 splat_quad(vec2 k) {\n"
+    "    return textureGather(u_height, (k + 1.0) * u_frame.texel.zw).wzxy;\n"
+    "}\n"
+    /* texel coordinate of uv, split into the first tap - 1 and fractions */
+    "vec2 splat_bspline_at(vec2 uv, out vec4 wx, out vec4 wz) {\n"
+    "    vec2 x = clamp(uv * u_frame.texel.xy - 0.5, vec2(-1.0), u_frame.texel.xy);\n"
+    "    vec2 i = floor(x), f = x - i;\n"
+    "    wx = splat_bspline_w(f.x);\n"
+    "    wz = splat_bspline_w(f.y);\n"
+    "    return i;\n"
+    "}\n"
+    "float splat_height_smooth_at(vec2 uv) {\n"
+    "    vec4 wx, wz;\n"
+    "    vec2 i = splat_bspline_at(uv, wx, wz);\n"
+    "    vec4 a = splat_quad(i + vec2(-1.0, -1.0)), b = splat_quad(i + vec2(1.0, -1.0));\n"
+    "    vec4 c = splat_quad(i + vec2(-1.0, 1.0)), d = splat_quad(i + vec2(1.0, 1.0));\n"
+    "    vec4 r = vec4(dot(wx, vec4(a.xy, b.xy)), dot(wx, vec4(a.zw, b.zw)),\n"
+    "                  dot(wx, vec4(c.xy, d.xy)), dot(wx, vec4(c.zw, d.zw)));\n"
+    "    return dot(wz, r) * u_frame.terrain.z + u_frame.terrain.w;\n"
+    "}\n"
+    /* rows z-2 .. z+3 of columns x-2 .. x+3: row r is lo[r] (columns
+     * x-2 .. x+1) and hi[r] (x .. x+3) */
+    "void splat_terrain_at(vec2 uv, out float h, out vec3 n) {\n"
+    "    vec4 wx, wz;\n"
+    "    vec2 i = splat_bspline_at(uv, wx, wz);\n"
+    "    vec4 lo[6], hi[6];\n"
+    "    for (int q = 0; q < 3; q++) {\n"
+    "        vec2 k = i + vec2(-2.0, float(2 * q - 2));\n"
+    "        vec4 a = splat_quad(k), b = splat_quad(k + vec2(2.0, 0.0));\n"
+    "        vec4 c = splat_quad(k + vec2(4.0, 0.0));\n"
+    "        lo[2 * q] = vec4(a.xy, b.xy);  hi[2 * q] = vec4(b.xy, c.xy);\n"
+    "        lo[2 * q + 1] = vec4(a.zw, b.zw);  hi[2 * q + 1] = vec4(b.zw, c.zw);\n"
+    "    }\n"
+    "    vec4 m[6];   /* columns x-1 .. x+2 */\n"
+    "    for (int r = 0; r < 6; r++) m[r] = vec4(lo[r].yzw, hi[r].z);\n"
+    "    vec4 ha, ga, gb;\n"
+    "    for (int r = 0; r < 4; r++) {\n"
+    "        ha[r] = dot(wx, m[r + 1]);\n"
+    "        ga[r] = dot(wx, lo[r + 1] - hi[r + 1]);\n"
+    "        gb[r] = dot(wx, m[r] - m[r + 2]);\n"
+    "    }\n"
+    "    h = dot(wz, ha) * u_frame.terrain.z + u_frame.terrain.w;\n"
     "    vec2 t = u_frame.texel.zw;\n"
-    "    float hd = splat_texture0(u_height, uv + vec2(0.0, -t.y)).r;\n"
-    "    float hl = splat_texture0(u_height, uv + vec2(-t.x, 0.0)).r;\n"
-    "    float hr = splat_texture0(u_height, uv + vec2(t.x, 0.0)).r;\n"
-    "    float hu = splat_texture0(u_height, uv + vec2(0.0, t.y)).r;\n"
     "    float dx = u_frame.terrain.x * t.x;\n"
     "    float dz = u_frame.terrain.y * t.y;\n"
-    "    vec3 n = vec3((hl - hr) * u_frame.terrain.z / dx, 2.0,\n"
-    "                  (hd - hu) * u_frame.terrain.z / dz);\n"
-    "    return normalize(n);\n"
+    "    n = normalize(vec3(dot(wz, ga) * u_frame.terrain.z / dx, 2.0,\n"
+    "                       dot(wz, gb) * u_frame.terrain.z / dz));\n"
     "}\n"
-    "float splat_height() { return splat_height_at(v_uv); }\n"
+    "vec3 splat_normal_at(vec2 uv) {\n"
+    "    float h;\n"
+    "    vec3 n;\n"
+    "    splat_terrain_at(uv, h, n);\n"
+    "    return n;\n"
+    "}\n"
     /* compute, and fragments with gradients: computed once per pixel
      * before the composite (for the derivatives) */
     "#if defined(SPLAT_COMPUTE)\n"
     "vec3 splat_normal() { return splat_nrm; }\n"
+    "float splat_height() { return splat_hgt; }\n"
     "#elif defined(SPLAT_GRADIENTS)\n"
     "vec3 splat_nrm, splat_dpdx, splat_dpdy;  /* FRAGMENT_MAIN sets them */\n"
+    "float splat_hgt;\n"
     "vec3 splat_normal() { return splat_nrm; }\n"
+    "float splat_height() { return splat_hgt; }\n"
     "#else\n"
     "vec3 splat_normal() { return splat_normal_at(v_uv); }\n"
+    "float splat_height() { return splat_height_smooth_at(v_uv); }\n"
     "#endif\n"
     "float splat_slope() { return 1.0 - splat_normal().y; }\n"
     "vec3 splat_position() { return vec3(v_local.x, splat_height(), v_local.z); }\n"

@@ -500,7 +500,11 @@ typedef struct splat_push {
  *                          at any distance: precision.c builds on it)
  *     vec3 splat_view_direction() (unit, surface -> camera, terrain-local)
  *     float splat_destruction()   float splat_painted(int layer)
- *     float splat_height_at(vec2 uv)  vec3 splat_normal_at(vec2 uv)
+ *     float splat_height_at(vec2 uv)  the mesh's height (bilinear, metres)
+ *     float splat_height_smooth_at(vec2 uv)  vec3 splat_normal_at(vec2 uv)
+ *     void splat_terrain_at(vec2 uv, out float h, out vec3 n)
+ *                          the shading inputs' height and normal: the cubic
+ *                          B-spline over the texels and Listing 1 on it
  *     void splat_finish(vec3 albedo, vec3 normal, float roughness,
  *                       float height, float coverage)
  *     uint splat_view()   the debug view (SPLAT_SPEC_VIEW above)
@@ -525,11 +529,12 @@ extern const char SPLAT_GLSL_COMBO_COLOR[];
 extern const char SPLAT_GLSL_TERRAIN[];
 
 /* The normal filter of Andersson 2007 Listing 1, honouring texel aspect, on the
- * CPU.  `h` returns the normalised height (0..1) at a texel, clamped to the
- * edges; the result is what splat_normal_at() computes at texel centres:
+ * CPU, from the heights one texel either side (normalised, 0..1):
  *   n = normalize((hl - hr) * maxh / dx, 2, (hd - hu) * maxh / dz)
  * where dx, dz are the texel spacings in metres (hl, hr: x-1, x+1; hd, hu:
- * z-1, z+1).  Shared by the analysis and the tests. */
+ * z-1, z+1).  splat_normal_at() applies it to the B-spline surface, whose
+ * differences hl - hr and hd - hu terrain.c passes as (a, 0, b, 0).
+ * Shared by terrain.c and the tests. */
 void splat_normal_filter(double hl, double hr, double hd, double hu,
                          double maxh, double dx, double dz, double n[3]);
 

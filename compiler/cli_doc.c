@@ -122,7 +122,10 @@ static void inputs_table(FILE *out)
           "Read as node types (`node s : terrain.slope`) or as values\n"
           "(`x = terrain.position.xz`); IR_INPUTS in compiler/ir.h.  The range is every\n"
           "value the input can take (a scene's terrain bounds height and position\n"
-          "tighter); `splatc eval --at KEY=…` sets it.\n\n"
+          "tighter); `splatc eval --at KEY=…` sets it.  Height, normal and slope\n"
+          "read smoothly between the heightfield's texels: the cubic B-spline over\n"
+          "them (it never overshoots the texels), the normal Listing 1's cross\n"
+          "filter on it, so mask edges follow curves, not the texel grid.\n\n"
           "| input | type | range (per component) | eval key |\n|---|---|---|---|\n", out);
     for (int k = 0; k < IR_IN_COUNT; k++) {
         const ir_input_info *in = ir_input_get((ir_input_kind)k);

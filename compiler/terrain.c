@@ -7,22 +7,27 @@
  *
  * Why the bounds are sound.  A fragment whose uv lies in texels
  * [x0, x1) x [z0, z1) sits at texel coordinate x = u*W - 0.5 in
- * [x0 - 0.5, x1 - 0.5], so bilinear filtering reads texels x0-1 .. x1 (the
- * rectangle plus a one-texel ring, clamped to the edges): the "footprint".
- *  - Height is a convex combination of footprint texels: [min, max].
+ * [x0 - 0.5, x1 - 0.5].  The shading inputs (abi.c splat_terrain_at) are
+ * the uniform cubic B-spline H over the texels, whose 4 taps per axis are
+ * floor(x) - 1 .. floor(x) + 2, so they read texels x0-2 .. x1+1 (the
+ * rectangle plus a two-texel ring, clamped to the edges): the "footprint".
+ * (The mesh's bilinear heights read x0-1 .. x1, inside it.)
+ *  - Height is a convex combination of footprint texels (the B-spline's
+ *    weights are >= 0 and sum to 1; it never overshoots): [min, max].
  *  - Listing 1's unnormalised normal is (a, 2, b) with
  *      a = (H(x-1) - H(x+1)) * maxh/dx,  b = (H(z-1) - H(z+1)) * maxh/dz,
- *    and because both taps share their bilinear weights, a is the bilinear
- *    interpolation of the per-texel differences gx(i,j) = h(i-1,j) - h(i+1,j)
- *    (indices clamped *after* the +-1; gx = 0 beyond the edge), likewise b.
+ *    and because both taps share their weights, a is the same B-spline of
+ *    the per-texel differences gx(i,j) = h(i-1,j) - h(i+1,j) (indices
+ *    clamped *after* the +-1; gx = 0 beyond the edge), likewise b.
  *    So a and b lie in [min, max] of gx, gz over the footprint; the
  *    normalised components and slope = 1 - n.y then follow by monotonicity
  *    (normal_bounds below).
  * GPU error, so the bounds hold on real pixels (documented constants):
- *  - the two taps of a difference may get bilinear weights that differ by
- *    one step of sub-texel precision (8 bits on lavapipe, NVIDIA and AMD;
- *    SUBTEXEL_EPS adds margin for the float uv + texel offset): widens gx,
- *    gz by SUBTEXEL_EPS * (largest difference of neighbouring texels);
+ *  - the GPU computes the weights in float from a float uv, so they can
+ *    differ from the exact ones by a few ulps, and before the B-spline
+ *    the bilinear filter's two taps differed by a step of sub-texel
+ *    precision; SUBTEXEL_EPS stays as margin for both: widens gx, gz by
+ *    SUBTEXEL_EPS * (largest difference of neighbouring texels);
  *  - texel conversion and filtering arithmetic: UNORM16_EPS (one 16-bit
  *    step) on gx, gz and on heights that vary; FLOAT_EPS on the normalised
  *    normal and slope, and times the magnitudes involved on heights
@@ -350,20 +355,62 @@ static double bilinear(const splat_terrain *t, double u, double v)
     return top + (bot - top) * az;
 }
 
-double splat_terrain_height(const splat_terrain *t, double u, double v)
+double splat_terrain_mesh_height(const splat_terrain *t, double u, double v)
 {
     return bilinear(t, u, v) * t->max_height + t->height_offset;
 }
 
+/* The uniform cubic B-spline at texel coordinate x = u*W - 0.5 (clamped
+ * as bilinear() does): the first of its 4 taps, ix - 1, in *ix, and
+ * their weights (abi.c splat_bspline_w). */
+static void bspline(double u, int n, int *ix, double w[4])
+{
+    double x = fmin(fmax(u * n - 0.5, -1.0), (double)n);
+    double f = floor(x), t = x - f, s = 1.0 - t, t2 = t * t, t3 = t2 * t;
+    *ix = (int)f;
+    w[0] = s * s * s / 6.0;
+    w[1] = (3.0 * t3 - 6.0 * t2 + 4.0) / 6.0;
+    w[2] = (-3.0 * t3 + 3.0 * t2 + 3.0 * t + 1.0) / 6.0;
+    w[3] = t3 / 6.0;
+}
+
+/* The B-spline's value, and Listing 1's differences on it: a = H(x-1) -
+ * H(x+1), b = H(z-1) - H(z+1), each the B-spline of the per-texel
+ * differences (terrain.c's header; abi.c splat_terrain_at). */
+static double smooth(const splat_terrain *t, double u, double v, double *a, double *b)
+{
+    int ix, iz;
+    double wx[4], wz[4], h = 0, ga = 0, gb = 0;
+    bspline(u, t->width, &ix, wx);
+    bspline(v, t->height, &iz, wz);
+    for (int j = 0; j < 4; j++) {
+        int z = iz - 1 + j;
+        double rh = 0, ra = 0, rb = 0;
+        for (int i = 0; i < 4; i++) {
+            int x = ix - 1 + i;
+            rh += wx[i] * texel(t, x, z);
+            ra += wx[i] * (texel(t, x - 1, z) - texel(t, x + 1, z));
+            rb += wx[i] * (texel(t, x, z - 1) - texel(t, x, z + 1));
+        }
+        h += wz[j] * rh;
+        ga += wz[j] * ra;
+        gb += wz[j] * rb;
+    }
+    if (a) *a = ga;
+    if (b) *b = gb;
+    return h;
+}
+
+double splat_terrain_height(const splat_terrain *t, double u, double v)
+{
+    return smooth(t, u, v, NULL, NULL) * t->max_height + t->height_offset;
+}
+
 void splat_terrain_normal(const splat_terrain *t, double u, double v, double n[3])
 {
-    double tx = 1.0 / t->width, tz = 1.0 / t->height;
-    double hd = bilinear(t, u, v - tz);
-    double hl = bilinear(t, u - tx, v);
-    double hr = bilinear(t, u + tx, v);
-    double hu = bilinear(t, u, v + tz);
-    splat_normal_filter(hl, hr, hd, hu, t->max_height,
-                        t->size[0] * tx, t->size[1] * tz, n);
+    double tx = 1.0 / t->width, tz = 1.0 / t->height, a, b;
+    smooth(t, u, v, &a, &b);
+    splat_normal_filter(a, 0.0, b, 0.0, t->max_height, t->size[0] * tx, t->size[1] * tz, n);
 }
 
 /* ---- ranges ------------------------------------------------------------- */
@@ -430,11 +477,11 @@ void splat_terrain_ranges(const splat_terrain *t, int x0, int z0, int x1, int z1
     int gxmin = 65535, gxmax = -65535;     /* h(i-1) - h(i+1)              */
     int gzmin = 65535, gzmax = -65535;
     int step = 0;                          /* largest neighbour difference */
-    for (int j = z0 - 1; j <= z1; j++) {
+    for (int j = z0 - 2; j <= z1 + 1; j++) {
         size_t row = (size_t)clampi(j, 0, t->height - 1) * W;
         size_t rowd = (size_t)clampi(j - 1, 0, t->height - 1) * W;
         size_t rowu = (size_t)clampi(j + 1, 0, t->height - 1) * W;
-        for (int i = x0 - 1; i <= x1; i++) {
+        for (int i = x0 - 2; i <= x1 + 1; i++) {
             size_t c = (size_t)clampi(i, 0, t->width - 1);
             size_t l = (size_t)clampi(i - 1, 0, t->width - 1);
             size_t r = (size_t)clampi(i + 1, 0, t->width - 1);

@@ -79,10 +79,14 @@ uint8_t *splat_raster_mask(const char *what, const char *path, int *w, int *h,
 
 /* Normalised height (0..1) of texel (x, z), clamped to the edges. */
 double splat_terrain_texel(const splat_terrain *t, int x, int z);
-/* The CPU twins of the ABI's splat_height_at / splat_normal_at: bilinear
- * (clamp to edge) at heightfield uv, and Listing 1's cross filter. */
+/* The CPU twins of the ABI's shading inputs (abi.c splat_terrain_at,
+ * splat_height_smooth_at, splat_normal_at): the uniform cubic B-spline
+ * over the texels (clamp to edge) at heightfield uv, and Listing 1's cross
+ * filter on it.  splat_terrain_mesh_height: the mesh's bilinear height
+ * (splat_height_at), which the geometry and its depth use. */
 double splat_terrain_height(const splat_terrain *t, double u, double v);
 void   splat_terrain_normal(const splat_terrain *t, double u, double v, double n[3]);
+double splat_terrain_mesh_height(const splat_terrain *t, double u, double v);
 
 /* Sound ranges of the terrain inputs over a rectangle of texels
  * [x0, x1) x [z0, z1): every fragment whose uv falls in that rectangle

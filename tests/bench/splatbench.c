@@ -258,6 +258,10 @@ static const char sobel_normal[] =
     "    float gz = ((h00 + 2.0 * h10 + h20) - (h02 + 2.0 * h12 + h22)) * 0.25;\n"
     "    vec3 n = vec3(gx * u_frame.terrain.z / dx, 2.0, gz * u_frame.terrain.z / dz);\n"
     "    return normalize(n);\n"
+    "}\n"
+    "void splat_terrain_at(vec2 uv, out float h, out vec3 n) {\n"
+    "    h = splat_height_smooth_at(uv);\n"
+    "    n = splat_normal_at(uv);\n"
     "}\n";
 
 /* The preview lighting before issue 16 (abi.c's splat_light then). */
@@ -290,6 +294,10 @@ static const char analytic_normal[] =
     "    vec3 n = vec3(-du * u_frame.terrain.z / u_frame.terrain.x, 1.0,\n"
     "                  -dv * u_frame.terrain.z / u_frame.terrain.y);\n"
     "    return normalize(n);\n"
+    "}\n"
+    "void splat_terrain_at(vec2 uv, out float h, out vec3 n) {\n"
+    "    h = splat_height_smooth_at(uv);\n"
+    "    n = splat_normal_at(uv);\n"
     "}\n";
 
 /* GLSL of a combination with the variant's change; NULL if the text does
@@ -309,9 +317,8 @@ static char *transform_glsl(const char *src, kind k, const char *name)
         at += strlen("#version 450\n");
         end = at;
         insert = "precision mediump float;\n";
-    } else {
-        const char *fn = k == K_LAMBERT ? "vec3 splat_light(vec3 albedo, vec3 n, float rough,"
-                                        : "vec3 splat_normal_at(vec2 uv) {\n";
+    } else if (k == K_LAMBERT) {
+        const char *fn = "vec3 splat_light(vec3 albedo, vec3 n, float rough,";
         at = strstr(src, fn);
         end = at ? strstr(at, "\n}\n") : NULL;
         if (!end) {
@@ -319,7 +326,21 @@ static char *transform_glsl(const char *src, kind k, const char *name)
             return NULL;
         }
         end += 3;
-        insert = k == K_SOBEL ? sobel_normal : k == K_LAMBERT ? lambert_light : analytic_normal;
+        insert = lambert_light;
+    } else {
+        /* the prelude's splat_terrain_at (height and normal, one pass over
+         * the texels) and the splat_normal_at after it: the variant's
+         * normal, the height apart */
+        const char *fn = "void splat_terrain_at(vec2 uv, out float h, out vec3 n) {\n";
+        at = strstr(src, fn);
+        const char *nf = at ? strstr(at, "vec3 splat_normal_at(vec2 uv) {\n") : NULL;
+        end = nf ? strstr(nf, "\n}\n") : NULL;
+        if (!end) {
+            fprintf(stderr, "splatbench: %s: no '%s' to replace\n", name, fn);
+            return NULL;
+        }
+        end += 3;
+        insert = k == K_SOBEL ? sobel_normal : analytic_normal;
     }
     size_t a = (size_t)(at - src), b = strlen(end), c = strlen(insert);
     char *out = xcalloc(a + b + c + 1, 1);

@@ -12,5 +12,7 @@ endfunction()
 
 splat_gpu_test(test_harness)
 splat_gpu_test(test_gpu_agree)
+# the B-spline height and normal (abi.c) against terrain.c's twins
+splat_gpu_test(test_terrain_gpu)
 # random_ir.h: the IR's random graph generator, shared with the CPU test
 target_include_directories(test_gpu_agree PRIVATE ${PROJECT_SOURCE_DIR}/tests/unit)

@@ -181,6 +181,16 @@ if(TARGET splatrt AND TARGET splatview)
              WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
     set_tests_properties(render.dclass PROPERTIES LABELS render TIMEOUT 900
                          FIXTURES_REQUIRED colorado_pack ENVIRONMENT "SPLAT_VALIDATE=1")
+    # issue 31, masks without stair steps: snowfield's mask edge at
+    # colorado's valley camera follows a smooth curve (stairs.c), in both
+    # shading paths
+    add_executable(stairs ${RENDER_DIR}/stairs.c)
+    target_link_libraries(stairs splatrt m)
+    add_test(NAME render.stairs_colorado
+             COMMAND sh ${RENDER_DIR}/stairs.sh $<TARGET_FILE:splatview> $<TARGET_FILE:stairs>
+                     ${RENDER_OUT}/colorado ${RENDER_OUT}/stairs)
+    set_tests_properties(render.stairs_colorado PROPERTIES LABELS render TIMEOUT 600
+                         FIXTURES_REQUIRED colorado_pack ENVIRONMENT "SPLAT_VALIDATE=1")
     # the undergrowth's cells, GPU passes and pack sections under the
     # sanitizers too
     set_tests_properties(render.undergrowth PROPERTIES LABELS "render;asan")

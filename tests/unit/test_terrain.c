@@ -284,9 +284,10 @@ static void test_load_errors(void **state)
     assert_null(t.texels);
 }
 
-/* ---- the CPU twins of splat_height_at / splat_normal_at ------------------ */
+/* ---- the CPU twins of the ABI's height and normal ----------------------- */
 
-static void test_height_bilinear_clamped(void **state)
+/* The mesh's height (splat_height_at): bilinear between texel centres. */
+static void test_mesh_height_bilinear_clamped(void **state)
 {
     splat_terrain t;
     make_terrain(&t, 4, 2, 40, 20, 100, -10);
@@ -294,70 +295,127 @@ static void test_height_bilinear_clamped(void **state)
                              65535, 0, 39321, 52428 };
     memcpy(t.texels, px, sizeof px);
     /* Texel centres: the texel, scaled and offset. */
-    assert_float_equal(splat_terrain_height(&t, 1.5 / 4, 0.5 / 2), 90.0, 1e-9);
-    assert_float_equal(splat_terrain_height(&t, 3.5 / 4, 1.5 / 2), 70.0, 1e-9);
+    assert_float_equal(splat_terrain_mesh_height(&t, 1.5 / 4, 0.5 / 2), 90.0, 1e-9);
+    assert_float_equal(splat_terrain_mesh_height(&t, 3.5 / 4, 1.5 / 2), 70.0, 1e-9);
     /* Halfway between texels 2 and 3 of row 0: (20 + 40) / 2 - 10. */
-    assert_float_equal(splat_terrain_height(&t, 3.0 / 4, 0.5 / 2), 20.0, 1e-9);
+    assert_float_equal(splat_terrain_mesh_height(&t, 3.0 / 4, 0.5 / 2), 20.0, 1e-9);
     /* The middle of four texels 0, 1 (row 0) and 0, 1 (row 1): all 0.5. */
-    assert_float_equal(splat_terrain_height(&t, 1.0 / 4, 1.0 / 2), 40.0, 1e-9);
+    assert_float_equal(splat_terrain_mesh_height(&t, 1.0 / 4, 1.0 / 2), 40.0, 1e-9);
     /* Clamp to edge: uv 0 and beyond read the corner texel. */
-    assert_float_equal(splat_terrain_height(&t, 0, 0), -10.0, 1e-9);
-    assert_float_equal(splat_terrain_height(&t, -3, -7), -10.0, 1e-9);
-    assert_float_equal(splat_terrain_height(&t, 1, 1), 70.0, 1e-9);
-    assert_float_equal(splat_terrain_height(&t, 1e30, 1e30), 70.0, 1e-9);
+    assert_float_equal(splat_terrain_mesh_height(&t, 0, 0), -10.0, 1e-9);
+    assert_float_equal(splat_terrain_mesh_height(&t, -3, -7), -10.0, 1e-9);
+    assert_float_equal(splat_terrain_mesh_height(&t, 1, 1), 70.0, 1e-9);
+    assert_float_equal(splat_terrain_mesh_height(&t, 1e30, 1e30), 70.0, 1e-9);
     splat_terrain_free(&t);
 }
 
-/* Listing 1 by hand on a 5x5 heightfield with non-square texels:
- * dx = 50 m / 5 = 10 m, dz = 100 m / 5 = 20 m, max height 100 m.  Around
- * texel (2, 2): left 0.6, right 0.4, down (z-1) 0.6, up (z+1) 0.2, so
- *   n.x = (0.6 - 0.4) * 100 / 10 = 2,  n.z = (0.6 - 0.2) * 100 / 20 = 2,
- *   n = normalize(2, 2, 2) = (1, 1, 1) / sqrt(3),  slope = 1 - 1/sqrt(3). */
+/* The shading height: the uniform cubic B-spline.  By hand: at a texel
+ * centre its weights are 1/6, 4/6, 1/6 per axis; halfway between two
+ * centres 1/48, 23/48, 23/48, 1/48.  Row z = 1 of a 5 x 3 field varies
+ * (0, 0.6, 0.3, 0.9, 0.6); rows 0 and 2 equal it, so z drops out. */
+static void test_height_bspline_by_hand(void **state)
+{
+    splat_terrain t;
+    make_terrain(&t, 5, 3, 50, 30, 100, -10);
+    const double row[5] = { 0, 0.6, 0.3, 0.9, 0.6 };
+    for (int z = 0; z < 3; z++)
+        for (int x = 0; x < 5; x++)
+            t.texels[z * 5 + x] = (uint16_t)lround(row[x] * 65535);
+    double r[5];
+    for (int x = 0; x < 5; x++) r[x] = t.texels[5 + x] / 65535.0;
+    /* texel 2's centre: (0.6 + 4 * 0.3 + 0.9) / 6 */
+    assert_float_equal(splat_terrain_height(&t, 2.5 / 5, 1.5 / 3),
+                       (r[1] + 4 * r[2] + r[3]) / 6 * 100 - 10, 1e-9);
+    /* between texels 2 and 3 */
+    assert_float_equal(splat_terrain_height(&t, 3.0 / 5, 0.5 / 3),
+                       (r[1] + 23 * r[2] + 23 * r[3] + r[4]) / 48 * 100 - 10, 1e-9);
+    /* clamp to edge: texel 0's centre reads texel 0 twice on its left */
+    assert_float_equal(splat_terrain_height(&t, 0.5 / 5, 2.5 / 3),
+                       (5 * r[0] + r[1]) / 6 * 100 - 10, 1e-9);
+    assert_float_equal(splat_terrain_height(&t, -3, 1e30), r[0] * 100 - 10, 1e-9);
+    assert_float_equal(splat_terrain_height(&t, 1e30, -7), r[4] * 100 - 10, 1e-9);
+
+    /* Smooth: the height's slope along x is continuous across the texel
+     * boundaries, where a bilinear height's jumps.  Central differences
+     * just left and right of the centre of texel 2 (x = 2.5): */
+    double e = 1e-4 / 5, u = 2.5 / 5, v = 1.5 / 3;
+    double sl = (splat_terrain_height(&t, u, v) - splat_terrain_height(&t, u - e, v)) / e;
+    double sr = (splat_terrain_height(&t, u + e, v) - splat_terrain_height(&t, u, v)) / e;
+    assert_true(fabs(sl - sr) < 1e-2 * (fabs(sl) + fabs(sr)) + 1e-6);
+    double ml = (splat_terrain_mesh_height(&t, u, v) - splat_terrain_mesh_height(&t, u - e, v)) / e;
+    double mr = (splat_terrain_mesh_height(&t, u + e, v) - splat_terrain_mesh_height(&t, u, v)) / e;
+    assert_true(fabs(ml - mr) > 100);   /* 0.3 -> 0.9 after 0.6 -> 0.3: a kink */
+    splat_terrain_free(&t);
+}
+
+/* Listing 1 on the B-spline surface, by hand: the B-spline reproduces a
+ * plane, so away from the edges the normal of a planar heightfield is the
+ * plane's, at any uv.  9 x 9 texels, dx = 90 m / 9 = 10 m, dz = 180 m / 9
+ * = 20 m, max height 100 m, h = 0.1 + 0.02 x + 0.05 z (texel units): one
+ * texel further along x the height grows 0.02 * 100 = 2 m over 10 m, so
+ *   n.x = (h(x-1) - h(x+1)) * 100 / 10 = -0.4,  n.z = -0.1 * 100 / 20 = -0.5. */
 static void test_normal_listing1_by_hand(void **state)
 {
     splat_terrain t;
-    make_terrain(&t, 5, 5, 50, 100, 100, 0);
-    for (int i = 0; i < 25; i++) t.texels[i] = 26214;        /* 0.4 */
-    t.texels[2 * 5 + 1] = 39321;                             /* left  0.6 */
-    t.texels[2 * 5 + 3] = 26214;                             /* right 0.4 */
-    t.texels[1 * 5 + 2] = 39321;                             /* down  0.6 */
-    t.texels[3 * 5 + 2] = 13107;                             /* up    0.2 */
-    double n[3];
-    splat_terrain_normal(&t, 2.5 / 5, 2.5 / 5, n);
-    double k = 1 / sqrt(3.0);
-    assert_float_equal(n[0], k, 1e-12);
-    assert_float_equal(n[1], k, 1e-12);
-    assert_float_equal(n[2], k, 1e-12);
+    make_terrain(&t, 9, 9, 90, 180, 100, 0);
+    /* 65535 * 0.02 and 65535 * 0.05 are not whole, so the 16-bit texels
+     * hold steps of 1311 and 3277: the plane is exact in those. */
+    for (int z = 0; z < 9; z++)
+        for (int x = 0; x < 9; x++)
+            t.texels[z * 9 + x] = (uint16_t)(6554 + 1311 * x + 3277 * z);
+    double a = -2 * 1311 / 65535.0 * 100 / 10, b = -2 * 3277 / 65535.0 * 100 / 20;
+    double len = sqrt(a * a + 4 + b * b);
+    for (int k = 0; k < 50; k++) {
+        /* taps reach 3 texels either side: x in [3, 5] keeps them inside */
+        double x = 3 + 2 * rnd01(), z = 3 + 2 * rnd01(), n[3];
+        splat_terrain_normal(&t, (x + 0.5) / 9, (z + 0.5) / 9, n);
+        assert_float_equal(n[0], a / len, 1e-12);
+        assert_float_equal(n[1], 2 / len, 1e-12);
+        assert_float_equal(n[2], b / len, 1e-12);
+        double h = (6554 + 1311 * x + 3277 * z) / 65535.0 * 100;
+        assert_float_equal(splat_terrain_height(&t, (x + 0.5) / 9, (z + 0.5) / 9), h, 1e-9);
+    }
 
-    /* The ABI's C helper gives the same at the texel centre. */
-    double m[3];
+    /* The ABI's C helper is Listing 1's formula. */
+    double m[3], k3 = 1 / sqrt(3.0);
     splat_normal_filter(0.6, 0.4, 0.6, 0.2, 100, 10, 20, m);
-    for (int c = 0; c < 3; c++) assert_float_equal(m[c], k, 1e-12);
-
-    /* Square texels (x and z both 10 m) make the z gradient twice as
-     * steep: n = normalize(2, 2, 4). */
-    t.size[1] = 50;
-    splat_terrain_normal(&t, 2.5 / 5, 2.5 / 5, n);
-    double len = sqrt(4 + 4 + 16.0);
-    assert_float_equal(n[0], 2 / len, 1e-12);
-    assert_float_equal(n[1], 2 / len, 1e-12);
-    assert_float_equal(n[2], 4 / len, 1e-12);
-
-    /* Between texel centres the taps are bilinear: halfway between (2,2)
-     * and (3,2) the left tap reads (0.6 + 0.4)/2 = 0.5 and the right tap
-     * (0.4 + 0.4)/2, the down/up taps (0.6+0.4)/2 and (0.2+0.4)/2. */
-    t.size[1] = 100;
-    splat_terrain_normal(&t, 3.0 / 5, 2.5 / 5, n);
-    double a = (0.5 - 0.4) * 100 / 10, b = (0.5 - 0.3) * 100 / 20;
-    len = sqrt(a * a + 4 + b * b);
-    assert_float_equal(n[0], a / len, 1e-12);
-    assert_float_equal(n[1], 2 / len, 1e-12);
-    assert_float_equal(n[2], b / len, 1e-12);
+    for (int c = 0; c < 3; c++) assert_float_equal(m[c], k3, 1e-12);
 
     /* Flat terrain: straight up. */
-    for (int i = 0; i < 25; i++) t.texels[i] = 777;
+    for (int i = 0; i < 81; i++) t.texels[i] = 777;
+    double n[3];
     splat_terrain_normal(&t, 0.37, 0.81, n);
     assert_true(n[0] == 0 && n[1] == 1 && n[2] == 0);
+    splat_terrain_free(&t);
+}
+
+/* The slope is smooth across texel boundaries: one raised texel makes a
+ * bump whose slope, sampled densely along a line through it, never jumps
+ * between neighbouring samples by more than a smooth function's step
+ * would (the bilinear cross filter's slope has kinks there, not jumps, so
+ * the check is on the second difference: bounded for the B-spline). */
+static void test_slope_smooth(void **state)
+{
+    splat_terrain t;
+    make_terrain(&t, 16, 16, 160, 160, 10, 0);
+    for (int i = 0; i < 256; i++) t.texels[i] = 20000;
+    t.texels[8 * 16 + 8] = 40000;
+    const int N = 4000;
+    double prev[2] = { 0, 0 }, worst = 0;
+    for (int k = 0; k < N; k++) {
+        double x = 5 + 7.0 * k / N, n[3];
+        splat_terrain_normal(&t, x / 16, 8.3 / 16, n);
+        double s = 1 - n[1];
+        if (k >= 2) {
+            double d2 = fabs(s - 2 * prev[1] + prev[0]) * (N / 7.0) * (N / 7.0);
+            worst = fmax(worst, d2);
+        }
+        prev[0] = prev[1];
+        prev[1] = s;
+    }
+    /* A C1 slope has a bounded second difference (about 0.05 here); a
+     * kinked one's grows with N (about N / 7 * the kink, hundreds). */
+    assert_true(worst < 1.0);
     splat_terrain_free(&t);
 }
 
@@ -407,8 +465,8 @@ static void check_ranges(const splat_terrain *t, int x0, int z0, int x1, int z1,
     }
     /* Not vacuous: the height bounds are those of the footprint texels. */
     int lo = 65535, hi = 0;
-    for (int z = z0 - 1; z <= z1; z++)
-        for (int x = x0 - 1; x <= x1; x++) {
+    for (int z = z0 - 2; z <= z1 + 1; z++)
+        for (int x = x0 - 2; x <= x1 + 1; x++) {
             int v = (int)lround(splat_terrain_texel(t, x, z) * 65535);
             lo = v < lo ? v : lo;
             hi = v > hi ? v : hi;
@@ -456,33 +514,59 @@ static void test_ranges_flat_and_tight(void **state)
     assert_true(e.normal[0].lo > -2e-4 && e.normal[0].hi < 2e-4);
     assert_true(e.normal[2].lo > -2e-4 && e.normal[2].hi < 2e-4);
 
-    /* A single steep texel just outside the rectangle's one-texel ring does
-     * not widen it; one inside the ring does (bilinear footprint). */
-    t.texels[4 * 16 + 10] = 65535;                 /* x = 10: two away */
+    /* A single steep texel just outside the rectangle's two-texel ring does
+     * not widen it; one inside the ring does (the B-spline's footprint). */
+    t.texels[4 * 16 + 10] = 65535;                 /* x = 10: three away */
     splat_terrain_ranges(&t, 4, 4, 8, 8, &e);
     assert_true(e.height.hi < h + 1e-3);
-    t.texels[4 * 16 + 8] = 65535;                  /* x = 8: the ring */
+    t.texels[4 * 16 + 9] = 65535;                  /* x = 9: the ring */
     splat_terrain_ranges(&t, 4, 4, 8, 8, &e);
     assert_true(e.height.hi >= 205 - 1e-9);
     assert_true(e.slope.hi > 0.1);
     splat_terrain_free(&t);
 }
 
-/* A model of the GPU: every tap of the cross filter gets its own bilinear
- * weights, quantised to 8 bits (rounded or truncated), from a uv offset by
- * a float-rounded texel size.  The ranges must still hold. */
-static double tap_gpu(const splat_terrain *t, double u, double v, int mode)
+/* A model of the GPU (abi.c splat_terrain_at): the texel coordinate, the
+ * B-spline's weights and every sum in float, the fraction nudged by a few
+ * ulps either way (mode) as a different rounding order would.  The ranges
+ * must still hold. */
+static void gpu_smooth(const splat_terrain *t, float u, float v, int mode, double *hgt,
+                       double n[3])
 {
-    double x = (float)(u * t->width) - 0.5, z = (float)(v * t->height) - 0.5;
-    double fx = floor(x), fz = floor(z);
-    double ax = x - fx, az = z - fz;
-    ax = mode & 1 ? floor(ax * 256) / 256 : round(ax * 256) / 256;
-    az = mode & 2 ? floor(az * 256) / 256 : round(az * 256) / 256;
-    int ix = (int)fx, iz = (int)fz;
-    double h00 = splat_terrain_texel(t, ix, iz), h10 = splat_terrain_texel(t, ix + 1, iz);
-    double h01 = splat_terrain_texel(t, ix, iz + 1), h11 = splat_terrain_texel(t, ix + 1, iz + 1);
-    double a = h00 + (h10 - h00) * ax, b = h01 + (h11 - h01) * ax;
-    return (float)(a + (b - a) * az);
+    float x = u * (float)t->width - 0.5f, z = v * (float)t->height - 0.5f;
+    x = fminf(fmaxf(x, -1.0f), (float)t->width);
+    z = fminf(fmaxf(z, -1.0f), (float)t->height);
+    float ix = floorf(x), iz = floorf(z), f[2] = { x - ix, z - iz }, w[2][4];
+    for (int a = 0; a < 2; a++) {
+        float q = f[a];
+        if (mode & (1 << a)) q = nextafterf(nextafterf(q, 2.0f), 2.0f);
+        if (mode & (4 << a)) q = nextafterf(nextafterf(q, -1.0f), -1.0f);
+        q = fminf(fmaxf(q, 0.0f), 1.0f);
+        float s = 1.0f - q, q2 = q * q, q3 = q2 * q;
+        w[a][0] = s * s * s * (1.0f / 6.0f);
+        w[a][1] = (3.0f * q3 - 6.0f * q2 + 4.0f) * (1.0f / 6.0f);
+        w[a][2] = (-3.0f * q3 + 3.0f * q2 + 3.0f * q + 1.0f) * (1.0f / 6.0f);
+        w[a][3] = q3 * (1.0f / 6.0f);
+    }
+#define TX(i, j) ((float)splat_terrain_texel(t, (int)ix + (i), (int)iz + (j)))
+    float h = 0, ga = 0, gb = 0;
+    for (int j = 0; j < 4; j++) {
+        float rh = 0, ra = 0, rb = 0;
+        for (int i = 0; i < 4; i++) {
+            rh += w[0][i] * TX(i - 1, j - 1);
+            ra += w[0][i] * (TX(i - 2, j - 1) - TX(i, j - 1));
+            rb += w[0][i] * (TX(i - 1, j - 2) - TX(i - 1, j));
+        }
+        h += w[1][j] * rh;
+        ga += w[1][j] * ra;
+        gb += w[1][j] * rb;
+    }
+#undef TX
+    *hgt = (float)(h * (float)t->max_height + (float)t->height_offset);
+    float dx = (float)t->size[0] / t->width, dz = (float)t->size[1] / t->height;
+    float m[3] = { ga * (float)t->max_height / dx, 2.0f, gb * (float)t->max_height / dz };
+    float len = sqrtf(m[0] * m[0] + m[1] * m[1] + m[2] * m[2]);
+    for (int c = 0; c < 3; c++) n[c] = m[c] / len;
 }
 
 static void test_ranges_sound_gpu_model(void **state)
@@ -492,7 +576,6 @@ static void test_ranges_sound_gpu_model(void **state)
      * keep the normal sensitive to every error of the taps. */
     make_terrain(&t, 33, 33, 33, 66, 2, 0);
     for (int i = 0; i < 33 * 33; i++) t.texels[i] = (uint16_t)rnd();
-    float tx = (float)(1.0 / 33), tz = (float)(1.0 / 33);
     for (int iter = 0; iter < 400; iter++) {
         int x0 = (int)(rnd() % 30), z0 = (int)(rnd() % 30);
         int x1 = x0 + 1 + (int)(rnd() % 2), z1 = z0 + 1 + (int)(rnd() % 2);
@@ -500,24 +583,26 @@ static void test_ranges_sound_gpu_model(void **state)
         splat_terrain_ranges(&t, x0, z0, x1, z1, &e);
         for (int s = 0; s < 300; s++) {
             double fu = x0 + rnd01() * (x1 - x0), fv = z0 + rnd01() * (z1 - z0);
-            if (s % 2) {    /* near texel centres, where rounding flips */
+            if (s % 2) {    /* near texel centres, where the taps change */
                 fu = floor(fu) + 0.5 + (rnd01() - 0.5) * 0.01;
                 fv = floor(fv) + 0.5 + (rnd01() - 0.5) * 0.01;
             }
-            float u = (float)(fu / 33), v = (float)(fv / 33);
-            int mode = (int)(rnd() % 4);
-            double hd = tap_gpu(&t, u, (float)(v - tz), mode);
-            double hl = tap_gpu(&t, (float)(u - tx), v, mode ^ 1);
-            double hr = tap_gpu(&t, (float)(u + tx), v, mode);
-            double hu = tap_gpu(&t, u, (float)(v + tz), mode ^ 2);
-            double n[3];
-            splat_normal_filter(hl, hr, hd, hu, t.max_height,
-                                t.size[0] / 33, t.size[1] / 33, n);
+            double h, n[3];
+            gpu_smooth(&t, (float)(fu / 33), (float)(fv / 33), (int)(rnd() % 16), &h, n);
             for (int c = 0; c < 3; c++) assert_true(in(e.normal[c], n[c]));
             assert_true(in(e.slope, 1 - n[1]));
-            double h = tap_gpu(&t, u, v, mode) * t.max_height + t.height_offset;
             assert_true(in(e.height, h));
         }
+    }
+    /* A flat area stays flat in float: slope within the margin of 0. */
+    for (int i = 0; i < 33 * 33; i++) t.texels[i] = 40000;
+    ir_ienv e;
+    splat_terrain_ranges(&t, 10, 10, 12, 12, &e);
+    for (int s = 0; s < 1000; s++) {
+        double h, n[3];
+        gpu_smooth(&t, (float)((10 + 2 * rnd01()) / 33), (float)((10 + 2 * rnd01()) / 33),
+                   (int)(rnd() % 16), &h, n);
+        assert_true(in(e.slope, 1 - n[1]) && in(e.height, h));
     }
     splat_terrain_free(&t);
 }
@@ -552,8 +637,10 @@ int main(void)
         cmocka_unit_test(test_load_png8_scales_by_257),
         cmocka_unit_test(test_load_raw_r16),
         cmocka_unit_test(test_load_errors),
-        cmocka_unit_test(test_height_bilinear_clamped),
+        cmocka_unit_test(test_mesh_height_bilinear_clamped),
+        cmocka_unit_test(test_height_bspline_by_hand),
         cmocka_unit_test(test_normal_listing1_by_hand),
+        cmocka_unit_test(test_slope_smooth),
         cmocka_unit_test(test_ranges_sound_random),
         cmocka_unit_test(test_ranges_flat_and_tight),
         cmocka_unit_test(test_ranges_sound_gpu_model),
