@@ -391,13 +391,18 @@ bool rt_shadow_gpu_map(rt_shadow_gpu *s, const double sun[3], double top, const 
         for (int a = 0; a < 2; a++)
             push.inv[a] = push.d[a] != 0 ? 1.0f / push.d[a] : 1e30f;
         size_t first = (size_t)j0 * (size_t)W / 4, end = ((size_t)j1 * (size_t)W + 3) / 4;
-        push.first = (uint32_t)first;
-        push.count = (uint32_t)(end - first);
         vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, s->pipe);
         vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, s->layout, 0, 1, &s->set, 0,
                                 NULL);
-        vkCmdPushConstants(cb, s->layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof push, &push);
-        vkCmdDispatch(cb, (push.count + 63) / 64, 1, 1);
+        /* in runs of at most 65,535 workgroups (the guaranteed
+         * maxComputeWorkGroupCount: a 4096^2 map needs 65,536) */
+        const size_t run = (size_t)65535 * 64;
+        for (size_t at = first; at < end; at += run) {
+            push.first = (uint32_t)at;
+            push.count = (uint32_t)(end - at < run ? end - at : run);
+            vkCmdPushConstants(cb, s->layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof push, &push);
+            vkCmdDispatch(cb, (push.count + 63) / 64, 1, 1);
+        }
     }
     rt_cmd_barrier(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT | VK_PIPELINE_STAGE_TRANSFER_BIT,
                    VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_TRANSFER_WRITE_BIT,
