@@ -195,7 +195,7 @@ static void settings_tables(FILE *out)
           "| `materials` | `[bottom, …, top]`: the stack |\n"
           "| `compositor` | the shader that blends the layers (`linear_alpha`, `height_blend`, `stochastic_select`) |\n"
           "| `painted` | `NAME = \"file\" [{ max_level, max_error, near, origin, size }]`: a painted mask; `holes` cuts the terrain |\n"
-          "| `spline` | `NAME { points = [x z, x z, …], width = W, falloff = F, profile = smoothstep\\|linear }`: a road through the points (Catmull-Rom, terrain-local metres), read as `vector.NAME` |\n"
+          "| `spline` | `NAME { points = [x z, x z, …], width = W, falloff = F, profile = smoothstep\\|linear }`: a road through the points (centripetal Catmull-Rom, terrain-local metres), read as `vector.NAME` |\n"
           "| `polygon` | `NAME { points = [x z, …], falloff = F, profile = … }`: a decal area, read as `vector.NAME` |\n"
           "| `cell` | heightfield texels per analysis cell (default 32) |\n"
           "| `destruction` | `{ origin = X Z, size = X Z, cell = C }`: where craters can be made |\n"

@@ -2,16 +2,16 @@
  * masks", Unreal's landscape splines): `spline` roads and `polygon` decal
  * areas, read by materials as resolution-free masks.
  *
- * A spline is a Catmull-Rom curve through its points, flattened here into
- * short segments; a polygon is its points closed into a loop.  A shape's
+ * A spline is a centripetal Catmull-Rom curve through its points,
+ * flattened here into segments within 5 cm of it; a polygon is its points closed into a loop.  A shape's
  * value at a point is its distance d (metres) to the nearest segment (0
  * inside a polygon); the mask is 1 for d <= half width (the core) and falls
  * to 0 over `falloff` metres (linear or smoothstep), and `across` is
  * d / (half width + falloff) clamped to [0, 1].
  *
  *   spline road { points = [0 0, 400 120, 900 100], width = 7, falloff = 3 }
- *   -> segments (0,0)-(9.6,2.7) ... ; vector.road = 1 within 3.5 m of them,
- *      0 beyond 6.5 m
+ *   -> 4 to 256 segments a span; vector.road = 1 within 3.5 m of them, 0
+ *      beyond 6.5 m
  *
  * The shader finds the segments near a pixel through a uniform grid: each
  * cell lists the segments whose distance to the cell is within their
@@ -29,6 +29,7 @@
 #include "scene_load.h"
 #include "util.h"
 
+#include <assert.h>
 #include <float.h>
 #include <math.h>
 #include <stdlib.h>
@@ -208,22 +209,58 @@ void splat_vector_range(const splat_vectors *v, int s, const double rect[4], dou
     const double c[4][2] = { { rect[0], rect[1] }, { rect[2], rect[1] },
                              { rect[0], rect[3] }, { rect[2], rect[3] } };
     bool meets = false;
-    for (uint32_t k = v->shape_first[s]; k < v->shape_first[s + 1]; k++) {
-        double a[2], b[2];
-        seg_get(v, k, a, b);
-        double dr = seg_rect_dist(a, b, rect);
-        meets |= dr == 0;
-        lo = fmin(lo, dr);
-        /* the distance to a segment is convex: its largest over the
-         * rectangle is at a corner; the shape's is at most the least */
-        double far = 0;
-        for (int q = 0; q < 4; q++)
-            far = fmax(far, seg_dist(c[q], a, b));
-        hi = fmin(hi, far);
-    }
+    /* Only the segments the shader can see there: those listed in the
+     * grid cells the rectangle (and a margin) overlaps.  Where none is,
+     * the shader's distance is 1e30 at every point (and the true one past
+     * the reach).  Elsewhere the shader's distance is the least over its
+     * cell's list, at least `lo` below; it is the true distance wherever
+     * that is within the reach, so `hi` bounds it where it matters (past
+     * the reach the mask is 0 and across 1 either way). */
+    uint32_t ncx = v->words[0], ncz = v->words[1];
+    double o[2] = { wf(v, 5), wf(v, 6) }, cs = wf(v, 7), gm = 1e-3 * cs + v->margin;
+    double gx0 = floor((rect[0] - gm - o[0]) / cs), gx1 = floor((rect[2] + gm - o[0]) / cs);
+    double gz0 = floor((rect[1] - gm - o[1]) / cs), gz1 = floor((rect[3] + gm - o[1]) / cs);
+    gx0 = fmax(gx0, 0), gz0 = fmax(gz0, 0), gx1 = fmin(gx1, ncx - 1.0), gz1 = fmin(gz1, ncz - 1.0);
+    bool listed = false;
+    for (double gz = gz0; gz <= gz1; gz++)
+        for (double gx = gx0; gx <= gx1; gx++) {
+            size_t cb = cells_at(v) + (size_t)SPLAT_VEC_CELL * ((size_t)gz * ncx + (size_t)gx);
+            for (uint32_t e = 0; e < v->words[cb + 1]; e++) {
+                uint32_t k = v->words[entries_at(v) + v->words[cb] + e];
+                double a[2], b[2];
+                if (seg_get(v, k, a, b) != s) continue;
+                listed = true;
+                double dr = seg_rect_dist(a, b, rect);
+                meets |= dr == 0;
+                lo = fmin(lo, dr);
+                /* the distance to a segment is convex: its largest over
+                 * the rectangle is at a corner; the shape's is at most
+                 * the least of those */
+                double far = 0;
+                for (int q = 0; q < 4; q++)
+                    far = fmax(far, seg_dist(c[q], a, b));
+                hi = fmin(hi, far);
+            }
+        }
     double hw, f;
     int profile, kind;
     splat_vector_shape(v, s, &hw, &f, &profile, &kind);
+    bool polygon_here = false;
+    if (kind == SPLAT_VEC_POLYGON) {   /* a cell wholly inside lists no edge */
+        for (double gz = gz0; gz <= gz1 && !polygon_here; gz++)
+            for (double gx = gx0; gx <= gx1 && !polygon_here; gx++) {
+                size_t cb = cells_at(v) + (size_t)SPLAT_VEC_CELL * ((size_t)gz * ncx + (size_t)gx);
+                polygon_here = (v->words[cb + 2] >> s) & 1u;
+            }
+    }
+    if (!listed && !polygon_here) {
+        *dlo = *dhi = 1e30;
+        return;
+    }
+    if (!listed) {   /* every overlapped cell inside the polygon, no edge near */
+        *dlo = *dhi = 0;
+        return;
+    }
     /* the shader's fp32 position and arithmetic: a margin */
     double m = v->margin;
     bool wholly = false;
@@ -242,15 +279,22 @@ void splat_vector_range(const splat_vectors *v, int s, const double rect[4], dou
 
 /* ---- building ----------------------------------------------------------- */
 
-/* Catmull-Rom (uniform) point at t in [0, 1] of the span p1-p2. */
-static void catmull(const double *p0, const double *p1, const double *p2, const double *p3,
-                    double t, double out[2])
+/* A centripetal Catmull-Rom span (Barry-Goldman), from p1 (at knot t1)
+ * to p2 (t2); knots spaced by the square root of the chord lengths, so
+ * uneven point spacing neither loops nor overshoots. */
+typedef struct span { double p[4][2], t[4]; } span;
+
+static void span_at(const span *S, double t, double out[2])
 {
-    double t2 = t * t, t3 = t2 * t;
-    for (int k = 0; k < 2; k++)
-        out[k] = 0.5 * (2 * p1[k] + (-p0[k] + p2[k]) * t +
-                        (2 * p0[k] - 5 * p1[k] + 4 * p2[k] - p3[k]) * t2 +
-                        (-p0[k] + 3 * p1[k] - 3 * p2[k] + p3[k]) * t3);
+    const double *t_ = S->t;
+    for (int k = 0; k < 2; k++) {
+        double a1 = ((t_[1] - t) * S->p[0][k] + (t - t_[0]) * S->p[1][k]) / (t_[1] - t_[0]);
+        double a2 = ((t_[2] - t) * S->p[1][k] + (t - t_[1]) * S->p[2][k]) / (t_[2] - t_[1]);
+        double a3 = ((t_[3] - t) * S->p[2][k] + (t - t_[2]) * S->p[3][k]) / (t_[3] - t_[2]);
+        double b1 = ((t_[2] - t) * a1 + (t - t_[0]) * a2) / (t_[2] - t_[0]);
+        double b2 = ((t_[3] - t) * a2 + (t - t_[1]) * a3) / (t_[3] - t_[1]);
+        out[k] = ((t_[2] - t) * b1 + (t - t_[1]) * b2) / (t_[2] - t_[1]);
+    }
 }
 
 typedef struct seglist { float (*xz)[4]; int *shape; size_t n, cap; } seglist;
@@ -267,8 +311,28 @@ static void seg_push(seglist *l, const double a[2], const double b[2], int s)
     l->shape[l->n++] = s;
 }
 
-/* Shape s's segments: a spline's spans cut into pieces about a width
- * long (at most 64 a span), a polygon's edges as they are. */
+/* Shape s's segments: each span of a spline cut in halves until the
+ * chord's midpoint lies within FLAT_TOL metres of the curve's (at least 4
+ * pieces, so an S-bend is seen; at most 256); a polygon's edges as they
+ * are.  A span's missing neighbour is its end mirrored. */
+#define FLAT_TOL 0.05
+
+static void flatten_span(const span *S, double ta, double tb, const double a[2],
+                         const double b[2], int depth, seglist *l, int s)
+{
+    double m[2], tm = 0.5 * (ta + tb);
+    span_at(S, tm, m);
+    double ab[2] = { b[0] - a[0], b[1] - a[1] }, len = hypot(ab[0], ab[1]);
+    double dev = len > 0 ? fabs(ab[0] * (m[1] - a[1]) - ab[1] * (m[0] - a[0])) / len
+                         : hypot(m[0] - a[0], m[1] - a[1]);
+    if (depth >= 8 || (depth >= 2 && dev <= FLAT_TOL)) {
+        seg_push(l, a, b, s);
+        return;
+    }
+    flatten_span(S, ta, tm, a, m, depth + 1, l, s);
+    flatten_span(S, tm, tb, m, b, depth + 1, l, s);
+}
+
 static void flatten(const sg_scene_vector *sv, int s, seglist *l)
 {
     int n = sv->npoints;
@@ -278,21 +342,79 @@ static void flatten(const sg_scene_vector *sv, int s, seglist *l)
             seg_push(l, &P[2 * i], &P[2 * ((i + 1) % n)], s);
         return;
     }
-    double step = fmax(sv->width, 1.0);
     for (int i = 0; i + 1 < n; i++) {
-        const double *p0 = &P[2 * (i > 0 ? i - 1 : 0)], *p1 = &P[2 * i], *p2 = &P[2 * (i + 1)];
-        const double *p3 = &P[2 * (i + 2 < n ? i + 2 : n - 1)];
+        const double *p1 = &P[2 * i], *p2 = &P[2 * (i + 1)];
         double len = hypot(p2[0] - p1[0], p2[1] - p1[1]);
-        int pieces = (int)fmin(fmax(ceil(len / step), 1), 64);
-        double a[2] = { p1[0], p1[1] };
-        for (int k = 1; k <= pieces; k++) {
-            double b[2];
-            if (k == pieces) b[0] = p2[0], b[1] = p2[1];
-            else catmull(p0, p1, p2, p3, (double)k / pieces, b);
-            seg_push(l, a, b, s);
-            a[0] = b[0], a[1] = b[1];
+        if (!(len > 0)) continue;   /* a repeated point: no span */
+        span S;
+        for (int k = 0; k < 2; k++) {
+            S.p[1][k] = p1[k];
+            S.p[2][k] = p2[k];
+            S.p[0][k] = i > 0 ? P[2 * (i - 1) + k] : 2 * p1[k] - p2[k];
+            S.p[3][k] = i + 2 < n ? P[2 * (i + 2) + k] : 2 * p2[k] - p1[k];
         }
+        /* a neighbour on top of its point: mirror instead */
+        if (!(hypot(S.p[0][0] - p1[0], S.p[0][1] - p1[1]) > 0))
+            for (int k = 0; k < 2; k++) S.p[0][k] = 2 * p1[k] - p2[k];
+        if (!(hypot(S.p[3][0] - p2[0], S.p[3][1] - p2[1]) > 0))
+            for (int k = 0; k < 2; k++) S.p[3][k] = 2 * p2[k] - p1[k];
+        S.t[0] = 0;
+        for (int k = 1; k < 4; k++)
+            S.t[k] = S.t[k - 1] + sqrt(hypot(S.p[k][0] - S.p[k - 1][0],
+                                             S.p[k][1] - S.p[k - 1][1]));
+        flatten_span(&S, S.t[1], S.t[2], p1, p2, 0, l, s);
     }
+}
+
+/* The grid's lists: count[i] and first[i] of each cell, the entries
+ * (pass 2), for cell size c from origin o; returns the largest count,
+ * its cell in *worst.  A segment is listed in every cell within its
+ * shape's reach (plus the margins). */
+static uint32_t bucket(const sg_scene *sc, const seglist *l, const double o[2], double c,
+                       uint32_t ncx, uint32_t ncz, double margin, uint32_t *count,
+                       uint32_t *first, uint32_t **entries, size_t *nentries, size_t *worst)
+{
+    size_t ncells = (size_t)ncx * ncz;
+    double cm = 1e-3 * c + margin;   /* a pixel's cell may be its neighbour's */
+    uint32_t most = 0;
+    *entries = NULL;
+    for (int pass = 0; pass < 2; pass++) {
+        if (pass == 1) {
+            size_t at = 0;
+            for (size_t i = 0; i < ncells; i++) {
+                first[i] = (uint32_t)at;
+                at += count[i];
+                count[i] = 0;
+            }
+            *nentries = at;
+            *entries = xcalloc(at ? at : 1, sizeof **entries);
+        } else
+            memset(count, 0, ncells * sizeof *count);
+        for (size_t k = 0; k < l->n; k++) {
+            const sg_scene_vector *sv = &sc->vectors[l->shape[k]];
+            double r = (sv->kind == SPLAT_VEC_SPLINE ? 0.5 * sv->width : 0) + sv->falloff;
+            double a[2] = { l->xz[k][0], l->xz[k][1] }, b[2] = { l->xz[k][2], l->xz[k][3] };
+            double x0 = floor((fmin(a[0], b[0]) - r - cm - o[0]) / c);
+            double x1 = floor((fmax(a[0], b[0]) + r + cm - o[0]) / c);
+            double z0 = floor((fmin(a[1], b[1]) - r - cm - o[1]) / c);
+            double z1 = floor((fmax(a[1], b[1]) + r + cm - o[1]) / c);
+            for (int gz = z0 < 0 ? 0 : (int)z0; gz <= z1 && gz < (int)ncz; gz++)
+                for (int gx = x0 < 0 ? 0 : (int)x0; gx <= x1 && gx < (int)ncx; gx++) {
+                    double rect[4] = { o[0] + gx * c - cm, o[1] + gz * c - cm,
+                                       o[0] + (gx + 1) * c + cm, o[1] + (gz + 1) * c + cm };
+                    if (seg_rect_dist(a, b, rect) > r + margin) continue;
+                    size_t i = (size_t)gz * ncx + gx;
+                    if (pass == 1) (*entries)[first[i] + count[i]] = (uint32_t)k;
+                    count[i]++;
+                }
+        }
+        if (pass == 0)
+            for (size_t i = 0; i < ncells; i++)
+                if (count[i] > most) most = count[i], *worst = i;
+        if (pass == 0 && most > SPLAT_MAX_VECTOR_CELL)
+            return most;
+    }
+    return most;
 }
 
 void splat_vectors_free(splat_vectors *v)
@@ -333,60 +455,40 @@ bool splat_vectors_build(const sg_scene *sc, splat_vectors *v, sg_diags *d)
     /* the shader's fp32 position (ulp 1/2^24 of it) and arithmetic */
     v->margin = 0.05 + 4e-6 * (ext + reach);
     double pad = reach + 2 * v->margin;
-    double o[2] = { box[0] - pad, box[1] - pad };
+    double o[2] = { (float)(box[0] - pad), (float)(box[1] - pad) };
     double span = fmax(box[2] - box[0], box[3] - box[1]) + 2 * pad;
-    double c = fmax(fmax(2 * reach, 1.0), span / SPLAT_MAX_VECTOR_GRID);
-    c = (float)c;
-    o[0] = (float)o[0], o[1] = (float)o[1];
-    uint32_t ncx = (uint32_t)ceil((box[2] + pad - o[0]) / c) + 1;
-    uint32_t ncz = (uint32_t)ceil((box[3] + pad - o[1]) / c) + 1;
-    if (ncx > SPLAT_MAX_VECTOR_GRID) ncx = SPLAT_MAX_VECTOR_GRID;
-    if (ncz > SPLAT_MAX_VECTOR_GRID) ncz = SPLAT_MAX_VECTOR_GRID;
-    size_t ncells = (size_t)ncx * ncz;
-    uint32_t *count = xcalloc(ncells, sizeof *count), *first = xcalloc(ncells, sizeof *first);
-    uint32_t *entries = NULL;
-    size_t nentries = 0;
-    double cm = 1e-3 * c + v->margin;   /* a pixel's cell may be its neighbour's */
-    for (int pass = 0; pass < 2; pass++) {
-        if (pass == 1) {
-            size_t at = 0;
-            for (size_t i = 0; i < ncells; i++) {
-                first[i] = (uint32_t)at;
-                at += count[i];
-                count[i] = 0;
-            }
-            nentries = at;
-            entries = xcalloc(nentries ? nentries : 1, sizeof *entries);
-        }
-        for (size_t k = 0; k < l.n; k++) {
-            const sg_scene_vector *sv = &sc->vectors[l.shape[k]];
-            double r = (sv->kind == SPLAT_VEC_SPLINE ? 0.5 * sv->width : 0) + sv->falloff;
-            double a[2] = { l.xz[k][0], l.xz[k][1] }, b[2] = { l.xz[k][2], l.xz[k][3] };
-            int x0 = (int)floor((fmin(a[0], b[0]) - r - cm - o[0]) / c);
-            int x1 = (int)floor((fmax(a[0], b[0]) + r + cm - o[0]) / c);
-            int z0 = (int)floor((fmin(a[1], b[1]) - r - cm - o[1]) / c);
-            int z1 = (int)floor((fmax(a[1], b[1]) + r + cm - o[1]) / c);
-            for (int gz = z0 < 0 ? 0 : z0; gz <= z1 && gz < (int)ncz; gz++)
-                for (int gx = x0 < 0 ? 0 : x0; gx <= x1 && gx < (int)ncx; gx++) {
-                    double rect[4] = { o[0] + gx * c - cm, o[1] + gz * c - cm,
-                                       o[0] + (gx + 1) * c + cm, o[1] + (gz + 1) * c + cm };
-                    if (seg_rect_dist(a, b, rect) > r + v->margin) continue;
-                    size_t i = (size_t)gz * ncx + gx;
-                    if (pass == 1) entries[first[i] + count[i]] = (uint32_t)k;
-                    count[i]++;
-                }
-        }
-        for (size_t i = 0; pass == 0 && i < ncells; i++)
-            if (count[i] > SPLAT_MAX_VECTOR_CELL) {
-                double cx = o[0] + ((double)(i % ncx) + 0.5) * c;
-                double cz = o[1] + ((double)(i / ncx) + 0.5) * c;
-                sg_errorf(d, sg_loc_or(sc->vectors[0].loc, sc->loc), SG_E_OVER_LIMIT,
-                          "%u spline or polygon segments lie near x %.0f z %.0f (a %.1f m "
-                          "grid cell), over the limit of %d a cell: fewer points there, or "
-                          "narrower shapes", count[i], cx, cz, c, SPLAT_MAX_VECTOR_CELL);
-                free(count), free(first);
-                goto fail;
-            }
+    /* The cell: twice the largest reach, and cells enough for a buffer
+     * of about 2^16 cells (1.5 MB) over the shapes' box; halved while a
+     * cell lists more than SPLAT_MAX_VECTOR_CELL segments, down to half
+     * the reach (closer segments stay in every cell near them). */
+    double c = fmax(fmax(2 * reach, 1.0), fmax(span / (SPLAT_MAX_VECTOR_GRID - 4), span / 256));
+    uint32_t ncx, ncz, *count = NULL, *first = NULL, *entries = NULL, most;
+    size_t nentries = 0, worst = 0, ncells;
+    for (;;) {
+        c = (float)c;
+        ncx = (uint32_t)ceil((box[2] + pad - o[0]) / c) + 1;
+        ncz = (uint32_t)ceil((box[3] + pad - o[1]) / c) + 1;
+        assert(ncx <= SPLAT_MAX_VECTOR_GRID && ncz <= SPLAT_MAX_VECTOR_GRID);
+        ncells = (size_t)ncx * ncz;
+        count = xrealloc(count, ncells * sizeof *count);
+        first = xrealloc(first, ncells * sizeof *first);
+        free(entries);
+        most = bucket(sc, &l, o, c, ncx, ncz, v->margin, count, first, &entries, &nentries,
+                      &worst);
+        if (most <= SPLAT_MAX_VECTOR_CELL || c / 2 < fmax(0.5 * reach, 0.5) ||
+            ceil(span / (c / 2)) + 4 > SPLAT_MAX_VECTOR_GRID)
+            break;
+        c /= 2;
+    }
+    if (most > SPLAT_MAX_VECTOR_CELL) {
+        double cx = o[0] + ((double)(worst % ncx) + 0.5) * c;
+        double cz = o[1] + ((double)(worst / ncx) + 0.5) * c;
+        sg_errorf(d, sg_loc_or(sc->vectors[0].loc, sc->loc), SG_E_OVER_LIMIT,
+                  "%u spline or polygon segments lie near x %.0f z %.0f (a %.1f m "
+                  "grid cell), over the limit of %d a cell: fewer points there, or "
+                  "narrower shapes", most, cx, cz, c, SPLAT_MAX_VECTOR_CELL);
+        free(count), free(first), free(entries);
+        goto fail;
     }
     /* the words */
     v->nwords = SPLAT_VEC_HEADER + (size_t)SPLAT_VEC_SHAPE * ns + SPLAT_VEC_CELL * ncells +
