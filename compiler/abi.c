@@ -429,8 +429,6 @@ _Static_assert(SORT_KEYS == SPLAT_SORT_KEYS && SORT_TILES_MIN == SPLAT_SORT_TILE
     "}\n"
 
 _Static_assert(SPLAT_BIND_SHADOW == 11, "LIGHTING_TEXT's u_shadow binding");
-#define SPLAT_VEC_MAX_ 32
-_Static_assert(SPLAT_MAX_VECTORS == SPLAT_VEC_MAX_, "the prelude's distance cache");
 _Static_assert(SPLAT_BIND_VECTORS == 13 && SPLAT_VEC_HEADER == 8 && SPLAT_VEC_SHAPE == 4 &&
                SPLAT_VEC_CELL == 6 && SPLAT_VEC_SEG == 6 && SPLAT_VEC_POLYGON == 1 &&
                SPLAT_VEC_SMOOTHSTEP == 1, "the prelude's vector buffer layout");
@@ -743,7 +741,7 @@ const char SPLAT_GLSL_PRELUDE[] =
     "layout(set = 0, binding = 13, std430) readonly buffer "
     "splat_vectors_block { uint w[]; } u_vectors;\n"
     "float splat_vf(uint i) { return uintBitsToFloat(u_vectors.w[i]); }\n"
-    "float splat_vector_walk(int s) {\n"
+    "float splat_vector_distance(int s) {\n"
     "    vec2 p = v_local.xz;\n"
     "    uint ncx = u_vectors.w[0], ncz = u_vectors.w[1], nsh = u_vectors.w[2];\n"
     "    vec2 g = floor((p - vec2(splat_vf(5u), splat_vf(6u))) / splat_vf(7u));\n"
@@ -770,18 +768,6 @@ const char SPLAT_GLSL_PRELUDE[] =
     "    }\n"
     "    uint kind = u_vectors.w[8u + 4u * uint(s) + 2u] >> 8u;\n"
     "    return kind == 1u && inside ? 0.0 : d;\n"
-    "}\n"
-    /* one walk per shape and point: a material reading a shape's mask
-     * and across value (or two materials the same shape) share it */
-    "float splat_vd[" SPLAT_STR(SPLAT_VEC_MAX_) "];\n"
-    "vec2 splat_vd_at = vec2(3.0e38);\n"
-    "float splat_vector_distance(int s) {\n"
-    "    if (v_local.xz != splat_vd_at) {\n"
-    "        splat_vd_at = v_local.xz;\n"
-    "        for (int i = 0; i < " SPLAT_STR(SPLAT_VEC_MAX_) "; i++) splat_vd[i] = -1.0;\n"
-    "    }\n"
-    "    if (splat_vd[s] < 0.0) splat_vd[s] = splat_vector_walk(s);\n"
-    "    return splat_vd[s];\n"
     "}\n"
     "float splat_vector_mask(int s) {\n"
     "    uint b = 8u + 4u * uint(s);\n"
