@@ -1027,28 +1027,33 @@ static bool painted_decl(parser *ps, scene_parse *sp)
     return true;
 }
 
-/* points = "[" NUM NUM { "," NUM NUM } "]": x z pairs, terrain-local m */
-static bool vector_points(parser *ps, sg_scene_vector *v)
+/* The parse of one spline or polygon block: its capacities. */
+typedef struct vector_parse {
+    sg_scene_vector *v;
+    int cap_points, cap_curves, cap_locs;
+} vector_parse;
+
+/* points = "[" NUM NUM { "," NUM NUM } "]": x z pairs, terrain-local m;
+ * each `points` adds a curve */
+static bool vector_points(parser *ps, vector_parse *vp, sg_loc kloc)
 {
+    sg_scene_vector *v = vp->v;
     sg_token *open = cur(ps);
     if (!expect(ps, SG_TK_LBRACK, "'['"))
         return false;
-    int cap = 0, n = 0;      /* n: doubles pushed */
-    v->npoints = 0;
-    v->points = NULL;
-    if (accept(ps, SG_TK_RBRACK))
-        return true;
-    do {
+    int n = 2 * v->npoints;      /* doubles pushed */
+    while (cur(ps)->kind != SG_TK_RBRACK) {
         double xz[2];
         if (!parse_numbers(ps, xz, 2))
             return false;
-        if (n >= 2 * SPLAT_MAX_VECTOR_POINTS + 2) {   /* sg_scene_check says so */
-            continue;
+        if (n < 2 * SPLAT_MAX_VECTOR_POINTS + 2) {   /* sg_scene_check says when over */
+            SG_PUSH(ps->a, v->points, n, vp->cap_points)[0] = xz[0];
+            SG_PUSH(ps->a, v->points, n, vp->cap_points)[0] = xz[1];
+            v->npoints = n / 2;
         }
-        SG_PUSH(ps->a, v->points, n, cap)[0] = xz[0];
-        SG_PUSH(ps->a, v->points, n, cap)[0] = xz[1];
-        v->npoints = n / 2;
-    } while (accept(ps, SG_TK_COMMA));
+        if (!accept(ps, SG_TK_COMMA))
+            break;
+    }
     if (cur(ps)->kind != SG_TK_RBRACK) {
         if (cur(ps)->kind == SG_TK_EOF)
             sg_error(ps->d, loc_of(ps, open), SG_E_UNTERMINATED, "'['", open->line);
@@ -1057,6 +1062,11 @@ static bool vector_points(parser *ps, sg_scene_vector *v)
         return false;
     }
     next(ps);
+    int c = v->ncurves;
+    *SG_PUSH(ps->a, v->curve_end, v->ncurves, vp->cap_curves) = v->npoints;
+    *SG_PUSH(ps->a, v->curve_loc, c, vp->cap_locs) = kloc;
+    if (v->points_loc.line == 0)
+        v->points_loc = kloc;
     return true;
 }
 
@@ -1064,7 +1074,8 @@ static bool vector_points(parser *ps, sg_scene_vector *v)
  *             | "falloff" "=" NUM | "profile" "=" ("linear" | "smoothstep") */
 static bool vector_stmt(parser *ps, void *user)
 {
-    sg_scene_vector *v = user;
+    vector_parse *vp = user;
+    sg_scene_vector *v = vp->v;
     sg_token *key = cur(ps);
     sg_loc kloc = loc_of(ps, key);
     bool spline = v->kind == SPLAT_VEC_SPLINE;
@@ -1073,8 +1084,7 @@ static bool vector_stmt(parser *ps, void *user)
     bool ok;
     if (key->kind == SG_TK_IDENT && is_kw(key, "points")) {
         next(ps);
-        v->points_loc = kloc;
-        ok = expect(ps, SG_TK_EQ, "'='") && vector_points(ps, v);
+        ok = expect(ps, SG_TK_EQ, "'='") && vector_points(ps, vp, kloc);
     } else if (key->kind == SG_TK_IDENT && spline && is_kw(key, "width")) {
         next(ps);
         v->width_loc = kloc;
@@ -1126,8 +1136,9 @@ static bool vector_decl(parser *ps, scene_parse *sp, int kind)
         expected(ps, "'{'");
         return false;
     }
+    vector_parse vp = { .v = v };
     parse_block(ps, kind == SPLAT_VEC_SPLINE ? "block of spline" : "block of polygon",
-                vector_stmt, v);
+                vector_stmt, &vp);
     return true;
 }
 

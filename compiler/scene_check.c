@@ -149,11 +149,18 @@ static void check_vector(const sg_scene *sc, const sg_scene_vector *v, sg_diags 
     if (v->points_loc.line == 0)
         sg_errorf(d, loc, SG_E_MISSING_SETTING, "%s '%s' needs its points (points = "
                   "[x z, x z, ...], terrain-local metres)", what, v->name);
-    else if (v->npoints < need)
-        sg_errorf(d, ploc, SG_E_SETTING, "%s '%s' has %d point%s; a %s needs at least %d",
-                  what, v->name, v->npoints, v->npoints == 1 ? "" : "s", what, need);
-    else if (v->npoints > SPLAT_MAX_VECTOR_POINTS)
-        sg_errorf(d, ploc, SG_E_OVER_LIMIT, "%s '%s' has more than %d points, the pack limit",
+    for (int c = 0; c < v->ncurves; c++) {   /* each `points` is a curve */
+        int n = v->curve_end[c] - (c ? v->curve_end[c - 1] : 0);
+        if (n < need && v->npoints <= SPLAT_MAX_VECTOR_POINTS) {
+            sg_errorf(d, sg_loc_or(v->curve_loc[c], loc), SG_E_SETTING, "%s '%s' has %d "
+                      "point%s; a %s needs at least %d", what, v->name, n, n == 1 ? "" : "s",
+                      v->ncurves > 1 ? "curve" : what, need);
+            break;
+        }
+    }
+    if (v->npoints > SPLAT_MAX_VECTOR_POINTS)
+        sg_errorf(d, ploc, SG_E_OVER_LIMIT, "%s '%s' has more than %d points (all its curves), "
+                  "the pack limit",
                   what, v->name, SPLAT_MAX_VECTOR_POINTS);
     for (int i = 0; i < 2 * v->npoints && i < 2 * SPLAT_MAX_VECTOR_POINTS; i++)
         if (!(fabs(v->points[i]) <= SPLAT_MAX_EXTENT)) {

@@ -333,10 +333,9 @@ static void flatten_span(const span *S, double ta, double tb, const double a[2],
     flatten_span(S, tm, tb, m, b, depth + 1, l, s);
 }
 
-static void flatten(const sg_scene_vector *sv, int s, seglist *l)
+static void flatten_curve(const sg_scene_vector *sv, const double *P, int n, int s,
+                          seglist *l)
 {
-    int n = sv->npoints;
-    const double *P = sv->points;
     if (sv->kind == SPLAT_VEC_POLYGON) {
         for (int i = 0; i < n; i++)
             seg_push(l, &P[2 * i], &P[2 * ((i + 1) % n)], s);
@@ -363,6 +362,15 @@ static void flatten(const sg_scene_vector *sv, int s, seglist *l)
             S.t[k] = S.t[k - 1] + sqrt(hypot(S.p[k][0] - S.p[k - 1][0],
                                              S.p[k][1] - S.p[k - 1][1]));
         flatten_span(&S, S.t[1], S.t[2], p1, p2, 0, l, s);
+    }
+}
+
+/* Each curve of the shape (each `points` of its block) on its own. */
+static void flatten(const sg_scene_vector *sv, int s, seglist *l)
+{
+    for (int c = 0; c < sv->ncurves; c++) {
+        int at = c ? sv->curve_end[c - 1] : 0;
+        flatten_curve(sv, &sv->points[2 * at], sv->curve_end[c] - at, s, l);
     }
 }
 

@@ -12,9 +12,9 @@
  *   road.png — roads found as least-cost paths (Dijkstra; cost grows with
  *       slope) between fixed end points, so they follow valleys and passes
  *       as real ones do.  The fields keep clear of it.
- * With SPLINES.txt, the same roads as scene `spline` blocks (smoothed,
- * simplified to 40 m): what scene.sg's road0..2 were made from (the road
- * material reads them as vector masks, compiler/vector.c).
+ * With SPLINES.txt, the same roads as a scene `spline` block of one curve
+ * each (smoothed, simplified to 40 m): what scene.sg's spline road was made
+ * from (the road material reads it as a vector mask, compiler/vector.c).
  */
 #include <math.h>
 #include <stdint.h>
@@ -160,7 +160,7 @@ static void simplify(const double *p, int lo, int hi, double tol, uint8_t *keep)
     simplify(p, at, hi, tol, keep);
 }
 
-/* The road's path as a spline block's points (terrain-local metres at
+/* The road's path as a `points` curve of the spline (terrain-local metres at
  * texel centres): smoothed along the path (a 9-texel moving average takes
  * out the 8-connected stair steps), then Douglas-Peucker to 40 m. */
 static void print_spline(FILE *out, int r, const int32_t *path, int n, int w)
@@ -185,21 +185,20 @@ static void print_spline(FILE *out, int r, const int32_t *path, int n, int w)
     }
     keep[0] = keep[n - 1] = 1;
     simplify(p, 0, n - 1, 40.0, keep);
-    fprintf(out, "    spline road%d { width = 10, falloff = 4, profile = smoothstep,\n"
-                 "        points = [", r);
+    fprintf(out, "        # road %d\n        points = [", r);
     int col = 0;
     for (int i = 0; i < n; i++)
         if (keep[i])
             fprintf(out, "%s%.0f %.0f", col == 0 ? "" : col % 7 ? ", " : ",\n                  ",
                     p[2 * i], p[2 * i + 1]), col++;
-    fprintf(out, "] }\n");
+    fprintf(out, "]\n");
     free(p);
     free(keep);
 }
 
 /* Least-cost 8-connected path from a to b; cost per step = metres x
  * (1 + 400 slope^2 x ...), so steep ground is avoided.  Paints the path;
- * with `splines`, prints it as spline block `road<r>` there. */
+ * with `splines`, prints it there as a curve of spline `road`. */
 static bool paint_road(const grid *g, int ax, int az, int bx, int bz, uint8_t *m,
                        FILE *splines, int r)
 {
@@ -307,6 +306,8 @@ int main(int argc, char **argv)
         {0.12, 0.02, 0.22, 0.98},
     };
     int status = 0;
+    if (splines)   /* one spline of a curve per road (the material reads one shape) */
+        fprintf(splines, "    spline road { width = 10, falloff = 4, profile = smoothstep\n");
     for (size_t r = 0; r < sizeof roads / sizeof roads[0]; r++)
         if (!paint_road(&g, (int)(roads[r][0] * (g.w - 1)), (int)(roads[r][1] * (g.h - 1)),
                         (int)(roads[r][2] * (g.w - 1)), (int)(roads[r][3] * (g.h - 1)), masks[3],
@@ -314,6 +315,8 @@ int main(int argc, char **argv)
             fprintf(stderr, "road %zu: no path (or out of memory)\n", r);
             status = 1;
         }
+    if (splines)
+        fprintf(splines, "    }\n");
     /* a road is not a field */
     for (size_t i = 0; i < n; i++)
         if (masks[3][i])

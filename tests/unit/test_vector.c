@@ -7,6 +7,7 @@
  *   - splat_vector_range bounds the distance at random points of random
  *     rectangles (the analysis's soundness), and is tight where it must
  *     be: 0 far away, 1 wholly inside;
+ *   - a polygon's second ring is a hole, a spline's curves are apart;
  *   - too many segments in a grid cell is a located OVER_LIMIT error.
  * The GPU side is tests/vector/probe.sh. */
 #include <setjmp.h>
@@ -28,8 +29,21 @@ static double rnd(double lo, double hi)   /* xorshift64*, deterministic */
     return lo + (hi - lo) * (double)((rng * 2685821657736338717ull) >> 11) / 9007199254740992.0;
 }
 
+/* one curve of all its points, for a shape given without curves */
+static void one_curve(sg_scene_vector *v, int n)
+{
+    static int ends[16];
+    for (int i = 0; i < n && i < 16; i++)
+        if (v[i].ncurves == 0) {
+            ends[i] = v[i].npoints;
+            v[i].curve_end = &ends[i];
+            v[i].ncurves = 1;
+        }
+}
+
 static void build(sg_scene *sc, sg_scene_vector *v, int n, splat_vectors *out)
 {
+    one_curve(v, n);
     memset(sc, 0, sizeof *sc);
     sc->name = "t";
     sc->vectors = v;
@@ -207,6 +221,48 @@ static void test_range_sound(void **state)
     splat_vectors_free(&vs);
 }
 
+/* Curves: a polygon of two rings (the inner one a hole, even-odd) and a
+ * spline of two curves (nothing joins them): the analytic distances. */
+static void test_curves(void **state)
+{
+    (void)state;
+    double ring[] = { 100, 100, 500, 100, 500, 500, 100, 500,      /* outer */
+                      250, 250, 350, 250, 350, 350, 250, 350 };    /* hole  */
+    int ring_end[] = { 4, 8 };
+    double two[] = { 100, 700, 400, 700, 600, 700, 900, 700 };
+    int two_end[] = { 2, 4 };
+    sg_scene_vector v[2] = {
+        { .name = "yard", .kind = SPLAT_VEC_POLYGON, .points = ring, .npoints = 8,
+          .curve_end = ring_end, .ncurves = 2, .falloff = 10, .profile = SPLAT_VEC_LINEAR },
+        { .name = "roads", .kind = SPLAT_VEC_SPLINE, .points = two, .npoints = 4,
+          .curve_end = two_end, .ncurves = 2, .width = 6, .falloff = 2,
+          .profile = SPLAT_VEC_LINEAR },
+    };
+    sg_scene sc;
+    splat_vectors vs;
+    build(&sc, v, 2, &vs);
+    int hole = 0, gap = 0;
+    for (int i = 0; i < 20000; i++) {
+        double x = rnd(0, 1000), z = rnd(0, 800);
+        double out = box_dist(x, z, 100, 100, 500, 500);
+        double in_hole = x > 250 && x < 350 && z > 250 && z < 350;
+        double to_hole = -fmax(fmax(250 - x, x - 350), fmax(250 - z, z - 350));
+        double want = in_hole ? to_hole : out;   /* 0 inside the ring's area */
+        double got = splat_vector_distance_grid(&vs, 0, x, z);
+        if (want <= 10) assert_true(fabs(got - want) < 1e-3);
+        else assert_true(got > 10);
+        hole += in_hole && want > 10;
+        /* the road: two pieces along z = 700, none between x 400 and 600 */
+        double r = fmin(seg_dist(x, z, 100, 700, 400, 700), seg_dist(x, z, 600, 700, 900, 700));
+        double gr = splat_vector_distance_grid(&vs, 1, x, z);
+        if (r <= 5) assert_true(fabs(gr - r) < 1e-3);
+        else assert_true(gr > 5);
+        gap += x > 420 && x < 580 && fabs(z - 700) < 3;
+    }
+    assert_true(hole > 50 && gap > 10);
+    splat_vectors_free(&vs);
+}
+
 static void test_cell_limit(void **state)
 {
     (void)state;
@@ -219,6 +275,7 @@ static void test_cell_limit(void **state)
     sg_scene_vector v = { .name = "knot", .kind = SPLAT_VEC_SPLINE, .points = pts,
                           .npoints = N, .width = 2, .falloff = 1, .profile = 0,
                           .loc = { "scene.sg", 7, 12 } };
+    one_curve(&v, 1);
     sg_scene sc = { .name = "t", .vectors = &v, .nvectors = 1 };
     splat_vectors vs;
     sg_diags d;
@@ -239,6 +296,7 @@ int main(void)
         cmocka_unit_test(test_square_polygon),
         cmocka_unit_test(test_grid_equals_all_segments),
         cmocka_unit_test(test_range_sound),
+        cmocka_unit_test(test_curves),
         cmocka_unit_test(test_cell_limit),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
