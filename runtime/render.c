@@ -1571,7 +1571,7 @@ static bool same_bytes(const void *a, const void *b, size_t n)
 
 /* What of the new pack differs from the data the renderer uploaded at
  * creation (heights, bounds, textures and samplers, painted masks,
- * destruction settings, terrain scale), or NULL: only shaders, params and
+ * vector shapes, destruction settings, terrain scale), or NULL: only shaders, params and
  * combination ids may change in a hot reload, never old data under new
  * shaders. */
 static const char *reload_refused(const rt_pack *o, const rt_pack *p)
@@ -1624,6 +1624,9 @@ static const char *reload_refused(const rt_pack *o, const rt_pack *p)
           p->destr_size[0] != o->destr_size[0] || p->destr_size[1] != o->destr_size[1] ||
           p->destr_cell != o->destr_cell)))
         return "the destructible area changed";
+    if (p->nvectors != o->nvectors || !p->vectors != !o->vectors ||
+        (p->vectors && !same_bytes(p->vectors, o->vectors, 4 * p->nvectors)))
+        return "the spline or polygon shapes changed";
     if (p->params_size > o->params_size)
         return "the params block grew";
     return NULL;
