@@ -430,6 +430,9 @@ _Static_assert(SORT_KEYS == SPLAT_SORT_KEYS && SORT_TILES_MIN == SPLAT_SORT_TILE
     "}\n"
 
 _Static_assert(SPLAT_BIND_SHADOW == 11, "LIGHTING_TEXT's u_shadow binding");
+_Static_assert(SPLAT_BIND_VECTORS == 13 && SPLAT_VEC_HEADER == 8 && SPLAT_VEC_SHAPE == 4 &&
+               SPLAT_VEC_CELL == 6 && SPLAT_VEC_SEG == 6 && SPLAT_VEC_POLYGON == 1 &&
+               SPLAT_VEC_SMOOTHSTEP == 1, "the prelude's vector buffer layout");
 
 const splat_light_key splat_light_keys[SPLAT_LIGHT_COUNT] = {
 #define X(id, key, n, lo, hi) { key, n, lo, hi },
@@ -807,6 +810,55 @@ const char SPLAT_GLSL_PRELUDE[] =
     "#else\n"
     "float splat_painted(int layer) {\n"
     "    return splat_texture0(u_painted, vec3(v_uv, float(layer))).r;\n"
+    "}\n"
+    "#endif\n"
+    /* The vector shapes (vector.c, abi.h "vector shapes' buffer"):
+     * shape s's distance at the surface point from its grid cell's
+     * segments, a polygon's inside parity from the cell's reference point;
+     * mask and across from the distance as splat_vector_profile does. */
+    "#ifdef SPLAT_VECTORS\n"
+    "layout(set = 0, binding = 13, std430) readonly buffer "
+    "splat_vectors_block { uint w[]; } u_vectors;\n"
+    "float splat_vf(uint i) { return uintBitsToFloat(u_vectors.w[i]); }\n"
+    "float splat_vector_distance(int s) {\n"
+    "    vec2 p = v_local.xz;\n"
+    "    uint ncx = u_vectors.w[0], ncz = u_vectors.w[1], nsh = u_vectors.w[2];\n"
+    "    vec2 g = floor((p - vec2(splat_vf(5u), splat_vf(6u))) / splat_vf(7u));\n"
+    "    if (g.x < 0.0 || g.y < 0.0 || g.x >= float(ncx) || g.y >= float(ncz)) return 1e30;\n"
+    "    uint cells = 8u + 4u * nsh;\n"
+    "    uint cb = cells + 6u * (uint(g.y) * ncx + uint(g.x));\n"
+    "    uint first = u_vectors.w[cb], count = u_vectors.w[cb + 1u];\n"
+    "    bool inside = ((u_vectors.w[cb + 2u] >> uint(s)) & 1u) != 0u;\n"
+    "    vec2 r = vec2(splat_vf(cb + 4u), splat_vf(cb + 5u));\n"
+    "    uint ent = cells + 6u * ncx * ncz, segs = ent + u_vectors.w[4];\n"
+    "    float d = 1e30;\n"
+    "    for (uint k = 0u; k < count; k++) {\n"
+    "        uint b = segs + 6u * u_vectors.w[ent + first + k];\n"
+    "        if (u_vectors.w[b + 4u] != uint(s)) continue;\n"
+    "        vec2 a = vec2(splat_vf(b), splat_vf(b + 1u));\n"
+    "        vec2 ab = vec2(splat_vf(b + 2u), splat_vf(b + 3u)) - a, ap = p - a;\n"
+    "        float l2 = dot(ab, ab);\n"
+    "        float t = l2 > 0.0 ? clamp(dot(ap, ab) / l2, 0.0, 1.0) : 0.0;\n"
+    "        d = min(d, length(ap - t * ab));\n"
+    "        vec2 pr = r - p, ar = r - a, pb = a + ab - p, pa = -ap;\n"
+    "        float o1 = ab.x * ap.y - ab.y * ap.x, o2 = ab.x * ar.y - ab.y * ar.x;\n"
+    "        float o3 = pr.x * pa.y - pr.y * pa.x, o4 = pr.x * pb.y - pr.y * pb.x;\n"
+    "        if ((o1 > 0.0) != (o2 > 0.0) && (o3 > 0.0) != (o4 > 0.0)) inside = !inside;\n"
+    "    }\n"
+    "    uint kind = u_vectors.w[8u + 4u * uint(s) + 2u] >> 8u;\n"
+    "    return kind == 1u && inside ? 0.0 : d;\n"
+    "}\n"
+    "float splat_vector_mask(int s) {\n"
+    "    uint b = 8u + 4u * uint(s);\n"
+    "    float hw = splat_vf(b), f = splat_vf(b + 1u), d = splat_vector_distance(s);\n"
+    "    float t = f > 0.0 ? clamp((d - hw) / f, 0.0, 1.0) : (d > hw ? 1.0 : 0.0);\n"
+    "    if ((u_vectors.w[b + 2u] & 255u) == 1u) t = t * t * (3.0 - 2.0 * t);\n"
+    "    return 1.0 - t;\n"
+    "}\n"
+    "float splat_vector_across(int s) {\n"
+    "    uint b = 8u + 4u * uint(s);\n"
+    "    float reach = max(splat_vf(b) + splat_vf(b + 1u), 1e-6);\n"
+    "    return clamp(splat_vector_distance(s) / reach, 0.0, 1.0);\n"
     "}\n"
     "#endif\n"
     "float splat_destruction() {\n"

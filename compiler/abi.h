@@ -195,7 +195,11 @@
 #define SPLAT_ABI_VERSION 5   /* 2: splat_frame.light; 3: GGX lighting, screen.w;
                                  4: splat_surface / splat_opaque, SPLAT_SORT;
                                  5: set 1's textures are sampler2DArray layers;
-                                    terrain vertices on the lattice (splat_push) */
+                                    terrain vertices on the lattice (splat_push);
+                                    SPLAT_BIND_VECTORS, SPLAT_VECTORS */
+/* The pack's format version (manifest.json "version", PACK.md): 2 adds
+ * vectors.bin, the scene's spline and polygon shapes. */
+#define SPLAT_PACK_VERSION 2
 
 /* Undergrowth masks (above): texels per cell side, undergrowth-bearing
  * materials at most (4 per word), the fixed view distance (m). */
@@ -222,6 +226,9 @@ enum {
     SPLAT_BIND_COUNTERS = 10,      /* fragment + compute, SPLAT_COUNT only */
     SPLAT_BIND_SHADOW = 11,        /* fragment + compute: sun visibility,
                                       R8 per heightfield texel (shadow.c) */
+    SPLAT_BIND_VECTORS = 13,       /* fragment + compute: the vector shapes'
+                                      buffer (below; a 1-word dummy when
+                                      the pack has none)                  */
 
     SPLAT_TILE = 8,                /* compute: pixels per tile side = local size */
     SPLAT_SORT_TILES_MIN = 4,      /* compute, SPLAT_SORT: tiles per workgroup: */
@@ -258,6 +265,41 @@ enum {
     SPLAT_MAX_MESH_VERTICES = 65536,  /* vertices of one undergrowth mesh    */
     SPLAT_MAX_MESH_INDICES = 196608,  /* indices of one (a triangle list)     */
     SPLAT_MAX_UG_BLOCKS = 64,       /* undergrowth blocks of a pack          */
+    SPLAT_MAX_VECTORS = 32,         /* spline and polygon shapes of a scene
+                                       (a polygon's inside bit per cell: one
+                                       uint of the vector buffer)           */
+    SPLAT_MAX_VECTOR_POINTS = 4096, /* control points of one shape           */
+    SPLAT_MAX_VECTOR_SEGMENTS = 1 << 20, /* segments of every shape, after a
+                                       spline is flattened                  */
+    SPLAT_MAX_VECTOR_CELL = 64,     /* segments listed in one grid cell: a
+                                       pixel's cost bound                    */
+    SPLAT_MAX_VECTOR_GRID = 2048,   /* vector grid cells per side            */
+    SPLAT_MAX_VECTOR_WORDS = 1 << 25, /* words of the vector buffer: 128 MiB,
+                                       Vulkan's minimum maxStorageBufferRange */
+};
+
+/* |width| and |falloff| of a vector shape (m). */
+#define SPLAT_MAX_VECTOR_WIDTH 1.0e4
+
+/* The vector shapes' buffer (set 0 binding SPLAT_BIND_VECTORS, std430
+ * `uint w[]`, floats as their bits; compiler/vector.c builds it, the pack
+ * stores it in vectors.bin, PACK.md).  Words:
+ *   header  0 cells_x, 1 cells_z, 2 nshapes, 3 nsegments, 4 nentries,
+ *           5 f32 origin x, 6 f32 origin z (terrain-local m), 7 f32 cell (m)
+ *   shapes  SPLAT_VEC_SHAPE words each: f32 half width (0 for a polygon),
+ *           f32 falloff, u32 profile | kind << 8, 0
+ *   cells   SPLAT_VEC_CELL words each, row-major: u32 first entry, u32
+ *           count (<= SPLAT_MAX_VECTOR_CELL), u32 inside bits (bit s: the
+ *           reference point is inside polygon s), 0, f32 reference x, z
+ *           (a point of the cell)
+ *   entries u32 segment index, nentries of them
+ *   segments SPLAT_VEC_SEG words each: f32 ax, az, bx, bz, u32 shape, 0
+ * A cell lists every segment whose distance to the cell (grown by a
+ * margin) is at most its shape's reach, half width + falloff. */
+enum {
+    SPLAT_VEC_HEADER = 8, SPLAT_VEC_SHAPE = 4, SPLAT_VEC_CELL = 6, SPLAT_VEC_SEG = 6,
+    SPLAT_VEC_SPLINE = 0, SPLAT_VEC_POLYGON = 1,          /* kinds    */
+    SPLAT_VEC_LINEAR = 0, SPLAT_VEC_SMOOTHSTEP = 1,       /* profiles */
 };
 
 /* Values of a pack, bounded on both sides (PACK.md "Limits"); every

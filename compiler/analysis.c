@@ -246,6 +246,8 @@ typedef struct block_ctx {
     const ir          *mir;         /* the masks alone                     */
     const ir_ref      *masks;       /* mask root of each material (0 unused) */
     const int         *painted_src; /* mir painted k -> scene raster, or -1 */
+    const int         *vector_src;  /* mir painted k -> 2 * scene vector shape
+                                       + 1 if its across value, or -1    */
     ir_iv             *painted;     /* scratch, one per mir painted mask   */
     double             texel_x, texel_z;
 } block_ctx;
@@ -281,7 +283,25 @@ static void block_combo(const block_ctx *bc, int x0, int z0, int x1, int z1,
         } else if (bc->painted_src[k] >= 0 && !placed(s, bc->painted_src[k]))
             bc->painted[k] = painted_range(s->painted[bc->painted_src[k]], t->width,
                                            t->height, x0, z0, x1, z1);
-        else
+        else if (bc->vector_src[k] >= 0) {
+            /* a vector shape: its distance bounded over the block (one
+             * texel wider: any texel-centre convention) and the profile,
+             * monotone in the distance, at both ends */
+            int vs = bc->vector_src[k] >> 1;
+            bool across = bc->vector_src[k] & 1;
+            double rect[4] = { (x0 - 1) * bc->texel_x, (z0 - 1) * bc->texel_z,
+                               (x1 + 1) * bc->texel_x, (z1 + 1) * bc->texel_z };
+            double dlo, dhi;
+            splat_vector_range(&s->vectors, vs, rect, &dlo, &dhi);
+            double a = splat_vector_profile(&s->vectors, vs, dlo, across);
+            double b = splat_vector_profile(&s->vectors, vs, dhi, across);
+            ir_iv r = { fmin(a, b), fmax(a, b) };
+            /* the shader's fp32 profile: interior values within 1e-6 (0
+             * and 1 are exact: the clamps) */
+            if (r.lo > 0 && r.lo < 1) r.lo = fmax(r.lo - 1e-6, 0.0);
+            if (r.hi > 0 && r.hi < 1) r.hi = fmin(r.hi + 1e-6, 1.0);
+            bc->painted[k] = r;
+        } else
             bc->painted[k] = (ir_iv){ 0.0, 1.0 };   /* no raster: any */
     }
     env.painted = bc->painted;
@@ -334,7 +354,7 @@ static bool bits_empty(const uint64_t *bits, int words)
  * mir's painted mask k (-1: none).  False (error at the scene) if a
  * material has no mask root. */
 static bool mask_ir(const splat_scene *s, ir *mir, ir_ref *masks, int **painted_src,
-                    sg_diags *d)
+                    int **vector_src, sg_diags *d)
 {
     const sg_scene *sc = s->desc;
     bool ok = true;
@@ -360,6 +380,12 @@ static bool mask_ir(const splat_scene *s, ir *mir, ir_ref *masks, int **painted_
             if (s->painted && s->painted[j] &&
                 strcmp(mir->painted[k].name, sc->painted[j].name) == 0)
                 (*painted_src)[k] = j;
+    }
+    *vector_src = xcalloc((size_t)(mir->npainted ? mir->npainted : 1), sizeof **vector_src);
+    for (int k = 0; k < mir->npainted; k++) {
+        bool across;
+        int vs = s->vectors.words ? splat_vector_find(sc, mir->painted[k].name, &across) : -1;
+        (*vector_src)[k] = vs >= 0 ? 2 * vs + across : -1;
     }
     return ok;
 }
@@ -639,17 +665,17 @@ bool splat_analyze_merged(const splat_scene *s, int max_combos, splat_analysis *
 
     combo_set cs = { .a = a, .words = n > 64 ? (n + 63) / 64 : 1 };
     ir_ref *masks = xcalloc((size_t)(n ? n : 1), sizeof *masks);
-    int *painted_src = NULL;
+    int *painted_src = NULL, *vector_src = NULL;
     ir mir;
     ir_init(&mir);
-    bool ok = mask_ir(s, &mir, masks, &painted_src, d);
+    bool ok = mask_ir(s, &mir, masks, &painted_src, &vector_src, d);
     ir_iv *painted = xcalloc((size_t)(mir.npainted ? mir.npainted : 1), sizeof *painted);
     alloc_levels(a);
     /* member bitsets of the current level's nodes */
     size_t ncells = (size_t)a->cells_x * (size_t)a->cells_z;
     uint64_t *bits = xcalloc(ncells * (size_t)cs.words, sizeof *bits);
     block_ctx bc = { .s = s, .mir = &mir, .masks = masks, .painted_src = painted_src,
-                     .painted = painted, .texel_x = t->size[0] / t->width,
+                     .vector_src = vector_src, .painted = painted, .texel_x = t->size[0] / t->width,
                      .texel_z = t->size[1] / t->height };
     ok = ok && analyze_cells(&bc, &cs, bits, d);
     a->nleaf = a->ncombos;
@@ -679,6 +705,7 @@ bool splat_analyze_merged(const splat_scene *s, int max_combos, splat_analysis *
     free(bits);
     free(painted);
     free(painted_src);
+    free(vector_src);
     free(masks);
     ir_free(&mir);
     free(cs.keys);

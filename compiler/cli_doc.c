@@ -140,6 +140,14 @@ static void inputs_table(FILE *out)
         fprintf(out, "| `%s` | %s | %s | `%s` |\n", in->name, ir_type_name(in->type), range,
                 in->key);
     }
+    fputs("| `vector.NAME` | float | [0, 1] | — |\n"
+          "| `vector.NAME.across` | float | [0, 1] | — |\n\n"
+          "`vector.NAME` reads the scene's `spline` or `polygon` NAME (values only, not\n"
+          "node types): its mask, 1 within half the width of the curve (inside the\n"
+          "polygon) falling to 0 over `falloff` metres; `.across` is the distance from\n"
+          "the centre line (the polygon's edge) over half width + falloff, clamped to\n"
+          "[0, 1]: 0 on the centre line, 1 at the outer edge of the falloff and beyond,\n"
+          "for profiles across a road (tyre tracks, verges).\n", out);
 }
 
 static void outputs_table(FILE *out)
@@ -190,6 +198,8 @@ static void settings_tables(FILE *out)
           "| `materials` | `[bottom, …, top]`: the stack |\n"
           "| `compositor` | the shader that blends the layers (`linear_alpha`, `height_blend`, `stochastic_select`) |\n"
           "| `painted` | `NAME = \"file\" [{ max_level, max_error, near, origin, size }]`: a painted mask; `holes` cuts the terrain |\n"
+          "| `spline` | `NAME { points = [x z, x z, …], width = W, falloff = F, profile = smoothstep\\|linear }`: a road through the points (centripetal Catmull-Rom, terrain-local metres; each further `points` adds a curve), read as `vector.NAME` |\n"
+          "| `polygon` | `NAME { points = [x z, …], falloff = F, profile = … }`: a decal area (a further `points` ring cuts a hole: even-odd), read as `vector.NAME` |\n"
           "| `cell` | heightfield texels per analysis cell (default 32) |\n"
           "| `destruction` | `{ origin = X Z, size = X Z, cell = C }`: where craters can be made |\n"
           "| `camera` | `NAME { position = X Y Z, look = X Y Z }`: a preset (`overview` is the default view) |\n"

@@ -112,6 +112,40 @@ bool splat_layout_init(splat_layout *L, const ir *src, sg_program *prog,
     return true;
 }
 
+/* The shape a painted leaf named "vector.NAME[.across]" reads, or -1. */
+static int layout_vector(const splat_layout *L, const char *name, bool *across)
+{
+    if (strncmp(name, "vector.", 7) != 0) return -1;
+    const char *nm = name + 7, *dot = strchr(nm, '.');
+    size_t n = dot ? (size_t)(dot - nm) : strlen(nm);
+    *across = dot != NULL;
+    for (int i = 0; i < L->nvectors; i++)
+        if (strlen(L->vectors[i]) == n && !strncmp(L->vectors[i], nm, n))
+            return i;
+    return -1;
+}
+
+/* A painted leaf's local: in_painted<layer>, or in_vector<shape>[_across]. */
+static void painted_local(const splat_layout *L, const char *name, char *buf, size_t n,
+                          char *expr, size_t nexpr)
+{
+    bool across;
+    int v = layout_vector(L, name, &across);
+    if (v >= 0) {
+        snprintf(buf, n, "in_vector%d%s", v, across ? "_across" : "");
+        if (expr)
+            snprintf(expr, nexpr, "splat_vector_%s(%d)", across ? "across" : "mask", v);
+        return;
+    }
+    int layer = 0;
+    for (int p = 0; p < L->npainted; p++)
+        if (strcmp(L->painted[p], name) == 0)
+            layer = p;
+    snprintf(buf, n, "in_painted%d", layer);
+    if (expr)
+        snprintf(expr, nexpr, "splat_painted(%d)", layer);
+}
+
 bool splat_layout_from_scene(splat_layout *L, const splat_scene *s, sg_diags *d)
 {
     const sg_scene *sc = s->desc;
@@ -122,6 +156,12 @@ bool splat_layout_from_scene(splat_layout *L, const splat_scene *s, sg_diags *d)
                                 (const char *const *)sc->materials, sc->nmaterials,
                                 painted, sc->npainted, d);
     free(painted);
+    if (ok && sc->nvectors > 0) {
+        L->vectors = xcalloc((size_t)sc->nvectors, sizeof *L->vectors);
+        for (int i = 0; i < sc->nvectors; i++)
+            L->vectors[i] = sc->vectors[i].name;
+        L->nvectors = sc->nvectors;
+    }
     return ok;
 }
 
@@ -154,6 +194,7 @@ void splat_layout_free(splat_layout *L)
 {
     free(L->materials);
     free(L->painted);
+    free(L->vectors);
     free(L->texture_of);
     free(L->textures);
     free(L->tex_array);
@@ -309,9 +350,10 @@ static void collect_used(const splat_layout *L, splat_composite *c, sg_diags *d)
                 if (strcmp(L->src->params[p].name, ir->params[n->imm].name) == 0)
                     par[p] = true;
         } else if (n->op == IR_OP_PAINTED) {
-            bool found = false;
+            bool found = false, across;
             for (int p = 0; p < L->npainted; p++)
                 found |= strcmp(L->painted[p], ir->painted[n->imm].name) == 0;
+            found |= layout_vector(L, ir->painted[n->imm].name, &across) >= 0;
             if (!found)
                 sg_error(d, (sg_loc){0}, SG_E_UNDECLARED, "unknown painted mask");
         }
@@ -782,12 +824,10 @@ static void declare_leaf(emit *em, uint32_t id, const char *ind)
         ir_buf_printf(em->out, "%s%s %s = %s;\n", ind, ir_type_name((ir_type)n->type),
                       in->local, in->glsl);
     } else if (n->op == IR_OP_PAINTED) {
-        int layer = 0;
-        for (int p = 0; p < em->L->npainted; p++)
-            if (strcmp(em->L->painted[p], em->ir.painted[n->imm].name) == 0)
-                layer = p;
-        ir_buf_printf(em->out, "%sfloat in_painted%d = splat_painted(%d);\n", ind, layer,
-                      layer);
+        char local[64], expr[64];
+        painted_local(em->L, em->ir.painted[n->imm].name, local, sizeof local, expr,
+                      sizeof expr);
+        ir_buf_printf(em->out, "%sfloat %s = %s;\n", ind, local, expr);
     }
 }
 
@@ -1097,6 +1137,11 @@ static void emit_header(emit *em, const splat_glsl_desc *desc)
         ir_buf_printf(o, "#define SPLAT_PAINTED_SPARSE 1\n");
     if (desc->painted_sparse && desc->painted_places)
         ir_buf_printf(o, "%s", desc->painted_places);
+    for (int i = 0; i < em->ir.npainted; i++)
+        if (!strncmp(em->ir.painted[i].name, "vector.", 7)) {
+            ir_buf_printf(o, "#define SPLAT_VECTORS 1\n");   /* binding 13 */
+            break;
+        }
     if (desc->compute)
         ir_buf_printf(o, "#define SPLAT_COMPUTE 1\n");
     else if (has_op(&em->ir, IR_OP_DINPUT))
@@ -1163,12 +1208,8 @@ static void names_init(names *nm, const splat_layout *L, const ir *ir,
     nm->npainted = ir->npainted;
     nm->painted = xcalloc((size_t)ir->npainted, sizeof *nm->painted);
     for (int i = 0; i < ir->npainted; i++) {
-        int layer = 0;
-        for (int p = 0; p < L->npainted; p++)
-            if (strcmp(L->painted[p], ir->painted[i].name) == 0)
-                layer = p;
-        char buf[40];
-        snprintf(buf, sizeof buf, "in_painted%d", layer);
+        char buf[64];
+        painted_local(L, ir->painted[i].name, buf, sizeof buf, NULL, 0);
         nm->painted[i] = xstrdup(buf);
     }
     nm->g.param = (const char *const *)nm->param;

@@ -20,6 +20,10 @@ typedef struct splat_layout {
     int            nmaterials;
     const char   **painted;    /* painted mask names, layer order             */
     int            npainted;
+    const char   **vectors;    /* the scene's spline and polygon names, shape
+                                  order (vector.c); a painted leaf named
+                                  "vector.NAME[.across]" reads one       */
+    int            nvectors;
     int           *texture_of; /* src texture index -> layout texture index   */
     int           *textures;   /* layout texture -> its first src texture     */
     int            ntextures;

@@ -235,6 +235,15 @@ static bool eval_point(far_bake *fb, double u, double v, double sx, double sz,
     double painted[256] = {0};
     for (int k = 0; k < c->ir.npainted && k < 256; k++) {
         int sp = fb->painted_of[id][k];
+        bool across;
+        int vs = sp < 0 && s->vectors.words
+                     ? splat_vector_find(s->desc, c->ir.painted[k].name, &across) : -1;
+        if (vs >= 0) {   /* a vector shape (vector.c), as the shader reads it */
+            double dist = splat_vector_distance_grid(&s->vectors, vs, u * t->size[0],
+                                                     v * t->size[1]);
+            painted[k] = splat_vector_profile(&s->vectors, vs, dist, across);
+            continue;
+        }
         if (sp < 0 || !s->painted || !s->painted[sp])
             continue;
         int pw = s->painted_size[sp][0], ph = s->painted_size[sp][1];

@@ -378,7 +378,12 @@ typedef struct ir_texture {
                            (0..1 for UNORM files)                           */
 } ir_texture;
 
-/* A painted mask raster named by the scene (OP_PAINTED reads it, 0..1). */
+/* A painted mask raster named by the scene (OP_PAINTED reads it, 0..1).
+ * The names "vector.NAME" and "vector.NAME.across" are the scene's
+ * spline or polygon NAME instead (compiler/vector.c: its mask and its
+ * distance across, both 0..1), read through the same leaf so that every
+ * pass treats them alike; the composite reads them with
+ * splat_vector_mask / splat_vector_across (abi.c), not splat_painted. */
 typedef struct ir_painted {
     char *name;
 } ir_painted;

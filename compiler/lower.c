@@ -220,6 +220,13 @@ static ir_ref lower_value(lowerer *L, const frame *f, const sg_value *v)
     case SG_REF_IN:      r = f->ins[v->index]; break;
     case SG_REF_PARAM:   r = ir_param_ref(L->ir, L->param_ids[v->index]); break;
     case SG_REF_INPUT:   r = ir_input(L->ir, (ir_input_kind)v->index); break;
+    case SG_REF_VECTOR: {
+        /* a painted leaf named vector.NAME[.across] (ir.h) */
+        char name[300];
+        snprintf(name, sizeof name, "vector.%s%s", v->parts[1], v->index ? ".across" : "");
+        r = ir_painted_ref(L->ir, ir_add_painted(L->ir, name));
+        break;
+    }
     case SG_REF_TEXTURE:
         if (L->tex_ids[v->index] < 0) {
             r = texture_ref(L, L->p->textures[v->index]);

@@ -554,7 +554,7 @@ static json_t *manifest(build *b, char **tex_names, const char *dir)
     const splat_layout *L = &b->layout;
     json_t *m = json_object();
     json_object_set_new(m, "format", json_string("splatc-pack"));
-    json_object_set_new(m, "version", json_integer(1));
+    json_object_set_new(m, "version", json_integer(SPLAT_PACK_VERSION));
     json_object_set_new(m, "abi", json_integer(SPLAT_ABI_VERSION));
     json_object_set_new(m, "compiler", json_string("splatc " SPLATC_VERSION));
     json_object_set_new(m, "inputs", json_string(b->inputs));
@@ -581,6 +581,17 @@ static json_t *manifest(build *b, char **tex_names, const char *dir)
     json_t *ug = jundergrowth(&b->ug);
     if (ug)
         json_object_set_new(m, "undergrowth", ug);
+    const splat_vectors *vs = &b->scene.vectors;
+    if (vs->words) {   /* vector.c, abi.h: the shapes' buffer */
+        json_t *vo = json_object(), *names = json_array();
+        const sg_scene *sc = b->scene.desc;
+        for (int i = 0; i < sc->nvectors; i++)
+            json_array_append_new(names, json_string(sc->vectors[i].name));
+        json_object_set_new(vo, "file", json_string("vectors.bin"));
+        json_object_set_new(vo, "words", json_integer((json_int_t)vs->nwords));
+        json_object_set_new(vo, "shapes", names);
+        json_object_set_new(m, "vectors", vo);
+    }
     if (b->far.data) {   /* far_atlas.h */
         json_t *fa = json_object();
         json_object_set_new(fa, "file", json_string("far.atlas"));
@@ -705,6 +716,20 @@ static bool write_contents(build *b, const char *dir)
         ok = write_with(b, dir, "meshes.bin", put_meshes, &b->ug);
     if (ok && b->ug.ntextures > 0)
         ok = write_with(b, dir, "ugtex.bin", put_ug_textures, &b->ug);
+    if (ok && s->vectors.words) {
+        /* vectors.bin: "SPLATVEC", u32 version 1, u32 words, the words */
+        size_t nw = s->vectors.nwords, n = 16 + 4 * nw;
+        uint8_t *vb = xmalloc(n);
+        memcpy(vb, "SPLATVEC", 8);
+        uint32_t head[2] = { 1, (uint32_t)nw };
+        for (size_t i = 0; i < 2 + nw; i++) {
+            uint32_t w = i < 2 ? head[i] : s->vectors.words[i - 2];
+            for (int k = 0; k < 4; k++)
+                vb[8 + 4 * i + k] = (uint8_t)(w >> (8 * k));
+        }
+        ok = write_file(b, dir, "vectors.bin", vb, n);
+        free(vb);
+    }
     if (ok && b->far.data)
         ok = write_file(b, dir, "far.atlas", b->far.data, b->far.n);
 

@@ -477,8 +477,8 @@ const char *const sg_ug_keys[] = { "density", "scale", "align", "blend", "color"
 const char *const sg_texture_keys[] = { "file", "filter", "mip", "wrap", "srgb", NULL };
 const char *const sg_scene_keys[] = { "heightfield", "heightfield_size", "size",
                                       "max_height", "height_offset", "materials",
-                                      "compositor", "painted", "destruction", "cell",
-                                      "camera", "light", NULL };
+                                      "compositor", "painted", "spline", "polygon",
+                                      "destruction", "cell", "camera", "light", NULL };
 const char *const sg_painted_keys[] = { "max_level", "max_error", "near", "origin",
                                         "size", NULL };
 const char *const sg_camera_keys[] = { "position", "look", NULL };
@@ -970,7 +970,7 @@ static bool parse_import(parser *ps)
 
 typedef struct scene_parse {
     sg_scene *sc;
-    int cap_materials, cap_material_locs, cap_painted, cap_cameras;
+    int cap_materials, cap_material_locs, cap_painted, cap_cameras, cap_vectors;
 } scene_parse;
 
 static void scene_error(parser *ps, sg_error_id id, sg_loc loc, const char *fmt,
@@ -1159,6 +1159,121 @@ static bool painted_decl(parser *ps, scene_parse *sp)
     return true;
 }
 
+/* The parse of one spline or polygon block: its capacities. */
+typedef struct vector_parse {
+    sg_scene_vector *v;
+    int cap_points, cap_curves, cap_locs;
+} vector_parse;
+
+/* points = "[" NUM NUM { "," NUM NUM } "]": x z pairs, terrain-local m;
+ * each `points` adds a curve */
+static bool vector_points(parser *ps, vector_parse *vp, sg_loc kloc)
+{
+    sg_scene_vector *v = vp->v;
+    sg_token *open = cur(ps);
+    if (!expect(ps, SG_TK_LBRACK, "'['"))
+        return false;
+    int n = 2 * v->npoints;      /* doubles pushed */
+    while (cur(ps)->kind != SG_TK_RBRACK) {
+        double xz[2];
+        if (!parse_numbers(ps, xz, 2))
+            return false;
+        if (n < 2 * SPLAT_MAX_VECTOR_POINTS + 2) {   /* sg_scene_check says when over */
+            SG_PUSH(ps->a, v->points, n, vp->cap_points)[0] = xz[0];
+            SG_PUSH(ps->a, v->points, n, vp->cap_points)[0] = xz[1];
+            v->npoints = n / 2;
+        }
+        if (!accept(ps, SG_TK_COMMA))
+            break;
+    }
+    if (cur(ps)->kind != SG_TK_RBRACK) {
+        if (cur(ps)->kind == SG_TK_EOF)
+            sg_error(ps->d, loc_of(ps, open), SG_E_UNTERMINATED, "'['", open->line);
+        else
+            expected(ps, "',' or ']'");
+        return false;
+    }
+    next(ps);
+    int c = v->ncurves;
+    *SG_PUSH(ps->a, v->curve_end, v->ncurves, vp->cap_curves) = v->npoints;
+    *SG_PUSH(ps->a, v->curve_loc, c, vp->cap_locs) = kloc;
+    if (v->points_loc.line == 0)
+        v->points_loc = kloc;
+    return true;
+}
+
+/* vector_stmt = "points" "=" "[" ... "]" | "width" "=" NUM
+ *             | "falloff" "=" NUM | "profile" "=" ("linear" | "smoothstep") */
+static bool vector_stmt(parser *ps, void *user)
+{
+    vector_parse *vp = user;
+    sg_scene_vector *v = vp->v;
+    sg_token *key = cur(ps);
+    sg_loc kloc = loc_of(ps, key);
+    bool spline = v->kind == SPLAT_VEC_SPLINE;
+    const char *keys = spline ? "'points', 'width', 'falloff', 'profile' or '}'"
+                              : "'points', 'falloff', 'profile' or '}'";
+    bool ok;
+    if (key->kind == SG_TK_IDENT && is_kw(key, "points")) {
+        next(ps);
+        ok = expect(ps, SG_TK_EQ, "'='") && vector_points(ps, vp, kloc);
+    } else if (key->kind == SG_TK_IDENT && spline && is_kw(key, "width")) {
+        next(ps);
+        v->width_loc = kloc;
+        ok = expect(ps, SG_TK_EQ, "'='") && parse_number(ps, &v->width);
+    } else if (key->kind == SG_TK_IDENT && is_kw(key, "falloff")) {
+        next(ps);
+        v->falloff_loc = kloc;
+        ok = expect(ps, SG_TK_EQ, "'='") && parse_number(ps, &v->falloff);
+    } else if (key->kind == SG_TK_IDENT && is_kw(key, "profile")) {
+        next(ps);
+        v->profile_loc = kloc;
+        ok = expect(ps, SG_TK_EQ, "'='");
+        sg_token *p = cur(ps);
+        if (ok && !expect(ps, SG_TK_IDENT, "'linear' or 'smoothstep'"))
+            return false;
+        if (ok)
+            v->profile = is_kw(p, "linear") ? SPLAT_VEC_LINEAR
+                       : is_kw(p, "smoothstep") ? SPLAT_VEC_SMOOTHSTEP : -1;
+        if (ok && v->profile < 0)
+            v->profile_loc = loc_of(ps, p);
+    } else {
+        expected(ps, keys);
+        static const char *const sk[] = { "points", "width", "falloff", "profile", NULL };
+        static const char *const pk[] = { "points", "falloff", "profile", NULL };
+        if (key->kind == SG_TK_IDENT)
+            hint_key(ps, key, spline ? sk : pk);
+        return false;
+    }
+    if (ok)
+        accept(ps, SG_TK_COMMA);
+    return ok;
+}
+
+/* spline NAME "{" { vector_stmt } "}" | polygon NAME "{" ... "}", after
+ * the keyword */
+static bool vector_decl(parser *ps, scene_parse *sp, int kind)
+{
+    sg_scene *sc = sp->sc;
+    sg_token *name = cur(ps);
+    if (!expect(ps, SG_TK_IDENT, kind == SPLAT_VEC_SPLINE ? "a spline name" : "a polygon name"))
+        return false;
+    sg_scene_vector *v = SG_PUSH(ps->a, sc->vectors, sc->nvectors, sp->cap_vectors);
+    memset(v, 0, sizeof *v);
+    v->name = tok_text(ps, name);
+    v->loc = loc_of(ps, name);
+    v->kind = kind;
+    v->profile = SPLAT_VEC_SMOOTHSTEP;
+    if (cur(ps)->kind != SG_TK_LBRACE) {
+        expected(ps, "'{'");
+        return false;
+    }
+    vector_parse vp = { .v = v };
+    parse_block(ps, kind == SPLAT_VEC_SPLINE ? "block of spline" : "block of polygon",
+                vector_stmt, &vp);
+    return true;
+}
+
 /* heightfield = "FILE": the format from the extension */
 static bool heightfield_value(parser *ps, scene_parse *sp)
 {
@@ -1215,6 +1330,7 @@ static bool materials_list(parser *ps, scene_parse *sp)
  *            | "materials" "=" "[" IDENT { "," IDENT } "]"
  *            | "compositor" "=" IDENT
  *            | "painted" IDENT "=" STRING [painted_opts]
+ *            | ("spline" | "polygon") IDENT "{" { vector_stmt } "}"
  *            | destruction | camera */
 static bool scene_stmt(parser *ps, void *user)
 {
@@ -1248,6 +1364,10 @@ static bool scene_stmt(parser *ps, void *user)
     if (is_kw(key, "painted")) {
         next(ps);
         return painted_decl(ps, sp);
+    }
+    if (is_kw(key, "spline") || is_kw(key, "polygon")) {
+        next(ps);
+        return vector_decl(ps, sp, is_kw(key, "spline") ? SPLAT_VEC_SPLINE : SPLAT_VEC_POLYGON);
     }
     next(ps);
     if (!expect(ps, SG_TK_EQ, "'='"))
@@ -1304,7 +1424,8 @@ static bool scene_stmt(parser *ps, void *user)
     char buf[96];
     sg_error(ps->d, kloc, SG_E_SYNTAX,
              "a scene setting (heightfield, heightfield_size, size, max_height, "
-             "height_offset, materials, compositor, painted, destruction, cell, camera, light)",
+             "height_offset, materials, compositor, painted, spline, polygon, destruction, "
+             "cell, camera, light)",
              sg_tok_describe(key, buf, sizeof buf));
     hint_key(ps, key, sg_scene_keys);
     return false;

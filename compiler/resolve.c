@@ -295,6 +295,26 @@ static bool resolve_path(checker *c, sg_value *v, bool allow_locals)
         v->ref = SG_REF_TEXTURE;
         v->index = sg_map_get(&c->p->globals, first) >> 1;
         v->type = IR_T_TEX;
+    } else if (!strcmp(first, "vector") && v->nparts >= 2) {
+        /* vector.NAME: the scene's spline or polygon NAME as a mask;
+         * vector.NAME.across: 0 on its centre line (or inside the
+         * polygon), 1 at the outer edge of its falloff and beyond.  The
+         * scene checks that NAME is one of its shapes (scene.c). */
+        v->ref = SG_REF_VECTOR;
+        v->index = 0;
+        v->type = IR_T_FLOAT;
+        rest = 2;
+        if (v->nparts >= 3 && !strcmp(v->parts[2], "across")) {
+            v->index = 1;
+            rest = 3;
+        } else if (v->nparts >= 3 && strcmp(v->parts[2], "x") && strcmp(v->parts[2], "r")) {
+            char msg[300];
+            snprintf(msg, sizeof msg, "'%s' is not a part of a vector shape (vector.NAME is "
+                     "its mask, vector.NAME.across its distance across) in '%s'",
+                     v->parts[2], path_text(v, buf, sizeof buf));
+            sg_error(c->d, v->loc, SG_E_BAD_REFERENCE, msg);
+            return false;
+        }
     } else if ((!strcmp(first, "terrain") || !strcmp(first, "view")) && v->nparts >= 2) {
         snprintf(buf, sizeof buf, "%s.%s", first, v->parts[1]);
         int in = ir_input_by_name(buf);

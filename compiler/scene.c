@@ -257,6 +257,13 @@ static bool lower_materials(splat_scene *s, sg_diags *d)
         int k = ir_add_painted(&s->ir, sc->painted[i].name);
         (void)k;   /* == i: names are unique (check_scene) */
     }
+    for (int i = 0; i < sc->nvectors; i++) {   /* then the vector shapes' */
+        char name[300];
+        snprintf(name, sizeof name, "vector.%s", sc->vectors[i].name);
+        ir_add_painted(&s->ir, name);
+        snprintf(name, sizeof name, "vector.%s.across", sc->vectors[i].name);
+        ir_add_painted(&s->ir, name);
+    }
     bool ok = true;
     int *first_material = NULL;   /* per texture: the material that first samples it */
     for (int i = 0; i < sc->nmaterials; i++) {
@@ -271,10 +278,20 @@ static bool lower_materials(splat_scene *s, sg_diags *d)
             continue;
         }
         /* Painted masks first named by this material are not the scene's:
-         * the error at the stack entry, a note at the material. */
+         * the error at the stack entry, a note at the material.  (The
+         * scene's vector shapes are registered above, both names each.) */
         for (int k = before; k < s->ir.npainted; k++) {
             sg_loc loc = sc->material_locs ? sg_loc_or(sc->material_locs[i], sc->loc)
                                            : sc->loc;
+            const char *name = s->ir.painted[k].name;
+            if (!strncmp(name, "vector.", 7)) {
+                const char *dot = strchr(name + 7, '.');
+                int n = dot ? (int)(dot - name - 7) : (int)strlen(name + 7);
+                sg_errorf(d, loc, SG_E_UNDECLARED, "material '%s' reads %s, but scene '%s' "
+                          "has no spline or polygon '%.*s' (spline %.*s { points = [...], "
+                          "width = W })", sc->materials[i], name, sc->name, n, name + 7,
+                          n, name + 7);
+            } else
             sg_errorf(d, loc, SG_E_UNDECLARED, "material '%s' reads painted mask '%s', which "
                         "scene '%s' does not declare (painted %s = \"FILE.png\")",
                         sc->materials[i], s->ir.painted[k].name, sc->name,
@@ -414,7 +431,7 @@ bool splat_scene_load(splat_scene *s, const char *path,
         !sg_scene_cells_fit(sc, s->terrain.width, s->terrain.height, d))
         goto fail;
     if (!load_holes(s, d) || !lower_materials(s, d) || !load_painted(s, d) ||
-        d->nerrors > errors)
+        !splat_vectors_build(sc, &s->vectors, d) || d->nerrors > errors)
         goto fail;
     if (!splat_compositor_check(s->prog, sc->compositor ? sc->compositor : "linear_alpha",
                                 sg_loc_or(sc->compositor_loc, sc->loc), d))
@@ -441,6 +458,7 @@ void splat_scene_free(splat_scene *s)
         free(s->own_desc);
     }
     splat_terrain_free(&s->terrain);
+    splat_vectors_free(&s->vectors);
     ir_free(&s->ir);
     if (s->prog) sg_free(s->prog);
     free(s->path);

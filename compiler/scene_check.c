@@ -136,6 +136,59 @@ static void check_destruction(const sg_scene *sc, sg_diags *d)
                     sc->size[0], sc->size[1]);
 }
 
+/* A spline or polygon block: enough points, finite and within the pack's
+ * extent, width and falloff within their limits, a known profile, a
+ * unique name (abi.h SPLAT_MAX_VECTOR_*). */
+static void check_vector(const sg_scene *sc, const sg_scene_vector *v, sg_diags *d)
+{
+    bool spline = v->kind == SPLAT_VEC_SPLINE;
+    const char *what = spline ? "spline" : "polygon";
+    sg_loc loc = sg_loc_or(v->loc, sc->loc);
+    sg_loc ploc = sg_loc_or(v->points_loc, loc);
+    int need = spline ? 2 : 3;
+    if (v->points_loc.line == 0)
+        sg_errorf(d, loc, SG_E_MISSING_SETTING, "%s '%s' needs its points (points = "
+                  "[x z, x z, ...], terrain-local metres)", what, v->name);
+    for (int c = 0; c < v->ncurves; c++) {   /* each `points` is a curve */
+        int n = v->curve_end[c] - (c ? v->curve_end[c - 1] : 0);
+        if (n < need && v->npoints <= SPLAT_MAX_VECTOR_POINTS) {
+            sg_errorf(d, sg_loc_or(v->curve_loc[c], loc), SG_E_SETTING, "%s '%s' has %d "
+                      "point%s; a %s needs at least %d", what, v->name, n, n == 1 ? "" : "s",
+                      v->ncurves > 1 ? "curve" : what, need);
+            break;
+        }
+    }
+    if (v->npoints > SPLAT_MAX_VECTOR_POINTS)
+        sg_errorf(d, ploc, SG_E_OVER_LIMIT, "%s '%s' has more than %d points (all its curves), "
+                  "the pack limit",
+                  what, v->name, SPLAT_MAX_VECTOR_POINTS);
+    for (int i = 0; i < 2 * v->npoints && i < 2 * SPLAT_MAX_VECTOR_POINTS; i++)
+        if (!(fabs(v->points[i]) <= SPLAT_MAX_EXTENT)) {
+            sg_errorf(d, ploc, SG_E_SETTING, "%s '%s': point %d's %s is %g; points must be "
+                      "finite, within +-%g m", what, v->name, i / 2 + 1, i % 2 ? "z" : "x",
+                      v->points[i], SPLAT_MAX_EXTENT);
+            break;
+        }
+    if (spline && v->width_loc.line == 0)
+        sg_errorf(d, loc, SG_E_MISSING_SETTING, "spline '%s' needs a width (metres)", v->name);
+    else if (spline && !(v->width > 0 && v->width <= SPLAT_MAX_VECTOR_WIDTH))
+        sg_errorf(d, v->width_loc, SG_E_SETTING, "spline '%s': width must be in (0, %g] "
+                  "metres, found %g", v->name, SPLAT_MAX_VECTOR_WIDTH, v->width);
+    if (!(v->falloff >= 0 && v->falloff <= SPLAT_MAX_VECTOR_WIDTH))
+        sg_errorf(d, sg_loc_or(v->falloff_loc, loc), SG_E_SETTING, "%s '%s': falloff must be "
+                  "in [0, %g] metres, found %g", what, v->name, SPLAT_MAX_VECTOR_WIDTH,
+                  v->falloff);
+    if (v->profile < 0)
+        sg_errorf(d, sg_loc_or(v->profile_loc, loc), SG_E_SETTING, "%s '%s': profile must be "
+                  "'linear' or 'smoothstep'", what, v->name);
+    for (const sg_scene_vector *q = sc->vectors; q < v; q++)
+        if (strcmp(v->name, q->name) == 0) {
+            sg_error(d, loc, SG_E_DUPLICATE, "vector shape", v->name, q->loc.file,
+                     q->loc.line, q->loc.col);
+            break;
+        }
+}
+
 static void check_light(const sg_scene_light *l, sg_diags *d)
 {
     for (int k = 0; k < SPLAT_LIGHT_COUNT; k++)
@@ -161,6 +214,12 @@ bool sg_scene_check(const sg_scene *sc, sg_diags *d)
         sg_errorf(d, sg_loc_or(sc->painted[SPLAT_MAX_PAINTED].loc, sc->loc), SG_E_OVER_LIMIT,
                     "scene '%s' declares %d painted masks, over the pack limit of %d",
                     sc->name, sc->npainted, SPLAT_MAX_PAINTED);
+    for (int i = 0; i < sc->nvectors; i++)
+        check_vector(sc, &sc->vectors[i], d);
+    if (sc->nvectors > SPLAT_MAX_VECTORS)
+        sg_errorf(d, sg_loc_or(sc->vectors[SPLAT_MAX_VECTORS].loc, sc->loc), SG_E_OVER_LIMIT,
+                    "scene '%s' declares %d splines and polygons, over the pack limit of %d",
+                    sc->name, sc->nvectors, SPLAT_MAX_VECTORS);
     if (sc->has_destruction)
         check_destruction(sc, d);
     if (sc->has_light)

@@ -8,6 +8,39 @@
 #include "sparse.h"
 #include "terrain.h"
 
+/* ---- vector.c: the scene's splines and polygons -------------------------- */
+
+/* The shapes as the shader's buffer (abi.h "vector shapes' buffer"), which
+ * the pack stores as vectors.bin, and what the CPU needs to read it. */
+typedef struct splat_vectors {
+    uint32_t *words;        /* the buffer; NULL when the scene has no shapes */
+    size_t    nwords;
+    uint32_t *shape_first;  /* shape s's segments: [first[s], first[s + 1]) */
+    double    margin;       /* metres added to distance bounds for the
+                               shader's fp32 position and arithmetic      */
+} splat_vectors;
+
+/* Flatten the scene's shapes, bucket their segments in the grid.  Errors
+ * (over a pack limit) at the shapes.  No shapes: words NULL, true. */
+bool   splat_vectors_build(const sg_scene *sc, splat_vectors *v, sg_diags *d);
+void   splat_vectors_free(splat_vectors *v);
+/* Shape s's distance (m) at terrain-local x, z over all its segments (0
+ * inside a polygon): the reference.  _grid: as the shader finds it
+ * (its cell's segments; 1e30 where none of shape s is listed). */
+double splat_vector_distance(const splat_vectors *v, int s, double x, double z);
+double splat_vector_distance_grid(const splat_vectors *v, int s, double x, double z);
+/* Its mask (across false) or across value at distance d. */
+double splat_vector_profile(const splat_vectors *v, int s, double d, bool across);
+void   splat_vector_shape(const splat_vectors *v, int s, double *half_width,
+                          double *falloff, int *profile, int *kind);
+/* Bounds dlo <= d <= dhi of shape s's distance, as the shader computes it
+ * (margin included), over the rectangle x0 z0 x1 z1 (terrain-local m). */
+void   splat_vector_range(const splat_vectors *v, int s, const double rect[4],
+                          double *dlo, double *dhi);
+/* The shape an IR painted leaf named "vector.NAME[.across]" reads, or -1
+ * (not such a name, or no such shape). */
+int    splat_vector_find(const sg_scene *sc, const char *painted_name, bool *across);
+
 /* ---- scene.c: a loaded scene ------------------------------------------- */
 
 typedef struct splat_scene {
@@ -22,6 +55,7 @@ typedef struct splat_scene {
      * analysis then bounds the dense rasters.  Not owned by the scene:
      * whoever built it (build.c) frees it. */
     const sparse_masks *sparse;
+    splat_vectors  vectors;    /* the spline and polygon shapes (vector.c)    */
     int            nmaterials; /* desc->nmaterials, bottom (0) first          */
     /* Every material lowered into one shared ir: roots "<name>.mask", … */
     ir             ir;

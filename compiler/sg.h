@@ -335,6 +335,28 @@ typedef struct sg_scene_painted {
     sg_loc max_level_loc, max_error_loc, near_loc;
 } sg_scene_painted;
 
+/* `spline NAME { points = [x z, x z, ...], width = W, falloff = F,
+ * profile = linear|smoothstep }` and `polygon NAME { points = [...],
+ * falloff = F, profile = ... }`: a vector shape (compiler/vector.c) of
+ * one curve per `points` (a road network, a polygon with holes),
+ * points in terrain-local metres, read by materials as vector.NAME (the
+ * mask, 1 in the core, 0 past the falloff) and vector.NAME.across. */
+typedef struct sg_scene_vector {
+    char   *name;
+    sg_loc  loc;
+    int     kind;          /* SPLAT_VEC_SPLINE or SPLAT_VEC_POLYGON (abi.h) */
+    double *points;        /* npoints x, z pairs, every curve's             */
+    int     npoints;       sg_loc points_loc;   /* the first `points`     */
+    int    *curve_end;     /* each `points = [...]` is a curve (a polygon's
+                              ring: even-odd, so a second one cuts a hole):
+                              curve c is points [curve_end[c-1],
+                              curve_end[c]) (from 0 for c = 0)           */
+    sg_loc *curve_loc;     int ncurves;
+    double  width;         sg_loc width_loc;    /* spline only            */
+    double  falloff;       sg_loc falloff_loc;  /* default 0              */
+    int     profile;       sg_loc profile_loc;  /* SPLAT_VEC_*; -1: unknown */
+} sg_scene_vector;
+
 typedef struct sg_scene_camera {
     char  *name;
     double position[3], look[3];   /* terrain-local metres */
@@ -376,6 +398,7 @@ typedef struct sg_scene {
     sg_loc destruction_cell_loc;
     int    cell_texels;      sg_loc cell_texels_loc; /* default 32         */
     sg_scene_camera *cameras; int ncameras;
+    sg_scene_vector *vectors; int nvectors;     /* spline and polygon blocks */
     bool   has_light;        sg_loc light_loc;
     sg_scene_light light;
 } sg_scene;

@@ -111,6 +111,8 @@ typedef enum sg_ref_kind {
     SG_REF_PARAM,        /* param `index` of the enclosing material       */
     SG_REF_TEXTURE,      /* top-level texture `index` (program.textures)  */
     SG_REF_INPUT,        /* terrain input `index` (ir_input)              */
+    SG_REF_VECTOR,       /* vector.NAME (index 0: the mask) or
+                            vector.NAME.across (index 1), NAME = parts[1] */
 } sg_ref_kind;
 
 typedef struct sg_value {

@@ -146,7 +146,7 @@ static bool make_baker(far_baker *fb, VkDescriptorSet set0_src, const splat_fram
         return false;
     memcpy(fb->frame.map, frame, sizeof *frame);
     VkDescriptorPoolSize sizes[3] = {
-        { VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1 },
+        { VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 2 },   /* points, vector shapes */
         { VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 16 },
         { VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 1 },
     };

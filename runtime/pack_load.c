@@ -619,6 +619,112 @@ static bool read_far(reader *r, json_t *root)
     return true;
 }
 
+/* Whether the words are a well-formed vector buffer of `nshapes` shapes
+ * (abi.h): every count within its pack limit, the sections adding up to
+ * the words exactly, every float finite and in range, every index in
+ * bounds — the shader indexes with them unchecked.  64-bit sums. */
+static bool vectors_valid(const uint32_t *w, size_t nw, uint32_t nshapes, const char **why)
+{
+#define VFAIL(msg) do { *why = msg; return false; } while (0)
+    if (nw < SPLAT_VEC_HEADER) VFAIL("is shorter than its header");
+    uint64_t ncx = w[0], ncz = w[1], ns = w[2], nseg = w[3], nent = w[4];
+    if (ncx < 1 || ncz < 1 || ncx > SPLAT_MAX_VECTOR_GRID || ncz > SPLAT_MAX_VECTOR_GRID)
+        VFAIL("has a grid outside 1..SPLAT_MAX_VECTOR_GRID cells a side");
+    if (ns != nshapes || ns < 1 || ns > SPLAT_MAX_VECTORS)
+        VFAIL("has a shape count that is not the manifest's (1..SPLAT_MAX_VECTORS)");
+    if (nseg < 1 || nseg > SPLAT_MAX_VECTOR_SEGMENTS)
+        VFAIL("has a segment count outside 1..SPLAT_MAX_VECTOR_SEGMENTS");
+    uint64_t ncells = ncx * ncz;
+    if (nent > ncells * SPLAT_MAX_VECTOR_CELL)
+        VFAIL("has more entries than its cells may list");
+    uint64_t cells = SPLAT_VEC_HEADER + (uint64_t)SPLAT_VEC_SHAPE * ns;
+    uint64_t ent = cells + (uint64_t)SPLAT_VEC_CELL * ncells, segs = ent + nent;
+    if (segs + (uint64_t)SPLAT_VEC_SEG * nseg != nw)
+        VFAIL("has sections that do not add up to its size");
+    float f[3];
+    memcpy(f, &w[5], sizeof f);
+    if (!(fabsf(f[0]) <= SPLAT_MAX_EXTENT * 2) || !(fabsf(f[1]) <= SPLAT_MAX_EXTENT * 2) ||
+        !(f[2] > 0 && f[2] <= SPLAT_MAX_EXTENT * 2))
+        VFAIL("has a non-finite grid origin or cell size");
+    for (uint64_t s = 0; s < ns; s++) {
+        const uint32_t *q = &w[SPLAT_VEC_HEADER + SPLAT_VEC_SHAPE * s];
+        float hf[2];
+        memcpy(hf, q, sizeof hf);
+        if (!(hf[0] >= 0 && hf[0] <= SPLAT_MAX_VECTOR_WIDTH) ||
+            !(hf[1] >= 0 && hf[1] <= SPLAT_MAX_VECTOR_WIDTH) || (q[2] & 255u) > 1 ||
+            (q[2] >> 8) > 1)
+            VFAIL("has a shape with a bad width, falloff, profile or kind");
+    }
+    for (uint64_t i = 0; i < ncells; i++) {
+        const uint32_t *q = &w[cells + SPLAT_VEC_CELL * i];
+        float r[2];
+        memcpy(r, &q[4], sizeof r);
+        if (q[1] > SPLAT_MAX_VECTOR_CELL || (uint64_t)q[0] + q[1] > nent ||
+            (ns < 32 && (q[2] >> ns) != 0) || !isfinite(r[0]) || !isfinite(r[1]))
+            VFAIL("has a cell whose entries, inside bits or reference point are out of range");
+    }
+    for (uint64_t i = 0; i < nent; i++)
+        if (w[ent + i] >= nseg) VFAIL("has an entry past its segments");
+    for (uint64_t k = 0; k < nseg; k++) {
+        const uint32_t *q = &w[segs + SPLAT_VEC_SEG * k];
+        float c[4];
+        memcpy(c, q, sizeof c);
+        for (int j = 0; j < 4; j++)
+            if (!(fabsf(c[j]) <= SPLAT_MAX_EXTENT * 2)) VFAIL("has a non-finite segment");
+        if (q[4] >= ns) VFAIL("has a segment of no shape");
+    }
+    return true;
+#undef VFAIL
+}
+
+/* "vectors" (optional): the spline and polygon shapes, vectors.bin. */
+static bool read_vectors(reader *r, json_t *root)
+{
+    json_t *o = get(r, root, "vectors", "manifest", false);
+    if (!o || json_is_null(o))
+        return true;
+    const char *file;
+    int words;
+    /* the buffer within Vulkan's minimum maxStorageBufferRange (2^27 B) */
+    if (!get_int(r, o, "words", "vectors", SPLAT_VEC_HEADER, SPLAT_MAX_VECTOR_WORDS, &words) ||
+        !get_string(r, o, "file", "vectors", &file))
+        return false;
+    json_t *names = get_array(r, o, "shapes", "vectors", true);
+    if (!names)
+        return false;
+    size_t ns = json_array_size(names);
+    if (ns < 1 || ns > SPLAT_MAX_VECTORS)
+        return field_fail(r, "vectors.shapes:", "must have 1 to 32 entries");
+    for (size_t i = 0; i < ns; i++)
+        if (!json_is_string(json_array_get(names, i)))
+            return field_fail(r, "vectors.shapes:", "must be names (strings)");
+    size_t want = 16 + 4 * (size_t)words, n = 0;
+    uint8_t *data = pack_file(r, "vectors.file", file, want, want, &n);
+    if (!data)
+        return false;
+    if (memcmp(data, "SPLATVEC", 8) || le32(data + 8) != 1 || le32(data + 12) != (uint32_t)words) {
+        free(data);
+        return rt_fail(r->e, RT_E_PACK_FILE, r->manifest, "vectors.file", file,
+                       "does not match the manifest's vectors (magic, version 1, words)");
+    }
+    uint32_t *w = malloc(4 * (size_t)words);
+    if (!w) {
+        free(data);
+        return false;
+    }
+    for (int i = 0; i < words; i++)
+        w[i] = le32(data + 16 + 4 * (size_t)i);
+    free(data);
+    const char *why = NULL;
+    if (!vectors_valid(w, (size_t)words, (uint32_t)ns, &why)) {
+        free(w);
+        return rt_fail(r->e, RT_E_PACK_FILE, r->manifest, "vectors.file", file, why);
+    }
+    r->p->vectors = w;
+    r->p->nvectors = (size_t)words;
+    return true;
+}
+
 /* "undergrowth" (optional): slots, meshes, blocks, meshes.bin. */
 static bool read_undergrowth(reader *r, json_t *root)
 {
@@ -1527,17 +1633,17 @@ bool rt_pack_load(rt_pack *p, const char *dir, rt_error *e)
     if (!get_int(&r, root, "version", "manifest", 0, 1 << 20, &version) ||
         !get_int(&r, root, "abi", "manifest", 0, 1 << 20, &abi))
         goto done;
-    if (version != 1 || abi != SPLAT_ABI_VERSION) {
+    if (version != SPLAT_PACK_VERSION || abi != SPLAT_ABI_VERSION) {
         char what[128];
-        snprintf(what, sizeof what, "pack version %d / abi %d; this runtime reads version 1 / abi %d",
-                 version, abi, SPLAT_ABI_VERSION);
+        snprintf(what, sizeof what, "pack version %d / abi %d; this runtime reads version %d / "
+                 "abi %d", version, abi, SPLAT_PACK_VERSION, SPLAT_ABI_VERSION);
         rt_fail(e, RT_E_PACK_VERSION, manifest, what);
         goto done;
     }
     ok = read_scene(&r, root) && read_materials(&r, root) && read_params(&r, root) &&
          read_textures(&r, root) && read_painted(&r, root) && read_sites(&r, root) &&
          read_combos(&r, root) && read_quadtree(&r, root) && read_undergrowth(&r, root) &&
-         read_far(&r, root);
+         read_far(&r, root) && read_vectors(&r, root);
     if (ok) {
         json_t *vx = get(&r, root, "vertex", "manifest", true);
         ok = vx && read_spirv(&r, vx, "vertex", &p->vertex);
@@ -1615,6 +1721,7 @@ void rt_pack_free(rt_pack *p)
     free(p->ug.vertices);
     free(p->ug.indices);
     free(p->far.data);
+    free(p->vectors);
     free_spirv(&p->vertex);
     free(p->cameras);
     free(p->materials);

@@ -178,6 +178,7 @@ static bool make_layouts(rt_device *d, int ntextures /* arrays */, rt_pipelines 
         { SPLAT_BIND_PAINTED_LEVEL, smp, 1, fs, NULL },
         { SPLAT_BIND_HOLES, smp, 1, VK_SHADER_STAGE_VERTEX_BIT, NULL },
         { SPLAT_BIND_SHADOW, smp, 1, fs, NULL },
+        { SPLAT_BIND_VECTORS, sbuf, 1, fs, NULL },   /* vector shapes */
         { SPLAT_BIND_DEPTH, smp, 1, cs, NULL },
         { SPLAT_BIND_OUT, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1, cs, NULL },
         { SPLAT_BIND_TILES, sbuf, 1, cs, NULL },
@@ -809,28 +810,32 @@ enum { NTERRAIN = sizeof terrain_bindings / sizeof *terrain_bindings };
 
 bool rt_terrain_compute_layout(rt_device *d, VkDescriptorSetLayout *out, rt_error *e)
 {
-    VkDescriptorSetLayoutBinding b[NTERRAIN + 1];
+    VkDescriptorSetLayoutBinding b[NTERRAIN + 2];
     for (int i = 0; i < NTERRAIN; i++)
         b[i] = (VkDescriptorSetLayoutBinding){ terrain_bindings[i],
             VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, VK_SHADER_STAGE_COMPUTE_BIT, NULL };
     b[NTERRAIN] = (VkDescriptorSetLayoutBinding){ SPLAT_BIND_FRAME,
         VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, NULL };
-    return rt_set_layout(d, b, NTERRAIN + 1, out, e);
+    b[NTERRAIN + 1] = (VkDescriptorSetLayoutBinding){ SPLAT_BIND_VECTORS,
+        VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, NULL };
+    return rt_set_layout(d, b, NTERRAIN + 2, out, e);
 }
 
 void rt_terrain_compute_set(rt_device *d, VkDescriptorSet src, VkDescriptorSet dst,
                             VkBuffer frame)
 {
-    VkCopyDescriptorSet cp[NTERRAIN];
-    for (int i = 0; i < NTERRAIN; i++)
+    VkCopyDescriptorSet cp[NTERRAIN + 1];
+    for (int i = 0; i <= NTERRAIN; i++) {
+        uint32_t bi = i < NTERRAIN ? terrain_bindings[i] : SPLAT_BIND_VECTORS;
         cp[i] = (VkCopyDescriptorSet){ .sType = VK_STRUCTURE_TYPE_COPY_DESCRIPTOR_SET,
-            .srcSet = src, .srcBinding = terrain_bindings[i], .dstSet = dst,
-            .dstBinding = terrain_bindings[i], .descriptorCount = 1 };
+            .srcSet = src, .srcBinding = bi, .dstSet = dst, .dstBinding = bi,
+            .descriptorCount = 1 };
+    }
     VkDescriptorBufferInfo fb = { frame, 0, sizeof(splat_frame) };
     VkWriteDescriptorSet w = {
         .sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = dst,
         .dstBinding = SPLAT_BIND_FRAME, .descriptorCount = 1,
         .descriptorType = VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, .pBufferInfo = &fb,
     };
-    vkUpdateDescriptorSets(d->dev, 1, &w, NTERRAIN, cp);
+    vkUpdateDescriptorSets(d->dev, 1, &w, NTERRAIN + 1, cp);
 }

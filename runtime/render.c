@@ -41,6 +41,8 @@ struct rt_renderer {
     uint32_t          perm_first[RT_PERMS], perm_count[RT_PERMS];
     rt_buffer         frame_ubo, params_ubo, readback;
     rt_buffer         counters;        /* forward counting variant: device  */
+    rt_buffer         vectors;         /* the pack's vector shapes (abi.h
+                                          SPLAT_BIND_VECTORS), or one word */
     rt_buffer         counters_host;   /* its copy for the host             */
     rt_image         *tex;
     VkSampler        *tex_smp;
@@ -315,6 +317,15 @@ static bool make_descriptors(rt_renderer *r, rt_error *e)
                           &r->counters_host, e))
         return false;
     memset(r->counters_host.map, 0, sizeof(splat_counters));
+    /* the vector shapes, host-visible (read once per pixel that needs
+     * them); a pack without shapes binds one word no shader reads */
+    VkDeviceSize vbytes = p->vectors ? 4 * (VkDeviceSize)p->nvectors : 16;
+    if (!rt_buffer_create(d, vbytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, true, &r->vectors, e))
+        return false;
+    if (p->vectors)
+        memcpy(r->vectors.map, p->vectors, 4 * p->nvectors);
+    else
+        memset(r->vectors.map, 0, 16);
     memset(r->params_ubo.map, 0, p->params_size);
     for (int i = 0; i < p->nparams; i++)
         memcpy((uint8_t *)r->params_ubo.map + p->params[i].offset, p->params[i].value, 16);
@@ -323,7 +334,7 @@ static bool make_descriptors(rt_renderer *r, rt_error *e)
         { VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 3 },
         { VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 2 * 10 + (uint32_t)r->ntex + 3 },
         { VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1 },
-        { VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 3 },
+        { VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 3 + 2 },   /* + the vectors', two sets */
     };
     VkDescriptorPoolCreateInfo pci = {
         .sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO,
@@ -363,6 +374,7 @@ static bool make_descriptors(rt_renderer *r, rt_error *e)
     VkDescriptorBufferInfo fb = { r->frame_ubo.buf, 0, sizeof(splat_frame) };
     VkDescriptorBufferInfo pb = { r->params_ubo.buf, 0, p->params_size };
     VkDescriptorBufferInfo cb = { r->counters.buf, 0, sizeof(splat_counters) };
+    VkDescriptorBufferInfo vb = { r->vectors.buf, 0, VK_WHOLE_SIZE };
     img[0] = (VkDescriptorImageInfo){ t->linear_clamp, t->height.view, ro };
     img[1] = (VkDescriptorImageInfo){ t->linear_clamp, t->painted.view, ro };
     img[2] = (VkDescriptorImageInfo){ t->linear_clamp, t->destr_atlas.view, ro };
@@ -389,6 +401,7 @@ static bool make_descriptors(rt_renderer *r, rt_error *e)
     img[10] = (VkDescriptorImageInfo){ t->linear_clamp, t->shadow.view, ro };
     W(r->set0, SPLAT_BIND_SHADOW, smp, &img[10], NULL);
     W(r->set0, SPLAT_BIND_COUNTERS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, NULL, &cb);
+    W(r->set0, SPLAT_BIND_VECTORS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, NULL, &vb);
     W(r->set1, SPLAT_BIND_PARAMS, ubo, NULL, &pb);
     for (int i = 0; i < r->ntex; i++) {
         timg[i] = (VkDescriptorImageInfo){ r->tex_smp[i], r->tex[i].view, ro };
@@ -409,7 +422,7 @@ static bool make_descriptors(rt_renderer *r, rt_error *e)
             SPLAT_BIND_HEIGHTFIELD, SPLAT_BIND_FRAME, SPLAT_BIND_PAINTED,
             SPLAT_BIND_DESTRUCTION_ATLAS, SPLAT_BIND_DESTRUCTION_INDEX,
             SPLAT_BIND_PAINTED_INDEX, SPLAT_BIND_PAINTED_LEVEL, SPLAT_BIND_HOLES,
-            SPLAT_BIND_SHADOW,
+            SPLAT_BIND_SHADOW, SPLAT_BIND_VECTORS,
         };
         enum { N = sizeof terrain / sizeof *terrain };
         VkCopyDescriptorSet cp[N];
@@ -607,6 +620,7 @@ void rt_renderer_destroy(rt_renderer *r)
         rt_buffer_destroy(d, &r->readback);
         rt_buffer_destroy(d, &r->counters);
         rt_buffer_destroy(d, &r->counters_host);
+        rt_buffer_destroy(d, &r->vectors);
         rt_destruction_destroy(r->destr);
         rt_terrain_destroy(d, &r->terrain);
     }
@@ -1581,7 +1595,7 @@ static bool same_bytes(const void *a, const void *b, size_t n)
 
 /* What of the new pack differs from the data the renderer uploaded at
  * creation (heights, bounds, textures and samplers, painted masks,
- * destruction settings, terrain scale), or NULL: only shaders, params and
+ * vector shapes, destruction settings, terrain scale), or NULL: only shaders, params and
  * combination ids may change in a hot reload, never old data under new
  * shaders. */
 static const char *reload_refused(const rt_pack *o, const rt_pack *p)
@@ -1635,6 +1649,9 @@ static const char *reload_refused(const rt_pack *o, const rt_pack *p)
           p->destr_size[0] != o->destr_size[0] || p->destr_size[1] != o->destr_size[1] ||
           p->destr_cell != o->destr_cell)))
         return "the destructible area changed";
+    if (p->nvectors != o->nvectors || !p->vectors != !o->vectors ||
+        (p->vectors && !same_bytes(p->vectors, o->vectors, 4 * p->nvectors)))
+        return "the spline or polygon shapes changed";
     if (p->params_size > o->params_size)
         return "the params block grew";
     return NULL;

@@ -43,6 +43,7 @@ const rt_binding_rule rt_abi_bindings[] = {
     { 0, SPLAT_BIND_PAINTED_LEVEL,       RT_RES_SAMPLED, RT_IMAGE_2D, true,  RT_UINT,  0,                   FS, RT_PAINTED_ANY },
     { 0, SPLAT_BIND_SHADOW,              RT_RES_SAMPLED, RT_IMAGE_2D, false, RT_FLOAT, 0,                   FS, RT_PAINTED_ANY },
     { 0, SPLAT_BIND_HOLES,               RT_RES_SAMPLED, RT_IMAGE_2D, false, RT_FLOAT, 0,                   VK_SHADER_STAGE_VERTEX_BIT, RT_PAINTED_ANY },
+    { 0, SPLAT_BIND_VECTORS,             RT_RES_STORAGE_BUFFER, 0,    false, 0,        0,                   FS, RT_PAINTED_ANY },
     /* compute stage (abi.h "compute stage"): depth, colour out, tiles; the
      * counters of the counting variant, fragment or compute */
     { 0, SPLAT_BIND_DEPTH,               RT_RES_SAMPLED, RT_IMAGE_2D, false, RT_FLOAT, 0,                   CS, RT_PAINTED_ANY },

@@ -331,6 +331,10 @@ typedef struct rt_pack {
     rt_light         light;          /* scene.light over the defaults       */
     rt_pack_ug       ug;             /* undergrowth; ug.nslots 0: none      */
     rt_pack_far      far;            /* far atlas; far.data NULL: none      */
+    uint32_t        *vectors;        /* vectors.bin's words (abi.h "vector
+                                        shapes' buffer"), validated; NULL:
+                                        the pack has no spline or polygon */
+    size_t           nvectors;       /* words                               */
 } rt_pack;
 
 /* Read and check a pack, untrusted input: every file it names is a

@@ -714,7 +714,7 @@ static bool make_sets(rt_ug *u, VkDescriptorSet set0_src, const rt_image *height
 {
     rt_device *d = u->d;
     VkDescriptorPoolSize sizes[3] = {
-        { VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 13 },
+        { VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 13 + 1 },   /* + set 0's vector shapes */
         { VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 16 + SPLAT_MAX_UG_TEXTURES },
         { VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 2 },
     };

@@ -11,7 +11,10 @@
  *       plains (the east); each field gets one of the three crops;
  *   road.png — roads found as least-cost paths (Dijkstra; cost grows with
  *       slope) between fixed end points, so they follow valleys and passes
- *       as real ones do.
+ *       as real ones do.  The fields keep clear of it.
+ * With SPLINES.txt, the same roads as a scene `spline` block of one curve
+ * each (smoothed, simplified to 40 m): what scene.sg's spline road was made
+ * from (the road material reads it as a vector mask, compiler/vector.c).
  */
 #include <math.h>
 #include <stdint.h>
@@ -138,9 +141,66 @@ static int32_t heap_pop(heap *hp)
     return top;
 }
 
+/* Douglas-Peucker: keep[i] set for the points of p[lo..hi] (x, z pairs)
+ * that the polyline needs to stay within `tol` metres. */
+static void simplify(const double *p, int lo, int hi, double tol, uint8_t *keep)
+{
+    double ax = p[2 * lo], az = p[2 * lo + 1], bx = p[2 * hi], bz = p[2 * hi + 1];
+    double len = hypot(bx - ax, bz - az), worst = 0;
+    int at = -1;
+    for (int i = lo + 1; i < hi; i++) {
+        double d = len > 0 ? fabs((bx - ax) * (az - p[2 * i + 1]) - (ax - p[2 * i]) * (bz - az)) / len
+                           : hypot(p[2 * i] - ax, p[2 * i + 1] - az);
+        if (d > worst) worst = d, at = i;
+    }
+    if (at < 0 || worst <= tol)
+        return;
+    keep[at] = 1;
+    simplify(p, lo, at, tol, keep);
+    simplify(p, at, hi, tol, keep);
+}
+
+/* The road's path as a `points` curve of the spline (terrain-local metres at
+ * texel centres): smoothed along the path (a 9-texel moving average takes
+ * out the 8-connected stair steps), then Douglas-Peucker to 40 m. */
+static void print_spline(FILE *out, int r, const int32_t *path, int n, int w)
+{
+    double *p = malloc(2 * (size_t)n * sizeof *p);
+    uint8_t *keep = calloc((size_t)n, 1);
+    if (!p || !keep) {
+        free(p); free(keep);
+        return;
+    }
+    for (int i = 0; i < n; i++) {
+        double sx = 0, sz = 0;
+        int k = 0;
+        for (int j = i - 4; j <= i + 4; j++) {
+            int q = j < 0 ? 0 : j >= n ? n - 1 : j;
+            sx += (path[q] % w + 0.5) * DX;
+            sz += (path[q] / w + 0.5) * DZ;
+            k++;
+        }
+        p[2 * i] = sx / k;
+        p[2 * i + 1] = sz / k;
+    }
+    keep[0] = keep[n - 1] = 1;
+    simplify(p, 0, n - 1, 40.0, keep);
+    fprintf(out, "        # road %d\n        points = [", r);
+    int col = 0;
+    for (int i = 0; i < n; i++)
+        if (keep[i])
+            fprintf(out, "%s%.0f %.0f", col == 0 ? "" : col % 7 ? ", " : ",\n                  ",
+                    p[2 * i], p[2 * i + 1]), col++;
+    fprintf(out, "]\n");
+    free(p);
+    free(keep);
+}
+
 /* Least-cost 8-connected path from a to b; cost per step = metres x
- * (1 + 400 slope^2 x ...), so steep ground is avoided.  Paints the path. */
-static bool paint_road(const grid *g, int ax, int az, int bx, int bz, uint8_t *m)
+ * (1 + 400 slope^2 x ...), so steep ground is avoided.  Paints the path;
+ * with `splines`, prints it there as a curve of spline `road`. */
+static bool paint_road(const grid *g, int ax, int az, int bx, int bz, uint8_t *m,
+                       FILE *splines, int r)
 {
     size_t n = (size_t)g->w * g->h;
     double *dist = malloc(n * sizeof *dist);
@@ -181,6 +241,19 @@ static bool paint_road(const grid *g, int ax, int az, int bx, int bz, uint8_t *m
         }
     }
     bool ok = from[dst] >= 0;
+    if (ok && splines) {   /* the path, a to b */
+        int np = 0;
+        for (int32_t v = dst; v >= 0; v = from[v])
+            np++;
+        int32_t *path = malloc((size_t)np * sizeof *path);
+        if (path) {
+            int i = np;
+            for (int32_t v = dst; v >= 0; v = from[v])
+                path[--i] = v;
+            print_spline(splines, r, path, np, g->w);
+            free(path);
+        }
+    }
     for (int32_t v = dst; ok && v >= 0; v = from[v]) {
         int x = v % g->w, z = v / g->w;
         for (int dz = -1; dz <= 1; dz++)
@@ -199,9 +272,14 @@ static bool paint_road(const grid *g, int ax, int az, int bx, int bz, uint8_t *m
 
 int main(int argc, char **argv)
 {
-    if (argc != 3) {
-        fprintf(stderr, "usage: %s DEM.png OUTDIR\n", argv[0]);
+    if (argc != 3 && argc != 4) {
+        fprintf(stderr, "usage: %s DEM.png OUTDIR [SPLINES.txt]\n", argv[0]);
         return 2;
+    }
+    FILE *splines = NULL;
+    if (argc == 4 && !(splines = fopen(argv[3], "w"))) {
+        fprintf(stderr, "%s: cannot write\n", argv[3]);
+        return 1;
     }
     grid g = {0};
     int ch;
@@ -228,12 +306,17 @@ int main(int argc, char **argv)
         {0.12, 0.02, 0.22, 0.98},
     };
     int status = 0;
+    if (splines)   /* one spline of a curve per road (the material reads one shape) */
+        fprintf(splines, "    spline road { width = 10, falloff = 4, profile = smoothstep\n");
     for (size_t r = 0; r < sizeof roads / sizeof roads[0]; r++)
         if (!paint_road(&g, (int)(roads[r][0] * (g.w - 1)), (int)(roads[r][1] * (g.h - 1)),
-                        (int)(roads[r][2] * (g.w - 1)), (int)(roads[r][3] * (g.h - 1)), masks[3])) {
+                        (int)(roads[r][2] * (g.w - 1)), (int)(roads[r][3] * (g.h - 1)), masks[3],
+                        splines, (int)r)) {
             fprintf(stderr, "road %zu: no path (or out of memory)\n", r);
             status = 1;
         }
+    if (splines)
+        fprintf(splines, "    }\n");
     /* a road is not a field */
     for (size_t i = 0; i < n; i++)
         if (masks[3][i])
@@ -259,5 +342,7 @@ int main(int argc, char **argv)
         free(masks[i]);
     free(g.slope);
     stbi_image_free(hf);
+    if (splines && fclose(splines) != 0)
+        status = 1;
     return status;
 }

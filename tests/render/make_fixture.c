@@ -348,7 +348,7 @@ int main(int argc, char **argv)
         " s:o, s:[{s:s, s:s, s:[f, f, f, f], s:f, s:f, s:i}], s:i,"
         " s:[{s:s, s:i, s:s, s:s, s:s, s:b}], s:[], s:o,"
         " s:{s:s, s:s}, s:{s:s, s:s}, s:{s:s, s:o}}",
-        "format", "splatc-pack", "version", 1, "abi", SPLAT_ABI_VERSION, "compiler", "make_fixture",
+        "format", "splatc-pack", "version", SPLAT_PACK_VERSION, "abi", SPLAT_ABI_VERSION, "compiler", "make_fixture",
         "scene", "name", "fixture", "heightfield", "file", "heightfield.r16", "width", W, "height", H,
         "size", SIZE_X, SIZE_Z, "max_height", MAXH, "height_offset", 0.0, "cell_texels", CELL,
         "cameras",

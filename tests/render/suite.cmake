@@ -104,11 +104,18 @@ if(TARGET splatrt AND TARGET splatview)
               --cache ${RENDER_OUT}/spv_cache
       WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
     set_tests_properties(render.pack_notex PROPERTIES LABELS render FIXTURES_SETUP notex_pack)
+    # a spline road and a polygon decal read as vector masks (compiler/vector.c)
+    add_test(NAME render.pack_vector
+      COMMAND $<TARGET_FILE:splatc_cli> build tests/vector/vector.sg -o ${RENDER_OUT}/vector
+              --cache ${RENDER_OUT}/spv_cache
+      WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
+    set_tests_properties(render.pack_vector PROPERTIES LABELS render FIXTURES_SETUP vector_pack)
     set(SCREEN_CASES
       "colorado|textured|overview blanca valley spanish_peaks pivots trinidad"
       "billingsley|textured|overview ground peak"
       "minimal|textured|overview"
-      "notex|notex|overview low")
+      "notex|notex|overview low"
+      "vector|notex|low overview")
     foreach(sc IN LISTS SCREEN_CASES)
       string(REPLACE "|" ";" f "${sc}")
       list(GET f 0 pk)

@@ -132,13 +132,22 @@ static uint64_t rng = 0x853c49e6748fea9bull;
 static double raster_painted(void *user, int p, double u, double v)
 {
     const splat_scene *s = user;
+    bool across;
+    int vs = p >= s->desc->npainted
+                 ? splat_vector_find(s->desc, s->ir.painted[p].name, &across) : -1;
+    if (vs >= 0) {   /* a spline or polygon (vector.c): as the shader reads it */
+        double d = splat_vector_distance_grid(&s->vectors, vs, u * s->terrain.size[0],
+                                              v * s->terrain.size[1]);
+        return splat_vector_profile(&s->vectors, vs, d, across);
+    }
     return points_raster_bilinear(s->painted[p], s->terrain.width, s->terrain.height, u, v);
 }
 
 /* At random points of every leaf cell (and random params and texture
  * content), every material the CPU reference makes visible (front to back:
  * w = T * mask > 0 until T reaches 0) is in the cell's combination; painted
- * values bilinear in the scene's rasters. */
+ * values bilinear in the scene's rasters, vector shapes (colorado's roads)
+ * from their grid as the shader reads them. */
 static void check_points_sound(const splat_scene *s, const splat_analysis *a,
                                int samples)
 {
@@ -301,6 +310,77 @@ static void test_colorado_sound(void **state)
     splat_scene_free(&s);
 }
 
+/* colorado's roads are splines: at random points within 12 m of them
+ * (the falloff's edge is 9 m), the material stack evaluated front to back
+ * as in check_points_sound; every visible material, the road most of all,
+ * must be in the point's leaf-cell combination. */
+static void test_colorado_roads_sound(void **state)
+{
+    (void)state;
+    splat_scene s;
+    load_ok(&s, "examples/colorado/scene.sg", NULL);
+    sg_diags d;
+    sg_diags_init(&d);
+    splat_analysis a;
+    assert_true(splat_analyze(&s, &a, &d));
+    const splat_vectors *vs = &s.vectors;
+    assert_non_null(vs->words);
+    int n = s.nmaterials, road = -1, seen = 0;
+    ir_ref *masks = calloc((size_t)n, sizeof *masks);
+    double *painted = calloc((size_t)s.ir.npainted + 1, sizeof *painted);
+    assert_true(masks && painted);
+    for (int m = 0; m < n; m++) {
+        char root[256];
+        snprintf(root, sizeof root, "%s.mask", s.desc->materials[m]);
+        masks[m] = ir_find_root(&s.ir, root);
+        if (!strcmp(s.desc->materials[m], "road")) road = m;
+    }
+    assert_true(road > 0);
+    uint32_t nseg = vs->shape_first[s.desc->nvectors];
+    const double W = s.terrain.size[0], H = s.terrain.size[1];
+    for (int k = 0; k < 4000; k++) {
+        /* a point of a random segment, pushed sideways */
+        uint32_t seg = points_rnd(&rng) % nseg;
+        size_t at = vs->nwords - (size_t)SPLAT_VEC_SEG * (nseg - seg);
+        float f[4];
+        memcpy(f, &vs->words[at], sizeof f);
+        double t = points_rnd01(&rng);
+        double x = f[0] + t * (f[2] - f[0]) + (points_rnd01(&rng) - 0.5) * 24;
+        double z = f[1] + t * (f[3] - f[1]) + (points_rnd01(&rng) - 0.5) * 24;
+        double u = x / W, v = z / H;
+        if (!(u >= 0 && u < 1 && v >= 0 && v < 1)) continue;
+        int T = a.cell_texels, cx = (int)(u * s.terrain.width) / T;
+        int cz = (int)(v * s.terrain.height) / T;
+        const splat_combo *c = &a.combos[a.levels[0].ids[cz * a.cells_x + cx]];
+        ir_env env;
+        points_env(&s.terrain, u, v, &env);
+        env.view_distance = points_rnd01(&rng) * 2000;
+        for (int p = 0; p < s.ir.npainted; p++)
+            painted[p] = raster_painted(&s, p, u, v);
+        env.painted = painted;
+        env.sample = points_any_texture;
+        double cover = 1;
+        for (int m = n - 1; m >= 0 && cover > 0; m--) {
+            double mask[4] = { 1 };
+            if (m > 0) ir_eval(&s.ir, masks[m], &env, mask);
+            double w = cover * mask[0];
+            if (w > 0 && !points_combo_has(c, m)) {
+                print_error("cell (%d, %d): '%s' visible (w = %g) at x %.2f z %.2f but not "
+                            "in the combination\n", cx, cz, s.desc->materials[m], w, x, z);
+                fail();
+            }
+            seen += m == road && w > 0;
+            cover -= w;
+        }
+    }
+    assert_true(seen > 1000);   /* the points did land on the roads */
+    free(masks);
+    free(painted);
+    splat_analysis_free(&a);
+    sg_diags_free(&d);
+    splat_scene_free(&s);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -310,6 +390,7 @@ int main(void)
         cmocka_unit_test(test_raw_matches_png),
         cmocka_unit_test(test_minimal_example),
         cmocka_unit_test(test_colorado_sound),
+        cmocka_unit_test(test_colorado_roads_sound),
         cmocka_unit_test(test_materials_twice),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);

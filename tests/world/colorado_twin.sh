@@ -1,6 +1,7 @@
 #!/bin/sh
 # colorado_twin.sh SPLATC GEN_GEOTIFF OUTDIR — examples/colorado's GeoTIFF
-# twin: the heightfield and the four painted masks written as GeoTIFFs
+# twin: the heightfield and the three painted masks (the roads are splines)
+# written as GeoTIFFs
 # (UTM 13N, UInt16 heights with the PNG's scale and offset, Byte masks) by
 # gen_geotiff, a copy of scene.sg that names them and leaves size,
 # max_height and height_offset to the file, then both scenes built: every
@@ -16,7 +17,7 @@ rm -rf "$OUT"
 mkdir -p "$OUT/twin/masks"
 C=examples/colorado
 "$GEN" $C/trinidad.png "$OUT/twin/trinidad.tif" 176473.5 111212.6 2962.242 1358.652
-for m in field_wheat field_plowed field_fallow road; do
+for m in field_wheat field_plowed field_fallow; do
     "$GEN" $C/masks/$m.png "$OUT/twin/masks/$m.tif" 176473.5 111212.6
 done
 sed -e 's/"trinidad.png"/"trinidad.tif"/' \
@@ -24,7 +25,7 @@ sed -e 's/"trinidad.png"/"trinidad.tif"/' \
     -e '/^ *size = /d' -e '/^ *max_height = /d' -e '/^ *height_offset = /d' \
     $C/scene.sg > "$OUT/twin/scene.sg"
 grep -q '"trinidad.tif"' "$OUT/twin/scene.sg" || fail "sed did not rename the heightfield"
-[ "$(grep -c '\.tif"' "$OUT/twin/scene.sg")" = 5 ] || fail "sed did not rename the masks"
+[ "$(grep -c '\.tif"' "$OUT/twin/scene.sg")" = 4 ] || fail "sed did not rename the masks"
 grep -q 'max_height' "$OUT/twin/scene.sg" && fail "max_height left in the twin"
 
 "$SPLATC" build $C/scene.sg -o "$OUT/png.pack" --cache "$OUT/cache" -j 2 2> "$OUT/png.err" ||
