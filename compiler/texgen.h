@@ -145,4 +145,40 @@ bool texgen_example_image(int i, int size, uint32_t seed, texgen_image *out);
 bool texgen_write_examples(const char *dir, int size, uint32_t seed,
                            bool all_mips, FILE *log, char **err);
 
+/* ---- texgen_surfaces.c: colour PBR surface sets ------------------------ */
+
+/* Procedural ground surfaces, each a set of five images from one height
+ * field (tileable, deterministic):
+ *   NAME_albedo.png     RGB, sRGB-encoded colour; its mean linear luminance
+ *                       is set inside the surface's measured albedo range
+ *   NAME_normal.png     RGB tangent-space normal, 0.5-centred, +z out, +x
+ *                       along u (columns), +y along v (rows), from the height
+ *   NAME_height.png     grey, linear, 0 low .. 255 high
+ *   NAME_roughness.png  grey, linear perceptual roughness
+ *   NAME_ao.png         grey, linear ambient occlusion (1 open) from the
+ *                       height's horizons
+ * The albedo ranges and their sources are the table in texgen_surfaces.c. */
+typedef struct texgen_surface_set {
+    texgen_image albedo, normal, height, roughness, ao;
+} texgen_surface_set;
+
+int         texgen_surface_count(void);
+const char *texgen_surface_name(int i);     /* "grass", "dry_grass" …       */
+const char *texgen_surface_about(int i);
+/* The measured range of the surface's mean albedo (linear, 0..1). */
+void        texgen_surface_albedo_range(int i, double *lo, double *hi);
+/* Generate surface i at `size` texels square (a power of two >= 16). */
+bool texgen_surface_make(int i, int size, uint32_t seed, texgen_surface_set *out);
+void texgen_surface_free(texgen_surface_set *set);
+/* Mean linear luminance (Rec. 709) of an sRGB-encoded RGB(A) image. */
+double texgen_mean_albedo(const texgen_image *srgb);
+/* Write every surface set into `dir` (which must exist), one log line per
+ * surface. */
+bool texgen_write_surfaces(const char *dir, int size, uint32_t seed,
+                           FILE *log, char **err);
+/* The swatch sheet: one row per surface (albedo, normal, height, roughness,
+ * AO and a lit preview), labelled, `cell` texels per swatch, as an RGB PNG. */
+bool texgen_write_sheet(const char *path, int size, uint32_t seed, int cell,
+                        char **err);
+
 #endif

@@ -24,6 +24,9 @@
 #              project builds and renders as it stands (SPLATVIEW, IMGCHECK
 #              in the environment), its picture is not mostly fog (luma
 #              contrast), a second init into it is refused
+#   texgen     `splatc texgen`: two runs write byte-identical files (the
+#              example textures, the 12 colour surface sets, the swatch
+#              sheet); bad sizes exit 2
 #   malformed  empty file, binary garbage, truncated files, 10 MB inputs,
 #              10000-deep instance nesting: exit 1 with a diagnostic, no crash
 #              or hang
@@ -149,6 +152,17 @@ eval)
         fail "interval all: $(cat "$TMP/out")"
     run 2 "$SPLATC" eval graphs/cliff.sg -m cliff --at slope=0:1
     run 2 "$SPLATC" eval graphs/cliff.sg -m cliff --at nothing=1
+    ;;
+texgen)
+    for d in a b; do
+        run 0 "$SPLATC" texgen --out "$TMP/$d" --size 16 --surface-size 32 --sheet "$TMP/$d/sheet.png"
+    done
+    n=$(ls "$TMP/a/surfaces" | grep -c '_\(albedo\|normal\|height\|roughness\|ao\)\.png$')
+    [ "$n" -ge 60 ] || fail "texgen wrote $n surface files, expected 12 sets of 5"
+    [ -s "$TMP/a/sheet.png" ] || fail "no swatch sheet"
+    diff -r "$TMP/a" "$TMP/b" >/dev/null || fail "two texgen runs differ"
+    run 2 "$SPLATC" texgen --out "$TMP/c" --surface-size 100
+    run 2 "$SPLATC" texgen --out "$TMP/c" --surface-size 8
     ;;
 tools)
     run 0 "$SPLATC" check graphs/cliff.sg graphs/grass.sg nodes/masks.sg nodes/compositors.sg
