@@ -21,7 +21,8 @@
  * vanishes in the distance; picking one texel per 2×2 block keeps the
  * value distribution of the level above).
  *
- * Sections: texgen.c (fields, images, examples, PNG); the CLI command is
+ * Sections: texgen.c (fields, images, examples, PNG), texgen_surfaces.c
+ * (the colour PBR surface sets and their swatch sheet); the CLI command is
  * cli_texgen.c (cli.h).
  */
 #ifndef SPLAT_TEXGEN_H
@@ -149,8 +150,9 @@ bool texgen_write_examples(const char *dir, int size, uint32_t seed,
 
 /* Procedural ground surfaces, each a set of five images from one height
  * field (tileable, deterministic):
- *   NAME_albedo.png     RGB, sRGB-encoded colour; its mean linear luminance
- *                       is set inside the surface's measured albedo range
+ *   NAME_albedo.png     RGBA: sRGB-encoded colour, its mean linear luminance
+ *                       set inside the surface's measured albedo range; the
+ *                       height (linear) in alpha, for one-sample materials
  *   NAME_normal.png     RGB tangent-space normal, 0.5-centred, +z out, +x
  *                       along u (columns), +y along v (rows), from the height
  *   NAME_height.png     grey, linear, 0 low .. 255 high

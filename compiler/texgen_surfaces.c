@@ -18,6 +18,11 @@
  *   - the ambient occlusion is 1 - the mean sine of the horizon angle in 8
  *     directions, marched over 1..16 texels (at 256) of the same relief.
  *
+ * The albedo image carries the height in its alpha channel (linear: an
+ * sRGB sampler decodes only the colour), so that a material reads colour
+ * and height in one sample and one texture binding; the height image is the
+ * same values on their own.
+ *
  * Albedo ranges (broadband surface albedo, 0..1).  Sources:
  *   [W]  Wikipedia, "Albedo", table of typical albedos (fresh asphalt 0.04,
  *        worn asphalt 0.12, conifer forest 0.08-0.15, bare soil 0.17, green
@@ -222,8 +227,8 @@ static void grass_like(const ctx *x, int i, int j, double u, double v, texel *o,
         c = mixc(c, hex(0x8d7c52), smooth(0.75, 1.0, r2) * 0.8);         /* grey-brown dead   */
         c = mixc(c, hex(0x8f9256), smooth(0.6, 0.9, patch) * 0.35);        /* a trace of green  */
     } else {
-        c = mixc(hex(0x3f6420), hex(0x6a8c2c), r);
-        c = mixc(c, hex(0x4d7a2a), smooth(0.3, 0.8, patch) * 0.6);         /* lusher patches    */
+        c = mixc(hex(0x46592a), hex(0x6f7d3c), r);
+        c = mixc(c, hex(0x4f6b2c), smooth(0.3, 0.8, patch) * 0.6);         /* lusher patches    */
         c = mixc(c, hex(0x9a9048), smooth(0.86, 1.0, r2));                 /* dry blades        */
     }
     c = mixc(c, scalec(c, 1.25), smooth(0.5, 1.0, b.t));                   /* lighter tips      */
@@ -250,11 +255,11 @@ static void r_dirt(const ctx *x, int i, int j, double u, double v, texel *o)
     double clod = n01(u, v, 6, 5, x->seed);
     double fine = n01(u, v, 32, 2, x->seed + 1);
     cell c;
-    double p = pebble(u, v, 22, 0.35, x->seed + 2, &c);
-    rgb soil = mixc(hex(0x5c4431), hex(0x866548), n01(u, v, 8, 3, x->seed + 3));
-    soil = mixc(soil, hex(0x3b2b1e), (1 - clod) * 0.6);
+    double p = pebble(u, v, 22, 0.2, x->seed + 2, &c);
+    rgb soil = mixc(hex(0x5e4c3c), hex(0x7e6a54), n01(u, v, 8, 3, x->seed + 3));
+    soil = mixc(soil, hex(0x3d3024), (1 - clod) * 0.6);
     soil = scalec(soil, 0.9 + 0.2 * GRAIN(4));
-    rgb stone = mixc(hex(0x8a8176), hex(0xa08c72), id01(c.id, 5));
+    rgb stone = mixc(hex(0x6e665c), hex(0x857560), id01(c.id, 5));
     o->h = 0.6 * clod + 0.15 * fine + 0.3 * p;
     o->c = mixc(soil, stone, smooth(0.0, 0.3, p));
     o->rough = p > 0 ? 0.75 : 0.92;
@@ -364,7 +369,7 @@ static void r_cliff_rock(const ctx *x, int i, int j, double u, double v, texel *
     double wu = 0.05 * texgen_fbm(u * 5, v * 5, 5, 5, 3, 0.5, x->seed + 7);
     cell c = cells(u + wu, v + 0.3 * wu, 4, x->seed + 3);
     double crack = (1 - smooth(0.0, 0.03, c.f2 - c.f1)) * smooth(0.4, 0.55, n01(u, v, 3, 3, x->seed + 9));
-    static const unsigned pal[] = {0x8a6a55, 0xa08470, 0x6d5a4e, 0x977b63, 0x7e6a5a, 0xa68f7a, 0x74604f};
+    static const unsigned pal[] = {0x857064, 0x9a8a7c, 0x6d625a, 0x8f8072, 0x7a6f66, 0xa09284, 0x726860};
     rgb col = mixc(hex(pal[band]), hex(pal[(band + 1) % 7]), smooth(0.8, 1.0, f));
     col = mixc(col, scalec(col, 1.15), smooth(0.4, 0.9, rd));
     col = mixc(col, hex(0x3f3a36), smooth(0.55, 0.9, streak) * 0.6);   /* desert varnish */
@@ -409,7 +414,7 @@ static void r_moss(const ctx *x, int i, int j, double u, double v, texel *o)
 
 static void r_forest_floor(const ctx *x, int i, int j, double u, double v, texel *o)
 {
-    static const unsigned pal[] = {0x7a4a22, 0x94662f, 0x5e3a1e, 0xa37a3a, 0x4a3a26, 0x6b5330};
+    static const unsigned pal[] = {0x6a4a2e, 0x7e6240, 0x54402c, 0x8a7050, 0x4a3e30, 0x665438};
     scatter_desc leaves = {10, 3, 1.0, 0.3, 0.0, true};
     scatter_desc needles = {28, 4, 1.3, 0.05, 0.0, false};
     stroke l = scatter(u, v, &leaves, x->seed);
@@ -425,7 +430,7 @@ static void r_forest_floor(const ctx *x, int i, int j, double u, double v, texel
         h = 0.2 + 0.8 * l.h;
         rough = 0.75;
     } else if (n.h > 0) {
-        col = mixc(hex(0x6b4b2a), hex(0x8a5f33), id01(n.id, 1));
+        col = mixc(hex(0x6b5036), hex(0x80654a), id01(n.id, 1));
         h = 0.25 + 0.7 * n.h;
         rough = 0.7;
     }
@@ -519,7 +524,7 @@ bool texgen_surface_make(int i, int size, uint32_t seed, texgen_surface_set *out
     texel *f = malloc(sizeof *f * n);
     double *hh = malloc(sizeof *hh * n);
     if (!f || !hh ||
-        !texgen_image_alloc(&out->albedo, size, size, 3) ||
+        !texgen_image_alloc(&out->albedo, size, size, 4) ||
         !texgen_image_alloc(&out->normal, size, size, 3) ||
         !texgen_image_alloc(&out->height, size, size, 1) ||
         !texgen_image_alloc(&out->roughness, size, size, 1) ||
@@ -560,10 +565,11 @@ bool texgen_surface_make(int i, int size, uint32_t seed, texgen_surface_set *out
     double span = hmax > hmin ? hmax - hmin : 1;
     for (size_t p = 0; p < n; p++) {
         rgb c = scalec(f[p].c, k);
-        out->albedo.pixels[3 * p + 0] = unorm8(linear_to_srgb(c.r));
-        out->albedo.pixels[3 * p + 1] = unorm8(linear_to_srgb(c.g));
-        out->albedo.pixels[3 * p + 2] = unorm8(linear_to_srgb(c.b));
         hh[p] = (f[p].h - hmin) / span;
+        out->albedo.pixels[4 * p + 0] = unorm8(linear_to_srgb(c.r));
+        out->albedo.pixels[4 * p + 1] = unorm8(linear_to_srgb(c.g));
+        out->albedo.pixels[4 * p + 2] = unorm8(linear_to_srgb(c.b));
+        out->albedo.pixels[4 * p + 3] = unorm8(hh[p]);      /* the height again */
         out->height.pixels[p] = unorm8(hh[p]);
         out->roughness.pixels[p] = unorm8(f[p].rough);
     }
@@ -699,7 +705,7 @@ static void put_swatch(texgen_image *sheet, int x0, int y0, int cell,
                 for (int i = 0; i < f; i++) {
                     size_t p = (size_t)(y * f + j) * src->width + (size_t)(x * f + i);
                     if (lit) {
-                        const uint8_t *a = lit->albedo.pixels + 3 * p, *nn = lit->normal.pixels + 3 * p;
+                        const uint8_t *a = lit->albedo.pixels + 4 * p, *nn = lit->normal.pixels + 3 * p;
                         double nv[3], d = 0;
                         for (int k = 0; k < 3; k++)
                             nv[k] = nn[k] / 127.5 - 1;
@@ -739,7 +745,8 @@ bool texgen_write_sheet(const char *path, int size, uint32_t seed, int cell, cha
     }
     memset(sheet.pixels, 40, (size_t)w * h * 3);
     for (int c = 0; c < COLS; c++)
-        put_text(&sheet, LABEL + c * (cell + GAP) + GAP, 10, 2, heads[c], 230);
+        put_text(&sheet, LABEL + c * (cell + GAP) + GAP, 10,
+                 (int)strlen(heads[c]) * 12 <= cell ? 2 : 1, heads[c], 230);
     bool ok = true;
     for (int i = 0; i < NSURF && ok; i++) {
         texgen_surface_set set;

@@ -195,8 +195,9 @@ depfile)
     # the listed files, one a line ("  PATH \" or "  PATH" last)
     sed -n 's/^  //p' "$W/pack.d" | sed 's/ \\$//' > "$TMP/deps"
     for f in examples/minimal/scene.sg nodes/compositors.sg nodes/masks.sg graphs/grass.sg \
-             examples/minimal/heightfield.png examples/minimal/fields.png \
-             graphs/textures/rock.png graphs/textures/rock.mip1.png graphs/textures/grass.png; do
+             graphs/surfaces.sg examples/minimal/heightfield.png examples/minimal/fields.png \
+             graphs/textures/rock.png graphs/textures/rock.mip1.png \
+             graphs/textures/surfaces/grass_albedo.png; do
         grep -qxF "$f" "$TMP/deps" || fail "depfile lacks $f"
     done
     while read -r f; do [ -f "$W/$f" ] || fail "depfile names a missing file: $f"; done < "$TMP/deps"

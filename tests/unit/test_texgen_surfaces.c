@@ -76,7 +76,10 @@ static void test_albedo_colour_and_range(void **state)
 {
     for (int i = 0; i < texgen_surface_count(); i++) {
         const texgen_image *a = &sets[i].albedo;
-        assert_int_equal(a->channels, 3);
+        assert_int_equal(a->channels, 4);
+        /* its alpha is the height */
+        for (int p = 0; p < SIZE * SIZE; p++)
+            assert_int_equal(a->pixels[4 * p + 3], sets[i].height.pixels[p]);
         double chroma = mean_chroma(a);
         if (chroma < 3.0)
             fail_msg("%s: albedo is grey (mean chroma %.2f / 255)", texgen_surface_name(i), chroma);
@@ -89,7 +92,7 @@ static void test_albedo_colour_and_range(void **state)
         double s = 0, s2 = 0;
         size_t n = (size_t)a->width * a->height;
         for (size_t p = 0; p < n; p++) {
-            double g = a->pixels[3 * p + 1];
+            double g = a->pixels[4 * p + 1];
             s += g;
             s2 += g * g;
         }
@@ -173,7 +176,7 @@ static void test_deterministic(void **state)
         for (int k = 0; k < 5; k++)
             assert_memory_equal(x[k]->pixels, y[k]->pixels,
                                 (size_t)SIZE * SIZE * x[k]->channels);
-        assert_true(memcmp(sets[i].albedo.pixels, c.albedo.pixels, (size_t)SIZE * SIZE * 3) != 0);
+        assert_true(memcmp(sets[i].albedo.pixels, c.albedo.pixels, (size_t)SIZE * SIZE * 4) != 0);
         texgen_surface_free(&b);
         texgen_surface_free(&c);
     }
