@@ -21,7 +21,8 @@
  * vanishes in the distance; picking one texel per 2×2 block keeps the
  * value distribution of the level above).
  *
- * Sections: texgen.c (fields, images, examples, PNG); the CLI command is
+ * Sections: texgen.c (fields, images, examples, PNG), texgen_surfaces.c
+ * (the colour PBR surface sets and their swatch sheet); the CLI command is
  * cli_texgen.c (cli.h).
  */
 #ifndef SPLAT_TEXGEN_H
@@ -144,5 +145,42 @@ bool texgen_example_image(int i, int size, uint32_t seed, texgen_image *out);
  * textures that do not need them. */
 bool texgen_write_examples(const char *dir, int size, uint32_t seed,
                            bool all_mips, FILE *log, char **err);
+
+/* ---- texgen_surfaces.c: colour PBR surface sets ------------------------ */
+
+/* Procedural ground surfaces, each a set of five images from one height
+ * field (tileable, deterministic):
+ *   NAME_albedo.png     RGBA: sRGB-encoded colour, its mean linear luminance
+ *                       set inside the surface's measured albedo range; the
+ *                       height (linear) in alpha, for one-sample materials
+ *   NAME_normal.png     RGB tangent-space normal, 0.5-centred, +z out, +x
+ *                       along u (columns), +y along v (rows), from the height
+ *   NAME_height.png     grey, linear, 0 low .. 255 high
+ *   NAME_roughness.png  grey, linear perceptual roughness
+ *   NAME_ao.png         grey, linear ambient occlusion (1 open) from the
+ *                       height's horizons
+ * The albedo ranges and their sources are the table in texgen_surfaces.c. */
+typedef struct texgen_surface_set {
+    texgen_image albedo, normal, height, roughness, ao;
+} texgen_surface_set;
+
+int         texgen_surface_count(void);
+const char *texgen_surface_name(int i);     /* "grass", "dry_grass" …       */
+const char *texgen_surface_about(int i);
+/* The measured range of the surface's mean albedo (linear, 0..1). */
+void        texgen_surface_albedo_range(int i, double *lo, double *hi);
+/* Generate surface i at `size` texels square (a power of two >= 16). */
+bool texgen_surface_make(int i, int size, uint32_t seed, texgen_surface_set *out);
+void texgen_surface_free(texgen_surface_set *set);
+/* Mean linear luminance (Rec. 709) of an sRGB-encoded RGB(A) image. */
+double texgen_mean_albedo(const texgen_image *srgb);
+/* Write every surface set into `dir` (which must exist), one log line per
+ * surface. */
+bool texgen_write_surfaces(const char *dir, int size, uint32_t seed,
+                           FILE *log, char **err);
+/* The swatch sheet: one row per surface (albedo, normal, height, roughness,
+ * AO and a lit preview), labelled, `cell` texels per swatch, as an RGB PNG. */
+bool texgen_write_sheet(const char *path, int size, uint32_t seed, int cell,
+                        char **err);
 
 #endif

@@ -27,6 +27,9 @@
 #              contrast), nor with the default fog (its fog_density taken
 #              out; the old 1.5 / extent fails the same check), a second
 #              init into it is refused
+#   texgen     `splatc texgen`: two runs write byte-identical files (the
+#              example textures, the 12 colour surface sets, the swatch
+#              sheet); bad sizes exit 2
 #   malformed  empty file, binary garbage, truncated files, 10 MB inputs,
 #              10000-deep instance nesting: exit 1 with a diagnostic, no crash
 #              or hang
@@ -158,6 +161,17 @@ eval)
     run 2 "$SPLATC" eval graphs/cliff.sg -m cliff --at slope=0:1
     run 2 "$SPLATC" eval graphs/cliff.sg -m cliff --at nothing=1
     ;;
+texgen)
+    for d in a b; do
+        run 0 "$SPLATC" texgen --out "$TMP/$d" --size 16 --surface-size 32 --sheet "$TMP/$d/sheet.png"
+    done
+    n=$(ls "$TMP/a/surfaces" | grep -c '_\(albedo\|normal\|height\|roughness\|ao\)\.png$')
+    [ "$n" -ge 60 ] || fail "texgen wrote $n surface files, expected 12 sets of 5"
+    [ -s "$TMP/a/sheet.png" ] || fail "no swatch sheet"
+    diff -r "$TMP/a" "$TMP/b" >/dev/null || fail "two texgen runs differ"
+    run 2 "$SPLATC" texgen --out "$TMP/c" --surface-size 100
+    run 2 "$SPLATC" texgen --out "$TMP/c" --surface-size 8
+    ;;
 tools)
     run 0 "$SPLATC" check graphs/cliff.sg graphs/grass.sg nodes/masks.sg nodes/compositors.sg
     run 1 "$SPLATC" check graphs/cliff.sg tests/golden/cycle.sg
@@ -231,8 +245,9 @@ depfile)
     # the listed files, one a line ("  PATH \" or "  PATH" last)
     sed -n 's/^  //p' "$W/pack.d" | sed 's/ \\$//' > "$TMP/deps"
     for f in examples/minimal/scene.sg nodes/compositors.sg nodes/masks.sg graphs/grass.sg \
-             examples/minimal/heightfield.png examples/minimal/fields.png \
-             graphs/textures/rock.png graphs/textures/rock.mip1.png graphs/textures/grass.png; do
+             graphs/surfaces.sg examples/minimal/heightfield.png examples/minimal/fields.png \
+             graphs/textures/rock.png graphs/textures/rock.mip1.png \
+             graphs/textures/surfaces/grass_albedo.png; do
         grep -qxF "$f" "$TMP/deps" || fail "depfile lacks $f"
     done
     while read -r f; do [ -f "$W/$f" ] || fail "depfile names a missing file: $f"; done < "$TMP/deps"

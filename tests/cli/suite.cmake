@@ -1,7 +1,7 @@
 # Command-line tests of splatc (tests/cli/cli.sh): every graph through
 # glsl/spirv and the validators, exit codes, eval, tools, malformed input.
 if(TARGET splatc_cli)
-  foreach(case graphs status eval tools depfile preview malformed teach)
+  foreach(case graphs status eval tools depfile preview malformed teach texgen)
     add_test(NAME cli.${case}
              COMMAND sh ${CMAKE_CURRENT_LIST_DIR}/cli.sh $<TARGET_FILE:splatc_cli> ${case}
              WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
