@@ -185,7 +185,7 @@ static void settings_tables(FILE *out)
           "| `max_height` | metres at the heightfield's white |\n"
           "| `height_offset` | metres added to every height |\n"
           "| `materials` | `[bottom, …, top]`: the stack |\n"
-          "| `compositor` | the shader that blends the layers (`linear_alpha`, `height_blend`, `stochastic_select`) |\n"
+          "| `compositor` | the shader that blends the layers (`linear_alpha`, `height_blend`, `stochastic_select`, `height_softmax`) |\n"
           "| `painted` | `NAME = \"file\" [{ max_level, max_error, near, origin, size }]`: a painted mask; `holes` cuts the terrain |\n"
           "| `cell` | heightfield texels per analysis cell (default 32) |\n"
           "| `destruction` | `{ origin = X Z, size = X Z, cell = C }`: where craters can be made |\n"
