@@ -473,6 +473,9 @@ typedef struct splat_push {
  *                          at any distance: precision.c builds on it)
  *     vec3 splat_view_direction() (unit, surface -> camera, terrain-local)
  *     float splat_destruction()   float splat_painted(int layer)
+ *     float splat_cavity()  terrain.cavity: the heightfield's mean at 4
+ *                          diagonal taps 2 texels away minus the height
+ *                          here, metres (4 more height reads)
  *     float splat_height_at(vec2 uv)  vec3 splat_normal_at(vec2 uv)
  *     void splat_finish(vec3 albedo, vec3 normal, float roughness,
  *                       float height, float coverage)

@@ -4,7 +4,8 @@
  *                          scales blended by view distance;
  *   nodes/variation.sg     macro_variation;
  *   nodes/normal_blend.sg  reoriented normal mapping and whiteout
- *                          (Barré-Brisebois and Hill 2012), tangent_to_world.
+ *                          (Barré-Brisebois and Hill 2012), tangent_to_world;
+ *   nodes/cavity.sg        occlusion and ridge light from terrain.cavity.
  * The graphs are lowered through the real front end and evaluated with
  * ir_eval (double); textures read a smooth procedural function of the raw
  * uv, so a wrong offset or weight shows.  Runs from the repository root. */
@@ -19,7 +20,9 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "compose.h"
 #include "lowered.h"
+#include "spv.h"
 
 /* ---- helpers ------------------------------------------------------------- */
 
@@ -332,6 +335,131 @@ static void test_normal_blend(void **state)
     CLOSE(got[1], 0.6, 1e-12);
 }
 
+/* ---- cavity ------------------------------------------------------------------ */
+
+static void test_cavity_ao(void **state)
+{
+    (void)state;
+    static const double cav[] = {-30, -10, -4, 0, 2.5, 5, 9.9, 10, 40};
+    for (size_t i = 0; i < sizeof cav / sizeof cav[0]; i++) {
+        ir_env e = env_at(0, 0, 0, 0);
+        e.cavity = cav[i];
+        double got[4];
+        eval_node("cavity.sg", &e, "mask", "n.out",
+                  "cavity_ao { depth = 10.0, strength = 0.6, ridge = 0.2 }", got);
+        double o = fmin(1, fmax(0, cav[i] / 10)), r = fmin(1, fmax(0, -cav[i] / 10));
+        CLOSE(got[0], 1 - 0.6 * o + 0.2 * r, 1e-12);
+        eval_node("cavity.sg", &e, "albedo", "n.out",
+                  "cavity_darken { albedo = vec3(0.5, 0.4, 0.3), depth = 10.0, strength = 0.6 }",
+                  got);
+        CLOSE(got[1], 0.4 * (1 - 0.6 * o), 1e-12);
+    }
+}
+
+/* ---- in a composite: every GLSL variant compiles ------------------------------ */
+
+static const char LOOK[] =
+    "import \"nodes/compositors.sg\"\n"
+    "import \"nodes/height_softmax.sg\"\n"
+    "import \"nodes/detile.sg\"\n"
+    "import \"nodes/variation.sg\"\n"
+    "import \"nodes/normal_blend.sg\"\n"
+    "import \"nodes/cavity.sg\"\n"
+    "import \"nodes/projection.sg\"\n"
+    "texture noise { file = \"graphs/textures/noise.png\" }\n"
+    "texture nrm { file = \"graphs/textures/rock_normal.png\" }\n"
+    "material base {\n"
+    "    node d : detile { tex = noise, scale = 3.0 }\n"
+    "    node v : macro_variation { albedo = d.out.rgb, tint = vec3(0.9, 1.0, 0.7), tint_amount = 0.4 }\n"
+    "    node c : cavity_darken { albedo = v.out, ridge = 0.1 }\n"
+    "    node u1 : top_down_uv { scale = 4.0 }\n"
+    "    node a : sample { tex = nrm, uv = u1.uv }\n"
+    "    node u2 : mul { a = u1.uv, b = 5.0 }\n"
+    "    node b : sample { tex = nrm, uv = u2.out }\n"
+    "    node na : unpack_normal { c = a.rgb }\n"
+    "    node nb : unpack_normal { c = b.rgb, strength = 0.5 }\n"
+    "    node r : rnm_blend { base = na.out, detail = nb.out }\n"
+    "    node w : whiteout_blend { a = na.out, b = nb.out }\n"
+    "    node m : mix { a = r.out, b = w.out, t = 0.5 }\n"
+    "    node n : tangent_to_world { n = m.out }\n"
+    "    out albedo = c.out\n"
+    "    out normal = n.out\n"
+    "    out height = d.out.r\n"
+    "}\n"
+    "material top {\n"
+    "    node k : mul { a = terrain.cavity, b = 0.1 }\n"
+    "    node m : saturate { x = k.out }\n"
+    "    out mask = m.out\n"
+    "    out albedo = vec3(0.3, 0.3, 0.3)\n"
+    "    out height = 0.7\n"
+    "}\n";
+
+static void compiles(const char *glsl, spv_stage stage, const char *name)
+{
+    uint32_t *w = NULL;
+    size_t n = 0;
+    char *log = NULL;
+    bool ok = spv_compile(glsl, stage, name, &w, &n, &log);
+    if (!ok)
+        fprintf(stderr, "%s\n%s", glsl, log ? log : "");
+    assert_true(ok);
+    free(log);
+    log = NULL;
+    ok = spv_validate(w, n, &log);
+    if (!ok)
+        fprintf(stderr, "%s", log ? log : "");
+    assert_true(ok);
+    free(log);
+    free(w);
+}
+
+static void test_composite_compiles(void **state)
+{
+    (void)state;
+    static const char *const names[] = {"base", "top"};
+    static const char *const search[] = {".", NULL};
+    static const char *const compositors[] = {"linear_alpha", "height_softmax"};
+    sg_diags d;
+    sg_diags_init(&d);
+    sg_program *p = sg_load_string("look.sg", LOOK, search, &d);
+    assert_non_null(p);
+    ir src;
+    ir_init(&src);
+    bool ok = true;
+    for (int i = 0; i < 2; i++)
+        ok = ok && sg_lower_material(p, names[i], &src, &d);
+    sg_diags_print(&d, stderr);
+    assert_true(ok);
+    assert_int_equal(d.nerrors, 0);
+    for (int k = 0; k < 2; k++) {
+        splat_layout L;
+        assert_true(splat_layout_init(&L, &src, p, compositors[k], names, 2, NULL, 0, &d));
+        static const int mats[] = {1, 0};
+        splat_compose_desc desc = {.materials = mats, .nmaterials = 2};
+        splat_composite c;
+        assert_true(splat_compose(&L, &desc, &c, &d));
+        int ug_slot[2] = {0, -1};
+        struct { splat_glsl_desc g; spv_stage st; } v[] = {
+            {{.title = "forward"}, SPV_STAGE_FRAGMENT},
+            {{.title = "flat", .flat = true}, SPV_STAGE_FRAGMENT},
+            {{.title = "compute", .compute = true}, SPV_STAGE_COMPUTE},
+            {{.title = "ug", .compute = true, .ug_slot = ug_slot}, SPV_STAGE_COMPUTE},
+        };
+        for (size_t i = 0; i < sizeof v / sizeof v[0]; i++) {
+            ir_buf b = {0};
+            splat_composite_glsl(&L, &c, &v[i].g, &b);
+            assert_non_null(strstr(b.s, "splat_cavity()"));
+            compiles(b.s, v[i].st, v[i].g.title);
+            ir_buf_free(&b);
+        }
+        splat_composite_free(&c);
+        splat_layout_free(&L);
+    }
+    ir_free(&src);
+    sg_free(p);
+    sg_diags_free(&d);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
@@ -339,6 +467,8 @@ int main(void)
         cmocka_unit_test(test_detile),
         cmocka_unit_test(test_macro_variation),
         cmocka_unit_test(test_normal_blend),
+        cmocka_unit_test(test_cavity_ao),
+        cmocka_unit_test(test_composite_compiles),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
