@@ -113,7 +113,8 @@ static void hex_ref(double u, double v, double grid, double sharp, double out[4]
         out[c] = 0;
     for (int k = 0; k < 3; k++) {
         double h1 = hash_perm(vx[k], vy[k]);
-        double h2 = hash_perm(vy[k] + 289 * h1, vx[k] + 289 * h1);
+        double k1 = floor(289 * h1 + 0.5);        /* the integer h1 stands for */
+        double h2 = hash_perm(vy[k] + k1, vx[k] + k1);
         double c[4];
         tex_fn(u + h1, v + h2, c);
         double p = pow(fmin(1, fmax(0, w[k])), sharp);
@@ -160,7 +161,8 @@ static void test_hex_tile(void **state)
     snprintf(node, sizeof node, "hex_tile { tex = tx, uv = vec2(%.17g, %.17g) }", u, v);
     double got[4], one[4];
     eval_node("detile.sg", &e, "albedo", "n.out.rgb", node, got);
-    double h1 = hash_perm(3, 5), h2 = hash_perm(5 + 289 * h1, 3 + 289 * h1);
+    double h1 = hash_perm(3, 5), k1 = floor(289 * h1 + 0.5);
+    double h2 = hash_perm(5 + k1, 3 + k1);
     tex_fn(u + h1, v + h2, one);
     for (int c = 0; c < 3; c++)
         CLOSE(got[c], one[c], 1e-6);
