@@ -18,7 +18,8 @@
  * left is the sampler: lavapipe's 8-bit sub-texel weights and the texel
  * coordinate's rounding, (2^-8 + 4u TEX (1 + |uv|)) times the texture's
  * largest texel step, per read, and a floor of 2^-16 for the arithmetic.
- * The CPU side of the same formulas is tests/unit/test_look_nodes.c. */
+ * The CPU side of the same formulas is tests/unit/test_look_nodes.c.
+ * Last, the height_softmax composite's normalised sums the same way. */
 #include <setjmp.h>
 #include <stdarg.h>
 #include <stddef.h>
@@ -30,6 +31,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "compose.h"
 #include "harness.h"
 #include "sg.h"
 
@@ -226,10 +228,125 @@ static void test_look_nodes_agree(void **state)
     sg_diags_free(&d);
 }
 
+/* The height_softmax composite (nodes/height_softmax.sg, compiler/DESIGN.md
+ * §6.2), its "composite.albedo" and ".roughness" roots (the normalised sums
+ * the GLSL accumulates), on the device against the double reference with
+ * the spread-based tolerance; masks and heights are ramps of the inputs. */
+static const char STACK[] =
+    "import \"nodes/height_softmax.sg\"\n"
+    "material base {\n"
+    "    node h : mul { a = terrain.slope, b = 0.8 }\n"
+    "    out albedo = vec3(0.4, 0.3, 0.2)\n"
+    "    out roughness = 0.9\n"
+    "    out height = h.out\n"
+    "}\n"
+    "material sand {\n"
+    "    node k : mul { a = terrain.normal.x, b = 3.0 }\n"
+    "    node m : saturate { x = k.out }\n"
+    "    node h : mul { a = terrain.cavity, b = 0.05 }\n"
+    "    out mask = m.out\n"
+    "    out albedo = vec3(0.8, 0.7, 0.5)\n"
+    "    out roughness = 0.7\n"
+    "    out height = h.out\n"
+    "}\n"
+    "material rock {\n"
+    "    node k : mul { a = terrain.normal.z, b = 2.5 }\n"
+    "    node m : saturate { x = k.out }\n"
+    "    node h : mul { a = view.distance, b = 0.01 }\n"
+    "    out mask = m.out\n"
+    "    out albedo = vec3(0.5, 0.5, 0.55)\n"
+    "    out roughness = 0.5\n"
+    "    out height = h.out\n"
+    "}\n";
+
+static void test_height_softmax_agrees(void **state)
+{
+    (void)state;
+    static const char *const names[] = {"base", "sand", "rock"};
+    static const char *const search[] = {".", NULL};
+    sg_diags d;
+    sg_diags_init(&d);
+    sg_program *p = sg_load_string("stack.sg", STACK, search, &d);
+    assert_non_null(p);
+    ir src;
+    ir_init(&src);
+    bool ok = true;
+    for (int i = 0; i < 3; i++)
+        ok = ok && sg_lower_material(p, names[i], &src, &d);
+    sg_diags_print(&d, stderr);
+    assert_true(ok);
+    splat_layout L;
+    assert_true(splat_layout_init(&L, &src, p, "height_softmax", names, 3, NULL, 0, &d));
+    static const int mats[] = {2, 1, 0};
+    splat_compose_desc desc = {.materials = mats, .nmaterials = 3};
+    splat_composite c;
+    assert_true(splat_compose(&L, &desc, &c, &d));
+    ir_ref roots[2] = {ir_find_root(&c.ir, "composite.albedo"),
+                       ir_find_root(&c.ir, "composite.roughness")};
+    assert_true(ir_ref_ok(roots[0]) && ir_ref_ok(roots[1]));
+    static ir_env env[POINTS];
+    uint64_t s = 7;
+    for (int i = 0; i < POINTS; i++) {
+        ir_env *e = &env[i];
+        memset(e, 0, sizeof *e);
+        double n[3] = {rnd(&s, -0.6, 0.6), rnd(&s, 0.3, 1), rnd(&s, -0.6, 0.6)};
+        double l = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+        for (int k = 0; k < 3; k++)
+            e->normal[k] = f32(n[k] / l);
+        e->slope = f32(1 - e->normal[1]);
+        e->cavity = f32(rnd(&s, -5, 25));
+        e->view_distance = f32(rnd(&s, 0, 120));
+    }
+    float *gpu = calloc((size_t)POINTS * 2 * 4, sizeof *gpu);
+    char *err = NULL;
+    harness_ir_desc hd = {.ir = &c.ir, .roots = roots, .nroots = 2, .points = env,
+                          .npoints = POINTS};
+    ok = harness_eval_ir(H, &hd, gpu, NULL, &err);
+    if (!ok)
+        fprintf(stderr, "harness_eval_ir: %s\n", err ? err : "?");
+    assert_true(ok);
+    harness_ref_opts ro = {.samples = 16};
+    long compared = 0, partial = 0;
+    double worst = 0;
+    for (int i = 0; i < POINTS; i++) {
+        for (int r = 0; r < 2; r++) {
+            harness_refval rv;
+            ro.seed = 77u + (uint64_t)i;
+            harness_reference(&c.ir, roots[r], &env[i], &ro, &rv);
+            for (int k = 0; k < (r ? 1 : 3); k++) {
+                double ref = rv.value[k], scale = fmax(1, fabs(ref));
+                assert_int_equal(rv.flags[k], 0);
+                assert_true(rv.spread[k] <= ILL_COND * scale);
+                double tol = FLOOR_TOL * scale + 4 * rv.spread[k];
+                double e = fabs(gpu[((size_t)i * 2 + (size_t)r) * 4 + (size_t)k] - ref);
+                worst = fmax(worst, e / tol);
+                if (e > tol)
+                    fail_msg("point %d root %d [%d]: device %.9g, reference %.9g", i, r, k,
+                             gpu[((size_t)i * 2 + (size_t)r) * 4 + (size_t)k], ref);
+                compared++;
+            }
+        }
+        /* points where the roughness is a blend, not one layer's */
+        double rr = gpu[(size_t)i * 8 + 4];
+        partial += fabs(rr - 0.9) > 1e-3 && fabs(rr - 0.7) > 1e-3 && fabs(rr - 0.5) > 1e-3;
+    }
+    printf("height_softmax: %ld values compared, worst error/tolerance %.3g, %ld blended points\n",
+           compared, worst, partial);
+    assert_true(partial > POINTS / 8);
+    free(gpu);
+    free(err);
+    splat_composite_free(&c);
+    splat_layout_free(&L);
+    ir_free(&src);
+    sg_free(p);
+    sg_diags_free(&d);
+}
+
 int main(void)
 {
     const struct CMUnitTest tests[] = {
         cmocka_unit_test(test_look_nodes_agree),
+        cmocka_unit_test(test_height_softmax_agrees),
     };
     return cmocka_run_group_tests(tests, setup, teardown);
 }
