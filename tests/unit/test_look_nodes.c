@@ -117,7 +117,7 @@ static void hex_ref(double u, double v, double grid, double sharp, double out[4]
         double h2 = hash_perm(vy[k] + k1, vx[k] + k1);
         double c[4];
         tex_fn(u + h1, v + h2, c);
-        double p = pow(fmin(1, fmax(0, w[k])), sharp);
+        double p = pow(fabs(w[k]), sharp);
         sum += p;
         for (int j = 0; j < 4; j++)
             out[j] += p * c[j];
