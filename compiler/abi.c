@@ -667,6 +667,17 @@ const char SPLAT_GLSL_PRELUDE[] =
     "float splat_height() { return splat_height_smooth_at(v_uv); }\n"
     "#endif\n"
     "float splat_slope() { return 1.0 - splat_normal().y; }\n"
+    /* terrain.cavity (splat_terrain_cavity is its CPU twin): the mean of
+     * 4 diagonal taps 2 texels away minus the height here, in metres;
+     * positive in hollows, negative on ridges */
+    "float splat_cavity() {\n"
+    "    vec2 t = 2.0 * u_frame.texel.zw;\n"
+    "    float s = splat_texture0(u_height, v_uv - t).r\n"
+    "            + splat_texture0(u_height, v_uv + t).r\n"
+    "            + splat_texture0(u_height, v_uv + vec2(t.x, -t.y)).r\n"
+    "            + splat_texture0(u_height, v_uv + vec2(-t.x, t.y)).r;\n"
+    "    return (0.25 * s - splat_texture0(u_height, v_uv).r) * u_frame.terrain.z;\n"
+    "}\n"
     "vec3 splat_position() { return vec3(v_local.x, splat_height(), v_local.z); }\n"
     "vec2 splat_uv() { return v_uv; }\n"
     "vec3 splat_offset() { return v_rel; }\n"

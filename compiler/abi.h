@@ -547,6 +547,9 @@ typedef struct splat_push {
  *     void splat_terrain_at(vec2 uv, out float h, out vec3 n)
  *                          the shading inputs' height and normal: the cubic
  *                          B-spline over the texels and Listing 1 on it
+ *     float splat_cavity()  terrain.cavity: the heightfield's mean at 4
+ *                          diagonal taps 2 texels away minus the height
+ *                          here, metres (4 more height reads)
  *     void splat_finish(vec3 albedo, vec3 normal, float roughness,
  *                       float height, float coverage)
  *     uint splat_view()   the debug view (SPLAT_SPEC_VIEW above)

@@ -196,7 +196,7 @@ static void settings_tables(FILE *out)
           "| `max_height` | metres at the heightfield's white |\n"
           "| `height_offset` | metres added to every height |\n"
           "| `materials` | `[bottom, …, top]`: the stack |\n"
-          "| `compositor` | the shader that blends the layers (`linear_alpha`, `height_blend`, `stochastic_select`) |\n"
+          "| `compositor` | the shader that blends the layers (`linear_alpha`, `height_blend`, `stochastic_select`, `height_softmax`) |\n"
           "| `painted` | `NAME = \"file\" [{ max_level, max_error, near, origin, size }]`: a painted mask; `holes` cuts the terrain |\n"
           "| `spline` | `NAME { points = [x z, x z, …], width = W, falloff = F, profile = smoothstep\\|linear }`: a road through the points (centripetal Catmull-Rom, terrain-local metres; each further `points` adds a curve), read as `vector.NAME` |\n"
           "| `polygon` | `NAME { points = [x z, …], falloff = F, profile = … }`: a decal area (a further `points` ring cuts a hole: even-odd), read as `vector.NAME` |\n"

@@ -11,6 +11,10 @@
  *     T_0 = 1;  w_j, T_j+1 = compositor(T_j, m_j, h_j)
  *     composite.albedo = sum_j w_j * albedo_j     (same for the others)
  *
+ * A normalised compositor (one with a `blend` output: nodes/height_softmax.sg)
+ * adds blend_j in place of w_j and the sums are divided by sum_j blend_j at
+ * the end (s_wsum in the GLSL); T still runs the alpha chain.
+ *
  * The bottom layer's mask is 1: the analysis ends every combination at a
  * material that is opaque wherever the combination is used.
  *
@@ -243,28 +247,51 @@ static bool has_input(const sg_program *prog, const char *name, const char *port
     return false;
 }
 
+/* Whether shader `name` of prog has an output port `port`. */
+static bool has_output(const sg_program *prog, const char *name, const char *port)
+{
+    int si = sg_shader_find(prog, name);
+    if (si < 0)
+        return false;
+    const sg_shader *s = prog->shaders[si];
+    for (int i = 0; i < s->nouts; i++)
+        if (strcmp(s->outs[i].name, port) == 0)
+            return true;
+    return false;
+}
+
+bool splat_compositor_normalised(const sg_program *prog, const char *name)
+{
+    return prog && has_output(prog, name ? name : "linear_alpha", "blend");
+}
+
 /* The compositor inlined for one layer: T, m, h, and the material's index
  * as `id` where the compositor declares that port (a per-material seed:
- * nodes/stochastic.sg). */
+ * nodes/stochastic.sg).  A normalised compositor's `blend` output goes to
+ * *blend (else IR_NONE). */
 static bool lower_compositor(const splat_layout *L, ir *ir, ir_ref T, ir_ref m,
                              ir_ref h, int material, ir_ref *w, ir_ref *T_next,
-                             sg_diags *d)
+                             ir_ref *blend, sg_diags *d)
 {
+    *blend = IR_NONE;
     if (!L->prog) {
         builtin_alpha(ir, T, m, w, T_next);
         return true;
     }
     static const char *const in_names[] = {"T", "m", "h", "id"};
-    static const char *const out_names[] = {"weight", "T_next"};
+    static const char *const out_names[] = {"weight", "T_next", "blend"};
     ir_ref in_vals[4] = {T, m, h, ir_constf(ir, material)};
-    ir_ref outs[2];
+    ir_ref outs[3];
     const char *name = L->compositor ? L->compositor : "linear_alpha";
     int nin = has_input(L->prog, name, "id") ? 4 : 3;
+    int nout = splat_compositor_normalised(L->prog, name) ? 3 : 2;
     if (!sg_lower_shader(L->prog, name, ir, in_names, in_vals, nin, out_names,
-                         outs, 2, d))
+                         outs, nout, d))
         return false;
     *w = outs[0];
     *T_next = outs[1];
+    if (nout == 3)
+        *blend = outs[2];
     return true;
 }
 
@@ -275,7 +302,7 @@ static bool compositor_bounds(sg_program *prog, const char *name, int out, doubl
                               ir_iv T, ir_iv h, ir_iv *b, sg_diags *d)
 {
     static const char *const in_names[] = {"T", "m", "h"};
-    static const char *const out_names[] = {"weight", "T_next"};
+    static const char *const out_names[] = {"weight", "T_next", "blend"};
     ir ir;
     ir_init(&ir);
     ir_param pt = {.name = "T", .type = IR_T_FLOAT, .def = {T.lo}, .lo = T.lo, .hi = T.hi};
@@ -283,8 +310,8 @@ static bool compositor_bounds(sg_program *prog, const char *name, int out, doubl
     ir_ref in[3] = {T.lo == T.hi ? ir_constf(&ir, T.lo) : ir_param_ref(&ir, ir_add_param(&ir, &pt)),
                     ir_constf(&ir, m),
                     h.lo == h.hi ? ir_constf(&ir, h.lo) : ir_param_ref(&ir, ir_add_param(&ir, &ph))};
-    ir_ref outs[2];
-    bool ok = sg_lower_shader(prog, name, &ir, in_names, in, 3, out_names, outs, 2, d);
+    ir_ref outs[3];
+    bool ok = sg_lower_shader(prog, name, &ir, in_names, in, 3, out_names, outs, out + 1, d);
     if (ok) {
         ir_set_root(&ir, "checked", outs[out]);
         ir_optimize(&ir, NULL);
@@ -301,7 +328,8 @@ static bool compositor_bounds(sg_program *prog, const char *name, int out, doubl
 
 /* The compositor's soundness contract (compiler/DESIGN.md §6), which the analysis and
  * the front-to-back loop rely on: its weight is 0 where m = 0 and its
- * T_next is 0 where m = 1, for every T in [0, 1].  Checked with the
+ * T_next is 0 where m = 1, for every T in [0, 1]; a normalised
+ * compositor's blend is 0 where m = 0 too.  Checked with the
  * interval evaluator: first over the whole box (T and h in [0, 1], every
  * other input over its domain), which proves most compositors (bounds
  * within DBL_MIN of 0 count as 0: the evaluator's outward rounding of an
@@ -311,21 +339,23 @@ static bool compositor_bounds(sg_program *prog, const char *name, int out, doubl
  * T - T * pow(1, e)) is never an error. */
 bool splat_compositor_check(sg_program *prog, const char *name, sg_loc at, sg_diags *d)
 {
-    static const char *const what[] = {"weight", "T_next"};
+    static const char *const what[] = {"weight", "T_next", "blend"};
     const ir_iv unit = {0, 1};
-    for (int out = 0; out < 2; out++) {
+    int nout = splat_compositor_normalised(prog, name) ? 3 : 2;
+    for (int out = 0; out < nout; out++) {
+        int m = out == 1;   /* weight and blend at m = 0, T_next at m = 1 */
         ir_iv b;
-        if (!compositor_bounds(prog, name, out, out, unit, unit, &b, d))
+        if (!compositor_bounds(prog, name, out, m, unit, unit, &b, d))
             return false;
         if (b.lo >= -DBL_MIN && b.hi <= DBL_MIN)
             continue;                                   /* proved */
         for (int k = 1; k <= 8; k++)
             for (int j = 0; j <= 2; j++) {
                 ir_iv T = {k / 8.0, k / 8.0}, h = {j / 2.0, j / 2.0};
-                if (!compositor_bounds(prog, name, out, out, T, h, &b, d))
+                if (!compositor_bounds(prog, name, out, m, T, h, &b, d))
                     return false;
                 if (b.lo > DBL_MIN || b.hi < -DBL_MIN) {
-                    sg_error(d, at, SG_E_COMPOSITOR_CONTRACT, name, what[out], out, T.lo,
+                    sg_error(d, at, SG_E_COMPOSITOR_CONTRACT, name, what[out], m, T.lo,
                              h.lo, b.lo, b.hi);
                     return false;
                 }
@@ -405,6 +435,7 @@ bool splat_compose(const splat_layout *L, const splat_compose_desc *desc,
     ir_ref one = ir_constf(dst, 1.0);
     ir_ref T = one;
     ir_ref acc[SG_OUT_COUNT] = {{0}};
+    ir_ref wsum = IR_NONE;        /* normalised compositor: sum of the blends */
     for (int j = 0; j < n; j++) {
         int k = desc->materials[j];
         assert(k >= 0 && k < L->nmaterials);
@@ -424,14 +455,20 @@ bool splat_compose(const splat_layout *L, const splat_compose_desc *desc,
         ir_ref view_mask = k == 0 ? one : ir_op1(dst, IR_OP_SATURATE, s[SG_OUT_MASK]);
         bool bottom = desc->reference ? k == 0 : j == n - 1;
         ir_ref m = bottom ? one : view_mask;
-        ir_ref w, T_next = IR_NONE;
+        ir_ref w, T_next = IR_NONE, blend = IR_NONE;
         if (desc->reference) {
             w = m;
         } else {
-            if (!lower_compositor(L, dst, T, m, s[SG_OUT_HEIGHT], k, &w, &T_next, d))
+            if (!lower_compositor(L, dst, T, m, s[SG_OUT_HEIGHT], k, &w, &T_next, &blend, d))
                 break;
             if (j == n - 1)
                 T_next = IR_NONE;  /* nothing below the bottom layer */
+            if (ir_ref_ok(blend)) {
+                /* normalised: the layer adds blend * s, divided by the
+                 * sum of the blends at the end */
+                w = blend;
+                wsum = ir_ref_ok(wsum) ? ir_op2(dst, IR_OP_ADD, wsum, w) : w;
+            }
         }
         ir_ref f[] = {T, m, w, T_next, view_mask};
         for (int i = 0; i < 5; i++)
@@ -448,6 +485,11 @@ bool splat_compose(const splat_layout *L, const splat_compose_desc *desc,
     if (d->nerrors > errors) {
         splat_composite_free(c);
         return false;
+    }
+    if (ir_ref_ok(wsum)) {
+        set_root(dst, -1, "wsum", wsum);
+        for (int o = 1; o < SG_OUT_COUNT; o++)
+            acc[o] = ir_op2(dst, IR_OP_DIV, acc[o], ir_splat(dst, wsum, ir_typeof(dst, acc[o])));
     }
     for (int o = 1; o < SG_OUT_COUNT; o++)
         set_root(dst, -1, sg_output_names[o], acc[o]);
@@ -744,6 +786,8 @@ typedef struct emit {
     sched                  s;
     char                   indent[256];
     const int             *ug_slot;  /* desc->ug_slot                        */
+    bool                   normalised; /* the compositor has `blend`: sums
+                                          s_wsum, divides before finishing */
 } emit;
 
 static ir_ref map_ref(const uint32_t *map, ir_ref r)
@@ -991,6 +1035,8 @@ static void emit_accumulate(emit *em, const splat_layer *l, int depth)
     bool unit = is_const(&em->ir, l->weight, &wv) && wv == 1.0;
     char *w = value(em, l->weight, depth);
     ir_buf_printf(em->out, "%ssplat_count_layer(%s);\n", indent_at(em, depth), w);
+    if (em->normalised)
+        ir_buf_printf(em->out, "%ss_wsum += %s;\n", indent_at(em, depth), w);
     if (em->ug_slot && em->ug_slot[l->material] >= 0)
         ir_buf_printf(em->out, "%ssplat_ug_weight(%d, %s);\n", indent_at(em, depth),
                       em->ug_slot[l->material], w);
@@ -1004,6 +1050,28 @@ static void emit_accumulate(emit *em, const splat_layer *l, int depth)
         free(x);
     }
     free(w);
+}
+
+/* A normalised compositor (its `blend` output, compiler/DESIGN.md §6.2):
+ * the sums divided by the sum of the blends, the undergrowth weights too.
+ * s_wsum > 0 wherever a layer was added (the bottom layer's alpha weight
+ * is what the ones above left, and its blend a positive multiple of it);
+ * the max only keeps the sorted variant's first run, which adds nothing,
+ * away from 0 / 0. */
+static void emit_normalise(emit *em)
+{
+    ir_buf_printf(em->out, "    float s_inv = 1.0 / max(s_wsum, 1e-30);\n"
+                           "    s_albedo *= s_inv;\n"
+                           "    s_roughness *= s_inv;\n"
+                           "    s_height *= s_inv;\n");
+    if (!em->ug_slot)
+        return;
+    for (int j = 0; j < em->c->nlayers; j++) {
+        int slot = em->ug_slot[em->layers[j].material];
+        if (slot >= 0)
+            ir_buf_printf(em->out, "    splat_ug_weight(%d, splat_ug_w[%d] * s_inv);\n",
+                          slot, slot);
+    }
 }
 
 /* Layer j: we are inside G_j's block (at `depth`). */
@@ -1360,7 +1428,9 @@ void splat_composite_glsl(const splat_layout *L, const splat_composite *c,
                           const splat_glsl_desc *desc, ir_buf *out)
 {
     emit em = {.L = L, .c = c, .out = out, .src = &c->ir, .src_layers = c->layers,
-               .ug_slot = desc->ug_slot};
+               .ug_slot = desc->ug_slot,
+               .normalised = !c->reference &&
+                             splat_compositor_normalised(L->prog, L->compositor)};
     assert(!desc->ug_slot || desc->compute);
     ir dir;
     splat_layer *dlayers = NULL;
@@ -1391,6 +1461,8 @@ void splat_composite_glsl(const splat_layout *L, const splat_composite *c,
                           o == SG_OUT_ALBEDO || o == SG_OUT_NORMAL ? "vec3" : "float",
                           acc_names[o],
                           o == SG_OUT_ALBEDO || o == SG_OUT_NORMAL ? "vec3(0.0)" : "0.0");
+        if (em.normalised)
+            ir_buf_printf(out, "    float s_wsum = 0.0;\n");
         uint8_t *plat = NULL;
         ir_iv (*bounds)[4] = NULL;
         if (!desc->flat && !desc->no_lazy) {
@@ -1418,6 +1490,8 @@ void splat_composite_glsl(const splat_layout *L, const splat_composite *c,
         }
         sched_free(&em.s);
         count_samples(&em, 1);
+        if (em.normalised)
+            emit_normalise(&em);
         ir_buf_printf(out, "    splat_finish(s_albedo, normalize(s_normal), s_roughness, "
                            "s_height, 1.0);\n");
     }

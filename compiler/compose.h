@@ -69,6 +69,10 @@ bool splat_layout_from_scene(splat_layout *L, const splat_scene *s, sg_diags *d)
  * can neither prove nor refute passes).  splat_scene_load checks the
  * scene's compositor. */
 bool splat_compositor_check(sg_program *prog, const char *name, sg_loc at, sg_diags *d);
+/* Whether compositor `name` (NULL: linear_alpha) is normalised: it has a
+ * `blend` output, which the composite adds in place of `weight` and divides
+ * by the sum of at the end (compiler/DESIGN.md §6.2). */
+bool splat_compositor_normalised(const sg_program *prog, const char *name);
 void splat_layout_free(splat_layout *L);
 /* Share texture arrays: layout textures of one size (w[t] x h[t]), one
  * count of their own mip files (mips[t]) and one sampler state (filter,
@@ -102,7 +106,10 @@ typedef struct splat_layer {
  * compositor inlined once per layer, then optimised.  Roots:
  *   "layer<j>.{T,mask,weight,T_next,view_mask,albedo,normal,roughness,height}"
  *   "composite.{albedo,normal,roughness,height}" = sum_j weight_j * s_j
- *   (the normal not yet normalised), for the CPU reference. */
+ *   (the normal not yet normalised), for the CPU reference.  With a
+ *   normalised compositor (splat_compositor_normalised) layer<j>.weight is
+ *   its `blend`, "composite.wsum" = sum_j blend_j and the composite outputs
+ *   are divided by it. */
 typedef struct splat_composite {
     ir           ir;
     splat_layer *layers;      /* top first                                   */

@@ -279,6 +279,7 @@ static bool eval_point(far_bake *fb, double u, double v, double sx, double sz,
     env.uv[1] = v;
     env.view_distance = FAR_ATLAS_BAKE_DISTANCE;
     env.view_direction[1] = 1.0;
+    env.cavity = splat_terrain_cavity(t, u, v);
     env.painted = painted;
     env.sample_grad = sample_grad;
     env.sample_user = &smp;

@@ -97,7 +97,10 @@ ir_type     ir_type_from_name(const char *s); /* IR_T_ERROR if unknown       */
       NULL)                                                            /* 0 = none */ \
     X(VIEW_DIRECTION, "view.direction",      IR_T_VEC3,  "splat_view_direction()",\
       "direction",    view_direction, IV_NONE,           SIGNED, 0,               \
-      "splat_d_view_direction")                                        /* unit     */
+      "splat_d_view_direction")                                        /* unit     */ \
+    X(CAVITY,         "terrain.cavity",      IR_T_FLOAT, "splat_cavity()",        \
+      "cavity",       cavity,         IV_NONE,           ALL,    1,               \
+      NULL)                                                            /* m, + in hollows */
 
 /* The type is `enum ir_input` (alias ir_input_kind): the plain name
  * `ir_input` is the builder function below. */
@@ -563,6 +566,10 @@ typedef struct ir_env {
     double view_direction[3];      /* unit vector from the point to the
                                       camera, terrain-local; (0, 0, 0)
                                       reads as (0, 1, 0), straight down  */
+    double cavity;                 /* terrain.cavity: the heightfield's
+                                      mean at 4 diagonal taps 2 texels
+                                      away minus the height here, metres
+                                      (splat_terrain_cavity)             */
     double d_input[2][IR_IN_COUNT][4]; /* DINPUT leaves: screen-space
                                       derivative of each input, per axis
                                       (d/dx, d/dy); 0 when unset          */

@@ -413,6 +413,14 @@ void splat_terrain_normal(const splat_terrain *t, double u, double v, double n[3
     splat_normal_filter(a, 0.0, b, 0.0, t->max_height, t->size[0] * tx, t->size[1] * tz, n);
 }
 
+double splat_terrain_cavity(const splat_terrain *t, double u, double v)
+{
+    double tx = 2.0 / t->width, tz = 2.0 / t->height;
+    double s = bilinear(t, u - tx, v - tz) + bilinear(t, u + tx, v + tz) +
+               bilinear(t, u + tx, v - tz) + bilinear(t, u - tx, v + tz);
+    return (0.25 * s - bilinear(t, u, v)) * t->max_height;
+}
+
 /* ---- ranges ------------------------------------------------------------- */
 
 static inline ir_iv iv(double lo, double hi) { return (ir_iv){ lo, hi }; }

@@ -87,6 +87,9 @@ double splat_terrain_texel(const splat_terrain *t, int x, int z);
 double splat_terrain_height(const splat_terrain *t, double u, double v);
 void   splat_terrain_normal(const splat_terrain *t, double u, double v, double n[3]);
 double splat_terrain_mesh_height(const splat_terrain *t, double u, double v);
+/* ... and of splat_cavity (terrain.cavity): the mean of the 4 diagonal
+ * taps 2 texels away minus the height at (u, v), in metres. */
+double splat_terrain_cavity(const splat_terrain *t, double u, double v);
 
 /* Sound ranges of the terrain inputs over a rectangle of texels
  * [x0, x1) x [z0, z1): every fragment whose uv falls in that rectangle

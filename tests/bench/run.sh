@@ -256,7 +256,7 @@ comp_pack() {  # SCENE COMPOSITOR -> pack dir
     mirror "$R"
     d=$(mirror_scene "$R" "$1" "$1_$2")
     sed -e "s/compositor *= *[a-z_]*/compositor = $2/" \
-        -e 's|^import "nodes/compositors.sg"|import "nodes/compositors.sg"\nimport "nodes/compositors_extra.sg"\nimport "nodes/stochastic.sg"|' \
+        -e 's|^import "nodes/compositors.sg"|import "nodes/compositors.sg"\nimport "nodes/compositors_extra.sg"\nimport "nodes/stochastic.sg"\nimport "nodes/height_softmax.sg"|' \
         "examples/$1/scene.sg" > "$d/scene.sg"
     "$SPLATC" build "$d/scene.sg" -o "$W/$1_$2" -j 2 --cache "$W/cache-$1" >/dev/null
     echo "$W/$1_$2"
@@ -272,6 +272,36 @@ cliffs_pack() {
     "$SPLATC" build "$d/scene.sg" -o "$2" -j 2 --cache "$W/cache-cliffs" -I "$R" >/dev/null
     echo "$2"
 }
+# look_pack SCENE LABEL SED... -> pack dir: the scene with node-library
+# files edited, each SED "FILE:SCRIPT" (nodes/FILE.sg through sed SCRIPT),
+# so a look addition (issue 31) is switched off in whatever graphs use it
+# (group look)
+look_pack() {
+    R=$W/mirror-look-$2
+    mirror "$R"
+    rm -f "$R/nodes"
+    mkdir -p "$R/nodes"
+    for f in "$REPO"/nodes/*; do ln -sf "$f" "$R/nodes/"; done
+    scene=$1; label=$2; shift 2
+    for e in "$@"; do
+        f=${e%%:*}
+        rm -f "$R/nodes/$f.sg"
+        sed -e "${e#*:}" "nodes/$f.sg" > "$R/nodes/$f.sg"
+        if cmp -s "nodes/$f.sg" "$R/nodes/$f.sg"; then
+            echo "run.sh: look $label: the edit does not change nodes/$f.sg" >&2; exit 1
+        fi
+    done
+    d=$(mirror_scene "$R" "$scene" "$scene")
+    cp "examples/$scene/scene.sg" "$d/scene.sg"
+    "$SPLATC" build "$d/scene.sg" -o "$W/${scene}_look_$label" -j 2 --cache "$W/cache-$scene" -I "$R" >/dev/null
+    echo "$W/${scene}_look_$label"
+}
+# the look additions' off switches (nodes/detile.sg, variation.sg, cavity.sg)
+LOOK_PLAIN='detile:s/: hex_tile { tex = tex, uv = \([a-z]*\)\.out, sharpness = sharpness }/: sample { tex = tex, uv = \1.out }/;s/b = far_amount }/b = 0.0 }/'
+LOOK_HEXNEAR='detile:s/b = far_amount }/b = 0.0 }/'
+LOOK_NOMACRO='variation:s/out vec3 out = r.out/out vec3 out = albedo/'
+LOOK_NOCAVITY='cavity:s/out vec3 out = s.out/out vec3 out = albedo/'
+
 # graph knob variants: one graph file with a node type replaced
 KNOB_BUILD_ARGS=""
 # knob_pack SCENE LABEL GRAPH GRAPH-SED [SCENE-SED] -> pack dir: the scene
@@ -497,6 +527,24 @@ else
     for p in ground topdown; do
         render knob_lazy colorado "$p" 1280x720 "eager=composite,pack=$pe" lazy=composite \
             "eager_screen=screen,pack=$pe" lazy_screen=screen
+    done
+    # the look additions (issue 31), each switched off in the node library
+    # against the scene as it stands (everything on), same frames: detile
+    # as a plain top-down read (1 sample) and hex-tiled near only (3), no
+    # macro variation, no cavity darkening, all of them off; and the
+    # height_softmax compositor.  samples_per_px and GPU ms side by side.
+    lp=$(look_pack colorado plain "$LOOK_PLAIN")
+    lh=$(look_pack colorado hexnear "$LOOK_HEXNEAR")
+    lm=$(look_pack colorado nomacro "$LOOK_NOMACRO")
+    lc=$(look_pack colorado nocavity "$LOOK_NOCAVITY")
+    lo=$(look_pack colorado off "$LOOK_PLAIN" "$LOOK_NOMACRO" "$LOOK_NOCAVITY")
+    hs=$(comp_pack colorado height_softmax)
+    for p in ground topdown; do
+        render look colorado "$p" 1280x720 on=composite "detile_plain=composite,pack=$lp" \
+            "detile_hex_near=composite,pack=$lh" "no_macro=composite,pack=$lm" \
+            "no_cavity=composite,pack=$lc" "all_off=composite,pack=$lo" \
+            "height_softmax=composite,pack=$hs" on_screen=screen \
+            "all_off_screen=screen,pack=$lo" "height_softmax_screen=screen,pack=$hs"
     done
     # the far atlas (issue 11 part 3; splatc build --far-atlas, one texel per
     # heightfield texel): the screen path with the tiles at least D m away

@@ -8,7 +8,7 @@
  *   rec[0]                 height, slope, view distance, destruction
  *   rec[1]                 normal.xyz, view direction.x
  *   rec[2]                 position.xyz, view direction.y
- *   rec[3]                 uv.xy, view direction.z
+ *   rec[3]                 uv.xy, view direction.z, cavity
  *   rec[4 + i]             param i (its first ir_type_width components)
  *   rec[4 + P + k / 4][k % 4]  painted mask k        (P = number of params)
  *
@@ -54,6 +54,7 @@ static const char INPUTS[] =
     "vec3 splat_normal() { return h_in.rec[h_base + 1u].xyz; }\n"
     "vec3 splat_position() { return h_in.rec[h_base + 2u].xyz; }\n"
     "vec2 splat_uv() { return h_in.rec[h_base + 3u].xy; }\n"
+    "float splat_cavity() { return h_in.rec[h_base + 3u].w; }\n"
     "vec3 splat_view_direction() {\n"
     "    return vec3(h_in.rec[h_base + 1u].w, h_in.rec[h_base + 2u].w, h_in.rec[h_base + 3u].z);\n"
     "}\n";
@@ -179,6 +180,7 @@ static float *pack_points(const harness_ir_desc *d, size_t *bytes)
         r[7] = (float)vd[0];
         r[11] = (float)(unset ? 1.0 : vd[1]);
         r[14] = (float)vd[2];
+        r[15] = (float)env->cavity;
         for (int i = 0; i < ir->nparams; i++)
             for (int c = 0; c < 4; c++)
                 r[(4 + i) * 4 + c] = (float)(env->params ? env->params[4 * i + c]

@@ -16,3 +16,5 @@ splat_gpu_test(test_gpu_agree)
 splat_gpu_test(test_terrain_gpu)
 # random_ir.h: the IR's random graph generator, shared with the CPU test
 target_include_directories(test_gpu_agree PRIVATE ${PROJECT_SOURCE_DIR}/tests/unit)
+# the look nodes of issue 31 (nodes/detile.sg ...) against their reference
+splat_gpu_test(test_look_gpu)

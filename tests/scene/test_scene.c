@@ -107,10 +107,11 @@ static void test_error_fixtures(void **state)
 static void test_shipped_compositors(void **state)
 {
     static const char *const files[] = {"nodes/compositors.sg", "nodes/compositors_extra.sg",
-                                        "nodes/stochastic.sg"};
-    static const char *const names[] = {"linear_alpha", "height_blend", "stochastic_select"};
+                                        "nodes/stochastic.sg", "nodes/height_softmax.sg"};
+    static const char *const names[] = {"linear_alpha", "height_blend", "stochastic_select",
+                                        "height_softmax"};
     const char *search[] = {".", NULL};
-    for (int i = 0; i < 3; i++) {
+    for (int i = 0; i < 4; i++) {
         sg_diags d;
         sg_diags_init(&d);
         sg_program *p = sg_load(files[i], search, &d);

@@ -61,6 +61,7 @@ void points_env(const splat_terrain *t, double u, double v, ir_env *env)
     memset(env, 0, sizeof *env);
     env->height = splat_terrain_height(t, u, v);
     splat_terrain_normal(t, u, v, env->normal);
+    env->cavity = splat_terrain_cavity(t, u, v);
     env->slope = 1 - env->normal[1];
     env->uv[0] = u;
     env->uv[1] = v;

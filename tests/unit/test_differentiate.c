@@ -137,9 +137,11 @@ static void check_point(const ir *ir, ir_ref r, ir_ref dr, const ir_env *base,
     ir_eval(ir, r, &e, f0);
     ir_eval(ir, dr, &e, d);
     bool skip = wild(ir, r, base);
-    bool sampled = false;
-    for (uint32_t id = 1; id <= r.id; id++)
+    bool sampled = false, wraps = false;
+    for (uint32_t id = 1; id <= r.id; id++) {
         sampled = sampled || ir->nodes[id].op == IR_OP_SAMPLE;
+        wraps = wraps || ir->nodes[id].op == IR_OP_FRACT || ir->nodes[id].op == IR_OP_MOD;
+    }
     double tol = sampled ? TOL_SAMPLE : TOL_ALU;
     for (int c = 0; c < ir_type_width(ir_typeof(ir, r)); c++) {
         t->values++;
@@ -150,10 +152,15 @@ static void check_point(const ir *ir, ir_ref r, ir_ref dr, const ir_env *base,
         double a3 = fd(ir, r, base, dir, H / 3, c);
         double floor_ = 1e-4 * fmax(1.0, fabs(f0[c]));
         double scale = fmax(fmax(fabs(a1), fabs(b)), floor_);
+        double got = d[c] / EPS;
         if (skip || !isfinite(a) || fabs(a1 - b) > 1e-2 * scale || fabs(b - a3) > 1e-2 * scale)
             continue;   /* not smooth within h here */
+        /* a fract or mod of a value that moves by more than half a period
+         * within h wraps inside every difference, whose steps can then agree
+         * by aliasing (hash_sin's sin * 43758) */
+        if (wraps && fabs(got) * H > 0.5)
+            continue;
         t->compared++;
-        double got = d[c] / EPS;
         double err = fabs(got - a) / fmax(fmax(fabs(a), fabs(got)), floor_);
         if (!(err <= tol)) {
             fprintf(stderr, "%s: component %d: derivative %.9g, finite difference %.9g "
@@ -312,6 +319,12 @@ static void test_nodes(void **state)
         for (const char *s = strstr(text, "\nshader "); s; s = strstr(s + 1, "\nshader ")) {
             char name[64];
             assert_int_equal(sscanf(s, "\nshader %63[A-Za-z0-9_]", name), 1);
+            /* each shader's points from its name: a new node file leaves
+             * the other shaders' points alone */
+            uint64_t h = 4242;
+            for (const char *c = name; *c; c++)
+                h = h * 131 + (unsigned char)*c;
+            rng = (random_ir_rng){h};
             port in[16], out[16];
             int nin = ports_of(s, "in", in, 16), nout = ports_of(s, "out", out, 16);
             ir ir;

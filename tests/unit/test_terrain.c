@@ -286,6 +286,36 @@ static void test_load_errors(void **state)
 
 /* ---- the CPU twins of the ABI's height and normal ----------------------- */
 
+/* terrain.cavity (splat_cavity's twin): at a texel centre, the mean of the
+ * texels 2 away diagonally minus this one, in metres (the offset cancels);
+ * a bowl is positive at its bottom, a dome negative at its top, a plane 0. */
+static void test_cavity(void **state)
+{
+    splat_terrain t;
+    make_terrain(&t, 9, 9, 90, 90, 200, 1000);
+    for (int z = 0; z < 9; z++)
+        for (int x = 0; x < 9; x++)
+            t.texels[z * 9 + x] = (uint16_t)(1000 * ((x - 4) * (x - 4) + (z - 4) * (z - 4)));
+    /* bowl: centre 0, diagonal taps 2 away (8 * 1000 each) */
+    double want = 8000.0 / 65535 * 200;
+    assert_float_equal(splat_terrain_cavity(&t, 4.5 / 9, 4.5 / 9), want, 1e-9);
+    /* off centre, (3, 5): taps (1,3) (5,3) (1,7) (5,7): 9+1, 1+1, 9+9, 1+9 */
+    double mean = (10 + 2 + 18 + 10) / 4.0, here = 1 + 1;
+    assert_float_equal(splat_terrain_cavity(&t, 3.5 / 9, 5.5 / 9),
+                       (mean - here) * 1000 / 65535 * 200, 1e-9);
+    /* dome: negative */
+    for (int i = 0; i < 81; i++)
+        t.texels[i] = (uint16_t)(65535 - t.texels[i]);
+    assert_float_equal(splat_terrain_cavity(&t, 4.5 / 9, 4.5 / 9), -want, 1e-9);
+    /* a plane: 0 (inside, and at the clamped edge it is not a plane) */
+    for (int z = 0; z < 9; z++)
+        for (int x = 0; x < 9; x++)
+            t.texels[z * 9 + x] = (uint16_t)(3000 * x + 500 * z);
+    assert_float_equal(splat_terrain_cavity(&t, 4.5 / 9, 3.5 / 9), 0.0, 1e-9);
+    assert_float_equal(splat_terrain_cavity(&t, 4.2 / 9, 3.7 / 9), 0.0, 1e-9);
+    splat_terrain_free(&t);
+}
+
 /* The mesh's height (splat_height_at): bilinear between texel centres. */
 static void test_mesh_height_bilinear_clamped(void **state)
 {
@@ -639,6 +669,7 @@ int main(void)
         cmocka_unit_test(test_load_errors),
         cmocka_unit_test(test_mesh_height_bilinear_clamped),
         cmocka_unit_test(test_height_bspline_by_hand),
+        cmocka_unit_test(test_cavity),
         cmocka_unit_test(test_normal_listing1_by_hand),
         cmocka_unit_test(test_slope_smooth),
         cmocka_unit_test(test_ranges_sound_random),
