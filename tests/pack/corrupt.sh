@@ -55,7 +55,7 @@ printf '#version 450\nlayout(location = 0) in vec2 g;\nlayout(location = 0) out 
 glslangValidator -V --target-env vulkan1.2 -o "$OUT/glsl/novary.spv" "$OUT/glsl/novary.vert" \
     > /dev/null || fail "glslang: novary.vert"
 printf 'outside the pack\n' > "$OUT/outside.txt"
-cp "$OUT/bc4/textures/grass.png" "$OUT/outside.png"
+cp "$OUT/bc4/textures/grass_albedo.png" "$OUT/outside.png"
 
 n=0
 # case NAME BASE PATTERN: copy BASE to NAME, run the corruption (stdin, in
@@ -89,8 +89,8 @@ EOF
 case_ symlink_devzero bc4 "heightfield.r16', which is a symbolic link" <<EOF
 rm heightfield.r16; ln -s /dev/zero heightfield.r16
 EOF
-case_ symlink_out bc4 "textures/grass.png', which is a symbolic link" <<EOF
-rm textures/grass.png; ln -s ../../outside.png textures/grass.png
+case_ symlink_out bc4 "textures/grass_albedo.png', which is a symbolic link" <<EOF
+rm textures/grass_albedo.png; ln -s ../../outside.png textures/grass_albedo.png
 EOF
 case_ symlink_folder bc4 "names 'shaders/ref_0000.spv', which is inside a symbolic link" <<EOF
 mv shaders ../../shaders_moved_\$\$; ln -s ../../shaders_moved_\$\$ shaders
@@ -106,6 +106,16 @@ case_ painted_dotdot bc4 "names '../x', which is outside the pack" <<EOF
 EOF
 case_ texture_dotdot bc4 "names 'textures/../../outside.png', which is outside the pack" <<EOF
 "$PE" set $M textures.0.file '"textures/../../outside.png"'
+EOF
+# texture arrays (PACK.md): noise and rock share binding 2
+case_ array_unlike bc4 "its textures differ in size, mip levels or sampler state" <<EOF
+"$PE" set $M textures.2.wrap '"clamp"'
+EOF
+case_ array_layer_twice bc4 "its layers must be 0, 1, … once each" <<EOF
+"$PE" set $M textures.2.layer 0
+EOF
+case_ array_gap bc4 "the bindings must be dense" <<EOF
+"$PE" set $M textures.0.binding 3
 EOF
 case_ spirv_absolute bc4 "names '/etc/passwd', which is outside the pack" <<EOF
 "$PE" set $M combinations.1.spirv '"/etc/passwd"'

@@ -66,7 +66,7 @@ static void test_minimal(void **state)
             "over the device's maxImageDimension2D (200)");
     int hw = p.hf_width, hh = p.hf_height;
     p.hf_width = p.hf_height = 16;               /* textures are 256 */
-    refused(&p, &d, "textures[0] (textures/grass.png): the larger side is 256",
+    refused(&p, &d, "textures[0] (textures/grass_albedo.png): the larger side is 256",
             "maxImageDimension2D (200)");
     for (int i = 0; i < p.ntextures; i++)
         p.textures[i].width = p.textures[i].height = 8;

@@ -28,8 +28,10 @@ EOF2
 variant texture base <<EOF2
 "$PE" png textures/rock.png 256 256
 EOF2
+# texture 0 (the grass set's albedo) is alone in its texture array: a
+# sampler change there is a valid pack that hot reload must refuse
 variant sampler base <<EOF2
-"$PE" set $M textures.1.wrap '"clamp"'
+"$PE" set $M textures.0.wrap '"clamp"'
 EOF2
 variant mask base <<EOF2
 printf '\125\252' | dd of=painted.sparse bs=1 seek=1100 conv=notrunc 2>/dev/null
