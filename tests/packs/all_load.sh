@@ -10,7 +10,7 @@
 set -u
 SV=$1 B=$2
 fail() { echo "FAIL: $*"; exit 1; }
-corrupted='/tests/corrupt/c/|/tests/render/out/bad_packs/|/tests/far/bad$|/tests/mips/bad\.pack$|/fuzz/'
+corrupted='/tests/corrupt/c/|/tests/render/out/bad_packs/|/tests/far/bad$|/tests/mips/bad\.pack$|/fuzz/|/tests/vector/hostile/'
 list=$(find "$B/tests" "$B/examples" -name manifest.json 2>/dev/null |
        xargs grep -l '"splatc-pack"' 2>/dev/null | sed 's|/manifest.json$||' |
        grep -Ev "$corrupted" | sort)
