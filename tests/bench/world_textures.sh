@@ -55,4 +55,23 @@ for a in $arrays; do
             awk '{ print $1 % 2 }' | sort -u | wc -l)
     [ "$sizes" -eq 1 ] || fail "array $a mixes texture sizes"
 done
-echo "8 textures in $na arrays: ok"
+# every combination shades leaf cells (none is only a coarse node's union:
+# "cells" >= 1), one per pipeline built, and binds exactly the textures of
+# its materials (material k > 0 samples texture k - 1; the base none)
+built=$(echo "$line" | sed -n 's/.*pipelines built: \([0-9]*\).*/\1/p')
+tr -d ' \n' < "$D/pack/manifest.json" |
+    grep -o '"materials":\[[0-9,]*\],"glsl":"[^"]*","spirv":"[^"]*","textures":\[[0-9,]*\],"params":\[[0-9,]*\],"cells":[0-9]*' \
+    > "$D/combos.txt"
+nc=$(wc -l < "$D/combos.txt")
+[ "$nc" -eq "$built" ] || fail "the manifest lists $nc combinations, the report $built built"
+awk -F'[][]' '{
+        split($2, m, ","); want = ""
+        for (i = length(m); i >= 1; i--) if (m[i] > 0) want = want (want == "" ? "" : ",") m[i] - 1
+        n = split($4, t, ","); got = ""
+        # textures ascending, materials top first: compare as sorted sets
+        for (i = 1; i <= n; i++) got = got (got == "" ? "" : ",") t[i]
+        if (got != want) { print "FAIL: combination " NR ": materials [" $2 "] bind textures [" $4 "], expected [" want "]"; bad = 1 }
+        c = $0; sub(/.*"cells":/, "", c)
+        if (c + 0 < 1) { print "FAIL: combination " NR " (materials [" $2 "]) shades no leaf cell: a coarse node union"; bad = 1 }
+    } END { exit bad }' "$D/combos.txt" || exit 1
+echo "8 textures in $na arrays, $nc combinations each on leaf cells binding its own textures: ok"
