@@ -131,6 +131,14 @@ for M in $COUNTS; do
             --cache "$D/cache" --stats >> "$D/cold.txt"
         r=$((r + 1))
     done
+    if [ ! -f "$D/pack/manifest.json" ]; then   # the build failed: say so, go on
+        log "$M materials: splatc build failed"
+        tail -5 "$D/cold_stats.txt"
+        printf '%s\t%s\tfailed' "$M" "$NB" >> "$TSV"
+        for k in $(seq 4 24); do printf '\tNA' >> "$TSV"; done
+        echo >> "$TSV"
+        continue
+    fi
     cold=$(awk '{ print $1 }' "$D/cold.txt" | median)
     bpeak=$(awk '{ print $2 }' "$D/cold.txt" | median)
     S=$D/cold_stats.txt
