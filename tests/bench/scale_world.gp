@@ -28,16 +28,19 @@ unset logscale y
 
 set title "splatc build -j 2"
 set ylabel "seconds"
+set yrange [0:*]
 plot "" skip 1 using 1:7 with linespoints lw 2 pt 7 title "cold (empty cache)", \
      "" skip 1 using 1:9 with linespoints lw 1 pt 1 title "  of which glslang", \
      "" skip 1 using 1:10 with linespoints lw 1 pt 2 title "  of which spirv-val", \
      "" skip 1 using 1:11 with linespoints lw 2 pt 5 title "one-material edit (warm cache)"
 
+set key inside bottom right
 set title "one-material edit: shaders recompiled"
 set ylabel "shaders"
 plot "" skip 1 using 1:12 with linespoints lw 2 pt 7 title "recompiled", \
      "" skip 1 using 1:14 with linespoints lw 2 dt 2 pt 1 title "combinations holding the material"
 
+set key inside top left
 set title "pack size (du -sb)"
 set ylabel "MB"
 plot "" skip 1 using 1:15 with linespoints lw 2 pt 7 title "pack"

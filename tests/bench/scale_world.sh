@@ -6,7 +6,7 @@
 #
 #   sh tests/bench/scale_world.sh BUILD_DIR [--smoke] [--out DIR]
 #       [--counts "8 32 ..."] [--reps N] [--size WxH] [--hf N]
-#       [--view-timeout S] [--keep-work]
+#       [--view-timeout S] [--no-view] [--keep-work]
 #
 # Per material count (a multiple of 8):
 #   combinations   the leaf cells' combinations and the pipelines built,
@@ -31,7 +31,7 @@
 #                  written as "timeout"; peak RSS of the viewer (the largest
 #                  of its runs).
 # --reps N repeats every build and picture N times (default 1) and reports
-# medians.  --smoke: 8 and 16 materials on a 256^2 heightfield, pictures at
+# medians.  --no-view: builds only (the picture columns NA).  --smoke: 8 and 16 materials on a 256^2 heightfield, pictures at
 # 320x180 (bench.smoke, a minute or two).
 #
 # Writes OUT/scale_world.tsv (one row per material count), OUT/scale_world.md
@@ -46,7 +46,7 @@ if [ $# -lt 1 ]; then
 fi
 B=$(cd "$1" && pwd)
 shift
-MODE=full OUT=out/bench COUNTS="" REPS=1 SIZE="" HF="" VT=900 KEEP=no
+MODE=full OUT=out/bench COUNTS="" REPS=1 SIZE="" HF="" VT=900 KEEP=no NOVIEW=no
 while [ $# -gt 0 ]; do
     case $1 in
     --smoke) MODE=smoke ;;
@@ -57,6 +57,7 @@ while [ $# -gt 0 ]; do
     --hf) HF=$2; shift ;;
     --view-timeout) VT=$2; shift ;;
     --keep-work) KEEP=yes ;;
+    --no-view) NOVIEW=yes ;;
     *) echo "scale_world.sh: unknown option '$1'" >&2; exit 2 ;;
     esac
     shift
@@ -175,7 +176,9 @@ for M in $COUNTS; do
     recompiled=$(sed -n 's/^shaders: [0-9]* ([0-9]* from cache, \([0-9]*\) compiled)/\1/p' "$D/edit_stats.txt")
     # ---- first picture: screen, screen with async pipelines, forward ----
     : > "$D/vpeak.txt"
-    for v in screen screen_async forward; do
+    VIEWS="screen screen_async forward"
+    [ "$NOVIEW" = yes ] && { VIEWS=""; t_screen=NA t_screen_async=NA t_forward=NA; }
+    for v in $VIEWS; do
         case $v in
         screen) args="--shading screen --async-pipelines off" ;;
         screen_async) args="--shading screen --async-pipelines on" ;;
