@@ -47,9 +47,16 @@ plot "" skip 1 using 1:15 with linespoints lw 2 pt 7 title "pack"
 
 set title "first picture, lavapipe headless (process wall time)"
 set ylabel "seconds"
-plot "" skip 1 using 1:18 with linespoints lw 2 pt 7 title "screen (all pipelines first)", \
-     "" skip 1 using 1:19 with linespoints lw 2 pt 5 title "screen, async pipelines", \
-     "" skip 1 using 1:20 with linespoints lw 2 pt 9 title "forward"
+if (exists("noview")) {
+    # scale_world.sh --no-view: no pictures taken, an empty panel
+    set label 1 "no pictures (--no-view)" at graph 0.5, 0.5 center
+    plot "" skip 1 using 1:7 with points lc rgb "white" notitle
+    unset label 1
+} else {
+    plot "" skip 1 using 1:18 with linespoints lw 2 pt 7 title "screen (all pipelines first)", \
+         "" skip 1 using 1:19 with linespoints lw 2 pt 5 title "screen, async pipelines", \
+         "" skip 1 using 1:20 with linespoints lw 2 pt 9 title "forward"
+}
 
 set title "peak resident memory"
 set ylabel "MB"

@@ -230,13 +230,16 @@ done
             ($20 ~ /^[0-9.]+$/ ? $20 " s" : $20), $21 }' "$TSV"
     echo
     echo "gen_world --textures B 8 $HF 16 (B biomes x 8 materials, a texture each, over a base);"
-    echo "$(nproc) CPUs, load average at the end: $(cut -d' ' -f1-3 /proc/loadavg); medians of $REPS run(s)."
+    echo "$(nproc) CPUs, load average at the end: $(cut -d' ' -f1-3 /proc/loadavg); medians of $REPS run(s)"
+    echo "(the TSV's glslang_s and validation_s: the last cold build's --stats phases)."
 } > "$OUT/scale_world.md"
 cat "$OUT/scale_world.md"
 
 if command -v gnuplot >/dev/null 2>&1; then
     log "plots"
-    (cd "$OUT" && gnuplot "$REPO/tests/bench/scale_world.gp") || echo "scale_world.sh: gnuplot failed (plots skipped)"
+    noview=""
+    [ "$NOVIEW" = yes ] && noview="noview = 1"
+    (cd "$OUT" && gnuplot -e "$noview" "$REPO/tests/bench/scale_world.gp") || echo "scale_world.sh: gnuplot failed (plots skipped)"
 else
     log "gnuplot not installed: plots skipped"
 fi
