@@ -2,8 +2,8 @@
 # inside the bench output folder, next to scale_world.tsv):
 #   scale_world.png   against the material count: combinations and the
 #                     largest composite; cold build and one-material-edit
-#                     rebuild; pack size; first picture (screen, screen with
-#                     async pipelines, forward); peak memory of build and
+#                     rebuild; pack size; first picture (screen cold and
+#                     warm, screen with async pipelines, forward); peak memory of build and
 #                     viewer.  Runs that timed out or failed are left out.
 set terminal pngcairo size 1500,900 noenhanced font ",10"
 set datafile separator "\t"
@@ -54,6 +54,7 @@ if (exists("noview")) {
     unset label 1
 } else {
     plot "" skip 1 using 1:18 with linespoints lw 2 pt 7 title "screen (all pipelines first)", \
+         "" skip 1 using 1:25 with linespoints lw 2 dt 2 pt 6 title "screen, warm caches (second run)", \
          "" skip 1 using 1:19 with linespoints lw 2 pt 5 title "screen, async pipelines", \
          "" skip 1 using 1:20 with linespoints lw 2 pt 9 title "forward"
 }

@@ -27,7 +27,9 @@
 #                  made up front: headless waits for all), the screen path
 #                  with --async-pipelines on (the uber-shader shades the
 #                  tiles of pipelines still compiling) and the forward
-#                  path; a run past --view-timeout (default 900 s) is
+#                  path, each with a fresh Mesa shader cache and pipeline
+#                  cache, and the screen path again with the caches its
+#                  first run left (warm); a run past --view-timeout (default 900 s) is
 #                  written as "timeout"; peak RSS of the viewer (the largest
 #                  of its runs).
 # --reps N repeats every build and picture N times (default 1) and reports
@@ -111,7 +113,7 @@ median() { sort -g | awk '/^[0-9.]+$/ { v[n++] = $1; next } { bad = 1 }
 stat_field() { awk -v re="$2" -v f="$3" '$0 ~ re { print $f; exit }' "$1"; }
 
 TSV=$OUT/scale_world.tsv
-printf 'materials\tbiomes\tcombinations\tpipelines\tlargest_layers\tleaf_overlap\tcold_build_s\tbuild_peak_mb\tglslang_s\tvalidation_s\tedit_rebuild_s\tedit_shaders_recompiled\tshaders\tedit_combos_with_material\tpack_mb\ttextures\ttexture_arrays\tview_screen_s\tview_screen_async_s\tview_forward_s\tview_peak_mb\tsize\theightfield\treps\n' > "$TSV"
+printf 'materials\tbiomes\tcombinations\tpipelines\tlargest_layers\tleaf_overlap\tcold_build_s\tbuild_peak_mb\tglslang_s\tvalidation_s\tedit_rebuild_s\tedit_shaders_recompiled\tshaders\tedit_combos_with_material\tpack_mb\ttextures\ttexture_arrays\tview_screen_s\tview_screen_async_s\tview_forward_s\tview_peak_mb\tsize\theightfield\treps\tview_screen_warm_s\n' > "$TSV"
 
 for M in $COUNTS; do
     NB=$((M / 8))
@@ -136,7 +138,7 @@ for M in $COUNTS; do
         log "$M materials: splatc build failed"
         tail -5 "$D/cold_stats.txt"
         printf '%s\t%s\tfailed' "$M" "$NB" >> "$TSV"
-        for k in $(seq 4 24); do printf '\tNA' >> "$TSV"; done
+        for k in $(seq 4 25); do printf '\tNA' >> "$TSV"; done
         echo >> "$TSV"
         continue
     fi
@@ -176,11 +178,11 @@ for M in $COUNTS; do
     recompiled=$(sed -n 's/^shaders: [0-9]* ([0-9]* from cache, \([0-9]*\) compiled)/\1/p' "$D/edit_stats.txt")
     # ---- first picture: screen, screen with async pipelines, forward ----
     : > "$D/vpeak.txt"
-    VIEWS="screen screen_async forward"
-    [ "$NOVIEW" = yes ] && { VIEWS=""; t_screen=NA t_screen_async=NA t_forward=NA; }
+    VIEWS="screen screen_warm screen_async forward"
+    [ "$NOVIEW" = yes ] && { VIEWS=""; t_screen=NA t_screen_warm=NA t_screen_async=NA t_forward=NA; }
     for v in $VIEWS; do
         case $v in
-        screen) args="--shading screen --async-pipelines off" ;;
+        screen|screen_warm) args="--shading screen --async-pipelines off" ;;
         screen_async) args="--shading screen --async-pipelines on" ;;
         forward) args="--shading forward" ;;
         esac
@@ -189,8 +191,16 @@ for M in $COUNTS; do
         while [ $r -lt "$REPS" ]; do
             log "$M materials: first picture $v $SIZE ($((r + 1))/$REPS)"
             # shellcheck disable=SC2086
-            res=$(measure "$D/view_$v.log" timeout "$VT" "$VIEW" "$D/pack" --headless \
-                --size "$SIZE" $args -o "$D/$v.png")
+            # cold: a fresh Mesa shader disk cache and pipeline cache file
+            # (lavapipe keeps what it compiled in ~/.cache/mesa_shader_cache:
+            # a second run of the same pack would find it there); warm: the
+            # caches the screen run before it left
+            c=$D/caches/$v.$r
+            [ "$v" = screen_warm ] && c=$D/caches/screen.$r
+            mkdir -p "$c"
+            res=$(measure "$D/view_$v.log" env MESA_SHADER_CACHE_DIR="$c/mesa" \
+                SPLAT_PIPELINE_CACHE="$c/pipelines.bin" timeout "$VT" "$VIEW" "$D/pack" \
+                --headless --size "$SIZE" $args -o "$D/$v.png")
             case $res in
             "NA NA 124") echo "timeout" >> "$D/view_$v.txt" ;;
             NA*) echo "failed" >> "$D/view_$v.txt"; sed 's/^/  /' "$D/view_$v.log" | tail -5 ;;
@@ -207,26 +217,28 @@ for M in $COUNTS; do
     vpeak_mb=$( [ -n "$vpeak" ] && echo "$vpeak" | awk '{ printf "%.0f", $1 / 1024 }' || echo NA)
     bpeak_mb=$(echo "$bpeak" | awk '/^[0-9.]+$/ { printf "%.0f", $1 / 1024; next } { print "NA" }')
     # shellcheck disable=SC2154
-    printf '%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\n' \
+    printf '%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\n' \
         "$M" "$NB" "$combos" "$pipes" "$largest" "$overlap" "$cold" "$bpeak_mb" "$gl" "$va" \
         "$edit" "$recompiled" "$shaders" "$with" "$pack_mb" "$ntex" "$narr" \
-        "$t_screen" "$t_screen_async" "$t_forward" "$vpeak_mb" "$SIZE" "$HF" "$REPS" >> "$TSV"
+        "$t_screen" "$t_screen_async" "$t_forward" "$vpeak_mb" "$SIZE" "$HF" "$REPS" \
+        "$t_screen_warm" >> "$TSV"
     log "$M materials: $(tail -1 "$TSV")"
     # the pictures stay (small); the packs go unless kept
     for v in screen screen_async forward; do
         [ -f "$D/$v.png" ] && cp "$D/$v.png" "$OUT/scale_world_m${M}_$v.png"
     done
-    [ "$KEEP" = yes ] || rm -rf "$D/pack" "$D/cache" "$D/world/textures"
+    [ "$KEEP" = yes ] || rm -rf "$D/pack" "$D/cache" "$D/caches" "$D/world/textures"
 done
 
 # ---- the table ----
 {
-    echo "| materials | combinations (leaf) / pipelines | largest composite / leaf overlap (layers) | cold build -j 2 | peak RSS build | edit rebuild (shaders recompiled / combos with it) | pack | textures / arrays | first picture $SIZE screen | screen, async pipelines | forward | peak RSS viewer |"
-    echo "|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
+    echo "| materials | combinations (leaf) / pipelines | largest composite / leaf overlap (layers) | cold build -j 2 | peak RSS build | edit rebuild (shaders recompiled / combos with it) | pack | textures / arrays | first picture $SIZE screen | screen, warm caches | screen, async pipelines | forward | peak RSS viewer |"
+    echo "|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
     awk -F'\t' 'NR > 1 {
-        printf "| %s | %s / %s | %s / %s | %s s | %s MB | %s s (%s / %s) | %s MB | %s / %s | %s | %s | %s | %s MB |\n",
+        printf "| %s | %s / %s | %s / %s | %s s | %s MB | %s s (%s / %s) | %s MB | %s / %s | %s | %s | %s | %s | %s MB |\n",
             $1, $3, $4, $5, $6, $7, $8, $11, $12, $14, $15, $16, $17,
-            ($18 ~ /^[0-9.]+$/ ? $18 " s" : $18), ($19 ~ /^[0-9.]+$/ ? $19 " s" : $19),
+            ($18 ~ /^[0-9.]+$/ ? $18 " s" : $18), ($25 ~ /^[0-9.]+$/ ? $25 " s" : $25),
+            ($19 ~ /^[0-9.]+$/ ? $19 " s" : $19),
             ($20 ~ /^[0-9.]+$/ ? $20 " s" : $20), $21 }' "$TSV"
     echo
     echo "gen_world --textures B 8 $HF 16 (B biomes x 8 materials, a texture each, over a base);"
