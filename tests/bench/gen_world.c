@@ -3,7 +3,7 @@
  * on an fBm heightfield, each biome's materials confined to it by a
  * painted biome mask.
  *
- *   gen_world OUTDIR BIOMES MATERIALS [SIZE [CELL]]
+ *   gen_world [--textures] OUTDIR BIOMES MATERIALS [SIZE [CELL]]
  *
  * writes OUTDIR/scene.sg, OUTDIR/heightfield.png (SIZE x SIZE texels,
  * 16-bit, default 512) and OUTDIR/biome_K.png (8-bit masks, one per biome).
@@ -15,10 +15,18 @@
  * materials bottom to top, then biome 1's, ...): i = 0 is the biome's
  * ground (its mask alone), the others the mask times a slope, height or
  * noise-free facing rule with thresholds spread over i, so within a biome
- * the materials overlap as a real stack does.  Colours are ALU tints (no
- * textures: the structure tests compile nothing, and the 64-texture limit
- * is another part of the issue).  Deterministic: same arguments, same
- * bytes. */
+ * the materials overlap as a real stack does.  Colours are ALU tints (the
+ * structure tests compile nothing).  With --textures every material but
+ * the base samples its own texture instead (issue 29: "their own textures,
+ * texgen variants, tinted"): OUTDIR/textures/bB_mI.png, an RGB texgen fBm
+ * variant (its own seed, period and octaves) tinted with the material's
+ * own hue, 64 x 64 for even I and 128 x 128 for odd I (so the build puts
+ * them into two texture arrays per 256 layers), sRGB, projected straight
+ * down every 4-11 m, times the material's colour constant (the vec3 a
+ * one-material edit changes).  Without --textures the output is what it
+ * was before the flag existed, byte for byte.  Deterministic: same
+ * arguments, same bytes. */
+#include <errno.h>
 #include <math.h>
 #include <stdarg.h>
 #include <stdbool.h>
@@ -26,12 +34,13 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 
 #include "texgen.h"
 
 static int usage(void)
 {
-    fprintf(stderr, "usage: gen_world OUTDIR BIOMES MATERIALS [SIZE [CELL]]\n"
+    fprintf(stderr, "usage: gen_world [--textures] OUTDIR BIOMES MATERIALS [SIZE [CELL]]\n"
                     "  BIOMES 1..64, MATERIALS 1..64 per biome (BIOMES x MATERIALS <= 511),\n"
                     "  SIZE 64..4096 texels (default 512), CELL leaf cell texels (default 16)\n");
     return 2;
@@ -70,8 +79,43 @@ static void put(text *t, const char *fmt, ...)
 
 static double unit(uint32_t h) { return (h & 0xFFFFFF) / 16777216.0; }
 
+/* Material (b, i)'s texture: OUTDIR/textures/bB_mI.png, a one-channel
+ * texgen fBm (seeded by b and i, 2-5 cells across, 3-5 octaves) turned into
+ * RGB with a hue of the material's own: texel = (0.35 + 0.65 d) * tint,
+ * tint in [0.7, 1] per channel. */
+static bool write_texture(const char *dir, int b, int i)
+{
+    uint32_t h = texgen_hash(b, i, 11);
+    int size = i % 2 ? 128 : 64, period = 2 + (int)(h % 4), octaves = 3 + (int)(h >> 4) % 3;
+    texgen_image grey, rgb;
+    if (!texgen_perlin(&grey, size, 1, period, octaves, h)) return false;
+    if (!texgen_image_alloc(&rgb, size, size, 3)) {
+        texgen_image_free(&grey);
+        return false;
+    }
+    double tint[3] = { 0.7 + 0.3 * unit(h >> 5), 0.7 + 0.3 * unit(h * 2246822519u),
+                       0.7 + 0.3 * unit(h * 3266489917u) };
+    for (size_t k = 0; k < (size_t)size * size; k++)
+        for (int c = 0; c < 3; c++)
+            rgb.pixels[3 * k + c] =
+                (uint8_t)lrint(255.0 * (0.35 + 0.65 * grey.pixels[k] / 255.0) * tint[c]);
+    char path[4096], *err = NULL;
+    snprintf(path, sizeof path, "%s/textures/b%d_m%d.png", dir, b, i);
+    bool ok = texgen_write_png(path, &rgb, &err);
+    if (!ok) fprintf(stderr, "gen_world: %s: %s\n", path, err ? err : "cannot write");
+    free(err);
+    texgen_image_free(&grey);
+    texgen_image_free(&rgb);
+    return ok;
+}
+
 int main(int argc, char **argv)
 {
+    bool textures = argc > 1 && strcmp(argv[1], "--textures") == 0;
+    if (textures) {
+        argv++;
+        argc--;
+    }
     if (argc < 4 || argc > 6) return usage();
     const char *dir = argv[1];
     int B = atoi(argv[2]), M = atoi(argv[3]);
@@ -131,8 +175,22 @@ int main(int argc, char **argv)
 
     /* the scene */
     text t = { 0 };
-    put(&t, "# gen_world %s %d %d %d %d: %d biomes x %d materials over a base "
-            "(tests/bench/gen_world.c)\n", dir, B, M, N, cell, B, M);
+    put(&t, "# gen_world %s%s %d %d %d %d: %d biomes x %d materials over a base "
+            "(tests/bench/gen_world.c)\n", textures ? "--textures " : "", dir, B, M, N, cell, B, M);
+    if (textures) {
+        snprintf(path, sizeof path, "%s/textures", dir);
+        if (mkdir(path, 0777) != 0 && errno != EEXIST) {
+            fprintf(stderr, "gen_world: cannot make %s: %s\n", path, strerror(errno));
+            return 1;
+        }
+        for (int b = 0; b < B; b++)
+            for (int i = 0; i < M; i++) {
+                if (!write_texture(dir, b, i)) return 1;
+                put(&t, "texture tex_b%d_m%d { file = \"textures/b%d_m%d.png\", filter = linear, "
+                        "mip = linear, wrap = repeat, srgb = true }\n", b, i, b, i);
+            }
+        put(&t, "\n");
+    }
     put(&t, "import \"nodes/compositors.sg\"\nimport \"nodes/masks.sg\"\n\n");
     put(&t, "material base {\n    out mask      = 1.0\n    out albedo    = vec3(0.30, 0.28, 0.25)\n"
             "    out roughness = 0.9\n}\n\n");
@@ -162,8 +220,19 @@ int main(int argc, char **argv)
                 }
                 put(&t, "    node k : mul { a = p.out, b = r.out }\n    out mask      = k.out\n");
             }
-            put(&t, "    out albedo    = vec3(%.3f, %.3f, %.3f)\n    out roughness = %.2f\n}\n\n",
-                r, gr, bl, 0.5 + 0.4 * unit(h >> 7));
+            if (textures) {
+                /* the colour constant times the material's own texture,
+                 * projected straight down every 4-11 m */
+                put(&t, "    node uv : div { a = terrain.position.xz, b = %.1f }\n"
+                        "    node tx : sample { tex = tex_b%d_m%d, uv = uv.out }\n"
+                        "    node c : mul { a = tx.out.rgb, b = vec3(%.3f, %.3f, %.3f) }\n"
+                        "    out albedo    = c.out\n    out roughness = %.2f\n}\n\n",
+                    4.0 + (h >> 11) % 8, b, i, 1.5 * r, 1.5 * gr, 1.5 * bl,
+                    0.5 + 0.4 * unit(h >> 7));
+            } else {
+                put(&t, "    out albedo    = vec3(%.3f, %.3f, %.3f)\n    out roughness = %.2f\n}\n\n",
+                    r, gr, bl, 0.5 + 0.4 * unit(h >> 7));
+            }
         }
     put(&t, "scene world_%dx%d {\n    heightfield = \"heightfield.png\"\n", B, M);
     put(&t, "    size = %.0f %.0f\n    max_height = %.0f\n    cell = %d\n", metres, metres,
@@ -180,7 +249,7 @@ int main(int argc, char **argv)
     free(t.s);
     free(cx);
     free(cz);
-    if (ok) printf("gen_world: %s: %d materials (%d biomes x %d + base), %d x %d texels\n",
-                   dir, B * M + 1, B, M, N, N);
+    if (ok) printf("gen_world: %s: %d materials (%d biomes x %d + base), %d x %d texels%s\n",
+                   dir, B * M + 1, B, M, N, N, textures ? ", a texture each" : "");
     return ok ? 0 : 1;
 }

@@ -3,7 +3,7 @@
 # `make bench-smoke`, CTest bench.smoke).
 #
 #   sh tests/bench/run.sh BUILD_DIR [--smoke] [--quick] [--out DIR]
-#                         [--frames N] [--keep-work]
+#                         [--frames N] [--keep-work] [--only scale_world]
 #
 # Writes into DIR (default out/bench): compile.csv (per scene: phases of
 # `splatc build --stats`, cold and warm, peak memory; colorado_geotiff:
@@ -24,6 +24,12 @@
 # --frames N: frames per camera path (medians over them; default 4, smoke 2).
 # --keep-work: keep OUT/work (packs, scene mirrors, the last frame of every
 # variant as RGBA32F); by default it is deleted at the end.
+# The group scale_world (tests/bench/scale_world.sh: gen_world's textured
+# worlds of 8, 32, 64, 128 and 256 materials, one table: combinations,
+# largest composite, cold and one-material-edit builds, pack, first picture
+# on both paths, peak memory; scale_world.tsv, scale_world.md,
+# scale_world.png) runs last, scaled down to 8 and 16 materials in --smoke;
+# --only scale_world runs it alone (tens of minutes on lavapipe at 256).
 set -eu
 
 if [ $# -lt 1 ]; then
@@ -36,8 +42,10 @@ MODE=full
 OUT=out/bench
 NFRAMES=""
 KEEP=no
+ONLY=""
 while [ $# -gt 0 ]; do
     case $1 in
+    --only) ONLY=$2; shift ;;
     --smoke) MODE=smoke ;;
     --quick) MODE=quick ;;
     --out) OUT=$2; shift ;;
@@ -48,6 +56,18 @@ while [ $# -gt 0 ]; do
     shift
 done
 REPO=$(cd "$(dirname "$0")/../.." && pwd)
+# scale_world.sh's options: the mode, the output folder, --keep-work
+scale_world() {
+    set -- "$B" --out "$OUT"
+    [ "$MODE" = smoke ] && set -- "$@" --smoke
+    [ "$KEEP" = yes ] && set -- "$@" --keep-work
+    sh "$REPO/tests/bench/scale_world.sh" "$@"
+}
+case $ONLY in
+"") ;;
+scale_world) scale_world; exit 0 ;;
+*) echo "run.sh: --only expects scale_world, found '$ONLY'" >&2; exit 2 ;;
+esac
 SPLATC=$B/compiler/splatc
 BENCH=$B/tests/splatbench
 for t in "$SPLATC" "$BENCH"; do
@@ -619,9 +639,16 @@ if [ "$MODE" != smoke ]; then
     fi
 fi
 
+# ---- scale_world: gen_world's textured worlds, 8..256 materials ------------------
+log "scale_world"
+scale_world
+
 # ---- summary and plots --------------------------------------------------------------
 log "summary"
 sh "$REPO/tests/bench/summary.sh" "$OUT" "$MODE" > "$OUT/summary.md"
+if [ -f "$OUT/scale_world.md" ]; then
+    { echo; echo "## scale_world (tests/bench/scale_world.sh)"; echo; cat "$OUT/scale_world.md"; } >> "$OUT/summary.md"
+fi
 # plot data: one file per knob/compositor group and view (label, GPU ms,
 # mean error) with its Pareto front; the ratio bars; the scaling curves
 awk -F, -v dir="$OUT" 'NR > 1 && $1 != "main" {

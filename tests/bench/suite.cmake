@@ -20,6 +20,9 @@ endif()
 # union, the largest within the largest leaf overlap, merging covering every
 # leaf within its bound, sound at random points), then world.sh builds its
 # pack with --max-combinations and reads the build report.
+# peakrss: wall time and peak memory of a command where GNU time is not
+# installed (scale_world.sh, the scale_world group of `make bench`)
+add_executable(peakrss ${CMAKE_CURRENT_LIST_DIR}/peakrss.c)
 if(TARGET splatc)
   add_executable(gen_world ${CMAKE_CURRENT_LIST_DIR}/gen_world.c)
   target_link_libraries(gen_world splatc m)
@@ -35,6 +38,13 @@ if(TARGET splatc)
     set_tests_properties(bench.world_structure PROPERTIES LABELS unit
                          FIXTURES_REQUIRED world_scene TIMEOUT 300)
     if(TARGET splatc_cli)
+      # gen_world --textures (a texture each, two sizes): the pack builds,
+      # every texture a layer of one of at most 20 arrays (two here)
+      add_test(NAME bench.world_textures
+        COMMAND sh ${CMAKE_CURRENT_LIST_DIR}/world_textures.sh $<TARGET_FILE:gen_world>
+                $<TARGET_FILE:splatc_cli> ${CMAKE_BINARY_DIR}/tests/bench/world_textures
+        WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
+      set_tests_properties(bench.world_textures PROPERTIES LABELS cli TIMEOUT 600)
       add_test(NAME bench.world_merge
         COMMAND sh ${CMAKE_CURRENT_LIST_DIR}/world.sh $<TARGET_FILE:splatc_cli> ${WORLD_OUT}
         WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
