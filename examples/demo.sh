@@ -28,4 +28,4 @@ echo
 echo "pictures:  out/demo.png  out/demo_combos.png  (camera preset '$CAMERA'),"
 echo "           out/demo_meadow.png  (preset 'meadow': undergrowth)"
 echo "viewer:    $VIEW out/colorado.pack --camera-preset $CAMERA"
-echo "other presets: valley overview blanca spanish_peaks pivots trinidad meadow (SPLAT_DEMO_CAMERA=...)"
+echo "other presets: valley overview blanca spanish_peaks pivots trinidad meadow ground mid cliffs far top_down (SPLAT_DEMO_CAMERA=...)"
