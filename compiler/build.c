@@ -274,7 +274,7 @@ static bool analyse(build *b)
 }
 
 /* The layout's textures into arrays (abi.h set 1) by size, mip files and
- * sampler state; scene.c has checked every file is a readable image. */
+ * sampler state; scene.c has checked every file and read its size. */
 static bool group_textures(build *b)
 {
     splat_layout *L = &b->layout;
@@ -282,17 +282,9 @@ static bool group_textures(build *b)
     int *w = xcalloc((size_t)n + 1, sizeof *w), *h = xcalloc((size_t)n + 1, sizeof *h);
     int *mips = xcalloc((size_t)n + 1, sizeof *mips);
     for (int t = 0; t < n; t++) {
-        const char *file = L->src->textures[L->textures[t]].file;
-        char why[256];
-        FILE *f = splat_input_fopen(file, SPLAT_MAX_IMAGE_BYTES, why, sizeof why);
-        long long iw = 0, ih = 0;
-        int comp;
-        bool is16;
-        if (f && splat_image_info(f, &iw, &ih, &comp, &is16))
-            w[t] = (int)iw, h[t] = (int)ih;
-        if (f)
-            fclose(f);
-        mips[t] = build_mip_count(file);
+        int src = L->textures[t];   /* sizes as splat_scene_load read them */
+        w[t] = b->scene.texture_size[src][0], h[t] = b->scene.texture_size[src][1];
+        mips[t] = build_mip_count(L->src->textures[src].file);
     }
     splat_layout_group_textures(L, w, h, mips);
     free(w);

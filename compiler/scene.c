@@ -321,6 +321,7 @@ static bool check_textures(splat_scene *s, const int *first_material, sg_diags *
 {
     const sg_scene *sc = s->desc;
     bool ok = true;
+    s->texture_size = xcalloc((size_t)s->ir.ntextures + 1, sizeof *s->texture_size);
     for (int i = 0; i < s->ir.ntextures; i++) {
         const char *file = s->ir.textures[i].file;
         sg_loc loc = sg_texture_file_loc(s->prog, file);
@@ -341,6 +342,8 @@ static bool check_textures(splat_scene *s, const int *first_material, sg_diags *
         bool is16;
         bool image = splat_image_info(f, &w, &h, &comp, &is16);
         fclose(f);
+        if (image && w > 0 && h > 0 && w <= SPLAT_MAX_TEXTURE && h <= SPLAT_MAX_TEXTURE)
+            s->texture_size[i][0] = (int)w, s->texture_size[i][1] = (int)h;
         if (!image) {
             sg_errorf(d, loc, SG_E_IO, "cannot read texture '%s': not an image "
                       "(PNG, JPEG, TGA, BMP, …)", file);
@@ -453,6 +456,7 @@ void splat_scene_free(splat_scene *s)
     }
     free(s->painted);
     free(s->painted_size);
+    free(s->texture_size);
     if (s->own_desc) {
         free(s->own_desc->cameras);
         free(s->own_desc);

@@ -56,6 +56,8 @@ typedef struct splat_scene {
      * whoever built it (build.c) frees it. */
     const sparse_masks *sparse;
     splat_vectors  vectors;    /* the spline and polygon shapes (vector.c)    */
+    int          (*texture_size)[2]; /* ir.textures[i]'s texels, W and H, read
+                                  when the scene checked the files          */
     int            nmaterials; /* desc->nmaterials, bottom (0) first          */
     /* Every material lowered into one shared ir: roots "<name>.mask", … */
     ir             ir;

@@ -15,6 +15,7 @@
 
 #include "abi.h"
 #include "scene.h"
+#include "glsl_check.h"
 #include "spv.h"
 
 /* ---- a small scene built with the IR builder ------------------------------
@@ -410,25 +411,6 @@ static void test_placement(void **state)
     splat_composite_free(&c);
 }
 
-static void compiles(const char *glsl, const char *name)
-{
-    uint32_t *w = NULL;
-    size_t n = 0;
-    char *log = NULL;
-    bool ok = spv_compile(glsl, SPV_STAGE_FRAGMENT, name, &w, &n, &log);
-    if (!ok)
-        fprintf(stderr, "%s\n%s", glsl, log ? log : "");
-    assert_true(ok);
-    free(log);
-    log = NULL;
-    ok = spv_validate(w, n, &log);
-    if (!ok)
-        fprintf(stderr, "%s", log ? log : "");
-    assert_true(ok);
-    free(log);
-    free(w);
-}
-
 static void test_variants_compile(void **state)
 {
     fixture *f = *state;
@@ -437,18 +419,18 @@ static void test_variants_compile(void **state)
     splat_composite c;
     compose(f, mats, 3, false, &c);
     char *g = glsl_of(f, &c, false);
-    compiles(g, "composite");
+    glsl_check_compiles(g, SPV_STAGE_FRAGMENT, "composite");
     assert_true(count(composite_body(g), "if (") >= 3);
     free(g);
     g = glsl_of(f, &c, true);
-    compiles(g, "flat");
+    glsl_check_compiles(g, SPV_STAGE_FRAGMENT, "flat");
     assert_int_equal(count(composite_body(g), "if ("), 0);
     free(g);
     splat_composite_free(&c);
 
     compose(f, uber, 3, false, &c);
     g = glsl_of(f, &c, false);
-    compiles(g, "uber");
+    glsl_check_compiles(g, SPV_STAGE_FRAGMENT, "uber");
     free(g);
     splat_composite_free(&c);
 
@@ -457,7 +439,7 @@ static void test_variants_compile(void **state)
         g = glsl_of(f, &c, false);
         assert_non_null(strstr(g, "#define SPLAT_MULTIPASS"));
         assert_non_null(strstr(g, "splat_finish("));
-        compiles(g, "reference");
+        glsl_check_compiles(g, SPV_STAGE_FRAGMENT, "reference");
         free(g);
         splat_composite_free(&c);
     }
@@ -571,7 +553,7 @@ static void test_graph_compositor(void **state)
     splat_composite_glsl(&graph, &a, &gd, &ga);
     splat_composite_glsl(&builtin, &b, &gd, &gb);
     assert_string_equal(ga.s, gb.s);
-    compiles(ga.s, "graph composite");
+    glsl_check_compiles(ga.s, SPV_STAGE_FRAGMENT, "graph composite");
 
     /* an unknown compositor is an error, not a crash */
     splat_layout bad;

@@ -17,6 +17,7 @@
 #include "ir.h"
 #include "random_ir.h"
 #include "shader.h"
+#include "glsl_check.h"
 #include "spv.h"
 
 static int count(const char *hay, const char *needle)
@@ -155,26 +156,6 @@ static void build_material(ir *ir)
     /* no height: the default */
 }
 
-static void compile_ok(const char *glsl, const char *name)
-{
-    uint32_t *words = NULL;
-    size_t nwords = 0;
-    char *log = NULL;
-    bool ok = spv_compile(glsl, SPV_STAGE_FRAGMENT, name, &words, &nwords, &log);
-    if (!ok) {
-        fprintf(stderr, "%s\n%s\n", glsl, log ? log : "");
-        fail();
-    }
-    free(log);
-    log = NULL;
-    if (!spv_validate(words, nwords, &log)) {
-        fprintf(stderr, "%s\n", log ? log : "");
-        fail();
-    }
-    free(log);
-    free(words);
-}
-
 static void test_material_shader(void **state)
 {
     ir ir;
@@ -198,7 +179,7 @@ static void test_material_shader(void **state)
     assert_non_null(strstr(a.s, "notEqual("));
     assert_non_null(strstr(a.s, ", 0.5, v"));                     /* default height */
     assert_non_null(strstr(a.s, "splat_finish("));
-    compile_ok(a.s, "cliff");
+    glsl_check_compiles(a.s, SPV_STAGE_FRAGMENT, "cliff");
     ir_buf_free(&a);
     ir_buf_free(&b);
     ir_free(&ir);
@@ -212,7 +193,7 @@ static void test_empty_material_compiles(void **state)
     glsl_material_shader(&ir, "plain", &a);
     assert_null(strstr(a.s, "uniform splat_params"));             /* no empty block */
     assert_non_null(strstr(a.s, "splat_finish(vec3(0.5), splat_normal(), 0.8, 0.5, 1.0);"));
-    compile_ok(a.s, "plain");
+    glsl_check_compiles(a.s, SPV_STAGE_FRAGMENT, "plain");
     ir_buf_free(&a);
     ir_free(&ir);
 }
@@ -242,7 +223,7 @@ static void test_random_graphs_compile(void **state)
             seen[ir.nodes[id].op] = true;
         ir_buf a = {0};
         glsl_material_shader(&ir, "rnd", &a);
-        compile_ok(a.s, "rnd");
+        glsl_check_compiles(a.s, SPV_STAGE_FRAGMENT, "rnd");
         ir_buf_free(&a);
         ir_free(&ir);
     }

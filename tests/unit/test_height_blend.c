@@ -19,6 +19,7 @@
 #include <string.h>
 
 #include "compose.h"
+#include "glsl_check.h"
 #include "spv.h"
 
 /* Four materials: masks and heights are ramps of uv and position with
@@ -315,25 +316,6 @@ static void test_contract(void **state)
     splat_composite_free(&rock_alone);
 }
 
-static void compiles(const char *glsl, spv_stage stage, const char *name)
-{
-    uint32_t *w = NULL;
-    size_t n = 0;
-    char *log = NULL;
-    bool ok = spv_compile(glsl, stage, name, &w, &n, &log);
-    if (!ok)
-        fprintf(stderr, "%s\n%s", glsl, log ? log : "");
-    assert_true(ok);
-    free(log);
-    log = NULL;
-    ok = spv_validate(w, n, &log);
-    if (!ok)
-        fprintf(stderr, "%s", log ? log : "");
-    assert_true(ok);
-    free(log);
-    free(w);
-}
-
 static int count(const char *s, const char *what)
 {
     int n = 0;
@@ -370,7 +352,7 @@ static void test_glsl(void **state)
             assert_int_equal(count(body, "splat_surface("), 4);
         if (v[k].d.ug_slot)
             assert_int_equal(count(body, "splat_ug_w[1] * s_inv"), 1);
-        compiles(b.s, v[k].st, v[k].name);
+        glsl_check_compiles(b.s, v[k].st, v[k].name);
         ir_buf_free(&b);
     }
     splat_composite_free(&c);

@@ -22,6 +22,7 @@
 
 #include "compose.h"
 #include "lowered.h"
+#include "glsl_check.h"
 #include "spv.h"
 
 /* ---- helpers ------------------------------------------------------------- */
@@ -396,25 +397,6 @@ static const char LOOK[] =
     "    out height = 0.7\n"
     "}\n";
 
-static void compiles(const char *glsl, spv_stage stage, const char *name)
-{
-    uint32_t *w = NULL;
-    size_t n = 0;
-    char *log = NULL;
-    bool ok = spv_compile(glsl, stage, name, &w, &n, &log);
-    if (!ok)
-        fprintf(stderr, "%s\n%s", glsl, log ? log : "");
-    assert_true(ok);
-    free(log);
-    log = NULL;
-    ok = spv_validate(w, n, &log);
-    if (!ok)
-        fprintf(stderr, "%s", log ? log : "");
-    assert_true(ok);
-    free(log);
-    free(w);
-}
-
 static void test_composite_compiles(void **state)
 {
     (void)state;
@@ -451,7 +433,7 @@ static void test_composite_compiles(void **state)
             ir_buf b = {0};
             splat_composite_glsl(&L, &c, &v[i].g, &b);
             assert_non_null(strstr(b.s, "splat_cavity()"));
-            compiles(b.s, v[i].st, v[i].g.title);
+            glsl_check_compiles(b.s, v[i].st, v[i].g.title);
             ir_buf_free(&b);
         }
         splat_composite_free(&c);
