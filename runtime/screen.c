@@ -25,7 +25,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#define MAX_WORDS 8      /* material set bits per tile: 256 materials */
+#define MAX_WORDS 16     /* material set bits per tile: 512 materials */
 
 struct rt_screen {
     rt_device            *d;

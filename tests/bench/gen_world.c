@@ -3,7 +3,7 @@
  * on an fBm heightfield, each biome's materials confined to it by a
  * painted biome mask.
  *
- *   gen_world [--textures] OUTDIR BIOMES MATERIALS [SIZE [CELL]]
+ *   gen_world [--textures] [--view K] [--only K] OUTDIR BIOMES MATERIALS [SIZE [CELL]]
  *
  * writes OUTDIR/scene.sg, OUTDIR/heightfield.png (SIZE x SIZE texels,
  * 16-bit, default 512) and OUTDIR/biome_K.png (8-bit masks, one per biome).
@@ -25,7 +25,10 @@
  * down every 4-11 m, times the material's colour constant (the vec3 a
  * one-material edit changes).  Without --textures the output is what it
  * was before the flag existed, byte for byte.  Deterministic: same
- * arguments, same bytes. */
+ * arguments, same bytes.  --view K adds camera 'biome', 120 m above biome
+ * K's centre looking steeply down into it; --only K writes the same terrain and
+ * masks but keeps only the base and biome K's materials, with that camera:
+ * the world that issue 29's presence comparison holds the full one to. */
 #include <errno.h>
 #include <math.h>
 #include <stdarg.h>
@@ -40,9 +43,12 @@
 
 static int usage(void)
 {
-    fprintf(stderr, "usage: gen_world [--textures] OUTDIR BIOMES MATERIALS [SIZE [CELL]]\n"
+    fprintf(stderr, "usage: gen_world [--textures] [--view K] [--only K] OUTDIR BIOMES MATERIALS "
+                    "[SIZE [CELL]]\n"
                     "  BIOMES 1..64, MATERIALS 1..64 per biome (BIOMES x MATERIALS <= 511),\n"
-                    "  SIZE 64..4096 texels (default 512), CELL leaf cell texels (default 16)\n");
+                    "  SIZE 64..4096 texels (default 512), CELL leaf cell texels (default 16);\n"
+                    "  --view K adds camera 'biome' looking down into biome K, --only K keeps\n"
+                    "  only biome K's materials (and adds that camera)\n");
     return 2;
 }
 
@@ -109,10 +115,32 @@ static bool write_texture(const char *dir, int b, int i)
     return ok;
 }
 
+/* The heightfield at texel coordinates (x, z) of N, 0..1: fBm, ridged a
+ * little so slopes vary. */
+static double world_height(double x, double z, int N)
+{
+    double h = 0.5 + 0.9 * texgen_fbm(x / N * 4, z / N * 4, 4, 4, 6, 0.5, 29u);
+    return h < 0 ? 0 : h > 1 ? 1 : h;
+}
+
 int main(int argc, char **argv)
 {
-    bool textures = argc > 1 && strcmp(argv[1], "--textures") == 0;
-    if (textures) {
+    bool textures = false;
+    int view = -1, only = -1;
+    while (argc > 1 && !strncmp(argv[1], "--", 2)) {
+        if (!strcmp(argv[1], "--textures")) {
+            textures = true;
+        } else if (argc > 2 && (!strcmp(argv[1], "--view") || !strcmp(argv[1], "--only"))) {
+            char *end;
+            long k = strtol(argv[2], &end, 10);
+            if (*end || k < 0 || k > 63) return usage();
+            view = (int)k;
+            if (argv[1][2] == 'o') only = (int)k;
+            argv++;
+            argc--;
+        } else {
+            return usage();
+        }
         argv++;
         argc--;
     }
@@ -121,7 +149,7 @@ int main(int argc, char **argv)
     int B = atoi(argv[2]), M = atoi(argv[3]);
     int N = argc > 4 ? atoi(argv[4]) : 512, cell = argc > 5 ? atoi(argv[5]) : 16;
     if (B < 1 || B > 64 || M < 1 || M > 64 || B * M > 511 || N < 64 || N > 4096 ||
-        cell < 1 || (cell & (cell - 1)) || cell > N)
+        cell < 1 || (cell & (cell - 1)) || cell > N || view >= B)
         return usage();
     const double metres = 4.0 * N, max_height = 0.25 * metres;
 
@@ -130,10 +158,7 @@ int main(int argc, char **argv)
     if (!hf) return 1;
     for (int z = 0; z < N; z++)
         for (int x = 0; x < N; x++) {
-            double v = texgen_fbm((x + 0.5) / N * 4, (z + 0.5) / N * 4, 4, 4, 6, 0.5, 29u);
-            double h = 0.5 + 0.9 * v;
-            h = h < 0 ? 0 : h > 1 ? 1 : h;
-            hf[(size_t)z * N + x] = (uint16_t)lrint(h * 65535.0);
+            hf[(size_t)z * N + x] = (uint16_t)lrint(world_height(x + 0.5, z + 0.5, N) * 65535.0);
         }
     char path[4096], *err = NULL;
     snprintf(path, sizeof path, "%s/heightfield.png", dir);
@@ -177,6 +202,10 @@ int main(int argc, char **argv)
     text t = { 0 };
     put(&t, "# gen_world %s%s %d %d %d %d: %d biomes x %d materials over a base "
             "(tests/bench/gen_world.c)\n", textures ? "--textures " : "", dir, B, M, N, cell, B, M);
+    if (view >= 0)
+        put(&t, "# %s %d: %s\n", only >= 0 ? "--only" : "--view", view,
+            only >= 0 ? "only this biome's materials, camera 'biome' inside it"
+                      : "camera 'biome' inside this biome");
     if (textures) {
         snprintf(path, sizeof path, "%s/textures", dir);
         if (mkdir(path, 0777) != 0 && errno != EEXIST) {
@@ -184,6 +213,7 @@ int main(int argc, char **argv)
             return 1;
         }
         for (int b = 0; b < B; b++)
+            if (only < 0 || b == only)
             for (int i = 0; i < M; i++) {
                 if (!write_texture(dir, b, i)) return 1;
                 put(&t, "texture tex_b%d_m%d { file = \"textures/b%d_m%d.png\", filter = linear, "
@@ -195,6 +225,7 @@ int main(int argc, char **argv)
     put(&t, "material base {\n    out mask      = 1.0\n    out albedo    = vec3(0.30, 0.28, 0.25)\n"
             "    out roughness = 0.9\n}\n\n");
     for (int b = 0; b < B; b++)
+        if (only < 0 || b == only)
         for (int i = 0; i < M; i++) {
             uint32_t h = texgen_hash(b, i, 7);
             double r = 0.15 + 0.6 * unit(h), gr = 0.15 + 0.6 * unit(h >> 3 ^ 0x9e3779b9u),
@@ -239,17 +270,29 @@ int main(int argc, char **argv)
         max_height, cell);
     put(&t, "    compositor = linear_alpha\n    materials = [base");
     for (int b = 0; b < B; b++)
+        if (only < 0 || b == only)
         for (int i = 0; i < M; i++) put(&t, ", b%d_m%d", b, i);
     put(&t, "]\n");
-    for (int b = 0; b < B; b++) put(&t, "    painted biome_%d = \"biome_%d.png\"\n", b, b);
-    put(&t, "    camera overview { position = %.0f %.0f %.0f, look = %.0f 0 %.0f }\n}\n",
+    for (int b = 0; b < B; b++)
+        if (only < 0 || b == only) put(&t, "    painted biome_%d = \"biome_%d.png\"\n", b, b);
+    put(&t, "    camera overview { position = %.0f %.0f %.0f, look = %.0f 0 %.0f }\n",
         -0.2 * metres, 0.8 * metres, -0.2 * metres, 0.5 * metres, 0.5 * metres);
+    if (view >= 0) {
+        /* 120 m above biome K's centre, 30 m off it, looking at the ground
+         * there: a view inside the biome (issue 29's presence comparison) */
+        double x = cx[view] * 4.0, z = cz[view] * 4.0;
+        double y = world_height(cx[view], cz[view], N) * max_height;
+        put(&t, "    camera biome { position = %.1f %.1f %.1f, look = %.1f %.1f %.1f }\n",
+            x - 30.0, y + 120.0, z, x, y, z);
+    }
+    put(&t, "}\n");
     snprintf(path, sizeof path, "%s/scene.sg", dir);
     bool ok = write_text(path, t.s);
     free(t.s);
     free(cx);
     free(cz);
     if (ok) printf("gen_world: %s: %d materials (%d biomes x %d + base), %d x %d texels%s\n",
-                   dir, B * M + 1, B, M, N, N, textures ? ", a texture each" : "");
+                   dir, only >= 0 ? M + 1 : B * M + 1, only >= 0 ? 1 : B, M, N, N,
+                   textures ? ", a texture each" : "");
     return ok ? 0 : 1;
 }

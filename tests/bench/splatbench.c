@@ -56,7 +56,8 @@
  *       the kinds that recompile the composites (flat fp16 sobel analytic
  *       lambert) always run without them.
  *       Paths (--path): ground (2 m above the terrain looking 150 m ahead,
- *       from --start-preset NAME or --start x,z,dx,dz), topdown, grazing.
+ *       from --start-preset NAME or --start x,z,dx,dz), topdown, grazing,
+ *       preset (--start-preset NAME's camera itself, still).
  *       --warmup N (default 1) untimed frames at the path's start first;
  *       --warmup path: every frame of the path once, untimed, so nothing a
  *       view needs is made or JIT-compiled inside a timed frame (llvmpipe
@@ -557,8 +558,18 @@ static bool path_camera(const rt_pack *p, const path_desc *pd, int f, int n, rt_
         c->look[0] = lx, c->look[1] = ground(p, lx, lz), c->look[2] = lz;
         if (c->look[1] > c->position[1] - 1.0)
             c->look[1] = c->position[1] - 0.02 * hypot(lx - x, lz - z);
+    } else if (!strcmp(pd->name, "preset")) {
+        /* the camera preset itself, still: every frame the same view */
+        int k = pd->preset ? rt_pack_camera_find(p, pd->preset) : -1;
+        if (k < 0) {
+            fprintf(stderr, "splatbench: path 'preset' needs --start-preset NAME of the pack\n");
+            return false;
+        }
+        memcpy(c->position, p->cameras[k].position, sizeof c->position);
+        memcpy(c->look, p->cameras[k].look, sizeof c->look);
     } else {
-        fprintf(stderr, "splatbench: unknown path '%s' (ground, topdown, grazing)\n", pd->name);
+        fprintf(stderr, "splatbench: unknown path '%s' (ground, topdown, grazing, preset)\n",
+                pd->name);
         return false;
     }
     return true;
