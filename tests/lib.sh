@@ -6,7 +6,8 @@
 # POSIX sh has no pipefail: in `splatc build … | sed …` a crashing splatc
 # leaves the status of sed, 0, and the test passes.  `cmp -s A B && fail`
 # passes when B is missing (cmp exits 2).  These helpers check every status
-# instead:
+# instead.  A pipe stays only where its first command reads a file (`sed …
+# FILE | sort`): the program under test never writes into a pipe.
 #
 #   fail MSG...           print "FAIL: MSG" on stderr, exit 1.  A script may
 #                         define its own fail after sourcing (one that counts
