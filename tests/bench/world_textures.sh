@@ -19,7 +19,7 @@ rm -rf "$D" && mkdir -p "$D/a" "$D/b" || fail "cannot make $D"
 sed -i '1d' "$D/b/scene.sg" && sed '1d' "$D/a/scene.sg" > "$D/a.scene" || fail "sed"
 same "$D/a.scene" "$D/b/scene.sg" "gen_world --textures: the scene differs between two runs"
 for f in "$D"/a/textures/*.png "$D"/a/*.png; do
-    cmp -s "$f" "$D/b/${f#$D/a/}" || fail "gen_world --textures: $f differs between two runs"
+    same "$f" "$D/b/${f#$D/a/}" "gen_world --textures: $f differs between two runs"
 done
 n=$(ls "$D"/a/textures/*.png | wc -l)
 [ "$n" -eq 8 ] || fail "$n textures written, expected 8"

@@ -14,7 +14,7 @@ PACK=$OUT/bl.pack
 n=0
 for src in graphs/textures/uniform.mip*.png; do
     n=$((n + 1))
-    cmp -s "$src" "$PACK/textures/uniform.mip$n.png" || fail "level $n not copied"
+    same "$src" "$PACK/textures/uniform.mip$n.png" "level $n not copied"
 done
 [ "$n" -gt 0 ] || fail "no mip files in graphs/textures (splatc texgen writes them)"
 grep -q "\"mips\": $n" "$PACK/manifest.json" || fail "manifest does not say \"mips\": $n"
