@@ -31,6 +31,8 @@
 # scale_world.png) runs last, scaled down to 8 and 16 materials in --smoke;
 # --only scale_world runs it alone (tens of minutes on lavapipe at 256).
 set -eu
+# must, differ, to: statuses checked (no pipe without pipefail)
+. "$(dirname "$0")/../lib.sh"
 
 if [ $# -lt 1 ]; then
     echo "usage: sh tests/bench/run.sh BUILD_DIR [--smoke] [--quick] [--out DIR]" >&2
@@ -154,8 +156,9 @@ build_row() {
 # The device name: one tiny render of the minimal pack.
 log "device"
 "$SPLATC" build examples/minimal/scene.sg -o "$W/minimal" --flat --cache "$W/cache" >/dev/null
-DEVICE=$("$BENCH" render --pack "$W/minimal" --variant c=composite --size 64x36 --frames 1 \
-         --warmup 0 | awk -F'"' 'NR == 2 { print $2 }')
+to "$W/device.csv" "$BENCH" render --pack "$W/minimal" --variant c=composite --size 64x36 --frames 1 \
+    --warmup 0
+DEVICE=$(awk -F'"' 'NR == 2 { print $2 }' "$W/device.csv")
 [ -n "$DEVICE" ] || { echo "run.sh: no Vulkan device answers" >&2; exit 1; }
 log "device: $DEVICE"
 
@@ -307,9 +310,7 @@ look_pack() {
         f=${e%%:*}
         rm -f "$R/nodes/$f.sg"
         sed -e "${e#*:}" "nodes/$f.sg" > "$R/nodes/$f.sg"
-        if cmp -s "nodes/$f.sg" "$R/nodes/$f.sg"; then
-            echo "run.sh: look $label: the edit does not change nodes/$f.sg" >&2; exit 1
-        fi
+        differ "nodes/$f.sg" "$R/nodes/$f.sg" "run.sh: look $label: the edit does not change nodes/$f.sg"
     done
     d=$(mirror_scene "$R" "$scene" "$scene")
     cp "examples/$scene/scene.sg" "$d/scene.sg"
@@ -333,15 +334,14 @@ knob_pack() {
     if [ -n "$3" ]; then
         rm -f "$R/graphs/$3.sg"
         sed -e "$4" "graphs/$3.sg" > "$R/graphs/$3.sg"
-        if cmp -s "graphs/$3.sg" "$R/graphs/$3.sg"; then
-            echo "run.sh: knob $2: the edit does not change graphs/$3.sg" >&2; exit 1
-        fi
+        differ "graphs/$3.sg" "$R/graphs/$3.sg" "run.sh: knob $2: the edit does not change graphs/$3.sg"
     fi
     d=$(mirror_scene "$R" "$1" "$1")
     sed -e "${5:-}" "examples/$1/scene.sg" > "$d/scene.sg"
     # -I first: imports search -I folders before the current folder (REPO)
     "$SPLATC" build "$d/scene.sg" -o "$W/$1_knob_$2" -j 2 --cache "$W/cache-$1" -I "$R" $KNOB_BUILD_ARGS >/dev/null
     # the variant must differ from the scene's own pack, or the knob is void
+    # (a warning: both manifests exist, the builds above succeeded)
     if cmp -s "$W/$1_knob_$2/manifest.json" "$W/$1/manifest.json"; then
         echo "run.sh: warning: knob $2 did not change $1's pack" >&2
     fi
@@ -424,9 +424,8 @@ if [ "$MODE" = smoke ]; then
     # renders it: group compositor_cliffs)
     cliffs_pack linear_alpha "$W/cliffs" >/dev/null
     cliffs_pack stochastic_select "$W/cliffs_stochastic" >/dev/null
-    if cmp -s "$W/cliffs/manifest.json" "$W/cliffs_stochastic/manifest.json"; then
-        echo "run.sh: the cliffs stack's compositor did not change its pack" >&2; exit 1
-    fi
+    differ "$W/cliffs/manifest.json" "$W/cliffs_stochastic/manifest.json" \
+        "run.sh: the cliffs stack's compositor did not change its pack"
 else
     # (c) compositors, against the alpha composite of the same frames
     for s in minimal colorado; do
@@ -589,13 +588,18 @@ rm -f "$CSV.body"
 # ---- the far atlas's bake: the CPU reference against the device ------------------
 # (splatc build --far-bake cpu, its --stats phase; splatbench far-bake, the
 # device's pipelines and shading) on the same machine, one run each
+# (each command's output goes to a file, its status checked, then filtered:
+# `splatc build … | sed` under sh passed a crashing splatc)
 far_bake() {   # SCENE N
     rm -rf "$W/farbake_cpu"
-    s=$("$SPLATC" build "examples/$1/scene.sg" -o "$W/farbake_cpu" --far-atlas="$2" --far-bake cpu \
-        -j 2 --cache "$W/cache-$1" --stats | sed -n 's/^far atlas  *\([0-9.]*\)$/\1/p')
+    to "$W/farbake_cpu.txt" "$SPLATC" build "examples/$1/scene.sg" -o "$W/farbake_cpu" \
+        --far-atlas="$2" --far-bake cpu -j 2 --cache "$W/cache-$1" --stats
+    s=$(sed -n 's/^far atlas  *\([0-9.]*\)$/\1/p' "$W/farbake_cpu.txt")
+    [ -n "$s" ] || fail "splatc build --far-bake cpu --stats printed no 'far atlas' time"
     echo "$1,$2,cpu,,,$s"
-    "$BENCH" far-bake --pack "$W/$1" --far-atlas "$2" --runs 1 |
-        awk -F, -v s="$1" -v n="$2" 'NR > 2 { print s "," n ",device," $2 "," $3 "," $5 }'
+    to "$W/farbake_device.txt" "$BENCH" far-bake --pack "$W/$1" --far-atlas "$2" --runs 1
+    awk -F, -v s="$1" -v n="$2" 'NR > 2 { print s "," n ",device," $2 "," $3 "," $5 }' \
+        "$W/farbake_device.txt"
 }
 {
     echo "scene,far_atlas_n,bake,combos,compile_s,total_s"

@@ -41,6 +41,7 @@
 # (tests/bench/scale_world.gp).  Nothing is asserted: figures only (the
 # structure is asserted by bench.world_* in `make test`).
 set -eu
+. "$(dirname "$0")/../lib.sh"   # differ
 
 if [ $# -lt 1 ]; then
     echo "usage: sh tests/bench/scale_world.sh BUILD_DIR [--smoke] [--out DIR] [--counts LIST] [--reps N]" >&2
@@ -166,8 +167,7 @@ for M in $COUNTS; do
         awk -v v="0.9$r$r" '/^material b0_m1 /{ inm = 1 }
             inm && /vec3\(/ && !done { sub(/vec3\([0-9.]+/, "vec3(" v); done = 1 }
             /^}/{ inm = 0 } { print }' "$D/world/scene.sg" > "$D/world/scene.sg.new"
-        cmp -s "$D/world/scene.sg" "$D/world/scene.sg.new" &&
-            { echo "scale_world.sh: the edit changed nothing" >&2; exit 1; }
+        differ "$D/world/scene.sg" "$D/world/scene.sg.new" "scale_world.sh: the edit changed nothing"
         mv "$D/world/scene.sg.new" "$D/world/scene.sg"
         log "$M materials: one-material edit, rebuild ($((r + 1))/$REPS)"
         measure "$D/edit_stats.txt" "$SPLATC" build "$D/world/scene.sg" -o "$D/pack" -j 2 \

@@ -40,6 +40,8 @@ TMP=$(mktemp -d "${TMPDIR:-/tmp}/splatc_cli.XXXXXX")
 trap 'rm -rf "$TMP"' EXIT
 fails=0
 
+. "$(dirname "$0")/../lib.sh"   # same (through the fail below)
+# every failure counted, the cases go on
 fail() { echo "FAIL: $*"; fails=$((fails + 1)); }
 
 # run EXPECTED_STATUS CMD... : status must match; stderr kept in $TMP/err
@@ -76,9 +78,9 @@ graphs)
             run 0 "$SPLATC" spirv "$g" -m "$m" -o "$TMP/$m.spv"
             run 0 spirv-val --target-env vulkan1.2 "$TMP/$m.spv"
             run 0 "$SPLATC" glsl "$g" -m "$m" -o "$TMP/$m.2.frag"
-            cmp -s "$TMP/$m.frag" "$TMP/$m.2.frag" || fail "glsl of $m differs between runs"
+            same "$TMP/$m.frag" "$TMP/$m.2.frag" "glsl of $m differs between runs"
             run 0 "$SPLATC" spirv "$g" -m "$m" -o "$TMP/$m.2.spv"
-            cmp -s "$TMP/$m.spv" "$TMP/$m.2.spv" || fail "spirv of $m differs between runs"
+            same "$TMP/$m.spv" "$TMP/$m.2.spv" "spirv of $m differs between runs"
             grep -q "^#version 450" "$TMP/$m.frag" || fail "$m.frag has no #version 450"
         done
     done
@@ -156,7 +158,8 @@ eval)
     run 0 "$SPLATC" eval graphs/cliff.sg -m cliff --interval --output mask --at slope=0:0.3
     [ "$(cat "$TMP/out")" = "[0, 0]" ] || fail "interval flat: $(cat "$TMP/out")"
     run 0 "$SPLATC" eval graphs/cliff.sg -m cliff --interval --output mask --at slope=0:1
-    tr -d '[],' < "$TMP/out" | awk '{ exit !($1 <= 0 && $2 >= 1) }' ||
+    # (END: an empty output is no interval, not a pass)
+    tr -d '[],' < "$TMP/out" | awk '{ ok = $1 <= 0 && $2 >= 1 } END { exit !(NR == 1 && ok) }' ||
         fail "interval all: $(cat "$TMP/out")"
     run 2 "$SPLATC" eval graphs/cliff.sg -m cliff --at slope=0:1
     run 2 "$SPLATC" eval graphs/cliff.sg -m cliff --at nothing=1
@@ -192,7 +195,7 @@ tools)
     [ "$(echo $inst | wc -w)" -ge 4 ] || fail "rock has too few shader nodes to test ($inst)"
     run 0 "$SPLATC" dot graphs/rock.sg -m rock -o "$TMP/r.dot"
     run 0 "$SPLATC" dot graphs/rock.sg -m rock -o "$TMP/r2.dot"
-    cmp -s "$TMP/r.dot" "$TMP/r2.dot" || fail "dot output differs between runs"
+    same "$TMP/r.dot" "$TMP/r2.dot" "dot output differs between runs"
     run 0 "$SPLATC" dot graphs/rock.sg -m rock --expand -o "$TMP/rx.dot"
     for n in $inst; do
         grep -q "^    \"rock/$n\" \[shape=box3d.*label=\"$n : [a-z0-9_]*  (shader)" "$TMP/r.dot" ||
@@ -230,7 +233,7 @@ tools)
     # a dump is a graph file: it reads back and dumps to the same text
     run 0 "$SPLATC" check "$TMP/cliff_dump.sg"
     run 0 "$SPLATC" dump "$TMP/cliff_dump.sg" -m cliff -o "$TMP/cliff_dump2.sg"
-    cmp -s "$TMP/cliff_dump.sg" "$TMP/cliff_dump2.sg" || fail "dump of the dump differs"
+    same "$TMP/cliff_dump.sg" "$TMP/cliff_dump2.sg" "dump of the dump differs"
     ;;
 depfile)
     # a copy of examples/minimal in a folder with a space, and a mip level
@@ -413,8 +416,8 @@ preview)
            .scene.light.fog_density == 0' "$TMP/sw/manifest.json" > /dev/null ||
         fail "the swatch pack is not rock alone on the test hill"
     run 0 "$SPLATC" build examples/minimal/scene.sg -o "$TMP/sw2" --preview rock --no-cache
-    cmp -s "$TMP/sw/heightfield.r16" "$TMP/sw2/heightfield.r16" &&
-        cmp -s "$TMP/sw/combos.bin" "$TMP/sw2/combos.bin" || fail "two swatch builds differ"
+    same "$TMP/sw/heightfield.r16" "$TMP/sw2/heightfield.r16" "two swatch builds differ (heightfield)"
+    same "$TMP/sw/combos.bin" "$TMP/sw2/combos.bin" "two swatch builds differ (combos.bin)"
     run 0 "$SPLATC" build examples/minimal/scene.sg -o "$TMP/sw3" --preview field --no-cache
     jq -e '[.materials[].name] == ["field"]' "$TMP/sw3/manifest.json" > /dev/null ||
         fail "--preview field did not build field alone"

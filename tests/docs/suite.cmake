@@ -33,3 +33,10 @@ diff -u docs/language.md '${CMAKE_CURRENT_BINARY_DIR}/language.md' || \
            WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
   set_tests_properties(docs.language PROPERTIES LABELS docs)
 endif()
+
+# The runtime's file map (runtime/DESIGN.md, "Files"): one line for every
+# file of runtime/, and no line for a file that is gone (file_map.sh; the
+# compiler's map, compiler/DESIGN.md, can be checked the same way).
+add_test(NAME docs.file_map
+  COMMAND sh ${CMAKE_CURRENT_LIST_DIR}/file_map.sh ${PROJECT_SOURCE_DIR} runtime runtime/DESIGN.md)
+set_tests_properties(docs.file_map PROPERTIES LABELS unit TIMEOUT 60)

@@ -32,6 +32,8 @@ trap 'rm -rf "$TMP"' EXIT
 fails=0
 SECONDS_MAX=30     # a refusal takes well under a second; a hang is killed
 
+. "$(dirname "$0")/../lib.sh"   # differ (through the fail below)
+# every failure counted, the cases go on
 fail() { echo "FAIL: $*"; fails=$((fails + 1)); }
 
 # The base scene: a 16x16 heightfield, a texture, a painted mask, an OBJ
@@ -246,8 +248,7 @@ depfile)
     # and with a writable one the same rebuild replaces the pack
     timeout 120 "$SPLATC" build "$d/scene.sg" -o "$d/pack" -I . --depfile "$d/pack.d" \
         > /dev/null 2> "$d/err" || { fail "rebuild with a depfile"; cat "$d/err"; }
-    if cmp -s "$TMP/pack.before/manifest.json" "$d/pack/manifest.json"; then
-        fail "the rebuild did not replace the pack"; fi
+    differ "$TMP/pack.before/manifest.json" "$d/pack/manifest.json" "the rebuild did not replace the pack"
     [ -s "$d/pack.d" ] || fail "no depfile written"
     ;;
 *)

@@ -4,12 +4,19 @@
 # strongly connected set of two or more files is printed on one line,
 # largest first.  Exit status: 0 when there is none, 1 when there are.
 set -eu
+# (nm's output goes to a file and its status is checked: exit 2 when nm
+# fails, not a silent "no cycle")
 [ $# -gt 0 ] || { echo "usage: cycles.sh OBJ..." >&2; exit 2; }
+T=$(mktemp -d "${TMPDIR:-/tmp}/splat-cycles.XXXXXX") || exit 2
+trap 'rm -rf "$T"' EXIT
 for o in "$@"; do
 	[ -f "$o" ] || { echo "cycles.sh: $o: no such file" >&2; exit 2; }
-	nm -g --defined-only "$o" | awk -v f="$o" 'NF == 3 { print "D", f, $3 }'
-	nm -u "$o" | awk -v f="$o" 'NF == 2 { print "U", f, $2 }'
-done | awk '
+	nm -g --defined-only "$o" > "$T/nm" || { echo "cycles.sh: nm $o failed" >&2; exit 2; }
+	awk -v f="$o" 'NF == 3 { print "D", f, $3 }' "$T/nm"
+	nm -u "$o" > "$T/nm" || { echo "cycles.sh: nm -u $o failed" >&2; exit 2; }
+	awk -v f="$o" 'NF == 2 { print "U", f, $2 }' "$T/nm"
+done > "$T/symbols"
+awk '
 function name(o,   n) { n = o; sub(/.*\//, "", n); sub(/\.o$/, "", n); return n }
 $1 == "D" { def[$3] = $2; next }
 $1 == "U" { use[++nu] = $2 SUBSEP $3 }
@@ -34,4 +41,5 @@ END {
 	}
 	for (v in node) if (!(v in index_)) strong(v)
 	for (k = 1; k <= ns; k++) print sets[k]
-}' | sort -t: -k1,1nr -k2 | awk -F: '{ n++; print "cycle of " $1 " files:" $2 } END { exit n > 0 }'
+}' "$T/symbols" > "$T/sets" || exit 2
+sort -t: -k1,1nr -k2 "$T/sets" | awk -F: '{ n++; print "cycle of " $1 " files:" $2 } END { exit n > 0 }'

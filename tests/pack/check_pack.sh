@@ -5,17 +5,22 @@
 # the vertex shader and the compute variants (built with --compute-spirv, so
 # splatc compiles and validates them too) and their counting variants.
 # The checks run two files at a time (colorado has some 500 shaders).
-set -e
+set -eu
+. "$(dirname "$0")/../lib.sh"   # to, fail
 splatc=$1 scene=$2 out=$3 cache=$4
 "$splatc" build "$scene" -o "$out" --cache "$cache" -j 2 --compute-spirv
-n=$(ls "$out"/shaders/*.spv | wc -l)
-test -n "$(ls "$out"/shaders/*.comp.spv)"
+# the lists: ls fails (and so the test) when a kind of shader is missing
+to "$out.spv.list" ls "$out"/shaders/*.spv
+to "$out.comp.spv.list" ls "$out"/shaders/*.comp.spv
+to "$out.glsl.list" ls "$out"/shaders/*.frag "$out"/shaders/*.vert "$out"/shaders/*.comp
+to "$out.comp.list" ls "$out"/shaders/*.comp
+n=$(wc -l < "$out.spv.list")
 # each batch exits 255 on the first failure, which stops xargs (and set -e)
-ls "$out"/shaders/*.spv | xargs -P 2 -n 16 sh -c '
+xargs -P 2 -n 16 < "$out.spv.list" sh -c '
     for f; do
         spirv-val --target-env vulkan1.2 "$f" || { echo "spirv-val: $f" >&2; exit 255; }
     done' sh
-ls "$out"/shaders/*.frag "$out"/shaders/*.vert "$out"/shaders/*.comp | xargs -P 2 -n 8 sh -c '
+xargs -P 2 -n 8 < "$out.glsl.list" sh -c '
     for f; do
         if ! glslangValidator -V --target-env vulkan1.2 -o /dev/null "$f" >/dev/null; then
             glslangValidator -V --target-env vulkan1.2 -o /dev/null "$f" >&2
@@ -23,7 +28,7 @@ ls "$out"/shaders/*.frag "$out"/shaders/*.vert "$out"/shaders/*.comp | xargs -P 
         fi
     done' sh
 # the counting variant the runtime compiles from each compute shader (abi.h)
-ls "$out"/shaders/*.comp | xargs -P 2 -n 8 sh -c '
+xargs -P 2 -n 8 < "$out.comp.list" sh -c '
     v=$(mktemp --suffix=.spv)
     for f; do
         if ! glslangValidator -V --target-env vulkan1.2 -DSPLAT_COUNT=1 -o "$v" "$f" >/dev/null ||

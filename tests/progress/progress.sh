@@ -8,7 +8,7 @@ set -eu
 SPLATC=$1 SCENE=$2 OUT=$3/progress
 rm -rf "$OUT"
 mkdir -p "$OUT"
-fail() { echo "FAIL: $*"; exit 1; }
+. "$(dirname "$0")/../lib.sh"   # fail, same
 "$SPLATC" build "$SCENE" -o "$OUT/a" --no-cache 2> "$OUT/quiet.err" > /dev/null || fail "build"
 if grep -q 'splatc: \(compose\|glslang\|spirv-val\)' "$OUT/quiet.err"; then
     cat "$OUT/quiet.err"; fail "progress printed where stderr is not a terminal"
@@ -25,5 +25,5 @@ if command -v script > /dev/null; then
     grep -q 'splatc: glslang .*ETA' "$OUT/tty.log" || { cat -v "$OUT/tty.log"; fail "no bar on a terminal"; }
     grep -q "$(printf '\r\033\\[K')" "$OUT/tty.log" || fail "the bar's line is not cleared"
 fi
-cmp "$OUT/a/manifest.json" "$OUT/b/manifest.json" || fail "progress changed the pack"
+same "$OUT/a/manifest.json" "$OUT/b/manifest.json" "progress changed the pack"
 echo "ok"

@@ -7,9 +7,9 @@
 # destructible area; test_reload must refuse each by name, and take the
 # variants that change only shaders or parameters.
 set -u
+. "$(dirname "$0")/../lib.sh"   # fail, differ
 SC=$1 PE=$2 TR=$3 OUT=$4
 export SPLAT_VALIDATE=1
-fail() { echo "FAIL: $*"; exit 1; }
 rm -rf "$OUT" && mkdir -p "$OUT" || fail "cannot make $OUT"
 cd "$(dirname "$0")/../.." || fail "no repository root"
 "$SC" build examples/minimal/scene.sg -o "$OUT/base" --no-cache > /dev/null || fail "build minimal"
@@ -48,7 +48,7 @@ EOF2
 variant dshader dbase <<EOF2
 "$PE" set $M params.0.default '[0.5, 0, 0, 0]'
 EOF2
-cmp -s "$OUT/base/painted.sparse" "$OUT/mask/painted.sparse" && fail "the mask variant changed nothing"
+differ "$OUT/base/painted.sparse" "$OUT/mask/painted.sparse" "the mask variant changed nothing"
 # both shading paths (--screen: the screen-space path's tile classification)
 for path in "" --screen; do
     "$TR" $path "$OUT/base" "$OUT/heights=the heightfield's contents changed" \

@@ -24,13 +24,13 @@
 #     back faces are dropped, so equal up to nothing (1e-6 absorbs nothing
 #     visible but keeps the check from depending on bitwise equal floats).
 set -u
+. "$(dirname "$0")/../lib.sh"   # fail, differ, must_fail
 case_=$1 SV=$2 IC=$3 PACK=$4 OUT=$5/$1
 mkdir -p "$OUT"
 export SPLAT_VALIDATE=1
 # the cases were written for the forward path; screen.sh tests the other
 export SPLAT_SHADING=forward
 export SPLAT_PIPELINE_CACHE="$OUT/pipelines.bin"
-fail() { echo "FAIL: $*"; exit 1; }
 run() { echo "+ splatview $*"; "$SV" "$@" || fail "splatview $* (exit $?)"; }
 # viewer_until_shot SHOT LOG ARGS...: the viewer in the background (pid in
 # $pid), back once its script wrote SHOT (the first screenshot)
@@ -256,7 +256,7 @@ hot_reload)
     viewer_done "$OUT/viewer.log"
     grep -q "does not compile" "$OUT/viewer.log" || fail "the syntax error was not reported"
     grep -q "reloaded" "$OUT/viewer.log" || fail "no reload"
-    cmp -s "$OUT/a.png" "$OUT/b.png" && fail "the picture did not change after the edit"
+    differ "$OUT/a.png" "$OUT/b.png" "the picture did not change after the edit"
     ;;
 hot_reload_far)
     # a pack with a far atlas keeps it across a hot reload, rebaked on the
@@ -277,9 +277,9 @@ hot_reload_far)
     grep -q "reloaded in .*far atlas baked on the device" "$OUT/viewer.log" ||
         fail "the far atlas was not rebaked on the device"
     grep -q '"far_atlas"' "$OUT/pack/manifest.json" || fail "the reloaded pack lost its far atlas"
-    cmp -s "$OUT/far_before.atlas" "$OUT/pack/far.atlas" && fail "the far atlas did not change"
+    differ "$OUT/far_before.atlas" "$OUT/pack/far.atlas" "the far atlas did not change"
     grep -q "validation message" "$OUT/viewer.log" && fail "validation messages"
-    cmp -s "$OUT/a.png" "$OUT/b.png" && fail "the picture did not change after the edit"
+    differ "$OUT/a.png" "$OUT/b.png" "the picture did not change after the edit"
     ;;
 preview)
     # splatview --material: one material of a copy of examples/minimal alone
@@ -293,7 +293,7 @@ preview)
     for m in field rock; do
         "$IC" nonuniform "$OUT/$m.png" || fail "the $m swatch is uniform"
     done
-    cmp -s "$OUT/field.png" "$OUT/rock.png" && fail "two materials gave the same swatch"
+    differ "$OUT/field.png" "$OUT/rock.png" "two materials gave the same swatch"
     ls "$OUT"/cache/splatc/preview/*/field/manifest.json > /dev/null || fail "no swatch pack in the cache"
     "$SV" "$OUT/pack" --material nope --headless --size 16x16 -o "$OUT/x.png" 2> "$OUT/err.txt" &&
         fail "an unknown material was previewed"
@@ -308,7 +308,7 @@ preview)
     sed -i 's/vec3(0.55, 0.47, 0.22)/vec3(0.9, 0.05, 0.05)/' "$SCENE"
     viewer_done "$OUT/viewer.log"
     grep -q "reloaded" "$OUT/viewer.log" || fail "no reload"
-    cmp -s "$OUT/a.png" "$OUT/b.png" && fail "the swatch did not change after the edit"
+    differ "$OUT/a.png" "$OUT/b.png" "the swatch did not change after the edit"
     ;;
 real)
     # a pack written by splatc build: pictures, combination colours, and the

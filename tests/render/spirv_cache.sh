@@ -12,7 +12,7 @@ SV=$1 PACK=$2 OUT=$3/spirv_cache
 rm -rf "$OUT"
 mkdir -p "$OUT"
 export SPLAT_VALIDATE=1 SPLATC_CACHE="$OUT/cache" SPLAT_PIPELINE_CACHE="$OUT/pipelines.bin"
-fail() { echo "FAIL: $*"; exit 1; }
+. "$(dirname "$0")/../lib.sh"   # fail, same
 render() {   # render N: the picture and the --stats line of run N
     "$SV" "$PACK" --headless --size 320x180 --shading screen --stats \
         -o "$OUT/run$1.png" > "$OUT/run$1.log" 2>&1 || { cat "$OUT/run$1.log"; fail "splatview run $1"; }
@@ -33,7 +33,7 @@ render 2
 set -- $(counts 2)
 [ "$1" = "$compiled" ] && [ "$2" = 0 ] ||
     fail "run 2: expected $compiled cached and 0 compiled, got $1 and $2"
-cmp "$OUT/run1.png" "$OUT/run2.png" || fail "run 2's picture differs from run 1's"
+same "$OUT/run1.png" "$OUT/run2.png" "run 2's picture differs from run 1's"
 
 for f in $(find "$OUT/cache" -type f); do
     printf '\377' | dd of="$f" bs=1 seek=40 conv=notrunc status=none
@@ -42,5 +42,5 @@ render 3
 set -- $(counts 3)
 [ "$1" = 0 ] && [ "$2" = "$compiled" ] ||
     fail "run 3 (damaged entries): expected 0 cached and $compiled compiled, got $1 and $2"
-cmp "$OUT/run1.png" "$OUT/run3.png" || fail "run 3's picture differs from run 1's"
+same "$OUT/run1.png" "$OUT/run3.png" "run 3's picture differs from run 1's"
 echo "ok: $compiled compute modules compiled, then all from the cache, then compiled again past damaged entries"
