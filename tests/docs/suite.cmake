@@ -33,3 +33,14 @@ diff -u docs/language.md '${CMAKE_CURRENT_BINARY_DIR}/language.md' || \
            WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
   set_tests_properties(docs.language PROPERTIES LABELS docs)
 endif()
+# README.md's option lists are generated from the programs' option tables
+# (compiler/args.h): a table row added or changed without regenerating
+# them fails here (regenerate: sh tests/docs/options.sh --update README.md
+# build/compiler build/runtime).
+if(TARGET splatc_cli AND TARGET splatview)
+  add_test(NAME docs.options
+           COMMAND sh ${CMAKE_CURRENT_LIST_DIR}/options.sh README.md
+                   $<TARGET_FILE_DIR:splatc_cli> $<TARGET_FILE_DIR:splatview>
+           WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
+  set_tests_properties(docs.options PROPERTIES LABELS "docs;unit")
+endif()
