@@ -75,7 +75,6 @@ static void wrap(FILE *f, const char *text, int at, int col, int width)
  * desc's column (plus `base`). */
 static void print_rows(const splat_args_desc *d, FILE *f, int base)
 {
-    int col = (d->column ? d->column : 26) + base;
     for (int i = 0; i < d->nargs; i++) {
         const splat_arg *a = &d->args[i];
         if (a->kind == SPLAT_ARG_SECTION) {   /* a blank line before all but the first */
@@ -84,15 +83,28 @@ static void print_rows(const splat_args_desc *d, FILE *f, int base)
         }
         if (!row_active(d, a))
             continue;
-        char head[128];
+        char head[128], help[1024];
         row_head(a, head, sizeof head);
-        int at = fprintf(f, "%*s%s", base + 2, "", head);
-        if (at + 2 > col) {
-            fputc('\n', f);
-            at = 0;
-        }
-        wrap(f, a->help, at, col, WIDTH + base);
+        size_t n = 0;
+        help[0] = '\0';
+        for (int b = 0; a->only && d->command_names && b < 32 && n < sizeof help; b++)
+            if (a->only & (1u << b))
+                n += (size_t)snprintf(help + n, sizeof help - n, "%s%s", n ? ", " : "(",
+                                      d->command_names[b]);
+        snprintf(help + n, sizeof help - n, "%s%s", n ? ") " : "", a->help);
+        splat_args_item(f, head, help, base, d->column ? d->column : 26);
     }
+}
+
+void splat_args_item(FILE *f, const char *head, const char *help, int base, int column)
+{
+    int col = column + base;
+    int at = fprintf(f, "%*s%s", base + 2, "", head);
+    if (at + 2 > col) {
+        fputc('\n', f);
+        at = 0;
+    }
+    wrap(f, help, at, col, WIDTH + base);
 }
 
 void splat_args_help(const splat_args_desc *d, FILE *f)

@@ -77,6 +77,8 @@ typedef struct splat_args_desc {
     int              nargs;
     int              column;    /* help text column (0: 26)                    */
     unsigned         command;   /* the bit of the command parsing (0: all rows) */
+    const char *const *command_names; /* bit i's command, named in the help of
+                                         a row with `only` (NULL: none)      */
     bool             once;      /* a string option given twice is an error     */
     /* a word that is not an option (a file, a pack); NULL: an error */
     bool           (*positional)(const char *word, void *opts, splat_arg_why *why);
@@ -93,6 +95,9 @@ int  splat_args_parse(const splat_args_desc *d, int argc, char **argv, int first
 void splat_args_help(const splat_args_desc *d, FILE *f);
 /* The option list alone, as an indented (code) block of Markdown. */
 void splat_args_markdown(const splat_args_desc *d, FILE *f);
+/* One "HEAD  help" item as the lists print them (a program's commands):
+ * HEAD at column base + 2, the help wrapped from base + column. */
+void splat_args_item(FILE *f, const char *head, const char *help, int base, int column);
 /* The rows that take a value, as "NAME ARG" (for the usage line). */
 const char *splat_arg_value_name(const splat_arg *a);
 
