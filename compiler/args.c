@@ -199,7 +199,7 @@ static int refuse(const splat_args_desc *d, const splat_arg *a, const char *valu
         exp = buf;
     } else if (!exp && (a->kind == SPLAT_ARG_INT || a->kind == SPLAT_ARG_FLOAT) &&
                (a->min || a->max)) {
-        snprintf(buf, sizeof buf, "%s %g..%g", a->kind == SPLAT_ARG_INT ? "a whole number"
+        snprintf(buf, sizeof buf, "%s %.15g..%.15g", a->kind == SPLAT_ARG_INT ? "a whole number"
                  : "a number", a->min, a->max);
         exp = buf;
     } else if (!exp) {
