@@ -13,7 +13,11 @@ README=$1 SPLATC_DIR=$2 SPLATVIEW_DIR=$3
 TMP=$(mktemp -d)
 trap 'rm -rf "$TMP"' EXIT
 regions=$(sed -n 's/^<!-- options: \(.*\) -->$/\1/p' "$README")
-[ -n "$regions" ] || { echo "FAIL: no '<!-- options: COMMAND -->' regions in $README"; exit 1; }
+# every program's list is there (a region deleted with its list fails too)
+for want in "splatc" "splatc build" "splatview"; do
+    echo "$regions" | grep -qx "$want" ||
+        { echo "FAIL: $README has no '<!-- options: $want -->' region"; exit 1; }
+done
 n=0
 for cmd in $(echo "$regions" | tr ' ' '+'); do
     cmd=$(echo "$cmd" | tr '+' ' ')
