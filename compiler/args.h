@@ -31,7 +31,8 @@ typedef enum splat_arg_kind {
     SPLAT_ARG_INT,      /* int, a whole decimal number within [min, max]       */
     SPLAT_ARG_FLOAT,    /* double, finite, within [min, max]                   */
     SPLAT_ARG_STRING,   /* const char *, pointing into argv                    */
-    SPLAT_ARG_ENUM,     /* int: values[i] for the i-th of choices "a|b|c"      */
+    SPLAT_ARG_ENUM,     /* int (or an int-sized enum): values[i] for the i-th
+                           of choices "a|b|c"                                 */
     SPLAT_ARG_LIST,     /* const char *field[max] with an int count: repeatable */
     SPLAT_ARG_CUSTOM,   /* parse(value, opts, why): anything else              */
     SPLAT_ARG_SECTION,  /* no option: `help` is a heading in --help and lists  */
@@ -45,8 +46,8 @@ typedef struct splat_arg_why {
 } splat_arg_why;
 
 typedef struct splat_arg {
-    const char    *name;     /* "--size", "-o"; "--far-atlas[=N]" takes its value
-                                only after '=' (see `optional`)                  */
+    const char    *name;     /* "--size", "-o" (a short one also takes "-oVALUE");
+                                every long one also takes "--name=VALUE"       */
     splat_arg_kind kind;
     const char    *arg;      /* the value as help shows it ("WxH"); NULL: a flag,
                                 or an enum's choices                             */
@@ -61,8 +62,8 @@ typedef struct splat_arg {
     const char    *expects;  /* the error's "expects ..."; NULL: from arg/choices */
     bool         (*parse)(const char *value, void *opts, splat_arg_why *why);
                              /* CUSTOM (also FLAG: value NULL): false refuses     */
-    const char    *optional; /* the value when given without '=VALUE' (only
-                                --name=VALUE then sets another)                   */
+    const char    *optional; /* the value when given alone: then only
+                                --name=VALUE sets another ("--far-atlas[=N]")  */
     unsigned       only;     /* a bit set: the commands that take it; 0: all     */
 } splat_arg;
 
