@@ -1,15 +1,13 @@
-/* cli_build.c — `splatc build SCENE.sg -o PACKDIR [-j N] [--stats]
- * [--cache DIR | --no-cache] [--flat] [--no-lazy] [--compute-spirv] [--no-distance-classes]
- * [--max-combinations P]
- * [--painted bc4|r8|dense] [-I DIR]... [--depfile FILE] [--preview MATERIAL] [--far-atlas[=N]]
- * [--far-bake auto|cpu|gpu] [--json]`:
- * the command-line face
- * of splat_build (build.c).  Exit status 0 on success, 1 on input errors,
- * 2 on usage errors. */
+/* cli_build.c — `splatc build SCENE.sg -o PACKDIR [options]`, the
+ * command-line face of splat_build (build.c); the options are the table
+ * `options` below (splatc build --help).  Exit status 0 on success, 1 on
+ * input errors, 2 on usage errors. */
 #include "cli.h"
+#include "args.h"
 #include "scene.h"
 #include "util.h"
 
+#include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
@@ -17,44 +15,6 @@
 #ifdef SPLATC_DEVICE_BAKE   /* the runtime is built: it bakes on a device */
 #include "splatrt.h"
 #endif
-
-static const char usage[] =
-    "usage: splatc build SCENE.sg -o PACKDIR [options]\n"
-    "  -o PACKDIR     the shader pack folder to write (replaced only on success)\n"
-    "  -j N           compile shaders on N threads (default 1)\n"
-    "  --stats        print the analysis report, per-phase times, cache hits\n"
-    "                 and the painted masks' bytes next to their dense size\n"
-    "  --cache DIR    SPIR-V cache folder (default $SPLATC_CACHE, else\n"
-    "                 $XDG_CACHE_HOME/splatc, else ~/.cache/splatc)\n"
-    "  --no-cache     neither read nor write the cache\n"
-    "  --flat         also write each composite without dynamic branches\n"
-    "  --no-lazy      no lazy branches inside materials (a mix/select/mul side\n"
-    "                 is skipped where its weight is 0; compiler/DESIGN.md 6.1)\n"
-    "  --compute-spirv  also compile the compute variants to SPIR-V (default:\n"
-    "                 their GLSL only; the runtime compiles them on first use)\n"
-    "  --no-distance-classes  no distance class variants (compiler/distance.c)\n"
-    "  --max-combinations P  cover the leaf cells' combinations with at most P\n"
-    "                 supersets, merging those that add the fewest layers\n"
-    "                 (compiler/analysis.c; default 0: no merging)\n"
-    "  --painted F    painted mask storage: bc4 (default: sparse quad-tree,\n"
-    "                 BC4 atlas), r8 (sparse, R8 atlas) or dense (painted.r8)\n"
-    "  -I DIR         search DIR for imports (repeatable; then $SPLATC_PATH,\n"
-    "                 '.', the project root, the installed nodes)\n"
-    "  --depfile FILE write a Make/Ninja depfile: PACKDIR/manifest.json and\n"
-    "                 every file the pack was made from\n"
-    "  --preview M    write material M's swatch pack instead: M alone on a\n"
-    "                 built-in test hill under the scene's light (splatview\n"
-    "                 --material renders it)\n"
-    "  --far-atlas[=N]  also bake the far atlas: each terrain texel's composited\n"
-    "                 albedo, normal and roughness, one atlas texel per N x N\n"
-    "                 heightfield texels (default 1), BC-compressed (far.atlas)\n"
-    "  --far-bake W   where to bake it: gpu (the Vulkan device; an error where\n"
-    "                 there is none), cpu (the compiler's double reference) or\n"
-    "                 auto (default: a GPU if there is one, a CPU's device\n"
-    "                 (lavapipe) for atlases of 10,000 texels a combination\n"
-    "                 and more, else the CPU;\n"
-    "                 $SPLAT_FAR_BAKE sets the default)\n"
-    "  --json         diagnostics as JSON Lines on stderr (for editors)\n";
 
 static void print_stats(const splat_build_stats *st, FILE *out)
 {
@@ -87,137 +47,153 @@ static void print_stats(const splat_build_stats *st, FILE *out)
     fprintf(out, "distance classes: %d variants added\n", st->dclasses);
 }
 
-int splat_cli_build(int argc, char **argv)
+/* The command line, parsed by the table below (args.h). */
+typedef struct build_opts {
+    splat_build_desc desc;
+    bool stats, json;
+    const char *include[256];   /* -I DIR, in order */
+    int ninclude;
+} build_opts;
+
+static bool parse_painted(const char *v, void *o, splat_arg_why *why)
 {
-    splat_build_desc desc = {.jobs = 1};
+    (void)why;
+    return splat_painted_format_parse(v, &((build_opts *)o)->desc.painted);
+}
+
+static bool parse_far_bake(const char *v, void *o, splat_arg_why *why)
+{
+    (void)why;
+    return splat_far_bake_parse(v, &((build_opts *)o)->desc.far_bake);
+}
+
+static bool parse_scene(const char *word, void *o_, splat_arg_why *why)
+{
+    build_opts *o = o_;
+    if (o->desc.scene) {
+        snprintf(why->text, sizeof why->text, "one scene at a time, found '%s' after '%s'",
+                 word, o->desc.scene);
+        return false;
+    }
+    o->desc.scene = word;
+    return true;
+}
+
+/* The options: one row each; README.md's list is this table (splatc build
+ * --help-markdown, checked by docs.options). */
+#define F(field) offsetof(build_opts, field)
+static const splat_arg options[] = {
+    { "-o", SPLAT_ARG_STRING, "PACKDIR", "the shader pack folder to write (replaced only on "
+      "success)", F(desc.out) },
+    { "-j", SPLAT_ARG_INT, "N", "compile shaders on N threads (default 1; -jN too)",
+      F(desc.jobs), .min = 1, .max = 256, .expects = "a thread count 1..256" },
+    { "--stats", SPLAT_ARG_FLAG, NULL, "print the analysis report (cells, combinations, the "
+      "largest one), per-phase times, cache hits, the lazy branches and distance classes "
+      "added, and the painted masks' bytes next to their dense size", F(stats) },
+    { "--cache", SPLAT_ARG_STRING, "DIR", "SPIR-V cache folder (default $SPLATC_CACHE, else "
+      "$XDG_CACHE_HOME/splatc, else ~/.cache/splatc)", F(desc.cache_dir) },
+    { "--no-cache", SPLAT_ARG_FLAG, NULL, "neither read nor write the cache",
+      F(desc.no_cache) },
+    { "--flat", SPLAT_ARG_FLAG, NULL, "also write each composite without dynamic branches",
+      F(desc.flat) },
+    { "--no-lazy", SPLAT_ARG_FLAG, NULL, "no lazy branches inside materials (a mix/select/mul "
+      "side is skipped where its weight is 0; compiler/DESIGN.md 6.1)", F(desc.no_lazy) },
+    { "--no-distance-classes", SPLAT_ARG_FLAG, NULL, "no distance class variants "
+      "(compiler/distance.c)", F(desc.no_dclasses) },
+    { "--max-combinations", SPLAT_ARG_INT, "P", "cover the leaf cells' combinations with at "
+      "most P supersets, merging those that add the fewest layers (compiler/analysis.c; "
+      "default 0: no merging)", F(desc.max_combos), .min = 0, .max = 65534,
+      .expects = "a count 0..65534 (0: no merging)" },
+    { "--compute-spirv", SPLAT_ARG_FLAG, NULL, "also compile the screen path's compute "
+      "variants to SPIR-V (default: their GLSL only; the runtime compiles them on first use)",
+      F(desc.compute_spirv) },
+    { "--painted", SPLAT_ARG_CUSTOM, "bc4|r8|dense", "painted mask storage: a sparse "
+      "quad-tree with a BC4 atlas (bc4, the default) or an R8 atlas (r8), or dense rasters "
+      "(painted.r8)", .parse = parse_painted, .expects = "bc4, r8 or dense" },
+    { "--far-atlas", SPLAT_ARG_INT, "N", "also bake the far atlas: each terrain texel's "
+      "composited albedo, normal and roughness, one atlas texel per N x N heightfield texels "
+      "(default 1), BC-compressed (compiler/PACK.md \"Far atlas\")", F(desc.far_atlas),
+      .optional = "1", .min = 1, .max = 64,
+      .expects = "heightfield texels per atlas texel 1..64" },
+    { "--far-bake", SPLAT_ARG_CUSTOM, "auto|cpu|gpu", "where to bake it: gpu (the Vulkan "
+      "device; an error where there is none), cpu (the compiler's double-precision reference) "
+      "or auto (the default: a GPU if there is one, a CPU's device (lavapipe) for atlases of "
+      "10,000 texels a combination and more, else the CPU); $SPLAT_FAR_BAKE sets the default",
+      .parse = parse_far_bake, .expects = "auto, cpu or gpu" },
+    { "--preview", SPLAT_ARG_STRING, "M", "write material M's swatch pack instead: M alone on "
+      "a built-in test hill under the scene's light (splatview --material renders it)",
+      F(desc.preview) },
+    { "-I", SPLAT_ARG_LIST, "DIR", "search DIR for imports (repeatable; then $SPLATC_PATH, "
+      "'.', the project root, the installed nodes)", F(include), .count = F(ninclude),
+      .capacity = 255 },
+    { "--depfile", SPLAT_ARG_STRING, "FILE", "write a Make/Ninja depfile: "
+      "PACKDIR/manifest.json and every file the pack was made from", F(desc.depfile) },
+    { "--json", SPLAT_ARG_FLAG, NULL, "diagnostics as JSON Lines on stderr (for editors)",
+      F(json) },
+};
+#undef F
+
+static const splat_args_desc args = {
+    .prog = "splatc build", .usage = "usage: splatc build SCENE.sg -o PACKDIR [options]\n",
+    .args = options, .nargs = (int)(sizeof options / sizeof options[0]), .column = 24,
+    .positional = parse_scene,
+};
+
+/* Options into o; 0, or the exit status (0 after --help: *done). */
+static int parse_build_args(int argc, char **argv, build_opts *o, bool *done)
+{
+    memset(o, 0, sizeof *o);
+    o->desc.jobs = 1;
+    *done = false;
     const char *bake_env = getenv("SPLAT_FAR_BAKE");   /* --far-bake's default */
-    if (bake_env && *bake_env && !splat_far_bake_parse(bake_env, &desc.far_bake)) {
+    if (bake_env && *bake_env && !splat_far_bake_parse(bake_env, &o->desc.far_bake)) {
         fprintf(stderr, "splatc build: SPLAT_FAR_BAKE expects auto, cpu or gpu, found '%s'\n",
                 bake_env);
         return 2;
     }
-    bool stats = false, json = false;
-    const char **include = xcalloc((size_t)argc + 1, sizeof *include);
-    int ninclude = 0;
-    char **search = NULL;
-    int status = 2;
-    for (int i = 1; i < argc; i++) {
-        const char *a = argv[i];
-        const char *next = i + 1 < argc ? argv[i + 1] : NULL;
-        if (strcmp(a, "-h") == 0 || strcmp(a, "--help") == 0) {
-            fputs(usage, stdout);
-            status = 0;
-            goto done;
-        } else if (strcmp(a, "-o") == 0 && next) {
-            desc.out = next;
-            i++;
-        } else if (strncmp(a, "-j", 2) == 0 && (a[2] || next)) {
-            /* -j N or -jN, as make takes it */
-            const char *v = a[2] ? a + 2 : next;
-            char *end;
-            long n = strtol(v, &end, 10);
-            if (*end || n < 1 || n > 256) {
-                fprintf(stderr, "splatc build: -j expects a thread count 1..256, found '%s'\n",
-                        v);
-                goto done;
-            }
-            desc.jobs = (int)n;
-            if (!a[2])
-                i++;
-        } else if (strcmp(a, "--stats") == 0) {
-            stats = true;
-        } else if (strcmp(a, "--cache") == 0 && next) {
-            desc.cache_dir = next;
-            i++;
-        } else if (strcmp(a, "--no-cache") == 0) {
-            desc.no_cache = true;
-        } else if (strcmp(a, "--flat") == 0) {
-            desc.flat = true;
-        } else if (strcmp(a, "--no-lazy") == 0) {
-            desc.no_lazy = true;
-        } else if (strcmp(a, "--compute-spirv") == 0) {
-            desc.compute_spirv = true;
-        } else if (strcmp(a, "--far-atlas") == 0 || strncmp(a, "--far-atlas=", 12) == 0) {
-            char *end;
-            long n = a[11] ? strtol(a + 12, &end, 10) : 1;
-            if (a[11] && (*end || n < 1 || n > 64)) {
-                fprintf(stderr, "splatc build: --far-atlas=N expects heightfield texels per "
-                                "atlas texel 1..64, found '%s'\n", a + 12);
-                goto done;
-            }
-            desc.far_atlas = (int)n;
-        } else if (strcmp(a, "--far-bake") == 0 && next) {
-            if (!splat_far_bake_parse(next, &desc.far_bake)) {
-                fprintf(stderr, "splatc build: --far-bake expects auto, cpu or gpu, found '%s'\n",
-                        next);
-                goto done;
-            }
-            i++;
-        } else if (strcmp(a, "--max-combinations") == 0 && next) {
-            char *end;
-            long n = strtol(next, &end, 10);
-            if (*end || !*next || n < 0 || n > 65534) {
-                fprintf(stderr, "splatc build: --max-combinations expects a count 0..65534 "
-                                "(0: no merging), found '%s'\n", next);
-                goto done;
-            }
-            desc.max_combos = (int)n;
-            i++;
-        } else if (strcmp(a, "--no-distance-classes") == 0) {
-            desc.no_dclasses = true;
-        } else if (strcmp(a, "--painted") == 0 && next) {
-            if (!splat_painted_format_parse(next, &desc.painted)) {
-                fprintf(stderr, "splatc build: --painted expects bc4, r8 or dense, found '%s'\n",
-                        next);
-                goto done;
-            }
-            i++;
-        } else if (strcmp(a, "-I") == 0 && next) {
-            include[ninclude++] = next;
-            i++;
-        } else if (strcmp(a, "--depfile") == 0 && next) {
-            desc.depfile = next;
-            i++;
-        } else if (strcmp(a, "--preview") == 0 && next) {
-            desc.preview = next;
-            i++;
-        } else if (strcmp(a, "--json") == 0) {
-            json = true;
-        } else if (a[0] == '-') {
-            fprintf(stderr, "splatc build: unknown or incomplete option '%s'\n%s", a, usage);
-            goto done;
-        } else if (!desc.scene) {
-            desc.scene = a;
-        } else {
-            fprintf(stderr, "splatc build: one scene at a time, found '%s' after '%s'\n",
-                    a, desc.scene);
-            goto done;
-        }
+    int rc = splat_args_parse(&args, argc, argv, 1, o);
+    if (rc == SPLAT_ARGS_HELP) {
+        *done = true;
+        return 0;
     }
-    if (!desc.scene || !desc.out) {
-        fprintf(stderr, "splatc build: %s\n%s",
-                !desc.scene ? "no scene file given" : "no output folder (-o PACKDIR)", usage);
-        goto done;
+    if (rc)
+        return rc;
+    if (!o->desc.scene || !o->desc.out) {
+        fprintf(stderr, "splatc build: %s\n",
+                !o->desc.scene ? "no scene file given" : "no output folder (-o PACKDIR)");
+        splat_args_help(&args, stderr);
+        return 2;
     }
-    if (desc.no_cache && desc.cache_dir) {
+    if (o->desc.no_cache && o->desc.cache_dir) {
         fprintf(stderr, "splatc build: --cache and --no-cache exclude each other\n");
-        goto done;
+        return 2;
     }
-    search = splat_search_path(include, ninclude, desc.scene);
+    return 0;
+}
+
+int splat_cli_build(int argc, char **argv)
+{
+    build_opts o;
+    bool done;
+    int status = parse_build_args(argc, argv, &o, &done);
+    if (status || done)
+        return status;
+    splat_build_desc desc = o.desc;
+    char **search = splat_search_path(o.include, o.ninclude, desc.scene);
     desc.search_paths = (const char *const *)search;
     /* the -I folders, which the pack records (SPLATC_PATH is the
      * environment's, which splatview reads itself) */
-    include[ninclude] = NULL;
-    desc.pack_search = include;
+    o.include[o.ninclude] = NULL;
+    desc.pack_search = o.include;
     /* the report is held until the diagnostics are out, so a warning never
      * lands inside its tables (stdout and stderr share a terminal) */
     char *report = NULL;
     size_t report_len = 0;
-    FILE *report_f = stats ? open_memstream(&report, &report_len) : NULL;
-    if (stats && !report_f) {
+    FILE *report_f = o.stats ? open_memstream(&report, &report_len) : NULL;
+    if (o.stats && !report_f) {
         fprintf(stderr, "splatc build: out of memory\n");
-        status = 1;
-        goto done;
+        splat_search_path_free(search);
+        return 1;
     }
     desc.report = report_f;
 #ifdef SPLATC_DEVICE_BAKE
@@ -230,7 +206,7 @@ int splat_cli_build(int argc, char **argv)
     sg_diags_init(&d);
     splat_build_stats st;
     bool ok = splat_build(&desc, &st, &d);
-    if (json)
+    if (o.json)
         sg_diags_print_json(&d, stderr);
     else
         sg_diags_print(&d, stderr);
@@ -242,11 +218,8 @@ int splat_cli_build(int argc, char **argv)
             fwrite(report, 1, report_len, stdout);
         free(report);
     }
-    if (ok && stats)
+    if (ok && o.stats)
         print_stats(&st, stdout);
-    status = ok ? 0 : 1;
-done:
     splat_search_path_free(search);
-    free(include);
-    return status;
+    return ok ? 0 : 1;
 }

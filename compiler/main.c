@@ -19,6 +19,7 @@
  * then in -I folders, $SPLATC_PATH (':'-separated), the current folder and
  * the nearest folder above the input file that has a nodes/ folder (the
  * repository root for files inside it). */
+#include "args.h"
 #include "cli.h"
 #include "ir.h"
 #include "scene.h"
@@ -30,54 +31,13 @@
 
 #include <errno.h>
 #include <math.h>
+#include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
 enum { EXIT_OK = 0, EXIT_INPUT = 1, EXIT_USAGE = 2 };
-
-static const char usage_text[] =
-    "usage: splatc COMMAND [options]\n"
-    "commands:\n"
-    "  check FILE... [--json]             parse and type-check graph files, their texture\n"
-    "                                     files and their masks' bounds (--json: the\n"
-    "                                     diagnostics as JSON Lines, for editors)\n"
-    "  glsl  FILE -m MATERIAL [-o OUT]    Vulkan GLSL 450 fragment shader of a material\n"
-    "  spirv FILE -m MATERIAL -o OUT.spv  the same compiled to SPIR-V and validated\n"
-    "        --stage fragment|compute     (glsl, spirv) the fragment shader (default) or\n"
-    "                                     the compute variant (screen-space shading)\n"
-    "  dot   FILE [-m MATERIAL] [-o OUT]  Graphviz DOT of the graphs (dot -Tsvg draws it);\n"
-    "        --expand                     with -m, each shader node is one box naming its\n"
-    "                                     type and wired ports; --expand draws the inside\n"
-    "                                     of every shader it instantiates too\n"
-    "  dump  FILE -m MATERIAL [--after PASS]\n"
-    "                                     the material's IR in .sg form, after the whole\n"
-    "                                     pipeline or after PASS (lower = no pass)\n"
-    "  eval  FILE -m MATERIAL [--output NAME] --at KEY=V,...\n"
-    "                                     CPU reference value (double precision);\n"
-    "                                     keys: height=H slope=S normal=X,Y,Z position=X,Z\n"
-    "                                     uv=U,V distance=D destruction=D painted.NAME=V\n"
-    "                                     direction=X,Y,Z (unit, to the camera) PARAM=V...\n"
-    "                                     (unset: 0, normal and direction 0,1,0, defaults)\n"
-    "        --interval                   the same keys take LO:HI ranges; prints sound\n"
-    "                                     bounds (unset: slope 0:1, normal -1:1,0:1,-1:1,\n"
-    "                                     uv 0:1, distance 0:inf, others unbounded;\n"
-    "                                     direction is always -1:1)\n"
-    "  build SCENE.sg -o PACKDIR ...      compile a scene into a shader pack (build --help)\n"
-    "  texgen --out DIR ...               write the example textures (texgen --help)\n"
-    "  init  DIR                          a starter project: scene.sg, heightfield.png,\n"
-    "                                     README.md (builds and renders as it stands)\n"
-    "  doc   [-o FILE]                    the language reference (docs/language.md) from\n"
-    "                                     the compiler's tables and the node library\n"
-    "  lsp                                a Language Server Protocol server on stdin and\n"
-    "                                     stdout, for editors (docs/editors.md)\n"
-    "options:\n"
-    "  -I DIR       also search DIR for imports (repeatable; SPLATC_PATH=DIR:DIR...\n"
-    "               in the environment does the same)\n"
-    "  --help       this text\n"
-    "  --version    the compiler version\n"
-    "exit status: 0 ok, 1 errors in the input, 2 usage errors\n";
 
 static int usage_error(const char *fmt, const char *arg)
 {
@@ -103,59 +63,78 @@ typedef struct options {
     const char **include; int ninclude;
 } options;
 
-/* Parse argv[1..]; `allowed` lists the options this command takes. */
-static int parse_options(int argc, char **argv, const char *allowed, options *o)
+/* The commands that parse `options`: a row's `only` bits (args.h). */
+enum { C_CHECK = 1, C_GLSL = 2, C_SPIRV = 4, C_DOT = 8, C_DUMP = 16, C_EVAL = 32 };
+static const char *const command_bits[] = { "check", "glsl", "spirv", "dot", "dump", "eval" };
+
+/* -I and the files go into arrays of argc entries (options_new). */
+static bool add_include(const char *v, void *o_, splat_arg_why *why)
+{
+    options *o = o_;
+    (void)why;
+    o->include[o->ninclude++] = v;
+    return true;
+}
+
+static bool add_file(const char *word, void *o_, splat_arg_why *why)
+{
+    options *o = o_;
+    (void)why;
+    o->files[o->nfiles++] = word;
+    return true;
+}
+
+/* The commands' options: one row each; `splatc --help` and README.md's
+ * list print this table (docs.options checks the README). */
+#define F(field) offsetof(options, field)
+static const splat_arg option_rows[] = {
+    { "-m", SPLAT_ARG_STRING, "MATERIAL", "the material", F(material),
+      .only = C_GLSL | C_SPIRV | C_DOT | C_DUMP | C_EVAL },
+    { "-o", SPLAT_ARG_STRING, "OUT", "the file to write (atomically; default stdout, spirv "
+      "needs it)", F(out), .only = C_GLSL | C_SPIRV | C_DOT | C_DUMP },
+    { "--stage", SPLAT_ARG_STRING, "fragment|compute", "the fragment shader (default) or the "
+      "compute variant of screen-space shading; both sample with the compiler's derivatives",
+      F(stage), .only = C_GLSL | C_SPIRV },
+    { "--expand", SPLAT_ARG_FLAG, NULL, "draw the inside of every shader node too (with -m each "
+      "is one box naming its type and wired ports)",
+      F(expand), .only = C_DOT },
+    { "--after", SPLAT_ARG_STRING, "PASS", "the IR after PASS instead of after the whole "
+      "pipeline (lower: no pass)", F(after), .only = C_DUMP },
+    { "--at", SPLAT_ARG_STRING, "KEY=V,...", "the inputs; keys: height=H slope=S "
+      "normal=X,Y,Z position=X,Z uv=U,V distance=D destruction=D painted.NAME=V "
+      "direction=X,Y,Z (unit, to the camera) PARAM=V... (unset: 0, normal and direction "
+      "0,1,0, the params' defaults)", F(at), .only = C_EVAL },
+    { "--output", SPLAT_ARG_STRING, "NAME", "one output (mask, albedo, normal, roughness, "
+      "height) instead of all", F(output), .only = C_EVAL },
+    { "--interval", SPLAT_ARG_FLAG, NULL, "the --at keys take LO:HI ranges; prints sound "
+      "bounds (unset: slope 0:1, normal -1:1,0:1,-1:1, uv 0:1, distance 0:inf, others "
+      "unbounded; direction is always -1:1)", F(interval), .only = C_EVAL },
+    { "--json", SPLAT_ARG_FLAG, NULL, "the diagnostics as JSON Lines, for editors", F(json),
+      .only = C_CHECK },
+    { "-I", SPLAT_ARG_CUSTOM, "DIR", "also search DIR for imports (repeatable; "
+      "SPLATC_PATH=DIR:DIR... in the environment does the same); may come before the command",
+      .parse = add_include },
+};
+#undef F
+
+static splat_args_desc options_desc(unsigned command)
+{
+    return (splat_args_desc){ .prog = "splatc", .args = option_rows,
+                              .nargs = (int)(sizeof option_rows / sizeof option_rows[0]),
+                              .column = 24, .command = command, .once = true,
+                              .command_names = command_bits, .positional = add_file };
+}
+
+/* Parse argv[1..] by the rows `command` takes. */
+static int parse_options(int argc, char **argv, unsigned command, options *o)
 {
     memset(o, 0, sizeof *o);
     o->files = calloc((size_t)argc + 1, sizeof *o->files);
     o->include = calloc((size_t)argc + 1, sizeof *o->include);
     if (!o->files || !o->include)
         return EXIT_USAGE;
-    for (int i = 1; i < argc; i++) {
-        const char *a = argv[i];
-        const char *val = i + 1 < argc ? argv[i + 1] : NULL;
-        const char **slot = NULL;
-        if (!strcmp(a, "-m") && strstr(allowed, "m"))
-            slot = &o->material;
-        else if (!strcmp(a, "-o") && strstr(allowed, "o"))
-            slot = &o->out;
-        else if (!strcmp(a, "--after") && strstr(allowed, "A"))
-            slot = &o->after;
-        else if (!strcmp(a, "--output") && strstr(allowed, "O"))
-            slot = &o->output;
-        else if (!strcmp(a, "--at") && strstr(allowed, "@"))
-            slot = &o->at;
-        else if (!strcmp(a, "--stage") && strstr(allowed, "S"))
-            slot = &o->stage;
-        else if (!strcmp(a, "-I")) {
-            if (!val)
-                return usage_error("option '%s' needs a value", a);
-            o->include[o->ninclude++] = val;
-            i++;
-            continue;
-        } else if (!strcmp(a, "--interval") && strstr(allowed, "@")) {
-            o->interval = true;
-            continue;
-        } else if (!strcmp(a, "--json") && strstr(allowed, "J")) {
-            o->json = true;
-            continue;
-        } else if (!strcmp(a, "--expand") && strstr(allowed, "X")) {
-            o->expand = true;
-            continue;
-        } else if (a[0] == '-' && a[1]) {
-            return usage_error("unknown option '%s' for this command", a);
-        } else {
-            o->files[o->nfiles++] = a;
-            continue;
-        }
-        if (!val)
-            return usage_error("option '%s' needs a value", a);
-        if (*slot)
-            return usage_error("option '%s' given twice", a);
-        *slot = val;
-        i++;
-    }
-    return EXIT_OK;
+    splat_args_desc d = options_desc(command);
+    return splat_args_parse(&d, argc, argv, 1, o) ? EXIT_USAGE : EXIT_OK;
 }
 
 static void options_free(options *o)
@@ -247,7 +226,7 @@ static int write_output(const char *path, const void *data, size_t len)
 static int cmd_check(int argc, char **argv)
 {
     options o;
-    int st = parse_options(argc, argv, "J", &o);
+    int st = parse_options(argc, argv, C_CHECK, &o);
     if (st == EXIT_OK && o.nfiles == 0)
         st = usage_error("%s needs at least one FILE", "check");
     /* one list for all the files, so an error in a file that several of
@@ -312,7 +291,7 @@ static int material_glsl(const options *o, const char *cmd, ir_buf *glsl)
 static int cmd_glsl(int argc, char **argv)
 {
     options o;
-    int st = parse_options(argc, argv, "moS", &o);
+    int st = parse_options(argc, argv, C_GLSL, &o);
     ir_buf glsl = { 0 };
     if (st == EXIT_OK)
         st = material_glsl(&o, "glsl", &glsl);
@@ -326,7 +305,7 @@ static int cmd_glsl(int argc, char **argv)
 static int cmd_spirv(int argc, char **argv)
 {
     options o;
-    int st = parse_options(argc, argv, "moS", &o);
+    int st = parse_options(argc, argv, C_SPIRV, &o);
     if (st == EXIT_OK && !o.out)
         st = usage_error("%s needs -o OUT.spv", "spirv");
     ir_buf glsl = { 0 };
@@ -382,7 +361,7 @@ static void emit_dot(void *user, FILE *f)
 static int cmd_dot(int argc, char **argv)
 {
     options o;
-    int st = parse_options(argc, argv, "moX", &o);
+    int st = parse_options(argc, argv, C_DOT, &o);
     if (st == EXIT_OK && o.nfiles != 1)
         st = usage_error("%s needs exactly one FILE", "dot");
     if (st == EXIT_OK) {
@@ -433,7 +412,7 @@ static void textures_relative_to(ir *ir, const char *out)
 static int cmd_dump(int argc, char **argv)
 {
     options o;
-    int st = parse_options(argc, argv, "moA", &o);
+    int st = parse_options(argc, argv, C_DUMP, &o);
     if (st == EXIT_OK && o.after && strcmp(o.after, "lower")) {
         bool known = false;
         for (const ir_pass *ps = ir_passes; ps->name; ps++)
@@ -666,7 +645,7 @@ static int set_inputs(const ir *ir, const char *material, const at_item *items, 
 static int cmd_eval(int argc, char **argv)
 {
     options o;
-    int st = parse_options(argc, argv, "mO@", &o);
+    int st = parse_options(argc, argv, C_EVAL, &o);
     if (st == EXIT_OK && !o.at)
         st = usage_error("%s needs --at KEY=V,...", "eval");
     at_item *items = NULL;
@@ -739,20 +718,59 @@ static int cmd_eval(int argc, char **argv)
 
 typedef int (*command_fn)(int argc, char **argv);
 
-/* Every subcommand gets argv starting at its own name. */
-static const struct { const char *name; command_fn run; } commands[] = {
-    { "check",  cmd_check },
-    { "glsl",   cmd_glsl },
-    { "spirv",  cmd_spirv },
-    { "dot",    cmd_dot },
-    { "dump",   cmd_dump },
-    { "eval",   cmd_eval },
-    { "build",  splat_cli_build },
-    { "texgen", splat_cli_texgen },
-    { "init",   splat_cli_init },
-    { "doc",    splat_cli_doc },
-    { "lsp",    splat_cli_lsp },
+/* Every subcommand gets argv starting at its own name.  own_help: it
+ * answers --help itself; general: -I given before it is passed on. */
+static const struct {
+    const char *name;
+    command_fn  run;
+    const char *synopsis, *help;
+    bool        own_help, general;
+} commands[] = {
+    { "check", cmd_check, "splatc check FILE... [--json]", "parse and type-check graph files, their "
+      "texture files and their masks' bounds", false, true },
+    { "glsl", cmd_glsl, "splatc glsl FILE -m MATERIAL [-o OUT] [--stage fragment|compute]",
+      "Vulkan GLSL 450 shader of a material", false, true },
+    { "spirv", cmd_spirv, "splatc spirv FILE -m MATERIAL -o OUT.spv [--stage ...]",
+      "the same compiled to SPIR-V and validated", false, true },
+    { "dot", cmd_dot, "splatc dot FILE [-m MATERIAL [--expand]] [-o OUT]", "Graphviz DOT of the "
+      "graphs (dot -Tsvg draws it)", false, true },
+    { "dump", cmd_dump, "splatc dump FILE -m MATERIAL [--after PASS]", "the material's IR in .sg "
+      "form", false, true },
+    { "eval", cmd_eval, "splatc eval FILE -m MATERIAL [--output NAME] [--interval] --at KEY=V,...",
+      "the CPU reference value (double precision), or with --interval sound bounds over "
+      "ranges", false, true },
+    { "build", splat_cli_build, "splatc build SCENE.sg -o PACKDIR [options]", "compile a scene into "
+      "a shader pack (splatc build --help)", true, true },
+    { "texgen", splat_cli_texgen, "splatc texgen --out DIR [options]", "write the example textures, "
+      "their mips and the colour PBR surface sets (splatc texgen --help, docs/textures.md)",
+      true, false },
+    { "init", splat_cli_init, "splatc init DIR", "a starter project: scene.sg, heightfield.png, "
+      "README.md (builds and renders as it stands)", true, false },
+    { "doc", splat_cli_doc, "splatc doc [-o FILE]", "the language reference (docs/language.md) from "
+      "the compiler's tables and the node library", true, false },
+    { "lsp", splat_cli_lsp, "splatc lsp [-I DIR]...", "a Language Server Protocol server on stdin and "
+      "stdout, for editors (docs/editors.md)", true, true },
 };
+enum { NCOMMANDS = sizeof commands / sizeof commands[0] };
+
+/* The commands and their options (base 4: README.md's code block). */
+static void print_usage(FILE *f, int base)
+{
+    if (!base)
+        fputs("usage: splatc COMMAND [options]\ncommands:\n", f);
+    for (int i = 0; i < NCOMMANDS; i++)
+        splat_args_item(f, commands[i].synopsis, commands[i].help, base, 36);
+    fprintf(f, "\n%*soptions of the commands above:\n", base, "");
+    splat_args_desc d = options_desc(0);
+    if (base)
+        splat_args_markdown(&d, f);
+    else
+        splat_args_help(&d, f);
+    splat_args_item(f, "--help", "this text (build --help, texgen --help: theirs)", base, 24);
+    splat_args_item(f, "--version", "the compiler version", base, 24);
+    if (!base)
+        fputs("exit status: 0 ok, 1 errors in the input, 2 usage errors\n", f);
+}
 
 /* General options may come before the command (`splatc -I DIR check F`):
  * they are moved behind the command's name, where every command that reads
@@ -768,31 +786,29 @@ int main(int argc, char **argv)
     if (first >= argc)
         return usage_error("%s", "no command given");
     const char *cmd = argv[first];
-    if (!strcmp(cmd, "--help") || !strcmp(cmd, "-h") || !strcmp(cmd, "help")) {
-        fputs(usage_text, stdout);
+    if (!strcmp(cmd, "--help") || !strcmp(cmd, "-h") || !strcmp(cmd, "help") ||
+        !strcmp(cmd, "--help-markdown")) {
+        print_usage(stdout, strcmp(cmd, "--help-markdown") ? 0 : 4);
         return EXIT_OK;
     }
     if (!strcmp(cmd, "--version")) {
         printf("splatc %s\n", SPLATC_VERSION);
         return EXIT_OK;
     }
-    for (size_t i = 0; i < sizeof commands / sizeof commands[0]; i++)
+    for (int i = 0; i < NCOMMANDS; i++)
         if (!strcmp(cmd, commands[i].name)) {
-            for (int j = first + 1; j < argc; j++)
-                if (!strcmp(argv[j], "--help") && strcmp(cmd, "build") && strcmp(cmd, "texgen") &&
-                    strcmp(cmd, "init") && strcmp(cmd, "doc") && strcmp(cmd, "lsp")) {
-                    fputs(usage_text, stdout);
+            for (int j = first + 1; j < argc && !commands[i].own_help; j++)
+                if (!strcmp(argv[j], "--help")) {
+                    print_usage(stdout, 0);
                     return EXIT_OK;
                 }
             /* argv for the command: its name, the general options, the rest */
-            bool keep = strcmp(cmd, "texgen") != 0 && strcmp(cmd, "init") != 0 &&
-                        strcmp(cmd, "doc") != 0;
             char **av = calloc((size_t)argc + 1, sizeof *av);
             if (!av)
                 return EXIT_USAGE;
             int n = 0;
             av[n++] = argv[first];
-            for (int j = 1; keep && j < first; j++)
+            for (int j = 1; commands[i].general && j < first; j++)
                 av[n++] = argv[j];
             for (int j = first + 1; j < argc; j++)
                 av[n++] = argv[j];

@@ -1,99 +1,18 @@
 /* splatview — render a shader pack: headless to PNG (and raw floats), or in
- * a GLFW window with a fly camera and hot reload.  See usage() below. */
+ * a GLFW window with a fly camera and hot reload.  The options are the
+ * table `options` below (splatview --help). */
 #include "splatrt.h"
+#include "args.h"
 #include "far_atlas.h"
 #include "scene.h"
 #include "util.h"
 
 #include <jansson.h>
 #include <math.h>
+#include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
 #include <xxhash.h>
-
-static void usage(FILE *f)
-{
-    char views[256];
-    rt_view_list(views, sizeof views);
-    fprintf(f,
-        "usage: splatview PACK [options]\n"
-        "  --headless -o OUT.png     render offscreen and write a PNG\n"
-        "  --size WxH                image or window size (default 1280x720)\n"
-        "  --camera x,y,z --look x,y,z   camera in terrain-local metres\n"
-        "  --camera-preset NAME      a camera of the manifest's scene.cameras\n"
-        "                            (default: the preset 'overview', else the first)\n"
-        "  --view V                  %s\n"
-        "  --frames N                render N frames (stats over them)\n"
-        "  --overlay                 headless: draw the window's help overlay (key H)\n"
-        "                            onto the PNG, as the window shows it\n"
-        "  --stats                   patches, pipelines, GPU and CPU times, device;\n"
-        "                            layers and texture samples per pixel from one\n"
-        "                            counting frame (both paths, not multipass)\n"
-        "  --reference multipass|uber   the multi-pass alpha reference or the uber-shader\n"
-        "  --shading forward|screen  forward: each patch shaded by its composite;\n"
-        "                            screen: depth pass, 8x8 tiles classified by\n"
-        "                            combination, shaded in compute (default: screen\n"
-        "                            where the pack has compute variants and no\n"
-        "                            --reference multipass, else forward;\n"
-        "                            $SPLAT_SHADING=forward|screen sets it)\n"
-        "  --screen-depth auto|raster|raycast   the screen path's depth: the patches\n"
-        "                            drawn depth only, or the heightfield ray cast in\n"
-        "                            compute (auto: ray cast on GPUs without holes)\n"
-        "  --pixel-sort on|off       the screen path: sort each 16 tiles' pixels by\n"
-        "                            the layers they need before shading them, so\n"
-        "                            SIMD lanes skip the same surfaces (default off:\n"
-        "                            the sort's masks-only run costs more than it\n"
-        "                            saves on the devices measured)\n"
-        "  --float-out FILE          also write the RGBA32F image (SPLATF32 format)\n"
-        "  --param NAME=v[,v,v,v]    set a material param\n"
-        "  --lod-pixels P            screen error per grid step (default 3)\n"
-        "  --far-atlas-distance D    screen tiles and forward patches wholly at least\n"
-        "                            D m away are shaded from the pack's far atlas\n"
-        "                            (splatc build --far-atlas); 0: off (default)\n"
-        "  --sun AZ,EL               the sun: azimuth (degrees clockwise from north)\n"
-        "                            and elevation, over the scene's light block\n"
-        "  --exposure EV             exposure in stops (default: the scene's, or 0)\n"
-        "  --fog-density D           fog per metre at the fog height (0: none)\n"
-        "  --no-shadows              the sun casts no terrain shadows\n"
-        "  --shadow gpu|cpu          where the shadow map is marched when the sun\n"
-        "                            moves or a crater lands: a compute pass (the\n"
-        "                            default; $SPLAT_SHADOW=cpu|gpu sets it) or the\n"
-        "                            CPU reference\n"
-        "  --no-undergrowth          draw no undergrowth (grass, plants, stones)\n"
-        "  --check                   load the pack and set up a renderer on the\n"
-        "                            device, draw nothing: exit 0 if the runtime\n"
-        "                            takes the pack\n"
-        "  --async-pipelines on|off  screen path: make compute pipelines on worker\n"
-        "                            threads, the uber-shader drawing their tiles\n"
-        "                            meanwhile (default: on in the window, off\n"
-        "                            headless, which waits for every pipeline)\n"
-        "  --no-distance-classes     shade with the combinations only, not their\n"
-        "                            distance classes (compiler/PACK.md)\n"
-        "  --uncovered uber|split    forward coarse patches no compiled combination\n"
-        "                            covers: drawn with the uber-shader (default) or\n"
-        "                            split down to nodes that have one\n"
-        "  --light KEY=V[,V,V]       any key of the scene's light block (sun, sun_color,\n"
-        "                            intensity, sky, fog_density, fog_height, exposure)\n"
-        "  --clear r,g,b             background colour (linear)\n"
-        "  --pipeline-cache FILE     pipeline cache file\n"
-        "  --scene FILE              scene.sg to watch for hot reload (viewer)\n"
-        "  --material M              material M alone on a built-in test hill under the\n"
-        "                            scene's light (a swatch; the pack's scene.source or\n"
-        "                            --scene is built with splatc build --preview M\n"
-        "                            into the cache; hot reload rebuilds it)\n"
-        "  -I DIR                    search DIR for the scene's imports, as splatc\n"
-        "                            build -I does (repeatable; also $SPLATC_PATH)\n"
-        "  --script S                viewer script: \"frames=30;screenshot=out.png;quit\"\n"
-        "  --no-stitch               draw patches without stitching (tests)\n"
-        "  --no-cull                 never cull back faces (tests)\n"
-        "  --crater x,z,r[,depth]    a crater before the frames (metres; repeatable;\n"
-        "                            depth defaults to r/4)\n"
-        "  --crater-at-view R        a crater of radius R where the view's centre ray\n"
-        "                            meets the terrain\n"
-        "  --destruction-pool N      destruction mask tiles (default 256); when full,\n"
-        "                            a crater needing more is refused with a warning\n"
-        "environment: SPLAT_DEVICE=<index|name>, SPLAT_VALIDATE=1\n", views);
-}
 
 static bool parse_vec(const char *s, double *v, int n)
 {
@@ -138,7 +57,7 @@ typedef struct opts {
     bool no_distance_classes;
     bool check;            /* --check: load and set up, draw nothing       */
     int async_pipelines;   /* --async-pipelines: 1 on, 0 off, -1 default */
-    bool split_uncovered;
+    int split_uncovered;   /* --uncovered: 1 split, 0 uber                 */
     int width, height, frames;
     double camera[3], look[3], lod_pixels;
     double far_distance;   /* --far-atlas-distance */
@@ -163,10 +82,62 @@ typedef struct opts {
     double light[SPLAT_LIGHT_COUNT][3];
 } opts;
 
+/* The table stores enums through int (args.h ENUM). */
+_Static_assert(sizeof(rt_shading) == sizeof(int) && sizeof(rt_reference) == sizeof(int) &&
+               sizeof(rt_screen_depth) == sizeof(int) && sizeof(rt_shadow_path) == sizeof(int) &&
+               sizeof(rt_pixel_sort) == sizeof(int), "enum fields are int-sized");
+
+/* ---- the parsers of the values the table's kinds do not cover ----------- */
+
+static bool parse_size(const char *v, void *o_, splat_arg_why *why)
+{
+    opts *o = o_;
+    char tail;
+    (void)why;
+    return sscanf(v, "%dx%d%c", &o->width, &o->height, &tail) == 2 && o->width > 0 &&
+           o->height > 0 && o->width <= 16384 && o->height <= 16384;
+}
+
+static bool parse_camera(const char *v, void *o, splat_arg_why *why)
+{
+    (void)why;
+    return parse_vec(v, ((opts *)o)->camera, 3);
+}
+
+static bool parse_look(const char *v, void *o, splat_arg_why *why)
+{
+    (void)why;
+    return parse_vec(v, ((opts *)o)->look, 3);
+}
+
+static bool parse_clear(const char *v, void *o_, splat_arg_why *why)
+{
+    opts *o = o_;
+    double c[3];
+    (void)why;
+    if (!parse_vec(v, c, 3))
+        return false;
+    for (int k = 0; k < 3; k++)
+        o->clear[k] = (float)c[k];
+    o->clear[3] = 1.0f;
+    return true;
+}
+
+static bool parse_sun(const char *v, void *o_, splat_arg_why *why)
+{
+    opts *o = o_;
+    char *end;
+    (void)why;
+    o->sun[0] = strtod(v, &end);
+    o->sun[1] = *end == ',' ? strtod(end + 1, &end) : NAN;
+    return !*end && fabs(o->sun[0]) <= 360 && o->sun[1] >= -90 && o->sun[1] <= 90;
+}
+
 /* --light KEY=V[,V,V]: any key of the scene's light block (abi.h
  * SPLAT_LIGHT_KEYS), its values in range. */
-static bool parse_light(const char *s, opts *o)
+static bool parse_light(const char *s, void *o_, splat_arg_why *why)
 {
+    opts *o = o_;
     const char *eq = strchr(s, '=');
     for (int k = 0; eq && k < SPLAT_LIGHT_COUNT; k++) {
         const splat_light_key *key = &splat_light_keys[k];
@@ -178,9 +149,9 @@ static bool parse_light(const char *s, opts *o)
             double v = strtod(p, &end), lo, hi;
             splat_light_range(k, i, &lo, &hi);
             if (end == p || !(v >= lo && v <= hi) || *end != (i + 1 < key->n ? ',' : '\0')) {
-                fprintf(stderr, "splatview: --light %s expects %d number%s (number %d in "
-                        "%g..%g), found '%s'\n", key->key, key->n,
-                        key->n > 1 ? "s separated by commas" : "", i + 1, lo, hi, s);
+                snprintf(why->text, sizeof why->text, "--light %s expects %d number%s (number "
+                         "%d in %g..%g), found '%s'", key->key, key->n,
+                         key->n > 1 ? "s separated by commas" : "", i + 1, lo, hi, s);
                 return false;
             }
             o->light[k][i] = v;
@@ -189,11 +160,229 @@ static bool parse_light(const char *s, opts *o)
         o->light_keys |= 1u << k;
         return true;
     }
-    fprintf(stderr, "splatview: --light expects KEY=VALUES with KEY one of");
-    for (int k = 0; k < SPLAT_LIGHT_COUNT; k++)
-        fprintf(stderr, " %s", splat_light_keys[k].key);
-    fprintf(stderr, ", found '%s'\n", s);
+    size_t n = (size_t)snprintf(why->text, sizeof why->text,
+                                "--light expects KEY=VALUES with KEY one of");
+    for (int k = 0; k < SPLAT_LIGHT_COUNT && n < sizeof why->text; k++)
+        n += (size_t)snprintf(why->text + n, sizeof why->text - n, " %s", splat_light_keys[k].key);
+    if (n < sizeof why->text)
+        snprintf(why->text + n, sizeof why->text - n, ", found '%s'", s);
     return false;
+}
+
+/* "x,z,radius[,depth]" in metres; depth defaults to radius / 4. */
+static bool parse_crater(const char *s, void *o_, splat_arg_why *why)
+{
+    opts *o = o_;
+    double v[4] = { 0, 0, 0, -1 };
+    int n = 0;
+    char *end;
+    (void)why;
+    while (n < 4) {
+        v[n] = strtod(s, &end);
+        if (end == s)
+            return false;
+        n++;
+        if (*end != ',')
+            break;
+        s = end + 1;
+    }
+    if (*end || n < 3 || !(v[2] > 0) || o->ncraters == 64)
+        return false;
+    rt_crater *c = &o->craters[o->ncraters++];
+    memset(c, 0, sizeof *c);
+    c->x = v[0];
+    c->z = v[1];
+    c->radius = v[2];
+    c->depth = n == 4 ? v[3] : v[2] / 4;
+    return true;
+}
+
+static bool parse_material(const char *v, void *o, splat_arg_why *why)
+{
+    (void)why;
+    ((opts *)o)->material = v;
+    return *v && strspn(v, "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_") ==
+                     strlen(v);
+}
+
+static bool check_implies_headless(const char *v, void *o, splat_arg_why *why)
+{
+    (void)v, (void)why;
+    ((opts *)o)->headless = true;
+    return true;
+}
+
+static bool parse_pack(const char *word, void *o_, splat_arg_why *why)
+{
+    opts *o = o_;
+    if (o->pack) {
+        snprintf(why->text, sizeof why->text, "more than one pack given ('%s')", word);
+        return false;
+    }
+    o->pack = word;
+    return true;
+}
+
+/* ---- the options: one row each (args.h); README.md's list is this table
+ * (splatview --help-markdown, checked by docs.options) -------------------- */
+
+#define F(field) offsetof(opts, field)
+#define GIVEN(field) SPLAT_ARG_GIVEN(opts, field)
+static const int on_off[] = { 1, 0 };
+static const int sort_on_off[] = { RT_SORT_ON, RT_SORT_OFF };
+static const int reference_values[] = { RT_REF_MULTIPASS, RT_REF_UBER };
+static const int shadow_values[] = { RT_SHADOW_GPU, RT_SHADOW_CPU };
+
+static const splat_arg options[] = {
+    { NULL, SPLAT_ARG_SECTION, .help = "Output:" },
+    { "--headless", SPLAT_ARG_FLAG, NULL, "render offscreen (with -o, --float-out or --stats) "
+      "instead of opening the window", F(headless) },
+    { "-o", SPLAT_ARG_STRING, "OUT.png", "headless: write the picture as a PNG", F(out) },
+    { "--float-out", SPLAT_ARG_STRING, "FILE", "also write the linear RGBA32F image (SPLATF32 "
+      "format)", F(float_out) },
+    { "--size", SPLAT_ARG_CUSTOM, "WxH", "image or window size (default 1280x720)",
+      .parse = parse_size, .expects = "WxH (1..16384 each)" },
+    { "--frames", SPLAT_ARG_INT, "N", "render N frames (--stats over them)", F(frames),
+      .min = 1, .max = 1e9, .expects = "a positive count" },
+    { "--stats", SPLAT_ARG_FLAG, NULL, "patches, pipelines, GPU and CPU times, the device; the "
+      "screen path's GPU time per pass; layers and texture samples per pixel from one "
+      "counting frame (both paths, not the multi-pass reference)", F(stats) },
+    { "--overlay", SPLAT_ARG_FLAG, NULL, "headless: draw the window's help overlay (key H) "
+      "onto the PNG, as the window shows it", F(overlay) },
+    { "--check", SPLAT_ARG_FLAG, NULL, "load the pack and set up a renderer on the device, "
+      "draw nothing: exit 0 if the runtime takes the pack", F(check),
+      .parse = check_implies_headless },
+    { NULL, SPLAT_ARG_SECTION, .help = "Camera and view:" },
+    { "--camera", SPLAT_ARG_CUSTOM, "X,Y,Z", "camera position in terrain-local metres (with "
+      "--look)", .parse = parse_camera, .given = GIVEN(have_camera) },
+    { "--look", SPLAT_ARG_CUSTOM, "X,Y,Z", "the point the camera looks at (with --camera)",
+      .parse = parse_look, .given = GIVEN(have_look) },
+    { "--camera-preset", SPLAT_ARG_STRING, "NAME", "a camera of the manifest's scene.cameras "
+      "(default: the preset 'overview', else the first)", F(preset) },
+    { "--view", SPLAT_ARG_STRING, "V", "what to show (default final; --help lists the views)",
+      F(view) },
+    { "--lod-pixels", SPLAT_ARG_FLOAT, "P", "screen error per grid step (default 3)",
+      F(lod_pixels), .min = 1e-9, .max = 1e9, .expects = "a positive number" },
+    { NULL, SPLAT_ARG_SECTION, .help = "Shading:" },
+    { "--shading", SPLAT_ARG_ENUM, NULL, "forward: each patch shaded by its composite; screen: "
+      "a depth pass, 8x8 tiles classified by combination, shaded in compute (default, in the "
+      "window as headless: screen where the pack has compute variants and no --reference "
+      "multipass, else forward; $SPLAT_SHADING=forward|screen sets it)", F(shading),
+      .choices = "forward|screen", .given = GIVEN(shading_set) },
+    { "--screen-depth", SPLAT_ARG_ENUM, NULL, "the screen path's depth: the patches drawn "
+      "depth only, or the heightfield ray cast in compute (auto: ray cast on GPUs, for "
+      "terrains without holes)", F(screen_depth), .choices = "auto|raster|raycast" },
+    { "--pixel-sort", SPLAT_ARG_ENUM, NULL, "the screen path: sort each 16 tiles' pixels by "
+      "the layers they need before shading them, so SIMD lanes skip the same surfaces "
+      "(default off: the sort costs more than it saves on the devices measured)",
+      F(pixel_sort), .choices = "on|off", .values = sort_on_off },
+    { "--reference", SPLAT_ARG_ENUM, NULL, "the multi-pass alpha reference or the "
+      "über-shader, to compare against", F(ref), .choices = "multipass|uber",
+      .values = reference_values },
+    { "--async-pipelines", SPLAT_ARG_ENUM, NULL, "the screen path: make shading pipelines "
+      "on worker threads while the über-shader draws their tiles (default on in the window, "
+      "off headless, which waits for them); the title and --stats say how many are pending",
+      F(async_pipelines), .choices = "on|off", .values = on_off },
+    { "--no-distance-classes", SPLAT_ARG_FLAG, NULL, "shade with the combinations only, not "
+      "their distance classes (compiler/PACK.md)", F(no_distance_classes) },
+    { "--uncovered", SPLAT_ARG_ENUM, NULL, "forward path: a coarse patch no compiled "
+      "combination covers is drawn by the über-shader (default) or split down to nodes that "
+      "have one", F(split_uncovered), .choices = "uber|split" },
+    { "--far-atlas-distance", SPLAT_ARG_FLOAT, "D", "screen tiles and forward patches wholly "
+      "at least D m away are shaded from the pack's far atlas (splatc build --far-atlas); "
+      "0: off (default)", F(far_distance), .min = 0, .max = 1e12,
+      .expects = "metres >= 0" },
+    { "--param", SPLAT_ARG_LIST, "NAME=V[,V,V,V]", "set a material param (repeatable)",
+      F(params), .count = F(nparams), .capacity = 64 },
+    { "--pipeline-cache", SPLAT_ARG_STRING, "FILE", "the Vulkan pipeline cache file",
+      F(cache) },
+    { NULL, SPLAT_ARG_SECTION, .help = "Light:" },
+    { "--sun", SPLAT_ARG_CUSTOM, "AZ,EL", "the sun: azimuth (degrees clockwise from north) "
+      "and elevation, over the scene's light block", .parse = parse_sun,
+      .given = GIVEN(sun_set),
+      .expects = "AZIMUTH,ELEVATION in degrees (-360..360, -90..90)" },
+    { "--exposure", SPLAT_ARG_FLOAT, "EV", "exposure in stops (default: the scene's, or 0)",
+      F(exposure), .min = -20, .max = 20, .given = GIVEN(exposure_set),
+      .expects = "stops -20..20" },
+    { "--fog-density", SPLAT_ARG_FLOAT, "D", "fog per metre at the fog height (0: none)",
+      F(fog_density), .min = 0, .max = 1, .given = GIVEN(fog_set),
+      .expects = "a density 0..1 per metre" },
+    { "--light", SPLAT_ARG_CUSTOM, "KEY=V[,V,V]", "any key of the scene's light block (sun, "
+      "sun_color, intensity, sky, fog_density, fog_height, exposure)", .parse = parse_light },
+    { "--clear", SPLAT_ARG_CUSTOM, "R,G,B", "background colour (linear) instead of the sky",
+      .parse = parse_clear },
+    { "--no-shadows", SPLAT_ARG_FLAG, NULL, "the sun casts no terrain shadows",
+      F(no_shadows) },
+    { "--shadow", SPLAT_ARG_ENUM, NULL, "where the shadow map is marched when the sun moves "
+      "or a crater lands: a compute pass (gpu, the default; $SPLAT_SHADOW=cpu|gpu sets it) or "
+      "the CPU reference", F(shadow), .choices = "gpu|cpu", .values = shadow_values },
+    { "--no-undergrowth", SPLAT_ARG_FLAG, NULL, "draw no undergrowth (grass, plants, stones)",
+      F(no_undergrowth) },
+    { NULL, SPLAT_ARG_SECTION, .help = "Destruction:" },
+    { "--crater", SPLAT_ARG_CUSTOM, "X,Z,R[,DEPTH]", "a crater before the frames (metres; "
+      "repeatable; depth defaults to R/4)", .parse = parse_crater,
+      .expects = "x,z,radius[,depth] in metres (radius > 0, at most 64)" },
+    { "--crater-at-view", SPLAT_ARG_FLOAT, "R", "a crater of radius R where the view's "
+      "centre ray meets the terrain", F(crater_at_view), .min = 1e-9, .max = 1e12,
+      .expects = "a radius in metres" },
+    { "--destruction-pool", SPLAT_ARG_INT, "N", "destruction mask tiles (default 256); when "
+      "full, a crater needing more is refused with a warning", F(destruction_pool), .min = 1,
+      .max = 65025, .expects = "1..65025 tiles" },
+    { NULL, SPLAT_ARG_SECTION, .help = "Window, hot reload and swatches:" },
+    { "--scene", SPLAT_ARG_STRING, "FILE", "the scene.sg to watch for hot reload (default: "
+      "the one the pack was built from)", F(scene) },
+    { "--material", SPLAT_ARG_CUSTOM, "M", "material M alone on a built-in test hill under "
+      "the scene's light (a swatch: the pack's scene.source or --scene is built with splatc "
+      "build --preview M into the cache; hot reload rebuilds it)", .parse = parse_material,
+      .expects = "a material's name" },
+    { "-I", SPLAT_ARG_LIST, "DIR", "search DIR for the scene's imports, as splatc build -I "
+      "does (repeatable; also $SPLATC_PATH)", F(include), .count = F(ninclude),
+      .capacity = 64 },
+    { "--script", SPLAT_ARG_STRING, "S", "drive the window without a person: "
+      "\"frames=30;screenshot=out.png;quit\"", F(script) },
+    { NULL, SPLAT_ARG_SECTION, .help = "Tests:" },
+    { "--no-stitch", SPLAT_ARG_FLAG, NULL, "draw patches without stitching", F(no_stitch) },
+    { "--no-cull", SPLAT_ARG_FLAG, NULL, "never cull back faces", F(no_cull) },
+};
+#undef F
+#undef GIVEN
+
+static const char usage_lines[] =
+    "usage: splatview PACK --headless -o OUT.png [options]   render a picture\n"
+    "       splatview PACK [options]                         the viewer window\n"
+    "       splatview PACK --material M [options]            one material alone\n";
+
+static int parse_args(int argc, char **argv, opts *o)
+{
+    memset(o, 0, sizeof *o);
+    o->frames = 1;
+    o->async_pipelines = -1;
+    char views[256], epilog[512];
+    rt_view_list(views, sizeof views);
+    snprintf(epilog, sizeof epilog, "views (--view): %s\n"
+             "environment: SPLAT_DEVICE=<index|name>, SPLAT_VALIDATE=1, SPLAT_SHADING, "
+             "SPLAT_SHADOW\n", views);
+    splat_args_desc d = { .prog = "splatview", .usage = usage_lines, .epilog = epilog,
+                          .args = options, .nargs = (int)(sizeof options / sizeof options[0]),
+                          .positional = parse_pack };
+    int rc = splat_args_parse(&d, argc, argv, 1, o);
+    if (rc == SPLAT_ARGS_HELP)
+        exit(0);
+    if (rc)
+        return rc;
+    if (!o->pack) {
+        splat_args_help(&d, stderr);
+        return 2;
+    }
+    if (o->have_camera != o->have_look) {
+        fprintf(stderr, "splatview: --camera and --look go together\n");
+        return 2;
+    }
+    if (o->headless && !o->out && !o->float_out && !o->stats && !o->check) {
+        fprintf(stderr, "splatview: --headless needs -o OUT.png, --float-out or --stats\n");
+        return 2;
+    }
+    return 0;
 }
 
 /* --sun, --exposure, --fog-density into a render desc. */
@@ -207,296 +396,6 @@ static void light_options(const opts *o, rt_render_desc *rd)
     memcpy(rd->sun, o->sun, sizeof rd->sun);
     rd->exposure = o->exposure;
     rd->fog_density = o->fog_density;
-}
-
-/* "x,z,radius[,depth]" in metres; depth defaults to radius / 4. */
-static bool parse_crater(const char *s, rt_crater *c)
-{
-    double v[4] = { 0, 0, 0, -1 };
-    int n = 0;
-    char *end;
-    while (n < 4) {
-        v[n] = strtod(s, &end);
-        if (end == s)
-            return false;
-        n++;
-        if (*end != ',')
-            break;
-        s = end + 1;
-    }
-    if (*end || n < 3 || !(v[2] > 0))
-        return false;
-    memset(c, 0, sizeof *c);
-    c->x = v[0];
-    c->z = v[1];
-    c->radius = v[2];
-    c->depth = n == 4 ? v[3] : v[2] / 4;
-    return true;
-}
-
-static int parse_args(int argc, char **argv, opts *o)
-{
-    memset(o, 0, sizeof *o);
-    o->frames = 1;
-    o->async_pipelines = -1;
-    for (int i = 1; i < argc; i++) {
-        const char *a = argv[i];
-        const char *v = i + 1 < argc ? argv[i + 1] : NULL;
-#define NEED() do { if (!v) { fprintf(stderr, "splatview: %s needs a value\n", a); return 2; } i++; } while (0)
-        if (!strcmp(a, "--help") || !strcmp(a, "-h")) {
-            usage(stdout);
-            exit(0);
-        } else if (!strcmp(a, "--headless")) {
-            o->headless = true;
-        } else if (!strcmp(a, "--check")) {
-            o->check = o->headless = true;
-        } else if (!strcmp(a, "--stats")) {
-            o->stats = true;
-        } else if (!strcmp(a, "--overlay")) {
-            o->overlay = true;
-        } else if (!strcmp(a, "--no-stitch")) {
-            o->no_stitch = true;
-        } else if (!strcmp(a, "--no-cull")) {
-            o->no_cull = true;
-        } else if (!strcmp(a, "--no-shadows")) {
-            o->no_shadows = true;
-        } else if (!strcmp(a, "--no-undergrowth")) {
-            o->no_undergrowth = true;
-        } else if (!strcmp(a, "--no-distance-classes")) {
-            o->no_distance_classes = true;
-        } else if (!strcmp(a, "--async-pipelines")) {
-            NEED();
-            if (strcmp(v, "on") && strcmp(v, "off")) {
-                fprintf(stderr, "splatview: --async-pipelines takes on or off, not '%s'\n", v);
-                return 2;
-            }
-            o->async_pipelines = !strcmp(v, "on");
-        } else if (!strcmp(a, "--uncovered")) {
-            NEED();
-            if (!strcmp(v, "split") || !strcmp(v, "uber")) {
-                o->split_uncovered = !strcmp(v, "split");
-            } else {
-                fprintf(stderr, "splatview: --uncovered expects split or uber, found '%s'\n", v);
-                return 2;
-            }
-        } else if (!strcmp(a, "-o")) {
-            NEED(); o->out = v;
-        } else if (!strcmp(a, "--float-out")) {
-            NEED(); o->float_out = v;
-        } else if (!strcmp(a, "--size")) {
-            NEED();
-            if (sscanf(v, "%dx%d", &o->width, &o->height) != 2 || o->width <= 0 ||
-                o->height <= 0 || o->width > 16384 || o->height > 16384) {
-                fprintf(stderr, "splatview: --size expects WxH, found '%s'\n", v);
-                return 2;
-            }
-        } else if (!strcmp(a, "--camera")) {
-            NEED();
-            if (!parse_vec(v, o->camera, 3)) {
-                fprintf(stderr, "splatview: --camera expects x,y,z, found '%s'\n", v);
-                return 2;
-            }
-            o->have_camera = true;
-        } else if (!strcmp(a, "--look")) {
-            NEED();
-            if (!parse_vec(v, o->look, 3)) {
-                fprintf(stderr, "splatview: --look expects x,y,z, found '%s'\n", v);
-                return 2;
-            }
-            o->have_look = true;
-        } else if (!strcmp(a, "--clear")) {
-            NEED();
-            double c[3];
-            if (!parse_vec(v, c, 3)) {
-                fprintf(stderr, "splatview: --clear expects r,g,b, found '%s'\n", v);
-                return 2;
-            }
-            for (int k = 0; k < 3; k++)
-                o->clear[k] = (float)c[k];
-            o->clear[3] = 1.0f;
-        } else if (!strcmp(a, "--camera-preset")) {
-            NEED(); o->preset = v;
-        } else if (!strcmp(a, "--view")) {
-            NEED(); o->view = v;
-        } else if (!strcmp(a, "--frames")) {
-            NEED();
-            o->frames = atoi(v);
-            if (o->frames < 1) {
-                fprintf(stderr, "splatview: --frames expects a positive count, found '%s'\n", v);
-                return 2;
-            }
-        } else if (!strcmp(a, "--far-atlas-distance")) {
-            NEED();
-            char *end;
-            o->far_distance = strtod(v, &end);
-            if (*end || !(o->far_distance >= 0) || !isfinite(o->far_distance)) {
-                fprintf(stderr, "splatview: --far-atlas-distance expects metres >= 0, found '%s'\n", v);
-                return 2;
-            }
-        } else if (!strcmp(a, "--lod-pixels")) {
-            NEED();
-            o->lod_pixels = atof(v);
-            if (!(o->lod_pixels > 0)) {
-                fprintf(stderr, "splatview: --lod-pixels expects a positive number\n");
-                return 2;
-            }
-        } else if (!strcmp(a, "--sun")) {
-            NEED();
-            char *end;
-            o->sun[0] = strtod(v, &end);
-            o->sun[1] = *end == ',' ? strtod(end + 1, &end) : NAN;
-            if (*end || !(fabs(o->sun[0]) <= 360) || !(o->sun[1] >= -90 && o->sun[1] <= 90)) {
-                fprintf(stderr, "splatview: --sun expects AZIMUTH,ELEVATION in degrees "
-                        "(-360..360, -90..90), found '%s'\n", v);
-                return 2;
-            }
-            o->sun_set = true;
-        } else if (!strcmp(a, "--light")) {
-            NEED();
-            if (!parse_light(v, o))
-                return 2;
-        } else if (!strcmp(a, "--exposure") || !strcmp(a, "--fog-density")) {
-            NEED();
-            char *end;
-            double x = strtod(v, &end);
-            bool fog = !strcmp(a, "--fog-density");
-            if (*end || end == v || (fog ? !(x >= 0 && x <= 1) : !(x >= -20 && x <= 20))) {
-                fprintf(stderr, "splatview: %s expects %s, found '%s'\n", a,
-                        fog ? "a density 0..1 per metre" : "stops -20..20", v);
-                return 2;
-            }
-            *(fog ? &o->fog_density : &o->exposure) = x;
-            *(fog ? &o->fog_set : &o->exposure_set) = true;
-        } else if (!strcmp(a, "--shading")) {
-            NEED();
-            if (!strcmp(v, "forward"))
-                o->shading = RT_SHADING_FORWARD, o->shading_set = true;
-            else if (!strcmp(v, "screen"))
-                o->shading = RT_SHADING_SCREEN, o->shading_set = true;
-            else {
-                fprintf(stderr, "splatview: --shading expects forward or screen, found '%s'\n", v);
-                return 2;
-            }
-        } else if (!strcmp(a, "--shadow")) {
-            NEED();
-            if (!strcmp(v, "gpu"))
-                o->shadow = RT_SHADOW_GPU;
-            else if (!strcmp(v, "cpu"))
-                o->shadow = RT_SHADOW_CPU;
-            else {
-                fprintf(stderr, "splatview: --shadow expects gpu or cpu, found '%s'\n", v);
-                return 2;
-            }
-        } else if (!strcmp(a, "--screen-depth")) {
-            NEED();
-            if (!strcmp(v, "auto"))
-                o->screen_depth = RT_DEPTH_AUTO;
-            else if (!strcmp(v, "raster"))
-                o->screen_depth = RT_DEPTH_RASTER;
-            else if (!strcmp(v, "raycast"))
-                o->screen_depth = RT_DEPTH_RAYCAST;
-            else {
-                fprintf(stderr, "splatview: --screen-depth expects auto, raster or raycast, "
-                        "found '%s'\n", v);
-                return 2;
-            }
-        } else if (!strcmp(a, "--pixel-sort")) {
-            NEED();
-            if (!strcmp(v, "on"))
-                o->pixel_sort = RT_SORT_ON;
-            else if (!strcmp(v, "off"))
-                o->pixel_sort = RT_SORT_OFF;
-            else {
-                fprintf(stderr, "splatview: --pixel-sort expects on or off, found '%s'\n", v);
-                return 2;
-            }
-        } else if (!strcmp(a, "--reference")) {
-            NEED();
-            if (!strcmp(v, "multipass"))
-                o->ref = RT_REF_MULTIPASS;
-            else if (!strcmp(v, "uber"))
-                o->ref = RT_REF_UBER;
-            else {
-                fprintf(stderr, "splatview: --reference expects multipass or uber, found '%s'\n", v);
-                return 2;
-            }
-        } else if (!strcmp(a, "--param")) {
-            NEED();
-            if (o->nparams == 64) {
-                fprintf(stderr, "splatview: more than 64 --param options\n");
-                return 2;
-            }
-            o->params[o->nparams++] = v;
-        } else if (!strcmp(a, "--pipeline-cache")) {
-            NEED(); o->cache = v;
-        } else if (!strcmp(a, "--scene")) {
-            NEED(); o->scene = v;
-        } else if (!strcmp(a, "--material")) {
-            NEED(); o->material = v;
-            if (!*v || strspn(v, "abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ"
-                                 "0123456789_") != strlen(v)) {
-                fprintf(stderr, "splatview: --material expects a material's name, found "
-                        "'%s'\n", v);
-                return 2;
-            }
-        } else if (!strcmp(a, "-I")) {
-            NEED();
-            if (o->ninclude == 64) {
-                fprintf(stderr, "splatview: too many -I folders (at most 64)\n");
-                return 2;
-            }
-            o->include[o->ninclude++] = v;
-        } else if (!strcmp(a, "--script")) {
-            NEED(); o->script = v;
-        } else if (!strcmp(a, "--crater")) {
-            NEED();
-            if (o->ncraters == 64 || !parse_crater(v, &o->craters[o->ncraters])) {
-                fprintf(stderr, "splatview: --crater expects x,z,radius[,depth] in metres "
-                        "(radius > 0, at most 64), found '%s'\n", v);
-                return 2;
-            }
-            o->ncraters++;
-        } else if (!strcmp(a, "--crater-at-view")) {
-            NEED();
-            char *end;
-            o->crater_at_view = strtod(v, &end);
-            if (*end || !(o->crater_at_view > 0)) {
-                fprintf(stderr, "splatview: --crater-at-view expects a radius in metres, found '%s'\n", v);
-                return 2;
-            }
-        } else if (!strcmp(a, "--destruction-pool")) {
-            NEED();
-            char *end;
-            long n = strtol(v, &end, 10);
-            if (*end || n < 1 || n > 65025) {
-                fprintf(stderr, "splatview: --destruction-pool expects 1..65025 tiles, found '%s'\n", v);
-                return 2;
-            }
-            o->destruction_pool = (int)n;
-        } else if (a[0] == '-') {
-            fprintf(stderr, "splatview: unknown option '%s' (see --help)\n", a);
-            return 2;
-        } else if (!o->pack) {
-            o->pack = a;
-        } else {
-            fprintf(stderr, "splatview: more than one pack given ('%s')\n", a);
-            return 2;
-        }
-#undef NEED
-    }
-    if (!o->pack) {
-        usage(stderr);
-        return 2;
-    }
-    if (o->have_camera != o->have_look) {
-        fprintf(stderr, "splatview: --camera and --look go together\n");
-        return 2;
-    }
-    if (o->headless && !o->out && !o->float_out && !o->stats && !o->check) {
-        fprintf(stderr, "splatview: --headless needs -o OUT.png, --float-out or --stats\n");
-        return 2;
-    }
-    return 0;
 }
 
 static bool pick_camera(const opts *o, const rt_pack *p, rt_camera *cam)
@@ -608,6 +507,211 @@ static bool shading_chosen(const opts *o, rt_shading *out)
     return false;
 }
 
+/* The timings of headless's frames, per frame (medians by summary()). */
+typedef struct frame_times {
+    double *gpu, *sel, *cpu;   /* GPU ms, quadtree selection and recording ms */
+    double *pass[3];           /* screen path: depth, classification, shading */
+    double *ug_draw;           /* undergrowth draw GPU ms                    */
+    double shadow_ms;          /* the first frame makes the shadow map       */
+    double ug_gen_ms;          /* and generates the undergrowth's cells      */
+    int ug_generated;
+    double compile_ms;
+} frame_times;
+
+/* o->frames frames, their times into t; st: the last frame's stats. */
+static bool run_frames(const opts *o, rt_renderer *r, const rt_camera *cam, frame_times *t,
+                       rt_frame_stats *st, rt_error *e)
+{
+    for (int f = 0; f < o->frames; f++) {
+        if (!rt_renderer_frame(r, cam, st, e))
+            return false;
+        t->gpu[f] = st->gpu_ms;
+        t->shadow_ms += st->shadow_ms;
+        t->compile_ms += st->compile_ms;
+        t->sel[f] = st->select_ms;
+        t->cpu[f] = st->cpu_ms;
+        for (int k = 0; k < 3; k++)
+            t->pass[k][f] = st->pass_ms[k];
+        t->ug_draw[f] = st->undergrowth.draw_ms;
+        if (st->undergrowth.generated > 0) {
+            t->ug_gen_ms += st->undergrowth.gen_ms;
+            t->ug_generated += st->undergrowth.generated;
+        }
+    }
+    return true;
+}
+
+/* -o (tone-mapped, with --overlay's box) and --float-out of the last frame. */
+static bool write_pictures(const opts *o, rt_device *dev, const rt_pack *pack, rt_renderer *r,
+                           splat_view view, int material, const rt_frame_stats *st, int W,
+                           int H, rt_error *e)
+{
+    float *rgba = malloc((size_t)W * (size_t)H * 16);
+    uint8_t *png = malloc((size_t)W * (size_t)H * 4);
+    bool ok = rgba && png && rt_renderer_read(r, rgba, e) &&
+              (!o->float_out || rt_write_float(o->float_out, rgba, W, H, e));
+    if (ok && o->out) {
+        rt_tonemap_rgba8(rgba, W, H, tonemap_for(view), png);
+        if (o->overlay) {   /* no frame rate: the picture stays reproducible */
+            char text[2048];
+            rt_overlay_info in = {
+                .pack = pack->name, .view = view, .screen = st->screen,
+                .material = view == SPLAT_VIEW_MASK ? pack->materials[material].name : NULL,
+                .pending = st->pipelines_pending, .status = "headless",
+            };
+            rt_overlay_text(&in, text, sizeof text);
+            ok = rt_overlay_draw_rgba8(dev, text, png, W, H, e);
+        }
+        ok = ok && rt_write_png(o->out, png, W, H, e);
+    }
+    if (!rgba || !png)
+        rt_fail(e, RT_E_IO, "hold the picture for", o->out ? o->out : o->float_out,
+                "out of memory");
+    free(rgba);
+    free(png);
+    return ok;
+}
+
+/* --stats: one more frame with the counting variant (not timed), its
+ * layers and samples per pixel. */
+static bool print_counts(rt_renderer *r, const rt_camera *cam, splat_view view, rt_error *e)
+{
+    rt_renderer_set_counting(r, true);
+    rt_frame_stats cs;
+    if (!rt_renderer_frame(r, cam, &cs, e))
+        return false;
+    rt_renderer_set_counting(r, view == SPLAT_VIEW_COST);
+    double px = cs.tiles.pixels ? (double)cs.tiles.pixels : 1.0;
+    printf("layers per pixel: evaluated %.3f, needed %.3f (efficiency %.1f %%)\n",
+           cs.tiles.layers_evaluated / px, cs.tiles.layers_needed / px,
+           cs.tiles.layers_evaluated
+               ? 100.0 * cs.tiles.layers_needed / cs.tiles.layers_evaluated : 100.0);
+    printf("texture samples per pixel: %.3f\n", cs.tiles.samples / px);
+    printf("dynamic branches uniform over the subgroup: %.1f %% of %.2f per pixel\n",
+           cs.tiles.branches ? 100.0 * cs.tiles.branches_uniform / cs.tiles.branches : 100.0,
+           cs.tiles.branches / px);
+    return true;
+}
+
+/* --stats: the patches, paths and pipelines of the last frame. */
+static void print_paths(const rt_pack *pack, const rt_frame_stats *st, const frame_times *t)
+{
+    printf("patches drawn: %d  culled: %d\n", st->patches, st->culled);
+    printf("back faces culled: %s\n", st->backfaces_culled ? "yes" : "no");
+    printf("pipelines bound: %d\n", st->pipelines);
+    if (st->screen)
+        printf("compute modules: %d from the SPIR-V cache, %d compiled from GLSL; "
+               "%.1f ms making pipelines between frames\n", st->spirv_cached,
+               st->spirv_compiled, t->compile_ms);
+    printf("combinations in view: %d of %d\n", st->combos_in_view, pack->ncombos);
+    if (!st->screen) {
+        printf("distance classes: %d of %d patches\n", st->class_patches, st->patches);
+        printf("far atlas: %d of %d patches\n", st->far_patches, st->patches);
+        printf("uber-shader fallback: %d of %d patches (no compiled combination "
+               "covers their node)\n", st->uber_patches, st->patches);
+        printf("uncovered nodes split: %d\n", st->split_uncovered);
+    }
+}
+
+/* --stats: the screen path's passes. */
+static void print_passes(const opts *o, const frame_times *t)
+{
+    static const char *const names[3] = { "depth", "classification", "shading (compute)" };
+    for (int k = 0; k < 3; k++) {
+        double m, l, h;
+        summary(t->pass[k], o->frames, &m, &l, &h);
+        printf("  %-18s gpu ms: median %.3f  p10 %.3f  p90 %.3f\n", names[k], m, l, h);
+    }
+}
+
+/* --stats: everything after the frames. */
+static bool print_stats(const opts *o, rt_device *dev, const rt_pack *pack, rt_renderer *r,
+                        const rt_camera *cam, splat_view view, const rt_frame_stats *st,
+                        frame_times *t, int W, int H, rt_error *e)
+{
+    double gm, gl, gh, sm, sl, sh, cm, cl, ch;
+    summary(t->gpu, o->frames, &gm, &gl, &gh);
+    summary(t->sel, o->frames, &sm, &sl, &sh);
+    summary(t->cpu, o->frames, &cm, &cl, &ch);
+    printf("device: %s\n", dev->props.deviceName);
+    printf("size: %dx%d  view: %s  reference: %s  frames: %d\n", W, H, rt_view_name(view),
+           o->ref == RT_REF_MULTIPASS ? "multipass" : o->ref == RT_REF_UBER ? "uber" : "none",
+           o->frames);
+    print_paths(pack, st, t);
+    if (gm >= 0)
+        printf("gpu ms/frame: median %.3f  p10 %.3f  p90 %.3f\n", gm, gl, gh);
+    else
+        printf("gpu ms/frame: n/a (no timestamp support)\n");
+    if (st->screen) {
+        if (gm >= 0)
+            print_passes(o, t);
+        printf("tiles: %d of %d shaded, %d lists, %d by the uber-shader, %d from the far "
+               "atlas\n", st->tiles.tiles, st->tiles.tiles_total, st->tiles.lists,
+               st->tiles.tiles_uber, st->tiles.tiles_far);
+        printf("distance classes: %d of %d tiles\n", st->tiles.tiles_class, st->tiles.tiles);
+        printf("pipelines pending: %d (tiles the uber-shader stood in for: %d)\n",
+               st->pipelines_pending, st->tiles.tiles_stand_in);
+    }
+    printf("quadtree cpu ms/frame: median %.4f  p10 %.4f  p90 %.4f\n", sm, sl, sh);
+    if (o->no_shadows)
+        printf("shadow map: off\n");
+    else
+        printf("shadow map %s ms: %.2f (when the sun moves or a crater lands; "
+               "per frame a texture tap)\n", st->shadow_gpu ? "gpu" : "cpu", t->shadow_ms);
+    if (pack->ug.nslots > 0 && !o->no_undergrowth && view == SPLAT_VIEW_FINAL) {
+        double um, ul, uh;
+        summary(t->ug_draw, o->frames, &um, &ul, &uh);
+        printf("undergrowth: %d cells, %ld instances, %.3f ms generation\n",
+               st->undergrowth.cells, st->undergrowth.instances, t->ug_gen_ms);
+        printf("  generated %d cells (%.4f ms per cell), draw gpu ms/frame: median %.3f  "
+               "p10 %.3f  p90 %.3f, %zu bytes per cell\n", t->ug_generated,
+               t->ug_generated ? t->ug_gen_ms / t->ug_generated : 0.0, um, ul, uh,
+               st->undergrowth.bytes_per_cell);
+    } else if (pack->ug.nslots > 0) {
+        printf("undergrowth: off\n");
+    }
+    printf("cpu ms/frame (record): median %.3f  p10 %.3f  p90 %.3f\n", cm, cl, ch);
+    if ((st->screen || (dev->count_fragments && o->ref != RT_REF_MULTIPASS)) &&
+        !print_counts(r, cam, view, e))
+        return false;
+    printf("shading: %s%s\n", st->screen ? "screen" : "forward",
+           st->sorted ? ", pixels sorted by layer set" : "");
+    if (pack->far.data)   /* the BC blocks as uploaded (PACK.md "Far atlas") */
+        printf("far atlas: %d x %d texels of %.1f x %.1f m, %d levels, %zu bytes; %s\n",
+               pack->far.width, pack->far.height, pack->far.texel[0], pack->far.texel[1],
+               pack->far.levels, pack->far.n - FAR_ATLAS_HEADER,
+               o->far_distance <= 0 ? "not used"
+               : st->screen ? "screen tiles beyond --far-atlas-distance use it"
+                            : "forward patches beyond --far-atlas-distance use it");
+    rt_painted_print_stats(pack, stdout);
+    if (rt_renderer_destruction(r))
+        rt_destruction_print_stats(rt_renderer_destruction(r), stdout);
+    return true;
+}
+
+/* The render desc of the options (the window's is built in window()). */
+static rt_render_desc render_desc(const opts *o, const rt_pack *pack)
+{
+    rt_render_desc rd = {
+        .width = o->width, .height = o->height, .reference = o->ref,
+        .pipeline_cache = o->cache, .no_stitch = o->no_stitch,
+        .no_cull = o->no_cull, .lod_pixels = o->lod_pixels, .no_shadows = o->no_shadows,
+        .shadow = o->shadow,
+        .no_undergrowth = o->no_undergrowth,
+        .no_distance_classes = o->no_distance_classes,
+        .async_pipelines = o->async_pipelines == 1,
+        .split_uncovered = o->split_uncovered,
+        .destruction_pool = o->destruction_pool, .shading = o->shading,
+        .screen_depth = o->screen_depth, .pixel_sort = o->pixel_sort, .far_atlas_distance = o->far_distance,
+    };
+    if (!shading_chosen(o, &rd.shading))
+        rd.shading = pack->uber_compute && o->ref != RT_REF_MULTIPASS ? RT_SHADING_SCREEN
+                                                                      : RT_SHADING_FORWARD;
+    light_options(o, &rd);
+    memcpy(rd.clear, o->clear, sizeof rd.clear);
+    return rd;
+}
+
 static int headless(const opts *o)
 {
     rt_error e = { 0 };
@@ -615,9 +719,7 @@ static int headless(const opts *o)
     rt_device dev;
     rt_renderer *r = NULL;
     int status = 1;
-    float *rgba = NULL;
-    uint8_t *png = NULL;
-    double *gpu = NULL, *sel = NULL, *cpu = NULL;
+    double *times = NULL;
     bool have_dev = false;
 
     if (!rt_pack_load(&pack, o->pack, &e)) {
@@ -634,23 +736,7 @@ static int headless(const opts *o)
     if (!rt_device_create(&dev, NULL, &e))
         goto done;
     have_dev = true;
-    rt_render_desc rd = {
-        .width = o->width, .height = o->height, .reference = o->ref,
-        .pipeline_cache = o->cache, .no_stitch = o->no_stitch,
-        .no_cull = o->no_cull, .lod_pixels = o->lod_pixels, .no_shadows = o->no_shadows,
-        .shadow = o->shadow,
-        .no_undergrowth = o->no_undergrowth,
-        .no_distance_classes = o->no_distance_classes,
-        .async_pipelines = o->async_pipelines == 1,
-        .split_uncovered = o->split_uncovered,
-        .destruction_pool = o->destruction_pool, .shading = o->shading,
-        .screen_depth = o->screen_depth, .pixel_sort = o->pixel_sort, .far_atlas_distance = o->far_distance,
-    };
-    if (!shading_chosen(o, &rd.shading))
-        rd.shading = pack.uber_compute && o->ref != RT_REF_MULTIPASS ? RT_SHADING_SCREEN
-                                                                     : RT_SHADING_FORWARD;
-    light_options(o, &rd);
-    memcpy(rd.clear, o->clear, sizeof rd.clear);
+    rt_render_desc rd = render_desc(o, &pack);
     if (!rt_renderer_create(&dev, &pack, &rd, &r, &e) || !apply_params(o, r, &e) ||
         !apply_craters(o, r, &cam, &e))
         goto done;
@@ -662,152 +748,21 @@ static int headless(const opts *o)
     }
     rt_renderer_set_view(r, view, material);
     int W = o->width > 0 ? o->width : 1280, H = o->height > 0 ? o->height : 720;
-    gpu = calloc((size_t)o->frames * 7, sizeof *gpu);
-    if (!gpu)
+    times = calloc((size_t)o->frames * 7, sizeof *times);
+    if (!times)
         goto done;
-    sel = gpu + o->frames;
-    cpu = sel + o->frames;
-    double *pass = cpu + o->frames;   /* 3 per frame: geometry, classify, shade */
-    double *ug_draw = pass + 3 * o->frames;
+    frame_times t = { .gpu = times, .sel = times + o->frames, .cpu = times + 2 * o->frames,
+                      .pass = { times + 3 * o->frames, times + 4 * o->frames,
+                                times + 5 * o->frames },
+                      .ug_draw = times + 6 * o->frames };
     rt_frame_stats st = { 0 };
-    double shadow_ms = 0;   /* the first frame makes the shadow map */
-    double ug_gen_ms = 0;   /* and generates the undergrowth's cells */
-    int ug_generated = 0;
-    double compile_ms = 0;
     /* the cost view needs the counting variant's counters */
     rt_renderer_set_counting(r, view == SPLAT_VIEW_COST);
-    for (int f = 0; f < o->frames; f++) {
-        if (!rt_renderer_frame(r, &cam, &st, &e))
-            goto done;
-        gpu[f] = st.gpu_ms;
-        shadow_ms += st.shadow_ms;
-        compile_ms += st.compile_ms;
-        sel[f] = st.select_ms;
-        cpu[f] = st.cpu_ms;
-        for (int k = 0; k < 3; k++)
-            pass[k * o->frames + f] = st.pass_ms[k];
-        ug_draw[f] = st.undergrowth.draw_ms;
-        if (st.undergrowth.generated > 0) {
-            ug_gen_ms += st.undergrowth.gen_ms;
-            ug_generated += st.undergrowth.generated;
-        }
-    }
-    if (o->out || o->float_out) {
-        rgba = malloc((size_t)W * (size_t)H * 16);
-        png = malloc((size_t)W * (size_t)H * 4);
-        if (!rgba || !png || !rt_renderer_read(r, rgba, &e))
-            goto done;
-        if (o->float_out && !rt_write_float(o->float_out, rgba, W, H, &e))
-            goto done;
-        if (o->out) {
-            rt_tonemap_rgba8(rgba, W, H, tonemap_for(view), png);
-            if (o->overlay) {   /* no frame rate: the picture stays reproducible */
-                char text[2048];
-                rt_overlay_info in = {
-                    .pack = pack.name, .view = view, .screen = st.screen,
-                    .material = view == SPLAT_VIEW_MASK ? pack.materials[material].name : NULL,
-                    .pending = st.pipelines_pending, .status = "headless",
-                };
-                rt_overlay_text(&in, text, sizeof text);
-                if (!rt_overlay_draw_rgba8(&dev, text, png, W, H, &e))
-                    goto done;
-            }
-            if (!rt_write_png(o->out, png, W, H, &e))
-                goto done;
-        }
-    }
-    if (o->stats) {
-        double gm, gl, gh, sm, sl, sh, cm, cl, ch;
-        summary(gpu, o->frames, &gm, &gl, &gh);
-        summary(sel, o->frames, &sm, &sl, &sh);
-        summary(cpu, o->frames, &cm, &cl, &ch);
-        printf("device: %s\n", dev.props.deviceName);
-        printf("size: %dx%d  view: %s  reference: %s  frames: %d\n", W, H, rt_view_name(view),
-               o->ref == RT_REF_MULTIPASS ? "multipass" : o->ref == RT_REF_UBER ? "uber" : "none",
-               o->frames);
-        printf("patches drawn: %d  culled: %d\n", st.patches, st.culled);
-        printf("back faces culled: %s\n", st.backfaces_culled ? "yes" : "no");
-        printf("pipelines bound: %d\n", st.pipelines);
-        if (st.screen)
-            printf("compute modules: %d from the SPIR-V cache, %d compiled from GLSL; "
-                   "%.1f ms making pipelines between frames\n", st.spirv_cached,
-                   st.spirv_compiled, compile_ms);
-        printf("combinations in view: %d of %d\n", st.combos_in_view, pack.ncombos);
-        if (!st.screen) {
-            printf("distance classes: %d of %d patches\n", st.class_patches, st.patches);
-            printf("far atlas: %d of %d patches\n", st.far_patches, st.patches);
-            printf("uber-shader fallback: %d of %d patches (no compiled combination "
-                   "covers their node)\n", st.uber_patches, st.patches);
-            printf("uncovered nodes split: %d\n", st.split_uncovered);
-        }
-        if (gm >= 0)
-            printf("gpu ms/frame: median %.3f  p10 %.3f  p90 %.3f\n", gm, gl, gh);
-        else
-            printf("gpu ms/frame: n/a (no timestamp support)\n");
-        if (st.screen) {
-            static const char *const names[3] = { "depth", "classification",
-                                                  "shading (compute)" };
-            for (int k = 0; k < 3 && gm >= 0; k++) {
-                double m, l, h;
-                summary(pass + k * o->frames, o->frames, &m, &l, &h);
-                printf("  %-18s gpu ms: median %.3f  p10 %.3f  p90 %.3f\n", names[k], m, l, h);
-            }
-            printf("tiles: %d of %d shaded, %d lists, %d by the uber-shader, %d from the far "
-                   "atlas\n", st.tiles.tiles, st.tiles.tiles_total, st.tiles.lists,
-                   st.tiles.tiles_uber, st.tiles.tiles_far);
-            printf("distance classes: %d of %d tiles\n", st.tiles.tiles_class, st.tiles.tiles);
-            printf("pipelines pending: %d (tiles the uber-shader stood in for: %d)\n",
-                   st.pipelines_pending, st.tiles.tiles_stand_in);
-        }
-        printf("quadtree cpu ms/frame: median %.4f  p10 %.4f  p90 %.4f\n", sm, sl, sh);
-        if (o->no_shadows)
-            printf("shadow map: off\n");
-        else
-            printf("shadow map %s ms: %.2f (when the sun moves or a crater lands; "
-                   "per frame a texture tap)\n", st.shadow_gpu ? "gpu" : "cpu", shadow_ms);
-        if (pack.ug.nslots > 0 && !o->no_undergrowth && view == SPLAT_VIEW_FINAL) {
-            double um, ul, uh;
-            summary(ug_draw, o->frames, &um, &ul, &uh);
-            printf("undergrowth: %d cells, %ld instances, %.3f ms generation\n",
-                   st.undergrowth.cells, st.undergrowth.instances, ug_gen_ms);
-            printf("  generated %d cells (%.4f ms per cell), draw gpu ms/frame: median %.3f  "
-                   "p10 %.3f  p90 %.3f, %zu bytes per cell\n", ug_generated,
-                   ug_generated ? ug_gen_ms / ug_generated : 0.0, um, ul, uh,
-                   st.undergrowth.bytes_per_cell);
-        } else if (pack.ug.nslots > 0) {
-            printf("undergrowth: off\n");
-        }
-        printf("cpu ms/frame (record): median %.3f  p10 %.3f  p90 %.3f\n", cm, cl, ch);
-        if (st.screen || (dev.count_fragments && o->ref != RT_REF_MULTIPASS)) {
-            /* one more frame with the counting variant (not timed) */
-            rt_renderer_set_counting(r, true);
-            rt_frame_stats cs;
-            if (!rt_renderer_frame(r, &cam, &cs, &e))
-                goto done;
-            rt_renderer_set_counting(r, view == SPLAT_VIEW_COST);
-            double px = cs.tiles.pixels ? (double)cs.tiles.pixels : 1.0;
-            printf("layers per pixel: evaluated %.3f, needed %.3f (efficiency %.1f %%)\n",
-                   cs.tiles.layers_evaluated / px, cs.tiles.layers_needed / px,
-                   cs.tiles.layers_evaluated
-                       ? 100.0 * cs.tiles.layers_needed / cs.tiles.layers_evaluated : 100.0);
-            printf("texture samples per pixel: %.3f\n", cs.tiles.samples / px);
-            printf("dynamic branches uniform over the subgroup: %.1f %% of %.2f per pixel\n",
-                   cs.tiles.branches ? 100.0 * cs.tiles.branches_uniform / cs.tiles.branches : 100.0,
-                   cs.tiles.branches / px);
-        }
-        printf("shading: %s%s\n", st.screen ? "screen" : "forward",
-               st.sorted ? ", pixels sorted by layer set" : "");
-        if (pack.far.data)   /* the BC blocks as uploaded (PACK.md "Far atlas") */
-            printf("far atlas: %d x %d texels of %.1f x %.1f m, %d levels, %zu bytes; %s\n",
-                   pack.far.width, pack.far.height, pack.far.texel[0], pack.far.texel[1],
-                   pack.far.levels, pack.far.n - FAR_ATLAS_HEADER,
-                   o->far_distance <= 0 ? "not used"
-                   : st.screen ? "screen tiles beyond --far-atlas-distance use it"
-                               : "forward patches beyond --far-atlas-distance use it");
-        rt_painted_print_stats(&pack, stdout);
-        if (rt_renderer_destruction(r))
-            rt_destruction_print_stats(rt_renderer_destruction(r), stdout);
-    }
+    if (!run_frames(o, r, &cam, &t, &st, &e) ||
+        ((o->out || o->float_out) &&
+         !write_pictures(o, &dev, &pack, r, view, material, &st, W, H, &e)) ||
+        (o->stats && !print_stats(o, &dev, &pack, r, &cam, view, &st, &t, W, H, &e)))
+        goto done;
     status = 0;
 done:
     if (e.msg)
@@ -822,9 +777,7 @@ done:
         }
     }
     rt_pack_free(&pack);
-    free(rgba);
-    free(png);
-    free(gpu);
+    free(times);
     return status;
 }
 

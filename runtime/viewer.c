@@ -103,6 +103,7 @@ typedef struct viewer {
     /* hot reload */
     watch          w;
     const char    *scene;
+    char           scene_buf[2048];   /* the manifest's scene.source */
     int            reloads, reload_errors;
     double         last_check;
     char           status[256];
@@ -848,6 +849,49 @@ static void teardown(viewer *v)
     watch_free(&v->w);
 }
 
+/* The view and camera the desc asks for (--view, --camera-preset,
+ * --camera), the fly speed from the terrain's size. */
+static bool start_view(viewer *v, rt_error *e)
+{
+    const rt_viewer_desc *desc = v->desc;
+    if (desc->view_name && !rt_parse_view(desc->view_name, v->pack, &v->view, &v->material, e))
+        return false;
+    rt_default_camera(v->pack, &v->cam);
+    if (desc->preset) {
+        int c = rt_pack_camera_find(v->pack, desc->preset);
+        if (c < 0)
+            return rt_fail(e, RT_E_WINDOW, "the pack has no such camera preset");
+        memcpy(v->cam.position, v->pack->cameras[c].position, sizeof v->cam.position);
+        memcpy(v->cam.look, v->pack->cameras[c].look, sizeof v->cam.look);
+    }
+    if (desc->have_camera && !desc->preset)
+        v->cam = desc->camera;
+    angles_from_camera(v);
+    camera_from_angles(v);
+    double ext = v->pack->size[0] > v->pack->size[1] ? v->pack->size[0] : v->pack->size[1];
+    v->speed = ext / 20.0;
+    return true;
+}
+
+/* The scene to watch: --scene, else the manifest's scene.source. */
+static void start_watch(viewer *v)
+{
+    v->scene = v->desc->scene;
+    if (!v->scene && v->pack->scene_path) {
+        snprintf(v->scene_buf, sizeof v->scene_buf, "%s/%s", v->desc->pack_dir,
+                 v->pack->scene_path);
+        struct stat st;
+        if (stat(v->scene_buf, &st) == 0)
+            v->scene = v->scene_buf;
+    }
+    if (v->scene) {
+        watch_scene(v);
+        snprintf(v->status, sizeof v->status, "watching %d files", v->w.n);
+    } else {
+        snprintf(v->status, sizeof v->status, "no scene source: hot reload off");
+    }
+}
+
 int rt_viewer_run(const rt_viewer_desc *desc)
 {
     viewer vw;
@@ -864,24 +908,8 @@ int rt_viewer_run(const rt_viewer_desc *desc)
         free(v->pack);
         return 1;
     }
-    if (desc->view_name && !rt_parse_view(desc->view_name, v->pack, &v->view, &v->material, &e))
+    if (!start_view(v, &e))
         goto done;
-    rt_default_camera(v->pack, &v->cam);
-    if (desc->preset) {
-        int c = rt_pack_camera_find(v->pack, desc->preset);
-        if (c < 0) {
-            rt_fail(&e, RT_E_WINDOW, "the pack has no such camera preset");
-            goto done;
-        }
-        memcpy(v->cam.position, v->pack->cameras[c].position, sizeof v->cam.position);
-        memcpy(v->cam.look, v->pack->cameras[c].look, sizeof v->cam.look);
-    }
-    if (desc->have_camera && !desc->preset)
-        v->cam = desc->camera;
-    angles_from_camera(v);
-    camera_from_angles(v);
-    double ext = v->pack->size[0] > v->pack->size[1] ? v->pack->size[0] : v->pack->size[1];
-    v->speed = ext / 20.0;
 
     if (!glfwInit()) {
         rt_fail(&e, RT_E_WINDOW, "glfwInit failed (no display?)");
@@ -942,21 +970,7 @@ int rt_viewer_run(const rt_viewer_desc *desc)
     printf("splatview: %s shading\n",
            rt_renderer_shading(v->r) == RT_SHADING_SCREEN ? "screen-space" : "forward");
     rt_renderer_set_view(v->r, v->view, v->material);
-    /* the scene to watch: --scene, else the manifest's scene.source */
-    char scene_buf[2048];
-    v->scene = desc->scene;
-    if (!v->scene && v->pack->scene_path) {
-        snprintf(scene_buf, sizeof scene_buf, "%s/%s", desc->pack_dir, v->pack->scene_path);
-        struct stat st;
-        if (stat(scene_buf, &st) == 0)
-            v->scene = scene_buf;
-    }
-    if (v->scene) {
-        watch_scene(v);
-        snprintf(v->status, sizeof v->status, "watching %d files", v->w.n);
-    } else {
-        snprintf(v->status, sizeof v->status, "no scene source: hot reload off");
-    }
+    start_watch(v);
     glfwSetKeyCallback(v->win, on_key);
     glfwSetScrollCallback(v->win, on_scroll);
     glfwSetMouseButtonCallback(v->win, on_button);

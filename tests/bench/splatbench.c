@@ -64,10 +64,10 @@
  *       compiles shader variants when a draw or dispatch first needs them,
  *       inside the GPU timestamps).
  *   splatbench far-bake --pack P [--far-atlas N] [--runs K] [--out PREFIX]
- *       the far atlas baked on the device (cmd_far_bake says more).
+ *       the far atlas baked on the device (bench_device.c says more).
  *   splatbench shadow --pack P [--runs K] [--sun AZ,EL]
  *       the shadow map marched on the CPU and on the device, side by side
- *       (cmd_shadow says more).
+ *       (bench_device.c says more).
  *   splatbench upscale IN.png K OUT
  *       K times the texels per side, bilinear: a 16-bit PNG becomes raw
  *       little-endian R16 (OUT), an 8-bit one an 8-bit PNG (nearest).
@@ -77,129 +77,18 @@
  *   splatbench compare A.f32 B.f32
  *       max/mean abs error and PSNR of two --float-out images.
  *
+ * The options of render, far-bake and shadow are tables (compiler/args.h):
+ * `splatbench COMMAND --help` lists them.  This file is the render command
+ * (variants, camera paths, the run); bench.h names the other files.
  * Exit status: 0 ok, 1 a failure (message on stderr), 2 usage. */
-#include "rt_internal.h"
+#include "bench.h"
 
 #include <errno.h>
 #include <jansson.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
-#include <sys/resource.h>
 #include <sys/stat.h>
-#include <unistd.h>
-
-#include <stb/stb_image.h>
-#include <stb/stb_image_write.h>
-
-/* ---- small helpers ------------------------------------------------------- */
-
-static void *xcalloc(size_t n, size_t size)
-{
-    void *p = calloc(n ? n : 1, size);
-    if (!p) {
-        fprintf(stderr, "splatbench: out of memory\n");
-        abort();
-    }
-    return p;
-}
-
-static char *read_text(const char *path)
-{
-    FILE *f = fopen(path, "rb");
-    if (!f)
-        return NULL;
-    fseek(f, 0, SEEK_END);
-    long n = ftell(f);
-    fseek(f, 0, SEEK_SET);
-    char *s = xcalloc((size_t)n + 1, 1);
-    if (n > 0 && fread(s, 1, (size_t)n, f) != (size_t)n) {
-        free(s);
-        s = NULL;
-    }
-    fclose(f);
-    return s;
-}
-
-static bool read_words(const char *path, uint32_t **words, size_t *n)
-{
-    FILE *f = fopen(path, "rb");
-    if (!f)
-        return false;
-    fseek(f, 0, SEEK_END);
-    long bytes = ftell(f);
-    fseek(f, 0, SEEK_SET);
-    bool ok = bytes > 0 && bytes % 4 == 0;
-    if (ok) {
-        *words = xcalloc((size_t)bytes / 4, 4);
-        *n = (size_t)bytes / 4;
-        ok = fread(*words, 4, *n, f) == *n;
-    }
-    fclose(f);
-    return ok;
-}
-
-static int cmp_double(const void *a, const void *b)
-{
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
-
-/* median, 10th and 90th percentile of n samples (sorted in place) */
-static void percentiles(double *v, int n, double *med, double *p10, double *p90)
-{
-    qsort(v, (size_t)n, sizeof *v, cmp_double);
-    *med = n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-    *p10 = v[(int)floor(0.1 * (n - 1))];
-    *p90 = v[(int)ceil(0.9 * (n - 1))];
-}
-
-/* resident set size now, MB (lavapipe's "GPU" memory is host memory) */
-static double rss_mb(void)
-{
-    FILE *f = fopen("/proc/self/statm", "r");
-    long pages = 0, res = 0;
-    if (f) {
-        if (fscanf(f, "%ld %ld", &pages, &res) != 2)
-            res = 0;
-        fclose(f);
-    }
-    return (double)res * (double)sysconf(_SC_PAGESIZE) / (1024.0 * 1024.0);
-}
-
-/* ---- image error ---------------------------------------------------------- */
-
-typedef struct err_acc {
-    double max_abs, sum_abs, sum_sq;
-    long   n, nonfinite;
-} err_acc;
-
-/* RGB of `img` against `ref` (w*h RGBA floats).  A NaN/Inf in img counts
- * as nonfinite and as an error of 1 (so it cannot hide in the mean). */
-static void err_add(err_acc *a, const float *img, const float *ref, size_t npx)
-{
-    for (size_t i = 0; i < npx; i++)
-        for (int c = 0; c < 3; c++) {
-            float v = img[4 * i + c], r = ref[4 * i + c];
-            double d;
-            if (!isfinite(v) || !isfinite(r)) {
-                a->nonfinite++;
-                d = 1.0;
-            } else {
-                d = fabs((double)v - (double)r);
-            }
-            a->max_abs = d > a->max_abs ? d : a->max_abs;
-            a->sum_abs += d;
-            a->sum_sq += d * d;
-            a->n++;
-        }
-}
-
-static double err_psnr(const err_acc *a)
-{
-    double mse = a->n ? a->sum_sq / (double)a->n : 0;
-    return mse > 0 ? 10.0 * log10(1.0 / mse) : 999.0;
-}
 
 /* ---- variants -------------------------------------------------------------- */
 
@@ -277,15 +166,8 @@ static const char lambert_light[] =
     "    return c * u_frame.light.z;\n"
     "}\n";
 
-/* The analytic heightfield: normalised height at heightfield uv (u, v),
- * within 0.1 .. 0.9, and its exact normal in GLSL (terrain.x, .y: size in
- * metres, .z: max height), written from the same formula. */
-static double analytic_height(double u, double v)
-{
-    const double tau = 6.283185307179586;
-    return 0.5 + 0.25 * sin(tau * 3 * u) * cos(tau * 2 * v) + 0.15 * sin(tau * 7 * (u + v));
-}
-
+/* The analytic heightfield's exact normal in GLSL (terrain.x, .y: size in
+ * metres, .z: max height), written from analytic_height's formula. */
 static const char analytic_normal[] =
     "vec3 splat_normal_at(vec2 uv) {\n"
     "    const float TAU = 6.283185307179586;\n"
@@ -577,205 +459,295 @@ static bool path_camera(const rt_pack *p, const path_desc *pd, int f, int n, rt_
 
 /* ---- render ---------------------------------------------------------------- */
 
-static int cmd_render(int argc, char **argv)
+/* `splatbench render`'s options (the table below). */
+typedef struct render_opts {
+    const char *pack_dir, *csv, *scene, *save, *ref_label, *view_name;
+    path_desc   pd;
+    int         width, height, frames, warmup;   /* warmup -1: the whole path */
+    const char *specs[128];                      /* --variant LABEL=KIND,...  */
+    int         nspecs;
+} render_opts;
+
+static bool parse_start(const char *v, void *o_, splat_arg_why *why)
 {
-    const char *pack_dir = NULL, *csv = NULL, *scene = NULL, *save = NULL, *ref_label = NULL;
-    const char *view_name = "final";
-    path_desc pd = {.name = "ground"};
-    int width = 1280, height = 720, frames = 5, warmup = 1;
-    char **specs = xcalloc((size_t)argc, sizeof *specs);
-    int nspecs = 0;
-    for (int i = 2; i < argc; i++) {
-        const char *a = argv[i], *next = i + 1 < argc ? argv[i + 1] : NULL;
-        if (!next) {
-            fprintf(stderr, "splatbench render: %s needs a value\n", a);
-            return 2;
-        }
-        i++;
-        if (!strcmp(a, "--pack")) pack_dir = next;
-        else if (!strcmp(a, "--variant")) specs[nspecs++] = (char *)next;
-        else if (!strcmp(a, "--ref")) ref_label = next;
-        else if (!strcmp(a, "--path")) pd.name = next;
-        else if (!strcmp(a, "--start-preset")) pd.preset = next;
-        else if (!strcmp(a, "--start")) {
-            if (sscanf(next, "%lf,%lf,%lf,%lf", &pd.start[0], &pd.start[1], &pd.start[2],
-                       &pd.start[3]) != 4) {
-                fprintf(stderr, "splatbench render: --start expects x,z,dx,dz\n");
-                return 2;
-            }
-            pd.have_start = true;
-        }
-        else if (!strcmp(a, "--csv")) csv = next;
-        else if (!strcmp(a, "--view")) view_name = next;
-        else if (!strcmp(a, "--scene")) scene = next;
-        else if (!strcmp(a, "--save")) save = next;
-        else if (!strcmp(a, "--frames")) frames = atoi(next);
-        else if (!strcmp(a, "--warmup")) warmup = !strcmp(next, "path") ? -1 : atoi(next);
-        else if (!strcmp(a, "--size")) {
-            if (sscanf(next, "%dx%d", &width, &height) != 2 || width <= 0 || height <= 0) {
-                fprintf(stderr, "splatbench render: --size expects WxH\n");
-                return 2;
-            }
-        } else {
-            fprintf(stderr, "splatbench render: unknown option '%s'\n", a);
-            return 2;
-        }
-    }
-    if (nspecs == 0 || frames < 1 || warmup < -1) {
-        fprintf(stderr, "splatbench render: needs --variant LABEL=KIND... and --frames >= 1\n");
-        return 2;
-    }
-    variant *v = xcalloc((size_t)nspecs, sizeof *v);
-    for (int i = 0; i < nspecs; i++)
-        if (!parse_variant(specs[i], pack_dir, &v[i])) {
+    render_opts *o = o_;
+    char tail;
+    (void)why;
+    return sscanf(v, "%lf,%lf,%lf,%lf%c", &o->pd.start[0], &o->pd.start[1], &o->pd.start[2],
+                  &o->pd.start[3], &tail) == 4;
+}
+
+static bool parse_warmup(const char *v, void *o_, splat_arg_why *why)
+{
+    render_opts *o = o_;
+    char *end;
+    (void)why;
+    long n = strtol(v, &end, 10);
+    o->warmup = !strcmp(v, "path") ? -1 : (int)n;
+    return !strcmp(v, "path") || (*v && !*end && n >= 0 && n <= 100000);
+}
+
+static bool parse_size(const char *v, void *o_, splat_arg_why *why)
+{
+    render_opts *o = o_;
+    char tail;
+    (void)why;
+    return sscanf(v, "%dx%d%c", &o->width, &o->height, &tail) == 2 && o->width > 0 &&
+           o->height > 0 && o->width <= 16384 && o->height <= 16384;
+}
+
+#define F(field) offsetof(render_opts, field)
+static const splat_arg render_rows[] = {
+    { "--variant", SPLAT_ARG_LIST, "LABEL=KIND[,KNOB...]", "a variant to render (repeatable; "
+      "the kinds and knobs: the comment atop tests/bench/splatbench.c)", F(specs),
+      .count = F(nspecs), .capacity = 128 },
+    { "--pack", SPLAT_ARG_STRING, "DIR", "the pack of the variants without pack=",
+      F(pack_dir) },
+    { "--ref", SPLAT_ARG_STRING, "LABEL", "the variant the others are compared against "
+      "(default the first)", F(ref_label) },
+    { "--path", SPLAT_ARG_STRING, "ground|topdown|grazing", "the camera path (default "
+      "ground)", F(pd.name) },
+    { "--start-preset", SPLAT_ARG_STRING, "NAME", "ground: start at this camera preset",
+      F(pd.preset) },
+    { "--start", SPLAT_ARG_CUSTOM, "X,Z,DX,DZ", "ground: start here, heading along DX,DZ",
+      .parse = parse_start, .given = SPLAT_ARG_GIVEN(render_opts, pd.have_start) },
+    { "--frames", SPLAT_ARG_INT, "N", "timed frames along the path (default 5)", F(frames),
+      .min = 1, .max = 1e6, .expects = "a positive count" },
+    { "--warmup", SPLAT_ARG_CUSTOM, "N|path", "N untimed frames at the path's start first "
+      "(default 1), or every frame of the path once", .parse = parse_warmup,
+      .expects = "a count >= 0 or 'path'" },
+    { "--size", SPLAT_ARG_CUSTOM, "WxH", "image size (default 1280x720)", .parse = parse_size,
+      .expects = "WxH (1..16384 each)" },
+    { "--view", SPLAT_ARG_STRING, "V", "the view rendered (default final)", F(view_name) },
+    { "--csv", SPLAT_ARG_STRING, "FILE", "append the rows to FILE (header when new) instead "
+      "of stdout", F(csv) },
+    { "--scene", SPLAT_ARG_STRING, "NAME", "the scene column (default the pack's name)",
+      F(scene) },
+    { "--save", SPLAT_ARG_STRING, "DIR", "write each variant's last frame as DIR/LABEL.f32 "
+      "and keep a pipeline cache there", F(save) },
+};
+#undef F
+
+static const splat_args_desc render_args = {
+    .prog = "splatbench render",
+    .usage = "usage: splatbench render --variant LABEL=KIND[,pack=DIR][,lod=P]... [options]\n",
+    .args = render_rows, .nargs = (int)(sizeof render_rows / sizeof render_rows[0]),
+    .column = 28,
+};
+
+/* One render run: the variants, their packs, the device and the images. */
+typedef struct bench_run {
+    const render_opts *o;
+    variant *v;
+    int      nv, ref;
+    rt_pack *packs;
+    const char **pack_dirs;
+    int      npacks;
+    rt_device dev;
+    bool     have_dev;
+    float   *img, *refimg;
+    size_t   npx;
+} bench_run;
+
+/* The variants of --variant, --ref's index, every distinct pack loaded
+ * once.  Exit status 2 on a bad variant or --ref. */
+static int load_variants(bench_run *b, rt_error *e)
+{
+    const render_opts *o = b->o;
+    for (int i = 0; i < b->nv; i++)
+        if (!parse_variant(o->specs[i], o->pack_dir, &b->v[i])) {
             fprintf(stderr, "splatbench render: bad variant '%s' (LABEL=KIND[,pack=DIR][,lod=P];"
                     " KIND composite|multipass|uber|flat|fp16|sobel|analytic|screen|screen_uber|"
-                    "screen_raster|screen_raycast;"
-                    " a pack from --pack"
-                    " or pack=)\n",
-                    specs[i]);
+                    "screen_raster|screen_raycast; a pack from --pack or pack=)\n", o->specs[i]);
             return 2;
         }
-    int ref = 0;
-    if (ref_label) {
-        ref = -1;
-        for (int i = 0; i < nspecs; i++)
-            if (!strcmp(v[i].label, ref_label))
-                ref = i;
-        if (ref < 0) {
-            fprintf(stderr, "splatbench render: --ref '%s' is not a variant\n", ref_label);
+    if (o->ref_label) {
+        b->ref = -1;
+        for (int i = 0; i < b->nv; i++)
+            if (!strcmp(b->v[i].label, o->ref_label))
+                b->ref = i;
+        if (b->ref < 0) {
+            fprintf(stderr, "splatbench render: --ref '%s' is not a variant\n", o->ref_label);
             return 2;
         }
     }
-
-    int status = 1;
-    rt_error e = {0};
-    rt_device dev;
-    bool have_dev = false;
-    rt_pack *packs = xcalloc((size_t)nspecs, sizeof *packs);
-    const char **pack_dirs = xcalloc((size_t)nspecs, sizeof *pack_dirs);
-    int npacks = 0;
-    size_t npx = (size_t)width * (size_t)height;
-    float *img = xcalloc(npx * 4, sizeof *img), *refimg = xcalloc(npx * 4, sizeof *refimg);
-
-    /* every distinct pack once */
-    for (int i = 0; i < nspecs; i++) {
+    for (int i = 0; i < b->nv; i++) {
         int k = 0;
-        while (k < npacks && strcmp(pack_dirs[k], v[i].pack_dir))
+        while (k < b->npacks && strcmp(b->pack_dirs[k], b->v[i].pack_dir))
             k++;
-        if (k == npacks) {
-            if (!rt_pack_load(&packs[k], v[i].pack_dir, &e))
-                goto done;
-            pack_dirs[npacks++] = v[i].pack_dir;
+        if (k == b->npacks) {
+            if (!rt_pack_load(&b->packs[k], b->v[i].pack_dir, e))
+                return 1;
+            b->pack_dirs[b->npacks++] = b->v[i].pack_dir;
         }
-        v[i].base = &packs[k];
-        if (packs[k].hf_width != packs[0].hf_width || packs[k].hf_height != packs[0].hf_height) {
+        b->v[i].base = &b->packs[k];
+        if (b->packs[k].hf_width != b->packs[0].hf_width ||
+            b->packs[k].hf_height != b->packs[0].hf_height) {
             fprintf(stderr, "splatbench: pack '%s' has another terrain than '%s'\n",
-                    v[i].pack_dir, pack_dirs[0]);
-            goto done;
+                    b->v[i].pack_dir, b->pack_dirs[0]);
+            return 1;
         }
-        if (!variant_shaders(&v[i]))
-            goto done;
+        if (!variant_shaders(&b->v[i]))
+            return 1;
     }
-    if (!rt_device_create(&dev, NULL, &e))
-        goto done;
-    have_dev = true;
-    char cache[4096];
-    if (save)
-        snprintf(cache, sizeof cache, "%s/pipeline-cache.bin", save);
-    for (int i = 0; i < nspecs; i++) {
-        rt_render_desc rd = {
-            .width = width, .height = height, .lod_pixels = v[i].lod,
-            .no_shadows = v[i].no_shadows, .no_undergrowth = !v[i].ug,
-            .no_distance_classes = v[i].no_dclass, .pixel_sort = v[i].sort,
-            .async_pipelines = v[i].async,
-            .sort_tiles = v[i].sort_tiles,
-            .undergrowth_radius = v[i].ug_radius, .far_atlas_distance = v[i].far,
-            .reference = v[i].k == K_MULTIPASS ? RT_REF_MULTIPASS
-                       : v[i].k == K_UBER || v[i].k == K_SCREEN_UBER ? RT_REF_UBER : RT_REF_NONE,
-            .pipeline_cache = save ? cache : NULL,
-            .shading = IS_SCREEN(v[i].k) ? RT_SHADING_SCREEN : RT_SHADING_FORWARD,
-            .screen_depth = v[i].k == K_SCREEN_RASTER ? RT_DEPTH_RASTER
-                          : v[i].k == K_SCREEN_RAYCAST ? RT_DEPTH_RAYCAST : RT_DEPTH_AUTO,
-        };
-        double before = rss_mb();
-        if (!rt_renderer_create(&dev, &v[i].view, &rd, &v[i].r, &e))
-            goto done;
-        splat_view view;
-        int material = 0;
-        if (!rt_parse_view(view_name, &v[i].view, &view, &material, &e))
-            goto done;
-        rt_renderer_set_view(v[i].r, view, material);
-        v[i].gpu = xcalloc((size_t)frames, sizeof(double));
-        v[i].cpu = xcalloc((size_t)frames, sizeof(double));
-        v[i].sel = xcalloc((size_t)frames, sizeof(double));
-        for (int k = 0; k < 3; k++)
-            v[i].pass[k] = xcalloc((size_t)frames, sizeof(double));
-        v[i].ug_gen = xcalloc((size_t)frames, sizeof(double));
-        v[i].ug_draw = xcalloc((size_t)frames, sizeof(double));
-        /* warm-up frames: pipelines are made (and JIT-compiled) on first use */
-        rt_camera cam;
-        rt_frame_stats st;
-        for (int w = 0; w < (warmup < 0 ? frames : warmup); w++) {
-            if (!path_camera(&v[i].view, &pd, warmup < 0 ? w : 0, frames, &cam))
-                goto done;
-            if (!rt_renderer_frame(v[i].r, &cam, &st, &e))
-                goto done;
-            v[i].shadow_ms += st.shadow_ms;
-        }
-        v[i].rss_delta = rss_mb() - before;
-    }
-    for (int f = 0; f < frames; f++) {
-        rt_camera cam;
-        if (!path_camera(&packs[0], &pd, f, frames, &cam))
-            goto done;
-        /* the reference first, so the others compare against this frame */
-        for (int o = 0; o < nspecs; o++) {
-            int i = o == 0 ? ref : o == ref ? 0 : o;
-            rt_frame_stats st;
-            if (!rt_renderer_frame(v[i].r, &cam, &st, &e))
-                goto done;
-            v[i].gpu[f] = st.gpu_ms;
-            v[i].cpu[f] = st.cpu_ms;
-            v[i].sel[f] = st.select_ms;
-            for (int k = 0; k < 3; k++)
-                v[i].pass[k][f] = st.pass_ms[k];
-            v[i].ug_gen[f] = st.undergrowth.gen_ms;
-            v[i].ug_draw[f] = st.undergrowth.draw_ms;
-            v[i].ug_cells += st.undergrowth.generated;
-            v[i].ug_last = st.undergrowth;
-            v[i].patches = st.patches;
-            v[i].pipelines = st.pipelines;
-            if (!rt_renderer_read(v[i].r, i == ref ? refimg : img, &e))
-                goto done;
-            err_add(&v[i].err, i == ref ? refimg : img, refimg, npx);
-            if (save && f == frames - 1) {
-                char path[4096];
-                snprintf(path, sizeof path, "%s/%s.f32", save, v[i].label);
-                if (!rt_write_float(path, i == ref ? refimg : img, width, height, &e))
-                    goto done;
-            }
-        }
-    }
+    return 0;
+}
 
-    /* one counting frame per variant the pack's GLSL shades (the screen
-     * kinds, composite and uber), after the timed ones */
-    for (int i = 0; i < nspecs; i++) {
-        if (!IS_SCREEN(v[i].k) && !(dev.count_fragments &&
-                                    (v[i].k == K_COMPOSITE || v[i].k == K_UBER)))
+/* Variant i's renderer, its per-frame arrays and its warm-up frames
+ * (pipelines are made, and JIT-compiled, on first use). */
+static bool make_renderer(bench_run *b, int i, const char *cache, rt_error *e)
+{
+    const render_opts *o = b->o;
+    variant *v = &b->v[i];
+    rt_render_desc rd = {
+        .width = o->width, .height = o->height, .lod_pixels = v->lod,
+        .no_shadows = v->no_shadows, .no_undergrowth = !v->ug,
+        .no_distance_classes = v->no_dclass, .pixel_sort = v->sort,
+        .async_pipelines = v->async,
+        .sort_tiles = v->sort_tiles,
+        .undergrowth_radius = v->ug_radius, .far_atlas_distance = v->far,
+        .reference = v->k == K_MULTIPASS ? RT_REF_MULTIPASS
+                   : v->k == K_UBER || v->k == K_SCREEN_UBER ? RT_REF_UBER : RT_REF_NONE,
+        .pipeline_cache = cache,
+        .shading = IS_SCREEN(v->k) ? RT_SHADING_SCREEN : RT_SHADING_FORWARD,
+        .screen_depth = v->k == K_SCREEN_RASTER ? RT_DEPTH_RASTER
+                      : v->k == K_SCREEN_RAYCAST ? RT_DEPTH_RAYCAST : RT_DEPTH_AUTO,
+    };
+    double before = rss_mb();
+    if (!rt_renderer_create(&b->dev, &v->view, &rd, &v->r, e))
+        return false;
+    splat_view view;
+    int material = 0;
+    if (!rt_parse_view(o->view_name, &v->view, &view, &material, e))
+        return false;
+    rt_renderer_set_view(v->r, view, material);
+    size_t n = (size_t)o->frames;
+    v->gpu = xcalloc(n, sizeof(double));
+    v->cpu = xcalloc(n, sizeof(double));
+    v->sel = xcalloc(n, sizeof(double));
+    for (int k = 0; k < 3; k++)
+        v->pass[k] = xcalloc(n, sizeof(double));
+    v->ug_gen = xcalloc(n, sizeof(double));
+    v->ug_draw = xcalloc(n, sizeof(double));
+    rt_camera cam;
+    rt_frame_stats st;
+    for (int w = 0; w < (o->warmup < 0 ? o->frames : o->warmup); w++) {
+        if (!path_camera(&v->view, &o->pd, o->warmup < 0 ? w : 0, o->frames, &cam) ||
+            !rt_renderer_frame(v->r, &cam, &st, e))
+            return false;
+        v->shadow_ms += st.shadow_ms;
+    }
+    v->rss_delta = rss_mb() - before;
+    return true;
+}
+
+/* Frame f of every variant, the reference first so the others compare
+ * against this frame; --save writes the last. */
+static bool timed_frame(bench_run *b, int f, rt_error *e)
+{
+    const render_opts *o = b->o;
+    rt_camera cam;
+    if (!path_camera(&b->packs[0], &o->pd, f, o->frames, &cam))
+        return false;
+    for (int k = 0; k < b->nv; k++) {
+        int i = k == 0 ? b->ref : k == b->ref ? 0 : k;
+        variant *v = &b->v[i];
+        float *img = i == b->ref ? b->refimg : b->img;
+        rt_frame_stats st;
+        if (!rt_renderer_frame(v->r, &cam, &st, e))
+            return false;
+        v->gpu[f] = st.gpu_ms;
+        v->cpu[f] = st.cpu_ms;
+        v->sel[f] = st.select_ms;
+        for (int p = 0; p < 3; p++)
+            v->pass[p][f] = st.pass_ms[p];
+        v->ug_gen[f] = st.undergrowth.gen_ms;
+        v->ug_draw[f] = st.undergrowth.draw_ms;
+        v->ug_cells += st.undergrowth.generated;
+        v->ug_last = st.undergrowth;
+        v->patches = st.patches;
+        v->pipelines = st.pipelines;
+        if (!rt_renderer_read(v->r, img, e))
+            return false;
+        err_add(&v->err, img, b->refimg, b->npx);
+        if (o->save && f == o->frames - 1) {
+            char path[4096];
+            snprintf(path, sizeof path, "%s/%s.f32", o->save, v->label);
+            if (!rt_write_float(path, img, o->width, o->height, e))
+                return false;
+        }
+    }
+    return true;
+}
+
+/* One counting frame per variant the pack's GLSL shades (the screen
+ * kinds, composite and uber), after the timed ones. */
+static bool counting_frames(bench_run *b, rt_error *e)
+{
+    for (int i = 0; i < b->nv; i++) {
+        variant *v = &b->v[i];
+        if (!IS_SCREEN(v->k) && !(b->dev.count_fragments &&
+                                  (v->k == K_COMPOSITE || v->k == K_UBER)))
             continue;
         rt_camera cam;
         rt_frame_stats st;
-        if (!path_camera(&packs[0], &pd, frames - 1, frames, &cam))
-            goto done;
-        rt_renderer_set_counting(v[i].r, true);
-        if (!rt_renderer_frame(v[i].r, &cam, &st, &e))
-            goto done;
-        v[i].tiles = st.tiles;
+        if (!path_camera(&b->packs[0], &b->o->pd, b->o->frames - 1, b->o->frames, &cam))
+            return false;
+        rt_renderer_set_counting(v->r, true);
+        if (!rt_renderer_frame(v->r, &cam, &st, e))
+            return false;
+        v->tiles = st.tiles;
         if (!st.screen)   /* forward: the far column counts patches */
-            v[i].tiles.tiles_far = st.far_patches;
+            v->tiles.tiles_far = st.far_patches;
     }
+    return true;
+}
 
+/* One CSV row of variant i. */
+static void csv_row(FILE *out, const bench_run *b, int i, const char *devname)
+{
+    const render_opts *o = b->o;
+    variant *v = &b->v[i];
+    int frames = o->frames;
+    double gm, g10, g90, cm, c10, c90, sm, s10, s90;
+    percentiles(v->gpu, frames, &gm, &g10, &g90);
+    percentiles(v->cpu, frames, &cm, &c10, &c90);
+    percentiles(v->sel, frames, &sm, &s10, &s90);
+    double pm[3] = { -1, -1, -1 }, lo, hi;
+    for (int k = 0; k < 3 && IS_SCREEN(v->k); k++)
+        percentiles(v->pass[k], frames, &pm[k], &lo, &hi);
+    double px = v->tiles.pixels ? (double)v->tiles.pixels : 1.0;
+    double ugm = -1, ugd = -1, gen_sum = 0;
+    if (v->ug) {
+        percentiles(v->ug_gen, frames, &ugm, &lo, &hi);
+        percentiles(v->ug_draw, frames, &ugd, &lo, &hi);
+        for (int f = 0; f < frames; f++)
+            gen_sum += v->ug_gen[f];
+    }
+    const char *pk = strrchr(v->pack_dir, '/');
+    fprintf(out, "\"%s\",%s,%s,%d,%d,%s,%s,%s,%g,%d,%.3f,%.3f,%.3f,%.3f,%.4f,%d,%d,"
+                 "%.6g,%.6g,%.2f,%ld,%.1f,%s,%s,%.3f,%.3f,%.3f,%d,%d,%.4f,%.4f,%.3f,%.1f,"
+                 "%.2f,%.4f,%.4f,%.4f,%.2f,%ld,%zu,%g,%d,%d,%d\n",
+            devname, o->scene ? o->scene : v->base->name, o->pd.name, o->width, o->height,
+            v->label, kind_names[v->k], pk ? pk + 1 : v->pack_dir,
+            v->lod > 0 ? v->lod : 3.0, frames, gm, g10, g90, cm, sm,
+            v->patches, v->pipelines, v->err.max_abs,
+            v->err.n ? v->err.sum_abs / (double)v->err.n : 0.0,
+            err_psnr(&v->err), v->err.nonfinite, v->rss_delta, b->v[b->ref].label,
+            o->view_name, pm[0], pm[1], pm[2], v->tiles.tiles, v->tiles.tiles_uber,
+            v->tiles.layers_evaluated / px, v->tiles.layers_needed / px,
+            v->tiles.samples / px,
+            v->tiles.branches ? 100.0 * v->tiles.branches_uniform / v->tiles.branches : 100.0,
+            v->shadow_ms, ugm, v->ug_cells ? gen_sum / (double)v->ug_cells : -1.0,
+            ugd, (double)v->ug_cells / frames, v->ug_last.instances,
+            v->ug_last.bytes_per_cell, v->far, v->tiles.tiles_far, !v->no_dclass,
+            v->tiles.tiles_class);
+}
+
+/* The rows, on stdout or appended to --csv (a header when it is new). */
+static bool write_csv(const bench_run *b)
+{
+    const char *csv = b->o->csv;
     FILE *out = stdout;
     bool header = true;
     if (csv) {
@@ -784,7 +756,7 @@ static int cmd_render(int argc, char **argv)
         out = fopen(csv, "a");
         if (!out) {
             fprintf(stderr, "splatbench: cannot write '%s': %s\n", csv, strerror(errno));
-            goto done;
+            return false;
         }
     }
     if (header)
@@ -797,420 +769,93 @@ static int cmd_render(int argc, char **argv)
                      "ug_instances,ug_bytes_per_cell,far_distance,tiles_far,distclass,tiles_class\n");
     /* the device name in CSV: its commas become ';' */
     char devname[VK_MAX_PHYSICAL_DEVICE_NAME_SIZE];
-    snprintf(devname, sizeof devname, "%s", dev.props.deviceName);
+    snprintf(devname, sizeof devname, "%s", b->dev.props.deviceName);
     for (char *c = devname; *c; c++)
         if (*c == ',' || *c == '"')
             *c = ';';
-    for (int i = 0; i < nspecs; i++) {
-        double gm, g10, g90, cm, c10, c90, sm, s10, s90;
-        percentiles(v[i].gpu, frames, &gm, &g10, &g90);
-        percentiles(v[i].cpu, frames, &cm, &c10, &c90);
-        percentiles(v[i].sel, frames, &sm, &s10, &s90);
-        double pm[3] = { -1, -1, -1 }, lo, hi;
-        bool scr = IS_SCREEN(v[i].k);
-        for (int k = 0; k < 3 && scr; k++)
-            percentiles(v[i].pass[k], frames, &pm[k], &lo, &hi);
-        double px = v[i].tiles.pixels ? (double)v[i].tiles.pixels : 1.0;
-        double ugm = -1, ugd = -1, gen_sum = 0;
-        if (v[i].ug) {
-            percentiles(v[i].ug_gen, frames, &ugm, &lo, &hi);
-            percentiles(v[i].ug_draw, frames, &ugd, &lo, &hi);
-            for (int f = 0; f < frames; f++)
-                gen_sum += v[i].ug_gen[f];
-        }
-        const char *pk = strrchr(v[i].pack_dir, '/');
-        fprintf(out, "\"%s\",%s,%s,%d,%d,%s,%s,%s,%g,%d,%.3f,%.3f,%.3f,%.3f,%.4f,%d,%d,"
-                     "%.6g,%.6g,%.2f,%ld,%.1f,%s,%s,%.3f,%.3f,%.3f,%d,%d,%.4f,%.4f,%.3f,%.1f,"
-                     "%.2f,%.4f,%.4f,%.4f,%.2f,%ld,%zu,%g,%d,%d,%d\n",
-                devname, scene ? scene : v[i].base->name, pd.name, width, height,
-                v[i].label, kind_names[v[i].k], pk ? pk + 1 : v[i].pack_dir,
-                v[i].lod > 0 ? v[i].lod : 3.0, frames, gm, g10, g90, cm, sm,
-                v[i].patches, v[i].pipelines, v[i].err.max_abs,
-                v[i].err.n ? v[i].err.sum_abs / (double)v[i].err.n : 0.0,
-                err_psnr(&v[i].err), v[i].err.nonfinite, v[i].rss_delta, v[ref].label,
-                view_name, pm[0], pm[1], pm[2], v[i].tiles.tiles, v[i].tiles.tiles_uber,
-                v[i].tiles.layers_evaluated / px, v[i].tiles.layers_needed / px,
-                v[i].tiles.samples / px,
-                v[i].tiles.branches ? 100.0 * v[i].tiles.branches_uniform / v[i].tiles.branches
-                                    : 100.0,
-                v[i].shadow_ms, ugm, v[i].ug_cells ? gen_sum / (double)v[i].ug_cells : -1.0,
-                ugd, (double)v[i].ug_cells / frames, v[i].ug_last.instances,
-                v[i].ug_last.bytes_per_cell, v[i].far, v[i].tiles.tiles_far, !v[i].no_dclass,
-                v[i].tiles.tiles_class);
-    }
+    for (int i = 0; i < b->nv; i++)
+        csv_row(out, b, i, devname);
     if (csv)
         fclose(out);
-    status = 0;
+    return true;
+}
+
+/* Every variant on every frame of a camera path, frames interleaved (the
+ * comment atop this file); one CSV row per variant. */
+static int cmd_render(int argc, char **argv)
+{
+    render_opts o = { .view_name = "final", .pd = { .name = "ground" }, .width = 1280,
+                      .height = 720, .frames = 5, .warmup = 1 };
+    int rc = splat_args_parse(&render_args, argc, argv, 2, &o);
+    if (rc)
+        return rc == SPLAT_ARGS_HELP ? 0 : rc;
+    if (o.nspecs == 0) {
+        fprintf(stderr, "splatbench render: needs --variant LABEL=KIND...\n");
+        return 2;
+    }
+    bench_run b = { .o = &o, .nv = o.nspecs, .npx = (size_t)o.width * (size_t)o.height };
+    b.v = xcalloc((size_t)b.nv, sizeof *b.v);
+    b.packs = xcalloc((size_t)b.nv, sizeof *b.packs);
+    b.pack_dirs = xcalloc((size_t)b.nv, sizeof *b.pack_dirs);
+    b.img = xcalloc(b.npx * 4, sizeof *b.img);
+    b.refimg = xcalloc(b.npx * 4, sizeof *b.refimg);
+    rt_error e = {0};
+    int status = load_variants(&b, &e);
+    if (status)
+        goto done;
+    status = 1;
+    if (!(b.have_dev = rt_device_create(&b.dev, NULL, &e)))
+        goto done;
+    char cache[4096];
+    if (o.save)
+        snprintf(cache, sizeof cache, "%s/pipeline-cache.bin", o.save);
+    for (int i = 0; i < b.nv; i++)
+        if (!make_renderer(&b, i, o.save ? cache : NULL, &e))
+            goto done;
+    for (int f = 0; f < o.frames; f++)
+        if (!timed_frame(&b, f, &e))
+            goto done;
+    if (counting_frames(&b, &e) && write_csv(&b))
+        status = 0;
 done:
     if (e.msg)
         fprintf(stderr, "splatbench: %s\n", e.msg);
     rt_error_clear(&e);
-    for (int i = 0; i < nspecs; i++)
-        variant_free(&v[i]);
-    if (have_dev) {
-        if (dev.validating && dev.messages) {
-            fprintf(stderr, "splatbench: %d validation message(s)\n", dev.messages);
+    for (int i = 0; i < b.nv; i++)
+        variant_free(&b.v[i]);
+    if (b.have_dev) {
+        if (b.dev.validating && b.dev.messages) {
+            fprintf(stderr, "splatbench: %d validation message(s)\n", b.dev.messages);
             status = status ? status : 3;
         }
-        rt_device_destroy(&dev);
+        rt_device_destroy(&b.dev);
     }
-    for (int k = 0; k < npacks; k++)
-        rt_pack_free(&packs[k]);
-    free(packs);
-    free(pack_dirs);
-    free(v);
-    free(specs);
-    free(img);
-    free(refimg);
+    for (int k = 0; k < b.npacks; k++)
+        rt_pack_free(&b.packs[k]);
+    free(b.packs);
+    free(b.pack_dirs);
+    free(b.v);
+    free(b.img);
+    free(b.refimg);
     return status;
 }
 
-/* ---- upscale ---------------------------------------------------------------- */
-
-static int cmd_upscale(int argc, char **argv)
-{
-    if (argc != 5 || atoi(argv[3]) < 1) {
-        fprintf(stderr, "usage: splatbench upscale IN.png K OUT\n");
-        return 2;
-    }
-    const char *in = argv[2], *outp = argv[4];
-    int k = atoi(argv[3]), w, h, ch;
-    bool sixteen = stbi_is_16_bit(in);
-    void *px = sixteen ? (void *)stbi_load_16(in, &w, &h, &ch, 1) : (void *)stbi_load(in, &w, &h, &ch, 1);
-    if (!px) {
-        fprintf(stderr, "splatbench: cannot read '%s': %s\n", in, stbi_failure_reason());
-        return 1;
-    }
-    /* texel centres stay aligned: output texel i samples input (i + 0.5)/k - 0.5 */
-    size_t W = (size_t)w * (size_t)k, H = (size_t)h * (size_t)k;
-    int status = 0;
-    if (sixteen) {
-        const uint16_t *s = px;
-        uint16_t *o = xcalloc(W * H, 2);
-        for (size_t j = 0; j < H; j++) {
-            double v = fmin(fmax((j + 0.5) / k - 0.5, 0), h - 1);
-            int j0 = (int)v, j1 = j0 + 1 < h ? j0 + 1 : j0;
-            double fv = v - j0;
-            for (size_t i = 0; i < W; i++) {
-                double u = fmin(fmax((i + 0.5) / k - 0.5, 0), w - 1);
-                int i0 = (int)u, i1 = i0 + 1 < w ? i0 + 1 : i0;
-                double fu = u - i0;
-                double a = s[(size_t)j0 * w + i0] * (1 - fu) + s[(size_t)j0 * w + i1] * fu;
-                double b = s[(size_t)j1 * w + i0] * (1 - fu) + s[(size_t)j1 * w + i1] * fu;
-                o[j * W + i] = (uint16_t)lround(a * (1 - fv) + b * fv);   /* little-endian host */
-            }
-        }
-        FILE *f = fopen(outp, "wb");
-        if (!f || fwrite(o, 2, W * H, f) != W * H) {
-            fprintf(stderr, "splatbench: cannot write '%s'\n", outp);
-            status = 1;
-        }
-        if (f)
-            fclose(f);
-        free(o);
-    } else {
-        const uint8_t *s = px;
-        uint8_t *o = xcalloc(W * H, 1);
-        for (size_t j = 0; j < H; j++)
-            for (size_t i = 0; i < W; i++)
-                o[j * W + i] = s[(j / (size_t)k) * (size_t)w + i / (size_t)k];
-        stbi_write_png_compression_level = 1;
-        if (!stbi_write_png(outp, (int)W, (int)H, 1, o, (int)W)) {
-            fprintf(stderr, "splatbench: cannot write '%s'\n", outp);
-            status = 1;
-        }
-        free(o);
-    }
-    stbi_image_free(px);
-    printf("%s: %zu x %zu\n", outp, W, H);
-    return status;
-}
-
-/* ---- analytic-hf ----------------------------------------------------------- */
-
-static int cmd_analytic_hf(int argc, char **argv)
-{
-    int w = argc == 5 ? atoi(argv[2]) : 0, h = argc == 5 ? atoi(argv[3]) : 0;
-    if (w < 1 || h < 1) {
-        fprintf(stderr, "usage: splatbench analytic-hf W H OUT.r16\n");
-        return 2;
-    }
-    FILE *f = fopen(argv[4], "wb");
-    if (!f) {
-        fprintf(stderr, "splatbench: cannot write '%s'\n", argv[4]);
-        return 1;
-    }
-    bool ok = true;
-    for (int j = 0; j < h; j++)
-        for (int i = 0; i < w; i++) {
-            long q = lround(analytic_height((i + 0.5) / w, (j + 0.5) / h) * 65535.0);
-            uint8_t b[2] = {(uint8_t)(q & 255), (uint8_t)(q >> 8)};
-            ok = ok && fwrite(b, 1, 2, f) == 2;
-        }
-    if (fclose(f) != 0 || !ok) {
-        fprintf(stderr, "splatbench: cannot write '%s'\n", argv[4]);
-        return 1;
-    }
-    return 0;
-}
-
-/* ---- compare ------------------------------------------------------------------ */
-
-static int cmd_compare(int argc, char **argv)
-{
-    if (argc != 4) {
-        fprintf(stderr, "usage: splatbench compare A.f32 B.f32\n");
-        return 2;
-    }
-    float *a = NULL, *b = NULL;
-    int wa, ha, wb, hb;
-    rt_error e = {0};
-    int status = 1;
-    if (!rt_read_float(argv[2], &a, &wa, &ha, &e) || !rt_read_float(argv[3], &b, &wb, &hb, &e))
-        goto done;
-    if (wa != wb || ha != hb) {
-        fprintf(stderr, "splatbench: images differ in size (%dx%d, %dx%d)\n", wa, ha, wb, hb);
-        goto done;
-    }
-    err_acc acc = {0};
-    err_add(&acc, a, b, (size_t)wa * (size_t)ha);
-    printf("max_abs %.6g mean_abs %.6g psnr_db %.2f nonfinite %ld\n", acc.max_abs,
-           acc.n ? acc.sum_abs / (double)acc.n : 0.0, err_psnr(&acc), acc.nonfinite);
-    status = 0;
-done:
-    if (e.msg)
-        fprintf(stderr, "splatbench: %s\n", e.msg);
-    rt_error_clear(&e);
-    free(a);
-    free(b);
-    return status;
-}
-
-/* splatbench far-bake --pack P [--far-atlas N] [--runs K] [--out PREFIX]:
- * the far atlas baked on the device (runtime/far_bake.c) from pack P, one
- * texel per N x N heightfield texels, K times (the first compiles with a
- * cold pipeline cache of its own, the later ones hit it): per run the
- * combinations compiled and the seconds of compiling and of shading.
- * --out writes the last run's level 0 for `splatbench compare`:
- * PREFIX.albedo.f32 (albedo rgb, roughness) and PREFIX.normal.f32 (xyz, 1). */
-static int cmd_far_bake(int argc, char **argv)
-{
-    const char *pack_dir = NULL, *out = NULL;
-    int n = 1, runs = 1;
-    for (int i = 2; i < argc; i++) {
-        const char *a = argv[i], *next = i + 1 < argc ? argv[i + 1] : NULL;
-        if (!strcmp(a, "--pack") && next)
-            pack_dir = argv[++i];
-        else if (!strcmp(a, "--far-atlas") && next)
-            n = atoi(argv[++i]);
-        else if (!strcmp(a, "--runs") && next)
-            runs = atoi(argv[++i]);
-        else if (!strcmp(a, "--out") && next)
-            out = argv[++i];
-        else {
-            fprintf(stderr, "usage: splatbench far-bake --pack P [--far-atlas N] [--runs K] "
-                            "[--out PREFIX]\n");
-            return 2;
-        }
-    }
-    if (!pack_dir || n < 1 || n > 64 || runs < 1) {
-        fprintf(stderr, "splatbench far-bake: --pack, N in 1..64 and K >= 1 needed\n");
-        return 2;
-    }
-    rt_error e = {0};
-    rt_pack p;
-    rt_device dev;
-    rt_renderer *r = NULL;
-    bool have_pack = false, have_dev = false;
-    int status = 1;
-    float *al = NULL, *no = NULL, *ro = NULL, *img = NULL;
-    char cache[64];
-    snprintf(cache, sizeof cache, "/tmp/splatbench-farbake-%d.bin", (int)getpid());
-    remove(cache);
-    if (!(have_pack = rt_pack_load(&p, pack_dir, &e)) ||
-        !(have_dev = rt_device_create(&dev, NULL, &e)))
-        goto done;
-    int w = (p.hf_width + n - 1) / n, h = (p.hf_height + n - 1) / n;
-    size_t texels = (size_t)w * (size_t)h;
-    al = xcalloc(texels * 3, sizeof *al);
-    no = xcalloc(texels * 3, sizeof *no);
-    ro = xcalloc(texels, sizeof *ro);
-    printf("device %s, far atlas %d x %d texels (N = %d)\n", dev.props.deviceName, w, h, n);
-    printf("run,combos,compile_s,shade_s,total_s\n");
-    for (int k = 0; k < runs; k++) {
-        rt_render_desc rd = { .width = 8, .height = 8, .no_undergrowth = true, .no_shadows = true,
-                              .pipeline_cache = cache };
-        rt_far_bake_stats st;
-        if (!rt_renderer_create(&dev, &p, &rd, &r, &e) ||
-            !rt_renderer_bake_far(r, w, h, al, no, ro, &st, &e))
-            goto done;
-        rt_renderer_destroy(r);   /* saves the pipeline cache */
-        r = NULL;
-        printf("%d,%d,%.3f,%.3f,%.3f\n", k + 1, st.combos, st.compile_s, st.shade_s,
-               st.compile_s + st.shade_s);
-    }
-    if (out) {
-        img = xcalloc(texels * 4, sizeof *img);
-        char path[4096];
-        for (size_t i = 0; i < texels; i++) {
-            memcpy(img + 4 * i, al + 3 * i, 3 * sizeof *img);
-            img[4 * i + 3] = ro[i];
-        }
-        snprintf(path, sizeof path, "%s.albedo.f32", out);
-        if (!rt_write_float(path, img, w, h, &e))
-            goto done;
-        for (size_t i = 0; i < texels; i++) {
-            memcpy(img + 4 * i, no + 3 * i, 3 * sizeof *img);
-            img[4 * i + 3] = 1.0f;
-        }
-        snprintf(path, sizeof path, "%s.normal.f32", out);
-        if (!rt_write_float(path, img, w, h, &e))
-            goto done;
-    }
-    status = 0;
-done:
-    if (e.msg)
-        fprintf(stderr, "splatbench: %s\n", e.msg);
-    rt_error_clear(&e);
-    rt_renderer_destroy(r);
-    if (have_dev)
-        rt_device_destroy(&dev);
-    if (have_pack)
-        rt_pack_free(&p);
-    remove(cache);
-    free(al);
-    free(no);
-    free(ro);
-    free(img);
-    return status;
-}
-
-/* splatbench shadow --pack P [--runs K] [--sun AZ,EL]: the terrain's
- * shadow map marched on the CPU (shadow.c, the reference) and on the
- * device (shadow_gpu.c), side by side: K maps each, the two paths
- * interleaved (map k of the CPU, then of the device, so a change of machine
- * load hits both), the sun turned by 0.01 degree between maps so each is
- * made whole.  Prints one CSV row per map, then per path the median, p10
- * and p90 wall milliseconds, the ratio of the medians, and the largest
- * difference of the last two maps (1/255). */
-static int cmd_shadow(int argc, char **argv)
-{
-    const char *pack_dir = NULL;
-    int runs = 5;
-    double sun[2] = { 144, 21 };
-    bool sun_set = false;
-    for (int i = 2; i < argc; i++) {
-        const char *a = argv[i], *next = i + 1 < argc ? argv[i + 1] : NULL;
-        if (!strcmp(a, "--pack") && next)
-            pack_dir = argv[++i];
-        else if (!strcmp(a, "--runs") && next)
-            runs = atoi(argv[++i]);
-        else if (!strcmp(a, "--sun") && next && sscanf(argv[++i], "%lf,%lf", &sun[0], &sun[1]) == 2)
-            sun_set = true;
-        else {
-            fprintf(stderr, "usage: splatbench shadow --pack P [--runs K] [--sun AZ,EL]\n");
-            return 2;
-        }
-    }
-    if (!pack_dir || runs < 1) {
-        fprintf(stderr, "splatbench shadow: --pack and K >= 1 needed\n");
-        return 2;
-    }
-    rt_error e = {0};
-    rt_pack p;
-    rt_device dev;
-    rt_renderer *r[2] = { NULL, NULL };
-    bool have_pack = false, have_dev = false;
-    int status = 1;
-    double *ms = NULL;
-    uint8_t *map[2] = { NULL, NULL };
-    static const char *const names[2] = { "cpu", "gpu" };
-    if (!(have_pack = rt_pack_load(&p, pack_dir, &e)) ||
-        !(have_dev = rt_device_create(&dev, NULL, &e)))
-        goto done;
-    size_t n = (size_t)p.hf_width * (size_t)p.hf_height;
-    ms = xcalloc((size_t)runs * 2, sizeof *ms);
-    map[0] = xcalloc(n, 1);
-    map[1] = xcalloc(n, 1);
-    for (int k = 0; k < 2; k++) {
-        rt_render_desc rd = { .width = 8, .height = 8, .no_undergrowth = true,
-                              .shading = RT_SHADING_FORWARD,
-                              .shadow = k ? RT_SHADOW_GPU : RT_SHADOW_CPU };
-        if (!rt_renderer_create(&dev, &p, &rd, &r[k], &e))
-            goto done;
-    }
-    rt_light l = *rt_renderer_light(r[0]);
-    if (sun_set)
-        memcpy(l.sun, sun, sizeof sun);
-    printf("device %s, heightfield %d x %d, sun %g/%g, %d maps per path\n", dev.props.deviceName,
-           p.hf_width, p.hf_height, l.sun[0], l.sun[1], runs);
-    rt_camera cam;
-    rt_default_camera(&p, &cam);
-    /* an untimed map each: the device's pyramid and pipeline are made,
-     * llvmpipe compiles the shader at its first dispatch */
-    for (int k = 0; k < 2; k++) {
-        rt_renderer_set_light(r[k], &l);
-        if (!rt_renderer_frame(r[k], &cam, NULL, &e))
-            goto done;
-    }
-    printf("run,path,ms\n");
-    for (int i = 0; i < runs; i++) {
-        l.sun[0] += 0.01;
-        for (int k = 0; k < 2; k++) {
-            rt_frame_stats st;
-            rt_renderer_set_light(r[k], &l);
-            if (!rt_renderer_frame(r[k], &cam, &st, &e))
-                goto done;
-            ms[k * runs + i] = st.shadow_ms;
-            printf("%d,%s,%.2f\n", i + 1, names[k], st.shadow_ms);
-        }
-    }
-    int worst = 0;
-    for (int k = 0; k < 2; k++)
-        if (!rt_renderer_shadow_read(r[k], map[k], &e))
-            goto done;
-    for (size_t i = 0; i < n; i++) {
-        int d = abs((int)map[0][i] - (int)map[1][i]);
-        worst = d > worst ? d : worst;
-    }
-    double med[2], lo[2], hi[2];
-    for (int k = 0; k < 2; k++) {
-        percentiles(ms + k * runs, runs, &med[k], &lo[k], &hi[k]);
-        printf("shadow map %s ms: median %.1f  p10 %.1f  p90 %.1f\n", names[k], med[k], lo[k],
-               hi[k]);
-    }
-    printf("shadow map cpu / gpu: %.2fx; largest difference %d/255\n", med[0] / med[1], worst);
-    status = 0;
-done:
-    if (e.msg)
-        fprintf(stderr, "splatbench: %s\n", e.msg);
-    rt_error_clear(&e);
-    rt_renderer_destroy(r[0]);
-    rt_renderer_destroy(r[1]);
-    if (have_dev)
-        rt_device_destroy(&dev);
-    if (have_pack)
-        rt_pack_free(&p);
-    free(ms);
-    free(map[0]);
-    free(map[1]);
-    return status;
-}
+/* The commands: argv[1] names one; each takes its own --help. */
+static const struct {
+    const char *name;
+    int (*run)(int argc, char **argv);
+} commands[] = {
+    { "render", cmd_render },           { "far-bake", bench_far_bake },
+    { "shadow", bench_shadow },         { "upscale", bench_upscale },
+    { "compare", bench_compare },       { "analytic-hf", bench_analytic_hf },
+};
 
 int main(int argc, char **argv)
 {
-    if (argc >= 2 && !strcmp(argv[1], "far-bake"))
-        return cmd_far_bake(argc, argv);
-    if (argc >= 2 && !strcmp(argv[1], "shadow"))
-        return cmd_shadow(argc, argv);
-    if (argc >= 2 && !strcmp(argv[1], "render"))
-        return cmd_render(argc, argv);
-    if (argc >= 2 && !strcmp(argv[1], "upscale"))
-        return cmd_upscale(argc, argv);
-    if (argc >= 2 && !strcmp(argv[1], "compare"))
-        return cmd_compare(argc, argv);
-    if (argc >= 2 && !strcmp(argv[1], "analytic-hf"))
-        return cmd_analytic_hf(argc, argv);
-    fprintf(stderr, "usage: splatbench render|upscale|compare|far-bake|shadow ... (see tests/bench/splatbench.c)\n");
+    for (size_t i = 0; argc >= 2 && i < sizeof commands / sizeof commands[0]; i++)
+        if (!strcmp(argv[1], commands[i].name))
+            return commands[i].run(argc, argv);
+    fprintf(stderr, "usage: splatbench render|far-bake|shadow|upscale|compare|analytic-hf ... "
+                    "(render, far-bake, shadow: COMMAND --help; tests/bench/splatbench.c)\n");
     return 2;
 }

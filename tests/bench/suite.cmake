@@ -4,7 +4,9 @@
 # few small frames of examples/minimal through the whole pipeline, so the
 # benchmark cannot rot.  Figures are printed, never asserted (compiler/DESIGN.md §9).
 if(TARGET splatrt AND TARGET splatview AND TARGET splatc_cli)
-  add_executable(splatbench ${CMAKE_CURRENT_LIST_DIR}/splatbench.c)
+  add_executable(splatbench ${CMAKE_CURRENT_LIST_DIR}/splatbench.c
+                 ${CMAKE_CURRENT_LIST_DIR}/bench_util.c ${CMAKE_CURRENT_LIST_DIR}/bench_tools.c
+                 ${CMAKE_CURRENT_LIST_DIR}/bench_device.c)
   target_link_libraries(splatbench splatrt)
   add_test(NAME bench.smoke
     COMMAND sh ${CMAKE_CURRENT_LIST_DIR}/run.sh ${CMAKE_BINARY_DIR} --smoke

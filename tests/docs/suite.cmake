@@ -40,3 +40,15 @@ endif()
 add_test(NAME docs.file_map
   COMMAND sh ${CMAKE_CURRENT_LIST_DIR}/file_map.sh ${PROJECT_SOURCE_DIR} runtime runtime/DESIGN.md)
 set_tests_properties(docs.file_map PROPERTIES LABELS unit TIMEOUT 60)
+
+# README.md's option lists are generated from the programs' option tables
+# (compiler/args.h): a table row added or changed without regenerating
+# them fails here (regenerate: sh tests/docs/options.sh --update README.md
+# build/compiler build/runtime).
+if(TARGET splatc_cli AND TARGET splatview)
+  add_test(NAME docs.options
+           COMMAND sh ${CMAKE_CURRENT_LIST_DIR}/options.sh README.md
+                   $<TARGET_FILE_DIR:splatc_cli> $<TARGET_FILE_DIR:splatview>
+           WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
+  set_tests_properties(docs.options PROPERTIES LABELS "docs;unit")
+endif()

@@ -1,0 +1,108 @@
+/* bench_util.c — splatbench's shared helpers (bench.h): files, medians,
+ * memory, the image error and the analytic heightfield. */
+#include "bench.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <unistd.h>
+
+char *read_text(const char *path)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return NULL;
+    fseek(f, 0, SEEK_END);
+    long n = ftell(f);
+    fseek(f, 0, SEEK_SET);
+    char *s = xcalloc((size_t)n + 1, 1);
+    if (n > 0 && fread(s, 1, (size_t)n, f) != (size_t)n) {
+        free(s);
+        s = NULL;
+    }
+    fclose(f);
+    return s;
+}
+
+bool read_words(const char *path, uint32_t **words, size_t *n)
+{
+    FILE *f = fopen(path, "rb");
+    if (!f)
+        return false;
+    fseek(f, 0, SEEK_END);
+    long bytes = ftell(f);
+    fseek(f, 0, SEEK_SET);
+    bool ok = bytes > 0 && bytes % 4 == 0;
+    if (ok) {
+        *words = xcalloc((size_t)bytes / 4, 4);
+        *n = (size_t)bytes / 4;
+        ok = fread(*words, 4, *n, f) == *n;
+    }
+    fclose(f);
+    return ok;
+}
+
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* median, 10th and 90th percentile of n samples (sorted in place) */
+void percentiles(double *v, int n, double *med, double *p10, double *p90)
+{
+    qsort(v, (size_t)n, sizeof *v, cmp_double);
+    *med = n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+    *p10 = v[(int)floor(0.1 * (n - 1))];
+    *p90 = v[(int)ceil(0.9 * (n - 1))];
+}
+
+/* resident set size now, MB (lavapipe's "GPU" memory is host memory) */
+double rss_mb(void)
+{
+    FILE *f = fopen("/proc/self/statm", "r");
+    long pages = 0, res = 0;
+    if (f) {
+        if (fscanf(f, "%ld %ld", &pages, &res) != 2)
+            res = 0;
+        fclose(f);
+    }
+    return (double)res * (double)sysconf(_SC_PAGESIZE) / (1024.0 * 1024.0);
+}
+
+/* ---- image error ---------------------------------------------------------- */
+
+
+/* RGB of `img` against `ref` (w*h RGBA floats).  A NaN/Inf in img counts
+ * as nonfinite and as an error of 1 (so it cannot hide in the mean). */
+void err_add(err_acc *a, const float *img, const float *ref, size_t npx)
+{
+    for (size_t i = 0; i < npx; i++)
+        for (int c = 0; c < 3; c++) {
+            float v = img[4 * i + c], r = ref[4 * i + c];
+            double d;
+            if (!isfinite(v) || !isfinite(r)) {
+                a->nonfinite++;
+                d = 1.0;
+            } else {
+                d = fabs((double)v - (double)r);
+            }
+            a->max_abs = d > a->max_abs ? d : a->max_abs;
+            a->sum_abs += d;
+            a->sum_sq += d * d;
+            a->n++;
+        }
+}
+
+double err_psnr(const err_acc *a)
+{
+    double mse = a->n ? a->sum_sq / (double)a->n : 0;
+    return mse > 0 ? 10.0 * log10(1.0 / mse) : 999.0;
+}
+/* The analytic heightfield: normalised height at heightfield uv (u, v),
+ * within 0.1 .. 0.9, and its exact normal in GLSL (terrain.x, .y: size in
+ * metres, .z: max height), written from the same formula. */
+double analytic_height(double u, double v)
+{
+    const double tau = 6.283185307179586;
+    return 0.5 + 0.25 * sin(tau * 3 * u) * cos(tau * 2 * v) + 0.15 * sin(tau * 7 * (u + v));
+}
