@@ -8,7 +8,7 @@
 # (then take it off the list).
 set -eu
 ROOT=$1
-allowed="tests/bench/splatbench.c
+allowed="tests/bench/bench.h
 tests/destruction/test_destruction.c
 tests/extreme/extreme.c
 tests/fuzz/fuzz_combos.c
