@@ -30,7 +30,7 @@
  *   - a textured OBJ card (uv, `texture` red at alpha 0.5): opaque, the
  *     pixels it covers are red; with `cutout = alpha` it covers half as
  *     many (0.35 to 0.65 of them: the dithered alpha). */
-#include "splatrt.h"
+#include "rt_internal.h"   /* asserts on the loaded undergrowth blocks (rt_pack.ug) */
 #include "../check.h"
 
 #include <math.h>
