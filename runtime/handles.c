@@ -90,12 +90,15 @@ void rt_pack_info_get(const rt_pack *p, rt_pack_info *out)
         .nbase = p->nbase,
         .nlevels = p->nlevels,
         .npainted = p->npainted,
+        .nsites = p->nsites,
         .has_holes = p->holes != NULL,
         .has_destruction = p->has_destruction,
         .has_uber = p->uber.words != NULL,
         .has_far_atlas = p->far.data != NULL,
         .has_undergrowth = p->ug.nslots > 0,
         .has_vectors = p->vectors != NULL,
+        .ug_slots = p->ug.nslots,
+        .ug_blocks = p->ug.nblocks,
         .has_reference = reference,
         .has_compute = p->uber_compute != NULL,
         .far_width = p->far.width,
@@ -128,4 +131,9 @@ bool rt_pack_camera_at(const rt_pack *p, int i, double position[3], double look[
 const rt_light *rt_pack_light(const rt_pack *p)
 {
     return &p->light;
+}
+
+const uint16_t *rt_pack_heights(const rt_pack *p)
+{
+    return p->heights;
 }

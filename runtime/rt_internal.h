@@ -16,6 +16,7 @@
 #include <stdatomic.h>
 #include <vulkan/vulkan.h>
 
+#include "far_atlas.h"
 #include "sparse.h"
 
 /* ---- the device and the pack, behind splatrt.h's opaque handles ----------

@@ -24,7 +24,6 @@
 #include <stdio.h>
 
 #include "abi.h"
-#include "far_atlas.h"
 
 /* ---- errors (device.c) -------------------------------------------------
  * X(id, format): one list so tests and callers can switch on the id. */
@@ -174,8 +173,11 @@ typedef struct rt_pack_info {
     int    nbase;                 /* combinations of combos.bin             */
     int    nlevels;               /* combination levels (quadtree depths)   */
     int    npainted;              /* painted masks                          */
+    int    nsites;                /* periodic sites of terrain.position
+                                     (u_frame.world, abi.h)                 */
     bool   has_holes, has_destruction, has_uber, has_far_atlas;
     bool   has_undergrowth, has_vectors;
+    int    ug_slots, ug_blocks;   /* undergrowth slots and blocks (PACK.md)  */
     bool   has_reference;         /* every material has a multi-pass pass   */
     bool   has_compute;           /* screen-path (compute) variants         */
     /* the far atlas (PACK.md "Far atlas"), when has_far_atlas */
@@ -192,6 +194,10 @@ const char *rt_pack_camera_name(const rt_pack *p, int i);
 bool rt_pack_camera_at(const rt_pack *p, int i, double position[3], double look[3]);
 /* The scene's lighting over the defaults. */
 const rt_light *rt_pack_light(const rt_pack *p);
+/* The heightfield as loaded (hf_width * hf_height, x fastest, row z = 0
+ * first): metres = height_offset + h / 65535 * max_height.
+ * rt_renderer_heights has it with a renderer's craters. */
+const uint16_t *rt_pack_heights(const rt_pack *p);
 /* Each size of the pack against the device's limits (maxImageDimension2D,
  * maxImageArrayLayers, samplers per stage, uniform range), before any of
  * it is created; RT_E_PACK_LIMIT naming the limit. */
@@ -503,7 +509,9 @@ bool rt_renderer_bake_far(rt_renderer *r, int w, int h, float *albedo, float *no
  * an rt_far_bake_host): rt_renderer_bake_far on the pack in pack_dir, on
  * host->device (the viewer's, for a hot reload) or on one of its own. */
 typedef struct rt_far_bake_host {
-    splat_far_bake mode;      /* auto: a CPU's device declines            */
+    int            mode;      /* a splat_far_bake (compiler/far_atlas.h,
+                                 not needed here): auto, a CPU's device
+                                 declines                                  */
     rt_device     *device;    /* NULL: create one (splatc)                */
 } rt_far_bake_host;
 bool rt_far_bake_device(void *user, const char *pack_dir, int w, int h, float *albedo,

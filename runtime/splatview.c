@@ -1,7 +1,6 @@
 /* splatview — render a shader pack: headless to PNG (and raw floats), or in
  * a GLFW window with a fly camera and hot reload.  See usage() below. */
 #include "splatrt.h"
-#include "far_atlas.h"
 #include "scene.h"
 #include "util.h"
 

@@ -26,14 +26,7 @@ tests/render/test_ug_look.c          asserts on the loaded undergrowth blocks (r
 tests/render/test_shadow_gpu.c       compares the device shadow map with the CPU reference (rt_shadow_map)
 tests/world/test_holes.c             checks the combination levels and node bounds over holes (rt_pack_level, rt_bounds_build)
 tests/world/test_placed.c            reads the sparse painted store of the loaded pack (rt_pack.sparse)
-tests/destruction/test_destruction.c pending: moves to tests/kit and splatrt.h
-tests/reload/test_reload.c           pending: moves to tests/kit and splatrt.h
-tests/render/test_brdf.c             pending: moves to tests/kit and splatrt.h
-tests/render/test_dclass.c           pending: moves to tests/kit and splatrt.h
-tests/render/test_lighting.c         pending: moves to tests/kit and splatrt.h
-tests/render/test_shadow.c           pending: moves to tests/kit and splatrt.h
-tests/render/test_undergrowth.c      pending: moves to tests/kit and splatrt.h
-tests/world/test_far.c               pending: moves to tests/kit and splatrt.h
+tests/render/test_dclass.c           picks rock texels from the leaf combination map (rt_pack.levels, rt_pack.combos)
 '
 cd "$ROOT"
 # every C file but the library's own (runtime/*.c except splatview.c) and
