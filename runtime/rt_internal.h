@@ -2,7 +2,9 @@
  * by the tests that reach inside (not installed; splatrt.h is the public
  * API, as Lua keeps lstate.h beside lua.h).
  *
- * Sections: errors, device.c (buffers, images, one-shot commands),
+ * Sections: the structs behind splatrt.h's rt_device and rt_pack (with
+ * their in-place create/load; handles.c wraps them), errors, device.c
+ * (buffers, images, one-shot commands),
  * shader_compile.c, spirv_check.c, pack_load.c (files inside the pack
  * folder, combos.bin), painted_upload.c, terrain_upload.c, quadtree.c,
  * pipelines.c, screen.c, destruction.c.
@@ -243,7 +245,8 @@ struct rt_pack {
  * combination id in combos.bin is in range.  Errors name the pack file
  * and what is wrong. */
 bool rt_pack_load(rt_pack *p, const char *dir, rt_error *e);
-
+/* Free what rt_pack_load allocated (not p itself); rt_pack_open and
+ * rt_pack_close allocate and free the struct around these two. */
 void rt_pack_free(rt_pack *p);
 
 /* The offscreen colour image (TRANSFER_SRC_OPTIMAL after a frame). */

@@ -12,8 +12,8 @@
  * checks, uploads, the quadtree, pipelines, the screen path) are in
  * rt_internal.h, as Lua keeps lstate.h beside lua.h.
  *
- * Sections: errors + device.c, image.c, pack_load.c, render.c,
- * destruction.c, viewer.c.
+ * Sections: errors + device.c, image.c, pack_load.c (the handles and their
+ * accessors in handles.c), render.c, destruction.c, viewer.c.
  */
 #ifndef SPLAT_RT_H
 #define SPLAT_RT_H
@@ -63,7 +63,7 @@ void        rt_error_clear(rt_error *e);
  * that `return rt_fail(e, RT_E_IO, ...)` reads naturally.  `e` may be NULL. */
 bool        rt_fail(rt_error *e, rt_error_id id, ...);
 
-/* ---- device.c: instance, device, memory -------------------------------- */
+/* ---- device.c, handles.c: the device ----------------------------------- */
 
 typedef struct rt_device_desc {
     bool         validate;      /* validation layer + messenger; default: env
@@ -124,7 +124,7 @@ bool rt_write_float(const char *path, const float *rgba, int w, int h,
                     rt_error *e);
 bool rt_read_float(const char *path, float **rgba, int *w, int *h, rt_error *e);
 
-/* ---- pack_load.c: reading a shader pack ------------------------------- */
+/* ---- pack_load.c, handles.c: reading a shader pack ----------------------- */
 
 /* Preview lighting (light.c): the scene's `light` block, splatview's
  * --sun, --exposure and --fog-density, the viewer's keys.  NAN fog
