@@ -2,7 +2,9 @@
  * by the tests that reach inside (not installed; splatrt.h is the public
  * API, as Lua keeps lstate.h beside lua.h).
  *
- * Sections: errors, device.c (buffers, images, one-shot commands),
+ * Sections: the structs behind splatrt.h's rt_device and rt_pack (with
+ * their in-place create/load; handles.c wraps them), errors, device.c
+ * (buffers, images, one-shot commands),
  * shader_compile.c, spirv_check.c, pack_load.c (files inside the pack
  * folder, combos.bin), painted_upload.c, terrain_upload.c, quadtree.c,
  * pipelines.c, screen.c, destruction.c.
@@ -14,6 +16,241 @@
 #include "cache.h"
 
 #include <stdatomic.h>
+#include <vulkan/vulkan.h>
+
+#include "far_atlas.h"
+#include "sparse.h"
+
+/* ---- the device and the pack, behind splatrt.h's opaque handles ----------
+ * (moved here from splatrt.h: the runtime's files and the tests of its
+ * insides read the fields; tools go through rt_device_open, rt_pack_open
+ * and the accessors.) */
+
+struct rt_device {
+    VkInstance               instance;
+    VkDebugUtilsMessengerEXT messenger;
+    VkPhysicalDevice         phys;
+    VkPhysicalDeviceProperties props;
+    VkPhysicalDeviceMemoryProperties mem;
+    VkDevice                 dev;
+    VkQueue                  queue;
+    uint32_t                 queue_family;
+    VkCommandPool            pool;       /* resettable command buffers      */
+    bool                     wireframe;  /* fillModeNonSolid enabled        */
+    bool                     bc;         /* textureCompressionBC enabled    */
+    bool                     count_fragments; /* fragmentStoresAndAtomics and
+                                            fragment subgroup votes: the
+                                            forward counting variant       */
+    bool                     validating;
+    int                      messages;   /* validation warnings + errors    */
+};
+
+/* In place, for the library's own devices (the viewer's, the far bake's);
+ * rt_device_open allocates one around it. */
+bool rt_device_create(rt_device *d, const rt_device_desc *desc, rt_error *e);
+void rt_device_destroy(rt_device *d);
+
+typedef struct rt_buffer {
+    VkBuffer       buf;
+    VkDeviceMemory mem;
+    VkDeviceSize   size;
+    void          *map;      /* persistently mapped when host visible       */
+} rt_buffer;
+
+typedef struct rt_image {
+    VkImage        img;
+    VkDeviceMemory mem;
+    VkImageView    view;
+    VkFormat       format;
+    uint32_t       width, height, layers, mips;
+} rt_image;
+
+
+typedef struct rt_spirv {
+    char     *path;       /* relative to the pack                          */
+    uint32_t *words;
+    size_t    nwords;
+} rt_spirv;
+
+typedef struct rt_pack_camera {
+    char  *name;
+    double position[3], look[3];
+} rt_pack_camera;
+
+typedef struct rt_pack_material {
+    char    *name;
+    char    *source;      /* graph file, relative to the scene (hot reload) */
+    rt_spirv reference;   /* SPLAT_MULTIPASS pass; words NULL if absent     */
+} rt_pack_material;
+
+typedef struct rt_pack_param {
+    char  *name;
+    float  value[4];      /* default                                       */
+    uint32_t offset;      /* bytes into the params block                    */
+    int    width;         /* components (manifest "type"; 4 if absent)      */
+    bool   has_range;     /* "min" < "max" given: the declared range, which
+                             the pack's analysis assumed                    */
+    double min, max;
+} rt_pack_param;
+
+typedef struct rt_pack_texture {
+    char    *file;
+    uint32_t binding;     /* 1 + its texture array (abi.h set 1)           */
+    int      layer;       /* its layer in that array                       */
+    bool     linear, mip_linear, srgb;
+    VkSamplerAddressMode wrap;
+    uint8_t *rgba;        /* decoded RGBA8                                 */
+    int      width, height;
+    uint8_t **mips;       /* stored levels 1..nmips (manifest "mips", files
+                             "X.mipK.png"; level k is max(1, w >> k) x
+                             max(1, h >> k)); NULL: the runtime blits them */
+    int      nmips;
+} rt_pack_texture;
+
+/* A texture array of set 1: textures of one size, mip count and sampler
+ * state, textures[layer] = the index of the texture at that layer. */
+typedef struct rt_pack_array {
+    int     *textures;
+    int      nlayers;
+} rt_pack_array;
+
+typedef struct rt_pack_combo {
+    int     *materials;   /* scene indices, top first                       */
+    int      nmaterials;
+    rt_spirv spirv;
+    char    *compute;     /* compute variant's GLSL (PACK.md); NULL: none   */
+    char    *ug_compute;  /* undergrowth mask GLSL (PACK.md); NULL: none    */
+    double   cost;        /* per-pixel cost, op-table units; 0: not given   */
+    /* Distance classes (PACK.md): entries nbase.. of rt_pack.combos are
+     * the class variants, after the combinations of combos.bin; a class
+     * holds where view.distance lies in [dlo, dhi] (base ones [0, inf]).
+     * Its fragment shader may come as GLSL alone (spirv.words NULL),
+     * compiled on first use. */
+    int      base;        /* the combination it is a variant of (own id)    */
+    double   dlo, dhi;    /* metres; dhi INFINITY: and beyond               */
+    char    *glsl;        /* a class's fragment GLSL; NULL for the others   */
+    char    *frag_path;   /* "glsl" beside "spirv": the forward counting
+                             variant's source, read on first use
+                             (rt_pack_read_glsl); NULL: absent              */
+    int      first_class, nclasses; /* a combination's classes, contiguous */
+} rt_pack_combo;
+
+typedef struct rt_pack_level {
+    int       width, height;
+    uint16_t *ids;        /* combination per node, row-major                */
+} rt_pack_level;
+
+/* A periodic site of terrain.position (compiler/precision.c). */
+typedef struct rt_pack_site {
+    int    axes[2];         /* camera components: 0 x, 1 y, 2 z          */
+    bool   mul;             /* position * scale; else / scale            */
+    int    param;           /* params index of the scale, or -1          */
+    double scale[2];        /* constant scale per component              */
+} rt_pack_site;
+
+
+/* Undergrowth (PACK.md "Undergrowth"): a block of a material, and the
+ * meshes, every one's vertices (8 floats: position, normal, uv) and
+ * indices concatenated. */
+typedef struct rt_pack_ug_block {
+    int      material, slot, mesh;
+    double   density, scale[2], blend, root_blend, color[3];
+    bool     align_normal;
+    bool     light_terrain;  /* lit with the terrain normal (else the mesh's) */
+    int      cutout;         /* 0 none, 1 a leaf cut from the mesh's quads
+                                (frond), 2 the texture's alpha, dithered  */
+    int      texture;        /* index into the pack's textures, or -1       */
+    double   wind[4];        /* direction x, z (unit), sway at 1 m, gust     */
+    double   shadow;         /* darkening of the ground under an instance    */
+} rt_pack_ug_block;
+
+typedef struct rt_pack_ug_mesh {
+    uint32_t nv, nidx;
+    uint32_t first_vertex, first_index;
+    int      far;          /* the mesh drawn beyond the LOD distance, or -1 */
+} rt_pack_ug_mesh;
+
+typedef struct rt_pack_ug_texture {
+    int      width, height;
+    uint8_t *rgba;                 /* rows top first; sRGB rgb, alpha       */
+} rt_pack_ug_texture;
+
+typedef struct rt_pack_ug {
+    int               nslots;      /* 0: the pack has no undergrowth        */
+    rt_pack_ug_texture *textures; int ntextures;   /* ugtex.bin             */
+    rt_pack_ug_block *blocks;  int nblocks;
+    rt_pack_ug_mesh  *meshes;  int nmeshes;
+    float            *vertices;    /* 8 per vertex                          */
+    uint32_t          nvertices;
+    uint32_t         *indices;     /* per mesh, from its own vertex 0       */
+    uint32_t          nindices;
+} rt_pack_ug;
+
+/* The far atlas (compiler/far_atlas.h): far.atlas as read, checked. */
+typedef struct rt_pack_far {
+    uint8_t *data;             /* the whole file; NULL: the pack has none  */
+    size_t   n;
+    int      width, height, levels;
+    double   texel[2];         /* metres per level-0 texel                  */
+} rt_pack_far;
+
+struct rt_pack {
+    char            *dir;
+    char            *name;
+    int              hf_width, hf_height;
+    uint16_t        *heights;        /* hf_width * hf_height               */
+    rt_pack_site     sites[SPLAT_WORLD_SITES];  /* u_frame.world (abi.h)  */
+    int              nsites;
+    uint8_t         *holes;          /* hf_width * hf_height, 255 = cut, or
+                                        NULL: no holes (PACK.md)           */
+    double           size[2], max_height, height_offset;
+    int              cell_texels;
+    rt_pack_camera  *cameras;   int ncameras;
+    rt_pack_material *materials; int nmaterials;
+    rt_pack_param   *params;    int nparams;
+    uint32_t         params_size;
+    rt_pack_texture *textures;  int ntextures;
+    rt_pack_array   *arrays;    int narrays;     /* binding 1 + index    */
+    int              npainted;
+    uint8_t         *painted;        /* npainted * W * H, NULL if none or
+                                        sparse                             */
+    sparse_masks    *sparse;         /* painted.sparse (painted_format bc4
+                                        or r8), NULL: dense painted         */
+    bool             has_destruction; /* scene.destruction is not null      */
+    double           destr_origin[2], destr_size[2], destr_cell; /* metres */
+    rt_pack_combo   *combos;    int ncombos;  /* combinations, then their
+                                                 distance classes           */
+    int              nbase;          /* combinations of combos.bin          */
+    rt_spirv         uber;           /* words NULL if absent               */
+    char            *uber_frag_path; /* its fragment GLSL ("glsl"); NULL if
+                                        absent: read on first use          */
+    char            *uber_compute;   /* its compute GLSL; NULL if absent    */
+    rt_spirv         vertex;
+    rt_pack_level   *levels;    int nlevels;
+    char            *scene_path;     /* scene.source: scene.sg relative to
+                                        the pack (hot reload), or NULL      */
+    rt_light         light;          /* scene.light over the defaults       */
+    rt_pack_ug       ug;             /* undergrowth; ug.nslots 0: none      */
+    rt_pack_far      far;            /* far atlas; far.data NULL: none      */
+    uint32_t        *vectors;        /* vectors.bin's words (abi.h "vector
+                                        shapes' buffer"), validated; NULL:
+                                        the pack has no spline or polygon */
+    size_t           nvectors;       /* words                               */
+};
+
+/* Read and check a pack, untrusted input: every file it names is a
+ * regular file inside the pack folder (rt_pack_read_file) of the right
+ * size, every size within the pack limits (abi.h), every SPIR-V module
+ * validates and fits the interface of its role (rt_spirv_check), every
+ * combination id in combos.bin is in range.  Errors name the pack file
+ * and what is wrong. */
+bool rt_pack_load(rt_pack *p, const char *dir, rt_error *e);
+/* Free what rt_pack_load allocated (not p itself); rt_pack_open and
+ * rt_pack_close allocate and free the struct around these two. */
+void rt_pack_free(rt_pack *p);
+
+/* The offscreen colour image (TRANSFER_SRC_OPTIMAL after a frame). */
+const rt_image *rt_renderer_target(const rt_renderer *r);
 
 /* ---- errors (device.c) ------------------------------------------------- */
 

@@ -5,12 +5,15 @@
  * from a camera (forward or screen-space shading, debug views, craters),
  * pictures written out, and the GLFW viewer.  Everything is prefixed rt_.
  * Library code never exits: a failing call returns false and fills an
- * rt_error (id + message).  The library's internals (Vulkan helpers,
- * shader checks, uploads, the quadtree, pipelines, the screen path) are in
+ * rt_error (id + message).  The device and the pack are opaque handles
+ * (rt_device_open, rt_pack_open; what tools need of them through
+ * rt_device_info and the rt_pack_ accessors), and no Vulkan type appears
+ * here.  The library's internals (the two structs, Vulkan helpers, shader
+ * checks, uploads, the quadtree, pipelines, the screen path) are in
  * rt_internal.h, as Lua keeps lstate.h beside lua.h.
  *
- * Sections: errors + device.c, image.c, pack_load.c, render.c,
- * destruction.c, viewer.c.
+ * Sections: errors + device.c, image.c, pack_load.c (the handles and their
+ * accessors in handles.c), render.c, destruction.c, viewer.c.
  */
 #ifndef SPLAT_RT_H
 #define SPLAT_RT_H
@@ -20,11 +23,7 @@
 #include <stdint.h>
 #include <stdio.h>
 
-#include <vulkan/vulkan.h>
-
 #include "abi.h"
-#include "far_atlas.h"
-#include "sparse.h"
 
 /* ---- errors (device.c) -------------------------------------------------
  * X(id, format): one list so tests and callers can switch on the id. */
@@ -64,7 +63,7 @@ void        rt_error_clear(rt_error *e);
  * that `return rt_fail(e, RT_E_IO, ...)` reads naturally.  `e` may be NULL. */
 bool        rt_fail(rt_error *e, rt_error_id id, ...);
 
-/* ---- device.c: instance, device, memory -------------------------------- */
+/* ---- device.c, handles.c: the device ----------------------------------- */
 
 typedef struct rt_device_desc {
     bool         validate;      /* validation layer + messenger; default: env
@@ -79,44 +78,28 @@ typedef struct rt_device_desc {
     bool         swapchain;     /* enable VK_KHR_swapchain                  */
 } rt_device_desc;
 
-typedef struct rt_device {
-    VkInstance               instance;
-    VkDebugUtilsMessengerEXT messenger;
-    VkPhysicalDevice         phys;
-    VkPhysicalDeviceProperties props;
-    VkPhysicalDeviceMemoryProperties mem;
-    VkDevice                 dev;
-    VkQueue                  queue;
-    uint32_t                 queue_family;
-    VkCommandPool            pool;       /* resettable command buffers      */
-    bool                     wireframe;  /* fillModeNonSolid enabled        */
-    bool                     bc;         /* textureCompressionBC enabled    */
-    bool                     count_fragments; /* fragmentStoresAndAtomics and
-                                            fragment subgroup votes: the
-                                            forward counting variant       */
-    bool                     validating;
-    int                      messages;   /* validation warnings + errors    */
-} rt_device;
+/* A Vulkan instance and device with its queue (opaque; rt_internal.h). */
+typedef struct rt_device rt_device;
 
-bool rt_device_create(rt_device *d, const rt_device_desc *desc, rt_error *e);
-void rt_device_destroy(rt_device *d);
+/* Make one (desc may be NULL: the defaults); *out stays NULL on failure. */
+bool rt_device_open(const rt_device_desc *desc, rt_device **out, rt_error *e);
+/* Wait for it to be idle and free it; returns the validation messages
+ * counted over its whole life, teardown included (0 when not validating
+ * or d is NULL), which is what a "validation stays silent" check asks. */
+int  rt_device_close(rt_device *d);
 /* Validation messages counted so far (0 when not validating). */
 int  rt_device_messages(const rt_device *d);
 
-typedef struct rt_buffer {
-    VkBuffer       buf;
-    VkDeviceMemory mem;
-    VkDeviceSize   size;
-    void          *map;      /* persistently mapped when host visible       */
-} rt_buffer;
-
-typedef struct rt_image {
-    VkImage        img;
-    VkDeviceMemory mem;
-    VkImageView    view;
-    VkFormat       format;
-    uint32_t       width, height, layers, mips;
-} rt_image;
+/* What the device is and what it enabled. */
+typedef struct rt_device_info {
+    const char *name;            /* the driver's device name (owned by d)  */
+    bool        cpu;             /* a CPU implementation (lavapipe)        */
+    bool        wireframe;       /* fillModeNonSolid: wireframe drawing    */
+    bool        bc;              /* BC textures (painted_format bc4)       */
+    bool        count_fragments; /* the forward counting variant           */
+    bool        validating;      /* the validation layer is on             */
+} rt_device_info;
+void rt_device_info_get(const rt_device *d, rt_device_info *out);
 
 /* ---- image.c: writing pictures ---------------------------------------- */
 
@@ -141,89 +124,7 @@ bool rt_write_float(const char *path, const float *rgba, int w, int h,
                     rt_error *e);
 bool rt_read_float(const char *path, float **rgba, int *w, int *h, rt_error *e);
 
-/* ---- pack_load.c: reading a shader pack ------------------------------- */
-
-typedef struct rt_spirv {
-    char     *path;       /* relative to the pack                          */
-    uint32_t *words;
-    size_t    nwords;
-} rt_spirv;
-
-typedef struct rt_pack_camera {
-    char  *name;
-    double position[3], look[3];
-} rt_pack_camera;
-
-typedef struct rt_pack_material {
-    char    *name;
-    char    *source;      /* graph file, relative to the scene (hot reload) */
-    rt_spirv reference;   /* SPLAT_MULTIPASS pass; words NULL if absent     */
-} rt_pack_material;
-
-typedef struct rt_pack_param {
-    char  *name;
-    float  value[4];      /* default                                       */
-    uint32_t offset;      /* bytes into the params block                    */
-    int    width;         /* components (manifest "type"; 4 if absent)      */
-    bool   has_range;     /* "min" < "max" given: the declared range, which
-                             the pack's analysis assumed                    */
-    double min, max;
-} rt_pack_param;
-
-typedef struct rt_pack_texture {
-    char    *file;
-    uint32_t binding;     /* 1 + its texture array (abi.h set 1)           */
-    int      layer;       /* its layer in that array                       */
-    bool     linear, mip_linear, srgb;
-    VkSamplerAddressMode wrap;
-    uint8_t *rgba;        /* decoded RGBA8                                 */
-    int      width, height;
-    uint8_t **mips;       /* stored levels 1..nmips (manifest "mips", files
-                             "X.mipK.png"; level k is max(1, w >> k) x
-                             max(1, h >> k)); NULL: the runtime blits them */
-    int      nmips;
-} rt_pack_texture;
-
-/* A texture array of set 1: textures of one size, mip count and sampler
- * state, textures[layer] = the index of the texture at that layer. */
-typedef struct rt_pack_array {
-    int     *textures;
-    int      nlayers;
-} rt_pack_array;
-
-typedef struct rt_pack_combo {
-    int     *materials;   /* scene indices, top first                       */
-    int      nmaterials;
-    rt_spirv spirv;
-    char    *compute;     /* compute variant's GLSL (PACK.md); NULL: none   */
-    char    *ug_compute;  /* undergrowth mask GLSL (PACK.md); NULL: none    */
-    double   cost;        /* per-pixel cost, op-table units; 0: not given   */
-    /* Distance classes (PACK.md): entries nbase.. of rt_pack.combos are
-     * the class variants, after the combinations of combos.bin; a class
-     * holds where view.distance lies in [dlo, dhi] (base ones [0, inf]).
-     * Its fragment shader may come as GLSL alone (spirv.words NULL),
-     * compiled on first use. */
-    int      base;        /* the combination it is a variant of (own id)    */
-    double   dlo, dhi;    /* metres; dhi INFINITY: and beyond               */
-    char    *glsl;        /* a class's fragment GLSL; NULL for the others   */
-    char    *frag_path;   /* "glsl" beside "spirv": the forward counting
-                             variant's source, read on first use
-                             (rt_pack_read_glsl); NULL: absent              */
-    int      first_class, nclasses; /* a combination's classes, contiguous */
-} rt_pack_combo;
-
-typedef struct rt_pack_level {
-    int       width, height;
-    uint16_t *ids;        /* combination per node, row-major                */
-} rt_pack_level;
-
-/* A periodic site of terrain.position (compiler/precision.c). */
-typedef struct rt_pack_site {
-    int    axes[2];         /* camera components: 0 x, 1 y, 2 z          */
-    bool   mul;             /* position * scale; else / scale            */
-    int    param;           /* params index of the scale, or -1          */
-    double scale[2];        /* constant scale per component              */
-} rt_pack_site;
+/* ---- pack_load.c, handles.c: reading a shader pack ----------------------- */
 
 /* Preview lighting (light.c): the scene's `light` block, splatview's
  * --sun, --exposure and --fog-density, the viewer's keys.  NAN fog
@@ -248,107 +149,59 @@ double *rt_light_values(rt_light *l, int key);
  * defaults), else what is wrong (a static string). */
 const char *rt_light_check(const rt_light *l);
 
-/* Undergrowth (PACK.md "Undergrowth"): a block of a material, and the
- * meshes, every one's vertices (8 floats: position, normal, uv) and
- * indices concatenated. */
-typedef struct rt_pack_ug_block {
-    int      material, slot, mesh;
-    double   density, scale[2], blend, root_blend, color[3];
-    bool     align_normal;
-    bool     light_terrain;  /* lit with the terrain normal (else the mesh's) */
-    int      cutout;         /* 0 none, 1 a leaf cut from the mesh's quads
-                                (frond), 2 the texture's alpha, dithered  */
-    int      texture;        /* index into the pack's textures, or -1       */
-    double   wind[4];        /* direction x, z (unit), sway at 1 m, gust     */
-    double   shadow;         /* darkening of the ground under an instance    */
-} rt_pack_ug_block;
+/* A shader pack as loaded (opaque; rt_internal.h). */
+typedef struct rt_pack rt_pack;
 
-typedef struct rt_pack_ug_mesh {
-    uint32_t nv, nidx;
-    uint32_t first_vertex, first_index;
-    int      far;          /* the mesh drawn beyond the LOD distance, or -1 */
-} rt_pack_ug_mesh;
+/* Read and check the pack in folder `dir`, untrusted input (every file it
+ * names inside the folder and of the right size, every size within the
+ * pack limits of abi.h, every SPIR-V module validated against its role,
+ * every combination id in range); errors name the pack file and what is
+ * wrong.  *out stays NULL on failure. */
+bool rt_pack_open(const char *dir, rt_pack **out, rt_error *e);
+/* Free it; NULL does nothing. */
+void rt_pack_close(rt_pack *p);
 
-typedef struct rt_pack_ug_texture {
-    int      width, height;
-    uint8_t *rgba;                 /* rows top first; sRGB rgb, alpha       */
-} rt_pack_ug_texture;
-
-typedef struct rt_pack_ug {
-    int               nslots;      /* 0: the pack has no undergrowth        */
-    rt_pack_ug_texture *textures; int ntextures;   /* ugtex.bin             */
-    rt_pack_ug_block *blocks;  int nblocks;
-    rt_pack_ug_mesh  *meshes;  int nmeshes;
-    float            *vertices;    /* 8 per vertex                          */
-    uint32_t          nvertices;
-    uint32_t         *indices;     /* per mesh, from its own vertex 0       */
-    uint32_t          nindices;
-} rt_pack_ug;
-
-/* The far atlas (compiler/far_atlas.h): far.atlas as read, checked. */
-typedef struct rt_pack_far {
-    uint8_t *data;             /* the whole file; NULL: the pack has none  */
-    size_t   n;
-    int      width, height, levels;
-    double   texel[2];         /* metres per level-0 texel                  */
-} rt_pack_far;
-
-typedef struct rt_pack {
-    char            *dir;
-    char            *name;
-    int              hf_width, hf_height;
-    uint16_t        *heights;        /* hf_width * hf_height               */
-    rt_pack_site     sites[SPLAT_WORLD_SITES];  /* u_frame.world (abi.h)  */
-    int              nsites;
-    uint8_t         *holes;          /* hf_width * hf_height, 255 = cut, or
-                                        NULL: no holes (PACK.md)           */
-    double           size[2], max_height, height_offset;
-    int              cell_texels;
-    rt_pack_camera  *cameras;   int ncameras;
-    rt_pack_material *materials; int nmaterials;
-    rt_pack_param   *params;    int nparams;
-    uint32_t         params_size;
-    rt_pack_texture *textures;  int ntextures;
-    rt_pack_array   *arrays;    int narrays;     /* binding 1 + index    */
-    int              npainted;
-    uint8_t         *painted;        /* npainted * W * H, NULL if none or
-                                        sparse                             */
-    sparse_masks    *sparse;         /* painted.sparse (painted_format bc4
-                                        or r8), NULL: dense painted         */
-    bool             has_destruction; /* scene.destruction is not null      */
-    double           destr_origin[2], destr_size[2], destr_cell; /* metres */
-    rt_pack_combo   *combos;    int ncombos;  /* combinations, then their
-                                                 distance classes           */
-    int              nbase;          /* combinations of combos.bin          */
-    rt_spirv         uber;           /* words NULL if absent               */
-    char            *uber_frag_path; /* its fragment GLSL ("glsl"); NULL if
-                                        absent: read on first use          */
-    char            *uber_compute;   /* its compute GLSL; NULL if absent    */
-    rt_spirv         vertex;
-    rt_pack_level   *levels;    int nlevels;
-    char            *scene_path;     /* scene.source: scene.sg relative to
-                                        the pack (hot reload), or NULL      */
-    rt_light         light;          /* scene.light over the defaults       */
-    rt_pack_ug       ug;             /* undergrowth; ug.nslots 0: none      */
-    rt_pack_far      far;            /* far atlas; far.data NULL: none      */
-    uint32_t        *vectors;        /* vectors.bin's words (abi.h "vector
-                                        shapes' buffer"), validated; NULL:
-                                        the pack has no spline or polygon */
-    size_t           nvectors;       /* words                               */
-} rt_pack;
-
-/* Read and check a pack, untrusted input: every file it names is a
- * regular file inside the pack folder (rt_pack_read_file) of the right
- * size, every size within the pack limits (abi.h), every SPIR-V module
- * validates and fits the interface of its role (rt_spirv_check), every
- * combination id in combos.bin is in range.  Errors name the pack file
- * and what is wrong. */
-bool rt_pack_load(rt_pack *p, const char *dir, rt_error *e);
+/* What a tool or test asks of a pack. */
+typedef struct rt_pack_info {
+    const char *name, *dir;       /* owned by the pack                      */
+    const char *scene_path;       /* scene.sg relative to the pack, or NULL */
+    int    hf_width, hf_height;   /* heightfield texels                     */
+    double size[2];               /* terrain metres along x and z           */
+    double max_height, height_offset;
+    int    ncameras, nmaterials, nparams, ntextures;
+    int    ncombos;               /* combinations, then distance classes    */
+    int    nbase;                 /* combinations of combos.bin             */
+    int    nlevels;               /* combination levels (quadtree depths)   */
+    int    npainted;              /* painted masks                          */
+    int    nsites;                /* periodic sites of terrain.position
+                                     (u_frame.world, abi.h)                 */
+    bool   has_holes, has_destruction, has_uber, has_far_atlas;
+    bool   has_undergrowth, has_vectors;
+    int    ug_slots, ug_blocks;   /* undergrowth slots and blocks (PACK.md)  */
+    bool   has_reference;         /* every material has a multi-pass pass   */
+    bool   has_compute;           /* screen-path (compute) variants         */
+    /* the far atlas (PACK.md "Far atlas"), when has_far_atlas */
+    int    far_width, far_height, far_levels;
+    double far_texel[2];          /* metres per level-0 texel               */
+    size_t far_bytes;             /* its BC blocks, the header left out     */
+} rt_pack_info;
+void rt_pack_info_get(const rt_pack *p, rt_pack_info *out);
+/* Material i's name (0 <= i < nmaterials; else NULL). */
+const char *rt_pack_material_name(const rt_pack *p, int i);
+/* Camera preset i: its name (NULL out of range), and where it stands and
+ * looks (terrain-local metres). */
+const char *rt_pack_camera_name(const rt_pack *p, int i);
+bool rt_pack_camera_at(const rt_pack *p, int i, double position[3], double look[3]);
+/* The scene's lighting over the defaults. */
+const rt_light *rt_pack_light(const rt_pack *p);
+/* The heightfield as loaded (hf_width * hf_height, x fastest, row z = 0
+ * first): metres = height_offset + h / 65535 * max_height.
+ * rt_renderer_heights has it with a renderer's craters. */
+const uint16_t *rt_pack_heights(const rt_pack *p);
 /* Each size of the pack against the device's limits (maxImageDimension2D,
  * maxImageArrayLayers, samplers per stage, uniform range), before any of
  * it is created; RT_E_PACK_LIMIT naming the limit. */
 bool rt_pack_check_device(const rt_pack *p, const rt_device *d, rt_error *e);
-void rt_pack_free(rt_pack *p);
 /* Print the bytes of each painted mask representation next to dense. */
 void rt_painted_print_stats(const rt_pack *p, FILE *out);
 int  rt_pack_material_find(const rt_pack *p, const char *name);   /* -1 */
@@ -583,8 +436,6 @@ bool rt_renderer_frame(rt_renderer *r, const rt_camera *c,
                        rt_frame_stats *st, rt_error *e);
 /* The last frame's colour as RGBA32F, top row first (w * h * 4 floats). */
 bool rt_renderer_read(rt_renderer *r, float *rgba, rt_error *e);
-/* The offscreen colour image (TRANSFER_SRC_OPTIMAL after a frame). */
-const rt_image *rt_renderer_target(const rt_renderer *r);
 /* Replace the combination pipelines with those of a new pack of the same
  * terrain (hot reload); on failure the old ones stay.  Refused
  * (RT_E_RELOAD naming the input) when the pack's data differ from what was
@@ -658,7 +509,9 @@ bool rt_renderer_bake_far(rt_renderer *r, int w, int h, float *albedo, float *no
  * an rt_far_bake_host): rt_renderer_bake_far on the pack in pack_dir, on
  * host->device (the viewer's, for a hot reload) or on one of its own. */
 typedef struct rt_far_bake_host {
-    splat_far_bake mode;      /* auto: a CPU's device declines            */
+    int            mode;      /* a splat_far_bake (compiler/far_atlas.h,
+                                 not needed here): auto, a CPU's device
+                                 declines                                  */
     rt_device     *device;    /* NULL: create one (splatc)                */
 } rt_far_bake_host;
 bool rt_far_bake_device(void *user, const char *pack_dir, int w, int h, float *albedo,

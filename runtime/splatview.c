@@ -3,7 +3,6 @@
  * table `options` below (splatview --help). */
 #include "splatrt.h"
 #include "args.h"
-#include "far_atlas.h"
 #include "scene.h"
 #include "util.h"
 
@@ -405,13 +404,12 @@ static bool pick_camera(const opts *o, const rt_pack *p, rt_camera *cam)
         int c = rt_pack_camera_find(p, o->preset);
         if (c < 0) {
             fprintf(stderr, "splatview: the pack has no camera preset '%s'", o->preset);
-            for (int i = 0; i < p->ncameras; i++)
-                fprintf(stderr, "%s'%s'", i ? ", " : " (it has ", p->cameras[i].name);
-            fprintf(stderr, "%s\n", p->ncameras ? ")" : "");
+            for (int i = 0; rt_pack_camera_name(p, i); i++)
+                fprintf(stderr, "%s'%s'", i ? ", " : " (it has ", rt_pack_camera_name(p, i));
+            fprintf(stderr, "%s\n", rt_pack_camera_name(p, 0) ? ")" : "");
             return false;
         }
-        memcpy(cam->position, p->cameras[c].position, sizeof cam->position);
-        memcpy(cam->look, p->cameras[c].look, sizeof cam->look);
+        rt_pack_camera_at(p, c, cam->position, cam->look);
     }
     if (o->have_camera) {
         memcpy(cam->position, o->camera, sizeof cam->position);
@@ -546,6 +544,8 @@ static bool write_pictures(const opts *o, rt_device *dev, const rt_pack *pack, r
                            splat_view view, int material, const rt_frame_stats *st, int W,
                            int H, rt_error *e)
 {
+    rt_pack_info pi;
+    rt_pack_info_get(pack, &pi);
     float *rgba = malloc((size_t)W * (size_t)H * 16);
     uint8_t *png = malloc((size_t)W * (size_t)H * 4);
     bool ok = rgba && png && rt_renderer_read(r, rgba, e) &&
@@ -555,8 +555,8 @@ static bool write_pictures(const opts *o, rt_device *dev, const rt_pack *pack, r
         if (o->overlay) {   /* no frame rate: the picture stays reproducible */
             char text[2048];
             rt_overlay_info in = {
-                .pack = pack->name, .view = view, .screen = st->screen,
-                .material = view == SPLAT_VIEW_MASK ? pack->materials[material].name : NULL,
+                .pack = pi.name, .view = view, .screen = st->screen,
+                .material = view == SPLAT_VIEW_MASK ? rt_pack_material_name(pack, material) : NULL,
                 .pending = st->pipelines_pending, .status = "headless",
             };
             rt_overlay_text(&in, text, sizeof text);
@@ -594,7 +594,7 @@ static bool print_counts(rt_renderer *r, const rt_camera *cam, splat_view view, 
 }
 
 /* --stats: the patches, paths and pipelines of the last frame. */
-static void print_paths(const rt_pack *pack, const rt_frame_stats *st, const frame_times *t)
+static void print_paths(const rt_pack_info *pi, const rt_frame_stats *st, const frame_times *t)
 {
     printf("patches drawn: %d  culled: %d\n", st->patches, st->culled);
     printf("back faces culled: %s\n", st->backfaces_culled ? "yes" : "no");
@@ -603,7 +603,7 @@ static void print_paths(const rt_pack *pack, const rt_frame_stats *st, const fra
         printf("compute modules: %d from the SPIR-V cache, %d compiled from GLSL; "
                "%.1f ms making pipelines between frames\n", st->spirv_cached,
                st->spirv_compiled, t->compile_ms);
-    printf("combinations in view: %d of %d\n", st->combos_in_view, pack->ncombos);
+    printf("combinations in view: %d of %d\n", st->combos_in_view, pi->ncombos);
     if (!st->screen) {
         printf("distance classes: %d of %d patches\n", st->class_patches, st->patches);
         printf("far atlas: %d of %d patches\n", st->far_patches, st->patches);
@@ -629,15 +629,19 @@ static bool print_stats(const opts *o, rt_device *dev, const rt_pack *pack, rt_r
                         const rt_camera *cam, splat_view view, const rt_frame_stats *st,
                         frame_times *t, int W, int H, rt_error *e)
 {
+    rt_pack_info pi;
+    rt_device_info di;
+    rt_pack_info_get(pack, &pi);
+    rt_device_info_get(dev, &di);
     double gm, gl, gh, sm, sl, sh, cm, cl, ch;
     summary(t->gpu, o->frames, &gm, &gl, &gh);
     summary(t->sel, o->frames, &sm, &sl, &sh);
     summary(t->cpu, o->frames, &cm, &cl, &ch);
-    printf("device: %s\n", dev->props.deviceName);
+    printf("device: %s\n", di.name);
     printf("size: %dx%d  view: %s  reference: %s  frames: %d\n", W, H, rt_view_name(view),
            o->ref == RT_REF_MULTIPASS ? "multipass" : o->ref == RT_REF_UBER ? "uber" : "none",
            o->frames);
-    print_paths(pack, st, t);
+    print_paths(&pi, st, t);
     if (gm >= 0)
         printf("gpu ms/frame: median %.3f  p10 %.3f  p90 %.3f\n", gm, gl, gh);
     else
@@ -658,7 +662,7 @@ static bool print_stats(const opts *o, rt_device *dev, const rt_pack *pack, rt_r
     else
         printf("shadow map %s ms: %.2f (when the sun moves or a crater lands; "
                "per frame a texture tap)\n", st->shadow_gpu ? "gpu" : "cpu", t->shadow_ms);
-    if (pack->ug.nslots > 0 && !o->no_undergrowth && view == SPLAT_VIEW_FINAL) {
+    if (pi.has_undergrowth && !o->no_undergrowth && view == SPLAT_VIEW_FINAL) {
         double um, ul, uh;
         summary(t->ug_draw, o->frames, &um, &ul, &uh);
         printf("undergrowth: %d cells, %ld instances, %.3f ms generation\n",
@@ -667,19 +671,19 @@ static bool print_stats(const opts *o, rt_device *dev, const rt_pack *pack, rt_r
                "p10 %.3f  p90 %.3f, %zu bytes per cell\n", t->ug_generated,
                t->ug_generated ? t->ug_gen_ms / t->ug_generated : 0.0, um, ul, uh,
                st->undergrowth.bytes_per_cell);
-    } else if (pack->ug.nslots > 0) {
+    } else if (pi.has_undergrowth) {
         printf("undergrowth: off\n");
     }
     printf("cpu ms/frame (record): median %.3f  p10 %.3f  p90 %.3f\n", cm, cl, ch);
-    if ((st->screen || (dev->count_fragments && o->ref != RT_REF_MULTIPASS)) &&
+    if ((st->screen || (di.count_fragments && o->ref != RT_REF_MULTIPASS)) &&
         !print_counts(r, cam, view, e))
         return false;
     printf("shading: %s%s\n", st->screen ? "screen" : "forward",
            st->sorted ? ", pixels sorted by layer set" : "");
-    if (pack->far.data)   /* the BC blocks as uploaded (PACK.md "Far atlas") */
+    if (pi.has_far_atlas)   /* the BC blocks as uploaded (PACK.md "Far atlas") */
         printf("far atlas: %d x %d texels of %.1f x %.1f m, %d levels, %zu bytes; %s\n",
-               pack->far.width, pack->far.height, pack->far.texel[0], pack->far.texel[1],
-               pack->far.levels, pack->far.n - FAR_ATLAS_HEADER,
+               pi.far_width, pi.far_height, pi.far_texel[0], pi.far_texel[1],
+               pi.far_levels, pi.far_bytes,
                o->far_distance <= 0 ? "not used"
                : st->screen ? "screen tiles beyond --far-atlas-distance use it"
                             : "forward patches beyond --far-atlas-distance use it");
@@ -690,7 +694,7 @@ static bool print_stats(const opts *o, rt_device *dev, const rt_pack *pack, rt_r
 }
 
 /* The render desc of the options (the window's is built in window()). */
-static rt_render_desc render_desc(const opts *o, const rt_pack *pack)
+static rt_render_desc render_desc(const opts *o, const rt_pack_info *pi)
 {
     rt_render_desc rd = {
         .width = o->width, .height = o->height, .reference = o->ref,
@@ -705,8 +709,8 @@ static rt_render_desc render_desc(const opts *o, const rt_pack *pack)
         .screen_depth = o->screen_depth, .pixel_sort = o->pixel_sort, .far_atlas_distance = o->far_distance,
     };
     if (!shading_chosen(o, &rd.shading))
-        rd.shading = pack->uber_compute && o->ref != RT_REF_MULTIPASS ? RT_SHADING_SCREEN
-                                                                      : RT_SHADING_FORWARD;
+        rd.shading = pi->has_compute && o->ref != RT_REF_MULTIPASS ? RT_SHADING_SCREEN
+                                                                   : RT_SHADING_FORWARD;
     light_options(o, &rd);
     memcpy(rd.clear, o->clear, sizeof rd.clear);
     return rd;
@@ -715,34 +719,34 @@ static rt_render_desc render_desc(const opts *o, const rt_pack *pack)
 static int headless(const opts *o)
 {
     rt_error e = { 0 };
-    rt_pack pack;
-    rt_device dev;
+    rt_pack *pack = NULL;
+    rt_pack_info pi;
+    rt_device *dev = NULL;
     rt_renderer *r = NULL;
     int status = 1;
     double *times = NULL;
-    bool have_dev = false;
 
-    if (!rt_pack_load(&pack, o->pack, &e)) {
+    if (!rt_pack_open(o->pack, &pack, &e)) {
         fprintf(stderr, "splatview: %s\n", e.msg);
         rt_error_clear(&e);
         return 1;
     }
+    rt_pack_info_get(pack, &pi);
     splat_view view = SPLAT_VIEW_FINAL;
     int material = 0;
     rt_camera cam;
-    if ((o->view && !rt_parse_view(o->view, &pack, &view, &material, &e)) ||
-        !pick_camera(o, &pack, &cam))
+    if ((o->view && !rt_parse_view(o->view, pack, &view, &material, &e)) ||
+        !pick_camera(o, pack, &cam))
         goto done;
-    if (!rt_device_create(&dev, NULL, &e))
+    if (!rt_device_open(NULL, &dev, &e))
         goto done;
-    have_dev = true;
-    rt_render_desc rd = render_desc(o, &pack);
-    if (!rt_renderer_create(&dev, &pack, &rd, &r, &e) || !apply_params(o, r, &e) ||
+    rt_render_desc rd = render_desc(o, &pi);
+    if (!rt_renderer_create(dev, pack, &rd, &r, &e) || !apply_params(o, r, &e) ||
         !apply_craters(o, r, &cam, &e))
         goto done;
     if (o->check) {   /* the pack loads and a renderer stands on this device */
-        printf("%s: loads (%d combinations, %d materials, %s path)\n", o->pack, pack.ncombos,
-               pack.nmaterials, rd.shading == RT_SHADING_SCREEN ? "screen" : "forward");
+        printf("%s: loads (%d combinations, %d materials, %s path)\n", o->pack, pi.ncombos,
+               pi.nmaterials, rd.shading == RT_SHADING_SCREEN ? "screen" : "forward");
         status = 0;
         goto done;
     }
@@ -760,8 +764,8 @@ static int headless(const opts *o)
     rt_renderer_set_counting(r, view == SPLAT_VIEW_COST);
     if (!run_frames(o, r, &cam, &t, &st, &e) ||
         ((o->out || o->float_out) &&
-         !write_pictures(o, &dev, &pack, r, view, material, &st, W, H, &e)) ||
-        (o->stats && !print_stats(o, &dev, &pack, r, &cam, view, &st, &t, W, H, &e)))
+         !write_pictures(o, dev, pack, r, view, material, &st, W, H, &e)) ||
+        (o->stats && !print_stats(o, dev, pack, r, &cam, view, &st, &t, W, H, &e)))
         goto done;
     status = 0;
 done:
@@ -769,14 +773,12 @@ done:
         fprintf(stderr, "splatview: %s\n", e.msg);
     rt_error_clear(&e);
     rt_renderer_destroy(r);
-    if (have_dev) {
-        rt_device_destroy(&dev);
-        if (dev.validating && dev.messages) {
-            fprintf(stderr, "splatview: %d validation message(s)\n", dev.messages);
-            status = status ? status : 3;
-        }
+    int messages = rt_device_close(dev);
+    if (messages) {
+        fprintf(stderr, "splatview: %d validation message(s)\n", messages);
+        status = status ? status : 3;
     }
-    rt_pack_free(&pack);
+    rt_pack_close(pack);
     free(times);
     return status;
 }
@@ -788,15 +790,17 @@ static int build_preview(opts *o)
 {
     char *scene = o->scene ? strdup(o->scene) : NULL;
     if (!scene) {
-        rt_pack p;
+        rt_pack *p;
         rt_error e = { 0 };
-        if (!rt_pack_load(&p, o->pack, &e)) {
+        if (!rt_pack_open(o->pack, &p, &e)) {
             fprintf(stderr, "splatview: %s\n", e.msg);
             rt_error_clear(&e);
             return 1;
         }
-        scene = p.scene_path ? splat_path_join(o->pack, p.scene_path) : NULL;
-        rt_pack_free(&p);
+        rt_pack_info pi;
+        rt_pack_info_get(p, &pi);
+        scene = pi.scene_path ? splat_path_join(o->pack, pi.scene_path) : NULL;
+        rt_pack_close(p);
         if (!scene) {
             fprintf(stderr, "splatview: --material: the pack names no scene.source; "
                             "give --scene FILE\n");

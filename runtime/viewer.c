@@ -333,8 +333,9 @@ static void reload(viewer *v)
     splat_build_desc bd = { .scene = v->scene, .out = v->desc->pack_dir,
                             .search_paths = (const char *const *)paths, .jobs = 2,
                             .preview = v->desc->preview };
-    rt_far_bake_host host = { .mode = SPLAT_FAR_BAKE_AUTO, .device = &v->dev };
-    bool asked = splat_far_bake_parse(getenv("SPLAT_FAR_BAKE"), &host.mode);
+    splat_far_bake mode = SPLAT_FAR_BAKE_AUTO;
+    bool asked = splat_far_bake_parse(getenv("SPLAT_FAR_BAKE"), &mode);
+    rt_far_bake_host host = { .mode = mode, .device = &v->dev };
     int far_n = v->desc->preview ? 0 : far_atlas_n(v->pack);
     if (far_n && (asked || v->dev.props.deviceType != VK_PHYSICAL_DEVICE_TYPE_CPU)) {
         bd.far_atlas = far_n;

@@ -5,7 +5,7 @@ if(TARGET splatrt AND TARGET splatc_cli)
   set(DESTR_OUT ${CMAKE_BINARY_DIR}/tests/destruction)
   file(MAKE_DIRECTORY ${DESTR_OUT})
   add_executable(test_destruction ${CMAKE_CURRENT_LIST_DIR}/test_destruction.c)
-  target_link_libraries(test_destruction splatrt m)
+  target_link_libraries(test_destruction splat_testkit)
   add_test(NAME destruction.pack
     COMMAND $<TARGET_FILE:splatc_cli> build ${PROJECT_SOURCE_DIR}/tests/destruction/scene.sg
             -o ${DESTR_OUT}/pack --no-cache)

@@ -6,11 +6,6 @@ add_test(NAME docs.links
   WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
 set_tests_properties(docs.links PROPERTIES LABELS unit TIMEOUT 60)
 
-# The runtime's library boundary: who may include rt_internal.h.
-add_test(NAME docs.internal_includes
-  COMMAND sh ${CMAKE_CURRENT_LIST_DIR}/internal_includes.sh ${PROJECT_SOURCE_DIR})
-set_tests_properties(docs.internal_includes PROPERTIES LABELS unit)
-
 # Documentation tests: docs/getting-started.md followed verbatim (its ```sh
 # blocks, in an empty folder outside the repository, with the built tools
 # on PATH); fails if any step fails.

@@ -23,7 +23,7 @@
  * mask leaves [0, 1], or an error exceeds its stated bound. */
 #include "harness.h"
 #include "sg.h"
-#include "rt_internal.h"
+#include "splatrt.h"
 
 #include <math.h>
 #include <stdio.h>

@@ -19,6 +19,11 @@ for f in bin/splatc bin/splatview lib/libsplatc.a lib/libsplatrt.a include/splat
     [ -e "$P/$f" ] || fail "not installed: $f"
 done
 [ -e "$P/include/splatc/sg_internal.h" ] && fail "an internal header was installed"
+[ -e "$P/include/splatc/rt_internal.h" ] && fail "the runtime's internal header was installed"
+# the runtime's public header stands on abi.h and the C library alone: no
+# Vulkan, no compiler internals (rt_device and rt_pack are opaque)
+grep '^#include' "$P/include/splatc/splatrt.h" | grep -v -e '<std[a-z]*\.h>' -e '"abi.h"' &&
+    fail "splatrt.h includes more than abi.h and the C library"
 
 # 1. a scene outside any project, importing the node library, no -I
 mkdir "$T/work" && cp "$HF" "$T/work/heightfield.png" || fail "copy"
@@ -71,6 +76,27 @@ pkg-config --exists splatrt || fail "pkg-config does not find splatrt"
 "$CC" -o "$T/work/tiny_pc" "$T/work/tiny.c" $(pkg-config --cflags --libs splatrt) \
     > "$T/pc.log" 2>&1 || { cat "$T/pc.log"; fail "link through pkg-config"; }
 "$T/work/tiny_pc" || fail "the pkg-config program failed"
+# the opaque handles from the installed header: a missing pack is refused
+# with a message, and no handle comes back
+cat > "$T/work/opaque.c" <<'C'
+#include <stdio.h>
+#include <splatrt.h>
+int main(void)
+{
+    rt_pack *p = (rt_pack *)&p;
+    rt_error e = { 0 };
+    bool ok = rt_pack_open("no such pack", &p, &e);
+    printf("%s\n", e.msg ? e.msg : "(no message)");
+    int bad = ok || p != NULL || e.id == RT_OK || !e.msg;
+    rt_error_clear(&e);
+    rt_pack_close(NULL);
+    return bad || rt_device_close(NULL) != 0;
+}
+C
+# shellcheck disable=SC2046
+"$CC" -o "$T/work/opaque" "$T/work/opaque.c" $(pkg-config --cflags --libs splatrt) \
+    > "$T/opaque.log" 2>&1 || { cat "$T/opaque.log"; fail "the opaque handles do not build"; }
+"$T/work/opaque" || fail "rt_pack_open on a missing folder"
 
 mkdir "$T/cm" && cp "$T/work/tiny.c" "$T/cm/" || fail "copy"
 cat > "$T/cm/CMakeLists.txt" <<'CM'

@@ -5,7 +5,7 @@
 # tests/pack.
 if(TARGET splatrt AND TARGET splatc_cli AND TARGET packedit)
   add_executable(test_reload ${CMAKE_CURRENT_LIST_DIR}/test_reload.c)
-  target_link_libraries(test_reload splatrt)
+  target_link_libraries(test_reload splat_testkit)
   add_test(NAME reload.inputs
            COMMAND sh ${CMAKE_CURRENT_LIST_DIR}/reload.sh $<TARGET_FILE:splatc_cli>
                    $<TARGET_FILE:packedit> $<TARGET_FILE:test_reload>

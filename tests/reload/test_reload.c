@@ -14,17 +14,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "rt_internal.h"
-
-static int failures;
-
-static void check(bool ok, const char *what, const char *detail)
-{
-    if (!ok) {
-        fprintf(stderr, "FAIL: %s%s%s\n", what, detail ? ": " : "", detail ? detail : "");
-        failures++;
-    }
-}
+#include "kit.h"
 
 int main(int argc, char **argv)
 {
@@ -39,21 +29,19 @@ int main(int argc, char **argv)
         return 2;
     }
     rt_error e = { 0 };
-    rt_pack base;
-    rt_device dev;
+    rt_pack *base = kit_pack(argv[1]);
+    rt_device *dev = base ? kit_device() : NULL;
     rt_renderer *r = NULL;
-    if (!rt_pack_load(&base, argv[1], &e) || !rt_device_create(&dev, NULL, &e)) {
-        fprintf(stderr, "FAIL: setup: %s\n", e.msg);
-        return 1;
-    }
+    if (!dev)
+        return kit_finish("reload");
     rt_camera cam;
-    rt_default_camera(&base, &cam);
-    if (!rt_renderer_create(&dev, &base, &rd, &r, &e) || !rt_renderer_frame(r, &cam, NULL, &e)) {
-        fprintf(stderr, "FAIL: renderer: %s\n", e.msg);
-        return 1;
+    rt_default_camera(base, &cam);
+    if (!rt_renderer_create(dev, base, &rd, &r, &e) || !rt_renderer_frame(r, &cam, NULL, &e)) {
+        CHECK(false, "renderer: %s", e.msg);
+        return kit_finish("reload");
     }
     /* every pack handed over stays alive until the renderer is gone */
-    rt_pack *packs = calloc((size_t)argc, sizeof *packs);
+    rt_pack **packs = calloc((size_t)argc, sizeof *packs);
     int npacks = 0;
     for (int i = 2; i < argc; i++) {
         char *arg = strdup(argv[i]), *eq = strchr(arg, '=');
@@ -63,37 +51,36 @@ int main(int argc, char **argv)
         }
         *eq = '\0';
         const char *dir = arg, *phrase = eq + 1;
-        rt_pack *p = &packs[npacks];
-        rt_error_clear(&e);
-        check(rt_pack_load(p, dir, &e), dir, e.msg);
-        if (e.msg) {
+        rt_pack *p = kit_pack(dir);
+        if (!p) {
             free(arg);
             continue;
         }
-        npacks++;
+        packs[npacks++] = p;
         bool ok = rt_renderer_swap_pack(r, p, &e);
         printf("%s: %s\n", dir, ok ? "reloaded" : e.msg);
         if (!strcmp(phrase, "ok")) {
-            check(ok, dir, "a shader-only change was refused");
+            CHECK(ok, "%s: a shader-only change was refused: %s", dir, e.msg);
             rt_frame_stats st;
-            check(rt_renderer_frame(r, &cam, &st, &e), dir, e.msg);
-            check(st.screen == (rd.shading == RT_SHADING_SCREEN), dir, "drawn by the wrong path");
+            bool drawn = rt_renderer_frame(r, &cam, &st, &e);
+            CHECK(drawn, "%s: %s", dir, e.msg);
+            CHECK(!drawn || st.screen == (rd.shading == RT_SHADING_SCREEN),
+                  "%s: drawn by the wrong path", dir);
         } else {
-            check(!ok && e.id == RT_E_RELOAD, dir, "reloaded with changed data");
-            check(!ok && e.msg && strstr(e.msg, phrase), dir, "the message does not name the input");
+            CHECK(!ok && e.id == RT_E_RELOAD, "%s: reloaded with changed data", dir);
+            CHECK(!ok && e.msg && strstr(e.msg, phrase),
+                  "%s: the message does not name the input '%s'", dir, phrase);
         }
+        rt_error_clear(&e);
         free(arg);
     }
-    rt_error_clear(&e);
-    check(rt_renderer_frame(r, &cam, NULL, &e), "a frame after the reloads", e.msg);
+    CHECK(rt_renderer_frame(r, &cam, NULL, &e), "a frame after the reloads: %s", e.msg);
     rt_renderer_destroy(r);
-    rt_device_destroy(&dev);
-    check(!dev.validating || dev.messages == 0, "validation messages", NULL);
+    kit_device_close(dev);
     for (int i = 0; i < npacks; i++)
-        rt_pack_free(&packs[i]);
+        rt_pack_close(packs[i]);
     free(packs);
-    rt_pack_free(&base);
+    rt_pack_close(base);
     rt_error_clear(&e);
-    printf("%s\n", failures ? "FAILED" : "PASS");
-    return failures ? 1 : 0;
+    return kit_finish("reload");
 }

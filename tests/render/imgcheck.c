@@ -26,7 +26,7 @@
  *                                        channels >= 230) in the top-left
  *                                        BW x BH box
  */
-#include "rt_internal.h"
+#include "splatrt.h"
 
 #include <math.h>
 #include <stdlib.h>

@@ -154,7 +154,7 @@ if(TARGET splatrt AND TARGET splatview)
   # (test_lighting.c builds its own packs of examples/minimal)
   if(TARGET splatc)
     add_executable(test_lighting ${RENDER_DIR}/test_lighting.c)
-    target_link_libraries(test_lighting splatrt splatc m)
+    target_link_libraries(test_lighting splat_testkit)
     file(MAKE_DIRECTORY ${RENDER_OUT}/lighting)
     add_test(NAME render.lighting COMMAND test_lighting ${RENDER_OUT}/lighting
              WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
@@ -164,7 +164,7 @@ if(TARGET splatrt AND TARGET splatview)
     # terrain's shadows
     foreach(t brdf shadow undergrowth ug_look)
       add_executable(test_${t} ${RENDER_DIR}/test_${t}.c)
-      target_link_libraries(test_${t} splatrt splatc m)
+      target_link_libraries(test_${t} splat_testkit)
       file(MAKE_DIRECTORY ${RENDER_OUT}/${t})
       add_test(NAME render.${t} COMMAND test_${t} ${RENDER_OUT}/${t}
                WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
@@ -174,7 +174,7 @@ if(TARGET splatrt AND TARGET splatview)
     # the shadow map marched on the device against the CPU reference within
     # 1/255: three suns and a crater (test_shadow_gpu.c)
     add_executable(test_shadow_gpu ${RENDER_DIR}/test_shadow_gpu.c)
-    target_link_libraries(test_shadow_gpu splatrt splatc m)
+    target_link_libraries(test_shadow_gpu splat_testkit)
     file(MAKE_DIRECTORY ${RENDER_OUT}/shadow_gpu)
     add_test(NAME render.shadow_gpu COMMAND test_shadow_gpu ${RENDER_OUT}/shadow_gpu
              WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
@@ -183,7 +183,7 @@ if(TARGET splatrt AND TARGET splatview)
     # distance classes against the über-shader at 20 random cameras on
     # colorado, both paths (test_dclass.c)
     add_executable(test_dclass ${RENDER_DIR}/test_dclass.c)
-    target_link_libraries(test_dclass splatrt splatc m)
+    target_link_libraries(test_dclass splat_testkit)
     add_test(NAME render.dclass COMMAND test_dclass ${RENDER_OUT}/colorado
              WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
     set_tests_properties(render.dclass PROPERTIES LABELS render TIMEOUT 900

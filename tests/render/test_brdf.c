@@ -15,8 +15,7 @@
  * multi-pass reference paths alike.  Also checks that the model is what
  * the issue asks of it: roughness moves the highlight's peak, and the
  * highlight follows the camera. */
-#include "rt_internal.h"
-#include "../check.h"
+#include "kit.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -35,7 +34,7 @@ static bool write_scene(const char *dir, int k)
 {
     char name[32];
     snprintf(name, sizeof name, "r%d.sg", k);
-    char *sg = join(dir, name);
+    char *sg = kit_join(dir, name);
     FILE *f = fopen(sg, "w");
     free(sg);
     if (!f) return false;
@@ -174,30 +173,27 @@ int main(int argc, char **argv)
     const char *dir = argv[1];
     uint8_t hf[N * N];
     memset(hf, 128, sizeof hf);
-    char *png = join(dir, "flat.png");
+    char *png = kit_join(dir, "flat.png");
     bool ok = stbi_write_png(png, N, N, 1, hf, N) != 0;
     free(png);
-    rt_pack packs[3];
-    int loaded = 0;
-    rt_error e = { 0 };
+    rt_pack *packs[3] = { 0 };
     for (int k = 0; ok && k < 3; k++) {
         char name[32];
         snprintf(name, sizeof name, "r%d.sg", k);
-        char *sg = join(dir, name);
+        char *sg = kit_join(dir, name);
         snprintf(name, sizeof name, "r%d.pack", k);
-        char *pack = join(dir, name);
-        ok = write_scene(dir, k) && build_pack_ok(sg, pack) && rt_pack_load(&packs[k], pack, &e);
-        loaded += ok;
+        char *pack = kit_join(dir, name);
+        ok = write_scene(dir, k) && kit_build_pack_ok(sg, pack) && (packs[k] = kit_pack(pack));
         free(sg);
         free(pack);
     }
-    rt_device dev;
-    if (!ok || !rt_device_create(&dev, NULL, &e)) {
-        fprintf(stderr, "FAIL: setup: %s\n", e.msg ? e.msg : "the scenes do not build");
-        return 1;
-    }
+    CHECK(ok, "the scenes do not build into packs");
+    rt_device *dev = ok ? kit_device() : NULL;
+    if (!dev)
+        return kit_finish("brdf");
     /* the plane: 128/255 of max_height above the offset (an 8-bit PNG) */
-    double h0 = packs[0].height_offset + packs[0].max_height * 128.0 / 255.0;
+    rt_pack_info pi = kit_pack_info(packs[0]);
+    double h0 = pi.height_offset + pi.max_height * 128.0 / 255.0;
     rt_camera cam = { .position = { SIZE / 2, h0 + ABOVE, SIZE - 20 },
                       .look = { SIZE / 2, h0, SIZE / 2 }, .fovy = FOVY };
     double peaks[3] = { 0 };
@@ -205,7 +201,7 @@ int main(int argc, char **argv)
         for (size_t p = 0; p < sizeof PATHS / sizeof *PATHS; p++) {
             rt_render_desc rd = { .width = W, .height = H, .shading = PATHS[p].shading,
                                   .reference = PATHS[p].ref };
-            float *img = render_frame(&dev, &packs[k], &rd, SPLAT_VIEW_FINAL, 0, &cam);
+            float *img = kit_render(dev, packs[k], &rd, SPLAT_VIEW_FINAL, 0, &cam);
             if (!img) continue;
             double peak, err = compare(img, &cam, h0, ROUGH[k], &peak);
             printf("roughness %.1f, %-9s: largest error %.3g against the double model "
@@ -215,7 +211,7 @@ int main(int argc, char **argv)
                 peaks[k] = peak;
                 char name[32];
                 snprintf(name, sizeof name, "r%d.png", k);
-                write_picture(dir, name, img, W, H, SPLAT_VIEW_FINAL);
+                kit_write_picture(dir, name, img, W, H, SPLAT_VIEW_FINAL);
             }
             free(img);
         }
@@ -227,8 +223,8 @@ int main(int argc, char **argv)
     rt_camera high = cam;
     high.position[1] = h0 + 60;
     rt_render_desc rd = { .width = W, .height = H };
-    float *lo = render_frame(&dev, &packs[0], &rd, SPLAT_VIEW_FINAL, 0, &cam);
-    float *hi = render_frame(&dev, &packs[0], &rd, SPLAT_VIEW_FINAL, 0, &high);
+    float *lo = kit_render(dev, packs[0], &rd, SPLAT_VIEW_FINAL, 0, &cam);
+    float *hi = kit_render(dev, packs[0], &rd, SPLAT_VIEW_FINAL, 0, &high);
     for (int s = 0; lo && hi && s < 2; s++) {
         const float *img = s ? hi : lo;
         const rt_camera *c = s ? &high : &cam;
@@ -245,14 +241,8 @@ int main(int argc, char **argv)
     }
     free(lo);
     free(hi);
-    CHECK(rt_device_messages(&dev) == 0, "%d validation messages", rt_device_messages(&dev));
-    rt_device_destroy(&dev);
-    for (int k = 0; k < loaded; k++)
-        rt_pack_free(&packs[k]);
-    if (failures) {
-        fprintf(stderr, "%d failures\n", failures);
-        return 1;
-    }
-    printf("brdf: all checks passed\n");
-    return 0;
+    kit_device_close(dev);
+    for (int k = 0; k < 3; k++)
+        rt_pack_close(packs[k]);
+    return kit_finish("brdf");
 }

@@ -15,8 +15,8 @@
  * every channel of every pixel.  The classes must have been used (patches
  * and tiles shaded by one) and not everywhere, or the test proves nothing;
  * and with rd.no_distance_classes none is used. */
-#include "rt_internal.h"
-#include "../check.h"
+#include "rt_internal.h"   /* the leaf combination map: rt_pack.levels, combos */
+#include "kit.h"
 
 #include <math.h>
 #include <stdint.h>
@@ -76,48 +76,46 @@ int main(int argc, char **argv)
         fprintf(stderr, "usage: test_dclass PACKDIR\n");
         return 2;
     }
-    rt_pack p;
-    rt_device dev;
+    rt_pack *p = kit_pack(argv[1]);
+    rt_device *dev = p ? kit_device() : NULL;
     rt_error e = { 0 };
-    if (!rt_pack_load(&p, argv[1], &e) || !rt_device_create(&dev, NULL, &e)) {
-        fprintf(stderr, "FAIL: setup: %s\n", e.msg ? e.msg : "?");
-        return 1;
-    }
-    CHECK(p.ncombos > p.nbase, "the pack has no distance classes (%d combinations)", p.nbase);
+    if (!dev)
+        return kit_finish("distance classes");
+    CHECK(p->ncombos > p->nbase, "the pack has no distance classes (%d combinations)", p->nbase);
     /* texels whose leaf cell has rock as the top material of its
      * combination (nothing above it is present) and whose slope is over
      * rock's ramp (graphs/rock.sg: 0.16 .. 0.24), so bare rock: half the
      * cameras look at one from 20 to 250 m, where the parallax is on (a
      * class used there would show) */
-    int rock = rt_pack_material_find(&p, "rock");
-    const rt_pack_level *leaf = &p.levels[0];
-    int *texels = malloc(sizeof(int) * (size_t)p.hf_width * (size_t)p.hf_height), ntexels = 0;
-    for (int tz = 0; texels && tz < p.hf_height; tz++)
-        for (int tx = 0; tx < p.hf_width; tx++) {
-            int cx = tx / p.cell_texels, cz = tz / p.cell_texels;
+    int rock = rt_pack_material_find(p, "rock");
+    const rt_pack_level *leaf = &p->levels[0];
+    int *texels = malloc(sizeof(int) * (size_t)p->hf_width * (size_t)p->hf_height), ntexels = 0;
+    for (int tz = 0; texels && tz < p->hf_height; tz++)
+        for (int tx = 0; tx < p->hf_width; tx++) {
+            int cx = tx / p->cell_texels, cz = tz / p->cell_texels;
             int id = leaf->ids[(size_t)cz * (size_t)leaf->width + (size_t)cx];
-            double x = (tx + 0.5) * p.size[0] / p.hf_width, z = (tz + 0.5) * p.size[1] / p.hf_height;
-            if (id < p.nbase && p.combos[id].materials[0] == rock && slope(&p, x, z) > 0.24)
-                texels[ntexels++] = tz * p.hf_width + tx;
+            double x = (tx + 0.5) * p->size[0] / p->hf_width, z = (tz + 0.5) * p->size[1] / p->hf_height;
+            if (id < p->nbase && p->combos[id].materials[0] == rock && slope(p, x, z) > 0.24)
+                texels[ntexels++] = tz * p->hf_width + tx;
         }
     printf("%d texels of bare rock\n", ntexels);
     CHECK(rock >= 0 && ntexels > 0, "colorado has no bare rock");
     rt_camera cams[CAMERAS];
     for (int i = 0; i < CAMERAS; i++) {
-        double x = p.size[0] * (0.02 + 0.96 * rnd01()), z = p.size[1] * (0.02 + 0.96 * rnd01());
+        double x = p->size[0] * (0.02 + 0.96 * rnd01()), z = p->size[1] * (0.02 + 0.96 * rnd01());
         double above = 2.0 * pow(200.0, rnd01());
         double yaw = 2 * M_PI * rnd01(), pitch = (5 + 40 * rnd01()) * M_PI / 180;
-        double y = ground(&p, x, z) + above;
+        double y = ground(p, x, z) + above;
         double look[3] = { x + cos(yaw) * cos(pitch), y - sin(pitch), z + sin(yaw) * cos(pitch) };
         if (i % 2 && ntexels > 0) {   /* at bare rock */
             int t = texels[(int)(rnd01() * ntexels) % ntexels];
-            look[0] = (t % p.hf_width + rnd01()) * p.size[0] / p.hf_width;
-            look[2] = (t / p.hf_width + rnd01()) * p.size[1] / p.hf_height;
-            look[1] = ground(&p, look[0], look[2]);
+            look[0] = (t % p->hf_width + rnd01()) * p->size[0] / p->hf_width;
+            look[2] = (t / p->hf_width + rnd01()) * p->size[1] / p->hf_height;
+            look[1] = ground(p, look[0], look[2]);
             double d = 20 * pow(12.5, rnd01());
             x = look[0] + d * cos(yaw);
             z = look[2] + d * sin(yaw);
-            y = fmax(ground(&p, x, z), look[1]) + 2 + 48 * rnd01();
+            y = fmax(ground(p, x, z), look[1]) + 2 + 48 * rnd01();
         }
         cams[i] = (rt_camera){ .position = { x, y, z }, .look = { look[0], look[1], look[2] },
                                .fovy = M_PI / 3, .znear = 0.25 };
@@ -132,9 +130,9 @@ int main(int argc, char **argv)
         uber.reference = RT_REF_UBER;
         off.no_distance_classes = true;
         rt_renderer *ro = NULL, *ru = NULL, *rf = NULL;
-        bool made = rt_renderer_create(&dev, &p, &on, &ro, &e) &&
-                    rt_renderer_create(&dev, &p, &uber, &ru, &e) &&
-                    rt_renderer_create(&dev, &p, &off, &rf, &e);
+        bool made = rt_renderer_create(dev, p, &on, &ro, &e) &&
+                    rt_renderer_create(dev, p, &uber, &ru, &e) &&
+                    rt_renderer_create(dev, p, &off, &rf, &e);
         CHECK(made, "%s renderers: %s", names[s], e.msg ? e.msg : "?");
         rt_error_clear(&e);
         long used = 0, total = 0, used_off = 0;
@@ -166,7 +164,7 @@ int main(int argc, char **argv)
                    "(%zu, %zu)\n", names[s], i,
                    cams[i].position[0], cams[i].position[1], cams[i].position[2],
                    cams[i].look[0], cams[i].look[1], cams[i].look[2],
-                   cams[i].position[1] - ground(&p, cams[i].position[0], cams[i].position[2]),
+                   cams[i].position[1] - ground(p, cams[i].position[0], cams[i].position[2]),
                    u, t, s ? "tiles" : "patches", cam_worst, at % W, at / W);
             CHECK(cam_worst <= 1.0 / 255, "%s camera %d: classes differ from the über-shader "
                   "by %g", names[s], i, cam_worst);
@@ -183,13 +181,7 @@ int main(int argc, char **argv)
     }
     free(a);
     free(b);
-    CHECK(rt_device_messages(&dev) == 0, "%d validation messages", rt_device_messages(&dev));
-    rt_device_destroy(&dev);
-    rt_pack_free(&p);
-    if (failures) {
-        fprintf(stderr, "%d failures\n", failures);
-        return 1;
-    }
-    printf("distance classes: all checks passed\n");
-    return 0;
+    kit_device_close(dev);
+    rt_pack_close(p);
+    return kit_finish("distance classes");
 }

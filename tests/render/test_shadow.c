@@ -15,8 +15,7 @@
  *     and the map remade only where the crater can matter is the whole
  *     map made again (the sun turned away and back);
  *   - turning the sun to the west moves the shadow to the box's east. */
-#include "rt_internal.h"
-#include "../check.h"
+#include "kit.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -36,7 +35,7 @@ static bool write_inputs(const char *dir)
     for (int z = 56; z < 72; z++)
         for (int x = 90; x < 100; x++)
             hf[z * N + x] = 40;   /* 40 / 255 * 25.5 m = 4 m */
-    char *png = join(dir, "box.png"), *sg = join(dir, "box.sg");
+    char *png = kit_join(dir, "box.png"), *sg = kit_join(dir, "box.sg");
     bool ok = stbi_write_png(png, N, N, 1, hf, N) != 0;
     FILE *f = fopen(sg, "w");
     ok = ok && f;
@@ -101,15 +100,12 @@ int main(int argc, char **argv)
         return 2;
     }
     const char *dir = argv[1];
-    char *sg = join(dir, "box.sg"), *packdir = join(dir, "box.pack");
-    rt_pack p;
-    rt_device dev;
+    char *sg = kit_join(dir, "box.sg"), *packdir = kit_join(dir, "box.pack");
+    rt_pack *p = write_inputs(dir) && kit_build_pack_ok(sg, packdir) ? kit_pack(packdir) : NULL;
+    rt_device *dev = p ? kit_device() : NULL;
     rt_error e = { 0 };
-    if (!write_inputs(dir) || !build_pack_ok(sg, packdir) || !rt_pack_load(&p, packdir, &e) ||
-        !rt_device_create(&dev, NULL, &e)) {
-        fprintf(stderr, "FAIL: setup: %s\n", e.msg ? e.msg : "the scene does not build");
-        return 1;
-    }
+    if (!dev)
+        return kit_finish("shadow");
     free(sg);
     free(packdir);
     rt_camera cam = { .position = { N / 2.0, ABOVE, N / 2.0 }, .look = { N / 2.0, 0, N / 2.0 },
@@ -121,7 +117,7 @@ int main(int argc, char **argv)
     for (int s = 0; s < 2; s++) {
         rt_render_desc rd = { .width = W, .height = H,
                               .shading = s ? RT_SHADING_SCREEN : RT_SHADING_FORWARD };
-        float *img = render_frame(&dev, &p, &rd, SPLAT_VIEW_FINAL, 0, &cam);
+        float *img = kit_render(dev, p, &rd, SPLAT_VIEW_FINAL, 0, &cam);
         if (!img) continue;
         double end = half_lit_x(img, edge_px, -1);
         printf("%s: shadow ends at x = %.2f m, length %.2f m; geometry: %.2f m, length %.2f m\n",
@@ -130,13 +126,13 @@ int main(int argc, char **argv)
               want);
         CHECK(lum(img, mid_px, H / 2) < 1e-4, "%s: the shadow's middle is lit (%g)", paths[s],
               lum(img, mid_px, H / 2));
-        if (s == 0) write_picture(dir, "shadow.png", img, W, H, SPLAT_VIEW_FINAL);
+        if (s == 0) kit_write_picture(dir, "shadow.png", img, W, H, SPLAT_VIEW_FINAL);
         free(img);
     }
 
     /* --no-shadows */
     rt_render_desc off = { .width = W, .height = H, .no_shadows = true };
-    float *img = render_frame(&dev, &p, &off, SPLAT_VIEW_FINAL, 0, &cam);
+    float *img = kit_render(dev, p, &off, SPLAT_VIEW_FINAL, 0, &cam);
     if (img) {
         double mid = lum(img, mid_px, H / 2), lit = lum(img, 4, H / 2);
         printf("no shadows: the shadow's middle %.4f, lit ground %.4f\n", mid, lit);
@@ -148,10 +144,10 @@ int main(int argc, char **argv)
     /* a crater on the box, and the sun turned to the west: one renderer */
     rt_render_desc rd = { .width = W, .height = H };
     rt_renderer *r = NULL;
-    CHECK(rt_renderer_create(&dev, &p, &rd, &r, &e), "renderer: %s", e.msg ? e.msg : "?");
+    CHECK(rt_renderer_create(dev, p, &rd, &r, &e), "renderer: %s", e.msg ? e.msg : "?");
     rt_error_clear(&e);
     if (r) {
-        float *before = frame_of(r, &cam, W, H);
+        float *before = kit_frame(r, &cam, W, H);
         rt_crater c = { .x = 95, .z = 64, .radius = 8, .depth = 3 };
         rt_crater_stats cs;
         CHECK(rt_renderer_crater(r, &c, &cs, &e) && cs.result == RT_CRATER_DONE, "crater: %s",
@@ -160,24 +156,24 @@ int main(int argc, char **argv)
         rt_frame_stats st;
         float *after = NULL;
         CHECK(rt_renderer_frame(r, &cam, &st, &e), "frame: %s", e.msg ? e.msg : "?");
-        after = frame_of(r, &cam, W, H);
+        after = kit_frame(r, &cam, W, H);
         if (before && after) {
             double b = half_lit_x(before, edge_px, -1), a = half_lit_x(after, edge_px, -1);
             printf("crater on the box: the shadow ends at %.2f m (was %.2f m); map remade in "
                    "%.2f ms\n", a, b, st.shadow_ms);
             CHECK(a > b + 5.0, "the crater did not shorten the shadow (%.2f -> %.2f)", b, a);
             CHECK(st.shadow_ms > 0, "no new shadow map after the crater");
-            write_picture(dir, "crater.png", after, W, H, SPLAT_VIEW_FINAL);
+            kit_write_picture(dir, "crater.png", after, W, H, SPLAT_VIEW_FINAL);
         }
         /* the same map made whole: the sun turned by a degree and back */
         rt_light l = *rt_renderer_light(r), turned = l;
         turned.sun[0] += 1;
         rt_renderer_set_light(r, &turned);
-        float *t = frame_of(r, &cam, W, H);
+        float *t = kit_frame(r, &cam, W, H);
         rt_renderer_set_light(r, &l);
         rt_frame_stats fs;
         CHECK(rt_renderer_frame(r, &cam, &fs, &e), "frame: %s", e.msg ? e.msg : "?");
-        float *whole = frame_of(r, &cam, W, H);
+        float *whole = kit_frame(r, &cam, W, H);
         if (after && whole) {
             double worst = 0;
             for (size_t i = 0; i < (size_t)W * H * 4; i++)
@@ -190,7 +186,7 @@ int main(int argc, char **argv)
         free(whole);
         l.sun[0] = 270;
         rt_renderer_set_light(r, &l);
-        float *west = frame_of(r, &cam, W, H);
+        float *west = kit_frame(r, &cam, W, H);
         if (west) {
             int east_px = column(100.5 + 10);
             printf("sun in the west: 10 m east of the box %.4f, 10 m west %.4f\n",
@@ -203,13 +199,7 @@ int main(int argc, char **argv)
         free(west);
         rt_renderer_destroy(r);
     }
-    CHECK(rt_device_messages(&dev) == 0, "%d validation messages", rt_device_messages(&dev));
-    rt_device_destroy(&dev);
-    rt_pack_free(&p);
-    if (failures) {
-        fprintf(stderr, "%d failures\n", failures);
-        return 1;
-    }
-    printf("shadow: all checks passed\n");
-    return 0;
+    kit_device_close(dev);
+    rt_pack_close(p);
+    return kit_finish("shadow");
 }

@@ -17,7 +17,7 @@
  * With PACK (e.g. out/colorado.pack) the same comparison runs on that
  * pack's terrain and prints both marches' times. */
 #include "rt_internal.h"
-#include "../check.h"
+#include "kit.h"
 #include "util.h"
 
 #include <math.h>
@@ -43,7 +43,7 @@ static bool write_inputs(const char *dir)
     for (int z = 0; z < NZ; z++)
         for (int x = 0; x < NX; x++)
             hf[z * NX + x] = (uint8_t)lrint(255.0 * hill(x, z));
-    char *png = join(dir, "hills.png"), *sg = join(dir, "hills.sg");
+    char *png = kit_join(dir, "hills.png"), *sg = kit_join(dir, "hills.sg");
     bool ok = stbi_write_png(png, NX, NZ, 1, hf, NX) != 0;
     FILE *f = fopen(sg, "w");
     ok = ok && f;
@@ -107,23 +107,21 @@ int main(int argc, char **argv)
         return 2;
     }
     const char *dir = argv[1];
-    char *sg = join(dir, "hills.sg"), *packdir = argc == 3 ? strdup(argv[2]) : join(dir, "hills.pack");
-    rt_pack p;
-    rt_device dev;
+    char *sg = kit_join(dir, "hills.sg"), *packdir = argc == 3 ? strdup(argv[2]) : kit_join(dir, "hills.pack");
+    bool built = argc == 3 || (write_inputs(dir) && kit_build_pack_ok(sg, packdir));
+    rt_pack *p = built ? kit_pack(packdir) : NULL;
+    rt_device *dev = p ? kit_device() : NULL;
     rt_error e = { 0 };
-    if ((argc == 2 && (!write_inputs(dir) || !build_pack_ok(sg, packdir))) ||
-        !rt_pack_load(&p, packdir, &e) || !rt_device_create(&dev, NULL, &e)) {
-        fprintf(stderr, "FAIL: setup: %s\n", e.msg ? e.msg : "the scene does not build");
-        return 1;
-    }
+    if (!dev)
+        return kit_finish("shadow_gpu");
     free(sg);
     free(packdir);
-    size_t n = (size_t)p.hf_width * (size_t)p.hf_height;
+    size_t n = (size_t)p->hf_width * (size_t)p->hf_height;
     uint8_t *gpu = malloc(n), *cpu = malloc(n), *before = malloc(n);
     rt_render_desc rd = { .width = 32, .height = 32, .shading = RT_SHADING_FORWARD,
                           .shadow = RT_SHADOW_GPU, .no_undergrowth = true };
     rt_renderer *r = NULL;
-    if (!gpu || !cpu || !before || !rt_renderer_create(&dev, &p, &rd, &r, &e)) {
+    if (!gpu || !cpu || !before || !rt_renderer_create(dev, p, &rd, &r, &e)) {
         fprintf(stderr, "FAIL: renderer: %s\n", e.msg ? e.msg : "out of memory");
         return 1;
     }
@@ -135,7 +133,7 @@ int main(int argc, char **argv)
         l.sun[0] = suns[k][0];
         l.sun[1] = suns[k][1];
         rt_renderer_set_light(r, &l);
-        compare(r, &p, gpu, cpu, what);
+        compare(r, p, gpu, cpu, what);
         if (argc == 2) {   /* the synthetic terrain has all three kinds of texel */
             size_t shade = 0, lit = 0, half = 0;
             for (size_t i = 0; i < n; i++) {
@@ -154,14 +152,14 @@ int main(int argc, char **argv)
         l.sun[0] = suns[1][0];
         l.sun[1] = suns[1][1];
         rt_renderer_set_light(r, &l);
-        compare(r, &p, gpu, cpu, "before the crater");
+        compare(r, p, gpu, cpu, "before the crater");
         memcpy(before, gpu, n);
         rt_crater c = { .x = 460, .z = 200, .radius = 30, .depth = 12 };
         rt_crater_stats cs;
         CHECK(rt_renderer_crater(r, &c, &cs, &e) && cs.result == RT_CRATER_DONE, "crater: %s",
               e.msg ? e.msg : "refused or outside");
         rt_error_clear(&e);
-        compare(r, &p, gpu, cpu, "after the crater");
+        compare(r, p, gpu, cpu, "after the crater");
         size_t changed = 0;
         for (size_t i = 0; i < n; i++)
             changed += gpu[i] != before[i];
@@ -172,13 +170,7 @@ int main(int argc, char **argv)
     free(gpu);
     free(cpu);
     free(before);
-    CHECK(rt_device_messages(&dev) == 0, "%d validation messages", rt_device_messages(&dev));
-    rt_device_destroy(&dev);
-    rt_pack_free(&p);
-    if (failures) {
-        fprintf(stderr, "%d failures\n", failures);
-        return 1;
-    }
-    printf("shadow_gpu: all checks passed\n");
-    return 0;
+    kit_device_close(dev);
+    rt_pack_close(p);
+    return kit_finish("shadow_gpu");
 }

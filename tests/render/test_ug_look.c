@@ -30,8 +30,8 @@
  *   - a textured OBJ card (uv, `texture` red at alpha 0.5): opaque, the
  *     pixels it covers are red; with `cutout = alpha` it covers half as
  *     many (0.35 to 0.65 of them: the dithered alpha). */
-#include "splatrt.h"
-#include "../check.h"
+#include "rt_internal.h"   /* asserts on the loaded undergrowth blocks (rt_pack.ug) */
+#include "kit.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -45,7 +45,7 @@ static const double RING = 2.0, RADIUS = 48.0;
 
 static bool write_scene(const char *dir, const char *name, const char *wind)
 {
-    char *sg = join(dir, name);
+    char *sg = kit_join(dir, name);
     FILE *f = fopen(sg, "w");
     free(sg);
     if (!f)
@@ -97,7 +97,7 @@ static rt_renderer *make(rt_device *dev, const rt_pack *p, bool off);
  * them (cutout: "none" or "alpha"). */
 static bool write_card(const char *dir, const char *name, const char *cutout)
 {
-    char *obj = join(dir, "card.obj"), *png = join(dir, "red.png"), *sg = join(dir, name);
+    char *obj = kit_join(dir, "card.obj"), *png = kit_join(dir, "red.png"), *sg = kit_join(dir, name);
     FILE *f = fopen(obj, "w");
     bool ok = f != NULL;
     if (f) {
@@ -132,26 +132,23 @@ static bool write_card(const char *dir, const char *name, const char *cutout)
 
 static void check_texture(rt_device *dev, const char *dir)
 {
-    rt_pack p[2];
+    rt_pack *p[2];
     long covered[2] = { 0 }, red = 0;
     for (int k = 0; k < 2; k++) {
-        char *sg = join(dir, k ? "card_cut.sg" : "card.sg");
-        char *pk = join(dir, k ? "card_cut.pack" : "card.pack");
-        rt_error e = { 0 };
+        char *sg = kit_join(dir, k ? "card_cut.sg" : "card.sg");
+        char *pk = kit_join(dir, k ? "card_cut.pack" : "card.pack");
         bool ok = write_card(dir, k ? "card_cut.sg" : "card.sg", k ? "alpha" : "none") &&
-                  build_pack_ok(sg, pk) && rt_pack_load(&p[k], pk, &e);
-        CHECK(ok, "card pack: %s", e.msg ? e.msg : "does not build");
-        rt_error_clear(&e);
+                  kit_build_pack_ok(sg, pk) && (p[k] = kit_pack(pk));
         free(sg);
         free(pk);
         if (!ok)
             return;
-        CHECK(p[k].ug.ntextures == 1 && p[k].ug.textures[0].width == 4 &&
-              p[k].ug.blocks[0].texture == 0 && p[k].ug.blocks[0].cutout == (k ? 2 : 0),
-              "card pack %d: %d textures", k, p[k].ug.ntextures);
-        rt_renderer *on = make(dev, &p[k], false), *off = make(dev, &p[k], true);
+        CHECK(p[k]->ug.ntextures == 1 && p[k]->ug.textures[0].width == 4 &&
+              p[k]->ug.blocks[0].texture == 0 && p[k]->ug.blocks[0].cutout == (k ? 2 : 0),
+              "card pack %d: %d textures", k, p[k]->ug.ntextures);
+        rt_renderer *on = make(dev, p[k], false), *off = make(dev, p[k], true);
         rt_camera cam = { .position = { 64, 1.0, 50 }, .look = { 64, 0.5, 60 } };
-        float *a = on ? frame_of(on, &cam, W, H) : NULL, *b = off ? frame_of(off, &cam, W, H) : NULL;
+        float *a = on ? kit_frame(on, &cam, W, H) : NULL, *b = off ? kit_frame(off, &cam, W, H) : NULL;
         for (long i = 0; a && b && i < (long)W * H; i++) {
             bool c = memcmp(a + 4 * i, b + 4 * i, 12) != 0;
             covered[k] += c;
@@ -159,12 +156,12 @@ static void check_texture(rt_device *dev, const char *dir)
                 red += a[4 * i] > 1.5 * a[4 * i + 1] && a[4 * i] > 1.5 * a[4 * i + 2];
         }
         if (a)
-            write_picture(dir, k ? "card_cut.png" : "card.png", a, W, H, SPLAT_VIEW_FINAL);
+            kit_write_picture(dir, k ? "card_cut.png" : "card.png", a, W, H, SPLAT_VIEW_FINAL);
         free(a);
         free(b);
         rt_renderer_destroy(on);
         rt_renderer_destroy(off);
-        rt_pack_free(&p[k]);
+        rt_pack_free(p[k]);
     }
     double share = covered[0] ? (double)covered[1] / covered[0] : 0;
     printf("texture: the card covers %ld pixels (%ld of them red), cut by its alpha %ld (%.2f)\n",
@@ -292,28 +289,27 @@ int main(int argc, char **argv)
     }
     const char *dir = argv[1];
     static uint8_t hf[N * N];
-    char *png = join(dir, "flat.png");
+    char *png = kit_join(dir, "flat.png");
     bool ok = stbi_write_png(png, N, N, 1, hf, N) != 0 && write_scene(dir, "still.sg", "") &&
               write_scene(dir, "unshadowed.sg", ", shadow = 0") &&
               write_scene(dir, "windy.sg", ", wind = 1.5, wind_dir = 1 0.5, gust = 0.7");
     free(png);
-    char *sg = join(dir, "still.sg"), *pk = join(dir, "still.pack");
-    char *wsg = join(dir, "windy.sg"), *wpk = join(dir, "windy.pack");
-    char *usg = join(dir, "unshadowed.sg"), *upk = join(dir, "unshadowed.pack");
-    rt_pack p, wp, up;
-    rt_device dev;
-    rt_error e = { 0 };
-    if (!ok || !build_pack_ok(sg, pk) || !build_pack_ok(wsg, wpk) || !build_pack_ok(usg, upk) ||
-        !rt_pack_load(&p, pk, &e) || !rt_pack_load(&wp, wpk, &e) || !rt_pack_load(&up, upk, &e) ||
-        !rt_device_create(&dev, NULL, &e)) {
-        fprintf(stderr, "FAIL: setup: %s\n", e.msg ? e.msg : "the scene does not build");
-        return 1;
+    char *sg = kit_join(dir, "still.sg"), *pk = kit_join(dir, "still.pack");
+    char *wsg = kit_join(dir, "windy.sg"), *wpk = kit_join(dir, "windy.pack");
+    char *usg = kit_join(dir, "unshadowed.sg"), *upk = kit_join(dir, "unshadowed.pack");
+    rt_pack *p = NULL, *wp = NULL, *up = NULL;
+    rt_device *dev = NULL;
+    if (!ok || !kit_build_pack_ok(sg, pk) || !kit_build_pack_ok(wsg, wpk) || !kit_build_pack_ok(usg, upk) ||
+        !(p = kit_pack(pk)) || !(wp = kit_pack(wpk)) || !(up = kit_pack(upk)) ||
+        !(dev = kit_device())) {
+        CHECK(false, "setup: the scenes do not build or load, or no device");
+        return kit_finish("ug_look");
     }
-    CHECK(wp.ug.nblocks == 1 && fabs(wp.ug.blocks[0].wind[2] - 1.5) < 1e-9 &&
-          fabs(hypot(wp.ug.blocks[0].wind[0], wp.ug.blocks[0].wind[1]) - 1) < 1e-9 &&
-          fabs(wp.ug.blocks[0].wind[3] - 0.7) < 1e-9, "the windy pack's block has no wind");
-    rt_renderer *r = make(&dev, &p, false), *wr = make(&dev, &wp, false);
-    rt_renderer *off = make(&dev, &wp, true);
+    CHECK(wp->ug.nblocks == 1 && fabs(wp->ug.blocks[0].wind[2] - 1.5) < 1e-9 &&
+          fabs(hypot(wp->ug.blocks[0].wind[0], wp->ug.blocks[0].wind[1]) - 1) < 1e-9 &&
+          fabs(wp->ug.blocks[0].wind[3] - 0.7) < 1e-9, "the windy pack's block has no wind");
+    rt_renderer *r = make(dev, p, false), *wr = make(dev, wp, false);
+    rt_renderer *off = make(dev, wp, true);
     if (!r || !wr || !off)
         return 1;
     rt_camera cam = { .position = { 64, 2, 64 }, .look = { 64, 1, 90 } };
@@ -322,12 +318,12 @@ int main(int argc, char **argv)
 
     /* the wind moves blades, not the ground; a still block stays still */
     rt_camera low = { .position = { 64, 1.2, 40 }, .look = { 64, 0.3, 52 } };
-    float *still = frame_of(r, &low, W, H), *bare = frame_of(off, &low, W, H);
+    float *still = kit_frame(r, &low, W, H), *bare = kit_frame(off, &low, W, H);
     low.time = 0;
-    float *w0 = frame_of(wr, &low, W, H);
+    float *w0 = kit_frame(wr, &low, W, H);
     low.time = 2.5;
-    float *w1 = frame_of(wr, &low, W, H);
-    float *still1 = frame_of(r, &low, W, H);
+    float *w1 = kit_frame(wr, &low, W, H);
+    float *still1 = kit_frame(r, &low, W, H);
     if (still && bare && w0 && w1 && still1) {
         long grass = 0, moved = 0, ground = 0;
         for (long i = 0; i < (long)W * H; i++) {
@@ -343,17 +339,17 @@ int main(int argc, char **argv)
               moved, grass);
         CHECK(ground == 0, "the wind changed %ld pixels of bare ground", ground);
         CHECK(memcmp(still, still1, (size_t)W * H * 16) == 0, "a block without wind moves");
-        write_picture(dir, "still.png", still, W, H, SPLAT_VIEW_FINAL);
-        write_picture(dir, "windy0.png", w0, W, H, SPLAT_VIEW_FINAL);
-        write_picture(dir, "windy1.png", w1, W, H, SPLAT_VIEW_FINAL);
+        kit_write_picture(dir, "still.png", still, W, H, SPLAT_VIEW_FINAL);
+        kit_write_picture(dir, "windy0.png", w0, W, H, SPLAT_VIEW_FINAL);
+        kit_write_picture(dir, "windy1.png", w1, W, H, SPLAT_VIEW_FINAL);
     } else {
         CHECK(false, "frames failed");
     }
 
     /* contact shadows: darker ground, nothing brighter */
-    rt_renderer *ur = make(&dev, &up, false);
+    rt_renderer *ur = make(dev, up, false);
     rt_camera look = { .position = { 64, 1.6, 60 }, .look = { 64, 0, 64 } };
-    float *sh = r ? frame_of(r, &look, W, H) : NULL, *un = ur ? frame_of(ur, &look, W, H) : NULL;
+    float *sh = r ? kit_frame(r, &look, W, H) : NULL, *un = ur ? kit_frame(ur, &look, W, H) : NULL;
     if (sh && un) {
         long darker = 0, brighter = 0;
         double most = 0;
@@ -370,16 +366,16 @@ int main(int argc, char **argv)
         CHECK(darker > W * H / 10, "contact shadows darken only %ld pixels", darker);
         CHECK(most > 0.2 && most < 0.85, "contact shadows darken by up to %.2f (shadow 0.35, "
               "overlapping discs compound)", most);
-        write_picture(dir, "shadowed.png", sh, W, H, SPLAT_VIEW_FINAL);
-        write_picture(dir, "unshadowed.png", un, W, H, SPLAT_VIEW_FINAL);
+        kit_write_picture(dir, "shadowed.png", sh, W, H, SPLAT_VIEW_FINAL);
+        kit_write_picture(dir, "unshadowed.png", un, W, H, SPLAT_VIEW_FINAL);
     } else {
         CHECK(false, "shadow frames failed");
     }
     free(sh);
     free(un);
     rt_renderer_destroy(ur);
-    rt_pack_free(&up);
-    check_texture(&dev, dir);
+    rt_pack_close(up);
+    check_texture(dev, dir);
     free(usg);
     free(upk);
     free(still);
@@ -390,16 +386,12 @@ int main(int argc, char **argv)
     rt_renderer_destroy(r);
     rt_renderer_destroy(wr);
     rt_renderer_destroy(off);
-    rt_pack_free(&p);
-    rt_pack_free(&wp);
+    rt_pack_close(p);
+    rt_pack_close(wp);
     free(sg);
     free(pk);
     free(wsg);
     free(wpk);
-    int msgs = rt_device_messages(&dev);
-    CHECK(msgs == 0, "%d validation messages", msgs);
-    rt_device_destroy(&dev);
-    if (failures)
-        fprintf(stderr, "%d failures\n", failures);
-    return failures ? 1 : 0;
+    kit_device_close(dev);
+    return kit_finish("ug_look");
 }

@@ -25,8 +25,7 @@
  *   - the instances cover the same pixels (within 3 %) from a ground
  *     camera on the forward path and on the screen path with raster and
  *     with ray-cast depth. */
-#include "rt_internal.h"
-#include "../check.h"
+#include "kit.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -41,7 +40,7 @@ static const double WEIGHT = 128.0 / 255.0;
 /* grass: the grass block's density (0: no undergrowth blocks at all) */
 static bool write_scene(const char *dir, const char *name, double grass)
 {
-    char *sg = join(dir, name);
+    char *sg = kit_join(dir, name);
     FILE *f = fopen(sg, "w");
     free(sg);
     if (!f)
@@ -66,7 +65,7 @@ static bool write_scene(const char *dir, const char *name, double grass)
 static bool write_inputs(const char *dir)
 {
     static uint8_t hf[N * N];
-    char *png = join(dir, "flat.png");
+    char *png = kit_join(dir, "flat.png");
     bool ok = stbi_write_png(png, N, N, 1, hf, N) != 0;
     free(png);
     return ok && write_scene(dir, "meadow.sg", 2.0) && write_scene(dir, "bare.sg", 0) &&
@@ -115,23 +114,22 @@ int main(int argc, char **argv)
         return 2;
     }
     const char *dir = argv[1];
-    char *sg = join(dir, "meadow.sg"), *packdir = join(dir, "meadow.pack");
-    char *bsg = join(dir, "bare.sg"), *bpackdir = join(dir, "bare.pack");
-    rt_pack p, bp;
-    rt_device dev;
+    char *sg = kit_join(dir, "meadow.sg"), *packdir = kit_join(dir, "meadow.pack");
+    char *bsg = kit_join(dir, "bare.sg"), *bpackdir = kit_join(dir, "bare.pack");
+    bool built = write_inputs(dir) && kit_build_pack_ok(sg, packdir) &&
+                 kit_build_pack_ok(bsg, bpackdir);
+    rt_pack *p = built ? kit_pack(packdir) : NULL, *bp = built ? kit_pack(bpackdir) : NULL;
+    rt_device *dev = p && bp ? kit_device() : NULL;
     rt_error e = { 0 };
-    if (!write_inputs(dir) || !build_pack_ok(sg, packdir) || !build_pack_ok(bsg, bpackdir) ||
-        !rt_pack_load(&p, packdir, &e) || !rt_pack_load(&bp, bpackdir, &e) ||
-        !rt_device_create(&dev, NULL, &e)) {
-        fprintf(stderr, "FAIL: setup: %s\n", e.msg ? e.msg : "the scene does not build");
-        return 1;
-    }
-    CHECK(p.ug.nslots == 1 && p.ug.nblocks == 2, "pack undergrowth: %d slots, %d blocks",
-          p.ug.nslots, p.ug.nblocks);
-    CHECK(bp.ug.nslots == 0, "the bare pack has undergrowth");
+    if (!dev)
+        return kit_finish("undergrowth");
+    rt_pack_info pi = kit_pack_info(p), bpi = kit_pack_info(bp);
+    CHECK(pi.ug_slots == 1 && pi.ug_blocks == 2, "pack undergrowth: %d slots, %d blocks",
+          pi.ug_slots, pi.ug_blocks);
+    CHECK(bpi.ug_slots == 0 && !bpi.has_undergrowth, "the bare pack has undergrowth");
     rt_camera cam = { .position = { 64, 60, 64 }, .look = { 64, 0, 64.01 } };
     rt_ug_instance *a = malloc(sizeof *a * MAXI), *b = malloc(sizeof *b * MAXI);
-    rt_renderer *r1 = renderer(&dev, &p, false), *r2 = renderer(&dev, &p, false);
+    rt_renderer *r1 = renderer(dev, p, false), *r2 = renderer(dev, p, false);
     if (!a || !b || !r1 || !r2)
         return 1;
 
@@ -200,13 +198,10 @@ int main(int argc, char **argv)
 
     /* hot reload (rt_renderer_swap_pack): the grass at a quarter of the
      * density, every cell generated again */
-    char *ssg = join(dir, "sparse.sg"), *spackdir = join(dir, "sparse.pack");
-    rt_pack sp;
-    bool loaded = build_pack_ok(ssg, spackdir) && rt_pack_load(&sp, spackdir, &e);
-    CHECK(loaded, "sparse pack: %s", e.msg ? e.msg : "does not build");
-    rt_error_clear(&e);
-    if (loaded) {
-        CHECK(rt_renderer_swap_pack(r2, &sp, &e), "swap: %s", e.msg ? e.msg : "?");
+    char *ssg = kit_join(dir, "sparse.sg"), *spackdir = kit_join(dir, "sparse.pack");
+    rt_pack *sp = kit_build_pack_ok(ssg, spackdir) ? kit_pack(spackdir) : NULL;
+    if (sp) {
+        CHECK(rt_renderer_swap_pack(r2, sp, &e), "swap: %s", e.msg ? e.msg : "?");
         rt_error_clear(&e);
         CHECK(rt_renderer_frame(r2, &cam, &st, &e), "frame: %s", e.msg ? e.msg : "?");
         long grass = 0;
@@ -222,8 +217,7 @@ int main(int argc, char **argv)
               grass, want);
     }
     rt_renderer_destroy(r2);
-    if (loaded)
-        rt_pack_free(&sp);
+    rt_pack_close(sp);
     free(ssg);
     free(spackdir);
 
@@ -250,20 +244,20 @@ int main(int argc, char **argv)
     printf("crater: %d instances within %.1f m before, %d after\n", before, inner, after);
     CHECK(before > 50 && after * 50 <= before, "crater: %d instances before, %d after", before,
           after);
-    float *img = frame_of(r1, &cam, W, H);
+    float *img = kit_frame(r1, &cam, W, H);
     if (img)
-        write_picture(dir, "meadow.png", img, W, H, SPLAT_VIEW_FINAL);
+        kit_write_picture(dir, "meadow.png", img, W, H, SPLAT_VIEW_FINAL);
     free(img);
     rt_renderer_destroy(r1);
 
     /* undergrowth off: today's picture, to the byte */
-    rt_renderer *off = renderer(&dev, &p, true), *bare = renderer(&dev, &bp, false);
+    rt_renderer *off = renderer(dev, p, true), *bare = renderer(dev, bp, false);
     rt_camera low = { .position = { 20, 3, 20 }, .look = { 60, 0, 50 } };
-    float *x = off ? frame_of(off, &low, W, H) : NULL, *y = bare ? frame_of(bare, &low, W, H) : NULL;
+    float *x = off ? kit_frame(off, &low, W, H) : NULL, *y = bare ? kit_frame(bare, &low, W, H) : NULL;
     CHECK(x && y && memcmp(x, y, (size_t)W * H * 16) == 0,
           "no_undergrowth differs from the scene without undergrowth");
     if (x)
-        write_picture(dir, "off.png", x, W, H, SPLAT_VIEW_FINAL);
+        kit_write_picture(dir, "off.png", x, W, H, SPLAT_VIEW_FINAL);
     free(x);
     free(y);
     rt_renderer_destroy(off);
@@ -280,16 +274,16 @@ int main(int argc, char **argv)
     };
     long covered[3] = { 0 };
     for (int k = 0; k < 3; k++) {
-        rt_renderer *ron = renderer_on(&dev, &p, false, path[k].sh, path[k].d);
-        rt_renderer *roff = renderer_on(&dev, &p, true, path[k].sh, path[k].d);
-        float *z = ron ? frame_of(ron, &low, W, H) : NULL;
-        float *o = roff ? frame_of(roff, &low, W, H) : NULL;
+        rt_renderer *ron = renderer_on(dev, p, false, path[k].sh, path[k].d);
+        rt_renderer *roff = renderer_on(dev, p, true, path[k].sh, path[k].d);
+        float *z = ron ? kit_frame(ron, &low, W, H) : NULL;
+        float *o = roff ? kit_frame(roff, &low, W, H) : NULL;
         for (long i = 0; z && o && i < (long)W * H; i++)
             covered[k] += memcmp(z + 4 * i, o + 4 * i, 12) != 0;
         if (z && k == 0)
-            write_picture(dir, "ground.png", z, W, H, SPLAT_VIEW_FINAL);
+            kit_write_picture(dir, "ground.png", z, W, H, SPLAT_VIEW_FINAL);
         if (z && k == 2)
-            write_picture(dir, "ground_raycast.png", z, W, H, SPLAT_VIEW_FINAL);
+            kit_write_picture(dir, "ground_raycast.png", z, W, H, SPLAT_VIEW_FINAL);
         free(z);
         free(o);
         rt_renderer_destroy(ron);
@@ -308,12 +302,8 @@ int main(int argc, char **argv)
     free(packdir);
     free(bsg);
     free(bpackdir);
-    rt_pack_free(&p);
-    rt_pack_free(&bp);
-    int msgs = rt_device_messages(&dev);
-    CHECK(msgs == 0, "%d validation messages", msgs);
-    rt_device_destroy(&dev);
-    if (failures)
-        fprintf(stderr, "%d failures\n", failures);
-    return failures ? 1 : 0;
+    rt_pack_close(p);
+    rt_pack_close(bp);
+    kit_device_close(dev);
+    return kit_finish("undergrowth");
 }

@@ -11,7 +11,7 @@
 #include <math.h>
 #include <string.h>
 
-#include "splatrt.h"
+#include "rt_internal.h"   /* builds an rt_pack by hand: its camera presets and size */
 
 /* A camera `d` metres from its look point, along (3, 4, 12) / 13. */
 static rt_pack_camera cam_at(double d)

@@ -26,7 +26,7 @@ if(TARGET splatrt)
   set(HOLES_OUT ${CMAKE_BINARY_DIR}/tests/holes)
   file(MAKE_DIRECTORY ${HOLES_OUT})
   add_executable(test_holes ${CMAKE_CURRENT_LIST_DIR}/test_holes.c)
-  target_link_libraries(test_holes splatrt splatc PkgConfig::GDAL m)
+  target_link_libraries(test_holes splat_testkit PkgConfig::GDAL)
   add_test(NAME world.holes COMMAND test_holes ${HOLES_OUT}
            WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
   set_tests_properties(world.holes PROPERTIES LABELS render TIMEOUT 600
@@ -44,7 +44,7 @@ if(TARGET splatrt)
   set(FAR_OUT ${CMAKE_BINARY_DIR}/tests/far)
   file(MAKE_DIRECTORY ${FAR_OUT})
   add_executable(test_far ${CMAKE_CURRENT_LIST_DIR}/test_far.c)
-  target_link_libraries(test_far splatrt splatc m)
+  target_link_libraries(test_far splat_testkit)
   add_test(NAME world.far COMMAND test_far ${FAR_OUT}
            WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
   set_tests_properties(world.far PROPERTIES LABELS render TIMEOUT 600
@@ -59,7 +59,7 @@ if(TARGET splatrt)
   set(PLACED_OUT ${CMAKE_BINARY_DIR}/tests/placed)
   file(MAKE_DIRECTORY ${PLACED_OUT})
   add_executable(test_placed ${CMAKE_CURRENT_LIST_DIR}/test_placed.c)
-  target_link_libraries(test_placed splatrt splatc PkgConfig::GDAL m)
+  target_link_libraries(test_placed splat_testkit PkgConfig::GDAL)
   add_test(NAME world.placed_mask COMMAND test_placed ${PLACED_OUT}
            WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
   set_tests_properties(world.placed_mask PROPERTIES LABELS render TIMEOUT 600

@@ -31,8 +31,7 @@
  * Without the precision pass the 5,000 km view fails both (position's
  * fp32 ulp there is 0.5 m).  Pictures go to OUTDIR: each view, and
  * diff_*.png (red: over 8/255, grey: the difference times 16). */
-#include "rt_internal.h"
-#include "../check.h"
+#include "kit.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -61,7 +60,7 @@ static bool write_inputs(const char *dir)
     uint8_t *hf = malloc((size_t)N * N);
     if (!hf) return false;
     memset(hf, 128, (size_t)N * N);
-    char *png = join(dir, "flat.png");
+    char *png = kit_join(dir, "flat.png");
     bool ok = stbi_write_png(png, N, N, 1, hf, N) != 0;
     free(hf);
     free(png);
@@ -71,7 +70,7 @@ static bool write_inputs(const char *dir)
     for (int i = 0; ok && i < 3; i++) {
         char file[32];
         snprintf(file, sizeof file, "%s.sg", names[i]);
-        char *sg = join(dir, file);
+        char *sg = kit_join(dir, file);
         FILE *f = fopen(sg, "w");
         ok = f != NULL;
         if (f) {
@@ -89,24 +88,21 @@ static bool write_inputs(const char *dir)
 
 /* Build DIR/NAME.sg into DIR/NAME.pack (fresh: an old pack with the same
  * inputs would be kept as it is) and load it on the device. */
-static bool build(const char *dir, const char *name, rt_pack *pack)
+static bool build(const char *dir, const char *name, rt_pack **pack)
 {
     char file[64];
     snprintf(file, sizeof file, "%s.sg", name);
-    char *sg = join(dir, file);
+    char *sg = kit_join(dir, file);
     snprintf(file, sizeof file, "%s.pack", name);
-    char *packdir = join(dir, file);
+    char *packdir = kit_join(dir, file);
     sg_diags d;
-    bool ok = build_pack(sg, packdir, SPLAT_PAINTED_BC4, &d);
+    bool ok = kit_build_pack(sg, packdir, SPLAT_PAINTED_BC4, &d);
     if (!ok) sg_diags_print(&d, stderr);
     /* far.sg's uses of position are all periodic: no warning */
     for (int i = 0; i < d.n; i++)
         CHECK(d.items[i].severity != SG_WARNING, "warning: %s", d.items[i].msg);
     sg_diags_free(&d);
-    rt_error e = { 0 };
-    ok = ok && rt_pack_load(pack, packdir, &e);
-    if (e.msg) fprintf(stderr, "%s\n", e.msg);
-    rt_error_clear(&e);
+    ok = ok && (*pack = kit_pack(packdir));
     free(sg);
     free(packdir);
     return ok;
@@ -267,22 +263,24 @@ int main(int argc, char **argv)
     }
     const char *dir = argv[1];
     static const char *const search[] = { ".", NULL };
-    rt_pack tex, noise, coarse;
-    rt_device dev;
+    rt_pack *tex = NULL, *noise = NULL, *coarse = NULL;
+    rt_device *dev = NULL;
     rt_error e = { 0 };
     splat_scene s;
     sg_diags d;
     sg_diags_init(&d);
-    char *noise_sg = join(dir, "noise.sg");
+    char *noise_sg = kit_join(dir, "noise.sg");
     if (!write_inputs(dir) || !build(dir, "tex", &tex) || !build(dir, "noise", &noise) ||
-        !build(dir, "coarse", &coarse) || !splat_scene_load(&s, noise_sg, search, &d) || !rt_device_create(&dev, NULL, &e)) {
+        !build(dir, "coarse", &coarse) || !splat_scene_load(&s, noise_sg, search, &d) ||
+        !(dev = kit_device())) {
         sg_diags_print(&d, stderr);
-        fprintf(stderr, "FAIL: setup: %s\n", e.msg ? e.msg : "the scenes do not build");
-        return 1;
+        CHECK(false, "setup: the scenes do not build, load or find a device");
+        return kit_finish("far from the origin");
     }
     sg_diags_free(&d);
-    CHECK(tex.nsites == 4, "%d sites (1 m, three tri-planar)", tex.nsites);
-    CHECK(noise.nsites == 5, "%d sites (and the noise's)", noise.nsites);
+    rt_pack_info ti = kit_pack_info(tex), ni = kit_pack_info(noise);
+    CHECK(ti.nsites == 4, "%d sites (1 m, three tri-planar)", ti.nsites);
+    CHECK(ni.nsites == 5, "%d sites (and the noise's)", ni.nsites);
     check_detector();
     rt_render_desc rd = { .width = W, .height = H };
     rt_render_desc sd = { .width = W, .height = H, .shading = RT_SHADING_SCREEN,
@@ -292,9 +290,9 @@ int main(int argc, char **argv)
     /* per pack (tex, coarse): forward, screen, screen with ray casting */
     rt_renderer *rp[2][3] = { { NULL } }, *rn = NULL;
     const rt_render_desc *descs[3] = { &rd, &sd, &cd };
-    bool made = rt_renderer_create(&dev, &noise, &rd, &rn, &e);
+    bool made = rt_renderer_create(dev, noise, &rd, &rn, &e);
     for (int i = 0; made && i < 6; i++)
-        made = rt_renderer_create(&dev, i < 3 ? &tex : &coarse, descs[i % 3], &rp[i / 3][i % 3],
+        made = rt_renderer_create(dev, i < 3 ? tex : coarse, descs[i % 3], &rp[i / 3][i % 3],
                                   &e);
     CHECK(made, "renderer: %s", e.msg ? e.msg : "?");
     double h0 = splat_terrain_height(&s.terrain, 0.5, 0.5);
@@ -318,7 +316,7 @@ int main(int argc, char **argv)
             for (int q = 0; q < 3; q++) {
                 char name[96], what[64];
                 snprintf(name, sizeof name, "albedo_%s_%s_%.0fkm.png", views[v], paths[q], o / 1000);
-                char *png = join(dir, name);
+                char *png = kit_join(dir, name);
                 bool first = k == 0 && q == 0;
                 bool ok = render(rp[v == 2][q], cam, look, SPLAT_VIEW_ALBEDO, 0,
                                  first ? base : img, png);
@@ -327,7 +325,7 @@ int main(int argc, char **argv)
                     continue;
                 snprintf(name, sizeof name, "diff_%s_%s_%.0fkm.png", views[v], paths[q], o / 1000);
                 snprintf(what, sizeof what, "%s, %s", views[v], paths[q]);
-                png = join(dir, name);
+                png = kit_join(dir, name);
                 compare(img, base, what, o, png);
                 free(png);
             }
@@ -336,7 +334,7 @@ int main(int argc, char **argv)
             /* the noise's mask against the double reference */
             char name[64];
             snprintf(name, sizeof name, "mask_%.0fkm.png", o / 1000);
-            char *png = join(dir, name);
+            char *png = kit_join(dir, name);
             bool ok = render(rn, cam, look, SPLAT_VIEW_MASK, 1, img, png);
             free(png);
             double worst = 0;
@@ -361,17 +359,11 @@ int main(int argc, char **argv)
     if (rn) rt_renderer_destroy(rn);
     for (int i = 0; i < 6; i++)
         if (rp[i / 3][i % 3]) rt_renderer_destroy(rp[i / 3][i % 3]);
-    CHECK(rt_device_messages(&dev) == 0, "%d validation messages", rt_device_messages(&dev));
-    rt_device_destroy(&dev);
-    rt_pack_free(&tex);
-    rt_pack_free(&noise);
-    rt_pack_free(&coarse);
+    kit_device_close(dev);
+    rt_pack_close(tex);
+    rt_pack_close(noise);
+    rt_pack_close(coarse);
     splat_scene_free(&s);
     free(noise_sg);
-    if (failures) {
-        fprintf(stderr, "%d failures\n", failures);
-        return 1;
-    }
-    printf("far from the origin: all checks passed\n");
-    return 0;
+    return kit_finish("far from the origin");
 }

@@ -18,7 +18,7 @@
  *   - no validation messages.
  * Pictures of the views go to OUTDIR. */
 #include "rt_internal.h"
-#include "../check.h"
+#include "kit.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -52,7 +52,7 @@ static bool write_inputs(const char *dir)
             if (in_rect(HOLE_A, x, z, 0)) hf[z * N + x] = -32768.0f;
             if (x >= 178 && x < 182 && z >= 178 && z < 182) hf[z * N + x] = 900.0f;
         }
-    char *tif = join(dir, "hf.tif"), *png = join(dir, "holes.png"), *sg = join(dir, "scene.sg");
+    char *tif = kit_join(dir, "hf.tif"), *png = kit_join(dir, "holes.png"), *sg = kit_join(dir, "scene.sg");
     GDALAllRegister();
     GDALDatasetH ds = GDALCreate(GDALGetDriverByName("GTiff"), tif, N, N, 1, GDT_Float32, NULL);
     bool ok = ds != NULL;
@@ -85,9 +85,9 @@ static bool write_inputs(const char *dir)
 
 static bool build(const char *dir, char **pack)
 {
-    char *sg = join(dir, "scene.sg");
-    *pack = join(dir, "pack");
-    bool ok = build_pack_ok(sg, *pack);
+    char *sg = kit_join(dir, "scene.sg");
+    *pack = kit_join(dir, "pack");
+    bool ok = kit_build_pack_ok(sg, *pack);
     free(sg);
     return ok;
 }
@@ -142,7 +142,7 @@ static void check_view(const rt_pack *pack, rt_device *dev, rt_reference ref,
                           .clear = { CLEAR[0], CLEAR[1], CLEAR[2], CLEAR[3] } };
     rt_camera cam = { .position = { CAM[0], CAM[1], CAM[2] },
                       .look = { CAM[0], 0, CAM[2] }, .fovy = FOVY };
-    float *rgba = render_frame(dev, pack, &rd, view, 0, &cam);
+    float *rgba = kit_render(dev, pack, &rd, view, 0, &cam);
     bool ok = rgba != NULL;
     int hole = 0, ground = 0;
     for (int py = 0; ok && py < H; py++)
@@ -165,12 +165,12 @@ static void check_view(const rt_pack *pack, rt_device *dev, rt_reference ref,
                               xb > 3 && zb > 3 && xb < N - 4 && zb < N - 4;
             if (in) {
                 hole++;
-                if (!bg && failures < 20)
+                if (!bg && kit_failures() < 20)
                     CHECK(bg, "%s: pixel %d,%d (texel %.1f,%.1f) inside a hole is "
                           "%g %g %g", name, px, py, xa, za, c[0], c[1], c[2]);
             } else if (!near && on_terrain) {
                 ground++;
-                if (bg && failures < 20)
+                if (bg && kit_failures() < 20)
                     CHECK(!bg, "%s: pixel %d,%d (texel %.1f,%.1f) outside the holes "
                           "is background", name, px, py, xa, za);
             }
@@ -180,7 +180,7 @@ static void check_view(const rt_pack *pack, rt_device *dev, rt_reference ref,
     printf("%s: %d pixels inside holes are background, %d outside are terrain\n",
            name, hole, ground);
     if (ok)
-        write_picture(dir, name, rgba, W, H, view);
+        kit_write_picture(dir, name, rgba, W, H, view);
     free(rgba);
 }
 
@@ -197,27 +197,18 @@ int main(int argc, char **argv)
         free(packdir);
         return 1;
     }
-    rt_pack pack;
-    rt_device dev;
-    rt_error e = { 0 };
-    if (!rt_pack_load(&pack, packdir, &e) || !rt_device_create(&dev, NULL, &e)) {
-        fprintf(stderr, "FAIL: setup: %s\n", e.msg);
-        return 1;
-    }
-    check_analysis(&pack);
-    check_bounds(&pack);
-    check_view(&pack, &dev, RT_REF_NONE, SPLAT_VIEW_FINAL, dir, "final.png");
-    check_view(&pack, &dev, RT_REF_NONE, SPLAT_VIEW_COMBOS, dir, "combos.png");
-    check_view(&pack, &dev, RT_REF_UBER, SPLAT_VIEW_FINAL, dir, "uber.png");
-    CHECK(rt_device_messages(&dev) == 0, "%d validation messages", rt_device_messages(&dev));
-    rt_device_destroy(&dev);
-    rt_pack_free(&pack);
+    rt_pack *pack = kit_pack(packdir);
+    rt_device *dev = pack ? kit_device() : NULL;
+    if (!dev)
+        return kit_finish("holes");
+    check_analysis(pack);
+    check_bounds(pack);
+    check_view(pack, dev, RT_REF_NONE, SPLAT_VIEW_FINAL, dir, "final.png");
+    check_view(pack, dev, RT_REF_NONE, SPLAT_VIEW_COMBOS, dir, "combos.png");
+    check_view(pack, dev, RT_REF_UBER, SPLAT_VIEW_FINAL, dir, "uber.png");
+    kit_device_close(dev);
+    rt_pack_close(pack);
     free(packdir);
     GDALDestroyDriverManager();
-    if (failures) {
-        fprintf(stderr, "%d failures\n", failures);
-        return 1;
-    }
-    printf("holes: all checks passed\n");
-    return 0;
+    return kit_finish("holes");
 }

@@ -23,7 +23,7 @@
  *   - no validation messages.
  * Pictures of the views go to OUTDIR. */
 #include "rt_internal.h"
-#include "../check.h"
+#include "kit.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -44,7 +44,7 @@ static const double FOVY = M_PI / 3.0;
 
 static bool write_text(const char *dir, const char *name, const char *text)
 {
-    char *path = join(dir, name);
+    char *path = kit_join(dir, name);
     FILE *f = fopen(path, "w");
     bool ok = f && fputs(text, f) >= 0;
     if (f) ok &= fclose(f) == 0;
@@ -68,7 +68,7 @@ static bool write_mask(const char *dir)
                 if (r >= 2500.0 && r < 2504.0) row[x] = 255;
             }
     }
-    char *tif = join(dir, "road.tif");
+    char *tif = kit_join(dir, "road.tif");
     char opt_c[] = "COMPRESS=DEFLATE", opt_t[] = "TILED=YES";
     char *opts[] = { opt_c, opt_t, NULL };
     GDALAllRegister();
@@ -121,10 +121,10 @@ static double now(void)
 
 static bool build(const char *dir, char **pack)
 {
-    char *sg = join(dir, "scene.sg");
-    *pack = join(dir, "pack");
+    char *sg = kit_join(dir, "scene.sg");
+    *pack = kit_join(dir, "pack");
     double t0 = now();
-    bool ok = build_pack_ok(sg, *pack);
+    bool ok = kit_build_pack_ok(sg, *pack);
     double secs = now() - t0;
     free(sg);
     struct rusage ru;
@@ -139,9 +139,9 @@ static bool build(const char *dir, char **pack)
 /* --painted dense cannot store a placed mask: a located error, no pack. */
 static void check_dense_refused(const char *dir)
 {
-    char *sg = join(dir, "scene.sg"), *out = join(dir, "dense_pack");
+    char *sg = kit_join(dir, "scene.sg"), *out = kit_join(dir, "dense_pack");
     sg_diags d;
-    CHECK(!build_pack(sg, out, SPLAT_PAINTED_DENSE, &d), "--painted dense built a placed mask");
+    CHECK(!kit_build_pack(sg, out, SPLAT_PAINTED_DENSE, &d), "--painted dense built a placed mask");
     char *text = NULL;
     size_t n = 0;
     FILE *f = open_memstream(&text, &n);
@@ -191,8 +191,8 @@ static float *render(const rt_pack *pack, rt_device *dev, rt_reference ref, rt_s
                      splat_view view, const rt_camera *cam, const char *dir, const char *name)
 {
     rt_render_desc rd = { .width = W, .height = H, .reference = ref, .shading = shading };
-    float *rgba = render_frame(dev, pack, &rd, view, 1, cam);
-    if (rgba) write_picture(dir, name, rgba, W, H, view);
+    float *rgba = kit_render(dev, pack, &rd, view, 1, cam);
+    if (rgba) kit_write_picture(dir, name, rgba, W, H, view);
     return rgba;
 }
 
@@ -284,40 +284,31 @@ int main(int argc, char **argv)
         free(packdir);
         return 1;
     }
-    rt_pack pack;
-    rt_device dev;
-    rt_error e = { 0 };
-    if (!rt_pack_load(&pack, packdir, &e) || !rt_device_create(&dev, NULL, &e)) {
-        fprintf(stderr, "FAIL: setup: %s\n", e.msg);
-        return 1;
-    }
+    rt_pack *pack = kit_pack(packdir);
+    rt_device *dev = pack ? kit_device() : NULL;
+    if (!dev)
+        return kit_finish("placed");
     check_dense_refused(dir);
-    check_store(&pack);
-    check_width(&pack, &dev, 1500.0, ROAD_Z + 2.0, 4.0, dir, "road4.png");
-    check_width(&pack, &dev, ROAD_X + 4.0, 8500.0, 8.0, dir, "road8.png");
+    check_store(pack);
+    check_width(pack, dev, 1500.0, ROAD_Z + 2.0, 4.0, dir, "road4.png");
+    check_width(pack, dev, ROAD_X + 4.0, 8500.0, 8.0, dir, "road8.png");
     /* close over the crossing, the whole square, a grazing view along x */
     double cx = ORIGIN[0] + ROAD_X + 4, cz = ORIGIN[1] + ROAD_Z + 2;
-    double gy = ground(&pack, cx, cz);
+    double gy = ground(pack, cx, cz);
     rt_camera close = { .position = { cx - 30, gy + 40, cz - 30 }, .look = { cx, gy, cz },
                         .fovy = FOVY };
-    double mx = ORIGIN[0] + N / 2.0, mz = ORIGIN[1] + N / 2.0, my = ground(&pack, mx, mz);
+    double mx = ORIGIN[0] + N / 2.0, mz = ORIGIN[1] + N / 2.0, my = ground(pack, mx, mz);
     rt_camera over = { .position = { mx, my + 9000, mz + 1 }, .look = { mx, my, mz },
                        .fovy = FOVY };
     rt_camera graze = { .position = { ORIGIN[0] - 200, my + 150, mz + 1200 },
                         .look = { mx, my, mz + 1200 }, .fovy = FOVY };
-    check_sound(&pack, &dev, &close, dir, "close");
-    check_sound(&pack, &dev, &over, dir, "over");
-    check_sound(&pack, &dev, &graze, dir, "graze");
-    check_screen(&pack, &dev, &close, dir);
-    CHECK(rt_device_messages(&dev) == 0, "%d validation messages", rt_device_messages(&dev));
-    rt_device_destroy(&dev);
-    rt_pack_free(&pack);
+    check_sound(pack, dev, &close, dir, "close");
+    check_sound(pack, dev, &over, dir, "over");
+    check_sound(pack, dev, &graze, dir, "graze");
+    check_screen(pack, dev, &close, dir);
+    kit_device_close(dev);
+    rt_pack_close(pack);
     free(packdir);
     GDALDestroyDriverManager();
-    if (failures) {
-        fprintf(stderr, "%d failures\n", failures);
-        return 1;
-    }
-    printf("placed: all checks passed\n");
-    return 0;
+    return kit_finish("placed");
 }
