@@ -25,8 +25,8 @@
  * down every 4-11 m, times the material's colour constant (the vec3 a
  * one-material edit changes).  Without --textures the output is what it
  * was before the flag existed, byte for byte.  Deterministic: same
- * arguments, same bytes.  --view K adds camera 'biome', 120 m above biome
- * K's centre looking steeply down into it; --only K writes the same terrain and
+ * arguments, same bytes.  --view K adds camera 'biome' above biome K's
+ * centre, looking steeply down into it; --only K writes the same terrain and
  * masks but keeps only the base and biome K's materials, with that camera:
  * the world that issue 29's presence comparison holds the full one to. */
 #include <errno.h>
@@ -296,12 +296,14 @@ static void put_scene(text *t, const world *w)
     put(t, "    camera overview { position = %.0f %.0f %.0f, look = %.0f 0 %.0f }\n",
         -0.2 * w->metres, 0.8 * w->metres, -0.2 * w->metres, 0.5 * w->metres, 0.5 * w->metres);
     if (w->view >= 0) {
-        /* 120 m above biome K's centre, 30 m off it, looking at the ground
-         * there: a view inside the biome (issue 29's presence comparison) */
+        /* above biome K's centre by 0.12 of the biomes' spacing, a quarter
+         * of that off it, looking at the ground there: a view inside the
+         * biome (issue 29's presence comparison) */
         double x = w->cx[w->view] * 4.0, z = w->cz[w->view] * 4.0;
         double y = world_height(w->cx[w->view], w->cz[w->view], w->N) * w->max_height;
+        double up = 0.12 * w->metres / ceil(sqrt((double)w->B));
         put(t, "    camera biome { position = %.1f %.1f %.1f, look = %.1f %.1f %.1f }\n",
-            x - 30.0, y + 120.0, z, x, y, z);
+            x - 0.25 * up, y + up, z, x, y, z);
     }
     put(t, "}\n");
 }

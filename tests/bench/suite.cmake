@@ -52,6 +52,18 @@ if(TARGET splatc)
         WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
       set_tests_properties(bench.world_merge PROPERTIES LABELS cli
                            FIXTURES_REQUIRED world_scene TIMEOUT 600)
+      if(TARGET splatview)
+        # 265 materials cost what 9 do at a view inside one biome: every
+        # tile classified (material sets past 256 bits), the same layers
+        # and samples per pixel, the same picture (issue 29)
+        add_test(NAME bench.world_presence
+          COMMAND sh ${CMAKE_CURRENT_LIST_DIR}/world_presence.sh $<TARGET_FILE:gen_world>
+                  $<TARGET_FILE:splatc_cli> $<TARGET_FILE:splatview> $<TARGET_FILE:imgcheck>
+                  ${CMAKE_BINARY_DIR}/tests/bench/world_presence
+          WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
+        set_tests_properties(bench.world_presence PROPERTIES LABELS render TIMEOUT 900
+                             ENVIRONMENT "SPLAT_VALIDATE=1")
+      endif()
     endif()
   endif()
 endif()
