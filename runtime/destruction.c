@@ -205,6 +205,68 @@ static bool warm_up(rt_destruction *ds, rt_error *e)
     return rt_oneshot_end(ds->d, cb, e);
 }
 
+/* Staging for one event: the whole indirection and the heightfield
+ * texels under the grid (a crater never writes outside it). */
+static VkDeviceSize staging_bytes(const rt_destruction *ds)
+{
+    size_t ncell = (size_t)ds->n * (size_t)ds->n;
+    int tx0, tz0, tx1, tz1;
+    tx0 = (int)floor(ds->origin[0] / ds->size[0] * ds->hw) - 1;
+    tz0 = (int)floor(ds->origin[1] / ds->size[1] * ds->hh) - 1;
+    tx1 = (int)ceil((ds->origin[0] + ds->n * ds->cell) / ds->size[0] * ds->hw) + 1;
+    tz1 = (int)ceil((ds->origin[1] + ds->n * ds->cell) / ds->size[1] * ds->hh) + 1;
+    tx0 = tx0 < 0 ? 0 : tx0;
+    tz0 = tz0 < 0 ? 0 : tz0;
+    tx1 = tx1 > ds->hw ? ds->hw : tx1;
+    tz1 = tz1 > ds->hh ? ds->hh : tz1;
+    size_t hbytes = tx1 > tx0 && tz1 > tz0 ? (size_t)(tx1 - tx0) * (size_t)(tz1 - tz0) * 2 : 0;
+    return (VkDeviceSize)(ncell * 4 + hbytes + 16);
+}
+
+/* The atlas and indirection images (cleared), the decal pipeline, the
+ * ring's command buffers, fences and staging, and the warm-up decal. */
+static bool make_gpu(rt_destruction *ds, rt_error *e)
+{
+    rt_device *d = ds->d;
+    size_t ncell = (size_t)ds->n * (size_t)ds->n;
+    const VkImageUsageFlags use = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT;
+    uint32_t aside = (uint32_t)(ds->cols * RT_DESTR_TILE);
+    if (!rt_format_supports(d, VK_FORMAT_R8_UNORM, VK_FORMAT_FEATURE_COLOR_ATTACHMENT_BLEND_BIT |
+                                                   VK_FORMAT_FEATURE_SAMPLED_IMAGE_FILTER_LINEAR_BIT))
+        return rt_fail(e, RT_E_NO_FORMAT, "render with blending into R8_UNORM (destruction mask)");
+    uint8_t *zero = calloc((size_t)aside * aside > ncell * 4 ? (size_t)aside * aside : ncell * 4, 1);
+    if (!zero)
+        return rt_fail(e, RT_E_VULKAN, "destruction", "out of memory");
+    VkCommandBufferAllocateInfo ai = {
+        .sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO,
+        .commandPool = d->pool, .level = VK_COMMAND_BUFFER_LEVEL_PRIMARY,
+        .commandBufferCount = RT_DESTR_RING,
+    };
+    VkFenceCreateInfo fi = { .sType = VK_STRUCTURE_TYPE_FENCE_CREATE_INFO };
+    bool ok = rt_image_create(d, aside, aside, 1, false, 1, VK_FORMAT_R8_UNORM,
+                              use | VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT,
+                              VK_IMAGE_ASPECT_COLOR_BIT, &ds->atlas, e) &&
+              rt_image_upload(d, &ds->atlas, zero, (size_t)aside * aside, e) &&
+              rt_image_create(d, (uint32_t)ds->n, (uint32_t)ds->n, 1, false, 1,
+                              VK_FORMAT_R8G8B8A8_UNORM, use, VK_IMAGE_ASPECT_COLOR_BIT,
+                              &ds->indir, e) &&
+              rt_image_upload(d, &ds->indir, zero, ncell * 4, e) &&
+              make_pipeline(ds, e);
+    free(zero);
+    if (ok) {
+        VkResult r = vkAllocateCommandBuffers(d->dev, &ai, ds->cb);
+        for (int i = 0; r == VK_SUCCESS && i < RT_DESTR_RING; i++)
+            r = vkCreateFence(d->dev, &fi, NULL, &ds->fence[i]);
+        if (r != VK_SUCCESS)
+            ok = rt_fail(e, RT_E_VULKAN, "destruction commands", rt_vk_result_name(r));
+    }
+    VkDeviceSize sbytes = staging_bytes(ds);
+    for (int i = 0; ok && i < RT_DESTR_RING; i++)
+        ok = rt_buffer_create(d, sbytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, true,
+                              &ds->staging[i], e);
+    return ok && warm_up(ds, e);
+}
+
 bool rt_destruction_create(rt_device *d, const rt_pack *p, int pool_tiles,
                            rt_image *height, rt_bounds *bounds, rt_destruction **out,
                            rt_error *e)
@@ -261,62 +323,7 @@ bool rt_destruction_create(rt_device *d, const rt_pack *p, int pool_tiles,
         ds->cell_tile[i] = -1;
     memcpy(ds->heights, p->heights, texels * 2);
 
-    /* Staging for one event: the whole indirection and the heightfield
-     * texels under the grid (a crater never writes outside it). */
-    int tx0, tz0, tx1, tz1;
-    tx0 = (int)floor(ds->origin[0] / ds->size[0] * ds->hw) - 1;
-    tz0 = (int)floor(ds->origin[1] / ds->size[1] * ds->hh) - 1;
-    tx1 = (int)ceil((ds->origin[0] + ds->n * ds->cell) / ds->size[0] * ds->hw) + 1;
-    tz1 = (int)ceil((ds->origin[1] + ds->n * ds->cell) / ds->size[1] * ds->hh) + 1;
-    tx0 = tx0 < 0 ? 0 : tx0;
-    tz0 = tz0 < 0 ? 0 : tz0;
-    tx1 = tx1 > ds->hw ? ds->hw : tx1;
-    tz1 = tz1 > ds->hh ? ds->hh : tz1;
-    size_t hbytes = tx1 > tx0 && tz1 > tz0 ? (size_t)(tx1 - tx0) * (size_t)(tz1 - tz0) * 2 : 0;
-    VkDeviceSize sbytes = (VkDeviceSize)(ncell * 4 + hbytes + 16);
-
-    const VkImageUsageFlags use = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT;
-    uint32_t aside = (uint32_t)(ds->cols * RT_DESTR_TILE);
-    uint8_t *zero = calloc((size_t)aside * aside > ncell * 4 ? (size_t)aside * aside : ncell * 4, 1);
-    if (!zero) {
-        rt_destruction_destroy(ds);
-        return rt_fail(e, RT_E_VULKAN, "destruction", "out of memory");
-    }
-    if (!rt_format_supports(d, VK_FORMAT_R8_UNORM, VK_FORMAT_FEATURE_COLOR_ATTACHMENT_BLEND_BIT |
-                                                   VK_FORMAT_FEATURE_SAMPLED_IMAGE_FILTER_LINEAR_BIT)) {
-        free(zero);
-        rt_destruction_destroy(ds);
-        return rt_fail(e, RT_E_NO_FORMAT, "render with blending into R8_UNORM (destruction mask)");
-    }
-    VkCommandBufferAllocateInfo ai = {
-        .sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO,
-        .commandPool = d->pool, .level = VK_COMMAND_BUFFER_LEVEL_PRIMARY,
-        .commandBufferCount = 1,
-    };
-    VkFenceCreateInfo fi = { .sType = VK_STRUCTURE_TYPE_FENCE_CREATE_INFO };
-    bool ok = rt_image_create(d, aside, aside, 1, false, 1, VK_FORMAT_R8_UNORM,
-                              use | VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT,
-                              VK_IMAGE_ASPECT_COLOR_BIT, &ds->atlas, e) &&
-              rt_image_upload(d, &ds->atlas, zero, (size_t)aside * aside, e) &&
-              rt_image_create(d, (uint32_t)ds->n, (uint32_t)ds->n, 1, false, 1,
-                              VK_FORMAT_R8G8B8A8_UNORM, use, VK_IMAGE_ASPECT_COLOR_BIT,
-                              &ds->indir, e) &&
-              rt_image_upload(d, &ds->indir, zero, ncell * 4, e) &&
-              make_pipeline(ds, e);
-    free(zero);
-    ai.commandBufferCount = RT_DESTR_RING;
-    if (ok) {
-        VkResult r = vkAllocateCommandBuffers(d->dev, &ai, ds->cb);
-        for (int i = 0; r == VK_SUCCESS && i < RT_DESTR_RING; i++)
-            r = vkCreateFence(d->dev, &fi, NULL, &ds->fence[i]);
-        if (r != VK_SUCCESS)
-            ok = rt_fail(e, RT_E_VULKAN, "destruction commands", rt_vk_result_name(r));
-    }
-    for (int i = 0; ok && i < RT_DESTR_RING; i++)
-        ok = rt_buffer_create(d, sbytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, true,
-                              &ds->staging[i], e);
-    ok = ok && warm_up(ds, e);
-    if (!ok) {
+    if (!make_gpu(ds, e)) {
         rt_destruction_destroy(ds);
         return false;
     }

@@ -747,6 +747,89 @@ static void teardown(viewer *v)
     watch_free(&v->w);
 }
 
+/* The starting camera: the pack's default, a preset, or the desc's. */
+static bool start_camera(viewer *v, rt_error *e)
+{
+    const rt_viewer_desc *desc = v->desc;
+    rt_default_camera(v->pack, &v->cam);
+    if (desc->preset) {
+        int c = rt_pack_camera_find(v->pack, desc->preset);
+        if (c < 0) {
+            rt_fail(e, RT_E_WINDOW, "the pack has no such camera preset");
+            return false;
+        }
+        memcpy(v->cam.position, v->pack->cameras[c].position, sizeof v->cam.position);
+        memcpy(v->cam.look, v->pack->cameras[c].look, sizeof v->cam.look);
+    }
+    if (desc->have_camera && !desc->preset)
+        v->cam = desc->camera;
+    angles_from_camera(v);
+    camera_from_angles(v);
+    double ext = v->pack->size[0] > v->pack->size[1] ? v->pack->size[0] : v->pack->size[1];
+    v->speed = ext / 20.0;
+    return true;
+}
+
+/* GLFW's window, the device and a surface it can present to. */
+static bool open_window(viewer *v, rt_error *e)
+{
+    const rt_viewer_desc *desc = v->desc;
+    if (!glfwInit()) {
+        rt_fail(e, RT_E_WINDOW, "glfwInit failed (no display?)");
+        return false;
+    }
+    if (!glfwVulkanSupported()) {
+        rt_fail(e, RT_E_WINDOW, "GLFW finds no Vulkan loader");
+        return false;
+    }
+    glfwWindowHint(GLFW_CLIENT_API, GLFW_NO_API);
+    glfwWindowHint(GLFW_RESIZABLE, GLFW_FALSE);   /* fixed-size targets */
+    v->win = glfwCreateWindow(desc->width, desc->height, "splatview", NULL, NULL);
+    if (!v->win) {
+        rt_fail(e, RT_E_WINDOW, "cannot open a window");
+        return false;
+    }
+    glfwSetWindowUserPointer(v->win, v);
+    uint32_t next = 0;
+    const char **exts = glfwGetRequiredInstanceExtensions(&next);
+    rt_device_desc dd = { .instance_exts = exts, .ninstance_exts = next, .swapchain = true };
+    if (!rt_device_create(&v->dev, &dd, e))
+        return false;
+    VkResult vr = glfwCreateWindowSurface(v->dev.instance, v->win, NULL, &v->surface);
+    if (vr != VK_SUCCESS) {
+        rt_fail(e, RT_E_VULKAN, "glfwCreateWindowSurface", rt_vk_result_name(vr));
+        return false;
+    }
+    VkBool32 can_present = VK_FALSE;
+    vkGetPhysicalDeviceSurfaceSupportKHR(v->dev.phys, v->dev.queue_family, v->surface, &can_present);
+    if (!can_present) {
+        rt_fail(e, RT_E_WINDOW, "the chosen device's graphics queue cannot present to the window");
+        return false;
+    }
+    return true;
+}
+
+/* The renderer (screen-capable where the device allows), the tone map
+ * and the help overlay. */
+static bool make_renderer(viewer *v, rt_error *e)
+{
+    const rt_viewer_desc *desc = v->desc;
+    rt_render_desc rd = desc->render;
+    v->no_shadows = rd.no_shadows;
+    rd.width = (int)v->extent.width;
+    rd.height = (int)v->extent.height;
+    /* Screen-capable whenever the pack has compute variants, so the G key
+     * can switch paths. */
+    rd.shading = v->pack->uber_compute ? RT_SHADING_SCREEN : RT_SHADING_FORWARD;
+    bool made = rt_renderer_create(&v->dev, v->pack, &rd, &v->r, e);
+    if (!made && rd.shading == RT_SHADING_SCREEN && desc->render.shading != RT_SHADING_SCREEN) {
+        rt_error_clear(e);   /* the device cannot do the screen path */
+        rd.shading = RT_SHADING_FORWARD;
+        made = rt_renderer_create(&v->dev, v->pack, &rd, &v->r, e);
+    }
+    return made && make_tonemap(v, e) && rt_overlay_create(&v->dev, v->pass, &v->overlay, e);
+}
+
 int rt_viewer_run(const rt_viewer_desc *desc)
 {
     viewer vw;
@@ -765,71 +848,13 @@ int rt_viewer_run(const rt_viewer_desc *desc)
     }
     if (desc->view_name && !rt_parse_view(desc->view_name, v->pack, &v->view, &v->material, &e))
         goto done;
-    rt_default_camera(v->pack, &v->cam);
-    if (desc->preset) {
-        int c = rt_pack_camera_find(v->pack, desc->preset);
-        if (c < 0) {
-            rt_fail(&e, RT_E_WINDOW, "the pack has no such camera preset");
-            goto done;
-        }
-        memcpy(v->cam.position, v->pack->cameras[c].position, sizeof v->cam.position);
-        memcpy(v->cam.look, v->pack->cameras[c].look, sizeof v->cam.look);
-    }
-    if (desc->have_camera && !desc->preset)
-        v->cam = desc->camera;
-    angles_from_camera(v);
-    camera_from_angles(v);
-    double ext = v->pack->size[0] > v->pack->size[1] ? v->pack->size[0] : v->pack->size[1];
-    v->speed = ext / 20.0;
-
-    if (!glfwInit()) {
-        rt_fail(&e, RT_E_WINDOW, "glfwInit failed (no display?)");
+    if (!start_camera(v, &e))
         goto done;
-    }
-    if (!glfwVulkanSupported()) {
-        rt_fail(&e, RT_E_WINDOW, "GLFW finds no Vulkan loader");
+    if (!open_window(v, &e))
         goto done;
-    }
-    glfwWindowHint(GLFW_CLIENT_API, GLFW_NO_API);
-    glfwWindowHint(GLFW_RESIZABLE, GLFW_FALSE);   /* fixed-size targets */
-    v->win = glfwCreateWindow(desc->width, desc->height, "splatview", NULL, NULL);
-    if (!v->win) {
-        rt_fail(&e, RT_E_WINDOW, "cannot open a window");
-        goto done;
-    }
-    glfwSetWindowUserPointer(v->win, v);
-    uint32_t next = 0;
-    const char **exts = glfwGetRequiredInstanceExtensions(&next);
-    rt_device_desc dd = { .instance_exts = exts, .ninstance_exts = next, .swapchain = true };
-    if (!rt_device_create(&v->dev, &dd, &e))
-        goto done;
-    VkResult vr = glfwCreateWindowSurface(v->dev.instance, v->win, NULL, &v->surface);
-    if (vr != VK_SUCCESS) {
-        rt_fail(&e, RT_E_VULKAN, "glfwCreateWindowSurface", rt_vk_result_name(vr));
-        goto done;
-    }
-    VkBool32 can_present = VK_FALSE;
-    vkGetPhysicalDeviceSurfaceSupportKHR(v->dev.phys, v->dev.queue_family, v->surface, &can_present);
-    if (!can_present) {
-        rt_fail(&e, RT_E_WINDOW, "the chosen device's graphics queue cannot present to the window");
-        goto done;
-    }
     if (!make_swapchain(v, &e))
         goto done;
-    rt_render_desc rd = desc->render;
-    v->no_shadows = rd.no_shadows;
-    rd.width = (int)v->extent.width;
-    rd.height = (int)v->extent.height;
-    /* Screen-capable whenever the pack has compute variants, so the G key
-     * can switch paths. */
-    rd.shading = v->pack->uber_compute ? RT_SHADING_SCREEN : RT_SHADING_FORWARD;
-    bool made = rt_renderer_create(&v->dev, v->pack, &rd, &v->r, &e);
-    if (!made && rd.shading == RT_SHADING_SCREEN && desc->render.shading != RT_SHADING_SCREEN) {
-        rt_error_clear(&e);   /* the device cannot do the screen path */
-        rd.shading = RT_SHADING_FORWARD;
-        made = rt_renderer_create(&v->dev, v->pack, &rd, &v->r, &e);
-    }
-    if (!made || !make_tonemap(v, &e) || !rt_overlay_create(&v->dev, v->pass, &v->overlay, &e))
+    if (!make_renderer(v, &e))
         goto done;
     /* the path asked for, else screen where the pack can (splatview's
      * headless default) */
