@@ -44,6 +44,8 @@
  *     either, and a mesh-lit instance's normal the terrain's) as ug_far
  *     goes from 0 at 0.35 r1 to 1 at 0.8 r1: the cover turns into the
  *     ground it stands on before it thins out.
+ * The shaders are in undergrowth_glsl.c, the tests' probe pass in
+ * undergrowth_probe.c, what they share in undergrowth_impl.h.
  */
 #include "undergrowth_impl.h"
 
