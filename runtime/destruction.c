@@ -34,6 +34,7 @@
  * Memory (slides: 2048 m at 4 px/m is 64 MB dense): rt_destruction_memory
  * gives the figures for any configuration. */
 #include "rt_internal.h"
+#include "vk_build.h"
 #include "util.h"
 
 #include <math.h>
@@ -63,6 +64,7 @@ struct rt_destruction {
     VkFramebuffer    fb;
     VkPipelineLayout layout;
     VkPipeline       pipe;
+    rt_vk_list       keep;     /* pass, fb, layout, pipe                    */
     /* RT_DESTR_RING events in flight, each with its command buffer, fence
      * and staging memory; an event waits only when the oldest is still
      * running (reported as wait_ms, not part of the event's cpu_ms) */
@@ -140,23 +142,9 @@ void rt_destruction_memory(double area_m, double px_per_m, double cell_m,
 
 static bool make_pipeline(rt_destruction *ds, rt_error *e)
 {
-    VkDevice dev = ds->d->dev;
-    VkAttachmentDescription att = {
-        .format = VK_FORMAT_R8_UNORM,
-        .samples = VK_SAMPLE_COUNT_1_BIT,
-        .loadOp = VK_ATTACHMENT_LOAD_OP_LOAD,
-        .storeOp = VK_ATTACHMENT_STORE_OP_STORE,
-        .stencilLoadOp = VK_ATTACHMENT_LOAD_OP_DONT_CARE,
-        .stencilStoreOp = VK_ATTACHMENT_STORE_OP_DONT_CARE,
-        .initialLayout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
-        .finalLayout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
-    };
-    VkAttachmentReference ref = { 0, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL };
-    VkSubpassDescription sub = {
-        .pipelineBindPoint = VK_PIPELINE_BIND_POINT_GRAPHICS,
-        .colorAttachmentCount = 1,
-        .pColorAttachments = &ref,
-    };
+    rt_device *d = ds->d;
+    rt_vk_list *k = &ds->keep;
+    const VkImageLayout ro = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL;
     /* Earlier frames' reads of the atlas finish before the decals write;
      * the decals are visible to the fragment shaders of later frames. */
     VkSubpassDependency dep[2] = {
@@ -167,100 +155,28 @@ static bool make_pipeline(rt_destruction *ds, rt_error *e)
           VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT, VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT,
           VK_ACCESS_SHADER_READ_BIT, 0 },
     };
-    VkRenderPassCreateInfo rci = {
-        .sType = VK_STRUCTURE_TYPE_RENDER_PASS_CREATE_INFO,
-        .attachmentCount = 1, .pAttachments = &att,
-        .subpassCount = 1, .pSubpasses = &sub,
-        .dependencyCount = 2, .pDependencies = dep,
+    /* MAX: overlapping craters keep the stronger mark */
+    VkPipelineColorBlendAttachmentState blend = {
+        .blendEnable = VK_TRUE,
+        .srcColorBlendFactor = VK_BLEND_FACTOR_ONE, .dstColorBlendFactor = VK_BLEND_FACTOR_ONE,
+        .colorBlendOp = VK_BLEND_OP_MAX,
+        .srcAlphaBlendFactor = VK_BLEND_FACTOR_ONE, .dstAlphaBlendFactor = VK_BLEND_FACTOR_ONE,
+        .alphaBlendOp = VK_BLEND_OP_MAX,
+        .colorWriteMask = VK_COLOR_COMPONENT_R_BIT,
     };
-    RT_VK(e, vkCreateRenderPass(dev, &rci, NULL, &ds->pass));
-    VkFramebufferCreateInfo fci = {
-        .sType = VK_STRUCTURE_TYPE_FRAMEBUFFER_CREATE_INFO,
-        .renderPass = ds->pass,
-        .attachmentCount = 1, .pAttachments = &ds->atlas.view,
-        .width = ds->atlas.width, .height = ds->atlas.height, .layers = 1,
-    };
-    RT_VK(e, vkCreateFramebuffer(dev, &fci, NULL, &ds->fb));
-    VkPushConstantRange push = { VK_SHADER_STAGE_FRAGMENT_BIT, 0, sizeof(decal_push) };
-    VkPipelineLayoutCreateInfo lci = {
-        .sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO,
-        .pushConstantRangeCount = 1, .pPushConstantRanges = &push,
-    };
-    RT_VK(e, vkCreatePipelineLayout(dev, &lci, NULL, &ds->layout));
-
-    uint32_t *vw = NULL, *fw = NULL;
-    size_t vn = 0, fn = 0;
-    VkShaderModule vm = VK_NULL_HANDLE, fm = VK_NULL_HANDLE;
-    bool ok = rt_glsl_compile(decal_vert, VK_SHADER_STAGE_VERTEX_BIT, "decal.vert", &vw, &vn, e) &&
-              rt_glsl_compile(decal_frag, VK_SHADER_STAGE_FRAGMENT_BIT, "decal.frag", &fw, &fn, e);
-    VkResult vr = VK_SUCCESS;
-    if (ok) {
-        VkShaderModuleCreateInfo mci = { .sType = VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO,
-                                         .codeSize = vn * 4, .pCode = vw };
-        vr = vkCreateShaderModule(dev, &mci, NULL, &vm);
-        mci.codeSize = fn * 4;
-        mci.pCode = fw;
-        if (vr == VK_SUCCESS)
-            vr = vkCreateShaderModule(dev, &mci, NULL, &fm);
-    }
-    if (ok && vr == VK_SUCCESS) {
-        VkPipelineShaderStageCreateInfo st[2] = {
-            { .sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO,
-              .stage = VK_SHADER_STAGE_VERTEX_BIT, .module = vm, .pName = "main" },
-            { .sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO,
-              .stage = VK_SHADER_STAGE_FRAGMENT_BIT, .module = fm, .pName = "main" },
-        };
-        VkPipelineVertexInputStateCreateInfo vi = {
-            .sType = VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO };
-        VkPipelineInputAssemblyStateCreateInfo ia = {
-            .sType = VK_STRUCTURE_TYPE_PIPELINE_INPUT_ASSEMBLY_STATE_CREATE_INFO,
-            .topology = VK_PRIMITIVE_TOPOLOGY_TRIANGLE_STRIP };
-        VkPipelineViewportStateCreateInfo vp = {
-            .sType = VK_STRUCTURE_TYPE_PIPELINE_VIEWPORT_STATE_CREATE_INFO,
-            .viewportCount = 1, .scissorCount = 1 };
-        VkPipelineRasterizationStateCreateInfo rs = {
-            .sType = VK_STRUCTURE_TYPE_PIPELINE_RASTERIZATION_STATE_CREATE_INFO,
-            .polygonMode = VK_POLYGON_MODE_FILL, .cullMode = VK_CULL_MODE_NONE,
-            .lineWidth = 1.0f };
-        VkPipelineMultisampleStateCreateInfo ms = {
-            .sType = VK_STRUCTURE_TYPE_PIPELINE_MULTISAMPLE_STATE_CREATE_INFO,
-            .rasterizationSamples = VK_SAMPLE_COUNT_1_BIT };
-        /* MAX: overlapping craters keep the stronger mark */
-        VkPipelineColorBlendAttachmentState blend = {
-            .blendEnable = VK_TRUE,
-            .srcColorBlendFactor = VK_BLEND_FACTOR_ONE, .dstColorBlendFactor = VK_BLEND_FACTOR_ONE,
-            .colorBlendOp = VK_BLEND_OP_MAX,
-            .srcAlphaBlendFactor = VK_BLEND_FACTOR_ONE, .dstAlphaBlendFactor = VK_BLEND_FACTOR_ONE,
-            .alphaBlendOp = VK_BLEND_OP_MAX,
-            .colorWriteMask = VK_COLOR_COMPONENT_R_BIT,
-        };
-        VkPipelineColorBlendStateCreateInfo cb = {
-            .sType = VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO,
-            .attachmentCount = 1, .pAttachments = &blend };
-        VkDynamicState dyn[2] = { VK_DYNAMIC_STATE_VIEWPORT, VK_DYNAMIC_STATE_SCISSOR };
-        VkPipelineDynamicStateCreateInfo ds_ = {
-            .sType = VK_STRUCTURE_TYPE_PIPELINE_DYNAMIC_STATE_CREATE_INFO,
-            .dynamicStateCount = 2, .pDynamicStates = dyn };
-        VkGraphicsPipelineCreateInfo pci = {
-            .sType = VK_STRUCTURE_TYPE_GRAPHICS_PIPELINE_CREATE_INFO,
-            .stageCount = 2, .pStages = st,
-            .pVertexInputState = &vi, .pInputAssemblyState = &ia, .pViewportState = &vp,
-            .pRasterizationState = &rs, .pMultisampleState = &ms, .pColorBlendState = &cb,
-            .pDynamicState = &ds_, .layout = ds->layout, .renderPass = ds->pass,
-        };
-        vr = vkCreateGraphicsPipelines(dev, VK_NULL_HANDLE, 1, &pci, NULL, &ds->pipe);
-    }
-    if (vm)
-        vkDestroyShaderModule(dev, vm, NULL);
-    if (fm)
-        vkDestroyShaderModule(dev, fm, NULL);
-    free(vw);
-    free(fw);
-    if (!ok)
-        return false;
-    if (vr != VK_SUCCESS)
-        return rt_fail(e, RT_E_VULKAN, "decal pipeline", rt_vk_result_name(vr));
-    return true;
+    return rt_vk_pass(d, k, &(rt_vk_pass_desc){ .label = "decal",
+                          .color = { { .format = VK_FORMAT_R8_UNORM, .initial = ro, .final = ro } },
+                          .ncolor = 1, .deps = dep, .ndeps = 2 }, &ds->pass, e) &&
+           rt_vk_fb(d, k, &(rt_vk_fb_desc){ .label = "decal", .pass = ds->pass,
+                        .views = &ds->atlas.view, .nviews = 1, .width = ds->atlas.width,
+                        .height = ds->atlas.height }, &ds->fb, e) &&
+           rt_vk_layout(d, k, &(rt_vk_layout_desc){ .label = "decal",
+                            .push_stages = VK_SHADER_STAGE_FRAGMENT_BIT,
+                            .push_bytes = sizeof(decal_push) }, &ds->layout, e) &&
+           rt_vk_gfx(d, k, &(rt_vk_gfx_desc){ .label = "decal", .vs_glsl = decal_vert,
+                         .fs_glsl = decal_frag, .topology = VK_PRIMITIVE_TOPOLOGY_TRIANGLE_STRIP,
+                         .ncolor = 1, .blend = &blend, .layout = ds->layout, .pass = ds->pass },
+                     &ds->pipe, e);
 }
 
 /* One decal of strength 0 (MAX blend: no change) at load time, so that
@@ -287,6 +203,68 @@ static bool warm_up(rt_destruction *ds, rt_error *e)
     vkCmdDraw(cb, 4, 1, 0, 0);
     vkCmdEndRenderPass(cb);
     return rt_oneshot_end(ds->d, cb, e);
+}
+
+/* Staging for one event: the whole indirection and the heightfield
+ * texels under the grid (a crater never writes outside it). */
+static VkDeviceSize staging_bytes(const rt_destruction *ds)
+{
+    size_t ncell = (size_t)ds->n * (size_t)ds->n;
+    int tx0, tz0, tx1, tz1;
+    tx0 = (int)floor(ds->origin[0] / ds->size[0] * ds->hw) - 1;
+    tz0 = (int)floor(ds->origin[1] / ds->size[1] * ds->hh) - 1;
+    tx1 = (int)ceil((ds->origin[0] + ds->n * ds->cell) / ds->size[0] * ds->hw) + 1;
+    tz1 = (int)ceil((ds->origin[1] + ds->n * ds->cell) / ds->size[1] * ds->hh) + 1;
+    tx0 = tx0 < 0 ? 0 : tx0;
+    tz0 = tz0 < 0 ? 0 : tz0;
+    tx1 = tx1 > ds->hw ? ds->hw : tx1;
+    tz1 = tz1 > ds->hh ? ds->hh : tz1;
+    size_t hbytes = tx1 > tx0 && tz1 > tz0 ? (size_t)(tx1 - tx0) * (size_t)(tz1 - tz0) * 2 : 0;
+    return (VkDeviceSize)(ncell * 4 + hbytes + 16);
+}
+
+/* The atlas and indirection images (cleared), the decal pipeline, the
+ * ring's command buffers, fences and staging, and the warm-up decal. */
+static bool make_gpu(rt_destruction *ds, rt_error *e)
+{
+    rt_device *d = ds->d;
+    size_t ncell = (size_t)ds->n * (size_t)ds->n;
+    const VkImageUsageFlags use = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT;
+    uint32_t aside = (uint32_t)(ds->cols * RT_DESTR_TILE);
+    if (!rt_format_supports(d, VK_FORMAT_R8_UNORM, VK_FORMAT_FEATURE_COLOR_ATTACHMENT_BLEND_BIT |
+                                                   VK_FORMAT_FEATURE_SAMPLED_IMAGE_FILTER_LINEAR_BIT))
+        return rt_fail(e, RT_E_NO_FORMAT, "render with blending into R8_UNORM (destruction mask)");
+    uint8_t *zero = calloc((size_t)aside * aside > ncell * 4 ? (size_t)aside * aside : ncell * 4, 1);
+    if (!zero)
+        return rt_fail(e, RT_E_VULKAN, "destruction", "out of memory");
+    VkCommandBufferAllocateInfo ai = {
+        .sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO,
+        .commandPool = d->pool, .level = VK_COMMAND_BUFFER_LEVEL_PRIMARY,
+        .commandBufferCount = RT_DESTR_RING,
+    };
+    VkFenceCreateInfo fi = { .sType = VK_STRUCTURE_TYPE_FENCE_CREATE_INFO };
+    bool ok = rt_image_create(d, aside, aside, 1, false, 1, VK_FORMAT_R8_UNORM,
+                              use | VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT,
+                              VK_IMAGE_ASPECT_COLOR_BIT, &ds->atlas, e) &&
+              rt_image_upload(d, &ds->atlas, zero, (size_t)aside * aside, e) &&
+              rt_image_create(d, (uint32_t)ds->n, (uint32_t)ds->n, 1, false, 1,
+                              VK_FORMAT_R8G8B8A8_UNORM, use, VK_IMAGE_ASPECT_COLOR_BIT,
+                              &ds->indir, e) &&
+              rt_image_upload(d, &ds->indir, zero, ncell * 4, e) &&
+              make_pipeline(ds, e);
+    free(zero);
+    if (ok) {
+        VkResult r = vkAllocateCommandBuffers(d->dev, &ai, ds->cb);
+        for (int i = 0; r == VK_SUCCESS && i < RT_DESTR_RING; i++)
+            r = vkCreateFence(d->dev, &fi, NULL, &ds->fence[i]);
+        if (r != VK_SUCCESS)
+            ok = rt_fail(e, RT_E_VULKAN, "destruction commands", rt_vk_result_name(r));
+    }
+    VkDeviceSize sbytes = staging_bytes(ds);
+    for (int i = 0; ok && i < RT_DESTR_RING; i++)
+        ok = rt_buffer_create(d, sbytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, true,
+                              &ds->staging[i], e);
+    return ok && warm_up(ds, e);
 }
 
 bool rt_destruction_create(rt_device *d, const rt_pack *p, int pool_tiles,
@@ -345,62 +323,7 @@ bool rt_destruction_create(rt_device *d, const rt_pack *p, int pool_tiles,
         ds->cell_tile[i] = -1;
     memcpy(ds->heights, p->heights, texels * 2);
 
-    /* Staging for one event: the whole indirection and the heightfield
-     * texels under the grid (a crater never writes outside it). */
-    int tx0, tz0, tx1, tz1;
-    tx0 = (int)floor(ds->origin[0] / ds->size[0] * ds->hw) - 1;
-    tz0 = (int)floor(ds->origin[1] / ds->size[1] * ds->hh) - 1;
-    tx1 = (int)ceil((ds->origin[0] + ds->n * ds->cell) / ds->size[0] * ds->hw) + 1;
-    tz1 = (int)ceil((ds->origin[1] + ds->n * ds->cell) / ds->size[1] * ds->hh) + 1;
-    tx0 = tx0 < 0 ? 0 : tx0;
-    tz0 = tz0 < 0 ? 0 : tz0;
-    tx1 = tx1 > ds->hw ? ds->hw : tx1;
-    tz1 = tz1 > ds->hh ? ds->hh : tz1;
-    size_t hbytes = tx1 > tx0 && tz1 > tz0 ? (size_t)(tx1 - tx0) * (size_t)(tz1 - tz0) * 2 : 0;
-    VkDeviceSize sbytes = (VkDeviceSize)(ncell * 4 + hbytes + 16);
-
-    const VkImageUsageFlags use = VK_IMAGE_USAGE_SAMPLED_BIT | VK_IMAGE_USAGE_TRANSFER_DST_BIT;
-    uint32_t aside = (uint32_t)(ds->cols * RT_DESTR_TILE);
-    uint8_t *zero = calloc((size_t)aside * aside > ncell * 4 ? (size_t)aside * aside : ncell * 4, 1);
-    if (!zero) {
-        rt_destruction_destroy(ds);
-        return rt_fail(e, RT_E_VULKAN, "destruction", "out of memory");
-    }
-    if (!rt_format_supports(d, VK_FORMAT_R8_UNORM, VK_FORMAT_FEATURE_COLOR_ATTACHMENT_BLEND_BIT |
-                                                   VK_FORMAT_FEATURE_SAMPLED_IMAGE_FILTER_LINEAR_BIT)) {
-        free(zero);
-        rt_destruction_destroy(ds);
-        return rt_fail(e, RT_E_NO_FORMAT, "render with blending into R8_UNORM (destruction mask)");
-    }
-    VkCommandBufferAllocateInfo ai = {
-        .sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO,
-        .commandPool = d->pool, .level = VK_COMMAND_BUFFER_LEVEL_PRIMARY,
-        .commandBufferCount = 1,
-    };
-    VkFenceCreateInfo fi = { .sType = VK_STRUCTURE_TYPE_FENCE_CREATE_INFO };
-    bool ok = rt_image_create(d, aside, aside, 1, false, 1, VK_FORMAT_R8_UNORM,
-                              use | VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT,
-                              VK_IMAGE_ASPECT_COLOR_BIT, &ds->atlas, e) &&
-              rt_image_upload(d, &ds->atlas, zero, (size_t)aside * aside, e) &&
-              rt_image_create(d, (uint32_t)ds->n, (uint32_t)ds->n, 1, false, 1,
-                              VK_FORMAT_R8G8B8A8_UNORM, use, VK_IMAGE_ASPECT_COLOR_BIT,
-                              &ds->indir, e) &&
-              rt_image_upload(d, &ds->indir, zero, ncell * 4, e) &&
-              make_pipeline(ds, e);
-    free(zero);
-    ai.commandBufferCount = RT_DESTR_RING;
-    if (ok) {
-        VkResult r = vkAllocateCommandBuffers(d->dev, &ai, ds->cb);
-        for (int i = 0; r == VK_SUCCESS && i < RT_DESTR_RING; i++)
-            r = vkCreateFence(d->dev, &fi, NULL, &ds->fence[i]);
-        if (r != VK_SUCCESS)
-            ok = rt_fail(e, RT_E_VULKAN, "destruction commands", rt_vk_result_name(r));
-    }
-    for (int i = 0; ok && i < RT_DESTR_RING; i++)
-        ok = rt_buffer_create(d, sbytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT, true,
-                              &ds->staging[i], e);
-    ok = ok && warm_up(ds, e);
-    if (!ok) {
+    if (!make_gpu(ds, e)) {
         rt_destruction_destroy(ds);
         return false;
     }
@@ -423,14 +346,7 @@ void rt_destruction_destroy(rt_destruction *ds)
                 vkFreeCommandBuffers(d->dev, d->pool, 1, &ds->cb[i]);
             rt_buffer_destroy(d, &ds->staging[i]);
         }
-        if (ds->pipe)
-            vkDestroyPipeline(d->dev, ds->pipe, NULL);
-        if (ds->layout)
-            vkDestroyPipelineLayout(d->dev, ds->layout, NULL);
-        if (ds->fb)
-            vkDestroyFramebuffer(d->dev, ds->fb, NULL);
-        if (ds->pass)
-            vkDestroyRenderPass(d->dev, ds->pass, NULL);
+        rt_vk_list_destroy(d, &ds->keep);
         rt_image_destroy(d, &ds->atlas);
         rt_image_destroy(d, &ds->indir);
     }

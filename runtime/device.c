@@ -449,35 +449,6 @@ void rt_image_destroy(rt_device *d, rt_image *img)
     memset(img, 0, sizeof *img);
 }
 
-bool rt_set_layout(rt_device *d, const VkDescriptorSetLayoutBinding *b, uint32_t n,
-                   VkDescriptorSetLayout *out, rt_error *e)
-{
-    VkDescriptorSetLayoutCreateInfo ci = {
-        .sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO,
-        .bindingCount = n,
-        .pBindings = b,
-    };
-    RT_VK(e, vkCreateDescriptorSetLayout(d->dev, &ci, NULL, out));
-    return true;
-}
-
-bool rt_descriptor_sets(rt_device *d, const VkDescriptorPoolSize *sizes, uint32_t nsizes,
-                        const VkDescriptorSetLayout *layouts, uint32_t nsets,
-                        VkDescriptorPool *pool, VkDescriptorSet *sets, rt_error *e)
-{
-    VkDescriptorPoolCreateInfo pci = {
-        .sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO,
-        .maxSets = nsets, .poolSizeCount = nsizes, .pPoolSizes = sizes,
-    };
-    RT_VK(e, vkCreateDescriptorPool(d->dev, &pci, NULL, pool));
-    VkDescriptorSetAllocateInfo ai = {
-        .sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO,
-        .descriptorPool = *pool, .descriptorSetCount = nsets, .pSetLayouts = layouts,
-    };
-    RT_VK(e, vkAllocateDescriptorSets(d->dev, &ai, sets));
-    return true;
-}
-
 bool rt_format_supports(rt_device *d, VkFormat f, VkFormatFeatureFlags need)
 {
     VkFormatProperties fp;

@@ -9,6 +9,7 @@
  * composites take theirs) and calls splat_finish: the same lighting, fog
  * and views as the composites, from three samples. */
 #include "rt_internal.h"
+#include "vk_build.h"
 #include "far_atlas.h"
 
 #include <stdlib.h>
@@ -43,6 +44,7 @@ struct rt_far {
     VkDescriptorSet       set;
     VkPipelineLayout      layout;
     VkPipeline            pipe[RT_VARIANTS];
+    rt_vk_list            keep;          /* every Vulkan object but the images */
 };
 
 static bool upload(rt_device *d, const rt_pack *p, rt_image img[3], rt_error *e)
@@ -179,46 +181,35 @@ bool rt_far_create(rt_device *d, const rt_pack *p, const rt_pipelines *pl, rt_fa
         return rt_fail(e, RT_E_VULKAN, "far atlas", "out of memory");
     f->d = d;
     *out = f;
-    VkSamplerCreateInfo si = {
-        .sType = VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO,
-        .magFilter = VK_FILTER_LINEAR, .minFilter = VK_FILTER_LINEAR,
-        .mipmapMode = VK_SAMPLER_MIPMAP_MODE_LINEAR,
-        .addressModeU = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE,
-        .addressModeV = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE,
-        .addressModeW = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE,
-        .maxLod = VK_LOD_CLAMP_NONE,
-    };
-    RT_VK(e, vkCreateSampler(d->dev, &si, NULL, &f->sampler));
-    if (!upload(d, p, f->img, e))
+    rt_vk_list *k = &f->keep;
+    if (!rt_vk_sampler(d, k, &(rt_vk_sampler_desc){ .label = "far atlas", .filter = VK_FILTER_LINEAR,
+                           .mip = VK_SAMPLER_MIPMAP_MODE_LINEAR,
+                           .wrap = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE,
+                           .max_lod = VK_LOD_CLAMP_NONE }, &f->sampler, e) ||
+        !upload(d, p, f->img, e))
         return false;
     const VkDescriptorType cis = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
     VkDescriptorSetLayoutBinding b[3];
     VkDescriptorImageInfo ii[3];
-    VkWriteDescriptorSet w[3];
-    for (uint32_t k = 0; k < 3; k++) {
-        b[k] = (VkDescriptorSetLayoutBinding){ 5 + k, cis, 1, VK_SHADER_STAGE_FRAGMENT_BIT, NULL };
-        ii[k] = rt_far_image_info(f, (int)k);
+    for (uint32_t i = 0; i < 3; i++) {
+        b[i] = (VkDescriptorSetLayoutBinding){ 5 + i, cis, 1, VK_SHADER_STAGE_FRAGMENT_BIT, NULL };
+        ii[i] = rt_far_image_info(f, (int)i);
     }
-    if (!rt_set_layout(d, b, 3, &f->set_layout, e))
-        return false;
     VkDescriptorPoolSize size = { cis, 3 };
-    if (!rt_descriptor_sets(d, &size, 1, &f->set_layout, 1, &f->pool, &f->set, e))
+    if (!rt_vk_set_layout(d, k, &(rt_vk_set_layout_desc){ "far atlas", b, 3 }, &f->set_layout, e) ||
+        !rt_vk_sets(d, k, &(rt_vk_sets_desc){ .label = "far atlas", .sizes = &size, .nsizes = 1,
+                        .layouts = &f->set_layout, .nsets = 1 }, &f->pool, &f->set, e))
         return false;
-    for (uint32_t k = 0; k < 3; k++)
-        w[k] = (VkWriteDescriptorSet){ .sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET,
-            .dstSet = f->set, .dstBinding = 5 + k, .descriptorCount = 1,
-            .descriptorType = cis, .pImageInfo = &ii[k] };
-    vkUpdateDescriptorSets(d->dev, 3, w, 0, NULL);
+    rt_vk_write w[3];
+    for (uint32_t i = 0; i < 3; i++)
+        w[i] = (rt_vk_write){ .set = f->set, .binding = 5 + i, .type = cis, .images = &ii[i],
+                              .count = 1 };
+    rt_vk_write_sets(d, w, 3);
     VkDescriptorSetLayout sets[3] = { pl->set_terrain, pl->set_material, f->set_layout };
-    VkPushConstantRange push = { VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT, 0,
-                                 sizeof(splat_push) };
-    VkPipelineLayoutCreateInfo li = {
-        .sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO,
-        .setLayoutCount = 3, .pSetLayouts = sets,
-        .pushConstantRangeCount = 1, .pPushConstantRanges = &push,
-    };
-    RT_VK(e, vkCreatePipelineLayout(d->dev, &li, NULL, &f->layout));
-    return true;
+    return rt_vk_layout(d, k, &(rt_vk_layout_desc){ .label = "far atlas", .sets = sets,
+                            .nsets = 3,
+                            .push_stages = VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT,
+                            .push_bytes = sizeof(splat_push) }, &f->layout, e);
 }
 
 VkDescriptorImageInfo rt_far_image_info(const rt_far *f, int k)
@@ -249,7 +240,7 @@ bool rt_far_bind_forward(rt_far *f, const rt_pack *p, const rt_passes *rp, rt_pi
         bool ok = rt_pipelines_glsl_fragment(f->d, pl, rp, f->layout, src, "far.frag", variant,
                                              slot, e);
         free(src);
-        if (!ok)
+        if (!ok || !rt_vk_keep(f->d, &f->keep, VK_OBJECT_TYPE_PIPELINE, RT_VK_H(*slot), e))
             return false;
     }
     vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_GRAPHICS, *slot);
@@ -262,18 +253,8 @@ void rt_far_destroy(rt_far *f)
     if (!f)
         return;
     rt_device *d = f->d;
-    for (int k = 0; k < RT_VARIANTS; k++)
-        if (f->pipe[k])
-            vkDestroyPipeline(d->dev, f->pipe[k], NULL);
-    if (f->layout)
-        vkDestroyPipelineLayout(d->dev, f->layout, NULL);
-    if (f->pool)
-        vkDestroyDescriptorPool(d->dev, f->pool, NULL);
-    if (f->set_layout)
-        vkDestroyDescriptorSetLayout(d->dev, f->set_layout, NULL);
+    rt_vk_list_destroy(d, &f->keep);
     for (int k = 0; k < 3; k++)
         rt_image_destroy(d, &f->img[k]);
-    if (f->sampler)
-        vkDestroySampler(d->dev, f->sampler, NULL);
     free(f);
 }

@@ -17,6 +17,7 @@
  * destructible area is empty; set 1 the renderer's materials; set 2 the
  * points. */
 #include "rt_internal.h"
+#include "vk_build.h"
 #include "far_atlas.h"
 #include "util.h"   /* splat_now */
 
@@ -34,10 +35,12 @@ typedef struct far_baker {
     rt_pipelines         *pl;
     VkDescriptorSetLayout set_terrain, set_out;
     VkPipelineLayout      layout;
-    VkPipeline           *pipes;        /* per base combination, on first use */
+    VkPipeline           *pipes;        /* per base combination, on first use
+                                           (on worker threads: not in keep)  */
     VkDescriptorPool      dpool;
     VkDescriptorSet       set0, set_points;
     rt_buffer             frame, points;
+    rt_vk_list            keep;         /* layouts, pool                     */
 } far_baker;
 
 static bool bake_pipeline(far_baker *fb, int combo, VkPipeline *out, rt_error *e)
@@ -128,17 +131,17 @@ static bool make_baker(far_baker *fb, VkDescriptorSet set0_src, const splat_fram
         return rt_fail(e, RT_E_VULKAN, "far atlas bake", "out of memory");
     VkDescriptorSetLayoutBinding out = { 0, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1,
                                          VK_SHADER_STAGE_COMPUTE_BIT, NULL };
+    rt_vk_list *k = &fb->keep;
     if (!rt_terrain_compute_layout(d, &fb->set_terrain, e) ||
-        !rt_set_layout(d, &out, 1, &fb->set_out, e))
+        !rt_vk_keep(d, k, VK_OBJECT_TYPE_DESCRIPTOR_SET_LAYOUT, RT_VK_H(fb->set_terrain), e) ||
+        !rt_vk_set_layout(d, k, &(rt_vk_set_layout_desc){ "far atlas bake", &out, 1 },
+                          &fb->set_out, e))
         return false;
     VkDescriptorSetLayout sets[3] = { fb->set_terrain, fb->pl->set_material, fb->set_out };
-    VkPushConstantRange pr = { VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof(splat_push) };
-    VkPipelineLayoutCreateInfo lci = {
-        .sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO,
-        .setLayoutCount = 3, .pSetLayouts = sets,
-        .pushConstantRangeCount = 1, .pPushConstantRanges = &pr,
-    };
-    RT_VK(e, vkCreatePipelineLayout(d->dev, &lci, NULL, &fb->layout));
+    if (!rt_vk_layout(d, k, &(rt_vk_layout_desc){ .label = "far atlas bake", .sets = sets,
+                          .nsets = 3, .push_stages = VK_SHADER_STAGE_COMPUTE_BIT,
+                          .push_bytes = sizeof(splat_push) }, &fb->layout, e))
+        return false;
     if (!rt_buffer_create(d, sizeof(splat_frame), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, true,
                           &fb->frame, e) ||
         !rt_buffer_create(d, band_bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT |
@@ -152,18 +155,15 @@ static bool make_baker(far_baker *fb, VkDescriptorSet set0_src, const splat_fram
     };
     VkDescriptorSetLayout ls[2] = { fb->set_terrain, fb->set_out };
     VkDescriptorSet ds[2];
-    if (!rt_descriptor_sets(d, sizes, 3, ls, 2, &fb->dpool, ds, e))
+    if (!rt_vk_sets(d, k, &(rt_vk_sets_desc){ .label = "far atlas bake", .sizes = sizes,
+                        .nsizes = 3, .layouts = ls, .nsets = 2 }, &fb->dpool, ds, e))
         return false;
     fb->set0 = ds[0];
     fb->set_points = ds[1];
     rt_terrain_compute_set(d, set0_src, fb->set0, fb->frame.buf);
-    VkDescriptorBufferInfo pb = { fb->points.buf, 0, VK_WHOLE_SIZE };
-    VkWriteDescriptorSet w = {
-        .sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = fb->set_points,
-        .dstBinding = 0, .descriptorCount = 1,
-        .descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, .pBufferInfo = &pb,
-    };
-    vkUpdateDescriptorSets(d->dev, 1, &w, 0, NULL);
+    rt_vk_write_sets(d, &(rt_vk_write){ .set = fb->set_points, .binding = 0,
+                                        .type = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
+                                        .buf = fb->points.buf }, 1);
     return true;
 }
 
@@ -174,14 +174,7 @@ static void destroy_baker(far_baker *fb)
         if (fb->pipes[k])
             vkDestroyPipeline(d->dev, fb->pipes[k], NULL);
     free(fb->pipes);
-    if (fb->dpool)
-        vkDestroyDescriptorPool(d->dev, fb->dpool, NULL);
-    if (fb->layout)
-        vkDestroyPipelineLayout(d->dev, fb->layout, NULL);
-    if (fb->set_terrain)
-        vkDestroyDescriptorSetLayout(d->dev, fb->set_terrain, NULL);
-    if (fb->set_out)
-        vkDestroyDescriptorSetLayout(d->dev, fb->set_out, NULL);
+    rt_vk_list_destroy(d, &fb->keep);
     rt_buffer_destroy(d, &fb->points);
     rt_buffer_destroy(d, &fb->frame);
 }

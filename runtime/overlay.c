@@ -18,6 +18,7 @@
  * the test sees what the window shows.
  */
 #include "rt_internal.h"
+#include "vk_build.h"
 
 #include <stdio.h>
 #include <stdlib.h>
@@ -56,6 +57,7 @@ struct rt_overlay {
     VkPipeline       pipeline;
     rt_buffer        vb;          /* host visible, persistently mapped    */
     uint32_t         nverts;      /* laid out by rt_overlay_layout        */
+    rt_vk_list       keep;        /* layout and pipeline                  */
 };
 
 void rt_overlay_text(const rt_overlay_info *in, char *buf, size_t n)
@@ -98,85 +100,29 @@ bool rt_overlay_create(rt_device *d, VkRenderPass pass, rt_overlay **out, rt_err
         return rt_fail(e, RT_E_WINDOW, "out of memory");
     o->d = d;
     *out = o;
-    VkPushConstantRange pr = { VK_SHADER_STAGE_VERTEX_BIT, 0, 8 };
-    VkPipelineLayoutCreateInfo pli = {
-        .sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO,
-        .pushConstantRangeCount = 1, .pPushConstantRanges = &pr,
+    VkVertexInputBindingDescription vb = { 0, sizeof(vertex), VK_VERTEX_INPUT_RATE_VERTEX };
+    VkVertexInputAttributeDescription va[2] = {
+        { 0, 0, VK_FORMAT_R32G32_SFLOAT, offsetof(vertex, x) },
+        { 1, 0, VK_FORMAT_R8G8B8A8_UNORM, offsetof(vertex, rgba) },
     };
-    RT_VK(e, vkCreatePipelineLayout(d->dev, &pli, NULL, &o->layout));
-    VkShaderModule vm = VK_NULL_HANDLE, fm = VK_NULL_HANDLE;
-    bool ok = rt_glsl_module(d, overlay_vert, VK_SHADER_STAGE_VERTEX_BIT, "overlay.vert", NULL,
-                             &vm, e) &&
-              rt_glsl_module(d, overlay_frag, VK_SHADER_STAGE_FRAGMENT_BIT, "overlay.frag", NULL,
-                             &fm, e);
-    if (ok) {
-        VkPipelineShaderStageCreateInfo st[2] = {
-            { .sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO,
-              .stage = VK_SHADER_STAGE_VERTEX_BIT, .module = vm, .pName = "main" },
-            { .sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO,
-              .stage = VK_SHADER_STAGE_FRAGMENT_BIT, .module = fm, .pName = "main" },
-        };
-        VkVertexInputBindingDescription vb = { 0, sizeof(vertex), VK_VERTEX_INPUT_RATE_VERTEX };
-        VkVertexInputAttributeDescription va[2] = {
-            { 0, 0, VK_FORMAT_R32G32_SFLOAT, offsetof(vertex, x) },
-            { 1, 0, VK_FORMAT_R8G8B8A8_UNORM, offsetof(vertex, rgba) },
-        };
-        VkPipelineVertexInputStateCreateInfo vi = {
-            .sType = VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO,
-            .vertexBindingDescriptionCount = 1, .pVertexBindingDescriptions = &vb,
-            .vertexAttributeDescriptionCount = 2, .pVertexAttributeDescriptions = va,
-        };
-        VkPipelineInputAssemblyStateCreateInfo ia = {
-            .sType = VK_STRUCTURE_TYPE_PIPELINE_INPUT_ASSEMBLY_STATE_CREATE_INFO,
-            .topology = VK_PRIMITIVE_TOPOLOGY_TRIANGLE_LIST,
-        };
-        VkPipelineViewportStateCreateInfo vps = {
-            .sType = VK_STRUCTURE_TYPE_PIPELINE_VIEWPORT_STATE_CREATE_INFO,
-            .viewportCount = 1, .scissorCount = 1,
-        };
-        VkDynamicState dyn[2] = { VK_DYNAMIC_STATE_VIEWPORT, VK_DYNAMIC_STATE_SCISSOR };
-        VkPipelineDynamicStateCreateInfo ds = {
-            .sType = VK_STRUCTURE_TYPE_PIPELINE_DYNAMIC_STATE_CREATE_INFO,
-            .dynamicStateCount = 2, .pDynamicStates = dyn,
-        };
-        VkPipelineRasterizationStateCreateInfo rs = {
-            .sType = VK_STRUCTURE_TYPE_PIPELINE_RASTERIZATION_STATE_CREATE_INFO,
-            .polygonMode = VK_POLYGON_MODE_FILL, .cullMode = VK_CULL_MODE_NONE, .lineWidth = 1.0f,
-        };
-        VkPipelineMultisampleStateCreateInfo ms = {
-            .sType = VK_STRUCTURE_TYPE_PIPELINE_MULTISAMPLE_STATE_CREATE_INFO,
-            .rasterizationSamples = VK_SAMPLE_COUNT_1_BIT,
-        };
-        VkPipelineColorBlendAttachmentState cba = {
-            .blendEnable = VK_TRUE,
-            .srcColorBlendFactor = VK_BLEND_FACTOR_SRC_ALPHA,
-            .dstColorBlendFactor = VK_BLEND_FACTOR_ONE_MINUS_SRC_ALPHA,
-            .colorBlendOp = VK_BLEND_OP_ADD,
-            .srcAlphaBlendFactor = VK_BLEND_FACTOR_ZERO,
-            .dstAlphaBlendFactor = VK_BLEND_FACTOR_ONE,
-            .alphaBlendOp = VK_BLEND_OP_ADD,
-            .colorWriteMask = 0xf,
-        };
-        VkPipelineColorBlendStateCreateInfo cb = {
-            .sType = VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO,
-            .attachmentCount = 1, .pAttachments = &cba,
-        };
-        VkGraphicsPipelineCreateInfo gi = {
-            .sType = VK_STRUCTURE_TYPE_GRAPHICS_PIPELINE_CREATE_INFO,
-            .stageCount = 2, .pStages = st, .pVertexInputState = &vi, .pInputAssemblyState = &ia,
-            .pViewportState = &vps, .pRasterizationState = &rs, .pMultisampleState = &ms,
-            .pColorBlendState = &cb, .pDynamicState = &ds, .layout = o->layout,
-            .renderPass = pass,
-        };
-        VkResult r = vkCreateGraphicsPipelines(d->dev, VK_NULL_HANDLE, 1, &gi, NULL, &o->pipeline);
-        if (r != VK_SUCCESS)
-            ok = rt_fail(e, RT_E_VULKAN, "vkCreateGraphicsPipelines(overlay)", rt_vk_result_name(r));
-    }
-    if (vm)
-        vkDestroyShaderModule(d->dev, vm, NULL);
-    if (fm)
-        vkDestroyShaderModule(d->dev, fm, NULL);
-    return ok;
+    VkPipelineColorBlendAttachmentState alpha = {
+        .blendEnable = VK_TRUE,
+        .srcColorBlendFactor = VK_BLEND_FACTOR_SRC_ALPHA,
+        .dstColorBlendFactor = VK_BLEND_FACTOR_ONE_MINUS_SRC_ALPHA,
+        .colorBlendOp = VK_BLEND_OP_ADD,
+        .srcAlphaBlendFactor = VK_BLEND_FACTOR_ZERO,
+        .dstAlphaBlendFactor = VK_BLEND_FACTOR_ONE,
+        .alphaBlendOp = VK_BLEND_OP_ADD,
+        .colorWriteMask = 0xf,
+    };
+    return rt_vk_layout(d, &o->keep, &(rt_vk_layout_desc){ .label = "overlay",
+                            .push_stages = VK_SHADER_STAGE_VERTEX_BIT, .push_bytes = 8 },
+                        &o->layout, e) &&
+           rt_vk_gfx(d, &o->keep, &(rt_vk_gfx_desc){ .label = "overlay",
+                         .vs_glsl = overlay_vert, .fs_glsl = overlay_frag,
+                         .vbufs = &vb, .nvbufs = 1, .attrs = va, .nattrs = 2,
+                         .ncolor = 1, .blend = &alpha, .layout = o->layout, .pass = pass },
+                     &o->pipeline, e);
 }
 
 void rt_overlay_destroy(rt_overlay *o)
@@ -184,10 +130,7 @@ void rt_overlay_destroy(rt_overlay *o)
     if (!o)
         return;
     rt_device *d = o->d;
-    if (o->pipeline)
-        vkDestroyPipeline(d->dev, o->pipeline, NULL);
-    if (o->layout)
-        vkDestroyPipelineLayout(d->dev, o->layout, NULL);
+    rt_vk_list_destroy(d, &o->keep);
     rt_buffer_destroy(d, &o->vb);
     free(o);
 }
@@ -268,35 +211,19 @@ void rt_overlay_record(rt_overlay *o, VkCommandBuffer cb, uint32_t w, uint32_t h
 bool rt_overlay_draw_rgba8(rt_device *d, const char *text, uint8_t *rgba, int w, int h,
                            rt_error *e)
 {
-    VkAttachmentDescription att = {
-        .format = VK_FORMAT_R8G8B8A8_UNORM,
-        .samples = VK_SAMPLE_COUNT_1_BIT,
-        .loadOp = VK_ATTACHMENT_LOAD_OP_LOAD,
-        .storeOp = VK_ATTACHMENT_STORE_OP_STORE,
-        .stencilLoadOp = VK_ATTACHMENT_LOAD_OP_DONT_CARE,
-        .stencilStoreOp = VK_ATTACHMENT_STORE_OP_DONT_CARE,
-        .initialLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
-        .finalLayout = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
-    };
-    VkAttachmentReference ref = { 0, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL };
-    VkSubpassDescription sub = {
-        .pipelineBindPoint = VK_PIPELINE_BIND_POINT_GRAPHICS,
-        .colorAttachmentCount = 1, .pColorAttachments = &ref,
-    };
-    VkRenderPassCreateInfo rp = {
-        .sType = VK_STRUCTURE_TYPE_RENDER_PASS_CREATE_INFO,
-        .attachmentCount = 1, .pAttachments = &att, .subpassCount = 1, .pSubpasses = &sub,
-    };
     VkRenderPass pass = VK_NULL_HANDLE;
     VkFramebuffer fb = VK_NULL_HANDLE;
     rt_overlay *o = NULL;
     rt_image img = { 0 };
     rt_buffer buf = { 0 };
     VkDeviceSize bytes = (VkDeviceSize)w * (VkDeviceSize)h * 4;
-    VkResult r = vkCreateRenderPass(d->dev, &rp, NULL, &pass);
-    bool ok = r == VK_SUCCESS || rt_fail(e, RT_E_VULKAN, "vkCreateRenderPass(overlay)",
-                                         rt_vk_result_name(r));
-    ok = ok && rt_overlay_create(d, pass, &o, e) &&
+    rt_vk_list keep = { 0 };
+    const VkImageLayout att = VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL;
+    bool ok = rt_vk_pass(d, &keep, &(rt_vk_pass_desc){ .label = "overlay",
+                             .color = { { .format = VK_FORMAT_R8G8B8A8_UNORM,
+                                          .initial = att, .final = att } }, .ncolor = 1 },
+                         &pass, e) &&
+              rt_overlay_create(d, pass, &o, e) &&
          rt_overlay_layout(o, text, (uint32_t)w, (uint32_t)h, e) &&
          rt_image_create(d, (uint32_t)w, (uint32_t)h, 1, false, 1, VK_FORMAT_R8G8B8A8_UNORM,
                          VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT |
@@ -304,16 +231,9 @@ bool rt_overlay_draw_rgba8(rt_device *d, const char *text, uint8_t *rgba, int w,
                          VK_IMAGE_ASPECT_COLOR_BIT, &img, e) &&
          rt_buffer_create(d, bytes, VK_BUFFER_USAGE_TRANSFER_SRC_BIT |
                                         VK_BUFFER_USAGE_TRANSFER_DST_BIT, true, &buf, e);
-    if (ok) {
-        VkFramebufferCreateInfo fi = {
-            .sType = VK_STRUCTURE_TYPE_FRAMEBUFFER_CREATE_INFO,
-            .renderPass = pass, .attachmentCount = 1, .pAttachments = &img.view,
-            .width = (uint32_t)w, .height = (uint32_t)h, .layers = 1,
-        };
-        r = vkCreateFramebuffer(d->dev, &fi, NULL, &fb);
-        ok = r == VK_SUCCESS || rt_fail(e, RT_E_VULKAN, "vkCreateFramebuffer(overlay)",
-                                        rt_vk_result_name(r));
-    }
+    ok = ok && rt_vk_fb(d, &keep, &(rt_vk_fb_desc){ .label = "overlay", .pass = pass,
+                                 .views = &img.view, .nviews = 1, .width = (uint32_t)w,
+                                 .height = (uint32_t)h }, &fb, e);
     VkCommandBuffer cb;
     if (ok && (ok = rt_oneshot_begin(d, &cb, e))) {
         memcpy(buf.map, rgba, (size_t)bytes);
@@ -352,11 +272,8 @@ bool rt_overlay_draw_rgba8(rt_device *d, const char *text, uint8_t *rgba, int w,
         if (ok)
             memcpy(rgba, buf.map, (size_t)bytes);
     }
-    if (fb)
-        vkDestroyFramebuffer(d->dev, fb, NULL);
     rt_overlay_destroy(o);
-    if (pass)
-        vkDestroyRenderPass(d->dev, pass, NULL);
+    rt_vk_list_destroy(d, &keep);
     rt_image_destroy(d, &img);
     rt_buffer_destroy(d, &buf);
     return ok;

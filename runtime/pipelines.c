@@ -5,6 +5,7 @@
  * ABI's splat_light), the über-shader pipeline, and a pipeline cache kept
  * on disk between runs. */
 #include "rt_internal.h"
+#include "vk_build.h"
 #include "util.h"   /* splat_write_atomic */
 
 #include <errno.h>
@@ -184,7 +185,8 @@ static bool make_layouts(rt_device *d, int ntextures /* arrays */, rt_pipelines 
         { SPLAT_BIND_TILES, sbuf, 1, cs, NULL },
         { SPLAT_BIND_COUNTERS, sbuf, 1, fs, NULL },
     };
-    if (!rt_set_layout(d, terrain, sizeof terrain / sizeof *terrain, &pl->set_terrain, e))
+    if (!rt_vk_set_layout(d, NULL, &(rt_vk_set_layout_desc){ "terrain", terrain,
+                              sizeof terrain / sizeof *terrain }, &pl->set_terrain, e))
         return false;
     VkDescriptorSetLayoutBinding *mat = calloc((size_t)ntextures + 1, sizeof *mat);
     if (!mat)
@@ -192,30 +194,25 @@ static bool make_layouts(rt_device *d, int ntextures /* arrays */, rt_pipelines 
     mat[0] = (VkDescriptorSetLayoutBinding){ SPLAT_BIND_PARAMS, VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 1, fs, NULL };
     for (int i = 0; i < ntextures; i++)
         mat[i + 1] = (VkDescriptorSetLayoutBinding){ (uint32_t)(SPLAT_BIND_TEXTURE0 + i), smp, 1, fs, NULL };
-    bool ok = rt_set_layout(d, mat, (uint32_t)ntextures + 1, &pl->set_material, e);
+    bool ok = rt_vk_set_layout(d, NULL, &(rt_vk_set_layout_desc){ "material", mat,
+                                   (uint32_t)ntextures + 1 }, &pl->set_material, e);
     free(mat);
     VkDescriptorSetLayoutBinding res[] = {
         { 0, smp, 1, fs, NULL }, { 1, smp, 1, fs, NULL }, { 2, smp, 1, fs, NULL },
     };
-    if (!ok || !rt_set_layout(d, res, 3, &pl->set_resolve, e))
+    if (!ok || !rt_vk_set_layout(d, NULL, &(rt_vk_set_layout_desc){ "resolve", res, 3 },
+                                 &pl->set_resolve, e))
         return false;
-    VkPushConstantRange push = { vf, 0, sizeof(splat_push) };
     VkDescriptorSetLayout sets[3] = { pl->set_terrain, pl->set_material, pl->set_resolve };
-    VkPipelineLayoutCreateInfo li = {
-        .sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO,
-        .setLayoutCount = 2,
-        .pSetLayouts = sets,
-        .pushConstantRangeCount = 1,
-        .pPushConstantRanges = &push,
-    };
-    RT_VK(e, vkCreatePipelineLayout(d->dev, &li, NULL, &pl->layout));
-    li.setLayoutCount = 3;
-    RT_VK(e, vkCreatePipelineLayout(d->dev, &li, NULL, &pl->resolve_layout));
-    VkPushConstantRange cpush = { cs, 0, sizeof(splat_push) };
-    li.setLayoutCount = 2;
-    li.pPushConstantRanges = &cpush;
-    RT_VK(e, vkCreatePipelineLayout(d->dev, &li, NULL, &pl->compute_layout));
-    return true;
+    return rt_vk_layout(d, NULL, &(rt_vk_layout_desc){ .label = "terrain", .sets = sets,
+                            .nsets = 2, .push_stages = vf, .push_bytes = sizeof(splat_push) },
+                        &pl->layout, e) &&
+           rt_vk_layout(d, NULL, &(rt_vk_layout_desc){ .label = "resolve", .sets = sets,
+                            .nsets = 3, .push_stages = vf, .push_bytes = sizeof(splat_push) },
+                        &pl->resolve_layout, e) &&
+           rt_vk_layout(d, NULL, &(rt_vk_layout_desc){ .label = "terrain compute", .sets = sets,
+                            .nsets = 2, .push_stages = cs, .push_bytes = sizeof(splat_push) },
+                        &pl->compute_layout, e);
 }
 
 /* ---- pipelines ----------------------------------------------------------- */
@@ -252,53 +249,6 @@ static bool make_pipeline_in(rt_device *d, rt_pipelines *pl, VkPipelineLayout la
     static const uint32_t final_view = SPLAT_VIEW_FINAL;
     static const VkSpecializationMapEntry view_entry = { SPLAT_SPEC_VIEW, 0, sizeof final_view };
     static const VkSpecializationInfo final_spec = { 1, &view_entry, sizeof final_view, &final_view };
-    VkPipelineShaderStageCreateInfo stages[2] = {
-        { .sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO,
-          .stage = VK_SHADER_STAGE_VERTEX_BIT, .module = vs, .pName = "main" },
-        { .sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO,
-          .stage = VK_SHADER_STAGE_FRAGMENT_BIT, .module = fs, .pName = "main",
-          .pSpecializationInfo = (variant & RT_VARIANT_DEBUG) ? NULL : &final_spec },
-    };
-    VkVertexInputBindingDescription vb = { 0, 8, VK_VERTEX_INPUT_RATE_VERTEX };
-    VkVertexInputAttributeDescription va = { 0, 0, VK_FORMAT_R32G32_SFLOAT, 0 };
-    VkPipelineVertexInputStateCreateInfo vi = {
-        .sType = VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO,
-        .vertexBindingDescriptionCount = k == K_RESOLVE || k == K_SKY ? 0 : 1,
-        .pVertexBindingDescriptions = &vb,
-        .vertexAttributeDescriptionCount = k == K_RESOLVE || k == K_SKY ? 0 : 1,
-        .pVertexAttributeDescriptions = &va,
-    };
-    VkPipelineInputAssemblyStateCreateInfo ia = {
-        .sType = VK_STRUCTURE_TYPE_PIPELINE_INPUT_ASSEMBLY_STATE_CREATE_INFO,
-        .topology = VK_PRIMITIVE_TOPOLOGY_TRIANGLE_LIST,
-    };
-    VkPipelineViewportStateCreateInfo vp = {
-        .sType = VK_STRUCTURE_TYPE_PIPELINE_VIEWPORT_STATE_CREATE_INFO,
-        .viewportCount = 1,
-        .scissorCount = 1,
-    };
-    VkPipelineRasterizationStateCreateInfo rs = {
-        .sType = VK_STRUCTURE_TYPE_PIPELINE_RASTERIZATION_STATE_CREATE_INFO,
-        .polygonMode = (variant & RT_VARIANT_WIRE) ? VK_POLYGON_MODE_LINE : VK_POLYGON_MODE_FILL,
-        /* Without RT_VARIANT_CULL terrain seen from below shows too.  The
-         * grid's triangles are clockwise on screen seen from above (the
-         * projection flips y). */
-        .cullMode = (variant & RT_VARIANT_CULL) ? VK_CULL_MODE_BACK_BIT : VK_CULL_MODE_NONE,
-        .frontFace = VK_FRONT_FACE_CLOCKWISE,
-        .lineWidth = 1.0f,
-    };
-    VkPipelineMultisampleStateCreateInfo ms = {
-        .sType = VK_STRUCTURE_TYPE_PIPELINE_MULTISAMPLE_STATE_CREATE_INFO,
-        .rasterizationSamples = VK_SAMPLE_COUNT_1_BIT,
-    };
-    /* Reversed Z (1 at the near plane, 0 at infinity): greater is nearer. */
-    VkPipelineDepthStencilStateCreateInfo ds = {
-        .sType = VK_STRUCTURE_TYPE_PIPELINE_DEPTH_STENCIL_STATE_CREATE_INFO,
-        .depthTestEnable = k != K_RESOLVE,
-        .depthWriteEnable = k == K_OPAQUE || k == K_BASE || k == K_DEPTH,
-        .depthCompareOp = k == K_BLEND || k == K_SKY ? VK_COMPARE_OP_EQUAL
-                                                     : VK_COMPARE_OP_GREATER_OR_EQUAL,
-    };
     const VkColorComponentFlags all = VK_COLOR_COMPONENT_R_BIT | VK_COLOR_COMPONENT_G_BIT |
                                       VK_COLOR_COMPONENT_B_BIT | VK_COLOR_COMPONENT_A_BIT;
     VkPipelineColorBlendAttachmentState att[3];
@@ -313,34 +263,27 @@ static bool make_pipeline_in(rt_device *d, rt_pipelines *pl, VkPipelineLayout la
             .alphaBlendOp = VK_BLEND_OP_ADD,
             .colorWriteMask = all,
         };
-    VkPipelineColorBlendStateCreateInfo cb = {
-        .sType = VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO,
-        .attachmentCount = (k == K_BASE || k == K_BLEND) ? 3 : k == K_DEPTH ? 0 : 1,
-        .pAttachments = att,
-    };
-    VkDynamicState dyn[2] = { VK_DYNAMIC_STATE_VIEWPORT, VK_DYNAMIC_STATE_SCISSOR };
-    VkPipelineDynamicStateCreateInfo dy = {
-        .sType = VK_STRUCTURE_TYPE_PIPELINE_DYNAMIC_STATE_CREATE_INFO,
-        .dynamicStateCount = 2,
-        .pDynamicStates = dyn,
-    };
-    VkGraphicsPipelineCreateInfo ci = {
-        .sType = VK_STRUCTURE_TYPE_GRAPHICS_PIPELINE_CREATE_INFO,
-        .stageCount = k == K_DEPTH ? 1 : 2,
-        .pStages = stages,
-        .pVertexInputState = &vi,
-        .pInputAssemblyState = &ia,
-        .pViewportState = &vp,
-        .pRasterizationState = &rs,
-        .pMultisampleState = &ms,
-        .pDepthStencilState = &ds,
-        .pColorBlendState = &cb,
-        .pDynamicState = &dy,
+    VkVertexInputBindingDescription vb = { 0, 8, VK_VERTEX_INPUT_RATE_VERTEX };
+    VkVertexInputAttributeDescription va = { 0, 0, VK_FORMAT_R32G32_SFLOAT, 0 };
+    bool grid = k != K_RESOLVE && k != K_SKY;   /* vertex input: the grid's x, z */
+    return rt_vk_gfx(d, NULL, &(rt_vk_gfx_desc){
+        .label = "terrain", .vs = vs, .fs = k == K_DEPTH ? VK_NULL_HANDLE : fs,
+        .fs_spec = (variant & RT_VARIANT_DEBUG) ? NULL : &final_spec,
+        .vbufs = &vb, .nvbufs = grid, .attrs = &va, .nattrs = grid,
+        .polygon = (variant & RT_VARIANT_WIRE) ? VK_POLYGON_MODE_LINE : VK_POLYGON_MODE_FILL,
+        /* Without RT_VARIANT_CULL terrain seen from below shows too.  The
+         * grid's triangles are clockwise on screen seen from above (the
+         * projection flips y). */
+        .cull = (variant & RT_VARIANT_CULL) ? VK_CULL_MODE_BACK_BIT : VK_CULL_MODE_NONE,
+        .front = VK_FRONT_FACE_CLOCKWISE,
+        /* Reversed Z (1 at the near plane, 0 at infinity): greater is nearer. */
+        .depth_test = k != K_RESOLVE,
+        .depth_write = k == K_OPAQUE || k == K_BASE || k == K_DEPTH,
+        .depth_compare = k == K_BLEND || k == K_SKY ? VK_COMPARE_OP_EQUAL
+                                                    : VK_COMPARE_OP_GREATER_OR_EQUAL,
+        .ncolor = (k == K_BASE || k == K_BLEND) ? 3 : k == K_DEPTH ? 0 : 1, .blend = att,
         .layout = layout ? layout : k == K_RESOLVE ? pl->resolve_layout : pl->layout,
-        .renderPass = pass,
-    };
-    RT_VK(e, vkCreateGraphicsPipelines(d->dev, pl->cache, 1, &ci, NULL, out));
-    return true;
+        .pass = pass, .cache = pl->cache }, out, e);
 }
 
 static bool make_pipeline(rt_device *d, rt_pipelines *pl, VkShaderModule vs,
@@ -637,16 +580,9 @@ bool rt_pipelines_compute_make(rt_device *d, const rt_pack *p, rt_pipelines *pl,
         static const uint32_t final_view = SPLAT_VIEW_FINAL;
         static const VkSpecializationMapEntry entry = { SPLAT_SPEC_VIEW, 0, sizeof final_view };
         static const VkSpecializationInfo spec = { 1, &entry, sizeof final_view, &final_view };
-        VkComputePipelineCreateInfo ci = {
-            .sType = VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO,
-            .stage = { .sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO,
-                       .stage = VK_SHADER_STAGE_COMPUTE_BIT, .module = m, .pName = "main",
-                       .pSpecializationInfo = (variant & RT_CVARIANT_DEBUG) ? NULL : &spec },
-            .layout = pl->compute_layout,
-        };
-        VkResult r = vkCreateComputePipelines(d->dev, pl->cache, 1, &ci, NULL, out);
-        if (r != VK_SUCCESS)
-            ok = rt_fail(e, RT_E_VULKAN, "vkCreateComputePipelines", rt_vk_result_name(r));
+        ok = rt_vk_compute(d, NULL, &(rt_vk_compute_desc){ .label = name, .module = m,
+                               .spec = (variant & RT_CVARIANT_DEBUG) ? NULL : &spec,
+                               .layout = pl->compute_layout, .cache = pl->cache }, out, e);
         vkDestroyShaderModule(d->dev, m, NULL);
     } else {
         ok = false;
@@ -818,7 +754,8 @@ bool rt_terrain_compute_layout(rt_device *d, VkDescriptorSetLayout *out, rt_erro
         VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, NULL };
     b[NTERRAIN + 1] = (VkDescriptorSetLayoutBinding){ SPLAT_BIND_VECTORS,
         VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 1, VK_SHADER_STAGE_COMPUTE_BIT, NULL };
-    return rt_set_layout(d, b, NTERRAIN + 2, out, e);
+    return rt_vk_set_layout(d, NULL, &(rt_vk_set_layout_desc){ "terrain bake", b, NTERRAIN + 2 },
+                            out, e);
 }
 
 void rt_terrain_compute_set(rt_device *d, VkDescriptorSet src, VkDescriptorSet dst,

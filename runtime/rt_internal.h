@@ -300,14 +300,6 @@ void rt_cmd_image_barrier(VkCommandBuffer cb, VkImage img, uint32_t mip, uint32_
                           VkAccessFlags src_access, VkAccessFlags dst_access,
                           VkPipelineStageFlags src, VkPipelineStageFlags dst);
 bool rt_format_supports(rt_device *d, VkFormat f, VkFormatFeatureFlags need);
-/* A descriptor set layout of these bindings. */
-bool rt_set_layout(rt_device *d, const VkDescriptorSetLayoutBinding *b, uint32_t n,
-                   VkDescriptorSetLayout *out, rt_error *e);
-/* A descriptor pool holding exactly `nsizes` sizes and `nsets` sets, and
- * one set of each layout allocated from it. */
-bool rt_descriptor_sets(rt_device *d, const VkDescriptorPoolSize *sizes, uint32_t nsizes,
-                        const VkDescriptorSetLayout *layouts, uint32_t nsets,
-                        VkDescriptorPool *pool, VkDescriptorSet *sets, rt_error *e);
 /* The sampler address mode of an ir_wrap (ir.h IR_WRAPS). */
 VkSamplerAddressMode rt_sampler_wrap(int ir_wrap);
 

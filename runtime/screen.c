@@ -20,6 +20,8 @@
  * returned frame is always complete and the steady state reads back only
  * the list counts. */
 #include "rt_internal.h"
+#include "vk_build.h"
+#include "screen_glsl.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -71,332 +73,10 @@ struct rt_screen {
     float                 far_distance;      /* m; 0: off (rt_screen_far)    */
     const rt_far         *far;               /* the renderer's               */
     VkPipeline            far_pipe[2];       /* plain, counting              */
+    rt_vk_list            keep;              /* every Vulkan object but buffers
+                                                and images                    */
 };
 
-/* The classification shader: SPLAT_GLSL_TERRAIN (frame block) + this. */
-static const char classify_glsl[] =
-    "layout(set = 0, binding = 7) uniform sampler2D u_depth;\n"
-    "layout(set = 2, binding = 0, std430) readonly buffer cls_info_block {\n"
-    "    uint ncombos, words, cells_x, cells_z;\n"
-    "    uint ntiles, nbase, cell_texels, tiles_x;\n"
-    "    uint data[];   /* order[ncombos], masks[ncombos][words], cells[],\n"
-    "                      distance[ncombos][2] (float bits) */\n"
-    "} u_info;\n"
-    "layout(set = 2, binding = 1, std430) writeonly buffer cls_tiles_block {\n"
-    "    uint tiles[];\n"
-    "} u_lists;\n"
-    "layout(set = 2, binding = 2, std430) buffer cls_args_block {\n"
-    "    uint args[];   /* per list: x y z of vkCmdDispatchIndirect */\n"
-    "} u_args;\n"
-    "layout(set = 0, binding = 8, rgba32f) uniform writeonly image2D u_out;\n"
-    "uint mask[WORDS];\n"
-    "uint last = 0xffffffffu;\n"
-    "bool any_cell = false;\n"
-    "float dmin = 3.0e38, dmax = 0.0;   /* the tile's terrain pixels' distances */\n"
-    "float dfar = 3.0e38;   /* dmin, but 0 over the destructible area (far atlas) */\n"
-    "void add_cell(ivec2 c) {\n"
-    "    c = clamp(c, ivec2(0), ivec2(u_info.cells_x, u_info.cells_z) - 1);\n"
-    "    uint i = uint(c.y) * u_info.cells_x + uint(c.x);\n"
-    "    if (i == last) return;   /* most pixels of a tile share a cell */\n"
-    "    last = i;\n"
-    "    uint id = u_info.data[u_info.ncombos * (1u + u_info.words) + i];\n"
-    "    if (id >= u_info.ncombos) return;   /* all hole: never drawn */\n"
-    "    for (uint w = 0u; w < u_info.words; w++)\n"
-    "        mask[w] |= u_info.data[u_info.ncombos + id * u_info.words + w];\n"
-    "    any_cell = true;\n"
-    "}\n"
-    /* Appending a tile: one atomic per list and subgroup where the
-     * subgroup operations allow (AGGREGATE), since tiles of one list hit
-     * one counter and a GPU serialises atomics on one address; the lowest
-     * list first, then the next, until every tile of the subgroup is in. */
-    "#ifdef AGGREGATE\n"
-    "bool pending = false;\n"
-    "void append(uint list, uint entry) {\n"
-    "    pending = true;\n"
-    "    while (subgroupAny(pending)) {\n"
-    "        uint leader = subgroupMin(pending ? list : 0xffffffffu);\n"
-    "        bool mine = pending && list == leader;\n"
-    "        uvec4 b = subgroupBallot(mine);\n"
-    "        uint rank = subgroupBallotExclusiveBitCount(b), base = 0u;\n"
-    "        if (mine && rank == 0u)\n"
-    "            base = atomicAdd(u_args.args[leader * 3u], subgroupBallotBitCount(b));\n"
-    "        base = subgroupMax(base);\n"
-    "        if (mine) {\n"
-    "            u_lists.tiles[leader * u_info.ntiles + base + rank] = entry;\n"
-    "            pending = false;\n"
-    "        }\n"
-    "    }\n"
-    "}\n"
-    "#else\n"
-    "void append(uint list, uint entry) {\n"
-    "    uint slot = atomicAdd(u_args.args[list * 3u], 1u);\n"
-    "    u_lists.tiles[list * u_info.ntiles + slot] = entry;\n"
-    "}\n"
-    "#endif\n"
-    /* one pixel: the background where empty, else its cell(s) */
-    "void pixel(ivec2 px) {\n"
-    "    float d = texelFetch(u_depth, px, 0).r;\n"
-    "    vec2 ndc = (vec2(px) + 0.5) / u_frame.screen.xy * 2.0 - 1.0;\n"
-    "    if (d == u_frame.screen.z) {   /* empty: the sky, or the background colour */\n"
-    "        vec4 q = u_frame.inv_view_proj * vec4(ndc, 0.5, 1.0);\n"
-    "        imageStore(u_out, px, u_frame.sky_color.a > 0.0\n"
-    "            ? vec4(splat_sky(normalize(q.xyz / q.w)) * u_frame.light.z, 1.0)\n"
-    "            : u_push.patch_xz);\n"
-    "        return;\n"
-    "    }\n"
-    "    vec4 p = u_frame.inv_view_proj * vec4(ndc, d, 1.0);\n"
-    /* view.distance as the compute variants reconstruct it (abi.c
-     * splat_unproject): the same depth, the same pixel centre */
-    "    float dist = length(p.xyz / p.w);\n"
-    "    dmin = min(dmin, dist);\n"
-    "    dmax = max(dmax, dist);\n"
-    "    vec2 local = p.xz / p.w + u_frame.camera.xz;\n"
-    /* far atlas: never over the destructible area (patch_uv), craters
-     * change what the bake saw */
-    "    dfar = min(dfar, dist);\n"
-    "    if (all(greaterThanEqual(local, u_push.patch_uv.xy)) &&\n"
-    "        all(lessThan(local, u_push.patch_uv.zw))) dfar = 0.0;\n"
-    "    vec2 cf = local / u_frame.terrain.xy * u_frame.texel.xy / float(u_info.cell_texels);\n"
-    /* a pixel within 1/64 cell of an edge counts for both cells: the
-     * position from depth is rounded, the analysis is per closed cell */
-    "    ivec2 lo = ivec2(floor(cf - 1.0 / 64.0)), hi = ivec2(floor(cf + 1.0 / 64.0));\n"
-    "    add_cell(lo);\n"
-    "    if (hi.x != lo.x) add_cell(ivec2(hi.x, lo.y));\n"
-    "    if (hi.y != lo.y) add_cell(ivec2(lo.x, hi.y));\n"
-    "    if (hi.x != lo.x && hi.y != lo.y) add_cell(hi);\n"
-    "}\n"
-    /* distance classes (c >= nbase, PACK.md): only where the tile's
-     * distances, widened by SLACK, lie inside the class's interval, and
-     * not at all with push info.z set (--no-distance-classes) */
-    "bool fits(uint c) {\n"
-    "    if (c < u_info.nbase) return true;\n"
-    "    if (u_push.info.z != 0u) return false;\n"
-    "    uint at = u_info.ncombos * (1u + u_info.words) + u_info.cells_x * u_info.cells_z + 2u * c;\n"
-    "    return dmin * (1.0 - SLACK) >= uintBitsToFloat(u_info.data[at]) &&\n"
-    "           dmax * (1.0 + SLACK) <= uintBitsToFloat(u_info.data[at + 1u]);\n"
-    "}\n"
-    /* whether combination c's set covers mask and its distances fit */
-    "bool usable(uint c) {\n"
-    "    for (uint w = 0u; w < u_info.words; w++)\n"
-    "        if ((mask[w] & ~u_info.data[u_info.ncombos + c * u_info.words + w]) != 0u)\n"
-    "            return false;\n"
-    "    return fits(c);\n"
-    "}\n"
-    /* the cheapest combination whose set covers mask, else the über-shader */
-    "uint pick() {\n"
-    "    if (u_push.info.x != 0u || u_info.words == 0u) return u_info.ncombos;\n"
-    "    for (uint i = 0u; i < u_info.ncombos; i++)\n"
-    "        if (usable(u_info.data[i])) return u_info.data[i];\n"
-    "    return u_info.ncombos;\n"
-    "}\n"
-    /* a tile wholly beyond the far distance (info.y, float bits; 0: off)
-     * goes to the far atlas's list */
-    "bool far_tile() {\n"
-    "    float fd = uintBitsToFloat(u_push.info.y);\n"
-    "    return fd > 0.0 && dfar >= fd;\n"
-    "}\n"
-    "#ifdef WIDE\n"
-    /* GPUs: one workgroup per tile, one invocation per pixel; the sets
-     * ORed over each subgroup, then over the workgroup in shared memory;
-     * the cover search split over the invocations (each takes every 64th
-     * combination in cost order, the first that covers wins) */
-    "layout(local_size_x = 64) in;\n"
-    "shared uint s_mask[WORDS];\n"
-    "shared uint s_any, s_dmin, s_dmax, s_dfar;   /* distances as bits: >= 0 orders as uint */\n"
-    "shared uint s_first;   /* the first covering position in cost order */\n"
-    "uint pick_wide(uint li) {\n"
-    "    if (u_push.info.x != 0u || u_info.words == 0u) return u_info.ncombos;\n"
-    "    uint first = 0xffffffffu;\n"
-    "    for (uint i = li; i < u_info.ncombos && first == 0xffffffffu; i += 64u)\n"
-    "        if (usable(u_info.data[i])) first = i;\n"
-    "    first = subgroupMin(first);\n"
-    "    if (subgroupElect()) atomicMin(s_first, first);\n"
-    "    barrier();\n"
-    "    return s_first == 0xffffffffu ? u_info.ncombos : u_info.data[s_first];\n"
-    "}\n"
-    "void main() {\n"
-    "    uint li = gl_LocalInvocationIndex;\n"
-    "    if (li < uint(WORDS)) s_mask[li] = 0u;\n"
-    "    if (li == 0u) {\n"
-    "        s_any = 0u; s_dmin = floatBitsToUint(3.0e38); s_dmax = 0u;\n"
-    "        s_dfar = floatBitsToUint(3.0e38);\n"
-    "        s_first = 0xffffffffu;\n"
-    "    }\n"
-    "    for (int w = 0; w < WORDS; w++) mask[w] = 0u;\n"
-    "    barrier();\n"
-    "    uvec2 tile = gl_WorkGroupID.xy;\n"
-    "    ivec2 px = ivec2(tile * 8u + uvec2(li & 7u, li >> 3u));\n"
-    "    if (all(lessThan(px, ivec2(u_frame.screen.xy)))) pixel(px);\n"
-    "    for (int w = 0; w < WORDS; w++) {\n"
-    "        uint v = subgroupOr(mask[w]);\n"
-    "        if (subgroupElect() && v != 0u) atomicOr(s_mask[w], v);\n"
-    "    }\n"
-    "    if (subgroupAny(any_cell) && subgroupElect()) atomicOr(s_any, 1u);\n"
-    "    float a = subgroupMin(dmin), b = subgroupMax(dmax), f = subgroupMin(dfar);\n"
-    "    if (subgroupElect()) {\n"
-    "        atomicMin(s_dmin, floatBitsToUint(a));\n"
-    "        atomicMax(s_dmax, floatBitsToUint(b));\n"
-    "        atomicMin(s_dfar, floatBitsToUint(f));\n"
-    "    }\n"
-    "    barrier();\n"
-    "    if (s_any == 0u) return;   /* sky tile: skipped (uniform) */\n"
-    "    for (int w = 0; w < WORDS; w++) mask[w] = s_mask[w];\n"
-    "    dmin = uintBitsToFloat(s_dmin);\n"
-    "    dmax = uintBitsToFloat(s_dmax);\n"
-    "    dfar = uintBitsToFloat(s_dfar);\n"
-    "    uint list = far_tile() ? u_info.ncombos + 1u : pick_wide(li);\n"
-    "    if (li == 0u) append(list, tile.x | (tile.y << 16u));\n"
-    "}\n"
-    "#else\n"
-    /* CPU drivers (lavapipe): one invocation per tile, no shared memory
-     * and no barriers, which they pay for dearly */
-    "layout(local_size_x = 64) in;\n"
-    "void classify(uint t) {\n"
-    "    uvec2 tile = uvec2(t % u_info.tiles_x, t / u_info.tiles_x);\n"
-    "    for (int w = 0; w < WORDS; w++) mask[w] = 0u;\n"
-    "    ivec2 size = ivec2(u_frame.screen.xy);\n"
-    "    for (int y = 0; y < 8; y++)\n"
-    "        for (int x = 0; x < 8; x++) {\n"
-    "            ivec2 px = ivec2(tile * 8u) + ivec2(x, y);\n"
-    "            if (all(lessThan(px, size))) pixel(px);\n"
-    "        }\n"
-    "    if (any_cell) append(far_tile() ? u_info.ncombos + 1u : pick(), tile.x | (tile.y << 16u));\n"
-    "}\n"
-    /* every invocation reaches append's subgroup loop or none past it */
-    "void main() {\n"
-    "    uint t = gl_GlobalInvocationID.x;\n"
-    "    if (t < u_info.ntiles) classify(t);\n"
-    "}\n"
-    "#endif\n";
-
-/* Pixel sorting's list pass (one invocation per list): pad list k with
- * empty entries (0xffffffff) to a multiple of G tiles and write its
- * grouped dispatch size at args[3 * (nlists + k)]; info.x = nlists. */
-static const char group_glsl[] =
-    "layout(local_size_x = 64) in;\n"
-    "layout(set = 2, binding = 0, std430) readonly buffer cls_info_block {\n"
-    "    uint ncombos, words, cells_x, cells_z;\n"
-    "    uint stride;\n"
-    "} u_info;\n"
-    "layout(set = 2, binding = 1, std430) writeonly buffer cls_tiles_block {\n"
-    "    uint tiles[];\n"
-    "} u_lists;\n"
-    "layout(set = 2, binding = 2, std430) buffer cls_args_block {\n"
-    "    uint args[];\n"
-    "} u_args;\n"
-    "void main() {\n"
-    "    uint k = gl_GlobalInvocationID.x, nlists = u_push.info.x;\n"
-    "    if (k >= nlists) return;\n"
-    "    uint n = u_args.args[3u * k], g = (n + G - 1u) / G;\n"
-    "    u_args.args[3u * (nlists + k)] = g;\n"
-    "    u_args.args[3u * (nlists + k) + 1u] = 1u;\n"
-    "    u_args.args[3u * (nlists + k) + 2u] = 1u;\n"
-    "    for (uint i = n; i < g * G; i++) u_lists.tiles[k * u_info.stride + i] = 0xffffffffu;\n"
-    "}\n";
-
-/* Depth by ray casting (Tevs et al. 2008, "Maximum mipmaps"): the ray
- * through each pixel centre walks a pyramid of maximum heights from the
- * top level down, skipping cells it passes above, and at the finest level
- * meets the two triangles of the mesh quad exactly as the patches'
- * finest LOD draws them (corners at texel edges, heights bilinear there,
- * diagonal from (i, j) to (i+1, j+1): rt_grid_indices).  It writes the
- * reversed-Z depth of the hit, or the clear value 0, into an R32F image
- * that classification and shading read in place of the geometry pass's
- * depth.  Level 0 holds, per quad, the highest of its four corners (plus
- * a margin for the GPU's rounding; craters only lower the terrain, so the
- * bound stays valid under destruction); each level the largest of
- * four, 8 levels up; the grid is padded to a multiple of 256 so every level
- * halves exactly (Vulkan's mip sizes round down). */
-static const char raycast_glsl[] =
-    "layout(local_size_x = 8, local_size_y = 8) in;\n"
-    "layout(set = 2, binding = 3) uniform sampler2D u_maxmip;\n"
-    "layout(set = 2, binding = 4, r32f) uniform writeonly image2D u_rdepth;\n"
-    "float corner(ivec2 k) { return splat_height_at(vec2(k) * u_frame.texel.zw); }\n"
-    /* The ray against mesh quad k's two triangles, in the quad's own
-     * coordinates (u, v in [0, 1]: precise however far the quad is):
-     * (0,0) (1,0) (1,1) where u >= v, (0,0) (1,1) (0,1) where v >= u.
-     * The nearest hit with t in [t0, t1], else -1. */
-    "float quad_hit(vec3 O, vec3 D, ivec2 k, float t0, float t1) {\n"
-    "    float ha = corner(k), hb = corner(k + ivec2(1, 0));\n"
-    "    float hc = corner(k + ivec2(1, 1)), hd = corner(k + ivec2(0, 1));\n"
-    "    vec2 o = O.xz - vec2(k);\n"
-    "    const float eps = 1e-4;\n"
-    "    float best = -1.0;\n"
-    "    for (int s = 0; s < 2; s++) {\n"
-    "        float A = s == 0 ? hb - ha : hc - hd, B = s == 0 ? hc - hb : hd - ha;\n"
-    "        float den = D.y - A * D.x - B * D.z;\n"
-    "        if (den == 0.0) continue;\n"
-    "        float t = (ha + A * o.x + B * o.y - O.y) / den;\n"
-    "        if (t < t0 || t > t1) continue;\n"
-    "        vec2 uv = o + D.xz * t;\n"
-    "        vec2 w = s == 0 ? uv : uv.yx;   /* w.x >= w.y in the triangle */\n"
-    "        if (w.x < -eps || w.x > 1.0 + eps || w.y < -eps || w.y > w.x + eps) continue;\n"
-    "        best = best < 0.0 ? t : min(best, t);\n"
-    "    }\n"
-    "    return best;\n"
-    "}\n"
-    "void main() {\n"
-    "    ivec2 px = ivec2(gl_GlobalInvocationID.xy);\n"
-    "    if (any(greaterThanEqual(px, ivec2(u_frame.screen.xy)))) return;\n"
-    "    vec2 ndc = (vec2(px) + 0.5) / u_frame.screen.xy * 2.0 - 1.0;\n"
-    "    vec4 q = u_frame.inv_view_proj * vec4(ndc, 1.0, 1.0);\n"
-    "    vec3 dir = normalize(q.xyz / q.w);\n"
-    "    vec2 sc = u_frame.texel.xy / u_frame.terrain.xy;   /* texels per metre */\n"
-    "    vec3 O = vec3(u_frame.camera.x * sc.x, u_frame.camera.y, u_frame.camera.z * sc.y);\n"
-    "    vec3 D = vec3(dir.x * sc.x, dir.y, dir.z * sc.y);   /* t: metres along dir */\n"
-    "    const int top = TOP;\n"
-    /* the box [0, W] x (-inf, highest height] x [0, H] */
-    "    vec3 lo = vec3(0.0, -1e30, 0.0);\n"
-    "    vec3 hi = vec3(u_frame.texel.x, u_frame.terrain.z + u_frame.terrain.w, u_frame.texel.y);\n"
-    "    vec3 inv = 1.0 / D;\n"
-    "    vec3 ta = (lo - O) * inv, tb = (hi - O) * inv;\n"
-    "    vec3 tn = min(ta, tb), tf = max(ta, tb);\n"
-    "    float t = max(max(max(tn.x, tn.y), tn.z), 0.0), tend = min(min(tf.x, tf.y), tf.z);\n"
-    "    float hit = -1.0;\n"
-    "    int L = top;\n"
-    /* a walk over cells by index (a DDA), so rounding in the position can
-     * never hold it in place: down into the child under the ray where
-     * the ray may meet the cell's contents, else across to the neighbour
-     * on the exit side, up to the parent when that leaves this one */
-    "    ivec2 c = clamp(ivec2(floor((O.xz + D.xz * t) / float(1 << L))), ivec2(0),\n"
-    "                    (ivec2(PW, PH) >> L) - 1);\n"
-    "    for (int it = 0; it < 16384 && t <= tend && hit < 0.0; it++) {\n"
-    "        float size = float(1 << L);\n"
-    "        vec2 b0 = vec2(c) * size, b1 = b0 + size;\n"
-    "        vec2 tx = (mix(b0, b1, greaterThan(D.xz, vec2(0.0))) - O.xz) * inv.xz;\n"
-    "        tx = mix(tx, vec2(1e30), equal(D.xz, vec2(0.0)));\n"
-    "        int axis = tx.x < tx.y ? 0 : 1;\n"
-    "        float te = min(min(tx.x, tx.y), tend);\n"
-    "        float top_h = texelFetch(u_maxmip, c, L).r;\n"
-    "        if (min(O.y + D.y * t, O.y + D.y * te) <= top_h) {\n"
-    "            if (L > 0) {   /* the ray may meet something in here: look closer */\n"
-    "                L--;\n"
-    "                vec2 p = (O.xz + D.xz * t) / (size * 0.5);\n"
-    "                c = clamp(ivec2(floor(p)), 2 * c, 2 * c + 1);\n"
-    "                continue;\n"
-    "            }\n"
-    "            float slack = 1e-5 * te + 1e-4;\n"
-    "            hit = quad_hit(O, D, c, t - slack, te + slack);\n"
-    "        }\n"
-    "        t = max(t, te);\n"
-    "        ivec2 cn = c;\n"
-    "        if (axis == 0) cn.x += D.x > 0.0 ? 1 : -1; else cn.y += D.z > 0.0 ? 1 : -1;\n"
-    "        if (any(lessThan(cn, ivec2(0))) || any(greaterThanEqual(cn, ivec2(PW, PH) >> L)))\n"
-    "            break;   /* off the terrain */\n"
-    "        if (L < top && any(notEqual(cn >> 1, c >> 1))) {\n"
-    "            L++;\n"
-    "            c = cn >> 1;\n"
-    "        } else {\n"
-    "            c = cn;\n"
-    "        }\n"
-    "    }\n"
-    "    float depth = 0.0;   /* the clear value: sky */\n"
-    "    if (hit >= 0.0) {\n"
-    "        vec4 clip = u_frame.view_proj * vec4(dir * hit, 1.0);\n"
-    "        depth = clip.z / clip.w;\n"
-    "    }\n"
-    "    imageStore(u_rdepth, px, vec4(depth));\n"
-    "}\n";
 
 /* Cheapest first: the pack's cost, then fewer materials, then id. */
 static const rt_pack *sort_pack;
@@ -480,7 +160,7 @@ static double corner_height(const rt_pack *p, int x, int z)
     return sum / 4.0 / 65535.0 * p->max_height + p->height_offset;
 }
 
-/* The maximum-height pyramid of the ray caster (raycast_glsl), metres. */
+/* The maximum-height pyramid of the ray caster (rt_screen_raycast_glsl), metres. */
 static bool make_maxmip(rt_screen *s, rt_error *e)
 {
     const rt_pack *p = s->p;
@@ -530,20 +210,12 @@ static bool make_maxmip(rt_screen *s, rt_error *e)
         prev = cur;
     }
     s->mip_levels = K + 1;
-    VkSamplerCreateInfo si = {
-        .sType = VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO,
-        .magFilter = VK_FILTER_NEAREST, .minFilter = VK_FILTER_NEAREST,
-        .mipmapMode = VK_SAMPLER_MIPMAP_MODE_NEAREST,
-        .addressModeU = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE,
-        .addressModeV = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE,
-        .addressModeW = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE,
-        .maxLod = VK_LOD_CLAMP_NONE,
-    };
-    VkResult vr = vkCreateSampler(s->d->dev, &si, NULL, &s->mip_sampler);
-    if (vr != VK_SUCCESS) {
+    if (!rt_vk_sampler(s->d, &s->keep, &(rt_vk_sampler_desc){ .label = "height pyramid",
+                           .wrap = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE,
+                           .max_lod = VK_LOD_CLAMP_NONE }, &s->mip_sampler, e)) {
         free(levels);
         free(all);
-        return rt_fail(e, RT_E_VULKAN, "vkCreateSampler", rt_vk_result_name(vr));
+        return false;
     }
     bool ok = rt_image_create(s->d, (uint32_t)PW, (uint32_t)PH, 1, false, (uint32_t)K + 1,
                               VK_FORMAT_R32_SFLOAT,
@@ -557,21 +229,6 @@ static bool make_maxmip(rt_screen *s, rt_error *e)
 
 static bool make_depth_pass(rt_screen *s, const rt_image *depth, rt_error *e)
 {
-    VkAttachmentDescription att = {
-        .format = VK_FORMAT_D32_SFLOAT,
-        .samples = VK_SAMPLE_COUNT_1_BIT,
-        .loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR,
-        .storeOp = VK_ATTACHMENT_STORE_OP_STORE,
-        .stencilLoadOp = VK_ATTACHMENT_LOAD_OP_DONT_CARE,
-        .stencilStoreOp = VK_ATTACHMENT_STORE_OP_DONT_CARE,
-        .initialLayout = VK_IMAGE_LAYOUT_UNDEFINED,
-        .finalLayout = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
-    };
-    VkAttachmentReference ref = { 0, VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL };
-    VkSubpassDescription sub = {
-        .pipelineBindPoint = VK_PIPELINE_BIND_POINT_GRAPHICS,
-        .pDepthStencilAttachment = &ref,
-    };
     /* The last frame's compute reads finish before the depth is written;
      * the depth is visible to this frame's compute passes. */
     VkSubpassDependency dep[2] = {
@@ -584,27 +241,15 @@ static bool make_depth_pass(rt_screen *s, const rt_image *depth, rt_error *e)
           VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
           VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT, VK_ACCESS_SHADER_READ_BIT, 0 },
     };
-    VkRenderPassCreateInfo ci = {
-        .sType = VK_STRUCTURE_TYPE_RENDER_PASS_CREATE_INFO,
-        .attachmentCount = 1,
-        .pAttachments = &att,
-        .subpassCount = 1,
-        .pSubpasses = &sub,
-        .dependencyCount = 2,
-        .pDependencies = dep,
-    };
-    RT_VK(e, vkCreateRenderPass(s->d->dev, &ci, NULL, &s->depth_pass));
-    VkFramebufferCreateInfo fi = {
-        .sType = VK_STRUCTURE_TYPE_FRAMEBUFFER_CREATE_INFO,
-        .renderPass = s->depth_pass,
-        .attachmentCount = 1,
-        .pAttachments = &depth->view,
-        .width = (uint32_t)s->width,
-        .height = (uint32_t)s->height,
-        .layers = 1,
-    };
-    RT_VK(e, vkCreateFramebuffer(s->d->dev, &fi, NULL, &s->depth_fb));
-    return true;
+    return rt_vk_pass(s->d, &s->keep, &(rt_vk_pass_desc){ .label = "screen depth",
+                          .depth = { .format = VK_FORMAT_D32_SFLOAT,
+                                     .load = VK_ATTACHMENT_LOAD_OP_CLEAR,
+                                     .final = VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL },
+                          .deps = dep, .ndeps = 2 }, &s->depth_pass, e) &&
+           rt_vk_fb(s->d, &s->keep, &(rt_vk_fb_desc){ .label = "screen depth",
+                        .pass = s->depth_pass, .views = &depth->view, .nviews = 1,
+                        .width = (uint32_t)s->width, .height = (uint32_t)s->height },
+                    &s->depth_fb, e);
 }
 
 /* A compute pipeline of the runtime's own GLSL over s->layout. */
@@ -618,7 +263,8 @@ static bool own_pipeline(rt_screen *s, const rt_pipelines *pl, const char *head,
     if (!src)
         return rt_fail(e, RT_E_VULKAN, name, "out of memory");
     snprintf(src, n, "#version 450\n%s%s%s%s", head, SPLAT_GLSL_TERRAIN, SPLAT_GLSL_SKY, body);
-    bool ok = rt_glsl_compute_pipeline(d, pl->cache, s->layout, src, name, NULL, out, e);
+    bool ok = rt_vk_compute(d, &s->keep, &(rt_vk_compute_desc){ .label = name, .glsl = src,
+                                .layout = s->layout, .cache = pl->cache }, out, e);
     free(src);
     return ok;
 }
@@ -655,49 +301,40 @@ static bool make_compute(rt_screen *s, const rt_pipelines *pl, VkSampler nearest
     uint32_t nb = s->raycast ? 5 : 3;
     for (uint32_t k = 0; s->far_ok && k < 3; k++)   /* far.c's atlas, bindings 5-7 */
         b[nb++] = (VkDescriptorSetLayoutBinding){ 5 + k, cis, 1, cs, NULL };
-    VkDescriptorSetLayoutCreateInfo li = {
-        .sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO,
-        .bindingCount = nb,
-        .pBindings = b,
-    };
-    RT_VK(e, vkCreateDescriptorSetLayout(d->dev, &li, NULL, &s->set_layout));
-    VkDescriptorSetLayout sets[3] = { pl->set_terrain, pl->set_material, s->set_layout };
-    VkPushConstantRange push = { cs, 0, sizeof(splat_push) };
-    VkPipelineLayoutCreateInfo pi = {
-        .sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO,
-        .setLayoutCount = 3,
-        .pSetLayouts = sets,
-        .pushConstantRangeCount = 1,
-        .pPushConstantRanges = &push,
-    };
-    RT_VK(e, vkCreatePipelineLayout(d->dev, &pi, NULL, &s->layout));
-
+    VkDescriptorSetLayout sets[3] = { pl->set_terrain, pl->set_material, VK_NULL_HANDLE };
     VkDescriptorPoolSize sizes[3] = {
         { sb, 3 }, { cis, (s->raycast ? 1 : 0) + (s->far_ok ? 3 : 0) },
         { VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1 },
     };
-    if (!rt_descriptor_sets(d, sizes, s->raycast ? 3 : s->far_ok ? 2 : 1, &s->set_layout, 1,
-                            &s->pool, &s->set, e))
+    rt_vk_list *k = &s->keep;
+    if (!rt_vk_set_layout(d, k, &(rt_vk_set_layout_desc){ "classification", b, nb },
+                          &s->set_layout, e))
         return false;
-    VkDescriptorBufferInfo bi[3] = {
-        { s->info.buf, 0, VK_WHOLE_SIZE }, { s->tiles.buf, 0, VK_WHOLE_SIZE },
-        { s->args.buf, 0, VK_WHOLE_SIZE },
-    };
+    sets[2] = s->set_layout;
+    if (!rt_vk_layout(d, k, &(rt_vk_layout_desc){ .label = "classification", .sets = sets,
+                          .nsets = 3, .push_stages = cs, .push_bytes = sizeof(splat_push) },
+                      &s->layout, e) ||
+        !rt_vk_sets(d, k, &(rt_vk_sets_desc){ .label = "classification", .sizes = sizes,
+                        .nsizes = s->raycast ? 3 : s->far_ok ? 2 : 1,
+                        .layouts = &s->set_layout, .nsets = 1 }, &s->pool, &s->set, e))
+        return false;
+    VkBuffer bufs[3] = { s->info.buf, s->tiles.buf, s->args.buf };
     VkDescriptorImageInfo ii[8] = {
         [3] = { s->mip_sampler, s->maxmip.view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL },
         [4] = { VK_NULL_HANDLE, s->rdepth.view, VK_IMAGE_LAYOUT_GENERAL },
     };
-    for (int k = 0; s->far_ok && k < 3; k++)
-        ii[5 + k] = rt_far_image_info(s->far, k);
-    VkWriteDescriptorSet w[8];
+    for (int i = 0; s->far_ok && i < 3; i++)
+        ii[5 + i] = rt_far_image_info(s->far, i);
+    rt_vk_write w[8];
     for (uint32_t i = 0; i < nb; i++) {
         uint32_t at = b[i].binding;
-        w[i] = (VkWriteDescriptorSet){ .sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET,
-            .dstSet = s->set, .dstBinding = at, .descriptorCount = 1,
-            .descriptorType = b[i].descriptorType,
-            .pBufferInfo = at < 3 ? &bi[at] : NULL, .pImageInfo = at >= 3 ? &ii[at] : NULL };
+        w[i] = (rt_vk_write){ .set = s->set, .binding = at, .type = b[i].descriptorType };
+        if (at < 3)
+            w[i].buf = bufs[at];
+        else
+            w[i].images = &ii[at], w[i].count = 1;
     }
-    vkUpdateDescriptorSets(d->dev, nb, w, 0, NULL);
+    rt_vk_write_sets(d, w, nb);
 
     char head[320];
     bool sub = can_aggregate(d);
@@ -716,10 +353,11 @@ static bool make_compute(rt_screen *s, const rt_pipelines *pl, VkSampler nearest
              s->mip_levels - 1, s->maxmip.width, s->maxmip.height);
     char ghead[64];
     snprintf(ghead, sizeof ghead, "#define G %du\n", s->sort_tiles);
-    return own_pipeline(s, pl, head, classify_glsl, "classify.comp", &s->classify, e) &&
-           (!s->sort || own_pipeline(s, pl, ghead, group_glsl, "group.comp", &s->group, e)) &&
+    return own_pipeline(s, pl, head, rt_screen_classify_glsl, "classify.comp", &s->classify, e) &&
+           (!s->sort ||
+            own_pipeline(s, pl, ghead, rt_screen_group_glsl, "group.comp", &s->group, e)) &&
            (!s->raycast ||
-            own_pipeline(s, pl, rhead, raycast_glsl, "raycast.comp", &s->raycaster, e));
+            own_pipeline(s, pl, rhead, rt_screen_raycast_glsl, "raycast.comp", &s->raycaster, e));
 }
 
 bool rt_screen_create(rt_device *d, const rt_pack *p, const rt_pipelines *pl,
@@ -803,28 +441,16 @@ bool rt_screen_create(rt_device *d, const rt_pack *p, const rt_pipelines *pl,
         return false;
 
     /* set 0's compute bindings (abi.h): depth, colour, tiles, counters */
-    VkDescriptorImageInfo img[2] = {
-        raycast ? (VkDescriptorImageInfo){ nearest, s->rdepth.view, VK_IMAGE_LAYOUT_GENERAL }
-                : (VkDescriptorImageInfo){ nearest, depth->view,
-                                           VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL },
-        { VK_NULL_HANDLE, color->view, VK_IMAGE_LAYOUT_GENERAL },
+    rt_vk_write w[4] = {
+        { set0, SPLAT_BIND_DEPTH, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, .sampler = nearest,
+          .view = raycast ? s->rdepth.view : depth->view,
+          .layout = raycast ? VK_IMAGE_LAYOUT_GENERAL : VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL },
+        { set0, SPLAT_BIND_OUT, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, .view = color->view,
+          .layout = VK_IMAGE_LAYOUT_GENERAL },
+        { set0, SPLAT_BIND_TILES, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, s->tiles.buf },
+        { set0, SPLAT_BIND_COUNTERS, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, s->counters.buf },
     };
-    VkDescriptorBufferInfo buf[2] = {
-        { s->tiles.buf, 0, VK_WHOLE_SIZE }, { s->counters.buf, 0, VK_WHOLE_SIZE },
-    };
-    VkWriteDescriptorSet w[4];
-    const VkDescriptorType types[4] = {
-        VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, VK_DESCRIPTOR_TYPE_STORAGE_IMAGE,
-        VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
-    };
-    const uint32_t binds[4] = { SPLAT_BIND_DEPTH, SPLAT_BIND_OUT, SPLAT_BIND_TILES,
-                                SPLAT_BIND_COUNTERS };
-    for (int i = 0; i < 4; i++)
-        w[i] = (VkWriteDescriptorSet){ .sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET,
-            .dstSet = set0, .dstBinding = binds[i], .descriptorCount = 1,
-            .descriptorType = types[i], .pImageInfo = i < 2 ? &img[i] : NULL,
-            .pBufferInfo = i >= 2 ? &buf[i - 2] : NULL };
-    vkUpdateDescriptorSets(d->dev, 4, w, 0, NULL);
+    rt_vk_write_sets(d, w, 4);
     return true;
 }
 
@@ -833,31 +459,11 @@ void rt_screen_destroy(rt_screen *s)
     if (!s)
         return;
     rt_device *d = s->d;
+    rt_vk_list_destroy(d, &s->keep);
     if (d->dev) {
-        if (s->classify)
-            vkDestroyPipeline(d->dev, s->classify, NULL);
-        if (s->raycaster)
-            vkDestroyPipeline(d->dev, s->raycaster, NULL);
-        if (s->group)
-            vkDestroyPipeline(d->dev, s->group, NULL);
-        for (int k = 0; k < 2; k++)
-            if (s->far_pipe[k])
-                vkDestroyPipeline(d->dev, s->far_pipe[k], NULL);
         rt_image_destroy(d, &s->maxmip);
-        if (s->mip_sampler)
-            vkDestroySampler(d->dev, s->mip_sampler, NULL);
         rt_image_destroy(d, &s->rdepth);
         rt_buffer_destroy(d, &s->depth_copy);
-        if (s->layout)
-            vkDestroyPipelineLayout(d->dev, s->layout, NULL);
-        if (s->pool)
-            vkDestroyDescriptorPool(d->dev, s->pool, NULL);
-        if (s->set_layout)
-            vkDestroyDescriptorSetLayout(d->dev, s->set_layout, NULL);
-        if (s->depth_fb)
-            vkDestroyFramebuffer(d->dev, s->depth_fb, NULL);
-        if (s->depth_pass)
-            vkDestroyRenderPass(d->dev, s->depth_pass, NULL);
         rt_buffer_destroy(d, &s->info);
         rt_buffer_destroy(d, &s->tiles);
         rt_buffer_destroy(d, &s->args);
@@ -1069,8 +675,9 @@ bool rt_screen_dispatch(rt_screen *s, VkCommandBuffer cb, rt_pipelines *pl,
             char *src = rt_far_glsl(p, c);
             if (!src)
                 return rt_fail(e, RT_E_VULKAN, "far atlas shader", "no über compute GLSL");
-            bool ok = rt_glsl_compute_pipeline(d, pl->cache, s->layout, src, "far.comp", NULL,
-                                               &s->far_pipe[c], e);
+            bool ok = rt_vk_compute(d, &s->keep, &(rt_vk_compute_desc){ .label = "far.comp",
+                                        .glsl = src, .layout = s->layout, .cache = pl->cache },
+                                    &s->far_pipe[c], e);
             free(src);
             if (!ok)
                 return false;

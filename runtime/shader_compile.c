@@ -5,6 +5,7 @@
  * brings is validated before the driver sees it, so a corrupt file is an
  * error message, never a validation error or a driver crash. */
 #include "rt_internal.h"
+#include "vk_build.h"
 
 #include <stdlib.h>
 
@@ -66,18 +67,6 @@ bool rt_glsl_compute_pipeline(rt_device *d, VkPipelineCache cache, VkPipelineLay
                               const char *glsl, const char *name, const rt_interface *check,
                               VkPipeline *out, rt_error *e)
 {
-    VkShaderModule m;
-    if (!rt_glsl_module(d, glsl, VK_SHADER_STAGE_COMPUTE_BIT, name, check, &m, e))
-        return false;
-    VkComputePipelineCreateInfo ci = {
-        .sType = VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO,
-        .stage = { .sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO,
-                   .stage = VK_SHADER_STAGE_COMPUTE_BIT, .module = m, .pName = "main" },
-        .layout = layout,
-    };
-    VkResult r = vkCreateComputePipelines(d->dev, cache, 1, &ci, NULL, out);
-    vkDestroyShaderModule(d->dev, m, NULL);
-    if (r != VK_SUCCESS)
-        return rt_fail(e, RT_E_VULKAN, "vkCreateComputePipelines", rt_vk_result_name(r));
-    return true;
+    return rt_vk_compute(d, NULL, &(rt_vk_compute_desc){ .label = name, .glsl = glsl,
+                             .check = check, .layout = layout, .cache = cache }, out, e);
 }

@@ -36,6 +36,7 @@
  * the buffer copied into the sampled R8 map after the last frame's
  * reads. */
 #include "rt_internal.h"
+#include "vk_build.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -63,6 +64,7 @@ struct rt_shadow_gpu {
     VkDescriptorSet       set;
     VkPipeline            pipe;
     bool                  made;       /* the buffer holds a whole map      */
+    rt_vk_list            keep;       /* layouts, pool, pipeline           */
 };
 
 /* The push block of march_glsl. */
@@ -270,30 +272,20 @@ bool rt_shadow_gpu_create(rt_device *d, const rt_pack *p, const uint16_t *height
     VkDescriptorSetLayoutBinding b[3] = {
         { 0, sbt, 1, cs, NULL }, { 1, sbt, 1, cs, NULL }, { 2, sbt, 1, cs, NULL },
     };
-    if (!rt_set_layout(d, b, 3, &s->set_layout, e))
-        return false;
-    VkPushConstantRange push = { cs, 0, sizeof(march_push) };
-    VkPipelineLayoutCreateInfo pi = {
-        .sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO,
-        .setLayoutCount = 1,
-        .pSetLayouts = &s->set_layout,
-        .pushConstantRangeCount = 1,
-        .pPushConstantRanges = &push,
-    };
-    RT_VK(e, vkCreatePipelineLayout(d->dev, &pi, NULL, &s->layout));
     VkDescriptorPoolSize sizes[1] = { { sbt, 3 } };
-    if (!rt_descriptor_sets(d, sizes, 1, &s->set_layout, 1, &s->pool, &s->set, e))
+    rt_vk_list *k = &s->keep;
+    if (!rt_vk_set_layout(d, k, &(rt_vk_set_layout_desc){ "shadow march", b, 3 },
+                          &s->set_layout, e) ||
+        !rt_vk_layout(d, k, &(rt_vk_layout_desc){ .label = "shadow march",
+                          .sets = &s->set_layout, .nsets = 1, .push_stages = cs,
+                          .push_bytes = sizeof(march_push) }, &s->layout, e) ||
+        !rt_vk_sets(d, k, &(rt_vk_sets_desc){ .label = "shadow march", .sizes = sizes,
+                        .nsizes = 1, .layouts = &s->set_layout, .nsets = 1 },
+                    &s->pool, &s->set, e))
         return false;
-    VkDescriptorBufferInfo bi[3] = {
-        { s->heights.buf, 0, VK_WHOLE_SIZE }, { s->bound.buf, 0, VK_WHOLE_SIZE },
-        { s->map.buf, 0, VK_WHOLE_SIZE },
-    };
-    VkWriteDescriptorSet w[3];
-    for (uint32_t i = 0; i < 3; i++)
-        w[i] = (VkWriteDescriptorSet){ .sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET,
-            .dstSet = s->set, .dstBinding = i, .descriptorCount = 1,
-            .descriptorType = sbt, .pBufferInfo = &bi[i] };
-    vkUpdateDescriptorSets(d->dev, 3, w, 0, NULL);
+    rt_vk_write w[3] = { { s->set, 0, sbt, s->heights.buf }, { s->set, 1, sbt, s->bound.buf },
+                         { s->set, 2, sbt, s->map.buf } };
+    rt_vk_write_sets(d, w, 3);
     /* the pyramid's shape as constants */
     char head[512];
     int at = snprintf(head, sizeof head, "#version 450\n#define LEVELS %d\n#define PW %d\n"
@@ -307,7 +299,8 @@ bool rt_shadow_gpu_create(rt_device *d, const rt_pack *p, const uint16_t *height
         return rt_fail(e, RT_E_VULKAN, "shadow march", "out of memory");
     strcpy(src, head);
     strcat(src, march_glsl);
-    bool ok = rt_glsl_compute_pipeline(d, cache, s->layout, src, "shadow.comp", NULL, &s->pipe, e);
+    bool ok = rt_vk_compute(d, &s->keep, &(rt_vk_compute_desc){ .label = "shadow.comp",
+                                .glsl = src, .layout = s->layout, .cache = cache }, &s->pipe, e);
     free(src);
     return ok;
 }
@@ -317,15 +310,8 @@ void rt_shadow_gpu_destroy(rt_shadow_gpu *s)
     if (!s)
         return;
     rt_device *d = s->d;
+    rt_vk_list_destroy(d, &s->keep);
     if (d->dev) {
-        if (s->pipe)
-            vkDestroyPipeline(d->dev, s->pipe, NULL);
-        if (s->layout)
-            vkDestroyPipelineLayout(d->dev, s->layout, NULL);
-        if (s->pool)
-            vkDestroyDescriptorPool(d->dev, s->pool, NULL);
-        if (s->set_layout)
-            vkDestroyDescriptorSetLayout(d->dev, s->set_layout, NULL);
         rt_buffer_destroy(d, &s->bound);
         rt_buffer_destroy(d, &s->heights);
         rt_buffer_destroy(d, &s->map);

@@ -8,6 +8,7 @@
  * height of texels [x0 - 1, x1] (clamped): those are the texels its bounds
  * take.  Coarser nodes take the union of their children. */
 #include "rt_internal.h"
+#include "vk_build.h"
 
 #include <stdlib.h>
 #include <string.h>
@@ -116,18 +117,8 @@ void rt_bounds_free(rt_bounds *b)
 
 static bool make_sampler(rt_device *d, VkFilter filter, VkSampler *s, rt_error *e)
 {
-    VkSamplerCreateInfo ci = {
-        .sType = VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO,
-        .magFilter = filter,
-        .minFilter = filter,
-        .mipmapMode = VK_SAMPLER_MIPMAP_MODE_NEAREST,
-        .addressModeU = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE,
-        .addressModeV = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE,
-        .addressModeW = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE,
-        .maxLod = 0.0f,
-    };
-    RT_VK(e, vkCreateSampler(d->dev, &ci, NULL, s));
-    return true;
+    return rt_vk_sampler(d, NULL, &(rt_vk_sampler_desc){ .label = "terrain", .filter = filter,
+                             .wrap = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE }, s, e);
 }
 
 bool rt_terrain_upload(rt_device *d, const rt_pack *p, rt_terrain_gpu *t,

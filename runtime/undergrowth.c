@@ -44,480 +44,31 @@
  *     either, and a mesh-lit instance's normal the terrain's) as ug_far
  *     goes from 0 at 0.35 r1 to 1 at 0.8 r1: the cover turns into the
  *     ground it stands on before it thins out.
+ * The shaders are in undergrowth_glsl.c, the tests' probe pass in
+ * undergrowth_probe.c, what they share in undergrowth_impl.h.
  */
-#include "rt_internal.h"
+#include "undergrowth_impl.h"
 
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
-#define CELL    SPLAT_UG_CELL        /* metres per cell side (abi.h)        */
-#define TEXELS  SPLAT_UG_TEXELS      /* mask texels per cell side           */
-/* Distance LOD: beyond LOD_NEAR metres a cell draws the fraction
- * (LOD_NEAR / d)^2 of its instances (at least LOD_MIN), each widened by
- * 1 / sqrt(fraction) (at most LOD_GROW) but not raised: about as many
- * instances per pixel at every distance and the same cover seen from
- * above, without a wall of tall far clumps at a grazing view (a far tiny
- * triangle costs a whole quad of fragments; the H100 paid 0.25 us per
- * instance drawn). */
-#define LOD_NEAR 14.0
-#define LOD_MIN  0.08
-#define LOD_GROW 3.0
-#define LOD_GROW_S "3.0"
-#define UG_BLOCK_VEC4 5   /* vec4s per block of the block table (fill_blocks) */
-
-enum { CELL_FREE, CELL_PENDING, CELL_READY };
-
-typedef struct ug_cell {
-    int   ix, iz;      /* cell index: origin (ix, iz) * CELL metres        */
-    int   state;
-    bool  wanted;      /* within the radius this frame                     */
-    double dist;       /* 2D distance of its centre from the camera        */
-    bool  visible;     /* in the frustum this frame                        */
-} ug_cell;
-
-/* Push constants of the scatter pass (std430, 64 bytes). */
-typedef struct ug_push {
-    float    origin[2];
-    int32_t  cell[2];
-    uint32_t slot, nw, cap, mask_base;
-    float    terrain[4];      /* size x, size z, max height, offset       */
-    int32_t  hf[2];
-    uint32_t nblocks, pad;
-} ug_push;
-
-struct rt_ug {
-    rt_device            *d;
-    const rt_pack        *p;
-    rt_pipelines         *pl;
-    const rt_quadtree    *qt;
-    int                   pool, nblocks, nw;   /* nw: weight words per texel */
-    uint32_t              cap;                 /* instances per cell         */
-    uint32_t             *block_base;          /* first instance in a cell   */
-    uint32_t             *block_grid;          /* candidates per side        */
-    double                radius;
-    ug_cell              *cells;
-    int                  *order;               /* draw order, front to back  */
-    /* device-local: masks, instances, draw arguments (the GPU writes
-     * them and reads them every frame); host-visible: args_host (the
-     * arguments copied back after a generation, for the counts), blocks,
-     * meshes, the mask pass's frame block */
-    rt_buffer             masks, inst, args, args_host, blocks, vbuf, ibuf, frame;
-    rt_buffer             draw_args;           /* args with the LOD's counts */
-    rt_buffer             lod;                 /* per slot: fraction drawn   */
-    rt_buffer             far;                 /* per block: far mesh (LOD)  */
-    VkDescriptorSetLayout set_terrain;         /* set 0 of the mask pass     */
-    VkDescriptorSetLayout set_mask, set_gen, set_draw, set_lod;
-    VkPipelineLayout      mask_layout, gen_layout, draw_layout, lod_layout;
-    VkPipeline           *mask_pipes;          /* per combination            */
-    VkPipeline            gen_pipe, lod_pipe;
-    VkPipeline            draw_pipe[2];        /* opaque (early depth), cut out */
-    VkPipeline            shadow_pipe;         /* contact shadows (if shadows) */
-    rt_image              tex[SPLAT_MAX_UG_TEXTURES + 1];   /* the pack's, then white */
-    VkSampler             tex_smp;             /* trilinear, repeat          */
-    bool                  shadows;             /* the colour target blends   */
-    VkDescriptorPool      dpool;
-    VkDescriptorSet       set0, mask_set, gen_set, draw_set, lod_set;
-    VkRenderPass          pass_att, pass_ro;   /* depth in attachment / read */
-    VkFramebuffer         fb;
-    VkQueryPool           qpool;               /* VK_NULL_HANDLE: no timestamps */
-    int                   generated;           /* this frame                 */
-    double                time;                /* the camera's (the wind)    */
-    float                 cam_xz[2];           /* the camera's, this frame   */
-    /* the probe pass (tests only; made on first use) */
-    VkDescriptorSetLayout probe_sl;
-    VkPipelineLayout      probe_layout;
-    VkPipeline            probe_pipe;
-    VkDescriptorPool      probe_pool;
-    VkDescriptorSet       probe_set;
-    rt_buffer             probe_out;
-    bool                  drawn;
-};
-
-/* ---- shaders ---------------------------------------------------------------- */
-
-static const char gen_glsl[] =
-    "#version 450\n"
-    "layout(local_size_x = 64) in;\n"
-    "layout(set = 0, binding = 0, std430) readonly buffer M { uint w[]; } u_mask;\n"
-    "struct Inst { vec4 p; uvec4 q; };\n"
-    "layout(set = 0, binding = 1, std430) writeonly buffer I { Inst v[]; } u_inst;\n"
-    "layout(set = 0, binding = 2, std430) buffer A { uint a[]; } u_args;\n"
-    "layout(set = 0, binding = 3, std430) readonly buffer B { vec4 b[]; } u_blocks;\n"
-    "layout(set = 0, binding = 4) uniform sampler2D u_height;\n"
-    "layout(push_constant, std430) uniform P {\n"
-    "    vec2 origin; ivec2 cell; uint slot, nw, cap, mask_base;\n"
-    "    vec4 terrain; ivec2 hf; uint nblocks;\n"
-    "} u_p;\n"
-    "shared uint s_scan[64];\n"
-    "uint hash(uint x) {\n"
-    "    x ^= x >> 16; x *= 0x7feb352du; x ^= x >> 15; x *= 0x846ca68bu; x ^= x >> 16;\n"
-    "    return x;\n"
-    "}\n"
-    "float rnd(inout uint s) { s = hash(s + 0x9e3779b9u); return float(s >> 8) * (1.0 / 16777216.0); }\n"
-    /* bilinear between texel centres, as the terrain's vertices sample */
-    "float height_at(vec2 xz) {\n"
-    "    vec2 t = xz / u_p.terrain.xy * vec2(u_p.hf) - 0.5;\n"
-    "    ivec2 i = ivec2(floor(t)), m = u_p.hf - 1;\n"
-    "    vec2 f = t - vec2(i);\n"
-    "    float h00 = texelFetch(u_height, clamp(i, ivec2(0), m), 0).r;\n"
-    "    float h10 = texelFetch(u_height, clamp(i + ivec2(1, 0), ivec2(0), m), 0).r;\n"
-    "    float h01 = texelFetch(u_height, clamp(i + ivec2(0, 1), ivec2(0), m), 0).r;\n"
-    "    float h11 = texelFetch(u_height, clamp(i + ivec2(1, 1), ivec2(0), m), 0).r;\n"
-    "    float h = mix(mix(h00, h10, f.x), mix(h01, h11, f.x), f.y);\n"
-    "    return h * u_p.terrain.z + u_p.terrain.w;\n"
-    "}\n"
-    "void main() {\n"
-    "    uint b = gl_WorkGroupID.x, lid = gl_LocalInvocationID.x;\n"
-    "    vec4 b0 = u_blocks.b[5u * b], b1 = u_blocks.b[5u * b + 1u], b2 = u_blocks.b[5u * b + 2u];\n"
-    "    uint n = uint(b2.x), total = n * n, base = u_p.slot * u_p.cap + uint(b2.y);\n"
-    "    uint ms = uint(b1.w);\n"
-    "    float keep = b0.x * " "256.0" " / float(total);\n"
-    "    float step = 16.0 / float(n);\n"
-    "    uint seed0 = hash(uint(u_p.cell.x) * 73856093u ^ uint(u_p.cell.y) * 19349663u ^ b * 83492791u);\n"
-    "    uint run = 0u;\n"
-    "    for (uint c = 0u; c < total; c += 64u) {\n"
-    "        uint k = c + lid;\n"
-    "        bool ok = false;\n"
-    "        Inst it;\n"
-    "        if (k < total) {\n"
-    /* candidates in a lattice order (stride coprime with the count), so
-     * that every prefix of the kept instances spreads over the cell: the
-     * draw's distance LOD keeps a prefix */
-    "            uint q = (k * uint(b2.w)) % total;\n"
-    "            uint s = hash(seed0 ^ hash(q));\n"
-    "            vec2 g = vec2(float(q % n), float(q / n));\n"
-    "            vec2 l = (g + vec2(rnd(s), rnd(s))) * step;\n"
-    "            ivec2 tx = min(ivec2(l * (64.0 / 16.0)), ivec2(63));\n"
-    "            uint at = u_p.mask_base + uint(tx.y * 64 + tx.x) * (u_p.nw + 2u);\n"
-    "            float w = unpackUnorm4x8(u_mask.w[at + ms / 4u])[ms % 4u];\n"
-    "            ok = rnd(s) < w * keep;\n"
-    "            vec3 nrm = unpackSnorm4x8(u_mask.w[at + u_p.nw]).xyz;\n"
-    "            vec3 alb = unpackUnorm4x8(u_mask.w[at + u_p.nw + 1u]).rgb;\n"
-    "            vec2 xz = u_p.origin + l;\n"
-    "            float sc = mix(b0.y, b0.z, rnd(s));\n"
-    "            float ang = rnd(s) * 6.2831853;\n"
-    "            it.p = vec4(xz.x, height_at(xz), xz.y, sc);\n"
-    "            it.q = uvec4(packSnorm4x8(vec4(nrm, 0.0)), packUnorm4x8(vec4(alb, 1.0)),\n"
-    "                         floatBitsToUint(ang), b);\n"
-    "        }\n"
-    "        s_scan[lid] = ok ? 1u : 0u;\n"
-    "        barrier();\n"
-    "        for (uint o = 1u; o < 64u; o <<= 1u) {\n"
-    "            uint v = lid >= o ? s_scan[lid - o] : 0u;\n"
-    "            barrier();\n"
-    "            s_scan[lid] += v;\n"
-    "            barrier();\n"
-    "        }\n"
-    "        if (ok) u_inst.v[base + run + s_scan[lid] - 1u] = it;\n"
-    "        run += s_scan[63];\n"
-    "        barrier();\n"
-    "    }\n"
-    "    if (lid == 0u) u_args.a[(u_p.slot * u_p.nblocks + b) * 5u + 1u] = run;\n"
-    "}\n";
-
-/* The LOD pass, every frame: the draw arguments from the generated ones,
- * each cell's instance count times its fraction (a prefix: the scatter
- * pass keeps instances in a lattice order that spreads every prefix), and
- * beyond LOD_NEAR the block's far mesh where it has one (PACK.md: index
- * count, first index, vertex offset, and w = 1); after the n arguments,
- * the contact shadows' n: the same instances drawn with the shadow quad
- * (push qidx, qvtx), none for a block whose shadow is 0 (its second
- * uvec4 .x). */
-static const char lod_glsl[] =
-    "#version 450\n"
-    "layout(local_size_x = 64) in;\n"
-    "layout(set = 0, binding = 0, std430) readonly buffer A { uint a[]; } u_args;\n"
-    "layout(set = 0, binding = 1, std430) writeonly buffer D { uint a[]; } u_draw;\n"
-    "layout(set = 0, binding = 2, std430) readonly buffer F { float f[]; } u_lod;\n"
-    "layout(set = 0, binding = 3, std430) readonly buffer M { uvec4 m[]; } u_far;\n"
-    "layout(push_constant, std430) uniform P { uint n, nblocks, qidx, qvtx; } u_p;\n"
-    "void main() {\n"
-    "    uint i = gl_GlobalInvocationID.x;\n"
-    "    if (i >= u_p.n) return;\n"
-    "    for (uint k = 0u; k < 5u; k++) u_draw.a[5u * i + k] = u_args.a[5u * i + k];\n"
-    "    float f = u_lod.f[i / u_p.nblocks];\n"
-    "    uint count = uint(ceil(float(u_args.a[5u * i + 1u]) * f));\n"
-    "    u_draw.a[5u * i + 1u] = count;\n"
-    "    uint s = 5u * (u_p.n + i);\n"
-    "    u_draw.a[s] = 6u;\n"
-    "    u_draw.a[s + 1u] = u_far.m[2u * (i % u_p.nblocks) + 1u].x != 0u ? count : 0u;\n"
-    "    u_draw.a[s + 2u] = u_p.qidx;\n"
-    "    u_draw.a[s + 3u] = u_p.qvtx;\n"
-    "    u_draw.a[s + 4u] = u_args.a[5u * i + 4u];\n"
-    "    uvec4 m = u_far.m[2u * (i % u_p.nblocks)];   /* the block's far mesh */\n"
-    "    if (f < 1.0 && m.w != 0u) {\n"
-    "        u_draw.a[5u * i] = m.x;\n"
-    "        u_draw.a[5u * i + 2u] = m.y;\n"
-    "        u_draw.a[5u * i + 3u] = m.z;\n"
-    "    }\n"
-    "}\n";
-
-/* The vertex stage's fade and wind (the top comment), shared by the draw
- * and the probe pass so that the tests count what the draw keeps. */
-#define UG_GLSL_FUNCS \
-    "float ug_hash01(vec3 root) {\n" \
-    "    uint x = floatBitsToUint(root.x) * 0x9e3779b1u ^ floatBitsToUint(root.z) * 0x85ebca77u;\n" \
-    "    x ^= x >> 16; x *= 0x7feb352du; x ^= x >> 15; x *= 0x846ca68bu; x ^= x >> 16;\n" \
-    "    return float(x >> 8) * (1.0 / 16777216.0);\n" \
-    "}\n" \
-    "float ug_fade(float d, float r) {\n" \
-    "    float r1 = max(r - " UG_FADE_MARGIN_S ", 0.5 * r);\n" \
-    "    return 1.0 - smoothstep(" UG_FADE_START_S " * r1, r1, d);\n" \
-    "}\n" \
-    "float ug_far(float d, float r) {\n" \
-    "    float r1 = max(r - " UG_FADE_MARGIN_S ", 0.5 * r);\n" \
-    "    return smoothstep(0.35 * r1, 0.8 * r1, d);\n" \
-    "}\n" \
-    "float ug_fade_scale(vec3 root, float d, float r) {\n" \
-    "    return clamp((ug_fade(d, r) - ug_hash01(root)) * 5.0, 0.0, 1.0);\n" \
-    "}\n" \
-    "float ug_gust(vec2 xz, vec2 dir, float t) {\n" \
-    "    float along = dot(xz, dir), across = dot(xz, vec2(-dir.y, dir.x));\n" \
-    "    float p1 = 6.2831853 * fract(along / 24.0 - t / 5.7);\n" \
-    "    float p2 = 6.2831853 * fract(along / 9.1 + across / 37.0 - t / 2.3);\n" \
-    "    return 0.5 + 0.3 * sin(p1) + 0.2 * sin(p2);\n" \
-    "}\n" \
-    "vec3 ug_wind(vec3 root, float h, vec4 w, float t) {\n" \
-    "    h = max(h, 0.0);\n" \
-    "    float a = w.z * h * h * (1.0 - w.w + w.w * ug_gust(root.xz, w.xy, t));\n" \
-    "    return vec3(w.x * a, -min(0.5 * a * a / max(h, 1e-3), 0.5 * h), w.y * a);\n" \
-    "}\n"
-#define UG_FADE_MARGIN_S "12.0"   /* 0.75 CELL */
-#define UG_FADE_START_S "0.6"
-
-/* The draw pass: SPLAT_GLSL_TERRAIN (frame block) + this vertex main; the
- * prelude + draw_frag_main as the fragment shader (it reads v_rel, v_uv,
- * v_local at locations 0-2, as the terrain's). */
-static const char draw_vert_main[] =
-    "struct Inst { vec4 p; uvec4 q; };\n"
-    "layout(set = 2, binding = 0, std430) readonly buffer B { vec4 b[]; } u_blocks;\n"
-    "layout(set = 2, binding = 1, std430) readonly buffer I { Inst v[]; } u_inst;\n"
-    "layout(set = 2, binding = 2, std430) readonly buffer F { float f[]; } u_lod;\n"
-    "layout(location = 0) in vec3 a_pos;\n"
-    "layout(location = 1) in vec3 a_nrm;\n"
-    "layout(location = 2) in vec2 a_uv;\n"
-    "out gl_PerVertex { vec4 gl_Position; };\n"
-    "layout(location = 0) out vec3 v_rel;\n"
-    "layout(location = 1) out vec2 v_uv;\n"
-    "layout(location = 2) out vec3 v_local;\n"
-    "layout(location = 3) out vec3 g_color;\n"
-    "layout(location = 4) out vec3 g_normal;\n"
-    "layout(location = 5) out vec2 g_uv;\n"
-    "layout(location = 6) flat out uint g_flags;\n"
-    "layout(location = 7) out float g_far;\n"
-    "layout(location = 8) out vec3 g_tnormal;\n"
-    UG_GLSL_FUNCS
-    "void main() {\n"
-    "    Inst it = u_inst.v[gl_InstanceIndex];\n"
-    "    uint bi = 5u * it.q.w;\n"
-    "    vec4 b0 = u_blocks.b[bi], b1 = u_blocks.b[bi + 1u], b4 = u_blocks.b[bi + 4u];\n"
-    "    uint flags = uint(u_blocks.b[bi + 2u].z);\n"
-    "    vec3 n = normalize(unpackSnorm4x8(it.q.x).xyz + vec3(0.0, 1e-4, 0.0));\n"
-    "    float a = uintBitsToFloat(it.q.z), c = cos(a), s = sin(a);\n"
-    /* the distance fade (push patch_xz.x: the radius) */
-    "    float r = u_push.patch_xz.x, d = length(it.p.xz - u_frame.camera.xz);\n"
-    /* the LOD's growth (u_push.info.x: instances per cell) */
-    "    float grow = min(inversesqrt(u_lod.f[uint(gl_InstanceIndex) / u_push.info.x]), " LOD_GROW_S ");\n"
-    /* the growth widens, it does not raise: far cover, not a hedge */
-    "    vec3 p = a_pos * it.p.w * ug_fade_scale(it.p.xyz, d, r) * vec3(grow, 1.0, grow);\n"
-    "    p = vec3(c * p.x + s * p.z, p.y, -s * p.x + c * p.z);\n"
-    "    vec3 m = vec3(c * a_nrm.x + s * a_nrm.z, a_nrm.y, -s * a_nrm.x + c * a_nrm.z);\n"
-    "    if ((flags & 4u) != 0u) {   /* aligned to the terrain normal: a rotation (t, n, b) */\n"
-    "        vec3 t = normalize(cross(n, vec3(0.0, 0.0, 1.0)));\n"
-    "        vec3 bt = cross(t, n);\n"
-    "        p = t * p.x + n * p.y + bt * p.z;\n"
-    "        m = t * m.x + n * m.y + bt * m.z;\n"
-    "    }\n"
-    /* the wind (block vec4 3; push patch_xz.y: the time in seconds) */
-    "    p += ug_wind(it.p.xyz, p.y, u_blocks.b[bi + 3u], u_push.patch_xz.y);\n"
-    "    v_local = it.p.xyz + p;\n"
-    "    v_rel = v_local - u_frame.camera.xyz;\n"
-    "    v_uv = v_local.xz / u_frame.terrain.xy;\n"
-    /* towards the radius the colour becomes the ground's (the cover thins
-     * into the terrain it stands on, the root darkening goes with it) */
-    "    float far = ug_far(d, r);\n"
-    "    float share = mix(mix(b4.x, b0.w, clamp(a_uv.y, 0.0, 1.0)), 1.0, far);\n"
-    "    g_far = far;\n"
-    "    g_color = mix(b1.rgb, unpackUnorm4x8(it.q.y).rgb, share);\n"
-    "    g_normal = (flags & 2u) != 0u ? n : m;\n"
-    "    g_tnormal = n;\n"
-    "    g_uv = a_uv;\n"
-    "    g_flags = flags;\n"
-    "    gl_Position = u_frame.view_proj * vec4(v_rel, 1.0);\n"
-    "}\n";
-
-static const char draw_frag_main[] =
-    "layout(set = 2, binding = 3) uniform sampler2D u_ugtex[" SPLAT_STR(SPLAT_MAX_UG_TEXTURES) "];\n"
-    "layout(location = 3) in vec3 g_color;\n"
-    "layout(location = 4) in vec3 g_normal;\n"
-    "layout(location = 5) in vec2 g_uv;\n"
-    "layout(location = 6) flat in uint g_flags;\n"
-    "layout(location = 7) in float g_far;\n"
-    "layout(location = 8) in vec3 g_tnormal;\n"
-    /* constant indices: no dynamic indexing feature needed (the index is
-     * the block's, the same for a whole draw) */
-    "vec4 ug_texture(uint t, vec2 uv) {\n"
-    "    switch (t) {\n"
-    "    case 1u: return texture(u_ugtex[0], uv);\n"
-    "    case 2u: return texture(u_ugtex[1], uv);\n"
-    "    case 3u: return texture(u_ugtex[2], uv);\n"
-    "    case 4u: return texture(u_ugtex[3], uv);\n"
-    "    case 5u: return texture(u_ugtex[4], uv);\n"
-    "    case 6u: return texture(u_ugtex[5], uv);\n"
-    "    case 7u: return texture(u_ugtex[6], uv);\n"
-    "    case 8u: return texture(u_ugtex[7], uv);\n"
-    "    }\n"
-    "    return vec4(1.0);\n"
-    "}\n"
-    "void main() {\n"
-    /* the texture with v up the mesh (OBJ: v = 0 at the image's bottom) */
-    "    vec4 tex = ug_texture(g_flags >> 8, vec2(g_uv.x, 1.0 - g_uv.y));\n"
-    "#ifdef UG_CUTOUT\n"
-    "    if ((g_flags & 1u) != 0u) {\n"
-    "        /* a frond cut from the quad: a lens-shaped outline, chevron leaflets */\n"
-    "        float x = abs(g_uv.x * 2.0 - 1.0), t = clamp(g_uv.y, 0.0, 1.0);\n"
-    "        if (x > 0.9 * sin(t * 3.14159) || (x > 0.08 && fract(t * 7.0 - x * 2.5) > 0.6)) discard;\n"
-    "    } else {\n"
-    "        /* the texture's alpha, dithered (interleaved gradient noise): a\n"
-    "         * pixel is covered with that probability, as alpha to coverage\n"
-    "         * would with samples */\n"
-    "        float ign = fract(52.9829189 * fract(dot(gl_FragCoord.xy, vec2(0.06711056, 0.00583715))));\n"
-    "        if (tex.a <= ign) discard;\n"
-    "    }\n"
-    "#endif\n"
-    "    float dist = length(v_rel);\n"
-    "    vec3 v = dist > 0.0 ? -v_rel / dist : vec3(0.0, 1.0, 0.0);\n"
-    "    vec3 n = normalize(g_normal);\n"
-    "    if ((g_flags & 2u) == 0u && !gl_FrontFacing) n = -n;\n"
-    /* a mesh-lit instance shades as the ground as it turns into it */
-    "    n = normalize(mix(n, normalize(g_tnormal), g_far));\n"
-    "    float ao = mix(mix(0.5, 1.0, clamp(g_uv.y, 0.0, 1.0)), 1.0, g_far);   /* darker at the root */\n"
-    "    o_color = vec4(splat_light(g_color * tex.rgb * ao, n, 0.9, dist, v), 1.0);\n"
-    "}\n";
-
-/* The probe pass, for the tests only (made on first use): mode 0 counts
- * the instances the last frame's draw keeps in cell `slot`, per ring of
- * width ring.w around the camera ring.xy (the draw's arguments after the
- * LOD, and ug_fade_scale > 0: exactly the instances the vertex stage does
- * not collapse) into out[ring], and all the LOD's into out[rings + ring];
- * mode 1 evaluates ug_wind at n points (12 floats each:
- * root, h, the block's wind vec4, then the offset and the gust written). */
-static const char probe_glsl[] =
-    "#version 450\n"
-    "layout(local_size_x = 64) in;\n"
-    "struct Inst { vec4 p; uvec4 q; };\n"
-    "layout(set = 0, binding = 0, std430) readonly buffer I { Inst v[]; } u_inst;\n"
-    "layout(set = 0, binding = 1, std430) readonly buffer A { uint a[]; } u_draw;\n"
-    "layout(set = 0, binding = 2, std430) buffer O { uint u[]; } u_out;\n"
-    "layout(push_constant, std430) uniform P { vec4 ring; uvec4 info; } u_p;\n"
-    UG_GLSL_FUNCS
-    "void main() {\n"
-    "    uint lid = gl_LocalInvocationID.x;\n"
-    "    if (u_p.info.x == 1u) {\n"
-    "        uint i = gl_GlobalInvocationID.x;\n"
-    "        if (i >= u_p.info.y) return;\n"
-    "        float v[8];\n"
-    "        for (uint k = 0u; k < 8u; k++) v[k] = uintBitsToFloat(u_out.u[12u * i + k]);\n"
-    "        vec3 o = ug_wind(vec3(v[0], v[1], v[2]), v[3], vec4(v[4], v[5], v[6], v[7]), u_p.ring.z);\n"
-    "        u_out.u[12u * i + 8u] = floatBitsToUint(o.x);\n"
-    "        u_out.u[12u * i + 9u] = floatBitsToUint(o.y);\n"
-    "        u_out.u[12u * i + 10u] = floatBitsToUint(o.z);\n"
-    "        u_out.u[12u * i + 11u] = floatBitsToUint(ug_gust(vec2(v[0], v[2]), vec2(v[4], v[5]), u_p.ring.z));\n"
-    "        return;\n"
-    "    }\n"
-    "    uint at = 5u * (u_p.info.z * u_p.info.w + gl_WorkGroupID.x);\n"
-    "    uint n = u_draw.a[at + 1u], first = u_draw.a[at + 4u];\n"
-    "    for (uint k = lid; k < n; k += 64u) {\n"
-    "        vec3 root = u_inst.v[first + k].p.xyz;\n"
-    "        float d = length(root.xz - u_p.ring.xy);\n"
-    "        uint ring = uint(d / u_p.ring.w);\n"
-    "        if (ring >= u_p.info.y) continue;\n"
-    "        atomicAdd(u_out.u[u_p.info.y + ring], 1u);\n"
-    "        if (ug_fade_scale(root, d, u_p.ring.z) > 0.0) atomicAdd(u_out.u[ring], 1u);\n"
-    "    }\n"
-    "}\n";
-
-/* Contact shadows (a block's `shadow`): before the plants, every kept
- * instance darkens the ground under it by a disc on the terrain plane at
- * its root, 1.3 times its footprint, 4 cm up the normal, multiplied into
- * the colour (dst * src): shadow * (1 - smoothstep(0.2, 1, r^2)), gone
- * with the instance (the fade's scale) and with ug_far, so overlapping
- * discs under dense cover darken the ground the more. */
-static const char shadow_vert_main[] =
-    "struct Inst { vec4 p; uvec4 q; };\n"
-    "layout(set = 2, binding = 0, std430) readonly buffer B { vec4 b[]; } u_blocks;\n"
-    "layout(set = 2, binding = 1, std430) readonly buffer I { Inst v[]; } u_inst;\n"
-    "layout(set = 2, binding = 2, std430) readonly buffer F { float f[]; } u_lod;\n"
-    "layout(location = 0) in vec3 a_pos;\n"
-    "layout(location = 1) in vec3 a_nrm;   /* the vertex layout's; unused */\n"
-    "layout(location = 2) in vec2 a_uv;\n"
-    "out gl_PerVertex { vec4 gl_Position; };\n"
-    "layout(location = 0) out vec2 s_q;\n"
-    "layout(location = 1) out float s_a;\n"
-    UG_GLSL_FUNCS
-    "void main() {\n"
-    "    Inst it = u_inst.v[gl_InstanceIndex];\n"
-    "    vec4 b4 = u_blocks.b[5u * it.q.w + 4u];\n"
-    "    vec3 n = normalize(unpackSnorm4x8(it.q.x).xyz + vec3(0.0, 1e-4, 0.0));\n"
-    "    float r = u_push.patch_xz.x, d = length(it.p.xz - u_frame.camera.xz);\n"
-    "    float grow = min(inversesqrt(u_lod.f[uint(gl_InstanceIndex) / u_push.info.x]), " LOD_GROW_S ");\n"
-    "    float size = 1.3 * b4.z * it.p.w * grow * ug_fade_scale(it.p.xyz, d, r);\n"
-    "    vec3 t = normalize(cross(n, vec3(0.0, 0.0, 1.0))), bt = cross(t, n);\n"
-    "    vec3 p = it.p.xyz + (t * a_pos.x + bt * a_pos.z) * size + n * 0.04;\n"
-    "    s_q = a_uv * 2.0 - 1.0;\n"
-    "    s_a = b4.y * (1.0 - ug_far(d, r));\n"
-    "    gl_Position = u_frame.view_proj * vec4(p - u_frame.camera.xyz, 1.0);\n"
-    "}\n";
-
-static const char shadow_frag[] =
-    "#version 450\n"
-    "layout(early_fragment_tests) in;\n"
-    "layout(location = 0) in vec2 s_q;\n"
-    "layout(location = 1) in float s_a;\n"
-    "layout(location = 0) out vec4 o_color;\n"
-    "void main() {\n"
-    "    float a = s_a * (1.0 - smoothstep(0.2, 1.0, dot(s_q, s_q)));\n"
-    "    o_color = vec4(vec3(1.0 - a), 1.0);\n"
-    "}\n";
-
 /* ---- creation ----------------------------------------------------------------- */
 
-static bool pipe_layout(rt_device *d, const VkDescriptorSetLayout *sets, uint32_t n,
+static bool pipe_layout(rt_ug *u, const VkDescriptorSetLayout *sets, uint32_t n,
                         VkShaderStageFlags stages, uint32_t push, VkPipelineLayout *out,
                         rt_error *e)
 {
-    VkPushConstantRange pr = { stages, 0, push };
-    VkPipelineLayoutCreateInfo ci = {
-        .sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO,
-        .setLayoutCount = n, .pSetLayouts = sets,
-        .pushConstantRangeCount = 1, .pPushConstantRanges = &pr,
-    };
-    RT_VK(e, vkCreatePipelineLayout(d->dev, &ci, NULL, out));
-    return true;
+    return rt_vk_layout(u->d, &u->keep, &(rt_vk_layout_desc){ .label = "undergrowth",
+                            .sets = sets, .nsets = n, .push_stages = stages,
+                            .push_bytes = push }, out, e);
 }
 
 /* Colour RGBA32F loaded and left TRANSFER_SRC (as every path leaves it);
  * depth loaded from `depth_in` (the forward and multi-pass paths leave
  * it an attachment, the screen path's geometry pass SHADER_READ_ONLY). */
-static bool make_pass(rt_device *d, VkImageLayout depth_in, VkRenderPass *out, rt_error *e)
+static bool make_pass(rt_ug *u, VkImageLayout depth_in, VkRenderPass *out, rt_error *e)
 {
-    VkAttachmentDescription att[2] = {
-        { 0, VK_FORMAT_R32G32B32A32_SFLOAT, VK_SAMPLE_COUNT_1_BIT, VK_ATTACHMENT_LOAD_OP_LOAD,
-          VK_ATTACHMENT_STORE_OP_STORE, VK_ATTACHMENT_LOAD_OP_DONT_CARE,
-          VK_ATTACHMENT_STORE_OP_DONT_CARE, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
-          VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL },
-        { 0, VK_FORMAT_D32_SFLOAT, VK_SAMPLE_COUNT_1_BIT, VK_ATTACHMENT_LOAD_OP_LOAD,
-          VK_ATTACHMENT_STORE_OP_STORE, VK_ATTACHMENT_LOAD_OP_DONT_CARE,
-          VK_ATTACHMENT_STORE_OP_DONT_CARE, depth_in, depth_in },
-    };
-    VkAttachmentReference cref = { 0, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL };
-    VkAttachmentReference dref = { 1, VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL };
-    VkSubpassDescription sub = {
-        .pipelineBindPoint = VK_PIPELINE_BIND_POINT_GRAPHICS,
-        .colorAttachmentCount = 1, .pColorAttachments = &cref,
-        .pDepthStencilAttachment = &dref,
-    };
     VkSubpassDependency dep[2] = {
         { VK_SUBPASS_EXTERNAL, 0,
           VK_PIPELINE_STAGE_TRANSFER_BIT | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT |
@@ -534,13 +85,13 @@ static bool make_pass(rt_device *d, VkImageLayout depth_in, VkRenderPass *out, r
           VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT,
           VK_ACCESS_TRANSFER_READ_BIT | VK_ACCESS_SHADER_READ_BIT, 0 },
     };
-    VkRenderPassCreateInfo ci = {
-        .sType = VK_STRUCTURE_TYPE_RENDER_PASS_CREATE_INFO,
-        .attachmentCount = 2, .pAttachments = att, .subpassCount = 1, .pSubpasses = &sub,
-        .dependencyCount = 2, .pDependencies = dep,
-    };
-    RT_VK(e, vkCreateRenderPass(d->dev, &ci, NULL, out));
-    return true;
+    const VkImageLayout src = VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL;
+    return rt_vk_pass(u->d, &u->keep, &(rt_vk_pass_desc){ .label = "undergrowth",
+                          .color = { { .format = VK_FORMAT_R32G32B32A32_SFLOAT,
+                                       .initial = src, .final = src } }, .ncolor = 1,
+                          .depth = { .format = VK_FORMAT_D32_SFLOAT, .initial = depth_in,
+                                     .final = depth_in },
+                          .deps = dep, .ndeps = 2 }, out, e);
 }
 
 /* The draw pipeline of opaque meshes (depth tested before shading: blades
@@ -549,11 +100,10 @@ static bool make_pass(rt_device *d, VkImageLayout depth_in, VkRenderPass *out, r
  * contact shadows (kind 2: multiplied into the colour, no depth written). */
 static bool draw_pipeline(rt_ug *u, int kind, rt_error *e)
 {
-    rt_device *d = u->d;
     bool cutout = kind == 1, shadow = kind == 2;
-    const char *vmain = shadow ? shadow_vert_main : draw_vert_main;
+    const char *vmain = shadow ? rt_ug_shadow_vert_main : rt_ug_draw_vert_main;
     size_t nv = strlen(SPLAT_GLSL_TERRAIN) + strlen(vmain) + 32;
-    size_t nf = strlen(SPLAT_GLSL_PRELUDE) + strlen(draw_frag_main) + strlen(shadow_frag) + 96;
+    size_t nf = strlen(SPLAT_GLSL_PRELUDE) + strlen(rt_ug_draw_frag_main) + strlen(rt_ug_shadow_frag) + 96;
     char *vs = malloc(nv), *fs = malloc(nf);
     if (!vs || !fs) {
         free(vs);
@@ -562,89 +112,34 @@ static bool draw_pipeline(rt_ug *u, int kind, rt_error *e)
     }
     snprintf(vs, nv, "#version 450\n%s%s", SPLAT_GLSL_TERRAIN, vmain);
     if (shadow)
-        snprintf(fs, nf, "%s", shadow_frag);
+        snprintf(fs, nf, "%s", rt_ug_shadow_frag);
     else
         snprintf(fs, nf, "#version 450\n%s%s%s",
                  cutout ? "#define UG_CUTOUT 1\n" : "layout(early_fragment_tests) in;\n",
-                 SPLAT_GLSL_PRELUDE, draw_frag_main);
-    VkShaderModule vm = VK_NULL_HANDLE, fm = VK_NULL_HANDLE;
-    bool ok = rt_glsl_module(d, vs, VK_SHADER_STAGE_VERTEX_BIT, "undergrowth.vert", NULL, &vm, e) &&
-              rt_glsl_module(d, fs, VK_SHADER_STAGE_FRAGMENT_BIT, "undergrowth.frag", NULL, &fm, e);
+                 SPLAT_GLSL_PRELUDE, rt_ug_draw_frag_main);
+    VkVertexInputBindingDescription vb = { 0, 32, VK_VERTEX_INPUT_RATE_VERTEX };
+    VkVertexInputAttributeDescription va[3] = {
+        { 0, 0, VK_FORMAT_R32G32B32_SFLOAT, 0 },
+        { 1, 0, VK_FORMAT_R32G32B32_SFLOAT, 12 },
+        { 2, 0, VK_FORMAT_R32G32_SFLOAT, 24 },
+    };
+    /* shadows: dst * src, the colour darkened, its alpha kept */
+    VkPipelineColorBlendAttachmentState mul = {
+        .blendEnable = VK_TRUE, .srcColorBlendFactor = VK_BLEND_FACTOR_ZERO,
+        .dstColorBlendFactor = VK_BLEND_FACTOR_SRC_COLOR, .colorBlendOp = VK_BLEND_OP_ADD,
+        .srcAlphaBlendFactor = VK_BLEND_FACTOR_ZERO,
+        .dstAlphaBlendFactor = VK_BLEND_FACTOR_ONE, .alphaBlendOp = VK_BLEND_OP_ADD,
+        .colorWriteMask = 0xf };
+    bool ok = rt_vk_gfx(u->d, &u->keep, &(rt_vk_gfx_desc){ .label = "undergrowth",
+                            .vs_glsl = vs, .fs_glsl = fs, .vbufs = &vb, .nvbufs = 1,
+                            .attrs = va, .nattrs = 3,
+                            .depth_test = true, .depth_write = !shadow,   /* reversed Z */
+                            .depth_compare = VK_COMPARE_OP_GREATER,
+                            .ncolor = 1, .blend = shadow ? &mul : NULL,
+                            .layout = u->draw_layout, .pass = u->pass_att },
+                        shadow ? &u->shadow_pipe : &u->draw_pipe[cutout], e);
     free(vs);
     free(fs);
-    if (ok) {
-        VkPipelineShaderStageCreateInfo st[2] = {
-            { .sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO,
-              .stage = VK_SHADER_STAGE_VERTEX_BIT, .module = vm, .pName = "main" },
-            { .sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO,
-              .stage = VK_SHADER_STAGE_FRAGMENT_BIT, .module = fm, .pName = "main" },
-        };
-        VkVertexInputBindingDescription vb = { 0, 32, VK_VERTEX_INPUT_RATE_VERTEX };
-        VkVertexInputAttributeDescription va[3] = {
-            { 0, 0, VK_FORMAT_R32G32B32_SFLOAT, 0 },
-            { 1, 0, VK_FORMAT_R32G32B32_SFLOAT, 12 },
-            { 2, 0, VK_FORMAT_R32G32_SFLOAT, 24 },
-        };
-        VkPipelineVertexInputStateCreateInfo vi = {
-            .sType = VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO,
-            .vertexBindingDescriptionCount = 1, .pVertexBindingDescriptions = &vb,
-            .vertexAttributeDescriptionCount = 3, .pVertexAttributeDescriptions = va,
-        };
-        VkPipelineInputAssemblyStateCreateInfo ia = {
-            .sType = VK_STRUCTURE_TYPE_PIPELINE_INPUT_ASSEMBLY_STATE_CREATE_INFO,
-            .topology = VK_PRIMITIVE_TOPOLOGY_TRIANGLE_LIST,
-        };
-        VkPipelineViewportStateCreateInfo vps = {
-            .sType = VK_STRUCTURE_TYPE_PIPELINE_VIEWPORT_STATE_CREATE_INFO,
-            .viewportCount = 1, .scissorCount = 1,
-        };
-        VkPipelineRasterizationStateCreateInfo rs = {
-            .sType = VK_STRUCTURE_TYPE_PIPELINE_RASTERIZATION_STATE_CREATE_INFO,
-            .polygonMode = VK_POLYGON_MODE_FILL, .cullMode = VK_CULL_MODE_NONE,
-            .frontFace = VK_FRONT_FACE_COUNTER_CLOCKWISE, .lineWidth = 1.0f,
-        };
-        VkPipelineMultisampleStateCreateInfo ms = {
-            .sType = VK_STRUCTURE_TYPE_PIPELINE_MULTISAMPLE_STATE_CREATE_INFO,
-            .rasterizationSamples = VK_SAMPLE_COUNT_1_BIT,
-        };
-        VkPipelineDepthStencilStateCreateInfo ds = {   /* reversed Z */
-            .sType = VK_STRUCTURE_TYPE_PIPELINE_DEPTH_STENCIL_STATE_CREATE_INFO,
-            .depthTestEnable = VK_TRUE, .depthWriteEnable = shadow ? VK_FALSE : VK_TRUE,
-            .depthCompareOp = VK_COMPARE_OP_GREATER,
-        };
-        VkPipelineColorBlendAttachmentState cba = { .colorWriteMask = 0xf };
-        if (shadow)   /* dst * src: the colour darkened, its alpha kept */
-            cba = (VkPipelineColorBlendAttachmentState){
-                .blendEnable = VK_TRUE, .srcColorBlendFactor = VK_BLEND_FACTOR_ZERO,
-                .dstColorBlendFactor = VK_BLEND_FACTOR_SRC_COLOR, .colorBlendOp = VK_BLEND_OP_ADD,
-                .srcAlphaBlendFactor = VK_BLEND_FACTOR_ZERO,
-                .dstAlphaBlendFactor = VK_BLEND_FACTOR_ONE, .alphaBlendOp = VK_BLEND_OP_ADD,
-                .colorWriteMask = 0xf };
-        VkPipelineColorBlendStateCreateInfo cb = {
-            .sType = VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO,
-            .attachmentCount = 1, .pAttachments = &cba,
-        };
-        VkDynamicState dyn[2] = { VK_DYNAMIC_STATE_VIEWPORT, VK_DYNAMIC_STATE_SCISSOR };
-        VkPipelineDynamicStateCreateInfo dy = {
-            .sType = VK_STRUCTURE_TYPE_PIPELINE_DYNAMIC_STATE_CREATE_INFO,
-            .dynamicStateCount = 2, .pDynamicStates = dyn,
-        };
-        VkGraphicsPipelineCreateInfo ci = {
-            .sType = VK_STRUCTURE_TYPE_GRAPHICS_PIPELINE_CREATE_INFO,
-            .stageCount = 2, .pStages = st, .pVertexInputState = &vi,
-            .pInputAssemblyState = &ia, .pViewportState = &vps, .pRasterizationState = &rs,
-            .pMultisampleState = &ms, .pDepthStencilState = &ds, .pColorBlendState = &cb,
-            .pDynamicState = &dy, .layout = u->draw_layout, .renderPass = u->pass_att,
-        };
-        VkResult r = vkCreateGraphicsPipelines(d->dev, VK_NULL_HANDLE, 1, &ci, NULL,
-                                               shadow ? &u->shadow_pipe : &u->draw_pipe[cutout]);
-        if (r != VK_SUCCESS)
-            ok = rt_fail(e, RT_E_VULKAN, "vkCreateGraphicsPipelines", rt_vk_result_name(r));
-    }
-    if (vm)
-        vkDestroyShaderModule(d->dev, vm, NULL);
-    if (fm)
-        vkDestroyShaderModule(d->dev, fm, NULL);
     return ok;
 }
 
@@ -721,7 +216,8 @@ static bool make_sets(rt_ug *u, VkDescriptorSet set0_src, const rt_image *height
     VkDescriptorSetLayout layouts[5] = { u->set_terrain, u->set_mask, u->set_gen, u->set_draw,
                                          u->set_lod };
     VkDescriptorSet sets[5];
-    if (!rt_descriptor_sets(d, sizes, 3, layouts, 5, &u->dpool, sets, e))
+    if (!rt_vk_sets(d, &u->keep, &(rt_vk_sets_desc){ .label = "undergrowth", .sizes = sizes,
+                        .nsizes = 3, .layouts = layouts, .nsets = 5 }, &u->dpool, sets, e))
         return false;
     u->set0 = sets[0];
     u->mask_set = sets[1];
@@ -731,31 +227,6 @@ static bool make_sets(rt_ug *u, VkDescriptorSet set0_src, const rt_image *height
     /* set 0 of the mask pass: the terrain's, but the frame block whose
      * camera is the origin (abi.h "undergrowth masks") */
     rt_terrain_compute_set(d, set0_src, u->set0, u->frame.buf);
-    VkDescriptorBufferInfo mb = { u->masks.buf, 0, VK_WHOLE_SIZE };
-    VkDescriptorBufferInfo ib = { u->inst.buf, 0, VK_WHOLE_SIZE };
-    VkDescriptorBufferInfo ab = { u->args.buf, 0, VK_WHOLE_SIZE };
-    VkDescriptorBufferInfo bb = { u->blocks.buf, 0, VK_WHOLE_SIZE };
-    VkDescriptorBufferInfo db = { u->draw_args.buf, 0, VK_WHOLE_SIZE };
-    VkDescriptorBufferInfo lb = { u->lod.buf, 0, VK_WHOLE_SIZE };
-    VkDescriptorBufferInfo fm = { u->far.buf, 0, VK_WHOLE_SIZE };
-    VkDescriptorImageInfo hi = { nearest, height->view, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL };
-    const VkDescriptorType sb = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
-#define W(set_, b_, type_, img_, buf_) \
-    (VkWriteDescriptorSet){ .sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, \
-        .dstSet = set_, .dstBinding = b_, .descriptorCount = 1, .descriptorType = type_, \
-        .pImageInfo = img_, .pBufferInfo = buf_ }
-    VkWriteDescriptorSet w[] = {
-        W(u->mask_set, 0, sb, NULL, &mb),
-        W(u->gen_set, 0, sb, NULL, &mb), W(u->gen_set, 1, sb, NULL, &ib),
-        W(u->gen_set, 2, sb, NULL, &ab), W(u->gen_set, 3, sb, NULL, &bb),
-        W(u->gen_set, 4, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, &hi, NULL),
-        W(u->draw_set, 0, sb, NULL, &bb), W(u->draw_set, 1, sb, NULL, &ib),
-        W(u->draw_set, 2, sb, NULL, &lb),
-        W(u->lod_set, 0, sb, NULL, &ab), W(u->lod_set, 1, sb, NULL, &db),
-        W(u->lod_set, 2, sb, NULL, &lb), W(u->lod_set, 3, sb, NULL, &fm),
-    };
-#undef W
-    vkUpdateDescriptorSets(d->dev, sizeof w / sizeof *w, w, 0, NULL);
     /* the textures (every slot bound: the white one past the pack's) */
     VkDescriptorImageInfo ti[SPLAT_MAX_UG_TEXTURES];
     for (int i = 0; i < SPLAT_MAX_UG_TEXTURES; i++) {
@@ -763,12 +234,20 @@ static bool make_sets(rt_ug *u, VkDescriptorSet set0_src, const rt_image *height
         ti[i] = (VkDescriptorImageInfo){ u->tex_smp, u->tex[k].view,
                                          VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL };
     }
-    VkWriteDescriptorSet tw = {
-        .sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = u->draw_set, .dstBinding = 3,
-        .descriptorCount = SPLAT_MAX_UG_TEXTURES,
-        .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, .pImageInfo = ti,
+    const VkDescriptorType sb = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+    const VkDescriptorType cis = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
+    rt_vk_write w[] = {
+        { u->mask_set, 0, sb, u->masks.buf },
+        { u->gen_set, 0, sb, u->masks.buf }, { u->gen_set, 1, sb, u->inst.buf },
+        { u->gen_set, 2, sb, u->args.buf }, { u->gen_set, 3, sb, u->blocks.buf },
+        { u->gen_set, 4, cis, .sampler = nearest, .view = height->view },
+        { u->draw_set, 0, sb, u->blocks.buf }, { u->draw_set, 1, sb, u->inst.buf },
+        { u->draw_set, 2, sb, u->lod.buf },
+        { u->lod_set, 0, sb, u->args.buf }, { u->lod_set, 1, sb, u->draw_args.buf },
+        { u->lod_set, 2, sb, u->lod.buf }, { u->lod_set, 3, sb, u->far.buf },
+        { u->draw_set, 3, cis, .images = ti, .count = SPLAT_MAX_UG_TEXTURES },
     };
-    vkUpdateDescriptorSets(d->dev, 1, &tw, 0, NULL);
+    rt_vk_write_sets(d, w, sizeof w / sizeof *w);
     return true;
 }
 
@@ -792,15 +271,10 @@ static bool make_textures(rt_ug *u, rt_error *e)
             !rt_image_upload(d, img, own ? pu->textures[i].rgba : white, (size_t)w * h * 4, e))
             return false;
     }
-    VkSamplerCreateInfo ci = {
-        .sType = VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO,
-        .magFilter = VK_FILTER_LINEAR, .minFilter = VK_FILTER_LINEAR,
-        .mipmapMode = VK_SAMPLER_MIPMAP_MODE_LINEAR,
-        .addressModeU = VK_SAMPLER_ADDRESS_MODE_REPEAT, .addressModeV = VK_SAMPLER_ADDRESS_MODE_REPEAT,
-        .addressModeW = VK_SAMPLER_ADDRESS_MODE_REPEAT, .maxLod = 16.0f,
-    };
-    RT_VK(e, vkCreateSampler(d->dev, &ci, NULL, &u->tex_smp));
-    return true;
+    return rt_vk_sampler(d, &u->keep, &(rt_vk_sampler_desc){ .label = "undergrowth textures",
+                             .filter = VK_FILTER_LINEAR, .mip = VK_SAMPLER_MIPMAP_MODE_LINEAR,
+                             .wrap = VK_SAMPLER_ADDRESS_MODE_REPEAT, .max_lod = 16.0f },
+                         &u->tex_smp, e);
 }
 
 static bool make_layouts(rt_ug *u, rt_error *e)
@@ -823,16 +297,24 @@ static bool make_layouts(rt_ug *u, rt_error *e)
         { 0, sb, 1, cs, NULL }, { 1, sb, 1, cs, NULL }, { 2, sb, 1, cs, NULL },
         { 3, sb, 1, cs, NULL },
     };
+    rt_vk_list *k = &u->keep;
     if (!rt_terrain_compute_layout(d, &u->set_terrain, e) ||
-        !rt_set_layout(d, mask, 1, &u->set_mask, e) || !rt_set_layout(d, gen, 5, &u->set_gen, e) ||
-        !rt_set_layout(d, draw, 4, &u->set_draw, e) || !rt_set_layout(d, lod, 4, &u->set_lod, e))
+        !rt_vk_keep(d, k, VK_OBJECT_TYPE_DESCRIPTOR_SET_LAYOUT, RT_VK_H(u->set_terrain), e) ||
+        !rt_vk_set_layout(d, k, &(rt_vk_set_layout_desc){ "undergrowth masks", mask, 1 },
+                          &u->set_mask, e) ||
+        !rt_vk_set_layout(d, k, &(rt_vk_set_layout_desc){ "undergrowth scatter", gen, 5 },
+                          &u->set_gen, e) ||
+        !rt_vk_set_layout(d, k, &(rt_vk_set_layout_desc){ "undergrowth draw", draw, 4 },
+                          &u->set_draw, e) ||
+        !rt_vk_set_layout(d, k, &(rt_vk_set_layout_desc){ "undergrowth lod", lod, 4 },
+                          &u->set_lod, e))
         return false;
     VkDescriptorSetLayout ms[3] = { u->set_terrain, u->pl->set_material, u->set_mask };
     VkDescriptorSetLayout ds[3] = { u->pl->set_terrain, u->pl->set_material, u->set_draw };
-    return pipe_layout(d, ms, 3, cs, sizeof(splat_push), &u->mask_layout, e) &&
-           pipe_layout(d, &u->set_gen, 1, cs, sizeof(ug_push), &u->gen_layout, e) &&
-           pipe_layout(d, &u->set_lod, 1, cs, 16, &u->lod_layout, e) &&
-           pipe_layout(d, ds, 3, VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT,
+    return pipe_layout(u, ms, 3, cs, sizeof(splat_push), &u->mask_layout, e) &&
+           pipe_layout(u, &u->set_gen, 1, cs, sizeof(ug_push), &u->gen_layout, e) &&
+           pipe_layout(u, &u->set_lod, 1, cs, 16, &u->lod_layout, e) &&
+           pipe_layout(u, ds, 3, VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT,
                        sizeof(splat_push), &u->draw_layout, e);
 }
 
@@ -935,24 +417,25 @@ bool rt_ug_create(rt_device *d, const rt_pack *p, rt_pipelines *pl, const rt_qua
         .sType = VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO,
         .queryType = VK_QUERY_TYPE_TIMESTAMP, .queryCount = 4,
     };
+    VkImageView views[2] = { t->color->view, t->depth->view };
     if (!make_layouts(u, e) || !make_buffers(u, e) || !make_textures(u, e) ||
         !make_sets(u, t->set0, t->height, t->nearest, e) ||
-        !make_pass(d, VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL, &u->pass_att, e) ||
-        !make_pass(d, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, &u->pass_ro, e) ||
-        !rt_glsl_compute_pipeline(d, VK_NULL_HANDLE, u->gen_layout, gen_glsl, "undergrowth scatter", NULL, &u->gen_pipe, e) ||
-        !rt_glsl_compute_pipeline(d, VK_NULL_HANDLE, u->lod_layout, lod_glsl, "undergrowth lod", NULL, &u->lod_pipe, e) ||
+        !make_pass(u, VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL, &u->pass_att, e) ||
+        !make_pass(u, VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL, &u->pass_ro, e) ||
+        !rt_vk_compute(d, &u->keep, &(rt_vk_compute_desc){ .label = "undergrowth scatter",
+                           .glsl = rt_ug_gen_glsl, .layout = u->gen_layout }, &u->gen_pipe, e) ||
+        !rt_vk_compute(d, &u->keep, &(rt_vk_compute_desc){ .label = "undergrowth lod",
+                           .glsl = rt_ug_lod_glsl, .layout = u->lod_layout }, &u->lod_pipe, e) ||
         !draw_pipeline(u, 0, e) || !draw_pipeline(u, 1, e) ||
-        (u->shadows && !draw_pipeline(u, 2, e)))
+        (u->shadows && !draw_pipeline(u, 2, e)) ||
+        !rt_vk_fb(d, &u->keep, &(rt_vk_fb_desc){ .label = "undergrowth", .pass = u->pass_att,
+                      .views = views, .nviews = 2, .width = (uint32_t)t->width,
+                      .height = (uint32_t)t->height_px }, &u->fb, e))
         return false;
-    VkImageView views[2] = { t->color->view, t->depth->view };
-    VkFramebufferCreateInfo fci = {
-        .sType = VK_STRUCTURE_TYPE_FRAMEBUFFER_CREATE_INFO,
-        .renderPass = u->pass_att, .attachmentCount = 2, .pAttachments = views,
-        .width = (uint32_t)t->width, .height = (uint32_t)t->height_px, .layers = 1,
-    };
-    RT_VK(e, vkCreateFramebuffer(d->dev, &fci, NULL, &u->fb));
-    if (t->timestamps)
+    if (t->timestamps) {
         RT_VK(e, vkCreateQueryPool(d->dev, &qi, NULL, &u->qpool));
+        return rt_vk_keep(d, &u->keep, VK_OBJECT_TYPE_QUERY_POOL, RT_VK_H(u->qpool), e);
+    }
     return true;
 }
 
@@ -961,50 +444,14 @@ void rt_ug_destroy(rt_ug *u)
     if (!u)
         return;
     rt_device *d = u->d;
-    for (int i = 0; u->mask_pipes && i <= u->p->ncombos; i++)
-        if (u->mask_pipes[i])
-            vkDestroyPipeline(d->dev, u->mask_pipes[i], NULL);
-    VkPipeline pipes[5] = { u->gen_pipe, u->lod_pipe, u->draw_pipe[0], u->draw_pipe[1],
-                            u->shadow_pipe };
-    for (int i = 0; i < 5; i++)
-        if (pipes[i])
-            vkDestroyPipeline(d->dev, pipes[i], NULL);
-    VkPipelineLayout pls[4] = { u->mask_layout, u->gen_layout, u->draw_layout, u->lod_layout };
-    for (int i = 0; i < 4; i++)
-        if (pls[i])
-            vkDestroyPipelineLayout(d->dev, pls[i], NULL);
-    VkDescriptorSetLayout sls[5] = { u->set_terrain, u->set_mask, u->set_gen, u->set_draw,
-                                     u->set_lod };
-    for (int i = 0; i < 5; i++)
-        if (sls[i])
-            vkDestroyDescriptorSetLayout(d->dev, sls[i], NULL);
-    if (u->dpool)
-        vkDestroyDescriptorPool(d->dev, u->dpool, NULL);
-    if (u->fb)
-        vkDestroyFramebuffer(d->dev, u->fb, NULL);
-    if (u->pass_att)
-        vkDestroyRenderPass(d->dev, u->pass_att, NULL);
-    if (u->pass_ro)
-        vkDestroyRenderPass(d->dev, u->pass_ro, NULL);
-    if (u->qpool)
-        vkDestroyQueryPool(d->dev, u->qpool, NULL);
+    rt_vk_list_destroy(d, &u->keep);
     rt_buffer *bufs[] = { &u->masks, &u->inst, &u->args, &u->args_host, &u->draw_args, &u->lod,
                           &u->far, &u->blocks, &u->vbuf, &u->ibuf, &u->frame };
     for (size_t i = 0; i < sizeof bufs / sizeof *bufs; i++)
         rt_buffer_destroy(d, bufs[i]);
-    if (u->probe_pipe)
-        vkDestroyPipeline(d->dev, u->probe_pipe, NULL);
-    if (u->probe_layout)
-        vkDestroyPipelineLayout(d->dev, u->probe_layout, NULL);
-    if (u->probe_sl)
-        vkDestroyDescriptorSetLayout(d->dev, u->probe_sl, NULL);
-    if (u->probe_pool)
-        vkDestroyDescriptorPool(d->dev, u->probe_pool, NULL);
     rt_buffer_destroy(d, &u->probe_out);
     for (int i = 0; i <= SPLAT_MAX_UG_TEXTURES; i++)
         rt_image_destroy(d, &u->tex[i]);
-    if (u->tex_smp)
-        vkDestroySampler(d->dev, u->tex_smp, NULL);
     free(u->mask_pipes);
     free(u->cells);
     free(u->order);
@@ -1145,8 +592,9 @@ static bool mask_pipeline(rt_ug *u, int combo, VkPipeline *out, rt_error *e)
         rt_interface in;
         if (!rt_interface_for(u->p, RT_ROLE_UNDERGROWTH, &in))
             return rt_fail(e, RT_E_VULKAN, "undergrowth", "out of memory");
-        bool ok = rt_glsl_compute_pipeline(u->d, u->pl->cache, u->mask_layout, glsl, name, &in,
-                                           &u->mask_pipes[combo], e);
+        bool ok = rt_vk_compute(u->d, &u->keep, &(rt_vk_compute_desc){ .label = name,
+                                    .glsl = glsl, .check = &in, .layout = u->mask_layout,
+                                    .cache = u->pl->cache }, &u->mask_pipes[combo], e);
         rt_interface_free(&in);
         if (!ok)
             return false;
@@ -1421,108 +869,4 @@ int rt_ug_read_cell(rt_ug *u, int ix, int iz, rt_ug_instance *out, int max, rt_e
         }
     rt_buffer_destroy(u->d, &st);
     return n;
-}
-
-/* ---- the probe pass (tests) -------------------------------------------------------- */
-
-/* The probe's pipeline and an output buffer of at least `bytes`. */
-static bool probe_make(rt_ug *u, VkDeviceSize bytes, rt_error *e)
-{
-    rt_device *d = u->d;
-    if (!u->probe_pipe) {
-        const VkShaderStageFlags cs = VK_SHADER_STAGE_COMPUTE_BIT;
-        const VkDescriptorType sb = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
-        VkDescriptorSetLayoutBinding b[] = {
-            { 0, sb, 1, cs, NULL }, { 1, sb, 1, cs, NULL }, { 2, sb, 1, cs, NULL },
-        };
-        VkDescriptorPoolSize size = { sb, 3 };
-        if (!rt_set_layout(d, b, 3, &u->probe_sl, e) ||
-            !pipe_layout(d, &u->probe_sl, 1, cs, 32, &u->probe_layout, e) ||
-            !rt_descriptor_sets(d, &size, 1, &u->probe_sl, 1, &u->probe_pool, &u->probe_set, e) ||
-            !rt_glsl_compute_pipeline(d, VK_NULL_HANDLE, u->probe_layout, probe_glsl,
-                                      "undergrowth probe", NULL, &u->probe_pipe, e))
-            return false;
-    }
-    if (u->probe_out.size < bytes) {
-        rt_buffer_destroy(d, &u->probe_out);
-        if (!rt_buffer_create(d, bytes, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT, true, &u->probe_out, e))
-            return false;
-        VkDescriptorBufferInfo bi[3] = { { u->inst.buf, 0, VK_WHOLE_SIZE },
-                                         { u->draw_args.buf, 0, VK_WHOLE_SIZE },
-                                         { u->probe_out.buf, 0, VK_WHOLE_SIZE } };
-        VkWriteDescriptorSet w[3];
-        for (int i = 0; i < 3; i++)
-            w[i] = (VkWriteDescriptorSet){ .sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET,
-                                           .dstSet = u->probe_set, .dstBinding = (uint32_t)i,
-                                           .descriptorCount = 1,
-                                           .descriptorType = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER,
-                                           .pBufferInfo = &bi[i] };
-        vkUpdateDescriptorSets(d->dev, 3, w, 0, NULL);
-    }
-    return true;
-}
-
-typedef struct probe_push {
-    float    ring[4];     /* camera x, z; radius (mode 0) or time (1); ring width */
-    uint32_t info[4];     /* mode, rings or points, cell slot, blocks          */
-} probe_push;
-
-static bool probe_run(rt_ug *u, const probe_push *pp, const int *slots, int nslots,
-                      uint32_t groups, rt_error *e)
-{
-    VkCommandBuffer cb;
-    if (!rt_oneshot_begin(u->d, &cb, e))
-        return false;
-    vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, u->probe_pipe);
-    vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, u->probe_layout, 0, 1,
-                            &u->probe_set, 0, NULL);
-    for (int i = 0; i < (slots ? nslots : 1); i++) {
-        probe_push q = *pp;
-        if (slots)
-            q.info[2] = (uint32_t)slots[i];
-        vkCmdPushConstants(cb, u->probe_layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof q, &q);
-        vkCmdDispatch(cb, groups, 1, 1);
-    }
-    rt_cmd_barrier(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
-                   VK_PIPELINE_STAGE_HOST_BIT, VK_ACCESS_HOST_READ_BIT);
-    return rt_oneshot_end(u->d, cb, e);
-}
-
-int rt_ug_probe_rings(rt_ug *u, double width, int nrings, uint32_t *counts, rt_error *e)
-{
-    if (!u || nrings <= 0 || !(width > 0))
-        return 0;
-    if (!probe_make(u, (VkDeviceSize)nrings * 8, e))
-        return -1;
-    memset(u->probe_out.map, 0, (size_t)nrings * 8);
-    int *slots = malloc(sizeof *slots * (size_t)u->pool), n = 0;
-    if (!slots) {
-        rt_fail(e, RT_E_VULKAN, "undergrowth", "out of memory");
-        return -1;
-    }
-    for (int i = 0; i < u->pool; i++)
-        if (u->cells[i].state == CELL_READY)
-            slots[n++] = i;
-    probe_push pp = { { u->cam_xz[0], u->cam_xz[1], (float)u->radius, (float)width },
-                      { 0, (uint32_t)nrings, 0, (uint32_t)u->nblocks } };
-    bool ok = n == 0 || probe_run(u, &pp, slots, n, (uint32_t)u->nblocks, e);
-    free(slots);
-    if (!ok)
-        return -1;
-    memcpy(counts, u->probe_out.map, (size_t)nrings * 8);
-    return n;
-}
-
-bool rt_ug_probe_wind(rt_ug *u, float *points, int n, double time, rt_error *e)
-{
-    if (!u || n <= 0)
-        return true;
-    if (!probe_make(u, (VkDeviceSize)n * 48, e))
-        return false;
-    memcpy(u->probe_out.map, points, (size_t)n * 48);
-    probe_push pp = { { 0, 0, (float)time, 0 }, { 1, (uint32_t)n, 0, 0 } };
-    if (!probe_run(u, &pp, NULL, 0, ((uint32_t)n + 63) / 64, e))
-        return false;
-    memcpy(points, u->probe_out.map, (size_t)n * 48);
-    return true;
 }

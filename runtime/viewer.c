@@ -20,6 +20,7 @@
  * until a hot reload succeeded (compile errors on the way are shown and
  * survived; the time running out fails the script), "quit" ends. */
 #include "rt_internal.h"
+#include "vk_build.h"
 #include "util.h"
 #include "scene.h"
 
@@ -91,6 +92,7 @@ typedef struct viewer {
     VkFence        fence;
     rt_buffer      shot;
     rt_overlay    *overlay;      /* the help (H), drawn after the tone map */
+    rt_vk_list     keep;         /* pass, views, framebuffers, tone map, sync */
     bool           help;
     double         frame_ms;     /* smoothed, for the help                  */
     /* camera and state */
@@ -452,33 +454,15 @@ static bool make_swapchain(viewer *v, rt_error *e)
         return rt_fail(e, RT_E_WINDOW, "out of memory");
     RT_VK(e, vkGetSwapchainImagesKHR(d->dev, v->swapchain, &v->nimages, v->images));
 
-    VkAttachmentDescription att = {
-        .format = v->format,
-        .samples = VK_SAMPLE_COUNT_1_BIT,
-        .loadOp = VK_ATTACHMENT_LOAD_OP_DONT_CARE,
-        .storeOp = VK_ATTACHMENT_STORE_OP_STORE,
-        .stencilLoadOp = VK_ATTACHMENT_LOAD_OP_DONT_CARE,
-        .stencilStoreOp = VK_ATTACHMENT_STORE_OP_DONT_CARE,
-        .initialLayout = VK_IMAGE_LAYOUT_UNDEFINED,
-        .finalLayout = VK_IMAGE_LAYOUT_PRESENT_SRC_KHR,
-    };
-    VkAttachmentReference ref = { 0, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL };
-    VkSubpassDescription sub = {
-        .pipelineBindPoint = VK_PIPELINE_BIND_POINT_GRAPHICS,
-        .colorAttachmentCount = 1,
-        .pColorAttachments = &ref,
-    };
     VkSubpassDependency dep = {
         VK_SUBPASS_EXTERNAL, 0, VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT,
         VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT, 0, VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT, 0,
     };
-    VkRenderPassCreateInfo rp = {
-        .sType = VK_STRUCTURE_TYPE_RENDER_PASS_CREATE_INFO,
-        .attachmentCount = 1, .pAttachments = &att,
-        .subpassCount = 1, .pSubpasses = &sub,
-        .dependencyCount = 1, .pDependencies = &dep,
-    };
-    RT_VK(e, vkCreateRenderPass(d->dev, &rp, NULL, &v->pass));
+    if (!rt_vk_pass(d, &v->keep, &(rt_vk_pass_desc){ .label = "swapchain",
+                        .color = { { .format = v->format, .load = VK_ATTACHMENT_LOAD_OP_DONT_CARE,
+                                     .final = VK_IMAGE_LAYOUT_PRESENT_SRC_KHR } },
+                        .ncolor = 1, .deps = &dep, .ndeps = 1 }, &v->pass, e))
+        return false;
     for (uint32_t i = 0; i < v->nimages; i++) {
         VkImageViewCreateInfo vi = {
             .sType = VK_STRUCTURE_TYPE_IMAGE_VIEW_CREATE_INFO,
@@ -488,12 +472,11 @@ static bool make_swapchain(viewer *v, rt_error *e)
             .subresourceRange = { VK_IMAGE_ASPECT_COLOR_BIT, 0, 1, 0, 1 },
         };
         RT_VK(e, vkCreateImageView(d->dev, &vi, NULL, &v->views[i]));
-        VkFramebufferCreateInfo fi = {
-            .sType = VK_STRUCTURE_TYPE_FRAMEBUFFER_CREATE_INFO,
-            .renderPass = v->pass, .attachmentCount = 1, .pAttachments = &v->views[i],
-            .width = v->extent.width, .height = v->extent.height, .layers = 1,
-        };
-        RT_VK(e, vkCreateFramebuffer(d->dev, &fi, NULL, &v->fbs[i]));
+        if (!rt_vk_keep(d, &v->keep, VK_OBJECT_TYPE_IMAGE_VIEW, RT_VK_H(v->views[i]), e) ||
+            !rt_vk_fb(d, &v->keep, &(rt_vk_fb_desc){ .label = "swapchain", .pass = v->pass,
+                          .views = &v->views[i], .nviews = 1, .width = v->extent.width,
+                          .height = v->extent.height }, &v->fbs[i], e))
+            return false;
     }
     return rt_buffer_create(d, (VkDeviceSize)v->extent.width * v->extent.height * 4,
                             VK_BUFFER_USAGE_TRANSFER_DST_BIT, true, &v->shot, e);
@@ -502,102 +485,26 @@ static bool make_swapchain(viewer *v, rt_error *e)
 static bool make_tonemap(viewer *v, rt_error *e)
 {
     rt_device *d = &v->dev;
+    rt_vk_list *k = &v->keep;
     VkDescriptorSetLayoutBinding b = { 0, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1,
                                        VK_SHADER_STAGE_FRAGMENT_BIT, NULL };
-    VkDescriptorSetLayoutCreateInfo li = {
-        .sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_LAYOUT_CREATE_INFO, .bindingCount = 1, .pBindings = &b,
-    };
-    RT_VK(e, vkCreateDescriptorSetLayout(d->dev, &li, NULL, &v->set_layout));
-    VkPushConstantRange pr = { VK_SHADER_STAGE_FRAGMENT_BIT, 0, 4 };
-    VkPipelineLayoutCreateInfo pli = {
-        .sType = VK_STRUCTURE_TYPE_PIPELINE_LAYOUT_CREATE_INFO,
-        .setLayoutCount = 1, .pSetLayouts = &v->set_layout,
-        .pushConstantRangeCount = 1, .pPushConstantRanges = &pr,
-    };
-    RT_VK(e, vkCreatePipelineLayout(d->dev, &pli, NULL, &v->layout));
-    VkSamplerCreateInfo si = {
-        .sType = VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO,
-        .magFilter = VK_FILTER_NEAREST, .minFilter = VK_FILTER_NEAREST,
-        .addressModeU = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE,
-        .addressModeV = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE,
-        .addressModeW = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE,
-    };
-    RT_VK(e, vkCreateSampler(d->dev, &si, NULL, &v->sampler));
     VkDescriptorPoolSize ps = { VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1 };
-    if (!rt_descriptor_sets(d, &ps, 1, &v->set_layout, 1, &v->dpool, &v->set, e))
+    if (!rt_vk_set_layout(d, k, &(rt_vk_set_layout_desc){ "tone map", &b, 1 }, &v->set_layout,
+                          e) ||
+        !rt_vk_layout(d, k, &(rt_vk_layout_desc){ .label = "tone map", .sets = &v->set_layout,
+                          .nsets = 1, .push_stages = VK_SHADER_STAGE_FRAGMENT_BIT,
+                          .push_bytes = 4 }, &v->layout, e) ||
+        !rt_vk_sampler(d, k, &(rt_vk_sampler_desc){ .label = "tone map",
+                           .wrap = VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE }, &v->sampler, e) ||
+        !rt_vk_sets(d, k, &(rt_vk_sets_desc){ .label = "tone map", .sizes = &ps, .nsizes = 1,
+                        .layouts = &v->set_layout, .nsets = 1 }, &v->dpool, &v->set, e))
         return false;
-    VkDescriptorImageInfo ii = { v->sampler, rt_renderer_target(v->r)->view,
-                                 VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL };
-    VkWriteDescriptorSet w = {
-        .sType = VK_STRUCTURE_TYPE_WRITE_DESCRIPTOR_SET, .dstSet = v->set, .dstBinding = 0,
-        .descriptorCount = 1, .descriptorType = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
-        .pImageInfo = &ii,
-    };
-    vkUpdateDescriptorSets(d->dev, 1, &w, 0, NULL);
-
-    uint32_t *vw = NULL, *fw = NULL;
-    size_t vn = 0, fn = 0;
-    VkShaderModule vm = VK_NULL_HANDLE, fm = VK_NULL_HANDLE;
-    bool ok = rt_glsl_compile(tonemap_vert, VK_SHADER_STAGE_VERTEX_BIT, "tonemap.vert", &vw, &vn, e) &&
-              rt_glsl_compile(tonemap_frag, VK_SHADER_STAGE_FRAGMENT_BIT, "tonemap.frag", &fw, &fn, e);
-    if (ok) {
-        VkShaderModuleCreateInfo mi = { .sType = VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO,
-                                        .codeSize = vn * 4, .pCode = vw };
-        ok = vkCreateShaderModule(d->dev, &mi, NULL, &vm) == VK_SUCCESS;
-        mi.codeSize = fn * 4;
-        mi.pCode = fw;
-        ok = ok && vkCreateShaderModule(d->dev, &mi, NULL, &fm) == VK_SUCCESS;
-        if (!ok)
-            rt_fail(e, RT_E_VULKAN, "vkCreateShaderModule", "tone map");
-    }
-    free(vw);
-    free(fw);
-    if (ok) {
-        VkPipelineShaderStageCreateInfo st[2] = {
-            { .sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO,
-              .stage = VK_SHADER_STAGE_VERTEX_BIT, .module = vm, .pName = "main" },
-            { .sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO,
-              .stage = VK_SHADER_STAGE_FRAGMENT_BIT, .module = fm, .pName = "main" },
-        };
-        VkPipelineVertexInputStateCreateInfo vi = { .sType = VK_STRUCTURE_TYPE_PIPELINE_VERTEX_INPUT_STATE_CREATE_INFO };
-        VkPipelineInputAssemblyStateCreateInfo ia = {
-            .sType = VK_STRUCTURE_TYPE_PIPELINE_INPUT_ASSEMBLY_STATE_CREATE_INFO,
-            .topology = VK_PRIMITIVE_TOPOLOGY_TRIANGLE_LIST,
-        };
-        VkViewport vp = { 0, 0, (float)v->extent.width, (float)v->extent.height, 0, 1 };
-        VkRect2D sc = { { 0, 0 }, v->extent };
-        VkPipelineViewportStateCreateInfo vps = {
-            .sType = VK_STRUCTURE_TYPE_PIPELINE_VIEWPORT_STATE_CREATE_INFO,
-            .viewportCount = 1, .pViewports = &vp, .scissorCount = 1, .pScissors = &sc,
-        };
-        VkPipelineRasterizationStateCreateInfo rs = {
-            .sType = VK_STRUCTURE_TYPE_PIPELINE_RASTERIZATION_STATE_CREATE_INFO,
-            .polygonMode = VK_POLYGON_MODE_FILL, .cullMode = VK_CULL_MODE_NONE, .lineWidth = 1.0f,
-        };
-        VkPipelineMultisampleStateCreateInfo ms = {
-            .sType = VK_STRUCTURE_TYPE_PIPELINE_MULTISAMPLE_STATE_CREATE_INFO,
-            .rasterizationSamples = VK_SAMPLE_COUNT_1_BIT,
-        };
-        VkPipelineColorBlendAttachmentState cba = { .colorWriteMask = 0xf };
-        VkPipelineColorBlendStateCreateInfo cb = {
-            .sType = VK_STRUCTURE_TYPE_PIPELINE_COLOR_BLEND_STATE_CREATE_INFO,
-            .attachmentCount = 1, .pAttachments = &cba,
-        };
-        VkGraphicsPipelineCreateInfo gi = {
-            .sType = VK_STRUCTURE_TYPE_GRAPHICS_PIPELINE_CREATE_INFO,
-            .stageCount = 2, .pStages = st, .pVertexInputState = &vi, .pInputAssemblyState = &ia,
-            .pViewportState = &vps, .pRasterizationState = &rs, .pMultisampleState = &ms,
-            .pColorBlendState = &cb, .layout = v->layout, .renderPass = v->pass,
-        };
-        VkResult r = vkCreateGraphicsPipelines(d->dev, VK_NULL_HANDLE, 1, &gi, NULL, &v->pipeline);
-        if (r != VK_SUCCESS)
-            ok = rt_fail(e, RT_E_VULKAN, "vkCreateGraphicsPipelines(tone map)", rt_vk_result_name(r));
-    }
-    if (vm)
-        vkDestroyShaderModule(d->dev, vm, NULL);
-    if (fm)
-        vkDestroyShaderModule(d->dev, fm, NULL);
-    if (!ok)
+    rt_vk_write_sets(d, &(rt_vk_write){ .set = v->set, .type = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+                                        .sampler = v->sampler,
+                                        .view = rt_renderer_target(v->r)->view }, 1);
+    if (!rt_vk_gfx(d, k, &(rt_vk_gfx_desc){ .label = "tone map", .vs_glsl = tonemap_vert,
+                       .fs_glsl = tonemap_frag, .ncolor = 1, .viewport = v->extent,
+                       .layout = v->layout, .pass = v->pass }, &v->pipeline, e))
         return false;
     VkCommandBufferAllocateInfo cai = {
         .sType = VK_STRUCTURE_TYPE_COMMAND_BUFFER_ALLOCATE_INFO,
@@ -606,10 +513,14 @@ static bool make_tonemap(viewer *v, rt_error *e)
     RT_VK(e, vkAllocateCommandBuffers(d->dev, &cai, &v->cb));
     VkSemaphoreCreateInfo sci = { .sType = VK_STRUCTURE_TYPE_SEMAPHORE_CREATE_INFO };
     RT_VK(e, vkCreateSemaphore(d->dev, &sci, NULL, &v->acquired));
+    if (!rt_vk_keep(d, k, VK_OBJECT_TYPE_SEMAPHORE, RT_VK_H(v->acquired), e))
+        return false;
     RT_VK(e, vkCreateSemaphore(d->dev, &sci, NULL, &v->rendered));
+    if (!rt_vk_keep(d, k, VK_OBJECT_TYPE_SEMAPHORE, RT_VK_H(v->rendered), e))
+        return false;
     VkFenceCreateInfo fci = { .sType = VK_STRUCTURE_TYPE_FENCE_CREATE_INFO };
     RT_VK(e, vkCreateFence(d->dev, &fci, NULL, &v->fence));
-    return true;
+    return rt_vk_keep(d, k, VK_OBJECT_TYPE_FENCE, RT_VK_H(v->fence), e);
 }
 
 /* Tone-map the renderer's frame into the next swapchain image, present it;
@@ -819,19 +730,7 @@ static void teardown(viewer *v)
         v->r = NULL;
         rt_overlay_destroy(v->overlay);
         v->overlay = NULL;
-        if (v->pipeline) vkDestroyPipeline(d->dev, v->pipeline, NULL);
-        if (v->layout) vkDestroyPipelineLayout(d->dev, v->layout, NULL);
-        if (v->set_layout) vkDestroyDescriptorSetLayout(d->dev, v->set_layout, NULL);
-        if (v->dpool) vkDestroyDescriptorPool(d->dev, v->dpool, NULL);
-        if (v->sampler) vkDestroySampler(d->dev, v->sampler, NULL);
-        if (v->acquired) vkDestroySemaphore(d->dev, v->acquired, NULL);
-        if (v->rendered) vkDestroySemaphore(d->dev, v->rendered, NULL);
-        if (v->fence) vkDestroyFence(d->dev, v->fence, NULL);
-        for (uint32_t i = 0; i < v->nimages; i++) {
-            if (v->fbs && v->fbs[i]) vkDestroyFramebuffer(d->dev, v->fbs[i], NULL);
-            if (v->views && v->views[i]) vkDestroyImageView(d->dev, v->views[i], NULL);
-        }
-        if (v->pass) vkDestroyRenderPass(d->dev, v->pass, NULL);
+        rt_vk_list_destroy(d, &v->keep);   /* the passes' and tone map's objects */
         if (v->swapchain) vkDestroySwapchainKHR(d->dev, v->swapchain, NULL);
         rt_buffer_destroy(d, &v->shot);
     }
@@ -893,6 +792,66 @@ static void start_watch(viewer *v)
     }
 }
 
+/* GLFW's window, the device and a surface it can present to. */
+static bool open_window(viewer *v, rt_error *e)
+{
+    const rt_viewer_desc *desc = v->desc;
+    if (!glfwInit()) {
+        rt_fail(e, RT_E_WINDOW, "glfwInit failed (no display?)");
+        return false;
+    }
+    if (!glfwVulkanSupported()) {
+        rt_fail(e, RT_E_WINDOW, "GLFW finds no Vulkan loader");
+        return false;
+    }
+    glfwWindowHint(GLFW_CLIENT_API, GLFW_NO_API);
+    glfwWindowHint(GLFW_RESIZABLE, GLFW_FALSE);   /* fixed-size targets */
+    v->win = glfwCreateWindow(desc->width, desc->height, "splatview", NULL, NULL);
+    if (!v->win) {
+        rt_fail(e, RT_E_WINDOW, "cannot open a window");
+        return false;
+    }
+    glfwSetWindowUserPointer(v->win, v);
+    uint32_t next = 0;
+    const char **exts = glfwGetRequiredInstanceExtensions(&next);
+    rt_device_desc dd = { .instance_exts = exts, .ninstance_exts = next, .swapchain = true };
+    if (!rt_device_create(&v->dev, &dd, e))
+        return false;
+    VkResult vr = glfwCreateWindowSurface(v->dev.instance, v->win, NULL, &v->surface);
+    if (vr != VK_SUCCESS) {
+        rt_fail(e, RT_E_VULKAN, "glfwCreateWindowSurface", rt_vk_result_name(vr));
+        return false;
+    }
+    VkBool32 can_present = VK_FALSE;
+    vkGetPhysicalDeviceSurfaceSupportKHR(v->dev.phys, v->dev.queue_family, v->surface, &can_present);
+    if (!can_present) {
+        rt_fail(e, RT_E_WINDOW, "the chosen device's graphics queue cannot present to the window");
+        return false;
+    }
+    return true;
+}
+
+/* The renderer (screen-capable where the device allows), the tone map
+ * and the help overlay. */
+static bool make_renderer(viewer *v, rt_error *e)
+{
+    const rt_viewer_desc *desc = v->desc;
+    rt_render_desc rd = desc->render;
+    v->no_shadows = rd.no_shadows;
+    rd.width = (int)v->extent.width;
+    rd.height = (int)v->extent.height;
+    /* Screen-capable whenever the pack has compute variants, so the G key
+     * can switch paths. */
+    rd.shading = v->pack->uber_compute ? RT_SHADING_SCREEN : RT_SHADING_FORWARD;
+    bool made = rt_renderer_create(&v->dev, v->pack, &rd, &v->r, e);
+    if (!made && rd.shading == RT_SHADING_SCREEN && desc->render.shading != RT_SHADING_SCREEN) {
+        rt_error_clear(e);   /* the device cannot do the screen path */
+        rd.shading = RT_SHADING_FORWARD;
+        made = rt_renderer_create(&v->dev, v->pack, &rd, &v->r, e);
+    }
+    return made && make_tonemap(v, e) && rt_overlay_create(&v->dev, v->pass, &v->overlay, e);
+}
+
 int rt_viewer_run(const rt_viewer_desc *desc)
 {
     viewer vw;
@@ -911,55 +870,11 @@ int rt_viewer_run(const rt_viewer_desc *desc)
     }
     if (!start_view(v, &e))
         goto done;
-
-    if (!glfwInit()) {
-        rt_fail(&e, RT_E_WINDOW, "glfwInit failed (no display?)");
+    if (!open_window(v, &e))
         goto done;
-    }
-    if (!glfwVulkanSupported()) {
-        rt_fail(&e, RT_E_WINDOW, "GLFW finds no Vulkan loader");
-        goto done;
-    }
-    glfwWindowHint(GLFW_CLIENT_API, GLFW_NO_API);
-    glfwWindowHint(GLFW_RESIZABLE, GLFW_FALSE);   /* fixed-size targets */
-    v->win = glfwCreateWindow(desc->width, desc->height, "splatview", NULL, NULL);
-    if (!v->win) {
-        rt_fail(&e, RT_E_WINDOW, "cannot open a window");
-        goto done;
-    }
-    glfwSetWindowUserPointer(v->win, v);
-    uint32_t next = 0;
-    const char **exts = glfwGetRequiredInstanceExtensions(&next);
-    rt_device_desc dd = { .instance_exts = exts, .ninstance_exts = next, .swapchain = true };
-    if (!rt_device_create(&v->dev, &dd, &e))
-        goto done;
-    VkResult vr = glfwCreateWindowSurface(v->dev.instance, v->win, NULL, &v->surface);
-    if (vr != VK_SUCCESS) {
-        rt_fail(&e, RT_E_VULKAN, "glfwCreateWindowSurface", rt_vk_result_name(vr));
-        goto done;
-    }
-    VkBool32 can_present = VK_FALSE;
-    vkGetPhysicalDeviceSurfaceSupportKHR(v->dev.phys, v->dev.queue_family, v->surface, &can_present);
-    if (!can_present) {
-        rt_fail(&e, RT_E_WINDOW, "the chosen device's graphics queue cannot present to the window");
-        goto done;
-    }
     if (!make_swapchain(v, &e))
         goto done;
-    rt_render_desc rd = desc->render;
-    v->no_shadows = rd.no_shadows;
-    rd.width = (int)v->extent.width;
-    rd.height = (int)v->extent.height;
-    /* Screen-capable whenever the pack has compute variants, so the G key
-     * can switch paths. */
-    rd.shading = v->pack->uber_compute ? RT_SHADING_SCREEN : RT_SHADING_FORWARD;
-    bool made = rt_renderer_create(&v->dev, v->pack, &rd, &v->r, &e);
-    if (!made && rd.shading == RT_SHADING_SCREEN && desc->render.shading != RT_SHADING_SCREEN) {
-        rt_error_clear(&e);   /* the device cannot do the screen path */
-        rd.shading = RT_SHADING_FORWARD;
-        made = rt_renderer_create(&v->dev, v->pack, &rd, &v->r, &e);
-    }
-    if (!made || !make_tonemap(v, &e) || !rt_overlay_create(&v->dev, v->pass, &v->overlay, &e))
+    if (!make_renderer(v, &e))
         goto done;
     /* the path asked for, else screen where the pack can (splatview's
      * headless default) */

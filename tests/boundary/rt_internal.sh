@@ -27,6 +27,7 @@ tests/render/test_shadow_gpu.c       compares the device shadow map with the CPU
 tests/world/test_holes.c             checks the combination levels and node bounds over holes (rt_pack_level, rt_bounds_build)
 tests/world/test_placed.c            reads the sparse painted store of the loaded pack (rt_pack.sparse)
 tests/render/test_dclass.c           picks rock texels from the leaf combination map (rt_pack.levels, rt_pack.combos)
+tests/render/test_vk_build.c         tests the internal Vulkan builder (vk_build.h, the device handles)
 '
 cd "$ROOT"
 # every C file but the library's own (runtime/*.c except splatview.c) and

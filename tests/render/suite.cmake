@@ -198,6 +198,13 @@ if(TARGET splatrt AND TARGET splatview)
                      ${RENDER_OUT}/colorado ${RENDER_OUT}/stairs)
     set_tests_properties(render.stairs_colorado PROPERTIES LABELS render TIMEOUT 600
                          FIXTURES_REQUIRED colorado_pack ENVIRONMENT "SPLAT_VALIDATE=1")
+    # the runtime's Vulkan builder: desc defaults that draw, a failure that
+    # adds nothing, destroy lists that leave nothing alive (test_vk_build.c)
+    add_executable(test_vk_build ${RENDER_DIR}/test_vk_build.c)
+    target_link_libraries(test_vk_build splat_testkit splatrt splatc m)
+    add_test(NAME render.vk_build COMMAND test_vk_build)
+    set_tests_properties(render.vk_build PROPERTIES LABELS "render;asan" TIMEOUT 300
+                         ENVIRONMENT "SPLAT_VALIDATE=1")
     # the undergrowth's cells, GPU passes and pack sections under the
     # sanitizers too
     set_tests_properties(render.undergrowth PROPERTIES LABELS "render;asan")

@@ -1,0 +1,350 @@
+/* undergrowth_glsl.c — the undergrowth's own shaders (undergrowth.c
+ * describes what each pass does). */
+#include "undergrowth_impl.h"
+
+/* ---- shaders ---------------------------------------------------------------- */
+
+const char rt_ug_gen_glsl[] =
+    "#version 450\n"
+    "layout(local_size_x = 64) in;\n"
+    "layout(set = 0, binding = 0, std430) readonly buffer M { uint w[]; } u_mask;\n"
+    "struct Inst { vec4 p; uvec4 q; };\n"
+    "layout(set = 0, binding = 1, std430) writeonly buffer I { Inst v[]; } u_inst;\n"
+    "layout(set = 0, binding = 2, std430) buffer A { uint a[]; } u_args;\n"
+    "layout(set = 0, binding = 3, std430) readonly buffer B { vec4 b[]; } u_blocks;\n"
+    "layout(set = 0, binding = 4) uniform sampler2D u_height;\n"
+    "layout(push_constant, std430) uniform P {\n"
+    "    vec2 origin; ivec2 cell; uint slot, nw, cap, mask_base;\n"
+    "    vec4 terrain; ivec2 hf; uint nblocks;\n"
+    "} u_p;\n"
+    "shared uint s_scan[64];\n"
+    "uint hash(uint x) {\n"
+    "    x ^= x >> 16; x *= 0x7feb352du; x ^= x >> 15; x *= 0x846ca68bu; x ^= x >> 16;\n"
+    "    return x;\n"
+    "}\n"
+    "float rnd(inout uint s) { s = hash(s + 0x9e3779b9u); return float(s >> 8) * (1.0 / 16777216.0); }\n"
+    /* bilinear between texel centres, as the terrain's vertices sample */
+    "float height_at(vec2 xz) {\n"
+    "    vec2 t = xz / u_p.terrain.xy * vec2(u_p.hf) - 0.5;\n"
+    "    ivec2 i = ivec2(floor(t)), m = u_p.hf - 1;\n"
+    "    vec2 f = t - vec2(i);\n"
+    "    float h00 = texelFetch(u_height, clamp(i, ivec2(0), m), 0).r;\n"
+    "    float h10 = texelFetch(u_height, clamp(i + ivec2(1, 0), ivec2(0), m), 0).r;\n"
+    "    float h01 = texelFetch(u_height, clamp(i + ivec2(0, 1), ivec2(0), m), 0).r;\n"
+    "    float h11 = texelFetch(u_height, clamp(i + ivec2(1, 1), ivec2(0), m), 0).r;\n"
+    "    float h = mix(mix(h00, h10, f.x), mix(h01, h11, f.x), f.y);\n"
+    "    return h * u_p.terrain.z + u_p.terrain.w;\n"
+    "}\n"
+    "void main() {\n"
+    "    uint b = gl_WorkGroupID.x, lid = gl_LocalInvocationID.x;\n"
+    "    vec4 b0 = u_blocks.b[5u * b], b1 = u_blocks.b[5u * b + 1u], b2 = u_blocks.b[5u * b + 2u];\n"
+    "    uint n = uint(b2.x), total = n * n, base = u_p.slot * u_p.cap + uint(b2.y);\n"
+    "    uint ms = uint(b1.w);\n"
+    "    float keep = b0.x * " "256.0" " / float(total);\n"
+    "    float step = 16.0 / float(n);\n"
+    "    uint seed0 = hash(uint(u_p.cell.x) * 73856093u ^ uint(u_p.cell.y) * 19349663u ^ b * 83492791u);\n"
+    "    uint run = 0u;\n"
+    "    for (uint c = 0u; c < total; c += 64u) {\n"
+    "        uint k = c + lid;\n"
+    "        bool ok = false;\n"
+    "        Inst it;\n"
+    "        if (k < total) {\n"
+    /* candidates in a lattice order (stride coprime with the count), so
+     * that every prefix of the kept instances spreads over the cell: the
+     * draw's distance LOD keeps a prefix */
+    "            uint q = (k * uint(b2.w)) % total;\n"
+    "            uint s = hash(seed0 ^ hash(q));\n"
+    "            vec2 g = vec2(float(q % n), float(q / n));\n"
+    "            vec2 l = (g + vec2(rnd(s), rnd(s))) * step;\n"
+    "            ivec2 tx = min(ivec2(l * (64.0 / 16.0)), ivec2(63));\n"
+    "            uint at = u_p.mask_base + uint(tx.y * 64 + tx.x) * (u_p.nw + 2u);\n"
+    "            float w = unpackUnorm4x8(u_mask.w[at + ms / 4u])[ms % 4u];\n"
+    "            ok = rnd(s) < w * keep;\n"
+    "            vec3 nrm = unpackSnorm4x8(u_mask.w[at + u_p.nw]).xyz;\n"
+    "            vec3 alb = unpackUnorm4x8(u_mask.w[at + u_p.nw + 1u]).rgb;\n"
+    "            vec2 xz = u_p.origin + l;\n"
+    "            float sc = mix(b0.y, b0.z, rnd(s));\n"
+    "            float ang = rnd(s) * 6.2831853;\n"
+    "            it.p = vec4(xz.x, height_at(xz), xz.y, sc);\n"
+    "            it.q = uvec4(packSnorm4x8(vec4(nrm, 0.0)), packUnorm4x8(vec4(alb, 1.0)),\n"
+    "                         floatBitsToUint(ang), b);\n"
+    "        }\n"
+    "        s_scan[lid] = ok ? 1u : 0u;\n"
+    "        barrier();\n"
+    "        for (uint o = 1u; o < 64u; o <<= 1u) {\n"
+    "            uint v = lid >= o ? s_scan[lid - o] : 0u;\n"
+    "            barrier();\n"
+    "            s_scan[lid] += v;\n"
+    "            barrier();\n"
+    "        }\n"
+    "        if (ok) u_inst.v[base + run + s_scan[lid] - 1u] = it;\n"
+    "        run += s_scan[63];\n"
+    "        barrier();\n"
+    "    }\n"
+    "    if (lid == 0u) u_args.a[(u_p.slot * u_p.nblocks + b) * 5u + 1u] = run;\n"
+    "}\n";
+
+/* The LOD pass, every frame: the draw arguments from the generated ones,
+ * each cell's instance count times its fraction (a prefix: the scatter
+ * pass keeps instances in a lattice order that spreads every prefix), and
+ * beyond LOD_NEAR the block's far mesh where it has one (PACK.md: index
+ * count, first index, vertex offset, and w = 1); after the n arguments,
+ * the contact shadows' n: the same instances drawn with the shadow quad
+ * (push qidx, qvtx), none for a block whose shadow is 0 (its second
+ * uvec4 .x). */
+const char rt_ug_lod_glsl[] =
+    "#version 450\n"
+    "layout(local_size_x = 64) in;\n"
+    "layout(set = 0, binding = 0, std430) readonly buffer A { uint a[]; } u_args;\n"
+    "layout(set = 0, binding = 1, std430) writeonly buffer D { uint a[]; } u_draw;\n"
+    "layout(set = 0, binding = 2, std430) readonly buffer F { float f[]; } u_lod;\n"
+    "layout(set = 0, binding = 3, std430) readonly buffer M { uvec4 m[]; } u_far;\n"
+    "layout(push_constant, std430) uniform P { uint n, nblocks, qidx, qvtx; } u_p;\n"
+    "void main() {\n"
+    "    uint i = gl_GlobalInvocationID.x;\n"
+    "    if (i >= u_p.n) return;\n"
+    "    for (uint k = 0u; k < 5u; k++) u_draw.a[5u * i + k] = u_args.a[5u * i + k];\n"
+    "    float f = u_lod.f[i / u_p.nblocks];\n"
+    "    uint count = uint(ceil(float(u_args.a[5u * i + 1u]) * f));\n"
+    "    u_draw.a[5u * i + 1u] = count;\n"
+    "    uint s = 5u * (u_p.n + i);\n"
+    "    u_draw.a[s] = 6u;\n"
+    "    u_draw.a[s + 1u] = u_far.m[2u * (i % u_p.nblocks) + 1u].x != 0u ? count : 0u;\n"
+    "    u_draw.a[s + 2u] = u_p.qidx;\n"
+    "    u_draw.a[s + 3u] = u_p.qvtx;\n"
+    "    u_draw.a[s + 4u] = u_args.a[5u * i + 4u];\n"
+    "    uvec4 m = u_far.m[2u * (i % u_p.nblocks)];   /* the block's far mesh */\n"
+    "    if (f < 1.0 && m.w != 0u) {\n"
+    "        u_draw.a[5u * i] = m.x;\n"
+    "        u_draw.a[5u * i + 2u] = m.y;\n"
+    "        u_draw.a[5u * i + 3u] = m.z;\n"
+    "    }\n"
+    "}\n";
+
+/* The vertex stage's fade and wind (the top comment), shared by the draw
+ * and the probe pass so that the tests count what the draw keeps. */
+#define UG_GLSL_FUNCS \
+    "float ug_hash01(vec3 root) {\n" \
+    "    uint x = floatBitsToUint(root.x) * 0x9e3779b1u ^ floatBitsToUint(root.z) * 0x85ebca77u;\n" \
+    "    x ^= x >> 16; x *= 0x7feb352du; x ^= x >> 15; x *= 0x846ca68bu; x ^= x >> 16;\n" \
+    "    return float(x >> 8) * (1.0 / 16777216.0);\n" \
+    "}\n" \
+    "float ug_fade(float d, float r) {\n" \
+    "    float r1 = max(r - " UG_FADE_MARGIN_S ", 0.5 * r);\n" \
+    "    return 1.0 - smoothstep(" UG_FADE_START_S " * r1, r1, d);\n" \
+    "}\n" \
+    "float ug_far(float d, float r) {\n" \
+    "    float r1 = max(r - " UG_FADE_MARGIN_S ", 0.5 * r);\n" \
+    "    return smoothstep(0.35 * r1, 0.8 * r1, d);\n" \
+    "}\n" \
+    "float ug_fade_scale(vec3 root, float d, float r) {\n" \
+    "    return clamp((ug_fade(d, r) - ug_hash01(root)) * 5.0, 0.0, 1.0);\n" \
+    "}\n" \
+    "float ug_gust(vec2 xz, vec2 dir, float t) {\n" \
+    "    float along = dot(xz, dir), across = dot(xz, vec2(-dir.y, dir.x));\n" \
+    "    float p1 = 6.2831853 * fract(along / 24.0 - t / 5.7);\n" \
+    "    float p2 = 6.2831853 * fract(along / 9.1 + across / 37.0 - t / 2.3);\n" \
+    "    return 0.5 + 0.3 * sin(p1) + 0.2 * sin(p2);\n" \
+    "}\n" \
+    "vec3 ug_wind(vec3 root, float h, vec4 w, float t) {\n" \
+    "    h = max(h, 0.0);\n" \
+    "    float a = w.z * h * h * (1.0 - w.w + w.w * ug_gust(root.xz, w.xy, t));\n" \
+    "    return vec3(w.x * a, -min(0.5 * a * a / max(h, 1e-3), 0.5 * h), w.y * a);\n" \
+    "}\n"
+#define UG_FADE_MARGIN_S "12.0"   /* 0.75 CELL */
+#define UG_FADE_START_S "0.6"
+
+/* The draw pass: SPLAT_GLSL_TERRAIN (frame block) + this vertex main; the
+ * prelude + draw_frag_main as the fragment shader (it reads v_rel, v_uv,
+ * v_local at locations 0-2, as the terrain's). */
+const char rt_ug_draw_vert_main[] =
+    "struct Inst { vec4 p; uvec4 q; };\n"
+    "layout(set = 2, binding = 0, std430) readonly buffer B { vec4 b[]; } u_blocks;\n"
+    "layout(set = 2, binding = 1, std430) readonly buffer I { Inst v[]; } u_inst;\n"
+    "layout(set = 2, binding = 2, std430) readonly buffer F { float f[]; } u_lod;\n"
+    "layout(location = 0) in vec3 a_pos;\n"
+    "layout(location = 1) in vec3 a_nrm;\n"
+    "layout(location = 2) in vec2 a_uv;\n"
+    "out gl_PerVertex { vec4 gl_Position; };\n"
+    "layout(location = 0) out vec3 v_rel;\n"
+    "layout(location = 1) out vec2 v_uv;\n"
+    "layout(location = 2) out vec3 v_local;\n"
+    "layout(location = 3) out vec3 g_color;\n"
+    "layout(location = 4) out vec3 g_normal;\n"
+    "layout(location = 5) out vec2 g_uv;\n"
+    "layout(location = 6) flat out uint g_flags;\n"
+    "layout(location = 7) out float g_far;\n"
+    "layout(location = 8) out vec3 g_tnormal;\n"
+    UG_GLSL_FUNCS
+    "void main() {\n"
+    "    Inst it = u_inst.v[gl_InstanceIndex];\n"
+    "    uint bi = 5u * it.q.w;\n"
+    "    vec4 b0 = u_blocks.b[bi], b1 = u_blocks.b[bi + 1u], b4 = u_blocks.b[bi + 4u];\n"
+    "    uint flags = uint(u_blocks.b[bi + 2u].z);\n"
+    "    vec3 n = normalize(unpackSnorm4x8(it.q.x).xyz + vec3(0.0, 1e-4, 0.0));\n"
+    "    float a = uintBitsToFloat(it.q.z), c = cos(a), s = sin(a);\n"
+    /* the distance fade (push patch_xz.x: the radius) */
+    "    float r = u_push.patch_xz.x, d = length(it.p.xz - u_frame.camera.xz);\n"
+    /* the LOD's growth (u_push.info.x: instances per cell) */
+    "    float grow = min(inversesqrt(u_lod.f[uint(gl_InstanceIndex) / u_push.info.x]), " LOD_GROW_S ");\n"
+    /* the growth widens, it does not raise: far cover, not a hedge */
+    "    vec3 p = a_pos * it.p.w * ug_fade_scale(it.p.xyz, d, r) * vec3(grow, 1.0, grow);\n"
+    "    p = vec3(c * p.x + s * p.z, p.y, -s * p.x + c * p.z);\n"
+    "    vec3 m = vec3(c * a_nrm.x + s * a_nrm.z, a_nrm.y, -s * a_nrm.x + c * a_nrm.z);\n"
+    "    if ((flags & 4u) != 0u) {   /* aligned to the terrain normal: a rotation (t, n, b) */\n"
+    "        vec3 t = normalize(cross(n, vec3(0.0, 0.0, 1.0)));\n"
+    "        vec3 bt = cross(t, n);\n"
+    "        p = t * p.x + n * p.y + bt * p.z;\n"
+    "        m = t * m.x + n * m.y + bt * m.z;\n"
+    "    }\n"
+    /* the wind (block vec4 3; push patch_xz.y: the time in seconds) */
+    "    p += ug_wind(it.p.xyz, p.y, u_blocks.b[bi + 3u], u_push.patch_xz.y);\n"
+    "    v_local = it.p.xyz + p;\n"
+    "    v_rel = v_local - u_frame.camera.xyz;\n"
+    "    v_uv = v_local.xz / u_frame.terrain.xy;\n"
+    /* towards the radius the colour becomes the ground's (the cover thins
+     * into the terrain it stands on, the root darkening goes with it) */
+    "    float far = ug_far(d, r);\n"
+    "    float share = mix(mix(b4.x, b0.w, clamp(a_uv.y, 0.0, 1.0)), 1.0, far);\n"
+    "    g_far = far;\n"
+    "    g_color = mix(b1.rgb, unpackUnorm4x8(it.q.y).rgb, share);\n"
+    "    g_normal = (flags & 2u) != 0u ? n : m;\n"
+    "    g_tnormal = n;\n"
+    "    g_uv = a_uv;\n"
+    "    g_flags = flags;\n"
+    "    gl_Position = u_frame.view_proj * vec4(v_rel, 1.0);\n"
+    "}\n";
+
+const char rt_ug_draw_frag_main[] =
+    "layout(set = 2, binding = 3) uniform sampler2D u_ugtex[" SPLAT_STR(SPLAT_MAX_UG_TEXTURES) "];\n"
+    "layout(location = 3) in vec3 g_color;\n"
+    "layout(location = 4) in vec3 g_normal;\n"
+    "layout(location = 5) in vec2 g_uv;\n"
+    "layout(location = 6) flat in uint g_flags;\n"
+    "layout(location = 7) in float g_far;\n"
+    "layout(location = 8) in vec3 g_tnormal;\n"
+    /* constant indices: no dynamic indexing feature needed (the index is
+     * the block's, the same for a whole draw) */
+    "vec4 ug_texture(uint t, vec2 uv) {\n"
+    "    switch (t) {\n"
+    "    case 1u: return texture(u_ugtex[0], uv);\n"
+    "    case 2u: return texture(u_ugtex[1], uv);\n"
+    "    case 3u: return texture(u_ugtex[2], uv);\n"
+    "    case 4u: return texture(u_ugtex[3], uv);\n"
+    "    case 5u: return texture(u_ugtex[4], uv);\n"
+    "    case 6u: return texture(u_ugtex[5], uv);\n"
+    "    case 7u: return texture(u_ugtex[6], uv);\n"
+    "    case 8u: return texture(u_ugtex[7], uv);\n"
+    "    }\n"
+    "    return vec4(1.0);\n"
+    "}\n"
+    "void main() {\n"
+    /* the texture with v up the mesh (OBJ: v = 0 at the image's bottom) */
+    "    vec4 tex = ug_texture(g_flags >> 8, vec2(g_uv.x, 1.0 - g_uv.y));\n"
+    "#ifdef UG_CUTOUT\n"
+    "    if ((g_flags & 1u) != 0u) {\n"
+    "        /* a frond cut from the quad: a lens-shaped outline, chevron leaflets */\n"
+    "        float x = abs(g_uv.x * 2.0 - 1.0), t = clamp(g_uv.y, 0.0, 1.0);\n"
+    "        if (x > 0.9 * sin(t * 3.14159) || (x > 0.08 && fract(t * 7.0 - x * 2.5) > 0.6)) discard;\n"
+    "    } else {\n"
+    "        /* the texture's alpha, dithered (interleaved gradient noise): a\n"
+    "         * pixel is covered with that probability, as alpha to coverage\n"
+    "         * would with samples */\n"
+    "        float ign = fract(52.9829189 * fract(dot(gl_FragCoord.xy, vec2(0.06711056, 0.00583715))));\n"
+    "        if (tex.a <= ign) discard;\n"
+    "    }\n"
+    "#endif\n"
+    "    float dist = length(v_rel);\n"
+    "    vec3 v = dist > 0.0 ? -v_rel / dist : vec3(0.0, 1.0, 0.0);\n"
+    "    vec3 n = normalize(g_normal);\n"
+    "    if ((g_flags & 2u) == 0u && !gl_FrontFacing) n = -n;\n"
+    /* a mesh-lit instance shades as the ground as it turns into it */
+    "    n = normalize(mix(n, normalize(g_tnormal), g_far));\n"
+    "    float ao = mix(mix(0.5, 1.0, clamp(g_uv.y, 0.0, 1.0)), 1.0, g_far);   /* darker at the root */\n"
+    "    o_color = vec4(splat_light(g_color * tex.rgb * ao, n, 0.9, dist, v), 1.0);\n"
+    "}\n";
+
+/* The probe pass, for the tests only (made on first use): mode 0 counts
+ * the instances the last frame's draw keeps in cell `slot`, per ring of
+ * width ring.w around the camera ring.xy (the draw's arguments after the
+ * LOD, and ug_fade_scale > 0: exactly the instances the vertex stage does
+ * not collapse) into out[ring], and all the LOD's into out[rings + ring];
+ * mode 1 evaluates ug_wind at n points (12 floats each:
+ * root, h, the block's wind vec4, then the offset and the gust written). */
+const char rt_ug_probe_glsl[] =
+    "#version 450\n"
+    "layout(local_size_x = 64) in;\n"
+    "struct Inst { vec4 p; uvec4 q; };\n"
+    "layout(set = 0, binding = 0, std430) readonly buffer I { Inst v[]; } u_inst;\n"
+    "layout(set = 0, binding = 1, std430) readonly buffer A { uint a[]; } u_draw;\n"
+    "layout(set = 0, binding = 2, std430) buffer O { uint u[]; } u_out;\n"
+    "layout(push_constant, std430) uniform P { vec4 ring; uvec4 info; } u_p;\n"
+    UG_GLSL_FUNCS
+    "void main() {\n"
+    "    uint lid = gl_LocalInvocationID.x;\n"
+    "    if (u_p.info.x == 1u) {\n"
+    "        uint i = gl_GlobalInvocationID.x;\n"
+    "        if (i >= u_p.info.y) return;\n"
+    "        float v[8];\n"
+    "        for (uint k = 0u; k < 8u; k++) v[k] = uintBitsToFloat(u_out.u[12u * i + k]);\n"
+    "        vec3 o = ug_wind(vec3(v[0], v[1], v[2]), v[3], vec4(v[4], v[5], v[6], v[7]), u_p.ring.z);\n"
+    "        u_out.u[12u * i + 8u] = floatBitsToUint(o.x);\n"
+    "        u_out.u[12u * i + 9u] = floatBitsToUint(o.y);\n"
+    "        u_out.u[12u * i + 10u] = floatBitsToUint(o.z);\n"
+    "        u_out.u[12u * i + 11u] = floatBitsToUint(ug_gust(vec2(v[0], v[2]), vec2(v[4], v[5]), u_p.ring.z));\n"
+    "        return;\n"
+    "    }\n"
+    "    uint at = 5u * (u_p.info.z * u_p.info.w + gl_WorkGroupID.x);\n"
+    "    uint n = u_draw.a[at + 1u], first = u_draw.a[at + 4u];\n"
+    "    for (uint k = lid; k < n; k += 64u) {\n"
+    "        vec3 root = u_inst.v[first + k].p.xyz;\n"
+    "        float d = length(root.xz - u_p.ring.xy);\n"
+    "        uint ring = uint(d / u_p.ring.w);\n"
+    "        if (ring >= u_p.info.y) continue;\n"
+    "        atomicAdd(u_out.u[u_p.info.y + ring], 1u);\n"
+    "        if (ug_fade_scale(root, d, u_p.ring.z) > 0.0) atomicAdd(u_out.u[ring], 1u);\n"
+    "    }\n"
+    "}\n";
+
+/* Contact shadows (a block's `shadow`): before the plants, every kept
+ * instance darkens the ground under it by a disc on the terrain plane at
+ * its root, 1.3 times its footprint, 4 cm up the normal, multiplied into
+ * the colour (dst * src): shadow * (1 - smoothstep(0.2, 1, r^2)), gone
+ * with the instance (the fade's scale) and with ug_far, so overlapping
+ * discs under dense cover darken the ground the more. */
+const char rt_ug_shadow_vert_main[] =
+    "struct Inst { vec4 p; uvec4 q; };\n"
+    "layout(set = 2, binding = 0, std430) readonly buffer B { vec4 b[]; } u_blocks;\n"
+    "layout(set = 2, binding = 1, std430) readonly buffer I { Inst v[]; } u_inst;\n"
+    "layout(set = 2, binding = 2, std430) readonly buffer F { float f[]; } u_lod;\n"
+    "layout(location = 0) in vec3 a_pos;\n"
+    "layout(location = 1) in vec3 a_nrm;   /* the vertex layout's; unused */\n"
+    "layout(location = 2) in vec2 a_uv;\n"
+    "out gl_PerVertex { vec4 gl_Position; };\n"
+    "layout(location = 0) out vec2 s_q;\n"
+    "layout(location = 1) out float s_a;\n"
+    UG_GLSL_FUNCS
+    "void main() {\n"
+    "    Inst it = u_inst.v[gl_InstanceIndex];\n"
+    "    vec4 b4 = u_blocks.b[5u * it.q.w + 4u];\n"
+    "    vec3 n = normalize(unpackSnorm4x8(it.q.x).xyz + vec3(0.0, 1e-4, 0.0));\n"
+    "    float r = u_push.patch_xz.x, d = length(it.p.xz - u_frame.camera.xz);\n"
+    "    float grow = min(inversesqrt(u_lod.f[uint(gl_InstanceIndex) / u_push.info.x]), " LOD_GROW_S ");\n"
+    "    float size = 1.3 * b4.z * it.p.w * grow * ug_fade_scale(it.p.xyz, d, r);\n"
+    "    vec3 t = normalize(cross(n, vec3(0.0, 0.0, 1.0))), bt = cross(t, n);\n"
+    "    vec3 p = it.p.xyz + (t * a_pos.x + bt * a_pos.z) * size + n * 0.04;\n"
+    "    s_q = a_uv * 2.0 - 1.0;\n"
+    "    s_a = b4.y * (1.0 - ug_far(d, r));\n"
+    "    gl_Position = u_frame.view_proj * vec4(p - u_frame.camera.xyz, 1.0);\n"
+    "}\n";
+
+const char rt_ug_shadow_frag[] =
+    "#version 450\n"
+    "layout(early_fragment_tests) in;\n"
+    "layout(location = 0) in vec2 s_q;\n"
+    "layout(location = 1) in float s_a;\n"
+    "layout(location = 0) out vec4 o_color;\n"
+    "void main() {\n"
+    "    float a = s_a * (1.0 - smoothstep(0.2, 1.0, dot(s_q, s_q)));\n"
+    "    o_color = vec4(vec3(1.0 - a), 1.0);\n"
+    "}\n";

@@ -1,0 +1,105 @@
+/* undergrowth_impl.h — what the undergrowth files share (internal to
+ * undergrowth.c, undergrowth_glsl.c and undergrowth_probe.c): the cell
+ * pool's constants, struct rt_ug, and the runtime's own shaders.  The
+ * method is described at the top of undergrowth.c. */
+#ifndef SPLAT_UNDERGROWTH_IMPL_H
+#define SPLAT_UNDERGROWTH_IMPL_H
+
+#include "rt_internal.h"
+#include "vk_build.h"
+
+#define CELL    SPLAT_UG_CELL        /* metres per cell side (abi.h)        */
+#define TEXELS  SPLAT_UG_TEXELS      /* mask texels per cell side           */
+/* Distance LOD: beyond LOD_NEAR metres a cell draws the fraction
+ * (LOD_NEAR / d)^2 of its instances (at least LOD_MIN), each widened by
+ * 1 / sqrt(fraction) (at most LOD_GROW) but not raised: about as many
+ * instances per pixel at every distance and the same cover seen from
+ * above, without a wall of tall far clumps at a grazing view (a far tiny
+ * triangle costs a whole quad of fragments; the H100 paid 0.25 us per
+ * instance drawn). */
+#define LOD_NEAR 14.0
+#define LOD_MIN  0.08
+#define LOD_GROW 3.0
+#define LOD_GROW_S "3.0"
+#define UG_BLOCK_VEC4 5   /* vec4s per block of the block table (fill_blocks) */
+
+enum { CELL_FREE, CELL_PENDING, CELL_READY };
+
+typedef struct ug_cell {
+    int   ix, iz;      /* cell index: origin (ix, iz) * CELL metres        */
+    int   state;
+    bool  wanted;      /* within the radius this frame                     */
+    double dist;       /* 2D distance of its centre from the camera        */
+    bool  visible;     /* in the frustum this frame                        */
+} ug_cell;
+
+/* Push constants of the scatter pass (std430, 64 bytes). */
+typedef struct ug_push {
+    float    origin[2];
+    int32_t  cell[2];
+    uint32_t slot, nw, cap, mask_base;
+    float    terrain[4];      /* size x, size z, max height, offset       */
+    int32_t  hf[2];
+    uint32_t nblocks, pad;
+} ug_push;
+
+struct rt_ug {
+    rt_device            *d;
+    const rt_pack        *p;
+    rt_pipelines         *pl;
+    const rt_quadtree    *qt;
+    int                   pool, nblocks, nw;   /* nw: weight words per texel */
+    uint32_t              cap;                 /* instances per cell         */
+    uint32_t             *block_base;          /* first instance in a cell   */
+    uint32_t             *block_grid;          /* candidates per side        */
+    double                radius;
+    ug_cell              *cells;
+    int                  *order;               /* draw order, front to back  */
+    /* device-local: masks, instances, draw arguments (the GPU writes
+     * them and reads them every frame); host-visible: args_host (the
+     * arguments copied back after a generation, for the counts), blocks,
+     * meshes, the mask pass's frame block */
+    rt_buffer             masks, inst, args, args_host, blocks, vbuf, ibuf, frame;
+    rt_buffer             draw_args;           /* args with the LOD's counts */
+    rt_buffer             lod;                 /* per slot: fraction drawn   */
+    rt_buffer             far;                 /* per block: far mesh (LOD)  */
+    VkDescriptorSetLayout set_terrain;         /* set 0 of the mask pass     */
+    VkDescriptorSetLayout set_mask, set_gen, set_draw, set_lod;
+    VkPipelineLayout      mask_layout, gen_layout, draw_layout, lod_layout;
+    VkPipeline           *mask_pipes;          /* per combination            */
+    VkPipeline            gen_pipe, lod_pipe;
+    VkPipeline            draw_pipe[2];        /* opaque (early depth), cut out */
+    VkPipeline            shadow_pipe;         /* contact shadows (if shadows) */
+    rt_image              tex[SPLAT_MAX_UG_TEXTURES + 1];   /* the pack's, then white */
+    VkSampler             tex_smp;             /* trilinear, repeat          */
+    bool                  shadows;             /* the colour target blends   */
+    VkDescriptorPool      dpool;
+    VkDescriptorSet       set0, mask_set, gen_set, draw_set, lod_set;
+    VkRenderPass          pass_att, pass_ro;   /* depth in attachment / read */
+    VkFramebuffer         fb;
+    VkQueryPool           qpool;               /* VK_NULL_HANDLE: no timestamps */
+    int                   generated;           /* this frame                 */
+    double                time;                /* the camera's (the wind)    */
+    float                 cam_xz[2];           /* the camera's, this frame   */
+    /* the probe pass (tests only; made on first use) */
+    VkDescriptorSetLayout probe_sl;
+    VkPipelineLayout      probe_layout;
+    VkPipeline            probe_pipe;
+    VkDescriptorPool      probe_pool;
+    VkDescriptorSet       probe_set;
+    rt_buffer             probe_out;
+    bool                  drawn;
+    rt_vk_list            keep;                /* every Vulkan object but buffers and images */
+};
+
+/* ---- undergrowth_glsl.c: the runtime's own shaders ---------------------- */
+
+extern const char rt_ug_gen_glsl[];          /* the scatter pass             */
+extern const char rt_ug_lod_glsl[];          /* the LOD's draw arguments     */
+extern const char rt_ug_draw_vert_main[];    /* after SPLAT_GLSL_TERRAIN      */
+extern const char rt_ug_draw_frag_main[];    /* after SPLAT_GLSL_PRELUDE      */
+extern const char rt_ug_probe_glsl[];        /* the probe pass (tests)       */
+extern const char rt_ug_shadow_vert_main[];  /* contact shadows              */
+extern const char rt_ug_shadow_frag[];
+
+#endif
