@@ -1099,9 +1099,9 @@ static void emit_normalise(emit *em)
  * llvmpipe ignores every condition nested deeper than 80 (gallivm's
  * LP_MAX_TGSI_NESTING, Mesa 22.3): an über-shader drew the sky's colour
  * wherever its pixels needed a layer more than about 80 down the chain
- * (issue 29).  Breaks out of a do { } while (false) do not help: NIR nests
- * the code after each break again.  Shorter chains stay nested, their
- * GLSL unchanged. */
+ * (issue 29).  Breaks out of a do { } while (false) did not help there
+ * (NaN pictures, the same wrong counters: the code after a break is still
+ * nested in effect).  Shorter chains stay nested, their GLSL unchanged. */
 #define SPLAT_NESTED_LAYERS_MAX 32
 
 /* In a long_chain, guard what follows by `cond > 0.0`: the stretch ends
