@@ -788,6 +788,9 @@ typedef struct emit {
     const int             *ug_slot;  /* desc->ug_slot                        */
     bool                   normalised; /* the compositor has `blend`: sums
                                           s_wsum, divides before finishing */
+    ir_buf                *decls;    /* long_chain: main's declarations of
+                                        what its stretches compute, or NULL */
+    int                    nstretch; /* long_chain: scopes its stretches pushed */
 } emit;
 
 static ir_ref map_ref(const uint32_t *map, ir_ref r)
@@ -860,18 +863,33 @@ static void emission_free(emit *em)
 }
 
 /* Declare a leaf we name ourselves (an input or a painted mask). */
+/* `type name = init;`, or in a long chain (em->decls) `name = init;`
+ * with `type name;` among main's declarations, once. */
+static void declare(emit *em, const char *type, const char *name, const char *init,
+                    const char *ind)
+{
+    if (!em->decls) {
+        ir_buf_printf(em->out, "%s%s %s = %s;\n", ind, type, name, init);
+        return;
+    }
+    char line[160];
+    snprintf(line, sizeof line, "    %s %s;\n", type, name);
+    if (!em->decls->s || !strstr(em->decls->s, line))
+        ir_buf_printf(em->decls, "%s", line);
+    ir_buf_printf(em->out, "%s%s = %s;\n", ind, name, init);
+}
+
 static void declare_leaf(emit *em, uint32_t id, const char *ind)
 {
     const ir_node *n = &em->ir.nodes[id];
     if (n->op == IR_OP_PARAM && em->input_of[n->imm] >= 0) {
         const ir_input_info *in = ir_input_get((ir_input_kind)em->input_of[n->imm]);
-        ir_buf_printf(em->out, "%s%s %s = %s;\n", ind, ir_type_name((ir_type)n->type),
-                      in->local, in->glsl);
+        declare(em, ir_type_name((ir_type)n->type), in->local, in->glsl, ind);
     } else if (n->op == IR_OP_PAINTED) {
         char local[64], expr[64];
         painted_local(em->L, em->ir.painted[n->imm].name, local, sizeof local, expr,
                       sizeof expr);
-        ir_buf_printf(em->out, "%sfloat %s = %s;\n", ind, local, expr);
+        declare(em, "float", local, expr, ind);
     }
 }
 
@@ -942,7 +960,9 @@ static void emit_lazy(emit *em, uint32_t id, int depth)
         char name[48];
         snprintf(name, sizeof name, "lz%u_%d", id, a);
         char *cond = lazy_condition(em, id, a, depth);
-        ir_buf_printf(em->out, "%s%s %s = %s(0.0);\n", indent_at(em, depth), tn, name, tn);
+        char zero[48];
+        snprintf(zero, sizeof zero, "%s(0.0)", tn);
+        declare(em, tn, name, zero, indent_at(em, depth));
         ir_buf_printf(em->out, "%sif (splat_quad_any(%s)) {\n", indent_at(em, depth), cond);
         free(cond);
         glsl_scope_push(em->e);
@@ -1074,6 +1094,87 @@ static void emit_normalise(emit *em)
     }
 }
 
+/* Chains of more than this many layers are emitted as a long_chain: a
+ * guard per layer nests the code as deep as the chain is long, and
+ * llvmpipe ignores every condition nested deeper than 80 (gallivm's
+ * LP_MAX_TGSI_NESTING, Mesa 22.3): an über-shader drew the sky's colour
+ * wherever its pixels needed a layer more than about 80 down the chain
+ * (issue 29).  Breaks out of a do { } while (false) did not help there
+ * (NaN pictures, the same wrong counters: the code after a break is still
+ * nested in effect).  Shorter chains stay nested, their GLSL unchanged. */
+#define SPLAT_NESTED_LAYERS_MAX 32
+
+/* In a long_chain, guard what follows by `cond > 0.0`: the stretch ends
+ * with s_go set from the guard, and the next one opens under s_go.  True
+ * if what follows may run (a positive constant: the stretch goes on),
+ * false if it never does (a constant <= 0: the chain ends). */
+static bool stretch_guard(emit *em, ir_ref cond, int depth)
+{
+    double v;
+    if (is_const(&em->ir, cond, &v))
+        return v > 0.0;
+    char *x = value(em, cond, depth);
+    ir_buf_printf(em->out, "%ss_go = splat_quad_any(%s > 0.0);\n", indent_at(em, depth), x);
+    free(x);
+    count_samples(em, depth);
+    ir_buf_printf(em->out, "%s}\n%sif (s_go) {\n", indent_at(em, depth - 1),
+                  indent_at(em, depth - 1));
+    /* the next stretch counts its samples from here; what this one
+     * computed stays known, declared in main's scope (glsl_hoist) */
+    glsl_scope_push(em->e);
+    em->nstretch++;
+    return true;
+}
+
+/* The layers of a long chain (SPLAT_NESTED_LAYERS_MAX), one stretch of
+ * straight code per guard, each at the same depth:
+ *     float v11; float in_slope; ...     (what the stretches compute)
+ *     bool s_go = splat_quad_any(T0 > 0.0);
+ *     if (s_go) {
+ *         ... layer 0 ...
+ *         s_go = splat_quad_any(T1 > 0.0);
+ *     }
+ *     if (s_go) {
+ *         ... layer 1 ...
+ * A stretch runs exactly where every guard up to its own passed, as when
+ * nested; s_go is quad-uniform, as each guard was. */
+static void emit_layer(emit *em, int j, bool flat, int depth);
+
+static void long_chain(emit *em)
+{
+    double v;
+    ir_ref t0 = em->layers[0].T;
+    bool konst = is_const(&em->ir, t0, &v);
+    if (konst && !(v > 0.0))
+        return;
+    ir_buf *out = em->out, chain = {0}, decls = {0};
+    char *x = konst ? xstrdup("true") : value(em, t0, 1);
+    ir_buf_printf(&chain, "    bool s_go = %s%s%s;\n    if (s_go) {\n",
+                  konst ? "" : "splat_quad_any(", x, konst ? "" : " > 0.0)");
+    free(x);
+    em->out = &chain;   /* after the declarations, which it makes */
+    em->decls = &decls;
+    glsl_set_out(em->e, &chain);
+    glsl_hoist(em->e, &decls);
+    glsl_scope_push(em->e);
+    em->nstretch = 1;
+    emit_layer(em, 0, false, 2);
+    count_samples(em, 2);
+    ir_buf_printf(&chain, "    }\n");
+    while (em->nstretch-- > 0)
+        glsl_scope_pop(em->e);
+    em->nstretch = 0;
+    glsl_hoist(em->e, NULL);
+    glsl_set_out(em->e, out);
+    em->decls = NULL;
+    em->out = out;
+    if (decls.s)
+        ir_buf_printf(out, "%s", decls.s);
+    ir_buf_printf(out, "%s", chain.s);
+    ir_buf_free(&decls);
+    ir_buf_free(&chain);
+}
+
 /* Layer j: we are inside G_j's block (at `depth`). */
 static void emit_layer(emit *em, int j, bool flat, int depth)
 {
@@ -1097,6 +1198,9 @@ static void emit_layer(emit *em, int j, bool flat, int depth)
         return;
     if (flat) {
         emit_layer(em, j + 1, flat, depth);
+    } else if (em->decls) {
+        if (stretch_guard(em, l->T_next, depth))
+            emit_layer(em, j + 1, flat, depth);
     } else if (open_guard(em, l->T_next, depth, -1)) {
         emit_layer(em, j + 1, flat, depth + 1);
         close_block(em, depth);
@@ -1484,6 +1588,8 @@ void splat_composite_glsl(const splat_layout *L, const splat_composite *c,
         emit_placed(&em, 0, 1);
         if (desc->flat) {
             emit_layer(&em, 0, true, 1);
+        } else if (c->nlayers > SPLAT_NESTED_LAYERS_MAX) {
+            long_chain(&em);
         } else if (open_guard(&em, em.layers[0].T, 1, -1)) {
             emit_layer(&em, 0, false, 2);
             close_block(&em, 1);

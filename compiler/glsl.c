@@ -88,6 +88,8 @@ struct glsl_emitter {
     uint32_t  *work;      /* scratch for glsl_value                        */
     uint8_t   *seen;
     uint8_t   *bound;     /* per node: its expression came from glsl_bind  */
+    ir_buf    *decls;     /* glsl_hoist: where values are declared, or NULL */
+    uint8_t   *declared;  /* per node: declared there already              */
 };
 
 glsl_emitter *glsl_emitter_new(const ir *ir, const glsl_names *names, ir_buf *out)
@@ -121,6 +123,7 @@ void glsl_emitter_free(glsl_emitter *e)
     free(e->work);
     free(e->seen);
     free(e->bound);
+    free(e->declared);
     free(e);
 }
 
@@ -163,6 +166,18 @@ static void remember(glsl_emitter *e, uint32_t id, char *expr)
         e->emitted = xgrow(e->emitted, sizeof(uint32_t) * (size_t)e->capemitted);
     }
     e->emitted[e->nemitted++] = id;
+}
+
+void glsl_set_out(glsl_emitter *e, ir_buf *out)
+{
+    e->out = out;
+}
+
+void glsl_hoist(glsl_emitter *e, ir_buf *decls)
+{
+    e->decls = decls;
+    if (decls && !e->declared)
+        e->declared = xalloc(e->nnodes);   /* zeroed */
 }
 
 void glsl_bind(glsl_emitter *e, ir_ref r, const char *name)
@@ -331,8 +346,15 @@ const char *glsl_value(glsl_emitter *e, ir_ref r, const char *indent)
         const ir_node *n = &ir->nodes[id];
         rhs.len = 0;
         op_expr(e, n, &rhs);
-        ir_buf_printf(e->out, "%s%s v%u = %s;\n", indent ? indent : "",
-                      ir_type_name((ir_type)n->type), id, rhs.s);
+        if (e->decls) {   /* glsl_hoist: declared once, there */
+            if (!e->declared[id])
+                ir_buf_printf(e->decls, "    %s v%u;\n", ir_type_name((ir_type)n->type), id);
+            e->declared[id] = 1;
+            ir_buf_printf(e->out, "%sv%u = %s;\n", indent ? indent : "", id, rhs.s);
+        } else {
+            ir_buf_printf(e->out, "%s%s v%u = %s;\n", indent ? indent : "",
+                          ir_type_name((ir_type)n->type), id, rhs.s);
+        }
         ir_buf name = {0};
         ir_buf_printf(&name, "v%u", id);
         remember(e, id, name.s);

@@ -687,6 +687,12 @@ int           glsl_scope_count(const glsl_emitter *e, ir_op op);
  * variable `name`, which the caller has declared: a value computed inside
  * a block the caller closed (compose.c's lazy branches). */
 void          glsl_bind(glsl_emitter *e, ir_ref r, const char *name);
+/* While `decls` is non-NULL, each value is declared there (once, at one
+ * indent, no initialiser) and assigned where it is computed: values stay
+ * visible past the block they were computed in (compose.c's long chains). */
+void          glsl_hoist(glsl_emitter *e, ir_buf *decls);
+/* Where the emitter writes from now on. */
+void          glsl_set_out(glsl_emitter *e, ir_buf *out);
 
 /* GLSL literal for a constant of type t ("vec3(0.5, 0.5, 0.5)"), exact
  * enough to round-trip a float. */

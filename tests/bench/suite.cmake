@@ -64,6 +64,17 @@ if(TARGET splatc)
         set_tests_properties(bench.world_presence PROPERTIES LABELS render TIMEOUT 900
                              ENVIRONMENT "SPLAT_VALIDATE=1")
       endif()
+      if(TARGET splatrt AND TARGET splatview)
+        # uber_deep.sh: 105 layers seen deep in the über-shader's chain; it
+        # draws what the composites draw on both paths (issue 29); imgcheck
+        # is the render suite's (included after this one, on the same terms)
+        add_test(NAME bench.uber_deep
+          COMMAND sh ${CMAKE_CURRENT_LIST_DIR}/uber_deep.sh $<TARGET_FILE:gen_world>
+                  $<TARGET_FILE:splatc_cli> $<TARGET_FILE:splatview> $<TARGET_FILE:imgcheck>
+                  ${CMAKE_BINARY_DIR}/tests/bench/uber_deep
+          WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
+        set_tests_properties(bench.uber_deep PROPERTIES LABELS render TIMEOUT 600)
+      endif()
     endif()
   endif()
 endif()
