@@ -583,6 +583,9 @@ bool rt_renderer_frame(rt_renderer *r, const rt_camera *c,
                        rt_frame_stats *st, rt_error *e);
 /* The last frame's colour as RGBA32F, top row first (w * h * 4 floats). */
 bool rt_renderer_read(rt_renderer *r, float *rgba, rt_error *e);
+/* The last frame's plan (runtime/render_plan.c): its passes in order, what
+ * each reads and writes, with `times` each one's GPU time (timestamps). */
+void rt_renderer_print_plan(const rt_renderer *r, FILE *out, bool times);
 /* The offscreen colour image (TRANSFER_SRC_OPTIMAL after a frame). */
 const rt_image *rt_renderer_target(const rt_renderer *r);
 /* Replace the combination pipelines with those of a new pack of the same

@@ -29,6 +29,8 @@ static void usage(FILE *f)
         "  --stats                   patches, pipelines, GPU and CPU times, device;\n"
         "                            layers and texture samples per pixel from one\n"
         "                            counting frame (both paths, not multipass)\n"
+        "  --print-plan              headless: print the frame's passes, what each\n"
+        "                            reads and writes (with --stats its GPU time)\n"
         "  --reference multipass|uber   the multi-pass alpha reference or the uber-shader\n"
         "  --shading forward|screen  forward: each patch shaded by its composite;\n"
         "                            screen: depth pass, 8x8 tiles classified by\n"
@@ -133,6 +135,7 @@ typedef struct opts {
     char *preview_dir;          /* where that pack is built                 */
     char *owned_scene;          /* the scene path build_preview allocated   */
     bool overlay;
+    bool print_plan;            /* --print-plan: the last frame's passes      */
     bool headless, stats, have_camera, have_look, no_stitch, no_cull, no_shadows;
     bool no_undergrowth;
     bool no_distance_classes;
@@ -254,6 +257,8 @@ static int parse_args(int argc, char **argv, opts *o)
             o->stats = true;
         } else if (!strcmp(a, "--overlay")) {
             o->overlay = true;
+        } else if (!strcmp(a, "--print-plan")) {
+            o->print_plan = o->headless = true;
         } else if (!strcmp(a, "--no-stitch")) {
             o->no_stitch = true;
         } else if (!strcmp(a, "--no-cull")) {
@@ -492,7 +497,7 @@ static int parse_args(int argc, char **argv, opts *o)
         fprintf(stderr, "splatview: --camera and --look go together\n");
         return 2;
     }
-    if (o->headless && !o->out && !o->float_out && !o->stats && !o->check) {
+    if (o->headless && !o->out && !o->float_out && !o->stats && !o->check && !o->print_plan) {
         fprintf(stderr, "splatview: --headless needs -o OUT.png, --float-out or --stats\n");
         return 2;
     }
@@ -716,6 +721,8 @@ static int headless(const opts *o)
                 goto done;
         }
     }
+    if (o->print_plan)   /* the last frame's, its readback; before --stats' counting frame */
+        rt_renderer_print_plan(r, stdout, o->stats);
     if (o->stats) {
         double gm, gl, gh, sm, sl, sh, cm, cl, ch;
         summary(gpu, o->frames, &gm, &gl, &gh);
