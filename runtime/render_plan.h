@@ -119,6 +119,7 @@ typedef struct rt_tracker {
     VkImageLayout rest[RT_RES_COUNT];   /* the layout between frames, or 0 */
     bool         host_read[RT_RES_COUNT];
     int          barriers;              /* recorded this frame (stats)    */
+    bool         off;                   /* SPLAT_PLAN_BARRIERS=0 (tests)  */
 } rt_tracker;
 
 const char *rt_pass_name(rt_pass_kind k);
