@@ -478,12 +478,12 @@ bool rt_pipelines_reset_combos(rt_device *d, const rt_pack *p, rt_pipelines *pl,
 /* Saves the cache (if it has a path) and destroys everything. */
 void rt_pipelines_destroy(rt_device *d, rt_pipelines *pl);
 
-/* ---- render.c: the frame ----------------------------------------------- */
+/* ---- render_views.c: cameras ----------------------------------------------- */
 
 /* The camera's vertical field of view in radians (its default if unset). */
 double rt_camera_fovy(const rt_camera *c);
 
-/* ---- screen.c: screen-space shading (render.c drives it) -------------- */
+/* ---- screen.c: screen-space shading (render_record.c drives it) -------------- */
 
 typedef struct rt_screen rt_screen;
 typedef struct rt_far rt_far;   /* far.c */
@@ -568,7 +568,7 @@ char *rt_far_glsl(const rt_pack *p, bool count);
 bool  rt_far_bind_forward(rt_far *f, const rt_pack *p, const rt_passes *rp, rt_pipelines *pl,
                           VkCommandBuffer cb, unsigned variant, rt_error *e);
 
-/* ---- undergrowth.c: cells, generation, drawing (render.c drives it) ---- */
+/* ---- undergrowth.c: cells, generation, drawing (render_record.c drives it) ---- */
 
 typedef struct rt_ug rt_ug;
 

@@ -1,5 +1,5 @@
 /* screen.c — screen-space terrain shading (Moore 2018, "Screen Space
- * Shading"): after a depth-only geometry pass (render.c draws the patches
+ * Shading"): after a depth-only geometry pass (render_record.c draws the patches
  * with rt_pipelines_depth), a classification compute pass takes, per 8x8
  * pixel tile, the union of the material sets of the leaf cells its terrain
  * pixels fall in (the pack's level-0 combination map), picks the cheapest
