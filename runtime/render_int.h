@@ -71,6 +71,7 @@ struct rt_renderer {
     double            lod_distance;
     rt_tracker        tracker;         /* the resources' state between passes */
     rt_plan           plan;            /* the last frame's (render_plan.c)  */
+    bool              pass_times;      /* a timestamp after every pass      */
 };
 
 /* What this frame does, worked out once from the state (render_plan.c). */

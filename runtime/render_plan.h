@@ -1,8 +1,9 @@
 /* render_plan.h — the frame as a plan: a list of passes, each declaring
  * the images and buffers it reads and writes (stage, access, layout).
- * render_plan.c makes the plan from the renderer's state and derives the
- * barriers between passes from the declarations (rt_tracker);
- * render_record.c records each pass.  Runtime-internal. */
+ * render_plan.c makes the plan from the renderer's state; render_track.c
+ * keeps the plan's passes and derives the barriers between them from the
+ * declarations (rt_tracker); render_record.c records each pass.
+ * Runtime-internal. */
 #ifndef SPLAT_RENDER_PLAN_H
 #define SPLAT_RENDER_PLAN_H
 #include <stdbool.h>

@@ -527,8 +527,21 @@ static bool (*const recorders[RT_PASS_KINDS])(rec *, rt_error *) = {
 
 /* The passes [from, npasses) recorded into x->cb: host passes run, each
  * group after the barrier its declarations need; with `timed`, a
- * timestamp after each GPU pass (query 0 is the start).  On failure the
+ * timestamp (query 0 is the start) after the last GPU pass, after the
+ * screen path's depth and classification, and with r->pass_times after
+ * every GPU pass (few timestamps by default: the frame's GPU time stays
+ * what it measured before the plan).  On failure the
  * command buffer is ended (reset by the next frame). */
+static bool stamped(const rt_renderer *r, const rt_plan *pl, int i)
+{
+    rt_pass_kind k = pl->pass[i].kind;
+    bool last = true;
+    for (int j = i + 1; j < pl->npasses; j++)
+        last &= pl->pass[j].host || pl->pass[j].own;
+    return r->pass_times || last || k == RT_PASS_DEPTH || k == RT_PASS_RAYCAST ||
+           k == RT_PASS_CLASSIFY;
+}
+
 static bool record_plan(rec *x, rt_plan *pl, int from, bool timed, rt_error *e)
 {
     rt_renderer *r = x->r;
@@ -558,7 +571,7 @@ static bool record_plan(rec *x, rt_plan *pl, int from, bool timed, rt_error *e)
                     vkCmdEndRenderPass(x->cb);
                 goto fail;
             }
-            if (timed) {
+            if (timed && stamped(r, pl, i + k)) {
                 vkCmdWriteTimestamp(x->cb, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, r->qpool, q);
                 p[k].query = (int)q++;
             }
@@ -754,6 +767,8 @@ bool rt_renderer_read(rt_renderer *r, float *rgba, rt_error *e)
     memcpy(rgba, r->readback.map, (size_t)r->desc.width * (size_t)r->desc.height * 16);
     return true;
 }
+
+void rt_renderer_set_pass_times(rt_renderer *r, bool on) { r->pass_times = on; }
 
 void rt_renderer_print_plan(const rt_renderer *r, FILE *out, bool times)
 {

@@ -584,8 +584,11 @@ bool rt_renderer_frame(rt_renderer *r, const rt_camera *c,
 /* The last frame's colour as RGBA32F, top row first (w * h * 4 floats). */
 bool rt_renderer_read(rt_renderer *r, float *rgba, rt_error *e);
 /* The last frame's plan (runtime/render_plan.c): its passes in order, what
- * each reads and writes, with `times` each one's GPU time (timestamps). */
+ * each reads and writes; with `times` each one's GPU time, measured when
+ * set_pass_times is on (a timestamp after every pass; off by default:
+ * a few, the frame's and the screen path's three parts). */
 void rt_renderer_print_plan(const rt_renderer *r, FILE *out, bool times);
+void rt_renderer_set_pass_times(rt_renderer *r, bool on);
 /* The offscreen colour image (TRANSFER_SRC_OPTIMAL after a frame). */
 const rt_image *rt_renderer_target(const rt_renderer *r);
 /* Replace the combination pipelines with those of a new pack of the same

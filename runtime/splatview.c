@@ -666,6 +666,7 @@ static int headless(const opts *o)
         goto done;
     }
     rt_renderer_set_view(r, view, material);
+    rt_renderer_set_pass_times(r, o->print_plan && o->stats);
     int W = o->width > 0 ? o->width : 1280, H = o->height > 0 ? o->height : 720;
     gpu = calloc((size_t)o->frames * 7, sizeof *gpu);
     if (!gpu)
