@@ -102,6 +102,7 @@ typedef struct rt_plan {
     const char *path;              /* "forward", "screen", "multipass"       */
     int         width, height;
     int         npasses;
+    int         barriers;          /* the tracker recorded for them      */
     rt_pass     pass[RT_PLAN_MAX_PASSES];
 } rt_plan;
 
@@ -132,7 +133,6 @@ void rt_plan_readback(rt_plan *pl);
 rt_pass *rt_plan_add(rt_plan *pl, rt_pass_kind k);
 void rt_pass_use(rt_pass *p, rt_resource res, bool write, VkPipelineStageFlags stage,
                  VkAccessFlags access, VkImageLayout layout, VkImageLayout after);
-const rt_pass *rt_plan_find(const rt_plan *pl, rt_pass_kind k);
 
 /* Colour is the one image whose layout the tracker moves (the screen
  * path's storage writes, the undergrowth's and readback's needs). */

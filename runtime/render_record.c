@@ -694,6 +694,7 @@ static bool draw_frame(rt_renderer *r, const rt_camera *c, rt_frame_stats *st,
     r->tracker.barriers = 0;
     if (!record_plan(&x, &r->plan, 0, r->timestamps, e))
         return false;
+    r->plan.barriers = r->tracker.barriers;
     *shadow_ms = x.shadow_ms;
     RT_VK(e, vkEndCommandBuffer(r->cb));
     VkSubmitInfo si = {
@@ -762,8 +763,10 @@ bool rt_renderer_read(rt_renderer *r, float *rgba, rt_error *e)
     rec x = { .r = r };
     if (!rt_oneshot_begin(r->d, &x.cb, e))
         return false;
+    int before = r->tracker.barriers;
     if (!record_plan(&x, pl, from, false, e) || !rt_oneshot_end(r->d, x.cb, e))
         return false;
+    pl->barriers += r->tracker.barriers - before;
     memcpy(rgba, r->readback.map, (size_t)r->desc.width * (size_t)r->desc.height * 16);
     return true;
 }

@@ -50,14 +50,6 @@ void rt_pass_use(rt_pass *p, rt_resource res, bool write, VkPipelineStageFlags s
                                   .access = access, .layout = layout, .after = after };
 }
 
-const rt_pass *rt_plan_find(const rt_plan *pl, rt_pass_kind k)
-{
-    for (int i = 0; i < pl->npasses; i++)
-        if (pl->pass[i].kind == k)
-            return &pl->pass[i];
-    return NULL;
-}
-
 enum {
     VERT = VK_PIPELINE_STAGE_VERTEX_SHADER_BIT,
     FRAG = VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT,
@@ -266,8 +258,8 @@ static void print_uses(const rt_pass *p, bool write, FILE *out)
 
 void rt_plan_print(const rt_plan *pl, FILE *out, bool times)
 {
-    fprintf(out, "plan: %s path, %dx%d, %d passes\n", pl->path, pl->width, pl->height,
-            pl->npasses);
+    fprintf(out, "plan: %s path, %dx%d, %d passes, %d barriers\n", pl->path, pl->width,
+            pl->height, pl->npasses, pl->barriers);
     for (int i = 0; i < pl->npasses; i++) {
         const rt_pass *p = &pl->pass[i];
         fprintf(out, "  %2d %-22s %-5s", i + 1, rt_pass_name(p->kind),
