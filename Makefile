@@ -32,11 +32,14 @@ SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 # shows as an "<unknown module>" leak that no suppression can name, so the
 # tests that render under ASan preload it (it stays mapped, its memory
 # reachable); libasan then need not come first (verify_asan_link_order=0).
+# The validation layer likewise: what its synchronization checks keep
+# (SPLAT_VALIDATE=1) is then named, and suppressed, as the layer's.
 LVP_SO   := $(firstword $(wildcard /usr/lib/*/libvulkan_lvp.so))
+VVL_SO   := $(firstword $(wildcard /usr/lib/*/libVkLayer_khronos_validation.so))
 ASAN_ENV := ASAN_OPTIONS=detect_leaks=1:abort_on_error=0:strict_string_checks=1:verify_asan_link_order=0 \
             LSAN_OPTIONS=suppressions=$(CURDIR)/.ci/lsan.supp:print_suppressions=0 \
             UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
-            $(if $(LVP_SO),LD_PRELOAD=$(LVP_SO))
+            $(if $(LVP_SO)$(VVL_SO),LD_PRELOAD="$(strip $(LVP_SO) $(VVL_SO))")
 
 .PHONY: all deps configure build test test-asan demo gallery bench bench-smoke fuzz clean
 

@@ -132,6 +132,17 @@ static bool create_instance(rt_device *d, const rt_device_desc *desc, rt_error *
         .pfnUserCallback = on_message,
         .pUserData = d,
     };
+    /* synchronization validation too: hazards between the frame's passes
+     * (render_plan.c's barriers) and between submissions */
+    static const VkValidationFeatureEnableEXT sync[] = {
+        VK_VALIDATION_FEATURE_ENABLE_SYNCHRONIZATION_VALIDATION_EXT,
+    };
+    VkValidationFeaturesEXT features = {
+        .sType = VK_STRUCTURE_TYPE_VALIDATION_FEATURES_EXT,
+        .enabledValidationFeatureCount = 1,
+        .pEnabledValidationFeatures = sync,
+    };
+    mci.pNext = &features;
     VkInstanceCreateInfo ci = {
         .sType = VK_STRUCTURE_TYPE_INSTANCE_CREATE_INFO,
         .pNext = validate ? &mci : NULL,
@@ -149,6 +160,7 @@ static bool create_instance(rt_device *d, const rt_device_desc *desc, rt_error *
         if (!create)
             return rt_fail(e, RT_E_VULKAN, "vkGetInstanceProcAddr(vkCreateDebugUtilsMessengerEXT)",
                            "not found");
+        mci.pNext = NULL;   /* the features were the instance's */
         RT_VK(e, create(d->instance, &mci, NULL, &d->messenger));
     }
     return true;

@@ -3,7 +3,7 @@
  * paths), and the far shading shader: the screen path sends tiles wholly
  * beyond the far distance to its compute variant (screen.c), the forward
  * path draws quadtree patches wholly beyond it with its fragment variant
- * (render.c).  The shader is the prelude of the stage (abi.h) around a
+ * (render_record.c).  The shader is the prelude of the stage (abi.h) around a
  * main that reads albedo, normal and roughness from the atlas with the
  * pixel's own gradients (FC5's plane-through-the-pixel derivatives, as the
  * composites take theirs) and calls splat_finish: the same lighting, fog

@@ -707,12 +707,12 @@ bool rt_pipelines_reset_combos(rt_device *d, const rt_pack *p, rt_pipelines *pl,
 /* Saves the cache (if it has a path) and destroys everything. */
 void rt_pipelines_destroy(rt_device *d, rt_pipelines *pl);
 
-/* ---- render.c: the frame ----------------------------------------------- */
+/* ---- render_views.c: cameras ----------------------------------------------- */
 
 /* The camera's vertical field of view in radians (its default if unset). */
 double rt_camera_fovy(const rt_camera *c);
 
-/* ---- screen.c: screen-space shading (render.c drives it) -------------- */
+/* ---- screen.c: screen-space shading (render_record.c drives it) -------------- */
 
 typedef struct rt_screen rt_screen;
 typedef struct rt_far rt_far;   /* far.c */
@@ -743,17 +743,26 @@ void rt_screen_depth_out(rt_screen *s, VkCommandBuffer cb, const rt_image *depth
 void rt_screen_destroy(rt_screen *s);
 /* The geometry pass: depth only, ends in SHADER_READ_ONLY_OPTIMAL. */
 VkRenderPass rt_screen_depth_pass(const rt_screen *s, VkFramebuffer *fb);
-/* Before the geometry pass: reset the list counts (and the counters). */
+/* The passes of the screen path (render_plan.c places the barriers
+ * between them): reset the list counts (and the counters), by transfers. */
 void rt_screen_begin(rt_screen *s, VkCommandBuffer cb, bool count);
-/* After it: the background, the classification (force_uber: every tile
- * to the über-shader's list; no_classes: no distance class variants). */
+/* The background, the classification (force_uber: every tile to the
+ * über-shader's list; no_classes: no distance class variants); the colour
+ * image is GENERAL. */
 void rt_screen_classify(rt_screen *s, VkCommandBuffer cb, VkDescriptorSet set0,
                         const float clear[4], bool force_uber, bool no_classes, int *binds);
-/* Then one indirect dispatch per list whose pipeline in `variant`
- * (RT_CVARIANT_*) exists; the colour image ends in TRANSFER_SRC_OPTIMAL. */
+/* One indirect dispatch per list whose pipeline in `variant`
+ * (RT_CVARIANT_*) exists. */
 bool rt_screen_dispatch(rt_screen *s, VkCommandBuffer cb, rt_pipelines *pl,
                         const VkDescriptorSet sets[2], unsigned variant, bool stand_in,
                         int *binds, rt_error *e);
+/* The far list from the far atlas, when it is on. */
+bool rt_screen_far_on(const rt_screen *s);
+bool rt_screen_dispatch_far(rt_screen *s, VkCommandBuffer cb, rt_pipelines *pl,
+                            const VkDescriptorSet sets[2], unsigned variant, int *binds,
+                            rt_error *e);
+/* The list counts and counters copied for the host (rt_screen_read_stats). */
+void rt_screen_counts(rt_screen *s, VkCommandBuffer cb);
 /* After the frame completed: compiles the pipelines of lists that got
  * tiles but were not dispatched; returns how many (> 0: draw the frame
  * again), -1 on error.  Lists the über-shader stood in for are queued on
@@ -788,7 +797,7 @@ char *rt_far_glsl(const rt_pack *p, bool count);
 bool  rt_far_bind_forward(rt_far *f, const rt_pack *p, const rt_passes *rp, rt_pipelines *pl,
                           VkCommandBuffer cb, unsigned variant, rt_error *e);
 
-/* ---- undergrowth.c: cells, generation, drawing (render.c drives it) ---- */
+/* ---- undergrowth.c: cells, generation, drawing (render_record.c drives it) ---- */
 
 typedef struct rt_ug rt_ug;
 
@@ -802,6 +811,8 @@ typedef struct rt_ug rt_ug;
 bool rt_far_bake(rt_device *d, const rt_pack *p, rt_pipelines *pl, VkDescriptorSet set0,
                  VkDescriptorSet set1, const splat_frame *frame, int w, int h, float *albedo,
                  float *normal, float *rough, rt_far_bake_stats *st, rt_error *e);
+/* How many combinations the leaf cells name, each once. */
+int rt_far_bake_combos(const rt_pack *p);
 
 typedef struct rt_ug_targets {
     const rt_image *color, *depth, *height;
@@ -816,11 +827,14 @@ typedef struct rt_ug_targets {
 bool rt_ug_create(rt_device *d, const rt_pack *p, rt_pipelines *pl, const rt_quadtree *qt,
                   const rt_ug_targets *t, double radius, rt_ug **out, rt_error *e);
 void rt_ug_destroy(rt_ug *u);
-/* Allocate the cells around the camera and record the generation of up to
- * `budget` pending ones (<= 0: all), frustum first, near first. */
-bool rt_ug_generate(rt_ug *u, VkCommandBuffer cb, const rt_camera *c, const splat_frame *fr,
-                    VkDescriptorSet set1, int budget, rt_error *e);
-/* Whether a generated cell is in the frustum (else nothing to draw: the
+/* Allocate the cells around the camera (on the CPU: which are visible),
+ * then record the generation of up to `budget` pending ones (<= 0: all),
+ * frustum first, near first. */
+void rt_ug_prepare(rt_ug *u, const rt_camera *c, const splat_frame *fr);
+bool rt_ug_generate(rt_ug *u, VkCommandBuffer cb, const splat_frame *fr, VkDescriptorSet set1,
+                    int budget, rt_error *e);
+/* After rt_ug_prepare: whether a cell generated by now or by this frame's
+ * rt_ug_generate (budget 0) is in the frustum (else nothing to draw: the
  * pass and, on the screen path, the depth copy are left out). */
 bool rt_ug_visible(const rt_ug *u);
 /* After the terrain: the instances of the visible cells, front to back;

@@ -1,5 +1,5 @@
 /* screen.c — screen-space terrain shading (Moore 2018, "Screen Space
- * Shading"): after a depth-only geometry pass (render.c draws the patches
+ * Shading"): after a depth-only geometry pass (render_record.c draws the patches
  * with rt_pipelines_depth), a classification compute pass takes, per 8x8
  * pixel tile, the union of the material sets of the leaf cells its terrain
  * pixels fall in (the pack's level-0 combination map), picks the cheapest
@@ -560,19 +560,13 @@ void rt_screen_begin(rt_screen *s, VkCommandBuffer cb, bool count)
     vkCmdCopyBuffer(cb, s->args_reset.buf, s->args.buf, 1, &c);
     if (count)
         vkCmdFillBuffer(cb, s->counters.buf, 0, sizeof(splat_counters), 0);
-    rt_cmd_barrier(cb, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
-                   VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
-                   VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
 }
 
 void rt_screen_classify(rt_screen *s, VkCommandBuffer cb, VkDescriptorSet set0,
                         const float clear[4], bool force_uber, bool no_classes, int *binds)
 {
-    /* the colour image for storage writes: the classification writes the
-     * background of empty pixels, shading the terrain's */
-    rt_cmd_image_barrier(cb, s->color_img, 0, 1, 1, VK_IMAGE_LAYOUT_UNDEFINED,
-                         VK_IMAGE_LAYOUT_GENERAL, 0, VK_ACCESS_SHADER_WRITE_BIT,
-                         VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT);
+    /* the colour image is GENERAL (render_plan.c): the classification
+     * writes the background of empty pixels, shading the terrain's */
     vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, s->classify);
     vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, s->layout, 0, 1, &set0, 0, NULL);
     vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, s->layout, 2, 1, &s->set, 0, NULL);
@@ -604,20 +598,17 @@ void rt_screen_classify(rt_screen *s, VkCommandBuffer cb, VkDescriptorSet set0,
     else
         vkCmdDispatch(cb, (uint32_t)(s->ntiles + 63) / 64, 1, 1);
     (*binds)++;
+    if (!s->sort)
+        return;   /* the shading's wait for the lists: render_plan.c */
     rt_cmd_barrier(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
                    VK_PIPELINE_STAGE_DRAW_INDIRECT_BIT | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
                    VK_ACCESS_INDIRECT_COMMAND_READ_BIT | VK_ACCESS_SHADER_READ_BIT);
-    if (!s->sort)
-        return;
     vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, s->group);
     memset(&push, 0, sizeof push);
     push.info[0] = (uint32_t)s->nlists;
     vkCmdPushConstants(cb, s->layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof push, &push);
     vkCmdDispatch(cb, (uint32_t)(s->nlists + 63) / 64, 1, 1);
     (*binds)++;
-    rt_cmd_barrier(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
-                   VK_PIPELINE_STAGE_DRAW_INDIRECT_BIT | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
-                   VK_ACCESS_INDIRECT_COMMAND_READ_BIT | VK_ACCESS_SHADER_READ_BIT);
 }
 
 /* List k's indirect dispatch with the pipeline bound: workgroup g shades
@@ -669,40 +660,43 @@ bool rt_screen_dispatch(rt_screen *s, VkCommandBuffer cb, rt_pipelines *pl,
         (*binds)++;
         dispatch_list(s, cb, pl->compute_layout, k, variant, (variant & RT_CVARIANT_SORT) != 0);
     }
-    if (s->far_ok && s->far_distance > 0) {
-        int k = p->ncombos + 1, c = (variant & RT_CVARIANT_COUNT) != 0;
-        if (!s->far_pipe[c]) {
-            char *src = rt_far_glsl(p, c);
-            if (!src)
-                return rt_fail(e, RT_E_VULKAN, "far atlas shader", "no über compute GLSL");
-            bool ok = rt_vk_compute(d, &s->keep, &(rt_vk_compute_desc){ .label = "far.comp",
-                                        .glsl = src, .layout = s->layout, .cache = pl->cache },
-                                    &s->far_pipe[c], e);
-            free(src);
-            if (!ok)
-                return false;
-        }
-        VkDescriptorSet all[3] = { sets[0], sets[1], s->set };
-        vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, s->layout, 0, 3, all, 0, NULL);
-        vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, s->far_pipe[c]);
-        (*binds)++;
-        dispatch_list(s, cb, s->layout, k, variant, false);
+    return true;
+}
+
+bool rt_screen_far_on(const rt_screen *s) { return s->far_ok && s->far_distance > 0; }
+
+bool rt_screen_dispatch_far(rt_screen *s, VkCommandBuffer cb, rt_pipelines *pl,
+                            const VkDescriptorSet sets[2], unsigned variant, int *binds,
+                            rt_error *e)
+{
+    rt_device *d = s->d;
+    const rt_pack *p = s->p;
+    int k = p->ncombos + 1, c = (variant & RT_CVARIANT_COUNT) != 0;
+    if (!s->far_pipe[c]) {
+        char *src = rt_far_glsl(p, c);
+        if (!src)
+            return rt_fail(e, RT_E_VULKAN, "far atlas shader", "no über compute GLSL");
+        bool ok = rt_vk_compute(d, &s->keep, &(rt_vk_compute_desc){ .label = "far.comp",
+                                    .glsl = src, .layout = s->layout, .cache = pl->cache },
+                                &s->far_pipe[c], e);
+        free(src);
+        if (!ok)
+            return false;
     }
-    rt_cmd_image_barrier(cb, s->color_img, 0, 1, 1, VK_IMAGE_LAYOUT_GENERAL,
-                         VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_ACCESS_SHADER_WRITE_BIT,
-                         VK_ACCESS_TRANSFER_READ_BIT | VK_ACCESS_SHADER_READ_BIT,
-                         VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
-                         VK_PIPELINE_STAGE_TRANSFER_BIT | VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT);
-    /* the list counts and counters back to the host */
-    rt_cmd_barrier(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
-                   VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_READ_BIT);
+    VkDescriptorSet all[3] = { sets[0], sets[1], s->set };
+    vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, s->layout, 0, 3, all, 0, NULL);
+    vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, s->far_pipe[c]);
+    (*binds)++;
+    dispatch_list(s, cb, s->layout, k, variant, false);
+    return true;
+}
+
+void rt_screen_counts(rt_screen *s, VkCommandBuffer cb)
+{
     VkBufferCopy ca = { 0, 0, (VkDeviceSize)s->nlists * 12 };
     VkBufferCopy cc = { 0, (VkDeviceSize)s->nlists * 12, sizeof(splat_counters) };
     vkCmdCopyBuffer(cb, s->args.buf, s->readback.buf, 1, &ca);
     vkCmdCopyBuffer(cb, s->counters.buf, s->readback.buf, 1, &cc);
-    rt_cmd_barrier(cb, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
-                   VK_PIPELINE_STAGE_HOST_BIT, VK_ACCESS_HOST_READ_BIT);
-    return true;
 }
 
 int rt_screen_missing(rt_screen *s, rt_pipelines *pl, unsigned variant, rt_error *e)

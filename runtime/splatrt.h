@@ -436,6 +436,12 @@ bool rt_renderer_frame(rt_renderer *r, const rt_camera *c,
                        rt_frame_stats *st, rt_error *e);
 /* The last frame's colour as RGBA32F, top row first (w * h * 4 floats). */
 bool rt_renderer_read(rt_renderer *r, float *rgba, rt_error *e);
+/* The last frame's plan (runtime/render_plan.c): its passes in order, what
+ * each reads and writes; with `times` each one's GPU time, measured when
+ * set_pass_times is on (a timestamp after every pass; off by default:
+ * a few, the frame's and the screen path's three parts). */
+void rt_renderer_print_plan(const rt_renderer *r, FILE *out, bool times);
+void rt_renderer_set_pass_times(rt_renderer *r, bool on);
 /* Replace the combination pipelines with those of a new pack of the same
  * terrain (hot reload); on failure the old ones stay.  Refused
  * (RT_E_RELOAD naming the input) when the pack's data differ from what was

@@ -55,6 +55,7 @@ typedef struct opts {
     bool no_undergrowth;
     bool no_distance_classes;
     bool check;            /* --check: load and set up, draw nothing       */
+    bool print_plan;       /* --print-plan: the last frame's passes        */
     int async_pipelines;   /* --async-pipelines: 1 on, 0 off, -1 default */
     int split_uncovered;   /* --uncovered: 1 split, 0 uber                 */
     int width, height, frames;
@@ -251,6 +252,9 @@ static const splat_arg options[] = {
     { "--check", SPLAT_ARG_FLAG, NULL, "load the pack and set up a renderer on the device, "
       "draw nothing: exit 0 if the runtime takes the pack", F(check),
       .parse = check_implies_headless },
+    { "--print-plan", SPLAT_ARG_FLAG, NULL, "headless: print the frame's passes, what each "
+      "reads and writes (with --stats each pass's GPU time)", F(print_plan),
+      .parse = check_implies_headless },
     { NULL, SPLAT_ARG_SECTION, .help = "Camera and view:" },
     { "--camera", SPLAT_ARG_CUSTOM, "X,Y,Z", "camera position in terrain-local metres (with "
       "--look)", .parse = parse_camera, .given = GIVEN(have_camera) },
@@ -377,7 +381,7 @@ static int parse_args(int argc, char **argv, opts *o)
         fprintf(stderr, "splatview: --camera and --look go together\n");
         return 2;
     }
-    if (o->headless && !o->out && !o->float_out && !o->stats && !o->check) {
+    if (o->headless && !o->out && !o->float_out && !o->stats && !o->check && !o->print_plan) {
         fprintf(stderr, "splatview: --headless needs -o OUT.png, --float-out or --stats\n");
         return 2;
     }
@@ -762,10 +766,14 @@ static int headless(const opts *o)
     rt_frame_stats st = { 0 };
     /* the cost view needs the counting variant's counters */
     rt_renderer_set_counting(r, view == SPLAT_VIEW_COST);
+    rt_renderer_set_pass_times(r, o->print_plan && o->stats);
     if (!run_frames(o, r, &cam, &t, &st, &e) ||
         ((o->out || o->float_out) &&
-         !write_pictures(o, dev, pack, r, view, material, &st, W, H, &e)) ||
-        (o->stats && !print_stats(o, dev, pack, r, &cam, view, &st, &t, W, H, &e)))
+         !write_pictures(o, dev, pack, r, view, material, &st, W, H, &e)))
+        goto done;
+    if (o->print_plan)   /* the last frame's, its readback; before --stats' counting frame */
+        rt_renderer_print_plan(r, stdout, o->stats);
+    if (o->stats && !print_stats(o, dev, pack, r, &cam, view, &st, &t, W, H, &e))
         goto done;
     status = 0;
 done:

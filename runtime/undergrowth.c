@@ -80,9 +80,11 @@ static bool make_pass(rt_ug *u, VkImageLayout depth_in, VkRenderPass *out, rt_er
           VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT | VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT,
           VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT | VK_ACCESS_COLOR_ATTACHMENT_READ_BIT |
           VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT | VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_READ_BIT, 0 },
-        { 0, VK_SUBPASS_EXTERNAL, VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT,
+        /* the depth's store (and a final layout move) after its tests */
+        { 0, VK_SUBPASS_EXTERNAL, VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT |
+          VK_PIPELINE_STAGE_LATE_FRAGMENT_TESTS_BIT,
           VK_PIPELINE_STAGE_TRANSFER_BIT | VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT,
-          VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT,
+          VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT | VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT,
           VK_ACCESS_TRANSFER_READ_BIT | VK_ACCESS_SHADER_READ_BIT, 0 },
     };
     const VkImageLayout src = VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL;
@@ -658,26 +660,31 @@ static void reset_args(rt_ug *u, VkCommandBuffer cb, int slot)
                       (VkDeviceSize)u->nblocks * 20, a);
 }
 
-bool rt_ug_generate(rt_ug *u, VkCommandBuffer cb, const rt_camera *c, const splat_frame *fr,
-                    VkDescriptorSet set1, int budget, rt_error *e)
+void rt_ug_prepare(rt_ug *u, const rt_camera *c, const splat_frame *fr)
 {
-    u->generated = 0;
     u->time = c->time;
     u->cam_xz[0] = (float)c->position[0];
     u->cam_xz[1] = (float)c->position[2];
     allocate(u, c, fr->view_proj);
-    /* the mask pass's frame block: this frame's, seen from the origin */
+}
+
+bool rt_ug_generate(rt_ug *u, VkCommandBuffer cb, const splat_frame *fr, VkDescriptorSet set1,
+                    int budget, rt_error *e)
+{
+    /* the mask pass's frame block: this frame's (the craters' table
+     * included), seen from the origin */
     splat_frame *uf = u->frame.map;
     *uf = *fr;
     memset(uf->camera, 0, sizeof uf->camera);
     for (int k = 0; k < u->p->nsites; k++)
         for (int a = 0; a < 4; a++)
             uf->world[4 * k + a] = 0.0f;
+    u->generated = 0;
     if (u->qpool) {
         vkCmdResetQueryPool(cb, u->qpool, 0, 4);
         vkCmdWriteTimestamp(cb, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, u->qpool, 0);
     }
-    int todo[1024], n = 0;
+    int todo[UG_TODO], n = 0;
     for (int i = 0; i < u->pool && n < (int)(sizeof todo / sizeof *todo); i++) {
         int k = u->order[i];
         if (u->cells[k].state == CELL_PENDING && (budget <= 0 || n < budget))
@@ -719,9 +726,10 @@ bool rt_ug_generate(rt_ug *u, VkCommandBuffer cb, const rt_camera *c, const spla
             vkCmdDispatch(cb, (uint32_t)u->nblocks, 1, 1);
             u->cells[todo[i]].state = CELL_READY;
         }
+        /* the draw, the copy below, the LOD pass and the probes read them */
         rt_cmd_barrier(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
                        VK_PIPELINE_STAGE_DRAW_INDIRECT_BIT | VK_PIPELINE_STAGE_VERTEX_SHADER_BIT |
-                           VK_PIPELINE_STAGE_TRANSFER_BIT,
+                           VK_PIPELINE_STAGE_TRANSFER_BIT | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
                        VK_ACCESS_INDIRECT_COMMAND_READ_BIT | VK_ACCESS_SHADER_READ_BIT |
                            VK_ACCESS_TRANSFER_READ_BIT);
         /* the counts, for the stats and the tests (read after the frame) */
@@ -739,7 +747,8 @@ bool rt_ug_generate(rt_ug *u, VkCommandBuffer cb, const rt_camera *c, const spla
     vkCmdPushConstants(cb, u->lod_layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof pc, pc);
     vkCmdDispatch(cb, (pc[0] + 63) / 64, 1, 1);
     rt_cmd_barrier(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
-                   VK_PIPELINE_STAGE_DRAW_INDIRECT_BIT, VK_ACCESS_INDIRECT_COMMAND_READ_BIT);
+                   VK_PIPELINE_STAGE_DRAW_INDIRECT_BIT | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+                   VK_ACCESS_INDIRECT_COMMAND_READ_BIT | VK_ACCESS_SHADER_READ_BIT);
     if (u->qpool)   /* bottom of pipe: when everything before has finished */
         vkCmdWriteTimestamp(cb, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, u->qpool, 1);
     u->generated = n;
@@ -748,9 +757,15 @@ bool rt_ug_generate(rt_ug *u, VkCommandBuffer cb, const rt_camera *c, const spla
 
 bool rt_ug_visible(const rt_ug *u)
 {
-    for (int i = 0; u && i < u->pool; i++)
-        if (u->cells[i].state == CELL_READY && u->cells[i].visible)
+    /* ready, or pending and among those rt_ug_generate takes (all of
+     * them, up to UG_TODO, in the pool's order) */
+    for (int i = 0, pending = 0; u && i < u->pool; i++) {
+        const ug_cell *cl = &u->cells[u->order[i]];
+        bool ready = cl->state == CELL_READY ||
+                     (cl->state == CELL_PENDING && pending++ < UG_TODO);
+        if (ready && cl->visible)
             return true;
+    }
     return false;
 }
 

@@ -8,6 +8,7 @@
 #include "rt_internal.h"
 #include "vk_build.h"
 
+#define UG_TODO 1024   /* cells generated per frame at most */
 #define CELL    SPLAT_UG_CELL        /* metres per cell side (abi.h)        */
 #define TEXELS  SPLAT_UG_TEXELS      /* mask texels per cell side           */
 /* Distance LOD: beyond LOD_NEAR metres a cell draws the fraction
