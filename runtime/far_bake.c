@@ -60,8 +60,11 @@ static bool bake_pipeline(far_baker *fb, int combo, VkPipeline *out, rt_error *e
             free(src);
             return rt_fail(e, RT_E_VULKAN, "far atlas bake", "out of memory");
         }
-        bool ok = rt_glsl_compute_pipeline(fb->d, fb->pl->cache, fb->layout, src, name, &in,
-                                           &fb->pipes[combo], e);
+        /* no destroy list: the workers make these at once (the list is
+         * not thread-safe); rt_far_bake_destroy destroys them */
+        bool ok = rt_vk_compute(fb->d, NULL, &(rt_vk_compute_desc){ .label = name, .glsl = src,
+                                    .check = &in, .layout = fb->layout, .cache = fb->pl->cache },
+                                &fb->pipes[combo], e);
         rt_interface_free(&in);
         free(src);
         if (!ok)

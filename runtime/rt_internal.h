@@ -319,10 +319,6 @@ struct rt_interface;
 bool rt_glsl_module(rt_device *d, const char *glsl, VkShaderStageFlagBits stage,
                     const char *name, const struct rt_interface *check, VkShaderModule *out,
                     rt_error *e);
-/* A compute pipeline over `layout` from GLSL (rt_glsl_module). */
-bool rt_glsl_compute_pipeline(rt_device *d, VkPipelineCache cache, VkPipelineLayout layout,
-                              const char *glsl, const char *name,
-                              const struct rt_interface *check, VkPipeline *out, rt_error *e);
 
 /* ---- jobs.c: independent jobs on every core ------------------------- */
 

@@ -5,7 +5,6 @@
  * brings is validated before the driver sees it, so a corrupt file is an
  * error message, never a validation error or a driver crash. */
 #include "rt_internal.h"
-#include "vk_build.h"
 
 #include <stdlib.h>
 
@@ -61,12 +60,4 @@ bool rt_glsl_module(rt_device *d, const char *glsl, VkShaderStageFlagBits stage,
     }
     free(w);
     return ok;
-}
-
-bool rt_glsl_compute_pipeline(rt_device *d, VkPipelineCache cache, VkPipelineLayout layout,
-                              const char *glsl, const char *name, const rt_interface *check,
-                              VkPipeline *out, rt_error *e)
-{
-    return rt_vk_compute(d, NULL, &(rt_vk_compute_desc){ .label = name, .glsl = glsl,
-                             .check = check, .layout = layout, .cache = cache }, out, e);
 }

@@ -58,6 +58,11 @@ static bool make(rt_device *d, rt_vk_list *k, const rt_image *color, const rt_im
                                        VK_SHADER_STAGE_COMPUTE_BIT, NULL };
     VkDescriptorPoolSize size = { VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1 };
     VkImageView views[2] = { color->view, depth->view };
+    /* the colour's writes and its move to TRANSFER_SRC before the copy */
+    static const VkSubpassDependency to_copy = {
+        0, VK_SUBPASS_EXTERNAL, VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT,
+        VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT,
+        VK_ACCESS_TRANSFER_READ_BIT, 0 };
     return rt_vk_sampler(d, k, &(rt_vk_sampler_desc){ .label = "test" }, &o->smp, e) &&
            rt_vk_set_layout(d, k, &(rt_vk_set_layout_desc){ "test", &b, 1 }, &o->sl, e) &&
            rt_vk_layout(d, k, &(rt_vk_layout_desc){ .label = "test",
@@ -73,7 +78,8 @@ static bool make(rt_device *d, rt_vk_list *k, const rt_image *color, const rt_im
                           .depth = { .format = VK_FORMAT_D32_SFLOAT,
                                      .load = VK_ATTACHMENT_LOAD_OP_CLEAR,
                                      .store = VK_ATTACHMENT_STORE_OP_DONT_CARE,
-                                     .final = VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL } },
+                                     .final = VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL },
+                          .deps = &to_copy, .ndeps = 1 },
                       &o->pass, e) &&
            rt_vk_fb(d, k, &(rt_vk_fb_desc){ .label = "test", .pass = o->pass, .views = views,
                         .nviews = 2, .width = W, .height = H }, &o->fb, e) &&
