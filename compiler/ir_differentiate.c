@@ -8,8 +8,8 @@
  * duv/dy), which the emitter writes as splat_texture_grad (abi.c:
  * textureLod at textureGrad's level).  The gradients are IR,
  * built from the uv's expression by the chain rule: each op's row of the
- * op table (ir_ops.c) carries its derivative rule next to its GLSL, double
- * and interval semantics, and the leaves are
+ * op table (IR_OPS, ir.h) names its derivative rule (ir_derive_rules.c)
+ * next to its GLSL, double and interval semantics, and the leaves are
  *     terrain.position, .height, .uv, view.distance, view.direction
  *         -> DINPUT(input, axis): the prelude's splat_d_<input>(axis), from
  *            FC5's plane-ray intersection in both stages (abi.c)
