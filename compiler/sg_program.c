@@ -46,3 +46,37 @@ const sg_undergrowth *sg_undergrowth_get(const sg_program *p, int material, int 
 {
     return &p->shaders[p->materials[material]]->ug[k];
 }
+
+/* ---- shaders and their outputs ---------------------------------------- */
+
+const char *const sg_output_names[SG_OUT_COUNT] = {
+#define X(id, name, type) name,
+    SG_OUTPUTS(X)
+#undef X
+};
+
+
+int sg_shader_find(const sg_program *p, const char *name)
+{
+    int g = sg_map_get(&p->globals, name);
+    if (g < 0 || (g & 1) != SG_G_SHADER || p->shaders[g >> 1]->is_material)
+        return -1;
+    return g >> 1;
+}
+
+ir_type sg_node_output_type(const sg_program *p, const sg_shader *s,
+                            const sg_node *n, int index)
+{
+    switch (n->kind) {
+    case SG_NODE_OP:
+    case SG_NODE_INPUT:
+    case SG_NODE_PAINTED:
+        return index == 0 ? n->out_type : IR_T_ERROR;
+    case SG_NODE_INSTANCE: {
+        const sg_shader *c = p->shaders[n->shader];
+        return index < c->nouts ? c->outs[index].type : IR_T_ERROR;
+    }
+    default:
+        return IR_T_ERROR;
+    }
+}

@@ -22,6 +22,7 @@ if(SPLAT_FUZZ)
   endif()
   # the front end compiled into its target (as before: no runtime needed)
   set(FUZZ_FRONTEND abi.c sg_util.c diag.c lex.c parse_base.c parse.c parse_undergrowth.c parse_scene.c
+                    resolve_names.c resolve_types.c resolve_order.c texture_files.c
                     load.c sg_program.c scene_check.c resolve.c lower.c ir.c ir_ops.c
                     ir_differentiate.c ir_derive_rules.c ir_rebuild.c util.c opt.c opt_fold.c opt_dce.c
                     opt_dedup.c opt_pin.c ir_interval.c ir_validate.c
