@@ -6,7 +6,7 @@
 #ifndef SPLAT_TESTS_CHECK_H
 #define SPLAT_TESTS_CHECK_H
 
-#include "scene.h"
+#include "splatc.h"   /* libsplatc's public header: splat_build, diagnostics */
 #include "splatrt.h"
 
 #include <stdio.h>

@@ -33,6 +33,7 @@
  * diff_*.png (red: over 8/255, grey: the difference times 16). */
 #include "rt_internal.h"
 #include "../check.h"
+#include "scene_load.h"   /* the compiler's scene, to sample its composite on the CPU */
 
 #include <math.h>
 #include <stdio.h>
