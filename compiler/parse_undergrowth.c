@@ -79,6 +79,79 @@ static void check_ug_texture(parser *ps, const char *path, sg_loc at)
     fclose(f);
 }
 
+/* An unknown setting: reported with a "did you mean", then its value
+ * skipped (vec3(…) whole), then to ',', '}' or the next line. */
+static void ug_unknown(parser *ps, sg_token *key)
+{
+    sg_errorf(ps->d, ps_loc_of(ps, key), SG_E_BAD_OPTION, "unknown undergrowth setting '%.*s' "
+              "(expected " UG_KEY_LIST ")", key->len, key->start);
+    ps_hint_key(ps, key, sg_ug_keys);
+    ps_next(ps);
+    sg_value v;
+    if (ps_accept(ps, SG_TK_EQ) && ps_cur(ps)->kind != SG_TK_RBRACE)
+        ps_value(ps, &v);
+    while (ps_cur(ps)->kind != SG_TK_EOF && ps_cur(ps)->kind != SG_TK_RBRACE &&
+           ps_cur(ps)->kind != SG_TK_COMMA && ps_cur(ps)->line == key->line)
+        ps_next(ps);
+    ps_accept(ps, SG_TK_COMMA);
+}
+
+/* cutout = "none" | "frond" | "alpha" */
+static bool ug_cutout(parser *ps, sg_undergrowth *u, sg_loc vloc)
+{
+    sg_token *vt = ps_cur(ps);
+    char buf[96];
+    if (ps_is_kw(vt, "none") || ps_is_kw(vt, "frond") || ps_is_kw(vt, "alpha")) {
+        u->cutout = ps_is_kw(vt, "frond") ? SG_UG_CUT_FROND
+                  : ps_is_kw(vt, "alpha") ? SG_UG_CUT_ALPHA : SG_UG_CUT_NONE;
+    } else {
+        if (vt->kind != SG_TK_IDENT && vt->kind != SG_TK_NUMBER && vt->kind != SG_TK_STRING) {
+            ps_expected(ps, "none, frond or alpha");
+            return false;
+        }
+        sg_errorf(ps->d, vloc, SG_E_SETTING, "'cutout' must be none, frond or alpha, "
+                  "found %s", sg_tok_describe(vt, buf, sizeof buf));
+    }
+    ps_next(ps);
+    return true;
+}
+
+/* wind_dir = NUM NUM, a direction in the ground plane (normalised) */
+static bool ug_wind_dir(parser *ps, sg_undergrowth *u, sg_loc vloc)
+{
+    double x, z;
+    if (!ps_number(ps, &x) || !ps_number(ps, &z))
+        return false;
+    double len = hypot(x, z);
+    if (!(len > 1e-6 && len <= 1e6)) {
+        sg_errorf(ps->d, vloc, SG_E_SETTING, "'wind_dir' must be X Z, a direction in the "
+                  "ground plane (not 0 0, each at most 1e6), found %g %g", x, z);
+        return true;
+    }
+    u->wind_dir[0] = x / len;
+    u->wind_dir[1] = z / len;
+    return true;
+}
+
+/* color = vec3(r, g, b), linear, each in [0, 1] */
+static bool ug_color(parser *ps, sg_undergrowth *u, sg_loc vloc)
+{
+    sg_value v;
+    if (!ps_value(ps, &v))
+        return false;
+    if (v.kind != SG_V_VEC || v.width != 3) {
+        sg_errorf(ps->d, vloc, SG_E_SETTING, "'color' must be vec3(r, g, b), "
+                  "linear, each in [0, 1]");
+        return true;
+    }
+    if (!(v.num[0] >= 0 && v.num[0] <= 1 && v.num[1] >= 0 && v.num[1] <= 1 &&
+          v.num[2] >= 0 && v.num[2] <= 1))
+        sg_errorf(ps->d, vloc, SG_E_SETTING, "'color' components must be in [0, 1] "
+                  "(linear), found vec3(%g, %g, %g)", v.num[0], v.num[1], v.num[2]);
+    memcpy(u->color, v.num, sizeof u->color);
+    return true;
+}
+
 /* ug_setting = "density" "=" NUM | "scale" "=" NUM [ NUM ]
  *            | "align" "=" ("normal" | "upright") | "blend" "=" NUM
  *            | "color" "=" "vec3" "(" NUM "," NUM "," NUM ")"
@@ -100,18 +173,7 @@ static bool ug_stmt(parser *ps, void *user)
     while (k < UG_NKEYS && !ps_is_kw(key, sg_ug_keys[k]))
         k++;
     if (k == UG_NKEYS) {
-        sg_errorf(ps->d, kloc, SG_E_BAD_OPTION, "unknown undergrowth setting '%.*s' "
-                  "(expected " UG_KEY_LIST ")", key->len, key->start);
-        ps_hint_key(ps, key, sg_ug_keys);
-        /* skip its value (vec3(…) whole), then to ',', '}' or the next line */
-        ps_next(ps);
-        sg_value v;
-        if (ps_accept(ps, SG_TK_EQ) && ps_cur(ps)->kind != SG_TK_RBRACE)
-            ps_value(ps, &v);
-        while (ps_cur(ps)->kind != SG_TK_EOF && ps_cur(ps)->kind != SG_TK_RBRACE &&
-               ps_cur(ps)->kind != SG_TK_COMMA && ps_cur(ps)->line == key->line)
-            ps_next(ps);
-        ps_accept(ps, SG_TK_COMMA);
+        ug_unknown(ps, key);
         return true;
     }
     if (up->seen[k].line)
@@ -155,41 +217,17 @@ static bool ug_stmt(parser *ps, void *user)
             return false;
         break;
     case 7:
-    {
-        sg_token *vt = ps_cur(ps);
-        char buf[96];
-        if (ps_is_kw(vt, "none") || ps_is_kw(vt, "frond") || ps_is_kw(vt, "alpha")) {
-            u->cutout = ps_is_kw(vt, "frond") ? SG_UG_CUT_FROND
-                      : ps_is_kw(vt, "alpha") ? SG_UG_CUT_ALPHA : SG_UG_CUT_NONE;
-        } else {
-            if (vt->kind != SG_TK_IDENT && vt->kind != SG_TK_NUMBER && vt->kind != SG_TK_STRING) {
-                ps_expected(ps, "none, frond or alpha");
-                return false;
-            }
-            sg_errorf(ps->d, vloc, SG_E_SETTING, "'cutout' must be none, frond or alpha, "
-                      "found %s", sg_tok_describe(vt, buf, sizeof buf));
-        }
-        ps_next(ps);
+        if (!ug_cutout(ps, u, vloc))
+            return false;
         break;
-    }
     case 8:
         if (!ug_number(ps, "wind", 0, SPLAT_MAX_UG_WIND, false, &u->wind))
             return false;
         break;
-    case 9: {
-        double x, z;
-        if (!ps_number(ps, &x) || !ps_number(ps, &z))
+    case 9:
+        if (!ug_wind_dir(ps, u, vloc))
             return false;
-        double len = hypot(x, z);
-        if (!(len > 1e-6 && len <= 1e6)) {
-            sg_errorf(ps->d, vloc, SG_E_SETTING, "'wind_dir' must be X Z, a direction in the "
-                      "ground plane (not 0 0, each at most 1e6), found %g %g", x, z);
-            break;
-        }
-        u->wind_dir[0] = x / len;
-        u->wind_dir[1] = z / len;
         break;
-    }
     case 10:
         if (!ug_number(ps, "gust", 0, 1, false, &u->gust))
             return false;
@@ -211,22 +249,10 @@ static bool ug_stmt(parser *ps, void *user)
         ps_next(ps);
         break;
     }
-    case 4: {
-        sg_value v;
-        if (!ps_value(ps, &v))
+    case 4:
+        if (!ug_color(ps, u, vloc))
             return false;
-        if (v.kind != SG_V_VEC || v.width != 3) {
-            sg_errorf(ps->d, vloc, SG_E_SETTING, "'color' must be vec3(r, g, b), "
-                      "linear, each in [0, 1]");
-            break;
-        }
-        if (!(v.num[0] >= 0 && v.num[0] <= 1 && v.num[1] >= 0 && v.num[1] <= 1 &&
-              v.num[2] >= 0 && v.num[2] <= 1))
-            sg_errorf(ps->d, vloc, SG_E_SETTING, "'color' components must be in [0, 1] "
-                      "(linear), found vec3(%g, %g, %g)", v.num[0], v.num[1], v.num[2]);
-        memcpy(u->color, v.num, sizeof u->color);
         break;
-    }
     }
     ps_accept(ps, SG_TK_COMMA);
     return true;
