@@ -158,6 +158,79 @@ static int node_noutputs(checker *c, const sg_node *n)
     return n->kind == SG_NODE_UNRESOLVED ? 0 : 1;
 }
 
+/* `n` or `n.port` for local node `node`: its output index into v (a
+ * swizzle `d.r` is `d.out.r` when r is not a port of d); *rest past the
+ * parts used. */
+static bool node_ref(checker *c, sg_value *v, int node, int *rest)
+{
+    sg_node *n = &c->s->nodes[node];
+    v->ref = SG_REF_NODE;
+    v->node = node;
+    v->index = 0;
+    if (n->kind == SG_NODE_UNRESOLVED)
+        return false;               /* already reported */
+    int nout = node_noutputs(c, n);
+    if (v->nparts == 1) {
+        if (nout != 1) {
+            char msg[300];
+            snprintf(msg, sizeof msg, "node '%s' has %d outputs: write '%s.<output>'",
+                     n->name, nout, n->name);
+            sg_error(c->d, v->loc, SG_E_BAD_REFERENCE, msg);
+            return false;
+        }
+    } else {
+        int port = node_port(c, n, v->parts[1]);
+        int dummy;
+        if (port >= 0) {
+            v->index = port;
+            *rest = 2;
+        } else if (swizzle_ok(v->parts[1], &dummy) &&
+                   (node_port(c, n, "out") >= 0 || nout == 1)) {
+            /* `d.r` is `d.out.r` when r is not a port of d */
+            v->index = node_port(c, n, "out") >= 0 ? node_port(c, n, "out") : 0;
+        } else {
+            sg_error(c->d, v->loc, SG_E_UNKNOWN_PORT, n->name, "output", v->parts[1]);
+            if (n->kind == SG_NODE_INSTANCE) {
+                const sg_shader *callee = c->p->shaders[n->shader];
+                sg_hint_suggest(c->d, rs_near_port(callee->outs, callee->nouts, v->parts[1]));
+            } else {
+                sg_suggest sg;
+                sg_suggest_init(&sg, v->parts[1]);
+                sg_suggest_offer(&sg, "out");
+                sg_hint_suggest(c->d, sg_suggest_best(&sg));
+            }
+            return false;
+        }
+    }
+    return true;
+}
+
+/* vector.NAME[.across] */
+static bool vector_ref(checker *c, sg_value *v, int *rest)
+{
+    char buf[256];
+    /* vector.NAME: the scene's spline or polygon NAME as a mask;
+     * vector.NAME.across: 0 on its centre line (or inside the
+     * polygon), 1 at the outer edge of its falloff and beyond.  The
+     * scene checks that NAME is one of its shapes (scene.c). */
+    v->ref = SG_REF_VECTOR;
+    v->index = 0;
+    v->type = IR_T_FLOAT;
+    *rest = 2;
+    if (v->nparts >= 3 && !strcmp(v->parts[2], "across")) {
+        v->index = 1;
+        *rest = 3;
+    } else if (v->nparts >= 3 && strcmp(v->parts[2], "x") && strcmp(v->parts[2], "r")) {
+        char msg[300];
+        snprintf(msg, sizeof msg, "'%s' is not a part of a vector shape (vector.NAME is "
+                 "its mask, vector.NAME.across its distance across) in '%s'",
+                 v->parts[2], path_text(v, buf, sizeof buf));
+        sg_error(c->d, v->loc, SG_E_BAD_REFERENCE, msg);
+        return false;
+    }
+    return true;
+}
+
 /* Resolve what a value names (not yet its type when it is a node output).
  * In scope: nodes (if allow_nodes), inputs, params, textures, terrain
  * inputs.  Returns false (with a diagnostic) if it names nothing. */
@@ -176,45 +249,8 @@ bool rs_resolve_path(checker *c, sg_value *v, bool allow_locals)
     int rest = 1;                       /* index of the first unused part */
     int local = allow_locals ? sg_map_get(&c->locals, first) : -1;
     if (local >= 0 && (local & 3) == L_NODE) {
-        sg_node *n = &c->s->nodes[local >> 2];
-        v->ref = SG_REF_NODE;
-        v->node = local >> 2;
-        v->index = 0;
-        if (n->kind == SG_NODE_UNRESOLVED)
-            return false;               /* already reported */
-        int nout = node_noutputs(c, n);
-        if (v->nparts == 1) {
-            if (nout != 1) {
-                char msg[300];
-                snprintf(msg, sizeof msg, "node '%s' has %d outputs: write '%s.<output>'",
-                         n->name, nout, n->name);
-                sg_error(c->d, v->loc, SG_E_BAD_REFERENCE, msg);
-                return false;
-            }
-        } else {
-            int port = node_port(c, n, v->parts[1]);
-            int dummy;
-            if (port >= 0) {
-                v->index = port;
-                rest = 2;
-            } else if (swizzle_ok(v->parts[1], &dummy) &&
-                       (node_port(c, n, "out") >= 0 || nout == 1)) {
-                /* `d.r` is `d.out.r` when r is not a port of d */
-                v->index = node_port(c, n, "out") >= 0 ? node_port(c, n, "out") : 0;
-            } else {
-                sg_error(c->d, v->loc, SG_E_UNKNOWN_PORT, n->name, "output", v->parts[1]);
-                if (n->kind == SG_NODE_INSTANCE) {
-                    const sg_shader *callee = c->p->shaders[n->shader];
-                    sg_hint_suggest(c->d, rs_near_port(callee->outs, callee->nouts, v->parts[1]));
-                } else {
-                    sg_suggest sg;
-                    sg_suggest_init(&sg, v->parts[1]);
-                    sg_suggest_offer(&sg, "out");
-                    sg_hint_suggest(c->d, sg_suggest_best(&sg));
-                }
-                return false;
-            }
-        }
+        if (!node_ref(c, v, local >> 2, &rest))
+            return false;
     } else if (local >= 0) {
         v->ref = (local & 3) == L_IN ? SG_REF_IN : SG_REF_PARAM;
         v->index = local >> 2;
@@ -224,25 +260,8 @@ bool rs_resolve_path(checker *c, sg_value *v, bool allow_locals)
         v->index = sg_map_get(&c->p->globals, first) >> 1;
         v->type = IR_T_TEX;
     } else if (!strcmp(first, "vector") && v->nparts >= 2) {
-        /* vector.NAME: the scene's spline or polygon NAME as a mask;
-         * vector.NAME.across: 0 on its centre line (or inside the
-         * polygon), 1 at the outer edge of its falloff and beyond.  The
-         * scene checks that NAME is one of its shapes (scene.c). */
-        v->ref = SG_REF_VECTOR;
-        v->index = 0;
-        v->type = IR_T_FLOAT;
-        rest = 2;
-        if (v->nparts >= 3 && !strcmp(v->parts[2], "across")) {
-            v->index = 1;
-            rest = 3;
-        } else if (v->nparts >= 3 && strcmp(v->parts[2], "x") && strcmp(v->parts[2], "r")) {
-            char msg[300];
-            snprintf(msg, sizeof msg, "'%s' is not a part of a vector shape (vector.NAME is "
-                     "its mask, vector.NAME.across its distance across) in '%s'",
-                     v->parts[2], path_text(v, buf, sizeof buf));
-            sg_error(c->d, v->loc, SG_E_BAD_REFERENCE, msg);
+        if (!vector_ref(c, v, &rest))
             return false;
-        }
     } else if ((!strcmp(first, "terrain") || !strcmp(first, "view")) && v->nparts >= 2) {
         snprintf(buf, sizeof buf, "%s.%s", first, v->parts[1]);
         int in = ir_input_by_name(buf);
