@@ -151,6 +151,76 @@ static void resolve_node_type(checker *c, sg_node *n)
     sg_hint_suggest(c->d, rs_near_node_type(c, n->type));
 }
 
+/* Node types in dependency order: operands' types from their sources,
+ * then each node's check. */
+static void check_types(checker *c, sg_shader *s)
+{
+    for (int k = 0; k < s->norder; k++) {
+        sg_node *n = &s->nodes[s->order[k]];
+        for (int j = 0; j < n->nargs; j++) {
+            sg_value *v = &n->args[j].val;
+            if (v->kind == SG_V_PATH && v->ref == SG_REF_NODE) {
+                const sg_node *src = &s->nodes[v->node];
+                v->type = rs_apply_swizzle(c, v, sg_node_output_type(c->p, s, src, v->index));
+            }
+        }
+        switch (n->kind) {
+        case SG_NODE_OP:       rs_check_op(c, n); break;
+        case SG_NODE_INSTANCE: rs_check_instance(c, n); break;
+        case SG_NODE_PAINTED:  rs_check_painted(c, n); break;
+        default:               break;
+        }
+    }
+}
+
+/* A shader's outputs (a material's: one of SG_OUTPUTS, of its type):
+ * resolved and type-checked. */
+static void check_outputs(checker *c, sg_shader *s)
+{
+    for (int i = 0; i < s->nouts; i++) {
+        sg_port *o = &s->outs[i];
+        ir_type want = o->type;
+        if (s->is_material) {
+            o->output = -1;
+            for (int k = 0; k < SG_OUT_COUNT; k++)
+                if (!strcmp(o->name, sg_output_names[k]))
+                    o->output = k;
+            if (o->output < 0) {
+                sg_error(c->d, o->loc, SG_E_BAD_OUTPUT, o->name);
+                sg_suggest sg;
+                sg_suggest_init(&sg, o->name);
+                for (int k = 0; k < SG_OUT_COUNT; k++)
+                    sg_suggest_offer(&sg, sg_output_names[k]);
+                sg_hint_suggest(c->d, sg_suggest_best(&sg));
+                continue;
+            }
+            want = output_types[o->output];
+            if (o->type != IR_T_ERROR && o->type != want) {
+                char what[100];
+                snprintf(what, sizeof what, "material output '%s'", o->name);
+                sg_error(c->d, o->loc, SG_E_TYPE_MISMATCH, what, ir_type_name(want),
+                         ir_type_name(o->type));
+                continue;
+            }
+            o->type = want;
+        }
+        sg_value *v = &o->value;
+        if (!rs_resolve_path(c, v, true))
+            continue;
+        if (v->ref == SG_REF_NODE)
+            v->type = rs_apply_swizzle(c, v, sg_node_output_type(c->p, s, &s->nodes[v->node],
+                                                              v->index));
+        ir_type splat;
+        if (v->type != IR_T_ERROR && !rs_assignable(v, want, &splat)) {
+            char what[100];
+            snprintf(what, sizeof what, "output '%s'", o->name);
+            sg_error(c->d, v->loc, SG_E_TYPE_MISMATCH, what, ir_type_name(want),
+                     ir_type_name(v->type));
+            rs_hint_swizzle(c, v, want);
+        }
+    }
+}
+
 /* Defaults of inputs and params: constants (params: numbers only),
  * strings and textures (texture inputs), terrain inputs. */
 static void check_default(checker *c, sg_port *port, bool is_param)
@@ -244,68 +314,9 @@ static void check_shader(checker *c, sg_shader *s)
     /* types, dependencies first (skipped if there is a cycle: the order
      * would not be one) */
     bool cyclic = c->d->nerrors != errors_before_cycles;
-    if (!cyclic) {
-        for (int k = 0; k < s->norder; k++) {
-            sg_node *n = &s->nodes[s->order[k]];
-            for (int j = 0; j < n->nargs; j++) {
-                sg_value *v = &n->args[j].val;
-                if (v->kind == SG_V_PATH && v->ref == SG_REF_NODE) {
-                    const sg_node *src = &s->nodes[v->node];
-                    v->type = rs_apply_swizzle(c, v, sg_node_output_type(c->p, s, src, v->index));
-                }
-            }
-            switch (n->kind) {
-            case SG_NODE_OP:       rs_check_op(c, n); break;
-            case SG_NODE_INSTANCE: rs_check_instance(c, n); break;
-            case SG_NODE_PAINTED:  rs_check_painted(c, n); break;
-            default:               break;
-            }
-        }
-    }
-
-    /* outputs */
-    for (int i = 0; i < s->nouts; i++) {
-        sg_port *o = &s->outs[i];
-        ir_type want = o->type;
-        if (s->is_material) {
-            o->output = -1;
-            for (int k = 0; k < SG_OUT_COUNT; k++)
-                if (!strcmp(o->name, sg_output_names[k]))
-                    o->output = k;
-            if (o->output < 0) {
-                sg_error(c->d, o->loc, SG_E_BAD_OUTPUT, o->name);
-                sg_suggest sg;
-                sg_suggest_init(&sg, o->name);
-                for (int k = 0; k < SG_OUT_COUNT; k++)
-                    sg_suggest_offer(&sg, sg_output_names[k]);
-                sg_hint_suggest(c->d, sg_suggest_best(&sg));
-                continue;
-            }
-            want = output_types[o->output];
-            if (o->type != IR_T_ERROR && o->type != want) {
-                char what[100];
-                snprintf(what, sizeof what, "material output '%s'", o->name);
-                sg_error(c->d, o->loc, SG_E_TYPE_MISMATCH, what, ir_type_name(want),
-                         ir_type_name(o->type));
-                continue;
-            }
-            o->type = want;
-        }
-        sg_value *v = &o->value;
-        if (!rs_resolve_path(c, v, true))
-            continue;
-        if (v->ref == SG_REF_NODE)
-            v->type = rs_apply_swizzle(c, v, sg_node_output_type(c->p, s, &s->nodes[v->node],
-                                                              v->index));
-        ir_type splat;
-        if (v->type != IR_T_ERROR && !rs_assignable(v, want, &splat)) {
-            char what[100];
-            snprintf(what, sizeof what, "output '%s'", o->name);
-            sg_error(c->d, v->loc, SG_E_TYPE_MISMATCH, what, ir_type_name(want),
-                     ir_type_name(v->type));
-            rs_hint_swizzle(c, v, want);
-        }
-    }
+    if (!cyclic)
+        check_types(c, s);
+    check_outputs(c, s);
     s->ok = c->d->nerrors == errors && c->suppressed == 0;
 }
 
