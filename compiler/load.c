@@ -70,6 +70,30 @@ static const char *overlay_text(const loader *l, const char *path, size_t *len)
     return l->ov && l->ov->text ? l->ov->text(l->ov->user, path, len) : NULL;
 }
 
+/* File `known` reached again: an import cycle if it is still being
+ * loaded (on the stack), reported with its path stack[i] -> ... -> known. */
+static void report_cycle(const loader *l, int known, sg_loc from)
+{
+    const sg_program *p = l->p;
+    for (int i = 0; i < l->depth; i++)
+        if (l->stack[i] == known) {
+            size_t n = 1;
+            for (int j = i; j < l->depth; j++)
+                n += strlen(p->files[l->stack[j]]->path) + 4;
+            n += strlen(p->files[known]->path);
+            char *msg = xmalloc(n);
+            msg[0] = 0;
+            for (int j = i; j < l->depth; j++) {
+                strcat(msg, p->files[l->stack[j]]->path);
+                strcat(msg, " -> ");
+            }
+            strcat(msg, p->files[known]->path);
+            sg_error(l->d, from, SG_E_IMPORT_CYCLE, msg);
+            free(msg);
+            return;
+        }
+}
+
 /* Lex, parse and load the imports of `path` (text given, or read). */
 static int load_file(loader *l, const char *path, const char *text, size_t len,
                      sg_loc from, bool is_import)
@@ -80,24 +104,7 @@ static int load_file(loader *l, const char *path, const char *text, size_t len,
     int known = sg_map_get(&l->keys, key);
     if (known >= 0) {
         free(rp);
-        for (int i = 0; i < l->depth; i++)
-            if (l->stack[i] == known) {
-                /* the cycle: stack[i] -> … -> top -> known */
-                size_t n = 1;
-                for (int j = i; j < l->depth; j++)
-                    n += strlen(p->files[l->stack[j]]->path) + 4;
-                n += strlen(p->files[known]->path);
-                char *msg = xmalloc(n);
-                msg[0] = 0;
-                for (int j = i; j < l->depth; j++) {
-                    strcat(msg, p->files[l->stack[j]]->path);
-                    strcat(msg, " -> ");
-                }
-                strcat(msg, p->files[known]->path);
-                sg_error(l->d, from, SG_E_IMPORT_CYCLE, msg);
-                free(msg);
-                break;
-            }
+        report_cycle(l, known, from);
         return known;
     }
     if (l->depth >= SG_MAX_DEPTH) {
