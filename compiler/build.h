@@ -1,8 +1,10 @@
 /* build.h — `splatc build`'s internals, shared by its files (the public
  * entry point, splat_build, is in scene.h):
  *
- *   build.c         the pipeline in one function, its phases, the
- *                   up-to-date check (the inputs' key)
+ *   build.c         the pipeline in one function and its phases
+ *   build_inputs.c  the input files, their key, the up-to-date check and
+ *                   the depfile
+ *   texture_mips.c  a texture's stored mip files
  *   build_jobs.c    the shaders to compile: composed per combination,
  *                   compiled on N threads, validated, cached (cache.c)
  *   build_report.c  --stats's report: each composite against the über-shader
@@ -116,7 +118,16 @@ bool build_far_atlas_device(build *b, const char *dir);
 /* --stats: its size, density and bake time (nothing without an atlas). */
 void build_report_far(const build *b, FILE *out);
 
-/* ---- the depfile (build.c) ------------------------------------------------ */
+/* ---- the inputs (build_inputs.c) ----------------------------------------- */
+
+/* The key of everything the pack is made from (contents, not names or
+ * times), into b->inputs; false if a file cannot be read ("": never up to
+ * date). */
+bool build_inputs_key(build *b);
+/* Does the pack at b->out already hold what this build would write (same
+ * key, every shader file there)?  On yes, *ncombos is its combination
+ * count. */
+bool build_up_to_date(build *b, int *ncombos);
 
 /* --depfile (if given): "PACKDIR/manifest.json: every input", written
  * atomically.  build_write_pack calls it after the new pack is complete
@@ -133,6 +144,9 @@ bool build_write_pack(build *b);
  * entries, and the output is absent, a folder or a pack (what
  * build_write_pack will refuse, it refuses first). */
 bool build_check_out(build *b);
+
+/* ---- a texture's mip files (texture_mips.c) ------------------------------- */
+
 /* A texture's k-th mip file ("rock.mip1.png") and how many it has. */
 char *build_mip_path(const char *path, int k);
 int   build_mip_count(const char *src);

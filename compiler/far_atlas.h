@@ -18,6 +18,8 @@
 #include <stdint.h>
 #include <string.h>
 
+#include "splatc.h"
+
 #define FAR_ATLAS_MAGIC      "SPLATFAR"
 #define FAR_ATLAS_VERSION    1u
 #define FAR_ATLAS_HEADER     40           /* bytes before the level data   */
@@ -26,26 +28,7 @@
  * view straight down (view.direction (0, 1, 0)). */
 #define FAR_ATLAS_BAKE_DISTANCE 2000.0
 
-/* Where `splatc build --far-bake` bakes it: the CPU reference
- * (far_atlas.c), the device (runtime/far_bake.c), or auto: a GPU when
- * the CLI finds one; a CPU's Vulkan device (lavapipe) where the atlas has
- * enough texels per combination to pay for its shader compiles
- * (runtime/far_bake.c cpu_device_pays); else the CPU reference. */
-typedef enum splat_far_bake {
-    SPLAT_FAR_BAKE_AUTO, SPLAT_FAR_BAKE_CPU, SPLAT_FAR_BAKE_GPU,
-} splat_far_bake;
-
-/* "auto", "cpu" or "gpu" (--far-bake, $SPLAT_FAR_BAKE); false otherwise. */
-static inline bool splat_far_bake_parse(const char *s, splat_far_bake *out)
-{
-    static const char *const names[] = {"auto", "cpu", "gpu"};
-    for (int m = 0; s && m < 3; m++)
-        if (!strcmp(s, names[m])) {
-            *out = (splat_far_bake)m;
-            return true;
-        }
-    return false;
-}
+/* splat_far_bake (where it is baked) and splat_far_bake_parse: splatc.h. */
 
 /* Points per texel side: each texel is the mean of FAR_ATLAS_SS^2 points
  * spread over it (a box filter of the composite over the texel). */

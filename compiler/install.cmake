@@ -3,22 +3,20 @@
 # splatrt.pc), a CMake package (find_package(splatc): splatc::splatc,
 # splatc::splatrt) and the node library under share/splatc/nodes, where an
 # installed splatc finds it by default (search.c).
-set(SPLAT_PUBLIC_HEADERS
-  ${PROJECT_SOURCE_DIR}/compiler/abi.h ${PROJECT_SOURCE_DIR}/compiler/ir.h
-  ${PROJECT_SOURCE_DIR}/compiler/sg.h ${PROJECT_SOURCE_DIR}/compiler/scene.h
-  ${PROJECT_SOURCE_DIR}/compiler/terrain.h ${PROJECT_SOURCE_DIR}/compiler/scene_load.h
-  ${PROJECT_SOURCE_DIR}/compiler/analysis.h ${PROJECT_SOURCE_DIR}/compiler/compose.h
-  ${PROJECT_SOURCE_DIR}/compiler/cache.h ${PROJECT_SOURCE_DIR}/compiler/mesh.h
-  ${PROJECT_SOURCE_DIR}/compiler/sparse.h ${PROJECT_SOURCE_DIR}/compiler/shader.h
-  ${PROJECT_SOURCE_DIR}/compiler/spv.h ${PROJECT_SOURCE_DIR}/compiler/texgen.h
-  ${PROJECT_SOURCE_DIR}/compiler/util.h ${PROJECT_SOURCE_DIR}/compiler/far_atlas.h
-  ${PROJECT_SOURCE_DIR}/runtime/splatrt.h)
+# libsplatc's one public header (splatc.h: version, diagnostics, sg_load,
+# the build) and libsplatrt's (splatrt.h) with the compiler headers it
+# includes (abi.h: the pack's ABI; rt_device and rt_pack are opaque, so
+# nothing else).  The compiler's other headers are internal.
+set(SPLAT_PUBLIC_HEADERS ${PROJECT_SOURCE_DIR}/compiler/splatc.h)
+set(SPLAT_RUNTIME_PUBLIC_HEADERS
+  ${PROJECT_SOURCE_DIR}/runtime/splatrt.h ${PROJECT_SOURCE_DIR}/compiler/abi.h)
 
 install(TARGETS splatc_cli splatview RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
 install(TARGETS splatc splatrt EXPORT splatcTargets
         ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
         INCLUDES DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/splatc)
-install(FILES ${SPLAT_PUBLIC_HEADERS} DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/splatc)
+install(FILES ${SPLAT_PUBLIC_HEADERS} ${SPLAT_RUNTIME_PUBLIC_HEADERS}
+        DESTINATION ${CMAKE_INSTALL_INCLUDEDIR}/splatc)
 install(DIRECTORY ${PROJECT_SOURCE_DIR}/nodes/ DESTINATION ${CMAKE_INSTALL_DATADIR}/splatc/nodes
         FILES_MATCHING PATTERN "*.sg")
 

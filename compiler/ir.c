@@ -1,4 +1,4 @@
-/* ir.c — IR types, the node array and its hash-cons table, the builder, the
+/* ir.c — the node array and its hash-cons table, the builder, the
  * resource tables (params, textures, painted masks), roots, import between
  * irs, and the growable string ir_buf.
  *
@@ -21,43 +21,6 @@
             (ptr) = xrealloc((ptr), sizeof(*(ptr)) * (size_t)(cap));       \
         }                                                                  \
     } while (0)
-
-/* ---- types ------------------------------------------------------------ */
-
-int ir_type_width(ir_type t)
-{
-    switch (t) {
-    case IR_T_FLOAT: return 1;
-    case IR_T_VEC2:  return 2;
-    case IR_T_VEC3:  return 3;
-    case IR_T_VEC4:  return 4;
-    default:         return 0;
-    }
-}
-
-ir_type ir_type_vec(int width)
-{
-    static const ir_type t[] = {IR_T_ERROR, IR_T_FLOAT, IR_T_VEC2, IR_T_VEC3, IR_T_VEC4};
-    return width >= 1 && width <= 4 ? t[width] : IR_T_ERROR;
-}
-
-static const char *const type_names[IR_T_COUNT] = {
-    [IR_T_ERROR] = "error", [IR_T_FLOAT] = "float", [IR_T_VEC2] = "vec2",
-    [IR_T_VEC3] = "vec3",   [IR_T_VEC4] = "vec4",   [IR_T_TEX] = "texture",
-};
-
-const char *ir_type_name(ir_type t)
-{
-    return (unsigned)t < IR_T_COUNT ? type_names[t] : "?";
-}
-
-ir_type ir_type_from_name(const char *s)
-{
-    for (int t = IR_T_FLOAT; t < IR_T_COUNT; t++)
-        if (strcmp(s, type_names[t]) == 0)
-            return (ir_type)t;
-    return IR_T_ERROR;
-}
 
 /* ---- init / free -------------------------------------------------------- */
 

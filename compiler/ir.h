@@ -168,7 +168,7 @@ enum { IR_FIN_NO = 0, IR_FIN_YES = 1, IR_FIN_DATA = 2, IR_FIN_ARGS_BIT = 0x100 }
  *     fp32     IR_FP32_* error class (the GPU-agreement harness)
  *     cost     op cost units per component (below)
  *     deriv    forward-mode derivative rule (ir_differentiate.c): D(f) =
- *              d_f in ir_ops.c, building the derivative as IR from the
+ *              d_f in ir_derive_rules.c, building the derivative as IR from the
  *              operands and theirs; D0: always 0 (constants, floor, step…)
  *
  * A row is positional: a row missing a column does not compile.  To add a
@@ -307,12 +307,7 @@ typedef struct ir_opinfo {
     unsigned      finite;      /* IR_FIN_*                                */
     ir_fp32_class fp32;        /* fp32 error class                        */
     int           cost;        /* cost units per component (see IR_OPS)   */
-    /* Forward-mode derivative rule (ir_differentiate.c): the derivative of
-     * node `self` (a copy in `n`) along the context's screen axis, built
-     * in the context's ir from its operands and their derivatives d[i]
-     * (IR_NONE: zero); IR_NONE for a zero derivative.  NULL: always 0. */
-    struct ir_ref (*deriv)(struct ir_dctx *c, const struct ir_node *n,
-                           struct ir_ref self, const struct ir_ref *d);
+    /* The deriv column is not here: ir_deriv_rule (ir_derive_rules.c). */
 } ir_opinfo;
 
 const ir_opinfo *ir_opinfo_get(ir_op op);
@@ -524,6 +519,13 @@ ir_ref ir_d_mul(ir_dctx *c, ir_ref a, ir_ref b);   /* a * b (NONE if
 ir_ref ir_d_div(ir_dctx *c, ir_ref a, ir_ref b);   /* a / b (NONE if a is) */
 ir_ref ir_d_num(ir_dctx *c, ir_type t, double v);   /* constant v of type t */
 ir_ref ir_d_zero(ir_dctx *c, ir_ref d, ir_type t);  /* d, or 0 if NONE     */
+/* IR_OPS' deriv column (ir_derive_rules.c): the derivative of node `self`
+ * (a copy in `n`) along the context's screen axis, built in the context's
+ * ir from its operands and their derivatives d[i] (IR_NONE: zero); IR_NONE
+ * for a zero derivative.  ir_deriv_rule returns NULL where it is always 0
+ * (the D0 rows). */
+typedef ir_ref (*ir_deriv_fn)(ir_dctx *c, const ir_node *n, ir_ref self, const ir_ref *d);
+ir_deriv_fn ir_deriv_rule(ir_op op);
 
 /* ---- validator (ir_validate.c) ----------------------------------------- */
 

@@ -8,8 +8,8 @@
  * duv/dy), which the emitter writes as splat_texture_grad (abi.c:
  * textureLod at textureGrad's level).  The gradients are IR,
  * built from the uv's expression by the chain rule: each op's row of the
- * op table (ir_ops.c) carries its derivative rule next to its GLSL, double
- * and interval semantics, and the leaves are
+ * op table (IR_OPS, ir.h) names its derivative rule (ir_derive_rules.c)
+ * next to its GLSL, double and interval semantics, and the leaves are
  *     terrain.position, .height, .uv, view.distance, view.direction
  *         -> DINPUT(input, axis): the prelude's splat_d_<input>(axis), from
  *            FC5's plane-ray intersection in both stages (abi.c)
@@ -51,65 +51,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* ---- arithmetic on derivatives (IR_NONE is zero) ------------------------ */
-
-/* a float operand next to a vector one is splatted to its width */
-static void widen(ir_dctx *c, ir_ref *a, ir_ref *b)
-{
-    ir_type ta = ir_typeof(c->ir, *a), tb = ir_typeof(c->ir, *b);
-    if (ta == IR_T_FLOAT && tb != IR_T_FLOAT)
-        *a = ir_splat(c->ir, *a, tb);
-    else if (tb == IR_T_FLOAT && ta != IR_T_FLOAT)
-        *b = ir_splat(c->ir, *b, ta);
-}
-
-ir_ref ir_d_add(ir_dctx *c, ir_ref a, ir_ref b)
-{
-    if (!ir_ref_ok(a))
-        return b;
-    if (!ir_ref_ok(b))
-        return a;
-    widen(c, &a, &b);
-    return ir_op2(c->ir, IR_OP_ADD, a, b);
-}
-
-ir_ref ir_d_sub(ir_dctx *c, ir_ref a, ir_ref b)
-{
-    if (!ir_ref_ok(b))
-        return a;
-    if (!ir_ref_ok(a))
-        return ir_op1(c->ir, IR_OP_NEG, b);
-    widen(c, &a, &b);
-    return ir_op2(c->ir, IR_OP_SUB, a, b);
-}
-
-ir_ref ir_d_mul(ir_dctx *c, ir_ref a, ir_ref b)
-{
-    if (!ir_ref_ok(a) || !ir_ref_ok(b))
-        return IR_NONE;
-    widen(c, &a, &b);
-    return ir_op2(c->ir, IR_OP_MUL, a, b);
-}
-
-ir_ref ir_d_div(ir_dctx *c, ir_ref a, ir_ref b)
-{
-    if (!ir_ref_ok(a))
-        return IR_NONE;
-    widen(c, &a, &b);
-    return ir_op2(c->ir, IR_OP_DIV, a, b);
-}
-
-ir_ref ir_d_num(ir_dctx *c, ir_type t, double v)
-{
-    double vals[4] = {v, v, v, v};
-    return ir_const(c->ir, t, vals);
-}
-
-ir_ref ir_d_zero(ir_dctx *c, ir_ref d, ir_type t)
-{
-    return ir_ref_ok(d) ? d : ir_d_num(c, t, 0.0);
-}
-
 /* ---- the walk ----------------------------------------------------------- */
 
 static void memo_grow(ir_dctx *c)
@@ -149,12 +90,12 @@ static ir_ref derive(ir_dctx *c, ir_ref r)
         d[i] = derive(c, n.arg[i]);
         any = any || ir_ref_ok(d[i]);
     }
-    const ir_opinfo *info = ir_opinfo_get((ir_op)n.op);
+    ir_deriv_fn rule = ir_deriv_rule((ir_op)n.op);
     ir_ref out = IR_NONE;
     /* a leaf's rule says which inputs move; an op with constant operands
      * is constant */
-    if (info->deriv && (n.nargs == 0 || any))
-        out = info->deriv(c, &n, r, d);
+    if (rule && (n.nargs == 0 || any))
+        out = rule(c, &n, r, d);
     assert(!ir_ref_ok(out) || ir_typeof(c->ir, out) == (ir_type)n.type);
     memo_grow(c);
     c->memo[c->axis][r.id] = out.id + 1;

@@ -1,4 +1,5 @@
-/* ir_ops.c — the op and input tables: IR_OPS and IR_INPUTS (ir.h) expanded
+/* ir_ops.c — the IR's types and its op and input tables: IR_OPS and
+ * IR_INPUTS (ir.h) expanded
  * into rows, and the functions their rows name: each op's type rule,
  * double-precision evaluation and interval evaluation, written once, side
  * by side.  ir_eval, ir_interval, opt_fold, the GLSL emitter, the front
@@ -32,6 +33,43 @@
 #include <stddef.h>
 #include <stdlib.h>
 #include <string.h>
+
+/* ---- types (ir_type) ------------------------------------------------------------ */
+
+int ir_type_width(ir_type t)
+{
+    switch (t) {
+    case IR_T_FLOAT: return 1;
+    case IR_T_VEC2:  return 2;
+    case IR_T_VEC3:  return 3;
+    case IR_T_VEC4:  return 4;
+    default:         return 0;
+    }
+}
+
+ir_type ir_type_vec(int width)
+{
+    static const ir_type t[] = {IR_T_ERROR, IR_T_FLOAT, IR_T_VEC2, IR_T_VEC3, IR_T_VEC4};
+    return width >= 1 && width <= 4 ? t[width] : IR_T_ERROR;
+}
+
+static const char *const type_names[IR_T_COUNT] = {
+    [IR_T_ERROR] = "error", [IR_T_FLOAT] = "float", [IR_T_VEC2] = "vec2",
+    [IR_T_VEC3] = "vec3",   [IR_T_VEC4] = "vec4",   [IR_T_TEX] = "texture",
+};
+
+const char *ir_type_name(ir_type t)
+{
+    return (unsigned)t < IR_T_COUNT ? type_names[t] : "?";
+}
+
+ir_type ir_type_from_name(const char *s)
+{
+    for (int t = IR_T_FLOAT; t < IR_T_COUNT; t++)
+        if (strcmp(s, type_names[t]) == 0)
+            return (ir_type)t;
+    return IR_T_ERROR;
+}
 
 /* ---- type rules --------------------------------------------------------- */
 
@@ -623,251 +661,6 @@ static void i_cross(const ir_node *n, const ir_type *atype, const ir_iv *a, ir_i
     out[2] = iv_sub(iv_mul(x[0], y[1]), iv_mul(x[1], y[0]));
 }
 
-/* ---- derivative rules (ir_differentiate.c) ------------------------------ */
-
-/* Each returns the derivative of `self` (= *n) along c->axis from its
- * operands n->arg[i] and their derivatives d[i] (IR_NONE = 0), or IR_NONE.
- * They follow the double semantics above: min/max/abs/clamp/saturate take
- * the derivative of the operand they return, step/less/floor are 0, a
- * select differentiates the side it takes. */
-
-#define A(i) (n->arg[i])
-#define T    ((ir_type)n->type)
-
-/* An input moves where its row has a derivative accessor (IR_INPUTS'
- * dglsl column); normal, slope and destruction are taken as 0. */
-static ir_ref d_input(ir_dctx *c, const ir_node *n, ir_ref self, const ir_ref *d)
-{
-    if (!ir_input_get((ir_input_kind)n->imm)->dglsl)
-        return IR_NONE;
-    ir_node l = {.op = IR_OP_DINPUT, .type = n->type, .imm = IR_DINPUT_IMM(n->imm, c->axis)};
-    return ir_node_add(c->ir, &l);
-}
-
-/* The op itself over the derivatives (linear ops: splat, swizzle,
- * construct, neg; zeros written out where some operand moves). */
-static ir_ref d_linear(ir_dctx *c, const ir_node *n, ir_ref self, const ir_ref *d)
-{
-    ir_node m = *n;
-    for (int i = 0; i < n->nargs; i++)
-        m.arg[i] = ir_d_zero(c, d[i], ir_typeof(c->ir, n->arg[i]));
-    return ir_node_add(c->ir, &m);
-}
-
-static ir_ref d_add(ir_dctx *c, const ir_node *n, ir_ref self, const ir_ref *d)
-{
-    return ir_d_add(c, d[0], d[1]);
-}
-
-static ir_ref d_sub(ir_dctx *c, const ir_node *n, ir_ref self, const ir_ref *d)
-{
-    return ir_d_sub(c, d[0], d[1]);
-}
-
-static ir_ref d_mul(ir_dctx *c, const ir_node *n, ir_ref self, const ir_ref *d)
-{
-    return ir_d_add(c, ir_d_mul(c, d[0], A(1)), ir_d_mul(c, A(0), d[1]));
-}
-
-/* (a / b)' = (a' - q b') / b */
-static ir_ref d_div(ir_dctx *c, const ir_node *n, ir_ref self, const ir_ref *d)
-{
-    return ir_d_div(c, ir_d_sub(c, d[0], ir_d_mul(c, self, d[1])), A(1));
-}
-
-/* select(cond, a', b') with zeros written out; NONE if both are zero */
-static ir_ref pick(ir_dctx *c, ir_ref cond, ir_ref da, ir_ref db, ir_type t)
-{
-    if (!ir_ref_ok(da) && !ir_ref_ok(db))
-        return IR_NONE;
-    return ir_op3(c->ir, IR_OP_SELECT, cond, ir_d_zero(c, da, t), ir_d_zero(c, db, t));
-}
-
-/* fmin(a, b) is a where a < b, else b; fmax(a, b) a where b < a */
-static ir_ref min_rule(ir_dctx *c, ir_ref a, ir_ref b, ir_ref da, ir_ref db, ir_type t)
-{
-    return pick(c, ir_op2(c->ir, IR_OP_LESS, a, b), da, db, t);
-}
-
-static ir_ref max_rule(ir_dctx *c, ir_ref a, ir_ref b, ir_ref da, ir_ref db, ir_type t)
-{
-    return pick(c, ir_op2(c->ir, IR_OP_LESS, b, a), da, db, t);
-}
-
-static ir_ref d_min(ir_dctx *c, const ir_node *n, ir_ref self, const ir_ref *d)
-{
-    return min_rule(c, A(0), A(1), d[0], d[1], T);
-}
-
-static ir_ref d_max(ir_dctx *c, const ir_node *n, ir_ref self, const ir_ref *d)
-{
-    return max_rule(c, A(0), A(1), d[0], d[1], T);
-}
-
-static ir_ref d_abs(ir_dctx *c, const ir_node *n, ir_ref self, const ir_ref *d)
-{
-    ir_ref neg = ir_op2(c->ir, IR_OP_LESS, A(0), ir_d_num(c, T, 0.0));
-    return pick(c, neg, ir_op1(c->ir, IR_OP_NEG, d[0]), d[0], T);
-}
-
-static ir_ref d_fract(ir_dctx *c, const ir_node *n, ir_ref self, const ir_ref *d)
-{
-    return d[0];
-}
-
-/* mod(x, y) = x - y floor(x / y) */
-static ir_ref d_mod(ir_dctx *c, const ir_node *n, ir_ref self, const ir_ref *d)
-{
-    ir_ref k = ir_op1(c->ir, IR_OP_FLOOR, ir_op2(c->ir, IR_OP_DIV, A(0), A(1)));
-    return ir_d_sub(c, d[0], ir_d_mul(c, k, d[1]));
-}
-
-/* `e` where the operand's derivative d is not 0, else 0: for rules whose
- * partial is infinite where it does not move (sqrt(0), pow(0, 0.5)'s,
- * log2(0), length(0)): a clamped sqrt(saturate(x)) must read 0, not 0 * inf. */
-static ir_ref guarded(ir_dctx *c, ir_ref cond, ir_ref e)
-{
-    if (!ir_ref_ok(e))
-        return e;
-    ir_type t = ir_typeof(c->ir, e);
-    if (ir_typeof(c->ir, cond) != t)
-        cond = ir_splat(c->ir, cond, t);
-    return ir_op3(c->ir, IR_OP_SELECT, cond, e, ir_d_num(c, t, 0.0));
-}
-
-static ir_ref d_sqrt(ir_dctx *c, const ir_node *n, ir_ref self, const ir_ref *d)
-{
-    return guarded(c, d[0], ir_d_div(c, ir_d_mul(c, d[0], ir_d_num(c, T, 0.5)), self));
-}
-
-/* pow(x, y)' = y pow(x, y - 1) x' + pow(x, y) ln(x) y' */
-static ir_ref d_pow(ir_dctx *c, const ir_node *n, ir_ref self, const ir_ref *d)
-{
-    ir_ref dx = IR_NONE, dy = IR_NONE;
-    if (ir_ref_ok(d[0])) {
-        ir_ref ym1 = ir_op2(c->ir, IR_OP_SUB, A(1), ir_d_num(c, T, 1.0));
-        ir_ref k = ir_op2(c->ir, IR_OP_MUL, A(1), ir_op2(c->ir, IR_OP_POW, A(0), ym1));
-        dx = guarded(c, d[0], ir_d_mul(c, k, d[0]));
-    }
-    if (ir_ref_ok(d[1])) {
-        ir_ref ln = ir_op2(c->ir, IR_OP_MUL, ir_op1(c->ir, IR_OP_LOG2, A(0)),
-                           ir_d_num(c, T, M_LN2));
-        /* 0 where the power is 0 (x = 0: 0 * ln 0) */
-        dy = guarded(c, self, guarded(c, d[1], ir_d_mul(c, ir_op2(c->ir, IR_OP_MUL, self, ln),
-                                                        d[1])));
-    }
-    return ir_d_add(c, dx, dy);
-}
-
-static ir_ref d_exp2(ir_dctx *c, const ir_node *n, ir_ref self, const ir_ref *d)
-{
-    return ir_d_mul(c, ir_op2(c->ir, IR_OP_MUL, self, ir_d_num(c, T, M_LN2)), d[0]);
-}
-
-static ir_ref d_log2(ir_dctx *c, const ir_node *n, ir_ref self, const ir_ref *d)
-{
-    return guarded(c, d[0],
-                   ir_d_div(c, d[0], ir_op2(c->ir, IR_OP_MUL, A(0), ir_d_num(c, T, M_LN2))));
-}
-
-static ir_ref d_sin(ir_dctx *c, const ir_node *n, ir_ref self, const ir_ref *d)
-{
-    return ir_d_mul(c, ir_op1(c->ir, IR_OP_COS, A(0)), d[0]);
-}
-
-static ir_ref d_cos(ir_dctx *c, const ir_node *n, ir_ref self, const ir_ref *d)
-{
-    return ir_d_mul(c, ir_op1(c->ir, IR_OP_NEG, ir_op1(c->ir, IR_OP_SIN, A(0))), d[0]);
-}
-
-/* mix(a, b, t)' = mix(a', b', t) + (b - a) t' */
-static ir_ref d_mix(ir_dctx *c, const ir_node *n, ir_ref self, const ir_ref *d)
-{
-    ir_ref ab = IR_NONE;
-    if (ir_ref_ok(d[0]) || ir_ref_ok(d[1]))
-        ab = ir_op3(c->ir, IR_OP_MIX, ir_d_zero(c, d[0], T), ir_d_zero(c, d[1], T), A(2));
-    return ir_d_add(c, ab, ir_d_mul(c, ir_op2(c->ir, IR_OP_SUB, A(1), A(0)), d[2]));
-}
-
-/* clamp(x, lo, hi) = fmin(fmax(x, lo), hi) */
-static ir_ref d_clamp(ir_dctx *c, const ir_node *n, ir_ref self, const ir_ref *d)
-{
-    ir_ref m = ir_op2(c->ir, IR_OP_MAX, A(0), A(1));
-    ir_ref dm = max_rule(c, A(0), A(1), d[0], d[1], T);
-    return min_rule(c, m, A(2), dm, d[2], T);
-}
-
-/* x' inside [0, 1], 0 outside */
-static ir_ref d_saturate(ir_dctx *c, const ir_node *n, ir_ref self, const ir_ref *d)
-{
-    ir_ref zero = ir_d_num(c, T, 0.0), one = ir_d_num(c, T, 1.0);
-    ir_ref inner = pick(c, ir_op2(c->ir, IR_OP_LESS, one, A(0)), zero, d[0], T);
-    return pick(c, ir_op2(c->ir, IR_OP_LESS, A(0), zero), zero, inner, T);
-}
-
-/* t = clamp((x - e0) / (e1 - e0), 0, 1), t^2 (3 - 2t)' = 6 t (1 - t) q'
- * with q the unclamped ratio (6 t (1 - t) is 0 where the clamp holds) */
-static ir_ref d_smoothstep(ir_dctx *c, const ir_node *n, ir_ref self, const ir_ref *d)
-{
-    ir *ir = c->ir;
-    ir_ref num = ir_op2(ir, IR_OP_SUB, A(2), A(0)), den = ir_op2(ir, IR_OP_SUB, A(1), A(0));
-    ir_ref q = ir_op2(ir, IR_OP_DIV, num, den);
-    ir_ref dq = ir_d_div(c, ir_d_sub(c, ir_d_sub(c, d[2], d[0]),
-                                     ir_d_mul(c, q, ir_d_sub(c, d[1], d[0]))), den);
-    ir_ref t = ir_op1(ir, IR_OP_SATURATE, q);
-    ir_ref k = ir_op2(ir, IR_OP_MUL, ir_d_num(c, T, 6.0),
-                      ir_op2(ir, IR_OP_MUL, t, ir_op2(ir, IR_OP_SUB, ir_d_num(c, T, 1.0), t)));
-    return guarded(c, k, ir_d_mul(c, k, dq));   /* clamped: 0, even if e0 == e1 */
-}
-
-static ir_ref d_select(ir_dctx *c, const ir_node *n, ir_ref self, const ir_ref *d)
-{
-    return pick(c, A(0), d[1], d[2], T);
-}
-
-static ir_ref d_dot(ir_dctx *c, const ir_node *n, ir_ref self, const ir_ref *d)
-{
-    ir_ref a = ir_ref_ok(d[0]) ? ir_op2(c->ir, IR_OP_DOT, d[0], A(1)) : IR_NONE;
-    ir_ref b = ir_ref_ok(d[1]) ? ir_op2(c->ir, IR_OP_DOT, A(0), d[1]) : IR_NONE;
-    return ir_d_add(c, a, b);
-}
-
-/* |a|' = (a . a') / |a| */
-static ir_ref d_length(ir_dctx *c, const ir_node *n, ir_ref self, const ir_ref *d)
-{
-    return guarded(c, ir_op2(c->ir, IR_OP_DOT, d[0], d[0]),
-                   ir_d_div(c, ir_op2(c->ir, IR_OP_DOT, A(0), d[0]), self));
-}
-
-/* (a / |a|)' = (a' - u (u . a')) / |a|, u = the result */
-static ir_ref d_normalize(ir_dctx *c, const ir_node *n, ir_ref self, const ir_ref *d)
-{
-    ir_ref along = ir_d_mul(c, self, ir_op2(c->ir, IR_OP_DOT, self, d[0]));
-    return ir_d_div(c, ir_d_sub(c, d[0], along), ir_op1(c->ir, IR_OP_LENGTH, A(0)));
-}
-
-static ir_ref d_cross(ir_dctx *c, const ir_node *n, ir_ref self, const ir_ref *d)
-{
-    ir_ref a = ir_ref_ok(d[0]) ? ir_op2(c->ir, IR_OP_CROSS, d[0], A(1)) : IR_NONE;
-    ir_ref b = ir_ref_ok(d[1]) ? ir_op2(c->ir, IR_OP_CROSS, A(0), d[1]) : IR_NONE;
-    return ir_d_add(c, a, b);
-}
-
-/* A texture-space finite difference over the uv's step to the next pixel
- * (what a quad's dFdx of the sampled value is): sample(uv + uv') -
- * sample(uv), the extra sample taking the same gradients (SAMPLE_GRAD). */
-static ir_ref d_sample(ir_dctx *c, const ir_node *n, ir_ref self, const ir_ref *d)
-{
-    if (!ir_ref_ok(d[1]))
-        return IR_NONE;
-    ir_node m = *n;
-    m.arg[1] = ir_op2(c->ir, IR_OP_ADD, A(1), d[1]);
-    return ir_op2(c->ir, IR_OP_SUB, ir_node_add(c->ir, &m), self);
-}
-
-#undef A
-#undef T
-
 /* ---- sampler names ------------------------------------------------------- */
 
 static const char *const filter_names[] = {
@@ -926,13 +719,13 @@ int ir_wrap_by_name(const char *name)
 #define ENV NULL, NULL, NULL, NULL
 #define CW(f) cw_eval, cw_interval, e_##f, i_##f
 #define NODE(f) e_##f, i_##f, NULL, NULL
-#define D(f) d_##f
-#define D0 NULL
+#define D(f)
+#define D0
 
 static const ir_opinfo op_table[IR_OP_COUNT] = {
 #define X(id, name, nargs, flags, ports, glsl, type, sem, fin, fp32, cost, deriv) \
-    [IR_OP_##id] = {name, ports, nargs, flags, glsl, type, sem, fin, IR_FP32_##fp32, cost, \
-                    deriv /* new columns here */},
+    [IR_OP_##id] = {name, ports, nargs, flags, glsl, type, sem, fin, IR_FP32_##fp32, cost \
+                    /* new columns here; deriv: ir_derive_rules.c */},
     IR_OPS(X)
 #undef X
 };

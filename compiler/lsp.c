@@ -24,14 +24,6 @@
 
 /* ---- documents ------------------------------------------------------------ */
 
-lsp_doc *lsp_doc_by_path(lsp_server *s, const char *path)
-{
-    for (int i = 0; i < s->ndocs; i++)
-        if (!strcmp(s->docs[i].path, path))
-            return &s->docs[i];
-    return NULL;
-}
-
 static lsp_doc *doc_by_uri(lsp_server *s, const char *uri)
 {
     char *path = lsp_uri_path(uri);
@@ -75,13 +67,6 @@ static void fresh(lsp_server *s, lsp_doc *d)
 }
 
 /* ---- messages ------------------------------------------------------------- */
-
-void lsp_send(lsp_server *s, json_t *msg)
-{
-    if (msg && !lsp_write(s->out, msg))
-        fputs("splatc lsp: cannot write to standard output\n", stderr);
-    json_decref(msg);
-}
 
 static void respond(lsp_server *s, json_t *id, json_t *result)
 {

@@ -211,3 +211,14 @@ bool lsp_write(FILE *out, const json_t *msg)
     free(s);
     return ok;
 }
+
+/* ---- the server's messages --------------------------------------------- */
+
+/* One message to the client (taken: freed here); a write failure is
+ * reported on stderr. */
+void lsp_send(lsp_server *s, json_t *msg)
+{
+    if (msg && !lsp_write(s->out, msg))
+        fputs("splatc lsp: cannot write to standard output\n", stderr);
+    json_decref(msg);
+}

@@ -216,3 +216,14 @@ json_t *lsp_location(lsp_server *s, const sg_file *f, int line, int col)
     free(path);
     return loc;
 }
+
+/* ---- documents ------------------------------------------------------------ */
+
+/* The open document at canonical `path`, or NULL. */
+lsp_doc *lsp_doc_by_path(lsp_server *s, const char *path)
+{
+    for (int i = 0; i < s->ndocs; i++)
+        if (!strcmp(s->docs[i].path, path))
+            return &s->docs[i];
+    return NULL;
+}

@@ -1,4 +1,6 @@
-/* opt.c — the pass pipeline and the rebuild step every pass shares.
+/* opt.c — the pass manager: the pass table, one pass run with the
+ * validator after it, and the pipeline.  It sits above the passes; the
+ * rebuild step every pass shares is ir_rebuild.c, below them.
  *
  * The whole pipeline (ir_optimize), to a fixed point:
  *     dedup   merge texture resources with equal file + sampler state
@@ -35,84 +37,6 @@ const ir_pass *ir_pass_find(const char *name)
         if (!strcmp(p->name, name))
             return p;
     return NULL;
-}
-
-static bool rebuild_once(ir *ir, ir_rewrite_fn fn, void *user, bool *dead_left)
-{
-    uint32_t n = ir->nnodes;
-    uint8_t *reach = calloc(n, 1);
-    uint32_t *map = calloc(n, sizeof *map);
-    if (!reach || !map) {
-        fprintf(stderr, "splatc: out of memory\n");
-        abort();
-    }
-    for (int i = 0; i < ir->nroots; i++)
-        reach[ir->roots[i].ref.id] = 1;
-    for (uint32_t id = n - 1; id > 0; id--)
-        if (reach[id])
-            for (int i = 0; i < ir->nodes[id].nargs; i++)
-                reach[ir->nodes[id].arg[i].id] = 1;
-
-    /* A fresh node array; the tables move over unchanged. */
-    struct ir dst;
-    ir_init(&dst);
-    dst.params = ir->params;     dst.nparams = ir->nparams;     dst.capparams = ir->capparams;
-    dst.textures = ir->textures; dst.ntextures = ir->ntextures; dst.captextures = ir->captextures;
-    dst.painted = ir->painted;   dst.npainted = ir->npainted;   dst.cappainted = ir->cappainted;
-    dst.roots = ir->roots;       dst.nroots = ir->nroots;       dst.caproots = ir->caproots;
-
-    for (uint32_t id = 1; id < n; id++) {
-        if (!reach[id])
-            continue;
-        ir_node node = ir->nodes[id];
-        for (int i = 0; i < node.nargs; i++)
-            node.arg[i].id = map[node.arg[i].id];
-        map[id] = (fn ? fn(&dst, &node, user) : ir_node_add(&dst, &node)).id;
-        assert(map[id] != 0);
-    }
-
-    bool changed = dst.nnodes != ir->nnodes ||
-                   memcmp(dst.nodes, ir->nodes, sizeof(ir_node) * n) != 0;
-    for (int i = 0; i < dst.nroots; i++) {
-        uint32_t to = map[dst.roots[i].ref.id];
-        changed = changed || to != dst.roots[i].ref.id;
-        dst.roots[i].ref.id = to;
-    }
-    free(ir->nodes);
-    free(ir->table);
-    *ir = dst;
-
-    /* A rewrite may leave nodes behind that nothing uses any more (the
-     * operands of a folded constant): report them for a second sweep. */
-    free(reach);
-    reach = calloc(ir->nnodes, 1);
-    if (!reach) {
-        fprintf(stderr, "splatc: out of memory\n");
-        abort();
-    }
-    for (int i = 0; i < ir->nroots; i++)
-        reach[ir->roots[i].ref.id] = 1;
-    *dead_left = false;
-    for (uint32_t id = ir->nnodes - 1; id > 0; id--) {
-        if (!reach[id]) {
-            *dead_left = true;
-            continue;
-        }
-        for (int i = 0; i < ir->nodes[id].nargs; i++)
-            reach[ir->nodes[id].arg[i].id] = 1;
-    }
-    free(reach);
-    free(map);
-    return changed;
-}
-
-bool ir_rebuild(ir *ir, ir_rewrite_fn fn, void *user)
-{
-    bool dead;
-    bool changed = rebuild_once(ir, fn, user, &dead);
-    if (dead)
-        changed |= rebuild_once(ir, NULL, NULL, &dead);
-    return changed;
 }
 
 #ifdef SPLAT_VALIDATE_IR

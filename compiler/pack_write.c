@@ -196,43 +196,6 @@ static char **texture_names(build *b)
     return names;
 }
 
-/* A texture's stored mip files (texgen.h's contract): "X.mipK.ext" beside
- * "X.ext" for K = 1, 2, … while they exist.  build_mip_path(path, k) is that name
- * for any path (source or pack); build_mip_count(src) how many the source has. */
-char *build_mip_path(const char *path, int k)
-{
-    const char *slash = strrchr(path, '/');
-    const char *dot = strrchr(path, '.');
-    if (!dot || (slash && dot < slash))
-        return xasprintf("%s.mip%d", path, k);
-    return xasprintf("%.*s.mip%d%s", (int)(dot - path), path, k, dot);
-}
-
-int build_mip_count(const char *src)
-{
-    /* never more than the texture has below its base (PACK.md "Limits") */
-    long long w = 0, h = 0;
-    int comp, levels = 0;
-    bool is16;
-    char why[256];
-    FILE *f = splat_input_fopen(src, SPLAT_MAX_IMAGE_BYTES, why, sizeof why);
-    if (f && splat_image_info(f, &w, &h, &comp, &is16))
-        while ((w > h ? w : h) >> (levels + 1))
-            levels++;
-    if (f)
-        fclose(f);
-    int k = 0;
-    for (;;) {
-        char *p = build_mip_path(src, k + 1);
-        struct stat st;
-        bool there = stat(p, &st) == 0 && S_ISREG(st.st_mode);   /* stat: no open */
-        free(p);
-        if (!there || k >= levels)
-            return k;
-        k++;
-    }
-}
-
 /* ---- manifest.json, one function per section (PACK.md) -------------------- */
 
 static json_t *jscene(build *b, const char *dir)

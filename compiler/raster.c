@@ -211,6 +211,79 @@ static const char *type_name(GDALDataType t)
     return n ? n : "unknown";
 }
 
+/* The band's scale and offset (raw * scale + offset = metres); 1 and 0
+ * where it gives none or a useless one. */
+static void band_scale(GDALRasterBandH band, double *scale, double *offset)
+{
+    int has_scale = 0, has_off = 0;
+    *scale = GDALGetRasterScale(band, &has_scale);
+    *offset = GDALGetRasterOffset(band, &has_off);
+    if (!has_scale || !isfinite(*scale) || *scale == 0) *scale = 1.0;
+    if (!has_off || !isfinite(*offset)) *offset = 0.0;
+}
+
+/* Pass 1 over a heightfield band: the valid heights' range (raw and
+ * scaled) and the nodata count.  False if a strip cannot be read. */
+typedef struct height_scan {
+    double lo, hi;      /* scaled heights (metres)                 */
+    double rlo, rhi;    /* raw band values                         */
+    size_t nholes;      /* nodata or non-finite texels             */
+} height_scan;
+
+static bool scan_heights(GDALRasterBandH band, const nodata *nd, int w, int h, int rows,
+                         double *buf, double scale, double offset, height_scan *hs)
+{
+    for (int y = 0; y < h; y += rows) {
+        int m = y + rows <= h ? rows : h - y;
+        if (!read_rows(band, w, y, m, buf))
+            return false;
+        for (size_t i = 0; i < (size_t)w * (size_t)m; i++) {
+            if (!is_valid(nd, buf[i])) {
+                hs->nholes++;
+                continue;
+            }
+            if (buf[i] < hs->rlo) hs->rlo = buf[i];
+            if (buf[i] > hs->rhi) hs->rhi = buf[i];
+            double v = buf[i] * scale + offset;
+            if (v < hs->lo) hs->lo = v;
+            if (v > hs->hi) hs->hi = v;
+        }
+    }
+    return true;
+}
+
+/* Pass 2: the 16-bit texels, exact (a byte times 257, or the raw value
+ * less base_raw) or the scaled height quantised over [lo, lo + 65535 / q];
+ * nodata texels 0 and marked in `holes`. */
+typedef struct texel_rule {
+    bool   exact, byte;
+    double base_raw, scale, offset, lo, q;
+} texel_rule;
+
+static bool store_texels(GDALRasterBandH band, const nodata *nd, int w, int h, int rows,
+                         double *buf, const texel_rule *r, uint16_t *texels, uint8_t *holes)
+{
+    for (int y = 0; y < h; y += rows) {
+        int m = y + rows <= h ? rows : h - y;
+        if (!read_rows(band, w, y, m, buf))
+            return false;
+        size_t base = (size_t)y * (size_t)w;
+        for (size_t i = 0; i < (size_t)w * (size_t)m; i++) {
+            double v = buf[i];
+            bool valid = is_valid(nd, v);
+            if (!valid) holes[base + i] = 1;
+            uint16_t texel = 0;
+            if (valid && r->exact)
+                texel = (uint16_t)(r->byte ? v * 257.0 : v - r->base_raw);
+            else if (valid)
+                texel = (uint16_t)fmin(65535.0, fmax(0.0, round(((v * r->scale + r->offset) -
+                                                                 r->lo) * r->q)));
+            texels[base + i] = texel;
+        }
+    }
+    return true;
+}
+
 /* The world size (unless given) and origin from the geotransform: north
  * up, each axis's unit in metres (metres_per_unit); a raster without one
  * needs `size`. */
@@ -277,11 +350,8 @@ bool splat_raster_heightfield(splat_terrain *t, const char *path, bool size_give
         goto done;
 
     /* heights: pass 1, the valid range and the holes */
-    int has_scale = 0, has_off = 0;
-    double scale = GDALGetRasterScale(band, &has_scale);
-    double offset = GDALGetRasterOffset(band, &has_off);
-    if (!has_scale || !isfinite(scale) || scale == 0) scale = 1.0;
-    if (!has_off || !isfinite(offset)) offset = 0.0;
+    double scale, offset;
+    band_scale(band, &scale, &offset);
     nodata nd = band_nodata(band);
     size_t n = (size_t)w * (size_t)h;
     int rows = strip_rows(w, h);
@@ -291,26 +361,13 @@ bool splat_raster_heightfield(splat_terrain *t, const char *path, bool size_give
         sg_error(d, loc, SG_E_OUT_OF_MEMORY, "heightfield does not fit in memory");
         goto done;
     }
-    double lo = INFINITY, hi = -INFINITY, rlo = INFINITY, rhi = -INFINITY;
-    size_t nholes = 0;
-    for (int y = 0; y < h; y += rows) {
-        int m = y + rows <= h ? rows : h - y;
-        if (!read_rows(band, w, y, m, buf)) {
-            gdal_error(path, "truncated or corrupt raster", loc, d);
-            goto done;
-        }
-        for (size_t i = 0; i < (size_t)w * (size_t)m; i++) {
-            if (!is_valid(&nd, buf[i])) {
-                nholes++;
-                continue;
-            }
-            if (buf[i] < rlo) rlo = buf[i];
-            if (buf[i] > rhi) rhi = buf[i];
-            double v = buf[i] * scale + offset;
-            if (v < lo) lo = v;
-            if (v > hi) hi = v;
-        }
+    height_scan hs = {INFINITY, -INFINITY, INFINITY, -INFINITY, 0};
+    if (!scan_heights(band, &nd, w, h, rows, buf, scale, offset, &hs)) {
+        gdal_error(path, "truncated or corrupt raster", loc, d);
+        goto done;
     }
+    double lo = hs.lo, hi = hs.hi, rlo = hs.rlo, rhi = hs.rhi;
+    size_t nholes = hs.nholes;
     if (nholes == n || !isfinite(lo) || !isfinite(hi)) {
         snprintf(msg, sizeof msg, "heightfield '%s' has no valid height (every "
                  "texel is nodata or not finite)", path);
@@ -331,25 +388,11 @@ bool splat_raster_heightfield(splat_terrain *t, const char *path, bool size_give
     bool exact = u16 || shifted;
     double base_raw = shifted ? rlo : 0.0;
     double top = type == GDT_Byte ? 255.0 : 65535.0;
-    double q = hi > lo ? 65535.0 / (hi - lo) : 0.0;
-    for (int y = 0; y < h; y += rows) {
-        int m = y + rows <= h ? rows : h - y;
-        if (!read_rows(band, w, y, m, buf)) {
-            gdal_error(path, "truncated or corrupt raster", loc, d);
-            goto done;
-        }
-        size_t base = (size_t)y * (size_t)w;
-        for (size_t i = 0; i < (size_t)w * (size_t)m; i++) {
-            double v = buf[i];
-            bool valid = is_valid(&nd, v);
-            if (!valid) holes[base + i] = 1;
-            uint16_t texel = 0;
-            if (valid && exact)
-                texel = (uint16_t)(type == GDT_Byte ? v * 257.0 : v - base_raw);
-            else if (valid)
-                texel = (uint16_t)fmin(65535.0, fmax(0.0, round(((v * scale + offset) - lo) * q)));
-            t->texels[base + i] = texel;
-        }
+    texel_rule rule = {exact, type == GDT_Byte, base_raw, scale, offset, lo,
+                       hi > lo ? 65535.0 / (hi - lo) : 0.0};
+    if (!store_texels(band, &nd, w, h, rows, buf, &rule, t->texels, holes)) {
+        gdal_error(path, "truncated or corrupt raster", loc, d);
+        goto done;
     }
     if (u16) {
         t->max_height = top * scale;
@@ -361,8 +404,7 @@ bool splat_raster_heightfield(splat_terrain *t, const char *path, bool size_give
         t->max_height = hi - lo;
         t->height_offset = lo;
         sg_note(d, loc, "heightfield '%s': %s heights %.6g .. %.6g m stored in "
-                "16 bits (step %.3g m)", path, type_name(type), lo, hi,
-                (hi - lo) / 65535.0);
+                "16 bits (step %.3g m)", path, type_name(type), lo, hi, (hi - lo) / 65535.0);
     }
     if (nholes > 0)
         sg_note(d, loc, "heightfield '%s': %zu nodata texel%s cut the terrain "

@@ -85,12 +85,7 @@ bool splat_scene_preview(splat_scene *s, const char *material, sg_diags *d);
 
 /* ---- painted.c: how a pack stores the painted masks -------------------- */
 
-typedef enum splat_painted_format {
-    SPLAT_PAINTED_BC4 = 0,     /* default: sparse quad-tree, BC4 atlas      */
-    SPLAT_PAINTED_R8,          /* sparse quad-tree, R8 atlas (exact)        */
-    SPLAT_PAINTED_DENSE,       /* painted.r8: one W*H layer per mask        */
-} splat_painted_format;
-
+/* splat_painted_format: splatc.h. */
 const char *splat_painted_format_name(splat_painted_format f);  /* "bc4" … */
 bool splat_painted_format_parse(const char *s, splat_painted_format *f);
 
@@ -106,18 +101,7 @@ bool splat_painted_build(const splat_scene *s, splat_painted_format f,
 
 /* ---- search.c: where imports are found ---------------------------------- */
 
-/* The import search path, the one every entry point uses (splatc's
- * commands, splat_scene_load without one, the viewer's hot reload): the
- * `include` folders (-I) in order, $SPLATC_PATH (':'-separated), the
- * current folder, the nearest folder at or above `file`'s that has a
- * nodes/ folder, and the installed node library (splat_data_dir).
- * NULL-terminated, malloc'd: free with splat_search_path_free. */
-char **splat_search_path(const char *const *include, int ninclude, const char *file);
-/* What a scene's imports are resolved against: the scene's folder, then
- * `search` (NULL: splat_search_path's defaults).  Free with
- * splat_search_path_free. */
-char **splat_import_path(const char *scene, const char *const *search);
-void   splat_search_path_free(char **paths);
+/* splat_search_path, splat_import_path, splat_search_path_free: splatc.h. */
 /* The installed data folder, PREFIX/share/splatc when this program runs
  * from PREFIX/bin and the folder holds nodes/; else NULL.  malloc'd. */
 char  *splat_data_dir(void);

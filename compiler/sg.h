@@ -13,94 +13,11 @@
 
 #include "abi.h"
 #include "ir.h"
+#include "splatc.h"   /* the public part: diagnostics, sg_load, the build */
 
-/* ---- diagnostics (diag.c) ---------------------------------------------- */
+/* ---- diagnostics (diag.c; the types and printing: splatc.h) ------------- */
 
-typedef struct sg_loc {
-    const char *file;   /* path as given (owned by the source registry) */
-    int line, col;      /* 1-based; 0 if unknown                         */
-} sg_loc;
 
-/* Error identities, one X-macro list so tests can assert on the id.
- * X(id, format) — format is printf-style. */
-#define SG_ERRORS(X)                                                        \
-    X(IO,            "cannot read '%s': %s")                                \
-    X(WRITE,         "cannot write '%s': %s")                               \
-    X(COMPOSITOR_CONTRACT, "compositor '%s' breaks its contract: %s must be 0 where m = %d " \
-                     "for every T in [0, 1], but at T = %g, h = %g it lies in [%g, %g]") \
-    X(SYNTAX,        "expected %s, found %s")                               \
-    X(UNTERMINATED,  "unterminated %s (opened at line %d)")                 \
-    X(BAD_LITERAL,   "bad literal '%s': %s")                                \
-    X(BAD_CHAR,      "unexpected character %s")                             \
-    X(UNKNOWN_NODE,  "unknown node type '%s'")                              \
-    X(UNKNOWN_PORT,  "'%s' has no %s port '%s'")                            \
-    X(UNKNOWN_NAME,  "unknown name '%s'")                                   \
-    X(DUPLICATE,     "duplicate %s '%s' (first defined at %s:%d:%d)")       \
-    X(TYPE_MISMATCH, "type mismatch: %s expects %s, found %s")              \
-    X(MISSING_INPUT, "'%s' needs a value for input '%s'")                   \
-    X(CYCLE,         "cycle: %s")                                           \
-    X(MISSING_IMPORT,"cannot import '%s': %s")                              \
-    X(IMPORT_CYCLE,  "import cycle: %s")                                    \
-    X(BAD_OUTPUT,    "'%s' is not a material output (mask, albedo, normal, roughness, height)") \
-    X(TOO_DEEP,      "nesting deeper than %d levels")                       \
-    X(BAD_SWIZZLE,   "%s")      /* .xyzw past a value's end, or no swizzle */ \
-    X(BAD_REFERENCE, "%s")      /* a name of the wrong kind used here      */ \
-    X(BAD_DEFAULT,   "%s")      /* a default a param or input cannot take  */ \
-    X(BAD_COMPONENTS, "%s")     /* vecN(...) with the wrong count          */ \
-    X(BAD_OPTION,    "%s")      /* a texture or node option's value        */ \
-    X(EMPTY_RANGE,   "%s")      /* param range lo > hi                     */ \
-    X(REDEFINED,     "%s")      /* a built-in node type defined again      */ \
-    X(HAS_ERRORS,    "%s")      /* lowering a program that has errors      */ \
-    X(SETTING,       "%s")      /* a scene setting's value                 */ \
-    X(MISSING_SETTING, "%s")    /* a setting the scene needs               */ \
-    X(UNDECLARED,    "%s")      /* a painted mask or compositor not there  */ \
-    X(RASTER,        "%s")      /* a heightfield or mask raster's content  */ \
-    X(OVER_LIMIT,    "%s")      /* over a pack or device limit (PACK.md)   */ \
-    X(EMPTY_TERRAIN, "%s")      /* holes cover the whole terrain           */ \
-    X(NOT_A_PACK,    "%s")      /* the output folder is not a shader pack  */ \
-    X(NO_DEVICE,     "%s")      /* --far-bake gpu and no device to bake on */ \
-    X(OUT_OF_MEMORY, "%s")                                                  \
-    /* warnings (the input is accepted) */                                  \
-    X(W_MASK_RANGE,  "%s")      /* a mask's values leave [0, 1] (lint.c)   */ \
-    X(W_NAN,         "%s")      /* an output can be NaN or infinite        */ \
-    X(W_LO_HI,       "%s")      /* a constant lo >= hi on a ramp-like node */ \
-    X(W_PRECISION,   "%s")      /* position in fp32 past a quarter texel   */ \
-    X(WARNING,       "%s")      /* any other warning                       */ \
-    X(INTERNAL,      "internal compiler error: %s")
-
-typedef enum sg_error_id {
-#define X(id, fmt) SG_E_##id,
-    SG_ERRORS(X)
-#undef X
-    SG_E_COUNT
-} sg_error_id;
-
-typedef enum sg_severity { SG_ERROR, SG_WARNING, SG_NOTE } sg_severity;
-
-typedef struct sg_diag {
-    sg_loc       loc;
-    sg_severity  severity;
-    sg_error_id  id;
-    char        *msg;
-    char        *src_line;  /* the source line at loc (for the caret), or NULL */
-    char        *suggestion; /* "did you mean" replacement (sg_hint_suggest), or NULL */
-} sg_diag;
-
-typedef struct sg_diags {
-    sg_diag *items;
-    int      n, cap;
-    int      nerrors;
-    int      ndropped;  /* diagnostics counted but not stored (too many) */
-    struct sg_sources *sources; /* source texts for carets (diag.c)      */
-    bool     last_dropped; /* the latest diagnostic was not stored        */
-    bool     unique;    /* do not store a diagnostic equal to one stored
-                           (it still counts in nerrors): one list for
-                           several loads of files that share imports
-                           (`splatc check A B` prints each error once)    */
-} sg_diags;
-
-void sg_diags_init(sg_diags *d);
-void sg_diags_free(sg_diags *d);
 /* Record a diagnostic; the message is formatted from the id's format. */
 void sg_error(sg_diags *d, sg_loc loc, sg_error_id id, ...);
 /* `loc` if it was given (line > 0), else `fallback`. */
@@ -145,34 +62,10 @@ const char *sg_suggest_best(const sg_suggest *s);
 /* Edit distance of a and b as sg_suggest counts it (capped at 64). */
 int         sg_edit_distance(const char *a, const char *b);
 
-/* GCC style: "file:line:col: error: msg", the source line, a caret. */
-void sg_diags_print(const sg_diags *d, FILE *out);
-/* The same for the diagnostics from index `from` on (no "not shown" line). */
-void sg_diags_print_from(const sg_diags *d, int from, FILE *out);
-/* The same diagnostics for editors, one JSON object per line (JSON Lines):
- * {"file": …, "line": N, "column": N, "severity": "error", "id":
- * "UNKNOWN_NODE", "message": …} and, where the message says "did you
- * mean", "suggestion": the name; file is null and line/column 0 where
- * unknown; a last {"dropped": N} line if some were not stored. */
-void sg_diags_print_json(const sg_diags *d, FILE *out);
-/* The same from index `from` on (no "dropped" line). */
-void sg_diags_print_json_from(const sg_diags *d, int from, FILE *out);
-/* The id's name as in SG_ERRORS ("UNKNOWN_NODE"). */
-const char *sg_error_name(sg_error_id id);
-/* Make `text` the source of `path` for the caret lines of later
- * diagnostics at `path` (copied; sg_load does this for every file). */
-void sg_diags_add_source(sg_diags *d, const char *path, const char *text,
-                         size_t len);
 
 /* ---- programs ---------------------------------------------------------- */
 
-typedef struct sg_program sg_program;
 
-/* Parse `path` and everything it imports (import paths are relative to the
- * importing file, then to the search paths), resolve names and type-check.
- * Returns NULL only on allocation failure; check d->nerrors. */
-sg_program *sg_load(const char *path, const char *const *search_paths,
-                    sg_diags *d);
 /* Same, from memory (`name` is used in diagnostics and for imports). */
 sg_program *sg_load_string(const char *name, const char *text,
                            const char *const *search_paths, sg_diags *d);
@@ -216,11 +109,6 @@ sg_loc sg_texture_file_loc(const sg_program *p, const char *file);
  * is not.  sg_load does not look at files (a graph library may name
  * textures its user never builds); `splatc check` and scene loading do. */
 bool sg_check_texture_files(const sg_program *p, sg_diags *d);
-void        sg_free(sg_program *p);
-
-/* Every file the program read (for hot reload and cache keys). */
-int         sg_file_count(const sg_program *p);
-const char *sg_file_path(const sg_program *p, int i);
 
 int         sg_material_count(const sg_program *p);
 const char *sg_material_name(const sg_program *p, int i);

@@ -425,6 +425,62 @@ static uint32_t bucket(const sg_scene *sc, const seglist *l, const double o[2], 
     return most;
 }
 
+/* The shapes' words (half width, falloff, profile and kind) and the
+ * segments' (end points, shape). */
+static void shape_words(const sg_scene *sc, splat_vectors *v, const seglist *l)
+{
+    uint32_t *w = v->words;
+    for (int s = 0; s < sc->nvectors; s++) {
+        const sg_scene_vector *sv = &sc->vectors[s];
+        uint32_t *q = &w[shape_at(v, s)];
+        q[0] = fw(sv->kind == SPLAT_VEC_SPLINE ? (float)(0.5 * sv->width) : 0.0f);
+        q[1] = fw((float)sv->falloff);
+        q[2] = (uint32_t)sv->profile | (uint32_t)sv->kind << 8;
+    }
+    for (size_t k = 0; k < l->n; k++) {
+        uint32_t *q = &w[segs_at(v) + SPLAT_VEC_SEG * k];
+        for (int j = 0; j < 4; j++) q[j] = fw(l->xz[k][j]);
+        q[4] = (uint32_t)l->shape[k];
+    }
+}
+
+/* The cells' words: first entry and count, the reference point, and the
+ * polygons the reference point is inside (after the segments' words:
+ * it reads them back as the shader does). */
+static void cell_words(const sg_scene *sc, splat_vectors *v, const double o[2], double c,
+                       uint32_t ncx, size_t ncells, const uint32_t *count,
+                       const uint32_t *first, const uint32_t *entries)
+{
+    bool polygons = false;
+    for (int s = 0; s < sc->nvectors; s++)
+        polygons |= sc->vectors[s].kind == SPLAT_VEC_POLYGON;
+    for (size_t i = 0; i < ncells; i++) {
+        uint32_t *q = &v->words[cells_at(v) + SPLAT_VEC_CELL * i];
+        q[0] = first[i], q[1] = count[i];
+        double gx = (double)(i % ncx), gz = (double)(i / ncx);
+        /* the reference point: the candidate farthest from the cell's
+         * polygon edges, so the shader's fp32 crossings agree */
+        double best[2] = { o[0] + (gx + 0.5) * c, o[1] + (gz + 0.5) * c }, bestd = -1;
+        for (int cand = 0; polygons && count[i] > 0 && cand < 9; cand++) {
+            double p[2] = { (float)(o[0] + (gx + 0.25 + 0.25 * (cand % 3)) * c),
+                            (float)(o[1] + (gz + 0.25 + 0.25 * (cand / 3)) * c) };
+            double m = INFINITY;
+            for (uint32_t e = 0; e < count[i]; e++) {
+                double a[2], b[2];
+                int s = seg_get(v, entries[first[i] + e], a, b);
+                if (sc->vectors[s].kind == SPLAT_VEC_POLYGON) m = fmin(m, seg_dist(p, a, b));
+            }
+            if (m > bestd) bestd = m, best[0] = p[0], best[1] = p[1];
+        }
+        q[4] = fw((float)best[0]), q[5] = fw((float)best[1]);
+        double ref[2] = { wf(v, cells_at(v) + SPLAT_VEC_CELL * i + 4),
+                          wf(v, cells_at(v) + SPLAT_VEC_CELL * i + 5) };
+        for (int s = 0; s < sc->nvectors; s++)
+            if (sc->vectors[s].kind == SPLAT_VEC_POLYGON && inside_polygon(v, s, ref))
+                q[2] |= 1u << s;
+    }
+}
+
 void splat_vectors_free(splat_vectors *v)
 {
     free(v->words);
@@ -514,47 +570,9 @@ bool splat_vectors_build(const sg_scene *sc, splat_vectors *v, sg_diags *d)
     w[0] = ncx, w[1] = ncz, w[2] = (uint32_t)ns, w[3] = (uint32_t)l.n;
     w[4] = (uint32_t)nentries;
     w[5] = fw((float)o[0]), w[6] = fw((float)o[1]), w[7] = fw((float)c);
-    for (int s = 0; s < ns; s++) {
-        const sg_scene_vector *sv = &sc->vectors[s];
-        uint32_t *q = &w[shape_at(v, s)];
-        q[0] = fw(sv->kind == SPLAT_VEC_SPLINE ? (float)(0.5 * sv->width) : 0.0f);
-        q[1] = fw((float)sv->falloff);
-        q[2] = (uint32_t)sv->profile | (uint32_t)sv->kind << 8;
-    }
+    shape_words(sc, v, &l);
     memcpy(&w[entries_at(v)], entries, nentries * sizeof *entries);
-    for (size_t k = 0; k < l.n; k++) {
-        uint32_t *q = &w[segs_at(v) + SPLAT_VEC_SEG * k];
-        for (int j = 0; j < 4; j++) q[j] = fw(l.xz[k][j]);
-        q[4] = (uint32_t)l.shape[k];
-    }
-    bool polygons = false;
-    for (int s = 0; s < ns; s++)
-        polygons |= sc->vectors[s].kind == SPLAT_VEC_POLYGON;
-    for (size_t i = 0; i < ncells; i++) {
-        uint32_t *q = &w[cells_at(v) + SPLAT_VEC_CELL * i];
-        q[0] = first[i], q[1] = count[i];
-        double gx = (double)(i % ncx), gz = (double)(i / ncx);
-        /* the reference point: the candidate farthest from the cell's
-         * polygon edges, so the shader's fp32 crossings agree */
-        double best[2] = { o[0] + (gx + 0.5) * c, o[1] + (gz + 0.5) * c }, bestd = -1;
-        for (int cand = 0; polygons && count[i] > 0 && cand < 9; cand++) {
-            double p[2] = { (float)(o[0] + (gx + 0.25 + 0.25 * (cand % 3)) * c),
-                            (float)(o[1] + (gz + 0.25 + 0.25 * (cand / 3)) * c) };
-            double m = INFINITY;
-            for (uint32_t e = 0; e < count[i]; e++) {
-                double a[2], b[2];
-                int s = seg_get(v, entries[first[i] + e], a, b);
-                if (sc->vectors[s].kind == SPLAT_VEC_POLYGON) m = fmin(m, seg_dist(p, a, b));
-            }
-            if (m > bestd) bestd = m, best[0] = p[0], best[1] = p[1];
-        }
-        q[4] = fw((float)best[0]), q[5] = fw((float)best[1]);
-        double ref[2] = { wf(v, cells_at(v) + SPLAT_VEC_CELL * i + 4),
-                          wf(v, cells_at(v) + SPLAT_VEC_CELL * i + 5) };
-        for (int s = 0; s < ns; s++)
-            if (sc->vectors[s].kind == SPLAT_VEC_POLYGON && inside_polygon(v, s, ref))
-                q[2] |= 1u << s;
-    }
+    cell_words(sc, v, o, c, ncx, ncells, count, first, entries);
     free(count), free(first), free(entries);
     free(l.xz), free(l.shape);
     return true;

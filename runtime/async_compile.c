@@ -15,6 +15,7 @@
 #define MAX_WORKERS 16
 
 typedef struct rt_async {
+    rt_async_make   make;     /* rt_pipelines_compute_make: what a worker runs */
     rt_device      *d;
     const rt_pack  *p;
     rt_pipelines   *pl;
@@ -43,8 +44,8 @@ static void *worker(void *arg)
         pthread_mutex_unlock(&a->lock);
         VkPipeline pipe = VK_NULL_HANDLE;
         rt_error e = {0};
-        bool ok = rt_pipelines_compute_make(a->d, a->p, a->pl, slot / RT_CVARIANTS,
-                                            (unsigned)(slot % RT_CVARIANTS), &pipe, &e);
+        bool ok = a->make(a->d, a->p, a->pl, slot / RT_CVARIANTS,
+                          (unsigned)(slot % RT_CVARIANTS), &pipe, &e);
         pthread_mutex_lock(&a->lock);
         if (ok && a->pl->compute[slot])   /* made meanwhile by a frame */
             vkDestroyPipeline(a->d->dev, pipe, NULL);
@@ -61,7 +62,8 @@ static void *worker(void *arg)
     return NULL;
 }
 
-bool rt_async_start(rt_device *d, const rt_pack *p, rt_pipelines *pl, rt_error *e)
+bool rt_async_start(rt_device *d, const rt_pack *p, rt_pipelines *pl, rt_async_make make,
+                    rt_error *e)
 {
     rt_async *a = calloc(1, sizeof *a);
     int nslots = (p->ncombos + 1) * RT_CVARIANTS;
@@ -77,6 +79,7 @@ bool rt_async_start(rt_device *d, const rt_pack *p, rt_pipelines *pl, rt_error *
         free(a);
         return rt_fail(e, RT_E_VULKAN, "pipelines", "out of memory");
     }
+    a->make = make;
     a->d = d;
     a->p = p;
     a->pl = pl;

@@ -546,7 +546,7 @@ bool rt_renderer_create(rt_device *d, const rt_pack *p, const rt_render_desc *de
                              p->narrays, &r->pl, e) ||
         !make_geometry(r, e) || !make_textures(r, e) || !make_descriptors(r, e) ||
         !make_commands(r, e) || !make_pack_objects(r, r->set0c != VK_NULL_HANDLE, e) ||
-        (r->screen && r->desc.async_pipelines && !rt_async_start(d, p, &r->pl, e))) {
+        (r->screen && r->desc.async_pipelines && !rt_async_start(d, p, &r->pl, rt_pipelines_compute_make, e))) {
         rt_renderer_destroy(r);
         return false;
     }
@@ -702,7 +702,7 @@ bool rt_renderer_swap_pack(rt_renderer *r, const rt_pack *p, rt_error *e)
     /* the workers stop with the old pack's pipelines; new ones for the new */
     bool async = r->pl.async != NULL;
     if (!rt_pipelines_reset_combos(r->d, p, &r->pl, e) ||
-        (async && !rt_async_start(r->d, p, &r->pl, e))) {
+        (async && !rt_async_start(r->d, p, &r->pl, rt_pipelines_compute_make, e))) {
         free(counts);
         return false;
     }

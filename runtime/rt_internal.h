@@ -669,9 +669,14 @@ bool rt_pipelines_compute_make(rt_device *d, const rt_pack *p, rt_pipelines *pl,
 
 /* ---- async_compile.c: compute pipelines made on worker threads -------- */
 
-/* Workers for pl (pl->async); rt_async_stop joins them (destroy_combos
- * does, before a pack swap or the end) and drops what is still queued. */
-bool       rt_async_start(rt_device *d, const rt_pack *p, rt_pipelines *pl, rt_error *e);
+/* Workers for pl (pl->async), each making what is requested with `make`
+ * (rt_pipelines_compute_make: passed in, so this pool calls nothing of
+ * pipelines.c by name); rt_async_stop joins them (destroy_combos does,
+ * before a pack swap or the end) and drops what is still queued. */
+typedef bool (*rt_async_make)(rt_device *d, const rt_pack *p, rt_pipelines *pl, int id,
+                              unsigned variant, VkPipeline *out, rt_error *e);
+bool       rt_async_start(rt_device *d, const rt_pack *p, rt_pipelines *pl, rt_async_make make,
+                          rt_error *e);
 void       rt_async_stop(rt_pipelines *pl);
 /* Queue combination id's pipeline of `variant` unless made or queued. */
 void       rt_async_request(rt_pipelines *pl, int id, unsigned variant);

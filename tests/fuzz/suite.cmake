@@ -21,8 +21,11 @@ if(SPLAT_FUZZ)
     message(FATAL_ERROR "SPLAT_FUZZ=ON needs clang (CC=clang cmake ...)")
   endif()
   # the front end compiled into its target (as before: no runtime needed)
-  set(FUZZ_FRONTEND abi.c sg_util.c diag.c lex.c parse.c scene_check.c resolve.c lower.c ir.c ir_ops.c
-                    ir_differentiate.c util.c opt.c opt_fold.c opt_dce.c opt_dedup.c opt_pin.c ir_interval.c ir_validate.c
+  set(FUZZ_FRONTEND abi.c sg_util.c diag.c lex.c parse_base.c parse.c parse_undergrowth.c parse_scene.c
+                    resolve_names.c resolve_types.c resolve_order.c texture_files.c
+                    load.c sg_program.c scene_check.c resolve.c lower.c ir.c ir_ops.c
+                    ir_differentiate.c ir_derive_rules.c ir_rebuild.c util.c opt.c opt_fold.c opt_dce.c
+                    opt_dedup.c opt_pin.c ir_interval.c ir_validate.c
                     mesh.c mesh_obj.cpp)
   list(TRANSFORM FUZZ_FRONTEND PREPEND ${PROJECT_SOURCE_DIR}/compiler/)
   add_executable(fuzz_parse ${CMAKE_CURRENT_LIST_DIR}/fuzz_parse.c ${FUZZ_FRONTEND})

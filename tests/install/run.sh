@@ -13,17 +13,27 @@ P="$T/prefix"
 "$CMAKE" --install "$BUILD" --prefix "$P" > "$T/install.log" 2>&1 ||
     { cat "$T/install.log"; fail "cmake --install"; }
 for f in bin/splatc bin/splatview lib/libsplatc.a lib/libsplatrt.a include/splatc/splatrt.h \
-         include/splatc/abi.h include/splatc/scene.h lib/pkgconfig/splatc.pc \
+         include/splatc/splatc.h include/splatc/abi.h lib/pkgconfig/splatc.pc \
          lib/pkgconfig/splatrt.pc lib/cmake/splatc/splatcConfig.cmake \
          share/splatc/nodes/masks.sg share/splatc/nodes/compositors.sg; do
     [ -e "$P/$f" ] || fail "not installed: $f"
 done
-[ -e "$P/include/splatc/sg_internal.h" ] && fail "an internal header was installed"
 [ -e "$P/include/splatc/rt_internal.h" ] && fail "the runtime's internal header was installed"
 # the runtime's public header stands on abi.h and the C library alone: no
 # Vulkan, no compiler internals (rt_device and rt_pack are opaque)
 grep '^#include' "$P/include/splatc/splatrt.h" | grep -v -e '<std[a-z]*\.h>' -e '"abi.h"' &&
     fail "splatrt.h includes more than abi.h and the C library"
+# the compiler's internal headers stay in the source tree: splatc.h is
+# libsplatc's one public header (abi.h is splatrt.h's include)
+for h in sg_internal.h sg.h ir.h util.h scene.h scene_load.h compose.h build.h; do
+    [ -e "$P/include/splatc/$h" ] && fail "an internal header was installed: $h"
+done
+for h in "$P"/include/splatc/*.h; do
+    case ${h##*/} in
+    splatc.h|splatrt.h|abi.h) ;;
+    *) fail "a header not on the public list was installed: ${h##*/}" ;;
+    esac
+done
 
 # 1. a scene outside any project, importing the node library, no -I
 mkdir "$T/work" && cp "$HF" "$T/work/heightfield.png" || fail "copy"
@@ -57,17 +67,18 @@ cat > "$T/work/tiny.c" <<'C'
 #include <stdio.h>
 #include <string.h>
 #include <splatrt.h>
-#include <sg.h>
+#include <splatc.h>
 int main(void)
 {
-    /* a runtime function (libsplatrt) and a compiler one (libsplatc) */
+    /* a runtime function (libsplatrt) and compiler ones (libsplatc,
+     * through its one public header) */
     char views[256];
     rt_view_list(views, sizeof views);
     sg_diags d;
     sg_diags_init(&d);
     sg_diags_free(&d);
-    printf("%s %s\n", rt_view_name(SPLAT_VIEW_FINAL), views);
-    return strncmp(views, "final|", 6) != 0;
+    printf("%s %s %s\n", rt_view_name(SPLAT_VIEW_FINAL), views, splatc_version());
+    return strncmp(views, "final|", 6) != 0 || !*splatc_version();
 }
 C
 export PKG_CONFIG_PATH="$P/lib/pkgconfig"

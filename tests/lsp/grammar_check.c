@@ -1,10 +1,11 @@
-/* grammar_check.c — `grammar_check GRAMMAR PARSE_C`: the TextMate grammar
+/* grammar_check.c — `grammar_check GRAMMAR PARSER_C...`: the TextMate grammar
  * editors/sg.tmLanguage.json is valid JSON, names the scope source.sg for
  * .sg files, and its patterns name every word the language knows, so it
  * fails when one is added to the compiler and not to the grammar:
  *
- *   - every keyword compiler/parse.c recognises (each `is_kw(t, "word")`
- *     and `word_is(v, "word")` in its text: statements, settings, values);
+ *   - every keyword the parser's files (compiler/parse*.c) recognise (each
+ *     `is_kw(t, "word")` and `word_is(v, "word")` in their text:
+ *     statements, settings, values);
  *   - the types, the settings blocks' keys (sg_scene_keys, …), the light
  *     keys, filter and wrap names, built-in meshes, terrain and view inputs
  *     (the compiler's own tables).
@@ -78,7 +79,7 @@ static void need_list(const char *all, const char *const *words, const char *fro
         need(all, words[i], from);
 }
 
-/* The words parse.c recognises: is_kw(…, "w") and word_is(…, "w"). */
+/* The words a parser file recognises: is_kw(…, "w") and word_is(…, "w"). */
 static int parser_words(const char *all, const char *parse_c)
 {
     FILE *f = fopen(parse_c, "rb");
@@ -102,7 +103,7 @@ static int parser_words(const char *all, const char *parse_c)
                 continue;
             char word[64];
             snprintf(word, sizeof word, "%.*s", (int)(e - q - 1), q + 1);
-            need(all, word, "compiler/parse.c");
+            need(all, word, parse_c);
             found++;
         }
     return found;
@@ -110,8 +111,8 @@ static int parser_words(const char *all, const char *parse_c)
 
 int main(int argc, char **argv)
 {
-    if (argc != 3) {
-        fprintf(stderr, "usage: grammar_check GRAMMAR PARSE_C\n");
+    if (argc < 3) {
+        fprintf(stderr, "usage: grammar_check GRAMMAR PARSER_C...\n");
         return 2;
     }
     json_error_t je;
@@ -134,10 +135,16 @@ int main(int argc, char **argv)
     char *all = calloc(1, 1);
     size_t len = 0;
     patterns(g, &all, &len);
-    int words = parser_words(all, argv[2]);
+    int words = 0;
+    for (int i = 2; i < argc; i++) {
+        int n = parser_words(all, argv[i]);
+        if (n < 0)
+            failures++;
+        words += n > 0 ? n : 0;
+    }
     if (words < 30) {
-        fprintf(stderr, "FAIL: only %d keywords found in %s: has the parser changed how it "
-                "recognises them?\n", words, argv[2]);
+        fprintf(stderr, "FAIL: only %d keywords found in the parser's %d files: has the parser "
+                "changed how it recognises them?\n", words, argc - 2);
         failures++;
     }
     for (int t = IR_T_FLOAT; t <= IR_T_TEX; t++)

@@ -15,11 +15,13 @@ if(TARGET splatc_cli)
 endif()
 
 # The TextMate grammar for editors (editors/sg.tmLanguage.json) is valid
-# JSON and names every keyword parse.c recognises and every word of the
+# JSON and names every keyword the parser (parse*.c) recognises and every word of the
 # compiler's tables (settings keys, light keys, filters, inputs, meshes).
 add_executable(grammar_check ${CMAKE_CURRENT_LIST_DIR}/grammar_check.c)
 target_link_libraries(grammar_check splatc PkgConfig::JANSSON)
 add_test(NAME lsp.grammar
          COMMAND grammar_check ${PROJECT_SOURCE_DIR}/editors/sg.tmLanguage.json
-                 ${PROJECT_SOURCE_DIR}/compiler/parse.c)
+                 ${PROJECT_SOURCE_DIR}/compiler/parse.c ${PROJECT_SOURCE_DIR}/compiler/parse_base.c
+                 ${PROJECT_SOURCE_DIR}/compiler/parse_undergrowth.c
+                 ${PROJECT_SOURCE_DIR}/compiler/parse_scene.c)
 set_tests_properties(lsp.grammar PROPERTIES LABELS "unit;lsp")

@@ -32,6 +32,7 @@
  * fp32 ulp there is 0.5 m).  Pictures go to OUTDIR: each view, and
  * diff_*.png (red: over 8/255, grey: the difference times 16). */
 #include "kit.h"
+#include "scene_load.h"   /* the compiler's scene, to sample its composite on the CPU */
 
 #include <math.h>
 #include <stdio.h>
