@@ -112,18 +112,26 @@ static void run_pool(build *b, const char *phase, void (*fn)(build *, job *), bo
     pthread_mutex_destroy(&p.lock);
 }
 
+/* glslang, then spirv-val on what it produced, in one task of the pool:
+ * the über-shader's long validation runs beside the composites' compiles
+ * instead of after all of them (largest GLSL first).  A module whose
+ * shape (cache.h splat_spirv_shape_key: its words but the float
+ * constants' values) passed spirv-val before is not validated again. */
 static void compile_job(build *b, job *j)
 {
-    spv_compile(j->glsl.s, j->stage, j->file, &j->words, &j->nwords, &j->log);
-}
-
-static void validate_job(build *b, job *j)
-{
-    if (!j->words)
+    if (!spv_compile(j->glsl.s, j->stage, j->file, &j->words, &j->nwords, &j->log))
         return;
+    char shape[SPLAT_KEY_CHARS + 1];
+    bool keyed = splat_spirv_shape_key(j->words, j->nwords, shape);
+    if (keyed && splat_cache_valid(&b->cache, shape)) {
+        j->shape_valid = true;
+        return;
+    }
     char *log = NULL;
     if (spv_validate(j->words, j->nwords, &log)) {
         free(log);
+        if (keyed)
+            splat_cache_mark_valid(&b->cache, shape);   /* failure: validated again */
         return;
     }
     free(j->log);
@@ -323,7 +331,7 @@ bool build_compile(build *b)
                     splat_cache_get(&b->cache, j->key, &j->words, &j->nwords);
         pending[i] = !j->cached && !j->glsl_only;
     }
-    run_pool(b, "glslang", compile_job, pending, b->desc->jobs);
+    run_pool(b, "glslang+spirv-val", compile_job, pending, b->desc->jobs);
     free(pending);
     return true;
 }
@@ -343,11 +351,6 @@ static void report_job_error(build *b, const job *j)
 bool build_validate(build *b)
 {
     splat_build_stats *st = b->st;
-    bool *pending = xcalloc((size_t)b->njobs, sizeof *pending);
-    for (int i = 0; i < b->njobs; i++)
-        pending[i] = !b->jobs[i].cached && !b->jobs[i].glsl_only;
-    run_pool(b, "spirv-val", validate_job, pending, b->desc->jobs);
-    free(pending);
     bool ok = true;
     for (int i = 0; i < b->njobs; i++) {
         job *j = &b->jobs[i];
@@ -360,6 +363,7 @@ bool build_validate(build *b)
         }
         if (!j->cached)
             splat_cache_put(&b->cache, j->key, j->words, j->nwords);
+        st->shapes_known += j->shape_valid;
         bool combo = j->kind == JOB_COMBO;
         st->shaders++;
         st->combos += combo;

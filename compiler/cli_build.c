@@ -82,6 +82,8 @@ static void print_stats(const splat_build_stats *st, FILE *out)
             st->largest, st->leaf_largest, st->uber_nodes);
     fprintf(out, "shaders: %d (%d from cache, %d compiled)\n", st->shaders,
             st->shaders_cached, st->shaders_compiled);
+    fprintf(out, "spirv-val: %d modules validated, %d of known shape (float constants "
+            "changed only)\n", st->shaders_compiled - st->shapes_known, st->shapes_known);
     fprintf(out, "lazy branches: %d in the fragment composites written\n",
             st->lazy_branches);
     fprintf(out, "distance classes: %d variants added\n", st->dclasses);

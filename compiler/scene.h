@@ -69,6 +69,8 @@ typedef struct splat_build_stats {
                                 in one leaf cell                         */
     int    uber_nodes;       /* coarse quadtree nodes no combination covers */
     int    shaders, shaders_cached, shaders_compiled; /* every module         */
+    int    shapes_known;     /* compiled ones not validated again: their
+                                shape passed spirv-val before (cache.h)  */
     int    lazy_branches;    /* lazy branches in the composites compiled
                                 (fragment variants; compose.c)          */
     int    dclasses;         /* distance class variants added (distance.c)  */

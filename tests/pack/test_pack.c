@@ -366,6 +366,15 @@ static void test_incremental(void **state)
     assert_int_equal(cached, n - with_rock);
     stats_line(out, "shaders", &ns, &scached, &scompiled);
     assert_int_equal(scompiled, with_rock + 2);  /* + rock's reference, über */
+    /* a constant edit: every recompiled module's shape passed spirv-val in
+     * the first build, so none is validated again (cache.h) */
+    const char *sv = strstr(out, "\nspirv-val: ");
+    assert_non_null(sv);
+    int validated = -1, known = -1;
+    assert_int_equal(sscanf(sv, "\nspirv-val: %d modules validated, %d of known shape",
+                            &validated, &known), 2);
+    assert_int_equal(validated, 0);
+    assert_int_equal(known, with_rock + 2);
     free(out);
 
     free(build(0, scene, cold, "--no-cache"));
