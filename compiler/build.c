@@ -163,14 +163,17 @@ static bool inputs_key(build *b)
     return ok;
 }
 
-/* The shader's files are there: "glsl" and "spirv" (`spirv`: the entry
- * must name one; else only if it does — a compute variant's GLSL alone). */
+/* The shader's files are there: every file it names, "spirv" named
+ * where `spirv` (a compute variant may be GLSL alone, a reference pass
+ * SPIR-V alone). */
 static bool shader_files(const char *pack, json_t *shader, bool spirv)
 {
+    if (!json_is_object(shader))
+        return false;
     const char *keys[] = {"glsl", "spirv"};
     for (int i = 0; i < 2; i++) {
         const char *rel = json_string_value(json_object_get(shader, keys[i]));
-        if (!rel && i == 1 && !spirv && json_is_object(shader))
+        if (!rel && (i == 0 || !spirv))
             continue;
         if (!rel)
             return false;

@@ -6,6 +6,7 @@
 #include "rt_internal.h"
 #include "ir.h"
 #include "far_atlas.h"
+#include "zst.h"
 
 #include <errno.h>
 #include <fcntl.h>
@@ -178,6 +179,22 @@ uint8_t *rt_pack_read_file(int dirfd, const char *rel, size_t max, size_t *n, ch
     return buf;
 }
 
+uint8_t *rt_pack_read_content(int dirfd, const char *rel, size_t max, size_t *n, char *why,
+                              size_t nwhy)
+{
+    if (!splat_zst_name(rel))
+        return rt_pack_read_file(dirfd, rel, max, n, why, nwhy);
+    /* the file within the largest frame of `max` bytes; the frame's stated
+     * content size within `max` before its buffer is allocated (zst.h) */
+    size_t zn = 0;
+    uint8_t *z = rt_pack_read_file(dirfd, rel, splat_zst_bound(max), &zn, why, nwhy);
+    if (!z)
+        return NULL;
+    uint8_t *d = splat_zst_decompress(z, zn, max, n, why, nwhy);
+    free(z);
+    return d;
+}
+
 /* ---- typed field access with messages naming the field ------------------ */
 
 static bool field_fail(reader *r, const char *where, const char *what)
@@ -289,7 +306,7 @@ static uint8_t *pack_file(reader *r, const char *field, const char *rel,
 {
     char why[256];
     size_t n = 0;
-    uint8_t *data = rt_pack_read_file(r->dirfd, rel, want ? want : max, &n, why, sizeof why);
+    uint8_t *data = rt_pack_read_content(r->dirfd, rel, want ? want : max, &n, why, sizeof why);
     if (!data) {
         rt_fail(r->e, RT_E_PACK_FILE, r->manifest, field, rel, why);
         return NULL;
@@ -446,7 +463,7 @@ char *rt_pack_read_glsl(const rt_pack *p, const char *field, const char *rel, rt
     if (dirfd < 0) {
         snprintf(why, sizeof why, "cannot open the pack folder (%s)", strerror(errno));
     } else {
-        data = rt_pack_read_file(dirfd, rel, MAX_SPIRV, &n, why, sizeof why);
+        data = rt_pack_read_content(dirfd, rel, MAX_SPIRV, &n, why, sizeof why);
         close(dirfd);
     }
     char *text = data ? glsl_text(data, n, why, sizeof why) : NULL;

@@ -200,6 +200,13 @@ int      rt_pack_open_file(int dirfd, const char *rel, char *why, size_t nwhy);
  * `max` bytes (bounded reads; NUL appended, not counted in *n). */
 uint8_t *rt_pack_read_file(int dirfd, const char *rel, size_t max, size_t *n, char *why,
                            size_t nwhy);
+/* rt_pack_read_file, or for a name ending in ".zst" its content (PACK.md
+ * "Compressed shaders"): the file within the largest frame of `max`
+ * bytes, the frame's stated size at most `max` before its buffer is
+ * allocated, exactly one frame that decompresses to that size (its
+ * checksum checked).  `max` bounds the content either way. */
+uint8_t *rt_pack_read_content(int dirfd, const char *rel, size_t max, size_t *n, char *why,
+                              size_t nwhy);
 /* The GLSL text at `rel` in p's folder (the manifest's `field`), read now
  * under the same checks (malloc'd); NULL with `e` set if it cannot be. */
 char    *rt_pack_read_glsl(const rt_pack *p, const char *field, const char *rel, rt_error *e);

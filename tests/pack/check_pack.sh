@@ -8,6 +8,15 @@
 set -e
 splatc=$1 scene=$2 out=$3 cache=$4
 "$splatc" build "$scene" -o "$out" --cache "$cache" -j 2 --compute-spirv
+# the pack's shader files are zstd frames (compiler/PACK.md "Compressed
+# shaders"): checked as the plain files they hold, under OUT.plain
+pack=$out
+out=$out.plain
+rm -rf "$out" && mkdir -p "$out/shaders"
+for f in "$pack"/shaders/*.zst; do
+    b=${f##*/}
+    zstd -q -d "$f" -o "$out/shaders/${b%.zst}"
+done
 n=$(ls "$out"/shaders/*.spv | wc -l)
 test -n "$(ls "$out"/shaders/*.comp.spv)"
 # each batch exits 255 on the first failure, which stops xargs (and set -e)
@@ -34,5 +43,5 @@ ls "$out"/shaders/*.comp | xargs -P 2 -n 8 sh -c '
         fi
     done
     rm -f "$v"' sh
-test -f "$out/manifest.json"
+test -f "$pack/manifest.json"
 echo "$scene: $n SPIR-V modules and their GLSL valid, and the counting variants"
