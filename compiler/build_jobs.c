@@ -175,9 +175,9 @@ static void add_classes(build *b, int index, const splat_composite *c, combo_inf
             job *j = job_add(b, compute ? JOB_CLASS_COMPUTE : JOB_CLASS, index, file,
                              compute ? SPV_STAGE_COMPUTE : SPV_STAGE_FRAGMENT);
             j->dclass = k;
-            /* GLSL only, both stages, unless --compute-spirv: the runtime
-             * compiles a class on first use (PACK.md "Distance classes") */
-            j->glsl_only = !b->desc->compute_spirv;
+            /* GLSL only, both stages, with --glsl-compute: the runtime
+             * then compiles a class on first use (PACK.md "Distance classes") */
+            j->glsl_only = b->desc->glsl_compute;
             snprintf(j->title, sizeof j->title,
                      "composite of combination %d, distance class %d (%g m and %s)%s", index, k,
                      v[k].lo == 0 ? v[k].hi : v[k].lo, v[k].lo == 0 ? "nearer" : "beyond",
@@ -229,7 +229,7 @@ static bool add_composite(build *b, job_kind kind, int index, const int *materia
             file = xasprintf(k == JOB_FLAT ? "shaders/flat_%04d"
                              : compute     ? "shaders/%04d.comp" : "shaders/%04d", index);
         job *j = job_add(b, k, index, file, compute ? SPV_STAGE_COMPUTE : SPV_STAGE_FRAGMENT);
-        j->glsl_only = compute && !b->desc->compute_spirv;
+        j->glsl_only = compute && b->desc->glsl_compute;
         if (k == JOB_REF)
             snprintf(j->title, sizeof j->title, "multi-pass reference pass of material %d",
                      index);

@@ -1,5 +1,5 @@
 /* cli_build.c — `splatc build SCENE.sg -o PACKDIR [-j N] [--stats]
- * [--cache DIR | --no-cache] [--flat] [--no-lazy] [--compute-spirv] [--no-distance-classes]
+ * [--cache DIR | --no-cache] [--flat] [--no-lazy] [--glsl-compute] [--no-distance-classes]
  * [--max-combinations P]
  * [--painted bc4|r8|dense] [-I DIR]... [--depfile FILE] [--preview MATERIAL] [--far-atlas[=N]]
  * [--far-bake auto|cpu|gpu] [--json]`:
@@ -30,8 +30,10 @@ static const char usage[] =
     "  --flat         also write each composite without dynamic branches\n"
     "  --no-lazy      no lazy branches inside materials (a mix/select/mul side\n"
     "                 is skipped where its weight is 0; compiler/DESIGN.md 6.1)\n"
-    "  --compute-spirv  also compile the compute variants to SPIR-V (default:\n"
-    "                 their GLSL only; the runtime compiles them on first use)\n"
+    "  --glsl-compute the compute variants, distance classes and undergrowth\n"
+    "                 masks as GLSL only, compiled by the runtime on first use\n"
+    "                 (default: SPIR-V made and validated here too; the old\n"
+    "                 --compute-spirv is that default)\n"
     "  --no-distance-classes  no distance class variants (compiler/distance.c)\n"
     "  --max-combinations P  cover the leaf cells' combinations with at most P\n"
     "                 supersets, merging those that add the fewest layers\n"
@@ -138,7 +140,9 @@ int splat_cli_build(int argc, char **argv)
         } else if (strcmp(a, "--no-lazy") == 0) {
             desc.no_lazy = true;
         } else if (strcmp(a, "--compute-spirv") == 0) {
-            desc.compute_spirv = true;
+            desc.glsl_compute = false;   /* the default since issue 29 */
+        } else if (strcmp(a, "--glsl-compute") == 0) {
+            desc.glsl_compute = true;
         } else if (strcmp(a, "--far-atlas") == 0 || strncmp(a, "--far-atlas=", 12) == 0) {
             char *end;
             long n = a[11] ? strtol(a + 12, &end, 10) : 1;

@@ -409,6 +409,22 @@ static bool read_glsl(reader *r, json_t *obj, const char *key, const char *where
     return read_glsl_at(r, c, w, out);
 }
 
+/* read_glsl, and the variant's SPIR-V where the build made it
+ * ({"glsl": …, "spirv": …}; `spv` words NULL without): validated with
+ * every module of the pack, so the runtime compiles nothing for it. */
+static bool read_compute(reader *r, json_t *obj, const char *key, const char *where,
+                         char **out, rt_spirv *spv)
+{
+    if (!read_glsl(r, obj, key, where, out))
+        return false;
+    json_t *c = json_object_get(obj, key);
+    if (!json_is_object(c) || !json_object_get(c, "spirv"))
+        return true;
+    char w[96];
+    snprintf(w, sizeof w, "%s.%s", where, key);
+    return read_spirv(r, c, w, spv);
+}
+
 /* c["glsl"], the fragment GLSL beside c["spirv"]: optional, and only its
  * path is kept (the forward path's counting variant reads it on first use:
  * rt_pack_read_glsl). */
@@ -1408,7 +1424,7 @@ static bool read_classes(reader *r, json_t *cs)
                           !read_fragment_glsl(r, c, where, &co->frag_path)
                     : !read_glsl_at(r, c, where, &co->glsl))
                 return false;
-            if (!read_glsl(r, c, "compute", where, &co->compute) ||
+            if (!read_compute(r, c, "compute", where, &co->compute, &co->compute_spirv) ||
                 !get_number(r, c, "cost", where, &co->cost))
                 return false;
             if (!(co->cost >= 0) || co->cost > 1e12)
@@ -1459,8 +1475,8 @@ static bool read_combos(reader *r, json_t *root)
         }
         if (!read_spirv(r, c, where, &co->spirv) ||
             !read_fragment_glsl(r, c, where, &co->frag_path) ||
-            !read_glsl(r, c, "compute", where, &co->compute) ||
-            !read_glsl(r, c, "undergrowth", where, &co->ug_compute))
+            !read_compute(r, c, "compute", where, &co->compute, &co->compute_spirv) ||
+            !read_compute(r, c, "undergrowth", where, &co->ug_compute, &co->ug_spirv))
             return false;
         json_t *cost = get(r, c, "cost", where, false);
         if (cost && (!json_is_number(cost) || !(json_number_value(cost) >= 0) ||
@@ -1597,7 +1613,10 @@ static bool check_shaders(reader *r)
     ok = ok && check_one(r, &p->vertex, &in[RT_ROLE_VERTEX]) &&
          check_one(r, &p->uber, &in[RT_ROLE_COMPOSITE]);
     for (int i = 0; ok && i < p->ncombos; i++)
-        ok = check_one(r, &p->combos[i].spirv, &in[RT_ROLE_COMPOSITE]);
+        ok = check_one(r, &p->combos[i].spirv, &in[RT_ROLE_COMPOSITE]) &&
+             check_one(r, &p->combos[i].compute_spirv, &in[RT_ROLE_COMPUTE]) &&
+             check_one(r, &p->combos[i].ug_spirv, &in[RT_ROLE_UNDERGROWTH]);
+    ok = ok && check_one(r, &p->uber_compute_spirv, &in[RT_ROLE_COMPUTE]);
     for (int i = 0; ok && i < p->nmaterials; i++)
         ok = check_one(r, &p->materials[i].reference, &in[RT_ROLE_REFERENCE]);
     for (int i = 0; i < made; i++)
@@ -1670,7 +1689,8 @@ bool rt_pack_load(rt_pack *p, const char *dir, rt_error *e)
         if (ub && !json_is_null(ub))
             ok = read_spirv(&r, ub, "uber", &p->uber) &&
                  read_fragment_glsl(&r, ub, "uber", &p->uber_frag_path) &&
-                 read_glsl(&r, ub, "compute", "uber", &p->uber_compute);
+                 read_compute(&r, ub, "compute", "uber", &p->uber_compute,
+                              &p->uber_compute_spirv);
     }
     ok = ok && validate_all(&r) && check_shaders(&r);
 done:
@@ -1723,12 +1743,15 @@ void rt_pack_free(rt_pack *p)
         free(p->combos[i].glsl);
         free(p->combos[i].frag_path);
         free_spirv(&p->combos[i].spirv);
+        free_spirv(&p->combos[i].compute_spirv);
+        free_spirv(&p->combos[i].ug_spirv);
     }
     for (int i = 0; i < p->nlevels && p->levels; i++)
         free(p->levels[i].ids);
     free(p->holes);
     free_spirv(&p->uber);
     free(p->uber_compute);
+    free_spirv(&p->uber_compute_spirv);
     free(p->uber_frag_path);
     for (int i = 0; i < p->ug.ntextures; i++)
         free(p->ug.textures[i].rgba);

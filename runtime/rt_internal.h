@@ -94,6 +94,10 @@ bool rt_glsl_module(rt_device *d, const char *glsl, VkShaderStageFlagBits stage,
 bool rt_glsl_compute_pipeline(rt_device *d, VkPipelineCache cache, VkPipelineLayout layout,
                               const char *glsl, const char *name,
                               const struct rt_interface *check, VkPipeline *out, rt_error *e);
+/* The same from a pack's module already through spirv-val and the
+ * interface check (rt_pack_load): the build's SPIR-V, nothing compiled. */
+bool rt_spirv_compute_pipeline(rt_device *d, VkPipelineCache cache, VkPipelineLayout layout,
+                               const rt_spirv *s, VkPipeline *out, rt_error *e);
 
 /* ---- jobs.c: independent jobs on every core ------------------------- */
 

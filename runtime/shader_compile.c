@@ -62,6 +62,9 @@ bool rt_glsl_module(rt_device *d, const char *glsl, VkShaderStageFlagBits stage,
     return ok;
 }
 
+static bool compute_pipeline(rt_device *d, VkPipelineCache cache, VkPipelineLayout layout,
+                             VkShaderModule m, VkPipeline *out, rt_error *e);
+
 bool rt_glsl_compute_pipeline(rt_device *d, VkPipelineCache cache, VkPipelineLayout layout,
                               const char *glsl, const char *name, const rt_interface *check,
                               VkPipeline *out, rt_error *e)
@@ -69,6 +72,27 @@ bool rt_glsl_compute_pipeline(rt_device *d, VkPipelineCache cache, VkPipelineLay
     VkShaderModule m;
     if (!rt_glsl_module(d, glsl, VK_SHADER_STAGE_COMPUTE_BIT, name, check, &m, e))
         return false;
+    return compute_pipeline(d, cache, layout, m, out, e);
+}
+
+bool rt_spirv_compute_pipeline(rt_device *d, VkPipelineCache cache, VkPipelineLayout layout,
+                               const rt_spirv *s, VkPipeline *out, rt_error *e)
+{
+    VkShaderModuleCreateInfo ci = {
+        .sType = VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO,
+        .codeSize = s->nwords * 4, .pCode = s->words,
+    };
+    VkShaderModule m;
+    VkResult r = vkCreateShaderModule(d->dev, &ci, NULL, &m);
+    if (r != VK_SUCCESS)
+        return rt_fail(e, RT_E_VULKAN, "vkCreateShaderModule", rt_vk_result_name(r));
+    return compute_pipeline(d, cache, layout, m, out, e);
+}
+
+/* A compute pipeline of module `m`, which it destroys. */
+static bool compute_pipeline(rt_device *d, VkPipelineCache cache, VkPipelineLayout layout,
+                             VkShaderModule m, VkPipeline *out, rt_error *e)
+{
     VkComputePipelineCreateInfo ci = {
         .sType = VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO,
         .stage = { .sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO,

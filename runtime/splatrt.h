@@ -197,6 +197,9 @@ typedef struct rt_pack_combo {
     rt_spirv spirv;
     char    *compute;     /* compute variant's GLSL (PACK.md); NULL: none   */
     char    *ug_compute;  /* undergrowth mask GLSL (PACK.md); NULL: none    */
+    rt_spirv compute_spirv; /* their SPIR-V as the build made it (words
+                             NULL: compiled from the GLSL on first use)   */
+    rt_spirv ug_spirv;
     double   cost;        /* per-pixel cost, op-table units; 0: not given   */
     /* Distance classes (PACK.md): entries nbase.. of rt_pack.combos are
      * the class variants, after the combinations of combos.bin; a class
@@ -324,6 +327,7 @@ typedef struct rt_pack {
     char            *uber_frag_path; /* its fragment GLSL ("glsl"); NULL if
                                         absent: read on first use          */
     char            *uber_compute;   /* its compute GLSL; NULL if absent    */
+    rt_spirv         uber_compute_spirv; /* its SPIR-V; words NULL if absent */
     rt_spirv         vertex;
     rt_pack_level   *levels;    int nlevels;
     char            *scene_path;     /* scene.source: scene.sg relative to
@@ -516,7 +520,8 @@ typedef struct rt_frame_stats {
     rt_screen_stats tiles;    /* its tiles (screen only) and counters        */
     int    redraws;           /* frames drawn again after compiling pipelines */
     double compile_ms;        /* wall ms of this call making those pipelines */
-    int    spirv_cached;      /* compute modules so far from the SPIR-V cache */
+    int    spirv_cached;      /* compute modules so far from the pack (the
+                                 build's SPIR-V) or the SPIR-V cache */
     int    spirv_compiled;    /* ... and compiled from GLSL (glslang)        */
     int    pipelines_pending; /* being made on workers after this frame     */
     double shadow_ms;         /* wall ms of a new shadow map (the sun moved or

@@ -1145,8 +1145,11 @@ static bool mask_pipeline(rt_ug *u, int combo, VkPipeline *out, rt_error *e)
         rt_interface in;
         if (!rt_interface_for(u->p, RT_ROLE_UNDERGROWTH, &in))
             return rt_fail(e, RT_E_VULKAN, "undergrowth", "out of memory");
-        bool ok = rt_glsl_compute_pipeline(u->d, u->pl->cache, u->mask_layout, glsl, name, &in,
-                                           &u->mask_pipes[combo], e);
+        const rt_spirv *spv = &u->p->combos[combo].ug_spirv;   /* the build's */
+        bool ok = spv->words ? rt_spirv_compute_pipeline(u->d, u->pl->cache, u->mask_layout, spv,
+                                                         &u->mask_pipes[combo], e)
+                             : rt_glsl_compute_pipeline(u->d, u->pl->cache, u->mask_layout, glsl,
+                                                        name, &in, &u->mask_pipes[combo], e);
         rt_interface_free(&in);
         if (!ok)
             return false;
