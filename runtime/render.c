@@ -230,7 +230,7 @@ static bool make_geometry(rt_renderer *r, rt_error *e)
 }
 
 /* One image and sampler per texture array (abi.h set 1): its textures'
- * levels, one layer each; pack_load.c checked they are alike. */
+ * levels, one layer each; pack_textures.c checked they are alike. */
 static bool make_textures(rt_renderer *r, rt_error *e)
 {
     rt_device *d = r->d;
