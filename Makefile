@@ -20,6 +20,7 @@ PKGS := cmake make gcc g++ pkg-config clang libclang-rt-14-dev \
         glslang-dev glslang-tools spirv-tools libspirv-cross-c-shared-dev \
         libvulkan-dev mesa-vulkan-drivers vulkan-validationlayers vulkan-tools \
         libglfw3-dev libstb-dev libjansson-dev libcmocka-dev libxxhash-dev \
+        libzstd-dev zstd \
         libgdal-dev libtinyobjloader-dev \
         gnuplot-nox xvfb xauth graphviz time
 

@@ -199,7 +199,7 @@
                                     SPLAT_BIND_VECTORS, SPLAT_VECTORS */
 /* The pack's format version (manifest.json "version", PACK.md): 2 adds
  * vectors.bin, the scene's spline and polygon shapes. */
-#define SPLAT_PACK_VERSION 2
+#define SPLAT_PACK_VERSION 3
 
 /* Undergrowth masks (above): texels per cell side, undergrowth-bearing
  * materials at most (4 per word), the fixed view distance (m). */

@@ -10,10 +10,14 @@
  *   compose   a composite per combination (+ flat variants), the über-shader,
  *             a reference pass per material and the vertex shader: GLSL,
  *             then each shader's key (cache.c)
- *   glslang   cache lookups first; only misses are compiled, on N threads
- *   validate  spv_validate on every newly compiled module, which is then
- *             stored in the cache (only validated modules are; a hit was
- *             validated when it was stored, and its entry is checksummed)
+ *   glslang   cache lookups first; only misses are compiled, on N threads,
+ *             each followed at once by spv_validate in the same task (so
+ *             the über-shader's long validation overlaps the composites'
+ *             compiles), skipped for a module whose shape (its words but
+ *             the float constants' values, cache.h) passed it before
+ *   validate  errors reported; every newly compiled module stored in the
+ *             cache (only validated modules are; a hit was validated when
+ *             it was stored, and its entry is checksummed)
  *   write     everything into OUT.tmp-XXXXXX, then swapped into place
  *
  * Nothing changed: right after loading, the bytes of every input (the
@@ -227,8 +231,8 @@ bool splat_build(const splat_build_desc *desc, splat_build_stats *st, sg_diags *
     phase(&b, analyse, &st->analysis);      /* painted masks, combinations  */
     phase(&b, layout, &st->compose);        /* the pack's params, textures  */
     phase(&b, build_compose, &st->compose); /* GLSL and key per shader      */
-    phase(&b, build_compile, &st->glslang); /* cache, then glslang          */
-    phase(&b, build_validate, &st->validate); /* spirv-val, cache puts      */
+    phase(&b, build_compile, &st->glslang); /* cache, glslang and spirv-val */
+    phase(&b, build_validate, &st->validate); /* errors, cache puts         */
     phase(&b, build_far_atlas, &st->far_atlas); /* --far-atlas: the bake    */
     phase(&b, write_out, &st->write);       /* manifest, files, depfile, swap */
     return build_finish(&b);

@@ -39,6 +39,8 @@ typedef struct job {
     uint32_t *words;
     size_t    nwords;
     bool      cached;         /* came from the cache (and validated)      */
+    bool      shape_valid;    /* compiled, not validated: its shape passed
+                                 spirv-val before (cache.h)               */
     bool      glsl_only;      /* a compute variant without --compute-spirv:
                                  GLSL written, not compiled                */
     const splat_composite *composite; /* its GLSL is written from this, on

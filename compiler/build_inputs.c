@@ -106,7 +106,7 @@ bool build_inputs_key(build *b)
     int n = snprintf(head, sizeof head,
                      "splatc %s\nabi %d\nflat %d\nlazy %d\npainted %s\ncompute-spirv %d\nfar-atlas %d %s\ndclasses %d\nmax-combinations %d\npreview ",
                      SPLATC_VERSION, SPLAT_ABI_VERSION, b->desc->flat, !b->desc->no_lazy,
-                     splat_painted_format_name(b->desc->painted), b->desc->compute_spirv,
+                     splat_painted_format_name(b->desc->painted), !b->desc->glsl_compute,
                      b->desc->far_atlas, b->desc->far_atlas > 0 ? bakes[b->desc->far_bake] : "-",
                      !b->desc->no_dclasses, b->desc->max_combos);
     XXH3_128bits_update(st, head, (size_t)n);
@@ -133,14 +133,17 @@ bool build_inputs_key(build *b)
     return ok;
 }
 
-/* The shader's files are there: "glsl" and "spirv" (`spirv`: the entry
- * must name one; else only if it does — a compute variant's GLSL alone). */
+/* The shader's files are there: every file it names, "spirv" named
+ * where `spirv` (a compute variant may be GLSL alone, a reference pass
+ * SPIR-V alone). */
 static bool shader_files(const char *pack, json_t *shader, bool spirv)
 {
+    if (!json_is_object(shader))
+        return false;
     const char *keys[] = {"glsl", "spirv"};
     for (int i = 0; i < 2; i++) {
         const char *rel = json_string_value(json_object_get(shader, keys[i]));
-        if (!rel && i == 1 && !spirv && json_is_object(shader))
+        if (!rel && (i == 0 || !spirv))
             continue;
         if (!rel)
             return false;
@@ -174,20 +177,20 @@ bool build_up_to_date(build *b, int *ncombos)
     for (size_t i = 0; ok && i < json_array_size(combos); i++) {
         json_t *c = json_array_get(combos, i);
         ok = has_files(b->out, c) &&
-             shader_files(b->out, json_object_get(c, "compute"), b->desc->compute_spirv) &&
+             shader_files(b->out, json_object_get(c, "compute"), !b->desc->glsl_compute) &&
              (!b->desc->flat || has_files(b->out, json_object_get(c, "flat")));
         json_t *cls = json_object_get(c, "classes");   /* distance classes */
         for (size_t k = 0; ok && k < json_array_size(cls); k++)
-            ok = shader_files(b->out, json_array_get(cls, k), b->desc->compute_spirv) &&
+            ok = shader_files(b->out, json_array_get(cls, k), !b->desc->glsl_compute) &&
                  shader_files(b->out, json_object_get(json_array_get(cls, k), "compute"),
-                              b->desc->compute_spirv);
+                              !b->desc->glsl_compute);
     }
     json_t *mats = json_object_get(m, "materials");
     for (size_t i = 0; ok && i < json_array_size(mats); i++)
         ok = has_files(b->out, json_object_get(json_array_get(mats, i), "reference"));
     ok = ok && has_files(b->out, json_object_get(m, "uber")) &&
          shader_files(b->out, json_object_get(json_object_get(m, "uber"), "compute"),
-                      b->desc->compute_spirv) &&
+                      !b->desc->glsl_compute) &&
          has_files(b->out, json_object_get(m, "vertex"));
     if (ok && b->desc->far_atlas > 0) {   /* the key says it was baked */
         char *fa = xasprintf("%s/far.atlas", b->out);

@@ -112,18 +112,26 @@ static void run_pool(build *b, const char *phase, void (*fn)(build *, job *), bo
     pthread_mutex_destroy(&p.lock);
 }
 
+/* glslang, then spirv-val on what it produced, in one task of the pool:
+ * the über-shader's long validation runs beside the composites' compiles
+ * instead of after all of them (largest GLSL first).  A module whose
+ * shape (cache.h splat_spirv_shape_key: its words but the float
+ * constants' values) passed spirv-val before is not validated again. */
 static void compile_job(build *b, job *j)
 {
-    spv_compile(j->glsl.s, j->stage, j->file, &j->words, &j->nwords, &j->log);
-}
-
-static void validate_job(build *b, job *j)
-{
-    if (!j->words)
+    if (!spv_compile(j->glsl.s, j->stage, j->file, &j->words, &j->nwords, &j->log))
         return;
+    char shape[SPLAT_KEY_CHARS + 1];
+    bool keyed = splat_spirv_shape_key(j->words, j->nwords, shape);
+    if (keyed && splat_cache_valid(&b->cache, shape)) {
+        j->shape_valid = true;
+        return;
+    }
     char *log = NULL;
     if (spv_validate(j->words, j->nwords, &log)) {
         free(log);
+        if (keyed)
+            splat_cache_mark_valid(&b->cache, shape);   /* failure: validated again */
         return;
     }
     free(j->log);
@@ -167,9 +175,9 @@ static void add_classes(build *b, int index, const splat_composite *c, combo_inf
             job *j = job_add(b, compute ? JOB_CLASS_COMPUTE : JOB_CLASS, index, file,
                              compute ? SPV_STAGE_COMPUTE : SPV_STAGE_FRAGMENT);
             j->dclass = k;
-            /* GLSL only, both stages, unless --compute-spirv: the runtime
-             * compiles a class on first use (PACK.md "Distance classes") */
-            j->glsl_only = !b->desc->compute_spirv;
+            /* GLSL only, both stages, with --glsl-compute: the runtime
+             * then compiles a class on first use (PACK.md "Distance classes") */
+            j->glsl_only = b->desc->glsl_compute;
             snprintf(j->title, sizeof j->title,
                      "composite of combination %d, distance class %d (%g m and %s)%s", index, k,
                      v[k].lo == 0 ? v[k].hi : v[k].lo, v[k].lo == 0 ? "nearer" : "beyond",
@@ -221,7 +229,7 @@ static bool add_composite(build *b, job_kind kind, int index, const int *materia
             file = xasprintf(k == JOB_FLAT ? "shaders/flat_%04d"
                              : compute     ? "shaders/%04d.comp" : "shaders/%04d", index);
         job *j = job_add(b, k, index, file, compute ? SPV_STAGE_COMPUTE : SPV_STAGE_FRAGMENT);
-        j->glsl_only = compute && !b->desc->compute_spirv;
+        j->glsl_only = compute && b->desc->glsl_compute;
         if (k == JOB_REF)
             snprintf(j->title, sizeof j->title, "multi-pass reference pass of material %d",
                      index);
@@ -323,7 +331,7 @@ bool build_compile(build *b)
                     splat_cache_get(&b->cache, j->key, &j->words, &j->nwords);
         pending[i] = !j->cached && !j->glsl_only;
     }
-    run_pool(b, "glslang", compile_job, pending, b->desc->jobs);
+    run_pool(b, "glslang+spirv-val", compile_job, pending, b->desc->jobs);
     free(pending);
     return true;
 }
@@ -343,11 +351,6 @@ static void report_job_error(build *b, const job *j)
 bool build_validate(build *b)
 {
     splat_build_stats *st = b->st;
-    bool *pending = xcalloc((size_t)b->njobs, sizeof *pending);
-    for (int i = 0; i < b->njobs; i++)
-        pending[i] = !b->jobs[i].cached && !b->jobs[i].glsl_only;
-    run_pool(b, "spirv-val", validate_job, pending, b->desc->jobs);
-    free(pending);
     bool ok = true;
     for (int i = 0; i < b->njobs; i++) {
         job *j = &b->jobs[i];
@@ -360,6 +363,7 @@ bool build_validate(build *b)
         }
         if (!j->cached)
             splat_cache_put(&b->cache, j->key, j->words, j->nwords);
+        st->shapes_known += j->shape_valid;
         bool combo = j->kind == JOB_COMBO;
         st->shaders++;
         st->combos += combo;

@@ -12,6 +12,7 @@
 #include <string.h>
 
 #include "spv.h"
+#include "zst.h"
 
 /* ---- the report: what each composite costs against the über-shader ----- */
 
@@ -83,23 +84,33 @@ static int pack_spirv_instructions(const build *b, const char *rel)
         return -1;
     char *path = xasprintf("%s/%s", b->out, rel);
     char why[256];   /* the pack is read as any input: no FIFO hangs here */
-    FILE *f = splat_input_fopen(path, SPLAT_MAX_SPIRV_BYTES, why, sizeof why);
+    size_t max = SPLAT_MAX_SPIRV_BYTES;
+    FILE *f = splat_input_fopen(path, max, why, sizeof why);
     free(path);
     if (!f)
         return -1;
-    uint32_t *w = NULL;
+    uint8_t *data = NULL;
     size_t n = 0, cap = 0, got;
     do {
         if (n == cap) {
-            cap = cap ? 2 * cap : 4096;
-            w = xrealloc(w, cap * sizeof *w);
+            cap = cap ? 2 * cap : 16384;
+            data = xrealloc(data, cap);
         }
-        got = fread(w + n, sizeof *w, cap - n, f);
+        got = fread(data + n, 1, cap - n, f);
         n += got;
     } while (got > 0);
     fclose(f);
-    int count = spirv_instructions(w, n);
-    free(w);
+    if (splat_zst_name(rel)) {   /* PACK.md "Compressed shaders" */
+        size_t raw = 0;
+        uint8_t *w = splat_zst_decompress(data, n, max, &raw, why, sizeof why);
+        free(data);
+        if (!w)
+            return -1;
+        data = w;
+        n = raw;
+    }
+    int count = spirv_instructions((const uint32_t *)data, n / 4);
+    free(data);
     return count;
 }
 

@@ -97,17 +97,23 @@ void splat_cache_close(splat_cache *c)
     c->dir = NULL;
 }
 
-static char *entry_path(const splat_cache *c, const char *key, bool make_fanout)
+static char *entry_path_ext(const splat_cache *c, const char *key, bool make_fanout,
+                            const char *ext)
 {
     char sub[3] = {key[0], key[1], 0};
     char *fan = join(c->dir, sub);
     if (make_fanout)
         splat_make_dirs(fan);
     char file[SPLAT_KEY_CHARS + 8];
-    snprintf(file, sizeof file, "%s.spv", key);
+    snprintf(file, sizeof file, "%s%s", key, ext);
     char *path = join(fan, file);
     free(fan);
     return path;
+}
+
+static char *entry_path(const splat_cache *c, const char *key, bool make_fanout)
+{
+    return entry_path_ext(c, key, make_fanout, ".spv");
 }
 
 bool splat_cache_get(const splat_cache *c, const char *key, uint32_t **words,
@@ -163,5 +169,52 @@ bool splat_cache_put(const splat_cache *c, const char *key, const uint32_t *word
     bool ok = spv_write_file(path, w, nwords + TRAILER);
     free(path);
     free(w);
+    return ok;
+}
+
+/* ---- validation by shape --------------------------------------------------- */
+
+#define VALID_MAGIC   "splatc validated shape\n"
+
+bool splat_spirv_shape_key(const uint32_t *words, size_t nwords,
+                           char key[SPLAT_KEY_CHARS + 1])
+{
+    uint64_t h[2];
+    if (!spv_shape(words, nwords, h))
+        return false;
+    /* under the versions: a new splatc (its SPIRV-Tools) validates again */
+    char head[128];
+    int n = snprintf(head, sizeof head, "splatc %s\nabi %d\nshape %016llx%016llx\n",
+                     SPLATC_VERSION, SPLAT_ABI_VERSION, (unsigned long long)h[0],
+                     (unsigned long long)h[1]);
+    XXH128_hash_t k = XXH3_128bits(head, (size_t)n);
+    snprintf(key, SPLAT_KEY_CHARS + 1, "%016llx%016llx", (unsigned long long)k.high64,
+             (unsigned long long)k.low64);
+    return true;
+}
+
+bool splat_cache_valid(const splat_cache *c, const char *key)
+{
+    if (!c->dir)
+        return false;
+    char *path = entry_path_ext(c, key, false, ".val");
+    char why[256];
+    FILE *f = splat_input_fopen(path, 64, why, sizeof why);
+    free(path);
+    if (!f)
+        return false;
+    char buf[64] = {0};
+    size_t n = fread(buf, 1, sizeof buf - 1, f);
+    fclose(f);
+    return n == sizeof VALID_MAGIC - 1 && memcmp(buf, VALID_MAGIC, n) == 0;
+}
+
+bool splat_cache_mark_valid(const splat_cache *c, const char *key)
+{
+    if (!c->dir)
+        return false;
+    char *path = entry_path_ext(c, key, true, ".val");
+    bool ok = splat_write_atomic(path, VALID_MAGIC, sizeof VALID_MAGIC - 1);
+    free(path);
     return ok;
 }

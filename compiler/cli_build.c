@@ -42,6 +42,8 @@ static void print_stats(const splat_build_stats *st, FILE *out)
             st->largest, st->leaf_largest, st->uber_nodes);
     fprintf(out, "shaders: %d (%d from cache, %d compiled)\n", st->shaders,
             st->shaders_cached, st->shaders_compiled);
+    fprintf(out, "spirv-val: %d modules validated, %d of known shape (float constants "
+            "changed only)\n", st->shaders_compiled - st->shapes_known, st->shapes_known);
     fprintf(out, "lazy branches: %d in the fragment composites written\n",
             st->lazy_branches);
     fprintf(out, "distance classes: %d variants added\n", st->dclasses);
@@ -50,6 +52,7 @@ static void print_stats(const splat_build_stats *st, FILE *out)
 /* The command line, parsed by the table below (args.h). */
 typedef struct build_opts {
     splat_build_desc desc;
+    bool             compute_spirv_default;   /* --compute-spirv: a no-op now */
     bool stats, json;
     const char *include[256];   /* -I DIR, in order */
     int ninclude;
@@ -104,9 +107,11 @@ static const splat_arg options[] = {
       "most P supersets, merging those that add the fewest layers (compiler/analysis.c; "
       "default 0: no merging)", F(desc.max_combos), .min = 0, .max = 65534,
       .expects = "a count 0..65534 (0: no merging)" },
-    { "--compute-spirv", SPLAT_ARG_FLAG, NULL, "also compile the screen path's compute "
-      "variants to SPIR-V (default: their GLSL only; the runtime compiles them on first use)",
-      F(desc.compute_spirv) },
+    { "--glsl-compute", SPLAT_ARG_FLAG, NULL, "the compute variants, distance classes and "
+      "undergrowth masks as GLSL only, compiled by the runtime on first use (default: SPIR-V "
+      "made and validated here too)", F(desc.glsl_compute) },
+    { "--compute-spirv", SPLAT_ARG_FLAG, NULL, "the default (SPIR-V of every stage made "
+      "here); kept for old scripts", F(compute_spirv_default) },
     { "--painted", SPLAT_ARG_CUSTOM, "bc4|r8|dense", "painted mask storage: a sparse "
       "quad-tree with a BC4 atlas (bc4, the default) or an R8 atlas (r8), or dense rasters "
       "(painted.r8)", .parse = parse_painted, .expects = "bc4, r8 or dense" },

@@ -12,6 +12,7 @@
  */
 #include "ir.h"
 
+#include <stdlib.h>
 #include <string.h>
 
 typedef struct vstate {
@@ -112,6 +113,11 @@ static void validate_op(vstate *st, const ir *ir, uint32_t id, const ir_node *n)
         VALIDATE(st, n->val[c] == 0.0);
 }
 
+static int cmp_name(const void *a, const void *b)
+{
+    return strcmp(*(const char *const *)a, *(const char *const *)b);
+}
+
 bool ir_validate(const ir *ir, FILE *out)
 {
     vstate st = {out, 0, 0};
@@ -149,11 +155,27 @@ bool ir_validate(const ir *ir, FILE *out)
     }
     VALIDATE(&st, filled == ir->nnodes - 1);
 
+    /* root names unique: sorted, then neighbours compared (the validator
+     * runs after every pass, and the über-shader has a root per material
+     * output: pairwise it was a tenth of a one-material rebuild) */
+    const char **names = ir->nroots ? malloc((size_t)ir->nroots * sizeof *names) : NULL;
+    int nnames = 0;
     for (int i = 0; i < ir->nroots; i++) {
         VALIDATE(&st, ir->roots[i].name != NULL);
         VALIDATE(&st, ir->roots[i].ref.id < ir->nnodes);
-        for (int j = 0; j < i; j++)
-            VALIDATE(&st, strcmp(ir->roots[i].name, ir->roots[j].name) != 0);
+        if (names && ir->roots[i].name)
+            names[nnames++] = ir->roots[i].name;
+    }
+    if (names) {
+        qsort(names, (size_t)nnames, sizeof *names, cmp_name);
+        for (int i = 1; i < nnames; i++)
+            VALIDATE(&st, strcmp(names[i], names[i - 1]) != 0);
+        free(names);
+    } else {
+        for (int i = 0; i < ir->nroots; i++)   /* no memory: pairwise */
+            for (int j = 0; j < i; j++)
+                VALIDATE(&st, !ir->roots[i].name || !ir->roots[j].name ||
+                                  strcmp(ir->roots[i].name, ir->roots[j].name) != 0);
     }
     for (int i = 0; i < ir->nparams; i++) {
         VALIDATE(&st, ir->params[i].name != NULL);

@@ -27,6 +27,7 @@
 
 #include "abi.h"
 #include "spv.h"
+#include "zst.h"
 
 #ifndef SPLATC_VERSION
 #define SPLATC_VERSION "0"
@@ -67,6 +68,36 @@ static bool write_file(build *b, const char *dir, const char *name, const void *
 {
     bytes by = {data, n};
     return write_with(b, dir, name, put_bytes, &by);
+}
+
+/* A shader's files in the pack (PACK.md "Compressed shaders"): its GLSL
+ * text ("X.frag.zst" for a fragment shader, "X.comp.zst", "X.vert.zst")
+ * and its SPIR-V ("X.spv.zst"), each one zstd frame (zst.h). */
+static char *glsl_file(const char *file, bool fragment)
+{
+    return xasprintf("%s%s" SPLAT_ZST_SUFFIX, file, fragment ? ".frag" : "");
+}
+
+static char *spirv_file(const char *file)
+{
+    return xasprintf("%s.spv" SPLAT_ZST_SUFFIX, file);
+}
+
+static bool write_compressed(build *b, const char *dir, const char *name, const void *data,
+                             size_t n)
+{
+    uint8_t *z;
+    size_t zn;
+    if (!splat_zst_compress(data, n, &z, &zn)) {
+        char *path = xasprintf("%s/%s", dir, name);
+        errno = ENOMEM;
+        write_error(b, path);
+        free(path);
+        return false;
+    }
+    bool ok = write_file(b, dir, name, z, zn);
+    free(z);
+    return ok;
 }
 
 static bool copy_file(build *b, const char *from, const char *dir, const char *name)
@@ -140,14 +171,20 @@ static json_t *jints(const int *v, int n)
     return a;
 }
 
-static json_t *jshader(const char *file, const char *vert_ext)
+/* {"glsl", "spirv"} of a shader; `glsl` false: the SPIR-V alone (a
+ * reference pass, whose text the runtime never reads). */
+static json_t *jshader(const char *file, bool fragment, bool glsl)
 {
     json_t *o = json_object();
-    char buf[128];
-    snprintf(buf, sizeof buf, "%s%s", file, vert_ext ? "" : ".frag");
-    json_object_set_new(o, "glsl", json_string(buf));
-    snprintf(buf, sizeof buf, "%s.spv", file);
-    json_object_set_new(o, "spirv", json_string(buf));
+    char *name;
+    if (glsl) {
+        name = glsl_file(file, fragment);
+        json_object_set_new(o, "glsl", json_string(name));
+        free(name);
+    }
+    name = spirv_file(file);
+    json_object_set_new(o, "spirv", json_string(name));
+    free(name);
     return o;
 }
 
@@ -155,9 +192,11 @@ static json_t *jshader(const char *file, const char *vert_ext)
 static json_t *jcompute(const job *j)
 {
     json_t *o = json_object();
-    json_object_set_new(o, "glsl", json_string(j->file));
+    char *name = glsl_file(j->file, false);
+    json_object_set_new(o, "glsl", json_string(name));
+    free(name);
     if (!j->glsl_only) {
-        char *spv = xasprintf("%s.spv", j->file);
+        char *spv = spirv_file(j->file);
         json_object_set_new(o, "spirv", json_string(spv));
         free(spv);
     }
@@ -274,7 +313,7 @@ static json_t *jmaterials(build *b)
         free(src);
         char file[64];
         snprintf(file, sizeof file, "shaders/ref_%04d", k);
-        json_object_set_new(o, "reference", jshader(file, NULL));
+        json_object_set_new(o, "reference", jshader(file, true, false));
         json_array_append_new(mats, o);
     }
     free(scene_dir);
@@ -384,12 +423,13 @@ static json_t *jclasses(build *b, int i)
         json_array_append_new(dist, jreal(ci->dlo[k]));
         json_array_append_new(dist, isinf(ci->dhi[k]) ? json_null() : jreal(ci->dhi[k]));
         json_object_set_new(o, "distance", dist);
-        char buf[160];
-        snprintf(buf, sizeof buf, "%s.frag", fj->file);
-        json_object_set_new(o, "glsl", json_string(buf));
+        char *name = glsl_file(fj->file, true);
+        json_object_set_new(o, "glsl", json_string(name));
+        free(name);
         if (!fj->glsl_only) {
-            snprintf(buf, sizeof buf, "%s.spv", fj->file);
-            json_object_set_new(o, "spirv", json_string(buf));
+            name = spirv_file(fj->file);
+            json_object_set_new(o, "spirv", json_string(name));
+            free(name);
         }
         json_object_set_new(o, "hash", json_string(fj->key));
         json_object_set_new(o, "cost", jreal(ci->dcost[k]));
@@ -410,13 +450,14 @@ static json_t *jcombinations(build *b)
         json_object_set_new(o, "id", json_integer(i));
         json_object_set_new(o, "materials", jints(a->combos[i].materials,
                                                   a->combos[i].nmaterials));
-        char buf[160];
-        snprintf(buf, sizeof buf, "%s.frag", cj->file);
-        json_object_set_new(o, "glsl", json_string(buf));
-        snprintf(buf, sizeof buf, "%s.spv", cj->file);
-        json_object_set_new(o, "spirv", json_string(buf));
+        char *name = glsl_file(cj->file, true);
+        json_object_set_new(o, "glsl", json_string(name));
+        free(name);
+        name = spirv_file(cj->file);
+        json_object_set_new(o, "spirv", json_string(name));
+        free(name);
         if (fj)
-            json_object_set_new(o, "flat", jshader(fj->file, NULL));
+            json_object_set_new(o, "flat", jshader(fj->file, true, true));
         json_object_set_new(o, "textures", jints(b->combos[i].textures, b->combos[i].ntextures));
         json_object_set_new(o, "params", jints(b->combos[i].params, b->combos[i].nparams));
         json_object_set_new(o, "cells", json_integer(a->combos[i].ncells));
@@ -534,12 +575,12 @@ static json_t *manifest(build *b, char **tex_names, const char *dir)
     json_object_set_new(m, "painted_file",
                         json_string(b->sparse_ok ? "painted.sparse" : "painted.r8"));
     json_object_set_new(m, "combinations", jcombinations(b));
-    json_t *uber = jshader("shaders/uber", NULL);
+    json_t *uber = jshader("shaders/uber", true, true);
     for (int k = 0; k < b->njobs; k++)
         if (b->jobs[k].kind == JOB_UBER_COMPUTE)
             json_object_set_new(uber, "compute", jcompute(&b->jobs[k]));
     json_object_set_new(m, "uber", uber);
-    json_object_set_new(m, "vertex", jshader("shaders/terrain.vert", ""));
+    json_object_set_new(m, "vertex", jshader("shaders/terrain.vert", false, true));
     json_object_set_new(m, "quadtree", jquadtree(&b->analysis));
     json_t *ug = jundergrowth(&b->ug);
     if (ug)
@@ -698,13 +739,16 @@ static bool write_contents(build *b, const char *dir)
 
     for (int i = 0; ok && i < b->njobs; i++) {
         const job *j = &b->jobs[i];
-        char *name = xasprintf("%s%s", j->file, j->stage == SPV_STAGE_FRAGMENT ? ".frag" : "");
-        ok = write_file(b, dir, name, j->glsl.s, j->glsl.len);
-        free(name);
+        char *name;
+        if (j->kind != JOB_REF) {   /* a reference pass: SPIR-V only */
+            name = glsl_file(j->file, j->stage == SPV_STAGE_FRAGMENT);
+            ok = write_compressed(b, dir, name, j->glsl.s, j->glsl.len);
+            free(name);
+        }
         if (j->glsl_only)
             continue;
-        name = xasprintf("%s.spv", j->file);
-        ok = ok && write_file(b, dir, name, j->words, 4 * j->nwords);
+        name = spirv_file(j->file);
+        ok = ok && write_compressed(b, dir, name, j->words, 4 * j->nwords);
         free(name);
     }
 

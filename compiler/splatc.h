@@ -211,8 +211,10 @@ typedef struct splat_build_desc {
     bool               no_cache;
     bool               flat;         /* also write branch-free composites     */
     bool               no_lazy;      /* no lazy branches (compose.c)          */
-    bool               compute_spirv; /* also compile the compute variants
-                                        (default: their GLSL only; PACK.md) */
+    bool               glsl_compute; /* compute variants (and distance
+                                        classes, undergrowth masks) as GLSL
+                                        only, compiled by the runtime on
+                                        first use (default: SPIR-V too) */
     splat_painted_format painted;    /* painted mask storage; default BC4     */
     bool               no_dclasses;  /* no distance classes (distance.c)     */
     int                max_combos;   /* > 0: cover the leaf-cell combinations
@@ -247,6 +249,8 @@ typedef struct splat_build_stats {
                                 in one leaf cell                         */
     int    uber_nodes;       /* coarse quadtree nodes no combination covers */
     int    shaders, shaders_cached, shaders_compiled; /* every module         */
+    int    shapes_known;     /* compiled ones not validated again: their
+                                shape passed spirv-val before (cache.h)  */
     int    lazy_branches;    /* lazy branches in the composites compiled
                                 (fragment variants; compose.c)          */
     int    dclasses;         /* distance class variants added (distance.c)  */

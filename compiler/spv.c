@@ -15,6 +15,7 @@
 #include <glslang/Include/glslang_c_interface.h>
 #include <glslang/Public/resource_limits_c.h>
 #include <spirv-tools/libspirv.h>
+#include <xxhash.h>
 
 /* ---- a growable message ------------------------------------------------ */
 
@@ -299,6 +300,130 @@ bool spv_validate(const uint32_t *words, size_t nwords, char **log)
     spvValidatorOptionsDestroy(opts);
     spvContextDestroy(ctx);
     return r == SPV_SUCCESS;
+}
+
+/* ---- the shape of a module (spv_shape) ---------------------------------- */
+
+enum { OP_TYPE_FLOAT = 22, OP_TYPE_VECTOR = 23, OP_TYPE_MATRIX = 24, OP_CONSTANT = 43,
+       OP_CONSTANT_COMPOSITE = 44 };
+
+typedef struct shape_st {
+    uint32_t      bound;
+    uint32_t     *canon;     /* id -> its number in order of first use, 0: none */
+    uint32_t     *fconst;    /* id -> 1 + canon of its type where the id is a
+                                float-valued constant, else 0            */
+    uint8_t      *ftype;     /* id is a float scalar, vector or matrix type  */
+    uint32_t      next;
+    XXH3_state_t *h;
+} shape_st;
+
+static uint32_t shape_canon(shape_st *s, uint32_t id)
+{
+    if (id >= s->bound)
+        return 0xfffffffeu;
+    if (!s->canon[id])
+        s->canon[id] = ++s->next;
+    return s->canon[id];
+}
+
+static spv_result_t shape_header(void *user, spv_endianness_t e, uint32_t magic,
+                                 uint32_t version, uint32_t generator, uint32_t bound,
+                                 uint32_t schema)
+{
+    (void)e, (void)magic, (void)generator, (void)schema;
+    shape_st *s = user;
+    if (bound == 0 || bound > (1u << 24))
+        return SPV_ERROR_INVALID_BINARY;
+    s->bound = bound;
+    s->canon = xcalloc(bound, sizeof *s->canon);
+    s->fconst = xcalloc(bound, sizeof *s->fconst);
+    s->ftype = xcalloc(bound, 1);
+    XXH3_128bits_update(s->h, &version, sizeof version);
+    return SPV_SUCCESS;
+}
+
+static bool is_id_operand(spv_operand_type_t t)
+{
+    return t >= SPV_OPERAND_TYPE_ID && t <= SPV_OPERAND_TYPE_SCOPE_ID;
+}
+
+static spv_result_t shape_inst(void *user, const spv_parsed_instruction_t *in)
+{
+    shape_st *s = user;
+    const uint32_t *w = in->words;
+    uint32_t op = in->opcode, res = in->result_id, ty = in->type_id;
+    if (!s->bound || res >= s->bound || ty >= s->bound)
+        return SPV_ERROR_INVALID_BINARY;
+    if (op == OP_TYPE_FLOAT ||
+        ((op == OP_TYPE_VECTOR || op == OP_TYPE_MATRIX) && in->num_words >= 3 &&
+         w[2] < s->bound && s->ftype[w[2]]))
+        s->ftype[res] = 1;
+    bool fc = false;
+    if (op == OP_CONSTANT && s->ftype[ty])
+        fc = true;
+    else if (op == OP_CONSTANT_COMPOSITE && s->ftype[ty]) {
+        fc = true;
+        for (int k = 3; k < in->num_words; k++)
+            fc = fc && w[k] < s->bound && s->fconst[w[k]];
+    }
+    if (fc) {   /* its value is left out, and its identity: uses name its type */
+        s->fconst[res] = 1 + shape_canon(s, ty);
+        return SPV_SUCCESS;
+    }
+    /* debug information (OpSourceContinued, OpSource, OpSourceExtension,
+     * OpName, OpMemberName, OpString, OpLine, OpNoLine, OpModuleProcessed):
+     * the generated GLSL's value names follow the compiler's numbering,
+     * which a constant's value can shift; spirv-val's verdict does not
+     * depend on them */
+    if ((op >= 2 && op <= 8) || op == 317 || op == 330)
+        return SPV_SUCCESS;
+    uint32_t head[2] = { op, in->num_operands };
+    XXH3_128bits_update(s->h, head, sizeof head);
+    for (int k = 0; k < in->num_operands; k++) {
+        const spv_parsed_operand_t *o = &in->operands[k];
+        if (o->offset + o->num_words > in->num_words)
+            return SPV_ERROR_INVALID_BINARY;
+        if (is_id_operand(o->type) && o->num_words == 1) {
+            uint32_t id = w[o->offset];
+            uint32_t v[2] = { 0, 0 };
+            if (id < s->bound && s->fconst[id])
+                v[0] = 0xffffffffu, v[1] = s->fconst[id];
+            else
+                v[0] = shape_canon(s, id);
+            XXH3_128bits_update(s->h, v, sizeof v);
+        } else {
+            uint32_t t = (uint32_t)o->type;
+            XXH3_128bits_update(s->h, &t, sizeof t);
+            XXH3_128bits_update(s->h, &w[o->offset], 4 * (size_t)o->num_words);
+        }
+    }
+    return SPV_SUCCESS;
+}
+
+bool spv_shape(const uint32_t *words, size_t nwords, uint64_t hash[2])
+{
+    spv_context ctx = spvContextCreate(SPV_ENV_VULKAN_1_2);
+    shape_st s = {0};
+    s.h = XXH3_createState();
+    if (!ctx || !s.h) {
+        if (ctx)
+            spvContextDestroy(ctx);
+        XXH3_freeState(s.h);
+        return false;
+    }
+    XXH3_128bits_reset(s.h);
+    spv_diagnostic diag = NULL;
+    spv_result_t r = spvBinaryParse(ctx, &s, words, nwords, shape_header, shape_inst, &diag);
+    spvDiagnosticDestroy(diag);
+    XXH128_hash_t h = XXH3_128bits_digest(s.h);
+    hash[0] = h.high64;
+    hash[1] = h.low64;
+    XXH3_freeState(s.h);
+    free(s.canon);
+    free(s.fconst);
+    free(s.ftype);
+    spvContextDestroy(ctx);
+    return r == SPV_SUCCESS && s.bound;
 }
 
 bool spv_write_file(const char *path, const uint32_t *words, size_t nwords)

@@ -51,6 +51,14 @@ bool spv_compile(const char *glsl, int stage, const char *name,
 /* Validate a module with SPIRV-Tools for SPV_ENV_VULKAN_1_2. */
 bool spv_validate(const uint32_t *words, size_t nwords, char **log);
 
+/* The module's shape (cache.h splat_spirv_shape_key): a hash of every
+ * instruction but the float-valued constants (OpConstant of a float type,
+ * OpConstantComposite of such) and debug names and lines, ids numbered in
+ * order of first use and a use of such a constant written as its type.
+ * Two modules that differ only in those constants' values (and in which
+ * of them glslang merged because they became equal) have one shape.  False if `words` do not
+ * parse as SPIR-V. */
+bool spv_shape(const uint32_t *words, size_t nwords, uint64_t hash[2]);
 /* Write a module to `path` atomically: a temporary file beside it, then
  * rename, so a reader never sees half a file.  False (errno set) on error. */
 bool spv_write_file(const char *path, const uint32_t *words, size_t nwords);

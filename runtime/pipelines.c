@@ -566,9 +566,22 @@ bool rt_pipelines_compute_make(rt_device *d, const rt_pack *p, rt_pipelines *pl,
     size_t n = 0;
     rt_interface in;
     bool have_in = false;
-    bool ok = compute_spirv(pl, src ? src : glsl, name, &words, &n, e);
+    /* the plain variant: the build's SPIR-V where the pack has it (checked
+     * at load), so nothing is compiled on first use (issue 29) */
+    const rt_spirv *built = id < p->ncombos ? &p->combos[id].compute_spirv
+                                            : &p->uber_compute_spirv;
+    if (!defs[0] && built->words) {   /* (src is NULL: no defines) */
+        words = malloc(built->nwords * 4);
+        if (!words)
+            return rt_fail(e, RT_E_VULKAN, "pipelines", "out of memory");
+        memcpy(words, built->words, built->nwords * 4);
+        n = built->nwords;
+        atomic_fetch_add(&pl->spirv_cached, 1);
+        glsl = NULL;   /* checked at load: no second interface check */
+    }
+    bool ok = words || compute_spirv(pl, src ? src : glsl, name, &words, &n, e);
     free(src);
-    if (ok) {
+    if (ok && glsl) {
         have_in = rt_interface_for(p, RT_ROLE_COMPUTE, &in);
         ok = have_in ? rt_spirv_check(words, n, name, &in, e)
                      : rt_fail(e, RT_E_VULKAN, "pipelines", "out of memory");

@@ -120,6 +120,9 @@ typedef struct rt_pack_combo {
     rt_spirv spirv;
     char    *compute;     /* compute variant's GLSL (PACK.md); NULL: none   */
     char    *ug_compute;  /* undergrowth mask GLSL (PACK.md); NULL: none    */
+    rt_spirv compute_spirv; /* their SPIR-V as the build made it (words
+                             NULL: compiled from the GLSL on first use)   */
+    rt_spirv ug_spirv;
     double   cost;        /* per-pixel cost, op-table units; 0: not given   */
     /* Distance classes (PACK.md): entries nbase.. of rt_pack.combos are
      * the class variants, after the combinations of combos.bin; a class
@@ -225,6 +228,7 @@ struct rt_pack {
     char            *uber_frag_path; /* its fragment GLSL ("glsl"); NULL if
                                         absent: read on first use          */
     char            *uber_compute;   /* its compute GLSL; NULL if absent    */
+    rt_spirv         uber_compute_spirv; /* its SPIR-V; words NULL if absent */
     rt_spirv         vertex;
     rt_pack_level   *levels;    int nlevels;
     char            *scene_path;     /* scene.source: scene.sg relative to
@@ -425,6 +429,13 @@ int      rt_pack_open_file(int dirfd, const char *rel, char *why, size_t nwhy);
  * `max` bytes (bounded reads; NUL appended, not counted in *n). */
 uint8_t *rt_pack_read_file(int dirfd, const char *rel, size_t max, size_t *n, char *why,
                            size_t nwhy);
+/* rt_pack_read_file, or for a name ending in ".zst" its content (PACK.md
+ * "Compressed shaders"): the file within the largest frame of `max`
+ * bytes, the frame's stated size at most `max` before its buffer is
+ * allocated, exactly one frame that decompresses to that size (its
+ * checksum checked).  `max` bounds the content either way. */
+uint8_t *rt_pack_read_content(int dirfd, const char *rel, size_t max, size_t *n, char *why,
+                              size_t nwhy);
 /* The GLSL text at `rel` in p's folder (the manifest's `field`), read now
  * under the same checks (malloc'd); NULL with `e` set if it cannot be. */
 char    *rt_pack_read_glsl(const rt_pack *p, const char *field, const char *rel, rt_error *e);

@@ -369,7 +369,8 @@ typedef struct rt_frame_stats {
     rt_screen_stats tiles;    /* its tiles (screen only) and counters        */
     int    redraws;           /* frames drawn again after compiling pipelines */
     double compile_ms;        /* wall ms of this call making those pipelines */
-    int    spirv_cached;      /* compute modules so far from the SPIR-V cache */
+    int    spirv_cached;      /* compute modules so far from the pack (the
+                                 build's SPIR-V) or the SPIR-V cache */
     int    spirv_compiled;    /* ... and compiled from GLSL (glslang)        */
     int    pipelines_pending; /* being made on workers after this frame     */
     double shadow_ms;         /* wall ms of a new shadow map (the sun moved or

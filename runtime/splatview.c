@@ -604,7 +604,7 @@ static void print_paths(const rt_pack_info *pi, const rt_frame_stats *st, const 
     printf("back faces culled: %s\n", st->backfaces_culled ? "yes" : "no");
     printf("pipelines bound: %d\n", st->pipelines);
     if (st->screen)
-        printf("compute modules: %d from the SPIR-V cache, %d compiled from GLSL; "
+        printf("compute modules: %d from the pack or the SPIR-V cache, %d compiled from GLSL; "
                "%.1f ms making pipelines between frames\n", st->spirv_cached,
                st->spirv_compiled, t->compile_ms);
     printf("combinations in view: %d of %d\n", st->combos_in_view, pi->ncombos);

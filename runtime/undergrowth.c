@@ -594,8 +594,10 @@ static bool mask_pipeline(rt_ug *u, int combo, VkPipeline *out, rt_error *e)
         rt_interface in;
         if (!rt_interface_for(u->p, RT_ROLE_UNDERGROWTH, &in))
             return rt_fail(e, RT_E_VULKAN, "undergrowth", "out of memory");
+        const rt_spirv *spv = &u->p->combos[combo].ug_spirv;   /* the build's */
         bool ok = rt_vk_compute(u->d, &u->keep, &(rt_vk_compute_desc){ .label = name,
-                                    .glsl = glsl, .check = &in, .layout = u->mask_layout,
+                                    .glsl = glsl, .check = &in, .spirv = spv->words,
+                                    .nwords = spv->nwords, .layout = u->mask_layout,
                                     .cache = u->pl->cache }, &u->mask_pipes[combo], e);
         rt_interface_free(&in);
         if (!ok)

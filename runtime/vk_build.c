@@ -317,9 +317,19 @@ bool rt_vk_compute(rt_device *d, rt_vk_list *l, const rt_vk_compute_desc *desc, 
                    rt_error *e)
 {
     VkShaderModule m = desc->module, own = VK_NULL_HANDLE;
-    if (!m && !rt_glsl_module(d, desc->glsl, VK_SHADER_STAGE_COMPUTE_BIT,
-                              desc->label ? desc->label : "compute", desc->check, &own, e))
+    if (!m && desc->spirv) {
+        VkShaderModuleCreateInfo mi = {
+            .sType = VK_STRUCTURE_TYPE_SHADER_MODULE_CREATE_INFO,
+            .codeSize = desc->nwords * 4, .pCode = desc->spirv,
+        };
+        VkResult r = vkCreateShaderModule(d->dev, &mi, NULL, &own);
+        if (r != VK_SUCCESS)
+            return rt_fail(e, RT_E_VULKAN, "vkCreateShaderModule", rt_vk_result_name(r));
+    } else if (!m && !rt_glsl_module(d, desc->glsl, VK_SHADER_STAGE_COMPUTE_BIT,
+                                     desc->label ? desc->label : "compute", desc->check, &own,
+                                     e)) {
         return false;
+    }
     VkComputePipelineCreateInfo ci = {
         .sType = VK_STRUCTURE_TYPE_COMPUTE_PIPELINE_CREATE_INFO,
         .stage = { .sType = VK_STRUCTURE_TYPE_PIPELINE_SHADER_STAGE_CREATE_INFO,

@@ -155,6 +155,9 @@ typedef struct rt_vk_compute_desc {
     const char                 *label;
     VkShaderModule              module;
     const char                 *glsl;     /* instead of module            */
+    const uint32_t             *spirv;    /* or: SPIR-V already validated and
+                                             checked (a pack's, at load)  */
+    size_t                      nwords;
     const struct rt_interface  *check;    /* glsl: rt_spirv_check against it */
     const VkSpecializationInfo *spec;
     VkPipelineLayout            layout;

@@ -1,44 +1,61 @@
 /* bench_util.c — splatbench's shared helpers (bench.h): files, medians,
  * memory, the image error and the analytic heightfield. */
 #include "bench.h"
+#include "zst.h"
 
 #include <math.h>
 #include <stdlib.h>
 #include <unistd.h>
 
-char *read_text(const char *path)
+/* A pack file's bytes (NUL after them), decompressed where its name ends
+ * in ".zst" (compiler/PACK.md "Compressed shaders"). */
+static uint8_t *read_pack_file(const char *path, size_t *n)
 {
+    *n = 0;
     FILE *f = fopen(path, "rb");
     if (!f)
         return NULL;
     fseek(f, 0, SEEK_END);
-    long n = ftell(f);
+    long bytes = ftell(f);
     fseek(f, 0, SEEK_SET);
-    char *s = xcalloc((size_t)n + 1, 1);
-    if (n > 0 && fread(s, 1, (size_t)n, f) != (size_t)n) {
-        free(s);
-        s = NULL;
+    uint8_t *data = bytes >= 0 ? xcalloc((size_t)bytes + 1, 1) : NULL;
+    if (data && bytes > 0 && fread(data, 1, (size_t)bytes, f) != (size_t)bytes) {
+        free(data);
+        data = NULL;
     }
     fclose(f);
-    return s;
+    if (data && splat_zst_name(path)) {
+        char why[256];
+        size_t raw = 0;
+        uint8_t *d = splat_zst_decompress(data, (size_t)bytes, (size_t)64 << 20, &raw, why,
+                                          sizeof why);
+        if (!d)
+            fprintf(stderr, "splatbench: %s %s\n", path, why);
+        free(data);
+        *n = raw;
+        return d;
+    }
+    *n = data ? (size_t)bytes : 0;
+    return data;
+}
+
+char *read_text(const char *path)
+{
+    size_t n;
+    return (char *)read_pack_file(path, &n);
 }
 
 bool read_words(const char *path, uint32_t **words, size_t *n)
 {
-    FILE *f = fopen(path, "rb");
-    if (!f)
+    size_t bytes = 0;
+    uint8_t *data = read_pack_file(path, &bytes);
+    if (!data || bytes == 0 || bytes % 4) {
+        free(data);
         return false;
-    fseek(f, 0, SEEK_END);
-    long bytes = ftell(f);
-    fseek(f, 0, SEEK_SET);
-    bool ok = bytes > 0 && bytes % 4 == 0;
-    if (ok) {
-        *words = xcalloc((size_t)bytes / 4, 4);
-        *n = (size_t)bytes / 4;
-        ok = fread(*words, 4, *n, f) == *n;
     }
-    fclose(f);
-    return ok;
+    *words = (uint32_t *)data;
+    *n = bytes / 4;
+    return true;
 }
 
 static int cmp_double(const void *a, const void *b)

@@ -19,7 +19,7 @@ cp "$B/tests/splatbench" "$D/tests/"
 for t in test_quadtree gpu_sparse; do
     [ -x "$B/tests/$t" ] && cp "$B/tests/$t" "$D/tests/"
 done
-for l in libjansson.so.4 libxxhash.so.0 libstb.so.0 libvulkan.so.1 libspirv-cross-c-shared.so.0; do
+for l in libjansson.so.4 libxxhash.so.0 libstb.so.0 libvulkan.so.1 libspirv-cross-c-shared.so.0 libzstd.so.1; do
     p=$(ldconfig -p | awk -v l="$l" '$1 == l && /x86-64/ { print $NF; exit }')
     [ -n "$p" ] && cp -L "$p" "$D/lib/"
 done

@@ -22,7 +22,7 @@ built=$(echo "$line" | sed -n 's/^combinations found in leaf cells: \([0-9]*\), 
 [ "$found" -gt $P ] || fail "only $found leaf combinations: the merge had nothing to do"
 grep -q "^combinations: $found in leaf cells, $built compiled (merged to at most $P)" "$W/stats.txt" ||
     fail "the analysis report disagrees"
-n=$(grep -o '"glsl": "shaders/[0-9]*\.frag"' "$W/pack/manifest.json" | wc -l)
+n=$(grep -o '"glsl": "shaders/[0-9]*\.frag\.zst"' "$W/pack/manifest.json" | wc -l)
 [ "$n" -eq "$built" ] || fail "the manifest names $n composites, the report $built"
 # a bad bound is a usage error, nothing written
 "$SPLATC" build "$W/scene.sg" -o "$W/bad" --max-combinations -1 2> "$W/bad.txt" && fail "accepted -1"

@@ -43,8 +43,8 @@ mkdir -p "$C/fuzz_combos" "$C/fuzz_heightfield" "$C/fuzz_spirv"
     printf '\003ncols 4\nnrows 3\nxllcorner 0\nyllcorner 0\ncellsize 10\nNODATA_value -9999\n1 2 3 4\n5 6 -9999 8\n9 10 11 12\n' \
         > "$C/fuzz_heightfield/gdal_asc"; }
 seed fuzz_obj tests/golden/inc/*.obj
-[ -n "$(ls -A "$C/fuzz_spirv")" ] || for f in "$PACK"/shaders/*.spv; do
-    { printf '\001'; cat "$f"; } > "$C/fuzz_spirv/$(basename "$f")"; done
+[ -n "$(ls -A "$C/fuzz_spirv")" ] || for f in "$PACK"/shaders/*.spv.zst; do
+    { printf '\001'; zstd -q -dc "$f"; } > "$C/fuzz_spirv/$(basename "$f" .zst)"; done
 rc=0
 for t in $TARGETS; do
     log="$FB/$t.log"

@@ -30,6 +30,19 @@ cd "$ROOT" || fail "no repository root"
     fail "build dense"
 "$SC" build tests/destruction/scene.sg -o "$OUT/destr" --no-cache > /dev/null || fail "build destr"
 "$SV" "$OUT/bc4" --headless --size 32x32 -o "$OUT/ok.png" || fail "the intact pack does not render"
+# The compiler writes each shader as a zstd frame (PACK.md "Compressed
+# shaders"); a pack may also hold plain files, named without ".zst".  The
+# cases that swap or cut shader files work on plain copies (unzst), so
+# they corrupt the SPIR-V itself; the "zst_" cases below corrupt the
+# frames of the compiler's own pack (bc4z).
+unzst() {
+    for f in "$1"/shaders/*.zst; do zstd -q -d --rm "$f" || fail "unzst $f"; done
+    sed -i 's/\.zst"/"/g' "$1/manifest.json"
+}
+cp -r "$OUT/bc4" "$OUT/bc4z"
+for p in bc4 dense destr; do unzst "$OUT/$p"; done
+"$SV" "$OUT/bc4" --headless --size 32x32 -o "$OUT/ok_plain.png" || fail "the plain pack does not render"
+cmp -s "$OUT/ok.png" "$OUT/ok_plain.png" || fail "the plain pack renders another picture"
 
 # Shaders with a foreign interface, compiled here: frag NAME BODY
 frag() {
@@ -280,6 +293,37 @@ EOF
 case_ ug_lighting bc4 "undergrowth.blocks\[0\] lighting: must be \"terrain\" or \"mesh\"" <<EOF
 "$PE" set $M undergrowth.blocks.0.lighting '"sun"'
 EOF
+# -- compressed shader files (zst.h): every frame's stated size checked
+# against the file and the limit (64 MiB) before anything is allocated
+case_ zst_not_frame bc4z "names 'shaders/0001.spv.zst', which is not a zstd frame" <<EOF
+head -c 64 /dev/urandom > shaders/0001.spv.zst
+EOF
+case_ zst_bomb bc4z "names 'shaders/0000.spv.zst', which states 100000000 bytes of content, more than the limit" <<EOF
+head -c 100000000 /dev/zero | zstd -q --stream-size=100000000 -c > shaders/0000.spv.zst
+EOF
+case_ zst_glsl_bomb bc4z "names 'shaders/uber.comp.zst', which states 100000000 bytes of content, more than the limit" <<EOF
+head -c 100000000 /dev/zero | zstd -q --stream-size=100000000 -c > shaders/uber.comp.zst
+EOF
+case_ zst_no_size bc4z "names 'shaders/0000.spv.zst', which is a zstd frame without its content size" <<EOF
+zstd -q -dc shaders/0000.spv.zst | zstd -q -c > x && mv x shaders/0000.spv.zst
+EOF
+case_ zst_truncated bc4z "names 'shaders/0001.spv.zst', which is not exactly one zstd frame (the frame is cut short)" <<EOF
+head -c 100 shaders/0001.spv.zst > x && mv x shaders/0001.spv.zst
+EOF
+case_ zst_trailing bc4z "names 'shaders/ref_0000.spv.zst', which is not exactly one zstd frame (bytes after it)" <<EOF
+printf 'more' >> shaders/ref_0000.spv.zst
+EOF
+case_ zst_two_frames bc4z "names 'shaders/uber.spv.zst', which is not exactly one zstd frame (bytes after it)" <<EOF
+cat shaders/0000.spv.zst >> shaders/uber.spv.zst
+EOF
+case_ zst_checksum bc4z "names 'shaders/0000.spv.zst', which does not decompress" <<EOF
+s=\$(stat -c %s shaders/0000.spv.zst)
+printf '\\377\\377\\377\\377' | dd of=shaders/0000.spv.zst bs=1 seek=\$((s - 4)) conv=notrunc 2>/dev/null
+EOF
+case_ zst_corrupt_spirv bc4z "0001.spv.zst: error: corrupt SPIR-V" <<EOF
+head -c 400 /dev/urandom | zstd -q --stream-size=400 -c > shaders/0001.spv.zst
+EOF
+
 # The fragment GLSL the forward counting variant reads when first needed
 # (the cost view on the forward path): the same checks then, and the pack
 # still draws without it.

@@ -11,6 +11,8 @@
  *   (all by splatc build)
  */
 #include <dirent.h>
+#include <fcntl.h>
+#include <unistd.h>
 #include <stdlib.h>
 #include <setjmp.h>
 #include <stdarg.h>
@@ -139,18 +141,24 @@ static void test_dense_and_destruction(void **state)
 /* Check one SPIR-V file of the compute pack against a role. */
 static bool fits(const rt_pack *p, const char *file, rt_shader_role role, rt_error *e)
 {
-    char path[1024];
+    char path[1024], rel[1024], why[256];
     snprintf(path, sizeof path, "%s/shaders/%s", compute_dir, file);
-    FILE *f = fopen(path, "rb");
-    assert_non_null(f);
-    static uint32_t words[1 << 20];
-    size_t n = fread(words, 4, sizeof words / 4, f);
-    fclose(f);
+    snprintf(rel, sizeof rel, "shaders/%s", file);
+    int dirfd = open(compute_dir, O_RDONLY | O_DIRECTORY);
+    assert_true(dirfd >= 0);
+    size_t bytes = 0;   /* a ".zst" file decompressed (PACK.md) */
+    uint32_t *words = (uint32_t *)rt_pack_read_content(dirfd, rel, (size_t)64 << 20, &bytes,
+                                                        why, sizeof why);
+    close(dirfd);
+    if (!words)
+        fail_msg("%s: %s", rel, why);
+    size_t n = bytes / 4;
     rt_interface in;
     assert_true(rt_interface_for(p, role, &in));
     assert_true(rt_spirv_validate(words, n, path, e));
     bool ok = rt_spirv_check(words, n, path, &in, e);
     rt_interface_free(&in);
+    free(words);
     return ok;
 }
 
@@ -168,14 +176,14 @@ static void test_compute_role(void **state)
     struct dirent *ent;
     while ((ent = readdir(dir)) != NULL) {
         size_t len = strlen(ent->d_name);
-        if (len > 12 && !strcmp(ent->d_name + len - 12, ".ug.comp.spv")) {
+        if (len > 16 && !strcmp(ent->d_name + len - 16, ".ug.comp.spv.zst")) {
             /* undergrowth masks: their own role (set 2), not compute shading */
             if (!fits(&p, ent->d_name, RT_ROLE_UNDERGROWTH, &e))
                 fail_msg("%s", e.msg);
             assert_false(fits(&p, ent->d_name, RT_ROLE_COMPUTE, &e));
             rt_error_clear(&e);
             nug++;
-        } else if (len > 9 && !strcmp(ent->d_name + len - 9, ".comp.spv")) {
+        } else if (len > 13 && !strcmp(ent->d_name + len - 13, ".comp.spv.zst")) {
             if (!fits(&p, ent->d_name, RT_ROLE_COMPUTE, &e))
                 fail_msg("%s", e.msg);
             assert_false(fits(&p, ent->d_name, RT_ROLE_COMPOSITE, &e));
@@ -192,7 +200,7 @@ static void test_compute_role(void **state)
         want_ug += p.combos[i].ug_compute != NULL;
     assert_int_equal(nug, want_ug);
     assert_int_equal(ncomp, p.ncombos + 1);   /* every composite and the uber */
-    assert_false(fits(&p, "0000.spv", RT_ROLE_COMPUTE, &e));
+    assert_false(fits(&p, "0000.spv.zst", RT_ROLE_COMPUTE, &e));
     assert_non_null(strstr(e.msg, "no compute entry point"));
     rt_error_clear(&e);
     rt_pack_free(&p);

@@ -15,14 +15,14 @@ if grep -q 'splatc: \(compose\|glslang\|spirv-val\)' "$OUT/quiet.err"; then
 fi
 SPLATC_PROGRESS=lines "$SPLATC" build "$SCENE" -o "$OUT/b" --no-cache 2> "$OUT/lines.err" > /dev/null ||
     fail "build (lines)"
-for phase in compose glsl glslang spirv-val; do
+for phase in compose glsl glslang+spirv-val; do
     grep -q "^splatc: $phase \([0-9]*\)/\1 " "$OUT/lines.err" ||
         { cat "$OUT/lines.err"; fail "no finished '$phase' line"; }
 done
 if command -v script > /dev/null; then
     script -qec "'$SPLATC' build '$SCENE' -o '$OUT/c' --no-cache" "$OUT/tty.log" > /dev/null ||
         fail "build on a terminal"
-    grep -q 'splatc: glslang .*ETA' "$OUT/tty.log" || { cat -v "$OUT/tty.log"; fail "no bar on a terminal"; }
+    grep -q 'splatc: glslang+spirv-val .*ETA' "$OUT/tty.log" || { cat -v "$OUT/tty.log"; fail "no bar on a terminal"; }
     grep -q "$(printf '\r\033\\[K')" "$OUT/tty.log" || fail "the bar's line is not cleared"
 fi
 same "$OUT/a/manifest.json" "$OUT/b/manifest.json" "progress changed the pack"

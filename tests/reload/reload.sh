@@ -40,7 +40,7 @@ variant params base <<EOF2
 "$PE" set $M params.0.default '[0.5, 0, 0, 0]'
 EOF2
 variant shader base <<EOF2
-cp shaders/0001.spv shaders/0000.spv
+cp shaders/0001.spv.zst shaders/0000.spv.zst
 EOF2
 variant area dbase <<EOF2
 "$PE" set $M scene.destruction.cell_size 8

@@ -177,7 +177,7 @@ viewer)
     # the window's path is headless's: screen-space where the pack has
     # compute variants (issue 33)
     want=forward
-    [ -e "$PACK/shaders/uber.comp" ] && want=screen-space
+    { [ -e "$PACK/shaders/uber.comp" ] || [ -e "$PACK/shaders/uber.comp.zst" ]; } && want=screen-space
     grep -q "^splatview: $want shading" "$OUT/viewer.log" ||
         fail "the window did not open on the $want path"
     ;;

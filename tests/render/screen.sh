@@ -67,7 +67,7 @@ c="--camera-preset $1"
 # and the über-shader's, not one per combination of the pack
 run "$PACK" --headless $SIZE $c --shading screen --stats > "$OUT/made.log"
 lists=$(sed -n 's/^tiles: .* shaded, \([0-9]*\) lists.*/\1/p' "$OUT/made.log")
-made=$(sed -n 's/^compute modules: \([0-9]*\) from the SPIR-V cache, \([0-9]*\) compiled.*/\1 \2/p' "$OUT/made.log")
+made=$(sed -n 's/^compute modules: \([0-9]*\) from the pack or the SPIR-V cache, \([0-9]*\) compiled.*/\1 \2/p' "$OUT/made.log")
 [ -n "$lists" ] && [ -n "$made" ] || fail "no tiles or compute modules line in --stats"
 set -- $made "$@"
 [ $(($1 + $2)) -le $((lists + 1)) ] ||

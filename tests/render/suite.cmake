@@ -132,11 +132,18 @@ if(TARGET splatrt AND TARGET splatview)
       endif()
     endforeach()
     # the SPIR-V and pipeline caches across runs (spirv_cache.sh)
+    # (and examples/minimal built with --glsl-compute: compute variants the
+    # runtime compiles on first use)
+    add_test(NAME render.pack_minimal_glsl
+      COMMAND $<TARGET_FILE:splatc_cli> build ${PROJECT_SOURCE_DIR}/examples/minimal/scene.sg
+              -o ${RENDER_OUT}/minimal_glsl --glsl-compute --no-cache)
+    set_tests_properties(render.pack_minimal_glsl PROPERTIES LABELS render
+      FIXTURES_SETUP minimal_glsl_pack)
     add_test(NAME render.spirv_cache
       COMMAND sh ${RENDER_DIR}/spirv_cache.sh $<TARGET_FILE:splatview> ${RENDER_OUT}/minimal
-              ${RENDER_OUT}/out)
+              ${RENDER_OUT}/out ${RENDER_OUT}/minimal_glsl)
     set_tests_properties(render.spirv_cache PROPERTIES LABELS "render;asan" TIMEOUT 300
-      FIXTURES_REQUIRED minimal_pack)
+      FIXTURES_REQUIRED "minimal_pack;minimal_glsl_pack")
     # SPLAT_VALIDATE=1 without the validation layer: a loud failure
     add_test(NAME render.no_validation_layer
       COMMAND sh ${RENDER_DIR}/no_layer.sh $<TARGET_FILE:splatview> ${RENDER_OUT}/minimal

@@ -233,6 +233,52 @@ static void *compile_job(void *arg)
     return NULL;
 }
 
+/* spv_shape (cache.h: validation skipped for a known shape): equal for
+ * modules that differ only in float constants, including two constants
+ * that become equal (glslang then merges them: one OpConstant fewer, the
+ * ids after it shifted); different for any other change. */
+static void shape_of(const char *src, uint64_t h[2])
+{
+    uint32_t *w;
+    size_t n;
+    compile_ok(src, SPV_STAGE_COMPUTE, &w, &n);
+    assert_true(spv_shape(w, n, h));
+    free(w);
+}
+
+static void test_shape_ignores_float_constants(void **state)
+{
+    (void)state;
+    static const char *const fmt =
+        "#version 450\n"
+        "layout(local_size_x = 1) in;\n"
+        "layout(std430, set = 0, binding = 0) buffer Data { vec4 v[]; } d;\n"
+        "void main() {\n"
+        "    vec3 c = vec3(%s, 0.25, 0.5) * d.v[0].x;\n"
+        "    if (d.v[1].y > %s) c += vec3(0.75);\n"
+        "    d.v[2] = vec4(c, %s);\n"
+        "}\n";
+    char a[1024], b[1024], merged[1024], other[1024], typed[1024];
+    snprintf(a, sizeof a, fmt, "0.9", "0.125", "1.0");
+    snprintf(b, sizeof b, fmt, "0.95", "0.375", "2.0");
+    snprintf(merged, sizeof merged, fmt, "0.25", "0.5", "0.75");   /* collisions */
+    snprintf(other, sizeof other, fmt, "0.9", "0.125", "d.v[3].z");
+    snprintf(typed, sizeof typed, fmt, "0.9", "0.125", "float(d.v.length())");
+    uint64_t ha[2], hb[2], hm[2], ho[2], ht[2];
+    shape_of(a, ha);
+    shape_of(b, hb);
+    shape_of(merged, hm);
+    shape_of(other, ho);
+    shape_of(typed, ht);
+    assert_memory_equal(ha, hb, sizeof ha);
+    assert_memory_equal(ha, hm, sizeof ha);
+    assert_memory_not_equal(ha, ho, sizeof ha);
+    assert_memory_not_equal(ha, ht, sizeof ha);
+    assert_memory_not_equal(ho, ht, sizeof ha);
+    static const uint32_t junk[] = {0x07230203u, 0x00010500u, 0, 0, 0, 0xffff0011u};
+    assert_false(spv_shape(junk, 6, ha));
+}
+
 static void test_threads_deterministic(void **state)
 {
     uint32_t *ref;
@@ -265,6 +311,7 @@ int main(void)
         cmocka_unit_test(test_optimize_keeps_valid),
         cmocka_unit_test(test_write_file_atomic),
         cmocka_unit_test(test_threads_deterministic),
+        cmocka_unit_test(test_shape_ignores_float_constants),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }

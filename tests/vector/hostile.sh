@@ -1,5 +1,5 @@
 #!/bin/sh
-# vectors.bin is untrusted input (runtime/pack_load.c read_vectors): a
+# vectors.bin is untrusted input (runtime/pack_sections.c rt_pk_read_vectors): a
 # copy of the probe pack with its vectors.bin or manifest entry corrupted
 # one way at a time must be refused by splatview --check (exit non-zero,
 # an error naming vectors), never loaded or crashed on; the intact copy
