@@ -19,7 +19,9 @@ rm -rf "$D" && mkdir -p "$D/world" || fail "cannot make $D"
 "$SPLATC" build "$D/world/scene.sg" -o "$D/pack" -j 2 --no-cache > "$D/build.txt" 2>&1 ||
     { cat "$D/build.txt"; fail "splatc build"; }
 # the world is as deep as meant: the über-shader's header lists 105 layers
-n=$(sed -n 3p "$D/pack/shaders/uber.frag" | grep -o '([0-9]*)' | wc -l)
+# (a zstd frame in the pack: compiler/PACK.md "Compressed shaders")
+zstd -q -d -f "$D/pack/shaders/uber.frag.zst" -o "$D/uber.frag" || fail "zstd -d uber.frag.zst"
+n=$(sed -n 3p "$D/uber.frag" | grep -o '([0-9]*)' | wc -l)
 [ "$n" -eq 105 ] || fail "the über-shader has $n layers, expected 105"
 view() {   # view NAME ARGS...: a 160x90 frame of the 'biome' camera
     name=$1; shift

@@ -2,13 +2,13 @@
 # check_pack.sh SPLATC SCENE OUT CACHE — build SCENE into OUT (SPIR-V cache in
 # CACHE) and pass every shader of the pack through spirv-val and
 # glslangValidator: the composites, the reference passes, the über-shader,
-# the vertex shader and the compute variants (built with --compute-spirv, so
-# splatc compiles and validates them too) and their counting variants.
+# the vertex shader and the compute variants (their SPIR-V made and
+# validated by splatc too, the default) and their counting variants.
 # The checks run two files at a time (colorado has some 500 shaders).
 set -eu
 . "$(dirname "$0")/../lib.sh"   # to, fail
 splatc=$1 scene=$2 out=$3 cache=$4
-"$splatc" build "$scene" -o "$out" --cache "$cache" -j 2 --compute-spirv
+"$splatc" build "$scene" -o "$out" --cache "$cache" -j 2
 # the pack's shader files are zstd frames (compiler/PACK.md "Compressed
 # shaders"): checked as the plain files they hold, under OUT.plain
 pack=$out
@@ -16,10 +16,14 @@ out=$out.plain
 rm -rf "$out" && mkdir -p "$out/shaders"
 for f in "$pack"/shaders/*.zst; do
     b=${f##*/}
-    zstd -q -d "$f" -o "$out/shaders/${b%.zst}"
+    must zstd -q -d "$f" -o "$out/shaders/${b%.zst}"
 done
-n=$(ls "$out"/shaders/*.spv | wc -l)
-test -n "$(ls "$out"/shaders/*.comp.spv)"
+# the lists: ls fails (and so the test) when a kind of shader is missing
+to "$out.spv.list" ls "$out"/shaders/*.spv
+to "$out.comp.spv.list" ls "$out"/shaders/*.comp.spv
+to "$out.glsl.list" ls "$out"/shaders/*.frag "$out"/shaders/*.vert "$out"/shaders/*.comp
+to "$out.comp.list" ls "$out"/shaders/*.comp
+n=$(wc -l < "$out.spv.list")
 # each batch exits 255 on the first failure, which stops xargs (and set -e)
 xargs -P 2 -n 16 < "$out.spv.list" sh -c '
     for f; do
