@@ -348,6 +348,12 @@ static ir_iv  i_log2(const ir_iv *x)
     return widen(iv(log2(x[0].lo), log2(x[0].hi)), 2, 0);   /* libm */
 }
 
+/* fwidth: lowering expands it (ir_footprint), so these are never read;
+ * what they say is still true of any footprint: 0 for a value that does
+ * not move, within [0, inf] */
+static double e_fwidth(const double *x) { (void)x; return 0.0; }
+static ir_iv  i_fwidth(const ir_iv *x)  { (void)x; return iv(0, INFINITY); }
+
 static double e_sin(const double *x) { return sin(x[0]); }
 static ir_iv  i_sin(const ir_iv *x)  { return periodic_bounds(x[0], sin, M_PI / 2); }
 
@@ -635,11 +641,19 @@ static void i_cross(const ir_node *n, const ir_type *atype, const ir_iv *a, ir_i
 #define T    ((ir_type)n->type)
 
 /* An input moves where its row has a derivative accessor (IR_INPUTS'
- * dglsl column); normal, slope and destruction are taken as 0. */
+ * dglsl column); destruction is taken as 0, and so are normal and slope
+ * unless a footprint asks (c->curvature: texture gradients never do). */
 static ir_ref d_input(ir_dctx *c, const ir_node *n, ir_ref self, const ir_ref *d)
 {
     if (!ir_input_get((ir_input_kind)n->imm)->dglsl)
         return IR_NONE;
+    if (!c->curvature && (n->imm == IR_IN_SLOPE || n->imm == IR_IN_NORMAL))
+        return IR_NONE;
+    if (n->imm == IR_IN_SLOPE) {   /* 1 - normal.y: one normal step for both */
+        ir_node l = {.op = IR_OP_DINPUT, .type = IR_T_VEC3,
+                     .imm = IR_DINPUT_IMM(IR_IN_NORMAL, c->axis)};
+        return ir_op1(c->ir, IR_OP_NEG, ir_swizzle(c->ir, ir_node_add(c->ir, &l), "y"));
+    }
     ir_node l = {.op = IR_OP_DINPUT, .type = n->type, .imm = IR_DINPUT_IMM(n->imm, c->axis)};
     return ir_node_add(c->ir, &l);
 }
