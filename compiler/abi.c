@@ -751,6 +751,15 @@ const char SPLAT_GLSL_PRELUDE[] =
     "vec3 splat_d_position(int a) { return splat_d_rel(a); }\n"
     "float splat_d_height(int a) { return splat_d_rel(a).y; }\n"
     "vec2 splat_d_uv(int a) { return splat_d_rel(a).xz / u_frame.terrain.xy; }\n"
+    /* normal and slope (footprints only: .sg's fwidth): the smooth normal
+     * at the neighbouring pixel's uv minus this one's, what a quad's dFdx
+     * of it would be (9 more gathers; none where no gradients are taken) */
+    "vec3 splat_d_normal(int a) {\n"
+    "    vec2 du = splat_d_uv(a);\n"
+    "    if (du == vec2(0.0)) return vec3(0.0);\n"
+    "    return splat_normal_at(splat_uv() + du) - splat_normal();\n"
+    "}\n"
+    "float splat_d_slope(int a) { return -splat_d_normal(a).y; }\n"
     "#ifdef SPLAT_FAR_BAKE\n"   /* the reference's view does not move */
     "float splat_d_view_distance(int a) { return 0.0; }\n"
     "vec3 splat_d_view_direction(int a) { return vec3(0.0); }\n"

@@ -293,6 +293,20 @@ static bool eval_point(far_bake *fb, double u, double v, double sx, double sz,
     env.d_input[1][IR_IN_HEIGHT][0] = dhz;
     env.d_input[0][IR_IN_UV][0] = sx / t->size[0];
     env.d_input[1][IR_IN_UV][1] = sz / t->size[1];
+    /* normal and slope (footprints: .sg's fwidth) as the prelude's
+     * splat_d_normal: the normal one step over minus this one */
+    bool curv = false;
+    for (uint32_t n = 1; n < c->ir.nnodes && !curv; n++)
+        curv = c->ir.nodes[n].op == IR_OP_DINPUT &&
+               (IR_DINPUT_INPUT(c->ir.nodes[n].imm) == IR_IN_NORMAL ||
+                IR_DINPUT_INPUT(c->ir.nodes[n].imm) == IR_IN_SLOPE);
+    for (int a = 0; a < 2 && curv; a++) {
+        double n1[3];
+        splat_terrain_normal(t, u + (a ? 0 : sx / t->size[0]), v + (a ? sz / t->size[1] : 0), n1);
+        for (int k = 0; k < 3; k++)
+            env.d_input[a][IR_IN_NORMAL][k] = n1[k] - env.normal[k];
+        env.d_input[a][IR_IN_SLOPE][0] = -(n1[1] - env.normal[1]);
+    }
     for (uint32_t n = 1; n < c->ir.nnodes; n++)
         ir_eval_node(&c->ir, n, &env, vals);
     const double *A = vals[fb->roots[id][0].id], *N = vals[fb->roots[id][1].id];

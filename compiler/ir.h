@@ -66,9 +66,12 @@ ir_type     ir_type_from_name(const char *s); /* IR_T_ERROR if unknown       */
  *              more than a register read; compose.c)
  *     dglsl    its screen-space derivative rule (ir_differentiate.c): the
  *              prelude's splat_d_<input>(axis) accessor the DINPUT leaf
- *              reads (abi.c), or NULL: taken as 0 (normal and slope would
- *              need the heightfield's second derivatives; destruction is
- *              piecewise)
+ *              reads (abi.c), or NULL: taken as 0 (destruction is
+ *              piecewise).  normal and slope have one (the heightfield's
+ *              normal one pixel over, minus this one's: 9 gathers), read
+ *              only by footprint derivatives (fwidth, ir_footprint);
+ *              texture gradients take them as 0 (they weight, they do not
+ *              move, texture lookups)
  *
  * A new input: a row here, its ir_env (and ir_ienv) field below, its
  * accessor in the ABI prelude (abi.c), and in terrain.c if a region
@@ -79,10 +82,10 @@ ir_type     ir_type_from_name(const char *s); /* IR_T_ERROR if unknown       */
       "splat_d_height")                                                /* m        */ \
     X(SLOPE,          "terrain.slope",       IR_T_FLOAT, "splat_slope()",         \
       "slope",        slope,          IV(slope),         UNIT,   1,               \
-      NULL)                                                            /* 1-n.y    */ \
+      "splat_d_slope")                                                 /* 1-n.y    */ \
     X(NORMAL,         "terrain.normal",      IR_T_VEC3,  "splat_normal()",        \
       "normal",       normal,         IV(normal),        NORMAL, 1,               \
-      NULL)                                                            /* world    */ \
+      "splat_d_normal")                                                /* world    */ \
     X(POSITION,       "terrain.position",    IR_T_VEC3,  "splat_position()",      \
       "position",     position,       IV(position),      ALL,    1,               \
       "splat_d_position")                                              /* local m  */ \
@@ -250,7 +253,11 @@ enum { IR_FIN_NO = 0, IR_FIN_YES = 1, IR_FIN_DATA = 2, IR_FIN_ARGS_BIT = 0x100 }
     X(DINPUT,    NULL,  0, 0, NOPORTS, "splat_d_<input>(axis)", ty_leaf, ENV, IR_FIN_NO, EXACT, 0, D0) \
     X(SAMPLE_GRAD, NULL, 4, 0, PORTS("tex", "uv", "ddx", "ddy"), "splat_texture_grad($0, $1, $2, $3)", \
       ty_sample_grad, ENV, IR_FIN_DATA, SAMPLE, 4, D(sample))                               \
-    X(LOG2,      "log2", 1, IR_CWN, P1, "log2($0)", ty_same, CW(log2), IR_FIN_NO, ULP3, 4, D(log2))
+    X(LOG2,      "log2", 1, IR_CWN, P1, "log2($0)", ty_same, CW(log2), IR_FIN_NO, ULP3, 4, D(log2)) \
+    /* FWIDTH: .sg's fwidth, |d/dx| + |d/dy| of its operand over one      */                 \
+    /* pixel; lowering expands it (ir_footprint), so the IR never holds    */                 \
+    /* one: its value 0 and bounds [0, inf] are never read                 */                 \
+    X(FWIDTH,    "fwidth", 1, IR_COMPONENTWISE, P1, "fwidth($0)", ty_same, CW(fwidth), IR_FIN_NO, EXACT, 2, D0)
 
 /* IR_NAN_PROPAGATES: a NaN operand component gives a NaN result component
  * (the interval code short-circuits such operands to [-inf, inf]). */
@@ -503,6 +510,11 @@ bool   ir_differentiate(ir *ir);
 /* The derivative of `r` along `axis` (0: d/dx, 1: d/dy) as a node of `ir`
  * (a constant 0 if it is zero), built the same way (for tests). */
 ir_ref ir_derivative(ir *ir, ir_ref r, int axis);
+/* The footprint of `r` over one pixel, |dr/dx| + |dr/dy| (GLSL's fwidth,
+ * per component), as nodes of `ir`: .sg's fwidth node.  Unlike texture
+ * gradients it follows terrain.slope and terrain.normal too (their
+ * DINPUT leaves).  A constant 0 if r does not move. */
+ir_ref ir_footprint(ir *ir, ir_ref r);
 
 /* What the rules build with: the ir, the axis, and arithmetic that reads
  * IR_NONE as zero and splats a float operand to the other's width. */
@@ -511,6 +523,7 @@ struct ir_dctx {
     int       axis;
     uint32_t *memo[2];  /* per axis, per node: derivative id + 1, or 0      */
     uint32_t  cap;      /* entries of each memo                            */
+    bool      curvature; /* slope and normal move too (ir_footprint)       */
 };
 ir_ref ir_d_add(ir_dctx *c, ir_ref a, ir_ref b);   /* a + b, NONE = 0     */
 ir_ref ir_d_sub(ir_dctx *c, ir_ref a, ir_ref b);   /* a - b               */

@@ -85,11 +85,19 @@ ir_ref ir_d_zero(ir_dctx *c, ir_ref d, ir_type t)
 #define T    ((ir_type)n->type)
 
 /* An input moves where its row has a derivative accessor (IR_INPUTS'
- * dglsl column); normal, slope and destruction are taken as 0. */
+ * dglsl column); destruction is taken as 0, and so are normal and slope
+ * unless a footprint asks (c->curvature: texture gradients never do). */
 static ir_ref d_input(ir_dctx *c, const ir_node *n, ir_ref self, const ir_ref *d)
 {
     if (!ir_input_get((ir_input_kind)n->imm)->dglsl)
         return IR_NONE;
+    if (!c->curvature && (n->imm == IR_IN_SLOPE || n->imm == IR_IN_NORMAL))
+        return IR_NONE;
+    if (n->imm == IR_IN_SLOPE) {   /* 1 - normal.y: one normal step for both */
+        ir_node l = {.op = IR_OP_DINPUT, .type = IR_T_VEC3,
+                     .imm = IR_DINPUT_IMM(IR_IN_NORMAL, c->axis)};
+        return ir_op1(c->ir, IR_OP_NEG, ir_swizzle(c->ir, ir_node_add(c->ir, &l), "y"));
+    }
     ir_node l = {.op = IR_OP_DINPUT, .type = n->type, .imm = IR_DINPUT_IMM(n->imm, c->axis)};
     return ir_node_add(c->ir, &l);
 }

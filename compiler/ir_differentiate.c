@@ -116,6 +116,21 @@ ir_ref ir_derivative(ir *ir, ir_ref r, int axis)
     return ir_d_zero(&(ir_dctx){.ir = ir}, d, ir_typeof(ir, r));
 }
 
+ir_ref ir_footprint(ir *ir, ir_ref r)
+{
+    ir_dctx c = {.ir = ir, .curvature = true};
+    ir_type t = ir_typeof(ir, r);
+    ir_ref f = IR_NONE;
+    for (int a = 0; a < 2; a++) {
+        c.axis = a;
+        ir_ref d = derive(&c, r);
+        if (ir_ref_ok(d))
+            f = ir_d_add(&c, f, ir_op1(ir, IR_OP_ABS, d));
+    }
+    dctx_free(&c);
+    return ir_d_zero(&c, f, t);
+}
+
 static ir_ref rewrite(ir *dst, const ir_node *n, void *user)
 {
     ir_dctx *c = user;

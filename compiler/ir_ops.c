@@ -386,6 +386,12 @@ static ir_iv  i_log2(const ir_iv *x)
     return widen(iv(log2(x[0].lo), log2(x[0].hi)), 2, 0);   /* libm */
 }
 
+/* fwidth: lowering expands it (ir_footprint), so these are never read;
+ * what they say is still true of any footprint: 0 for a value that does
+ * not move, within [0, inf] */
+static double e_fwidth(const double *x) { (void)x; return 0.0; }
+static ir_iv  i_fwidth(const ir_iv *x)  { (void)x; return iv(0, INFINITY); }
+
 static double e_sin(const double *x) { return sin(x[0]); }
 static ir_iv  i_sin(const ir_iv *x)  { return periodic_bounds(x[0], sin, M_PI / 2); }
 

@@ -311,7 +311,12 @@ static bool inline_shader(lowerer *L, int si, const ir_ref *ins, ir_ref *outs,
                 const sg_binding *b = &n->args[j];
                 args[b->slot] = coerce(L, lower_value(L, &f, &b->val), b->splat);
             }
-            *out = ir_opn(L->ir, (ir_op)n->op, args, ir_opinfo_get((ir_op)n->op)->nargs);
+            /* fwidth expands here into its derivatives (ir_footprint):
+             * DINPUT leaves, which every stage and the analysis read */
+            if (n->op == IR_OP_FWIDTH)
+                *out = ir_footprint(L->ir, args[0]);
+            else
+                *out = ir_opn(L->ir, (ir_op)n->op, args, ir_opinfo_get((ir_op)n->op)->nargs);
             break;
         }
         case SG_NODE_INSTANCE: {
