@@ -210,7 +210,7 @@ static void dump_node(text *t, const dumper *D, uint32_t id)
     tx_printf(t, "    node n%u : ", D->number[id]);
     if (n->op == IR_OP_INPUT) {
         tx_printf(t, "%s", ir_input_get((ir_input_kind)n->imm)->name);
-    } else if (n->op == IR_OP_DINPUT) {   /* for reading: no .sg form */
+    } else if (n->op == IR_OP_DINPUT) {   /* terrain.X.dx / .dy (resolve.c) */
         tx_printf(t, "%s.d%c", ir_input_get((ir_input_kind)IR_DINPUT_INPUT(n->imm))->name,
                   "xy"[IR_DINPUT_AXIS(n->imm)]);
     } else if (n->op == IR_OP_PAINTED) {

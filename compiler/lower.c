@@ -300,7 +300,13 @@ static bool inline_shader(lowerer *L, int si, const ir_ref *ins, ir_ref *outs,
         ir_ref *out = &vals[off[s->order[k]]];
         switch (n->kind) {
         case SG_NODE_INPUT:
-            *out = ir_input(L->ir, (ir_input_kind)n->op);
+            if (SG_INPUT_AXIS(n->op) >= 0) {   /* terrain.X.dx / .dy */
+                ir_node d = { .op = IR_OP_DINPUT, .type = n->out_type,
+                              .imm = IR_DINPUT_IMM(SG_INPUT_OF(n->op), SG_INPUT_AXIS(n->op)) };
+                *out = ir_node_add(L->ir, &d);
+            } else {
+                *out = ir_input(L->ir, (ir_input_kind)n->op);
+            }
             break;
         case SG_NODE_PAINTED:
             *out = ir_painted_ref(L->ir, ir_add_painted(L->ir, n->args[0].val.str));

@@ -94,7 +94,7 @@ static entity node_type(const sg_program *p, const sg_node *n)
     entity e = { ENT_NONE };
     switch (n->kind) {
     case SG_NODE_OP:       e.kind = ENT_OP; e.index = n->op; break;
-    case SG_NODE_INPUT:    e.kind = ENT_INPUT; e.index = n->op; break;
+    case SG_NODE_INPUT:    e.kind = ENT_INPUT; e.index = SG_INPUT_OF(n->op); break;
     case SG_NODE_PAINTED:  e.kind = ENT_PAINTED; break;
     case SG_NODE_INSTANCE: e.kind = ENT_SHADER; e.index = n->shader; break;
     default:

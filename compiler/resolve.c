@@ -110,12 +110,33 @@ static void declare_locals(checker *c, sg_shader *s)
     sg_map_free(&m);
 }
 
+/* "terrain.X.dx" / ".dy": input X's change to the next pixel right or
+ * down (what fwidth lowers to, so `splatc dump` writes it), for the inputs
+ * with a derivative accessor; else -1.  The axis in *axis. */
+static int derivative_input(const char *type, int *axis)
+{
+    size_t len = strlen(type);
+    if (len < 4 || type[len - 3] != '.' || type[len - 2] != 'd' ||
+        (type[len - 1] != 'x' && type[len - 1] != 'y') || len - 3 >= 64)
+        return -1;
+    char base[64];
+    memcpy(base, type, len - 3);
+    base[len - 3] = '\0';
+    int in = ir_input_by_name(base);
+    if (in < 0 || !ir_input_get((ir_input_kind)in)->dglsl)
+        return -1;
+    *axis = type[len - 1] == 'y';
+    return in;
+}
+
 static void resolve_node_type(checker *c, sg_node *n)
 {
-    int in = ir_input_by_name(n->type);
+    int axis = 0, in = ir_input_by_name(n->type), din = -1;
+    if (in < 0 && (din = derivative_input(n->type, &axis)) >= 0)
+        in = din;
     if (in >= 0) {
         n->kind = SG_NODE_INPUT;
-        n->op = in;
+        n->op = din >= 0 ? SG_INPUT_DERIVATIVE(in, axis) : in;
         n->out_type = ir_input_get((ir_input_kind)in)->type;
         if (n->nargs)
             sg_error(c->d, n->args[0].loc, SG_E_UNKNOWN_PORT, n->type, "input", n->args[0].port);

@@ -148,6 +148,12 @@ typedef enum sg_node_kind {
     SG_NODE_PAINTED,        /* painted { mask = "fields" }                 */
 } sg_node_kind;
 
+/* An SG_NODE_INPUT's op for terrain.X.dx (axis 0) or .dy (1): the input
+ * in the low byte, axis + 1 above it. */
+#define SG_INPUT_DERIVATIVE(input, axis) ((input) | ((axis) + 1) << 8)
+#define SG_INPUT_OF(op)                  ((op) & 0xff)
+#define SG_INPUT_AXIS(op)                (((op) >> 8) - 1)   /* -1: the value */
+
 typedef struct sg_node {
     char       *name;
     sg_loc      loc;
@@ -159,7 +165,8 @@ typedef struct sg_node {
                                report the inputs they lost as missing   */
     /* resolved */
     sg_node_kind kind;
-    int          op;        /* ir_op, or ir_input for SG_NODE_INPUT       */
+    int          op;        /* ir_op, or ir_input for SG_NODE_INPUT (its
+                               derivative: SG_INPUT_DERIVATIVE)           */
     int          shader;    /* callee index (program.shaders)             */
     ir_type      out_type;  /* OP, INPUT, PAINTED: the one output          */
 } sg_node;

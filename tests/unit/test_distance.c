@@ -328,14 +328,26 @@ static void test_colorado_rock(void **state)
     check_classes(f, mats, 3, 0x9e3779b97f4a7c15ull, true);
 }
 
+/* The über-shader's stack without grassland: since its far tiling is
+ * hex-tiled and faded by distance (issue 31), no class of the full
+ * 15-layer stack saves SPLAT_DCLASS_MIN_SAVING of it (measured: none is
+ * kept; the combinations keep theirs, 57 on colorado); the other 14
+ * layers keep the classes this checks. */
 static void test_colorado_uber(void **state)
 {
     fixture *f = *state;
-    int n = f->L.nmaterials;
+    static const char *const filtered[] = { "grassland" };
+    int n = f->L.nmaterials, m = 0;
     int *all = calloc((size_t)n, sizeof *all);
-    for (int k = 0; k < n; k++)
-        all[k] = n - 1 - k;
-    check_classes(f, all, n, 0x2545f4914f6cdd1dull, false);
+    for (int k = n - 1; k >= 0; k--) {
+        bool skip = false;
+        for (size_t j = 0; j < sizeof filtered / sizeof *filtered; j++)
+            skip |= strcmp(f->L.materials[k], filtered[j]) == 0;
+        if (!skip)
+            all[m++] = k;
+    }
+    assert_true(m == n - 1);
+    check_classes(f, all, m, 0x2545f4914f6cdd1dull, false);
     free(all);
 }
 
