@@ -3,6 +3,7 @@
  * own objects (undergrowth, far atlas, screen-space path), made by one
  * helper at creation and again when a hot reload swaps the pack. */
 #include "render_int.h"
+#include "vk_build.h"
 #include "util.h"
 
 #include <math.h>
@@ -11,44 +12,15 @@
 
 /* ---- render passes -------------------------------------------------------- */
 
+/* The renderer's render passes: ncolor RGBA32F targets (cleared, kept,
+ * ending in color_final) and a cleared D32 depth if `depth` (kept: the
+ * undergrowth tests it). */
 static bool make_pass(rt_device *d, uint32_t ncolor, bool depth, VkImageLayout color_final,
                       VkRenderPass *out, rt_error *e)
 {
-    VkAttachmentDescription att[4];
-    VkAttachmentReference cref[3], dref = { ncolor, VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL };
-    for (uint32_t i = 0; i < ncolor; i++) {
-        att[i] = (VkAttachmentDescription){
-            .format = VK_FORMAT_R32G32B32A32_SFLOAT,
-            .samples = VK_SAMPLE_COUNT_1_BIT,
-            .loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR,
-            .storeOp = VK_ATTACHMENT_STORE_OP_STORE,
-            .stencilLoadOp = VK_ATTACHMENT_LOAD_OP_DONT_CARE,
-            .stencilStoreOp = VK_ATTACHMENT_STORE_OP_DONT_CARE,
-            .initialLayout = VK_IMAGE_LAYOUT_UNDEFINED,
-            .finalLayout = color_final,
-        };
-        cref[i] = (VkAttachmentReference){ i, VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL };
-    }
-    if (depth)
-        att[ncolor] = (VkAttachmentDescription){
-            .format = VK_FORMAT_D32_SFLOAT,
-            .samples = VK_SAMPLE_COUNT_1_BIT,
-            .loadOp = VK_ATTACHMENT_LOAD_OP_CLEAR,
-            .storeOp = VK_ATTACHMENT_STORE_OP_STORE,   /* undergrowth tests it */
-            .stencilLoadOp = VK_ATTACHMENT_LOAD_OP_DONT_CARE,
-            .stencilStoreOp = VK_ATTACHMENT_STORE_OP_DONT_CARE,
-            .initialLayout = VK_IMAGE_LAYOUT_UNDEFINED,
-            .finalLayout = VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL,
-        };
-    VkSubpassDescription sub = {
-        .pipelineBindPoint = VK_PIPELINE_BIND_POINT_GRAPHICS,
-        .colorAttachmentCount = ncolor,
-        .pColorAttachments = cref,
-        .pDepthStencilAttachment = depth ? &dref : NULL,
-    };
     /* Earlier reads (copies, resolve, viewer) finish before we write again;
      * our writes are visible to whatever reads the targets next. */
-    VkSubpassDependency dep[2] = {
+    static const VkSubpassDependency dep[2] = {
         { VK_SUBPASS_EXTERNAL, 0,
           VK_PIPELINE_STAGE_TRANSFER_BIT | VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT |
           VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT | VK_PIPELINE_STAGE_LATE_FRAGMENT_TESTS_BIT,
@@ -63,33 +35,23 @@ static bool make_pass(rt_device *d, uint32_t ncolor, bool depth, VkImageLayout c
           VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT,
           VK_ACCESS_TRANSFER_READ_BIT | VK_ACCESS_SHADER_READ_BIT, 0 },
     };
-    VkRenderPassCreateInfo ci = {
-        .sType = VK_STRUCTURE_TYPE_RENDER_PASS_CREATE_INFO,
-        .attachmentCount = ncolor + (depth ? 1 : 0),
-        .pAttachments = att,
-        .subpassCount = 1,
-        .pSubpasses = &sub,
-        .dependencyCount = 2,
-        .pDependencies = dep,
-    };
-    RT_VK(e, vkCreateRenderPass(d->dev, &ci, NULL, out));
-    return true;
+    rt_vk_pass_desc pd = { .label = "renderer", .ncolor = ncolor, .deps = dep, .ndeps = 2 };
+    for (uint32_t i = 0; i < ncolor; i++)
+        pd.color[i] = (rt_vk_attachment){ .format = VK_FORMAT_R32G32B32A32_SFLOAT,
+                                          .load = VK_ATTACHMENT_LOAD_OP_CLEAR,
+                                          .final = color_final };
+    if (depth)
+        pd.depth = (rt_vk_attachment){ .format = VK_FORMAT_D32_SFLOAT,
+                                       .load = VK_ATTACHMENT_LOAD_OP_CLEAR,
+                                       .final = VK_IMAGE_LAYOUT_DEPTH_STENCIL_ATTACHMENT_OPTIMAL };
+    return rt_vk_pass(d, NULL, &pd, out, e);   /* destroyed by hand (renderer teardown) */
 }
 
 static bool make_fb(rt_device *d, VkRenderPass pass, const VkImageView *views, uint32_t n,
                     int w, int h, VkFramebuffer *out, rt_error *e)
 {
-    VkFramebufferCreateInfo ci = {
-        .sType = VK_STRUCTURE_TYPE_FRAMEBUFFER_CREATE_INFO,
-        .renderPass = pass,
-        .attachmentCount = n,
-        .pAttachments = views,
-        .width = (uint32_t)w,
-        .height = (uint32_t)h,
-        .layers = 1,
-    };
-    RT_VK(e, vkCreateFramebuffer(d->dev, &ci, NULL, out));
-    return true;
+    return rt_vk_fb(d, NULL, &(rt_vk_fb_desc){ .label = "renderer", .pass = pass, .views = views,
+                        .nviews = n, .width = (uint32_t)w, .height = (uint32_t)h }, out, e);
 }
 
 static bool make_targets(rt_renderer *r, rt_error *e)
@@ -216,18 +178,12 @@ static bool make_textures(rt_renderer *r, rt_error *e)
         }
         if (!up)
             return false;
-        VkFilter filt = t->linear ? VK_FILTER_LINEAR : VK_FILTER_NEAREST;
-        VkSamplerCreateInfo ci = {
-            .sType = VK_STRUCTURE_TYPE_SAMPLER_CREATE_INFO,
-            .magFilter = filt,
-            .minFilter = filt,
-            .mipmapMode = t->mip_linear ? VK_SAMPLER_MIPMAP_MODE_LINEAR : VK_SAMPLER_MIPMAP_MODE_NEAREST,
-            .addressModeU = t->wrap,
-            .addressModeV = t->wrap,
-            .addressModeW = t->wrap,
-            .maxLod = (float)mips,
-        };
-        RT_VK(e, vkCreateSampler(d->dev, &ci, NULL, &r->tex_smp[a]));
+        if (!rt_vk_sampler(d, NULL, &(rt_vk_sampler_desc){ .label = "texture array",
+                               .filter = t->linear ? VK_FILTER_LINEAR : VK_FILTER_NEAREST,
+                               .mip = t->mip_linear ? VK_SAMPLER_MIPMAP_MODE_LINEAR
+                                                    : VK_SAMPLER_MIPMAP_MODE_NEAREST,
+                               .wrap = t->wrap, .max_lod = (float)mips }, &r->tex_smp[a], e))
+            return false;
     }
     return true;
 }
@@ -282,29 +238,22 @@ static bool make_sets(rt_renderer *r, rt_error *e)
         { VK_DESCRIPTOR_TYPE_STORAGE_IMAGE, 1 },
         { VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 3 + 2 },   /* + the vectors', two sets */
     };
-    VkDescriptorPoolCreateInfo pci = {
-        .sType = VK_STRUCTURE_TYPE_DESCRIPTOR_POOL_CREATE_INFO,
-        .maxSets = 4,
-        .poolSizeCount = 4,
-        .pPoolSizes = sizes,
-    };
-    RT_VK(e, vkCreateDescriptorPool(d->dev, &pci, NULL, &r->dpool));
-    VkDescriptorSetLayout layouts[3] = { r->pl.set_terrain, r->pl.set_material, r->pl.set_resolve };
-    VkDescriptorSet sets[3];
-    VkDescriptorSetAllocateInfo ai = {
-        .sType = VK_STRUCTURE_TYPE_DESCRIPTOR_SET_ALLOCATE_INFO,
-        .descriptorPool = r->dpool,
-        .descriptorSetCount = r->desc.reference == RT_REF_MULTIPASS ? 3 : 2,
-        .pSetLayouts = layouts,
-    };
-    RT_VK(e, vkAllocateDescriptorSets(d->dev, &ai, sets));
+    bool multi = r->desc.reference == RT_REF_MULTIPASS;
+    bool screen = r->desc.shading == RT_SHADING_SCREEN;
+    VkDescriptorSetLayout layouts[4] = { r->pl.set_terrain, r->pl.set_material };
+    uint32_t n = 2;
+    if (multi)
+        layouts[n++] = r->pl.set_resolve;
+    if (screen)
+        layouts[n++] = r->pl.set_terrain;   /* set 0c */
+    VkDescriptorSet sets[4];
+    if (!rt_vk_sets(d, NULL, &(rt_vk_sets_desc){ .label = "renderer", .sizes = sizes,
+                        .nsizes = 4, .layouts = layouts, .nsets = n }, &r->dpool, sets, e))
+        return false;   /* the pool: destroyed by hand (renderer teardown) */
     r->set0 = sets[0];
     r->set1 = sets[1];
-    r->set2 = r->desc.reference == RT_REF_MULTIPASS ? sets[2] : VK_NULL_HANDLE;
-    if (r->desc.shading == RT_SHADING_SCREEN) {
-        ai.descriptorSetCount = 1;
-        RT_VK(e, vkAllocateDescriptorSets(d->dev, &ai, &r->set0c));
-    }
+    r->set2 = multi ? sets[2] : VK_NULL_HANDLE;
+    r->set0c = screen ? sets[n - 1] : VK_NULL_HANDLE;
     return true;
 }
 
