@@ -25,5 +25,5 @@ run r2_ug --pack $col --scene colorado --path ground --start-preset meadow --var
 run r2_presence --pack $P/w8 --scene world --path preset --start-preset biome --variant w8=screen --variant w256=screen,pack=$P/w256 --variant w8b=screen --variant w256b=screen,pack=$P/w256 $H
 timeout 120 $SB shadow --pack $col --runs 5 > $O/shadow.log 2>&1 || echo "FAILED shadow"
 for pk in colorado w256; do
-    KINDS="screen screen,async" timeout 200 sh tests/bench/first_picture.sh $SB $P/$pk 1920x1080 $pk topdown
+    KINDS="screen screen,async" timeout 200 bash tests/bench/first_picture.sh $SB $P/$pk 1920x1080 $pk topdown
 done > $O/first.txt 2>&1
