@@ -3,6 +3,7 @@
  * are bound to; GLSL text; the combinations, their distance classes and
  * combos.bin's quadtree levels (pack_internal.h). */
 #include "pack_internal.h"
+#include "cache.h"
 
 #include <errno.h>
 #include <fcntl.h>
@@ -46,20 +47,28 @@ bool rt_pk_read_spirv(rt_pk_reader *r, json_t *obj, const char *where, rt_spirv 
     return true;
 }
 
-/* One job of validate_all: spirv-val on module k, its failure in errs[k]. */
+/* One job of validate_all: spirv-val on module k, its failure in errs[k]
+ * (none where the compiler's cache holds that the module's shape passed
+ * spirv-val before: cache.h splat_cache_valid; then marked so). */
 typedef struct validate_jobs {
     rt_pk_reader    *r;
     rt_error  *errs;
+    splat_cache     *cache;   /* NULL: none */
 } validate_jobs;
 
 static bool validate_one(void *ctx, int k, rt_error *e)
 {
     validate_jobs *j = ctx;
     const struct rt_pk_unchecked *s = &j->r->unchecked[k];
+    char key[SPLAT_KEY_CHARS + 1];
+    bool keyed = j->cache && splat_spirv_shape_key(s->words, s->nwords, key);
+    if (keyed && splat_cache_valid(j->cache, key))
+        return true;
     char path[512];
     snprintf(path, sizeof path, "%s/%s", j->r->p->dir, s->path);
     (void)e;   /* every module is validated: the first failure by index is reported */
-    rt_spirv_validate(s->words, s->nwords, path, &j->errs[k]);
+    if (rt_spirv_validate(s->words, s->nwords, path, &j->errs[k]) && keyed)
+        splat_cache_mark_valid(j->cache, key);
     return true;
 }
 
@@ -71,8 +80,15 @@ bool rt_pk_validate_all(rt_pk_reader *r)
     rt_error *errs = calloc((size_t)r->nunchecked + 1, sizeof *errs);
     if (!errs)
         return false;
-    validate_jobs j = { r, errs };
+    /* the compiler's cache ($SPLATC_CACHE, ...): a module of a shape that
+     * passed spirv-val on this machine before is not validated again, so
+     * loading a pack costs spirv-val once per module shape, not per load */
+    splat_cache cache;
+    bool cached = splat_cache_open(&cache, NULL);
+    validate_jobs j = { r, errs, cached ? &cache : NULL };
     bool ok = rt_parallel(r->nunchecked, validate_one, &j, r->e);
+    if (cached)
+        splat_cache_close(&cache);
     for (int k = 0; k < r->nunchecked; k++) {
         if (ok && errs[k].id != RT_OK) {
             *r->e = errs[k];

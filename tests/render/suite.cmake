@@ -125,7 +125,7 @@ if(TARGET splatrt AND TARGET splatview)
       add_test(NAME render.screen_${pk}
         COMMAND sh ${RENDER_DIR}/screen.sh $<TARGET_FILE:splatview> $<TARGET_FILE:imgcheck>
                 ${RENDER_OUT}/${pk} ${RENDER_OUT}/out ${kind} ${presets})
-      set_tests_properties(render.screen_${pk} PROPERTIES LABELS render TIMEOUT 900
+      set_tests_properties(render.screen_${pk} PROPERTIES LABELS render TIMEOUT 1800
         FIXTURES_REQUIRED ${pk}_pack ENVIRONMENT "SPLAT_VALIDATE=1")
       if(pk STREQUAL "minimal")   # the screen path under ASan + UBSan too
         set_property(TEST render.screen_${pk} APPEND PROPERTY LABELS asan)
