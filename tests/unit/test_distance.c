@@ -27,6 +27,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "glsl_check.h"
 #include "points.h"
 #include "scene.h"
 #include "spv.h"
@@ -260,21 +261,7 @@ static void compiles(const splat_layout *L, const splat_composite *c, bool compu
     ir_buf glsl = {0};
     splat_glsl_desc gd = {.title = "distance class", .no_mask_view = true, .compute = compute};
     splat_composite_glsl(L, c, &gd, &glsl);
-    uint32_t *w = NULL;
-    size_t n = 0;
-    char *log = NULL;
-    bool ok = spv_compile(glsl.s, compute ? SPV_STAGE_COMPUTE : SPV_STAGE_FRAGMENT, "class", &w,
-                          &n, &log);
-    if (ok) {
-        free(log);
-        log = NULL;
-        ok = spv_validate(w, n, &log);
-    }
-    if (!ok)
-        fprintf(stderr, "%s", log ? log : "");
-    assert_true(ok);
-    free(log);
-    free(w);
+    glsl_check_compiles(glsl.s, compute ? SPV_STAGE_COMPUTE : SPV_STAGE_FRAGMENT, "class");
     ir_buf_free(&glsl);
 }
 

@@ -239,20 +239,8 @@ static void test_composite_compiles(void **state)
     sg_diags_print(&d, stderr);
     assert_true(composed);
     int ug_slot[2] = {0, -1};
-    struct { splat_glsl_desc g; spv_stage st; } v[] = {
-        {{.title = "forward"}, SPV_STAGE_FRAGMENT},
-        {{.title = "flat", .flat = true}, SPV_STAGE_FRAGMENT},
-        {{.title = "compute", .compute = true}, SPV_STAGE_COMPUTE},
-        {{.title = "ug", .compute = true, .ug_slot = ug_slot}, SPV_STAGE_COMPUTE},
-    };
-    for (size_t i = 0; i < sizeof v / sizeof v[0]; i++) {
-        ir_buf b = {0};
-        splat_composite_glsl(&L, &c, &v[i].g, &b);
-        assert_non_null(strstr(b.s, "splat_d_normal(0)"));
-        assert_non_null(strstr(b.s, "splat_d_normal(1)"));
-        glsl_check_compiles(b.s, v[i].st, v[i].g.title);
-        ir_buf_free(&b);
-    }
+    static const char *const needles[] = {"splat_d_normal(0)", "splat_d_normal(1)", NULL};
+    glsl_check_every_stage(&L, &c, ug_slot, needles);
     splat_composite_free(&c);
     splat_layout_free(&L);
     ir_free(&src);

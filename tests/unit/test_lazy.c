@@ -22,6 +22,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "glsl_check.h"
 #include "abi.h"
 #include "scene.h"
 #include "spv.h"
@@ -146,22 +147,7 @@ static char *glsl(fixture *f, const splat_composite *c, bool lazy, bool compute,
 
 static void compiles(const char *g, bool compute)
 {
-    uint32_t *w = NULL;
-    size_t n = 0;
-    char *log = NULL;
-    bool ok = spv_compile(g, compute ? SPV_STAGE_COMPUTE : SPV_STAGE_FRAGMENT, "lazy", &w,
-                          &n, &log);
-    if (!ok)
-        fprintf(stderr, "%s\n%s", g, log ? log : "");
-    assert_true(ok);
-    free(log);
-    log = NULL;
-    ok = spv_validate(w, n, &log);
-    if (!ok)
-        fprintf(stderr, "%s", log ? log : "");
-    assert_true(ok);
-    free(log);
-    free(w);
+    glsl_check_compiles(g, compute ? SPV_STAGE_COMPUTE : SPV_STAGE_FRAGMENT, "lazy");
 }
 
 static int count(const char *s, const char *what)

@@ -423,19 +423,8 @@ static void test_composite_compiles(void **state)
         splat_composite c;
         assert_true(splat_compose(&L, &desc, &c, &d));
         int ug_slot[2] = {0, -1};
-        struct { splat_glsl_desc g; spv_stage st; } v[] = {
-            {{.title = "forward"}, SPV_STAGE_FRAGMENT},
-            {{.title = "flat", .flat = true}, SPV_STAGE_FRAGMENT},
-            {{.title = "compute", .compute = true}, SPV_STAGE_COMPUTE},
-            {{.title = "ug", .compute = true, .ug_slot = ug_slot}, SPV_STAGE_COMPUTE},
-        };
-        for (size_t i = 0; i < sizeof v / sizeof v[0]; i++) {
-            ir_buf b = {0};
-            splat_composite_glsl(&L, &c, &v[i].g, &b);
-            assert_non_null(strstr(b.s, "splat_cavity()"));
-            glsl_check_compiles(b.s, v[i].st, v[i].g.title);
-            ir_buf_free(&b);
-        }
+        static const char *const needles[] = {"splat_cavity()", NULL};
+        glsl_check_every_stage(&L, &c, ug_slot, needles);
         splat_composite_free(&c);
         splat_layout_free(&L);
     }
