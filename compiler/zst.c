@@ -40,24 +40,34 @@ bool splat_zst_compress(const void *src, size_t n, uint8_t **out, size_t *out_n)
     return true;
 }
 
-uint8_t *splat_zst_decompress(const uint8_t *src, size_t n, size_t max, size_t *out_n,
-                              char *why, size_t nwhy)
+bool splat_zst_stated(const uint8_t *src, size_t n, size_t max, size_t *out, char *why,
+                      size_t nwhy)
 {
-    *out_n = 0;
     unsigned long long size = ZSTD_getFrameContentSize(src, n);
     if (size == ZSTD_CONTENTSIZE_ERROR) {
         snprintf(why, nwhy, "is not a zstd frame");
-        return NULL;
+        return false;
     }
     if (size == ZSTD_CONTENTSIZE_UNKNOWN) {
         snprintf(why, nwhy, "is a zstd frame without its content size");
-        return NULL;
+        return false;
     }
     if (size > max) {
         snprintf(why, nwhy, "states %llu bytes of content, more than the limit of %zu", size,
                  max);
-        return NULL;
+        return false;
     }
+    *out = (size_t)size;
+    return true;
+}
+
+uint8_t *splat_zst_decompress(const uint8_t *src, size_t n, size_t max, size_t *out_n,
+                              char *why, size_t nwhy)
+{
+    *out_n = 0;
+    size_t size;
+    if (!splat_zst_stated(src, n, max, &size, why, nwhy))
+        return NULL;
     size_t frame = ZSTD_findFrameCompressedSize(src, n);
     if (ZSTD_isError(frame) || frame != n) {
         snprintf(why, nwhy, "is not exactly one zstd frame (%s)",

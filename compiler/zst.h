@@ -26,6 +26,12 @@ size_t   splat_zst_bound(size_t n);
 /* `n` bytes as one frame (malloc'd, *out_n bytes); false: out of memory or
  * a libzstd error. */
 bool     splat_zst_compress(const void *src, size_t n, uint8_t **out, size_t *out_n);
+/* The content size that the frame starting `src` (its first `n` bytes:
+ * SPLAT_ZST_HEAD or the whole file if shorter) states, checked against
+ * `max`; false with `why` set if it states none or more. */
+#define SPLAT_ZST_HEAD 18   /* ZSTD_FRAMEHEADERSIZE_MAX */
+bool     splat_zst_stated(const uint8_t *src, size_t n, size_t max, size_t *size, char *why,
+                          size_t nwhy);
 /* The content of one frame of at most `max` bytes, with one spare byte
  * allocated after it (a NUL, so text can be used in place); NULL with
  * `why` set on any mismatch. */

@@ -167,7 +167,10 @@ static char *far_source(const char *uber, const char *defs)
 
 char *rt_far_glsl(const rt_pack *p, bool count)
 {
-    return far_source(p->uber_compute, count ? "#define SPLAT_COUNT 1\n" : "");
+    /* NULL where the über-shader's compute GLSL is absent or fails its
+     * checks (read on first use) */
+    return far_source(rt_pack_text(p, &p->uber_compute, NULL),
+                      count ? "#define SPLAT_COUNT 1\n" : "");
 }
 
 bool rt_far_create(rt_device *d, const rt_pack *p, const rt_pipelines *pl, rt_far **out,

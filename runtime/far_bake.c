@@ -46,14 +46,17 @@ typedef struct far_baker {
 static bool bake_pipeline(far_baker *fb, int combo, VkPipeline *out, rt_error *e)
 {
     if (!fb->pipes[combo]) {
-        const char *glsl = fb->p->combos[combo].compute;
+        const rt_text *t = &fb->p->combos[combo].compute;
         char name[64];
         snprintf(name, sizeof name, "combination %d (far atlas bake)", combo);
-        if (!glsl) {
+        if (!t->mod) {
             char what[160];
             snprintf(what, sizeof what, "the pack has no compute variant of %s", name);
             return rt_fail(e, RT_E_PACK_FIELD, fb->p->dir, what);
         }
+        const char *glsl = rt_pack_text(fb->p, t, e);
+        if (!glsl)
+            return false;
         char *src = rt_glsl_with_defines(glsl, "#define SPLAT_FAR_BAKE 1\n");
         rt_interface in;
         if (!src || !rt_interface_for(fb->p, RT_ROLE_FAR_BAKE, &in)) {

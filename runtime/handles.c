@@ -72,7 +72,7 @@ void rt_pack_info_get(const rt_pack *p, rt_pack_info *out)
 {
     bool reference = p->nmaterials > 0;
     for (int i = 0; i < p->nmaterials; i++)
-        reference = reference && p->materials[i].reference.words;
+        reference = reference && rt_spirv_present(&p->materials[i].reference);
     *out = (rt_pack_info){
         .name = p->name,
         .dir = p->dir,
@@ -93,20 +93,21 @@ void rt_pack_info_get(const rt_pack *p, rt_pack_info *out)
         .nsites = p->nsites,
         .has_holes = p->holes != NULL,
         .has_destruction = p->has_destruction,
-        .has_uber = p->uber.words != NULL,
+        .has_uber = rt_spirv_present(&p->uber),
         .has_far_atlas = p->far.data != NULL,
         .has_undergrowth = p->ug.nslots > 0,
         .has_vectors = p->vectors != NULL,
         .ug_slots = p->ug.nslots,
         .ug_blocks = p->ug.nblocks,
         .has_reference = reference,
-        .has_compute = p->uber_compute != NULL,
+        .has_compute = p->uber_compute.mod != NULL,
         .far_width = p->far.width,
         .far_height = p->far.height,
         .far_levels = p->far.levels,
         .far_texel = { p->far.texel[0], p->far.texel[1] },
         .far_bytes = p->far.data ? p->far.n - FAR_ATLAS_HEADER : 0,
     };
+    out->shaders = rt_pack_shader_count(p, &out->shaders_read);
 }
 
 const char *rt_pack_material_name(const rt_pack *p, int i)

@@ -164,6 +164,38 @@ uint8_t *rt_pack_read_content(int dirfd, const char *rel, size_t max, size_t *n,
     return d;
 }
 
+bool rt_pack_stat_content(int dirfd, const char *rel, size_t max, size_t *n, char *why,
+                          size_t nwhy)
+{
+    int fd = rt_pack_open_file(dirfd, rel, why, nwhy);
+    if (fd < 0)
+        return false;
+    struct stat st;
+    bool zst = splat_zst_name(rel), ok = false;
+    if (fstat(fd, &st) != 0) {
+        snprintf(why, nwhy, "cannot be read (%s)", strerror(errno));
+    } else if ((uint64_t)st.st_size > (zst ? splat_zst_bound(max) : max)) {
+        snprintf(why, nwhy, "has %llu bytes, more than the %zu it may have",
+                 (unsigned long long)st.st_size, zst ? splat_zst_bound(max) : max);
+    } else if (!zst) {
+        *n = (size_t)st.st_size;
+        ok = true;
+    } else {
+        uint8_t head[SPLAT_ZST_HEAD];
+        size_t want = (size_t)st.st_size < sizeof head ? (size_t)st.st_size : sizeof head;
+        ssize_t got;
+        do
+            got = pread(fd, head, want, 0);
+        while (got < 0 && errno == EINTR);
+        if (got != (ssize_t)want)
+            snprintf(why, nwhy, "cannot be read (%s)", got < 0 ? strerror(errno) : "short read");
+        else
+            ok = splat_zst_stated(head, want, max, n, why, nwhy);
+    }
+    close(fd);
+    return ok;
+}
+
 /* ---- typed field access with messages naming the field ------------------ */
 
 bool rt_pk_field_fail(rt_pk_reader *r, const char *where, const char *what)

@@ -3,7 +3,8 @@
  *
  *   pack_load.c      rt_pack_load, rt_pack_free, rt_pack_check_device
  *   pack_files.c     the pack folder as untrusted input; typed field access
- *   pack_shaders.c   SPIR-V and GLSL, combinations, classes, quadtree
+ *   pack_shaders.c   SPIR-V and GLSL (read on first use), combinations,
+ *                    classes, quadtree
  *   pack_sections.c  scene, light, materials, params, sites, undergrowth,
  *                    far atlas, vectors
  *   pack_textures.c  textures, their mips and arrays; painted masks
@@ -23,22 +24,11 @@
 #include <stddef.h>
 #include <stdint.h>
 
-/* A module read but not validated yet: its words stay where the pack's
- * rt_spirv keeps them (that struct may move as arrays grow; they do not). */
-struct rt_pk_unchecked {
-    const uint32_t *words;
-    size_t          nwords;
-    char           *path;   /* pack-relative, owned */
-};
-
 typedef struct rt_pk_reader {
     const char *manifest;   /* path, for messages */
     rt_pack    *p;
     rt_error   *e;
     int         dirfd;      /* the pack folder: every file opened under it */
-    struct rt_pk_unchecked *unchecked; /* modules read, validated at the end on
-                               all cores (validate_all)                  */
-    int         nunchecked, capunchecked;
 } rt_pk_reader;
 
 /* Files bigger than these are refused before they are read. */
@@ -70,14 +60,16 @@ uint32_t rt_pk_le32(const uint8_t *b);
 
 /* ---- pack_shaders.c ---- */
 
-bool rt_pk_read_spirv(rt_pk_reader *r, json_t *obj, const char *where, rt_spirv *out);
-bool rt_pk_validate_all(rt_pk_reader *r);
+/* p->shaders made (before any module is registered) and freed */
+bool rt_pk_shaders_open(rt_pk_reader *r);
+void rt_pk_shaders_free(struct rt_pack_shaders *s);
+bool rt_pk_read_spirv(rt_pk_reader *r, json_t *obj, const char *where, rt_shader_role role,
+                      rt_spirv *out);
 bool rt_pk_read_compute(rt_pk_reader *r, json_t *obj, const char *key, const char *where,
-                         char **out, rt_spirv *spv);
+                        rt_shader_role role, rt_text *out, rt_spirv *spv);
 bool rt_pk_read_fragment_glsl(rt_pk_reader *r, json_t *c, const char *where, char **path);
 bool rt_pk_read_combos(rt_pk_reader *r, json_t *root);
 bool rt_pk_read_quadtree(rt_pk_reader *r, json_t *root);
-bool rt_pk_check_shaders(rt_pk_reader *r);
 
 /* ---- pack_sections.c ---- */
 

@@ -1,7 +1,8 @@
 /* pack_load.c — read a shader pack (compiler/PACK.md) and check it before the
  * GPU sees any of it: the manifest's fields and types, every file it names
- * (present, right size), every SPIR-V module (spirv-val), every
- * combination id in combos.bin (in range).  A bad pack is a message that
+ * (present, right size), every combination id in combos.bin (in range);
+ * each shader is read and checked (spirv-val, its role's interface) on
+ * first use (pack_shaders.c).  A bad pack is a message that
  * names the file and the field, never a crash or a validation error.
  * This file holds the entry points; the readers of the pack's parts are
  * in pack_files.c, pack_shaders.c, pack_sections.c and pack_textures.c
@@ -71,7 +72,7 @@ bool rt_pack_load(rt_pack *p, const char *dir, rt_error *e)
         rt_fail(e, RT_E_PACK_VERSION, manifest, what);
         goto done;
     }
-    ok = rt_pk_read_scene(&r, root) && rt_pk_read_materials(&r, root) &&
+    ok = rt_pk_shaders_open(&r) && rt_pk_read_scene(&r, root) && rt_pk_read_materials(&r, root) &&
          rt_pk_read_params(&r, root) && rt_pk_read_textures(&r, root) &&
          rt_pk_read_painted(&r, root) && rt_pk_read_sites(&r, root) &&
          rt_pk_read_combos(&r, root) && rt_pk_read_quadtree(&r, root) &&
@@ -79,21 +80,18 @@ bool rt_pack_load(rt_pack *p, const char *dir, rt_error *e)
          rt_pk_read_far(&r, root) && rt_pk_read_vectors(&r, root);
     if (ok) {
         json_t *vx = rt_pk_get(&r, root, "vertex", "manifest", true);
-        ok = vx && rt_pk_read_spirv(&r, vx, "vertex", &p->vertex);
+        ok = vx && rt_pk_read_spirv(&r, vx, "vertex", RT_ROLE_VERTEX, &p->vertex);
     }
     if (ok) {
         json_t *ub = rt_pk_get(&r, root, "uber", "manifest", false);
         if (ub && !json_is_null(ub))
-            ok = rt_pk_read_spirv(&r, ub, "uber", &p->uber) &&
+            ok = rt_pk_read_spirv(&r, ub, "uber", RT_ROLE_COMPOSITE, &p->uber) &&
                  rt_pk_read_fragment_glsl(&r, ub, "uber", &p->uber_frag_path) &&
-                 rt_pk_read_compute(&r, ub, "compute", "uber", &p->uber_compute,
-                                    &p->uber_compute_spirv);
+                 rt_pk_read_compute(&r, ub, "compute", "uber", RT_ROLE_COMPUTE,
+                                    &p->uber_compute, &p->uber_compute_spirv);
     }
-    ok = ok && rt_pk_validate_all(&r) && rt_pk_check_shaders(&r);
+    /* the shaders: read, validated and checked on first use (pack_shaders.c) */
 done:
-    for (int k = 0; k < r.nunchecked; k++)
-        free(r.unchecked[k].path);
-    free(r.unchecked);
     if (r.dirfd >= 0)
         close(r.dirfd);
     json_decref(root);
@@ -110,7 +108,7 @@ done:
 static void free_spirv(rt_spirv *s)
 {
     free(s->path);
-    free(s->words);
+    free(s->words);   /* the pack's own are in their rt_module */
 }
 
 void rt_pack_free(rt_pack *p)
@@ -135,9 +133,9 @@ void rt_pack_free(rt_pack *p)
         free(p->arrays[a].textures);
     for (int i = 0; i < p->ncombos && p->combos; i++) {
         free(p->combos[i].materials);
-        free(p->combos[i].compute);
-        free(p->combos[i].ug_compute);
-        free(p->combos[i].glsl);
+        free(p->combos[i].compute.path);
+        free(p->combos[i].ug_compute.path);
+        free(p->combos[i].glsl.path);
         free(p->combos[i].frag_path);
         free_spirv(&p->combos[i].spirv);
         free_spirv(&p->combos[i].compute_spirv);
@@ -147,7 +145,7 @@ void rt_pack_free(rt_pack *p)
         free(p->levels[i].ids);
     free(p->holes);
     free_spirv(&p->uber);
-    free(p->uber_compute);
+    free(p->uber_compute.path);
     free_spirv(&p->uber_compute_spirv);
     free(p->uber_frag_path);
     for (int i = 0; i < p->ug.ntextures; i++)
@@ -175,6 +173,7 @@ void rt_pack_free(rt_pack *p)
     free(p->name);
     free(p->scene_path);
     free(p->dir);
+    rt_pk_shaders_free(p->shaders);
     memset(p, 0, sizeof *p);
 }
 

@@ -591,7 +591,7 @@ bool rt_pk_read_materials(rt_pk_reader *r, json_t *root)
         if (ref && !json_is_null(ref)) {
             char w2[96];
             snprintf(w2, sizeof w2, "%s.reference", where);
-            if (!rt_pk_read_spirv(r, ref, w2, &p->materials[i].reference))
+            if (!rt_pk_read_spirv(r, ref, w2, RT_ROLE_REFERENCE, &p->materials[i].reference))
                 return false;
         }
     }

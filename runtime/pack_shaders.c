@@ -1,11 +1,15 @@
 /* pack_shaders.c — the pack's shaders (compiler/PACK.md): SPIR-V modules
- * read, validated on all cores (spirv-val) and checked against what they
- * are bound to; GLSL text; the combinations, their distance classes and
- * combos.bin's quadtree levels (pack_internal.h). */
+ * and GLSL texts registered at load and read on first use, each module
+ * validated (spirv-val) and checked against what it is bound to before
+ * it is handed out (rt_pack_spirv; rt_pack_validate: all of them, on all
+ * cores); the combinations, their distance classes and combos.bin's
+ * quadtree levels (pack_internal.h). */
 #include "pack_internal.h"
 #include "cache.h"
 
 #include <errno.h>
+#include <pthread.h>
+#include <stdatomic.h>
 #include <fcntl.h>
 #include <math.h>
 #include <stdlib.h>
@@ -13,137 +17,130 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
-/* {"glsl": …, "spirv": …} → a validated SPIR-V module. */
-bool rt_pk_read_spirv(rt_pk_reader *r, json_t *obj, const char *where, rt_spirv *out)
+/* ---- shaders read on first use (rt_module) ------------------------------
+ * Loading the pack registers each shader file: its name, that it is a
+ * regular file inside the pack and its size (a zstd frame's stated content
+ * size) within MAX_SPIRV (module_add).  The first rt_pack_spirv or
+ * rt_pack_text reads it, decompresses it and, for SPIR-V, validates it
+ * (spirv-val, once per module shape: the compiler's cache, cache.h
+ * splat_cache_valid) and checks it against its role's interface
+ * (rt_spirv_check): no module reaches the driver unchecked, and a first
+ * picture reads the few modules its view needs, not the pack's hundreds
+ * (issue 29: colorado's 627 files took 7.5 s cold, 2.4 s warm to load).
+ * Pipelines are made on worker threads, so the first use is under the
+ * pack's lock: one thread reads a module while others needing it wait. */
+enum { MOD_UNREAD, MOD_BUSY, MOD_READY, MOD_FAILED };
+
+struct rt_module {
+    char    *path;       /* pack-relative, as the manifest names it        */
+    char    *field;      /* the manifest field naming it, for messages     */
+    int      role;       /* rt_shader_role of a SPIR-V module; -1: GLSL    */
+    size_t   size;       /* content bytes, as checked at load              */
+    int      state;      /* MOD_*, under the pack's lock                   */
+    void    *data;       /* the words, or the NUL-terminated text          */
+    size_t   n;          /* words, or bytes of text                        */
+    rt_error err;        /* its failure, handed to every caller            */
+};
+
+struct rt_pack_shaders {
+    pthread_mutex_t lock;
+    pthread_cond_t  done;      /* a module left MOD_BUSY                     */
+    int             dirfd;     /* the pack folder, held open while it lives */
+    char           *manifest;  /* its path, for messages                    */
+    char           *dir;
+    splat_cache     cache;     /* modules whose shape passed spirv-val      */
+    bool            cached;
+    rt_module     **all;       /* in manifest order                         */
+    int             n, cap;
+    atomic_int      read;      /* modules read and checked                  */
+};
+
+bool rt_pk_shaders_open(rt_pk_reader *r)
 {
-    const char *rel;
-    if (!rt_pk_get_string(r, obj, "spirv", where, &rel))
+    struct rt_pack_shaders *s = calloc(1, sizeof *s);
+    if (!s)
         return false;
-    char field[256];
-    snprintf(field, sizeof field, "%s.spirv", where);
+    s->dirfd = fcntl(r->dirfd, F_DUPFD_CLOEXEC, 0);
+    s->manifest = rt_pk_strdup(r->manifest);
+    s->dir = rt_pk_strdup(r->p->dir);
+    if (s->dirfd < 0 || !s->manifest || !s->dir || pthread_mutex_init(&s->lock, NULL)) {
+        if (s->dirfd >= 0)
+            close(s->dirfd);
+        free(s->manifest);
+        free(s->dir);
+        free(s);
+        return false;
+    }
+    pthread_cond_init(&s->done, NULL);
+    /* the compiler's cache ($SPLATC_CACHE, ...): disabled if it cannot be made */
+    s->cached = splat_cache_open(&s->cache, NULL);
+    r->p->shaders = s;
+    return true;
+}
+
+void rt_pk_shaders_free(struct rt_pack_shaders *s)
+{
+    if (!s)
+        return;
+    for (int k = 0; k < s->n; k++) {
+        rt_module *m = s->all[k];
+        free(m->path);
+        free(m->field);
+        free(m->data);
+        rt_error_clear(&m->err);
+        free(m);
+    }
+    free(s->all);
+    if (s->cached)
+        splat_cache_close(&s->cache);
+    pthread_cond_destroy(&s->done);
+    pthread_mutex_destroy(&s->lock);
+    close(s->dirfd);
+    free(s->manifest);
+    free(s->dir);
+    free(s);
+}
+
+int rt_pack_shader_count(const rt_pack *p, int *read)
+{
+    struct rt_pack_shaders *s = p->shaders;
+    *read = s ? atomic_load(&s->read) : 0;
+    return s ? s->n : 0;
+}
+
+/* Register the shader file `rel` (the manifest's `field`) of `role`. */
+static rt_module *module_add(rt_pk_reader *r, const char *field, const char *rel, int role)
+{
+    struct rt_pack_shaders *s = r->p->shaders;
+    char why[256];
     size_t n = 0;
-    uint8_t *data = rt_pk_pack_file(r, field, rel, 0, MAX_SPIRV, &n);
-    if (!data)
-        return false;
-    out->path = rt_pk_strdup(rel);
-    if (n % 4) {
-        free(data);
+    if (!rt_pack_stat_content(r->dirfd, rel, MAX_SPIRV, &n, why, sizeof why)) {
+        rt_fail(r->e, RT_E_PACK_FILE, r->manifest, field, rel, why);
+        return NULL;
+    }
+    if (role >= 0 && n % 4) {
         char path[512];
         snprintf(path, sizeof path, "%s/%s", r->p->dir, rel);
-        return rt_fail(r->e, RT_E_PACK_SPIRV, path, "size is not a multiple of 4 bytes");
+        rt_fail(r->e, RT_E_PACK_SPIRV, path, "size is not a multiple of 4 bytes");
+        return NULL;
     }
-    out->words = (uint32_t *)data;
-    out->nwords = n / 4;
-    if (r->nunchecked == r->capunchecked) {
-        int cap = r->capunchecked ? 2 * r->capunchecked : 64;
-        struct rt_pk_unchecked *u = realloc(r->unchecked, (size_t)cap * sizeof *u);
-        if (!u)
-            return false;
-        r->unchecked = u;
-        r->capunchecked = cap;
+    if (s->n == s->cap) {
+        int cap = s->cap ? 2 * s->cap : 64;
+        rt_module **all = realloc(s->all, (size_t)cap * sizeof *all);
+        if (!all)
+            return NULL;
+        s->all = all;
+        s->cap = cap;
     }
-    r->unchecked[r->nunchecked++] =
-        (struct rt_pk_unchecked){ out->words, out->nwords, rt_pk_strdup(rel) };
-    return true;
-}
-
-/* One job of validate_all: spirv-val on module k, its failure in errs[k]
- * (none where the compiler's cache holds that the module's shape passed
- * spirv-val before: cache.h splat_cache_valid; then marked so). */
-typedef struct validate_jobs {
-    rt_pk_reader    *r;
-    rt_error  *errs;
-    splat_cache     *cache;   /* NULL: none */
-} validate_jobs;
-
-static bool validate_one(void *ctx, int k, rt_error *e)
-{
-    validate_jobs *j = ctx;
-    const struct rt_pk_unchecked *s = &j->r->unchecked[k];
-    char key[SPLAT_KEY_CHARS + 1];
-    bool keyed = j->cache && splat_spirv_shape_key(s->words, s->nwords, key);
-    if (keyed && splat_cache_valid(j->cache, key))
-        return true;
-    char path[512];
-    snprintf(path, sizeof path, "%s/%s", j->r->p->dir, s->path);
-    (void)e;   /* every module is validated: the first failure by index is reported */
-    if (rt_spirv_validate(s->words, s->nwords, path, &j->errs[k]) && keyed)
-        splat_cache_mark_valid(j->cache, key);
-    return true;
-}
-
-/* Every module read, validated before any reaches the driver: spirv-val
- * on all cores (jobs.c), the failure reported that of the first module in
- * manifest order, so the message does not depend on the threads. */
-bool rt_pk_validate_all(rt_pk_reader *r)
-{
-    rt_error *errs = calloc((size_t)r->nunchecked + 1, sizeof *errs);
-    if (!errs)
-        return false;
-    /* the compiler's cache ($SPLATC_CACHE, ...): a module of a shape that
-     * passed spirv-val on this machine before is not validated again, so
-     * loading a pack costs spirv-val once per module shape, not per load */
-    splat_cache cache;
-    bool cached = splat_cache_open(&cache, NULL);
-    validate_jobs j = { r, errs, cached ? &cache : NULL };
-    bool ok = rt_parallel(r->nunchecked, validate_one, &j, r->e);
-    if (cached)
-        splat_cache_close(&cache);
-    for (int k = 0; k < r->nunchecked; k++) {
-        if (ok && errs[k].id != RT_OK) {
-            *r->e = errs[k];
-            ok = false;
-        } else {
-            rt_error_clear(&errs[k]);
-        }
-    }
-    free(errs);
-    return ok;
-}
-
-/* {"compute": {"glsl": …}} of a combination or the über-shader: the
- * compute variant's GLSL text (PACK.md), NUL-terminated; optional (a pack
- * without it cannot be drawn by the screen-space path). */
-static bool read_glsl_at(rt_pk_reader *r, json_t *c, const char *w, char **out);
-
-static bool read_glsl(rt_pk_reader *r, json_t *obj, const char *key, const char *where, char **out)
-{
-    json_t *c = rt_pk_get(r, obj, key, where, false);
-    if (!c || json_is_null(c))
-        return true;
-    char w[96];
-    snprintf(w, sizeof w, "%s.%s", where, key);
-    return read_glsl_at(r, c, w, out);
-}
-
-/* read_glsl, and the variant's SPIR-V where the build made it
- * ({"glsl": …, "spirv": …}; `spv` words NULL without): validated with
- * every module of the pack, so the runtime compiles nothing for it. */
-bool rt_pk_read_compute(rt_pk_reader *r, json_t *obj, const char *key, const char *where,
-                         char **out, rt_spirv *spv)
-{
-    if (!read_glsl(r, obj, key, where, out))
-        return false;
-    json_t *c = json_object_get(obj, key);
-    if (!json_is_object(c) || !json_object_get(c, "spirv"))
-        return true;
-    char w[96];
-    snprintf(w, sizeof w, "%s.%s", where, key);
-    return rt_pk_read_spirv(r, c, w, spv);
-}
-
-/* c["glsl"], the fragment GLSL beside c["spirv"]: optional, and only its
- * path is kept (the forward path's counting variant reads it on first use:
- * rt_pack_read_glsl). */
-bool rt_pk_read_fragment_glsl(rt_pk_reader *r, json_t *c, const char *where, char **path)
-{
-    const char *rel;
-    if (!rt_pk_get(r, c, "glsl", where, false))
-        return true;
-    if (!rt_pk_get_string(r, c, "glsl", where, &rel))
-        return false;
-    *path = rt_pk_strdup(rel);
-    return true;
+    rt_module *m = calloc(1, sizeof *m);
+    if (!m)
+        return NULL;
+    m->path = rt_pk_strdup(rel);
+    m->field = rt_pk_strdup(field);
+    m->role = role;
+    m->size = n;
+    s->all[s->n++] = m;   /* freed with the pack from here on */
+    return m->path && m->field ? m : NULL;
 }
 
 /* The file's bytes as GLSL text: NUL-terminated, no NUL inside; NULL with
@@ -160,21 +157,211 @@ static char *glsl_text(uint8_t *data, size_t n, char *why, size_t nwhy)
     return text;
 }
 
-/* The text of c["glsl"] (`w` names c in errors). */
-static bool read_glsl_at(rt_pk_reader *r, json_t *c, const char *w, char **out)
+/* Read, decompress and check module m (outside the lock; m is MOD_BUSY). */
+static bool module_read(const rt_pack *p, rt_module *m, rt_error *e)
+{
+    struct rt_pack_shaders *s = p->shaders;
+    char why[256], path[1024];
+    size_t n = 0;
+    uint8_t *data = rt_pack_read_content(s->dirfd, m->path, m->size, &n, why, sizeof why);
+    if (data && n != m->size) {
+        snprintf(why, sizeof why, "has changed since the pack was loaded (%zu bytes, then %zu)",
+                 n, m->size);
+        free(data);
+        data = NULL;
+    }
+    if (data && m->role < 0 && !(data = (uint8_t *)glsl_text(data, n, why, sizeof why))) {
+        char msg[512];
+        snprintf(msg, sizeof msg, "%s %s", m->field, why);
+        return rt_fail(e, RT_E_PACK_FIELD, s->manifest, msg);
+    }
+    if (!data)
+        return rt_fail(e, RT_E_PACK_FILE, s->manifest, m->field, m->path, why);
+    m->data = data;
+    m->n = m->role < 0 ? n : n / 4;
+    if (m->role < 0)
+        return true;
+    snprintf(path, sizeof path, "%s/%s", s->dir, m->path);
+    const uint32_t *words = m->data;
+    /* spirv-val once per module shape on this machine (cache.h) */
+    char key[SPLAT_KEY_CHARS + 1];
+    bool keyed = s->cached && splat_spirv_shape_key(words, m->n, key);
+    if (!(keyed && splat_cache_valid(&s->cache, key))) {
+        if (!rt_spirv_validate(words, m->n, path, e))
+            return false;
+        if (keyed)
+            splat_cache_mark_valid(&s->cache, key);
+    }
+    rt_interface in;
+    if (!rt_interface_for(p, (rt_shader_role)m->role, &in))
+        return rt_fail(e, RT_E_PACK_FIELD, s->manifest, "out of memory");
+    bool ok = rt_spirv_check(words, m->n, path, &in, e);
+    rt_interface_free(&in);
+    return ok;
+}
+
+/* Module m, read and checked by whichever thread asks first. */
+static bool module_get(const rt_pack *p, rt_module *m, rt_error *e)
+{
+    struct rt_pack_shaders *s = p->shaders;
+    pthread_mutex_lock(&s->lock);
+    while (m->state == MOD_BUSY)
+        pthread_cond_wait(&s->done, &s->lock);
+    if (m->state == MOD_UNREAD) {
+        m->state = MOD_BUSY;
+        pthread_mutex_unlock(&s->lock);
+        rt_error err = { 0 };
+        bool ok = module_read(p, m, &err);
+        if (!ok && !err.msg)
+            rt_fail(&err, RT_E_PACK_FIELD, s->manifest, "out of memory");
+        if (ok)
+            atomic_fetch_add(&s->read, 1);
+        pthread_mutex_lock(&s->lock);
+        m->state = ok ? MOD_READY : MOD_FAILED;
+        m->err = err;
+        pthread_cond_broadcast(&s->done);
+    }
+    bool ok = m->state == MOD_READY;
+    pthread_mutex_unlock(&s->lock);
+    if (!ok && e) {   /* the same message to every caller */
+        rt_error_clear(e);
+        e->id = m->err.id;
+        e->msg = m->err.msg ? rt_pk_strdup(m->err.msg) : NULL;
+    }
+    return ok;
+}
+
+const uint32_t *rt_pack_spirv(const rt_pack *p, const rt_spirv *sp, size_t *nwords, rt_error *e)
+{
+    if (sp->words) {
+        *nwords = sp->nwords;
+        return sp->words;
+    }
+    if (!sp->mod) {
+        rt_fail(e, RT_E_PACK_FIELD, p->dir, "a shader the pack does not have");
+        return NULL;
+    }
+    if (!module_get(p, sp->mod, e))
+        return NULL;
+    *nwords = sp->mod->n;
+    return sp->mod->data;
+}
+
+const char *rt_pack_text(const rt_pack *p, const rt_text *t, rt_error *e)
+{
+    if (!t->mod) {
+        rt_fail(e, RT_E_PACK_FIELD, p->dir, "a GLSL text the pack does not have");
+        return NULL;
+    }
+    return module_get(p, t->mod, e) ? t->mod->data : NULL;
+}
+
+/* One job of rt_pack_validate: module k, its failure in errs[k]. */
+typedef struct validate_jobs {
+    const rt_pack *p;
+    rt_error      *errs;
+} validate_jobs;
+
+static bool validate_one(void *ctx, int k, rt_error *e)
+{
+    validate_jobs *j = ctx;
+    (void)e;   /* every module is read: the first failure by index is reported */
+    module_get(j->p, j->p->shaders->all[k], &j->errs[k]);
+    return true;
+}
+
+bool rt_pack_validate(const rt_pack *p, rt_error *e)
+{
+    struct rt_pack_shaders *s = p->shaders;
+    if (!s)
+        return true;
+    rt_error *errs = calloc((size_t)s->n + 1, sizeof *errs);
+    if (!errs)
+        return rt_fail(e, RT_E_PACK_FIELD, p->dir, "out of memory");
+    validate_jobs j = { p, errs };
+    bool ok = rt_parallel(s->n, validate_one, &j, e);
+    for (int k = 0; k < s->n; k++) {
+        if (ok && errs[k].id != RT_OK) {
+            *e = errs[k];
+            ok = false;
+        } else {
+            rt_error_clear(&errs[k]);
+        }
+    }
+    free(errs);
+    return ok;
+}
+
+/* {"glsl": …, "spirv": …} → the SPIR-V module of `role`, read on first use. */
+bool rt_pk_read_spirv(rt_pk_reader *r, json_t *obj, const char *where, rt_shader_role role,
+                      rt_spirv *out)
+{
+    const char *rel;
+    if (!rt_pk_get_string(r, obj, "spirv", where, &rel))
+        return false;
+    char field[256];
+    snprintf(field, sizeof field, "%s.spirv", where);
+    if (!(out->path = rt_pk_strdup(rel)))
+        return false;
+    return (out->mod = module_add(r, field, rel, (int)role)) != NULL;
+}
+
+/* {"compute": {"glsl": …}} of a combination or the über-shader: the
+ * compute variant's GLSL text (PACK.md), read on first use; optional (a
+ * pack without it cannot be drawn by the screen-space path). */
+static bool read_glsl_at(rt_pk_reader *r, json_t *c, const char *w, rt_text *out);
+
+static bool read_glsl(rt_pk_reader *r, json_t *obj, const char *key, const char *where,
+                      rt_text *out)
+{
+    json_t *c = rt_pk_get(r, obj, key, where, false);
+    if (!c || json_is_null(c))
+        return true;
+    char w[96];
+    snprintf(w, sizeof w, "%s.%s", where, key);
+    return read_glsl_at(r, c, w, out);
+}
+
+/* read_glsl, and the variant's SPIR-V where the build made it
+ * ({"glsl": …, "spirv": …}; `spv` absent without), of `role`. */
+bool rt_pk_read_compute(rt_pk_reader *r, json_t *obj, const char *key, const char *where,
+                        rt_shader_role role, rt_text *out, rt_spirv *spv)
+{
+    if (!read_glsl(r, obj, key, where, out))
+        return false;
+    json_t *c = json_object_get(obj, key);
+    if (!json_is_object(c) || !json_object_get(c, "spirv"))
+        return true;
+    char w[96];
+    snprintf(w, sizeof w, "%s.%s", where, key);
+    return rt_pk_read_spirv(r, c, w, role, spv);
+}
+
+/* c["glsl"], the fragment GLSL beside c["spirv"]: optional, and only its
+ * path is kept (the forward path's counting variant reads it on first use:
+ * rt_pack_read_glsl). */
+bool rt_pk_read_fragment_glsl(rt_pk_reader *r, json_t *c, const char *where, char **path)
+{
+    const char *rel;
+    if (!rt_pk_get(r, c, "glsl", where, false))
+        return true;
+    if (!rt_pk_get_string(r, c, "glsl", where, &rel))
+        return false;
+    *path = rt_pk_strdup(rel);
+    return true;
+}
+
+/* c["glsl"] (`w` names c in errors), read on first use. */
+static bool read_glsl_at(rt_pk_reader *r, json_t *c, const char *w, rt_text *out)
 {
     const char *rel;
     if (!rt_pk_get_string(r, c, "glsl", w, &rel))
         return false;
-    char field[128], why[96];
+    char field[128];
     snprintf(field, sizeof field, "%s.glsl", w);
-    size_t n = 0;
-    uint8_t *data = rt_pk_pack_file(r, field, rel, 0, MAX_SPIRV, &n);
-    if (!data)
+    if (!(out->path = rt_pk_strdup(rel)))
         return false;
-    if (!(*out = glsl_text(data, n, why, sizeof why)))
-        return rt_pk_field_fail(r, field, why);
-    return true;
+    return (out->mod = module_add(r, field, rel, -1)) != NULL;
 }
 
 char *rt_pack_read_glsl(const rt_pack *p, const char *field, const char *rel, rt_error *e)
@@ -253,11 +440,12 @@ static bool read_classes(rt_pk_reader *r, json_t *cs)
             if (!(co->dlo >= 0) || !(co->dhi >= co->dlo))
                 return rt_pk_field_fail(r, where, "distance: must have 0 <= lo <= hi");
             if (rt_pk_get(r, c, "spirv", where, false)
-                    ? !rt_pk_read_spirv(r, c, where, &co->spirv) ||
+                    ? !rt_pk_read_spirv(r, c, where, RT_ROLE_COMPOSITE, &co->spirv) ||
                           !rt_pk_read_fragment_glsl(r, c, where, &co->frag_path)
                     : !read_glsl_at(r, c, where, &co->glsl))
                 return false;
-            if (!rt_pk_read_compute(r, c, "compute", where, &co->compute, &co->compute_spirv) ||
+            if (!rt_pk_read_compute(r, c, "compute", where, RT_ROLE_COMPUTE, &co->compute,
+                                    &co->compute_spirv) ||
                 !rt_pk_get_number(r, c, "cost", where, &co->cost))
                 return false;
             if (!(co->cost >= 0) || co->cost > 1e12)
@@ -306,10 +494,12 @@ bool rt_pk_read_combos(rt_pk_reader *r, json_t *root)
                 return rt_pk_field_fail(r, where, "materials: index out of range");
             co->materials[k] = (int)json_integer_value(m);
         }
-        if (!rt_pk_read_spirv(r, c, where, &co->spirv) ||
+        if (!rt_pk_read_spirv(r, c, where, RT_ROLE_COMPOSITE, &co->spirv) ||
             !rt_pk_read_fragment_glsl(r, c, where, &co->frag_path) ||
-            !rt_pk_read_compute(r, c, "compute", where, &co->compute, &co->compute_spirv) ||
-            !rt_pk_read_compute(r, c, "undergrowth", where, &co->ug_compute, &co->ug_spirv))
+            !rt_pk_read_compute(r, c, "compute", where, RT_ROLE_COMPUTE, &co->compute,
+                                &co->compute_spirv) ||
+            !rt_pk_read_compute(r, c, "undergrowth", where, RT_ROLE_UNDERGROWTH,
+                                &co->ug_compute, &co->ug_spirv))
             return false;
         json_t *cost = rt_pk_get(r, c, "cost", where, false);
         if (cost && (!json_is_number(cost) || !(json_number_value(cost) >= 0) ||
@@ -417,42 +607,5 @@ bool rt_pk_read_quadtree(rt_pk_reader *r, json_t *root)
                                       r->e);
     free(data);
     free(offsets);
-    return ok;
-}
-
-/* Every shader against the interface of its role (spirv_check.c), so
- * that no module reaches the driver unchecked. */
-static bool check_one(rt_pk_reader *r, const rt_spirv *s, const rt_interface *in)
-{
-    if (!s->words)
-        return true;
-    char path[1024];
-    snprintf(path, sizeof path, "%s/%s", r->p->dir, s->path);
-    return rt_spirv_check(s->words, s->nwords, path, in, r->e);
-}
-
-bool rt_pk_check_shaders(rt_pk_reader *r)
-{
-    rt_pack *p = r->p;
-    rt_interface in[RT_ROLE_COUNT];
-    bool ok = true;
-    int made = 0;
-    for (; made < RT_ROLE_COUNT && ok; made++)
-        ok = rt_interface_for(p, (rt_shader_role)made, &in[made]);
-    if (!ok) {
-        made--;
-        rt_fail(r->e, RT_E_PACK_FIELD, r->manifest, "out of memory");
-    }
-    ok = ok && check_one(r, &p->vertex, &in[RT_ROLE_VERTEX]) &&
-         check_one(r, &p->uber, &in[RT_ROLE_COMPOSITE]);
-    for (int i = 0; ok && i < p->ncombos; i++)
-        ok = check_one(r, &p->combos[i].spirv, &in[RT_ROLE_COMPOSITE]) &&
-             check_one(r, &p->combos[i].compute_spirv, &in[RT_ROLE_COMPUTE]) &&
-             check_one(r, &p->combos[i].ug_spirv, &in[RT_ROLE_UNDERGROWTH]);
-    ok = ok && check_one(r, &p->uber_compute_spirv, &in[RT_ROLE_COMPUTE]);
-    for (int i = 0; ok && i < p->nmaterials; i++)
-        ok = check_one(r, &p->materials[i].reference, &in[RT_ROLE_REFERENCE]);
-    for (int i = 0; i < made; i++)
-        rt_interface_free(&in[i]);
     return ok;
 }

@@ -293,13 +293,23 @@ static bool make_pipeline(rt_device *d, rt_pipelines *pl, VkShaderModule vs,
     return make_pipeline_in(d, pl, VK_NULL_HANDLE, vs, fs, pass, k, variant, out, e);
 }
 
+/* The pack's module `s`, read and checked on its first use, as a
+ * VkShaderModule. */
+static bool pack_module(rt_device *d, const rt_pack *p, const rt_spirv *s, VkShaderModule *m,
+                        rt_error *e)
+{
+    size_t n = 0;
+    const uint32_t *words = rt_pack_spirv(p, s, &n, e);
+    return words && make_module(d, words, n, m, e);
+}
+
 /* A pipeline from a pack module over the shared vertex shader. */
-static bool pack_pipeline(rt_device *d, rt_pipelines *pl, const rt_spirv *fs,
+static bool pack_pipeline(rt_device *d, const rt_pack *p, rt_pipelines *pl, const rt_spirv *fs,
                           VkRenderPass pass, kind k, unsigned variant, VkPipeline *out,
                           rt_error *e)
 {
     VkShaderModule m;
-    if (!make_module(d, fs->words, fs->nwords, &m, e))
+    if (!pack_module(d, p, fs, &m, e))
         return false;
     bool ok = make_pipeline(d, pl, pl->vertex, m, pass, k, variant, out, e);
     vkDestroyShaderModule(d->dev, m, NULL);
@@ -347,12 +357,12 @@ static bool fragment_pipeline(rt_device *d, rt_pipelines *pl, const rt_passes *r
     return ok;
 }
 
-/* A composite's fragment pipeline from the pack's GLSL (`glsl`, else read
+/* A composite's fragment pipeline from the pack's GLSL (`g`, else read
  * from the pack's file `path`), compiled, validated and checked against
  * the composite interface here, on first use: a distance class without
  * SPIR-V, and every counting variant. */
 static bool glsl_pipeline(rt_device *d, const rt_pack *p, rt_pipelines *pl,
-                          const rt_passes *rp, const char *glsl, const char *field,
+                          const rt_passes *rp, const rt_text *g, const char *field,
                           const char *path, const char *name, unsigned variant,
                           VkPipeline *slot, rt_error *e)
 {
@@ -360,6 +370,9 @@ static bool glsl_pipeline(rt_device *d, const rt_pack *p, rt_pipelines *pl,
     if (!variant_supported(d, variant, e))
         return false;
     char *text = NULL;
+    const char *glsl = NULL;
+    if (g && g->mod && !(glsl = rt_pack_text(p, g, e)))
+        return false;
     if (!glsl && path && !(glsl = text = rt_pack_read_glsl(p, field, path, e)))
         return false;
     if (!glsl) {
@@ -431,22 +444,23 @@ bool rt_pipelines_combo(rt_device *d, const rt_pack *p, const rt_passes *rp,
     if (!variant_supported(d, variant, e))
         return false;
     VkPipeline *slot = &pl->combo[(size_t)id * RT_VARIANTS + (variant % RT_VARIANTS)];
-    if (!*slot && (!p->combos[id].spirv.words || (variant & RT_VARIANT_COUNT))) {
+    if (!*slot && (!rt_spirv_present(&p->combos[id].spirv) || (variant & RT_VARIANT_COUNT))) {
         /* a distance class (GLSL alone in the pack), or the counting variant */
         char name[64], field[64];
         snprintf(name, sizeof name, "combination %d (%s)", id,
-                 p->combos[id].spirv.words ? "counting" : "distance class");
+                 rt_spirv_present(&p->combos[id].spirv) ? "counting" : "distance class");
         const rt_pack_combo *c = &p->combos[id], *b = &p->combos[c->base];
         if (id >= p->nbase)   /* a distance class, as the manifest nests it */
             snprintf(field, sizeof field, "combinations[%d].classes[%d].glsl", c->base,
                      id - b->first_class);
         else
             snprintf(field, sizeof field, "combinations[%d].glsl", id);
-        if (!glsl_pipeline(d, p, pl, rp, p->combos[id].glsl, field, p->combos[id].frag_path,
+        if (!glsl_pipeline(d, p, pl, rp, &p->combos[id].glsl, field, p->combos[id].frag_path,
                            name, variant, slot, e))
             return false;
     }
-    if (!*slot && !pack_pipeline(d, pl, &p->combos[id].spirv, rp->main, K_OPAQUE, variant, slot, e))
+    if (!*slot && !pack_pipeline(d, p, pl, &p->combos[id].spirv, rp->main, K_OPAQUE, variant,
+                                 slot, e))
         return false;
     *out = *slot;
     return true;
@@ -458,14 +472,14 @@ bool rt_pipelines_uber(rt_device *d, const rt_pack *p, const rt_passes *rp,
 {
     if (!variant_supported(d, variant, e))
         return false;
-    if (!p->uber.words)
+    if (!rt_spirv_present(&p->uber))
         return rt_fail(e, RT_E_PACK_FIELD, p->dir, "the pack has no uber shader");
     VkPipeline *slot = &pl->uber[variant % RT_VARIANTS];
     if (!*slot && (variant & RT_VARIANT_COUNT) &&
         !glsl_pipeline(d, p, pl, rp, NULL, "uber.glsl", p->uber_frag_path, "uber (counting)",
                        variant, slot, e))
         return false;
-    if (!*slot && !pack_pipeline(d, pl, &p->uber, rp->main, K_OPAQUE, variant, slot, e))
+    if (!*slot && !pack_pipeline(d, p, pl, &p->uber, rp->main, K_OPAQUE, variant, slot, e))
         return false;
     *out = *slot;
     return true;
@@ -476,7 +490,7 @@ bool rt_pipelines_ref(rt_device *d, const rt_pack *p, const rt_passes *rp,
                       rt_error *e)
 {
     VkPipeline *slot = &pl->ref[2 * m + cull];
-    if (!*slot && !pack_pipeline(d, pl, &p->materials[m].reference, rp->multi,
+    if (!*slot && !pack_pipeline(d, p, pl, &p->materials[m].reference, rp->multi,
                                  m == 0 ? K_BASE : K_BLEND, cull ? RT_VARIANT_CULL : 0,
                                  slot, e))
         return false;
@@ -541,24 +555,30 @@ bool rt_pipelines_compute_make(rt_device *d, const rt_pack *p, rt_pipelines *pl,
                                unsigned variant, VkPipeline *out, rt_error *e)
 {
     *out = VK_NULL_HANDLE;
-    const char *glsl = id < p->ncombos ? p->combos[id].compute : p->uber_compute;
+    const rt_text *text = id < p->ncombos ? &p->combos[id].compute : &p->uber_compute;
+    const char *glsl = NULL;
     char name[64];
     if (id < p->ncombos)
         snprintf(name, sizeof name, "combination %d (compute)", id);
     else
         snprintf(name, sizeof name, "uber (compute)");
-    if (!glsl) {
+    if (!text->mod) {
         char what[160];
         snprintf(what, sizeof what, "the pack has no compute variant of %s: rebuild it with "
                  "this splatc for --shading screen", name);
         return rt_fail(e, RT_E_PACK_FIELD, p->dir, what);
     }
+    const rt_spirv *built = id < p->ncombos ? &p->combos[id].compute_spirv
+                                            : &p->uber_compute_spirv;
     char defs[96] = "", sort[64] = "";
     if (variant & RT_CVARIANT_SORT)
         snprintf(sort, sizeof sort, "#define SPLAT_SORT 1\n#define SPLAT_SORT_TILES %d\n",
                  pl->sort_tiles);
     snprintf(defs, sizeof defs, "%s%s", (variant & RT_CVARIANT_COUNT) ? "#define SPLAT_COUNT 1\n" : "",
              sort);
+    /* the GLSL text only where the build's SPIR-V does not serve */
+    if ((defs[0] || !rt_spirv_present(built)) && !(glsl = rt_pack_text(p, text, e)))
+        return false;
     char *src = defs[0] ? rt_glsl_with_defines(glsl, defs) : NULL;
     if (defs[0] && !src)
         return rt_fail(e, RT_E_VULKAN, "pipelines", "out of memory");
@@ -566,18 +586,19 @@ bool rt_pipelines_compute_make(rt_device *d, const rt_pack *p, rt_pipelines *pl,
     size_t n = 0;
     rt_interface in;
     bool have_in = false;
-    /* the plain variant: the build's SPIR-V where the pack has it (checked
-     * at load), so nothing is compiled on first use (issue 29) */
-    const rt_spirv *built = id < p->ncombos ? &p->combos[id].compute_spirv
-                                            : &p->uber_compute_spirv;
-    if (!defs[0] && built->words) {   /* (src is NULL: no defines) */
-        words = malloc(built->nwords * 4);
+    /* the plain variant: the build's SPIR-V where the pack has it (read,
+     * validated and checked against the compute role on first use), so
+     * nothing is compiled (issue 29) */
+    if (!defs[0] && rt_spirv_present(built)) {   /* (src is NULL: no defines) */
+        const uint32_t *bw = rt_pack_spirv(p, built, &n, e);
+        if (!bw)
+            return false;
+        words = malloc(n * 4);
         if (!words)
             return rt_fail(e, RT_E_VULKAN, "pipelines", "out of memory");
-        memcpy(words, built->words, built->nwords * 4);
-        n = built->nwords;
+        memcpy(words, bw, n * 4);
         atomic_fetch_add(&pl->spirv_cached, 1);
-        glsl = NULL;   /* checked at load: no second interface check */
+        glsl = NULL;   /* checked by rt_pack_spirv: no second interface check */
     }
     bool ok = words || compute_spirv(pl, src ? src : glsl, name, &words, &n, e);
     free(src);
@@ -678,13 +699,13 @@ bool rt_pipelines_create(rt_device *d, const rt_pack *p, const rt_passes *rp,
     memset(pl, 0, sizeof *pl);
     splat_cache_open(&pl->spv_cache, NULL);   /* disabled when it cannot be made */
     if (!make_layouts(d, ntextures, pl, e) || !open_cache(d, pl, cache_path, e) ||
-        !make_module(d, p->vertex.words, p->vertex.nwords, &pl->vertex, e))
+        !pack_module(d, p, &p->vertex, &pl->vertex, e))
         return false;
     if (!rt_pipelines_reset_combos(d, p, pl, e))
         return false;
     if (ref == RT_REF_MULTIPASS) {
         for (int i = 0; i < p->nmaterials; i++)
-            if (!p->materials[i].reference.words) {
+            if (!rt_spirv_present(&p->materials[i].reference)) {
                 char what[256];
                 snprintf(what, sizeof what, "materials[%d] (%s) has no reference shader",
                          i, p->materials[i].name);
@@ -698,7 +719,7 @@ bool rt_pipelines_create(rt_device *d, const rt_pack *p, const rt_passes *rp,
                                  &pl->resolve, e))
             return false;
     }
-    if (ref == RT_REF_UBER && !p->uber.words)
+    if (ref == RT_REF_UBER && !rt_spirv_present(&p->uber))
         return rt_fail(e, RT_E_PACK_FIELD, p->dir, "the pack has no uber shader");
     return fullscreen_pipeline(d, pl, rp->main, K_SKY, sky_frag_main, "sky.frag", &pl->sky, e);
 }

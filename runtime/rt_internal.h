@@ -66,11 +66,32 @@ typedef struct rt_image {
 } rt_image;
 
 
+/* A shader file of the pack, read on first use (pack_shaders.c): loading
+ * the pack checks its name, that it is a regular file inside the pack and
+ * its size (a zstd frame's stated size) against the limits; the first
+ * rt_pack_spirv / rt_pack_text reads it, decompresses it and, for SPIR-V,
+ * runs spirv-val (once per module shape: cache.h) and the check against
+ * its role's interface (rt_spirv_check), so no module reaches the driver
+ * unchecked.  Thread-safe: pipelines are made on worker threads. */
+typedef struct rt_module rt_module;
+
 typedef struct rt_spirv {
-    char     *path;       /* relative to the pack                          */
-    uint32_t *words;
-    size_t    nwords;
+    char      *path;      /* relative to the pack; NULL: absent            */
+    uint32_t  *words;     /* a module the caller set (a tool's variant,
+                             checked by it); NULL: the pack's, read on
+                             first use through rt_pack_spirv             */
+    size_t     nwords;
+    rt_module *mod;       /* the pack's lazy module; NULL: none            */
 } rt_spirv;
+
+/* A GLSL text of the pack (compute variants, distance classes), read on
+ * first use through rt_pack_text; mod NULL: absent. */
+typedef struct rt_text {
+    char      *path;
+    rt_module *mod;
+} rt_text;
+
+static inline bool rt_spirv_present(const rt_spirv *s) { return s->words || s->mod; }
 
 typedef struct rt_pack_camera {
     char  *name;
@@ -80,7 +101,7 @@ typedef struct rt_pack_camera {
 typedef struct rt_pack_material {
     char    *name;
     char    *source;      /* graph file, relative to the scene (hot reload) */
-    rt_spirv reference;   /* SPLAT_MULTIPASS pass; words NULL if absent     */
+    rt_spirv reference;   /* SPLAT_MULTIPASS pass; may be absent            */
 } rt_pack_material;
 
 typedef struct rt_pack_param {
@@ -118,20 +139,20 @@ typedef struct rt_pack_combo {
     int     *materials;   /* scene indices, top first                       */
     int      nmaterials;
     rt_spirv spirv;
-    char    *compute;     /* compute variant's GLSL (PACK.md); NULL: none   */
-    char    *ug_compute;  /* undergrowth mask GLSL (PACK.md); NULL: none    */
-    rt_spirv compute_spirv; /* their SPIR-V as the build made it (words
-                             NULL: compiled from the GLSL on first use)   */
+    rt_text  compute;     /* compute variant's GLSL (PACK.md); mod NULL: none */
+    rt_text  ug_compute;  /* undergrowth mask GLSL (PACK.md); mod NULL: none */
+    rt_spirv compute_spirv; /* their SPIR-V as the build made it (absent:
+                             compiled from the GLSL on first use)         */
     rt_spirv ug_spirv;
     double   cost;        /* per-pixel cost, op-table units; 0: not given   */
     /* Distance classes (PACK.md): entries nbase.. of rt_pack.combos are
      * the class variants, after the combinations of combos.bin; a class
      * holds where view.distance lies in [dlo, dhi] (base ones [0, inf]).
-     * Its fragment shader may come as GLSL alone (spirv.words NULL),
+     * Its fragment shader may come as GLSL alone (spirv absent),
      * compiled on first use. */
     int      base;        /* the combination it is a variant of (own id)    */
     double   dlo, dhi;    /* metres; dhi INFINITY: and beyond               */
-    char    *glsl;        /* a class's fragment GLSL; NULL for the others   */
+    rt_text  glsl;        /* a class's fragment GLSL; absent for the others */
     char    *frag_path;   /* "glsl" beside "spirv": the forward counting
                              variant's source, read on first use
                              (rt_pack_read_glsl); NULL: absent              */
@@ -224,11 +245,11 @@ struct rt_pack {
     rt_pack_combo   *combos;    int ncombos;  /* combinations, then their
                                                  distance classes           */
     int              nbase;          /* combinations of combos.bin          */
-    rt_spirv         uber;           /* words NULL if absent               */
+    rt_spirv         uber;           /* absent: no über-shader             */
     char            *uber_frag_path; /* its fragment GLSL ("glsl"); NULL if
                                         absent: read on first use          */
-    char            *uber_compute;   /* its compute GLSL; NULL if absent    */
-    rt_spirv         uber_compute_spirv; /* its SPIR-V; words NULL if absent */
+    rt_text          uber_compute;   /* its compute GLSL; mod NULL if absent */
+    rt_spirv         uber_compute_spirv; /* its SPIR-V; may be absent       */
     rt_spirv         vertex;
     rt_pack_level   *levels;    int nlevels;
     char            *scene_path;     /* scene.source: scene.sg relative to
@@ -240,15 +261,28 @@ struct rt_pack {
                                         shapes' buffer"), validated; NULL:
                                         the pack has no spline or polygon */
     size_t           nvectors;       /* words                               */
+    struct rt_pack_shaders *shaders; /* the shader files read on first use
+                                        (pack_shaders.c)                   */
 };
 
 /* Read and check a pack, untrusted input: every file it names is a
  * regular file inside the pack folder (rt_pack_read_file) of the right
- * size, every size within the pack limits (abi.h), every SPIR-V module
- * validates and fits the interface of its role (rt_spirv_check), every
- * combination id in combos.bin is in range.  Errors name the pack file
- * and what is wrong. */
+ * size, every size within the pack limits (abi.h), every combination id
+ * in combos.bin is in range.  Its shaders are read on first use
+ * (rt_module): each SPIR-V module validates and fits the interface of its
+ * role (rt_spirv_check) before it is handed out.  Errors name the pack
+ * file and what is wrong. */
 bool rt_pack_load(rt_pack *p, const char *dir, rt_error *e);
+/* A shader module of the pack, read, validated and checked on its first
+ * use (then kept); NULL with *e set when it does not pass, the same
+ * message on every call.  `s->words`, where a caller set them, are
+ * returned as they are. */
+const uint32_t *rt_pack_spirv(const rt_pack *p, const rt_spirv *s, size_t *nwords, rt_error *e);
+/* A GLSL text of the pack, read on first use (NUL-terminated, no NUL in
+ * it); NULL with *e set. */
+const char *rt_pack_text(const rt_pack *p, const rt_text *t, rt_error *e);
+/* The shader files the pack names; *read: of them read and checked so far. */
+int rt_pack_shader_count(const rt_pack *p, int *read);
 /* Free what rt_pack_load allocated (not p itself); rt_pack_open and
  * rt_pack_close allocate and free the struct around these two. */
 void rt_pack_free(rt_pack *p);
@@ -435,6 +469,11 @@ uint8_t *rt_pack_read_file(int dirfd, const char *rel, size_t max, size_t *n, ch
  * allocated, exactly one frame that decompresses to that size (its
  * checksum checked).  `max` bounds the content either way. */
 uint8_t *rt_pack_read_content(int dirfd, const char *rel, size_t max, size_t *n, char *why,
+                              size_t nwhy);
+/* What rt_pack_read_content checks before it reads: the file opened as
+ * rt_pack_open_file does, its size (a ".zst" file's: its frame header's
+ * stated content size) at most `max`, in *n; no content is read. */
+bool     rt_pack_stat_content(int dirfd, const char *rel, size_t max, size_t *n, char *why,
                               size_t nwhy);
 /* The GLSL text at `rel` in p's folder (the manifest's `field`), read now
  * under the same checks (malloc'd); NULL with `e` set if it cannot be. */

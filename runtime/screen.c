@@ -392,7 +392,7 @@ bool rt_screen_create(rt_device *d, const rt_pack *p, const rt_pipelines *pl,
     if (!s->sort)
         s->sort_tiles = 0;
     s->far = far;
-    s->far_ok = far && p->uber_compute;
+    s->far_ok = far && p->uber_compute.mod;
     s->nlists = p->ncombos + 1 + s->far_ok;   /* + the far atlas's list */
     s->words = (p->nmaterials + 31) / 32;
     if (s->words > MAX_WORDS)

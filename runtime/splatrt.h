@@ -154,10 +154,16 @@ typedef struct rt_pack rt_pack;
 
 /* Read and check the pack in folder `dir`, untrusted input (every file it
  * names inside the folder and of the right size, every size within the
- * pack limits of abi.h, every SPIR-V module validated against its role,
- * every combination id in range); errors name the pack file and what is
- * wrong.  *out stays NULL on failure. */
+ * pack limits of abi.h, every combination id in range); errors name the
+ * pack file and what is wrong.  *out stays NULL on failure.  Its shaders
+ * are read, decompressed and validated against their role on first use
+ * (a module that fails then fails the call that needed it); none reaches
+ * the driver unchecked. */
 bool rt_pack_open(const char *dir, rt_pack **out, rt_error *e);
+/* Read and validate every shader of the pack now, on all cores (what
+ * splatview --check does): false with the failure of the first in
+ * manifest order. */
+bool rt_pack_validate(const rt_pack *p, rt_error *e);
 /* Free it; NULL does nothing. */
 void rt_pack_close(rt_pack *p);
 
@@ -184,6 +190,9 @@ typedef struct rt_pack_info {
     int    far_width, far_height, far_levels;
     double far_texel[2];          /* metres per level-0 texel               */
     size_t far_bytes;             /* its BC blocks, the header left out     */
+    int    shaders;               /* shader files the pack names            */
+    int    shaders_read;          /* of them, read and checked so far (on
+                                     first use, or all by rt_pack_validate) */
 } rt_pack_info;
 void rt_pack_info_get(const rt_pack *p, rt_pack_info *out);
 /* Material i's name (0 <= i < nmaterials; else NULL). */

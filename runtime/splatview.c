@@ -249,7 +249,8 @@ static const splat_arg options[] = {
       "counting frame (both paths, not the multi-pass reference)", F(stats) },
     { "--overlay", SPLAT_ARG_FLAG, NULL, "headless: draw the window's help overlay (key H) "
       "onto the PNG, as the window shows it", F(overlay) },
-    { "--check", SPLAT_ARG_FLAG, NULL, "load the pack and set up a renderer on the device, "
+    { "--check", SPLAT_ARG_FLAG, NULL, "load the pack, read and validate every shader in it "
+      "(a frame reads only those it needs) and set up a renderer on the device, "
       "draw nothing: exit 0 if the runtime takes the pack", F(check),
       .parse = check_implies_headless },
     { "--print-plan", SPLAT_ARG_FLAG, NULL, "headless: print the frame's passes, what each "
@@ -518,6 +519,7 @@ typedef struct frame_times {
     double ug_gen_ms;          /* and generates the undergrowth's cells      */
     int ug_generated;
     double compile_ms;
+    int shaders_read;          /* the pack's shader files the frames read   */
 } frame_times;
 
 /* o->frames frames, their times into t; st: the last frame's stats. */
@@ -603,6 +605,8 @@ static void print_paths(const rt_pack_info *pi, const rt_frame_stats *st, const 
     printf("patches drawn: %d  culled: %d\n", st->patches, st->culled);
     printf("back faces culled: %s\n", st->backfaces_culled ? "yes" : "no");
     printf("pipelines bound: %d\n", st->pipelines);
+    printf("shader files read: %d of %d (read and checked on first use)\n", t->shaders_read,
+           pi->shaders);
     if (st->screen)
         printf("compute modules: %d from the pack or the SPIR-V cache, %d compiled from GLSL; "
                "%.1f ms making pipelines between frames\n", st->spirv_cached,
@@ -748,7 +752,9 @@ static int headless(const opts *o)
     if (!rt_renderer_create(dev, pack, &rd, &r, &e) || !apply_params(o, r, &e) ||
         !apply_craters(o, r, &cam, &e))
         goto done;
-    if (o->check) {   /* the pack loads and a renderer stands on this device */
+    if (o->check) {   /* the pack loads, every shader passes, a renderer stands */
+        if (!rt_pack_validate(pack, &e))
+            goto done;
         printf("%s: loads (%d combinations, %d materials, %s path)\n", o->pack, pi.ncombos,
                pi.nmaterials, rd.shading == RT_SHADING_SCREEN ? "screen" : "forward");
         status = 0;
@@ -767,7 +773,10 @@ static int headless(const opts *o)
     /* the cost view needs the counting variant's counters */
     rt_renderer_set_counting(r, view == SPLAT_VIEW_COST);
     rt_renderer_set_pass_times(r, o->print_plan && o->stats);
-    if (!run_frames(o, r, &cam, &t, &st, &e) ||
+    bool ran = run_frames(o, r, &cam, &t, &st, &e);
+    rt_pack_info_get(pack, &pi);   /* before --stats' counting frame reads more */
+    t.shaders_read = pi.shaders_read;
+    if (!ran ||
         ((o->out || o->float_out) &&
          !write_pictures(o, dev, pack, r, view, material, &st, W, H, &e)))
         goto done;

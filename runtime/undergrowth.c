@@ -584,20 +584,28 @@ void rt_ug_invalidate(rt_ug *u, const double *rect)
 static bool mask_pipeline(rt_ug *u, int combo, VkPipeline *out, rt_error *e)
 {
     if (!u->mask_pipes[combo]) {
-        const char *glsl = u->p->combos[combo].ug_compute;
+        const rt_pack_combo *co = &u->p->combos[combo];
         char name[64];
         snprintf(name, sizeof name, "combination %d (undergrowth masks)", combo);
-        if (!glsl) {
+        if (!co->ug_compute.mod) {
             *out = VK_NULL_HANDLE;   /* grows nothing: the texels stay 0 */
             return true;
         }
+        /* the build's SPIR-V (checked against the undergrowth role on its
+         * first use), else the GLSL, compiled and checked here */
+        const uint32_t *words = NULL;
+        const char *glsl = NULL;
+        size_t nwords = 0;
+        if (rt_spirv_present(&co->ug_spirv)
+                ? !(words = rt_pack_spirv(u->p, &co->ug_spirv, &nwords, e))
+                : !(glsl = rt_pack_text(u->p, &co->ug_compute, e)))
+            return false;
         rt_interface in;
         if (!rt_interface_for(u->p, RT_ROLE_UNDERGROWTH, &in))
             return rt_fail(e, RT_E_VULKAN, "undergrowth", "out of memory");
-        const rt_spirv *spv = &u->p->combos[combo].ug_spirv;   /* the build's */
         bool ok = rt_vk_compute(u->d, &u->keep, &(rt_vk_compute_desc){ .label = name,
-                                    .glsl = glsl, .check = &in, .spirv = spv->words,
-                                    .nwords = spv->nwords, .layout = u->mask_layout,
+                                    .glsl = glsl, .check = &in, .spirv = words,
+                                    .nwords = nwords, .layout = u->mask_layout,
                                     .cache = u->pl->cache }, &u->mask_pipes[combo], e);
         rt_interface_free(&in);
         if (!ok)

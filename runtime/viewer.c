@@ -842,7 +842,7 @@ static bool make_renderer(viewer *v, rt_error *e)
     rd.height = (int)v->extent.height;
     /* Screen-capable whenever the pack has compute variants, so the G key
      * can switch paths. */
-    rd.shading = v->pack->uber_compute ? RT_SHADING_SCREEN : RT_SHADING_FORWARD;
+    rd.shading = v->pack->uber_compute.mod ? RT_SHADING_SCREEN : RT_SHADING_FORWARD;
     bool made = rt_renderer_create(&v->dev, v->pack, &rd, &v->r, e);
     if (!made && rd.shading == RT_SHADING_SCREEN && desc->render.shading != RT_SHADING_SCREEN) {
         rt_error_clear(e);   /* the device cannot do the screen path */
@@ -880,7 +880,7 @@ int rt_viewer_run(const rt_viewer_desc *desc)
      * headless default) */
     rt_shading want = desc->render.shading;
     if (!desc->shading_set)
-        want = v->pack->uber_compute && desc->render.reference != RT_REF_MULTIPASS
+        want = v->pack->uber_compute.mod && desc->render.reference != RT_REF_MULTIPASS
                    ? RT_SHADING_SCREEN : RT_SHADING_FORWARD;
     rt_renderer_set_shading(v->r, want);
     printf("splatview: %s shading\n",

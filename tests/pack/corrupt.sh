@@ -4,7 +4,8 @@
 # examples/minimal and tests/destruction/scene.sg are built by splatc
 # (sparse BC4 and dense painted masks, a destructible area), then each case
 # copies one of them, corrupts it in one way and hands it to
-# `splatview --headless` with SPLAT_VALIDATE=1.  Every case must end with
+# `splatview --check` (the pack loaded, every shader read and validated,
+# a renderer set up) with SPLAT_VALIDATE=1.  Every case must end with
 # exit status 1, a message naming the pack file and the problem (the
 # pattern given), no validation message, no picture, in under 5 s.  The
 # classes: files that are not regular files inside the pack (FIFO, symlink
@@ -79,7 +80,7 @@ case_() {
     rm -rf "$P" && mkdir -p "$OUT/c" && cp -r "$OUT/$base" "$P" || fail "$name: copy"
     (cd "$P" && sh -e) || fail "$name: the corruption itself failed"
     t0=$(date +%s%N)
-    timeout 20 "$SV" "$P" --headless --size 32x32 -o "$P.png" > "$P.log" 2>&1
+    timeout 20 "$SV" "$P" --check --size 32x32 > "$P.log" 2>&1
     rc=$?
     t1=$(date +%s%N)
     ms=$(( (t1 - t0) / 1000000 ))
@@ -342,5 +343,25 @@ echo "[$n] frag_symlink: exit $rc: $(head -c 300 "$P.cost.log" | tr '\n' ' ')"
 grep -q -- "\.glsl names 'shaders/[0-9a-z]*\.frag', which is a symbolic link" "$P.cost.log" ||
     fail "frag_symlink: message lacks the file and the problem"
 [ -e "$P.cost.png" ] && fail "frag_symlink: wrote a picture"
+# Shaders are read and checked on first use (pack_shaders.c): a frame that
+# does not need a corrupt module draws, a frame that does is refused with
+# the module's message and writes no picture, and --check (every module)
+# refuses the pack.  ref_0001 is drawn only by the multi-pass reference.
+P="$OUT/c/lazy"
+rm -rf "$P" && cp -r "$OUT/bc4" "$P" && cp "$G/inloc.spv" "$P/shaders/ref_0001.spv" ||
+    fail "lazy: copy"
+want="ref_0001.spv: error: a multi-pass reference fragment shader does not fit the runtime"
+"$SV" "$P" --headless --size 32x32 -o "$P.png" > "$P.log" 2>&1 ||
+    { cat "$P.log"; fail "lazy: the final view needs no reference shader (exit $?)"; }
+"$SV" "$P" --check > "$P.check.log" 2>&1 && fail "lazy: --check took a corrupt module"
+grep -q -- "$want" "$P.check.log" || { cat "$P.check.log"; fail "lazy: --check's message"; }
+"$SV" "$P" --headless --size 32x32 --reference multipass -o "$P.mp.png" > "$P.mp.log" 2>&1
+rc=$?
+[ $rc = 1 ] || fail "lazy: the multi-pass reference drew with a corrupt module (exit $rc)"
+grep -q -- "$want" "$P.mp.log" || { cat "$P.mp.log"; fail "lazy: the frame's message"; }
+grep -qi "validation" "$P.mp.log" && fail "lazy: validation message"
+[ -e "$P.mp.png" ] && fail "lazy: wrote a picture"
+n=$((n + 1))
+echo "[$n] lazy: drawn without the module, refused by --check and by the frame that needs it"
 echo "PASS: $n corrupt packs refused"
 [ $n -ge 30 ] || fail "only $n cases"

@@ -6,11 +6,15 @@
  *   rt_spirv_check's compute role: every compute variant of a pack built
  *     with --compute-spirv fits it; its fragment shaders do not, nor does a
  *     compute variant in a fragment role.
+ *   Shaders read on first use (pack_shaders.c): loading reads none of
+ *     them; rt_pack_spirv reads one, the same words as the file, once
+ *     (from two threads at once); rt_pack_validate reads the rest.
  *
  *   test_pack_checks MINIMAL_PACK DESTRUCTION_PACK COMPUTE_PACK
  *   (all by splatc build)
  */
 #include <dirent.h>
+#include <pthread.h>
 #include <fcntl.h>
 #include <unistd.h>
 #include <stdlib.h>
@@ -197,12 +201,72 @@ static void test_compute_role(void **state)
            ncomp, nug);
     int want_ug = 0;
     for (int i = 0; i < p.ncombos; i++)
-        want_ug += p.combos[i].ug_compute != NULL;
+        want_ug += p.combos[i].ug_compute.mod != NULL;
     assert_int_equal(nug, want_ug);
     assert_int_equal(ncomp, p.ncombos + 1);   /* every composite and the uber */
     assert_false(fits(&p, "0000.spv.zst", RT_ROLE_COMPUTE, &e));
     assert_non_null(strstr(e.msg, "no compute entry point"));
     rt_error_clear(&e);
+    rt_pack_free(&p);
+}
+
+/* Two threads ask for the same module at once: one reads it. */
+typedef struct ask { const rt_pack *p; const rt_spirv *s; const uint32_t *got; } ask;
+
+static void *ask_one(void *arg)
+{
+    ask *a = arg;
+    rt_error e = { 0 };
+    size_t n = 0;
+    a->got = rt_pack_spirv(a->p, a->s, &n, &e);
+    rt_error_clear(&e);
+    return NULL;
+}
+
+static void test_lazy(void **state)
+{
+    (void)state;
+    rt_pack p;
+    rt_error e = { 0 };
+    assert_true(rt_pack_load(&p, compute_dir, &e));
+    int read = -1, total = rt_pack_shader_count(&p, &read);
+    /* every combination: fragment, compute and undergrowth SPIR-V with
+     * their GLSL; the über-shader's; the vertex shader */
+    assert_true(total > 4 * p.nbase);
+    assert_int_equal(read, 0);
+    const rt_spirv *s = &p.combos[0].compute_spirv;
+    assert_true(rt_spirv_present(s));
+    ask a = { &p, s, NULL }, b = { &p, s, NULL };
+    pthread_t ta, tb;
+    assert_int_equal(pthread_create(&ta, NULL, ask_one, &a), 0);
+    assert_int_equal(pthread_create(&tb, NULL, ask_one, &b), 0);
+    pthread_join(ta, NULL);
+    pthread_join(tb, NULL);
+    assert_non_null(a.got);
+    assert_ptr_equal(a.got, b.got);   /* one read, kept */
+    rt_pack_shader_count(&p, &read);
+    assert_int_equal(read, 1);
+    /* the words are the file's */
+    char why[256];
+    size_t bytes = 0, n = 0;
+    int dirfd = open(compute_dir, O_RDONLY | O_DIRECTORY);
+    uint8_t *file = rt_pack_read_content(dirfd, s->path, (size_t)64 << 20, &bytes, why,
+                                         sizeof why);
+    close(dirfd);
+    assert_non_null(file);
+    const uint32_t *w = rt_pack_spirv(&p, s, &n, &e);
+    assert_int_equal(n * 4, bytes);
+    assert_memory_equal(w, file, bytes);
+    free(file);
+    const char *text = rt_pack_text(&p, &p.combos[0].compute, &e);
+    assert_non_null(text);
+    assert_non_null(strstr(text, "void main"));
+    rt_pack_shader_count(&p, &read);
+    assert_int_equal(read, 2);
+    assert_true(rt_pack_validate(&p, &e));
+    rt_pack_shader_count(&p, &read);
+    assert_int_equal(read, total);
+    printf("  %d shader files: none read at load, all by rt_pack_validate\n", total);
     rt_pack_free(&p);
 }
 
@@ -219,6 +283,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_minimal),
         cmocka_unit_test(test_dense_and_destruction),
         cmocka_unit_test(test_compute_role),
+        cmocka_unit_test(test_lazy),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
