@@ -43,8 +43,10 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size)
     fclose(f);
     rt_pack p;
     rt_error e = { 0 };
-    if (rt_pack_load(&p, dir, &e))
+    if (rt_pack_load(&p, dir, &e)) {
+        rt_pack_validate(&p, &e);   /* the shaders it names, read on first use */
         rt_pack_free(&p);
+    }
     rt_error_clear(&e);
     return 0;
 }

@@ -132,9 +132,12 @@ stats)
     done
     ;;
 bad_packs)
-    expect_error() {   # name, expected message part
+    # name, expected message part[, --check: a shader's corruption, which a
+    # frame finds only where it needs that shader (read on first use) and
+    # --check finds in every shader]
+    expect_error() {
         rm -f "$OUT/$1.png"   # from an earlier run
-        "$SV" "$OUT/$1" --headless --size 32x32 -o "$OUT/$1.png" > "$OUT/$1.log" 2>&1
+        "$SV" "$OUT/$1" --headless ${3:-} --size 32x32 -o "$OUT/$1.png" > "$OUT/$1.log" 2>&1
         rc=$?
         cat "$OUT/$1.log"
         [ $rc = 1 ] || fail "$1: exit $rc, expected 1"
@@ -149,9 +152,9 @@ bad_packs)
     fresh bad_json; printf '{"format": "splatc-pack",\n  "version": 1,,\n' > "$OUT/bad_json/manifest.json"
     expect_error bad_json "manifest.json:2:"
     fresh corrupt_spirv; head -c 64 /dev/urandom > "$OUT/corrupt_spirv/shaders/0001.spv"
-    expect_error corrupt_spirv "0001.spv: error: corrupt SPIR-V"
+    expect_error corrupt_spirv "0001.spv: error: corrupt SPIR-V" --check
     fresh bad_spirv_body; { head -c 20 "$PACK/shaders/0000.spv"; head -c 400 /dev/zero; } > "$OUT/bad_spirv_body/shaders/0000.spv"
-    expect_error bad_spirv_body "corrupt SPIR-V"
+    expect_error bad_spirv_body "corrupt SPIR-V" --check
     fresh missing_file; rm "$OUT/missing_file/shaders/0000.spv"
     expect_error missing_file "names 'shaders/0000.spv', which cannot be read"
     fresh short_heightfield; head -c 1000 "$PACK/heightfield.r16" > "$OUT/short_heightfield/heightfield.r16"
