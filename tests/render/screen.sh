@@ -73,7 +73,19 @@ set -- $made "$@"
 [ $(($1 + $2)) -le $((lists + 1)) ] ||
     fail "$(($1 + $2)) compute pipelines made for $lists lists in view"
 echo "pipelines follow the view: $(($1 + $2)) made for $lists lists with tiles"
-shift 2
+# so do the shader files read (read, decompressed and validated on first
+# use, pack_shaders.c): one per compute module made and the vertex
+# shader's, undergrowth masks aside (none generated here)
+ug=$(sed -n 's/^undergrowth: \([0-9]*\) cells.*/\1/p' "$OUT/made.log")
+read=$(sed -n 's/^shader files read: \([0-9]*\) of \([0-9]*\).*/\1 \2/p' "$OUT/made.log")
+[ -n "$read" ] || fail "no shader files line in --stats"
+set -- $read "$@"
+if [ "${ug:-0}" = 0 ]; then
+    [ "$1" -le $(($3 + $4 + 1)) ] && [ "$1" -lt "$2" ] ||
+        fail "$1 of $2 shader files read for $(($3 + $4)) compute modules made"
+fi
+echo "shader files follow the view: $1 of $2 read"
+shift 4
 # pipelines made on workers (--async-pipelines on): the first frame has
 # none but the über-shader's, which stands in for every list with tiles;
 # its picture is the final one within 1/255 (the soundness bound above)
