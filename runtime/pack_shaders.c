@@ -101,6 +101,16 @@ void rt_pk_shaders_free(struct rt_pack_shaders *s)
     free(s);
 }
 
+size_t rt_pack_spirv_size(const rt_spirv *s)
+{
+    return s->words ? s->nwords * 4 : s->mod ? s->mod->size : 0;
+}
+
+size_t rt_pack_text_size(const rt_text *t)
+{
+    return t->mod ? t->mod->size : 0;
+}
+
 int rt_pack_shader_count(const rt_pack *p, int *read)
 {
     struct rt_pack_shaders *s = p->shaders;

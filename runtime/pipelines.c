@@ -423,9 +423,55 @@ static bool make_one(void *ctx, int k, rt_error *e)
                                            &pipe, e);
 }
 
+/* The bytes of combination id's compute module (SPIR-V where the pack
+ * has it, else its GLSL; id ncombos: the über-shader's). */
+static size_t compute_cost(const rt_pack *p, int id)
+{
+    const rt_spirv *s = id < p->ncombos ? &p->combos[id].compute_spirv : &p->uber_compute_spirv;
+    const rt_text *t = id < p->ncombos ? &p->combos[id].compute : &p->uber_compute;
+    return rt_spirv_present(s) ? rt_pack_spirv_size(s) : rt_pack_text_size(t);
+}
+
+bool rt_pipelines_stand_in(const rt_device *d, const rt_pack *p, rt_pipelines *pl,
+                           const int *ids, int n, unsigned variant)
+{
+    if (!pl->async || !p->uber_compute.mod)
+        return false;
+    if (rt_pipelines_has_compute(pl, p->ncombos, variant))
+        return true;   /* made: it costs nothing more */
+    const char *force = getenv("SPLAT_STAND_IN");
+    if (force && !strcmp(force, "always"))
+        return true;
+    if (force && !strcmp(force, "never"))
+        return false;
+    /* Making a pipeline costs about its module's size: llvmpipe JIT-compiles
+     * it in the frame (colorado's composites about 0.4 s each at 250 KB,
+     * serially), a GPU driver on the cores rt_parallel gives it.  One
+     * über-shader (491 KB on colorado, 694 KB for 257 materials) stands in
+     * for 19 composites of colorado's valley; the 3 small ones that a view
+     * of one biome of the 257-material world needs are made at once (the
+     * über-shader took 51 s of shading there on lavapipe, the composites
+     * 1.8 s: tests/bench/first_picture.sh). */
+    size_t sum = 0;
+    for (int k = 0; k < n; k++)
+        sum += compute_cost(p, ids[k]);
+    size_t par = d->props.deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU ? 1 : (size_t)rt_job_threads(n);
+    return compute_cost(p, p->ncombos) < sum / par;
+}
+
 bool rt_pipelines_make(rt_device *d, const rt_pack *p, const rt_passes *rp, rt_pipelines *pl,
                        bool compute, const int *ids, int n, unsigned variant, rt_error *e)
 {
+    if (compute && n > 0 && rt_pipelines_stand_in(d, p, pl, ids, n, variant)) {
+        /* the über-shader now; the others on the workers meanwhile */
+        VkPipeline uber;
+        if (!rt_pipelines_compute(d, p, pl, p->ncombos, variant, &uber, e))
+            return false;
+        for (int k = 0; k < n; k++)
+            if (ids[k] != p->ncombos)
+                rt_async_request(pl, ids[k], variant);
+        return true;
+    }
     /* each combination's slot is its own: made on all cores (jobs.c) */
     make_jobs j = { d, p, rp, pl, compute, ids, variant };
     return rt_parallel(n, make_one, &j, e);

@@ -304,8 +304,14 @@ static bool rec_shade(rec *x, rt_error *e)
 {
     rt_renderer *r = x->r;
     VkDescriptorSet csets[2] = { r->set0c, r->set1 };
-    return rt_screen_dispatch(r->screen, x->cb, &r->pl, csets, x->fs->cvariant,
-                              r->pl.async != NULL, &x->binds, e);
+    /* with async pipelines the über-shader stands in for lists whose
+     * pipelines are being made, once it is made itself: before that a
+     * list without one is left for rt_screen_missing, which makes the
+     * cheaper of the two (rt_pipelines_stand_in) and draws again */
+    bool stand_in = r->pl.async &&
+                    rt_pipelines_has_compute(&r->pl, r->p->ncombos, x->fs->cvariant);
+    return rt_screen_dispatch(r->screen, x->cb, &r->pl, csets, x->fs->cvariant, stand_in,
+                              &x->binds, e);
 }
 
 static bool rec_shade_far(rec *x, rt_error *e)

@@ -281,6 +281,10 @@ const uint32_t *rt_pack_spirv(const rt_pack *p, const rt_spirv *s, size_t *nword
 /* A GLSL text of the pack, read on first use (NUL-terminated, no NUL in
  * it); NULL with *e set. */
 const char *rt_pack_text(const rt_pack *p, const rt_text *t, rt_error *e);
+/* A shader's size in bytes as loading checked it (nothing is read): a
+ * cost estimate of making its pipeline; 0 when absent. */
+size_t rt_pack_spirv_size(const rt_spirv *s);
+size_t rt_pack_text_size(const rt_text *t);
 /* The shader files the pack names; *read: of them read and checked so far. */
 int rt_pack_shader_count(const rt_pack *p, int *read);
 /* Free what rt_pack_load allocated (not p itself); rt_pack_open and
@@ -695,9 +699,20 @@ bool rt_pipelines_glsl_fragment(rt_device *d, rt_pipelines *pl, const rt_passes 
                                 VkPipelineLayout layout, const char *glsl, const char *name,
                                 unsigned variant, VkPipeline *out, rt_error *e);
 /* The pipelines of combinations ids[0..n) in `variant`, made at once on
- * all cores: compute (screen path; rp unused) or composites (forward). */
+ * all cores: compute (screen path; rp unused) or composites (forward).
+ * Compute with pl->async, where rt_pipelines_stand_in says the über-shader
+ * costs less to make than they do: the über-shader's made instead (it
+ * stands in for them from the next draw) and they are queued on the
+ * workers. */
 bool rt_pipelines_make(rt_device *d, const rt_pack *p, const rt_passes *rp, rt_pipelines *pl,
                        bool compute, const int *ids, int n, unsigned variant, rt_error *e);
+/* Whether the über-shader should stand in for compute pipelines ids[0..n)
+ * while the workers make them: it is made already, or making it costs
+ * less than making them (their modules' bytes, over the cores that make
+ * them at once: one on a CPU device, whose JIT runs in the frame on one
+ * thread); `SPLAT_STAND_IN=always|never` forces the choice (tests). */
+bool rt_pipelines_stand_in(const rt_device *d, const rt_pack *p, rt_pipelines *pl,
+                           const int *ids, int n, unsigned variant);
 /* Whether combination id's pipeline of `variant` is made already. */
 bool rt_pipelines_has_combo(const rt_pipelines *pl, int id, unsigned variant);
 bool rt_pipelines_combo(rt_device *d, const rt_pack *p, const rt_passes *rp,

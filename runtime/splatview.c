@@ -284,8 +284,9 @@ static const splat_arg options[] = {
       "über-shader, to compare against", F(ref), .choices = "multipass|uber",
       .values = reference_values },
     { "--async-pipelines", SPLAT_ARG_ENUM, NULL, "the screen path: make shading pipelines "
-      "on worker threads while the über-shader draws their tiles (default on in the window, "
-      "off headless, which waits for them); the title and --stats say how many are pending",
+      "on worker threads while the über-shader draws their tiles, where making it costs less "
+      "than making them (default on in the window, off headless, which waits for them; on: "
+      "the quick first picture); the title and --stats say how many are pending",
       F(async_pipelines), .choices = "on|off", .values = on_off },
     { "--no-distance-classes", SPLAT_ARG_FLAG, NULL, "shade with the combinations only, not "
       "their distance classes (compiler/PACK.md)", F(no_distance_classes) },

@@ -88,8 +88,10 @@ echo "shader files follow the view: $1 of $2 read"
 shift 4
 # pipelines made on workers (--async-pipelines on): the first frame has
 # none but the über-shader's, which stands in for every list with tiles;
-# its picture is the final one within 1/255 (the soundness bound above)
-SPLATC_CACHE="$OUT/async_cache" run "$PACK" --headless $SIZE $c --shading screen \
+# its picture is the final one within 1/255 (the soundness bound above).
+# SPLAT_STAND_IN=always: the über-shader stands in even where making the
+# composites costs less (rt_pipelines_stand_in would make them instead)
+SPLAT_STAND_IN=always SPLATC_CACHE="$OUT/async_cache" run "$PACK" --headless $SIZE $c --shading screen \
     --async-pipelines on --frames 1 --stats --float-out "$OUT/async.f32" > "$OUT/async.log"
 cat "$OUT/async.log"
 tiles=$(sed -n 's/^tiles: \([0-9]*\) of .*/\1/p' "$OUT/async.log")
