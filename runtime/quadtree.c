@@ -332,6 +332,9 @@ void rt_quadtree_select(rt_quadtree *q, const rt_select_desc *s)
         f.planes[4][k] = r[2][k];
         f.planes[5][k] = r[3][k] - r[2][k];
     }
+    memcpy(q->planes, f.planes, sizeof q->planes);
+    memcpy(q->camera, s->camera, sizeof q->camera);
+    q->culled = s->cull;
     for (int L = 0; L < q->nlevels; L++)
         memset(q->split[L], 0, (size_t)q->width[L] * (size_t)q->height[L]);
     int top = q->nlevels - 1;
@@ -342,4 +345,21 @@ void rt_quadtree_select(rt_quadtree *q, const rt_select_desc *s)
     split_down(&f, top, 0, 0);
     restrict_levels(q);
     emit(&f, top, 0, 0);
+}
+
+bool rt_quadtree_node_visible(const rt_quadtree *q, int level, int x, int z, double margin)
+{
+    if (!q->culled)
+        return true;
+    rt_select_desc sd = { .cull = true };
+    memcpy(sd.camera, q->camera, sizeof sd.camera);
+    frame f = { (rt_quadtree *)q, &sd, { { 0 } } };
+    memcpy(f.planes, q->planes, sizeof f.planes);
+    double lo[3], hi[3];
+    node_box(q, level, x, z, lo, hi);
+    for (int k = 0; k < 3; k++) {
+        lo[k] -= margin;
+        hi[k] += margin;
+    }
+    return box_visible(&f, lo, hi);
 }

@@ -18,7 +18,7 @@
  * shows it (reads, then writes):
  *   destruction upload   host  reads -            writes frame
  *   depth                      reads frame height  writes depth
- *   tile lists reset           writes tiles
+ *   tile lists reset           writes tiles (and the classification's view)
  *   classification             reads depth tiles   writes tiles color
  *   shading, far               reads tiles ...     writes color tiles
  *   tile counts                reads tiles         writes tiles-host */

@@ -285,9 +285,8 @@ static bool rec_raycast(rec *x, rt_error *e)
 
 static bool rec_tiles_reset(rec *x, rt_error *e)
 {
-    (void)e;
-    rt_screen_begin(x->r->screen, x->cb, (x->fs->cvariant & RT_CVARIANT_COUNT) != 0);
-    return true;
+    return rt_screen_begin(x->r->screen, x->cb, (x->fs->cvariant & RT_CVARIANT_COUNT) != 0,
+                           &x->r->qt, x->r->desc.no_distance_classes, e);
 }
 
 static bool rec_classify(rec *x, rt_error *e)

@@ -595,6 +595,9 @@ typedef struct rt_quadtree {
     int        npatches, cap;
     int        nculled;           /* leaves dropped by the frustum           */
     int        nholes;            /* nodes not drawn: all hole (PACK.md)     */
+    double     planes[6][4];      /* the last selection's frustum (culling)  */
+    double     camera[3];         /* and its camera                          */
+    bool       culled;            /* whether it culled                       */
 } rt_quadtree;
 
 bool rt_quadtree_init(rt_quadtree *q, const rt_bounds *b, int cell_texels,
@@ -616,6 +619,10 @@ void rt_quadtree_select(rt_quadtree *q, const rt_select_desc *s);
  * Everything its patch rasterises lies inside. */
 void rt_node_distance(const rt_quadtree *q, int level, int x, int z, const double camera[3],
                       double *dmin, double *dmax);
+/* Whether the last selection's frustum holds node (level, x, z)'s box
+ * widened by `margin` m on every side (always true when it did not
+ * cull): everything drawn of it lies inside. */
+bool rt_quadtree_node_visible(const rt_quadtree *q, int level, int x, int z, double margin);
 /* World rectangle of a node (metres; may overhang the terrain). */
 void rt_node_rect(const rt_quadtree *q, int level, int x, int z,
                   double *x0, double *z0, double *sx, double *sz);
@@ -783,6 +790,38 @@ double rt_camera_fovy(const rt_camera *c);
 typedef struct rt_screen rt_screen;
 typedef struct rt_far rt_far;   /* far.c */
 
+/* The classification's view (issue 29): its cost follows the materials
+ * in view, not the world's.  From the materials of the leaf cells under
+ * the selected patches (and a ring of one cell around each), the
+ * materials are renumbered in view order, so a set takes ceil(in view /
+ * 32) words (1, or the pack's where more than 32 are in view), and the
+ * cover search tries only the candidates: the combinations, in cost
+ * order, that no earlier candidate dominates (one that covers all of its
+ * materials in view and fits wherever it fits: a base combination, or a
+ * class whose interval holds its interval).  Any set of materials in
+ * view gets the combination the search over every combination would
+ * pick.  A leaf cell whose combination has a material outside the view
+ * (RT_CLASS_OUTSIDE; the selection's boxes hold every drawn pixel, so
+ * none should) sends its tile to the über-shader. */
+#define RT_CLASS_OUTSIDE 1u
+typedef struct rt_class_view {
+    int       words;      /* words per material set: 1, or the pack's       */
+    int       nview;      /* materials in view                              */
+    int       ncand;      /* candidates, in cost order                      */
+    uint32_t *cand;       /* [ncombos] combination ids                      */
+    uint32_t *rec;        /* [ncombos][1 + words]: RT_CLASS_OUTSIDE flag,
+                             then the materials in view, renumbered         */
+    int      *remap;      /* [nmaterials]: the bit in view, or -1           */
+} rt_class_view;
+/* The view of material set `vmask` (full_words words, scene indices);
+ * `order`: the combinations in cost order; `dist`: [lo, hi] per
+ * combination as the GPU compares them.  Reuses v's arrays; false when
+ * out of memory. */
+bool rt_class_view_build(const rt_pack *p, const uint32_t *order, const float *dist,
+                         const uint32_t *vmask, int full_words, bool no_classes,
+                         rt_class_view *v);
+void rt_class_view_free(rt_class_view *v);
+
 
 /* Buffers, the depth-only pass over `depth`, the classification pipeline;
  * writes set 0's compute bindings (abi.h 7-10) into `set0`.  `far`: the
@@ -810,8 +849,14 @@ void rt_screen_destroy(rt_screen *s);
 /* The geometry pass: depth only, ends in SHADER_READ_ONLY_OPTIMAL. */
 VkRenderPass rt_screen_depth_pass(const rt_screen *s, VkFramebuffer *fb);
 /* The passes of the screen path (render_plan.c places the barriers
- * between them): reset the list counts (and the counters), by transfers. */
-void rt_screen_begin(rt_screen *s, VkCommandBuffer cb, bool count);
+ * between them): reset the list counts (and the counters), by transfers,
+ * and upload the classification's view of this frame's selection `q`
+ * (rt_class_view; no_classes: without distance classes). */
+bool rt_screen_begin(rt_screen *s, VkCommandBuffer cb, bool count, const rt_quadtree *q,
+                     bool no_classes, rt_error *e);
+/* The view of the last frame begun; NULL before one or when every tile
+ * goes to the über-shader (more than 512 materials). */
+const rt_class_view *rt_screen_class_view(const rt_screen *s);
 /* The background, the classification (force_uber: every tile to the
  * über-shader's list; no_classes: no distance class variants); the colour
  * image is GENERAL. */

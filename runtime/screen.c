@@ -8,6 +8,13 @@
  * count; then one indirect dispatch per list runs that composite's compute
  * variant (abi.h "compute stage"), which lights and writes the pixels.
  *
+ * The search follows the view, not the world (issue 29): each frame the
+ * materials of the leaf cells that the selection's frustum holds are
+ * renumbered densely (one mask word while at most 32 are in view), and
+ * the search tries only the candidates, the combinations no cheaper one
+ * dominates over those materials (rt_class_view); it picks what the
+ * search over every combination would, so pictures do not change.
+ *
  * Lists live in one buffer, a region of `stride` entries per list (list
  * k at k * stride; k = ncombos is the über-shader's; stride is the tile
  * count rounded up to SPLAT_SORT_TILES_MAX), so one pass with one atomic per
@@ -67,6 +74,17 @@ struct rt_screen {
     bool                  wide;              /* classification: a workgroup
                                                 per tile (GPUs), else an
                                                 invocation per tile (CPUs)   */
+    /* the classification's view (rt_class_view): recomputed where the
+     * selection's materials change, uploaded each frame */
+    VkPipeline            classify1;         /* WORDS 1: <= 32 in view       */
+    uint32_t             *order;             /* combinations, cost order     */
+    float                *dist;              /* [lo, hi] per combination     */
+    uint32_t            **node_masks;        /* per level, per node: words   */
+    uint32_t             *vmask, *vmask_last; /* materials in view (words)   */
+    bool                  view_built, view_no_classes;
+    double                view_margin;       /* m: 1/16 cell                 */
+    rt_class_view         view;
+    uint32_t              view_at;           /* the view block in info, words */
     /* the far atlas (far.c): list ncombos + 1 when far_ok */
     bool                  far_ok;            /* the pack has one, the device
                                                 samples BC formats          */
@@ -91,14 +109,19 @@ static int by_cost(const void *a, const void *b)
     return (*(const uint32_t *)a > *(const uint32_t *)b) - (*(const uint32_t *)a < *(const uint32_t *)b);
 }
 
-/* The classification's read-only data: header, order, masks, cell map. */
+/* The classification's data (info): the header, per combination its
+ * distance interval [lo, hi] (float bits), the leaf cells' combinations,
+ * then the view block (rt_class_view) the frame uploads: ncand, words, 0,
+ * 0, cand[ncombos], rec[ncombos][1 + words]. */
 static bool fill_info(rt_screen *s, rt_error *e)
 {
     const rt_pack *p = s->p;
     const rt_pack_level *leaf = &p->levels[0];
     size_t n = (size_t)p->ncombos;
     size_t cells = (size_t)leaf->width * (size_t)leaf->height;
-    size_t words = 8 + n + n * (size_t)s->words + cells + 2 * n;
+    int fw = s->words > 0 ? s->words : 1;
+    s->view_at = (uint32_t)(2 * n + cells);
+    size_t words = 8 + 2 * n + cells + 4 + n + n * (size_t)(1 + fw);
     rt_buffer staging;
     if (!rt_buffer_create(s->d, words * 4, VK_BUFFER_USAGE_STORAGE_BUFFER_BIT |
                           VK_BUFFER_USAGE_TRANSFER_DST_BIT, false, &s->info, e) ||
@@ -114,25 +137,22 @@ static bool fill_info(rt_screen *s, rt_error *e)
     u[5] = (uint32_t)p->nbase;
     u[6] = (uint32_t)p->cell_texels;
     u[7] = (uint32_t)s->tiles_x;
-    uint32_t *order = u + 8, *masks = order + n, *map = masks + n * (size_t)s->words;
     for (size_t i = 0; i < n; i++)
-        order[i] = (uint32_t)i;
+        s->order[i] = (uint32_t)i;
     sort_pack = p;
-    qsort(order, n, sizeof *order, by_cost);
-    for (size_t i = 0; i < n; i++)
-        for (int k = 0; k < p->combos[i].nmaterials && s->words > 0; k++) {
-            int m = p->combos[i].materials[k];
-            masks[i * (size_t)s->words + (size_t)(m / 32)] |= 1u << (m % 32);
-        }
-    for (size_t i = 0; i < cells; i++)
-        map[i] = leaf->ids[i];
-    float *dist = (float *)(map + cells);   /* [lo, hi] per combination */
+    qsort(s->order, n, sizeof *s->order, by_cost);
+    float *dist = (float *)(u + 8);   /* [lo, hi] per combination */
     for (size_t i = 0; i < n; i++) {
         /* rounded inwards: a class is never used outside its interval */
         float lo = (float)p->combos[i].dlo, hi = (float)p->combos[i].dhi;
         dist[2 * i] = lo < p->combos[i].dlo ? nextafterf(lo, INFINITY) : lo;
         dist[2 * i + 1] = hi > p->combos[i].dhi ? nextafterf(hi, 0.0f) : hi;
+        s->dist[2 * i] = dist[2 * i];
+        s->dist[2 * i + 1] = dist[2 * i + 1];
     }
+    uint32_t *map = u + 8 + 2 * n;
+    for (size_t i = 0; i < cells; i++)
+        map[i] = leaf->ids[i];
     VkCommandBuffer cb;
     bool ok = rt_oneshot_begin(s->d, &cb, e);
     if (ok) {
@@ -142,6 +162,171 @@ static bool fill_info(rt_screen *s, rt_error *e)
     }
     rt_buffer_destroy(s->d, &staging);
     return ok;
+}
+
+/* ---- the classification's view ----------------------------------------------------- */
+
+void rt_class_view_free(rt_class_view *v)
+{
+    free(v->cand);
+    free(v->rec);
+    free(v->remap);
+    memset(v, 0, sizeof *v);
+}
+
+/* Whether combination a fits wherever b does: a base combination fits
+ * everywhere, a class inside its interval (the uploaded, rounded one). */
+static bool fits_where(const rt_pack *p, const float *dist, uint32_t a, uint32_t b)
+{
+    if ((int)a < p->nbase)
+        return true;
+    return (int)b >= p->nbase && dist[2 * a] <= dist[2 * b] && dist[2 * a + 1] >= dist[2 * b + 1];
+}
+
+bool rt_class_view_build(const rt_pack *p, const uint32_t *order, const float *dist,
+                         const uint32_t *vmask, int full_words, bool no_classes,
+                         rt_class_view *v)
+{
+    int n = p->ncombos;
+    if (!v->cand) {
+        v->cand = malloc((size_t)(n > 0 ? n : 1) * sizeof *v->cand);
+        v->rec = malloc((size_t)(n > 0 ? n : 1) * (size_t)(1 + full_words) * sizeof *v->rec);
+        v->remap = malloc((size_t)(p->nmaterials > 0 ? p->nmaterials : 1) * sizeof *v->remap);
+        if (!v->cand || !v->rec || !v->remap) {
+            rt_class_view_free(v);
+            return false;
+        }
+    }
+    v->nview = 0;
+    for (int m = 0; m < p->nmaterials; m++)
+        v->remap[m] = (vmask[m / 32] >> (m % 32)) & 1u ? v->nview++ : -1;
+    v->words = v->nview <= 32 ? 1 : full_words;
+    int W = v->words, R = 1 + W;
+    memset(v->rec, 0, (size_t)n * (size_t)R * sizeof *v->rec);
+    for (int i = 0; i < n; i++) {
+        uint32_t *r = v->rec + (size_t)i * (size_t)R;
+        for (int k = 0; k < p->combos[i].nmaterials; k++) {
+            int m = p->combos[i].materials[k];
+            int b = m >= 0 && m < p->nmaterials ? v->remap[m] : -1;
+            if (b < 0)
+                r[0] |= RT_CLASS_OUTSIDE;
+            else
+                r[1 + b / 32] |= 1u << (b % 32);
+        }
+    }
+    /* the candidates: in cost order, those no earlier candidate dominates
+     * (covers its materials in view, and fits wherever it does).  A tile
+     * none of whose cells is outside needs a material unless some
+     * combination has none, so without such a one a combination with no
+     * material in view covers no tile's set: not a candidate. */
+    bool empty_need = false;
+    for (int i = 0; i < n; i++)
+        empty_need |= p->combos[i].nmaterials == 0;
+    v->ncand = 0;
+    for (int k = 0; k < n; k++) {
+        uint32_t c = order[k];
+        if (no_classes && (int)c >= p->nbase)
+            continue;
+        const uint32_t *mc = v->rec + (size_t)c * (size_t)R + 1;
+        bool dominated = !empty_need;
+        for (int w = 0; w < W && dominated; w++)
+            dominated = mc[w] == 0;
+        for (int j = 0; j < v->ncand && !dominated; j++) {
+            uint32_t d = v->cand[j];
+            if (!fits_where(p, dist, d, c))
+                continue;
+            const uint32_t *md = v->rec + (size_t)d * (size_t)R + 1;
+            bool covers = true;
+            for (int w = 0; w < W && covers; w++)
+                covers = (mc[w] & ~md[w]) == 0;
+            dominated = covers;
+        }
+        if (!dominated)
+            v->cand[v->ncand++] = c;
+    }
+    return true;
+}
+
+/* Node (L, x, z)'s visible leaves' materials into s->vmask: down the
+ * quadtree under a selected patch, past nodes the frustum does not hold
+ * and nodes with nothing new. */
+static void view_node(rt_screen *s, const rt_quadtree *q, int L, int x, int z)
+{
+    const rt_pack *p = s->p;
+    int W = s->words;
+    const uint32_t *m = s->node_masks[L] +
+                        ((size_t)z * (size_t)p->levels[L].width + (size_t)x) * (size_t)W;
+    bool fresh = false;
+    for (int w = 0; w < W && !fresh; w++)
+        fresh = (m[w] & ~s->vmask[w]) != 0;
+    if (!fresh || !rt_quadtree_node_visible(q, L, x, z, s->view_margin))
+        return;
+    if (L == 0) {
+        for (int w = 0; w < W; w++)
+            s->vmask[w] |= m[w];
+        return;
+    }
+    for (int c = 0; c < 4; c++) {
+        int cx = 2 * x + (c & 1), cz = 2 * z + (c >> 1);
+        if (cx < p->levels[L - 1].width && cz < p->levels[L - 1].height)
+            view_node(s, q, L - 1, cx, cz);
+    }
+}
+
+/* The materials in view (s->vmask): those of the leaf cells under the
+ * selected patches whose boxes, widened by 1/16 cell, the frustum holds
+ * (a pixel within 1/64 cell of an edge counts for the cell beyond).  A
+ * cell outside that would send its tile to the über-shader
+ * (RT_CLASS_OUTSIDE): the boxes hold everything drawn, so none should. */
+static void view_materials(rt_screen *s, const rt_quadtree *q)
+{
+    memset(s->vmask, 0, (size_t)s->words * sizeof *s->vmask);
+    for (int i = 0; i < q->npatches; i++) {
+        const rt_patch *pt = &q->patches[i];
+        if (pt->level < s->p->nlevels)
+            view_node(s, q, pt->level, pt->x, pt->z);
+    }
+}
+
+/* Per level, per node, the materials of the leaf cells under it. */
+static bool make_node_masks(rt_screen *s)
+{
+    const rt_pack *p = s->p;
+    int W = s->words;
+    s->node_masks = calloc((size_t)p->nlevels, sizeof *s->node_masks);
+    if (!s->node_masks)
+        return false;
+    for (int L = 0; L < p->nlevels; L++) {
+        const rt_pack_level *lv = &p->levels[L];
+        s->node_masks[L] = calloc((size_t)lv->width * (size_t)lv->height * (size_t)W,
+                                  sizeof **s->node_masks);
+        if (!s->node_masks[L])
+            return false;
+        for (int z = 0; z < lv->height; z++)
+            for (int x = 0; x < lv->width; x++) {
+                uint32_t *m = s->node_masks[L] + ((size_t)z * (size_t)lv->width + (size_t)x) * (size_t)W;
+                if (L == 0) {
+                    int id = lv->ids[(size_t)z * (size_t)lv->width + (size_t)x];
+                    for (int k = 0; id < p->ncombos && k < p->combos[id].nmaterials; k++) {
+                        int mat = p->combos[id].materials[k];
+                        if (mat >= 0 && mat < p->nmaterials)
+                            m[mat / 32] |= 1u << (mat % 32);
+                    }
+                    continue;
+                }
+                const rt_pack_level *below = &p->levels[L - 1];
+                for (int c = 0; c < 4; c++) {
+                    int cx = 2 * x + (c & 1), cz = 2 * z + (c >> 1);
+                    if (cx >= below->width || cz >= below->height)
+                        continue;
+                    const uint32_t *k = s->node_masks[L - 1] +
+                                        ((size_t)cz * (size_t)below->width + (size_t)cx) * (size_t)W;
+                    for (int w = 0; w < W; w++)
+                        m[w] |= k[w];
+                }
+            }
+    }
+    return true;
 }
 
 /* The mesh's height at corner (x, z) in metres, as the shaders read it:
@@ -342,18 +527,27 @@ static bool make_compute(rt_screen *s, const rt_pipelines *pl, VkSampler nearest
     const char *force = getenv("SPLAT_CLASSIFY");   /* tests: wide | tile */
     if (force && sub)
         s->wide = !strcmp(force, "wide");
+    /* two variants of the classification: WORDS 1 for views of at most
+     * 32 materials (rt_class_view), WORDS the pack's for the others */
+    char head1[320];
+    const char *ext = sub ? "#extension GL_KHR_shader_subgroup_vote : require\n"
+                            "#extension GL_KHR_shader_subgroup_ballot : require\n"
+                            "#extension GL_KHR_shader_subgroup_arithmetic : require\n" : "";
+    const char *mode = s->wide ? "#define WIDE 1\n" : sub ? "#define AGGREGATE 1\n" : "";
     snprintf(head, sizeof head, "#define WORDS %d\n#define SLACK %.9g\n%s%s",
-             s->words > 0 ? s->words : 1, RT_DCLASS_SLACK,
-             sub ? "#extension GL_KHR_shader_subgroup_vote : require\n"
-                   "#extension GL_KHR_shader_subgroup_ballot : require\n"
-                   "#extension GL_KHR_shader_subgroup_arithmetic : require\n" : "",
-             s->wide ? "#define WIDE 1\n" : sub ? "#define AGGREGATE 1\n" : "");
+             s->words > 0 ? s->words : 1, RT_DCLASS_SLACK, ext, mode);
+    snprintf(head1, sizeof head1, "#define WORDS 1\n#define SLACK %.9g\n%s%s",
+             RT_DCLASS_SLACK, ext, mode);
     char rhead[128];
     snprintf(rhead, sizeof rhead, "#define TOP %d\n#define PW %u\n#define PH %u\n",
              s->mip_levels - 1, s->maxmip.width, s->maxmip.height);
     char ghead[64];
     snprintf(ghead, sizeof ghead, "#define G %du\n", s->sort_tiles);
+    bool one = s->words <= 1;
     return own_pipeline(s, pl, head, rt_screen_classify_glsl, "classify.comp", &s->classify, e) &&
+           (one ? (s->classify1 = s->classify, true)
+                : own_pipeline(s, pl, head1, rt_screen_classify_glsl, "classify1.comp",
+                               &s->classify1, e)) &&
            (!s->sort ||
             own_pipeline(s, pl, ghead, rt_screen_group_glsl, "group.comp", &s->group, e)) &&
            (!s->raycast ||
@@ -399,8 +593,15 @@ bool rt_screen_create(rt_device *d, const rt_pack *p, const rt_pipelines *pl,
         s->words = 0;   /* too many materials to classify: über-shader only */
     s->dispatched = calloc((size_t)s->nlists, sizeof *s->dispatched);
     s->stand_in = calloc((size_t)s->nlists, 1);
+    s->order = calloc((size_t)p->ncombos + 1, sizeof *s->order);
+    s->dist = calloc(2 * (size_t)p->ncombos + 2, sizeof *s->dist);
+    s->vmask = calloc((size_t)s->words + 1, sizeof *s->vmask);
+    s->vmask_last = calloc((size_t)s->words + 1, sizeof *s->vmask_last);
+    s->view_margin = p->cell_texels * fmax(p->size[0] / p->hf_width, p->size[1] / p->hf_height) /
+                     16.0;
     *out = s;
-    if (!s->dispatched || !s->stand_in)
+    if (!s->dispatched || !s->stand_in || !s->order || !s->dist || !s->vmask ||
+        !s->vmask_last || (s->words > 0 && !make_node_masks(s)))
         return rt_fail(e, RT_E_VULKAN, "screen-space shading", "out of memory");
     VkDeviceSize list_bytes = (VkDeviceSize)s->nlists * (VkDeviceSize)s->stride * 4;
     if (list_bytes > d->props.limits.maxStorageBufferRange)
@@ -473,6 +674,14 @@ void rt_screen_destroy(rt_screen *s)
     }
     free(s->dispatched);
     free(s->stand_in);
+    free(s->order);
+    free(s->dist);
+    free(s->vmask);
+    free(s->vmask_last);
+    for (int L = 0; s->node_masks && L < s->p->nlevels; L++)
+        free(s->node_masks[L]);
+    free(s->node_masks);
+    rt_class_view_free(&s->view);
     free(s);
 }
 
@@ -554,12 +763,48 @@ void rt_screen_depth_out(rt_screen *s, VkCommandBuffer cb, const rt_image *depth
                       VK_PIPELINE_STAGE_LATE_FRAGMENT_TESTS_BIT);
 }
 
-void rt_screen_begin(rt_screen *s, VkCommandBuffer cb, bool count)
+bool rt_screen_begin(rt_screen *s, VkCommandBuffer cb, bool count, const rt_quadtree *q,
+                     bool no_classes, rt_error *e)
 {
     VkBufferCopy c = { 0, 0, (VkDeviceSize)s->nlists * 12 };
     vkCmdCopyBuffer(cb, s->args_reset.buf, s->args.buf, 1, &c);
     if (count)
         vkCmdFillBuffer(cb, s->counters.buf, 0, sizeof(splat_counters), 0);
+    if (s->words == 0)
+        return true;   /* every tile to the über-shader */
+    /* the view: rebuilt where the selection's materials changed */
+    view_materials(s, q);
+    size_t vb = (size_t)s->words * sizeof *s->vmask;
+    if (!s->view_built || no_classes != s->view_no_classes ||
+        memcmp(s->vmask, s->vmask_last, vb)) {
+        if (!rt_class_view_build(s->p, s->order, s->dist, s->vmask, s->words, no_classes,
+                                 &s->view))
+            return rt_fail(e, RT_E_VULKAN, "screen-space shading", "out of memory");
+        memcpy(s->vmask_last, s->vmask, vb);
+        s->view_built = true;
+        s->view_no_classes = no_classes;
+    }
+    /* uploaded every frame (a few kB, recorded in the command buffer):
+     * ncand, words, 0, 0, the candidates, the records */
+    const rt_class_view *v = &s->view;
+    size_t n = (size_t)s->p->ncombos;
+    uint32_t head[4] = { (uint32_t)v->ncand, (uint32_t)v->words, 0, 0 };
+    VkDeviceSize at = (VkDeviceSize)(8 + s->view_at) * 4;
+    vkCmdUpdateBuffer(cb, s->info.buf, at, sizeof head, head);
+    const uint8_t *parts[2] = { (const uint8_t *)v->cand, (const uint8_t *)v->rec };
+    size_t bytes[2] = { (size_t)v->ncand * 4, n * (size_t)(1 + v->words) * 4 };
+    VkDeviceSize to[2] = { at + 16, at + 16 + n * 4 };
+    for (int k = 0; k < 2; k++)
+        for (size_t o = 0; o < bytes[k]; o += 65536) {
+            size_t len = bytes[k] - o < 65536 ? bytes[k] - o : 65536;
+            vkCmdUpdateBuffer(cb, s->info.buf, to[k] + o, len, parts[k] + o);
+        }
+    return true;
+}
+
+const rt_class_view *rt_screen_class_view(const rt_screen *s)
+{
+    return s->view_built ? &s->view : NULL;
 }
 
 void rt_screen_classify(rt_screen *s, VkCommandBuffer cb, VkDescriptorSet set0,
@@ -567,7 +812,8 @@ void rt_screen_classify(rt_screen *s, VkCommandBuffer cb, VkDescriptorSet set0,
 {
     /* the colour image is GENERAL (render_plan.c): the classification
      * writes the background of empty pixels, shading the terrain's */
-    vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, s->classify);
+    vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE,
+                      s->view_built && s->view.words == 1 ? s->classify1 : s->classify);
     vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, s->layout, 0, 1, &set0, 0, NULL);
     vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, s->layout, 2, 1, &s->set, 0, NULL);
     /* abi.h's push block, read as: patch_xz the background colour,
@@ -741,6 +987,11 @@ void rt_screen_read_stats(const rt_screen *s, rt_screen_stats *st)
             st->tiles_class += (int)args[3 * k];
     }
     st->tiles_uber = (int)args[3 * s->p->ncombos];
+    if (s->view_built) {
+        st->class_candidates = s->view.ncand;
+        st->class_materials = s->view.nview;
+        st->class_words = s->view.words;
+    }
     st->tiles_far = s->far_ok ? (int)args[3 * (s->p->ncombos + 1)] : 0;
     rt_counters_read(args + 3 * s->nlists, st);
 }

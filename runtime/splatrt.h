@@ -286,6 +286,9 @@ typedef struct rt_screen_stats {
                                      combination's pipeline was being made
                                      (rt_render_desc.async_pipelines)       */
     int      lists;               /* combinations (and über) with tiles      */
+    /* The classification's view (issue 29): the combinations its cover
+     * search tries, the materials in view and the mask words per set. */
+    int      class_candidates, class_materials, class_words;
     /* Counting frames (rt_renderer_set_counting, the cost view), both
      * paths; on the forward path "pixels" are the fragments shaded. */
     uint32_t pixels, layers_evaluated, layers_needed, samples;

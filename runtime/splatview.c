@@ -662,6 +662,8 @@ static bool print_stats(const opts *o, rt_device *dev, const rt_pack *pack, rt_r
                "atlas\n", st->tiles.tiles, st->tiles.tiles_total, st->tiles.lists,
                st->tiles.tiles_uber, st->tiles.tiles_far);
         printf("distance classes: %d of %d tiles\n", st->tiles.tiles_class, st->tiles.tiles);
+        printf("classification: %d candidates, %d materials in view, %d words per set\n",
+               st->tiles.class_candidates, st->tiles.class_materials, st->tiles.class_words);
         printf("pipelines pending: %d (tiles the uber-shader stood in for: %d)\n",
                st->pipelines_pending, st->tiles.tiles_stand_in);
     }

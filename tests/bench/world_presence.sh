@@ -27,6 +27,17 @@ for w in full only; do
     [ -n "$uber" ] || fail "$w: no tiles line in --stats"
     [ "$uber" -eq 0 ] || fail "$w: $uber tiles shaded by the über-shader, expected none"
 done
+# the classification's cover search follows the view (screen.c
+# rt_class_view): the materials renumbered to those in view, in
+# ceil(in view / 32) words (1 up to 32), not the world's 9
+for w in full only; do
+    get cm "sed -n 's/^classification: [0-9]* candidates, \([0-9]*\) materials in view.*/\1/p'" cat "$D/$w.txt"
+    get cw "sed -n 's/^classification: .*, \([0-9]*\) words per set/\1/p'" cat "$D/$w.txt"
+    [ -n "$cm" ] && [ -n "$cw" ] || fail "$w: no classification line in --stats"
+    [ "$cm" -lt 133 ] || fail "$w: $cm of 265 materials in view, expected under half"
+    want=$(( cm <= 32 ? 1 : 9 ))
+    [ "$cw" -eq "$want" ] || fail "$w: $cw words per set for $cm materials in view, expected $want"
+done
 get lf "sed -n 's/^layers per pixel: evaluated \([0-9.]*\),.*/\1/p'" cat "$D/full.txt"
 get lo "sed -n 's/^layers per pixel: evaluated \([0-9.]*\),.*/\1/p'" cat "$D/only.txt"
 get sf "sed -n 's/^texture samples per pixel: \([0-9.]*\)/\1/p'" cat "$D/full.txt"
