@@ -23,6 +23,16 @@
 #define LOD_GROW 3.0
 #define LOD_GROW_S "3.0"
 #define UG_BLOCK_VEC4 5   /* vec4s per block of the block table (fill_blocks) */
+/* The cull passes' table (host-visible, written each frame): key k's
+ * entries are [e[k], e[k + 1]) (a key: a block's near or far mesh); its
+ * mesh at e[UG_KEYINFO + 4k]: index count, first index, vertex offset,
+ * contact shadows or not; the entries from e[UG_ENT0]: a cell's block,
+ * slot * blocks + block (undergrowth.c "cull"). */
+#define UG_MAX_KEYS  (2 * SPLAT_MAX_UG_BLOCKS)
+#define UG_KEYINFO   256
+#define UG_KEYINFO_S "256u"
+#define UG_ENT0      (UG_KEYINFO + 4 * UG_MAX_KEYS)
+#define UG_ENT0_S    "768u"
 
 enum { CELL_FREE, CELL_PENDING, CELL_READY };
 
@@ -44,6 +54,13 @@ typedef struct ug_push {
     uint32_t nblocks, pad;
 } ug_push;
 
+/* Push constants of the cull passes (std430, 112 bytes). */
+typedef struct ug_cull_push {
+    float    plane[5][4];     /* camera-relative, normalised              */
+    float    cam[4];          /* the frame's camera xyz; the radius       */
+    uint32_t info[4];         /* blocks, entries                          */
+} ug_cull_push;
+
 struct rt_ug {
     rt_device            *d;
     const rt_pack        *p;
@@ -64,18 +81,28 @@ struct rt_ug {
     rt_buffer             draw_args;           /* args with the LOD's counts */
     rt_buffer             lod;                 /* per slot: fraction drawn   */
     rt_buffer             far;                 /* per block: far mesh (LOD)  */
+    /* the cull passes: their table (host), the entries' counts and
+     * offsets, the drawn instances' indices, the draws per key (and a
+     * host copy of them, for the stats) */
+    rt_buffer             ent, cnt, vis, mdraw, mdraw_host;
+    int                   nkeys, nent;         /* this frame's               */
+    int                   key_block[UG_MAX_KEYS];   /* each key's block       */
+    bool                  key_used[UG_MAX_KEYS];    /* it has entries         */
+    bool                  mdraw_valid;         /* mdraw_host holds this frame's */
     VkDescriptorSetLayout set_terrain;         /* set 0 of the mask pass     */
-    VkDescriptorSetLayout set_mask, set_gen, set_draw, set_lod;
-    VkPipelineLayout      mask_layout, gen_layout, draw_layout, lod_layout;
+    VkDescriptorSetLayout set_mask, set_gen, set_draw, set_lod, set_cull, set_scan;
+    VkPipelineLayout      mask_layout, gen_layout, draw_layout, lod_layout, cull_layout,
+                          scan_layout;
     VkPipeline           *mask_pipes;          /* per combination            */
     VkPipeline            gen_pipe, lod_pipe;
+    VkPipeline            count_pipe, write_pipe, scan_pipe;   /* the cull passes */
     VkPipeline            draw_pipe[2];        /* opaque (early depth), cut out */
     VkPipeline            shadow_pipe;         /* contact shadows (if shadows) */
     rt_image              tex[SPLAT_MAX_UG_TEXTURES + 1];   /* the pack's, then white */
     VkSampler             tex_smp;             /* trilinear, repeat          */
     bool                  shadows;             /* the colour target blends   */
     VkDescriptorPool      dpool;
-    VkDescriptorSet       set0, mask_set, gen_set, draw_set, lod_set;
+    VkDescriptorSet       set0, mask_set, gen_set, draw_set, lod_set, cull_set, scan_set;
     VkRenderPass          pass_att, pass_ro;   /* depth in attachment / read */
     VkFramebuffer         fb;
     VkQueryPool           qpool;               /* VK_NULL_HANDLE: no timestamps */
@@ -97,6 +124,8 @@ struct rt_ug {
 
 extern const char rt_ug_gen_glsl[];          /* the scatter pass             */
 extern const char rt_ug_lod_glsl[];          /* the LOD's draw arguments     */
+extern const char rt_ug_cull_glsl[];         /* count / write (UG_WRITE)     */
+extern const char rt_ug_scan_glsl[];         /* offsets, draws per key       */
 extern const char rt_ug_draw_vert_main[];    /* after SPLAT_GLSL_TERRAIN      */
 extern const char rt_ug_draw_frag_main[];    /* after SPLAT_GLSL_PRELUDE      */
 extern const char rt_ug_probe_glsl[];        /* the probe pass (tests)       */

@@ -727,7 +727,7 @@ static void csv_row(FILE *out, const bench_run *b, int i, const char *devname)
     const char *pk = strrchr(v->pack_dir, '/');
     fprintf(out, "\"%s\",%s,%s,%d,%d,%s,%s,%s,%g,%d,%.3f,%.3f,%.3f,%.3f,%.4f,%d,%d,"
                  "%.6g,%.6g,%.2f,%ld,%.1f,%s,%s,%.3f,%.3f,%.3f,%d,%d,%.4f,%.4f,%.3f,%.1f,"
-                 "%.2f,%.4f,%.4f,%.4f,%.2f,%ld,%zu,%g,%d,%d,%d\n",
+                 "%.2f,%.4f,%.4f,%.4f,%.2f,%ld,%zu,%g,%d,%d,%d,%ld,%ld,%ld,%d\n",
             devname, o->scene ? o->scene : v->base->name, o->pd.name, o->width, o->height,
             v->label, kind_names[v->k], pk ? pk + 1 : v->pack_dir,
             v->lod > 0 ? v->lod : 3.0, frames, gm, g10, g90, cm, sm,
@@ -741,7 +741,8 @@ static void csv_row(FILE *out, const bench_run *b, int i, const char *devname)
             v->shadow_ms, ugm, v->ug_cells ? gen_sum / (double)v->ug_cells : -1.0,
             ugd, (double)v->ug_cells / frames, v->ug_last.instances,
             v->ug_last.bytes_per_cell, v->far, v->tiles.tiles_far, !v->no_dclass,
-            v->tiles.tiles_class);
+            v->tiles.tiles_class, v->ug_last.candidates, v->ug_last.drawn, v->ug_last.triangles,
+            v->ug_last.draws);
 }
 
 /* The rows, on stdout or appended to --csv (a header when it is new). */
@@ -766,7 +767,8 @@ static bool write_csv(const bench_run *b)
                      "geometry_ms,classify_ms,shade_ms,tiles,tiles_uber,layers_evaluated,"
                      "layers_needed,samples_per_px,branches_uniform_pct,shadow_map_ms,"
                      "ug_gen_med_ms,ug_gen_ms_per_cell,ug_draw_med_ms,ug_cells_per_frame,"
-                     "ug_instances,ug_bytes_per_cell,far_distance,tiles_far,distclass,tiles_class\n");
+                     "ug_instances,ug_bytes_per_cell,far_distance,tiles_far,distclass,tiles_class,"
+                     "ug_candidates,ug_drawn,ug_triangles,ug_draws\n");
     /* the device name in CSV: its commas become ';' */
     char devname[VK_MAX_PHYSICAL_DEVICE_NAME_SIZE];
     snprintf(devname, sizeof devname, "%s", b->dev.props.deviceName);

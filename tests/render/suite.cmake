@@ -169,7 +169,7 @@ if(TARGET splatrt AND TARGET splatview)
                          ENVIRONMENT "SPLAT_VALIDATE=1")
     # the lighting model against its double twin, on three paths, and the
     # terrain's shadows
-    foreach(t brdf shadow undergrowth ug_look)
+    foreach(t brdf shadow undergrowth ug_look ug_cull)
       add_executable(test_${t} ${RENDER_DIR}/test_${t}.c)
       target_link_libraries(test_${t} splat_testkit)
       file(MAKE_DIRECTORY ${RENDER_OUT}/${t})
