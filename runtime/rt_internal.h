@@ -837,7 +837,8 @@ typedef struct rt_ug_targets {
 /* *out stays NULL when the pack has no undergrowth; set even on failure
  * (free with rt_ug_destroy).  radius 0: RT_UG_RADIUS. */
 bool rt_ug_create(rt_device *d, const rt_pack *p, rt_pipelines *pl, const rt_quadtree *qt,
-                  const rt_ug_targets *t, double radius, rt_ug **out, rt_error *e);
+                  const rt_ug_targets *t, double radius, double thin, rt_ug **out,
+                  rt_error *e);
 void rt_ug_destroy(rt_ug *u);
 /* Allocate the cells around the camera (on the CPU: which are visible),
  * then record the generation of up to `budget` pending ones (<= 0: all),

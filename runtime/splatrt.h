@@ -312,6 +312,11 @@ typedef struct rt_render_desc {
                                        drawing their tiles meanwhile (the
                                        viewer's default; headless waits)   */
     double       undergrowth_radius; /* m around the camera; 0: RT_UG_RADIUS    */
+    double       undergrowth_thin;  /* m: beyond it a cell draws the fraction
+                                       (thin / d)^2 of its instances (at
+                                       least 8 %), widened; 0: 14 (the far
+                                       meshes' distance, which stays;
+                                       runtime/DESIGN.md)                   */
     bool         split_uncovered;   /* forward: coarse quadtree nodes that
                                        no compiled combination covers (the
                                        pack composes leaf cells only) are

@@ -21,8 +21,13 @@
  *      Instances are compacted by a workgroup prefix sum in candidate
  *      order, so the buffer is deterministic (no atomics), and the count
  *      goes straight into the block's indirect draw arguments.
- * Drawing is one indexed indirect draw per block and cell, cells front to
- * back, after the terrain into its colour and depth; lit by splat_light
+ * Every frame a LOD pass scales each cell's counts by its distance, then
+ * the cull passes ("cull", undergrowth_glsl.c rt_ug_cull_glsl) keep the
+ * instances the fade leaves a size and whose bounds touch the frustum,
+ * compacted into one list (deterministic: count, scan, write).  Drawing
+ * is one indexed indirect draw per key (a block's near or far mesh) over
+ * that list, cells front to back within a key, opaque blocks first,
+ * after the terrain into its colour and depth; lit by splat_light
  * (abi.c) with the terrain normal (a block's `lighting = terrain`) or the
  * mesh's.  In the vertex stage (ug_glsl, which the probe pass runs too):
  *   - the distance fade: an instance at distance d from the camera stays
@@ -179,6 +184,64 @@ static double bound(const rt_pack_ug *pu, int mesh)
     return r;
 }
 
+/* The single-triangle version of a far mesh made of tapered quads (each
+ * pair of triangles has 4 distinct vertices, 2 at the root, v = 0, and 2
+ * at the tip, v = 1): per quad one triangle from the root edge, widened
+ * about its middle by (root + tip width) / root width so that it keeps
+ * the quad's area, to the middle of the tip edge.  Writes 3 vertices (8
+ * floats) and 3 indices (from 0) per quad; returns the triangles, 0 when
+ * the mesh is not made of such quads (stone.far, an OBJ). */
+static uint32_t tri_mesh(const rt_pack_ug *pu, const rt_pack_ug_mesh *m, float *vout,
+                         uint32_t *iout)
+{
+    if (m->nidx == 0 || m->nidx % 6 != 0)
+        return 0;
+    for (uint32_t q = 0; q < m->nidx / 6; q++) {
+        const uint32_t *ix = pu->indices + m->first_index + 6 * q;
+        const float *v[4];
+        int n = 0;
+        for (int k = 0; k < 6; k++) {
+            const float *x = pu->vertices + 8 * (size_t)(m->first_vertex + ix[k]);
+            bool seen = false;
+            for (int j = 0; j < n; j++)
+                seen |= v[j] == x;
+            if (!seen && n == 4)
+                return 0;
+            if (!seen)
+                v[n++] = x;
+        }
+        const float *root[2], *tip[2];
+        int nr = 0, nt = 0;
+        for (int j = 0; j < n; j++) {
+            if (v[j][7] == 0.0f && nr < 2)
+                root[nr++] = v[j];
+            else if (v[j][7] == 1.0f && nt < 2)
+                tip[nt++] = v[j];
+        }
+        if (n != 4 || nr != 2 || nt != 2)
+            return 0;
+        double wr = 0, wt = 0;
+        for (int c = 0; c < 3; c++) {
+            wr += ((double)root[1][c] - root[0][c]) * ((double)root[1][c] - root[0][c]);
+            wt += ((double)tip[1][c] - tip[0][c]) * ((double)tip[1][c] - tip[0][c]);
+        }
+        double grow = wr > 0 ? (sqrt(wr) + sqrt(wt)) / sqrt(wr) : 1.0;
+        float *o = vout + 24 * (size_t)q;
+        for (int c = 0; c < 8; c++) {
+            double mid = 0.5 * ((double)root[0][c] + root[1][c]);
+            o[c] = (float)(c < 3 ? mid + (root[0][c] - mid) * grow : root[0][c]);
+            o[8 + c] = (float)(c < 3 ? mid + (root[1][c] - mid) * grow : root[1][c]);
+            o[16 + c] = (float)(0.5 * ((double)tip[0][c] + tip[1][c]));
+        }
+        o[6] = 0.0f;   /* u across the blade: 0, 1 at the root, 0.5 at the tip */
+        o[14] = 1.0f;
+        o[22] = 0.5f;
+        for (int k = 0; k < 3; k++)
+            iout[3 * q + (uint32_t)k] = 3 * q + (uint32_t)k;
+    }
+    return m->nidx / 6;
+}
+
 static uint32_t gcd(uint32_t a, uint32_t b)
 {
     while (b) {
@@ -222,6 +285,11 @@ static void fill_blocks(rt_ug *u, float *b)
             (float)k->wind[0], (float)k->wind[1], (float)k->wind[2], (float)k->wind[3],
             (float)k->root_blend, (float)k->shadow, (float)footprint(pu, k->mesh),
             (float)bound(pu, k->mesh) };
+        for (uint32_t t = 0; u->vbuf.map && t < u->tri[i][0]; t++) {   /* tri_mesh's */
+            const float *x = (const float *)u->vbuf.map + 8 * (size_t)(u->tri[i][2] + t);
+            float h = sqrtf(x[0] * x[0] + x[1] * x[1] + x[2] * x[2]);
+            v[4 * UG_BLOCK_VEC4 - 1] = h > v[4 * UG_BLOCK_VEC4 - 1] ? h : v[4 * UG_BLOCK_VEC4 - 1];
+        }
         memcpy(b + 4 * UG_BLOCK_VEC4 * i, v, sizeof v);
     }
     u->cap = at;
@@ -269,7 +337,7 @@ static bool make_sets(rt_ug *u, VkDescriptorSet set0_src, const rt_image *height
         { u->draw_set, 0, sb, u->blocks.buf }, { u->draw_set, 1, sb, u->inst.buf },
         { u->draw_set, 2, sb, u->lod.buf }, { u->draw_set, 4, sb, u->vis.buf },
         { u->lod_set, 0, sb, u->args.buf }, { u->lod_set, 1, sb, u->draw_args.buf },
-        { u->lod_set, 2, sb, u->lod.buf }, { u->lod_set, 3, sb, u->far.buf },
+        { u->lod_set, 2, sb, u->lod.buf },
         { u->cull_set, 0, sb, u->inst.buf }, { u->cull_set, 1, sb, u->draw_args.buf },
         { u->cull_set, 2, sb, u->lod.buf }, { u->cull_set, 3, sb, u->blocks.buf },
         { u->cull_set, 4, sb, u->ent.buf }, { u->cull_set, 5, sb, u->cnt.buf },
@@ -327,7 +395,6 @@ static bool make_layouts(rt_ug *u, rt_error *e)
     };
     VkDescriptorSetLayoutBinding lod[] = {
         { 0, sb, 1, cs, NULL }, { 1, sb, 1, cs, NULL }, { 2, sb, 1, cs, NULL },
-        { 3, sb, 1, cs, NULL },
     };
     VkDescriptorSetLayoutBinding cull[7], scan[3];
     for (uint32_t i = 0; i < 7; i++)
@@ -347,7 +414,7 @@ static bool make_layouts(rt_ug *u, rt_error *e)
                           &u->set_cull, e) ||
         !rt_vk_set_layout(d, k, &(rt_vk_set_layout_desc){ "undergrowth scan", scan, 3 },
                           &u->set_scan, e) ||
-        !rt_vk_set_layout(d, k, &(rt_vk_set_layout_desc){ "undergrowth lod", lod, 4 },
+        !rt_vk_set_layout(d, k, &(rt_vk_set_layout_desc){ "undergrowth lod", lod, 3 },
                           &u->set_lod, e))
         return false;
     VkDescriptorSetLayout ms[3] = { u->set_terrain, u->pl->set_material, u->set_mask };
@@ -397,19 +464,19 @@ static bool make_buffers(rt_ug *u, rt_error *e)
                           &u->cnt, e) ||
         !rt_buffer_create(d, (VkDeviceSize)u->pool * u->cap * 4 + 4,
                           st | VK_BUFFER_USAGE_TRANSFER_SRC_BIT, false, &u->vis, e) ||
-        !rt_buffer_create(d, (VkDeviceSize)u->nblocks * 4 * 20,   /* + the shadows' */
+        !rt_buffer_create(d, (VkDeviceSize)u->nblocks * 6 * 20,   /* + the shadows' */
                           st | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
                           false, &u->mdraw, e) ||
-        !rt_buffer_create(d, (VkDeviceSize)u->nblocks * 4 * 20, VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+        !rt_buffer_create(d, (VkDeviceSize)u->nblocks * 6 * 20, VK_BUFFER_USAGE_TRANSFER_DST_BIT,
                           true, &u->mdraw_host, e) ||
         !rt_buffer_create(d, (VkDeviceSize)u->pool * 4, st, true, &u->lod, e) ||
         !rt_buffer_create(d, (VkDeviceSize)u->nblocks * 16 * UG_BLOCK_VEC4, st, true, &u->blocks,
                           e) ||
-        !rt_buffer_create(d, (VkDeviceSize)u->nblocks * 32, st, true, &u->far, e) ||
-        !rt_buffer_create(d, (VkDeviceSize)(pu->nvertices + 4) * 32,
+        /* + the shadow quad, + the single-triangle meshes (tri_mesh) */
+        !rt_buffer_create(d, (VkDeviceSize)(pu->nvertices + 4 + pu->nindices / 2 + 3) * 32,
                           VK_BUFFER_USAGE_VERTEX_BUFFER_BIT, true, &u->vbuf, e) ||
-        !rt_buffer_create(d, (VkDeviceSize)(pu->nindices + 6) * 4, VK_BUFFER_USAGE_INDEX_BUFFER_BIT,
-                          true, &u->ibuf, e) ||
+        !rt_buffer_create(d, (VkDeviceSize)(pu->nindices + 6 + pu->nindices / 2 + 3) * 4,
+                          VK_BUFFER_USAGE_INDEX_BUFFER_BIT, true, &u->ibuf, e) ||
         !rt_buffer_create(d, sizeof(splat_frame), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, true,
                           &u->frame, e))
         return false;
@@ -421,14 +488,27 @@ static bool make_buffers(rt_ug *u, rt_error *e)
     static const uint32_t qi[6] = { 0, 1, 2, 0, 2, 3 };
     memcpy((float *)u->vbuf.map + (size_t)pu->nvertices * 8, quad, sizeof quad);
     memcpy((uint32_t *)u->ibuf.map + pu->nindices, qi, sizeof qi);
-    fill_blocks(u, u->blocks.map);
+    /* each block's single-triangle mesh from its far mesh, after those */
+    uint32_t nv = pu->nvertices + 4, ni = pu->nindices + 6;
     for (int b = 0; b < u->nblocks; b++) {
         int f = pu->meshes[pu->blocks[b].mesh].far;
-        const rt_pack_ug_mesh *m = &pu->meshes[f >= 0 ? f : 0];
-        uint32_t v[8] = { m->nidx, m->first_index, m->first_vertex, f >= 0,
-                          pu->blocks[b].shadow > 0 && u->shadows, 0, 0, 0 };
-        memcpy((uint32_t *)u->far.map + 8 * b, v, sizeof v);
+        int done = -1;   /* a block before with the same far mesh */
+        for (int c = 0; c < b && f >= 0 && done < 0; c++)
+            done = pu->meshes[pu->blocks[c].mesh].far == f && u->tri[c][0] ? c : -1;
+        if (done >= 0) {
+            memcpy(u->tri[b], u->tri[done], sizeof u->tri[b]);
+            continue;
+        }
+        uint32_t nt = f >= 0 ? tri_mesh(pu, &pu->meshes[f], (float *)u->vbuf.map + (size_t)nv * 8,
+                                        (uint32_t *)u->ibuf.map + ni)
+                             : 0;
+        u->tri[b][0] = 3 * nt;
+        u->tri[b][1] = ni;
+        u->tri[b][2] = nv;
+        nv += 3 * nt;
+        ni += 3 * nt;
     }
+    fill_blocks(u, u->blocks.map);
     memset(u->args_host.map, 0, (size_t)u->args_host.size);
     memset(u->mdraw_host.map, 0, (size_t)u->mdraw_host.size);
     for (int i = 0; i < u->pool; i++)
@@ -466,7 +546,8 @@ static bool cull_pipelines(rt_ug *u, rt_error *e)
 }
 
 bool rt_ug_create(rt_device *d, const rt_pack *p, rt_pipelines *pl, const rt_quadtree *qt,
-                  const rt_ug_targets *t, double radius, rt_ug **out, rt_error *e)
+                  const rt_ug_targets *t, double radius, double thin, rt_ug **out,
+                  rt_error *e)
 {
     *out = NULL;
     if (p->ug.nslots == 0)
@@ -480,6 +561,7 @@ bool rt_ug_create(rt_device *d, const rt_pack *p, rt_pipelines *pl, const rt_qua
     u->pl = pl;
     u->qt = qt;
     u->radius = radius > 0 ? radius : RT_UG_RADIUS;
+    u->thin = thin > 0 ? thin : LOD_NEAR;
     u->pool = (int)splat_ug_pool(u->radius);
     u->nblocks = p->ug.nblocks;
     u->nw = (p->ug.nslots + 3) / 4;
@@ -531,7 +613,7 @@ void rt_ug_destroy(rt_ug *u)
     rt_device *d = u->d;
     rt_vk_list_destroy(d, &u->keep);
     rt_buffer *bufs[] = { &u->masks, &u->inst, &u->args, &u->args_host, &u->draw_args, &u->lod,
-                          &u->far, &u->blocks, &u->vbuf, &u->ibuf, &u->frame, &u->ent,
+                          &u->blocks, &u->vbuf, &u->ibuf, &u->frame, &u->ent,
                           &u->cnt, &u->vis, &u->mdraw, &u->mdraw_host };
     for (size_t i = 0; i < sizeof bufs / sizeof *bufs; i++)
         rt_buffer_destroy(d, bufs[i]);
@@ -637,7 +719,7 @@ static void allocate(rt_ug *u, const rt_camera *c, const float view_proj[16])
         double hi[3] = { lo[0] + CELL, hmax - c->position[1] + 8, lo[2] + CELL };
         cl->visible = !box_outside(view_proj, lo, hi);
         double near = cl->dist - CELL * 0.7071;   /* the cell's nearest point, about */
-        double f = near > LOD_NEAR ? (LOD_NEAR / near) * (LOD_NEAR / near) : 1.0;
+        double f = near > u->thin ? (u->thin / near) * (u->thin / near) : 1.0;
         ((float *)u->lod.map)[i] = (float)(f > LOD_MIN ? f : LOD_MIN);
     }
     for (int i = 1; i < u->pool; i++)   /* insertion sort: a few hundred cells */
@@ -747,36 +829,40 @@ static void reset_args(rt_ug *u, VkCommandBuffer cb, int slot)
 }
 
 /* The cull passes' table for this frame (UG_KEYINFO): keys in the draw's
- * order (opaque blocks first; a block's near mesh, then its far one),
- * each key's entries the visible generated cells front to back whose
- * fraction (the LOD pass's) picks that mesh. */
+ * order (opaque blocks first; a block's near mesh, then its far one, then
+ * its single-triangle one), each key's entries the visible generated
+ * cells front to back whose distance picks that mesh (their nearest point
+ * beyond LOD_NEAR: the far mesh; beyond LOD_TRI LOD_NEAR: the single
+ * triangles). */
 static void fill_entries(rt_ug *u)
 {
     const rt_pack_ug *pu = &u->p->ug;
     uint32_t *e = u->ent.map;
-    const float *f = u->lod.map;
     int k = 0, n = 0;
     for (int cut = 0; cut < 2; cut++)
         for (int b = 0; b < u->nblocks; b++) {
             if ((pu->blocks[b].cutout != 0) != cut)
                 continue;
             int far = pu->meshes[pu->blocks[b].mesh].far;
-            for (int l = 0; l < 2; l++) {
-                if (l == 1 && far < 0)
+            for (int l = 0; l < 3; l++) {
+                if ((l == 1 && far < 0) || (l == 2 && (far < 0 || !u->tri[b][0])))
                     continue;
                 const rt_pack_ug_mesh *m = &pu->meshes[l ? far : pu->blocks[b].mesh];
                 uint32_t *ki = e + UG_KEYINFO + 4 * k;
-                ki[0] = m->nidx;
-                ki[1] = m->first_index;
-                ki[2] = m->first_vertex;
+                ki[0] = l == 2 ? u->tri[b][0] : m->nidx;
+                ki[1] = l == 2 ? u->tri[b][1] : m->first_index;
+                ki[2] = l == 2 ? u->tri[b][2] : m->first_vertex;
                 ki[3] = pu->blocks[b].shadow > 0 && u->shadows;
                 e[k] = (uint32_t)n;
                 u->key_block[k] = b;
                 for (int i = 0; i < u->pool; i++) {
                     int slot = u->order[i];
                     const ug_cell *cl = &u->cells[slot];
-                    if (cl->state != CELL_READY || !cl->visible ||
-                        (f[slot] < 1.0f && far >= 0) != (l == 1))
+                    double near = cl->dist - CELL * 0.7071;   /* its nearest point, about */
+                    int lv = near > LOD_NEAR && far >= 0;
+                    if (lv && u->tri[b][0] && near > LOD_TRI * LOD_NEAR)
+                        lv = 2;
+                    if (cl->state != CELL_READY || !cl->visible || lv != l)
                         continue;
                     e[UG_ENT0 + n++] = (uint32_t)(slot * u->nblocks + b);
                 }

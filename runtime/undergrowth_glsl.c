@@ -87,16 +87,15 @@ const char rt_ug_gen_glsl[] =
 /* The LOD pass, every frame: each cell's draw arguments from the
  * generated ones, its instance count times its fraction (a prefix: the
  * scatter pass keeps instances in a lattice order that spreads every
- * prefix), and beyond LOD_NEAR the block's far mesh where it has one
- * (PACK.md: index count, first index, vertex offset, and w = 1).  The
- * cull passes read them (and the probe); nothing draws them directly. */
+ * prefix).  The cull passes read the count and the first instance (and
+ * the probe does); the mesh is the cull's key's (undergrowth.c
+ * fill_entries). */
 const char rt_ug_lod_glsl[] =
     "#version 450\n"
     "layout(local_size_x = 64) in;\n"
     "layout(set = 0, binding = 0, std430) readonly buffer A { uint a[]; } u_args;\n"
     "layout(set = 0, binding = 1, std430) writeonly buffer D { uint a[]; } u_draw;\n"
     "layout(set = 0, binding = 2, std430) readonly buffer F { float f[]; } u_lod;\n"
-    "layout(set = 0, binding = 3, std430) readonly buffer M { uvec4 m[]; } u_far;\n"
     "layout(push_constant, std430) uniform P { uint n, nblocks, qidx, qvtx; } u_p;\n"
     "void main() {\n"
     "    uint i = gl_GlobalInvocationID.x;\n"
@@ -104,12 +103,6 @@ const char rt_ug_lod_glsl[] =
     "    for (uint k = 0u; k < 5u; k++) u_draw.a[5u * i + k] = u_args.a[5u * i + k];\n"
     "    float f = u_lod.f[i / u_p.nblocks];\n"
     "    u_draw.a[5u * i + 1u] = uint(ceil(float(u_args.a[5u * i + 1u]) * f));\n"
-    "    uvec4 m = u_far.m[2u * (i % u_p.nblocks)];   /* the block's far mesh */\n"
-    "    if (f < 1.0 && m.w != 0u) {\n"
-    "        u_draw.a[5u * i] = m.x;\n"
-    "        u_draw.a[5u * i + 2u] = m.y;\n"
-    "        u_draw.a[5u * i + 3u] = m.z;\n"
-    "    }\n"
     "}\n";
 
 /* The vertex stage's fade and wind (the top comment), shared by the draw

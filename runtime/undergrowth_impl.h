@@ -11,7 +11,9 @@
 #define UG_TODO 1024   /* cells generated per frame at most */
 #define CELL    SPLAT_UG_CELL        /* metres per cell side (abi.h)        */
 #define TEXELS  SPLAT_UG_TEXELS      /* mask texels per cell side           */
-/* Distance LOD: beyond LOD_NEAR metres a cell draws the fraction
+/* Distance LOD: beyond LOD_NEAR metres (rt_render_desc.undergrowth_thin
+ * may set another distance for the fraction, not the meshes) a cell draws
+ * the fraction
  * (LOD_NEAR / d)^2 of its instances (at least LOD_MIN), each widened by
  * 1 / sqrt(fraction) (at most LOD_GROW) but not raised: about as many
  * instances per pixel at every distance and the same cover seen from
@@ -28,11 +30,15 @@
  * mesh at e[UG_KEYINFO + 4k]: index count, first index, vertex offset,
  * contact shadows or not; the entries from e[UG_ENT0]: a cell's block,
  * slot * blocks + block (undergrowth.c "cull"). */
-#define UG_MAX_KEYS  (2 * SPLAT_MAX_UG_BLOCKS)
+#define UG_MAX_KEYS  (3 * SPLAT_MAX_UG_BLOCKS)
 #define UG_KEYINFO   256
 #define UG_KEYINFO_S "256u"
 #define UG_ENT0      (UG_KEYINFO + 4 * UG_MAX_KEYS)
-#define UG_ENT0_S    "768u"
+#define UG_ENT0_S    "1024u"
+/* Beyond LOD_TRI times the LOD distance (a cell's nearest point) a block
+ * whose far mesh is made of tapered quads draws them as single triangles
+ * (undergrowth.c tri_mesh). */
+#define LOD_TRI 2.0
 
 enum { CELL_FREE, CELL_PENDING, CELL_READY };
 
@@ -71,6 +77,8 @@ struct rt_ug {
     uint32_t             *block_base;          /* first instance in a cell   */
     uint32_t             *block_grid;          /* candidates per side        */
     double                radius;
+    double                thin;                /* the fraction's distance: LOD_NEAR
+                                                  or the renderer's          */
     ug_cell              *cells;
     int                  *order;               /* draw order, front to back  */
     /* device-local: masks, instances, draw arguments (the GPU writes
@@ -80,11 +88,14 @@ struct rt_ug {
     rt_buffer             masks, inst, args, args_host, blocks, vbuf, ibuf, frame;
     rt_buffer             draw_args;           /* args with the LOD's counts */
     rt_buffer             lod;                 /* per slot: fraction drawn   */
-    rt_buffer             far;                 /* per block: far mesh (LOD)  */
     /* the cull passes: their table (host), the entries' counts and
      * offsets, the drawn instances' indices, the draws per key (and a
      * host copy of them, for the stats) */
     rt_buffer             ent, cnt, vis, mdraw, mdraw_host;
+    uint32_t              tri[SPLAT_MAX_UG_BLOCKS][3];   /* per block: its single-
+                                               triangle mesh's index count
+                                               (0: none), first index, first
+                                               vertex (tri_mesh)              */
     int                   nkeys, nent;         /* this frame's               */
     int                   key_block[UG_MAX_KEYS];   /* each key's block       */
     bool                  key_used[UG_MAX_KEYS];    /* it has entries         */

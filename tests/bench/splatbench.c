@@ -38,9 +38,13 @@
  *       noshadow renders without the terrain's shadows (--no-shadows); ug
  *       draws the pack's undergrowth (off otherwise, so the other groups
  *       time what they always timed), ugradius=R within R metres of the
- *       camera instead of the runtime's 96: its rows add the generation GPU ms
- *       per frame and per generated cell, the draw GPU ms per frame, the
- *       instances and the memory per cell.  far=D shades screen tiles
+ *       camera instead of the runtime's 96, ugthin=D thins it (the distance
+ *       LOD's fraction (D / d)^2) from D metres instead of 14, the far
+ *       meshes staying at 14 m (rt_render_desc.undergrowth_thin): its rows add
+ *       the generation GPU ms per frame and per generated cell, the draw GPU
+ *       ms per frame, the instances and the memory per cell, and of the last
+ *       frame the candidates, the instances and triangles drawn and the
+ *       indirect draws.  far=D shades screen tiles
  *       (screen kinds) or quadtree patches (composite) at least D m away
  *       from the pack's far atlas (splatc build --far-atlas); its rows add
  *       the distance and the tiles (patches) the atlas shaded (from the
@@ -112,6 +116,7 @@ typedef struct variant {
                                shader standing in (screen kinds)          */
     bool         ug;        /* draw the undergrowth                         */
     double       ug_radius; /* its radius (m); 0: the runtime's default     */
+    double       ug_thin;   /* its thinning distance (m); 0: the runtime's  */
     double       far;       /* screen: the far atlas's distance (m); 0: off */
     double       shadow_ms; /* ms of the shadow map (the first frame)       */
     double      *ug_gen, *ug_draw; /* per timed frame, GPU ms               */
@@ -346,6 +351,10 @@ static bool parse_variant(const char *s, const char *default_pack, variant *v)
             v->ug = true;
             v->ug_radius = atof(t + 9);
             ok = v->ug_radius > 0;
+        } else if (!strncmp(t, "ugthin=", 7)) {
+            v->ug = true;
+            v->ug_thin = atof(t + 7);
+            ok = v->ug_thin > 0;
         } else if (!strncmp(t, "far=", 4)) {
             v->far = atof(t + 4);
             ok = v->far > 0;
@@ -605,7 +614,7 @@ static bool make_renderer(bench_run *b, int i, const char *cache, rt_error *e)
         .no_distance_classes = v->no_dclass, .pixel_sort = v->sort,
         .async_pipelines = v->async,
         .sort_tiles = v->sort_tiles,
-        .undergrowth_radius = v->ug_radius, .far_atlas_distance = v->far,
+        .undergrowth_radius = v->ug_radius, .undergrowth_thin = v->ug_thin, .far_atlas_distance = v->far,
         .reference = v->k == K_MULTIPASS ? RT_REF_MULTIPASS
                    : v->k == K_UBER || v->k == K_SCREEN_UBER ? RT_REF_UBER : RT_REF_NONE,
         .pipeline_cache = cache,

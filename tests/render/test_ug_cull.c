@@ -13,9 +13,11 @@
  *   - the cull removed what the frustum hides: the instances drawn are
  *     fewer than half of those the distance LOD and the fade keep in the
  *     allocated cells (the probe's count, rt_renderer_undergrowth_rings);
- *   - per block: a near key and a far key (the far mesh), both drawn, the
- *     far one with fewer indices per instance, its instances all beyond
- *     the LOD distance (14 m), the near one's within it plus a cell's
+ *   - per block its keys: the near mesh, the far mesh, and for the grass
+ *     (whose far mesh is tapered quads) single triangles, each with fewer
+ *     indices per instance than the one before, the grass drawn at every
+ *     LOD, each key's instances in its ring: from 0, 14 m (the LOD
+ *     distance) and 28 m on, to the next ring's start plus a cell's
  *     diagonal;
  *   - a second renderer draws the same list, byte for byte and in the
  *     same order;
@@ -152,29 +154,35 @@ int main(int argc, char **argv)
     printf("kept by the LOD and the fade: %ld, drawn after the frustum: %d\n", kept, n);
     CHECK(n * 2L < kept, "drawn %d of %ld kept: the frustum culled too little", n, kept);
 
-    /* the keys: per block a near and a far mesh, fewer indices far away */
+    /* the keys: per block a near, a far mesh and (grass: tapered quads) a
+     * single-triangle one, fewer indices each, their instances in rings */
     for (int blk = 0; blk < 2; blk++) {
-        int near = -1, far = -1;
+        int key[3] = { -1, -1, -1 }, nk = 0;
         for (int k = 0; k < u->keys; k++)
-            if (u->key_block[k] == blk)
-                *(near < 0 ? &near : &far) = k;
-        CHECK(near >= 0 && far >= 0, "block %d: keys %d, %d", blk, near, far);
-        if (near < 0 || far < 0)
-            continue;
-        printf("block %d: near %u instances x %u indices, far %u x %u\n", blk,
-               u->key_drawn[near], u->key_indices[near], u->key_drawn[far], u->key_indices[far]);
-        CHECK(u->key_indices[far] < u->key_indices[near], "block %d: far mesh %u indices, near %u",
-              blk, u->key_indices[far], u->key_indices[near]);
-        CHECK(blk == 1 || (u->key_drawn[near] > 0 && u->key_drawn[far] > 0),
-              "block %d: near %u, far %u drawn", blk, u->key_drawn[near], u->key_drawn[far]);
+            if (u->key_block[k] == blk && nk < 3)
+                key[nk++] = k;
+        CHECK(nk == (blk == 0 ? 3 : 2), "block %d: %d keys", blk, nk);
+        for (int l = 0; l < nk; l++)
+            printf("block %d, LOD %d: %u instances x %u indices\n", blk, l, u->key_drawn[key[l]],
+                   u->key_indices[key[l]]);
+        for (int l = 1; l < nk; l++)
+            CHECK(u->key_indices[key[l]] < u->key_indices[key[l - 1]],
+                  "block %d: LOD %d has %u indices, LOD %d %u", blk, l, u->key_indices[key[l]],
+                  l - 1, u->key_indices[key[l - 1]]);
+        for (int l = 0; l < nk && blk == 0; l++)
+            CHECK(u->key_drawn[key[l]] > 0, "block %d: nothing drawn at LOD %d", blk, l);
         int bad = 0;
         for (int i = 0; i < n; i++) {
             double d = hypot(a[i].pos[0] - cam.position[0], a[i].pos[2] - cam.position[2]);
-            if (ka[i] == far)
-                bad += d < LOD_NEAR - 1e-3;
-            else if (ka[i] == near)
-                bad += d > LOD_NEAR + CELL * sqrt(2.0) + 1e-3;
-            bad += (ka[i] == near || ka[i] == far) && a[i].block != (uint32_t)blk;
+            for (int l = 0; l < nk; l++) {
+                if (ka[i] != key[l])
+                    continue;
+                /* LOD l from its cell's nearest point on: 0, 14 m, 28 m */
+                double lo = l == 0 ? 0 : l == 1 ? LOD_NEAR : 2 * LOD_NEAR;
+                double hi = l == nk - 1 ? 1e9 : l == 0 ? LOD_NEAR : 2 * LOD_NEAR;
+                bad += d < lo - 1e-3 || d > hi + CELL * sqrt(2.0) + 1e-3 ||
+                       a[i].block != (uint32_t)blk;
+            }
         }
         CHECK(bad == 0, "block %d: %d instances in the wrong LOD ring or key", blk, bad);
     }
