@@ -839,6 +839,10 @@ static void fill_entries(rt_ug *u)
     const rt_pack_ug *pu = &u->p->ug;
     uint32_t *e = u->ent.map;
     int k = 0, n = 0;
+    /* contact shadows end where ug_far reaches 1 (undergrowth_glsl.c: 0.8
+     * r1, r1 = max(radius - 12, radius / 2)): a cell whose nearest point
+     * is farther multiplies the colour by 1 */
+    double shadow_end = 0.8 * fmax(u->radius - 12.0, 0.5 * u->radius);
     for (int cut = 0; cut < 2; cut++)
         for (int b = 0; b < u->nblocks; b++) {
             if ((pu->blocks[b].cutout != 0) != cut)
@@ -852,7 +856,7 @@ static void fill_entries(rt_ug *u)
                 ki[0] = l == 2 ? u->tri[b][0] : m->nidx;
                 ki[1] = l == 2 ? u->tri[b][1] : m->first_index;
                 ki[2] = l == 2 ? u->tri[b][2] : m->first_vertex;
-                ki[3] = pu->blocks[b].shadow > 0 && u->shadows;
+                bool shadows = pu->blocks[b].shadow > 0 && u->shadows;
                 e[k] = (uint32_t)n;
                 u->key_block[k] = b;
                 for (int i = 0; i < u->pool; i++) {
@@ -864,8 +868,14 @@ static void fill_entries(rt_ug *u)
                         lv = 2;
                     if (cl->state != CELL_READY || !cl->visible || lv != l)
                         continue;
+                    if (shadows && near >= shadow_end)   /* and every entry after */
+                        shadows = false, ki[3] = (uint32_t)n;
                     e[UG_ENT0 + n++] = (uint32_t)(slot * u->nblocks + b);
                 }
+                if (shadows)
+                    ki[3] = (uint32_t)n;
+                else if (!(pu->blocks[b].shadow > 0 && u->shadows))
+                    ki[3] = e[k];
                 u->key_used[k] = e[k] != (uint32_t)n;
                 k++;
             }

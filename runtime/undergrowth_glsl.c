@@ -216,8 +216,10 @@ const char rt_ug_cull_glsl[] =
  * total at c[2n]), then per key its draw (indexed indirect: the mesh's
  * index count, first index and vertex offset from the key table, the
  * instances of its entries, the first at its first entry's offset) and
- * its contact shadows' after the nkeys draws (none where the key's block
- * casts none). */
+ * its contact shadows' after the nkeys draws: the instances of its
+ * entries before the key table's shadow end (undergrowth.c fill_entries:
+ * the first entry too far for a shadow to show, its first entry where
+ * the block casts none). */
 const char rt_ug_scan_glsl[] =
     "layout(local_size_x = UG_LS) in;\n"
     "layout(set = 0, binding = 0, std430) readonly buffer E { uint e[]; } u_ent;\n"
@@ -254,7 +256,7 @@ const char rt_ug_scan_glsl[] =
     "        u_md.a[5u * k + 4u] = f;\n"
     "        uint s = 5u * (u_p.nkeys + k);\n"
     "        u_md.a[s] = 6u;\n"
-    "        u_md.a[s + 1u] = u_ent.e[ki + 3u] != 0u ? cnt : 0u;\n"
+    "        u_md.a[s + 1u] = u_cnt.c[n + max(u_ent.e[ki + 3u], e0)] - f;\n"
     "        u_md.a[s + 2u] = u_p.qidx;\n"
     "        u_md.a[s + 3u] = u_p.qvtx;\n"
     "        u_md.a[s + 4u] = f;\n"

@@ -28,7 +28,8 @@
 /* The cull passes' table (host-visible, written each frame): key k's
  * entries are [e[k], e[k + 1]) (a key: a block's near or far mesh); its
  * mesh at e[UG_KEYINFO + 4k]: index count, first index, vertex offset,
- * contact shadows or not; the entries from e[UG_ENT0]: a cell's block,
+ * the end of its entries with contact shadows; the entries from
+ * e[UG_ENT0]: a cell's block,
  * slot * blocks + block (undergrowth.c "cull"). */
 #define UG_MAX_KEYS  (3 * SPLAT_MAX_UG_BLOCKS)
 #define UG_KEYINFO   256
