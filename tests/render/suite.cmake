@@ -212,8 +212,8 @@ if(TARGET splatrt AND TARGET splatview)
     add_test(NAME render.vk_build COMMAND test_vk_build)
     set_tests_properties(render.vk_build PROPERTIES LABELS "render;asan" TIMEOUT 300
                          ENVIRONMENT "SPLAT_VALIDATE=1")
-    # the undergrowth's cells, GPU passes and pack sections under the
+    # the undergrowth's cells, GPU passes, cull passes and pack sections under the
     # sanitizers too
-    set_tests_properties(render.undergrowth PROPERTIES LABELS "render;asan")
+    set_tests_properties(render.undergrowth render.ug_cull PROPERTIES LABELS "render;asan")
   endif()
 endif()
