@@ -286,6 +286,12 @@ int rt_renderer_undergrowth_rings(rt_renderer *r, double width, int nrings, uint
     return rt_ug_probe_rings(r->ug, width, nrings, counts, e);
 }
 
+int rt_renderer_undergrowth_drawn(rt_renderer *r, rt_ug_instance *out, int *key, int max,
+                                  rt_error *e)
+{
+    return r->ug ? rt_ug_read_drawn(r->ug, out, key, max, e) : 0;
+}
+
 bool rt_renderer_undergrowth_wind(rt_renderer *r, float *points, int n, double time,
                                   rt_error *e)
 {

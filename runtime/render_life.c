@@ -399,7 +399,8 @@ static bool make_undergrowth(rt_renderer *r, rt_error *e)
         .width = r->desc.width, .height_px = r->desc.height,
         .nearest = r->terrain.nearest_clamp, .set0 = r->set0, .timestamps = r->timestamps,
     };
-    return rt_ug_create(r->d, r->p, &r->pl, &r->qt, &t, r->desc.undergrowth_radius, &r->ug, e);
+    return rt_ug_create(r->d, r->p, &r->pl, &r->qt, &t, r->desc.undergrowth_radius,
+                        r->desc.undergrowth_thin, &r->ug, e);
 }
 
 /* The objects made of the pack's own data, beside what a hot reload keeps

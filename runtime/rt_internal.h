@@ -936,7 +936,8 @@ typedef struct rt_ug_targets {
 /* *out stays NULL when the pack has no undergrowth; set even on failure
  * (free with rt_ug_destroy).  radius 0: RT_UG_RADIUS. */
 bool rt_ug_create(rt_device *d, const rt_pack *p, rt_pipelines *pl, const rt_quadtree *qt,
-                  const rt_ug_targets *t, double radius, rt_ug **out, rt_error *e);
+                  const rt_ug_targets *t, double radius, double thin, rt_ug **out,
+                  rt_error *e);
 void rt_ug_destroy(rt_ug *u);
 /* Allocate the cells around the camera (on the CPU: which are visible),
  * then record the generation of up to `budget` pending ones (<= 0: all),
@@ -966,6 +967,10 @@ int  rt_ug_read_cell(rt_ug *u, int ix, int iz, rt_ug_instance *out, int max, rt_
  * counts[nrings + k] all the LOD's there, kept or not; the generated
  * cells it counted, or -1 on error. */
 int  rt_ug_probe_rings(rt_ug *u, double width, int nrings, uint32_t *counts, rt_error *e);
+/* Tests: the instances the last frame drew, in the draw's order, up to
+ * max, with each one's key (rt_ug_stats: a block's near or far mesh) in
+ * key[] when not NULL; how many it drew (may exceed max), -1 on error. */
+int  rt_ug_read_drawn(rt_ug *u, rt_ug_instance *out, int *key, int max, rt_error *e);
 /* Tests: the vertex stage's wind at n points on the device, 12 floats
  * each: root xyz, h (m above the root), the block's wind (direction x, z,
  * sway, gust) in, then the offset xyz and the gust in [0, 1] out. */

@@ -324,6 +324,11 @@ typedef struct rt_render_desc {
                                        drawing their tiles meanwhile (the
                                        viewer's default; headless waits)   */
     double       undergrowth_radius; /* m around the camera; 0: RT_UG_RADIUS    */
+    double       undergrowth_thin;  /* m: beyond it a cell draws the fraction
+                                       (thin / d)^2 of its instances (at
+                                       least 8 %), widened; 0: 14 (the far
+                                       meshes' distance, which stays;
+                                       runtime/DESIGN.md)                   */
     bool         split_uncovered;   /* forward: coarse quadtree nodes that
                                        no compiled combination covers (the
                                        pack composes leaf cells only) are
@@ -354,10 +359,20 @@ typedef struct rt_ug_instance {
 /* Undergrowth of a frame (runtime/undergrowth.c). */
 #define RT_UG_RADIUS SPLAT_UG_RADIUS /* default radius of the cells around the camera
                                         (abi.h: splatc checks packs at it) */
+#define RT_UG_KEYS_MAX 16
 typedef struct rt_ug_stats {
     int    cells;             /* cells allocated around the camera          */
     int    generated;         /* of them, generated in this frame           */
     long   instances;         /* instances in the allocated cells           */
+    long   candidates;        /* the scatter pass's candidates in them      */
+    long   drawn;             /* instances drawn (after LOD, fade, frustum) */
+    long   triangles;         /* triangles drawn, contact shadows included  */
+    int    draws;             /* indirect draws                             */
+    /* per key (one draw: a block's near or far mesh, in the draw's order;
+     * the first RT_UG_KEYS_MAX): its block, index count, instances drawn */
+    int    keys;
+    int    key_block[RT_UG_KEYS_MAX];
+    uint32_t key_indices[RT_UG_KEYS_MAX], key_drawn[RT_UG_KEYS_MAX];
     double gen_ms, draw_ms;   /* GPU ms (timestamps; < 0 if unsupported)    */
     size_t bytes_per_cell;    /* masks + instance capacity + draw arguments */
 } rt_ug_stats;
@@ -423,6 +438,13 @@ int  rt_renderer_undergrowth_cell(rt_renderer *r, int ix, int iz, rt_ug_instance
  * farther ones not counted), and in counts[nrings + k] the LOD's before
  * the fade (2 nrings counts): the cells counted, -1 on error. */
 int  rt_renderer_undergrowth_rings(rt_renderer *r, double width, int nrings, uint32_t *counts,
+                                   rt_error *e);
+/* For tests: the undergrowth instances the last frame drew (after the
+ * distance LOD, the fade and the frustum: runtime/undergrowth.c "cull"),
+ * in the draw's order, up to max, each one's key (rt_ug_stats.key_*: the
+ * block's near or far mesh) in key[] when not NULL; returns how many it
+ * drew (may exceed max), -1 on error. */
+int  rt_renderer_undergrowth_drawn(rt_renderer *r, rt_ug_instance *out, int *key, int max,
                                    rt_error *e);
 /* For tests: the vertex stage's wind offset on the device at n points (12
  * floats each: root xyz, h metres above the root, a block's wind: unit

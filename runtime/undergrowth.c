@@ -21,8 +21,13 @@
  *      Instances are compacted by a workgroup prefix sum in candidate
  *      order, so the buffer is deterministic (no atomics), and the count
  *      goes straight into the block's indirect draw arguments.
- * Drawing is one indexed indirect draw per block and cell, cells front to
- * back, after the terrain into its colour and depth; lit by splat_light
+ * Every frame a LOD pass scales each cell's counts by its distance, then
+ * the cull passes ("cull", undergrowth_glsl.c rt_ug_cull_glsl) keep the
+ * instances the fade leaves a size and whose bounds touch the frustum,
+ * compacted into one list (deterministic: count, scan, write).  Drawing
+ * is one indexed indirect draw per key (a block's near or far mesh) over
+ * that list, cells front to back within a key, opaque blocks first,
+ * after the terrain into its colour and depth; lit by splat_light
  * (abi.c) with the terrain normal (a block's `lighting = terrain`) or the
  * mesh's.  In the vertex stage (ug_glsl, which the probe pass runs too):
  *   - the distance fade: an instance at distance d from the camera stays
@@ -159,6 +164,84 @@ static double footprint(const rt_pack_ug *pu, int mesh)
     return r;
 }
 
+/* The cull passes' bounding radius of a block at scale 1 (m): its mesh's
+ * and its far mesh's farthest vertex from the root, or its contact
+ * shadow's quad (1.3 footprints) if wider. */
+static double bound(const rt_pack_ug *pu, int mesh)
+{
+    double r = 1.3 * footprint(pu, mesh);
+    for (int k = 0; k < 2; k++) {
+        int id = k == 0 ? mesh : pu->meshes[mesh].far;
+        if (id < 0)
+            continue;
+        const rt_pack_ug_mesh *m = &pu->meshes[id];
+        for (uint32_t v = 0; v < m->nv; v++) {
+            const float *x = pu->vertices + 8 * (size_t)(m->first_vertex + v);
+            double h = sqrt((double)x[0] * x[0] + (double)x[1] * x[1] + (double)x[2] * x[2]);
+            r = h > r ? h : r;
+        }
+    }
+    return r;
+}
+
+/* The single-triangle version of a far mesh made of tapered quads (each
+ * pair of triangles has 4 distinct vertices, 2 at the root, v = 0, and 2
+ * at the tip, v = 1): per quad one triangle from the root edge, widened
+ * about its middle by (root + tip width) / root width so that it keeps
+ * the quad's area, to the middle of the tip edge.  Writes 3 vertices (8
+ * floats) and 3 indices (from 0) per quad; returns the triangles, 0 when
+ * the mesh is not made of such quads (stone.far, an OBJ). */
+static uint32_t tri_mesh(const rt_pack_ug *pu, const rt_pack_ug_mesh *m, float *vout,
+                         uint32_t *iout)
+{
+    if (m->nidx == 0 || m->nidx % 6 != 0)
+        return 0;
+    for (uint32_t q = 0; q < m->nidx / 6; q++) {
+        const uint32_t *ix = pu->indices + m->first_index + 6 * q;
+        const float *v[4];
+        int n = 0;
+        for (int k = 0; k < 6; k++) {
+            const float *x = pu->vertices + 8 * (size_t)(m->first_vertex + ix[k]);
+            bool seen = false;
+            for (int j = 0; j < n; j++)
+                seen |= v[j] == x;
+            if (!seen && n == 4)
+                return 0;
+            if (!seen)
+                v[n++] = x;
+        }
+        const float *root[2], *tip[2];
+        int nr = 0, nt = 0;
+        for (int j = 0; j < n; j++) {
+            if (v[j][7] == 0.0f && nr < 2)
+                root[nr++] = v[j];
+            else if (v[j][7] == 1.0f && nt < 2)
+                tip[nt++] = v[j];
+        }
+        if (n != 4 || nr != 2 || nt != 2)
+            return 0;
+        double wr = 0, wt = 0;
+        for (int c = 0; c < 3; c++) {
+            wr += ((double)root[1][c] - root[0][c]) * ((double)root[1][c] - root[0][c]);
+            wt += ((double)tip[1][c] - tip[0][c]) * ((double)tip[1][c] - tip[0][c]);
+        }
+        double grow = wr > 0 ? (sqrt(wr) + sqrt(wt)) / sqrt(wr) : 1.0;
+        float *o = vout + 24 * (size_t)q;
+        for (int c = 0; c < 8; c++) {
+            double mid = 0.5 * ((double)root[0][c] + root[1][c]);
+            o[c] = (float)(c < 3 ? mid + (root[0][c] - mid) * grow : root[0][c]);
+            o[8 + c] = (float)(c < 3 ? mid + (root[1][c] - mid) * grow : root[1][c]);
+            o[16 + c] = (float)(0.5 * ((double)tip[0][c] + tip[1][c]));
+        }
+        o[6] = 0.0f;   /* u across the blade: 0, 1 at the root, 0.5 at the tip */
+        o[14] = 1.0f;
+        o[22] = 0.5f;
+        for (int k = 0; k < 3; k++)
+            iout[3 * q + (uint32_t)k] = 3 * q + (uint32_t)k;
+    }
+    return m->nidx / 6;
+}
+
 static uint32_t gcd(uint32_t a, uint32_t b)
 {
     while (b) {
@@ -174,7 +257,7 @@ static uint32_t gcd(uint32_t a, uint32_t b)
  * scale lo, scale hi, blend), (colour, slot), (candidates per side, first
  * instance in the cell, flags, the stride of the candidates' lattice
  * order), (wind direction x, z, sway, gust), (root blend, shadow, the
- * mesh's footprint radius, 0).
+ * mesh's footprint radius, the cull passes' bounding radius).
  * Flags: 1 cut out (frond), 2 lit with the terrain normal, 4 aligned to
  * the terrain normal, 8 cut out by the texture's alpha; bits 8 and up the
  * texture + 1 (0: none). */
@@ -200,7 +283,13 @@ static void fill_blocks(rt_ug *u, float *b)
             (float)k->color[0], (float)k->color[1], (float)k->color[2], (float)k->slot,
             (float)n, (float)u->block_base[i], (float)flags, (float)(stride ? stride : 1),
             (float)k->wind[0], (float)k->wind[1], (float)k->wind[2], (float)k->wind[3],
-            (float)k->root_blend, (float)k->shadow, (float)footprint(pu, k->mesh), 0 };
+            (float)k->root_blend, (float)k->shadow, (float)footprint(pu, k->mesh),
+            (float)bound(pu, k->mesh) };
+        for (uint32_t t = 0; u->vbuf.map && t < u->tri[i][0]; t++) {   /* tri_mesh's */
+            const float *x = (const float *)u->vbuf.map + 8 * (size_t)(u->tri[i][2] + t);
+            float h = sqrtf(x[0] * x[0] + x[1] * x[1] + x[2] * x[2]);
+            v[4 * UG_BLOCK_VEC4 - 1] = h > v[4 * UG_BLOCK_VEC4 - 1] ? h : v[4 * UG_BLOCK_VEC4 - 1];
+        }
         memcpy(b + 4 * UG_BLOCK_VEC4 * i, v, sizeof v);
     }
     u->cap = at;
@@ -211,21 +300,23 @@ static bool make_sets(rt_ug *u, VkDescriptorSet set0_src, const rt_image *height
 {
     rt_device *d = u->d;
     VkDescriptorPoolSize sizes[3] = {
-        { VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 13 + 1 },   /* + set 0's vector shapes */
+        { VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 24 + 1 },   /* + set 0's vector shapes */
         { VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 16 + SPLAT_MAX_UG_TEXTURES },
         { VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 2 },
     };
-    VkDescriptorSetLayout layouts[5] = { u->set_terrain, u->set_mask, u->set_gen, u->set_draw,
-                                         u->set_lod };
-    VkDescriptorSet sets[5];
+    VkDescriptorSetLayout layouts[7] = { u->set_terrain, u->set_mask, u->set_gen, u->set_draw,
+                                         u->set_lod, u->set_cull, u->set_scan };
+    VkDescriptorSet sets[7];
     if (!rt_vk_sets(d, &u->keep, &(rt_vk_sets_desc){ .label = "undergrowth", .sizes = sizes,
-                        .nsizes = 3, .layouts = layouts, .nsets = 5 }, &u->dpool, sets, e))
+                        .nsizes = 3, .layouts = layouts, .nsets = 7 }, &u->dpool, sets, e))
         return false;
     u->set0 = sets[0];
     u->mask_set = sets[1];
     u->gen_set = sets[2];
     u->draw_set = sets[3];
     u->lod_set = sets[4];
+    u->cull_set = sets[5];
+    u->scan_set = sets[6];
     /* set 0 of the mask pass: the terrain's, but the frame block whose
      * camera is the origin (abi.h "undergrowth masks") */
     rt_terrain_compute_set(d, set0_src, u->set0, u->frame.buf);
@@ -244,9 +335,15 @@ static bool make_sets(rt_ug *u, VkDescriptorSet set0_src, const rt_image *height
         { u->gen_set, 2, sb, u->args.buf }, { u->gen_set, 3, sb, u->blocks.buf },
         { u->gen_set, 4, cis, .sampler = nearest, .view = height->view },
         { u->draw_set, 0, sb, u->blocks.buf }, { u->draw_set, 1, sb, u->inst.buf },
-        { u->draw_set, 2, sb, u->lod.buf },
+        { u->draw_set, 2, sb, u->lod.buf }, { u->draw_set, 4, sb, u->vis.buf },
         { u->lod_set, 0, sb, u->args.buf }, { u->lod_set, 1, sb, u->draw_args.buf },
-        { u->lod_set, 2, sb, u->lod.buf }, { u->lod_set, 3, sb, u->far.buf },
+        { u->lod_set, 2, sb, u->lod.buf },
+        { u->cull_set, 0, sb, u->inst.buf }, { u->cull_set, 1, sb, u->draw_args.buf },
+        { u->cull_set, 2, sb, u->lod.buf }, { u->cull_set, 3, sb, u->blocks.buf },
+        { u->cull_set, 4, sb, u->ent.buf }, { u->cull_set, 5, sb, u->cnt.buf },
+        { u->cull_set, 6, sb, u->vis.buf },
+        { u->scan_set, 0, sb, u->ent.buf }, { u->scan_set, 1, sb, u->cnt.buf },
+        { u->scan_set, 2, sb, u->mdraw.buf },
         { u->draw_set, 3, cis, .images = ti, .count = SPLAT_MAX_UG_TEXTURES },
     };
     rt_vk_write_sets(d, w, sizeof w / sizeof *w);
@@ -294,11 +391,16 @@ static bool make_layouts(rt_ug *u, rt_error *e)
         { 2, sb, 1, VK_SHADER_STAGE_VERTEX_BIT, NULL },
         { 3, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, SPLAT_MAX_UG_TEXTURES,
           VK_SHADER_STAGE_FRAGMENT_BIT, NULL },
+        { 4, sb, 1, VK_SHADER_STAGE_VERTEX_BIT, NULL },
     };
     VkDescriptorSetLayoutBinding lod[] = {
         { 0, sb, 1, cs, NULL }, { 1, sb, 1, cs, NULL }, { 2, sb, 1, cs, NULL },
-        { 3, sb, 1, cs, NULL },
     };
+    VkDescriptorSetLayoutBinding cull[7], scan[3];
+    for (uint32_t i = 0; i < 7; i++)
+        cull[i] = (VkDescriptorSetLayoutBinding){ i, sb, 1, cs, NULL };
+    for (uint32_t i = 0; i < 3; i++)
+        scan[i] = (VkDescriptorSetLayoutBinding){ i, sb, 1, cs, NULL };
     rt_vk_list *k = &u->keep;
     if (!rt_terrain_compute_layout(d, &u->set_terrain, e) ||
         !rt_vk_keep(d, k, VK_OBJECT_TYPE_DESCRIPTOR_SET_LAYOUT, RT_VK_H(u->set_terrain), e) ||
@@ -306,9 +408,13 @@ static bool make_layouts(rt_ug *u, rt_error *e)
                           &u->set_mask, e) ||
         !rt_vk_set_layout(d, k, &(rt_vk_set_layout_desc){ "undergrowth scatter", gen, 5 },
                           &u->set_gen, e) ||
-        !rt_vk_set_layout(d, k, &(rt_vk_set_layout_desc){ "undergrowth draw", draw, 4 },
+        !rt_vk_set_layout(d, k, &(rt_vk_set_layout_desc){ "undergrowth draw", draw, 5 },
                           &u->set_draw, e) ||
-        !rt_vk_set_layout(d, k, &(rt_vk_set_layout_desc){ "undergrowth lod", lod, 4 },
+        !rt_vk_set_layout(d, k, &(rt_vk_set_layout_desc){ "undergrowth cull", cull, 7 },
+                          &u->set_cull, e) ||
+        !rt_vk_set_layout(d, k, &(rt_vk_set_layout_desc){ "undergrowth scan", scan, 3 },
+                          &u->set_scan, e) ||
+        !rt_vk_set_layout(d, k, &(rt_vk_set_layout_desc){ "undergrowth lod", lod, 3 },
                           &u->set_lod, e))
         return false;
     VkDescriptorSetLayout ms[3] = { u->set_terrain, u->pl->set_material, u->set_mask };
@@ -316,6 +422,8 @@ static bool make_layouts(rt_ug *u, rt_error *e)
     return pipe_layout(u, ms, 3, cs, sizeof(splat_push), &u->mask_layout, e) &&
            pipe_layout(u, &u->set_gen, 1, cs, sizeof(ug_push), &u->gen_layout, e) &&
            pipe_layout(u, &u->set_lod, 1, cs, 16, &u->lod_layout, e) &&
+           pipe_layout(u, &u->set_cull, 1, cs, sizeof(ug_cull_push), &u->cull_layout, e) &&
+           pipe_layout(u, &u->set_scan, 1, cs, 16, &u->scan_layout, e) &&
            pipe_layout(u, ds, 3, VK_SHADER_STAGE_VERTEX_BIT | VK_SHADER_STAGE_FRAGMENT_BIT,
                        sizeof(splat_push), &u->draw_layout, e);
 }
@@ -348,16 +456,27 @@ static bool make_buffers(rt_ug *u, rt_error *e)
                               VK_BUFFER_USAGE_TRANSFER_SRC_BIT, false, &u->args, e) ||
         !rt_buffer_create(d, (VkDeviceSize)u->pool * u->nblocks * 20,
                           VK_BUFFER_USAGE_TRANSFER_DST_BIT, true, &u->args_host, e) ||
-        !rt_buffer_create(d, (VkDeviceSize)u->pool * u->nblocks * 40,   /* + the shadows' */
-                          st | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT, false, &u->draw_args, e) ||
+        !rt_buffer_create(d, (VkDeviceSize)u->pool * u->nblocks * 20, st, false, &u->draw_args,
+                          e) ||
+        !rt_buffer_create(d, (VkDeviceSize)(UG_ENT0 + u->pool * u->nblocks) * 4, st, true,
+                          &u->ent, e) ||
+        !rt_buffer_create(d, (VkDeviceSize)(2 * u->pool * u->nblocks + 1) * 4, st, false,
+                          &u->cnt, e) ||
+        !rt_buffer_create(d, (VkDeviceSize)u->pool * u->cap * 4 + 4,
+                          st | VK_BUFFER_USAGE_TRANSFER_SRC_BIT, false, &u->vis, e) ||
+        !rt_buffer_create(d, (VkDeviceSize)u->nblocks * 6 * 20,   /* + the shadows' */
+                          st | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
+                          false, &u->mdraw, e) ||
+        !rt_buffer_create(d, (VkDeviceSize)u->nblocks * 6 * 20, VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+                          true, &u->mdraw_host, e) ||
         !rt_buffer_create(d, (VkDeviceSize)u->pool * 4, st, true, &u->lod, e) ||
         !rt_buffer_create(d, (VkDeviceSize)u->nblocks * 16 * UG_BLOCK_VEC4, st, true, &u->blocks,
                           e) ||
-        !rt_buffer_create(d, (VkDeviceSize)u->nblocks * 32, st, true, &u->far, e) ||
-        !rt_buffer_create(d, (VkDeviceSize)(pu->nvertices + 4) * 32,
+        /* + the shadow quad, + the single-triangle meshes (tri_mesh) */
+        !rt_buffer_create(d, (VkDeviceSize)(pu->nvertices + 4 + pu->nindices / 2 + 3) * 32,
                           VK_BUFFER_USAGE_VERTEX_BUFFER_BIT, true, &u->vbuf, e) ||
-        !rt_buffer_create(d, (VkDeviceSize)(pu->nindices + 6) * 4, VK_BUFFER_USAGE_INDEX_BUFFER_BIT,
-                          true, &u->ibuf, e) ||
+        !rt_buffer_create(d, (VkDeviceSize)(pu->nindices + 6 + pu->nindices / 2 + 3) * 4,
+                          VK_BUFFER_USAGE_INDEX_BUFFER_BIT, true, &u->ibuf, e) ||
         !rt_buffer_create(d, sizeof(splat_frame), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, true,
                           &u->frame, e))
         return false;
@@ -369,22 +488,66 @@ static bool make_buffers(rt_ug *u, rt_error *e)
     static const uint32_t qi[6] = { 0, 1, 2, 0, 2, 3 };
     memcpy((float *)u->vbuf.map + (size_t)pu->nvertices * 8, quad, sizeof quad);
     memcpy((uint32_t *)u->ibuf.map + pu->nindices, qi, sizeof qi);
-    fill_blocks(u, u->blocks.map);
+    /* each block's single-triangle mesh from its far mesh, after those */
+    uint32_t nv = pu->nvertices + 4, ni = pu->nindices + 6;
     for (int b = 0; b < u->nblocks; b++) {
         int f = pu->meshes[pu->blocks[b].mesh].far;
-        const rt_pack_ug_mesh *m = &pu->meshes[f >= 0 ? f : 0];
-        uint32_t v[8] = { m->nidx, m->first_index, m->first_vertex, f >= 0,
-                          pu->blocks[b].shadow > 0 && u->shadows, 0, 0, 0 };
-        memcpy((uint32_t *)u->far.map + 8 * b, v, sizeof v);
+        int done = -1;   /* a block before with the same far mesh */
+        for (int c = 0; c < b && f >= 0 && done < 0; c++)
+            done = pu->meshes[pu->blocks[c].mesh].far == f && u->tri[c][0] ? c : -1;
+        if (done >= 0) {
+            memcpy(u->tri[b], u->tri[done], sizeof u->tri[b]);
+            continue;
+        }
+        uint32_t nt = f >= 0 ? tri_mesh(pu, &pu->meshes[f], (float *)u->vbuf.map + (size_t)nv * 8,
+                                        (uint32_t *)u->ibuf.map + ni)
+                             : 0;
+        u->tri[b][0] = 3 * nt;
+        u->tri[b][1] = ni;
+        u->tri[b][2] = nv;
+        nv += 3 * nt;
+        ni += 3 * nt;
     }
+    fill_blocks(u, u->blocks.map);
     memset(u->args_host.map, 0, (size_t)u->args_host.size);
+    memset(u->mdraw_host.map, 0, (size_t)u->mdraw_host.size);
     for (int i = 0; i < u->pool; i++)
         ((float *)u->lod.map)[i] = 1.0f;
     return true;
 }
 
+/* The cull passes' pipelines: count and write (the same GLSL, UG_WRITE),
+ * and the scan in one workgroup as wide as the device allows (up to 1024). */
+static bool cull_pipelines(rt_ug *u, rt_error *e)
+{
+    const VkPhysicalDeviceLimits *L = &u->d->props.limits;
+    uint32_t ls = 1024;
+    while (ls > 64 && (ls > L->maxComputeWorkGroupInvocations || ls > L->maxComputeWorkGroupSize[0]))
+        ls >>= 1;
+    size_t n = strlen(rt_ug_cull_glsl) + strlen(rt_ug_scan_glsl) + 64;
+    char *src = malloc(n);
+    if (!src)
+        return rt_fail(e, RT_E_VULKAN, "undergrowth", "out of memory");
+    bool ok = true;
+    for (int k = 0; k < 3 && ok; k++) {
+        if (k < 2)
+            snprintf(src, n, "#version 450\n%s%s", k ? "#define UG_WRITE 1\n" : "", rt_ug_cull_glsl);
+        else
+            snprintf(src, n, "#version 450\n#define UG_LS %u\n%s", ls, rt_ug_scan_glsl);
+        VkPipeline *out = k == 0 ? &u->count_pipe : k == 1 ? &u->write_pipe : &u->scan_pipe;
+        ok = rt_vk_compute(u->d, &u->keep, &(rt_vk_compute_desc){
+                               .label = k == 0 ? "undergrowth cull count"
+                                      : k == 1 ? "undergrowth cull write" : "undergrowth cull scan",
+                               .glsl = src, .layout = k < 2 ? u->cull_layout : u->scan_layout },
+                           out, e);
+    }
+    free(src);
+    return ok;
+}
+
 bool rt_ug_create(rt_device *d, const rt_pack *p, rt_pipelines *pl, const rt_quadtree *qt,
-                  const rt_ug_targets *t, double radius, rt_ug **out, rt_error *e)
+                  const rt_ug_targets *t, double radius, double thin, rt_ug **out,
+                  rt_error *e)
 {
     *out = NULL;
     if (p->ug.nslots == 0)
@@ -398,6 +561,7 @@ bool rt_ug_create(rt_device *d, const rt_pack *p, rt_pipelines *pl, const rt_qua
     u->pl = pl;
     u->qt = qt;
     u->radius = radius > 0 ? radius : RT_UG_RADIUS;
+    u->thin = thin > 0 ? thin : LOD_NEAR;
     u->pool = (int)splat_ug_pool(u->radius);
     u->nblocks = p->ug.nblocks;
     u->nw = (p->ug.nslots + 3) / 4;
@@ -428,6 +592,7 @@ bool rt_ug_create(rt_device *d, const rt_pack *p, rt_pipelines *pl, const rt_qua
                            .glsl = rt_ug_gen_glsl, .layout = u->gen_layout }, &u->gen_pipe, e) ||
         !rt_vk_compute(d, &u->keep, &(rt_vk_compute_desc){ .label = "undergrowth lod",
                            .glsl = rt_ug_lod_glsl, .layout = u->lod_layout }, &u->lod_pipe, e) ||
+        !cull_pipelines(u, e) ||
         !draw_pipeline(u, 0, e) || !draw_pipeline(u, 1, e) ||
         (u->shadows && !draw_pipeline(u, 2, e)) ||
         !rt_vk_fb(d, &u->keep, &(rt_vk_fb_desc){ .label = "undergrowth", .pass = u->pass_att,
@@ -448,7 +613,8 @@ void rt_ug_destroy(rt_ug *u)
     rt_device *d = u->d;
     rt_vk_list_destroy(d, &u->keep);
     rt_buffer *bufs[] = { &u->masks, &u->inst, &u->args, &u->args_host, &u->draw_args, &u->lod,
-                          &u->far, &u->blocks, &u->vbuf, &u->ibuf, &u->frame };
+                          &u->blocks, &u->vbuf, &u->ibuf, &u->frame, &u->ent,
+                          &u->cnt, &u->vis, &u->mdraw, &u->mdraw_host };
     for (size_t i = 0; i < sizeof bufs / sizeof *bufs; i++)
         rt_buffer_destroy(d, bufs[i]);
     rt_buffer_destroy(d, &u->probe_out);
@@ -553,7 +719,7 @@ static void allocate(rt_ug *u, const rt_camera *c, const float view_proj[16])
         double hi[3] = { lo[0] + CELL, hmax - c->position[1] + 8, lo[2] + CELL };
         cl->visible = !box_outside(view_proj, lo, hi);
         double near = cl->dist - CELL * 0.7071;   /* the cell's nearest point, about */
-        double f = near > LOD_NEAR ? (LOD_NEAR / near) * (LOD_NEAR / near) : 1.0;
+        double f = near > u->thin ? (u->thin / near) * (u->thin / near) : 1.0;
         ((float *)u->lod.map)[i] = (float)(f > LOD_MIN ? f : LOD_MIN);
     }
     for (int i = 1; i < u->pool; i++)   /* insertion sort: a few hundred cells */
@@ -670,6 +836,120 @@ static void reset_args(rt_ug *u, VkCommandBuffer cb, int slot)
                       (VkDeviceSize)u->nblocks * 20, a);
 }
 
+/* The cull passes' table for this frame (UG_KEYINFO): keys in the draw's
+ * order (opaque blocks first; a block's near mesh, then its far one, then
+ * its single-triangle one), each key's entries the visible generated
+ * cells front to back whose distance picks that mesh (their nearest point
+ * beyond LOD_NEAR: the far mesh; beyond LOD_TRI LOD_NEAR: the single
+ * triangles). */
+static void fill_entries(rt_ug *u)
+{
+    const rt_pack_ug *pu = &u->p->ug;
+    uint32_t *e = u->ent.map;
+    int k = 0, n = 0;
+    /* contact shadows end where ug_far reaches 1 (undergrowth_glsl.c: 0.8
+     * r1, r1 = max(radius - 12, radius / 2)): a cell whose nearest point
+     * is farther multiplies the colour by 1 */
+    double shadow_end = 0.8 * fmax(u->radius - 12.0, 0.5 * u->radius);
+    for (int cut = 0; cut < 2; cut++)
+        for (int b = 0; b < u->nblocks; b++) {
+            if ((pu->blocks[b].cutout != 0) != cut)
+                continue;
+            int far = pu->meshes[pu->blocks[b].mesh].far;
+            for (int l = 0; l < 3; l++) {
+                if ((l == 1 && far < 0) || (l == 2 && (far < 0 || !u->tri[b][0])))
+                    continue;
+                const rt_pack_ug_mesh *m = &pu->meshes[l ? far : pu->blocks[b].mesh];
+                uint32_t *ki = e + UG_KEYINFO + 4 * k;
+                ki[0] = l == 2 ? u->tri[b][0] : m->nidx;
+                ki[1] = l == 2 ? u->tri[b][1] : m->first_index;
+                ki[2] = l == 2 ? u->tri[b][2] : m->first_vertex;
+                bool shadows = pu->blocks[b].shadow > 0 && u->shadows;
+                e[k] = (uint32_t)n;
+                u->key_block[k] = b;
+                for (int i = 0; i < u->pool; i++) {
+                    int slot = u->order[i];
+                    const ug_cell *cl = &u->cells[slot];
+                    double near = cl->dist - CELL * 0.7071;   /* its nearest point, about */
+                    int lv = near > LOD_NEAR && far >= 0;
+                    if (lv && u->tri[b][0] && near > LOD_TRI * LOD_NEAR)
+                        lv = 2;
+                    if (cl->state != CELL_READY || !cl->visible || lv != l)
+                        continue;
+                    if (shadows && near >= shadow_end)   /* and every entry after */
+                        shadows = false, ki[3] = (uint32_t)n;
+                    e[UG_ENT0 + n++] = (uint32_t)(slot * u->nblocks + b);
+                }
+                if (shadows)
+                    ki[3] = (uint32_t)n;
+                else if (!(pu->blocks[b].shadow > 0 && u->shadows))
+                    ki[3] = e[k];
+                u->key_used[k] = e[k] != (uint32_t)n;
+                k++;
+            }
+        }
+    e[k] = (uint32_t)n;
+    u->nkeys = k;
+    u->nent = n;
+}
+
+/* The cull passes (the top comment; undergrowth_glsl.c rt_ug_cull_glsl):
+ * count, scan, write, then the draws per key copied back for the stats. */
+static void record_cull(rt_ug *u, VkCommandBuffer cb, const splat_frame *fr)
+{
+    fill_entries(u);
+    u->mdraw_valid = false;
+    if (u->nent == 0)
+        return;
+    ug_cull_push pc = { .cam = { fr->camera[0], fr->camera[1], fr->camera[2], (float)u->radius },
+                        .info = { (uint32_t)u->nblocks, (uint32_t)u->nent, 0, 0 } };
+    const float *m = fr->view_proj;   /* column-major: row r is m[r], m[4 + r], ... */
+    static const int row[5] = { 0, 0, 1, 1, 2 };
+    for (int k = 0; k < 5; k++) {
+        double sg = k == 4 || (k & 1) ? -1.0 : 1.0, v[4], len = 0;
+        for (int c = 0; c < 4; c++)
+            v[c] = m[4 * c + 3] + sg * m[4 * c + row[k]];
+        for (int c = 0; c < 3; c++)
+            len += v[c] * v[c];
+        len = len > 0 ? sqrt(len) : 1.0;
+        for (int c = 0; c < 4; c++)
+            pc.plane[k][c] = (float)(v[c] / len);
+    }
+    uint32_t gx = u->nent < 65535 ? (uint32_t)u->nent : 65535u;
+    uint32_t gy = ((uint32_t)u->nent + gx - 1) / gx;
+    const VkPipelineStageFlags cs = VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT;
+    vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, u->cull_layout, 0, 1, &u->cull_set,
+                            0, NULL);
+    vkCmdPushConstants(cb, u->cull_layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof pc, &pc);
+    vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, u->count_pipe);
+    vkCmdDispatch(cb, gx, gy, 1);
+    rt_cmd_barrier(cb, cs, VK_ACCESS_SHADER_WRITE_BIT, cs,
+                   VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
+    uint32_t sp[4] = { (uint32_t)u->nent, (uint32_t)u->nkeys, u->p->ug.nindices,
+                       u->p->ug.nvertices };   /* the shadow quad */
+    vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, u->scan_pipe);
+    vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, u->scan_layout, 0, 1, &u->scan_set,
+                            0, NULL);
+    vkCmdPushConstants(cb, u->scan_layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof sp, sp);
+    vkCmdDispatch(cb, 1, 1, 1);
+    rt_cmd_barrier(cb, cs, VK_ACCESS_SHADER_WRITE_BIT, cs, VK_ACCESS_SHADER_READ_BIT);
+    vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, u->write_pipe);
+    vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, u->cull_layout, 0, 1, &u->cull_set,
+                            0, NULL);
+    vkCmdPushConstants(cb, u->cull_layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof pc, &pc);
+    vkCmdDispatch(cb, gx, gy, 1);
+    rt_cmd_barrier(cb, cs, VK_ACCESS_SHADER_WRITE_BIT,
+                   VK_PIPELINE_STAGE_DRAW_INDIRECT_BIT | VK_PIPELINE_STAGE_VERTEX_SHADER_BIT |
+                       VK_PIPELINE_STAGE_TRANSFER_BIT,
+                   VK_ACCESS_INDIRECT_COMMAND_READ_BIT | VK_ACCESS_SHADER_READ_BIT |
+                       VK_ACCESS_TRANSFER_READ_BIT);
+    VkBufferCopy all = { 0, 0, (VkDeviceSize)u->nkeys * 40 };
+    vkCmdCopyBuffer(cb, u->mdraw.buf, u->mdraw_host.buf, 1, &all);
+    rt_cmd_barrier(cb, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
+                   VK_PIPELINE_STAGE_HOST_BIT, VK_ACCESS_HOST_READ_BIT);
+    u->mdraw_valid = true;
+}
+
 void rt_ug_prepare(rt_ug *u, const rt_camera *c, const splat_frame *fr)
 {
     u->time = c->time;
@@ -749,8 +1029,7 @@ bool rt_ug_generate(rt_ug *u, VkCommandBuffer cb, const splat_frame *fr, VkDescr
                        VK_PIPELINE_STAGE_HOST_BIT, VK_ACCESS_HOST_READ_BIT);
     }
     /* every frame: this camera's LOD of every cell's arguments */
-    uint32_t pc[4] = { (uint32_t)(u->pool * u->nblocks), (uint32_t)u->nblocks,
-                       u->p->ug.nindices, u->p->ug.nvertices };   /* the shadow quad */
+    uint32_t pc[4] = { (uint32_t)(u->pool * u->nblocks), (uint32_t)u->nblocks, 0, 0 };
     vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, u->lod_pipe);
     vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, u->lod_layout, 0, 1, &u->lod_set,
                             0, NULL);
@@ -759,6 +1038,7 @@ bool rt_ug_generate(rt_ug *u, VkCommandBuffer cb, const splat_frame *fr, VkDescr
     rt_cmd_barrier(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
                    VK_PIPELINE_STAGE_DRAW_INDIRECT_BIT | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
                    VK_ACCESS_INDIRECT_COMMAND_READ_BIT | VK_ACCESS_SHADER_READ_BIT);
+    record_cull(u, cb, fr);
     if (u->qpool)   /* bottom of pipe: when everything before has finished */
         vkCmdWriteTimestamp(cb, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, u->qpool, 1);
     u->generated = n;
@@ -805,28 +1085,17 @@ void rt_ug_draw(rt_ug *u, VkCommandBuffer cb, bool depth_read_only, VkDescriptor
     const rt_pack_ug *pu = &u->p->ug;
     if (u->shadows) {   /* under the plants: before them */
         vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_GRAPHICS, u->shadow_pipe);
-        VkDeviceSize shadows = (VkDeviceSize)u->pool * u->nblocks * 20;
-        for (int i = 0; i < u->pool; i++) {
-            int k = u->order[i];
-            if (u->cells[k].state != CELL_READY || !u->cells[k].visible)
-                continue;
-            VkDeviceSize at = shadows + (VkDeviceSize)k * u->nblocks * 20;
-            for (int b = 0; b < u->nblocks; b++)
-                if (pu->blocks[b].shadow > 0)
-                    vkCmdDrawIndexedIndirect(cb, u->draw_args.buf, at + 20 * (VkDeviceSize)b, 1, 20);
-        }
+        for (int k = 0; k < u->nkeys; k++)
+            if (u->key_used[k] && pu->blocks[u->key_block[k]].shadow > 0)
+                vkCmdDrawIndexedIndirect(cb, u->mdraw.buf, 20 * (VkDeviceSize)(u->nkeys + k), 1, 20);
     }
-    for (int cut = 0; cut < 2; cut++) {   /* opaque first: they hide the rest */
+    /* one draw per key (a block's near or far mesh), opaque first: they
+     * hide the rest; within a key the cells front to back */
+    for (int cut = 0; cut < 2; cut++) {
         vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_GRAPHICS, u->draw_pipe[cut]);
-        for (int i = 0; i < u->pool; i++) {   /* front to back */
-            int k = u->order[i];
-            if (u->cells[k].state != CELL_READY || !u->cells[k].visible)
-                continue;
-            VkDeviceSize at = (VkDeviceSize)k * u->nblocks * 20;
-            for (int b = 0; b < u->nblocks; b++)
-                if ((pu->blocks[b].cutout != 0) == cut)
-                    vkCmdDrawIndexedIndirect(cb, u->draw_args.buf, at + 20 * (VkDeviceSize)b, 1, 20);
-        }
+        for (int k = 0; k < u->nkeys; k++)
+            if (u->key_used[k] && (pu->blocks[u->key_block[k]].cutout != 0) == cut)
+                vkCmdDrawIndexedIndirect(cb, u->mdraw.buf, 20 * (VkDeviceSize)k, 1, 20);
     }
     vkCmdEndRenderPass(cb);
     if (u->qpool)
@@ -848,8 +1117,25 @@ void rt_ug_read_stats(rt_ug *u, rt_ug_stats *st)
         for (int b = 0; b < u->nblocks; b++)
             st->instances += a[((size_t)i * u->nblocks + b) * 5 + 1];
     }
+    for (int i = 0; i < u->pool; i++)
+        for (int b = 0; b < u->nblocks && u->cells[i].state == CELL_READY; b++)
+            st->candidates += (long)u->block_grid[b] * u->block_grid[b];
+    const uint32_t *md = u->mdraw_host.map;
+    for (int k = 0; u->mdraw_valid && k < u->nkeys; k++) {
+        const uint32_t *m = md + 5 * k, *sh = md + 5 * (u->nkeys + k);
+        st->drawn += m[1];
+        st->triangles += (long)m[1] * (m[0] / 3) + (long)sh[1] * 2;
+        st->draws += u->key_used[k] ? 1 + (u->shadows && u->p->ug.blocks[u->key_block[k]].shadow > 0)
+                                    : 0;
+        if (k < RT_UG_KEYS_MAX) {
+            st->key_drawn[k] = m[1];
+            st->key_indices[k] = m[0];
+            st->key_block[k] = u->key_block[k];
+        }
+    }
+    st->keys = u->mdraw_valid ? (u->nkeys < RT_UG_KEYS_MAX ? u->nkeys : RT_UG_KEYS_MAX) : 0;
     st->bytes_per_cell = (size_t)TEXELS * TEXELS * (size_t)(u->nw + 2) * 4 +
-                         (size_t)u->cap * 32 + (size_t)u->nblocks * 20;
+                         (size_t)u->cap * (32 + 4) + (size_t)u->nblocks * 28;
     if (!u->qpool)
         return;
     uint64_t q[4];

@@ -84,41 +84,25 @@ const char rt_ug_gen_glsl[] =
     "    if (lid == 0u) u_args.a[(u_p.slot * u_p.nblocks + b) * 5u + 1u] = run;\n"
     "}\n";
 
-/* The LOD pass, every frame: the draw arguments from the generated ones,
- * each cell's instance count times its fraction (a prefix: the scatter
- * pass keeps instances in a lattice order that spreads every prefix), and
- * beyond LOD_NEAR the block's far mesh where it has one (PACK.md: index
- * count, first index, vertex offset, and w = 1); after the n arguments,
- * the contact shadows' n: the same instances drawn with the shadow quad
- * (push qidx, qvtx), none for a block whose shadow is 0 (its second
- * uvec4 .x). */
+/* The LOD pass, every frame: each cell's draw arguments from the
+ * generated ones, its instance count times its fraction (a prefix: the
+ * scatter pass keeps instances in a lattice order that spreads every
+ * prefix).  The cull passes read the count and the first instance (and
+ * the probe does); the mesh is the cull's key's (undergrowth.c
+ * fill_entries). */
 const char rt_ug_lod_glsl[] =
     "#version 450\n"
     "layout(local_size_x = 64) in;\n"
     "layout(set = 0, binding = 0, std430) readonly buffer A { uint a[]; } u_args;\n"
     "layout(set = 0, binding = 1, std430) writeonly buffer D { uint a[]; } u_draw;\n"
     "layout(set = 0, binding = 2, std430) readonly buffer F { float f[]; } u_lod;\n"
-    "layout(set = 0, binding = 3, std430) readonly buffer M { uvec4 m[]; } u_far;\n"
     "layout(push_constant, std430) uniform P { uint n, nblocks, qidx, qvtx; } u_p;\n"
     "void main() {\n"
     "    uint i = gl_GlobalInvocationID.x;\n"
     "    if (i >= u_p.n) return;\n"
     "    for (uint k = 0u; k < 5u; k++) u_draw.a[5u * i + k] = u_args.a[5u * i + k];\n"
     "    float f = u_lod.f[i / u_p.nblocks];\n"
-    "    uint count = uint(ceil(float(u_args.a[5u * i + 1u]) * f));\n"
-    "    u_draw.a[5u * i + 1u] = count;\n"
-    "    uint s = 5u * (u_p.n + i);\n"
-    "    u_draw.a[s] = 6u;\n"
-    "    u_draw.a[s + 1u] = u_far.m[2u * (i % u_p.nblocks) + 1u].x != 0u ? count : 0u;\n"
-    "    u_draw.a[s + 2u] = u_p.qidx;\n"
-    "    u_draw.a[s + 3u] = u_p.qvtx;\n"
-    "    u_draw.a[s + 4u] = u_args.a[5u * i + 4u];\n"
-    "    uvec4 m = u_far.m[2u * (i % u_p.nblocks)];   /* the block's far mesh */\n"
-    "    if (f < 1.0 && m.w != 0u) {\n"
-    "        u_draw.a[5u * i] = m.x;\n"
-    "        u_draw.a[5u * i + 2u] = m.y;\n"
-    "        u_draw.a[5u * i + 3u] = m.z;\n"
-    "    }\n"
+    "    u_draw.a[5u * i + 1u] = uint(ceil(float(u_args.a[5u * i + 1u]) * f));\n"
     "}\n";
 
 /* The vertex stage's fade and wind (the top comment), shared by the draw
@@ -154,6 +138,131 @@ const char rt_ug_lod_glsl[] =
 #define UG_FADE_MARGIN_S "12.0"   /* 0.75 CELL */
 #define UG_FADE_START_S "0.6"
 
+/* The cull passes, every frame after the LOD pass (undergrowth.c "cull"):
+ * one workgroup per entry (a visible cell's block, in the draw's order:
+ * by key (block, LOD), cells front to back within a key); an instance of
+ * the LOD's prefix is drawn when the fade leaves it a size (the vertex
+ * stage's ug_fade_scale > 0) and its bounding sphere is inside the five
+ * planes of the frustum (camera-relative, normalised: left, right, top,
+ * bottom, near).  The sphere: at the root, radius s (grow r + sway s r^2)
+ * + 5 cm, r the block's farthest vertex (or contact shadow) from the root
+ * at scale 1 (block vec4 4 .w), s the instance's scale, grow the cell's
+ * LOD widening: the vertex stage's sway moves a vertex h up by at most
+ * sway h^2.  The count pass writes each entry's survivors, the scan pass
+ * (one workgroup) their exclusive prefix and every key's indirect draw,
+ * the write pass the survivors' instance indices at the prefix, in
+ * instance order within an entry: the list is the same on every run. */
+const char rt_ug_cull_glsl[] =
+    "layout(local_size_x = 64) in;\n"
+    "struct Inst { vec4 p; uvec4 q; };\n"
+    "layout(set = 0, binding = 0, std430) readonly buffer I { Inst v[]; } u_inst;\n"
+    "layout(set = 0, binding = 1, std430) readonly buffer A { uint a[]; } u_draw;\n"
+    "layout(set = 0, binding = 2, std430) readonly buffer F { float f[]; } u_lod;\n"
+    "layout(set = 0, binding = 3, std430) readonly buffer B { vec4 b[]; } u_blocks;\n"
+    "layout(set = 0, binding = 4, std430) readonly buffer E { uint e[]; } u_ent;\n"
+    "layout(set = 0, binding = 5, std430) buffer C { uint c[]; } u_cnt;\n"
+    "layout(set = 0, binding = 6, std430) writeonly buffer V { uint v[]; } u_vis;\n"
+    /* plane[5]; cam: the camera, the radius; info: blocks, entries */
+    "layout(push_constant, std430) uniform P { vec4 plane[5]; vec4 cam; uvec4 info; } u_p;\n"
+    UG_GLSL_FUNCS
+    "shared uint s_scan[64];\n"
+    "bool ug_keep(uint i, float grow) {\n"
+    "    Inst it = u_inst.v[i];\n"
+    "    float d = length(it.p.xz - u_p.cam.xz);\n"
+    "    if (!(ug_fade_scale(it.p.xyz, d, u_p.cam.w) > 0.0)) return false;\n"
+    "    uint bi = 5u * it.q.w;\n"
+    "    float sway = u_blocks.b[bi + 3u].z, h = it.p.w * u_blocks.b[bi + 4u].w;\n"
+    "    float rad = h * grow + sway * h * h + 0.05;\n"
+    "    vec3 c = it.p.xyz - u_p.cam.xyz;\n"
+    "    for (int k = 0; k < 5; k++)\n"
+    "        if (dot(u_p.plane[k].xyz, c) + u_p.plane[k].w < -rad) return false;\n"
+    "    return true;\n"
+    "}\n"
+    "void main() {\n"
+    "    uint g = gl_WorkGroupID.x + gl_WorkGroupID.y * gl_NumWorkGroups.x;\n"
+    "    uint lid = gl_LocalInvocationID.x, nent = u_p.info.y;\n"
+    "    if (g >= nent) return;\n"
+    "    uint idx = u_ent.e[" UG_ENT0_S " + g];\n"
+    "    uint n = u_draw.a[5u * idx + 1u], first = u_draw.a[5u * idx + 4u];\n"
+    "    float grow = clamp(inversesqrt(u_lod.f[idx / u_p.info.x]), 1.0, " LOD_GROW_S ");\n"
+    "#ifdef UG_WRITE\n"
+    "    uint at = u_cnt.c[nent + g];\n"
+    "#endif\n"
+    "    uint run = 0u;\n"
+    "    for (uint c0 = 0u; c0 < n; c0 += 64u) {\n"
+    "        uint k = c0 + lid;\n"
+    "        bool ok = k < n && ug_keep(first + k, grow);\n"
+    "        s_scan[lid] = ok ? 1u : 0u;\n"
+    "        barrier();\n"
+    "        for (uint o = 1u; o < 64u; o <<= 1u) {\n"
+    "            uint v = lid >= o ? s_scan[lid - o] : 0u;\n"
+    "            barrier();\n"
+    "            s_scan[lid] += v;\n"
+    "            barrier();\n"
+    "        }\n"
+    "#ifdef UG_WRITE\n"
+    "        if (ok) u_vis.v[at + run + s_scan[lid] - 1u] = first + k;\n"
+    "#endif\n"
+    "        run += s_scan[63];\n"
+    "        barrier();\n"
+    "    }\n"
+    "#ifndef UG_WRITE\n"
+    "    if (lid == 0u) u_cnt.c[g] = run;\n"
+    "#endif\n"
+    "}\n";
+
+/* The scan pass (one workgroup of UG_LS invocations, a power of two):
+ * the entries' counts into exclusive offsets after them (c[n + i], the
+ * total at c[2n]), then per key its draw (indexed indirect: the mesh's
+ * index count, first index and vertex offset from the key table, the
+ * instances of its entries, the first at its first entry's offset) and
+ * its contact shadows' after the nkeys draws: the instances of its
+ * entries before the key table's shadow end (undergrowth.c fill_entries:
+ * the first entry too far for a shadow to show, its first entry where
+ * the block casts none). */
+const char rt_ug_scan_glsl[] =
+    "layout(local_size_x = UG_LS) in;\n"
+    "layout(set = 0, binding = 0, std430) readonly buffer E { uint e[]; } u_ent;\n"
+    "layout(set = 0, binding = 1, std430) coherent buffer C { uint c[]; } u_cnt;\n"
+    "layout(set = 0, binding = 2, std430) writeonly buffer D { uint a[]; } u_md;\n"
+    "layout(push_constant, std430) uniform P { uint n, nkeys, qidx, qvtx; } u_p;\n"
+    "shared uint s_sum[UG_LS];\n"
+    "void main() {\n"
+    "    uint lid = gl_LocalInvocationID.x, n = u_p.n;\n"
+    "    uint ch = (n + uint(UG_LS) - 1u) / uint(UG_LS), a = min(lid * ch, n), b = min(a + ch, n);\n"
+    "    uint sum = 0u;\n"
+    "    for (uint i = a; i < b; i++) sum += u_cnt.c[i];\n"
+    "    s_sum[lid] = sum;\n"
+    "    barrier();\n"
+    "    for (uint o = 1u; o < uint(UG_LS); o <<= 1u) {\n"
+    "        uint v = lid >= o ? s_sum[lid - o] : 0u;\n"
+    "        barrier();\n"
+    "        s_sum[lid] += v;\n"
+    "        barrier();\n"
+    "    }\n"
+    "    uint base = s_sum[lid] - sum;\n"
+    "    for (uint i = a; i < b; i++) { uint c = u_cnt.c[i]; u_cnt.c[n + i] = base; base += c; }\n"
+    "    if (lid == uint(UG_LS) - 1u) u_cnt.c[2u * n] = s_sum[lid];\n"
+    "    memoryBarrierBuffer();\n"
+    "    barrier();\n"
+    "    for (uint k = lid; k < u_p.nkeys; k += uint(UG_LS)) {\n"
+    "        uint e0 = u_ent.e[k], e1 = u_ent.e[k + 1u];\n"
+    "        uint f = u_cnt.c[n + e0], cnt = u_cnt.c[n + e1] - f;\n"
+    "        uint ki = " UG_KEYINFO_S " + 4u * k;\n"
+    "        u_md.a[5u * k] = u_ent.e[ki];\n"
+    "        u_md.a[5u * k + 1u] = cnt;\n"
+    "        u_md.a[5u * k + 2u] = u_ent.e[ki + 1u];\n"
+    "        u_md.a[5u * k + 3u] = u_ent.e[ki + 2u];\n"
+    "        u_md.a[5u * k + 4u] = f;\n"
+    "        uint s = 5u * (u_p.nkeys + k);\n"
+    "        u_md.a[s] = 6u;\n"
+    "        u_md.a[s + 1u] = u_cnt.c[n + max(u_ent.e[ki + 3u], e0)] - f;\n"
+    "        u_md.a[s + 2u] = u_p.qidx;\n"
+    "        u_md.a[s + 3u] = u_p.qvtx;\n"
+    "        u_md.a[s + 4u] = f;\n"
+    "    }\n"
+    "}\n";
+
 /* The draw pass: SPLAT_GLSL_TERRAIN (frame block) + this vertex main; the
  * prelude + draw_frag_main as the fragment shader (it reads v_rel, v_uv,
  * v_local at locations 0-2, as the terrain's). */
@@ -162,6 +271,7 @@ const char rt_ug_draw_vert_main[] =
     "layout(set = 2, binding = 0, std430) readonly buffer B { vec4 b[]; } u_blocks;\n"
     "layout(set = 2, binding = 1, std430) readonly buffer I { Inst v[]; } u_inst;\n"
     "layout(set = 2, binding = 2, std430) readonly buffer F { float f[]; } u_lod;\n"
+    "layout(set = 2, binding = 4, std430) readonly buffer V { uint i[]; } u_vis;\n"
     "layout(location = 0) in vec3 a_pos;\n"
     "layout(location = 1) in vec3 a_nrm;\n"
     "layout(location = 2) in vec2 a_uv;\n"
@@ -177,7 +287,8 @@ const char rt_ug_draw_vert_main[] =
     "layout(location = 8) out vec3 g_tnormal;\n"
     UG_GLSL_FUNCS
     "void main() {\n"
-    "    Inst it = u_inst.v[gl_InstanceIndex];\n"
+    "    uint ii = u_vis.i[gl_InstanceIndex];   /* the cull passes' list */\n"
+    "    Inst it = u_inst.v[ii];\n"
     "    uint bi = 5u * it.q.w;\n"
     "    vec4 b0 = u_blocks.b[bi], b1 = u_blocks.b[bi + 1u], b4 = u_blocks.b[bi + 4u];\n"
     "    uint flags = uint(u_blocks.b[bi + 2u].z);\n"
@@ -186,7 +297,7 @@ const char rt_ug_draw_vert_main[] =
     /* the distance fade (push patch_xz.x: the radius) */
     "    float r = u_push.patch_xz.x, d = length(it.p.xz - u_frame.camera.xz);\n"
     /* the LOD's growth (u_push.info.x: instances per cell) */
-    "    float grow = min(inversesqrt(u_lod.f[uint(gl_InstanceIndex) / u_push.info.x]), " LOD_GROW_S ");\n"
+    "    float grow = min(inversesqrt(u_lod.f[ii / u_push.info.x]), " LOD_GROW_S ");\n"
     /* the growth widens, it does not raise: far cover, not a hedge */
     "    vec3 p = a_pos * it.p.w * ug_fade_scale(it.p.xyz, d, r) * vec3(grow, 1.0, grow);\n"
     "    p = vec3(c * p.x + s * p.z, p.y, -s * p.x + c * p.z);\n"
@@ -317,6 +428,7 @@ const char rt_ug_shadow_vert_main[] =
     "layout(set = 2, binding = 0, std430) readonly buffer B { vec4 b[]; } u_blocks;\n"
     "layout(set = 2, binding = 1, std430) readonly buffer I { Inst v[]; } u_inst;\n"
     "layout(set = 2, binding = 2, std430) readonly buffer F { float f[]; } u_lod;\n"
+    "layout(set = 2, binding = 4, std430) readonly buffer V { uint i[]; } u_vis;\n"
     "layout(location = 0) in vec3 a_pos;\n"
     "layout(location = 1) in vec3 a_nrm;   /* the vertex layout's; unused */\n"
     "layout(location = 2) in vec2 a_uv;\n"
@@ -325,11 +437,12 @@ const char rt_ug_shadow_vert_main[] =
     "layout(location = 1) out float s_a;\n"
     UG_GLSL_FUNCS
     "void main() {\n"
-    "    Inst it = u_inst.v[gl_InstanceIndex];\n"
+    "    uint ii = u_vis.i[gl_InstanceIndex];   /* the cull passes' list */\n"
+    "    Inst it = u_inst.v[ii];\n"
     "    vec4 b4 = u_blocks.b[5u * it.q.w + 4u];\n"
     "    vec3 n = normalize(unpackSnorm4x8(it.q.x).xyz + vec3(0.0, 1e-4, 0.0));\n"
     "    float r = u_push.patch_xz.x, d = length(it.p.xz - u_frame.camera.xz);\n"
-    "    float grow = min(inversesqrt(u_lod.f[uint(gl_InstanceIndex) / u_push.info.x]), " LOD_GROW_S ");\n"
+    "    float grow = min(inversesqrt(u_lod.f[ii / u_push.info.x]), " LOD_GROW_S ");\n"
     "    float size = 1.3 * b4.z * it.p.w * grow * ug_fade_scale(it.p.xyz, d, r);\n"
     "    vec3 t = normalize(cross(n, vec3(0.0, 0.0, 1.0))), bt = cross(t, n);\n"
     "    vec3 p = it.p.xyz + (t * a_pos.x + bt * a_pos.z) * size + n * 0.04;\n"

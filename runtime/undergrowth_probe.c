@@ -110,3 +110,49 @@ bool rt_ug_probe_wind(rt_ug *u, float *points, int n, double time, rt_error *e)
     memcpy(points, u->probe_out.map, (size_t)n * 48);
     return true;
 }
+
+/* ---- the drawn list (tests) --------------------------------------------------------- */
+
+int rt_ug_read_drawn(rt_ug *u, rt_ug_instance *out, int *key, int max, rt_error *e)
+{
+    if (!u || !u->mdraw_valid)
+        return 0;
+    const uint32_t *md = u->mdraw_host.map;
+    uint32_t total = 0;
+    for (int k = 0; k < u->nkeys; k++)
+        total += md[5 * k + 1];
+    uint32_t n = total < (uint32_t)(max > 0 ? max : 0) ? total : (uint32_t)(max > 0 ? max : 0);
+    if (n == 0)
+        return (int)total;
+    rt_buffer iv, ii;
+    VkDeviceSize ib = u->inst.size;
+    if (!rt_buffer_create(u->d, (VkDeviceSize)n * 4, VK_BUFFER_USAGE_TRANSFER_DST_BIT, true, &iv, e))
+        return -1;
+    if (!rt_buffer_create(u->d, ib, VK_BUFFER_USAGE_TRANSFER_DST_BIT, true, &ii, e)) {
+        rt_buffer_destroy(u->d, &iv);
+        return -1;
+    }
+    VkCommandBuffer cb;
+    bool ok = rt_oneshot_begin(u->d, &cb, e);
+    if (ok) {
+        /* the keys' lists are contiguous from the first key's first
+         * instance (the scan pass's offsets start at 0) */
+        VkBufferCopy a = { 0, 0, (VkDeviceSize)n * 4 }, b = { 0, 0, ib };
+        vkCmdCopyBuffer(cb, u->vis.buf, iv.buf, 1, &a);
+        vkCmdCopyBuffer(cb, u->inst.buf, ii.buf, 1, &b);
+        ok = rt_oneshot_end(u->d, cb, e);
+    }
+    for (uint32_t i = 0; ok && i < n; i++) {
+        uint32_t at = ((const uint32_t *)iv.map)[i];
+        memcpy(&out[i], (const uint8_t *)ii.map + 32 * (size_t)at, 32);
+        if (key) {
+            int k = 0;
+            while (k + 1 < u->nkeys && i >= md[5 * k + 4] + md[5 * k + 1])
+                k++;
+            key[i] = k;
+        }
+    }
+    rt_buffer_destroy(u->d, &iv);
+    rt_buffer_destroy(u->d, &ii);
+    return ok ? (int)total : -1;
+}

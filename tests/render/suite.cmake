@@ -169,7 +169,7 @@ if(TARGET splatrt AND TARGET splatview)
                          ENVIRONMENT "SPLAT_VALIDATE=1")
     # the lighting model against its double twin, on three paths, and the
     # terrain's shadows
-    foreach(t brdf shadow undergrowth ug_look)
+    foreach(t brdf shadow undergrowth ug_look ug_cull)
       add_executable(test_${t} ${RENDER_DIR}/test_${t}.c)
       target_link_libraries(test_${t} splat_testkit)
       file(MAKE_DIRECTORY ${RENDER_OUT}/${t})
@@ -212,8 +212,8 @@ if(TARGET splatrt AND TARGET splatview)
     add_test(NAME render.vk_build COMMAND test_vk_build)
     set_tests_properties(render.vk_build PROPERTIES LABELS "render;asan" TIMEOUT 300
                          ENVIRONMENT "SPLAT_VALIDATE=1")
-    # the undergrowth's cells, GPU passes and pack sections under the
+    # the undergrowth's cells, GPU passes, cull passes and pack sections under the
     # sanitizers too
-    set_tests_properties(render.undergrowth PROPERTIES LABELS "render;asan")
+    set_tests_properties(render.undergrowth render.ug_cull PROPERTIES LABELS "render;asan")
   endif()
 endif()
