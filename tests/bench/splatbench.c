@@ -44,7 +44,8 @@
  *       (screen kinds) or quadtree patches (composite) at least D m away
  *       from the pack's far atlas (splatc build --far-atlas); its rows add
  *       the distance and the tiles (patches) the atlas shaded (from the
- *       counting frame).  distclass=0 shades with the
+ *       counting frame).  preview=S renders at 1/S of the size (2 or 4)
+ *       and upsamples with the depth edges (--preview-scale).  distclass=0 shades with the
  *       combinations only (--no-distance-classes; PACK.md "Distance
  *       classes"), distclass=1 (the default) with their distance classes;
  *       async (screen kinds) makes compute pipelines on worker threads,
@@ -113,6 +114,7 @@ typedef struct variant {
     bool         ug;        /* draw the undergrowth                         */
     double       ug_radius; /* its radius (m); 0: the runtime's default     */
     double       far;       /* screen: the far atlas's distance (m); 0: off */
+    int          preview;   /* the preview scale (2, 4); 0: full resolution */
     double       shadow_ms; /* ms of the shadow map (the first frame)       */
     double      *ug_gen, *ug_draw; /* per timed frame, GPU ms               */
     long         ug_cells;  /* cells generated over the timed frames        */
@@ -349,6 +351,9 @@ static bool parse_variant(const char *s, const char *default_pack, variant *v)
         } else if (!strncmp(t, "far=", 4)) {
             v->far = atof(t + 4);
             ok = v->far > 0;
+        } else if (!strncmp(t, "preview=", 8)) {
+            v->preview = atoi(t + 8);
+            ok = v->preview == 1 || v->preview == 2 || v->preview == 4;
         } else if (!strncmp(t, "lod=", 4)) {
             v->lod = atof(t + 4);
             ok = v->lod > 0;
@@ -606,6 +611,7 @@ static bool make_renderer(bench_run *b, int i, const char *cache, rt_error *e)
         .async_pipelines = v->async,
         .sort_tiles = v->sort_tiles,
         .undergrowth_radius = v->ug_radius, .far_atlas_distance = v->far,
+        .preview_scale = v->preview,
         .reference = v->k == K_MULTIPASS ? RT_REF_MULTIPASS
                    : v->k == K_UBER || v->k == K_SCREEN_UBER ? RT_REF_UBER : RT_REF_NONE,
         .pipeline_cache = cache,
