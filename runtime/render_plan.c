@@ -229,6 +229,9 @@ void rt_render_plan(const rt_renderer *r, const rt_frame_setup *fs, rt_plan *pl)
                         fs->raycast ? GEN : RO, NONE);
         rt_pass_use(p, RT_RES_COLOR, false, COMP, SREAD, GEN, NONE);
         rt_pass_use(p, RT_RES_OUTPUT, true, COMP, SWRITE, GEN, NONE);
+        /* every pixel (the window leaves it SHADER_READ_ONLY after its
+         * tone map, which the tracker does not see) */
+        p->use[p->nuse - 1].discard = true;
     }
     if (fs->readback)
         rt_plan_readback(pl, fs->upscale);

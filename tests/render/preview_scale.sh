@@ -11,6 +11,8 @@
 #            silhouettes blurred into halos); measured 5034 against 5838
 #            pixels over on the screen path
 #   refused  --preview-scale 3
+#   window   P cycles the scale (1, 1/2, 1/4, 1) under xvfb, validation
+#            silent, each picture another, back at 1 the first
 set -u
 SV=$1 IC=$2 PACK=$3 OUT=$4
 mkdir -p "$OUT"
@@ -48,3 +50,20 @@ then
     fail "--preview-scale 3 was accepted"
 fi
 echo "ok: preview scales 2 and 4 over their PSNR floors on three paths; the depth guide beats bilinear"
+# the window: P cycles 1 -> 1/2 -> 1/4 -> 1, validation silent; each scale
+# shows another picture, and back at 1 the first one again
+command -v xvfb-run > /dev/null || { echo "SKIP: no xvfb-run for the window part"; exit 77; }
+rm -f "$OUT"/win_*.png
+SPLAT_VALIDATE=1 xvfb-run -a -s "-screen 0 640x480x24" "$SV" "$PACK" --size 320x200 --script \
+    "frames=3;screenshot=$OUT/win_1.png;key=P;frames=3;screenshot=$OUT/win_2.png;key=P;frames=3;screenshot=$OUT/win_4.png;key=P;frames=3;screenshot=$OUT/win_1b.png;quit" \
+    > "$OUT/window.log" 2>&1 || { cat "$OUT/window.log"; fail "window: splatview exit $?"; }
+for k in 2 4 1; do
+    grep -q "^splatview: preview scale 1/$k$" "$OUT/window.log" || fail "window: no 'preview scale 1/$k'"
+done
+for k in 1 2 4 1b; do
+    "$IC" nonuniform "$OUT/win_$k.png" || fail "window: the picture at $k is uniform"
+done
+cmp -s "$OUT/win_1.png" "$OUT/win_2.png" && fail "window: P changed nothing"
+cmp -s "$OUT/win_2.png" "$OUT/win_4.png" && fail "window: 1/2 and 1/4 look the same"
+cmp -s "$OUT/win_1.png" "$OUT/win_1b.png" || fail "window: back at scale 1, another picture"
+echo "ok: the window's P key cycles the preview scale"
