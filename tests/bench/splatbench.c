@@ -8,8 +8,11 @@
  *       ms per frame from timestamp queries (median, p10, p90), CPU ms per
  *       frame, and the error of its lit RGBA32F image against the reference
  *       variant's image of the same frame (max and mean absolute error over
- *       RGB, PSNR with peak 1, count of NaN/Inf values).  One CSV row per
- *       variant.  KIND:
+ *       RGB, PSNR with peak 1, count of NaN/Inf values); the last column,
+ *       proc_cpu_med_ms, is the process's CPU time per frame over every
+ *       thread (on lavapipe the rendering's work itself, which a loaded
+ *       machine does not inflate as it does wall and timestamp times).  One
+ *       CSV row per variant.  KIND:
  *         composite   per-combination composites (the pack's shaders)
  *         multipass   the multi-pass alpha-blended reference (Andersson 2007 §5.3)
  *         uber        the über-shader for every patch
@@ -124,6 +127,7 @@ typedef struct variant {
     rt_pack_combo *combos;  /* owned when the shaders differ, else NULL     */
     rt_renderer *r;
     double      *gpu, *cpu, *sel;
+    double      *proc;      /* process CPU ms of each frame (all threads)   */
     double      *pass[3];   /* screen: geometry, classification, shading */
     rt_screen_stats tiles;  /* screen: the last frame's tiles (counted)  */
     int          patches, pipelines;
@@ -309,6 +313,7 @@ static void variant_free(variant *v)
     free(v->label);
     free(v->gpu);
     free(v->cpu);
+    free(v->proc);
     free(v->sel);
     free(v->ug_gen);
     free(v->ug_draw);
@@ -630,6 +635,7 @@ static bool make_renderer(bench_run *b, int i, const char *cache, rt_error *e)
     size_t n = (size_t)o->frames;
     v->gpu = xcalloc(n, sizeof(double));
     v->cpu = xcalloc(n, sizeof(double));
+    v->proc = xcalloc(n, sizeof(double));
     v->sel = xcalloc(n, sizeof(double));
     for (int k = 0; k < 3; k++)
         v->pass[k] = xcalloc(n, sizeof(double));
@@ -660,8 +666,10 @@ static bool timed_frame(bench_run *b, int f, rt_error *e)
         variant *v = &b->v[i];
         float *img = i == b->ref ? b->refimg : b->img;
         rt_frame_stats st;
+        double c0 = process_cpu_ms();
         if (!rt_renderer_frame(v->r, &cam, &st, e))
             return false;
+        v->proc[f] = process_cpu_ms() - c0;
         v->gpu[f] = st.gpu_ms;
         v->cpu[f] = st.cpu_ms;
         v->sel[f] = st.select_ms;
@@ -719,6 +727,8 @@ static void csv_row(FILE *out, const bench_run *b, int i, const char *devname)
     percentiles(v->gpu, frames, &gm, &g10, &g90);
     percentiles(v->cpu, frames, &cm, &c10, &c90);
     percentiles(v->sel, frames, &sm, &s10, &s90);
+    double procm, lo0, hi0;
+    percentiles(v->proc, frames, &procm, &lo0, &hi0);
     double pm[3] = { -1, -1, -1 }, lo, hi;
     for (int k = 0; k < 3 && IS_SCREEN(v->k); k++)
         percentiles(v->pass[k], frames, &pm[k], &lo, &hi);
@@ -733,7 +743,7 @@ static void csv_row(FILE *out, const bench_run *b, int i, const char *devname)
     const char *pk = strrchr(v->pack_dir, '/');
     fprintf(out, "\"%s\",%s,%s,%d,%d,%s,%s,%s,%g,%d,%.3f,%.3f,%.3f,%.3f,%.4f,%d,%d,"
                  "%.6g,%.6g,%.2f,%ld,%.1f,%s,%s,%.3f,%.3f,%.3f,%d,%d,%.4f,%.4f,%.3f,%.1f,"
-                 "%.2f,%.4f,%.4f,%.4f,%.2f,%ld,%zu,%g,%d,%d,%d\n",
+                 "%.2f,%.4f,%.4f,%.4f,%.2f,%ld,%zu,%g,%d,%d,%d,%.3f\n",
             devname, o->scene ? o->scene : v->base->name, o->pd.name, o->width, o->height,
             v->label, kind_names[v->k], pk ? pk + 1 : v->pack_dir,
             v->lod > 0 ? v->lod : 3.0, frames, gm, g10, g90, cm, sm,
@@ -747,7 +757,7 @@ static void csv_row(FILE *out, const bench_run *b, int i, const char *devname)
             v->shadow_ms, ugm, v->ug_cells ? gen_sum / (double)v->ug_cells : -1.0,
             ugd, (double)v->ug_cells / frames, v->ug_last.instances,
             v->ug_last.bytes_per_cell, v->far, v->tiles.tiles_far, !v->no_dclass,
-            v->tiles.tiles_class);
+            v->tiles.tiles_class, procm);
 }
 
 /* The rows, on stdout or appended to --csv (a header when it is new). */
@@ -772,7 +782,8 @@ static bool write_csv(const bench_run *b)
                      "geometry_ms,classify_ms,shade_ms,tiles,tiles_uber,layers_evaluated,"
                      "layers_needed,samples_per_px,branches_uniform_pct,shadow_map_ms,"
                      "ug_gen_med_ms,ug_gen_ms_per_cell,ug_draw_med_ms,ug_cells_per_frame,"
-                     "ug_instances,ug_bytes_per_cell,far_distance,tiles_far,distclass,tiles_class\n");
+                     "ug_instances,ug_bytes_per_cell,far_distance,tiles_far,distclass,tiles_class,"
+                     "proc_cpu_med_ms\n");
     /* the device name in CSV: its commas become ';' */
     char devname[VK_MAX_PHYSICAL_DEVICE_NAME_SIZE];
     snprintf(devname, sizeof devname, "%s", b->dev.props.deviceName);
