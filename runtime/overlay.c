@@ -88,7 +88,7 @@ void rt_overlay_text(const rt_overlay_info *in, char *buf, size_t n)
     PUT("  (7 again: the next material's mask)\n"
         "W A S D move   Space / Ctrl up, down   right button: look   wheel: speed\n"
         "F wireframe   G forward / screen   R rebuild   O shadows   U undergrowth\n"
-        "J L turn the sun   I K raise, lower it   + - exposure\n"
+        "J L turn the sun   I K raise, lower it   + - exposure   P preview scale\n"
         "left click: a crater   Q / Esc quit");
 #undef PUT
 }

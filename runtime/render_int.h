@@ -41,7 +41,12 @@ struct rt_renderer {
     rt_image         *tex;
     VkSampler        *tex_smp;
     int               ntex;
-    rt_image          color, depth, mp[3];
+    rt_image          color, depth, mp[3];  /* at the internal size: the
+                                          output's / preview_scale     */
+    int               scale;           /* the preview scale; 1: none        */
+    int               out_w, out_h;    /* the output picture's size         */
+    rt_image          out;             /* scale > 1: the output picture     */
+    rt_upscale       *upscale;         /* scale > 1: color into out         */
     rt_passes         rp;
     VkFramebuffer     fb_main, fb_multi, fb_resolve;
     rt_pipelines      pl;
@@ -89,6 +94,7 @@ typedef struct rt_frame_setup {
     bool     ug, ug_draw;  /* undergrowth generated; drawn (cells in view)  */
     bool     shadow;       /* the shadow map is due                         */
     bool     readback;     /* the target copied for the host in the frame   */
+    bool     upscale;      /* the preview scale: colour into the output     */
     unsigned variant;      /* forward: RT_VARIANT_*                         */
     unsigned cvariant;     /* screen: RT_CVARIANT_*                         */
 } rt_frame_setup;

@@ -71,6 +71,13 @@ static bool make_targets(rt_renderer *r, rt_error *e)
         return rt_fail(e, RT_E_NO_FORMAT, "store to R32G32B32A32_SFLOAT images (--shading screen)");
     if (screen && !rt_format_supports(d, VK_FORMAT_D32_SFLOAT, VK_FORMAT_FEATURE_SAMPLED_IMAGE_BIT))
         return rt_fail(e, RT_E_NO_FORMAT, "sample D32_SFLOAT depth (--shading screen)");
+    if (r->scale > 1 &&
+        (!rt_format_supports(d, cf, VK_FORMAT_FEATURE_STORAGE_IMAGE_BIT) ||
+         !rt_image_create(d, (uint32_t)r->out_w, (uint32_t)r->out_h, 1, false, 1, cf,
+                          VK_IMAGE_USAGE_STORAGE_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT |
+                          VK_IMAGE_USAGE_SAMPLED_BIT, VK_IMAGE_ASPECT_COLOR_BIT, &r->out, e)))
+        return e->id ? false
+                     : rt_fail(e, RT_E_NO_FORMAT, "store to R32G32B32A32_SFLOAT images (--preview-scale)");
     if (!rt_image_create(d, (uint32_t)w, (uint32_t)h, 1, false, 1, cf,
                          VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT | VK_IMAGE_USAGE_TRANSFER_SRC_BIT |
                          VK_IMAGE_USAGE_SAMPLED_BIT |
@@ -373,7 +380,7 @@ static bool make_commands(rt_renderer *r, rt_error *e)
         };
         RT_VK(e, vkCreateQueryPool(d->dev, &qi, NULL, &r->qpool));
     }
-    return rt_buffer_create(d, (VkDeviceSize)r->desc.width * (VkDeviceSize)r->desc.height * 16,
+    return rt_buffer_create(d, (VkDeviceSize)r->out_w * (VkDeviceSize)r->out_h * 16,
                             VK_BUFFER_USAGE_TRANSFER_DST_BIT, true, &r->readback, e);
 }
 
@@ -411,12 +418,28 @@ static bool make_undergrowth(rt_renderer *r, rt_error *e)
  * again by swap_pack; on failure none is left. */
 static void drop_pack_objects(rt_renderer *r)
 {
+    rt_upscale_destroy(r->upscale);
+    r->upscale = NULL;
     rt_ug_destroy(r->ug);
     rt_screen_destroy(r->screen);
     rt_far_destroy(r->far);
     r->ug = NULL;
     r->screen = NULL;
     r->far = NULL;
+}
+
+/* The preview scale's upsample (upscale.c), guided by the screen path's
+ * depth: the ray caster's, else the geometry pass's D32. */
+static bool make_upscale(rt_renderer *r, rt_error *e)
+{
+    if (r->scale <= 1)
+        return true;
+    const rt_image *ray = r->screen ? rt_screen_ray_depth(r->screen) : NULL;
+    const rt_image *guide = ray ? ray : r->screen ? &r->depth : NULL;
+    return rt_upscale_create(r->d, r->pl.cache, r->terrain.nearest_clamp, &r->color, guide,
+                             ray ? VK_IMAGE_LAYOUT_GENERAL
+                                 : VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL,
+                             &r->out, &r->upscale, e);
 }
 
 static bool make_pack_objects(rt_renderer *r, bool screen, rt_error *e)
@@ -428,7 +451,7 @@ static bool make_pack_objects(rt_renderer *r, bool screen, rt_error *e)
                                      r->terrain.nearest_clamp, r->set0c, r->far,
                                      rt_render_use_raycast(r), r->desc.pixel_sort,
                                      r->desc.sort_tiles, &r->screen, e)) ||
-        !make_undergrowth(r, e)) {
+        !make_undergrowth(r, e) || !make_upscale(r, e)) {
         drop_pack_objects(r);
         return false;
     }
@@ -462,6 +485,17 @@ bool rt_renderer_create(rt_device *d, const rt_pack *p, const rt_render_desc *de
         r->desc.width = 1280;
     if (r->desc.height <= 0)
         r->desc.height = 720;
+    /* the preview scale: everything drawn at the internal size, the
+     * output made by upscale.c */
+    r->out_w = r->desc.width;
+    r->out_h = r->desc.height;
+    r->scale = r->desc.preview_scale > 1 ? r->desc.preview_scale : 1;
+    if (r->scale != 1 && r->scale != 2 && r->scale != 4) {
+        free(r);
+        return rt_fail(e, RT_E_VULKAN, "preview scale", "must be 1, 2 or 4");
+    }
+    r->desc.width = (r->out_w + r->scale - 1) / r->scale;
+    r->desc.height = (r->out_h + r->scale - 1) / r->scale;
     if (r->desc.lod_pixels <= 0)
         r->desc.lod_pixels = 3.0;
     if (r->desc.clear[3] == 0 && r->desc.clear[0] == 0 && r->desc.clear[1] == 0 && r->desc.clear[2] == 0) {
@@ -502,6 +536,10 @@ bool rt_renderer_create(rt_device *d, const rt_pack *p, const rt_render_desc *de
     }
     r->shading = r->screen ? RT_SHADING_SCREEN : RT_SHADING_FORWARD;
     rt_tracker_init(&r->tracker, r->color.img);
+    if (r->scale > 1) {
+        r->tracker.image[RT_RES_OUTPUT] = r->out.img;
+        r->tracker.rest[RT_RES_OUTPUT] = VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL;
+    }
     *out = r;
     return true;
 }
@@ -540,6 +578,8 @@ void rt_renderer_destroy(rt_renderer *r)
             if (r->tex_smp[i])
                 vkDestroySampler(d->dev, r->tex_smp[i], NULL);
         }
+        rt_upscale_destroy(r->upscale);
+        rt_image_destroy(d, &r->out);
         rt_image_destroy(d, &r->color);
         rt_image_destroy(d, &r->depth);
         for (int i = 0; i < 3; i++)

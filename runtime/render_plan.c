@@ -169,6 +169,7 @@ void rt_render_setup(const rt_renderer *r, rt_frame_setup *fs)
     fs->ug = r->ug && !r->ug_off && r->view == SPLAT_VIEW_FINAL && !r->wireframe;
     fs->shadow = rt_render_shadow_due(r);
     fs->cvariant = rt_render_compute_variant(r);
+    fs->upscale = r->scale > 1;
 }
 
 void rt_render_plan(const rt_renderer *r, const rt_frame_setup *fs, rt_plan *pl)
@@ -219,14 +220,27 @@ void rt_render_plan(const rt_renderer *r, const rt_frame_setup *fs, rt_plan *pl)
                     fs->screen ? DREAD : DREAD | DWRITE, fs->screen ? RO : ATT, NONE);
         rt_pass_use(p, RT_RES_COLOR, true, OUTPUT, CWRITE | CREAD, SRC, SRC);
     }
+    if (fs->upscale) {
+        p = rt_plan_add(pl, RT_PASS_UPSCALE);
+        /* the screen path's depth: the ray caster's, else the geometry
+         * pass's (left SHADER_READ_ONLY) */
+        if (fs->screen)
+            rt_pass_use(p, fs->raycast ? RT_RES_RAYDEPTH : RT_RES_DEPTH, false, COMP, SREAD,
+                        fs->raycast ? GEN : RO, NONE);
+        rt_pass_use(p, RT_RES_COLOR, false, COMP, SREAD, GEN, NONE);
+        rt_pass_use(p, RT_RES_OUTPUT, true, COMP, SWRITE, GEN, NONE);
+        /* every pixel (the window leaves it SHADER_READ_ONLY after its
+         * tone map, which the tracker does not see) */
+        p->use[p->nuse - 1].discard = true;
+    }
     if (fs->readback)
-        rt_plan_readback(pl);
+        rt_plan_readback(pl, fs->upscale);
 }
 
-void rt_plan_readback(rt_plan *pl)
+void rt_plan_readback(rt_plan *pl, bool scaled)
 {
     rt_pass *p = rt_plan_add(pl, RT_PASS_READBACK);
-    rt_pass_use(p, RT_RES_COLOR, false, XFER, XREAD, SRC, NONE);
+    rt_pass_use(p, scaled ? RT_RES_OUTPUT : RT_RES_COLOR, false, XFER, XREAD, SRC, NONE);
     rt_pass_use(p, RT_RES_READBACK, true, XFER, XWRITE, NONE, NONE);
 }
 

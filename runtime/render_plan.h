@@ -29,6 +29,7 @@
     X(COUNTERS,     "counters",     "the forward path's counters (device)")         \
     X(COUNTERS_HOST, "counters-host", "their copy for the host")                    \
     X(UG,           "undergrowth",  "the undergrowth's cells, instances, arguments") \
+    X(OUTPUT,       "output",       "the full-size picture (preview scale)")        \
     X(READBACK,     "readback",     "the target's copy for the host")
 
 typedef enum rt_resource {
@@ -60,6 +61,7 @@ typedef enum rt_resource {
     X(COUNT_READ,  "counters read",      "the counters to the host") \
     X(DEPTH_COPY,  "depth copy",         "the ray-cast depth into the depth target") \
     X(UG_DRAW,     "undergrowth draw",   "the visible cells' plants and contact shadows") \
+    X(UPSCALE,     "upscale",            "the preview scale's target to the full size") \
     X(READBACK,    "readback",           "the target to the host")
 
 typedef enum rt_pass_kind {
@@ -129,7 +131,7 @@ const char *rt_res_name(rt_resource r);
 
 /* Passes: appended in order by render_plan.c's builder; the readback
  * pass alone (rt_renderer_read). */
-void rt_plan_readback(rt_plan *pl);
+void rt_plan_readback(rt_plan *pl, bool scaled);
 rt_pass *rt_plan_add(rt_plan *pl, rt_pass_kind k);
 void rt_pass_use(rt_pass *p, rt_resource res, bool write, VkPipelineStageFlags stage,
                  VkAccessFlags access, VkImageLayout layout, VkImageLayout after);

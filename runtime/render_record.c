@@ -501,15 +501,24 @@ static bool rec_ug_draw(rec *x, rt_error *e)
     return true;
 }
 
+static bool rec_upscale(rec *x, rt_error *e)
+{
+    (void)e;
+    rt_upscale_record(x->r->upscale, x->cb, x->fs->screen);
+    x->binds++;
+    return true;
+}
+
 static bool rec_readback(rec *x, rt_error *e)
 {
     (void)e;
     rt_renderer *r = x->r;
     VkBufferImageCopy copy = {
         .imageSubresource = { VK_IMAGE_ASPECT_COLOR_BIT, 0, 0, 1 },
-        .imageExtent = { (uint32_t)r->desc.width, (uint32_t)r->desc.height, 1 },
+        .imageExtent = { (uint32_t)r->out_w, (uint32_t)r->out_h, 1 },
     };
-    vkCmdCopyImageToBuffer(x->cb, r->color.img, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+    vkCmdCopyImageToBuffer(x->cb, r->scale > 1 ? r->out.img : r->color.img,
+                           VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
                            r->readback.buf, 1, &copy);
     return true;
 }
@@ -525,7 +534,7 @@ static bool (*const recorders[RT_PASS_KINDS])(rec *, rt_error *) = {
     [RT_PASS_SKY] = rec_sky,                 [RT_PASS_MULTIPASS] = rec_multipass,
     [RT_PASS_RESOLVE] = rec_resolve,         [RT_PASS_COUNT_READ] = rec_count_read,
     [RT_PASS_DEPTH_COPY] = rec_depth_copy,   [RT_PASS_UG_DRAW] = rec_ug_draw,
-    [RT_PASS_READBACK] = rec_readback,
+    [RT_PASS_UPSCALE] = rec_upscale,         [RT_PASS_READBACK] = rec_readback,
 };
 
 /* ---- the walk ------------------------------------------------------------------ */
@@ -763,7 +772,7 @@ bool rt_renderer_read(rt_renderer *r, float *rgba, rt_error *e)
     if (pl->npasses && pl->pass[pl->npasses - 1].own)
         pl->npasses--;   /* a second read of the same frame: its pass again */
     int from = pl->npasses;
-    rt_plan_readback(pl);
+    rt_plan_readback(pl, r->scale > 1);
     pl->pass[from].own = true;
     rec x = { .r = r };
     if (!rt_oneshot_begin(r->d, &x.cb, e))
@@ -772,7 +781,7 @@ bool rt_renderer_read(rt_renderer *r, float *rgba, rt_error *e)
     if (!record_plan(&x, pl, from, false, e) || !rt_oneshot_end(r->d, x.cb, e))
         return false;
     pl->barriers += r->tracker.barriers - before;
-    memcpy(rgba, r->readback.map, (size_t)r->desc.width * (size_t)r->desc.height * 16);
+    memcpy(rgba, r->readback.map, (size_t)r->out_w * (size_t)r->out_h * 16);
     return true;
 }
 

@@ -40,7 +40,10 @@ void rt_default_camera(const rt_pack *p, rt_camera *c)
 }
 
 
-const rt_image *rt_renderer_target(const rt_renderer *r) { return &r->color; }
+const rt_image *rt_renderer_target(const rt_renderer *r)
+{
+    return r->scale > 1 ? &r->out : &r->color;
+}
 
 /* Camera-relative view-projection: rotation only (positions reach the GPU
  * relative to the camera), perspective with reversed infinite Z and
@@ -134,7 +137,9 @@ void rt_render_fill_frame(rt_renderer *r, const rt_camera *c, splat_frame *fr)
     const rt_pack *p = r->p;
     memset(fr, 0, sizeof *fr);
     double vp[16], inv[16];
-    camera_matrix(c, (double)r->desc.width / r->desc.height, vp);
+    /* the output's aspect: with a preview scale the internal size is
+     * rounded up and its pixels are not quite square */
+    camera_matrix(c, (double)r->out_w / r->out_h, vp);
     invert4(vp, inv);
     for (int i = 0; i < 16; i++) {
         fr->view_proj[i] = (float)vp[i];

@@ -888,6 +888,24 @@ void rt_counters_read(const void *counters, rt_screen_stats *st);
  * from it.  Nothing without an atlas in the pack (rt_screen_has_far). */
 void rt_screen_far(rt_screen *s, double distance);
 bool rt_screen_has_far(const rt_screen *s);
+/* The ray caster's R32F depth (GENERAL once cast), NULL when the depth
+ * comes from the geometry pass (upscale.c's guide). */
+const rt_image *rt_screen_ray_depth(const rt_screen *s);
+
+/* ---- upscale.c: the preview scale's depth-aware upsample ---------------- */
+
+typedef struct rt_upscale rt_upscale;
+
+/* `color` (the renderer's low-resolution target, read in GENERAL) into
+ * `out` (the output size, written in GENERAL); `guide`: the low-resolution
+ * reversed-Z depth in `guide_layout` (NULL: bilinear only).  *out is set
+ * even on failure (free with rt_upscale_destroy). */
+bool rt_upscale_create(rt_device *d, VkPipelineCache cache, VkSampler nearest,
+                       const rt_image *color, const rt_image *guide, VkImageLayout guide_layout,
+                       const rt_image *out, rt_upscale **u, rt_error *e);
+/* One dispatch over the output; `guided`: the frame's path wrote the guide. */
+void rt_upscale_record(rt_upscale *u, VkCommandBuffer cb, bool guided);
+void rt_upscale_destroy(rt_upscale *u);
 
 /* ---- far.c: the far atlas on the device ---------------------------------- */
 

@@ -1007,3 +1007,8 @@ void rt_counters_read(const void *counters, rt_screen_stats *st)
     st->branches = c.branches;
     st->branches_uniform = c.branches_uniform;
 }
+
+const rt_image *rt_screen_ray_depth(const rt_screen *s)
+{
+    return s->raycast ? &s->rdepth : NULL;
+}

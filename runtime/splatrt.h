@@ -336,6 +336,12 @@ typedef struct rt_render_desc {
                                        default: drawn with the über-shader,
                                        the same picture with the same
                                        geometry (splatview --uncovered split) */
+    int          preview_scale;     /* 2 or 4: depth, classification and
+                                       shading at 1/scale of width and height,
+                                       upsampled to the full size guided by
+                                       the depth edges (upscale.c); 0 or 1:
+                                       full resolution (splatview
+                                       --preview-scale)                     */
     double       far_atlas_distance; /* screen tiles, forward patches at least
                                     this far (m) are shaded from the pack's
                                     far atlas; 0: off (the default)          */

@@ -61,6 +61,7 @@ typedef struct opts {
     int width, height, frames;
     double camera[3], look[3], lod_pixels;
     double far_distance;   /* --far-atlas-distance */
+    int preview_scale;     /* --preview-scale: 1, 2, 4 (0: 1) */
     float clear[4];
     rt_reference ref;
     rt_shading shading;
@@ -232,6 +233,7 @@ static const int on_off[] = { 1, 0 };
 static const int sort_on_off[] = { RT_SORT_ON, RT_SORT_OFF };
 static const int reference_values[] = { RT_REF_MULTIPASS, RT_REF_UBER };
 static const int shadow_values[] = { RT_SHADOW_GPU, RT_SHADOW_CPU };
+static const int preview_values[] = { 1, 2, 4 };
 
 static const splat_arg options[] = {
     { NULL, SPLAT_ARG_SECTION, .help = "Output:" },
@@ -297,6 +299,10 @@ static const splat_arg options[] = {
       "at least D m away are shaded from the pack's far atlas (splatc build --far-atlas); "
       "0: off (default)", F(far_distance), .min = 0, .max = 1e12,
       .expects = "metres >= 0" },
+    { "--preview-scale", SPLAT_ARG_ENUM, NULL, "render depth, classification and shading at "
+      "1/S of the width and height and upsample to the full size along the depth edges "
+      "(faster, softer; the window's P key cycles it)", F(preview_scale), .choices = "1|2|4",
+      .values = preview_values },
     { "--param", SPLAT_ARG_LIST, "NAME=V[,V,V,V]", "set a material param (repeatable)",
       F(params), .count = F(nparams), .capacity = 64 },
     { "--pipeline-cache", SPLAT_ARG_STRING, "FILE", "the Vulkan pipeline cache file",
@@ -721,6 +727,7 @@ static rt_render_desc render_desc(const opts *o, const rt_pack_info *pi)
         .split_uncovered = o->split_uncovered,
         .destruction_pool = o->destruction_pool, .shading = o->shading,
         .screen_depth = o->screen_depth, .pixel_sort = o->pixel_sort, .far_atlas_distance = o->far_distance,
+        .preview_scale = o->preview_scale,
     };
     if (!shading_chosen(o, &rd.shading))
         rd.shading = pi->has_compute && o->ref != RT_REF_MULTIPASS ? RT_SHADING_SCREEN
@@ -895,6 +902,7 @@ static int window(const opts *o_)
                     .no_shadows = o.no_shadows, .shadow = o.shadow,
                     .no_undergrowth = o.no_undergrowth,
                     .far_atlas_distance = o.far_distance,
+                    .preview_scale = o.preview_scale,
                     .no_distance_classes = o.no_distance_classes,
                     .async_pipelines = o.async_pipelines != 0,
                     .split_uncovered = o.split_uncovered },

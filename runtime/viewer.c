@@ -9,7 +9,8 @@
  * held looks around, wheel changes speed, 1 final, 2 combinations, 3 LOD,
  * 4 normal, 5 slope, 6 albedo, 7 mask (again: next material), 8 tiles,
  * 9 cost, F wireframe, G forward / screen-space shading, R rebuild now,
- * J/L/I/K the sun, +/- exposure, O shadows, U undergrowth, H the on-screen
+ * J/L/I/K the sun, +/- exposure, O shadows, U undergrowth, P the preview
+ * scale (1, 1/2, 1/4: upscale.c), H the on-screen
  * help (overlay.c: these keys, the view, path, frame rate and shaders
  * still compiling), Q/Escape quit, left click: a crater there
  * (destruction.c).
@@ -101,6 +102,7 @@ typedef struct viewer {
     splat_view     view;
     int            material;
     bool           wire, quit, dragging, no_shadows, no_undergrowth;
+    int            scale;        /* the preview scale (P): 1, 2, 4          */
     double         mx, my;
     /* hot reload */
     watch          w;
@@ -153,6 +155,46 @@ static void move_camera(viewer *v, double dt)
 
 /* ---- keys (also from the script) -------------------------------------------- */
 
+/* The P key: the next preview scale (1, 2, 4; rt_render_desc.preview_scale).
+ * The renderer's targets have the internal size, so a new renderer is made
+ * with the old one's switches (light, path, wireframe, shadows,
+ * undergrowth) and the tone map reads its output; craters are not carried
+ * over (the new one starts from the pack's heightfield).  On failure the
+ * old renderer stays. */
+static void cycle_preview(viewer *v)
+{
+    int next = v->scale >= 4 ? 1 : v->scale * 2;
+    rt_render_desc rd = v->desc->render;
+    rd.width = (int)v->extent.width;
+    rd.height = (int)v->extent.height;
+    rd.shading = v->pack->uber_compute ? RT_SHADING_SCREEN : RT_SHADING_FORWARD;
+    rd.preview_scale = next;
+    rd.no_shadows = v->no_shadows;
+    rt_error e = { 0 };
+    rt_renderer *nr;
+    vkDeviceWaitIdle(v->dev.dev);
+    if (!rt_renderer_create(&v->dev, v->pack, &rd, &nr, &e)) {
+        fprintf(stderr, "splatview: preview scale 1/%d: %s\n", next, e.msg);
+        snprintf(v->status, sizeof v->status, "preview scale 1/%d failed (see console)", next);
+        rt_error_clear(&e);
+        return;
+    }
+    rt_renderer_set_light(nr, rt_renderer_light(v->r));
+    rt_renderer_set_shading(nr, rt_renderer_shading(v->r));
+    rt_renderer_set_wireframe(nr, v->wire);
+    rt_renderer_set_undergrowth(nr, !v->no_undergrowth);
+    rt_renderer_set_shadows(nr, !v->no_shadows);
+    rt_renderer_destroy(v->r);
+    v->r = nr;
+    rt_vk_write_sets(&v->dev, &(rt_vk_write){ .set = v->set,
+                                              .type = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER,
+                                              .sampler = v->sampler,
+                                              .view = rt_renderer_target(v->r)->view }, 1);
+    v->scale = next;
+    snprintf(v->status, sizeof v->status, "preview scale 1/%d", next);
+    printf("splatview: preview scale 1/%d\n", next);
+}
+
 static void key_action(viewer *v, int key)
 {
     int view = rt_view_by_key(key);   /* GLFW's digit keys are their ASCII */
@@ -191,6 +233,8 @@ static void key_action(viewer *v, int key)
         rt_renderer_set_undergrowth(v->r, !v->no_undergrowth);
         snprintf(v->status, sizeof v->status, "undergrowth %s",
                  v->no_undergrowth ? "off" : "on");
+    } else if (key == GLFW_KEY_P) {
+        cycle_preview(v);
     } else if (key == GLFW_KEY_H) {
         v->help = !v->help;
     } else if (key == GLFW_KEY_O) {
@@ -838,6 +882,7 @@ static bool make_renderer(viewer *v, rt_error *e)
     const rt_viewer_desc *desc = v->desc;
     rt_render_desc rd = desc->render;
     v->no_shadows = rd.no_shadows;
+    v->scale = rd.preview_scale > 1 ? rd.preview_scale : 1;
     rd.width = (int)v->extent.width;
     rd.height = (int)v->extent.height;
     /* Screen-capable whenever the pack has compute variants, so the G key

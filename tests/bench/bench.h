@@ -21,6 +21,9 @@ bool   read_words(const char *path, uint32_t **words, size_t *n);   /* SPIR-V */
 /* median, 10th and 90th percentile of n samples (sorted in place) */
 void   percentiles(double *v, int n, double *med, double *p10, double *p90);
 double rss_mb(void);                   /* resident set size now, MB */
+double process_cpu_ms(void);           /* CPU time of every thread so far, ms
+                                          (llvmpipe's too: the work, which a
+                                          loaded machine does not inflate) */
 
 /* The error of an image against a reference (RGB). */
 typedef struct err_acc {

@@ -5,6 +5,7 @@
 
 #include <math.h>
 #include <stdlib.h>
+#include <time.h>
 #include <unistd.h>
 
 /* A pack file's bytes (NUL after them), decompressed where its name ends
@@ -74,6 +75,13 @@ void percentiles(double *v, int n, double *med, double *p10, double *p90)
 }
 
 /* resident set size now, MB (lavapipe's "GPU" memory is host memory) */
+double process_cpu_ms(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+    return (double)ts.tv_sec * 1e3 + (double)ts.tv_nsec * 1e-6;
+}
+
 double rss_mb(void)
 {
     FILE *f = fopen("/proc/self/statm", "r");

@@ -420,6 +420,7 @@ if [ "$MODE" = smoke ]; then
     mf=$(knob_pack minimal far "" "")
     KNOB_BUILD_ARGS=""
     render knob_far minimal ground 320x180 "screen=screen,pack=$mf" "far50=screen,far=50,pack=$mf"
+    render knob_preview minimal ground 320x180 full=screen half=screen,preview=2
     # the cliffs stack still compiles under both compositors (a full run
     # renders it: group compositor_cliffs)
     cliffs_pack linear_alpha "$W/cliffs" >/dev/null
@@ -564,6 +565,13 @@ else
             "no_cavity=composite,pack=$lc" "all_off=composite,pack=$lo" \
             "height_softmax=composite,pack=$hs" on_screen=screen \
             "all_off_screen=screen,pack=$lo" "height_softmax_screen=screen,pack=$hs"
+    done
+    # the preview scale (issue 33; runtime/upscale.c): depth,
+    # classification and shading at 1/2 and 1/4 of the size, upsampled
+    # along the depth edges, against full resolution on the same frames
+    for p in ground topdown; do
+        render knob_preview colorado "$p" 1280x720 full=screen half=screen,preview=2 \
+            quarter=screen,preview=4
     done
     # the far atlas (issue 11 part 3; splatc build --far-atlas, one texel per
     # heightfield texel): the screen path with the tiles at least D m away

@@ -8,8 +8,11 @@
  *       ms per frame from timestamp queries (median, p10, p90), CPU ms per
  *       frame, and the error of its lit RGBA32F image against the reference
  *       variant's image of the same frame (max and mean absolute error over
- *       RGB, PSNR with peak 1, count of NaN/Inf values).  One CSV row per
- *       variant.  KIND:
+ *       RGB, PSNR with peak 1, count of NaN/Inf values); the last column,
+ *       proc_cpu_med_ms, is the process's CPU time per frame over every
+ *       thread (on lavapipe the rendering's work itself, which a loaded
+ *       machine does not inflate as it does wall and timestamp times).  One
+ *       CSV row per variant.  KIND:
  *         composite   per-combination composites (the pack's shaders)
  *         multipass   the multi-pass alpha-blended reference (Andersson 2007 §5.3)
  *         uber        the über-shader for every patch
@@ -48,7 +51,8 @@
  *       (screen kinds) or quadtree patches (composite) at least D m away
  *       from the pack's far atlas (splatc build --far-atlas); its rows add
  *       the distance and the tiles (patches) the atlas shaded (from the
- *       counting frame).  distclass=0 shades with the
+ *       counting frame).  preview=S renders at 1/S of the size (2 or 4)
+ *       and upsamples with the depth edges (--preview-scale).  distclass=0 shades with the
  *       combinations only (--no-distance-classes; PACK.md "Distance
  *       classes"), distclass=1 (the default) with their distance classes;
  *       async (screen kinds) makes compute pipelines on worker threads,
@@ -118,6 +122,7 @@ typedef struct variant {
     double       ug_radius; /* its radius (m); 0: the runtime's default     */
     double       ug_thin;   /* its thinning distance (m); 0: the runtime's  */
     double       far;       /* screen: the far atlas's distance (m); 0: off */
+    int          preview;   /* the preview scale (2, 4); 0: full resolution */
     double       shadow_ms; /* ms of the shadow map (the first frame)       */
     double      *ug_gen, *ug_draw; /* per timed frame, GPU ms               */
     long         ug_cells;  /* cells generated over the timed frames        */
@@ -127,6 +132,7 @@ typedef struct variant {
     rt_pack_combo *combos;  /* owned when the shaders differ, else NULL     */
     rt_renderer *r;
     double      *gpu, *cpu, *sel;
+    double      *proc;      /* process CPU ms of each frame (all threads)   */
     double      *pass[3];   /* screen: geometry, classification, shading */
     rt_screen_stats tiles;  /* screen: the last frame's tiles (counted)  */
     int          patches, pipelines;
@@ -312,6 +318,7 @@ static void variant_free(variant *v)
     free(v->label);
     free(v->gpu);
     free(v->cpu);
+    free(v->proc);
     free(v->sel);
     free(v->ug_gen);
     free(v->ug_draw);
@@ -358,6 +365,9 @@ static bool parse_variant(const char *s, const char *default_pack, variant *v)
         } else if (!strncmp(t, "far=", 4)) {
             v->far = atof(t + 4);
             ok = v->far > 0;
+        } else if (!strncmp(t, "preview=", 8)) {
+            v->preview = atoi(t + 8);
+            ok = v->preview == 1 || v->preview == 2 || v->preview == 4;
         } else if (!strncmp(t, "lod=", 4)) {
             v->lod = atof(t + 4);
             ok = v->lod > 0;
@@ -615,6 +625,7 @@ static bool make_renderer(bench_run *b, int i, const char *cache, rt_error *e)
         .async_pipelines = v->async,
         .sort_tiles = v->sort_tiles,
         .undergrowth_radius = v->ug_radius, .undergrowth_thin = v->ug_thin, .far_atlas_distance = v->far,
+        .preview_scale = v->preview,
         .reference = v->k == K_MULTIPASS ? RT_REF_MULTIPASS
                    : v->k == K_UBER || v->k == K_SCREEN_UBER ? RT_REF_UBER : RT_REF_NONE,
         .pipeline_cache = cache,
@@ -633,6 +644,7 @@ static bool make_renderer(bench_run *b, int i, const char *cache, rt_error *e)
     size_t n = (size_t)o->frames;
     v->gpu = xcalloc(n, sizeof(double));
     v->cpu = xcalloc(n, sizeof(double));
+    v->proc = xcalloc(n, sizeof(double));
     v->sel = xcalloc(n, sizeof(double));
     for (int k = 0; k < 3; k++)
         v->pass[k] = xcalloc(n, sizeof(double));
@@ -663,8 +675,10 @@ static bool timed_frame(bench_run *b, int f, rt_error *e)
         variant *v = &b->v[i];
         float *img = i == b->ref ? b->refimg : b->img;
         rt_frame_stats st;
+        double c0 = process_cpu_ms();
         if (!rt_renderer_frame(v->r, &cam, &st, e))
             return false;
+        v->proc[f] = process_cpu_ms() - c0;
         v->gpu[f] = st.gpu_ms;
         v->cpu[f] = st.cpu_ms;
         v->sel[f] = st.select_ms;
@@ -722,6 +736,8 @@ static void csv_row(FILE *out, const bench_run *b, int i, const char *devname)
     percentiles(v->gpu, frames, &gm, &g10, &g90);
     percentiles(v->cpu, frames, &cm, &c10, &c90);
     percentiles(v->sel, frames, &sm, &s10, &s90);
+    double procm, lo0, hi0;
+    percentiles(v->proc, frames, &procm, &lo0, &hi0);
     double pm[3] = { -1, -1, -1 }, lo, hi;
     for (int k = 0; k < 3 && IS_SCREEN(v->k); k++)
         percentiles(v->pass[k], frames, &pm[k], &lo, &hi);
@@ -736,7 +752,7 @@ static void csv_row(FILE *out, const bench_run *b, int i, const char *devname)
     const char *pk = strrchr(v->pack_dir, '/');
     fprintf(out, "\"%s\",%s,%s,%d,%d,%s,%s,%s,%g,%d,%.3f,%.3f,%.3f,%.3f,%.4f,%d,%d,"
                  "%.6g,%.6g,%.2f,%ld,%.1f,%s,%s,%.3f,%.3f,%.3f,%d,%d,%.4f,%.4f,%.3f,%.1f,"
-                 "%.2f,%.4f,%.4f,%.4f,%.2f,%ld,%zu,%g,%d,%d,%d,%ld,%ld,%ld,%d\n",
+                 "%.2f,%.4f,%.4f,%.4f,%.2f,%ld,%zu,%g,%d,%d,%d,%.3f,%ld,%ld,%ld,%d\n",
             devname, o->scene ? o->scene : v->base->name, o->pd.name, o->width, o->height,
             v->label, kind_names[v->k], pk ? pk + 1 : v->pack_dir,
             v->lod > 0 ? v->lod : 3.0, frames, gm, g10, g90, cm, sm,
@@ -750,7 +766,7 @@ static void csv_row(FILE *out, const bench_run *b, int i, const char *devname)
             v->shadow_ms, ugm, v->ug_cells ? gen_sum / (double)v->ug_cells : -1.0,
             ugd, (double)v->ug_cells / frames, v->ug_last.instances,
             v->ug_last.bytes_per_cell, v->far, v->tiles.tiles_far, !v->no_dclass,
-            v->tiles.tiles_class, v->ug_last.candidates, v->ug_last.drawn, v->ug_last.triangles,
+            v->tiles.tiles_class, procm, v->ug_last.candidates, v->ug_last.drawn, v->ug_last.triangles,
             v->ug_last.draws);
 }
 
@@ -777,7 +793,7 @@ static bool write_csv(const bench_run *b)
                      "layers_needed,samples_per_px,branches_uniform_pct,shadow_map_ms,"
                      "ug_gen_med_ms,ug_gen_ms_per_cell,ug_draw_med_ms,ug_cells_per_frame,"
                      "ug_instances,ug_bytes_per_cell,far_distance,tiles_far,distclass,tiles_class,"
-                     "ug_candidates,ug_drawn,ug_triangles,ug_draws\n");
+                     "proc_cpu_med_ms,ug_candidates,ug_drawn,ug_triangles,ug_draws\n");
     /* the device name in CSV: its commas become ';' */
     char devname[VK_MAX_PHYSICAL_DEVICE_NAME_SIZE];
     snprintf(devname, sizeof devname, "%s", b->dev.props.deviceName);

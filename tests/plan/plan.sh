@@ -73,6 +73,19 @@ plan raycast --shading screen --screen-depth raycast
 expect raycast "$UG,depth (ray cast),tile lists reset,classification,shading,tile counts,readback"
 has raycast classification "ray-depth(general)  writes"
 
+# the preview scale: the frame at 80x45, one more pass makes the 160x90
+# output from the colour and the path's depth; the readback reads it
+plan preview --shading screen --preview-scale 2
+expect preview "$UG,depth,tile lists reset,classification,shading,tile counts,upscale,readback"
+grep -q "^plan: screen path, 80x45, 8 passes" "$OUT/preview.txt" || fail "preview: header"
+has preview upscale "reads depth(shader-read) color(general)  writes output(general)"
+has preview readback "reads output(transfer-src)  writes readback"
+plan preview_raycast --shading screen --screen-depth raycast --preview-scale 4
+has preview_raycast upscale "reads ray-depth(general) color(general)  writes output(general)"
+plan preview_forward --shading forward --preview-scale 2
+expect preview_forward "$UG,forward,sky,upscale,readback"
+has preview_forward upscale "reads color(general)  writes output(general)"
+
 plan cost --shading forward --view cost
 expect cost "counters reset,forward,counters read,readback"
 has cost forward "writes color(transfer-src) depth(attachment) counters"
@@ -94,4 +107,4 @@ for sh in screen cost; do
     [ $rc = 3 ] || { cat "$OUT/nobar_$sh.log"; fail "no barriers ($sh): exit $rc, expected 3"; }
     grep -q "SYNC-HAZARD" "$OUT/nobar_$sh.log" || fail "no barriers ($sh): no hazard reported"
 done
-echo "ok: 8 plans as expected; without the plan's barriers validation reports hazards"
+echo "ok: 11 plans as expected; without the plan's barriers validation reports hazards"

@@ -47,6 +47,13 @@ if(TARGET splatrt AND TARGET splatview)
               $<TARGET_FILE:imgcheck> ${RENDER_OUT}/minimal ${RENDER_OUT}/out_viewer_minimal)
     set_tests_properties(render.viewer_minimal PROPERTIES LABELS render SKIP_RETURN_CODE 77
       FIXTURES_REQUIRED minimal_pack ENVIRONMENT "SPLAT_VALIDATE=1" TIMEOUT 300)
+    # the preview scale (runtime/upscale.c): PSNR floors against full
+    # resolution on three paths, the depth guide against bilinear
+    add_test(NAME render.preview_scale
+      COMMAND sh ${RENDER_DIR}/preview_scale.sh $<TARGET_FILE:splatview>
+              $<TARGET_FILE:imgcheck> ${RENDER_OUT}/minimal ${RENDER_OUT}/preview_scale)
+    set_tests_properties(render.preview_scale PROPERTIES LABELS render TIMEOUT 600
+      SKIP_RETURN_CODE 77 FIXTURES_REQUIRED minimal_pack)
     # the help overlay (key H): headless --overlay and the window
     add_test(NAME render.overlay
       COMMAND sh ${RENDER_DIR}/run.sh overlay $<TARGET_FILE:splatview>
