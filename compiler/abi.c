@@ -724,24 +724,32 @@ const char SPLAT_GLSL_PRELUDE[] =
      * leaves ir_differentiate writes.  All follow from the position's.
      * normal, slope, destruction and painted masks have derivative 0 (the
      * pass writes constants for them). */
-    /* A sample with explicit gradients (IR SAMPLE_GRAD): the level the
-     * Vulkan spec gives for textureGrad without anisotropy, log2 of the
-     * longer gradient in texels, sampled with textureLod.  The same mip
-     * as textureGrad, at the rate of a plain sample: NVIDIA runs
-     * textureGrad several times slower (H100, colorado top-down forward:
-     * 14.7 ms with textureGrad against 9.7 ms with implicit derivatives). */
+    /* A sample with explicit gradients (IR SAMPLE_GRAD), one textureLod
+     * tap: the level the Vulkan spec gives for textureGrad without
+     * anisotropy is log2 of the longer gradient in texels, which blurs
+     * grazing views (a footprint many times longer than wide takes the
+     * long side's mip).  This takes the level of the footprint's short
+     * side (its area over the long side) where that is finer, at most one
+     * level below the long side's: anisotropy 2 for one tap, sharper
+     * cliffs and ground at grazing angles with little aliasing, and the
+     * same level as before where the footprint is round.  textureLod, not
+     * textureGrad with an anisotropic sampler: NVIDIA runs textureGrad
+     * several times slower (H100, colorado top-down forward: 14.7 ms with
+     * textureGrad against 9.7 ms with implicit derivatives). */
+    "float splat_grad_lod(vec2 a, vec2 b) {\n"
+    "    float r = max(max(dot(a, a), dot(b, b)), 1e-30);\n"
+    "    float area = max(abs(a.x * b.y - a.y * b.x), 1e-30);\n"
+    "    float major = 0.5 * log2(r);\n"
+    "    return max(major - 1.0, log2(area) - major);\n"
+    "}\n"
     "vec4 splat_texture_grad(sampler2D t, vec2 uv, vec2 dx, vec2 dy) {\n"
     "    vec2 s = vec2(textureSize(t, 0));\n"
-    "    vec2 a = dx * s, b = dy * s;\n"
-    "    float r = max(max(dot(a, a), dot(b, b)), 1e-30);\n"
-    "    return textureLod(t, uv, 0.5 * log2(r));\n"
+    "    return textureLod(t, uv, splat_grad_lod(dx * s, dy * s));\n"
     "}\n"
     /* the same on a layer of a texture array: uvl = (uv, layer) */
     "vec4 splat_texture_grad(sampler2DArray t, vec3 uvl, vec2 dx, vec2 dy) {\n"
     "    vec2 s = vec2(textureSize(t, 0).xy);\n"
-    "    vec2 a = dx * s, b = dy * s;\n"
-    "    float r = max(max(dot(a, a), dot(b, b)), 1e-30);\n"
-    "    return textureLod(t, uvl, 0.5 * log2(r));\n"
+    "    return textureLod(t, uvl, splat_grad_lod(dx * s, dy * s));\n"
     "}\n"
     "#if defined(SPLAT_COMPUTE) || defined(SPLAT_GRADIENTS)\n"
     "vec3 splat_d_rel(int a) { return a == 0 ? splat_dpdx : splat_dpdy; }\n"

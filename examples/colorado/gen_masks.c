@@ -307,7 +307,7 @@ int main(int argc, char **argv)
     };
     int status = 0;
     if (splines)   /* one spline of a curve per road (the material reads one shape) */
-        fprintf(splines, "    spline road { width = 10, falloff = 4, profile = smoothstep\n");
+        fprintf(splines, "    spline road { width = 10, falloff = 32, profile = smoothstep\n");
     for (size_t r = 0; r < sizeof roads / sizeof roads[0]; r++)
         if (!paint_road(&g, (int)(roads[r][0] * (g.w - 1)), (int)(roads[r][1] * (g.h - 1)),
                         (int)(roads[r][2] * (g.w - 1)), (int)(roads[r][3] * (g.h - 1)), masks[3],

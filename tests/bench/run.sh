@@ -3,7 +3,7 @@
 # `make bench-smoke`, CTest bench.smoke).
 #
 #   sh tests/bench/run.sh BUILD_DIR [--smoke] [--quick] [--out DIR]
-#                         [--frames N] [--keep-work] [--only scale_world]
+#                         [--frames N] [--keep-work] [--only scale_world|look]
 #
 # Writes into DIR (default out/bench): compile.csv (per scene: phases of
 # `splatc build --stats`, cold and warm, peak memory; colorado_geotiff:
@@ -30,6 +30,8 @@
 # on both paths, peak memory; scale_world.tsv, scale_world.md,
 # scale_world.png) runs last, scaled down to 8 and 16 materials in --smoke;
 # --only scale_world runs it alone (tens of minutes on lavapipe at 256).
+# --only look: the group `look` alone (colorado's look additions on and
+# off, render.csv; about 15 minutes on lavapipe with --frames 2).
 set -eu
 # must, differ, to: statuses checked (no pipe without pipefail)
 . "$(dirname "$0")/../lib.sh"
@@ -68,7 +70,8 @@ scale_world() {
 case $ONLY in
 "") ;;
 scale_world) scale_world; exit 0 ;;
-*) echo "run.sh: --only expects scale_world, found '$ONLY'" >&2; exit 2 ;;
+look) ;;
+*) echo "run.sh: --only expects scale_world or look, found '$ONLY'" >&2; exit 2 ;;
 esac
 SPLATC=$B/compiler/splatc
 BENCH=$B/tests/splatbench
@@ -163,6 +166,8 @@ DEVICE=$(awk -F'"' 'NR == 2 { print $2 }' "$W/device.csv")
 log "device: $DEVICE"
 
 # ---- (a) compile figures: every scene cold (empty cache) and warm --------
+# (--only look: none of (a); its pack is built with the renders below)
+if [ "$ONLY" != look ]; then
 CSV=$OUT/compile.csv
 echo "$COMPILE_HEAD" > "$CSV"
 case $MODE in smoke) CSCENES=minimal ;; *) CSCENES="minimal colorado billingsley" ;; esac
@@ -271,6 +276,7 @@ if [ "$MODE" != smoke ]; then
     done
     rm -rf "$W/pack-mat"
 fi
+fi   # --only look
 
 # ---- compositor and knob packs ------------------------------------------------
 # compositor variants: the scene with another `compositor =`
@@ -322,6 +328,10 @@ LOOK_PLAIN='detile:s/: hex_tile { tex = tex, uv = \([a-z]*\)\.out, sharpness = s
 LOOK_HEXNEAR='detile:s/b = far_amount }/b = 0.0 }/'
 LOOK_NOMACRO='variation:s/out vec3 out = r.out/out vec3 out = albedo/'
 LOOK_NOCAVITY='cavity:s/out vec3 out = s.out/out vec3 out = albedo/'
+# the footprint filtering (nodes/footprint.sg): aa_* ramps with no widening
+# (the plain ramps: fwidth and the neighbours' normal gathers go dead) and
+# aa_footprint 1 mm (aa_coverage 1, aa_line the sharp band: graphs/road.sg)
+LOOK_NOFOOTPRINT='footprint:s/node fc  : mul { a = fs.out, b = cap.out }/node fc  : mul { a = 0.0, b = cap.out }/;s/node fpn : max { a = fpm.out, b = 0.001 }/node fpn : max { a = 0.0, b = 0.001 }/'
 
 # graph knob variants: one graph file with a node type replaced
 KNOB_BUILD_ARGS=""
@@ -367,7 +377,40 @@ render() {  # GROUP SCENE PATH SIZE VARIANT... (first variant = reference)
         --save "$W/img/$group-$scene-$path-$size" > "$W/render.txt"
     awk -v g="$group" -F, 'NR > 1 { print g "," $0 }' "$W/render.txt" >> "$CSV.body"
 }
+# the look additions (issue 31), each switched off in the node library
+# against the scene as it stands (everything on), same frames: detile
+# as a plain top-down read (1 sample) and hex-tiled near only (3), no
+# macro variation, no cavity darkening, no footprint filtering (masks
+# and the road's coverage), all of them off; and the height_softmax
+# compositor.  samples_per_px and GPU ms side by side.
+look_group() {
+    lp=$(look_pack colorado plain "$LOOK_PLAIN")
+    lh=$(look_pack colorado hexnear "$LOOK_HEXNEAR")
+    lm=$(look_pack colorado nomacro "$LOOK_NOMACRO")
+    lc=$(look_pack colorado nocavity "$LOOK_NOCAVITY")
+    lf=$(look_pack colorado nofootprint "$LOOK_NOFOOTPRINT")
+    lo=$(look_pack colorado off "$LOOK_PLAIN" "$LOOK_NOMACRO" "$LOOK_NOCAVITY" "$LOOK_NOFOOTPRINT")
+    hs=$(comp_pack colorado height_softmax)
+    for p in ground topdown; do
+        render look colorado "$p" 1280x720 on=composite "detile_plain=composite,pack=$lp" \
+            "detile_hex_near=composite,pack=$lh" "no_macro=composite,pack=$lm" \
+            "no_cavity=composite,pack=$lc" "no_footprint=composite,pack=$lf" \
+            "all_off=composite,pack=$lo" "height_softmax=composite,pack=$hs" on_screen=screen \
+            "no_footprint_screen=screen,pack=$lf" "all_off_screen=screen,pack=$lo" \
+            "height_softmax_screen=screen,pack=$hs"
+    done
+}
 rm -f "$CSV.body"
+if [ "$ONLY" = look ]; then
+    log "only look: colorado"
+    "$SPLATC" build examples/colorado/scene.sg -o "$W/colorado" -j 2 --cache "$W/cache-colorado" >/dev/null
+    look_group
+    { echo "group,$(sed -n 1p "$W/render.txt")"; cat "$CSV.body"; } > "$CSV"
+    rm -f "$CSV.body"
+    [ "$KEEP" = yes ] || rm -rf "$W"
+    log "done: $CSV"
+    exit 0
+fi
 for s in $SCENES; do
     for size in $SIZES; do
         for p in $PATHS; do
@@ -548,24 +591,7 @@ else
         render knob_lazy colorado "$p" 1280x720 "eager=composite,pack=$pe" lazy=composite \
             "eager_screen=screen,pack=$pe" lazy_screen=screen
     done
-    # the look additions (issue 31), each switched off in the node library
-    # against the scene as it stands (everything on), same frames: detile
-    # as a plain top-down read (1 sample) and hex-tiled near only (3), no
-    # macro variation, no cavity darkening, all of them off; and the
-    # height_softmax compositor.  samples_per_px and GPU ms side by side.
-    lp=$(look_pack colorado plain "$LOOK_PLAIN")
-    lh=$(look_pack colorado hexnear "$LOOK_HEXNEAR")
-    lm=$(look_pack colorado nomacro "$LOOK_NOMACRO")
-    lc=$(look_pack colorado nocavity "$LOOK_NOCAVITY")
-    lo=$(look_pack colorado off "$LOOK_PLAIN" "$LOOK_NOMACRO" "$LOOK_NOCAVITY")
-    hs=$(comp_pack colorado height_softmax)
-    for p in ground topdown; do
-        render look colorado "$p" 1280x720 on=composite "detile_plain=composite,pack=$lp" \
-            "detile_hex_near=composite,pack=$lh" "no_macro=composite,pack=$lm" \
-            "no_cavity=composite,pack=$lc" "all_off=composite,pack=$lo" \
-            "height_softmax=composite,pack=$hs" on_screen=screen \
-            "all_off_screen=screen,pack=$lo" "height_softmax_screen=screen,pack=$hs"
-    done
+    look_group
     # the preview scale (issue 33; runtime/upscale.c): depth,
     # classification and shading at 1/2 and 1/4 of the size, upsampled
     # along the depth edges, against full resolution on the same frames
