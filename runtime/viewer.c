@@ -167,7 +167,7 @@ static void cycle_preview(viewer *v)
     rt_render_desc rd = v->desc->render;
     rd.width = (int)v->extent.width;
     rd.height = (int)v->extent.height;
-    rd.shading = v->pack->uber_compute ? RT_SHADING_SCREEN : RT_SHADING_FORWARD;
+    rd.shading = v->pack->uber_compute.mod ? RT_SHADING_SCREEN : RT_SHADING_FORWARD;
     rd.preview_scale = next;
     rd.no_shadows = v->no_shadows;
     rt_error e = { 0 };
