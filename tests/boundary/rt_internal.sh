@@ -28,6 +28,7 @@ tests/world/test_holes.c             checks the combination levels and node boun
 tests/world/test_placed.c            reads the sparse painted store of the loaded pack (rt_pack.sparse)
 tests/render/test_dclass.c           picks rock texels from the leaf combination map (rt_pack.levels, rt_pack.combos)
 tests/render/test_vk_build.c         tests the internal Vulkan builder (vk_build.h, the device handles)
+tests/unit/test_classify_view.c      checks the view classification against a search over every combination (rt_class_view_build)
 '
 cd "$ROOT"
 # every C file but the library's own (runtime/*.c except splatview.c) and
