@@ -463,14 +463,12 @@ bool rt_pipelines_make(rt_device *d, const rt_pack *p, const rt_passes *rp, rt_p
                        bool compute, const int *ids, int n, unsigned variant, rt_error *e)
 {
     if (compute && n > 0 && rt_pipelines_stand_in(d, p, pl, ids, n, variant)) {
-        /* the über-shader now; the others on the workers meanwhile */
+        /* the über-shader now; it stands in for the others in the frame
+         * drawn again, after which rt_screen_missing queues them on the
+         * workers (not before: on a few cores they would compete with
+         * that frame, and a one-frame process drops them unmade) */
         VkPipeline uber;
-        if (!rt_pipelines_compute(d, p, pl, p->ncombos, variant, &uber, e))
-            return false;
-        for (int k = 0; k < n; k++)
-            if (ids[k] != p->ncombos)
-                rt_async_request(pl, ids[k], variant);
-        return true;
+        return rt_pipelines_compute(d, p, pl, p->ncombos, variant, &uber, e);
     }
     /* each combination's slot is its own: made on all cores (jobs.c) */
     make_jobs j = { d, p, rp, pl, compute, ids, variant };

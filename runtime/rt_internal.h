@@ -708,9 +708,9 @@ bool rt_pipelines_glsl_fragment(rt_device *d, rt_pipelines *pl, const rt_passes 
 /* The pipelines of combinations ids[0..n) in `variant`, made at once on
  * all cores: compute (screen path; rp unused) or composites (forward).
  * Compute with pl->async, where rt_pipelines_stand_in says the über-shader
- * costs less to make than they do: the über-shader's made instead (it
- * stands in for them from the next draw) and they are queued on the
- * workers. */
+ * costs less to make than they do: the über-shader's made instead; it
+ * stands in for them from the next draw, after which they are queued on
+ * the workers (rt_screen_missing). */
 bool rt_pipelines_make(rt_device *d, const rt_pack *p, const rt_passes *rp, rt_pipelines *pl,
                        bool compute, const int *ids, int n, unsigned variant, rt_error *e);
 /* Whether the über-shader should stand in for compute pipelines ids[0..n)

@@ -753,6 +753,10 @@ static int headless(const opts *o)
         return 1;
     }
     rt_pack_info_get(pack, &pi);
+    /* --check: every shader read and validated now (a frame reads only
+     * those it needs), before the device is opened, as a load did */
+    if (o->check && !rt_pack_validate(pack, &e))
+        goto done;
     splat_view view = SPLAT_VIEW_FINAL;
     int material = 0;
     rt_camera cam;
@@ -766,8 +770,6 @@ static int headless(const opts *o)
         !apply_craters(o, r, &cam, &e))
         goto done;
     if (o->check) {   /* the pack loads, every shader passes, a renderer stands */
-        if (!rt_pack_validate(pack, &e))
-            goto done;
         printf("%s: loads (%d combinations, %d materials, %s path)\n", o->pack, pi.ncombos,
                pi.nmaterials, rd.shading == RT_SHADING_SCREEN ? "screen" : "forward");
         status = 0;

@@ -9,6 +9,9 @@
  *   Shaders read on first use (pack_shaders.c): loading reads none of
  *     them; rt_pack_spirv reads one, the same words as the file, once
  *     (from two threads at once); rt_pack_validate reads the rest.
+ *   rt_pipelines_stand_in: with async pipelines the über-shader stands
+ *     in for lists whose modules together outweigh it, not for one
+ *     smaller composite; SPLAT_STAND_IN forces either.
  *
  *   test_pack_checks MINIMAL_PACK DESTRUCTION_PACK COMPUTE_PACK
  *   (all by splatc build)
@@ -270,6 +273,45 @@ static void test_lazy(void **state)
     rt_pack_free(&p);
 }
 
+static void test_stand_in(void **state)
+{
+    (void)state;
+    rt_pack p;
+    rt_error e = { 0 };
+    assert_true(rt_pack_load(&p, compute_dir, &e));
+    rt_device d;
+    memset(&d, 0, sizeof d);
+    d.props.deviceType = VK_PHYSICAL_DEVICE_TYPE_CPU;   /* one JIT at a time */
+    rt_pipelines pl;
+    memset(&pl, 0, sizeof pl);   /* no pipeline made yet */
+    int ids[64], n = p.nbase < 64 ? p.nbase : 64;
+    size_t uber = rt_pack_spirv_size(&p.uber_compute_spirv), sum = 0, one = 0;
+    int small = -1;
+    for (int k = 0; k < n; k++) {
+        ids[k] = k;
+        size_t s = rt_pack_spirv_size(&p.combos[k].compute_spirv);
+        assert_true(s > 0);
+        sum += s;
+        if (s < uber && small < 0)
+            small = k, one = s;
+    }
+    assert_true(small >= 0 && uber > 0);
+    assert_false(rt_pipelines_stand_in(&d, &p, &pl, ids, n, 0));   /* no workers */
+    pl.async = (struct rt_async *)&pl;   /* only tested against NULL here */
+    unsetenv("SPLAT_STAND_IN");
+    assert_false(rt_pipelines_stand_in(&d, &p, &pl, &small, 1, 0));
+    assert_int_equal(rt_pipelines_stand_in(&d, &p, &pl, ids, n, 0), uber < sum);
+    printf("  über-shader %zu bytes; combination %d %zu; all %d %zu: stands in %s\n", uber,
+           small, one, n, sum, uber < sum ? "for all" : "for none");
+    setenv("SPLAT_STAND_IN", "always", 1);
+    assert_true(rt_pipelines_stand_in(&d, &p, &pl, &small, 1, 0));
+    setenv("SPLAT_STAND_IN", "never", 1);
+    assert_false(rt_pipelines_stand_in(&d, &p, &pl, ids, n, 0));
+    unsetenv("SPLAT_STAND_IN");
+    pl.async = NULL;
+    rt_pack_free(&p);
+}
+
 int main(int argc, char **argv)
 {
     if (argc != 4) {
@@ -284,6 +326,7 @@ int main(int argc, char **argv)
         cmocka_unit_test(test_dense_and_destruction),
         cmocka_unit_test(test_compute_role),
         cmocka_unit_test(test_lazy),
+        cmocka_unit_test(test_stand_in),
     };
     return cmocka_run_group_tests(tests, NULL, NULL);
 }
