@@ -7,18 +7,19 @@
  * upsampling, Kopf et al. 2007, with the low-resolution depth as the
  * only guide, since a full-resolution depth would cost what the preview
  * saves): each output pixel blends the 2x2 low-resolution pixels around
- * it with bilinear weights, each multiplied by how close its depth is to
- * that of the nearest of them, exp(-((1 - ratio) / SIGMA)^2) with ratio
- * the smaller over the larger of the two reversed-Z depths (the ratio of
- * their distances; the sky, depth 0, matches only the sky).  On a smooth
- * surface the neighbours' distances differ by a few per cent and the
- * blend is bilinear (where the four are within 2 % the pass skips the
- * weighting: most pixels, sky and smooth ground); across a ridge against the sky or a nearer hill the
- * far side gets no weight, so the edge stays sharp (on the low
- * resolution's pixel grid) instead of blurring into a halo.  Paths
- * without a depth image of their own (forward, multi-pass) are
- * upsampled bilinearly (`guided` false), as every path is with
- * SPLAT_UPSCALE=bilinear (tests).
+ * it with bilinear weights.  Where their four depths agree within 2 %
+ * (sky, smooth ground: most pixels) that is all.  Elsewhere (an edge)
+ * each weight is multiplied by how alike its depth is to those of the
+ * side of the edge holding the most bilinear weight: the sample n whose
+ * sum over i of w_i sim(i, n) is largest, then w_i *= sim(i, n), with
+ * sim = exp(-((1 - ratio) / SIGMA)^2) and ratio the smaller over the
+ * larger of two reversed-Z depths (the ratio of their distances; the sky,
+ * depth 0, matches only the sky).  Across a ridge against the sky or a
+ * nearer hill the far side gets no weight, so the edge stays sharp (on
+ * the low resolution's pixel grid, along the bilinear weights' half-way
+ * line) instead of blurring into a halo.  Paths without a depth image of
+ * their own (forward, multi-pass) are upsampled bilinearly (`guided`
+ * false), as every path is with SPLAT_UPSCALE=bilinear (tests).
  *
  *     colour (w/s x h/s, GENERAL) + depth (w/s x h/s)  ->  output (w x h, GENERAL)
  */
