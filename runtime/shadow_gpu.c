@@ -143,16 +143,19 @@ static const char march_glsl[] =
     "    float k = 1.0;\n"
     "    vec2 size = vec2(u.size);\n"
     "    int L = 0;   /* the pyramid level looked at */\n"
+    /* the ray leaves the terrain's rectangle at `whole` from the start */
+    "    float whole = box_exit(vec2(base) + 0.5, vec2(0.0), size);\n"
+    "    float top = (u.top - h0) * u.kh;   /* the highest point above the start (m) */\n"
     "    while (lowest > -u.tan_r) {\n"
     "        float t = k * u.step;\n"
     "        vec2 o = u.d * t;\n"
     "        vec2 p = vec2(base) + 0.5 + o;   /* texels from the terrain's corner */\n"
     "        if (any(lessThan(p, vec2(0.0))) || any(greaterThan(p, size))) break;\n"
     "        float ray = u.eps + u.rise * t;   /* metres above the start */\n"
-    "        if (ray > (u.top - h0) * u.kh) break;   /* above the terrain: shadow.c's end */\n"
+    "        if (ray > top) break;   /* above the terrain: shadow.c's end */\n"
     "        float thr = min(lowest, u.tan_r);\n"
     /* the whole terrain below the ray: done */
-    "        if (clear_of(ray - (u.top - h0) * u.kh, t, box_exit(p, vec2(0.0), size), thr))\n"
+    "        if (clear_of(ray - top, t, max(whole - t, 0.0), thr))\n"
     "            break;\n"
     /* one cell a step, so SIMD lanes run the same code: skipped, then
      * its parent next; else its child at the same sample; else, at the

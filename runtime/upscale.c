@@ -7,17 +7,19 @@
  * upsampling, Kopf et al. 2007, with the low-resolution depth as the
  * only guide, since a full-resolution depth would cost what the preview
  * saves): each output pixel blends the 2x2 low-resolution pixels around
- * it with bilinear weights, each multiplied by how close its depth is to
- * that of the nearest of them, exp(-((1 - ratio) / SIGMA)^2) with ratio
- * the smaller over the larger of the two reversed-Z depths (the ratio of
- * their distances; the sky, depth 0, matches only the sky).  On a smooth
- * surface the neighbours' distances differ by a few per cent and the
- * blend is bilinear; across a ridge against the sky or a nearer hill the
- * far side gets no weight, so the edge stays sharp (on the low
- * resolution's pixel grid) instead of blurring into a halo.  Paths
- * without a depth image of their own (forward, multi-pass) are
- * upsampled bilinearly (`guided` false), as every path is with
- * SPLAT_UPSCALE=bilinear (tests).
+ * it with bilinear weights.  Where their four depths agree within 2 %
+ * (sky, smooth ground: most pixels) that is all.  Elsewhere (an edge)
+ * each weight is multiplied by how alike its depth is to those of the
+ * side of the edge holding the most bilinear weight: the sample n whose
+ * sum over i of w_i sim(i, n) is largest, then w_i *= sim(i, n), with
+ * sim = exp(-((1 - ratio) / SIGMA)^2) and ratio the smaller over the
+ * larger of two reversed-Z depths (the ratio of their distances; the sky,
+ * depth 0, matches only the sky).  Across a ridge against the sky or a
+ * nearer hill the far side gets no weight, so the edge stays sharp (on
+ * the low resolution's pixel grid, along the bilinear weights' half-way
+ * line) instead of blurring into a halo.  Paths without a depth image of
+ * their own (forward, multi-pass) are upsampled bilinearly (`guided`
+ * false), as every path is with SPLAT_UPSCALE=bilinear (tests).
  *
  *     colour (w/s x h/s, GENERAL) + depth (w/s x h/s)  ->  output (w x h, GENERAL)
  */
@@ -54,6 +56,12 @@ static const char upscale_glsl[] =
     "layout(set = 0, binding = 2, rgba32f) uniform writeonly image2D u_out;\n"
     "layout(push_constant) uniform P { ivec2 src; ivec2 dst; int guided; } u_pc;\n"
     "const float SIGMA = 0.08;\n"
+    /* how alike two reversed-Z depths are: their distances' ratio */
+    "float sim(float a, float b) {\n"
+    "    float big = max(a, b);\n"
+    "    float r = (big > 0.0 ? 1.0 - min(a, b) / big : 0.0) / SIGMA;\n"
+    "    return exp(-r * r);\n"
+    "}\n"
     "void main() {\n"
     "    ivec2 px = ivec2(gl_GlobalInvocationID.xy);\n"
     "    if (any(greaterThanEqual(px, u_pc.dst)))\n"
@@ -67,25 +75,27 @@ static const char upscale_glsl[] =
     "    float w[4] = float[4]((1.0 - f.x) * (1.0 - f.y), f.x * (1.0 - f.y),\n"
     "                          (1.0 - f.x) * f.y, f.x * f.y);\n"
     "    if (u_pc.guided != 0) {\n"
-    "        float d[4], sim[16];\n"
+    "        float d[4];\n"
     "        for (int i = 0; i < 4; i++)\n"
     "            d[i] = max(texelFetch(u_depth, q[i], 0).r, 0.0);\n"
-    /* the side of the edge with the most bilinear weight: sample n's
-     * depth cluster, its weight the sum of its similar neighbours' */
-    "        int n = 0;\n"
-    "        float best = -1.0;\n"
-    "        for (int j = 0; j < 4; j++) {\n"
-    "            float sum = 0.0;\n"
-    "            for (int i = 0; i < 4; i++) {\n"
-    "                float big = max(d[i], d[j]);\n"
-    "                float r = (big > 0.0 ? 1.0 - min(d[i], d[j]) / big : 0.0) / SIGMA;\n"
-    "                sim[4 * j + i] = exp(-r * r);\n"
-    "                sum += w[i] * sim[4 * j + i];\n"
-    "            }\n"
-    "            if (sum > best) { best = sum; n = j; }\n"
+    "        float lo = min(min(d[0], d[1]), min(d[2], d[3]));\n"
+    "        float hi = max(max(d[0], d[1]), max(d[2], d[3]));\n"
+    /* one surface (or all sky): bilinear; else an edge */
+    "        if (lo < hi * (1.0 - 0.25 * SIGMA)) {\n"
+    /* sim of each pair once (6 exps); then the side of the edge with the
+     * most bilinear weight: sample n's depth cluster, its weight the sum
+     * of its similar neighbours' */
+    "            float s01 = sim(d[0], d[1]), s02 = sim(d[0], d[2]), s03 = sim(d[0], d[3]);\n"
+    "            float s12 = sim(d[1], d[2]), s13 = sim(d[1], d[3]), s23 = sim(d[2], d[3]);\n"
+    "            vec4 r0 = vec4(1.0, s01, s02, s03), r1 = vec4(s01, 1.0, s12, s13);\n"
+    "            vec4 r2 = vec4(s02, s12, 1.0, s23), r3 = vec4(s03, s13, s23, 1.0);\n"
+    "            vec4 wv = vec4(w[0], w[1], w[2], w[3]);\n"
+    "            float m0 = dot(wv, r0), m1 = dot(wv, r1), m2 = dot(wv, r2), m3 = dot(wv, r3);\n"
+    "            vec4 pick = m0 >= max(max(m1, m2), m3) ? r0 : m1 >= max(m2, m3) ? r1\n"
+    "                      : m2 >= m3 ? r2 : r3;\n"
+    "            wv *= pick;\n"
+    "            w = float[4](wv.x, wv.y, wv.z, wv.w);\n"
     "        }\n"
-    "        for (int i = 0; i < 4; i++)\n"
-    "            w[i] *= sim[4 * n + i];\n"
     "    }\n"
     "    vec4 c = vec4(0.0);\n"
     "    float sum = 0.0;\n"

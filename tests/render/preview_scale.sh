@@ -9,7 +9,7 @@
 #   guide    the depth-aware upsample leaves more pixels within 0.05 of
 #            full resolution than a bilinear one (SPLAT_UPSCALE=bilinear:
 #            silhouettes blurred into halos); measured 5034 against 5838
-#            pixels over on the screen path
+#            pixels over on the screen path (5048 since the smooth fast path)
 #   refused  --preview-scale 3
 #   window   P cycles the scale (1, 1/2, 1/4, 1) under xvfb, validation
 #            silent, each picture another, back at 1 the first
