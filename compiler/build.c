@@ -18,7 +18,10 @@
  *   validate  errors reported; every newly compiled module stored in the
  *             cache (only validated modules are; a hit was validated when
  *             it was stored, and its entry is checksummed)
- *   write     everything into OUT.tmp-XXXXXX, then swapped into place
+ *   write     everything into OUT.tmp-XXXXXX, then swapped into place; a
+ *             file the old pack holds with the same bytes is linked from
+ *             it instead (pack_write.c: a colour edit writes only the
+ *             changed shaders' files and the manifest)
  *
  * Nothing changed: right after loading, the bytes of every input (the
  * graph files the program read, the heightfield, the painted rasters, the

@@ -100,6 +100,11 @@ typedef struct build {
     sg_loc         loc;       /* the scene file, for errors without a line */
     char          *out;       /* desc->out without trailing slashes        */
     far_atlas_out  far;       /* --far-atlas: far_atlas.c                 */
+    const char    *old_pack;  /* the pack being replaced, or NULL: its files
+                                 whose bytes this build would write again
+                                 are linked, not written (pack_write.c)   */
+    int            keep_zst;  /* 0: untried, 1: this libzstd remakes the old
+                                 pack's frames byte for byte, -1: it does not */
 } build;
 
 /* Phases: each returns false on failure (with diagnostics in b->d). */

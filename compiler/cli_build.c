@@ -47,6 +47,8 @@ static void print_stats(const splat_build_stats *st, FILE *out)
     fprintf(out, "lazy branches: %d in the fragment composites written\n",
             st->lazy_branches);
     fprintf(out, "distance classes: %d variants added\n", st->dclasses);
+    fprintf(out, "pack files: %d written, %d kept from the old pack (same bytes)\n",
+            st->files_written, st->files_kept);
 }
 
 /* The command line, parsed by the table below (args.h). */

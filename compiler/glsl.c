@@ -287,12 +287,17 @@ static void op_expr(glsl_emitter *e, const ir_node *n, ir_buf *b)
     }
     /* the op table's form, $k standing for operand k */
 substitute:
-    for (const char *p = form; *p; p++) {
+    for (const char *p = form; *p;) {
         if (p[0] == '$' && p[1] >= '0' && p[1] <= '3') {
-            ir_buf_printf(b, "%s", a[p[1] - '0']);
-            p++;
-        } else {
-            ir_buf_printf(b, "%c", *p);
+            const char *s = a[p[1] - '0'];
+            ir_buf_put(b, s ? s : "(null)", strlen(s ? s : "(null)"));
+            p += 2;
+        } else {   /* the literal run up to the next operand */
+            size_t k = 1;
+            while (p[k] && !(p[k] == '$' && p[k + 1] >= '0' && p[k + 1] <= '3'))
+                k++;
+            ir_buf_put(b, p, k);
+            p += k;
         }
     }
     free(layered);

@@ -450,24 +450,42 @@ void ir_import_end(ir_import_map *m)
 
 /* ---- ir_buf (declared with the GLSL emitter, used by every writer) ------ */
 
-void ir_buf_printf(ir_buf *b, const char *fmt, ...)
+static void buf_reserve(ir_buf *b, size_t more)
 {
-    va_list ap;
-    va_start(ap, fmt);
-    int n = vsnprintf(NULL, 0, fmt, ap);
-    va_end(ap);
-    assert(n >= 0);
-    if (b->len + (size_t)n + 1 > b->cap) {
+    if (b->len + more + 1 > b->cap) {
         size_t cap = b->cap ? b->cap : 256;
-        while (cap < b->len + (size_t)n + 1)
+        while (cap < b->len + more + 1)
             cap *= 2;
         b->s = xrealloc(b->s, cap);
         b->cap = cap;
     }
+}
+
+/* Formatted once into the room left where it fits (the common case: the
+ * GLSL writer appends short pieces), else again after growing. */
+void ir_buf_printf(ir_buf *b, const char *fmt, ...)
+{
+    va_list ap;
+    size_t room = b->cap > b->len ? b->cap - b->len : 0;
     va_start(ap, fmt);
-    vsnprintf(b->s + b->len, (size_t)n + 1, fmt, ap);
+    int n = vsnprintf(room ? b->s + b->len : NULL, room, fmt, ap);
     va_end(ap);
+    assert(n >= 0);
+    if ((size_t)n >= room) {
+        buf_reserve(b, (size_t)n);
+        va_start(ap, fmt);
+        vsnprintf(b->s + b->len, (size_t)n + 1, fmt, ap);
+        va_end(ap);
+    }
     b->len += (size_t)n;
+}
+
+void ir_buf_put(ir_buf *b, const char *s, size_t n)
+{
+    buf_reserve(b, n);
+    memcpy(b->s + b->len, s, n);
+    b->len += n;
+    b->s[b->len] = 0;
 }
 
 void ir_buf_free(ir_buf *b)

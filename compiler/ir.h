@@ -658,6 +658,8 @@ bool opt_pin(ir *ir, const ir_ienv *env);
 typedef struct ir_buf { char *s; size_t len, cap; } ir_buf;
 void ir_buf_printf(ir_buf *b, const char *fmt, ...)
     __attribute__((format(printf, 2, 3)));
+/* The `n` bytes at `s` appended (kept NUL-terminated). */
+void ir_buf_put(ir_buf *b, const char *s, size_t n);
 void ir_buf_free(ir_buf *b);
 
 /* The emitter writes each value once, operands first, as `T vN = …;`

@@ -51,6 +51,7 @@ static bool write_with(build *b, const char *dir, const char *name,
         ok = false;
     if (!ok)
         write_error(b, path);
+    b->st->files_written += ok;
     free(path);
     return ok;
 }
@@ -63,11 +64,77 @@ static bool put_bytes(FILE *f, const void *user)
     return fwrite(by->data, 1, by->n, f) == by->n;
 }
 
-static bool write_file(build *b, const char *dir, const char *name, const void *data,
-                       size_t n)
+/* ---- keeping the old pack's files ------------------------------------------
+ * A rebuild after a small edit writes mostly what the old pack already holds.
+ * A file whose bytes would be the same is hard-linked from the old pack into
+ * the new temporary folder (the swap stays atomic, and the old pack's removal
+ * leaves the link); a compressed file is compared by its content, so it is not
+ * compressed again.  The result is the same bytes a cold build writes. */
+
+/* The old pack's dir/name, whole, if it is a regular file of at most `max`
+ * bytes; NULL otherwise. */
+static uint8_t *old_bytes(build *b, const char *name, size_t max, size_t *n)
+{
+    if (!b->old_pack)
+        return NULL;
+    char *path = xasprintf("%s/%s", b->old_pack, name);
+    int fd = open(path, O_RDONLY | O_CLOEXEC | O_NOFOLLOW);
+    free(path);
+    if (fd < 0)
+        return NULL;
+    struct stat sb;
+    uint8_t *buf = NULL;
+    if (fstat(fd, &sb) == 0 && S_ISREG(sb.st_mode) && (uint64_t)sb.st_size <= max) {
+        *n = (size_t)sb.st_size;
+        buf = xmalloc(*n + 1);
+        size_t got = 0;
+        while (got < *n) {
+            ssize_t r = read(fd, buf + got, *n - got);
+            if (r <= 0)
+                break;
+            got += (size_t)r;
+        }
+        if (got != *n) {
+            free(buf);
+            buf = NULL;
+        }
+    }
+    close(fd);
+    return buf;
+}
+
+static bool write_file_now(build *b, const char *dir, const char *name, const void *data,
+                           size_t n)
 {
     bytes by = {data, n};
     return write_with(b, dir, name, put_bytes, &by);
+}
+
+/* dir/name as a link to the old pack's file of the same name, which holds
+ * `old` (its bytes, what this build writes there); written if the file
+ * system has no links. */
+static bool keep_old(build *b, const char *dir, const char *name, const void *old,
+                     size_t n)
+{
+    char *from = xasprintf("%s/%s", b->old_pack, name), *to = xasprintf("%s/%s", dir, name);
+    bool linked = link(from, to) == 0;
+    free(from);
+    free(to);
+    if (!linked)
+        return write_file_now(b, dir, name, old, n);
+    b->st->files_kept++;
+    return true;
+}
+
+static bool write_file(build *b, const char *dir, const char *name, const void *data,
+                       size_t n)
+{
+    size_t on;
+    uint8_t *old = old_bytes(b, name, n, &on);
+    bool ok = old && on == n && memcmp(old, data, n) == 0 ? keep_old(b, dir, name, old, n)
+                                                         : write_file_now(b, dir, name, data, n);
+    free(old);
+    return ok;
 }
 
 /* A shader's files in the pack (PACK.md "Compressed shaders"): its GLSL
@@ -88,6 +155,25 @@ static bool write_compressed(build *b, const char *dir, const char *name, const 
 {
     uint8_t *z;
     size_t zn;
+    /* the old pack's frame of the same content is kept, once this libzstd
+     * is seen to make that frame byte for byte (the first such file is
+     * compressed again and compared: a libzstd upgrade may make others) */
+    uint8_t *old = b->keep_zst >= 0 ? old_bytes(b, name, splat_zst_bound(n), &zn) : NULL;
+    if (old && splat_zst_holds(old, zn, data, n)) {
+        if (b->keep_zst == 0) {
+            uint8_t *again;
+            size_t an;
+            b->keep_zst = splat_zst_compress(data, n, &again, &an) && an == zn &&
+                          memcmp(again, old, an) == 0 ? 1 : -1;
+            free(again);
+        }
+        if (b->keep_zst > 0) {
+            bool ok = keep_old(b, dir, name, old, zn);
+            free(old);
+            return ok;
+        }
+    }
+    free(old);
     if (!splat_zst_compress(data, n, &z, &zn)) {
         char *path = xasprintf("%s/%s", dir, name);
         errno = ENOMEM;
@@ -95,7 +181,7 @@ static bool write_compressed(build *b, const char *dir, const char *name, const 
         free(path);
         return false;
     }
-    bool ok = write_file(b, dir, name, z, zn);
+    bool ok = write_file_now(b, dir, name, z, zn);
     free(z);
     return ok;
 }
@@ -123,6 +209,24 @@ static bool copy_file(build *b, const char *from, const char *dir, const char *n
     if (!ok)
         sg_error(b->d, b->loc, SG_E_IO, from, strerror(errno));
     ok = ok && write_file(b, dir, name, buf, n);
+    free(buf);
+    return ok;
+}
+
+/* dir/name made by fn(f, user) in memory first, so that write_file can keep
+ * the old pack's file when the bytes are the same. */
+static bool write_made(build *b, const char *dir, const char *name,
+                       bool (*fn)(FILE *f, const void *user), const void *user)
+{
+    if (!b->old_pack)
+        return write_with(b, dir, name, fn, user);
+    char *buf = NULL;
+    size_t n = 0;
+    FILE *m = open_memstream(&buf, &n);
+    bool made = m && fn(m, user);
+    if (m && fclose(m) != 0)
+        made = false;
+    bool ok = made ? write_file(b, dir, name, buf, n) : write_with(b, dir, name, fn, user);
     free(buf);
     return ok;
 }
@@ -627,7 +731,7 @@ static bool put_ug_textures(FILE *f, const void *user)
 
 static bool write_sparse(build *b, const char *dir)
 {
-    return write_with(b, dir, "painted.sparse", put_sparse, &b->sparse);
+    return write_made(b, dir, "painted.sparse", put_sparse, &b->sparse);
 }
 
 static bool write_manifest(build *b, const char *dir)
@@ -717,9 +821,9 @@ static bool write_contents(build *b, const char *dir)
     free(ids);
 
     if (ok && b->ug.nblocks > 0)
-        ok = write_with(b, dir, "meshes.bin", put_meshes, &b->ug);
+        ok = write_made(b, dir, "meshes.bin", put_meshes, &b->ug);
     if (ok && b->ug.ntextures > 0)
-        ok = write_with(b, dir, "ugtex.bin", put_ug_textures, &b->ug);
+        ok = write_made(b, dir, "ugtex.bin", put_ug_textures, &b->ug);
     if (ok && s->vectors.words) {
         /* vectors.bin: "SPLATVEC", u32 version 1, u32 words, the words */
         size_t nw = s->vectors.nwords, n = 16 + 4 * nw;
@@ -858,6 +962,7 @@ bool build_write_pack(build *b)
         return false;
     }
     chmod(tmp, 0755);
+    b->old_pack = exists ? out : NULL;   /* replaceable: a pack, or absent */
     bool ok = write_contents(b, tmp);
     /* the device bake reads the pack written so far, then the atlas and
      * the manifest naming it join it, all before the swap */

@@ -97,12 +97,16 @@ uint8_t *sparse_reduce(const raster *src, int level, raster *out)
  * -2..33 reads block texel clamp(j, -1, 32), clamped to the raster. */
 void sparse_make_slot(const raster *r, int bx, int bz, uint8_t *slot)
 {
+    size_t col[SPARSE_SLOT];   /* each slot column's raster column, clamped */
+    for (int i = 0; i < SPARSE_SLOT; i++)
+        col[i] = (size_t)sparse_clampi(SPARSE_TILE * bx +
+                                       sparse_clampi(i - SPARSE_PAD, -1, SPARSE_TILE),
+                                       0, r->w - 1);
     for (int j = 0; j < SPARSE_SLOT; j++) {
         int z = SPARSE_TILE * bz + sparse_clampi(j - SPARSE_PAD, -1, SPARSE_TILE);
-        for (int i = 0; i < SPARSE_SLOT; i++) {
-            int x = SPARSE_TILE * bx + sparse_clampi(i - SPARSE_PAD, -1, SPARSE_TILE);
-            slot[j * SPARSE_SLOT + i] = (uint8_t)sparse_texel(r, x, z);
-        }
+        const uint8_t *row = r->t + (size_t)sparse_clampi(z, 0, r->h - 1) * (size_t)r->w;
+        for (int i = 0; i < SPARSE_SLOT; i++)
+            slot[j * SPARSE_SLOT + i] = row[col[i]];
     }
 }
 

@@ -254,6 +254,8 @@ typedef struct splat_build_stats {
     int    lazy_branches;    /* lazy branches in the composites compiled
                                 (fragment variants; compose.c)          */
     int    dclasses;         /* distance class variants added (distance.c)  */
+    int    files_written;    /* pack files written, and those kept: the old */
+    int    files_kept;       /* pack held the same bytes (linked, not written) */
     bool   up_to_date;       /* the pack already held this build's output:
                                 nothing after `load` ran (combos = its count) */
 } splat_build_stats;

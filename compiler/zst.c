@@ -95,3 +95,16 @@ uint8_t *splat_zst_decompress(const uint8_t *src, size_t n, size_t max, size_t *
     *out_n = (size_t)size;
     return buf;
 }
+
+bool splat_zst_holds(const uint8_t *frame, size_t fn, const void *data, size_t n)
+{
+    unsigned long long size = ZSTD_getFrameContentSize(frame, fn);
+    if (size == ZSTD_CONTENTSIZE_ERROR || size == ZSTD_CONTENTSIZE_UNKNOWN || size != n)
+        return false;   /* the cheap test first: most changed files differ in size */
+    char why[64];
+    size_t got;
+    uint8_t *buf = splat_zst_decompress(frame, fn, n, &got, why, sizeof why);
+    bool same = buf && got == n && memcmp(buf, data, n) == 0;
+    free(buf);
+    return same;
+}

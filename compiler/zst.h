@@ -37,5 +37,9 @@ bool     splat_zst_stated(const uint8_t *src, size_t n, size_t max, size_t *size
  * `why` set on any mismatch. */
 uint8_t *splat_zst_decompress(const uint8_t *src, size_t n, size_t max, size_t *out_n,
                               char *why, size_t nwhy);
+/* Whether the `fn` bytes at `frame` are exactly one frame whose content is
+ * the `n` bytes at `data` (what a rebuild checks before it keeps a pack
+ * file instead of compressing it again); any mismatch or error: false. */
+bool     splat_zst_holds(const uint8_t *frame, size_t fn, const void *data, size_t n);
 
 #endif

@@ -381,6 +381,7 @@ static void test_incremental(void **state)
     assert_true(rock >= 0);
     json_t *combos = json_object_get(m, "combinations");
     int with_rock = 0, rock_modules = 0;   /* the modules of those combinations */
+    char kept[256] = "", changed[256] = "";  /* a file of one without rock, and with */
     for (size_t i = 0; i < json_array_size(combos); i++) {
         json_t *cm = json_object_get(json_array_get(combos, i), "materials");
         int has = 0;
@@ -389,7 +390,34 @@ static void test_incremental(void **state)
         with_rock += has;
         if (has)
             rock_modules += spirv_count(json_array_get(combos, i));
+        snprintf(has ? changed : kept, sizeof kept, "%s/%s", pack, json_string_value(
+                 json_object_get(json_array_get(combos, i), "spirv")));
     }
+    assert_true(kept[0] && changed[0]);
+    struct stat kept_before, changed_before, hf_before;
+    char hf[256];
+    snprintf(hf, sizeof hf, "%s/heightfield.r16", pack);
+    assert_int_equal(stat(kept, &kept_before), 0);
+    assert_int_equal(stat(changed, &changed_before), 0);
+    assert_int_equal(stat(hf, &hf_before), 0);
+    char count_cmd[300];
+    snprintf(count_cmd, sizeof count_cmd, "find '%s' -type f | wc -l", pack);
+    char *count = NULL;
+    assert_int_equal(run(&count, "%s", count_cmd), 0);
+    int nfiles = atoi(count);
+    free(count);
+    /* an old pack file that is not what it should be is never kept: that
+     * combination's GLSL, one byte changed (the cold pack's diff below) */
+    char damaged[300];
+    snprintf(damaged, sizeof damaged, "%.*s.frag.zst", (int)(strlen(kept) - 8), kept);
+    assert_true(strstr(damaged, ".frag.zst") && !strstr(damaged, ".spv"));
+    FILE *df = fopen(damaged, "r+b");
+    assert_non_null(df);
+    fseek(df, 20, SEEK_SET);
+    int dbyte = fgetc(df);
+    fseek(df, 20, SEEK_SET);
+    fputc(dbyte ^ 0x10, df);
+    fclose(df);
     /* + rock's reference pass and the über-shader's fragment and compute */
     rock_modules += 1 + spirv_count(json_object_get(m, "uber"));
     json_decref(m);
@@ -411,6 +439,22 @@ static void test_incremental(void **state)
                             &validated, &known), 2);
     assert_int_equal(validated, 0);
     assert_int_equal(known, rock_modules);
+    /* only what changed is written: each recompiled module's SPIR-V and
+     * GLSL (a reference pass has no GLSL) and the manifest; every other
+     * file is the old pack's, linked (pack_write.c) */
+    const char *pf = strstr(out, "\npack files: ");
+    assert_non_null(pf);
+    int written = -1, nkept = -1;
+    assert_int_equal(sscanf(pf, "\npack files: %d written, %d kept", &written, &nkept), 2);
+    assert_int_equal(written, 2 * rock_modules - 1 + 1 + 1);   /* + the damaged one */
+    assert_int_equal(written + nkept, nfiles);
+    struct stat kept_after, changed_after, hf_after;
+    assert_int_equal(stat(kept, &kept_after), 0);
+    assert_int_equal(stat(changed, &changed_after), 0);
+    assert_int_equal(stat(hf, &hf_after), 0);
+    assert_true(kept_after.st_ino == kept_before.st_ino);
+    assert_true(hf_after.st_ino == hf_before.st_ino);
+    assert_true(changed_after.st_ino != changed_before.st_ino);
     free(out);
 
     free(build(0, scene, cold, "--no-cache"));
