@@ -4,6 +4,17 @@
 
 /* ---- shaders ---------------------------------------------------------------- */
 
+/* An inclusive prefix sum of s_scan[] over the workgroup's 64 lanes
+ * (Hillis-Steele), after each lane has written its own entry. */
+#define SCAN64                                                              \
+    "        barrier();\n"                                                  \
+    "        for (uint o = 1u; o < 64u; o <<= 1u) {\n"                      \
+    "            uint v = lid >= o ? s_scan[lid - o] : 0u;\n"               \
+    "            barrier();\n"                                              \
+    "            s_scan[lid] += v;\n"                                       \
+    "            barrier();\n"                                              \
+    "        }\n"
+
 const char rt_ug_gen_glsl[] =
     "#version 450\n"
     "layout(local_size_x = 64) in;\n"
@@ -70,13 +81,7 @@ const char rt_ug_gen_glsl[] =
     "                         floatBitsToUint(ang), b);\n"
     "        }\n"
     "        s_scan[lid] = ok ? 1u : 0u;\n"
-    "        barrier();\n"
-    "        for (uint o = 1u; o < 64u; o <<= 1u) {\n"
-    "            uint v = lid >= o ? s_scan[lid - o] : 0u;\n"
-    "            barrier();\n"
-    "            s_scan[lid] += v;\n"
-    "            barrier();\n"
-    "        }\n"
+    SCAN64
     "        if (ok) u_inst.v[base + run + s_scan[lid] - 1u] = it;\n"
     "        run += s_scan[63];\n"
     "        barrier();\n"
@@ -193,13 +198,7 @@ const char rt_ug_cull_glsl[] =
     "        uint k = c0 + lid;\n"
     "        bool ok = k < n && ug_keep(first + k, grow);\n"
     "        s_scan[lid] = ok ? 1u : 0u;\n"
-    "        barrier();\n"
-    "        for (uint o = 1u; o < 64u; o <<= 1u) {\n"
-    "            uint v = lid >= o ? s_scan[lid - o] : 0u;\n"
-    "            barrier();\n"
-    "            s_scan[lid] += v;\n"
-    "            barrier();\n"
-    "        }\n"
+    SCAN64
     "#ifdef UG_WRITE\n"
     "        if (ok) u_vis.v[at + run + s_scan[lid] - 1u] = first + k;\n"
     "#endif\n"
