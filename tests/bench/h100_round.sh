@@ -40,12 +40,17 @@ if has preview; then
     done
     run preview_topdown --pack $col --scene colorado --path topdown --variant full=screen --variant half=screen,preview=2 --variant quarter=screen,preview=4 $H
 fi
-has look && [ -d $P/colorado_nofp ] && for p in topdown grazing; do
-    run look_$p --pack $col --scene colorado --path $p --variant on=screen --variant no_footprint=screen,pack=$P/colorado_nofp $H
-done
+if has look && [ -d $P/colorado_nofp ]; then
+    L="--variant on=screen --variant no_footprint=screen,pack=$P/colorado_nofp"
+    for p in topdown grazing; do
+        run look_$p --pack $col --scene colorado --path $p $L $H
+    done
+    run look_valley --pack $col --scene colorado --path ground --start-preset valley $L $H
+fi
 has shadow && { timeout 120 $SB shadow --pack $col --runs 5 > $O/shadow.log 2>&1 || echo "FAILED shadow"; }
 if has first; then
     for pk in colorado w256; do
+        [ -d $P/$pk ] || continue
         KINDS="screen screen,async" timeout 240 bash tests/bench/first_picture.sh $SB $P/$pk 1920x1080 $pk topdown
     done > $O/first.txt 2>&1
 fi
