@@ -49,7 +49,9 @@
  *     either, and a mesh-lit instance's normal the terrain's) as ug_far
  *     goes from 0 at 0.35 r1 to 1 at 0.8 r1: the cover turns into the
  *     ground it stands on before it thins out.
- * The shaders are in undergrowth_glsl.c, the tests' probe pass in
+ * The shaders are in undergrowth_glsl.c, the cull passes' recording in
+ * undergrowth_cull.c, the block table and the far meshes in
+ * undergrowth_mesh.c, the tests' probe pass in
  * undergrowth_probe.c, what they share in undergrowth_impl.h.
  */
 #include "undergrowth_impl.h"
@@ -148,151 +150,6 @@ static bool draw_pipeline(rt_ug *u, int kind, rt_error *e)
     free(vs);
     free(fs);
     return ok;
-}
-
-/* The radius of a mesh's footprint on the ground (m at scale 1): the
- * farthest vertex from its axis, for the contact shadow's quad. */
-static double footprint(const rt_pack_ug *pu, int mesh)
-{
-    const rt_pack_ug_mesh *m = &pu->meshes[mesh];
-    double r = 0;
-    for (uint32_t v = 0; v < m->nv; v++) {
-        const float *x = pu->vertices + 8 * (size_t)(m->first_vertex + v);
-        double h = hypot(x[0], x[2]);
-        r = h > r ? h : r;
-    }
-    return r;
-}
-
-/* The cull passes' bounding radius of a block at scale 1 (m): its mesh's
- * and its far mesh's farthest vertex from the root, or its contact
- * shadow's quad (1.3 footprints) if wider. */
-static double bound(const rt_pack_ug *pu, int mesh)
-{
-    double r = 1.3 * footprint(pu, mesh);
-    for (int k = 0; k < 2; k++) {
-        int id = k == 0 ? mesh : pu->meshes[mesh].far;
-        if (id < 0)
-            continue;
-        const rt_pack_ug_mesh *m = &pu->meshes[id];
-        for (uint32_t v = 0; v < m->nv; v++) {
-            const float *x = pu->vertices + 8 * (size_t)(m->first_vertex + v);
-            double h = sqrt((double)x[0] * x[0] + (double)x[1] * x[1] + (double)x[2] * x[2]);
-            r = h > r ? h : r;
-        }
-    }
-    return r;
-}
-
-/* The single-triangle version of a far mesh made of tapered quads (each
- * pair of triangles has 4 distinct vertices, 2 at the root, v = 0, and 2
- * at the tip, v = 1): per quad one triangle from the root edge, widened
- * about its middle by (root + tip width) / root width so that it keeps
- * the quad's area, to the middle of the tip edge.  Writes 3 vertices (8
- * floats) and 3 indices (from 0) per quad; returns the triangles, 0 when
- * the mesh is not made of such quads (stone.far, an OBJ). */
-static uint32_t tri_mesh(const rt_pack_ug *pu, const rt_pack_ug_mesh *m, float *vout,
-                         uint32_t *iout)
-{
-    if (m->nidx == 0 || m->nidx % 6 != 0)
-        return 0;
-    for (uint32_t q = 0; q < m->nidx / 6; q++) {
-        const uint32_t *ix = pu->indices + m->first_index + 6 * q;
-        const float *v[4];
-        int n = 0;
-        for (int k = 0; k < 6; k++) {
-            const float *x = pu->vertices + 8 * (size_t)(m->first_vertex + ix[k]);
-            bool seen = false;
-            for (int j = 0; j < n; j++)
-                seen |= v[j] == x;
-            if (!seen && n == 4)
-                return 0;
-            if (!seen)
-                v[n++] = x;
-        }
-        const float *root[2], *tip[2];
-        int nr = 0, nt = 0;
-        for (int j = 0; j < n; j++) {
-            if (v[j][7] == 0.0f && nr < 2)
-                root[nr++] = v[j];
-            else if (v[j][7] == 1.0f && nt < 2)
-                tip[nt++] = v[j];
-        }
-        if (n != 4 || nr != 2 || nt != 2)
-            return 0;
-        double wr = 0, wt = 0;
-        for (int c = 0; c < 3; c++) {
-            wr += ((double)root[1][c] - root[0][c]) * ((double)root[1][c] - root[0][c]);
-            wt += ((double)tip[1][c] - tip[0][c]) * ((double)tip[1][c] - tip[0][c]);
-        }
-        double grow = wr > 0 ? (sqrt(wr) + sqrt(wt)) / sqrt(wr) : 1.0;
-        float *o = vout + 24 * (size_t)q;
-        for (int c = 0; c < 8; c++) {
-            double mid = 0.5 * ((double)root[0][c] + root[1][c]);
-            o[c] = (float)(c < 3 ? mid + (root[0][c] - mid) * grow : root[0][c]);
-            o[8 + c] = (float)(c < 3 ? mid + (root[1][c] - mid) * grow : root[1][c]);
-            o[16 + c] = (float)(0.5 * ((double)tip[0][c] + tip[1][c]));
-        }
-        o[6] = 0.0f;   /* u across the blade: 0, 1 at the root, 0.5 at the tip */
-        o[14] = 1.0f;
-        o[22] = 0.5f;
-        for (int k = 0; k < 3; k++)
-            iout[3 * q + (uint32_t)k] = 3 * q + (uint32_t)k;
-    }
-    return m->nidx / 6;
-}
-
-static uint32_t gcd(uint32_t a, uint32_t b)
-{
-    while (b) {
-        uint32_t t = a % b;
-        a = b;
-        b = t;
-    }
-    return a;
-}
-
-/* The block table (set 0 binding 3 of the scatter pass, set 2 binding 0
- * of the draw and the probe): per block UG_BLOCK_VEC4 vec4s, (density,
- * scale lo, scale hi, blend), (colour, slot), (candidates per side, first
- * instance in the cell, flags, the stride of the candidates' lattice
- * order), (wind direction x, z, sway, gust), (root blend, shadow, the
- * mesh's footprint radius, the cull passes' bounding radius).
- * Flags: 1 cut out (frond), 2 lit with the terrain normal, 4 aligned to
- * the terrain normal, 8 cut out by the texture's alpha; bits 8 and up the
- * texture + 1 (0: none). */
-static void fill_blocks(rt_ug *u, float *b)
-{
-    const rt_pack_ug *pu = &u->p->ug;
-    uint32_t at = 0;
-    for (int i = 0; i < u->nblocks; i++) {
-        const rt_pack_ug_block *k = &pu->blocks[i];
-        /* enough candidates that keep = density * 256 / n^2 <= 1 */
-        uint32_t nn = splat_ug_candidates(k->density), n = (uint32_t)lround(sqrt(nn));
-        u->block_grid[i] = n;
-        u->block_base[i] = at;
-        at += nn;
-        unsigned flags = (k->cutout == 1 ? 1u : 0u) | (k->light_terrain ? 2u : 0u) |
-                         (k->align_normal ? 4u : 0u) | (k->cutout == 2 ? 8u : 0u) |
-                         (unsigned)(k->texture + 1) << 8;
-        uint32_t stride = (uint32_t)(0.618034 * n * n);
-        while (stride > 1 && gcd(stride, n * n) != 1)
-            stride++;
-        float v[4 * UG_BLOCK_VEC4] = {
-            (float)k->density, (float)k->scale[0], (float)k->scale[1], (float)k->blend,
-            (float)k->color[0], (float)k->color[1], (float)k->color[2], (float)k->slot,
-            (float)n, (float)u->block_base[i], (float)flags, (float)(stride ? stride : 1),
-            (float)k->wind[0], (float)k->wind[1], (float)k->wind[2], (float)k->wind[3],
-            (float)k->root_blend, (float)k->shadow, (float)footprint(pu, k->mesh),
-            (float)bound(pu, k->mesh) };
-        for (uint32_t t = 0; u->vbuf.map && t < u->tri[i][0]; t++) {   /* tri_mesh's */
-            const float *x = (const float *)u->vbuf.map + 8 * (size_t)(u->tri[i][2] + t);
-            float h = sqrtf(x[0] * x[0] + x[1] * x[1] + x[2] * x[2]);
-            v[4 * UG_BLOCK_VEC4 - 1] = h > v[4 * UG_BLOCK_VEC4 - 1] ? h : v[4 * UG_BLOCK_VEC4 - 1];
-        }
-        memcpy(b + 4 * UG_BLOCK_VEC4 * i, v, sizeof v);
-    }
-    u->cap = at;
 }
 
 static bool make_sets(rt_ug *u, VkDescriptorSet set0_src, const rt_image *height,
@@ -499,7 +356,7 @@ static bool make_buffers(rt_ug *u, rt_error *e)
             memcpy(u->tri[b], u->tri[done], sizeof u->tri[b]);
             continue;
         }
-        uint32_t nt = f >= 0 ? tri_mesh(pu, &pu->meshes[f], (float *)u->vbuf.map + (size_t)nv * 8,
+        uint32_t nt = f >= 0 ? rt_ug_tri_mesh(pu, &pu->meshes[f], (float *)u->vbuf.map + (size_t)nv * 8,
                                         (uint32_t *)u->ibuf.map + ni)
                              : 0;
         u->tri[b][0] = 3 * nt;
@@ -508,41 +365,12 @@ static bool make_buffers(rt_ug *u, rt_error *e)
         nv += 3 * nt;
         ni += 3 * nt;
     }
-    fill_blocks(u, u->blocks.map);
+    rt_ug_fill_blocks(u, u->blocks.map);
     memset(u->args_host.map, 0, (size_t)u->args_host.size);
     memset(u->mdraw_host.map, 0, (size_t)u->mdraw_host.size);
     for (int i = 0; i < u->pool; i++)
         ((float *)u->lod.map)[i] = 1.0f;
     return true;
-}
-
-/* The cull passes' pipelines: count and write (the same GLSL, UG_WRITE),
- * and the scan in one workgroup as wide as the device allows (up to 1024). */
-static bool cull_pipelines(rt_ug *u, rt_error *e)
-{
-    const VkPhysicalDeviceLimits *L = &u->d->props.limits;
-    uint32_t ls = 1024;
-    while (ls > 64 && (ls > L->maxComputeWorkGroupInvocations || ls > L->maxComputeWorkGroupSize[0]))
-        ls >>= 1;
-    size_t n = strlen(rt_ug_cull_glsl) + strlen(rt_ug_scan_glsl) + 64;
-    char *src = malloc(n);
-    if (!src)
-        return rt_fail(e, RT_E_VULKAN, "undergrowth", "out of memory");
-    bool ok = true;
-    for (int k = 0; k < 3 && ok; k++) {
-        if (k < 2)
-            snprintf(src, n, "#version 450\n%s%s", k ? "#define UG_WRITE 1\n" : "", rt_ug_cull_glsl);
-        else
-            snprintf(src, n, "#version 450\n#define UG_LS %u\n%s", ls, rt_ug_scan_glsl);
-        VkPipeline *out = k == 0 ? &u->count_pipe : k == 1 ? &u->write_pipe : &u->scan_pipe;
-        ok = rt_vk_compute(u->d, &u->keep, &(rt_vk_compute_desc){
-                               .label = k == 0 ? "undergrowth cull count"
-                                      : k == 1 ? "undergrowth cull write" : "undergrowth cull scan",
-                               .glsl = src, .layout = k < 2 ? u->cull_layout : u->scan_layout },
-                           out, e);
-    }
-    free(src);
-    return ok;
 }
 
 bool rt_ug_create(rt_device *d, const rt_pack *p, rt_pipelines *pl, const rt_quadtree *qt,
@@ -572,7 +400,7 @@ bool rt_ug_create(rt_device *d, const rt_pack *p, rt_pipelines *pl, const rt_qua
     u->mask_pipes = calloc((size_t)p->ncombos + 1, sizeof *u->mask_pipes);
     if (!u->cells || !u->order || !u->block_base || !u->block_grid || !u->mask_pipes)
         return rt_fail(e, RT_E_VULKAN, "undergrowth", "out of memory");
-    fill_blocks(u, (float[4 * UG_BLOCK_VEC4 * SPLAT_MAX_UG_BLOCKS]){0});   /* u->cap first */
+    rt_ug_fill_blocks(u, (float[4 * UG_BLOCK_VEC4 * SPLAT_MAX_UG_BLOCKS]){0});   /* u->cap first */
     /* contact shadows where the colour target blends (RGBA32F: most do) */
     VkFormatProperties fp;
     vkGetPhysicalDeviceFormatProperties(d->phys, VK_FORMAT_R32G32B32A32_SFLOAT, &fp);
@@ -592,7 +420,7 @@ bool rt_ug_create(rt_device *d, const rt_pack *p, rt_pipelines *pl, const rt_qua
                            .glsl = rt_ug_gen_glsl, .layout = u->gen_layout }, &u->gen_pipe, e) ||
         !rt_vk_compute(d, &u->keep, &(rt_vk_compute_desc){ .label = "undergrowth lod",
                            .glsl = rt_ug_lod_glsl, .layout = u->lod_layout }, &u->lod_pipe, e) ||
-        !cull_pipelines(u, e) ||
+        !rt_ug_cull_pipelines(u, e) ||
         !draw_pipeline(u, 0, e) || !draw_pipeline(u, 1, e) ||
         (u->shadows && !draw_pipeline(u, 2, e)) ||
         !rt_vk_fb(d, &u->keep, &(rt_vk_fb_desc){ .label = "undergrowth", .pass = u->pass_att,
@@ -836,120 +664,6 @@ static void reset_args(rt_ug *u, VkCommandBuffer cb, int slot)
                       (VkDeviceSize)u->nblocks * 20, a);
 }
 
-/* The cull passes' table for this frame (UG_KEYINFO): keys in the draw's
- * order (opaque blocks first; a block's near mesh, then its far one, then
- * its single-triangle one), each key's entries the visible generated
- * cells front to back whose distance picks that mesh (their nearest point
- * beyond LOD_NEAR: the far mesh; beyond LOD_TRI LOD_NEAR: the single
- * triangles). */
-static void fill_entries(rt_ug *u)
-{
-    const rt_pack_ug *pu = &u->p->ug;
-    uint32_t *e = u->ent.map;
-    int k = 0, n = 0;
-    /* contact shadows end where ug_far reaches 1 (undergrowth_glsl.c: 0.8
-     * r1, r1 = max(radius - 12, radius / 2)): a cell whose nearest point
-     * is farther multiplies the colour by 1 */
-    double shadow_end = 0.8 * fmax(u->radius - 12.0, 0.5 * u->radius);
-    for (int cut = 0; cut < 2; cut++)
-        for (int b = 0; b < u->nblocks; b++) {
-            if ((pu->blocks[b].cutout != 0) != cut)
-                continue;
-            int far = pu->meshes[pu->blocks[b].mesh].far;
-            for (int l = 0; l < 3; l++) {
-                if ((l == 1 && far < 0) || (l == 2 && (far < 0 || !u->tri[b][0])))
-                    continue;
-                const rt_pack_ug_mesh *m = &pu->meshes[l ? far : pu->blocks[b].mesh];
-                uint32_t *ki = e + UG_KEYINFO + 4 * k;
-                ki[0] = l == 2 ? u->tri[b][0] : m->nidx;
-                ki[1] = l == 2 ? u->tri[b][1] : m->first_index;
-                ki[2] = l == 2 ? u->tri[b][2] : m->first_vertex;
-                bool shadows = pu->blocks[b].shadow > 0 && u->shadows;
-                e[k] = (uint32_t)n;
-                u->key_block[k] = b;
-                for (int i = 0; i < u->pool; i++) {
-                    int slot = u->order[i];
-                    const ug_cell *cl = &u->cells[slot];
-                    double near = cl->dist - CELL * 0.7071;   /* its nearest point, about */
-                    int lv = near > LOD_NEAR && far >= 0;
-                    if (lv && u->tri[b][0] && near > LOD_TRI * LOD_NEAR)
-                        lv = 2;
-                    if (cl->state != CELL_READY || !cl->visible || lv != l)
-                        continue;
-                    if (shadows && near >= shadow_end)   /* and every entry after */
-                        shadows = false, ki[3] = (uint32_t)n;
-                    e[UG_ENT0 + n++] = (uint32_t)(slot * u->nblocks + b);
-                }
-                if (shadows)
-                    ki[3] = (uint32_t)n;
-                else if (!(pu->blocks[b].shadow > 0 && u->shadows))
-                    ki[3] = e[k];
-                u->key_used[k] = e[k] != (uint32_t)n;
-                k++;
-            }
-        }
-    e[k] = (uint32_t)n;
-    u->nkeys = k;
-    u->nent = n;
-}
-
-/* The cull passes (the top comment; undergrowth_glsl.c rt_ug_cull_glsl):
- * count, scan, write, then the draws per key copied back for the stats. */
-static void record_cull(rt_ug *u, VkCommandBuffer cb, const splat_frame *fr)
-{
-    fill_entries(u);
-    u->mdraw_valid = false;
-    if (u->nent == 0)
-        return;
-    ug_cull_push pc = { .cam = { fr->camera[0], fr->camera[1], fr->camera[2], (float)u->radius },
-                        .info = { (uint32_t)u->nblocks, (uint32_t)u->nent, 0, 0 } };
-    const float *m = fr->view_proj;   /* column-major: row r is m[r], m[4 + r], ... */
-    static const int row[5] = { 0, 0, 1, 1, 2 };
-    for (int k = 0; k < 5; k++) {
-        double sg = k == 4 || (k & 1) ? -1.0 : 1.0, v[4], len = 0;
-        for (int c = 0; c < 4; c++)
-            v[c] = m[4 * c + 3] + sg * m[4 * c + row[k]];
-        for (int c = 0; c < 3; c++)
-            len += v[c] * v[c];
-        len = len > 0 ? sqrt(len) : 1.0;
-        for (int c = 0; c < 4; c++)
-            pc.plane[k][c] = (float)(v[c] / len);
-    }
-    uint32_t gx = u->nent < 65535 ? (uint32_t)u->nent : 65535u;
-    uint32_t gy = ((uint32_t)u->nent + gx - 1) / gx;
-    const VkPipelineStageFlags cs = VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT;
-    vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, u->cull_layout, 0, 1, &u->cull_set,
-                            0, NULL);
-    vkCmdPushConstants(cb, u->cull_layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof pc, &pc);
-    vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, u->count_pipe);
-    vkCmdDispatch(cb, gx, gy, 1);
-    rt_cmd_barrier(cb, cs, VK_ACCESS_SHADER_WRITE_BIT, cs,
-                   VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
-    uint32_t sp[4] = { (uint32_t)u->nent, (uint32_t)u->nkeys, u->p->ug.nindices,
-                       u->p->ug.nvertices };   /* the shadow quad */
-    vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, u->scan_pipe);
-    vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, u->scan_layout, 0, 1, &u->scan_set,
-                            0, NULL);
-    vkCmdPushConstants(cb, u->scan_layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof sp, sp);
-    vkCmdDispatch(cb, 1, 1, 1);
-    rt_cmd_barrier(cb, cs, VK_ACCESS_SHADER_WRITE_BIT, cs, VK_ACCESS_SHADER_READ_BIT);
-    vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, u->write_pipe);
-    vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, u->cull_layout, 0, 1, &u->cull_set,
-                            0, NULL);
-    vkCmdPushConstants(cb, u->cull_layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof pc, &pc);
-    vkCmdDispatch(cb, gx, gy, 1);
-    rt_cmd_barrier(cb, cs, VK_ACCESS_SHADER_WRITE_BIT,
-                   VK_PIPELINE_STAGE_DRAW_INDIRECT_BIT | VK_PIPELINE_STAGE_VERTEX_SHADER_BIT |
-                       VK_PIPELINE_STAGE_TRANSFER_BIT,
-                   VK_ACCESS_INDIRECT_COMMAND_READ_BIT | VK_ACCESS_SHADER_READ_BIT |
-                       VK_ACCESS_TRANSFER_READ_BIT);
-    VkBufferCopy all = { 0, 0, (VkDeviceSize)u->nkeys * 40 };
-    vkCmdCopyBuffer(cb, u->mdraw.buf, u->mdraw_host.buf, 1, &all);
-    rt_cmd_barrier(cb, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
-                   VK_PIPELINE_STAGE_HOST_BIT, VK_ACCESS_HOST_READ_BIT);
-    u->mdraw_valid = true;
-}
-
 void rt_ug_prepare(rt_ug *u, const rt_camera *c, const splat_frame *fr)
 {
     u->time = c->time;
@@ -1038,7 +752,7 @@ bool rt_ug_generate(rt_ug *u, VkCommandBuffer cb, const splat_frame *fr, VkDescr
     rt_cmd_barrier(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
                    VK_PIPELINE_STAGE_DRAW_INDIRECT_BIT | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
                    VK_ACCESS_INDIRECT_COMMAND_READ_BIT | VK_ACCESS_SHADER_READ_BIT);
-    record_cull(u, cb, fr);
+    rt_ug_record_cull(u, cb, fr);
     if (u->qpool)   /* bottom of pipe: when everything before has finished */
         vkCmdWriteTimestamp(cb, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, u->qpool, 1);
     u->generated = n;

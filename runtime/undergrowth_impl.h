@@ -132,6 +132,25 @@ struct rt_ug {
     rt_vk_list            keep;                /* every Vulkan object but buffers and images */
 };
 
+/* ---- undergrowth_cull.c: the cull passes -------------------------------- */
+
+/* The count, write and scan pipelines (u->count_pipe, write_pipe,
+ * scan_pipe). */
+bool rt_ug_cull_pipelines(rt_ug *u, rt_error *e);
+/* This frame's keys and entries, then count, scan and write recorded
+ * into cb, and the draws per key copied back for the stats. */
+void rt_ug_record_cull(rt_ug *u, VkCommandBuffer cb, const splat_frame *fr);
+
+/* ---- undergrowth_mesh.c: the block table and the far meshes ------------ */
+
+/* Fills the block table b (UG_BLOCK_VEC4 vec4s a block), u->block_grid,
+ * u->block_base and u->cap. */
+void rt_ug_fill_blocks(rt_ug *u, float *b);
+/* The single-triangle version of far mesh m into vout (8 floats a
+ * vertex) and iout; the triangles, 0 when m is not made of tapered quads. */
+uint32_t rt_ug_tri_mesh(const rt_pack_ug *pu, const rt_pack_ug_mesh *m, float *vout,
+                        uint32_t *iout);
+
 /* ---- undergrowth_glsl.c: the runtime's own shaders ---------------------- */
 
 extern const char rt_ug_gen_glsl[];          /* the scatter pass             */

@@ -1,0 +1,153 @@
+/* undergrowth_cull.c — the undergrowth's cull passes on the CPU side
+ * (undergrowth.c's top comment says what they do; their GLSL is
+ * undergrowth_glsl.c rt_ug_cull_glsl and rt_ug_scan_glsl): the
+ * pipelines, the frame's table of keys and entries, the recording. */
+#include "undergrowth_impl.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* The cull passes' pipelines: count and write (the same GLSL, UG_WRITE),
+ * and the scan in one workgroup as wide as the device allows (up to 1024). */
+bool rt_ug_cull_pipelines(rt_ug *u, rt_error *e)
+{
+    const VkPhysicalDeviceLimits *L = &u->d->props.limits;
+    uint32_t ls = 1024;
+    while (ls > 64 && (ls > L->maxComputeWorkGroupInvocations || ls > L->maxComputeWorkGroupSize[0]))
+        ls >>= 1;
+    size_t n = strlen(rt_ug_cull_glsl) + strlen(rt_ug_scan_glsl) + 64;
+    char *src = malloc(n);
+    if (!src)
+        return rt_fail(e, RT_E_VULKAN, "undergrowth", "out of memory");
+    bool ok = true;
+    for (int k = 0; k < 3 && ok; k++) {
+        if (k < 2)
+            snprintf(src, n, "#version 450\n%s%s", k ? "#define UG_WRITE 1\n" : "", rt_ug_cull_glsl);
+        else
+            snprintf(src, n, "#version 450\n#define UG_LS %u\n%s", ls, rt_ug_scan_glsl);
+        VkPipeline *out = k == 0 ? &u->count_pipe : k == 1 ? &u->write_pipe : &u->scan_pipe;
+        ok = rt_vk_compute(u->d, &u->keep, &(rt_vk_compute_desc){
+                               .label = k == 0 ? "undergrowth cull count"
+                                      : k == 1 ? "undergrowth cull write" : "undergrowth cull scan",
+                               .glsl = src, .layout = k < 2 ? u->cull_layout : u->scan_layout },
+                           out, e);
+    }
+    free(src);
+    return ok;
+}
+
+/* The cull passes' table for this frame (UG_KEYINFO): keys in the draw's
+ * order (opaque blocks first; a block's near mesh, then its far one, then
+ * its single-triangle one), each key's entries the visible generated
+ * cells front to back whose distance picks that mesh (their nearest point
+ * beyond LOD_NEAR: the far mesh; beyond LOD_TRI LOD_NEAR: the single
+ * triangles). */
+static void fill_entries(rt_ug *u)
+{
+    const rt_pack_ug *pu = &u->p->ug;
+    uint32_t *e = u->ent.map;
+    int k = 0, n = 0;
+    /* contact shadows end where ug_far reaches 1 (undergrowth_glsl.c: 0.8
+     * r1, r1 = max(radius - 12, radius / 2)): a cell whose nearest point
+     * is farther multiplies the colour by 1 */
+    double shadow_end = 0.8 * fmax(u->radius - 12.0, 0.5 * u->radius);
+    for (int cut = 0; cut < 2; cut++)
+        for (int b = 0; b < u->nblocks; b++) {
+            if ((pu->blocks[b].cutout != 0) != cut)
+                continue;
+            int far = pu->meshes[pu->blocks[b].mesh].far;
+            for (int l = 0; l < 3; l++) {
+                if ((l == 1 && far < 0) || (l == 2 && (far < 0 || !u->tri[b][0])))
+                    continue;
+                const rt_pack_ug_mesh *m = &pu->meshes[l ? far : pu->blocks[b].mesh];
+                uint32_t *ki = e + UG_KEYINFO + 4 * k;
+                ki[0] = l == 2 ? u->tri[b][0] : m->nidx;
+                ki[1] = l == 2 ? u->tri[b][1] : m->first_index;
+                ki[2] = l == 2 ? u->tri[b][2] : m->first_vertex;
+                bool shadows = pu->blocks[b].shadow > 0 && u->shadows;
+                e[k] = (uint32_t)n;
+                u->key_block[k] = b;
+                for (int i = 0; i < u->pool; i++) {
+                    int slot = u->order[i];
+                    const ug_cell *cl = &u->cells[slot];
+                    double near = cl->dist - CELL * 0.7071;   /* its nearest point, about */
+                    int lv = near > LOD_NEAR && far >= 0;
+                    if (lv && u->tri[b][0] && near > LOD_TRI * LOD_NEAR)
+                        lv = 2;
+                    if (cl->state != CELL_READY || !cl->visible || lv != l)
+                        continue;
+                    if (shadows && near >= shadow_end)   /* and every entry after */
+                        shadows = false, ki[3] = (uint32_t)n;
+                    e[UG_ENT0 + n++] = (uint32_t)(slot * u->nblocks + b);
+                }
+                if (shadows)
+                    ki[3] = (uint32_t)n;
+                else if (!(pu->blocks[b].shadow > 0 && u->shadows))
+                    ki[3] = e[k];
+                u->key_used[k] = e[k] != (uint32_t)n;
+                k++;
+            }
+        }
+    e[k] = (uint32_t)n;
+    u->nkeys = k;
+    u->nent = n;
+}
+
+/* The cull passes (the top comment; undergrowth_glsl.c rt_ug_cull_glsl):
+ * count, scan, write, then the draws per key copied back for the stats. */
+void rt_ug_record_cull(rt_ug *u, VkCommandBuffer cb, const splat_frame *fr)
+{
+    fill_entries(u);
+    u->mdraw_valid = false;
+    if (u->nent == 0)
+        return;
+    ug_cull_push pc = { .cam = { fr->camera[0], fr->camera[1], fr->camera[2], (float)u->radius },
+                        .info = { (uint32_t)u->nblocks, (uint32_t)u->nent, 0, 0 } };
+    const float *m = fr->view_proj;   /* column-major: row r is m[r], m[4 + r], ... */
+    static const int row[5] = { 0, 0, 1, 1, 2 };
+    for (int k = 0; k < 5; k++) {
+        double sg = k == 4 || (k & 1) ? -1.0 : 1.0, v[4], len = 0;
+        for (int c = 0; c < 4; c++)
+            v[c] = m[4 * c + 3] + sg * m[4 * c + row[k]];
+        for (int c = 0; c < 3; c++)
+            len += v[c] * v[c];
+        len = len > 0 ? sqrt(len) : 1.0;
+        for (int c = 0; c < 4; c++)
+            pc.plane[k][c] = (float)(v[c] / len);
+    }
+    uint32_t gx = u->nent < 65535 ? (uint32_t)u->nent : 65535u;
+    uint32_t gy = ((uint32_t)u->nent + gx - 1) / gx;
+    const VkPipelineStageFlags cs = VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT;
+    vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, u->cull_layout, 0, 1, &u->cull_set,
+                            0, NULL);
+    vkCmdPushConstants(cb, u->cull_layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof pc, &pc);
+    vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, u->count_pipe);
+    vkCmdDispatch(cb, gx, gy, 1);
+    rt_cmd_barrier(cb, cs, VK_ACCESS_SHADER_WRITE_BIT, cs,
+                   VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
+    uint32_t sp[4] = { (uint32_t)u->nent, (uint32_t)u->nkeys, u->p->ug.nindices,
+                       u->p->ug.nvertices };   /* the shadow quad */
+    vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, u->scan_pipe);
+    vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, u->scan_layout, 0, 1, &u->scan_set,
+                            0, NULL);
+    vkCmdPushConstants(cb, u->scan_layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof sp, sp);
+    vkCmdDispatch(cb, 1, 1, 1);
+    rt_cmd_barrier(cb, cs, VK_ACCESS_SHADER_WRITE_BIT, cs, VK_ACCESS_SHADER_READ_BIT);
+    vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, u->write_pipe);
+    vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, u->cull_layout, 0, 1, &u->cull_set,
+                            0, NULL);
+    vkCmdPushConstants(cb, u->cull_layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof pc, &pc);
+    vkCmdDispatch(cb, gx, gy, 1);
+    rt_cmd_barrier(cb, cs, VK_ACCESS_SHADER_WRITE_BIT,
+                   VK_PIPELINE_STAGE_DRAW_INDIRECT_BIT | VK_PIPELINE_STAGE_VERTEX_SHADER_BIT |
+                       VK_PIPELINE_STAGE_TRANSFER_BIT,
+                   VK_ACCESS_INDIRECT_COMMAND_READ_BIT | VK_ACCESS_SHADER_READ_BIT |
+                       VK_ACCESS_TRANSFER_READ_BIT);
+    VkBufferCopy all = { 0, 0, (VkDeviceSize)u->nkeys * 40 };
+    vkCmdCopyBuffer(cb, u->mdraw.buf, u->mdraw_host.buf, 1, &all);
+    rt_cmd_barrier(cb, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
+                   VK_PIPELINE_STAGE_HOST_BIT, VK_ACCESS_HOST_READ_BIT);
+    u->mdraw_valid = true;
+}
