@@ -302,18 +302,26 @@ bool rt_pack_validate(const rt_pack *p, rt_error *e)
     return ok;
 }
 
+/* obj[key], a shader file's path (`where` names obj in errors): its path
+ * kept and its lazy module registered with `role` (-1: a GLSL text). */
+static bool lazy_file(rt_pk_reader *r, json_t *obj, const char *key, const char *where,
+                      int role, char **path, rt_module **mod)
+{
+    const char *rel;
+    if (!rt_pk_get_string(r, obj, key, where, &rel))
+        return false;
+    char field[256];
+    snprintf(field, sizeof field, "%s.%s", where, key);
+    if (!(*path = rt_pk_strdup(rel)))
+        return false;
+    return (*mod = module_add(r, field, rel, role)) != NULL;
+}
+
 /* {"glsl": …, "spirv": …} → the SPIR-V module of `role`, read on first use. */
 bool rt_pk_read_spirv(rt_pk_reader *r, json_t *obj, const char *where, rt_shader_role role,
                       rt_spirv *out)
 {
-    const char *rel;
-    if (!rt_pk_get_string(r, obj, "spirv", where, &rel))
-        return false;
-    char field[256];
-    snprintf(field, sizeof field, "%s.spirv", where);
-    if (!(out->path = rt_pk_strdup(rel)))
-        return false;
-    return (out->mod = module_add(r, field, rel, (int)role)) != NULL;
+    return lazy_file(r, obj, "spirv", where, (int)role, &out->path, &out->mod);
 }
 
 /* {"compute": {"glsl": …}} of a combination or the über-shader: the
@@ -364,14 +372,7 @@ bool rt_pk_read_fragment_glsl(rt_pk_reader *r, json_t *c, const char *where, cha
 /* c["glsl"] (`w` names c in errors), read on first use. */
 static bool read_glsl_at(rt_pk_reader *r, json_t *c, const char *w, rt_text *out)
 {
-    const char *rel;
-    if (!rt_pk_get_string(r, c, "glsl", w, &rel))
-        return false;
-    char field[128];
-    snprintf(field, sizeof field, "%s.glsl", w);
-    if (!(out->path = rt_pk_strdup(rel)))
-        return false;
-    return (out->mod = module_add(r, field, rel, -1)) != NULL;
+    return lazy_file(r, c, "glsl", w, -1, &out->path, &out->mod);
 }
 
 char *rt_pack_read_glsl(const rt_pack *p, const char *field, const char *rel, rt_error *e)
