@@ -299,6 +299,19 @@ static void replace_in_file(const char *path, const char *from, const char *to)
     free(text);
 }
 
+/* Damages file `path` in place: the byte at `at` xor `mask`. */
+static void flip_byte(const char *path, long at, int mask)
+{
+    FILE *f = fopen(path, "r+b");
+    assert_non_null(f);
+    fseek(f, at, SEEK_SET);
+    int byte = fgetc(f);
+    assert_true(byte != EOF);
+    fseek(f, at, SEEK_SET);
+    fputc(byte ^ mask, f);
+    fclose(f);
+}
+
 /* The SPIR-V modules a manifest entry names: its "spirv" and those of
  * the objects and arrays inside it (compute variant, undergrowth masks,
  * distance classes). */
@@ -411,13 +424,7 @@ static void test_incremental(void **state)
     char damaged[300];
     snprintf(damaged, sizeof damaged, "%.*s.frag.zst", (int)(strlen(kept) - 8), kept);
     assert_true(strstr(damaged, ".frag.zst") && !strstr(damaged, ".spv"));
-    FILE *df = fopen(damaged, "r+b");
-    assert_non_null(df);
-    fseek(df, 20, SEEK_SET);
-    int dbyte = fgetc(df);
-    fseek(df, 20, SEEK_SET);
-    fputc(dbyte ^ 0x10, df);
-    fclose(df);
+    flip_byte(damaged, 20, 0x10);
     /* + rock's reference pass and the über-shader's fragment and compute */
     rock_modules += 1 + spirv_count(json_object_get(m, "uber"));
     json_decref(m);
@@ -470,13 +477,7 @@ static void test_incremental(void **state)
     char entry[400];
     snprintf(entry, sizeof entry, "%s/cache-inc/spv1/%.2s/%s.spv", tmp, key, key);
     json_decref(m);
-    FILE *f = fopen(entry, "r+b");
-    assert_non_null(f);
-    fseek(f, 40, SEEK_SET);
-    int byte = fgetc(f);
-    fseek(f, 40, SEEK_SET);
-    fputc(byte ^ 0x40, f);
-    fclose(f);
+    flip_byte(entry, 40, 0x40);
     char pack3[200];
     snprintf(pack3, sizeof pack3, "%s/inc3", tmp);
     out = build(0, scene, pack3, opts);
