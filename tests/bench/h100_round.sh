@@ -27,6 +27,7 @@ if has frames; then
         run r${round}_meadow --pack $col --scene colorado --path ground --start-preset meadow --variant s=screen --variant ug=screen,ug $H
     done
     run r2_4k --pack $col --scene colorado --path topdown --variant s=screen --size 3840x2160 --frames 20 --warmup 2
+    run r2_blanca --pack $col --scene colorado --path ground --start 45000,47087,1,0 --variant s=screen $H
 fi
 if has ug; then
     U="--variant s=screen --variant ug=screen,ug --variant ug300=screen,ug,ugradius=300 --variant ug400t=screen,ug,ugradius=400,ugthin=1000 --variant ug450t=screen,ug,ugradius=450,ugthin=1000"
