@@ -671,8 +671,12 @@ static bool print_stats(const opts *o, rt_device *dev, const rt_pack *pack, rt_r
         printf("classification: %d candidates, %d materials in view, %d words per set\n",
                st->tiles.class_candidates, st->tiles.class_materials, st->tiles.class_words);
         printf("pipelines pending: %d (tiles the uber-shader stood in for: %d)\n",
-               st->pipelines_pending, st->tiles.tiles_stand_in);
+               st->pipelines_pending, st->tiles.tiles_stand_in_uber);
+        printf("stand-ins: %d tiles (uber-shader %d, far atlas %d, flat %d)\n",
+               st->tiles.tiles_stand_in, st->tiles.tiles_stand_in_uber,
+               st->tiles.tiles_stand_in_atlas, st->tiles.tiles_stand_in_flat);
     }
+    printf("first picture: %.3f s after launch\n", st->first_picture_s);
     printf("quadtree cpu ms/frame: median %.4f  p10 %.4f  p90 %.4f\n", sm, sl, sh);
     if (o->no_shadows)
         printf("shadow map: off\n");
@@ -928,6 +932,7 @@ static int window(const opts *o_)
 
 int main(int argc, char **argv)
 {
+    rt_seconds_since_launch();   /* the fallback's origin, where /proc is not read */
     opts o;
     int rc = parse_args(argc, argv, &o);
     if (rc)

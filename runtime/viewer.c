@@ -685,9 +685,13 @@ static bool frame(viewer *v, const char *shot, double *last, rt_error *e)
     static double shown;
     if (t - shown > 0.25) {
         shown = t;
-        char title[512], pending[48] = "";
-        if (st.pipelines_pending > 0)   /* their tiles on the über-shader meanwhile */
-            snprintf(pending, sizeof pending, " (%d shaders compiling)", st.pipelines_pending);
+        char title[640], pending[160] = "";
+        const rt_screen_stats *ts = &st.tiles;
+        if (st.pipelines_pending > 0 || ts->tiles_stand_in > 0)   /* stand-ins meanwhile */
+            snprintf(pending, sizeof pending,
+                     " (%d shaders compiling; stand-in tiles: %d uber, %d atlas, %d flat)",
+                     st.pipelines_pending, ts->tiles_stand_in_uber, ts->tiles_stand_in_atlas,
+                     ts->tiles_stand_in_flat);
         snprintf(title, sizeof title,
                  "splatview %s | %s%s | %s | %.1f ms/frame (gpu %.1f) | %d patches, %d pipelines%s | %s",
                  v->pack->name, rt_view_name(v->view), v->wire ? " wire" : "",
