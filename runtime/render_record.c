@@ -777,6 +777,12 @@ bool rt_renderer_frame(rt_renderer *r, const rt_camera *c, rt_frame_stats *st, r
     }
 }
 
+bool rt_renderer_wait_pipelines(rt_renderer *r, rt_error *e)
+{
+    rt_async_wait(&r->pl);
+    return !rt_async_failed(&r->pl, e);
+}
+
 /* The readback pass, in a command buffer of its own after the frame:
  * appended to the frame's plan (--print-plan shows it last). */
 bool rt_renderer_read(rt_renderer *r, float *rgba, rt_error *e)

@@ -780,6 +780,8 @@ void       rt_async_stop(rt_pipelines *pl);
 void       rt_async_request(rt_pipelines *pl, int id, unsigned variant);
 /* Queued or being made. */
 int        rt_async_pending(rt_pipelines *pl);
+/* Until none is queued or being made. */
+void       rt_async_wait(rt_pipelines *pl);
 /* A worker's failure, handed over once (true, *e set). */
 bool       rt_async_failed(rt_pipelines *pl, rt_error *e);
 /* A compute slot read, and one filled (a pipeline made twice is destroyed;

@@ -489,6 +489,10 @@ bool rt_renderer_set_param(rt_renderer *r, const char *name,
 /* Render one frame offscreen and wait for it. */
 bool rt_renderer_frame(rt_renderer *r, const rt_camera *c,
                        rt_frame_stats *st, rt_error *e);
+/* With async pipelines: until the workers have made every pipeline asked
+ * for so far (the next frame draws no stand-in for those lists); false,
+ * *e set, where one failed. */
+bool rt_renderer_wait_pipelines(rt_renderer *r, rt_error *e);
 /* The last frame's colour as RGBA32F, top row first (w * h * 4 floats). */
 bool rt_renderer_read(rt_renderer *r, float *rgba, rt_error *e);
 /* The last frame's plan (runtime/render_plan.c): its passes in order, what
