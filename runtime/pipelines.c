@@ -682,7 +682,7 @@ bool rt_pipelines_compute_make(rt_device *d, const rt_pack *p, rt_pipelines *pl,
 }
 
 bool rt_pipelines_flat(rt_device *d, const rt_pack *p, rt_pipelines *pl, unsigned variant,
-                       VkPipeline *out, rt_error *e)
+                       rt_glsl_source source, VkPipeline *out, rt_error *e)
 {
     VkPipeline *slot = &pl->flat[variant % RT_CVARIANTS];
     if (*slot) {
@@ -691,7 +691,7 @@ bool rt_pipelines_flat(rt_device *d, const rt_pack *p, rt_pipelines *pl, unsigne
     }
     /* the sorted variant's lists are dispatched a tile a workgroup here
      * (rt_screen_dispatch): the flat stand-in is never sorted */
-    char *src = rt_flat_glsl(p, (variant & RT_CVARIANT_COUNT) != 0, e);
+    char *src = source(p, (variant & RT_CVARIANT_COUNT) != 0, e);
     if (!src)
         return false;
     uint32_t *words = NULL;

@@ -43,6 +43,8 @@ struct rt_device {
                                             forward counting variant       */
     bool                     validating;
     int                      messages;   /* validation warnings + errors    */
+    struct rt_vk_batch      *batch;      /* pipelines deferred to run on all
+                                            cores (vk_build.c rt_vk_batch_*) */
 };
 
 /* In place, for the library's own devices (the viewer's, the far bake's);
@@ -743,9 +745,12 @@ typedef enum rt_stand_in {
 rt_stand_in rt_pipelines_stand_in(const rt_device *d, const rt_pack *p, rt_pipelines *pl,
                                   const int *ids, int n, unsigned variant, bool atlas);
 /* The flat stand-in's compute pipeline in `variant` (compute layout, the
- * SPIR-V cache), made on first use. */
+ * SPIR-V cache), made on first use from `source`'s GLSL (far.c's
+ * rt_flat_glsl, passed in so that pipelines.c and far.c do not call each
+ * other). */
+typedef char *(*rt_glsl_source)(const rt_pack *p, bool count, rt_error *e);
 bool rt_pipelines_flat(rt_device *d, const rt_pack *p, rt_pipelines *pl, unsigned variant,
-                       VkPipeline *out, rt_error *e);
+                       rt_glsl_source source, VkPipeline *out, rt_error *e);
 /* Whether combination id's pipeline of `variant` is made already. */
 bool rt_pipelines_has_combo(const rt_pipelines *pl, int id, unsigned variant);
 bool rt_pipelines_combo(rt_device *d, const rt_pack *p, const rt_passes *rp,

@@ -76,7 +76,8 @@ struct rt_screen {
                                                 invocation per tile (CPUs)   */
     /* the classification's view (rt_class_view): recomputed where the
      * selection's materials change, uploaded each frame */
-    VkPipeline            classify1;         /* WORDS 1: <= 32 in view       */
+    VkPipeline            classify1;         /* WORDS 1: <= 32 in view; NULL:
+                                                classify is that one         */
     uint32_t             *order;             /* combinations, cost order     */
     float                *dist;              /* [lo, hi] per combination     */
     uint32_t            **node_masks;        /* per level, per node: words   */
@@ -464,9 +465,9 @@ static bool make_compute(rt_screen *s, const rt_pipelines *pl, VkSampler nearest
     snprintf(ghead, sizeof ghead, "#define G %du\n", s->sort_tiles);
     bool one = s->words <= 1;
     return own_pipeline(s, pl, head, rt_screen_classify_glsl, "classify.comp", &s->classify, e) &&
-           (one ? (s->classify1 = s->classify, true)
-                : own_pipeline(s, pl, head1, rt_screen_classify_glsl, "classify1.comp",
-                               &s->classify1, e)) &&
+           /* (not a copy of classify's handle: a batch makes it later) */
+           (one || own_pipeline(s, pl, head1, rt_screen_classify_glsl, "classify1.comp",
+                                &s->classify1, e)) &&
            (!s->sort ||
             own_pipeline(s, pl, ghead, rt_screen_group_glsl, "group.comp", &s->group, e)) &&
            (!s->raycast ||
@@ -732,7 +733,8 @@ void rt_screen_classify(rt_screen *s, VkCommandBuffer cb, VkDescriptorSet set0,
     /* the colour image is GENERAL (render_plan.c): the classification
      * writes the background of empty pixels, shading the terrain's */
     vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE,
-                      s->view_built && s->view.words == 1 ? s->classify1 : s->classify);
+                      s->view_built && s->view.words == 1 && s->classify1 ? s->classify1
+                                                                           : s->classify);
     vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, s->layout, 0, 1, &set0, 0, NULL);
     vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, s->layout, 2, 1, &s->set, 0, NULL);
     /* abi.h's push block, read as: patch_xz the background colour,
@@ -840,7 +842,7 @@ bool rt_screen_dispatch(rt_screen *s, VkCommandBuffer cb, rt_pipelines *pl,
         }
         VkPipeline pipe;
         if (!have && stand_in == RT_STAND_FLAT
-                ? !rt_pipelines_flat(d, p, pl, variant, &pipe, e)
+                ? !rt_pipelines_flat(d, p, pl, variant, rt_flat_glsl, &pipe, e)
                 : !rt_pipelines_compute(d, p, pl, have ? k : p->ncombos, variant, &pipe, e))
             return false;
         s->stand_in[k] = have ? RT_STAND_NONE : (unsigned char)stand_in;

@@ -17,7 +17,8 @@
  *
  * --script runs without a person: "frames=N" renders N frames,
  * "view=NAME", "key=K" acts as if K was pressed, "screenshot=FILE" writes
- * the swapchain image as the window shows it, "wait_reload=SECONDS" renders
+ * the swapchain image as the window shows it (after the pipelines being
+ * made on the workers: the final picture, not a stand-in's), "wait_reload=SECONDS" renders
  * until a hot reload succeeded (compile errors on the way are shown and
  * survived; the time running out fails the script), "quit" ends. */
 #include "rt_internal.h"
@@ -719,7 +720,9 @@ static bool script_step(viewer *v, const char *step, double *last, rt_error *e)
             if (!frame(v, NULL, last, e))
                 return false;
     } else if (!strcmp(key, "screenshot")) {
-        return frame(v, val, last, e);
+        /* the final picture: the pipelines the workers are making first
+         * (the stand-ins shade their tiles until then) */
+        return rt_renderer_wait_pipelines(v->r, e) && frame(v, val, last, e);
     } else if (!strcmp(key, "view")) {
         splat_view view;
         int m;
