@@ -1,6 +1,7 @@
 /* vk_build.c — desc structs to Vulkan objects, and destroy lists
  * (vk_build.h).  Each maker fills the Vk*CreateInfo from the desc's
- * fields and defaults, creates, and records the handle in the list. */
+ * fields and defaults, creates, and records the handle in the list;
+ * pipelines within a batch are made together on every core. */
 #include "vk_build.h"
 
 #include <assert.h>

@@ -56,7 +56,12 @@
  *       combinations only (--no-distance-classes; PACK.md "Distance
  *       classes"), distclass=1 (the default) with their distance classes;
  *       async (screen kinds) makes compute pipelines on worker threads,
- *       the über-shader shading their tiles meanwhile (first pictures);
+ *       a stand-in shading their tiles meanwhile (first pictures; the far
+ *       atlas, the flat stand-in or the über-shader: $SPLAT_STAND_IN,
+ *       rt_pipelines_stand_in; the columns stand_in_uber, _atlas, _flat
+ *       count the last timed frame's tiles each drew, first_picture_s the
+ *       seconds from the process's launch to the variant's first complete
+ *       frame);
  *       sort=on|off (screen kinds) sorts each workgroup's pixels by the
  *       layers they need before shading (rt_pixel_sort; default off),
  *       sort=N on with N tiles per workgroup (4, 8 or 16; on: the most
