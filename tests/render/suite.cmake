@@ -157,7 +157,7 @@ if(TARGET splatrt AND TARGET splatview)
     add_test(NAME render.stand_in
       COMMAND sh ${RENDER_DIR}/stand_in.sh $<TARGET_FILE:splatc_cli> $<TARGET_FILE:splatview>
               $<TARGET_FILE:imgcheck> ${PROJECT_SOURCE_DIR} ${RENDER_OUT}/out)
-    set_tests_properties(render.stand_in PROPERTIES LABELS render TIMEOUT 600
+    set_tests_properties(render.stand_in PROPERTIES LABELS "render;asan" TIMEOUT 900
       ENVIRONMENT "SPLAT_VALIDATE=1")
     # SPLAT_VALIDATE=1 without the validation layer: a loud failure
     add_test(NAME render.no_validation_layer
