@@ -468,6 +468,9 @@ static bool make_pack_objects(rt_renderer *r, bool screen, rt_error *e)
  * the first frame. */
 static bool make_fixed_pipelines(rt_renderer *r, rt_error *e)
 {
+    const char *batch = getenv("SPLAT_PIPELINE_BATCH");   /* 0: one after another (timing) */
+    if (batch && !strcmp(batch, "0"))
+        return make_pack_objects(r, r->set0c != VK_NULL_HANDLE, e);
     if (!rt_vk_batch_begin(r->d, e))
         return false;
     bool ok = make_pack_objects(r, r->set0c != VK_NULL_HANDLE, e);
