@@ -707,18 +707,15 @@ bool rt_pipelines_flat(rt_device *d, const rt_pack *p, rt_pipelines *pl, unsigne
     }
     if (have_in)
         rt_interface_free(&in);
-    VkShaderModule m = VK_NULL_HANDLE;
-    if (ok && make_module(d, words, n, &m, e)) {
-        static const uint32_t final_view = SPLAT_VIEW_FINAL;
-        static const VkSpecializationMapEntry entry = { SPLAT_SPEC_VIEW, 0, sizeof final_view };
-        static const VkSpecializationInfo spec = { 1, &entry, sizeof final_view, &final_view };
-        ok = rt_vk_compute(d, NULL, &(rt_vk_compute_desc){ .label = "flat stand-in", .module = m,
-                               .spec = (variant & RT_CVARIANT_DEBUG) ? NULL : &spec,
-                               .layout = pl->compute_layout, .cache = pl->cache }, slot, e);
-        vkDestroyShaderModule(d->dev, m, NULL);
-    } else {
-        ok = false;
-    }
+    /* from the words (copied): inside a batch (renderer creation) the
+     * driver's compile runs beside the fixed pipelines' */
+    static const uint32_t final_view = SPLAT_VIEW_FINAL;
+    static const VkSpecializationMapEntry entry = { SPLAT_SPEC_VIEW, 0, sizeof final_view };
+    static const VkSpecializationInfo spec = { 1, &entry, sizeof final_view, &final_view };
+    ok = ok && rt_vk_compute(d, NULL, &(rt_vk_compute_desc){ .label = "flat stand-in",
+                                 .spirv = words, .nwords = n,
+                                 .spec = (variant & RT_CVARIANT_DEBUG) ? NULL : &spec,
+                                 .layout = pl->compute_layout, .cache = pl->cache }, slot, e);
     free(words);
     *out = *slot;
     return ok;

@@ -901,6 +901,10 @@ void rt_screen_classify(rt_screen *s, VkCommandBuffer cb, VkDescriptorSet set0,
 bool rt_screen_dispatch(rt_screen *s, VkCommandBuffer cb, rt_pipelines *pl,
                         const VkDescriptorSet sets[2], unsigned variant, rt_stand_in stand_in,
                         int *binds, rt_error *e);
+/* The pipeline of `stand_in` in `variant` made now (renderer creation,
+ * inside its batch), so the first frame does not make it. */
+bool rt_screen_prepare_stand_in(rt_screen *s, rt_pipelines *pl, rt_stand_in stand_in,
+                                unsigned variant, rt_error *e);
 /* The far list from the far atlas, when it is on. */
 bool rt_screen_far_on(const rt_screen *s);
 bool rt_screen_dispatch_far(rt_screen *s, VkCommandBuffer cb, rt_pipelines *pl,

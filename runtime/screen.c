@@ -811,6 +811,17 @@ static bool far_pipeline(rt_screen *s, rt_pipelines *pl, int c, rt_error *e)
     return ok;
 }
 
+bool rt_screen_prepare_stand_in(rt_screen *s, rt_pipelines *pl, rt_stand_in stand_in,
+                                unsigned variant, rt_error *e)
+{
+    VkPipeline pipe;
+    if (stand_in == RT_STAND_ATLAS && s->far_ok)
+        return far_pipeline(s, pl, (variant & RT_CVARIANT_COUNT) != 0, e);
+    if (stand_in == RT_STAND_ATLAS || stand_in == RT_STAND_FLAT)
+        return rt_pipelines_flat(s->d, s->p, pl, variant, rt_flat_glsl, &pipe, e);
+    return true;
+}
+
 bool rt_screen_dispatch(rt_screen *s, VkCommandBuffer cb, rt_pipelines *pl,
                         const VkDescriptorSet sets[2], unsigned variant, rt_stand_in stand_in,
                         int *binds, rt_error *e)
