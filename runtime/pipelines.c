@@ -449,8 +449,13 @@ rt_stand_in rt_pipelines_stand_in(const rt_device *d, const rt_pack *p, rt_pipel
     if (rt_pipelines_has_compute(pl, p->ncombos, variant))
         return RT_STAND_UBER;   /* made: it costs nothing more */
     bool uber_only = force && (!strcmp(force, "always") || !strcmp(force, "uber"));
-    if (!ids)   /* before the frame: nearly free, unless forced to the über-shader */
-        return uber_only ? RT_STAND_NONE : atlas ? RT_STAND_ATLAS : RT_STAND_FLAT;
+    /* before the frame: nearly free, unless forced to the über-shader; the
+     * atlas on GPUs only: llvmpipe decodes its BC blocks in software at
+     * every sample, and colorado's first picture took 1.2 s longer cold
+     * with the atlas than flat on lavapipe (3 samples a pixel at 720p) */
+    bool cpu = d->props.deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU;
+    if (!ids)
+        return uber_only ? RT_STAND_NONE : atlas && !cpu ? RT_STAND_ATLAS : RT_STAND_FLAT;
     if (force && !strcmp(force, "always"))
         return RT_STAND_UBER;
     if (!uber_only)   /* the cheap stand-ins took every list before the frame */
@@ -466,7 +471,7 @@ rt_stand_in rt_pipelines_stand_in(const rt_device *d, const rt_pack *p, rt_pipel
     size_t sum = 0;
     for (int k = 0; k < n; k++)
         sum += compute_cost(p, ids[k]);
-    size_t par = d->props.deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU ? 1 : (size_t)rt_job_threads(n);
+    size_t par = cpu ? 1 : (size_t)rt_job_threads(n);
     return compute_cost(p, p->ncombos) < sum / par ? RT_STAND_UBER : RT_STAND_NONE;
 }
 

@@ -730,9 +730,9 @@ typedef enum rt_stand_in {
 /* The stand-in for compute pipelines ids[0..n) in `variant` (`atlas`: the
  * screen path can shade from a far atlas).  Before the frame (ids NULL,
  * the lists unknown): the über-shader where it is made already (it costs
- * nothing more), else the far atlas where there is one, else the flat
- * stand-in, both nearly free to make, so the über-shader is not compiled
- * before the first picture.  After the frame, for the lists that got
+ * nothing more), else the far atlas where there is one and the device is
+ * a GPU, else the flat stand-in, both nearly free to make, so the
+ * über-shader is not compiled before the first picture.  After the frame, for the lists that got
  * tiles without a pipeline (only when nothing stood in before it): the
  * über-shader where making it costs less than making them (their
  * modules' bytes, over the cores that make them at once: one on a CPU

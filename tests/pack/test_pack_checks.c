@@ -305,10 +305,15 @@ static void test_stand_in(void **state)
     assert_int_equal(rt_pipelines_stand_in(&d, &p, &pl, ids, n, 0, false), RT_STAND_NONE);
     pl.async = (struct rt_async *)&pl;   /* only tested against NULL here */
     unsetenv("SPLAT_STAND_IN");
-    /* the default: before the frame the atlas or the flat stand-in, so the
+    /* the default: before the frame the atlas (on a GPU: a CPU device
+     * decodes its BC blocks per sample) or the flat stand-in, so the
      * lists are never left for after it */
+    assert_int_equal(rt_pipelines_stand_in(&d, &p, &pl, NULL, 0, 0, true), RT_STAND_FLAT);
+    assert_int_equal(rt_pipelines_stand_in(&d, &p, &pl, NULL, 0, 0, false), RT_STAND_FLAT);
+    d.props.deviceType = VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU;
     assert_int_equal(rt_pipelines_stand_in(&d, &p, &pl, NULL, 0, 0, true), RT_STAND_ATLAS);
     assert_int_equal(rt_pipelines_stand_in(&d, &p, &pl, NULL, 0, 0, false), RT_STAND_FLAT);
+    d.props.deviceType = VK_PHYSICAL_DEVICE_TYPE_CPU;
     assert_int_equal(rt_pipelines_stand_in(&d, &p, &pl, ids, n, 0, false), RT_STAND_NONE);
     setenv("SPLAT_STAND_IN", "auto", 1);
     assert_int_equal(rt_pipelines_stand_in(&d, &p, &pl, NULL, 0, 0, false), RT_STAND_FLAT);
