@@ -288,7 +288,7 @@ static const splat_arg options[] = {
       .values = reference_values },
     { "--async-pipelines", SPLAT_ARG_ENUM, NULL, "the screen path: make shading pipelines "
       "on worker threads while a stand-in draws their tiles: the far atlas where the pack has "
-      "one, else a flat lit terrain, or the über-shader once it is made (SPLAT_STAND_IN="
+      "one (on a GPU), else a flat lit terrain, or the über-shader once it is made (SPLAT_STAND_IN="
       "auto|always|uber|never|atlas|flat forces one; default on in the window, off headless, "
       "which waits for them; on: the quick first picture); the title and --stats say how many "
       "are pending and which stand-in drew how many tiles",
