@@ -446,14 +446,17 @@ rt_stand_in rt_pipelines_stand_in(const rt_device *d, const rt_pack *p, rt_pipel
         return ids ? RT_STAND_NONE : RT_STAND_FLAT;
     if (force && !strcmp(force, "atlas"))
         return ids ? RT_STAND_NONE : atlas ? RT_STAND_ATLAS : RT_STAND_FLAT;
-    if (rt_pipelines_has_compute(pl, p->ncombos, variant))
-        return RT_STAND_UBER;   /* made: it costs nothing more */
     bool uber_only = force && (!strcmp(force, "always") || !strcmp(force, "uber"));
+    bool cpu = d->props.deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU;
+    /* made: it costs nothing more to make, and on a GPU little to run; on
+     * a CPU device its shading is the cost (the 257-material world's first
+     * frame took 51 s of it on lavapipe), so there only when forced */
+    if (rt_pipelines_has_compute(pl, p->ncombos, variant) && (uber_only || !cpu))
+        return RT_STAND_UBER;
     /* before the frame: nearly free, unless forced to the über-shader; the
      * atlas on GPUs only: llvmpipe decodes its BC blocks in software at
      * every sample, and colorado's first picture took 1.2 s longer cold
      * with the atlas than flat on lavapipe (3 samples a pixel at 720p) */
-    bool cpu = d->props.deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU;
     if (!ids)
         return uber_only ? RT_STAND_NONE : atlas && !cpu ? RT_STAND_ATLAS : RT_STAND_FLAT;
     if (force && !strcmp(force, "always"))

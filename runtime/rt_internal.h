@@ -729,8 +729,9 @@ typedef enum rt_stand_in {
 } rt_stand_in;
 /* The stand-in for compute pipelines ids[0..n) in `variant` (`atlas`: the
  * screen path can shade from a far atlas).  Before the frame (ids NULL,
- * the lists unknown): the über-shader where it is made already (it costs
- * nothing more), else the far atlas where there is one and the device is
+ * the lists unknown): the über-shader where it is made already and the
+ * device is a GPU (it costs nothing more to make; a CPU device pays for
+ * its shading), else the far atlas where there is one and the device is
  * a GPU, else the flat stand-in, both nearly free to make, so the
  * über-shader is not compiled before the first picture.  After the frame, for the lists that got
  * tiles without a pipeline (only when nothing stood in before it): the
