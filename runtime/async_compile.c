@@ -21,6 +21,7 @@ typedef struct rt_async {
     rt_pipelines   *pl;
     pthread_mutex_t lock;
     pthread_cond_t  wake;
+    pthread_cond_t  idle;       /* pending came down to 0 (rt_async_wait)   */
     int            *queue;      /* slot indices (id * RT_CVARIANTS + variant) */
     int             head, tail, cap;
     unsigned char  *queued;     /* per slot: queued or being made            */
@@ -56,7 +57,8 @@ static void *worker(void *arg)
         else
             rt_error_clear(&e);
         a->queued[slot] = 0;
-        a->pending--;
+        if (--a->pending == 0)
+            pthread_cond_broadcast(&a->idle);
     }
     pthread_mutex_unlock(&a->lock);
     return NULL;
@@ -86,12 +88,14 @@ bool rt_async_start(rt_device *d, const rt_pack *p, rt_pipelines *pl, rt_async_m
     a->cap = nslots;
     pthread_mutex_init(&a->lock, NULL);
     pthread_cond_init(&a->wake, NULL);
+    pthread_cond_init(&a->idle, NULL);
     /* the caller's thread records frames: the workers take the rest */
     int want = rt_job_threads(MAX_WORKERS) - 1;
     for (int i = 0; i < (want > 0 ? want : 1); i++)
         if (pthread_create(&a->th[a->nth], NULL, worker, a) == 0)
             a->nth++;
     if (a->nth == 0) {
+        pthread_cond_destroy(&a->idle);
         pthread_cond_destroy(&a->wake);
         pthread_mutex_destroy(&a->lock);
         free(a->queue);
@@ -115,6 +119,7 @@ void rt_async_stop(rt_pipelines *pl)
     for (int i = 0; i < a->nth; i++)
         pthread_join(a->th[i], NULL);
     rt_error_clear(&a->e);
+    pthread_cond_destroy(&a->idle);
     pthread_cond_destroy(&a->wake);
     pthread_mutex_destroy(&a->lock);
     free(a->queue);
@@ -146,6 +151,17 @@ int rt_async_pending(rt_pipelines *pl)
     int n = a->pending;
     pthread_mutex_unlock(&a->lock);
     return n;
+}
+
+void rt_async_wait(rt_pipelines *pl)
+{
+    rt_async *a = pl->async;
+    if (!a)
+        return;
+    pthread_mutex_lock(&a->lock);
+    while (a->pending > 0)
+        pthread_cond_wait(&a->idle, &a->lock);
+    pthread_mutex_unlock(&a->lock);
 }
 
 bool rt_async_failed(rt_pipelines *pl, rt_error *e)

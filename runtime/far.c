@@ -145,11 +145,22 @@ static const char far_main[] =
     "    splat_finish(albedo, n, rough, 0.0, 1.0);\n"
     "}\n";
 
+/* The flat stand-in's main (rt_flat_glsl): the terrain's own normal from
+ * the heightfield (splat_begin_at's splat_nrm), lit, fogged and toned as
+ * the composites are, over one neutral albedo (a warm mid grey): the
+ * default material that Unreal shows while shaders compile, at the cost
+ * of a handful of instructions.  One tint for all: a tint per combination
+ * showed the classification's 8x8 tiles as a patchwork. */
+static const char flat_main[] =
+    "void main() {\n"
+    "    splat_finish(vec3(0.20, 0.19, 0.17), splat_nrm, 0.9, 0.0, 1.0);\n"
+    "}\n";
+
 /* `uber` (an über-shader's GLSL of the stage) cut at the prelude: its
  * head (its defines: painted storage and places) before the prelude, so
  * set 0 is declared as the composites do, then `defs`, the prelude and
- * far_main. */
-static char *far_source(const char *uber, const char *defs)
+ * `main_text` (far_main, flat_main). */
+static char *prelude_source(const char *uber, const char *defs, const char *main_text)
 {
     const char *v = uber ? strstr(uber, "#version 450\n") : NULL;
     const char *at = v ? strstr(v, SPLAT_GLSL_PRELUDE) : NULL;
@@ -157,11 +168,27 @@ static char *far_source(const char *uber, const char *defs)
         return NULL;
     v += strlen("#version 450\n");
     size_t head = (size_t)(at - v);
-    size_t n = 64 + strlen(defs) + head + strlen(SPLAT_GLSL_PRELUDE) + sizeof far_main;
+    size_t n = 64 + strlen(defs) + head + strlen(SPLAT_GLSL_PRELUDE) + strlen(main_text);
     char *s = malloc(n);
     if (!s)
         return NULL;
-    snprintf(s, n, "#version 450\n%.*s%s%s%s", (int)head, v, defs, SPLAT_GLSL_PRELUDE, far_main);
+    snprintf(s, n, "#version 450\n%.*s%s%s%s", (int)head, v, defs, SPLAT_GLSL_PRELUDE, main_text);
+    return s;
+}
+
+static char *far_source(const char *uber, const char *defs)
+{
+    return prelude_source(uber, defs, far_main);
+}
+
+char *rt_flat_glsl(const rt_pack *p, bool count, rt_error *e)
+{
+    const char *uber = rt_pack_text(p, &p->uber_compute, e);
+    if (!uber)
+        return NULL;
+    char *s = prelude_source(uber, count ? "#define SPLAT_COUNT 1\n" : "", flat_main);
+    if (!s)
+        rt_fail(e, RT_E_VULKAN, "flat stand-in", "no prelude in the uber compute GLSL");
     return s;
 }
 

@@ -432,18 +432,37 @@ static size_t compute_cost(const rt_pack *p, int id)
     return rt_spirv_present(s) ? rt_pack_spirv_size(s) : rt_pack_text_size(t);
 }
 
-bool rt_pipelines_stand_in(const rt_device *d, const rt_pack *p, rt_pipelines *pl,
-                           const int *ids, int n, unsigned variant)
+rt_stand_in rt_pipelines_stand_in(const rt_device *d, const rt_pack *p, rt_pipelines *pl,
+                                  const int *ids, int n, unsigned variant, bool atlas)
 {
-    if (!pl->async || !p->uber_compute.mod)
-        return false;
-    if (rt_pipelines_has_compute(pl, p->ncombos, variant))
-        return true;   /* made: it costs nothing more */
+    if (!pl->async || !p->uber_compute.mod)   /* the flat one takes the über's head */
+        return RT_STAND_NONE;
     const char *force = getenv("SPLAT_STAND_IN");
-    if (force && !strcmp(force, "always"))
-        return true;
+    if (force && !*force)
+        force = NULL;
     if (force && !strcmp(force, "never"))
-        return false;
+        return RT_STAND_NONE;
+    if (force && !strcmp(force, "flat"))
+        return ids ? RT_STAND_NONE : RT_STAND_FLAT;
+    if (force && !strcmp(force, "atlas"))
+        return ids ? RT_STAND_NONE : atlas ? RT_STAND_ATLAS : RT_STAND_FLAT;
+    bool uber_only = force && (!strcmp(force, "always") || !strcmp(force, "uber"));
+    bool cpu = d->props.deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU;
+    /* made: it costs nothing more to make, and on a GPU little to run; on
+     * a CPU device its shading is the cost (the 257-material world's first
+     * frame took 51 s of it on lavapipe), so there only when forced */
+    if (rt_pipelines_has_compute(pl, p->ncombos, variant) && (uber_only || !cpu))
+        return RT_STAND_UBER;
+    /* before the frame: nearly free, unless forced to the über-shader; the
+     * atlas on GPUs only: llvmpipe decodes its BC blocks in software at
+     * every sample, and colorado's first picture took 1.2 s longer cold
+     * with the atlas than flat on lavapipe (3 samples a pixel at 720p) */
+    if (!ids)
+        return uber_only ? RT_STAND_NONE : atlas && !cpu ? RT_STAND_ATLAS : RT_STAND_FLAT;
+    if (force && !strcmp(force, "always"))
+        return RT_STAND_UBER;
+    if (!uber_only)   /* the cheap stand-ins took every list before the frame */
+        return RT_STAND_NONE;
     /* Making a pipeline costs about its module's size: llvmpipe JIT-compiles
      * it in the frame (colorado's composites about 0.4 s each at 250 KB,
      * serially), a GPU driver on the cores rt_parallel gives it.  One
@@ -455,14 +474,15 @@ bool rt_pipelines_stand_in(const rt_device *d, const rt_pack *p, rt_pipelines *p
     size_t sum = 0;
     for (int k = 0; k < n; k++)
         sum += compute_cost(p, ids[k]);
-    size_t par = d->props.deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU ? 1 : (size_t)rt_job_threads(n);
-    return compute_cost(p, p->ncombos) < sum / par;
+    size_t par = cpu ? 1 : (size_t)rt_job_threads(n);
+    return compute_cost(p, p->ncombos) < sum / par ? RT_STAND_UBER : RT_STAND_NONE;
 }
 
 bool rt_pipelines_make(rt_device *d, const rt_pack *p, const rt_passes *rp, rt_pipelines *pl,
                        bool compute, const int *ids, int n, unsigned variant, rt_error *e)
 {
-    if (compute && n > 0 && rt_pipelines_stand_in(d, p, pl, ids, n, variant)) {
+    if (compute && n > 0 &&
+        rt_pipelines_stand_in(d, p, pl, ids, n, variant, false) == RT_STAND_UBER) {
         /* the über-shader now; it stands in for the others in the frame
          * drawn again, after which rt_screen_missing queues them on the
          * workers (not before: on a few cores they would compete with
@@ -669,6 +689,46 @@ bool rt_pipelines_compute_make(rt_device *d, const rt_pack *p, rt_pipelines *pl,
     return ok;
 }
 
+bool rt_pipelines_flat(rt_device *d, const rt_pack *p, rt_pipelines *pl, unsigned variant,
+                       rt_glsl_source source, VkPipeline *out, rt_error *e)
+{
+    VkPipeline *slot = &pl->flat[variant % RT_CVARIANTS];
+    if (*slot) {
+        *out = *slot;
+        return true;
+    }
+    /* the sorted variant's lists are dispatched a tile a workgroup here
+     * (rt_screen_dispatch): the flat stand-in is never sorted */
+    char *src = source(p, (variant & RT_CVARIANT_COUNT) != 0, e);
+    if (!src)
+        return false;
+    uint32_t *words = NULL;
+    size_t n = 0;
+    rt_interface in;
+    bool have_in = false;
+    bool ok = compute_spirv(pl, src, "flat stand-in (compute)", &words, &n, e);
+    free(src);
+    if (ok) {
+        have_in = rt_interface_for(p, RT_ROLE_COMPUTE, &in);
+        ok = have_in ? rt_spirv_check(words, n, "flat stand-in (compute)", &in, e)
+                     : rt_fail(e, RT_E_VULKAN, "pipelines", "out of memory");
+    }
+    if (have_in)
+        rt_interface_free(&in);
+    /* from the words (copied): inside a batch (renderer creation) the
+     * driver's compile runs beside the fixed pipelines' */
+    static const uint32_t final_view = SPLAT_VIEW_FINAL;
+    static const VkSpecializationMapEntry entry = { SPLAT_SPEC_VIEW, 0, sizeof final_view };
+    static const VkSpecializationInfo spec = { 1, &entry, sizeof final_view, &final_view };
+    ok = ok && rt_vk_compute(d, NULL, &(rt_vk_compute_desc){ .label = "flat stand-in",
+                                 .spirv = words, .nwords = n,
+                                 .spec = (variant & RT_CVARIANT_DEBUG) ? NULL : &spec,
+                                 .layout = pl->compute_layout, .cache = pl->cache }, slot, e);
+    free(words);
+    *out = *slot;
+    return ok;
+}
+
 bool rt_pipelines_depth(rt_device *d, rt_pipelines *pl, VkRenderPass pass, bool cull,
                         VkPipeline *out, rt_error *e)
 {
@@ -689,6 +749,11 @@ static void destroy_combos(rt_device *d, rt_pipelines *pl)
     for (size_t i = 0; pl->compute && i < ((size_t)pl->ncombos + 1) * RT_CVARIANTS; i++)
         if (pl->compute[i])
             vkDestroyPipeline(d->dev, pl->compute[i], NULL);
+    for (int i = 0; i < RT_CVARIANTS; i++)   /* its head is the pack's über-shader's */
+        if (pl->flat[i]) {
+            vkDestroyPipeline(d->dev, pl->flat[i], NULL);
+            pl->flat[i] = VK_NULL_HANDLE;
+        }
     free(pl->combo);
     free(pl->compute);
     pl->combo = NULL;

@@ -77,6 +77,8 @@ struct rt_renderer {
     rt_tracker        tracker;         /* the resources' state between passes */
     rt_plan           plan;            /* the last frame's (render_plan.c)  */
     bool              pass_times;      /* a timestamp after every pass      */
+    double            first_picture_s; /* rt_frame_stats.first_picture_s; 0:
+                                          no frame completed yet            */
 };
 
 /* What this frame does, worked out once from the state (render_plan.c). */

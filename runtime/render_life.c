@@ -462,6 +462,36 @@ static bool make_pack_objects(rt_renderer *r, bool screen, rt_error *e)
     return true;
 }
 
+/* The pack's objects with their fixed pipelines (classification, ray
+ * caster, list padding, undergrowth, upscale) made together on every core
+ * (vk_build.c's batch) instead of one after another: none is used before
+ * the first frame. */
+static bool make_fixed_pipelines(rt_renderer *r, rt_error *e)
+{
+    const char *batch = getenv("SPLAT_PIPELINE_BATCH");   /* 0: one after another (timing) */
+    if (batch && !strcmp(batch, "0"))
+        return make_pack_objects(r, r->set0c != VK_NULL_HANDLE, e);
+    if (!rt_vk_batch_begin(r->d, e))
+        return false;
+    bool ok = make_pack_objects(r, r->set0c != VK_NULL_HANDLE, e);
+    /* and the stand-in of the first frame's lists, with async pipelines:
+     * the flat one's or the far atlas's */
+    if (ok && r->screen && r->pl.async)
+        ok = rt_screen_prepare_stand_in(r->screen, &r->pl,
+                                        rt_pipelines_stand_in(r->d, r->p, &r->pl, NULL, 0,
+                                                              rt_render_compute_variant(r),
+                                                              rt_screen_has_far(r->screen)),
+                                        rt_render_compute_variant(r), e);
+    rt_error e2 = { 0 };
+    if (!rt_vk_batch_end(r->d, ok, ok ? e : &e2)) {
+        rt_error_clear(&e2);
+        if (ok)
+            drop_pack_objects(r);
+        return false;
+    }
+    return ok;
+}
+
 bool rt_renderer_create(rt_device *d, const rt_pack *p, const rt_render_desc *desc,
                         rt_renderer **out, rt_error *e)
 {
@@ -529,8 +559,11 @@ bool rt_renderer_create(rt_device *d, const rt_pack *p, const rt_render_desc *de
         !rt_pipelines_create(d, p, &r->rp, r->desc.reference, r->desc.pipeline_cache,
                              p->narrays, &r->pl, e) ||
         !make_geometry(r, e) || !make_textures(r, e) || !make_descriptors(r, e) ||
-        !make_commands(r, e) || !make_pack_objects(r, r->set0c != VK_NULL_HANDLE, e) ||
-        (r->screen && r->desc.async_pipelines && !rt_async_start(d, p, &r->pl, rt_pipelines_compute_make, e))) {
+        !make_commands(r, e) ||
+        /* the workers first: the stand-in is chosen with them there */
+        (r->set0c && r->desc.async_pipelines &&
+         !rt_async_start(d, p, &r->pl, rt_pipelines_compute_make, e)) ||
+        !make_fixed_pipelines(r, e)) {
         rt_renderer_destroy(r);
         return false;
     }

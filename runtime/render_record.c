@@ -303,12 +303,15 @@ static bool rec_shade(rec *x, rt_error *e)
 {
     rt_renderer *r = x->r;
     VkDescriptorSet csets[2] = { r->set0c, r->set1 };
-    /* with async pipelines the über-shader stands in for lists whose
-     * pipelines are being made, once it is made itself: before that a
-     * list without one is left for rt_screen_missing, which makes the
-     * cheaper of the two (rt_pipelines_stand_in) and draws again */
-    bool stand_in = r->pl.async &&
-                    rt_pipelines_has_compute(&r->pl, r->p->ncombos, x->fs->cvariant);
+    /* with async pipelines a stand-in shades the lists whose pipelines
+     * are being made: the über-shader once it is made, else the far atlas
+     * or the flat stand-in, nearly free to make (rt_pipelines_stand_in);
+     * with none (SPLAT_STAND_IN=uber|always before the über-shader is
+     * made, or never) a list without a pipeline is left for
+     * rt_screen_missing, which makes the über-shader or the lists'
+     * pipelines and draws again */
+    rt_stand_in stand_in = rt_pipelines_stand_in(r->d, r->p, &r->pl, NULL, 0, x->fs->cvariant,
+                                                 rt_screen_has_far(r->screen));
     return rt_screen_dispatch(r->screen, x->cb, &r->pl, csets, x->fs->cvariant, stand_in,
                               &x->binds, e);
 }
@@ -726,6 +729,16 @@ static bool draw_frame(rt_renderer *r, const rt_camera *c, rt_frame_stats *st,
     return read_times(r, &r->plan, st, e);
 }
 
+/* The first complete frame's time since launch, kept: the picture is on
+ * the GPU (the fence waited for), before any readback. */
+static bool first_picture(rt_renderer *r, rt_frame_stats *st)
+{
+    if (r->first_picture_s <= 0)
+        r->first_picture_s = rt_seconds_since_launch();
+    st->first_picture_s = r->first_picture_s;
+    return true;
+}
+
 /* A frame; on the screen-space path, drawn again while lists got tiles
  * whose pipelines did not exist yet (compiled in between): at most once
  * per variant in practice, since the classification is deterministic. */
@@ -749,7 +762,7 @@ bool rt_renderer_frame(rt_renderer *r, const rt_camera *c, rt_frame_stats *st, r
             return false;
         st->shadow_gpu = r->shadow_on_gpu;
         if (!st->screen)
-            return true;
+            return first_picture(r, st);
         double t0 = splat_now();
         int made = rt_screen_missing(r->screen, &r->pl, rt_render_compute_variant(r), e);
         compile_ms += 1e3 * (splat_now() - t0);
@@ -757,11 +770,17 @@ bool rt_renderer_frame(rt_renderer *r, const rt_camera *c, rt_frame_stats *st, r
         if (made < 0)
             return false;
         if (made == 0)
-            return true;
+            return first_picture(r, st);
         if (redraws >= 3)
             return rt_fail(e, RT_E_VULKAN, "screen-space shading",
                            "tile lists still need new pipelines after 3 redraws");
     }
+}
+
+bool rt_renderer_wait_pipelines(rt_renderer *r, rt_error *e)
+{
+    rt_async_wait(&r->pl);
+    return !rt_async_failed(&r->pl, e);
 }
 
 /* The readback pass, in a command buffer of its own after the frame:

@@ -43,6 +43,8 @@ struct rt_device {
                                             forward counting variant       */
     bool                     validating;
     int                      messages;   /* validation warnings + errors    */
+    struct rt_vk_batch      *batch;      /* pipelines deferred to run on all
+                                            cores (vk_build.c rt_vk_batch_*) */
 };
 
 /* In place, for the library's own devices (the viewer's, the far bake's);
@@ -668,6 +670,7 @@ typedef struct rt_pipelines {
     int                   sort_tiles;    /* RT_CVARIANT_SORT: SPLAT_SORT_TILES */
     VkPipeline           *compute;       /* RT_CVARIANTS per combination, the
                                             über-shader's last              */
+    VkPipeline            flat[8];       /* the flat stand-in, per RT_CVARIANTS */
     VkPipeline            depth[2];      /* geometry pass, [RT_VARIANT_CULL] */
     splat_cache           spv_cache;     /* compute variants' SPIR-V (cache.h) */
     struct rt_async      *async;         /* workers (async_compile.c) or NULL */
@@ -713,13 +716,42 @@ bool rt_pipelines_glsl_fragment(rt_device *d, rt_pipelines *pl, const rt_passes 
  * the workers (rt_screen_missing). */
 bool rt_pipelines_make(rt_device *d, const rt_pack *p, const rt_passes *rp, rt_pipelines *pl,
                        bool compute, const int *ids, int n, unsigned variant, rt_error *e);
-/* Whether the über-shader should stand in for compute pipelines ids[0..n)
- * while the workers make them: it is made already, or making it costs
- * less than making them (their modules' bytes, over the cores that make
- * them at once: one on a CPU device, whose JIT runs in the frame on one
- * thread); `SPLAT_STAND_IN=always|never` forces the choice (tests). */
-bool rt_pipelines_stand_in(const rt_device *d, const rt_pack *p, rt_pipelines *pl,
-                           const int *ids, int n, unsigned variant);
+/* What shades a screen list whose pipeline is not made yet, with async
+ * pipelines (the lists' pipelines are made on the workers meanwhile). */
+typedef enum rt_stand_in {
+    RT_STAND_NONE = 0,  /* nothing: the list's pipeline is made before the
+                           frame is drawn (again)                          */
+    RT_STAND_UBER,      /* the über-shader (the final picture within 1/255) */
+    RT_STAND_ATLAS,     /* the far atlas's shader (far.c), where the pack
+                           has an atlas the device samples                 */
+    RT_STAND_FLAT,      /* the flat stand-in: the lit terrain in one neutral
+                           albedo (rt_flat_glsl)                           */
+} rt_stand_in;
+/* The stand-in for compute pipelines ids[0..n) in `variant` (`atlas`: the
+ * screen path can shade from a far atlas).  Before the frame (ids NULL,
+ * the lists unknown): the über-shader where it is made already and the
+ * device is a GPU (it costs nothing more to make; a CPU device pays for
+ * its shading), else the far atlas where there is one and the device is
+ * a GPU, else the flat stand-in, both nearly free to make, so the
+ * über-shader is not compiled before the first picture.  After the frame, for the lists that got
+ * tiles without a pipeline (only when nothing stood in before it): the
+ * über-shader where making it costs less than making them (their
+ * modules' bytes, over the cores that make them at once: one on a CPU
+ * device, whose JIT runs in the frame on one thread), else none.
+ * `SPLAT_STAND_IN` forces it (tests, benchmarks): `always` the
+ * über-shader, `uber` the über-shader against the composites by that
+ * cost (never a flat or atlas stand-in), `never` none (the composites
+ * made at once), `atlas` the far atlas (else flat), `flat`; `auto` or
+ * unset: the default above. */
+rt_stand_in rt_pipelines_stand_in(const rt_device *d, const rt_pack *p, rt_pipelines *pl,
+                                  const int *ids, int n, unsigned variant, bool atlas);
+/* The flat stand-in's compute pipeline in `variant` (compute layout, the
+ * SPIR-V cache), made on first use from `source`'s GLSL (far.c's
+ * rt_flat_glsl, passed in so that pipelines.c and far.c do not call each
+ * other). */
+typedef char *(*rt_glsl_source)(const rt_pack *p, bool count, rt_error *e);
+bool rt_pipelines_flat(rt_device *d, const rt_pack *p, rt_pipelines *pl, unsigned variant,
+                       rt_glsl_source source, VkPipeline *out, rt_error *e);
 /* Whether combination id's pipeline of `variant` is made already. */
 bool rt_pipelines_has_combo(const rt_pipelines *pl, int id, unsigned variant);
 bool rt_pipelines_combo(rt_device *d, const rt_pack *p, const rt_passes *rp,
@@ -754,6 +786,8 @@ void       rt_async_stop(rt_pipelines *pl);
 void       rt_async_request(rt_pipelines *pl, int id, unsigned variant);
 /* Queued or being made. */
 int        rt_async_pending(rt_pipelines *pl);
+/* Until none is queued or being made. */
+void       rt_async_wait(rt_pipelines *pl);
 /* A worker's failure, handed over once (true, *e set). */
 bool       rt_async_failed(rt_pipelines *pl, rt_error *e);
 /* A compute slot read, and one filled (a pipeline made twice is destroyed;
@@ -863,10 +897,15 @@ const rt_class_view *rt_screen_class_view(const rt_screen *s);
 void rt_screen_classify(rt_screen *s, VkCommandBuffer cb, VkDescriptorSet set0,
                         const float clear[4], bool force_uber, bool no_classes, int *binds);
 /* One indirect dispatch per list whose pipeline in `variant`
- * (RT_CVARIANT_*) exists. */
+ * (RT_CVARIANT_*) exists; the others by `stand_in` (RT_STAND_NONE: left
+ * for rt_screen_missing; RT_STAND_ATLAS without an atlas: flat). */
 bool rt_screen_dispatch(rt_screen *s, VkCommandBuffer cb, rt_pipelines *pl,
-                        const VkDescriptorSet sets[2], unsigned variant, bool stand_in,
+                        const VkDescriptorSet sets[2], unsigned variant, rt_stand_in stand_in,
                         int *binds, rt_error *e);
+/* The pipeline of `stand_in` in `variant` made now (renderer creation,
+ * inside its batch), so the first frame does not make it. */
+bool rt_screen_prepare_stand_in(rt_screen *s, rt_pipelines *pl, rt_stand_in stand_in,
+                                unsigned variant, rt_error *e);
 /* The far list from the far atlas, when it is on. */
 bool rt_screen_far_on(const rt_screen *s);
 bool rt_screen_dispatch_far(rt_screen *s, VkCommandBuffer cb, rt_pipelines *pl,
@@ -921,6 +960,10 @@ VkDescriptorImageInfo rt_far_image_info(const rt_far *f, int k);
 /* The far shading compute shader (malloc'd; NULL without the über compute
  * GLSL whose head it reuses); `count`: the counting variant. */
 char *rt_far_glsl(const rt_pack *p, bool count);
+/* The flat stand-in's compute shader (rt_stand_in, malloc'd): the same
+ * head and prelude around a main that lights the terrain's normal over a
+ * neutral albedo; NULL with *e set. */
+char *rt_flat_glsl(const rt_pack *p, bool count, rt_error *e);
 /* Forward path, inside the main pass: binds the far shading fragment
  * pipeline of `variant` (made on first use) and its set 2. */
 bool  rt_far_bind_forward(rt_far *f, const rt_pack *p, const rt_passes *rp, rt_pipelines *pl,

@@ -60,8 +60,8 @@ struct rt_screen {
      * readback (args and counters copied back after the frame) */
     rt_buffer             info, tiles, args, args_reset, counters, readback;
     unsigned             *dispatched;        /* per list: variant + 1 drawn  */
-    unsigned char        *stand_in;          /* per list: drawn by the über-
-                                                shader while its pipeline is
+    unsigned char        *stand_in;          /* per list: the rt_stand_in that
+                                                drew it while its pipeline is
                                                 made (async_compile.c)      */
     VkImage               color_img;
     bool                  raycast;           /* depth by ray casting          */
@@ -76,7 +76,8 @@ struct rt_screen {
                                                 invocation per tile (CPUs)   */
     /* the classification's view (rt_class_view): recomputed where the
      * selection's materials change, uploaded each frame */
-    VkPipeline            classify1;         /* WORDS 1: <= 32 in view       */
+    VkPipeline            classify1;         /* WORDS 1: <= 32 in view; NULL:
+                                                classify is that one         */
     uint32_t             *order;             /* combinations, cost order     */
     float                *dist;              /* [lo, hi] per combination     */
     uint32_t            **node_masks;        /* per level, per node: words   */
@@ -464,9 +465,9 @@ static bool make_compute(rt_screen *s, const rt_pipelines *pl, VkSampler nearest
     snprintf(ghead, sizeof ghead, "#define G %du\n", s->sort_tiles);
     bool one = s->words <= 1;
     return own_pipeline(s, pl, head, rt_screen_classify_glsl, "classify.comp", &s->classify, e) &&
-           (one ? (s->classify1 = s->classify, true)
-                : own_pipeline(s, pl, head1, rt_screen_classify_glsl, "classify1.comp",
-                               &s->classify1, e)) &&
+           /* (not a copy of classify's handle: a batch makes it later) */
+           (one || own_pipeline(s, pl, head1, rt_screen_classify_glsl, "classify1.comp",
+                                &s->classify1, e)) &&
            (!s->sort ||
             own_pipeline(s, pl, ghead, rt_screen_group_glsl, "group.comp", &s->group, e)) &&
            (!s->raycast ||
@@ -732,7 +733,8 @@ void rt_screen_classify(rt_screen *s, VkCommandBuffer cb, VkDescriptorSet set0,
     /* the colour image is GENERAL (render_plan.c): the classification
      * writes the background of empty pixels, shading the terrain's */
     vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE,
-                      s->view_built && s->view.words == 1 ? s->classify1 : s->classify);
+                      s->view_built && s->view.words == 1 && s->classify1 ? s->classify1
+                                                                           : s->classify);
     vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, s->layout, 0, 1, &set0, 0, NULL);
     vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, s->layout, 2, 1, &s->set, 0, NULL);
     /* abi.h's push block, read as: patch_xz the background colour,
@@ -793,37 +795,94 @@ static void dispatch_list(rt_screen *s, VkCommandBuffer cb, VkPipelineLayout lay
     s->dispatched[k] = variant + 1;
 }
 
+/* The far shader's compute pipeline (c: the counting variant), made on
+ * first use: the far list's, and the atlas stand-in's. */
+static bool far_pipeline(rt_screen *s, rt_pipelines *pl, int c, rt_error *e)
+{
+    if (s->far_pipe[c])
+        return true;
+    char *src = rt_far_glsl(s->p, c);
+    if (!src)
+        return rt_fail(e, RT_E_VULKAN, "far atlas shader", "no über compute GLSL");
+    bool ok = rt_vk_compute(s->d, &s->keep, &(rt_vk_compute_desc){ .label = "far.comp",
+                                .glsl = src, .layout = s->layout, .cache = pl->cache },
+                            &s->far_pipe[c], e);
+    free(src);
+    return ok;
+}
+
+bool rt_screen_prepare_stand_in(rt_screen *s, rt_pipelines *pl, rt_stand_in stand_in,
+                                unsigned variant, rt_error *e)
+{
+    VkPipeline pipe;
+    if (stand_in == RT_STAND_ATLAS && s->far_ok)
+        return far_pipeline(s, pl, (variant & RT_CVARIANT_COUNT) != 0, e);
+    if (stand_in == RT_STAND_ATLAS || stand_in == RT_STAND_FLAT)
+        return rt_pipelines_flat(s->d, s->p, pl, variant, rt_flat_glsl, &pipe, e);
+    return true;
+}
+
 bool rt_screen_dispatch(rt_screen *s, VkCommandBuffer cb, rt_pipelines *pl,
-                        const VkDescriptorSet sets[2], unsigned variant, bool stand_in,
+                        const VkDescriptorSet sets[2], unsigned variant, rt_stand_in stand_in,
                         int *binds, rt_error *e)
 {
     rt_device *d = s->d;
     const rt_pack *p = s->p;
+    if (stand_in == RT_STAND_ATLAS && !s->far_ok)
+        stand_in = RT_STAND_FLAT;
 
     /* one indirect dispatch per list whose pipeline exists (the others
      * are found empty or compiled after the frame: rt_screen_missing);
-     * with stand_in, the others by the über-shader's pipeline meanwhile */
-    bool bound_sets = false;
+     * with a stand-in, the others by its pipeline meanwhile: the
+     * über-shader's or the flat one's here, the far atlas's after them
+     * (its own layout, set 2 the classification's with the atlas) */
+    bool bound_sets = false, atlas = false;
+    VkPipeline bound = VK_NULL_HANDLE;
     for (int k = 0; k < s->nlists; k++) {
         s->dispatched[k] = 0;
-        s->stand_in[k] = 0;
+        s->stand_in[k] = RT_STAND_NONE;
         if (k > p->ncombos)   /* the far list, below */
             continue;
         bool have = rt_pipelines_has_compute(pl, k, variant);
-        if (!have && !stand_in)
+        if (!have && stand_in == RT_STAND_NONE)
             continue;
+        if (!have && stand_in == RT_STAND_ATLAS) {
+            s->stand_in[k] = RT_STAND_ATLAS;
+            atlas = true;
+            continue;
+        }
         VkPipeline pipe;
-        if (!rt_pipelines_compute(d, p, pl, have ? k : p->ncombos, variant, &pipe, e))
+        if (!have && stand_in == RT_STAND_FLAT
+                ? !rt_pipelines_flat(d, p, pl, variant, rt_flat_glsl, &pipe, e)
+                : !rt_pipelines_compute(d, p, pl, have ? k : p->ncombos, variant, &pipe, e))
             return false;
-        s->stand_in[k] = !have;
+        s->stand_in[k] = have ? RT_STAND_NONE : (unsigned char)stand_in;
         if (!bound_sets) {
             vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, pl->compute_layout, 0, 2,
                                     sets, 0, NULL);
             bound_sets = true;
         }
-        vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, pipe);
+        if (pipe != bound) {
+            vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, pipe);
+            (*binds)++;
+            bound = pipe;
+        }
+        /* the flat stand-in is not sorted: a tile a workgroup, the list's
+         * own args; the über-shader is, as the composites */
+        dispatch_list(s, cb, pl->compute_layout, k, variant,
+                      s->stand_in[k] != RT_STAND_FLAT && (variant & RT_CVARIANT_SORT) != 0);
+    }
+    if (atlas) {
+        int c = (variant & RT_CVARIANT_COUNT) != 0;
+        if (!far_pipeline(s, pl, c, e))
+            return false;
+        VkDescriptorSet all[3] = { sets[0], sets[1], s->set };
+        vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, s->layout, 0, 3, all, 0, NULL);
+        vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, s->far_pipe[c]);
         (*binds)++;
-        dispatch_list(s, cb, pl->compute_layout, k, variant, (variant & RT_CVARIANT_SORT) != 0);
+        for (int k = 0; k <= p->ncombos; k++)
+            if (s->stand_in[k] == RT_STAND_ATLAS)
+                dispatch_list(s, cb, s->layout, k, variant, false);
     }
     return true;
 }
@@ -834,20 +893,10 @@ bool rt_screen_dispatch_far(rt_screen *s, VkCommandBuffer cb, rt_pipelines *pl,
                             const VkDescriptorSet sets[2], unsigned variant, int *binds,
                             rt_error *e)
 {
-    rt_device *d = s->d;
     const rt_pack *p = s->p;
     int k = p->ncombos + 1, c = (variant & RT_CVARIANT_COUNT) != 0;
-    if (!s->far_pipe[c]) {
-        char *src = rt_far_glsl(p, c);
-        if (!src)
-            return rt_fail(e, RT_E_VULKAN, "far atlas shader", "no über compute GLSL");
-        bool ok = rt_vk_compute(d, &s->keep, &(rt_vk_compute_desc){ .label = "far.comp",
-                                    .glsl = src, .layout = s->layout, .cache = pl->cache },
-                                &s->far_pipe[c], e);
-        free(src);
-        if (!ok)
-            return false;
-    }
+    if (!far_pipeline(s, pl, c, e))
+        return false;
     VkDescriptorSet all[3] = { sets[0], sets[1], s->set };
     vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, s->layout, 0, 3, all, 0, NULL);
     vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, s->far_pipe[c]);
@@ -902,6 +951,12 @@ void rt_screen_read_stats(const rt_screen *s, rt_screen_stats *st)
         st->lists += args[3 * k] > 0;
         if (s->stand_in[k])
             st->tiles_stand_in += (int)args[3 * k];
+        if (s->stand_in[k] == RT_STAND_UBER)
+            st->tiles_stand_in_uber += (int)args[3 * k];
+        else if (s->stand_in[k] == RT_STAND_ATLAS)
+            st->tiles_stand_in_atlas += (int)args[3 * k];
+        else if (s->stand_in[k] == RT_STAND_FLAT)
+            st->tiles_stand_in_flat += (int)args[3 * k];
         if (k >= s->p->nbase && k < s->p->ncombos)
             st->tiles_class += (int)args[3 * k];
     }

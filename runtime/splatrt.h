@@ -282,9 +282,14 @@ typedef struct rt_screen_stats {
     int      tiles_uber;          /* tiles no combination covered            */
     int      tiles_far;           /* tiles shaded from the far atlas         */
     int      tiles_class;         /* tiles shaded by a distance class        */
-    int      tiles_stand_in;      /* tiles the über-shader shaded while their
+    int      tiles_stand_in;      /* tiles a stand-in shaded while their
                                      combination's pipeline was being made
-                                     (rt_render_desc.async_pipelines)       */
+                                     (rt_render_desc.async_pipelines): the
+                                     sum of the three below                 */
+    int      tiles_stand_in_uber; /* ... by the über-shader                  */
+    int      tiles_stand_in_atlas;/* ... from the far atlas                  */
+    int      tiles_stand_in_flat; /* ... by the flat stand-in (lit terrain,
+                                     one neutral albedo)                    */
     int      lists;               /* combinations (and über) with tiles      */
     /* The classification's view (issue 29): the combinations its cover
      * search tries, the materials in view and the mask words per set. */
@@ -412,7 +417,16 @@ typedef struct rt_frame_stats {
                                  for; 0: none needed                        */
     bool   shadow_gpu;        /* the map is marched on the device          */
     rt_ug_stats undergrowth;  /* cells, instances, generation and draw     */
+    double first_picture_s;   /* seconds from the process's launch to the
+                                 end of this renderer's first complete frame
+                                 (rt_seconds_since_launch); the same in
+                                 every later frame's stats                  */
 } rt_frame_stats;
+
+/* Seconds since this process was launched (its start time in
+ * /proc/self/stat, 10 ms steps; where that cannot be read, since the first
+ * call: call it first thing in main). */
+double rt_seconds_since_launch(void);
 
 typedef struct rt_renderer rt_renderer;
 
@@ -475,6 +489,10 @@ bool rt_renderer_set_param(rt_renderer *r, const char *name,
 /* Render one frame offscreen and wait for it. */
 bool rt_renderer_frame(rt_renderer *r, const rt_camera *c,
                        rt_frame_stats *st, rt_error *e);
+/* With async pipelines: until the workers have made every pipeline asked
+ * for so far (the next frame draws no stand-in for those lists); false,
+ * *e set, where one failed. */
+bool rt_renderer_wait_pipelines(rt_renderer *r, rt_error *e);
 /* The last frame's colour as RGBA32F, top row first (w * h * 4 floats). */
 bool rt_renderer_read(rt_renderer *r, float *rgba, rt_error *e);
 /* The last frame's plan (runtime/render_plan.c): its passes in order, what

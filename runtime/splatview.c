@@ -54,6 +54,7 @@ typedef struct opts {
     bool headless, stats, have_camera, have_look, no_stitch, no_cull, no_shadows;
     bool no_undergrowth;
     bool no_distance_classes;
+    bool wait_pipelines;   /* --wait-pipelines */
     bool check;            /* --check: load and set up, draw nothing       */
     bool print_plan;       /* --print-plan: the last frame's passes        */
     int async_pipelines;   /* --async-pipelines: 1 on, 0 off, -1 default */
@@ -286,10 +287,16 @@ static const splat_arg options[] = {
       "über-shader, to compare against", F(ref), .choices = "multipass|uber",
       .values = reference_values },
     { "--async-pipelines", SPLAT_ARG_ENUM, NULL, "the screen path: make shading pipelines "
-      "on worker threads while the über-shader draws their tiles, where making it costs less "
-      "than making them (default on in the window, off headless, which waits for them; on: "
-      "the quick first picture); the title and --stats say how many are pending",
+      "on worker threads while a stand-in draws their tiles: the far atlas where the pack has "
+      "one (on a GPU), else a flat lit terrain, or the über-shader once it is made (SPLAT_STAND_IN="
+      "auto|always|uber|never|atlas|flat forces one; default on in the window, off headless, "
+      "which waits for them; on: the quick first picture); the title and --stats say how many "
+      "are pending and which stand-in drew how many tiles",
       F(async_pipelines), .choices = "on|off", .values = on_off },
+    { "--wait-pipelines", SPLAT_ARG_FLAG, NULL, "headless, with --async-pipelines on: before "
+      "each frame after the first, wait until the workers have made the pipelines the frames "
+      "so far asked for (the first frame shows the stand-ins, SPLAT_STAND_IN picks them; the "
+      "next the final picture)", F(wait_pipelines) },
     { "--no-distance-classes", SPLAT_ARG_FLAG, NULL, "shade with the combinations only, not "
       "their distance classes (compiler/PACK.md)", F(no_distance_classes) },
     { "--uncovered", SPLAT_ARG_ENUM, NULL, "forward path: a coarse patch no compiled "
@@ -534,7 +541,8 @@ static bool run_frames(const opts *o, rt_renderer *r, const rt_camera *cam, fram
                        rt_frame_stats *st, rt_error *e)
 {
     for (int f = 0; f < o->frames; f++) {
-        if (!rt_renderer_frame(r, cam, st, e))
+        if ((f > 0 && o->wait_pipelines && !rt_renderer_wait_pipelines(r, e)) ||
+            !rt_renderer_frame(r, cam, st, e))
             return false;
         t->gpu[f] = st->gpu_ms;
         t->shadow_ms += st->shadow_ms;
@@ -671,8 +679,12 @@ static bool print_stats(const opts *o, rt_device *dev, const rt_pack *pack, rt_r
         printf("classification: %d candidates, %d materials in view, %d words per set\n",
                st->tiles.class_candidates, st->tiles.class_materials, st->tiles.class_words);
         printf("pipelines pending: %d (tiles the uber-shader stood in for: %d)\n",
-               st->pipelines_pending, st->tiles.tiles_stand_in);
+               st->pipelines_pending, st->tiles.tiles_stand_in_uber);
+        printf("stand-ins: %d tiles (uber-shader %d, far atlas %d, flat %d)\n",
+               st->tiles.tiles_stand_in, st->tiles.tiles_stand_in_uber,
+               st->tiles.tiles_stand_in_atlas, st->tiles.tiles_stand_in_flat);
     }
+    printf("first picture: %.3f s after launch\n", st->first_picture_s);
     printf("quadtree cpu ms/frame: median %.4f  p10 %.4f  p90 %.4f\n", sm, sl, sh);
     if (o->no_shadows)
         printf("shadow map: off\n");
@@ -928,6 +940,7 @@ static int window(const opts *o_)
 
 int main(int argc, char **argv)
 {
+    rt_seconds_since_launch();   /* the fallback's origin, where /proc is not read */
     opts o;
     int rc = parse_args(argc, argv, &o);
     if (rc)

@@ -17,7 +17,8 @@
  *
  * --script runs without a person: "frames=N" renders N frames,
  * "view=NAME", "key=K" acts as if K was pressed, "screenshot=FILE" writes
- * the swapchain image as the window shows it, "wait_reload=SECONDS" renders
+ * the swapchain image as the window shows it (after the pipelines being
+ * made on the workers: the final picture, not a stand-in's), "wait_reload=SECONDS" renders
  * until a hot reload succeeded (compile errors on the way are shown and
  * survived; the time running out fails the script), "quit" ends. */
 #include "rt_internal.h"
@@ -685,9 +686,13 @@ static bool frame(viewer *v, const char *shot, double *last, rt_error *e)
     static double shown;
     if (t - shown > 0.25) {
         shown = t;
-        char title[512], pending[48] = "";
-        if (st.pipelines_pending > 0)   /* their tiles on the über-shader meanwhile */
-            snprintf(pending, sizeof pending, " (%d shaders compiling)", st.pipelines_pending);
+        char title[640], pending[160] = "";
+        const rt_screen_stats *ts = &st.tiles;
+        if (st.pipelines_pending > 0 || ts->tiles_stand_in > 0)   /* stand-ins meanwhile */
+            snprintf(pending, sizeof pending,
+                     " (%d shaders compiling; stand-in tiles: %d uber, %d atlas, %d flat)",
+                     st.pipelines_pending, ts->tiles_stand_in_uber, ts->tiles_stand_in_atlas,
+                     ts->tiles_stand_in_flat);
         snprintf(title, sizeof title,
                  "splatview %s | %s%s | %s | %.1f ms/frame (gpu %.1f) | %d patches, %d pipelines%s | %s",
                  v->pack->name, rt_view_name(v->view), v->wire ? " wire" : "",
@@ -715,7 +720,9 @@ static bool script_step(viewer *v, const char *step, double *last, rt_error *e)
             if (!frame(v, NULL, last, e))
                 return false;
     } else if (!strcmp(key, "screenshot")) {
-        return frame(v, val, last, e);
+        /* the final picture: the pipelines the workers are making first
+         * (the stand-ins shade their tiles until then) */
+        return rt_renderer_wait_pipelines(v->r, e) && frame(v, val, last, e);
     } else if (!strcmp(key, "view")) {
         splat_view view;
         int m;

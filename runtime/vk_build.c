@@ -1,9 +1,11 @@
 /* vk_build.c — desc structs to Vulkan objects, and destroy lists
  * (vk_build.h).  Each maker fills the Vk*CreateInfo from the desc's
- * fields and defaults, creates, and records the handle in the list. */
+ * fields and defaults, creates, and records the handle in the list;
+ * pipelines within a batch are made together on every core. */
 #include "vk_build.h"
 
 #include <assert.h>
+#include <pthread.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -296,8 +298,215 @@ static bool make_gfx(rt_device *d, const rt_vk_gfx_desc *desc, VkShaderModule vs
     return r == VK_SUCCESS || failed(e, "vkCreateGraphicsPipelines", desc->label, r);
 }
 
+/* ---- batches: pipelines made together on every core -------------------- */
+
+typedef struct batch_job {
+    bool                 gfx;
+    rt_vk_gfx_desc       g;        /* deep copies: the strings and arrays below */
+    rt_vk_compute_desc   c;
+    rt_vk_list          *l;
+    VkPipeline          *out;
+    VkSpecializationInfo spec;
+    void                *own[6];   /* what the copies own                      */
+    rt_error             e;
+} batch_job;
+
+struct rt_vk_batch {
+    pthread_t  owner;
+    batch_job *jobs;
+    int        n, cap;
+};
+
+bool rt_vk_batch_begin(rt_device *d, rt_error *e)
+{
+    if (d->batch)
+        return rt_fail(e, RT_E_VULKAN, "pipeline batch", "already begun");
+    d->batch = calloc(1, sizeof *d->batch);
+    if (!d->batch)
+        return rt_fail(e, RT_E_VULKAN, "pipeline batch", "out of memory");
+    d->batch->owner = pthread_self();
+    return true;
+}
+
+static void *dup_bytes(const void *p, size_t n, bool *ok)
+{
+    if (!p || !n)
+        return NULL;
+    void *q = malloc(n);
+    if (!q) {
+        *ok = false;
+        return NULL;
+    }
+    memcpy(q, p, n);
+    return q;
+}
+
+static char *dup_str(const char *s, bool *ok)
+{
+    return s ? dup_bytes(s, strlen(s) + 1, ok) : NULL;
+}
+
+/* A copy of `sp` into j (entries and data owned in j->own[4..5]). */
+static const VkSpecializationInfo *dup_spec(batch_job *j, const VkSpecializationInfo *sp,
+                                            bool *ok)
+{
+    if (!sp)
+        return NULL;
+    j->spec = *sp;
+    j->spec.pMapEntries = j->own[4] =
+        dup_bytes(sp->pMapEntries, sp->mapEntryCount * sizeof *sp->pMapEntries, ok);
+    j->spec.pData = j->own[5] = dup_bytes(sp->pData, sp->dataSize, ok);
+    return &j->spec;
+}
+
+/* The job slot for a deferred pipeline, or NULL: no batch on this thread,
+ * or a desc that cannot wait (modules the caller destroys, a check). */
+static batch_job *batch_slot(rt_device *d, bool deferrable)
+{
+    struct rt_vk_batch *b = d->batch;
+    if (!b || !deferrable || !pthread_equal(b->owner, pthread_self()))
+        return NULL;
+    if (b->n == b->cap) {
+        int cap = b->cap ? 2 * b->cap : 16;
+        batch_job *v = realloc(b->jobs, (size_t)cap * sizeof *v);
+        if (!v)
+            return NULL;   /* made at once instead */
+        b->jobs = v;
+        b->cap = cap;
+    }
+    batch_job *j = &b->jobs[b->n];
+    memset(j, 0, sizeof *j);
+    return j;
+}
+
+static void job_free(batch_job *j)
+{
+    for (int i = 0; i < 6; i++)
+        free(j->own[i]);
+}
+
+static bool defer_gfx(rt_device *d, rt_vk_list *l, const rt_vk_gfx_desc *desc, VkPipeline *out)
+{
+    batch_job *j = batch_slot(d, !desc->vs && !desc->fs);
+    if (!j)
+        return false;
+    bool ok = true;
+    j->gfx = true;
+    j->g = *desc;
+    j->g.label = j->own[0] = dup_str(desc->label, &ok);
+    j->g.vs_glsl = j->own[1] = dup_str(desc->vs_glsl, &ok);
+    j->g.fs_glsl = j->own[2] = dup_str(desc->fs_glsl, &ok);
+    /* one block for the three arrays */
+    size_t nv = desc->nvbufs * sizeof *desc->vbufs, na = desc->nattrs * sizeof *desc->attrs;
+    size_t nb = desc->blend ? desc->ncolor * sizeof *desc->blend : 0;
+    char *arr = j->own[3] = nv + na + nb ? malloc(nv + na + nb) : NULL;
+    if (nv + na + nb && !arr)
+        ok = false;
+    if (arr) {
+        if (nv)
+            j->g.vbufs = memcpy(arr, desc->vbufs, nv);
+        if (na)
+            j->g.attrs = memcpy(arr + nv, desc->attrs, na);
+        if (nb)
+            j->g.blend = memcpy(arr + nv + na, desc->blend, nb);
+    }
+    j->g.fs_spec = dup_spec(j, desc->fs_spec, &ok);
+    if (!ok) {
+        job_free(j);
+        return false;   /* made at once instead */
+    }
+    j->l = l;
+    j->out = out;
+    *out = VK_NULL_HANDLE;
+    d->batch->n++;
+    return true;
+}
+
+static bool defer_compute(rt_device *d, rt_vk_list *l, const rt_vk_compute_desc *desc,
+                          VkPipeline *out)
+{
+    batch_job *j = batch_slot(d, !desc->module && !desc->check);
+    if (!j)
+        return false;
+    bool ok = true;
+    j->c = *desc;
+    j->c.label = j->own[0] = dup_str(desc->label, &ok);
+    j->c.glsl = j->own[1] = dup_str(desc->glsl, &ok);
+    j->c.spirv = j->own[2] = dup_bytes(desc->spirv, desc->nwords * 4, &ok);
+    j->c.spec = dup_spec(j, desc->spec, &ok);
+    if (!ok) {
+        job_free(j);
+        return false;
+    }
+    j->l = l;
+    j->out = out;
+    *out = VK_NULL_HANDLE;
+    d->batch->n++;
+    return true;
+}
+
+static bool gfx_now(rt_device *d, rt_vk_list *l, const rt_vk_gfx_desc *desc, VkPipeline *out,
+                    rt_error *e);
+static bool compute_now(rt_device *d, rt_vk_list *l, const rt_vk_compute_desc *desc,
+                        VkPipeline *out, rt_error *e);
+
+typedef struct batch_run {
+    rt_device *d;
+    batch_job *jobs;
+} batch_run;
+
+/* One job on a worker: the pipeline alone (its list is filled after). */
+static bool run_job(void *ctx, int k, rt_error *e)
+{
+    batch_run *r = ctx;
+    batch_job *j = &r->jobs[k];
+    return j->gfx ? gfx_now(r->d, NULL, &j->g, j->out, e)
+                  : compute_now(r->d, NULL, &j->c, j->out, e);
+}
+
+bool rt_vk_batch_end(rt_device *d, bool run, rt_error *e)
+{
+    struct rt_vk_batch *b = d->batch;
+    if (!b)
+        return true;
+    d->batch = NULL;
+    bool ok = true;
+    if (run && b->n > 0) {
+        batch_run r = { d, b->jobs };
+        ok = rt_parallel(b->n, run_job, &r, e);
+        /* every pipeline made goes to its list, also after a failure,
+         * so its owner destroys it */
+        for (int k = 0; k < b->n; k++) {
+            batch_job *j = &b->jobs[k];
+            if (*j->out && !rt_vk_keep(d, j->l, VK_OBJECT_TYPE_PIPELINE, RT_VK_H(*j->out),
+                                       ok ? e : &j->e)) {
+                *j->out = VK_NULL_HANDLE;
+                rt_error_clear(&j->e);
+                ok = false;
+            }
+        }
+    }
+    for (int k = 0; k < b->n; k++)
+        job_free(&b->jobs[k]);
+    free(b->jobs);
+    free(b);
+    return ok;
+}
+
 bool rt_vk_gfx(rt_device *d, rt_vk_list *l, const rt_vk_gfx_desc *desc, VkPipeline *out,
                rt_error *e)
+{
+    return defer_gfx(d, l, desc, out) || gfx_now(d, l, desc, out, e);
+}
+
+bool rt_vk_compute(rt_device *d, rt_vk_list *l, const rt_vk_compute_desc *desc, VkPipeline *out,
+                   rt_error *e)
+{
+    return defer_compute(d, l, desc, out) || compute_now(d, l, desc, out, e);
+}
+
+static bool gfx_now(rt_device *d, rt_vk_list *l, const rt_vk_gfx_desc *desc, VkPipeline *out,
+                    rt_error *e)
 {
     VkShaderModule vs, fs, own_vs = VK_NULL_HANDLE, own_fs = VK_NULL_HANDLE;
     bool ok = stage_module(d, desc->vs, desc->vs_glsl, VK_SHADER_STAGE_VERTEX_BIT, desc->label,
@@ -313,8 +522,8 @@ bool rt_vk_gfx(rt_device *d, rt_vk_list *l, const rt_vk_gfx_desc *desc, VkPipeli
     return ok;
 }
 
-bool rt_vk_compute(rt_device *d, rt_vk_list *l, const rt_vk_compute_desc *desc, VkPipeline *out,
-                   rt_error *e)
+static bool compute_now(rt_device *d, rt_vk_list *l, const rt_vk_compute_desc *desc,
+                        VkPipeline *out, rt_error *e)
 {
     VkShaderModule m = desc->module, own = VK_NULL_HANDLE;
     if (!m && desc->spirv) {

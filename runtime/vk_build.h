@@ -167,6 +167,18 @@ typedef struct rt_vk_compute_desc {
 bool rt_vk_compute(rt_device *d, rt_vk_list *l, const rt_vk_compute_desc *desc, VkPipeline *out,
                    rt_error *e);
 
+/* A batch: between rt_vk_batch_begin and rt_vk_batch_end, on the thread
+ * that began it, rt_vk_gfx and rt_vk_compute of shaders given as GLSL or
+ * SPIR-V words (not as modules, nor with an interface check) only record
+ * what to make (the desc deep-copied) and return true; rt_vk_batch_end
+ * makes them all at once on every core (rt_parallel: glslang, spirv-val
+ * and the driver's compiler per pipeline), fills each *out and keeps it in
+ * its list, the first failure in *e.  The caller uses none of those
+ * handles before the end, and the structs they are written into stay put.
+ * `run` false drops what is recorded (a create that failed before). */
+bool rt_vk_batch_begin(rt_device *d, rt_error *e);
+bool rt_vk_batch_end(rt_device *d, bool run, rt_error *e);
+
 /* ---- descriptor sets --------------------------------------------------- */
 
 /* A pool of exactly these sizes holding one set of each layout. */

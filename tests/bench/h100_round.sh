@@ -52,7 +52,7 @@ has shadow && { timeout 120 $SB shadow --pack $col --runs 5 > $O/shadow.log 2>&1
 if has first; then
     for pk in colorado w256; do
         [ -d $P/$pk ] || continue
-        KINDS="screen screen,async" timeout 240 bash tests/bench/first_picture.sh $SB $P/$pk 1920x1080 $pk topdown
+        KINDS="screen screen,async screen,async+uber" timeout 300 bash tests/bench/first_picture.sh $SB $P/$pk 1920x1080 $pk topdown
     done > $O/first.txt 2>&1
 fi
 exit 0

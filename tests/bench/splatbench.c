@@ -56,7 +56,12 @@
  *       combinations only (--no-distance-classes; PACK.md "Distance
  *       classes"), distclass=1 (the default) with their distance classes;
  *       async (screen kinds) makes compute pipelines on worker threads,
- *       the über-shader shading their tiles meanwhile (first pictures);
+ *       a stand-in shading their tiles meanwhile (first pictures; the far
+ *       atlas, the flat stand-in or the über-shader: $SPLAT_STAND_IN,
+ *       rt_pipelines_stand_in; the columns stand_in_uber, _atlas, _flat
+ *       count the last timed frame's tiles each drew, first_picture_s the
+ *       seconds from the process's launch to the variant's first complete
+ *       frame);
  *       sort=on|off (screen kinds) sorts each workgroup's pixels by the
  *       layers they need before shading (rt_pixel_sort; default off),
  *       sort=N on with N tiles per workgroup (4, 8 or 16; on: the most
@@ -135,6 +140,9 @@ typedef struct variant {
     double      *proc;      /* process CPU ms of each frame (all threads)   */
     double      *pass[3];   /* screen: geometry, classification, shading */
     rt_screen_stats tiles;  /* screen: the last frame's tiles (counted)  */
+    double       first_picture_s; /* launch to its first complete frame   */
+    int          stand_in[3];     /* the last timed frame's stand-in tiles:
+                                     über-shader, far atlas, flat         */
     int          patches, pipelines;
     err_acc      err;
     double       rss_delta;
@@ -657,6 +665,8 @@ static bool make_renderer(bench_run *b, int i, const char *cache, rt_error *e)
             !rt_renderer_frame(v->r, &cam, &st, e))
             return false;
         v->shadow_ms += st.shadow_ms;
+        if (v->first_picture_s <= 0)
+            v->first_picture_s = st.first_picture_s;
     }
     v->rss_delta = rss_mb() - before;
     return true;
@@ -690,6 +700,11 @@ static bool timed_frame(bench_run *b, int f, rt_error *e)
         v->ug_last = st.undergrowth;
         v->patches = st.patches;
         v->pipelines = st.pipelines;
+        if (v->first_picture_s <= 0)
+            v->first_picture_s = st.first_picture_s;
+        v->stand_in[0] = st.tiles.tiles_stand_in_uber;
+        v->stand_in[1] = st.tiles.tiles_stand_in_atlas;
+        v->stand_in[2] = st.tiles.tiles_stand_in_flat;
         if (!rt_renderer_read(v->r, img, e))
             return false;
         err_add(&v->err, img, b->refimg, b->npx);
@@ -752,7 +767,7 @@ static void csv_row(FILE *out, const bench_run *b, int i, const char *devname)
     const char *pk = strrchr(v->pack_dir, '/');
     fprintf(out, "\"%s\",%s,%s,%d,%d,%s,%s,%s,%g,%d,%.3f,%.3f,%.3f,%.3f,%.4f,%d,%d,"
                  "%.6g,%.6g,%.2f,%ld,%.1f,%s,%s,%.3f,%.3f,%.3f,%d,%d,%.4f,%.4f,%.3f,%.1f,"
-                 "%.2f,%.4f,%.4f,%.4f,%.2f,%ld,%zu,%g,%d,%d,%d,%.3f,%ld,%ld,%ld,%d\n",
+                 "%.2f,%.4f,%.4f,%.4f,%.2f,%ld,%zu,%g,%d,%d,%d,%.3f,%ld,%ld,%ld,%d,%.3f,%d,%d,%d\n",
             devname, o->scene ? o->scene : v->base->name, o->pd.name, o->width, o->height,
             v->label, kind_names[v->k], pk ? pk + 1 : v->pack_dir,
             v->lod > 0 ? v->lod : 3.0, frames, gm, g10, g90, cm, sm,
@@ -767,7 +782,7 @@ static void csv_row(FILE *out, const bench_run *b, int i, const char *devname)
             ugd, (double)v->ug_cells / frames, v->ug_last.instances,
             v->ug_last.bytes_per_cell, v->far, v->tiles.tiles_far, !v->no_dclass,
             v->tiles.tiles_class, procm, v->ug_last.candidates, v->ug_last.drawn, v->ug_last.triangles,
-            v->ug_last.draws);
+            v->ug_last.draws, v->first_picture_s, v->stand_in[0], v->stand_in[1], v->stand_in[2]);
 }
 
 /* The rows, on stdout or appended to --csv (a header when it is new). */
@@ -793,7 +808,8 @@ static bool write_csv(const bench_run *b)
                      "layers_needed,samples_per_px,branches_uniform_pct,shadow_map_ms,"
                      "ug_gen_med_ms,ug_gen_ms_per_cell,ug_draw_med_ms,ug_cells_per_frame,"
                      "ug_instances,ug_bytes_per_cell,far_distance,tiles_far,distclass,tiles_class,"
-                     "proc_cpu_med_ms,ug_candidates,ug_drawn,ug_triangles,ug_draws\n");
+                     "proc_cpu_med_ms,ug_candidates,ug_drawn,ug_triangles,ug_draws,first_picture_s,"
+                     "stand_in_uber,stand_in_atlas,stand_in_flat\n");
     /* the device name in CSV: its commas become ';' */
     char devname[VK_MAX_PHYSICAL_DEVICE_NAME_SIZE];
     snprintf(devname, sizeof devname, "%s", b->dev.props.deviceName);
@@ -879,6 +895,7 @@ static const struct {
 
 int main(int argc, char **argv)
 {
+    rt_seconds_since_launch();   /* the fallback's origin, where /proc is not read */
     for (size_t i = 0; argc >= 2 && i < sizeof commands / sizeof commands[0]; i++)
         if (!strcmp(argv[1], commands[i].name))
             return commands[i].run(argc, argv);

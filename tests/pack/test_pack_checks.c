@@ -9,9 +9,13 @@
  *   Shaders read on first use (pack_shaders.c): loading reads none of
  *     them; rt_pack_spirv reads one, the same words as the file, once
  *     (from two threads at once); rt_pack_validate reads the rest.
- *   rt_pipelines_stand_in: with async pipelines the über-shader stands
- *     in for lists whose modules together outweigh it, not for one
- *     smaller composite; SPLAT_STAND_IN forces either.
+ *   rt_pipelines_stand_in: with async pipelines, before the frame the
+ *     far atlas stands in where there is one, else the flat stand-in (the
+ *     über-shader is not made for the first picture); SPLAT_STAND_IN=uber
+ *     keeps the über-shader against the composites by their modules'
+ *     bytes (it stands in for lists whose modules together outweigh it,
+ *     not for one smaller composite); always, never, atlas and flat force
+ *     one.
  *
  *   test_pack_checks MINIMAL_PACK DESTRUCTION_PACK COMPUTE_PACK
  *   (all by splatc build)
@@ -296,17 +300,43 @@ static void test_stand_in(void **state)
             small = k, one = s;
     }
     assert_true(small >= 0 && uber > 0);
-    assert_false(rt_pipelines_stand_in(&d, &p, &pl, ids, n, 0));   /* no workers */
+    /* no workers: nothing stands in, before or after the frame */
+    assert_int_equal(rt_pipelines_stand_in(&d, &p, &pl, NULL, 0, 0, true), RT_STAND_NONE);
+    assert_int_equal(rt_pipelines_stand_in(&d, &p, &pl, ids, n, 0, false), RT_STAND_NONE);
     pl.async = (struct rt_async *)&pl;   /* only tested against NULL here */
     unsetenv("SPLAT_STAND_IN");
-    assert_false(rt_pipelines_stand_in(&d, &p, &pl, &small, 1, 0));
-    assert_int_equal(rt_pipelines_stand_in(&d, &p, &pl, ids, n, 0), uber < sum);
+    /* the default: before the frame the atlas (on a GPU: a CPU device
+     * decodes its BC blocks per sample) or the flat stand-in, so the
+     * lists are never left for after it */
+    assert_int_equal(rt_pipelines_stand_in(&d, &p, &pl, NULL, 0, 0, true), RT_STAND_FLAT);
+    assert_int_equal(rt_pipelines_stand_in(&d, &p, &pl, NULL, 0, 0, false), RT_STAND_FLAT);
+    d.props.deviceType = VK_PHYSICAL_DEVICE_TYPE_DISCRETE_GPU;
+    assert_int_equal(rt_pipelines_stand_in(&d, &p, &pl, NULL, 0, 0, true), RT_STAND_ATLAS);
+    assert_int_equal(rt_pipelines_stand_in(&d, &p, &pl, NULL, 0, 0, false), RT_STAND_FLAT);
+    d.props.deviceType = VK_PHYSICAL_DEVICE_TYPE_CPU;
+    assert_int_equal(rt_pipelines_stand_in(&d, &p, &pl, ids, n, 0, false), RT_STAND_NONE);
+    setenv("SPLAT_STAND_IN", "auto", 1);
+    assert_int_equal(rt_pipelines_stand_in(&d, &p, &pl, NULL, 0, 0, false), RT_STAND_FLAT);
+    /* uber: nothing before the frame, then by the modules' bytes */
+    setenv("SPLAT_STAND_IN", "uber", 1);
+    assert_int_equal(rt_pipelines_stand_in(&d, &p, &pl, NULL, 0, 0, true), RT_STAND_NONE);
+    assert_int_equal(rt_pipelines_stand_in(&d, &p, &pl, &small, 1, 0, false), RT_STAND_NONE);
+    assert_int_equal(rt_pipelines_stand_in(&d, &p, &pl, ids, n, 0, false),
+                     uber < sum ? RT_STAND_UBER : RT_STAND_NONE);
     printf("  über-shader %zu bytes; combination %d %zu; all %d %zu: stands in %s\n", uber,
            small, one, n, sum, uber < sum ? "for all" : "for none");
     setenv("SPLAT_STAND_IN", "always", 1);
-    assert_true(rt_pipelines_stand_in(&d, &p, &pl, &small, 1, 0));
+    assert_int_equal(rt_pipelines_stand_in(&d, &p, &pl, NULL, 0, 0, true), RT_STAND_NONE);
+    assert_int_equal(rt_pipelines_stand_in(&d, &p, &pl, &small, 1, 0, false), RT_STAND_UBER);
     setenv("SPLAT_STAND_IN", "never", 1);
-    assert_false(rt_pipelines_stand_in(&d, &p, &pl, ids, n, 0));
+    assert_int_equal(rt_pipelines_stand_in(&d, &p, &pl, NULL, 0, 0, true), RT_STAND_NONE);
+    assert_int_equal(rt_pipelines_stand_in(&d, &p, &pl, ids, n, 0, false), RT_STAND_NONE);
+    setenv("SPLAT_STAND_IN", "atlas", 1);
+    assert_int_equal(rt_pipelines_stand_in(&d, &p, &pl, NULL, 0, 0, true), RT_STAND_ATLAS);
+    assert_int_equal(rt_pipelines_stand_in(&d, &p, &pl, NULL, 0, 0, false), RT_STAND_FLAT);
+    setenv("SPLAT_STAND_IN", "flat", 1);
+    assert_int_equal(rt_pipelines_stand_in(&d, &p, &pl, NULL, 0, 0, true), RT_STAND_FLAT);
+    assert_int_equal(rt_pipelines_stand_in(&d, &p, &pl, ids, n, 0, false), RT_STAND_NONE);
     unsetenv("SPLAT_STAND_IN");
     pl.async = NULL;
     rt_pack_free(&p);

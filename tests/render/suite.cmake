@@ -151,6 +151,14 @@ if(TARGET splatrt AND TARGET splatview)
               ${RENDER_OUT}/out ${RENDER_OUT}/minimal_glsl)
     set_tests_properties(render.spirv_cache PROPERTIES LABELS "render;asan" TIMEOUT 300
       FIXTURES_REQUIRED "minimal_pack;minimal_glsl_pack")
+    # the flat and far-atlas stand-ins of async pipelines: the first
+    # picture without the über-shader, the final one equal to the
+    # synchronous picture once the pipelines land (stand_in.sh)
+    add_test(NAME render.stand_in
+      COMMAND sh ${RENDER_DIR}/stand_in.sh $<TARGET_FILE:splatc_cli> $<TARGET_FILE:splatview>
+              $<TARGET_FILE:imgcheck> ${PROJECT_SOURCE_DIR} ${RENDER_OUT}/out)
+    set_tests_properties(render.stand_in PROPERTIES LABELS "render;asan" TIMEOUT 900
+      ENVIRONMENT "SPLAT_VALIDATE=1")
     # SPLAT_VALIDATE=1 without the validation layer: a loud failure
     add_test(NAME render.no_validation_layer
       COMMAND sh ${RENDER_DIR}/no_layer.sh $<TARGET_FILE:splatview> ${RENDER_OUT}/minimal
