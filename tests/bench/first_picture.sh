@@ -7,7 +7,9 @@
 #   LABEL PATH KIND cold|warm SECONDS
 # KINDS (default "screen screen,async composite") picks splatbench kinds;
 # screen,async is the first picture with the über-shader standing in for
-# pipelines still being made.
+# pipelines still being made.  FP_ARGS (default none): more splatbench
+# render arguments, e.g. FP_ARGS="--start-preset overview" with PATH preset
+# (a camera preset of the pack, the view splatview's first picture shows).
 set -u
 SB=$1 PACK=$2 SIZE=$3 LABEL=$4 P=${5:-topdown}
 TMP=$(mktemp -d)
@@ -20,7 +22,7 @@ for kind in ${KINDS:-screen screen,async composite}; do
         t=$( { time SPLATC_CACHE="$TMP/c/spv" SPLAT_PIPELINE_CACHE="$TMP/c/pipelines.bin" \
                  MESA_SHADER_CACHE_DIR="$TMP/c/mesa" __GL_SHADER_DISK_CACHE_PATH="$TMP/c/nv" \
                  "$SB" render --pack "$PACK" --variant "x=$kind" --path "$P" --frames 1 \
-                 --warmup 0 --size "$SIZE" --csv "$TMP/r.csv" > "$TMP/log" 2>&1; } 2>&1 ) ||
+                 --warmup 0 ${FP_ARGS:-} --size "$SIZE" --csv "$TMP/r.csv" > "$TMP/log" 2>&1; } 2>&1 ) ||
             { cat "$TMP/log"; echo "$LABEL $P $kind $run FAILED"; continue; }
         echo "$LABEL $P $kind $run $t"
     done
