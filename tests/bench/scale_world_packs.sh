@@ -4,7 +4,7 @@
 # tests/bench/scale_world_gpu.sh.
 #
 #   sh tests/bench/scale_world_packs.sh BUILD_DIR DEST [--counts "8 32 ..."]
-#       [--hf N] [--xz FILE]
+#       [--hf N] [--xz FILE] [--no-build]
 #
 # Per material count M (default 8 32 64 128 256, each a multiple of 8): the
 # world scale_world.sh measures (gen_world --textures M/8 8 HF 16, HF
@@ -12,9 +12,12 @@
 # --xz FILE: then one archive of them as packs/wM, its shader files
 # decompressed first (zstd -d, the manifest's ".zst" names edited to
 # match: xz finds more across plain SPIR-V and GLSL than inside zstd
-# frames), `tar cf - packs | xz -6e --lzma2=dict=256MiB -T2`, written
+# frames), `tar cf - packs | xz -6e --lzma2=dict=256MiB -T2` (tar sorted,
+# mtimes 0: the same packs give the same bytes), written
 # atomically; unpack it on the device with
 #   tar -C build-h100 -xJf FILE      # build-h100/packs/wM
+# --no-build: DEST's wM as they are (scale_world.sh --packs DEST's copies
+# of its cold packs) go into the archive, nothing is built.
 # Prints each pack's size and the archive's.  DEST is replaced world by
 # world (only the wM this run builds).
 set -eu
@@ -25,12 +28,13 @@ fi
 B=$(cd "$1" && pwd)
 D=$2
 shift 2
-COUNTS="8 32 64 128 256" HF=1024 XZ=""
+COUNTS="8 32 64 128 256" HF=1024 XZ="" BUILD=yes
 while [ $# -gt 0 ]; do
     case $1 in
     --counts) COUNTS=$2; shift ;;
     --hf) HF=$2; shift ;;
     --xz) XZ=$2; shift ;;
+    --no-build) BUILD=no ;;
     *) echo "scale_world_packs.sh: unknown option '$1'" >&2; exit 2 ;;
     esac
     shift
@@ -52,6 +56,11 @@ T=$(mktemp -d)
 trap 'rm -rf "$T"' EXIT
 cd "$REPO"   # the scenes import nodes/ from the project root
 for M in $COUNTS; do
+    if [ "$BUILD" = no ]; then
+        [ -f "$D/w$M/manifest.json" ] || { echo "scale_world_packs.sh: no pack $D/w$M" >&2; exit 1; }
+        du -sb "$D/w$M" | awk -v m="$M" '{ printf "w%s\t%.1f MB\n", m, $1 / 1e6 }'
+        continue
+    fi
     NB=$((M / 8))
     [ $((NB * 8)) -eq "$M" ] && [ "$NB" -ge 1 ] ||
         { echo "scale_world_packs.sh: $M materials is not a multiple of 8" >&2; exit 2; }
@@ -72,7 +81,7 @@ if [ -n "$XZ" ]; then
         sed -i 's/\.zst"/"/g' "$T/packs/w$M/manifest.json"
     done
     echo "[scale_world_packs] xz -6e (plain shaders: $(du -sb "$T/packs" | awk '{ printf "%.1f MB", $1 / 1e6 }'))" >&2
-    (cd "$T" && tar cf - packs | xz -6e --lzma2=dict=256MiB -T2) > "$XZ.tmp"
+    (cd "$T" && tar --sort=name --mtime=@0 --owner=0 --group=0 --numeric-owner -cf - packs | xz -6e --lzma2=dict=256MiB -T2) > "$XZ.tmp"
     mv "$XZ.tmp" "$XZ"
     du -b "$XZ" | awk '{ printf "archive\t%.1f MB\n", $1 / 1e6 }'
 fi
