@@ -38,8 +38,8 @@
 #                  held still: --path preset), the screen path and the
 #                  forward path (kind composite) as two variants of one run,
 #                  frames interleaved, after --steady-warmup untimed frames
-#                  (default 1: lavapipe JIT-compiles inside the first frame;
-#                  --smoke 0) --steady-frames timed frames (default 3,
+#                  (default 1: lavapipe JIT-compiles inside the first frame)
+#                  --steady-frames timed frames (default 3,
 #                  --smoke 1; 0 skips): GPU ms
 #                  per frame (timestamp median), layers evaluated and layers
 #                  needed per pixel and texture samples per pixel (the
@@ -87,7 +87,7 @@ while [ $# -gt 0 ]; do
     shift
 done
 if [ "$MODE" = smoke ]; then
-    : "${COUNTS:=8 16}" "${SIZE:=320x180}" "${HF:=256}" "${SFRAMES:=1}" "${SWARM:=0}"
+    : "${COUNTS:=8 16}" "${SIZE:=320x180}" "${HF:=256}" "${SFRAMES:=1}" "${SWARM:=1}"
 else
     : "${COUNTS:=8 32 64 128 256}" "${SIZE:=1280x720}" "${HF:=1024}" "${SFRAMES:=3}" "${SWARM:=1}"
 fi
