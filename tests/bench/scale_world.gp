@@ -91,6 +91,7 @@ unset logscale y
 set title "steady frame: work per pixel (forward: per fragment)"
 set ylabel "per pixel"
 set yrange [0:*]
+set key inside bottom right
 plot "scale_world.tsv" skip 1 using 1:27 with linespoints lw 2 pt 7 title "screen layers evaluated", \
      "" skip 1 using 1:28 with linespoints lw 1 dt 2 pt 6 title "screen layers needed", \
      "" skip 1 using 1:29 with linespoints lw 2 pt 5 title "screen samples", \
@@ -98,6 +99,7 @@ plot "scale_world.tsv" skip 1 using 1:27 with linespoints lw 2 pt 7 title "scree
      "" skip 1 using 1:33 with linespoints lw 1 dt 2 pt 8 title "forward layers needed", \
      "" skip 1 using 1:34 with linespoints lw 2 pt 11 title "forward samples"
 
+set key inside top left
 set title "first picture, H100 1920x1080 (splatbench, process wall time)"
 set ylabel "seconds"
 if (gpu) {

@@ -7,7 +7,7 @@
 #   sh tests/bench/scale_world.sh BUILD_DIR [--smoke] [--out DIR]
 #       [--counts "8 32 ..."] [--reps N] [--size WxH] [--hf N]
 #       [--view-timeout S] [--no-view] [--keep-work] [--packs DIR]
-#       [--steady-frames N] [--steady-warmup N]
+#       [--steady-frames N] [--steady-warmup N] [--steady-timeout S]
 #
 # Per material count (a multiple of 8):
 #   combinations   the leaf cells' combinations and the pipelines built,
@@ -44,7 +44,11 @@
 #                  per frame (timestamp median), layers evaluated and layers
 #                  needed per pixel and texture samples per pixel (the
 #                  counting frame's; forward: per fragment shaded), the
-#                  über-shader's screen tiles, and splatbench's peak RSS.
+#                  über-shader's screen tiles, and splatbench's peak RSS;
+#                  a run past --steady-timeout (default 2700 s: at 256
+#                  materials on this machine at load 10 it took over 900 s,
+#                  mostly making 291 compute and 291 forward pipelines) is
+#                  written as NA.
 # --reps N repeats every build and picture N times (default 1) and reports
 # medians (the steady frame runs once: its figures are already medians of
 # frames).  --no-view: builds only (the picture and steady columns NA).
@@ -67,7 +71,7 @@ fi
 B=$(cd "$1" && pwd)
 shift
 MODE=full OUT=out/bench COUNTS="" REPS=1 SIZE="" HF="" VT=900 KEEP=no NOVIEW=no PACKS=""
-SFRAMES="" SWARM=""
+SFRAMES="" SWARM="" STO=2700
 while [ $# -gt 0 ]; do
     case $1 in
     --smoke) MODE=smoke ;;
@@ -82,6 +86,7 @@ while [ $# -gt 0 ]; do
     --packs) PACKS=$2; shift ;;
     --steady-frames) SFRAMES=$2; shift ;;
     --steady-warmup) SWARM=$2; shift ;;
+    --steady-timeout) STO=$2; shift ;;
     *) echo "scale_world.sh: unknown option '$1'" >&2; exit 2 ;;
     esac
     shift
@@ -264,7 +269,7 @@ for M in $COUNTS; do
         mkdir -p "$c"
         rm -f "$D/steady.csv"
         res=$(measure "$D/steady.log" env MESA_SHADER_CACHE_DIR="$c/mesa" \
-            SPLAT_PIPELINE_CACHE="$c/pipelines.bin" timeout "$VT" "$SB" render \
+            SPLAT_PIPELINE_CACHE="$c/pipelines.bin" timeout "$STO" "$SB" render \
             --pack "$D/pack" --scene "w$M" --path preset --start-preset overview \
             --variant screen=screen --variant forward=composite --frames "$SFRAMES" \
             --warmup "$SWARM" --size "$SIZE" --csv "$D/steady.csv")
