@@ -18,6 +18,9 @@
 #   screen,async+uber  the über-shader standing in where making it costs
 #                      less than the lists' composites (the stand-in
 #                      before the flat one: the figures before it)
+# FP_ARGS (default none): more splatbench render arguments, e.g.
+# FP_ARGS="--start-preset overview" with PATH preset (a camera preset of
+# the pack, the view splatview's first picture shows).
 set -u
 SB=$1 PACK=$2 SIZE=$3 LABEL=$4 P=${5:-topdown}
 TMP=$(mktemp -d)
@@ -35,7 +38,7 @@ for entry in ${KINDS:-screen screen,async screen,async+uber composite}; do
                  SPLAT_PIPELINE_CACHE="$TMP/c/pipelines.bin" \
                  MESA_SHADER_CACHE_DIR="$TMP/c/mesa" __GL_SHADER_DISK_CACHE_PATH="$TMP/c/nv" \
                  "$SB" render --pack "$PACK" --variant "x=$kind" --path "$P" --frames 1 \
-                 --warmup 0 --size "$SIZE" --csv "$TMP/r.csv" > "$TMP/log" 2>&1; } 2>&1 ) ||
+                 --warmup 0 ${FP_ARGS:-} --size "$SIZE" --csv "$TMP/r.csv" > "$TMP/log" 2>&1; } 2>&1 ) ||
             { cat "$TMP/log"; echo "$LABEL $P $entry $run FAILED"; continue; }
         first=$(awk -F, 'NR == 1 { for (i = 1; i <= NF; i++) if ($i == "first_picture_s") c = i }
                          NR == 2 && c { print $c }' "$TMP/r.csv")

@@ -27,9 +27,11 @@
 # The group scale_world (tests/bench/scale_world.sh: gen_world's textured
 # worlds of 8, 32, 64, 128 and 256 materials, one table: combinations,
 # largest composite, cold and one-material-edit builds, pack, first picture
-# on both paths, peak memory; scale_world.tsv, scale_world.md,
-# scale_world.png) runs last, scaled down to 8 and 16 materials in --smoke;
-# --only scale_world runs it alone (tens of minutes on lavapipe at 256).
+# on both paths, steady GPU ms and layers and samples per pixel on the same
+# camera, peak memory; scale_world.tsv, scale_world.md, scale_world.png)
+# runs last, scaled down to 8 and 16 materials in --smoke; --only
+# scale_world runs it alone (40 minutes and more on lavapipe; its H100
+# columns: tests/bench/scale_world_gpu.sh).
 # --only look: the group `look` alone (colorado's look additions on and
 # off, render.csv; about 15 minutes on lavapipe with --frames 2).
 set -eu

@@ -6,7 +6,8 @@
 #
 #   sh tests/bench/scale_world.sh BUILD_DIR [--smoke] [--out DIR]
 #       [--counts "8 32 ..."] [--reps N] [--size WxH] [--hf N]
-#       [--view-timeout S] [--no-view] [--keep-work]
+#       [--view-timeout S] [--no-view] [--keep-work] [--packs DIR]
+#       [--steady-frames N] [--steady-warmup N] [--steady-timeout S]
 #
 # Per material count (a multiple of 8):
 #   combinations   the leaf cells' combinations and the pipelines built,
@@ -31,14 +32,34 @@
 #                  cache, and the screen path again with the caches its
 #                  first run left (warm); a run past --view-timeout (default 900 s) is
 #                  written as "timeout"; peak RSS of the viewer (the largest
-#                  of its runs).
+#                  of its runs);
+#   steady frame   tests/splatbench render on the same pack and camera (the
+#                  scene's 'overview' preset, splatview's first picture's,
+#                  held still: --path preset), the screen path and the
+#                  forward path (kind composite) as two variants of one run,
+#                  frames interleaved, after --steady-warmup untimed frames
+#                  (default 1: lavapipe JIT-compiles inside the first frame)
+#                  --steady-frames timed frames (default 3,
+#                  --smoke 1; 0 skips): GPU ms
+#                  per frame (timestamp median), layers evaluated and layers
+#                  needed per pixel and texture samples per pixel (the
+#                  counting frame's; forward: per fragment shaded), the
+#                  über-shader's screen tiles, and splatbench's peak RSS;
+#                  a run past --steady-timeout (default 2700 s: at 256
+#                  materials on this machine at load 10 it took over 900 s,
+#                  mostly making 291 compute and 291 forward pipelines) is
+#                  written as NA.
 # --reps N repeats every build and picture N times (default 1) and reports
-# medians.  --no-view: builds only (the picture columns NA).  --smoke: 8 and 16 materials on a 256^2 heightfield, pictures at
+# medians (the steady frame runs once: its figures are already medians of
+# frames).  --no-view: builds only (the picture and steady columns NA).
+# --packs DIR: a copy of each cold-built pack as DIR/wM (M the material
+# count; what tests/bench/scale_world_gpu.sh renders on the H100).  --smoke: 8 and 16 materials on a 256^2 heightfield, pictures at
 # 320x180 (bench.smoke, a minute or two).
 #
 # Writes OUT/scale_world.tsv (one row per material count), OUT/scale_world.md
 # (the same as a Markdown table) and, with gnuplot, OUT/scale_world.png
-# (tests/bench/scale_world.gp).  Nothing is asserted: figures only (the
+# (tests/bench/scale_world.gp; it adds the H100's figures when
+# OUT/scale_world_gpu.tsv is there, tests/bench/scale_world_gpu.sh's output).  Nothing is asserted: figures only (the
 # structure is asserted by bench.world_* in `make test`).
 set -eu
 . "$(dirname "$0")/../lib.sh"   # differ
@@ -49,7 +70,8 @@ if [ $# -lt 1 ]; then
 fi
 B=$(cd "$1" && pwd)
 shift
-MODE=full OUT=out/bench COUNTS="" REPS=1 SIZE="" HF="" VT=900 KEEP=no NOVIEW=no
+MODE=full OUT=out/bench COUNTS="" REPS=1 SIZE="" HF="" VT=900 KEEP=no NOVIEW=no PACKS=""
+SFRAMES="" SWARM="" STO=2700
 while [ $# -gt 0 ]; do
     case $1 in
     --smoke) MODE=smoke ;;
@@ -61,29 +83,39 @@ while [ $# -gt 0 ]; do
     --view-timeout) VT=$2; shift ;;
     --keep-work) KEEP=yes ;;
     --no-view) NOVIEW=yes ;;
+    --packs) PACKS=$2; shift ;;
+    --steady-frames) SFRAMES=$2; shift ;;
+    --steady-warmup) SWARM=$2; shift ;;
+    --steady-timeout) STO=$2; shift ;;
     *) echo "scale_world.sh: unknown option '$1'" >&2; exit 2 ;;
     esac
     shift
 done
 if [ "$MODE" = smoke ]; then
-    : "${COUNTS:=8 16}" "${SIZE:=320x180}" "${HF:=256}"
+    : "${COUNTS:=8 16}" "${SIZE:=320x180}" "${HF:=256}" "${SFRAMES:=1}" "${SWARM:=1}"
 else
-    : "${COUNTS:=8 32 64 128 256}" "${SIZE:=1280x720}" "${HF:=1024}"
+    : "${COUNTS:=8 32 64 128 256}" "${SIZE:=1280x720}" "${HF:=1024}" "${SFRAMES:=3}" "${SWARM:=1}"
 fi
 REPO=$(cd "$(dirname "$0")/../.." && pwd)
 SPLATC=$B/compiler/splatc
 VIEW=$B/runtime/splatview
 GEN=$B/tests/gen_world
-for t in "$SPLATC" "$VIEW" "$GEN"; do
+SB=$B/tests/splatbench
+for t in "$SPLATC" "$VIEW" "$GEN" "$SB"; do
     [ -x "$t" ] || { echo "scale_world.sh: $t is not built (cmake --build $B)" >&2; exit 1; }
 done
 mkdir -p "$OUT"
 OUT=$(cd "$OUT" && pwd)
+if [ -n "$PACKS" ]; then
+    mkdir -p "$PACKS"
+    PACKS=$(cd "$PACKS" && pwd)
+fi
 W=$OUT/scale_world_work
 rm -rf "$W" "$OUT/scale_world.tsv" "$OUT/scale_world.md" "$OUT/scale_world.png"
 mkdir -p "$W"
 cd "$REPO"   # the scenes import nodes/ from the project root
 START=$(date +%s)
+LOAD0=$(cut -d' ' -f1-3 /proc/loadavg)
 log() { echo "[scale_world $(( $(date +%s) - START ))s] $*"; }
 
 # measure OUTFILE CMD... : runs CMD (stdout to OUTFILE) and prints
@@ -113,8 +145,18 @@ median() { sort -g | awk '/^[0-9.]+$/ { v[n++] = $1; next } { bad = 1 }
 # stat FILE REGEX FIELD: a field of the first line of --stats output matching
 stat_field() { awk -v re="$2" -v f="$3" '$0 ~ re { print $f; exit }' "$1"; }
 
+# csv_field CSV LABEL COLUMN: splatbench's row of variant LABEL, the
+# column named COLUMN in the header (NA when absent; the device column, the
+# first, is quoted and dropped first)
+csv_field() {
+    [ -f "$1" ] || { echo NA; return 0; }
+    sed 's/^"[^"]*",//; s/^device,//' "$1" | awk -F, -v l="$2" -v c="$3" '
+        NR == 1 { for (i = 1; i <= NF; i++) if ($i == c) k = i; next }
+        $5 == l && k { v = $k } END { print (v == "" ? "NA" : v) }'
+}
+
 TSV=$OUT/scale_world.tsv
-printf 'materials\tbiomes\tcombinations\tpipelines\tlargest_layers\tleaf_overlap\tcold_build_s\tbuild_peak_mb\tglslang_s\tvalidation_s\tedit_rebuild_s\tedit_shaders_recompiled\tshaders\tedit_combos_with_material\tpack_mb\ttextures\ttexture_arrays\tview_screen_s\tview_screen_async_s\tview_forward_s\tview_peak_mb\tsize\theightfield\treps\tview_screen_warm_s\n' > "$TSV"
+printf 'materials\tbiomes\tcombinations\tpipelines\tlargest_layers\tleaf_overlap\tcold_build_s\tbuild_peak_mb\tglslang_s\tvalidation_s\tedit_rebuild_s\tedit_shaders_recompiled\tshaders\tedit_combos_with_material\tpack_mb\ttextures\ttexture_arrays\tview_screen_s\tview_screen_async_s\tview_forward_s\tview_peak_mb\tsize\theightfield\treps\tview_screen_warm_s\tsteady_screen_gpu_ms\tsteady_screen_layers_px\tsteady_screen_needed_px\tsteady_screen_samples_px\tsteady_screen_tiles_uber\tsteady_forward_gpu_ms\tsteady_forward_layers_px\tsteady_forward_needed_px\tsteady_forward_samples_px\tsteady_peak_mb\tsteady_camera\tsteady_frames\n' > "$TSV"
 
 for M in $COUNTS; do
     NB=$((M / 8))
@@ -139,9 +181,13 @@ for M in $COUNTS; do
         log "$M materials: splatc build failed"
         tail -5 "$D/cold_stats.txt"
         printf '%s\t%s\tfailed' "$M" "$NB" >> "$TSV"
-        for k in $(seq 4 25); do printf '\tNA' >> "$TSV"; done
+        for k in $(seq 4 37); do printf '\tNA' >> "$TSV"; done
         echo >> "$TSV"
         continue
+    fi
+    if [ -n "$PACKS" ]; then   # the cold pack, before the edit below changes it
+        rm -rf "$PACKS/w$M"
+        cp -R "$D/pack" "$PACKS/w$M"
     fi
     cold=$(awk '{ print $1 }' "$D/cold.txt" | median)
     bpeak=$(awk '{ print $2 }' "$D/cold.txt" | median)
@@ -214,14 +260,44 @@ for M in $COUNTS; do
         else eval "t_$v=$(median < "$D/view_$v.txt")"; fi
     done
     vpeak=$(sort -g "$D/vpeak.txt" | tail -1)
+    # ---- steady frame: the same camera, held still, both paths ----
+    st_screen_ms=NA st_screen_lay=NA st_screen_need=NA st_screen_spp=NA st_uber=NA
+    st_fwd_ms=NA st_fwd_lay=NA st_fwd_need=NA st_fwd_spp=NA st_peak_mb=NA
+    if [ "$NOVIEW" = no ] && [ "$SFRAMES" -gt 0 ]; then
+        log "$M materials: steady frame $SIZE, screen and forward ($SWARM + $SFRAMES frames)"
+        c=$D/caches/steady
+        mkdir -p "$c"
+        rm -f "$D/steady.csv"
+        res=$(measure "$D/steady.log" env MESA_SHADER_CACHE_DIR="$c/mesa" \
+            SPLAT_PIPELINE_CACHE="$c/pipelines.bin" timeout "$STO" "$SB" render \
+            --pack "$D/pack" --scene "w$M" --path preset --start-preset overview \
+            --variant screen=screen --variant forward=composite --frames "$SFRAMES" \
+            --warmup "$SWARM" --size "$SIZE" --csv "$D/steady.csv")
+        case $res in
+        NA*) log "$M materials: splatbench render failed ($res)"; tail -5 "$D/steady.log" | sed 's/^/  /' ;;
+        *) st_peak_mb=$(echo "$res" | awk '{ printf "%.0f", $2 / 1024 }')
+           st_screen_ms=$(csv_field "$D/steady.csv" screen gpu_med_ms)
+           st_screen_lay=$(csv_field "$D/steady.csv" screen layers_evaluated)
+           st_screen_need=$(csv_field "$D/steady.csv" screen layers_needed)
+           st_screen_spp=$(csv_field "$D/steady.csv" screen samples_per_px)
+           st_uber=$(csv_field "$D/steady.csv" screen tiles_uber)
+           st_fwd_ms=$(csv_field "$D/steady.csv" forward gpu_med_ms)
+           st_fwd_lay=$(csv_field "$D/steady.csv" forward layers_evaluated)
+           st_fwd_need=$(csv_field "$D/steady.csv" forward layers_needed)
+           st_fwd_spp=$(csv_field "$D/steady.csv" forward samples_per_px)
+           cp "$D/steady.csv" "$OUT/scale_world_m${M}_steady.csv" ;;
+        esac
+    fi
     vpeak_mb=$( [ -n "$vpeak" ] && echo "$vpeak" | awk '{ printf "%.0f", $1 / 1024 }' || echo NA)
     bpeak_mb=$(echo "$bpeak" | awk '/^[0-9.]+$/ { printf "%.0f", $1 / 1024; next } { print "NA" }')
     # shellcheck disable=SC2154
-    printf '%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\n' \
+    printf '%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\t%s\n' \
         "$M" "$NB" "$combos" "$pipes" "$largest" "$overlap" "$cold" "$bpeak_mb" "$gl" "$va" \
         "$edit" "$recompiled" "$shaders" "$with" "$pack_mb" "$ntex" "$narr" \
         "$t_screen" "$t_screen_async" "$t_forward" "$vpeak_mb" "$SIZE" "$HF" "$REPS" \
-        "$t_screen_warm" >> "$TSV"
+        "$t_screen_warm" "$st_screen_ms" "$st_screen_lay" "$st_screen_need" "$st_screen_spp" \
+        "$st_uber" "$st_fwd_ms" "$st_fwd_lay" "$st_fwd_need" "$st_fwd_spp" "$st_peak_mb" \
+        overview "$SFRAMES" >> "$TSV"
     log "$M materials: $(tail -1 "$TSV")"
     # the pictures stay (small); the packs go unless kept
     for v in screen screen_async forward; do
@@ -241,8 +317,16 @@ done
             ($19 ~ /^[0-9.]+$/ ? $19 " s" : $19),
             ($20 ~ /^[0-9.]+$/ ? $20 " s" : $20), $21 }' "$TSV"
     echo
+    echo "Steady frame, $SIZE, camera 'overview' held still (splatbench render --path preset, $SFRAMES frame(s) after $SWARM untimed; GPU ms: timestamp median; forward: per fragment shaded):"
+    echo
+    echo "| materials | screen GPU ms | screen layers evaluated / needed per px | screen samples/px | über-shader tiles | forward GPU ms | forward layers evaluated / needed | forward samples | splatbench peak RSS |"
+    echo "|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
+    awk -F'\t' 'NR > 1 {
+        printf "| %s | %s | %s / %s | %s | %s | %s | %s / %s | %s | %s MB |\n",
+            $1, $26, $27, $28, $29, $30, $31, $32, $33, $34, $35 }' "$TSV"
+    echo
     echo "gen_world --textures B 8 $HF 16 (B biomes x 8 materials, a texture each, over a base);"
-    echo "$(nproc) CPUs, load average at the end: $(cut -d' ' -f1-3 /proc/loadavg); medians of $REPS run(s)"
+    echo "$(nproc) CPUs, load average at the start: $LOAD0, at the end: $(cut -d' ' -f1-3 /proc/loadavg); medians of $REPS run(s)"
     echo "(the TSV's glslang_s and validation_s: the last cold build's --stats phases)."
 } > "$OUT/scale_world.md"
 cat "$OUT/scale_world.md"
