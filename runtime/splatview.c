@@ -696,9 +696,9 @@ static bool print_stats(const opts *o, rt_device *dev, const rt_pack *pack, rt_r
                "p10 %.3f  p90 %.3f, %zu bytes per cell\n", t->ug_generated,
                t->ug_generated ? t->ug_gen_ms / t->ug_generated : 0.0, um, ul, uh,
                st->undergrowth.bytes_per_cell);
-        printf("  drawn %ld instances (of %ld candidates), %ld triangles, %d draws\n",
-               st->undergrowth.drawn, st->undergrowth.candidates, st->undergrowth.triangles,
-               st->undergrowth.draws);
+        printf("  drawn %ld instances (of %ld candidates; %ld in compute), %ld triangles, "
+               "%d draws\n", st->undergrowth.drawn, st->undergrowth.candidates,
+               st->undergrowth.drawn_compute, st->undergrowth.triangles, st->undergrowth.draws);
     } else if (pi.has_undergrowth) {
         printf("undergrowth: off\n");
     }

@@ -814,7 +814,7 @@ void rt_ug_draw(rt_ug *u, VkCommandBuffer cb, bool depth_read_only, VkDescriptor
     if (u->shadows) {   /* under the plants: before them */
         vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_GRAPHICS, u->shadow_pipe);
         for (int k = 0; k < u->nkeys; k++)
-            if (u->key_used[k] && pu->blocks[u->key_block[k]].shadow > 0)
+            if (u->key_used[k] && pu->blocks[u->key_block[k]].shadow > 0 && !u->key_cs[k])
                 vkCmdDrawIndexedIndirect(cb, u->mdraw.buf, 20 * (VkDeviceSize)(u->nkeys + k), 1, 20);
     }
     /* one draw per key (a block's near or far mesh), opaque first: they
@@ -857,7 +857,8 @@ void rt_ug_read_stats(rt_ug *u, rt_ug_stats *st)
         st->drawn += m[1];
         st->triangles += (long)m[1] * (m[0] / 3) + (long)sh[1] * 2;
         st->draws += u->key_used[k] ? !(u->key_cs[k] && u->cr_ran) +
-                                          (u->shadows && u->p->ug.blocks[u->key_block[k]].shadow > 0)
+                                          (u->shadows && u->p->ug.blocks[u->key_block[k]].shadow > 0 &&
+                                           !u->key_cs[k])
                                     : 0;
         if (u->key_cs[k] && u->cr_ran)
             st->drawn_compute += m[1];

@@ -72,7 +72,10 @@ static void fill_entries(rt_ug *u)
                 ki[0] = l >= 2 ? u->tri[b][0] : m->nidx;
                 ki[1] = l >= 2 ? u->tri[b][1] : m->first_index;
                 ki[2] = l >= 2 ? u->tri[b][2] : m->first_vertex;
-                bool shadows = pu->blocks[b].shadow > 0 && u->shadows;
+                /* the compute key's blades cast no contact shadow (a disc
+                 * of a pixel or less that far: its quads would cost the
+                 * graphics front end what the key saves) */
+                bool shadows = pu->blocks[b].shadow > 0 && u->shadows && l != 3;
                 e[k] = (uint32_t)n;
                 u->key_block[k] = b;
                 for (int i = 0; i < u->pool; i++) {
@@ -92,7 +95,7 @@ static void fill_entries(rt_ug *u)
                 }
                 if (shadows)
                     ki[3] = (uint32_t)n;
-                else if (!(pu->blocks[b].shadow > 0 && u->shadows))
+                else if (!(pu->blocks[b].shadow > 0 && u->shadows) || l == 3)
                     ki[3] = e[k];
                 u->key_used[k] = e[k] != (uint32_t)n;
                 u->key_cs[k] = l == 3;

@@ -8,8 +8,9 @@
  * single triangles past 28 m) and stones, radius 160 m, seen from a low
  * camera on the screen path, once with the compute rasteriser off and once
  * on:
- *   - the counts add up: the same instances drawn and the same triangles
- *     both ways, some of them (at least a third) drawn in compute, the
+ *   - the counts add up: the same instances drawn both ways, the same
+ *     triangles less at most the contact shadows of those in compute
+ *     (which cast none), some of them (at least a third) drawn in compute, the
  *     compute key's and the graphics single-triangle key's instances
  *     together what the graphics path's single-triangle key drew, fewer
  *     indirect draws, and no compute triangle clipped to the cap;
@@ -132,7 +133,9 @@ int main(int argc, char **argv)
     printf("graphics: drawn %ld, triangles %ld, %d draws; compute: drawn %ld (%ld in compute), "
            "triangles %ld, %d draws, %ld clipped\n", ug->drawn, ug->triangles, ug->draws,
            uc->drawn, uc->drawn_compute, uc->triangles, uc->draws, uc->cr_overflow);
-    CHECK(ug->drawn > 1000 && uc->drawn == ug->drawn && uc->triangles == ug->triangles,
+    /* the compute blades cast no contact shadow: two triangles each fewer at most */
+    CHECK(ug->drawn > 1000 && uc->drawn == ug->drawn && uc->triangles <= ug->triangles &&
+              uc->triangles >= ug->triangles - 2 * uc->drawn_compute,
           "drawn %ld / %ld, triangles %ld / %ld", ug->drawn, uc->drawn, ug->triangles,
           uc->triangles);
     CHECK(ug->drawn_compute == 0 && uc->drawn_compute * 3 > uc->drawn,
