@@ -405,6 +405,7 @@ static bool make_undergrowth(rt_renderer *r, rt_error *e)
         .color = &r->color, .depth = &r->depth, .height = &r->terrain.height,
         .width = r->desc.width, .height_px = r->desc.height,
         .nearest = r->terrain.nearest_clamp, .set0 = r->set0, .timestamps = r->timestamps,
+        .compute = r->desc.undergrowth_compute && r->set0c != VK_NULL_HANDLE,
     };
     return rt_ug_create(r->d, r->p, &r->pl, &r->qt, &t, r->desc.undergrowth_radius,
                         r->desc.undergrowth_thin, &r->ug, e);

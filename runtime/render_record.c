@@ -500,7 +500,7 @@ static bool rec_ug_draw(rec *x, rt_error *e)
 {
     (void)e;
     rt_renderer *r = x->r;
-    rt_ug_draw(r->ug, x->cb, x->fs->screen, r->set0, r->set1, &x->vp, &x->area);
+    rt_ug_draw(r->ug, x->cb, x->fs->screen, r->set0, r->set1, r->set0c, &x->vp, &x->area);
     return true;
 }
 

@@ -992,6 +992,8 @@ typedef struct rt_ug_targets {
     VkSampler       nearest;
     VkDescriptorSet set0;         /* the graphics set 0 (terrain bindings)  */
     bool            timestamps;   /* the queue has them: GPU ms in the stats */
+    bool            compute;      /* far blades in compute (screen path only:
+                                     undergrowth_craster.c)                 */
 } rt_ug_targets;
 
 /* *out stays NULL when the pack has no undergrowth; set even on failure
@@ -1012,8 +1014,12 @@ bool rt_ug_generate(rt_ug *u, VkCommandBuffer cb, const splat_frame *fr, VkDescr
 bool rt_ug_visible(const rt_ug *u);
 /* After the terrain: the instances of the visible cells, front to back;
  * depth_read_only: the depth was left SHADER_READ_ONLY (screen path). */
+/* depth_read_only (the screen path): the compute keys' blades drawn in
+ * compute after the render pass with set0c, the compute set 0 whose
+ * SPLAT_BIND_OUT is the colour (undergrowth_craster.c). */
 void rt_ug_draw(rt_ug *u, VkCommandBuffer cb, bool depth_read_only, VkDescriptorSet set0,
-                VkDescriptorSet set1, const VkViewport *vp, const VkRect2D *area);
+                VkDescriptorSet set1, VkDescriptorSet set0c, const VkViewport *vp,
+                const VkRect2D *area);
 /* Regenerate the cells touching rect (x0, z0, x1, z1 terrain-local m) or,
  * NULL, every cell. */
 void rt_ug_invalidate(rt_ug *u, const double *rect);

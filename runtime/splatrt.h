@@ -329,6 +329,10 @@ typedef struct rt_render_desc {
                                        drawing their tiles meanwhile (the
                                        viewer's default; headless waits)   */
     double       undergrowth_radius; /* m around the camera; 0: RT_UG_RADIUS    */
+    bool         undergrowth_compute; /* screen path: far single-triangle blades
+                                       drawn in compute, not by the graphics
+                                       pipeline (runtime/undergrowth_craster.c;
+                                       splatbench ugcompute=1)              */
     double       undergrowth_thin;  /* m: beyond it a cell draws the fraction
                                        (thin / d)^2 of its instances (at
                                        least 8 %), widened; 0: 14 (the far
@@ -379,6 +383,9 @@ typedef struct rt_ug_stats {
     long   drawn;             /* instances drawn (after LOD, fade, frustum) */
     long   triangles;         /* triangles drawn, contact shadows included  */
     int    draws;             /* indirect draws                             */
+    long   drawn_compute;     /* of drawn, those drawn in compute (far
+                                 single triangles; undergrowth_compute)     */
+    long   cr_overflow;       /* compute triangles clipped to the cap (0)   */
     /* per key (one draw: a block's near or far mesh, in the draw's order;
      * the first RT_UG_KEYS_MAX): its block, index count, instances drawn */
     int    keys;

@@ -53,6 +53,8 @@ typedef struct opts {
     bool overlay;
     bool headless, stats, have_camera, have_look, no_stitch, no_cull, no_shadows;
     bool no_undergrowth;
+    bool ug_compute;       /* --ug-compute: far blades in compute          */
+    double ug_radius, ug_thin;   /* --ug-radius, --ug-thin (0: default)    */
     bool no_distance_classes;
     bool wait_pipelines;   /* --wait-pipelines */
     bool check;            /* --check: load and set up, draw nothing       */
@@ -336,6 +338,12 @@ static const splat_arg options[] = {
       "the CPU reference", F(shadow), .choices = "gpu|cpu", .values = shadow_values },
     { "--no-undergrowth", SPLAT_ARG_FLAG, NULL, "draw no undergrowth (grass, plants, stones)",
       F(no_undergrowth) },
+    { "--ug-radius", SPLAT_ARG_FLOAT, "R", "undergrowth within R metres of the camera "
+      "(default 96)", F(ug_radius), .min = 1, .max = 4096, .expects = "metres" },
+    { "--ug-thin", SPLAT_ARG_FLOAT, "D", "undergrowth thinned (D / d)^2 beyond D metres "
+      "(default 14)", F(ug_thin), .min = 1, .max = 1e6, .expects = "metres" },
+    { "--ug-compute", SPLAT_ARG_FLAG, NULL, "screen path: far single-triangle undergrowth "
+      "blades drawn in compute, not by the graphics pipeline", F(ug_compute) },
     { NULL, SPLAT_ARG_SECTION, .help = "Destruction:" },
     { "--crater", SPLAT_ARG_CUSTOM, "X,Z,R[,DEPTH]", "a crater before the frames (metres; "
       "repeatable; depth defaults to R/4)", .parse = parse_crater,
@@ -700,9 +708,9 @@ static bool print_stats(const opts *o, rt_device *dev, const rt_pack *pack, rt_r
                "p10 %.3f  p90 %.3f, %zu bytes per cell\n", t->ug_generated,
                t->ug_generated ? t->ug_gen_ms / t->ug_generated : 0.0, um, ul, uh,
                st->undergrowth.bytes_per_cell);
-        printf("  drawn %ld instances (of %ld candidates), %ld triangles, %d draws\n",
-               st->undergrowth.drawn, st->undergrowth.candidates, st->undergrowth.triangles,
-               st->undergrowth.draws);
+        printf("  drawn %ld instances (of %ld candidates; %ld in compute), %ld triangles, "
+               "%d draws\n", st->undergrowth.drawn, st->undergrowth.candidates,
+               st->undergrowth.drawn_compute, st->undergrowth.triangles, st->undergrowth.draws);
     } else if (pi.has_undergrowth) {
         printf("undergrowth: off\n");
     }
@@ -734,6 +742,8 @@ static rt_render_desc render_desc(const opts *o, const rt_pack_info *pi)
         .no_cull = o->no_cull, .lod_pixels = o->lod_pixels, .no_shadows = o->no_shadows,
         .shadow = o->shadow,
         .no_undergrowth = o->no_undergrowth,
+        .undergrowth_compute = o->ug_compute, .undergrowth_radius = o->ug_radius,
+        .undergrowth_thin = o->ug_thin,
         .no_distance_classes = o->no_distance_classes,
         .async_pipelines = o->async_pipelines == 1,
         .split_uncovered = o->split_uncovered,
@@ -915,6 +925,8 @@ static int window(const opts *o_)
                     .shading = o.shading, .screen_depth = o.screen_depth, .pixel_sort = o.pixel_sort,
                     .no_shadows = o.no_shadows, .shadow = o.shadow,
                     .no_undergrowth = o.no_undergrowth,
+                    .undergrowth_compute = o.ug_compute, .undergrowth_radius = o.ug_radius,
+                    .undergrowth_thin = o.ug_thin,
                     .far_atlas_distance = o.far_distance,
                     .preview_scale = o.preview_scale,
                     .no_distance_classes = o.no_distance_classes,

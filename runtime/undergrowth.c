@@ -87,10 +87,12 @@ static bool make_pass(rt_ug *u, VkImageLayout depth_in, VkRenderPass *out, rt_er
           VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT | VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT,
           VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT | VK_ACCESS_COLOR_ATTACHMENT_READ_BIT |
           VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT | VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_READ_BIT, 0 },
-        /* the depth's store (and a final layout move) after its tests */
+        /* the depth's store (and a final layout move) after its tests;
+         * the compute rasteriser reads both (undergrowth_craster.c) */
         { 0, VK_SUBPASS_EXTERNAL, VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT |
           VK_PIPELINE_STAGE_LATE_FRAGMENT_TESTS_BIT,
-          VK_PIPELINE_STAGE_TRANSFER_BIT | VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT,
+          VK_PIPELINE_STAGE_TRANSFER_BIT | VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT |
+          VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
           VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT | VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT,
           VK_ACCESS_TRANSFER_READ_BIT | VK_ACCESS_SHADER_READ_BIT, 0 },
     };
@@ -157,7 +159,7 @@ static bool make_sets(rt_ug *u, VkDescriptorSet set0_src, const rt_image *height
 {
     rt_device *d = u->d;
     VkDescriptorPoolSize sizes[3] = {
-        { VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 24 + 1 },   /* + set 0's vector shapes */
+        { VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 25 + 1 },   /* + set 0's vector shapes */
         { VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 16 + SPLAT_MAX_UG_TEXTURES },
         { VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 2 },
     };
@@ -201,6 +203,7 @@ static bool make_sets(rt_ug *u, VkDescriptorSet set0_src, const rt_image *height
         { u->cull_set, 6, sb, u->vis.buf },
         { u->scan_set, 0, sb, u->ent.buf }, { u->scan_set, 1, sb, u->cnt.buf },
         { u->scan_set, 2, sb, u->mdraw.buf },
+        { u->scan_set, 3, sb, u->cdisp.buf },
         { u->draw_set, 3, cis, .images = ti, .count = SPLAT_MAX_UG_TEXTURES },
     };
     rt_vk_write_sets(d, w, sizeof w / sizeof *w);
@@ -253,10 +256,10 @@ static bool make_layouts(rt_ug *u, rt_error *e)
     VkDescriptorSetLayoutBinding lod[] = {
         { 0, sb, 1, cs, NULL }, { 1, sb, 1, cs, NULL }, { 2, sb, 1, cs, NULL },
     };
-    VkDescriptorSetLayoutBinding cull[7], scan[3];
+    VkDescriptorSetLayoutBinding cull[7], scan[4];
     for (uint32_t i = 0; i < 7; i++)
         cull[i] = (VkDescriptorSetLayoutBinding){ i, sb, 1, cs, NULL };
-    for (uint32_t i = 0; i < 3; i++)
+    for (uint32_t i = 0; i < 4; i++)
         scan[i] = (VkDescriptorSetLayoutBinding){ i, sb, 1, cs, NULL };
     rt_vk_list *k = &u->keep;
     if (!rt_terrain_compute_layout(d, &u->set_terrain, e) ||
@@ -269,7 +272,7 @@ static bool make_layouts(rt_ug *u, rt_error *e)
                           &u->set_draw, e) ||
         !rt_vk_set_layout(d, k, &(rt_vk_set_layout_desc){ "undergrowth cull", cull, 7 },
                           &u->set_cull, e) ||
-        !rt_vk_set_layout(d, k, &(rt_vk_set_layout_desc){ "undergrowth scan", scan, 3 },
+        !rt_vk_set_layout(d, k, &(rt_vk_set_layout_desc){ "undergrowth scan", scan, 4 },
                           &u->set_scan, e) ||
         !rt_vk_set_layout(d, k, &(rt_vk_set_layout_desc){ "undergrowth lod", lod, 3 },
                           &u->set_lod, e))
@@ -321,19 +324,21 @@ static bool make_buffers(rt_ug *u, rt_error *e)
                           &u->cnt, e) ||
         !rt_buffer_create(d, (VkDeviceSize)u->pool * u->cap * 4 + 4,
                           st | VK_BUFFER_USAGE_TRANSFER_SRC_BIT, false, &u->vis, e) ||
-        !rt_buffer_create(d, (VkDeviceSize)u->nblocks * 6 * 20,   /* + the shadows' */
+        !rt_buffer_create(d, (VkDeviceSize)u->nblocks * 8 * 20,   /* + the shadows' */
                           st | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
                           false, &u->mdraw, e) ||
-        !rt_buffer_create(d, (VkDeviceSize)u->nblocks * 6 * 20, VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+        !rt_buffer_create(d, (VkDeviceSize)u->nblocks * 8 * 20, VK_BUFFER_USAGE_TRANSFER_DST_BIT,
                           true, &u->mdraw_host, e) ||
+        !rt_buffer_create(d, (VkDeviceSize)UG_MAX_KEYS * 12,   /* the compute keys' dispatches */
+                          st | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT, false, &u->cdisp, e) ||
         !rt_buffer_create(d, (VkDeviceSize)u->pool * 4, st, true, &u->lod, e) ||
         !rt_buffer_create(d, (VkDeviceSize)u->nblocks * 16 * UG_BLOCK_VEC4, st, true, &u->blocks,
                           e) ||
         /* + the shadow quad, + the single-triangle meshes (tri_mesh) */
         !rt_buffer_create(d, (VkDeviceSize)(pu->nvertices + 4 + pu->nindices / 2 + 3) * 32,
-                          VK_BUFFER_USAGE_VERTEX_BUFFER_BIT, true, &u->vbuf, e) ||
+                          VK_BUFFER_USAGE_VERTEX_BUFFER_BIT | st, true, &u->vbuf, e) ||
         !rt_buffer_create(d, (VkDeviceSize)(pu->nindices + 6 + pu->nindices / 2 + 3) * 4,
-                          VK_BUFFER_USAGE_INDEX_BUFFER_BIT, true, &u->ibuf, e) ||
+                          VK_BUFFER_USAGE_INDEX_BUFFER_BIT | st, true, &u->ibuf, e) ||
         !rt_buffer_create(d, sizeof(splat_frame), VK_BUFFER_USAGE_UNIFORM_BUFFER_BIT, true,
                           &u->frame, e))
         return false;
@@ -389,6 +394,12 @@ bool rt_ug_create(rt_device *d, const rt_pack *p, rt_pipelines *pl, const rt_qua
     u->pl = pl;
     u->qt = qt;
     u->radius = radius > 0 ? radius : RT_UG_RADIUS;
+    u->compute = t->compute;
+    u->color = t->color;
+    u->depth = t->depth;
+    u->cr_nearest = t->nearest;
+    u->width = t->width;
+    u->height_px = t->height_px;
     u->thin = thin > 0 ? thin : LOD_NEAR;
     u->pool = (int)splat_ug_pool(u->radius);
     u->nblocks = p->ug.nblocks;
@@ -423,6 +434,7 @@ bool rt_ug_create(rt_device *d, const rt_pack *p, rt_pipelines *pl, const rt_qua
         !rt_ug_cull_pipelines(u, e) ||
         !draw_pipeline(u, 0, e) || !draw_pipeline(u, 1, e) ||
         (u->shadows && !draw_pipeline(u, 2, e)) ||
+        !rt_ug_craster_create(u, e) ||
         !rt_vk_fb(d, &u->keep, &(rt_vk_fb_desc){ .label = "undergrowth", .pass = u->pass_att,
                       .views = views, .nviews = 2, .width = (uint32_t)t->width,
                       .height = (uint32_t)t->height_px }, &u->fb, e))
@@ -442,10 +454,11 @@ void rt_ug_destroy(rt_ug *u)
     rt_vk_list_destroy(d, &u->keep);
     rt_buffer *bufs[] = { &u->masks, &u->inst, &u->args, &u->args_host, &u->draw_args, &u->lod,
                           &u->blocks, &u->vbuf, &u->ibuf, &u->frame, &u->ent,
-                          &u->cnt, &u->vis, &u->mdraw, &u->mdraw_host };
+                          &u->cnt, &u->vis, &u->mdraw, &u->mdraw_host, &u->cdisp };
     for (size_t i = 0; i < sizeof bufs / sizeof *bufs; i++)
         rt_buffer_destroy(d, bufs[i]);
     rt_buffer_destroy(d, &u->probe_out);
+    rt_ug_craster_destroy(u);
     for (int i = 0; i <= SPLAT_MAX_UG_TEXTURES; i++)
         rt_image_destroy(d, &u->tex[i]);
     free(u->mask_pipes);
@@ -774,7 +787,8 @@ bool rt_ug_visible(const rt_ug *u)
 }
 
 void rt_ug_draw(rt_ug *u, VkCommandBuffer cb, bool depth_read_only, VkDescriptorSet set0,
-                VkDescriptorSet set1, const VkViewport *vp, const VkRect2D *area)
+                VkDescriptorSet set1, VkDescriptorSet set0c, const VkViewport *vp,
+                const VkRect2D *area)
 {
     u->drawn = true;
     if (u->qpool)   /* after the terrain has finished, not when it started */
@@ -800,7 +814,7 @@ void rt_ug_draw(rt_ug *u, VkCommandBuffer cb, bool depth_read_only, VkDescriptor
     if (u->shadows) {   /* under the plants: before them */
         vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_GRAPHICS, u->shadow_pipe);
         for (int k = 0; k < u->nkeys; k++)
-            if (u->key_used[k] && pu->blocks[u->key_block[k]].shadow > 0)
+            if (u->key_used[k] && pu->blocks[u->key_block[k]].shadow > 0 && !u->key_cs[k])
                 vkCmdDrawIndexedIndirect(cb, u->mdraw.buf, 20 * (VkDeviceSize)(u->nkeys + k), 1, 20);
     }
     /* one draw per key (a block's near or far mesh), opaque first: they
@@ -808,10 +822,13 @@ void rt_ug_draw(rt_ug *u, VkCommandBuffer cb, bool depth_read_only, VkDescriptor
     for (int cut = 0; cut < 2; cut++) {
         vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_GRAPHICS, u->draw_pipe[cut]);
         for (int k = 0; k < u->nkeys; k++)
-            if (u->key_used[k] && (pu->blocks[u->key_block[k]].cutout != 0) == cut)
+            if (u->key_used[k] && !(u->key_cs[k] && depth_read_only) &&
+                (pu->blocks[u->key_block[k]].cutout != 0) == cut)
                 vkCmdDrawIndexedIndirect(cb, u->mdraw.buf, 20 * (VkDeviceSize)k, 1, 20);
     }
     vkCmdEndRenderPass(cb);
+    if (depth_read_only)   /* the far blades in compute (undergrowth_craster.c) */
+        rt_ug_craster_record(u, cb, set0c, set1);
     if (u->qpool)
         vkCmdWriteTimestamp(cb, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, u->qpool, 3);
 }
@@ -839,14 +856,20 @@ void rt_ug_read_stats(rt_ug *u, rt_ug_stats *st)
         const uint32_t *m = md + 5 * k, *sh = md + 5 * (u->nkeys + k);
         st->drawn += m[1];
         st->triangles += (long)m[1] * (m[0] / 3) + (long)sh[1] * 2;
-        st->draws += u->key_used[k] ? 1 + (u->shadows && u->p->ug.blocks[u->key_block[k]].shadow > 0)
+        st->draws += u->key_used[k] ? !(u->key_cs[k] && u->cr_ran) +
+                                          (u->shadows && u->p->ug.blocks[u->key_block[k]].shadow > 0 &&
+                                           !u->key_cs[k])
                                     : 0;
+        if (u->key_cs[k] && u->cr_ran)
+            st->drawn_compute += m[1];
         if (k < RT_UG_KEYS_MAX) {
             st->key_drawn[k] = m[1];
             st->key_indices[k] = m[0];
             st->key_block[k] = u->key_block[k];
         }
     }
+    if (u->compute && u->cr_ran)
+        st->cr_overflow = ((const uint32_t *)u->crstat_host.map)[0];
     st->keys = u->mdraw_valid ? (u->nkeys < RT_UG_KEYS_MAX ? u->nkeys : RT_UG_KEYS_MAX) : 0;
     st->bytes_per_cell = (size_t)TEXELS * TEXELS * (size_t)(u->nw + 2) * 4 +
                          (size_t)u->cap * (32 + 4) + (size_t)u->nblocks * 28;

@@ -40,7 +40,8 @@ bool rt_ug_cull_pipelines(rt_ug *u, rt_error *e)
 
 /* The cull passes' table for this frame (UG_KEYINFO): keys in the draw's
  * order (opaque blocks first; a block's near mesh, then its far one, then
- * its single-triangle one), each key's entries the visible generated
+ * its single-triangle one, then with the compute rasteriser on its
+ * single-triangle cells drawn in compute: rt_ug_craster_fits), each key's entries the visible generated
  * cells front to back whose distance picks that mesh (their nearest point
  * beyond LOD_NEAR: the far mesh; beyond LOD_TRI LOD_NEAR: the single
  * triangles). */
@@ -58,15 +59,23 @@ static void fill_entries(rt_ug *u)
             if ((pu->blocks[b].cutout != 0) != cut)
                 continue;
             int far = pu->meshes[pu->blocks[b].mesh].far;
-            for (int l = 0; l < 3; l++) {
-                if ((l == 1 && far < 0) || (l == 2 && (far < 0 || !u->tri[b][0])))
+            /* the compute rasteriser's key: opaque single triangles, few
+             * enough a mesh for the payload's bits */
+            bool cs = u->compute && !cut && u->tri[b][0] &&
+                      u->tri[b][0] / 3 <= (1u << UG_CR_TBITS);
+            for (int l = 0; l < 4; l++) {
+                if ((l == 1 && far < 0) || (l >= 2 && (far < 0 || !u->tri[b][0])) ||
+                    (l == 3 && !cs))
                     continue;
                 const rt_pack_ug_mesh *m = &pu->meshes[l ? far : pu->blocks[b].mesh];
                 uint32_t *ki = e + UG_KEYINFO + 4 * k;
-                ki[0] = l == 2 ? u->tri[b][0] : m->nidx;
-                ki[1] = l == 2 ? u->tri[b][1] : m->first_index;
-                ki[2] = l == 2 ? u->tri[b][2] : m->first_vertex;
-                bool shadows = pu->blocks[b].shadow > 0 && u->shadows;
+                ki[0] = l >= 2 ? u->tri[b][0] : m->nidx;
+                ki[1] = l >= 2 ? u->tri[b][1] : m->first_index;
+                ki[2] = l >= 2 ? u->tri[b][2] : m->first_vertex;
+                /* the compute key's blades cast no contact shadow (a disc
+                 * of a pixel or less that far: its quads would cost the
+                 * graphics front end what the key saves) */
+                bool shadows = pu->blocks[b].shadow > 0 && u->shadows && l != 3;
                 e[k] = (uint32_t)n;
                 u->key_block[k] = b;
                 for (int i = 0; i < u->pool; i++) {
@@ -76,6 +85,8 @@ static void fill_entries(rt_ug *u)
                     int lv = near > LOD_NEAR && far >= 0;
                     if (lv && u->tri[b][0] && near > LOD_TRI * LOD_NEAR)
                         lv = 2;
+                    if (lv == 2 && cs && rt_ug_craster_fits(u, b, near, ((float *)u->lod.map)[slot]))
+                        lv = 3;
                     if (cl->state != CELL_READY || !cl->visible || lv != l)
                         continue;
                     if (shadows && near >= shadow_end)   /* and every entry after */
@@ -84,9 +95,10 @@ static void fill_entries(rt_ug *u)
                 }
                 if (shadows)
                     ki[3] = (uint32_t)n;
-                else if (!(pu->blocks[b].shadow > 0 && u->shadows))
+                else if (!(pu->blocks[b].shadow > 0 && u->shadows) || l == 3)
                     ki[3] = e[k];
                 u->key_used[k] = e[k] != (uint32_t)n;
+                u->key_cs[k] = l == 3;
                 k++;
             }
         }
@@ -99,6 +111,8 @@ static void fill_entries(rt_ug *u)
  * count, scan, write, then the draws per key copied back for the stats. */
 void rt_ug_record_cull(rt_ug *u, VkCommandBuffer cb, const splat_frame *fr)
 {
+    if (u->compute)
+        rt_ug_craster_frame(u, fr);
     fill_entries(u);
     u->mdraw_valid = false;
     if (u->nent == 0)

@@ -110,38 +110,7 @@ const char rt_ug_lod_glsl[] =
     "    u_draw.a[5u * i + 1u] = uint(ceil(float(u_args.a[5u * i + 1u]) * f));\n"
     "}\n";
 
-/* The vertex stage's fade and wind (the top comment), shared by the draw
- * and the probe pass so that the tests count what the draw keeps. */
-#define UG_GLSL_FUNCS \
-    "float ug_hash01(vec3 root) {\n" \
-    "    uint x = floatBitsToUint(root.x) * 0x9e3779b1u ^ floatBitsToUint(root.z) * 0x85ebca77u;\n" \
-    "    x ^= x >> 16; x *= 0x7feb352du; x ^= x >> 15; x *= 0x846ca68bu; x ^= x >> 16;\n" \
-    "    return float(x >> 8) * (1.0 / 16777216.0);\n" \
-    "}\n" \
-    "float ug_fade(float d, float r) {\n" \
-    "    float r1 = max(r - " UG_FADE_MARGIN_S ", 0.5 * r);\n" \
-    "    return 1.0 - smoothstep(" UG_FADE_START_S " * r1, r1, d);\n" \
-    "}\n" \
-    "float ug_far(float d, float r) {\n" \
-    "    float r1 = max(r - " UG_FADE_MARGIN_S ", 0.5 * r);\n" \
-    "    return smoothstep(0.35 * r1, 0.8 * r1, d);\n" \
-    "}\n" \
-    "float ug_fade_scale(vec3 root, float d, float r) {\n" \
-    "    return clamp((ug_fade(d, r) - ug_hash01(root)) * 5.0, 0.0, 1.0);\n" \
-    "}\n" \
-    "float ug_gust(vec2 xz, vec2 dir, float t) {\n" \
-    "    float along = dot(xz, dir), across = dot(xz, vec2(-dir.y, dir.x));\n" \
-    "    float p1 = 6.2831853 * fract(along / 24.0 - t / 5.7);\n" \
-    "    float p2 = 6.2831853 * fract(along / 9.1 + across / 37.0 - t / 2.3);\n" \
-    "    return 0.5 + 0.3 * sin(p1) + 0.2 * sin(p2);\n" \
-    "}\n" \
-    "vec3 ug_wind(vec3 root, float h, vec4 w, float t) {\n" \
-    "    h = max(h, 0.0);\n" \
-    "    float a = w.z * h * h * (1.0 - w.w + w.w * ug_gust(root.xz, w.xy, t));\n" \
-    "    return vec3(w.x * a, -min(0.5 * a * a / max(h, 1e-3), 0.5 * h), w.y * a);\n" \
-    "}\n"
-#define UG_FADE_MARGIN_S "12.0"   /* 0.75 CELL */
-#define UG_FADE_START_S "0.6"
+/* UG_GLSL_FUNCS, the vertex stage's fade and wind: undergrowth_impl.h. */
 
 /* The cull passes, every frame after the LOD pass (undergrowth.c "cull"):
  * one workgroup per entry (a visible cell's block, in the draw's order:
@@ -218,12 +187,14 @@ const char rt_ug_cull_glsl[] =
  * its contact shadows' after the nkeys draws: the instances of its
  * entries before the key table's shadow end (undergrowth.c fill_entries:
  * the first entry too far for a shadow to show, its first entry where
- * the block casts none). */
+ * the block casts none); and per key the compute rasteriser's indirect
+ * dispatch (undergrowth_craster.c), 64 threads a group. */
 const char rt_ug_scan_glsl[] =
     "layout(local_size_x = UG_LS) in;\n"
     "layout(set = 0, binding = 0, std430) readonly buffer E { uint e[]; } u_ent;\n"
     "layout(set = 0, binding = 1, std430) coherent buffer C { uint c[]; } u_cnt;\n"
     "layout(set = 0, binding = 2, std430) writeonly buffer D { uint a[]; } u_md;\n"
+    "layout(set = 0, binding = 3, std430) writeonly buffer DS { uint a[]; } u_ds;\n"
     "layout(push_constant, std430) uniform P { uint n, nkeys, qidx, qvtx; } u_p;\n"
     "shared uint s_sum[UG_LS];\n"
     "void main() {\n"
@@ -259,6 +230,10 @@ const char rt_ug_scan_glsl[] =
     "        u_md.a[s + 2u] = u_p.qidx;\n"
     "        u_md.a[s + 3u] = u_p.qvtx;\n"
     "        u_md.a[s + 4u] = f;\n"
+    /* the compute rasteriser's dispatch: a thread per instance and triangle */
+    "        u_ds.a[3u * k] = (cnt * (u_ent.e[ki] / 3u) + 63u) / 64u;\n"
+    "        u_ds.a[3u * k + 1u] = 1u;\n"
+    "        u_ds.a[3u * k + 2u] = 1u;\n"
     "    }\n"
     "}\n";
 

@@ -31,15 +31,56 @@
  * the end of its entries with contact shadows; the entries from
  * e[UG_ENT0]: a cell's block,
  * slot * blocks + block (undergrowth.c "cull"). */
-#define UG_MAX_KEYS  (3 * SPLAT_MAX_UG_BLOCKS)
-#define UG_KEYINFO   256
-#define UG_KEYINFO_S "256u"
+#define UG_MAX_KEYS  (4 * SPLAT_MAX_UG_BLOCKS)   /* near, far, triangles, compute */
+#define UG_KEYINFO   260
+#define UG_KEYINFO_S "260u"
 #define UG_ENT0      (UG_KEYINFO + 4 * UG_MAX_KEYS)
-#define UG_ENT0_S    "1024u"
+#define UG_ENT0_S    "1284u"
+_Static_assert(UG_KEYINFO > UG_MAX_KEYS && UG_ENT0 == 1284, "the cull table's strings");
 /* Beyond LOD_TRI times the LOD distance (a cell's nearest point) a block
  * whose far mesh is made of tapered quads draws them as single triangles
  * (undergrowth.c tri_mesh). */
 #define LOD_TRI 2.0
+/* The compute rasteriser (undergrowth_craster.c): a single-triangle cell
+ * whose every blade projects within UG_CR_CAP pixels a side is drawn in
+ * compute (a fourth key of its block); payloads carry a triangle index
+ * below 1 << UG_CR_TBITS. */
+#define UG_CR_CAP    32
+#define UG_CR_CAP_S  "32"
+#define UG_CR_TBITS  4
+
+/* The vertex stage's fade and wind (the top comment), shared by the draw,
+ * the compute rasteriser and the probe pass so that the tests count what the draw keeps. */
+#define UG_GLSL_FUNCS \
+    "float ug_hash01(vec3 root) {\n" \
+    "    uint x = floatBitsToUint(root.x) * 0x9e3779b1u ^ floatBitsToUint(root.z) * 0x85ebca77u;\n" \
+    "    x ^= x >> 16; x *= 0x7feb352du; x ^= x >> 15; x *= 0x846ca68bu; x ^= x >> 16;\n" \
+    "    return float(x >> 8) * (1.0 / 16777216.0);\n" \
+    "}\n" \
+    "float ug_fade(float d, float r) {\n" \
+    "    float r1 = max(r - " UG_FADE_MARGIN_S ", 0.5 * r);\n" \
+    "    return 1.0 - smoothstep(" UG_FADE_START_S " * r1, r1, d);\n" \
+    "}\n" \
+    "float ug_far(float d, float r) {\n" \
+    "    float r1 = max(r - " UG_FADE_MARGIN_S ", 0.5 * r);\n" \
+    "    return smoothstep(0.35 * r1, 0.8 * r1, d);\n" \
+    "}\n" \
+    "float ug_fade_scale(vec3 root, float d, float r) {\n" \
+    "    return clamp((ug_fade(d, r) - ug_hash01(root)) * 5.0, 0.0, 1.0);\n" \
+    "}\n" \
+    "float ug_gust(vec2 xz, vec2 dir, float t) {\n" \
+    "    float along = dot(xz, dir), across = dot(xz, vec2(-dir.y, dir.x));\n" \
+    "    float p1 = 6.2831853 * fract(along / 24.0 - t / 5.7);\n" \
+    "    float p2 = 6.2831853 * fract(along / 9.1 + across / 37.0 - t / 2.3);\n" \
+    "    return 0.5 + 0.3 * sin(p1) + 0.2 * sin(p2);\n" \
+    "}\n" \
+    "vec3 ug_wind(vec3 root, float h, vec4 w, float t) {\n" \
+    "    h = max(h, 0.0);\n" \
+    "    float a = w.z * h * h * (1.0 - w.w + w.w * ug_gust(root.xz, w.xy, t));\n" \
+    "    return vec3(w.x * a, -min(0.5 * a * a / max(h, 1e-3), 0.5 * h), w.y * a);\n" \
+    "}\n"
+#define UG_FADE_MARGIN_S "12.0"   /* 0.75 CELL */
+#define UG_FADE_START_S "0.6"
 
 enum { CELL_FREE, CELL_PENDING, CELL_READY };
 
@@ -101,6 +142,20 @@ struct rt_ug {
     int                   key_block[UG_MAX_KEYS];   /* each key's block       */
     bool                  key_used[UG_MAX_KEYS];    /* it has entries         */
     bool                  mdraw_valid;         /* mdraw_host holds this frame's */
+    /* the compute rasteriser (undergrowth_craster.c; NULL pipes: off) */
+    bool                  compute;             /* asked for and possible     */
+    bool                  key_cs[UG_MAX_KEYS]; /* the key is drawn in compute */
+    float                 cr_proj[3];          /* pixels per unit at depth 1,
+                                                  cos of the half diagonal   */
+    int                   width, height_px;    /* the colour target's        */
+    const rt_image       *color, *depth;
+    VkSampler             cr_nearest;
+    VkDescriptorSetLayout set_cr;
+    VkPipelineLayout      cr_layout;
+    VkPipeline            cr_pipe[2];          /* depth and id, resolve      */
+    VkDescriptorSet       cr_set;
+    rt_buffer             zbuf, idbuf, cdisp, crtab, crstat, crstat_host;
+    bool                  cr_ran;              /* this frame's ran           */
     VkDescriptorSetLayout set_terrain;         /* set 0 of the mask pass     */
     VkDescriptorSetLayout set_mask, set_gen, set_draw, set_lod, set_cull, set_scan;
     VkPipelineLayout      mask_layout, gen_layout, draw_layout, lod_layout, cull_layout,
@@ -140,6 +195,24 @@ bool rt_ug_cull_pipelines(rt_ug *u, rt_error *e);
 /* This frame's keys and entries, then count, scan and write recorded
  * into cb, and the draws per key copied back for the stats. */
 void rt_ug_record_cull(rt_ug *u, VkCommandBuffer cb, const splat_frame *fr);
+
+/* ---- undergrowth_craster.c: the far blades in compute ------------------- */
+
+/* The compute rasteriser's pipelines, set and buffers (after make_buffers
+ * and make_textures; u->compute false leaves them unmade). */
+bool rt_ug_craster_create(rt_ug *u, rt_error *e);
+void rt_ug_craster_destroy(rt_ug *u);
+/* This frame's distance per block beyond which its single-triangle cells
+ * go to compute: fills u->cr_proj from the frame's projection. */
+void rt_ug_craster_frame(rt_ug *u, const splat_frame *fr);
+/* Whether a single-triangle cell of block b whose nearest point is `near`
+ * metres away (and its LOD fraction f) projects every blade within the cap. */
+bool rt_ug_craster_fits(const rt_ug *u, int b, double near, float f);
+/* After the graphics draw's render pass: the compute keys' blades
+ * rasterised against the depth (SHADER_READ_ONLY), resolved into the
+ * colour (left TRANSFER_SRC). */
+void rt_ug_craster_record(rt_ug *u, VkCommandBuffer cb, VkDescriptorSet set0c,
+                          VkDescriptorSet set1);
 
 /* ---- undergrowth_mesh.c: the block table and the far meshes ------------ */
 

@@ -30,7 +30,7 @@ if has frames; then
     run r2_blanca --pack $col --scene colorado --path ground --start 45000,47087,1,0 --variant s=screen $H
 fi
 if has ug; then
-    U="--variant s=screen --variant ug=screen,ug --variant ug300=screen,ug,ugradius=300 --variant ug400t=screen,ug,ugradius=400,ugthin=1000 --variant ug450t=screen,ug,ugradius=450,ugthin=1000"
+    U="--variant s=screen --variant ug=screen,ug --variant ug300=screen,ug,ugradius=300 --variant ug400t=screen,ug,ugradius=400,ugthin=1000 --variant ug450t=screen,ug,ugradius=450,ugthin=1000 --variant ug400tc=screen,ug,ugradius=400,ugthin=1000,ugcompute=1 --variant ug450tc=screen,ug,ugradius=450,ugthin=1000,ugcompute=1"
     run ug_walk --pack $col --scene colorado --path ground --start-preset meadow $U $H
     run ug_stand --pack $col --scene colorado --path ground --start-preset meadow $U --size 1920x1080 --frames 1 --warmup 3
 fi

@@ -41,7 +41,9 @@
  *       noshadow renders without the terrain's shadows (--no-shadows); ug
  *       draws the pack's undergrowth (off otherwise, so the other groups
  *       time what they always timed), ugradius=R within R metres of the
- *       camera instead of the runtime's 96, ugthin=D thins it (the distance
+ *       camera instead of the runtime's 96, ugcompute=1 draws the far
+ *       single-triangle blades in compute (runtime/undergrowth_craster.c;
+ *       ug_drawn_compute: how many of ug_drawn), ugthin=D thins it (the distance
  *       LOD's fraction (D / d)^2) from D metres instead of 14, the far
  *       meshes staying at 14 m (rt_render_desc.undergrowth_thin): its rows add
  *       the generation GPU ms per frame and per generated cell, the draw GPU
@@ -126,6 +128,7 @@ typedef struct variant {
     bool         ug;        /* draw the undergrowth                         */
     double       ug_radius; /* its radius (m); 0: the runtime's default     */
     double       ug_thin;   /* its thinning distance (m); 0: the runtime's  */
+    bool         ug_compute; /* far single-triangle blades drawn in compute */
     double       far;       /* screen: the far atlas's distance (m); 0: off */
     int          preview;   /* the preview scale (2, 4); 0: full resolution */
     double       shadow_ms; /* ms of the shadow map (the first frame)       */
@@ -366,6 +369,10 @@ static bool parse_variant(const char *s, const char *default_pack, variant *v)
             v->ug = true;
             v->ug_radius = atof(t + 9);
             ok = v->ug_radius > 0;
+        } else if (!strncmp(t, "ugcompute=", 10)) {
+            v->ug = true;
+            v->ug_compute = atoi(t + 10) != 0;
+            ok = !strcmp(t + 10, "0") || !strcmp(t + 10, "1");
         } else if (!strncmp(t, "ugthin=", 7)) {
             v->ug = true;
             v->ug_thin = atof(t + 7);
@@ -632,7 +639,7 @@ static bool make_renderer(bench_run *b, int i, const char *cache, rt_error *e)
         .no_distance_classes = v->no_dclass, .pixel_sort = v->sort,
         .async_pipelines = v->async,
         .sort_tiles = v->sort_tiles,
-        .undergrowth_radius = v->ug_radius, .undergrowth_thin = v->ug_thin, .far_atlas_distance = v->far,
+        .undergrowth_radius = v->ug_radius, .undergrowth_thin = v->ug_thin, .undergrowth_compute = v->ug_compute, .far_atlas_distance = v->far,
         .preview_scale = v->preview,
         .reference = v->k == K_MULTIPASS ? RT_REF_MULTIPASS
                    : v->k == K_UBER || v->k == K_SCREEN_UBER ? RT_REF_UBER : RT_REF_NONE,
@@ -767,7 +774,7 @@ static void csv_row(FILE *out, const bench_run *b, int i, const char *devname)
     const char *pk = strrchr(v->pack_dir, '/');
     fprintf(out, "\"%s\",%s,%s,%d,%d,%s,%s,%s,%g,%d,%.3f,%.3f,%.3f,%.3f,%.4f,%d,%d,"
                  "%.6g,%.6g,%.2f,%ld,%.1f,%s,%s,%.3f,%.3f,%.3f,%d,%d,%.4f,%.4f,%.3f,%.1f,"
-                 "%.2f,%.4f,%.4f,%.4f,%.2f,%ld,%zu,%g,%d,%d,%d,%.3f,%ld,%ld,%ld,%d,%.3f,%d,%d,%d\n",
+                 "%.2f,%.4f,%.4f,%.4f,%.2f,%ld,%zu,%g,%d,%d,%d,%.3f,%ld,%ld,%ld,%d,%.3f,%d,%d,%d,%ld\n",
             devname, o->scene ? o->scene : v->base->name, o->pd.name, o->width, o->height,
             v->label, kind_names[v->k], pk ? pk + 1 : v->pack_dir,
             v->lod > 0 ? v->lod : 3.0, frames, gm, g10, g90, cm, sm,
@@ -782,7 +789,8 @@ static void csv_row(FILE *out, const bench_run *b, int i, const char *devname)
             ugd, (double)v->ug_cells / frames, v->ug_last.instances,
             v->ug_last.bytes_per_cell, v->far, v->tiles.tiles_far, !v->no_dclass,
             v->tiles.tiles_class, procm, v->ug_last.candidates, v->ug_last.drawn, v->ug_last.triangles,
-            v->ug_last.draws, v->first_picture_s, v->stand_in[0], v->stand_in[1], v->stand_in[2]);
+            v->ug_last.draws, v->first_picture_s, v->stand_in[0], v->stand_in[1], v->stand_in[2],
+            v->ug_last.drawn_compute);
 }
 
 /* The rows, on stdout or appended to --csv (a header when it is new). */
@@ -809,7 +817,7 @@ static bool write_csv(const bench_run *b)
                      "ug_gen_med_ms,ug_gen_ms_per_cell,ug_draw_med_ms,ug_cells_per_frame,"
                      "ug_instances,ug_bytes_per_cell,far_distance,tiles_far,distclass,tiles_class,"
                      "proc_cpu_med_ms,ug_candidates,ug_drawn,ug_triangles,ug_draws,first_picture_s,"
-                     "stand_in_uber,stand_in_atlas,stand_in_flat\n");
+                     "stand_in_uber,stand_in_atlas,stand_in_flat,ug_drawn_compute\n");
     /* the device name in CSV: its commas become ';' */
     char devname[VK_MAX_PHYSICAL_DEVICE_NAME_SIZE];
     snprintf(devname, sizeof devname, "%s", b->dev.props.deviceName);

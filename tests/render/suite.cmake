@@ -184,7 +184,7 @@ if(TARGET splatrt AND TARGET splatview)
                          ENVIRONMENT "SPLAT_VALIDATE=1")
     # the lighting model against its double twin, on three paths, and the
     # terrain's shadows
-    foreach(t brdf shadow undergrowth ug_look ug_cull)
+    foreach(t brdf shadow undergrowth ug_look ug_cull ug_compute)
       add_executable(test_${t} ${RENDER_DIR}/test_${t}.c)
       target_link_libraries(test_${t} splat_testkit)
       file(MAKE_DIRECTORY ${RENDER_OUT}/${t})
@@ -193,6 +193,10 @@ if(TARGET splatrt AND TARGET splatview)
       set_tests_properties(render.${t} PROPERTIES LABELS render TIMEOUT 600
                            ENVIRONMENT "SPLAT_VALIDATE=1")
     endforeach()
+    # far undergrowth blades drawn in compute against the graphics path
+    # (test_ug_compute.c: one lavapipe thread, see there)
+    set_tests_properties(render.ug_compute PROPERTIES
+                         ENVIRONMENT "SPLAT_VALIDATE=1;LP_NUM_THREADS=1")
     # the shadow map marched on the device against the CPU reference within
     # 1/255: three suns and a crater (test_shadow_gpu.c)
     add_executable(test_shadow_gpu ${RENDER_DIR}/test_shadow_gpu.c)

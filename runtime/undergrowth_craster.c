@@ -1,0 +1,391 @@
+/* undergrowth_craster.c — far undergrowth blades drawn in compute, not
+ * through the graphics pipeline (issue 33: on the H100 the graphics front
+ * end paid about 23 ns an instance whatever its size, and a blade past
+ * 28 m is a few pixels).
+ *
+ * The cull passes give each opaque block whose far mesh has a
+ * single-triangle version a fourth key: its single-triangle cells whose
+ * every blade projects within UG_CR_CAP pixels a side
+ * (rt_ug_craster_fits: the cull's own bounding sphere at the cell's
+ * nearest point, seen at the corner of the view).  That key is not drawn;
+ * after the graphics draw, three compute passes over its instances (the
+ * cull's list, one thread per instance and triangle, an indirect dispatch
+ * the scan pass writes):
+ *   1. depth: each triangle's pixels (centres inside its edges, its
+ *      bounding box clipped to the cap: a blade beyond it is counted in
+ *      the stats' overflow, which the tests hold at 0) whose depth passes
+ *      the depth attachment's (the terrain's and the graphics blades',
+ *      reversed Z: greater is nearer) atomicMax their depth, as a uint
+ *      (positive floats order as their bits), into a per-pixel buffer;
+ *   2. id: the same pixels whose depth equals the buffer's atomicMin a
+ *      payload, the list position << UG_CR_TBITS | the triangle: the
+ *      nearest blade per pixel, ties to the lowest payload (the same on
+ *      every run, whatever the order the threads ran in);
+ *   3. resolve, a thread per pixel: where a payload landed, the blade's
+ *      three vertices again (the vertex stage's own transform: fade,
+ *      widening, wind, colour, ug_far), perspective-correct barycentrics
+ *      at the pixel's centre, the fragment stage's shading (texture by
+ *      analytic gradients, root darkening, splat_light), stored into the
+ *      colour; the two buffers are reset for the next frame on the way.
+ * The compute blades are not written into the depth attachment (nothing
+ * after the undergrowth reads it).  Contact shadows of the compute keys'
+ * instances stay on the graphics path.  Screen path only (the depth is
+ * sampled there); rt_render_desc.undergrowth_compute (splatbench
+ * ugcompute=1) turns it on. */
+#include "undergrowth_impl.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* Set 2 of the three passes (sets 0 and 1: the renderer's compute set 0
+ * and its material set, for the prelude's frame block and splat_light). */
+#define CR_GLSL_DECLS                                                                  \
+    "struct Inst { vec4 p; uvec4 q; };\n"                                              \
+    "layout(set = 2, binding = 0, std430) readonly buffer B { vec4 b[]; } u_blocks;\n" \
+    "layout(set = 2, binding = 1, std430) readonly buffer I { Inst v[]; } u_inst;\n"   \
+    "layout(set = 2, binding = 2, std430) readonly buffer F { float f[]; } u_lod;\n"   \
+    "layout(set = 2, binding = 3, std430) readonly buffer V { uint i[]; } u_vis;\n"    \
+    "layout(set = 2, binding = 4, std430) readonly buffer D { uint a[]; } u_md;\n"     \
+    "layout(set = 2, binding = 5, std430) readonly buffer VB { float f[]; } u_vb;\n"   \
+    "layout(set = 2, binding = 6, std430) readonly buffer IB { uint i[]; } u_ib;\n"    \
+    "layout(set = 2, binding = 7, std430) coherent buffer Z { uint z[]; } u_z;\n"      \
+    "layout(set = 2, binding = 8, std430) coherent buffer ID { uint i[]; } u_id;\n"    \
+    "layout(set = 2, binding = 9) uniform sampler2D u_zs;\n"                            \
+    "layout(set = 2, binding = 10) uniform sampler2D u_ugtex[" SPLAT_STR(SPLAT_MAX_UG_TEXTURES) "];\n" \
+    "layout(set = 2, binding = 11, std430) readonly buffer T { uvec4 t[]; } u_tri;\n"  \
+    "layout(set = 2, binding = 12, std430) buffer S { uint s[]; } u_stat;\n"
+
+/* u_push: patch_xz (radius, time, width, height), info (instances per
+ * cell, key, triangles per instance, the pass: 0 depth, 1 id). */
+static const char cr_glsl_main[] =
+    UG_GLSL_FUNCS
+    "struct UgV { vec4 clip; vec3 rel; vec3 color; vec3 nrm; vec3 tnrm; vec2 uv; float far; uint flags; };\n"
+    /* the vertex stage's transform (undergrowth_glsl.c rt_ug_draw_vert_main) */
+    "UgV ug_vertex(uint ii, Inst it, uint vi) {\n"
+    "    vec3 a_pos = vec3(u_vb.f[8u * vi], u_vb.f[8u * vi + 1u], u_vb.f[8u * vi + 2u]);\n"
+    "    vec3 a_nrm = vec3(u_vb.f[8u * vi + 3u], u_vb.f[8u * vi + 4u], u_vb.f[8u * vi + 5u]);\n"
+    "    vec2 a_uv = vec2(u_vb.f[8u * vi + 6u], u_vb.f[8u * vi + 7u]);\n"
+    "    uint bi = 5u * it.q.w;\n"
+    "    vec4 b0 = u_blocks.b[bi], b1 = u_blocks.b[bi + 1u], b4 = u_blocks.b[bi + 4u];\n"
+    "    uint flags = uint(u_blocks.b[bi + 2u].z);\n"
+    "    vec3 n = normalize(unpackSnorm4x8(it.q.x).xyz + vec3(0.0, 1e-4, 0.0));\n"
+    "    float a = uintBitsToFloat(it.q.z), c = cos(a), s = sin(a);\n"
+    "    float r = u_push.patch_xz.x, d = length(it.p.xz - u_frame.camera.xz);\n"
+    "    float grow = min(inversesqrt(u_lod.f[ii / u_push.info.x]), " LOD_GROW_S ");\n"
+    "    vec3 p = a_pos * it.p.w * ug_fade_scale(it.p.xyz, d, r) * vec3(grow, 1.0, grow);\n"
+    "    p = vec3(c * p.x + s * p.z, p.y, -s * p.x + c * p.z);\n"
+    "    vec3 m = vec3(c * a_nrm.x + s * a_nrm.z, a_nrm.y, -s * a_nrm.x + c * a_nrm.z);\n"
+    "    if ((flags & 4u) != 0u) {\n"
+    "        vec3 t = normalize(cross(n, vec3(0.0, 0.0, 1.0)));\n"
+    "        vec3 bt = cross(t, n);\n"
+    "        p = t * p.x + n * p.y + bt * p.z;\n"
+    "        m = t * m.x + n * m.y + bt * m.z;\n"
+    "    }\n"
+    "    p += ug_wind(it.p.xyz, p.y, u_blocks.b[bi + 3u], u_push.patch_xz.y);\n"
+    "    UgV o;\n"
+    "    o.rel = it.p.xyz + p - u_frame.camera.xyz;\n"
+    "    float far = ug_far(d, r);\n"
+    "    float share = mix(mix(b4.x, b0.w, clamp(a_uv.y, 0.0, 1.0)), 1.0, far);\n"
+    "    o.far = far;\n"
+    "    o.color = mix(b1.rgb, unpackUnorm4x8(it.q.y).rgb, share);\n"
+    "    o.nrm = (flags & 2u) != 0u ? n : m;\n"
+    "    o.tnrm = n;\n"
+    "    o.uv = a_uv;\n"
+    "    o.flags = flags;\n"
+    "    o.clip = u_frame.view_proj * vec4(o.rel, 1.0);\n"
+    "    return o;\n"
+    "}\n"
+    /* triangle t of list position j: its three vertices */
+    /* three variables, no array: nothing indexed at run time, so nothing in
+     * scratch memory (llvmpipe shared it between its threads) */
+    "void ug_tri(uint j, uint t, out UgV v0, out UgV v1, out UgV v2) {\n"
+    "    uint ii = u_vis.i[j];\n"
+    "    Inst it = u_inst.v[ii];\n"
+    "    uvec4 tm = u_tri.t[it.q.w];   /* index count, first index, vertex offset */\n"
+    "    uint i0 = tm.y + 3u * t;\n"
+    "    v0 = ug_vertex(ii, it, u_ib.i[i0] + tm.z);\n"
+    "    v1 = ug_vertex(ii, it, u_ib.i[i0 + 1u] + tm.z);\n"
+    "    v2 = ug_vertex(ii, it, u_ib.i[i0 + 2u] + tm.z);\n"
+    "}\n"
+    "vec2 ug_screen(vec4 c) { return (c.xy / c.w * 0.5 + 0.5) * u_push.patch_xz.zw; }\n"
+    "float ug_edge(vec2 a, vec2 b, vec2 p) { return (b.x - a.x) * (p.y - a.y) - (b.y - a.y) * (p.x - a.x); }\n"
+    "#ifndef UG_RESOLVE\n"
+    "void main() {\n"
+    "    uint g = gl_WorkGroupID.x * 64u + gl_LocalInvocationIndex;\n"
+    "    uint k = u_push.info.y, nt = u_push.info.z;\n"
+    "    uint cnt = u_md.a[5u * k + 1u], first = u_md.a[5u * k + 4u];\n"
+    "    if (g >= cnt * nt) return;\n"
+    "    uint j = first + g / nt, t = g % nt;\n"
+    "    UgV v0, v1, v2;\n"
+    "    ug_tri(j, t, v0, v1, v2);\n"
+    "    if (min(v0.clip.w, min(v1.clip.w, v2.clip.w)) <= 1e-4) return;\n"
+    "    vec2 s0 = ug_screen(v0.clip), s1 = ug_screen(v1.clip), s2 = ug_screen(v2.clip);\n"
+    "    vec3 z = vec3(v0.clip.z / v0.clip.w, v1.clip.z / v1.clip.w, v2.clip.z / v2.clip.w);\n"
+    "    float area = ug_edge(s0, s1, s2);\n"
+    "    if (abs(area) < 1e-12) return;\n"
+    "    vec2 lo = min(s0, min(s1, s2)), hi = max(s0, max(s1, s2));\n"
+    "    ivec2 size = ivec2(u_push.patch_xz.zw);\n"
+    "    ivec2 a = max(ivec2(ceil(lo - 0.5)), ivec2(0)), b = min(ivec2(floor(hi - 0.5)), size - 1);\n"
+    "    if (any(greaterThan(b - a, ivec2(" UG_CR_CAP_S " - 1)))) {\n"
+    "        if (u_push.info.w == 0u) atomicAdd(u_stat.s[0], 1u);\n"
+    "        b = min(b, a + " UG_CR_CAP_S " - 1);\n"
+    "    }\n"
+    "    float ia = 1.0 / area;\n"
+    "    uint payload = (j << " SPLAT_STR(UG_CR_TBITS) ") | t;\n"
+    "    for (int y = a.y; y <= b.y; y++)\n"
+    "        for (int x = a.x; x <= b.x; x++) {\n"
+    "            vec2 p = vec2(x, y) + 0.5;\n"
+    "            vec3 w = vec3(ug_edge(s1, s2, p), ug_edge(s2, s0, p), ug_edge(s0, s1, p)) * ia;\n"
+    "            if (min(w.x, min(w.y, w.z)) < 0.0) continue;\n"
+    "            float d = dot(w, z);\n"
+    "            if (!(d > texelFetch(u_zs, ivec2(x, y), 0).r) || d > 1.0) continue;\n"
+    "            uint at = uint(y) * uint(size.x) + uint(x), du = floatBitsToUint(d);\n"
+    /* one pipeline for both passes (u_push.info.w), so that the id pass
+     * computes the very depth the depth pass stored */
+    "            if (u_push.info.w == 0u) atomicMax(u_z.z[at], du);\n"
+    "            else if (u_z.z[at] == du) atomicMin(u_id.i[at], payload);\n"
+    "        }\n"
+    "}\n"
+    "#else\n"
+    /* the fragment stage's texture lookup (rt_ug_draw_frag_main), by gradients */
+    "vec4 ug_texture(uint t, vec2 uv, vec2 dx, vec2 dy) {\n"
+    "    switch (t) {\n"
+    "    case 1u: return textureGrad(u_ugtex[0], uv, dx, dy);\n"
+    "    case 2u: return textureGrad(u_ugtex[1], uv, dx, dy);\n"
+    "    case 3u: return textureGrad(u_ugtex[2], uv, dx, dy);\n"
+    "    case 4u: return textureGrad(u_ugtex[3], uv, dx, dy);\n"
+    "    case 5u: return textureGrad(u_ugtex[4], uv, dx, dy);\n"
+    "    case 6u: return textureGrad(u_ugtex[5], uv, dx, dy);\n"
+    "    case 7u: return textureGrad(u_ugtex[6], uv, dx, dy);\n"
+    "    case 8u: return textureGrad(u_ugtex[7], uv, dx, dy);\n"
+    "    }\n"
+    "    return vec4(1.0);\n"
+    "}\n"
+    /* perspective-correct barycentrics at screen point p */
+    "vec3 ug_bary(vec2 s0, vec2 s1, vec2 s2, vec3 iw, float ia, vec2 p) {\n"
+    "    vec3 w = vec3(ug_edge(s1, s2, p), ug_edge(s2, s0, p), ug_edge(s0, s1, p)) * ia * iw;\n"
+    "    return w / (w.x + w.y + w.z);\n"
+    "}\n"
+    "void main() {\n"
+    "    ivec2 px = ivec2(gl_GlobalInvocationID.xy), size = ivec2(u_push.patch_xz.zw);\n"
+    "    if (any(greaterThanEqual(px, size))) return;\n"
+    "    uint at = uint(px.y) * uint(size.x) + uint(px.x);\n"
+    "    if (u_push.info.w == 2u) {   /* the clear, before the depth pass */\n"
+    "        u_z.z[at] = 0u;\n"
+    "        u_id.i[at] = 0xffffffffu;\n"
+    "        return;\n"
+    "    }\n"
+    "    uint id = u_id.i[at];\n"
+    "    if (id == 0xffffffffu) return;\n"
+    "    UgV v0, v1, v2;\n"
+    "    ug_tri(id >> " SPLAT_STR(UG_CR_TBITS) ", id & ((1u << " SPLAT_STR(UG_CR_TBITS) "u) - 1u), v0, v1, v2);\n"
+    "    vec2 s0 = ug_screen(v0.clip), s1 = ug_screen(v1.clip), s2 = ug_screen(v2.clip);\n"
+    "    float area = ug_edge(s0, s1, s2), ia = 1.0 / area;\n"
+    "    vec3 iw = vec3(1.0 / v0.clip.w, 1.0 / v1.clip.w, 1.0 / v2.clip.w);\n"
+    "    vec2 p = vec2(px) + 0.5;\n"
+    "    vec3 w = ug_bary(s0, s1, s2, iw, ia, p);\n"
+    "    vec3 wx = ug_bary(s0, s1, s2, iw, ia, p + vec2(1.0, 0.0));\n"
+    "    vec3 wy = ug_bary(s0, s1, s2, iw, ia, p + vec2(0.0, 1.0));\n"
+    "    mat3x2 uvs = mat3x2(v0.uv, v1.uv, v2.uv);\n"
+    "    vec2 uv = uvs * w;\n"
+    "    vec2 dx = uvs * wx - uv, dy = uvs * wy - uv;\n"
+    /* a sliver's neighbours extrapolate wildly: at most the whole texture
+     * a pixel (its coarsest mip, as the hardware's quads reach there) */
+    "    dx = all(lessThan(abs(dx), vec2(1.0))) ? dx : vec2(1.0, 0.0);\n"
+    "    dy = all(lessThan(abs(dy), vec2(1.0))) ? dy : vec2(0.0, 1.0);\n"
+    "    vec3 rel = mat3(v0.rel, v1.rel, v2.rel) * w;\n"
+    "    vec3 color = mat3(v0.color, v1.color, v2.color) * w;\n"
+    "    vec3 gn = mat3(v0.nrm, v1.nrm, v2.nrm) * w;\n"
+    "    vec3 tn = mat3(v0.tnrm, v1.tnrm, v2.tnrm) * w;\n"
+    "    float far = dot(vec3(v0.far, v1.far, v2.far), w);\n"
+    "    uint flags = v0.flags;\n"
+    "    vec4 tex = ug_texture(flags >> 8, vec2(uv.x, 1.0 - uv.y), vec2(dx.x, -dx.y), vec2(dy.x, -dy.y));\n"
+    "    float dist = length(rel);\n"
+    "    vec3 vv = dist > 0.0 ? -rel / dist : vec3(0.0, 1.0, 0.0);\n"
+    "    vec3 n = normalize(gn);\n"
+    /* front facing: counter-clockwise in framebuffer coordinates (y down)
+     * is a negative edge area (the draw pipeline's front face) */
+    "    if ((flags & 2u) == 0u && !(area < 0.0)) n = -n;\n"
+    "    n = normalize(mix(n, normalize(tn), far));\n"
+    "    float ao = mix(mix(0.5, 1.0, clamp(uv.y, 0.0, 1.0)), 1.0, far);\n"
+    "    imageStore(u_out, px, vec4(splat_light(color * tex.rgb * ao, n, 0.9, dist, vv), 1.0));\n"
+    "    atomicAdd(u_stat.s[1], 1u);\n"
+    "}\n"
+    "#endif\n";
+
+bool rt_ug_craster_create(rt_ug *u, rt_error *e)
+{
+    if (!u->compute)
+        return true;
+    rt_device *d = u->d;
+    const VkShaderStageFlags cs = VK_SHADER_STAGE_COMPUTE_BIT;
+    const VkDescriptorType sb = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
+    const VkDescriptorType cis = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
+    VkDescriptorSetLayoutBinding b[13];
+    for (uint32_t i = 0; i < 13; i++)
+        b[i] = (VkDescriptorSetLayoutBinding){ i, sb, 1, cs, NULL };
+    b[9].descriptorType = cis;
+    b[10].descriptorType = cis;
+    b[10].descriptorCount = SPLAT_MAX_UG_TEXTURES;
+    size_t npx = (size_t)u->width * (size_t)u->height_px;
+    const VkBufferUsageFlags st = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
+    if (!rt_vk_set_layout(d, &u->keep, &(rt_vk_set_layout_desc){ "undergrowth compute raster", b, 13 },
+                          &u->set_cr, e))
+        return false;
+    VkDescriptorSetLayout sets[3] = { u->pl->set_terrain, u->pl->set_material, u->set_cr };
+    if (!rt_vk_layout(d, &u->keep, &(rt_vk_layout_desc){ .label = "undergrowth compute raster",
+                          .sets = sets, .nsets = 3, .push_stages = cs,
+                          .push_bytes = sizeof(splat_push) }, &u->cr_layout, e) ||
+        !rt_buffer_create(d, npx * 4, st | VK_BUFFER_USAGE_TRANSFER_DST_BIT, false, &u->zbuf, e) ||
+        !rt_buffer_create(d, npx * 4, st | VK_BUFFER_USAGE_TRANSFER_DST_BIT, false, &u->idbuf, e) ||
+        !rt_buffer_create(d, (VkDeviceSize)SPLAT_MAX_UG_BLOCKS * 16, st, true, &u->crtab, e) ||
+        !rt_buffer_create(d, 16, st | VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
+                          false, &u->crstat, e) ||
+        !rt_buffer_create(d, 16, VK_BUFFER_USAGE_TRANSFER_DST_BIT, true, &u->crstat_host, e))
+        return false;
+    memset(u->crstat_host.map, 0, 16);
+    uint32_t *tab = u->crtab.map;
+    for (int i = 0; i < u->nblocks; i++)
+        memcpy(tab + 4 * i, u->tri[i], sizeof u->tri[i]);
+    VkDescriptorPoolSize sizes[2] = { { sb, 11 }, { cis, 1 + SPLAT_MAX_UG_TEXTURES } };
+    VkDescriptorPool pool;
+    if (!rt_vk_sets(d, &u->keep, &(rt_vk_sets_desc){ .label = "undergrowth compute raster",
+                        .sizes = sizes, .nsizes = 2, .layouts = &u->set_cr, .nsets = 1 },
+                    &pool, &u->cr_set, e))
+        return false;
+    VkDescriptorImageInfo ti[SPLAT_MAX_UG_TEXTURES];
+    for (int i = 0; i < SPLAT_MAX_UG_TEXTURES; i++) {
+        int k = i < u->p->ug.ntextures ? i : SPLAT_MAX_UG_TEXTURES;
+        ti[i] = (VkDescriptorImageInfo){ u->tex_smp, u->tex[k].view,
+                                         VK_IMAGE_LAYOUT_SHADER_READ_ONLY_OPTIMAL };
+    }
+    rt_vk_write w[] = {
+        { u->cr_set, 0, sb, u->blocks.buf }, { u->cr_set, 1, sb, u->inst.buf },
+        { u->cr_set, 2, sb, u->lod.buf }, { u->cr_set, 3, sb, u->vis.buf },
+        { u->cr_set, 4, sb, u->mdraw.buf }, { u->cr_set, 5, sb, u->vbuf.buf },
+        { u->cr_set, 6, sb, u->ibuf.buf }, { u->cr_set, 7, sb, u->zbuf.buf },
+        { u->cr_set, 8, sb, u->idbuf.buf },
+        { u->cr_set, 9, cis, .sampler = u->cr_nearest, .view = u->depth->view },
+        { u->cr_set, 10, cis, .images = ti, .count = SPLAT_MAX_UG_TEXTURES },
+        { u->cr_set, 11, sb, u->crtab.buf }, { u->cr_set, 12, sb, u->crstat.buf },
+    };
+    rt_vk_write_sets(d, w, sizeof w / sizeof *w);
+    size_t n = strlen(SPLAT_GLSL_PRELUDE) + strlen(cr_glsl_main) + strlen(CR_GLSL_DECLS) + 128;
+    char *src = malloc(n);
+    if (!src)
+        return rt_fail(e, RT_E_VULKAN, "undergrowth", "out of memory");
+    bool ok = true;
+    static const char *const defs[2] = { "", "#define UG_RESOLVE 1\n" };
+    static const char *const labels[2] = { "undergrowth compute raster",
+                                           "undergrowth compute raster resolve" };
+    for (int k = 0; k < 2 && ok; k++) {
+        snprintf(src, n, "#version 450\n#define SPLAT_COMPUTE 1\n%s%s%s%s", defs[k],
+                 SPLAT_GLSL_PRELUDE, CR_GLSL_DECLS, cr_glsl_main);
+        ok = rt_vk_compute(d, &u->keep, &(rt_vk_compute_desc){ .label = labels[k], .glsl = src,
+                               .layout = u->cr_layout }, &u->cr_pipe[k], e);
+    }
+    free(src);
+    return ok;
+}
+
+void rt_ug_craster_destroy(rt_ug *u)
+{
+    rt_buffer *bufs[] = { &u->zbuf, &u->idbuf, &u->crtab, &u->crstat, &u->crstat_host };
+    for (size_t i = 0; i < sizeof bufs / sizeof *bufs; i++)
+        rt_buffer_destroy(u->d, bufs[i]);
+}
+
+void rt_ug_craster_frame(rt_ug *u, const splat_frame *fr)
+{
+    const float *m = fr->view_proj;   /* column-major: row r is m[r], m[4 + r], m[8 + r] */
+    double r0 = sqrt(m[0] * m[0] + m[4] * m[4] + m[8] * m[8]);
+    double r1 = sqrt(m[1] * m[1] + m[5] * m[5] + m[9] * m[9]);
+    double px = fmax(r0 * u->width * 0.5, r1 * u->height_px * 0.5);
+    double c = r0 > 0 && r1 > 0 ? 1.0 / sqrt(1.0 + 1.0 / (r0 * r0) + 1.0 / (r1 * r1)) : 0.0;
+    u->cr_proj[0] = (float)px;
+    u->cr_proj[1] = (float)c;
+}
+
+bool rt_ug_craster_fits(const rt_ug *u, int b, double near, float f)
+{
+    if (!u->compute || u->cr_proj[1] <= 0)
+        return false;
+    const float *bl = (const float *)u->blocks.map + 4 * UG_BLOCK_VEC4 * b;
+    double grow = f > 0 ? 1.0 / sqrt(f) : LOD_GROW;
+    grow = grow < 1.0 ? 1.0 : grow > LOD_GROW ? LOD_GROW : grow;
+    double h = bl[2] * bl[19];   /* the largest scale times the farthest vertex */
+    double rad = h * grow + bl[14] * h * h + 0.05;
+    double z = near * u->cr_proj[1] - rad;   /* the least view depth of the cell's spheres */
+    /* the sphere's diameter in pixels, two pixels' margin for the rounding */
+    return z > 0 && 2.0 * rad * u->cr_proj[0] / z <= UG_CR_CAP - 2;
+}
+
+void rt_ug_craster_record(rt_ug *u, VkCommandBuffer cb, VkDescriptorSet set0c, VkDescriptorSet set1)
+{
+    u->cr_ran = false;
+    bool any = false;
+    for (int k = 0; k < u->nkeys; k++)
+        any |= u->key_used[k] && u->key_cs[k];
+    if (!u->compute || !any)
+        return;
+    const VkPipelineStageFlags cs = VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT;
+    vkCmdFillBuffer(cb, u->crstat.buf, 0, 16, 0);
+    /* the fills, and the cull passes' list and draws (their own barrier
+     * reaches the graphics stages only) */
+    rt_cmd_barrier(cb, VK_PIPELINE_STAGE_TRANSFER_BIT | cs,
+                   VK_ACCESS_TRANSFER_WRITE_BIT | VK_ACCESS_SHADER_WRITE_BIT, cs,
+                   VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
+    /* the draw's depth and colour writes before the passes read them; the
+     * colour to GENERAL for the resolve's stores */
+    rt_cmd_barrier(cb, VK_PIPELINE_STAGE_LATE_FRAGMENT_TESTS_BIT | VK_PIPELINE_STAGE_EARLY_FRAGMENT_TESTS_BIT,
+                   VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT, cs, VK_ACCESS_SHADER_READ_BIT);
+    rt_cmd_image_barrier(cb, u->color->img, 0, 1, 1, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+                         VK_IMAGE_LAYOUT_GENERAL, VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT,
+                         VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT, cs);
+    VkDescriptorSet sets[3] = { set0c, set1, u->cr_set };
+    vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, u->cr_layout, 0, 3, sets, 0, NULL);
+    splat_push push = { .patch_xz = { (float)u->radius, (float)u->time, (float)u->width,
+                                      (float)u->height_px },
+                        .info = { u->cap, 0, 0, 0 } };
+    /* the clear: the resolve's pipeline, pass 2 */
+    vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, u->cr_pipe[1]);
+    push.info[3] = 2;
+    vkCmdPushConstants(cb, u->cr_layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof push, &push);
+    vkCmdDispatch(cb, ((uint32_t)u->width + 7) / 8, ((uint32_t)u->height_px + 7) / 8, 1);
+    rt_cmd_barrier(cb, cs, VK_ACCESS_SHADER_WRITE_BIT, cs,
+                   VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
+    vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, u->cr_pipe[0]);
+    for (int pass = 0; pass < 2; pass++) {
+        push.info[3] = (uint32_t)pass;
+        for (int k = 0; k < u->nkeys; k++) {
+            if (!u->key_used[k] || !u->key_cs[k])
+                continue;
+            push.info[1] = (uint32_t)k;
+            push.info[2] = u->tri[u->key_block[k]][0] / 3;
+            vkCmdPushConstants(cb, u->cr_layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof push, &push);
+            vkCmdDispatchIndirect(cb, u->cdisp.buf, 12 * (VkDeviceSize)k);
+        }
+        rt_cmd_barrier(cb, cs, VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_SHADER_READ_BIT, cs,
+                       VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
+    }
+    vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, u->cr_pipe[1]);
+    push.info[3] = 1;
+    vkCmdPushConstants(cb, u->cr_layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof push, &push);
+    vkCmdDispatch(cb, ((uint32_t)u->width + 7) / 8, ((uint32_t)u->height_px + 7) / 8, 1);
+    rt_cmd_image_barrier(cb, u->color->img, 0, 1, 1, VK_IMAGE_LAYOUT_GENERAL,
+                         VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL, VK_ACCESS_SHADER_WRITE_BIT,
+                         VK_ACCESS_TRANSFER_READ_BIT | VK_ACCESS_SHADER_READ_BIT |
+                             VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT,
+                         cs, VK_PIPELINE_STAGE_TRANSFER_BIT | cs | VK_PIPELINE_STAGE_FRAGMENT_SHADER_BIT |
+                                 VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT);
+    /* the stats */
+    rt_cmd_barrier(cb, cs, VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_TRANSFER_BIT,
+                   VK_ACCESS_TRANSFER_READ_BIT);
+    VkBufferCopy all = { 0, 0, 16 };
+    vkCmdCopyBuffer(cb, u->crstat.buf, u->crstat_host.buf, 1, &all);
+    rt_cmd_barrier(cb, VK_PIPELINE_STAGE_TRANSFER_BIT, VK_ACCESS_TRANSFER_WRITE_BIT,
+                   VK_PIPELINE_STAGE_HOST_BIT, VK_ACCESS_HOST_READ_BIT);
+    u->cr_ran = true;
+}
