@@ -577,6 +577,18 @@ const char SPLAT_GLSL_PRELUDE[] =
     "    splat_layer_bits |= 1u << (j & 31u);\n"
     "    return false;\n"
     "}\n"
+    "#elif defined(SPLAT_COUNT)\n"
+    /* the counting variant: the layer whose block runs, for the layers
+     * view's per-pixel set (splat_count_layer) */
+    "uint splat_cur_layer = 0xffffffffu;\n"
+    "bool splat_surface(uint j, bool c) {\n"
+    "    splat_cur_layer = j;\n"
+    "    return splat_quad_any(c);\n"
+    "}\n"
+    "bool splat_opaque(uint j) {\n"
+    "    splat_cur_layer = j;\n"
+    "    return true;\n"
+    "}\n"
     "#else\n"
     "#define splat_surface(j, c) splat_quad_any(c)\n"
     "#define splat_opaque(j) true\n"
@@ -785,7 +797,19 @@ const char SPLAT_GLSL_PRELUDE[] =
     "#endif\n"
     /* The counting variant's hooks (abi.h); nothing elsewhere. */
     "#if defined(SPLAT_COUNT)\n"
+    /* the layers view: the set of layers the pixel needs (weight > 0),
+     * layer j as bit j (48 and up as bit 47); a flat composite has no
+     * layer blocks, its layers come in order */
+    "uint splat_need_lo = 0u, splat_need_hi = 0u;\n"
     "void splat_count_layer(float w) {\n"
+    "#ifndef SPLAT_SORT\n"
+    "    uint j = splat_cur_layer != 0xffffffffu ? splat_cur_layer : splat_n_evaluated;\n"
+    "    splat_cur_layer = 0xffffffffu;\n"
+    "    if (w > 0.0) {\n"
+    "        if (j < 24u) splat_need_lo |= 1u << j;\n"
+    "        else splat_need_hi |= 1u << min(j - 24u, 23u);\n"
+    "    }\n"
+    "#endif\n"
     "    splat_n_evaluated += 1u;\n"
     "    if (w > 0.0) splat_n_needed += 1u;\n"
     "}\n"
@@ -819,8 +843,18 @@ const char SPLAT_GLSL_PRELUDE[] =
     "}\n"
     "#if defined(SPLAT_COUNT)\n"
     "vec3 splat_cost_color() { return splat_heat(float(splat_n_samples)); }\n"
+    /* The layers view (counting variant, read back as floats, exact to
+     * 2^24): r layers 0-23 of the needed set, g layers 24-47, b 256 times
+     * 16 plus the combination (push info.y), plus the layers this pixel's
+     * lane evaluated (its subgroup ran them; at most 255);
+     * tests/bench/bench_lanes.c predicts other lane assignments from it */
+    "vec3 splat_layers_color() {\n"
+    "    return vec3(float(splat_need_lo), float(splat_need_hi),\n"
+    "                256.0 * float(16u + u_push.info.y) + float(min(splat_n_evaluated, 255u)));\n"
+    "}\n"
     "#else\n"
     "vec3 splat_cost_color() { return splat_heat(0.0); }\n"
+    "vec3 splat_layers_color() { return vec3(0.0); }\n"
     "#endif\n"
     "#ifdef SPLAT_PAINTED_SPARSE\n"
     SPARSE_GLSL_FUNCTIONS

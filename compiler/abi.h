@@ -149,6 +149,12 @@
  *   reads.  The cost view's row (SPLAT_VIEWS) writes splat_cost_color():
  *   those samples as a heat colour (splat_heat: 0 black, 4 blue, 8 green,
  *   16 yellow, 32 red, 64+ white), black outside the counting variant.
+ *   The layers view's row writes splat_layers_color(), numbers to read
+ *   back rather than a picture: the set of layers the pixel needs
+ *   (layer j as bit j, r bits 0-23, g bits 24-47) and in b 256 times 16
+ *   plus its combination, plus the layers its lane evaluated (at most
+ *   255), from which splatbench --lanes predicts
+ *   the efficiency of other subgroup sizes and pixel-to-lane assignments.
  *
  * ---- undergrowth masks (seed 000 §5.5) ----------------------
  * A combination holding undergrowth-bearing materials also comes as an
@@ -401,7 +407,8 @@ static inline uint32_t splat_ug_pool(double radius)
     X(MASK,   5, "mask",   '7', NONE,   COMPOSITE, "vec3(0.0)") /* material view.y */  \
     X(ALBEDO, 6, "albedo", '6', SRGB,   ALL,       "albedo")                           \
     X(TILES,  7, "tiles",  '8', NONE,   FORWARD,   "splat_tile_color()")               \
-    X(COST,   8, "cost",   '9', NONE,   FORWARD,   "splat_cost_color()")
+    X(COST,   8, "cost",   '9', NONE,   FORWARD,   "splat_cost_color()")               \
+    X(LAYERS, 9, "layers", '0', NONE,   FORWARD,   "splat_layers_color()")
 
 typedef enum splat_view {
 #define X(id, num, ...) SPLAT_VIEW_##id = num,

@@ -143,7 +143,7 @@ static void plan_multipass(rt_plan *pl)
 unsigned rt_render_compute_variant(const rt_renderer *r)
 {
     return (r->view != SPLAT_VIEW_FINAL ? RT_CVARIANT_DEBUG : 0) |
-           (r->counting || r->view == SPLAT_VIEW_COST ? RT_CVARIANT_COUNT : 0) |
+           (r->counting || r->view == SPLAT_VIEW_COST || r->view == SPLAT_VIEW_LAYERS ? RT_CVARIANT_COUNT : 0) |
            (r->screen && rt_screen_sorting(r->screen) ? RT_CVARIANT_SORT : 0);
 }
 
@@ -162,7 +162,7 @@ void rt_render_setup(const rt_renderer *r, rt_frame_setup *fs)
     fs->split = !fs->screen && r->desc.split_uncovered;
     fs->composites = r->desc.reference != RT_REF_UBER && r->view != SPLAT_VIEW_MASK;
     /* the multi-pass reference has no counting variant */
-    fs->count = (r->counting || r->view == SPLAT_VIEW_COST) && !fs->screen &&
+    fs->count = (r->counting || r->view == SPLAT_VIEW_COST || r->view == SPLAT_VIEW_LAYERS) && !fs->screen &&
                 r->d->count_fragments && !fs->multipass;
     fs->raycast = fs->screen && rt_screen_raycasting(r->screen);
     fs->sky = !fs->screen && !fs->multipass && rt_render_sky_drawn(r);

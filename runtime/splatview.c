@@ -609,7 +609,7 @@ static bool print_counts(rt_renderer *r, const rt_camera *cam, splat_view view, 
     rt_frame_stats cs;
     if (!rt_renderer_frame(r, cam, &cs, e))
         return false;
-    rt_renderer_set_counting(r, view == SPLAT_VIEW_COST);
+    rt_renderer_set_counting(r, view == SPLAT_VIEW_COST || view == SPLAT_VIEW_LAYERS);
     double px = cs.tiles.pixels ? (double)cs.tiles.pixels : 1.0;
     printf("layers per pixel: evaluated %.3f, needed %.3f (efficiency %.1f %%)\n",
            cs.tiles.layers_evaluated / px, cs.tiles.layers_needed / px,
@@ -808,7 +808,7 @@ static int headless(const opts *o)
                       .ug_draw = times + 6 * o->frames };
     rt_frame_stats st = { 0 };
     /* the cost view needs the counting variant's counters */
-    rt_renderer_set_counting(r, view == SPLAT_VIEW_COST);
+    rt_renderer_set_counting(r, view == SPLAT_VIEW_COST || view == SPLAT_VIEW_LAYERS);
     rt_renderer_set_pass_times(r, o->print_plan && o->stats);
     bool ran = run_frames(o, r, &cam, &t, &st, &e);
     rt_pack_info_get(pack, &pi);   /* before --stats' counting frame reads more */

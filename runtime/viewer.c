@@ -8,7 +8,7 @@
  * Keys: W/A/S/D move, Space/Ctrl up/down, mouse with the right button
  * held looks around, wheel changes speed, 1 final, 2 combinations, 3 LOD,
  * 4 normal, 5 slope, 6 albedo, 7 mask (again: next material), 8 tiles,
- * 9 cost, F wireframe, G forward / screen-space shading, R rebuild now,
+ * 9 cost, 0 layers, F wireframe, G forward / screen-space shading, R rebuild now,
  * J/L/I/K the sun, +/- exposure, O shadows, U undergrowth, P the preview
  * scale (1, 1/2, 1/4: upscale.c), H the on-screen
  * help (overlay.c: these keys, the view, path, frame rate and shaders

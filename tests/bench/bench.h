@@ -1,7 +1,8 @@
 /* bench.h — splatbench (tests/bench), split by job: the render command
  * and its variants and camera paths (splatbench.c), the device benchmarks
  * far-bake and shadow (bench_device.c), the file tools upscale,
- * analytic-hf and compare (bench_tools.c), and the helpers they share
+ * analytic-hf and compare (bench_tools.c), the lane assignments' predicted
+ * layer efficiency (bench_lanes.c), and the helpers they share
  * (bench_util.c). */
 #ifndef SPLAT_BENCH_H
 #define SPLAT_BENCH_H
@@ -12,6 +13,7 @@
 
 #include <stdbool.h>
 #include <stddef.h>
+#include <stdio.h>
 #include <stdint.h>
 
 /* ---- bench_util.c ---------------------------------------------------------- */
@@ -38,6 +40,15 @@ double err_psnr(const err_acc *a);     /* peak 1; 999 when equal */
 /* The analytic heightfield: normalised height at heightfield uv (u, v),
  * within 0.1 .. 0.9 (the reference of the normal-filter knob). */
 double analytic_height(double u, double v);
+
+/* ---- bench_lanes.c --------------------------------------------------------- */
+
+/* Layer efficiency predicted for subgroups of 8, 32 and 64 lanes and
+ * several pixel-to-lane assignments, from a w x h RGBA float image of the
+ * layers view (abi.h SPLAT_VIEW_LAYERS); prev: the frame before, or NULL.
+ * Lines "lanes LABEL: ..." on out. */
+void   lanes_predict(FILE *out, const char *label, const float *rgba, const float *prev,
+                     int w, int h);
 
 /* ---- the commands: argv[1] is the command's name; exit status ------------- */
 

@@ -70,6 +70,11 @@
  *       the device allows, 16 on GPUs and lavapipe);
  *       the kinds that recompile the composites (flat fp16 sobel analytic
  *       lambert) always run without them.
+ *       --lanes (screen kinds, unsorted, full size) renders the path's last
+ *       two frames again in the layers view and prints, per variant, the
+ *       layer efficiency measured on this device beside the efficiency
+ *       predicted for subgroups of 8, 32 and 64 lanes and other pixel
+ *       orders within the 8x8 tile (bench_lanes.c), lines "lanes LABEL:".
  *       Paths (--path): ground (2 m above the terrain looking 150 m ahead,
  *       from --start-preset NAME or --start x,z,dx,dz), topdown, grazing,
  *       preset (--start-preset NAME's camera itself, still).
@@ -500,6 +505,7 @@ typedef struct render_opts {
     int         width, height, frames, warmup;   /* warmup -1: the whole path */
     const char *specs[128];                      /* --variant LABEL=KIND,...  */
     int         nspecs;
+    bool        lanes;                           /* --lanes                   */
 } render_opts;
 
 static bool parse_start(const char *v, void *o_, splat_arg_why *why)
@@ -557,6 +563,8 @@ static const splat_arg render_rows[] = {
       "of stdout", F(csv) },
     { "--scene", SPLAT_ARG_STRING, "NAME", "the scene column (default the pack's name)",
       F(scene) },
+    { "--lanes", SPLAT_ARG_FLAG, NULL, "screen kinds: print the layer efficiency predicted "
+      "for 8, 32 and 64 lanes per subgroup and other pixel orders (bench_lanes.c)", F(lanes) },
     { "--save", SPLAT_ARG_STRING, "DIR", "write each variant's last frame as DIR/LABEL.f32 "
       "and keep a pipeline cache there", F(save) },
 };
@@ -748,6 +756,40 @@ static bool counting_frames(bench_run *b, rt_error *e)
     return true;
 }
 
+/* --lanes: per screen variant, the layers view (abi.h SPLAT_VIEW_LAYERS)
+ * of the path's last two frames, and the efficiencies bench_lanes.c
+ * predicts from them, on stdout; the view is put back after. */
+static bool lanes_frames(bench_run *b, rt_error *e)
+{
+    const render_opts *o = b->o;
+    float *prev = xcalloc(b->npx * 4, sizeof *prev);
+    bool ok = true;
+    for (int i = 0; i < b->nv && ok; i++) {
+        variant *v = &b->v[i];
+        if (!IS_SCREEN(v->k) || v->preview > 1 || v->sort == RT_SORT_ON)
+            continue;   /* the sorted variant records no sets */
+        splat_view view;
+        int material = 0;
+        ok = rt_parse_view(o->view_name, &v->view, &view, &material, e);
+        rt_renderer_set_view(v->r, SPLAT_VIEW_LAYERS, 0);
+        rt_renderer_set_counting(v->r, true);
+        int first = o->frames >= 2 ? o->frames - 2 : o->frames - 1;
+        for (int f = first; f < o->frames && ok; f++) {
+            rt_camera cam;
+            rt_frame_stats st;
+            ok = path_camera(&b->packs[0], &o->pd, f, o->frames, &cam) &&
+                 rt_renderer_frame(v->r, &cam, &st, e) &&
+                 rt_renderer_read(v->r, f == o->frames - 1 ? b->img : prev, e);
+        }
+        if (ok)
+            lanes_predict(stdout, v->label, b->img, first < o->frames - 1 ? prev : NULL,
+                          o->width, o->height);
+        rt_renderer_set_view(v->r, view, material);
+    }
+    free(prev);
+    return ok;
+}
+
 /* One CSV row of variant i. */
 static void csv_row(FILE *out, const bench_run *b, int i, const char *devname)
 {
@@ -866,7 +908,7 @@ static int cmd_render(int argc, char **argv)
     for (int f = 0; f < o.frames; f++)
         if (!timed_frame(&b, f, &e))
             goto done;
-    if (counting_frames(&b, &e) && write_csv(&b))
+    if (counting_frames(&b, &e) && (!o.lanes || lanes_frames(&b, &e)) && write_csv(&b))
         status = 0;
 done:
     if (e.msg)

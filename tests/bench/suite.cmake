@@ -6,13 +6,22 @@
 if(TARGET splatrt AND TARGET splatview AND TARGET splatc_cli)
   add_executable(splatbench ${CMAKE_CURRENT_LIST_DIR}/splatbench.c
                  ${CMAKE_CURRENT_LIST_DIR}/bench_util.c ${CMAKE_CURRENT_LIST_DIR}/bench_tools.c
-                 ${CMAKE_CURRENT_LIST_DIR}/bench_device.c)
+                 ${CMAKE_CURRENT_LIST_DIR}/bench_device.c ${CMAKE_CURRENT_LIST_DIR}/bench_lanes.c)
   target_link_libraries(splatbench splatrt)
   add_test(NAME bench.smoke
     COMMAND sh ${CMAKE_CURRENT_LIST_DIR}/run.sh ${CMAKE_BINARY_DIR} --smoke
             --out ${CMAKE_BINARY_DIR}/tests/bench/smoke
     WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
   set_tests_properties(bench.smoke PROPERTIES LABELS bench TIMEOUT 600)
+  # splatbench --lanes (bench_lanes.c): its model of subgroup efficiency
+  # against the device's own counters, on the render tests' minimal pack
+  if(TARGET splatc_cli)
+    add_test(NAME bench.lanes
+      COMMAND sh ${CMAKE_CURRENT_LIST_DIR}/lanes_check.sh $<TARGET_FILE:splatbench>
+              ${CMAKE_BINARY_DIR}/tests/render/minimal ${CMAKE_BINARY_DIR}/tests/bench/lanes)
+    set_tests_properties(bench.lanes PROPERTIES LABELS render TIMEOUT 300
+      FIXTURES_REQUIRED minimal_pack ENVIRONMENT "SPLAT_VALIDATE=1")
+  endif()
 endif()
 
 # The scaled-down synthetic world (gen_world.c: B biomes x M materials with
