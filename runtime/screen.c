@@ -25,7 +25,9 @@
  * first use: a list that gets tiles but has no pipeline yet is compiled
  * after the frame and the frame is drawn again (rt_screen_missing), so a
  * returned frame is always complete and the steady state reads back only
- * the list counts. */
+ * the list counts.  The classification visits the tiles by rows, or in
+ * 4x4 blocks of tiles (rt_screen_tile_blocks), so a list's consecutive
+ * tiles, a sorting workgroup's 16, lie together; pictures do not change. */
 #include "rt_internal.h"
 #include "vk_build.h"
 #include "screen_glsl.h"

@@ -108,6 +108,11 @@ stood=$(sed -n 's/^pipelines pending: [0-9]* (tiles the uber-shader stood in for
 # picture as the one CPU drivers run (an invocation per tile)
 SPLAT_CLASSIFY=wide run "$PACK" --headless $SIZE $c --shading screen --float-out "$OUT/wide.f32"
 "$IC" diff "$OUT/$1.s.f32" "$OUT/wide.f32" 0 || fail "the two classifications differ"
+# both in 4x4 blocks of tiles (--tile-order blocks; the unsorted run below)
+SPLAT_CLASSIFY=wide run "$PACK" --headless $SIZE $c --shading screen --tile-order blocks \
+    --float-out "$OUT/wide_blocks.f32"
+"$IC" diff "$OUT/$1.s.f32" "$OUT/wide_blocks.f32" 0 ||
+    fail "the classification a workgroup per tile in 4x4 blocks changed the picture"
 # pixel sorting (abi.h SPLAT_SORT; off unless asked): the
 # same picture to the bit, as each pixel is computed the same whichever
 # lane computes it; the same layers needed per pixel, and no more
