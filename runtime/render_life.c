@@ -458,6 +458,7 @@ static bool make_pack_objects(rt_renderer *r, bool screen, rt_error *e)
     }
     if (r->screen) {
         rt_screen_far(r->screen, r->desc.far_atlas_distance);
+        rt_screen_tile_blocks(r->screen, r->desc.tile_blocks);
         r->pl.sort_tiles = rt_screen_sort_tiles(r->screen);
     }
     return true;

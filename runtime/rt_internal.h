@@ -873,6 +873,10 @@ bool rt_screen_raycasting(const rt_screen *s);
 bool rt_screen_sorting(const rt_screen *s);
 /* Tiles per sorting workgroup (abi.h SPLAT_SORT_TILES); 0 when not sorting. */
 int rt_screen_sort_tiles(const rt_screen *s);
+/* The classification's tile order: rows of tiles (false, the default) or
+ * 4x4 blocks of tiles, block after block (rt_render_desc.tile_blocks); the
+ * lists then hold neighbours one after another.  Pictures do not change. */
+void rt_screen_tile_blocks(rt_screen *s, bool on);
 void rt_screen_raycast(rt_screen *s, VkCommandBuffer cb, VkDescriptorSet set0);
 /* After the shading, when ray casting: the ray-cast depth copied into
  * `depth` (D32, through a buffer: a colour image cannot be copied into a

@@ -25,7 +25,9 @@
  * first use: a list that gets tiles but has no pipeline yet is compiled
  * after the frame and the frame is drawn again (rt_screen_missing), so a
  * returned frame is always complete and the steady state reads back only
- * the list counts. */
+ * the list counts.  The classification visits the tiles by rows, or in
+ * 4x4 blocks of tiles (rt_screen_tile_blocks), so a list's consecutive
+ * tiles, a sorting workgroup's 16, lie together; pictures do not change. */
 #include "rt_internal.h"
 #include "vk_build.h"
 #include "screen_glsl.h"
@@ -74,6 +76,8 @@ struct rt_screen {
     bool                  wide;              /* classification: a workgroup
                                                 per tile (GPUs), else an
                                                 invocation per tile (CPUs)   */
+    bool                  blocks;            /* tiles classified in 4x4
+                                                blocks (rt_screen_tile_blocks) */
     /* the classification's view (rt_class_view): recomputed where the
      * selection's materials change, uploaded each frame */
     VkPipeline            classify1;         /* WORDS 1: <= 32 in view; NULL:
@@ -750,6 +754,7 @@ void rt_screen_classify(rt_screen *s, VkCommandBuffer cb, VkDescriptorSet set0,
     float fd = s->far_ok && !force_uber ? s->far_distance : 0.0f;
     memcpy(&push.info[1], &fd, sizeof fd);
     push.info[2] = no_classes;
+    push.info[3] = s->blocks;   /* the tile order */
     const rt_pack *p = s->p;
     float rect[4] = { 1.0f, 1.0f, 0.0f, 0.0f };   /* empty */
     if (p->has_destruction) {
@@ -760,10 +765,13 @@ void rt_screen_classify(rt_screen *s, VkCommandBuffer cb, VkDescriptorSet set0,
     }
     memcpy(push.patch_uv, rect, sizeof rect);
     vkCmdPushConstants(cb, s->layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof push, &push);
+    /* in blocks: padded to whole 4x4 blocks of tiles */
+    uint32_t bx = ((uint32_t)s->tiles_x + 3) / 4 * 4, by = ((uint32_t)s->tiles_y + 3) / 4 * 4;
     if (s->wide)
-        vkCmdDispatch(cb, (uint32_t)s->tiles_x, (uint32_t)s->tiles_y, 1);
+        vkCmdDispatch(cb, s->blocks ? bx : (uint32_t)s->tiles_x,
+                      s->blocks ? by : (uint32_t)s->tiles_y, 1);
     else
-        vkCmdDispatch(cb, (uint32_t)(s->ntiles + 63) / 64, 1, 1);
+        vkCmdDispatch(cb, ((s->blocks ? bx * by : (uint32_t)s->ntiles) + 63) / 64, 1, 1);
     (*binds)++;
     if (!s->sort)
         return;   /* the shading's wait for the lists: render_plan.c */
@@ -886,6 +894,8 @@ bool rt_screen_dispatch(rt_screen *s, VkCommandBuffer cb, rt_pipelines *pl,
     }
     return true;
 }
+
+void rt_screen_tile_blocks(rt_screen *s, bool on) { s->blocks = on; }
 
 bool rt_screen_far_on(const rt_screen *s) { return s->far_ok && s->far_distance > 0; }
 

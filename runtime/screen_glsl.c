@@ -131,6 +131,17 @@ const char rt_screen_classify_glsl[] =
     "        if (usable(cand(i))) return cand(i);\n"
     "    return u_info.ncombos;\n"
     "}\n"
+    /* The tile order (push info.w 1, rt_render_desc.tile_blocks): the
+     * dispatch's n-th tile in blocks of 4x4 tiles, block after block along
+     * rows of blocks, so the tiles a list gets one after another lie close
+     * together (a sorting workgroup's 16, the shading's neighbours);
+     * false past the screen's tiles (the dispatch is padded to whole
+     * blocks).  The tiles and what each is given do not change. */
+    "bool block_tile(uint n, out uvec2 tile) {\n"
+    "    uint bx = (u_info.tiles_x + 3u) / 4u, b = n / 16u, i = n % 16u;\n"
+    "    tile = uvec2((b % bx) * 4u + (i & 3u), (b / bx) * 4u + (i >> 2u));\n"
+    "    return tile.x < u_info.tiles_x && tile.y < (uint(u_frame.screen.y) + 7u) / 8u;\n"
+    "}\n"
     /* a tile wholly beyond the far distance (info.y, float bits; 0: off)
      * goes to the far atlas's list */
     "bool far_tile() {\n"
@@ -164,9 +175,12 @@ const char rt_screen_classify_glsl[] =
     "        s_dfar = floatBitsToUint(3.0e38);\n"
     "        s_first = 0xffffffffu;\n"
     "    }\n"
+    "    uvec2 tile = gl_WorkGroupID.xy;\n"
+    "    if (u_push.info.w != 0u &&\n"   /* uniform: the whole workgroup */
+    "        !block_tile(gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x, tile))\n"
+    "        return;\n"
     "    for (int w = 0; w < WORDS; w++) mask[w] = 0u;\n"
     "    barrier();\n"
-    "    uvec2 tile = gl_WorkGroupID.xy;\n"
     "    ivec2 px = ivec2(tile * 8u + uvec2(li & 7u, li >> 3u));\n"
     "    if (all(lessThan(px, ivec2(u_frame.screen.xy)))) pixel(px);\n"
     "    for (int w = 0; w < WORDS; w++) {\n"
@@ -195,8 +209,7 @@ const char rt_screen_classify_glsl[] =
     /* CPU drivers (lavapipe): one invocation per tile, no shared memory
      * and no barriers, which they pay for dearly */
     "layout(local_size_x = 64) in;\n"
-    "void classify(uint t) {\n"
-    "    uvec2 tile = uvec2(t % u_info.tiles_x, t / u_info.tiles_x);\n"
+    "void classify(uvec2 tile) {\n"
     "    for (int w = 0; w < WORDS; w++) mask[w] = 0u;\n"
     "    ivec2 size = ivec2(u_frame.screen.xy);\n"
     "    for (int y = 0; y < 8; y++)\n"
@@ -209,7 +222,12 @@ const char rt_screen_classify_glsl[] =
     /* every invocation reaches append's subgroup loop or none past it */
     "void main() {\n"
     "    uint t = gl_GlobalInvocationID.x;\n"
-    "    if (t < u_info.ntiles) classify(t);\n"
+    "    uvec2 tile;\n"
+    "    if (u_push.info.w != 0u) {\n"
+    "        if (block_tile(t, tile)) classify(tile);\n"
+    "    } else if (t < u_info.ntiles) {\n"
+    "        classify(uvec2(t % u_info.tiles_x, t / u_info.tiles_x));\n"
+    "    }\n"
     "}\n"
     "#endif\n";
 

@@ -314,6 +314,11 @@ typedef struct rt_render_desc {
     rt_pixel_sort pixel_sort;       /* screen path: pixels sorted by layer set */
     int          sort_tiles;        /* tiles a sorting workgroup takes (4, 8
                                        or 16); 0: the most the device allows */
+    bool         tile_blocks;       /* screen path: tiles classified, so
+                                       listed, in 4x4 blocks of tiles rather
+                                       than rows: a list's consecutive tiles
+                                       (a sorting workgroup's) lie together;
+                                       the same picture (--tile-order)      */
     /* lighting over the pack's (splatview --sun, --exposure, --fog-density) */
     bool         sun_set, exposure_set, fog_set;
     double       sun[2], exposure, fog_density;

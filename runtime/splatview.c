@@ -72,6 +72,7 @@ typedef struct opts {
     rt_screen_depth screen_depth;
     rt_shadow_path shadow;
     rt_pixel_sort pixel_sort;
+    int tile_blocks;       /* --tile-order: 1 blocks, 0 rows               */
     const char *params[64];
     int nparams;
     const char *include[64];    /* -I DIR: import folders for hot reload    */
@@ -285,6 +286,10 @@ static const splat_arg options[] = {
       "the layers they need before shading them, so SIMD lanes skip the same surfaces "
       "(default off: the sort costs more than it saves on the devices measured)",
       F(pixel_sort), .choices = "on|off", .values = sort_on_off },
+    { "--tile-order", SPLAT_ARG_ENUM, NULL, "the screen path: tiles classified, so listed "
+      "and shaded, by rows (default) or in 4x4 blocks of tiles, so a list's consecutive "
+      "tiles (a sorting workgroup's 16) lie together; the same picture", F(tile_blocks),
+      .choices = "rows|blocks" },
     { "--reference", SPLAT_ARG_ENUM, NULL, "the multi-pass alpha reference or the "
       "über-shader, to compare against", F(ref), .choices = "multipass|uber",
       .values = reference_values },
@@ -748,7 +753,8 @@ static rt_render_desc render_desc(const opts *o, const rt_pack_info *pi)
         .async_pipelines = o->async_pipelines == 1,
         .split_uncovered = o->split_uncovered,
         .destruction_pool = o->destruction_pool, .shading = o->shading,
-        .screen_depth = o->screen_depth, .pixel_sort = o->pixel_sort, .far_atlas_distance = o->far_distance,
+        .screen_depth = o->screen_depth, .pixel_sort = o->pixel_sort,
+        .tile_blocks = o->tile_blocks != 0, .far_atlas_distance = o->far_distance,
         .preview_scale = o->preview_scale,
     };
     if (!shading_chosen(o, &rd.shading))
@@ -923,6 +929,7 @@ static int window(const opts *o_)
         .height = o.height ? o.height : 720, .script = o.script,
         .render = { .reference = o.ref, .pipeline_cache = o.cache, .lod_pixels = o.lod_pixels,
                     .shading = o.shading, .screen_depth = o.screen_depth, .pixel_sort = o.pixel_sort,
+                    .tile_blocks = o.tile_blocks != 0,
                     .no_shadows = o.no_shadows, .shadow = o.shadow,
                     .no_undergrowth = o.no_undergrowth,
                     .undergrowth_compute = o.ug_compute, .undergrowth_radius = o.ug_radius,

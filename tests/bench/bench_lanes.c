@@ -28,7 +28,7 @@
 #include <string.h>
 
 #define T 64         /* pixels per tile */
-#define BLOCK_MAX 4  /* tiles per side of the widest grouping */
+#define BLOCK_MAX 16 /* tiles in the largest block */
 
 typedef struct lane_px {
     uint64_t need;   /* the layers the pixel needs, layer j as bit j */
@@ -52,14 +52,24 @@ typedef enum lane_scheme {
                        sorted by their set: workgroups of 4 tiles          */
     LS_SORT_PREV4,  /* the same, by last frame's set                      */
     LS_SORT_MASK16, /* 4x4 tiles (pixel sorting's 16 tiles, but square)   */
+    LS_SORT_PREV16, /* the same, by last frame's set                      */
+    LS_SORT_ROW16,  /* 16x1 tiles sorted by set: pixel sorting's 16 tiles
+                       where a list holds rows of tiles                    */
     LS_COUNT
 } lane_scheme;
 
 static const char *const scheme_names[LS_COUNT] = {
     "rows (now)", "columns", "Z order", "tile sorted by set", "tile sorted by last frame",
     "2x2 tiles sorted by set", "2x2 tiles by last frame", "4x4 tiles sorted by set",
+    "4x4 tiles by last frame", "16x1 tiles sorted by set",
 };
-static const int scheme_block[LS_COUNT] = { 1, 1, 1, 1, 1, 2, 2, 4 };
+/* the block of tiles a scheme orders, across and down */
+static const int scheme_bw[LS_COUNT] = { 1, 1, 1, 1, 1, 2, 2, 4, 4, 16 };
+static const int scheme_bh[LS_COUNT] = { 1, 1, 1, 1, 1, 2, 2, 4, 4, 1 };
+static bool scheme_prev(int s)
+{
+    return s == LS_SORT_PREV || s == LS_SORT_PREV4 || s == LS_SORT_PREV16;
+}
 
 static int popc(uint64_t v) { return __builtin_popcountll(v); }
 
@@ -105,8 +115,8 @@ static int by_key(const void *a, const void *b)
  * scheme s. */
 static double block_evaluated(const lane_px *px, int n, lane_scheme s, int S)
 {
-    static int order[T * BLOCK_MAX * BLOCK_MAX];
-    static sort_item it[T * BLOCK_MAX * BLOCK_MAX];
+    static int order[T * BLOCK_MAX];
+    static sort_item it[T * BLOCK_MAX];
     double ev = 0;
     if (s <= LS_MORTON) {   /* per tile, dead lanes kept in place */
         for (int t = 0; t < n; t += T) {
@@ -128,11 +138,11 @@ static double block_evaluated(const lane_px *px, int n, lane_scheme s, int S)
         }
         return ev;
     }
-    bool prev = s == LS_SORT_PREV || s == LS_SORT_PREV4;
+    bool prev = scheme_prev(s);
     int m = 0;
     for (int i = 0; i < n; i++)
         if (px[i].live)   /* per tile: the tile's index keeps tiles apart */
-            it[m++] = (sort_item){ scheme_block[s] == 1 ? i / T : px[i].list,
+            it[m++] = (sort_item){ scheme_bw[s] == 1 ? i / T : px[i].list,
                                    prev ? px[i].prev : px[i].need, i };
     qsort(it, (size_t)m, sizeof *it, by_key);
     for (int g = 0; g < m;) {
@@ -152,19 +162,19 @@ void lanes_predict(FILE *out, const char *label, const float *rgba, const float 
                    int w, int h)
 {
     static const int sizes[3] = { 8, 32, 64 };
-    static lane_px px[T * BLOCK_MAX * BLOCK_MAX];
+    static lane_px px[T * BLOCK_MAX];
     double ev[LS_COUNT][3] = { { 0 } }, need = 0, measured = 0;
     long live = 0;
     int tw = (w + 7) / 8, th = (h + 7) / 8;
     for (int s = 0; s < LS_COUNT; s++) {
-        if ((s == LS_SORT_PREV || s == LS_SORT_PREV4) && !prev_rgba)
+        if (scheme_prev(s) && !prev_rgba)
             continue;
-        int B = scheme_block[s];
-        for (int by = 0; by < th; by += B)
-            for (int bx = 0; bx < tw; bx += B) {
+        int BW = scheme_bw[s], BH = scheme_bh[s];
+        for (int by = 0; by < th; by += BH)
+            for (int bx = 0; bx < tw; bx += BW) {
                 int n = 0;
-                for (int ty = by; ty < by + B && ty < th; ty++)
-                    for (int tx = bx; tx < bx + B && tx < tw; tx++, n += T)
+                for (int ty = by; ty < by + BH && ty < th; ty++)
+                    for (int tx = bx; tx < bx + BW && tx < tw; tx++, n += T)
                         for (int i = 0; i < T; i++) {
                             int x = tx * 8 + (i & 7), y = ty * 8 + (i >> 3);
                             lane_px *q = &px[n + i];
@@ -198,7 +208,7 @@ void lanes_predict(FILE *out, const char *label, const float *rgba, const float 
     fprintf(out, "lanes %s: predicted efficiency     %9s %9s %9s   (lanes per subgroup)\n",
             label, "8", "32", "64");
     for (int s = 0; s < LS_COUNT; s++) {
-        if ((s == LS_SORT_PREV || s == LS_SORT_PREV4) && !prev_rgba)
+        if (scheme_prev(s) && !prev_rgba)
             continue;
         fprintf(out, "lanes %s:   %-27s", label, scheme_names[s]);
         for (int k = 0; k < 3; k++)

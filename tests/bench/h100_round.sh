@@ -18,15 +18,23 @@ run() { name=$1; shift; timeout 150 "$SB" render --csv "$O/$name.csv" "$@" > "$O
 has() { case " $G " in *" $1 "*) return 0;; esac; return 1; }
 if has frames; then
     for round in 1 2; do
+        # round 2 also prints, after the timed frames, the layer efficiency
+        # predicted for 8/32/64 lanes and other pixel orders (--lanes,
+        # bench_lanes.c: "lanes" lines in the .log; measured beside it),
+        # and times beside s the tiles classified in 4x4 blocks (b: the same
+        # picture, lists in block order), pixel sorting by 16 tiles (s16)
+        # and both (s16b: a sorting workgroup's 16 tiles a 4x4 block)
+        L=; [ $round = 2 ] && L="--lanes --variant b=screen,tiles=blocks --variant s16=screen,sort=16 --variant s16b=screen,sort=16,tiles=blocks"
         for path in topdown grazing; do
-            run r${round}_$path --pack $col --scene colorado --path $path --variant s=screen $H
+            run r${round}_$path --pack $col --scene colorado --path $path --variant s=screen $H $L
         done
         for pre in trinidad valley; do
-            run r${round}_$pre --pack $col --scene colorado --path ground --start-preset $pre --variant s=screen $H
+            run r${round}_$pre --pack $col --scene colorado --path ground --start-preset $pre --variant s=screen $H $L
         done
         run r${round}_meadow --pack $col --scene colorado --path ground --start-preset meadow --variant s=screen --variant ug=screen,ug $H
     done
-    run r2_4k --pack $col --scene colorado --path topdown --variant s=screen --size 3840x2160 --frames 20 --warmup 2
+    run r2_4k --pack $col --scene colorado --path topdown --variant s=screen --size 3840x2160 --frames 20 --warmup 2 \
+        --lanes --variant b=screen,tiles=blocks --variant s16=screen,sort=16 --variant s16b=screen,sort=16,tiles=blocks
     run r2_blanca --pack $col --scene colorado --path ground --start 45000,47087,1,0 --variant s=screen $H
 fi
 if has ug; then

@@ -67,14 +67,18 @@
  *       sort=on|off (screen kinds) sorts each workgroup's pixels by the
  *       layers they need before shading (rt_pixel_sort; default off),
  *       sort=N on with N tiles per workgroup (4, 8 or 16; on: the most
- *       the device allows, 16 on GPUs and lavapipe);
+ *       the device allows, 16 on GPUs and lavapipe); tiles=blocks|rows
+ *       (screen kinds) classifies, so lists, the tiles in 4x4 blocks of
+ *       tiles or by rows (the default; rt_render_desc.tile_blocks): the
+ *       same picture, neighbouring tiles one after another in each list;
  *       the kinds that recompile the composites (flat fp16 sobel analytic
  *       lambert) always run without them.
  *       --lanes (screen kinds, unsorted, full size) renders the path's last
  *       two frames again in the layers view and prints, per variant, the
  *       layer efficiency measured on this device beside the efficiency
  *       predicted for subgroups of 8, 32 and 64 lanes and other pixel
- *       orders within the 8x8 tile (bench_lanes.c), lines "lanes LABEL:".
+ *       orders within the 8x8 tile (bench_lanes.c), lines "lanes LABEL:";
+ *       --lanes-step K takes the frame before 1/K of a frame step earlier.
  *       Paths (--path): ground (2 m above the terrain looking 150 m ahead,
  *       from --start-preset NAME or --start x,z,dx,dz), topdown, grazing,
  *       preset (--start-preset NAME's camera itself, still).
@@ -127,6 +131,7 @@ typedef struct variant {
     bool         no_shadows;
     rt_pixel_sort sort;
     int          sort_tiles;
+    bool         tile_blocks; /* tiles=blocks                               */
     bool         no_dclass; /* distclass=0                                 */
     bool         async;     /* async: pipelines made on workers, the über-
                                shader standing in (screen kinds)          */
@@ -362,6 +367,8 @@ static bool parse_variant(const char *s, const char *default_pack, variant *v)
             v->async = true;
         } else if (!strcmp(t, "distclass=0") || !strcmp(t, "distclass=1")) {
             v->no_dclass = t[10] == '0';
+        } else if (!strcmp(t, "tiles=blocks") || !strcmp(t, "tiles=rows")) {
+            v->tile_blocks = t[6] == 'b';
         } else if (!strcmp(t, "sort=on") || !strcmp(t, "sort=off")) {
             v->sort = t[6] == 'n' ? RT_SORT_ON : RT_SORT_OFF;
         } else if (!strncmp(t, "sort=", 5)) {   /* sort=N: on, N tiles per workgroup */
@@ -506,6 +513,7 @@ typedef struct render_opts {
     const char *specs[128];                      /* --variant LABEL=KIND,...  */
     int         nspecs;
     bool        lanes;                           /* --lanes                   */
+    int         lanes_step;                      /* --lanes-step K            */
 } render_opts;
 
 static bool parse_start(const char *v, void *o_, splat_arg_why *why)
@@ -565,6 +573,9 @@ static const splat_arg render_rows[] = {
       F(scene) },
     { "--lanes", SPLAT_ARG_FLAG, NULL, "screen kinds: print the layer efficiency predicted "
       "for 8, 32 and 64 lanes per subgroup and other pixel orders (bench_lanes.c)", F(lanes) },
+    { "--lanes-step", SPLAT_ARG_INT, "K", "--lanes: the frame before is 1/K of a frame step "
+      "earlier on the path (default 1), as a slower camera would see it", F(lanes_step),
+      .min = 1, .max = 1000, .expects = "1 to 1000" },
     { "--save", SPLAT_ARG_STRING, "DIR", "write each variant's last frame as DIR/LABEL.f32 "
       "and keep a pipeline cache there", F(save) },
 };
@@ -646,8 +657,9 @@ static bool make_renderer(bench_run *b, int i, const char *cache, rt_error *e)
         .no_shadows = v->no_shadows, .no_undergrowth = !v->ug,
         .no_distance_classes = v->no_dclass, .pixel_sort = v->sort,
         .async_pipelines = v->async,
-        .sort_tiles = v->sort_tiles,
-        .undergrowth_radius = v->ug_radius, .undergrowth_thin = v->ug_thin, .undergrowth_compute = v->ug_compute, .far_atlas_distance = v->far,
+        .sort_tiles = v->sort_tiles, .tile_blocks = v->tile_blocks,
+        .undergrowth_radius = v->ug_radius, .undergrowth_thin = v->ug_thin,
+        .undergrowth_compute = v->ug_compute, .far_atlas_distance = v->far,
         .preview_scale = v->preview,
         .reference = v->k == K_MULTIPASS ? RT_REF_MULTIPASS
                    : v->k == K_UBER || v->k == K_SCREEN_UBER ? RT_REF_UBER : RT_REF_NONE,
@@ -773,17 +785,20 @@ static bool lanes_frames(bench_run *b, rt_error *e)
         ok = rt_parse_view(o->view_name, &v->view, &view, &material, e);
         rt_renderer_set_view(v->r, SPLAT_VIEW_LAYERS, 0);
         rt_renderer_set_counting(v->r, true);
-        int first = o->frames >= 2 ? o->frames - 2 : o->frames - 1;
-        for (int f = first; f < o->frames && ok; f++) {
+        /* the frame before at path step (n - 1) K - 1 of (n - 1) K (K =
+         * --lanes-step), then the last frame */
+        int K = o->lanes_step > 0 ? o->lanes_step : 1, last = o->frames - 1;
+        bool two = o->frames >= 2;
+        for (int k = two ? 0 : 1; k < 2 && ok; k++) {
             rt_camera cam;
             rt_frame_stats st;
-            ok = path_camera(&b->packs[0], &o->pd, f, o->frames, &cam) &&
+            ok = (k ? path_camera(&b->packs[0], &o->pd, last, o->frames, &cam)
+                    : path_camera(&b->packs[0], &o->pd, last * K - 1, last * K + 1, &cam)) &&
                  rt_renderer_frame(v->r, &cam, &st, e) &&
-                 rt_renderer_read(v->r, f == o->frames - 1 ? b->img : prev, e);
+                 rt_renderer_read(v->r, k ? b->img : prev, e);
         }
         if (ok)
-            lanes_predict(stdout, v->label, b->img, first < o->frames - 1 ? prev : NULL,
-                          o->width, o->height);
+            lanes_predict(stdout, v->label, b->img, two ? prev : NULL, o->width, o->height);
         rt_renderer_set_view(v->r, view, material);
     }
     free(prev);

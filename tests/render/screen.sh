@@ -28,7 +28,8 @@
 # crater of radius R where the view's centre ray meets the terrain, then
 # screen vs forward as above, and the crater must change the picture.
 # Pixel sorting (--pixel-sort on against off) at the first preset: the
-# same picture to the bit, the same layers needed, no more evaluated.
+# same picture to the bit, the same layers needed, no more evaluated; the
+# tiles classified in 4x4 blocks (--tile-order blocks): the same picture.
 # Then, at the first preset: the tiles and cost views render (the cost
 # view on both paths), --stats prints the per-pass times and the counting
 # lines with needed <= evaluated on both paths, and the two paths' layers
@@ -107,6 +108,11 @@ stood=$(sed -n 's/^pipelines pending: [0-9]* (tiles the uber-shader stood in for
 # picture as the one CPU drivers run (an invocation per tile)
 SPLAT_CLASSIFY=wide run "$PACK" --headless $SIZE $c --shading screen --float-out "$OUT/wide.f32"
 "$IC" diff "$OUT/$1.s.f32" "$OUT/wide.f32" 0 || fail "the two classifications differ"
+# both in 4x4 blocks of tiles (--tile-order blocks; the unsorted run below)
+SPLAT_CLASSIFY=wide run "$PACK" --headless $SIZE $c --shading screen --tile-order blocks \
+    --float-out "$OUT/wide_blocks.f32"
+"$IC" diff "$OUT/$1.s.f32" "$OUT/wide_blocks.f32" 0 ||
+    fail "the classification a workgroup per tile in 4x4 blocks changed the picture"
 # pixel sorting (abi.h SPLAT_SORT; off unless asked): the
 # same picture to the bit, as each pixel is computed the same whichever
 # lane computes it; the same layers needed per pixel, and no more
@@ -126,6 +132,15 @@ echo "sorted: $(sorted_layers "$OUT/sort_on.txt"), unsorted: $(sorted_layers "$O
 echo "$(sorted_layers "$OUT/sort_on.txt") $(sorted_layers "$OUT/sort_off.txt")" |
     awk '{ exit !($2 == $4 && $1 <= 1.02 * $3) }' ||
     fail "sorted: layers needed must equal unsorted's, evaluated not exceed it"
+# the tiles classified in 4x4 blocks (--tile-order blocks): only the lists'
+# order changes, so the picture is the same to the bit, sorted or not (a
+# tile lost or given twice by the block order would show)
+for so in off on; do
+    run "$PACK" --headless $SIZE $c --shading screen --pixel-sort $so --tile-order blocks \
+        --float-out "$OUT/blocks_$so.f32"
+    "$IC" diff "$OUT/sort_off.f32" "$OUT/blocks_$so.f32" 0 ||
+        fail "--tile-order blocks changed the picture (--pixel-sort $so)"
+done
 run "$PACK" --headless $SIZE $c --shading screen --screen-depth raycast --float-out "$OUT/ray.f32"
 run "$PACK" --headless $SIZE $c --shading screen --screen-depth raster --lod-pixels 0.01 \
     --float-out "$OUT/full.f32"
