@@ -198,11 +198,15 @@
 #include <math.h>
 #include <stdint.h>
 
-#define SPLAT_ABI_VERSION 5   /* 2: splat_frame.light; 3: GGX lighting, screen.w;
+#define SPLAT_ABI_VERSION 6   /* 2: splat_frame.light; 3: GGX lighting, screen.w;
                                  4: splat_surface / splat_opaque, SPLAT_SORT;
                                  5: set 1's textures are sampler2DArray layers;
                                     terrain vertices on the lattice (splat_push);
-                                    SPLAT_BIND_VECTORS, SPLAT_VECTORS */
+                                    SPLAT_BIND_VECTORS, SPLAT_VECTORS;
+                                 6: the prelude's splat_layers_color (view 9):
+                                    the runtime cuts a pack's GLSL at the
+                                    prelude it carries, so a new prelude is a
+                                    new ABI */
 /* The pack's format version (manifest.json "version", PACK.md): 2 adds
  * vectors.bin, the scene's spline and polygon shapes. */
 #define SPLAT_PACK_VERSION 3
