@@ -294,6 +294,20 @@ bool rt_device_create(rt_device *d, const rt_device_desc *desc, rt_error *e)
         return rt_fail(e, RT_E_NO_FORMAT, "write clip distances (shaderClipDistance: terrain holes)");
     }
     want.shaderClipDistance = VK_TRUE;
+    /* 64-bit storage buffer atomics: the undergrowth's compute rasteriser
+     * in one pass (undergrowth_craster.c), else its two-pass fallback */
+    VkPhysicalDeviceShaderAtomicInt64Features a64 = {
+        .sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SHADER_ATOMIC_INT64_FEATURES,
+    };
+    VkPhysicalDeviceFeatures2 f2 = { .sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_FEATURES_2,
+                                     .pNext = &a64 };
+    vkGetPhysicalDeviceFeatures2(d->phys, &f2);
+    d->int64_atomics = have.shaderInt64 && a64.shaderBufferInt64Atomics;
+    want.shaderInt64 = d->int64_atomics;
+    VkPhysicalDeviceShaderAtomicInt64Features a64_on = {
+        .sType = VK_STRUCTURE_TYPE_PHYSICAL_DEVICE_SHADER_ATOMIC_INT64_FEATURES,
+        .shaderBufferInt64Atomics = VK_TRUE,
+    };
 
     float prio = 1.0f;
     VkDeviceQueueCreateInfo qci = {
@@ -305,6 +319,7 @@ bool rt_device_create(rt_device *d, const rt_device_desc *desc, rt_error *e)
     const char *swap = VK_KHR_SWAPCHAIN_EXTENSION_NAME;
     VkDeviceCreateInfo dci = {
         .sType = VK_STRUCTURE_TYPE_DEVICE_CREATE_INFO,
+        .pNext = d->int64_atomics ? &a64_on : NULL,
         .queueCreateInfoCount = 1,
         .pQueueCreateInfos = &qci,
         .enabledExtensionCount = desc->swapchain ? 1 : 0,

@@ -41,6 +41,8 @@ struct rt_device {
     bool                     count_fragments; /* fragmentStoresAndAtomics and
                                             fragment subgroup votes: the
                                             forward counting variant       */
+    bool                     int64_atomics; /* shaderInt64 and
+                                            shaderBufferInt64Atomics enabled */
     bool                     validating;
     int                      messages;   /* validation warnings + errors    */
     struct rt_vk_batch      *batch;      /* pipelines deferred to run on all

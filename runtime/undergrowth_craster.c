@@ -8,9 +8,9 @@
  * every blade projects within UG_CR_CAP pixels a side
  * (rt_ug_craster_fits: the cull's own bounding sphere at the cell's
  * nearest point, seen at the corner of the view).  That key is not drawn;
- * after the graphics draw, three compute passes over its instances (the
- * cull's list, one thread per instance and triangle, an indirect dispatch
- * the scan pass writes):
+ * after the graphics draw, a clear of the two per-pixel buffers, then
+ * three compute passes over its instances (the cull's list, one thread per
+ * instance and triangle, an indirect dispatch the scan pass writes):
  *   1. depth: each triangle's pixels (centres inside its edges, its
  *      bounding box clipped to the cap: a blade beyond it is counted in
  *      the stats' overflow, which the tests hold at 0) whose depth passes
@@ -26,7 +26,9 @@
  *      widening, wind, colour, ug_far), perspective-correct barycentrics
  *      at the pixel's centre, the fragment stage's shading (texture by
  *      analytic gradients, root darkening, splat_light), stored into the
- *      colour; the two buffers are reset for the next frame on the way.
+ *      colour.
+ * With 64-bit storage buffer atomics passes 1 and 2 are one: atomicMax of
+ * depth << 32 | ~payload ($SPLAT_UG_ATOMICS=32: the two passes anyway).
  * The compute blades are not written into the depth attachment (nothing
  * after the undergrowth reads it).  Contact shadows of the compute keys'
  * instances stay on the graphics path.  Screen path only (the depth is
@@ -50,15 +52,35 @@
     "layout(set = 2, binding = 4, std430) readonly buffer D { uint a[]; } u_md;\n"     \
     "layout(set = 2, binding = 5, std430) readonly buffer VB { float f[]; } u_vb;\n"   \
     "layout(set = 2, binding = 6, std430) readonly buffer IB { uint i[]; } u_ib;\n"    \
+    "#ifdef UG_I64\n"                                                                  \
+    "layout(set = 2, binding = 7, std430) coherent buffer Z { uint64_t z[]; } u_z;\n"  \
+    "#else\n"                                                                          \
     "layout(set = 2, binding = 7, std430) coherent buffer Z { uint z[]; } u_z;\n"      \
+    "#endif\n"                                                                         \
     "layout(set = 2, binding = 8, std430) coherent buffer ID { uint i[]; } u_id;\n"    \
     "layout(set = 2, binding = 9) uniform sampler2D u_zs;\n"                            \
     "layout(set = 2, binding = 10) uniform sampler2D u_ugtex[" SPLAT_STR(SPLAT_MAX_UG_TEXTURES) "];\n" \
     "layout(set = 2, binding = 11, std430) readonly buffer T { uvec4 t[]; } u_tri;\n"  \
     "layout(set = 2, binding = 12, std430) buffer S { uint s[]; } u_stat;\n"
 
+/* The raster passes need no more of set 0 than the frame block's first
+ * two members (a block may be shorter than its buffer), so they are
+ * compiled without the prelude, 64 invocations in a row. */
+#define CR_GLSL_RASTER_DECLS                                                           \
+    "layout(local_size_x = 64) in;\n"                                                  \
+    "layout(set = 0, binding = 1, std140) uniform splat_frame_block {\n"               \
+    "    mat4 view_proj;\n"                                                            \
+    "    vec4 camera;\n"                                                               \
+    "} u_frame;\n"                                                                     \
+    "layout(push_constant, std430) uniform splat_push_block {\n"                       \
+    "    vec4 patch_xz;\n"                                                             \
+    "    vec4 patch_uv;\n"                                                             \
+    "    uvec4 info;\n"                                                                \
+    "} u_push;\n"
+
 /* u_push: patch_xz (radius, time, width, height), info (instances per
- * cell, key, triangles per instance, the pass: 0 depth, 1 id). */
+ * cell, key, triangles per instance, the pass: 0 depth, 1 id, 2 the
+ * clear of the per-pixel buffers). */
 static const char cr_glsl_main[] =
     UG_GLSL_FUNCS
     "struct UgV { vec4 clip; vec3 rel; vec3 color; vec3 nrm; vec3 tnrm; vec2 uv; float far; uint flags; };\n"
@@ -98,8 +120,7 @@ static const char cr_glsl_main[] =
     "    return o;\n"
     "}\n"
     /* triangle t of list position j: its three vertices */
-    /* three variables, no array: nothing indexed at run time, so nothing in
-     * scratch memory (llvmpipe shared it between its threads) */
+    /* three variables, no array: nothing indexed at run time */
     "void ug_tri(uint j, uint t, out UgV v0, out UgV v1, out UgV v2) {\n"
     "    uint ii = u_vis.i[j];\n"
     "    Inst it = u_inst.v[ii];\n"
@@ -114,6 +135,16 @@ static const char cr_glsl_main[] =
     "#ifndef UG_RESOLVE\n"
     "void main() {\n"
     "    uint g = gl_WorkGroupID.x * 64u + gl_LocalInvocationIndex;\n"
+    "    if (u_push.info.w == 2u) {   /* the clear, before the depth pass */\n"
+    "        if (g >= uint(u_push.patch_xz.z) * uint(u_push.patch_xz.w)) return;\n"
+    "#ifdef UG_I64\n"
+    "        u_z.z[g] = uint64_t(0);\n"
+    "#else\n"
+    "        u_z.z[g] = 0u;\n"
+    "        u_id.i[g] = 0xffffffffu;\n"
+    "#endif\n"
+    "        return;\n"
+    "    }\n"
     "    uint k = u_push.info.y, nt = u_push.info.z;\n"
     "    uint cnt = u_md.a[5u * k + 1u], first = u_md.a[5u * k + 4u];\n"
     "    if (g >= cnt * nt) return;\n"
@@ -144,8 +175,12 @@ static const char cr_glsl_main[] =
     "            uint at = uint(y) * uint(size.x) + uint(x), du = floatBitsToUint(d);\n"
     /* one pipeline for both passes (u_push.info.w), so that the id pass
      * computes the very depth the depth pass stored */
+    "#ifdef UG_I64\n"   /* one pass: depth above, the lowest payload wins a tie */
+    "            atomicMax(u_z.z[at], (uint64_t(du) << 32) | uint64_t(~payload));\n"
+    "#else\n"
     "            if (u_push.info.w == 0u) atomicMax(u_z.z[at], du);\n"
     "            else if (u_z.z[at] == du) atomicMin(u_id.i[at], payload);\n"
+    "#endif\n"
     "        }\n"
     "}\n"
     "#else\n"
@@ -172,13 +207,14 @@ static const char cr_glsl_main[] =
     "    ivec2 px = ivec2(gl_GlobalInvocationID.xy), size = ivec2(u_push.patch_xz.zw);\n"
     "    if (any(greaterThanEqual(px, size))) return;\n"
     "    uint at = uint(px.y) * uint(size.x) + uint(px.x);\n"
-    "    if (u_push.info.w == 2u) {   /* the clear, before the depth pass */\n"
-    "        u_z.z[at] = 0u;\n"
-    "        u_id.i[at] = 0xffffffffu;\n"
-    "        return;\n"
-    "    }\n"
+    "#ifdef UG_I64\n"
+    "    uint64_t zv = u_z.z[at];\n"
+    "    if (zv == uint64_t(0)) return;\n"
+    "    uint id = ~uint(zv & uint64_t(0xffffffffu));\n"
+    "#else\n"
     "    uint id = u_id.i[at];\n"
     "    if (id == 0xffffffffu) return;\n"
+    "#endif\n"
     "    UgV v0, v1, v2;\n"
     "    ug_tri(id >> " SPLAT_STR(UG_CR_TBITS) ", id & ((1u << " SPLAT_STR(UG_CR_TBITS) "u) - 1u), v0, v1, v2);\n"
     "    vec2 s0 = ug_screen(v0.clip), s1 = ug_screen(v1.clip), s2 = ug_screen(v2.clip);\n"
@@ -215,11 +251,17 @@ static const char cr_glsl_main[] =
     "}\n"
     "#endif\n";
 
+_Static_assert(SPLAT_BIND_OUT == 8, "the resolve's u_out binding");
+
 bool rt_ug_craster_create(rt_ug *u, rt_error *e)
 {
     if (!u->compute)
         return true;
     rt_device *d = u->d;
+    /* one pass with 64-bit atomics where the device has them
+     * ($SPLAT_UG_ATOMICS=32: the two-pass fallback, for the tests) */
+    const char *env = getenv("SPLAT_UG_ATOMICS");
+    u->cr64 = d->int64_atomics && !(env && !strcmp(env, "32"));
     const VkShaderStageFlags cs = VK_SHADER_STAGE_COMPUTE_BIT;
     const VkDescriptorType sb = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
     const VkDescriptorType cis = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
@@ -238,7 +280,8 @@ bool rt_ug_craster_create(rt_ug *u, rt_error *e)
     if (!rt_vk_layout(d, &u->keep, &(rt_vk_layout_desc){ .label = "undergrowth compute raster",
                           .sets = sets, .nsets = 3, .push_stages = cs,
                           .push_bytes = sizeof(splat_push) }, &u->cr_layout, e) ||
-        !rt_buffer_create(d, npx * 4, st | VK_BUFFER_USAGE_TRANSFER_DST_BIT, false, &u->zbuf, e) ||
+        !rt_buffer_create(d, npx * (u->cr64 ? 8 : 4), st | VK_BUFFER_USAGE_TRANSFER_DST_BIT, false,
+                          &u->zbuf, e) ||
         !rt_buffer_create(d, npx * 4, st | VK_BUFFER_USAGE_TRANSFER_DST_BIT, false, &u->idbuf, e) ||
         !rt_buffer_create(d, (VkDeviceSize)SPLAT_MAX_UG_BLOCKS * 16, st, true, &u->crtab, e) ||
         !rt_buffer_create(d, 16, st | VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
@@ -272,7 +315,11 @@ bool rt_ug_craster_create(rt_ug *u, rt_error *e)
         { u->cr_set, 11, sb, u->crtab.buf }, { u->cr_set, 12, sb, u->crstat.buf },
     };
     rt_vk_write_sets(d, w, sizeof w / sizeof *w);
-    size_t n = strlen(SPLAT_GLSL_PRELUDE) + strlen(cr_glsl_main) + strlen(CR_GLSL_DECLS) + 128;
+    size_t n = strlen(SPLAT_GLSL_TERRAIN) + strlen(SPLAT_GLSL_LIGHTING) + strlen(cr_glsl_main) +
+               strlen(CR_GLSL_DECLS) + strlen(CR_GLSL_RASTER_DECLS) + 512;
+    const char *i64 = u->cr64 ? "#extension GL_ARB_gpu_shader_int64 : require\n"
+                                "#extension GL_EXT_shader_atomic_int64 : require\n"
+                                "#define UG_I64 1\n" : "";
     char *src = malloc(n);
     if (!src)
         return rt_fail(e, RT_E_VULKAN, "undergrowth", "out of memory");
@@ -281,8 +328,16 @@ bool rt_ug_craster_create(rt_ug *u, rt_error *e)
     static const char *const labels[2] = { "undergrowth compute raster",
                                            "undergrowth compute raster resolve" };
     for (int k = 0; k < 2 && ok; k++) {
-        snprintf(src, n, "#version 450\n#define SPLAT_COMPUTE 1\n%s%s%s%s", defs[k],
-                 SPLAT_GLSL_PRELUDE, CR_GLSL_DECLS, cr_glsl_main);
+        /* the resolve: the frame block, splat_light and the colour, not the
+         * whole prelude (lavapipe 22.3 dropped work of this file's passes
+         * compiled with it: runtime/DESIGN.md) */
+        snprintf(src, n, "#version 450\n%s%s%s%s%s%s%s", i64, defs[k],
+                 k ? "layout(local_size_x = 8, local_size_y = 8) in;\n" : CR_GLSL_RASTER_DECLS,
+                 k ? SPLAT_GLSL_TERRAIN : "", k ? SPLAT_GLSL_LIGHTING : "",
+                 k ? "layout(set = 0, binding = 8, rgba32f) uniform writeonly image2D u_out;\n"
+                   : "",
+                 CR_GLSL_DECLS);
+        strncat(src, cr_glsl_main, n - strlen(src) - 1);
         ok = rt_vk_compute(d, &u->keep, &(rt_vk_compute_desc){ .label = labels[k], .glsl = src,
                                .layout = u->cr_layout }, &u->cr_pipe[k], e);
     }
@@ -349,15 +404,14 @@ void rt_ug_craster_record(rt_ug *u, VkCommandBuffer cb, VkDescriptorSet set0c, V
     splat_push push = { .patch_xz = { (float)u->radius, (float)u->time, (float)u->width,
                                       (float)u->height_px },
                         .info = { u->cap, 0, 0, 0 } };
-    /* the clear: the resolve's pipeline, pass 2 */
-    vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, u->cr_pipe[1]);
+    /* the clear: the raster pipeline, pass 2 */
+    vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, u->cr_pipe[0]);
     push.info[3] = 2;
     vkCmdPushConstants(cb, u->cr_layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof push, &push);
-    vkCmdDispatch(cb, ((uint32_t)u->width + 7) / 8, ((uint32_t)u->height_px + 7) / 8, 1);
+    vkCmdDispatch(cb, (uint32_t)(((size_t)u->width * (size_t)u->height_px + 63) / 64), 1, 1);
     rt_cmd_barrier(cb, cs, VK_ACCESS_SHADER_WRITE_BIT, cs,
                    VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
-    vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, u->cr_pipe[0]);
-    for (int pass = 0; pass < 2; pass++) {
+    for (int pass = 0; pass < (u->cr64 ? 1 : 2); pass++) {
         push.info[3] = (uint32_t)pass;
         for (int k = 0; k < u->nkeys; k++) {
             if (!u->key_used[k] || !u->key_cs[k])

@@ -144,6 +144,7 @@ struct rt_ug {
     bool                  mdraw_valid;         /* mdraw_host holds this frame's */
     /* the compute rasteriser (undergrowth_craster.c; NULL pipes: off) */
     bool                  compute;             /* asked for and possible     */
+    bool                  cr64;                /* one pass, 64-bit atomics   */
     bool                  key_cs[UG_MAX_KEYS]; /* the key is drawn in compute */
     float                 cr_proj[3];          /* pixels per unit at depth 1,
                                                   cos of the half diagonal   */

@@ -193,10 +193,13 @@ if(TARGET splatrt AND TARGET splatview)
       set_tests_properties(render.${t} PROPERTIES LABELS render TIMEOUT 600
                            ENVIRONMENT "SPLAT_VALIDATE=1")
     endforeach()
-    # far undergrowth blades drawn in compute against the graphics path
-    # (test_ug_compute.c: one lavapipe thread, see there)
-    set_tests_properties(render.ug_compute PROPERTIES
-                         ENVIRONMENT "SPLAT_VALIDATE=1;LP_NUM_THREADS=1")
+    # far undergrowth blades drawn in compute against the graphics path, the
+    # one-pass 64-bit atomics and the two-pass fallback (test_ug_compute.c)
+    add_test(NAME render.ug_compute_2pass COMMAND test_ug_compute ${RENDER_OUT}/ug_compute_2pass
+             WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
+    file(MAKE_DIRECTORY ${RENDER_OUT}/ug_compute_2pass)
+    set_tests_properties(render.ug_compute_2pass PROPERTIES LABELS render TIMEOUT 600
+                         ENVIRONMENT "SPLAT_VALIDATE=1;SPLAT_UG_ATOMICS=32")
     # the shadow map marched on the device against the CPU reference within
     # 1/255: three suns and a crater (test_shadow_gpu.c)
     add_executable(test_shadow_gpu ${RENDER_DIR}/test_shadow_gpu.c)

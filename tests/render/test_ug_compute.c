@@ -15,20 +15,18 @@
  *     together what the graphics path's single-triangle key drew, fewer
  *     indirect draws, and no compute triangle clipped to the cap;
  *   - the picture: the compute path's differs from the graphics path's in
- *     at most 12 % of the pixels the far blades cover, and by PSNR at
- *     least 32 dB over the frame (measured: 8 %, 35.4 dB; the blades past
- *     100 m are less than a pixel wide, so whether one covers a pixel's
- *     centre depends on the graphics rasteriser's snapping of vertices to
- *     its sub-pixel grid, which the compute one does not do);
+ *     at most 2 % of the pixels the far blades cover, and by PSNR at
+ *     least 45 dB over the frame (measured: 55 of 12,487 pixels, 55.0 dB:
+ *     edge pixels of sub-pixel-wide blades, where the graphics rasteriser
+ *     snaps vertices to its sub-pixel grid and the compute one does not,
+ *     and the contact shadows the compute blades do not cast);
  *   - the far blades are there: the compute frame differs from one with
- *     the far blades not drawn at all (radius 28 m) in at least as many
- *     pixels as the graphics frame does, within 10 %;
+ *     the far blades not drawn at all (radius 28 m) in as many pixels as
+ *     the graphics frame does, within 2 %;
  *   - deterministic: a second renderer with the compute path gives the
- *     same picture bit for bit.  This holds on lavapipe with one thread
- *     (the suite runs it with LP_NUM_THREADS=1); with several, about one
- *     run in three differs in a few hundred pixels (stale blade pixels in
- *     one SIMD row of some 8 x 8 tiles, even in the sky), which the
- *     barriers between the passes have not explained (runtime/DESIGN.md). */
+ *     same picture bit for bit.
+ * $SPLAT_UG_ATOMICS=32 runs the two-pass path where the device has 64-bit
+ * atomics (the suite runs both). */
 #include "kit.h"
 
 #include <math.h>
@@ -165,10 +163,10 @@ int main(int argc, char **argv)
            "(%.2f %%), PSNR %.1f dB\n", covered, covered_cs, moved,
            covered ? 100.0 * moved / covered : 0.0, db);
     CHECK(covered > W * H / 50, "the far blades cover %ld pixels", covered);
-    CHECK(moved * 100 <= 12 * covered && db >= 32.0,
+    CHECK(moved * 100 <= 2 * covered && db >= 45.0,
           "compute against graphics: %ld of %ld covered pixels differ, PSNR %.1f dB", moved,
           covered, db);
-    CHECK(labs(covered_cs - covered) * 10 <= covered, "far blades cover %ld (compute), %ld "
+    CHECK(labs(covered_cs - covered) * 50 <= covered, "far blades cover %ld (compute), %ld "
           "(graphics)", covered_cs, covered);
     kit_image_equal(b, c, W, H, "the compute path, a second renderer");
     if (a && b) {
