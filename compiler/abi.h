@@ -368,6 +368,16 @@ static inline uint32_t splat_ug_pool(double radius)
  * dynamic serves every debug view. */
 #define SPLAT_SPEC_VIEW         0
 #define SPLAT_SPEC_VIEW_DYNAMIC 0xffffffffu
+/* Specialization constant of every shader that includes the prelude:
+ * constant_id SPLAT_SPEC_LOD, a uint, default 0 (the full shading).  The
+ * runtime sets it to 1 on CPU devices (lavapipe), where every branch's
+ * both sides run (llvmpipe masks lanes, it does not jump): the prelude
+ * then drops what costs much there and little in the picture, the
+ * footprint filter's neighbour normals (splat_d_normal is 0: fwidth of
+ * terrain.slope and of the normal's facing take no heightfield gathers;
+ * runtime/DESIGN.md "CPU shading LOD").  Left at 0 the code is the same
+ * as without it (GPUs). */
+#define SPLAT_SPEC_LOD          1
 /* A macro's value as a GLSL literal string (the prelude pastes these). */
 #define SPLAT_STR_(x) #x
 #define SPLAT_STR(x)  SPLAT_STR_(x)
