@@ -373,9 +373,9 @@ static inline uint32_t splat_ug_pool(double radius)
  * runtime sets it to 1 on CPU devices (lavapipe), where every branch's
  * both sides run (llvmpipe masks lanes, it does not jump): the prelude
  * then drops what costs much there and little in the picture, the
- * footprint filter's neighbour normals (splat_d_normal is 0: fwidth of
- * terrain.slope and of the normal's facing take no heightfield gathers;
- * runtime/DESIGN.md "CPU shading LOD").  Left at 0 the code is the same
+ * footprint filter's neighbour normals (splat_fp of splat_d_normal is 0:
+ * fwidth of terrain.slope and of the normal's facing take no heightfield
+ * gathers; runtime/DESIGN.md "CPU shading LOD").  Left at 0 the code is the same
  * as without it (GPUs). */
 #define SPLAT_SPEC_LOD          1
 /* A macro's value as a GLSL literal string (the prelude pastes these). */

@@ -274,8 +274,8 @@ typedef enum ir_op {
 /* DINPUT immediates: the screen-space derivative of terrain input `input`
  * along axis 0 (d/dx, one pixel right) or 1 (d/dy, one pixel down).
  * IR_DINPUT_FOOTPRINT marks a footprint's (fwidth, ir_footprint): the
- * same value, written through the prelude's splat_fp, which the CPU
- * shading LOD (abi.h SPLAT_SPEC_LOD) makes 0. */
+ * same value; the normal's is written through the prelude's splat_fp,
+ * which the CPU shading LOD (abi.h SPLAT_SPEC_LOD) makes 0. */
 #define IR_DINPUT_IMM(input, axis) ((uint32_t)(input) | (uint32_t)(axis) << 8)
 #define IR_DINPUT_INPUT(imm)       ((int)((imm) & 255))
 #define IR_DINPUT_AXIS(imm)        ((int)(((imm) >> 8) & 255))
