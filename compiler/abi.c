@@ -532,6 +532,15 @@ const char SPLAT_GLSL_PRELUDE[] =
     /* the view: fixed at pipeline creation, or read per frame (abi.h) */
     "layout(constant_id = " SPLAT_STR(SPLAT_SPEC_VIEW) ") const uint splat_spec_view = "
     SPLAT_STR(SPLAT_SPEC_VIEW_DYNAMIC) ";\n"
+    /* the CPU shading LOD (abi.h SPLAT_SPEC_LOD): 0 on GPUs */
+    "layout(constant_id = " SPLAT_STR(SPLAT_SPEC_LOD) ") const uint splat_spec_lod = 0u;\n"
+    /* a footprint's derivative (fwidth's leaves, ir.h IR_DINPUT_FOOTPRINT):
+     * itself, or 0 under the CPU shading LOD, so the ramps are the plain
+     * ones and the derivatives' code is dead */
+    "float splat_fp(float d) { return splat_spec_lod != 0u ? 0.0 : d; }\n"
+    "vec2 splat_fp(vec2 d) { return splat_spec_lod != 0u ? vec2(0.0) : d; }\n"
+    "vec3 splat_fp(vec3 d) { return splat_spec_lod != 0u ? vec3(0.0) : d; }\n"
+    "vec4 splat_fp(vec4 d) { return splat_spec_lod != 0u ? vec4(0.0) : d; }\n"
     "uint splat_view() {\n"
     "    return splat_spec_view == " SPLAT_STR(SPLAT_SPEC_VIEW_DYNAMIC)
     " ? u_frame.view.x : splat_spec_view;\n"

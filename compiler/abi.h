@@ -203,7 +203,8 @@
                                  5: set 1's textures are sampler2DArray layers;
                                     terrain vertices on the lattice (splat_push);
                                     SPLAT_BIND_VECTORS, SPLAT_VECTORS;
-                                 6: the prelude's splat_layers_color (view 9):
+                                 6: the prelude's splat_layers_color (view 9)
+                                    and SPLAT_SPEC_LOD (the CPU shading LOD):
                                     the runtime cuts a pack's GLSL at the
                                     prelude it carries, so a new prelude is a
                                     new ABI */
@@ -378,6 +379,16 @@ static inline uint32_t splat_ug_pool(double radius)
  * dynamic serves every debug view. */
 #define SPLAT_SPEC_VIEW         0
 #define SPLAT_SPEC_VIEW_DYNAMIC 0xffffffffu
+/* Specialization constant of every shader that includes the prelude:
+ * constant_id SPLAT_SPEC_LOD, a uint, default 0 (the full shading).  The
+ * runtime sets it to 1 on CPU devices (lavapipe), where every branch's
+ * both sides run (llvmpipe masks lanes, it does not jump): the prelude
+ * then drops what costs much there and little in the picture, the
+ * footprint filter's neighbour normals (splat_fp of splat_d_normal is 0:
+ * fwidth of terrain.slope and of the normal's facing take no heightfield
+ * gathers; runtime/DESIGN.md "CPU shading LOD").  Left at 0 the code is the same
+ * as without it (GPUs). */
+#define SPLAT_SPEC_LOD          1
 /* A macro's value as a GLSL literal string (the prelude pastes these). */
 #define SPLAT_STR_(x) #x
 #define SPLAT_STR(x)  SPLAT_STR_(x)

@@ -221,7 +221,13 @@ static char *leaf_expr(glsl_emitter *e, const ir_node *n)
     case IR_OP_DINPUT: {   /* the input row's derivative accessor (abi.c) */
         const char *d = ir_input_get((ir_input_kind)IR_DINPUT_INPUT(n->imm))->dglsl;
         assert(d);
-        ir_buf_printf(&b, "%s(%d)", d, IR_DINPUT_AXIS(n->imm));
+        /* a footprint's normal step (slope, facing: 9 gathers an axis) is 0
+         * under the CPU shading LOD; position, height and view steps stay,
+         * so far roads and height bands keep their filtering */
+        if ((n->imm & IR_DINPUT_FOOTPRINT) && IR_DINPUT_INPUT(n->imm) == IR_IN_NORMAL)
+            ir_buf_printf(&b, "splat_fp(%s(%d))", d, IR_DINPUT_AXIS(n->imm));
+        else
+            ir_buf_printf(&b, "%s(%d)", d, IR_DINPUT_AXIS(n->imm));
         break;
     }
     case IR_OP_PAINTED:

@@ -272,10 +272,14 @@ typedef enum ir_op {
 } ir_op;
 
 /* DINPUT immediates: the screen-space derivative of terrain input `input`
- * along axis 0 (d/dx, one pixel right) or 1 (d/dy, one pixel down). */
+ * along axis 0 (d/dx, one pixel right) or 1 (d/dy, one pixel down).
+ * IR_DINPUT_FOOTPRINT marks a footprint's (fwidth, ir_footprint): the
+ * same value; the normal's is written through the prelude's splat_fp,
+ * which the CPU shading LOD (abi.h SPLAT_SPEC_LOD) makes 0. */
 #define IR_DINPUT_IMM(input, axis) ((uint32_t)(input) | (uint32_t)(axis) << 8)
 #define IR_DINPUT_INPUT(imm)       ((int)((imm) & 255))
-#define IR_DINPUT_AXIS(imm)        ((int)((imm) >> 8))
+#define IR_DINPUT_AXIS(imm)        ((int)(((imm) >> 8) & 255))
+#define IR_DINPUT_FOOTPRINT        (1u << 16)
 
 /* Swizzle immediates: n components, each 0..3 (x y z w). */
 #define IR_SWZ(n, a, b, c, d) \

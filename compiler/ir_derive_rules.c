@@ -93,12 +93,15 @@ static ir_ref d_input(ir_dctx *c, const ir_node *n, ir_ref self, const ir_ref *d
         return IR_NONE;
     if (!c->curvature && (n->imm == IR_IN_SLOPE || n->imm == IR_IN_NORMAL))
         return IR_NONE;
+    /* a footprint's leaves are marked (the CPU shading LOD's, ir.h) */
+    uint32_t fp = c->curvature ? IR_DINPUT_FOOTPRINT : 0;
     if (n->imm == IR_IN_SLOPE) {   /* 1 - normal.y: one normal step for both */
         ir_node l = {.op = IR_OP_DINPUT, .type = IR_T_VEC3,
-                     .imm = IR_DINPUT_IMM(IR_IN_NORMAL, c->axis)};
+                     .imm = IR_DINPUT_IMM(IR_IN_NORMAL, c->axis) | fp};
         return ir_op1(c->ir, IR_OP_NEG, ir_swizzle(c->ir, ir_node_add(c->ir, &l), "y"));
     }
-    ir_node l = {.op = IR_OP_DINPUT, .type = n->type, .imm = IR_DINPUT_IMM(n->imm, c->axis)};
+    ir_node l = {.op = IR_OP_DINPUT, .type = n->type,
+                 .imm = IR_DINPUT_IMM(n->imm, c->axis) | fp};
     return ir_node_add(c->ir, &l);
 }
 

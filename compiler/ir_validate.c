@@ -63,7 +63,8 @@ static void validate_leaf(vstate *st, const ir *ir, const ir_node *n)
         break;
     case IR_OP_DINPUT: {
         int in = IR_DINPUT_INPUT(n->imm);
-        VALIDATE(st, in < IR_IN_COUNT && IR_DINPUT_AXIS(n->imm) < 2);
+        VALIDATE(st, in < IR_IN_COUNT && IR_DINPUT_AXIS(n->imm) < 2 &&
+                     (n->imm >> 16) <= 1);
         if (in < IR_IN_COUNT)
             VALIDATE(st, t == ir_input_get((ir_input_kind)in)->type);
         break;

@@ -238,17 +238,42 @@ typedef enum kind {
     K_SKY,          /* fullscreen, depth EQUAL the clear value, no write      */
 } kind;
 
+/* The specialization of a composite's (or the über-shader's, or a
+ * reference pass's) pipeline: the final view unless `debug` (abi.h
+ * SPLAT_SPEC_VIEW: the driver drops the debug views' code) and the CPU
+ * shading LOD where it is on (SPLAT_SPEC_LOD; left at its default 0
+ * otherwise).  Shaders without a constant ignore its entry.  NULL when
+ * there is nothing to set. */
+typedef struct spec_buf {
+    uint32_t                 values[2];
+    VkSpecializationMapEntry entries[2];
+    VkSpecializationInfo     info;
+} spec_buf;
+
+static const VkSpecializationInfo *spec_for(const rt_pipelines *pl, bool debug, spec_buf *b)
+{
+    uint32_t n = 0;
+    if (!debug) {
+        b->entries[n] = (VkSpecializationMapEntry){ SPLAT_SPEC_VIEW, n * 4, 4 };
+        b->values[n++] = SPLAT_VIEW_FINAL;
+    }
+    if (pl->shading_lod) {
+        b->entries[n] = (VkSpecializationMapEntry){ SPLAT_SPEC_LOD, n * 4, 4 };
+        b->values[n++] = pl->shading_lod;
+    }
+    b->info = (VkSpecializationInfo){ n, b->entries, n * 4, b->values };
+    return n ? &b->info : NULL;
+}
+
 /* `layout`: VK_NULL_HANDLE for the pipelines' own (resolve or terrain). */
 static bool make_pipeline_in(rt_device *d, rt_pipelines *pl, VkPipelineLayout layout,
                              VkShaderModule vs, VkShaderModule fs, VkRenderPass pass, kind k,
                              unsigned variant, VkPipeline *out, rt_error *e)
 {
     /* Not RT_VARIANT_DEBUG: the fragment shader specialised to the final
-     * view (abi.h SPLAT_SPEC_VIEW), so the driver drops the debug views'
-     * code.  Shaders without the constant ignore it. */
-    static const uint32_t final_view = SPLAT_VIEW_FINAL;
-    static const VkSpecializationMapEntry view_entry = { SPLAT_SPEC_VIEW, 0, sizeof final_view };
-    static const VkSpecializationInfo final_spec = { 1, &view_entry, sizeof final_view, &final_view };
+     * view; the CPU shading LOD (spec_for) */
+    spec_buf sb;
+    const VkSpecializationInfo *fs_spec = spec_for(pl, (variant & RT_VARIANT_DEBUG) != 0, &sb);
     const VkColorComponentFlags all = VK_COLOR_COMPONENT_R_BIT | VK_COLOR_COMPONENT_G_BIT |
                                       VK_COLOR_COMPONENT_B_BIT | VK_COLOR_COMPONENT_A_BIT;
     VkPipelineColorBlendAttachmentState att[3];
@@ -268,7 +293,7 @@ static bool make_pipeline_in(rt_device *d, rt_pipelines *pl, VkPipelineLayout la
     bool grid = k != K_RESOLVE && k != K_SKY;   /* vertex input: the grid's x, z */
     return rt_vk_gfx(d, NULL, &(rt_vk_gfx_desc){
         .label = "terrain", .vs = vs, .fs = k == K_DEPTH ? VK_NULL_HANDLE : fs,
-        .fs_spec = (variant & RT_VARIANT_DEBUG) ? NULL : &final_spec,
+        .fs_spec = fs_spec,
         .vbufs = &vb, .nvbufs = grid, .attrs = &va, .nattrs = grid,
         .polygon = (variant & RT_VARIANT_WIRE) ? VK_POLYGON_MODE_LINE : VK_POLYGON_MODE_FILL,
         /* Without RT_VARIANT_CULL terrain seen from below shows too.  The
@@ -675,11 +700,9 @@ bool rt_pipelines_compute_make(rt_device *d, const rt_pack *p, rt_pipelines *pl,
         rt_interface_free(&in);
     VkShaderModule m = VK_NULL_HANDLE;
     if (ok && make_module(d, words, n, &m, e)) {
-        static const uint32_t final_view = SPLAT_VIEW_FINAL;
-        static const VkSpecializationMapEntry entry = { SPLAT_SPEC_VIEW, 0, sizeof final_view };
-        static const VkSpecializationInfo spec = { 1, &entry, sizeof final_view, &final_view };
+        spec_buf sb;   /* the final view (not RT_CVARIANT_DEBUG), the CPU LOD */
         ok = rt_vk_compute(d, NULL, &(rt_vk_compute_desc){ .label = name, .module = m,
-                               .spec = (variant & RT_CVARIANT_DEBUG) ? NULL : &spec,
+                               .spec = spec_for(pl, (variant & RT_CVARIANT_DEBUG) != 0, &sb),
                                .layout = pl->compute_layout, .cache = pl->cache }, out, e);
         vkDestroyShaderModule(d->dev, m, NULL);
     } else {
@@ -801,11 +824,25 @@ static bool fullscreen_pipeline(rt_device *d, rt_pipelines *pl, VkRenderPass pas
     return ok;
 }
 
+/* Whether the CPU shading LOD is on (splatrt.h rt_shading_lod): `want`,
+ * or with RT_SHADING_LOD_AUTO $SPLAT_SHADING_LOD=0|1, else whether the
+ * device is a CPU (lavapipe). */
+bool rt_shading_lod_on(const rt_device *d, rt_shading_lod want)
+{
+    if (want != RT_SHADING_LOD_AUTO)
+        return want == RT_SHADING_LOD_ON;
+    const char *env = getenv("SPLAT_SHADING_LOD");
+    if (env && (!strcmp(env, "0") || !strcmp(env, "1")))
+        return env[0] == '1';
+    return d->props.deviceType == VK_PHYSICAL_DEVICE_TYPE_CPU;
+}
+
 bool rt_pipelines_create(rt_device *d, const rt_pack *p, const rt_passes *rp,
                          rt_reference ref, const char *cache_path,
-                         int ntextures, rt_pipelines *pl, rt_error *e)
+                         int ntextures, bool shading_lod, rt_pipelines *pl, rt_error *e)
 {
     memset(pl, 0, sizeof *pl);
+    pl->shading_lod = shading_lod;
     splat_cache_open(&pl->spv_cache, NULL);   /* disabled when it cannot be made */
     if (!make_layouts(d, ntextures, pl, e) || !open_cache(d, pl, cache_path, e) ||
         !pack_module(d, p, &p->vertex, &pl->vertex, e))

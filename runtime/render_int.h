@@ -24,6 +24,7 @@ struct rt_renderer {
     bool              shadow_auto;     /* the path was not asked for         */
     rt_shadow_gpu    *shadow_gpu;      /* made at the first GPU map          */
     bool              default_clear;   /* no background given: the sky      */
+    bool              shading_lod;     /* the CPU shading LOD is on         */
     double            shadow_sun[3];   /* the sun the map was made for      */
     rt_terrain_gpu    terrain;
     rt_destruction   *destr;           /* NULL: no destructible area        */

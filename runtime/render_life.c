@@ -185,10 +185,13 @@ static bool make_textures(rt_renderer *r, rt_error *e)
         }
         if (!up)
             return false;
+        /* the CPU shading LOD (rt_shading_lod): the nearest level, half
+         * the texel fetches of llvmpipe's software sampler */
+        bool mip_linear = t->mip_linear && !r->shading_lod;
         if (!rt_vk_sampler(d, NULL, &(rt_vk_sampler_desc){ .label = "texture array",
                                .filter = t->linear ? VK_FILTER_LINEAR : VK_FILTER_NEAREST,
-                               .mip = t->mip_linear ? VK_SAMPLER_MIPMAP_MODE_LINEAR
-                                                    : VK_SAMPLER_MIPMAP_MODE_NEAREST,
+                               .mip = mip_linear ? VK_SAMPLER_MIPMAP_MODE_LINEAR
+                                                 : VK_SAMPLER_MIPMAP_MODE_NEAREST,
                                .wrap = t->wrap, .max_lod = (float)mips }, &r->tex_smp[a], e))
             return false;
     }
@@ -528,8 +531,11 @@ bool rt_renderer_create(rt_device *d, const rt_pack *p, const rt_render_desc *de
     }
     r->desc.width = (r->out_w + r->scale - 1) / r->scale;
     r->desc.height = (r->out_h + r->scale - 1) / r->scale;
+    /* the CPU shading LOD (rt_shading_lod) halves the geometry's detail:
+     * llvmpipe runs the vertex stage on one thread */
+    r->shading_lod = rt_shading_lod_on(d, r->desc.shading_lod);
     if (r->desc.lod_pixels <= 0)
-        r->desc.lod_pixels = 3.0;
+        r->desc.lod_pixels = r->shading_lod ? 6.0 : 3.0;
     if (r->desc.clear[3] == 0 && r->desc.clear[0] == 0 && r->desc.clear[1] == 0 && r->desc.clear[2] == 0) {
         /* the final view draws the analytic sky; the others this colour */
         static const float sky[4] = { 0.35f, 0.52f, 0.85f, 1.0f };
@@ -559,7 +565,7 @@ bool rt_renderer_create(rt_device *d, const rt_pack *p, const rt_render_desc *de
                                &r->destr, e) ||
         !make_targets(r, e) ||
         !rt_pipelines_create(d, p, &r->rp, r->desc.reference, r->desc.pipeline_cache,
-                             p->narrays, &r->pl, e) ||
+                             p->narrays, r->shading_lod, &r->pl, e) ||
         !make_geometry(r, e) || !make_textures(r, e) || !make_descriptors(r, e) ||
         !make_commands(r, e) ||
         /* the workers first: the stand-in is chosen with them there */

@@ -678,6 +678,8 @@ typedef struct rt_pipelines {
     struct rt_async      *async;         /* workers (async_compile.c) or NULL */
     atomic_int            spirv_cached;  /* compute modules found there      */
     atomic_int            spirv_compiled;/* ... and compiled with glslang    */
+    uint32_t              shading_lod;   /* abi.h SPLAT_SPEC_LOD of the shading
+                                            pipelines (rt_shading_lod_on)   */
 } rt_pipelines;
 
 /* Variants of a compute shading pipeline (screen-space path), as bits. */
@@ -700,9 +702,10 @@ typedef struct rt_passes {
  * über-shader and reference pipelines are made on first use
  * (rt_pipelines_combo/uber/ref): a view of colorado needs 13-20 of its 137,
  * and lavapipe compiles each in tens of milliseconds or more. */
+bool rt_shading_lod_on(const rt_device *d, rt_shading_lod want);
 bool rt_pipelines_create(rt_device *d, const rt_pack *p, const rt_passes *rp,
                          rt_reference ref, const char *cache_path,
-                         int ntextures, rt_pipelines *pl, rt_error *e);
+                         int ntextures, bool shading_lod, rt_pipelines *pl, rt_error *e);
 /* The pipeline of combination `id` in `variant` (RT_VARIANT_* bits), made
  * now if it does not exist yet. */
 /* A main-pass fragment pipeline from `glsl` over the terrain's vertex

@@ -57,7 +57,7 @@ const int rt_abi_nbindings = (int)(sizeof rt_abi_bindings / sizeof rt_abi_bindin
  * shaders (a subset); the vertex attribute. */
 static const rt_varying abi_varyings[] = { { 0, 3 }, { 1, 2 }, { 2, 3 } };
 static const rt_varying abi_attributes[] = { { 0, 2 } };
-static const uint32_t abi_spec_ids[] = { SPLAT_SPEC_VIEW };
+static const uint32_t abi_spec_ids[] = { SPLAT_SPEC_VIEW, SPLAT_SPEC_LOD };
 
 static const char *const role_names[RT_ROLE_COUNT] = {
     [RT_ROLE_VERTEX] = "the vertex shader",
@@ -102,14 +102,14 @@ bool rt_interface_for(const rt_pack *p, rt_shader_role role, rt_interface *out)
                role == RT_ROLE_FAR_BAKE) {
         out->stage = VK_SHADER_STAGE_COMPUTE_BIT;   /* no stage inputs or outputs */
         out->spec_ids = abi_spec_ids;
-        out->nspec = 1;
+        out->nspec = 2;
     } else {
         out->stage = VK_SHADER_STAGE_FRAGMENT_BIT;
         out->inputs = abi_varyings;
         out->ninputs = 3;
         out->colour_targets = role == RT_ROLE_REFERENCE ? 3 : 1;
         out->spec_ids = abi_spec_ids;
-        out->nspec = 1;
+        out->nspec = 2;
     }
     return true;
 }

@@ -270,6 +270,19 @@ typedef enum rt_shadow_path {
     RT_SHADOW_CPU,       /* the reference march, rows over the CPU's cores */
 } rt_shadow_path;
 
+/* The CPU shading LOD (runtime/DESIGN.md "CPU shading LOD"): on CPU
+ * devices (lavapipe), where both sides of every branch run, the footprint
+ * filter's derivatives off (abi.h SPLAT_SPEC_LOD), material textures from
+ * their nearest mip level and the geometry at twice the screen error
+ * (lod_pixels 6, unless lod_pixels is given).  GPUs draw the full
+ * shading. */
+typedef enum rt_shading_lod {
+    RT_SHADING_LOD_AUTO = 0,  /* on for CPU devices; $SPLAT_SHADING_LOD=0|1
+                                 overrides it                              */
+    RT_SHADING_LOD_OFF,       /* the full shading on every device          */
+    RT_SHADING_LOD_ON,        /* the CPU's on every device (tests, bench)   */
+} rt_shading_lod;
+
 typedef enum rt_reference {
     RT_REF_NONE = 0,      /* per-combination composites                     */
     RT_REF_MULTIPASS,     /* one blended pass per material + resolve        */
@@ -356,6 +369,8 @@ typedef struct rt_render_desc {
                                        the depth edges (upscale.c); 0 or 1:
                                        full resolution (splatview
                                        --preview-scale)                     */
+    rt_shading_lod shading_lod;     /* the CPU shading LOD (above); splatview
+                                       --shading-lod auto|off|on            */
     double       far_atlas_distance; /* screen tiles, forward patches at least
                                     this far (m) are shaded from the pack's
                                     far atlas; 0: off (the default)          */

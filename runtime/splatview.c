@@ -65,6 +65,7 @@ typedef struct opts {
     double camera[3], look[3], lod_pixels;
     double far_distance;   /* --far-atlas-distance */
     int preview_scale;     /* --preview-scale: 1, 2, 4 (0: 1) */
+    rt_shading_lod shading_lod;   /* --shading-lod */
     float clear[4];
     rt_reference ref;
     rt_shading shading;
@@ -238,6 +239,8 @@ static const int sort_on_off[] = { RT_SORT_ON, RT_SORT_OFF };
 static const int reference_values[] = { RT_REF_MULTIPASS, RT_REF_UBER };
 static const int shadow_values[] = { RT_SHADOW_GPU, RT_SHADOW_CPU };
 static const int preview_values[] = { 1, 2, 4 };
+static const int shading_lod_values[] = { RT_SHADING_LOD_AUTO, RT_SHADING_LOD_OFF,
+                                          RT_SHADING_LOD_ON };
 
 static const splat_arg options[] = {
     { NULL, SPLAT_ARG_SECTION, .help = "Output:" },
@@ -317,6 +320,10 @@ static const splat_arg options[] = {
       "1/S of the width and height and upsample to the full size along the depth edges "
       "(faster, softer; the window's P key cycles it)", F(preview_scale), .choices = "1|2|4",
       .values = preview_values },
+    { "--shading-lod", SPLAT_ARG_ENUM, NULL, "the CPU shading LOD: no footprint derivatives, "
+      "the nearest mip level, coarser geometry (auto: on CPU devices such as lavapipe only; "
+      "$SPLAT_SHADING_LOD=0|1 sets auto's choice)", F(shading_lod), .choices = "auto|off|on",
+      .values = shading_lod_values },
     { "--param", SPLAT_ARG_LIST, "NAME=V[,V,V,V]", "set a material param (repeatable)",
       F(params), .count = F(nparams), .capacity = 64 },
     { "--pipeline-cache", SPLAT_ARG_STRING, "FILE", "the Vulkan pipeline cache file",
@@ -755,7 +762,7 @@ static rt_render_desc render_desc(const opts *o, const rt_pack_info *pi)
         .destruction_pool = o->destruction_pool, .shading = o->shading,
         .screen_depth = o->screen_depth, .pixel_sort = o->pixel_sort,
         .tile_blocks = o->tile_blocks != 0, .far_atlas_distance = o->far_distance,
-        .preview_scale = o->preview_scale,
+        .preview_scale = o->preview_scale, .shading_lod = o->shading_lod,
     };
     if (!shading_chosen(o, &rd.shading))
         rd.shading = pi->has_compute && o->ref != RT_REF_MULTIPASS ? RT_SHADING_SCREEN
@@ -935,7 +942,7 @@ static int window(const opts *o_)
                     .undergrowth_compute = o.ug_compute, .undergrowth_radius = o.ug_radius,
                     .undergrowth_thin = o.ug_thin,
                     .far_atlas_distance = o.far_distance,
-                    .preview_scale = o.preview_scale,
+                    .preview_scale = o.preview_scale, .shading_lod = o.shading_lod,
                     .no_distance_classes = o.no_distance_classes,
                     .async_pipelines = o.async_pipelines != 0,
                     .split_uncovered = o.split_uncovered },

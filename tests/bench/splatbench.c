@@ -54,7 +54,10 @@
  *       from the pack's far atlas (splatc build --far-atlas); its rows add
  *       the distance and the tiles (patches) the atlas shaded (from the
  *       counting frame).  preview=S renders at 1/S of the size (2 or 4)
- *       and upsamples with the depth edges (--preview-scale).  distclass=0 shades with the
+ *       and upsamples with the depth edges (--preview-scale).  cpulod=on|off
+ *       turns the CPU shading LOD on or off (rt_shading_lod; by default on
+ *       CPU devices only: footprint derivatives off, nearest mip level,
+ *       lod_pixels 6 unless lod= is given).  distclass=0 shades with the
  *       combinations only (--no-distance-classes; PACK.md "Distance
  *       classes"), distclass=1 (the default) with their distance classes;
  *       async (screen kinds) makes compute pipelines on worker threads,
@@ -141,6 +144,7 @@ typedef struct variant {
     bool         ug_compute; /* far single-triangle blades drawn in compute */
     double       far;       /* screen: the far atlas's distance (m); 0: off */
     int          preview;   /* the preview scale (2, 4); 0: full resolution */
+    rt_shading_lod cpulod;  /* cpulod=on|off: the CPU shading LOD; default auto */
     double       shadow_ms; /* ms of the shadow map (the first frame)       */
     double      *ug_gen, *ug_draw; /* per timed frame, GPU ms               */
     long         ug_cells;  /* cells generated over the timed frames        */
@@ -395,6 +399,8 @@ static bool parse_variant(const char *s, const char *default_pack, variant *v)
         } else if (!strncmp(t, "preview=", 8)) {
             v->preview = atoi(t + 8);
             ok = v->preview == 1 || v->preview == 2 || v->preview == 4;
+        } else if (!strcmp(t, "cpulod=on") || !strcmp(t, "cpulod=off")) {
+            v->cpulod = t[9] == 'n' ? RT_SHADING_LOD_ON : RT_SHADING_LOD_OFF;
         } else if (!strncmp(t, "lod=", 4)) {
             v->lod = atof(t + 4);
             ok = v->lod > 0;
@@ -660,7 +666,7 @@ static bool make_renderer(bench_run *b, int i, const char *cache, rt_error *e)
         .sort_tiles = v->sort_tiles, .tile_blocks = v->tile_blocks,
         .undergrowth_radius = v->ug_radius, .undergrowth_thin = v->ug_thin,
         .undergrowth_compute = v->ug_compute, .far_atlas_distance = v->far,
-        .preview_scale = v->preview,
+        .preview_scale = v->preview, .shading_lod = v->cpulod,
         .reference = v->k == K_MULTIPASS ? RT_REF_MULTIPASS
                    : v->k == K_UBER || v->k == K_SCREEN_UBER ? RT_REF_UBER : RT_REF_NONE,
         .pipeline_cache = cache,

@@ -54,6 +54,13 @@ if(TARGET splatrt AND TARGET splatview)
               $<TARGET_FILE:imgcheck> ${RENDER_OUT}/minimal ${RENDER_OUT}/preview_scale)
     set_tests_properties(render.preview_scale PROPERTIES LABELS render TIMEOUT 600
       SKIP_RETURN_CODE 77 FIXTURES_REQUIRED minimal_pack)
+    # the CPU shading LOD (runtime/DESIGN.md): on against off, the paths
+    # with it on, auto on a CPU device
+    add_test(NAME render.shading_lod
+      COMMAND sh ${RENDER_DIR}/shading_lod.sh $<TARGET_FILE:splatview>
+              $<TARGET_FILE:imgcheck> ${RENDER_OUT}/colorado ${RENDER_OUT}/shading_lod valley)
+    set_tests_properties(render.shading_lod PROPERTIES LABELS render TIMEOUT 900
+      FIXTURES_REQUIRED colorado_pack)
     # the help overlay (key H): headless --overlay and the window
     add_test(NAME render.overlay
       COMMAND sh ${RENDER_DIR}/run.sh overlay $<TARGET_FILE:splatview>
