@@ -260,43 +260,19 @@ const char rt_ug_draw_vert_main[] =
     "layout(location = 7) out float g_far;\n"
     "layout(location = 8) out vec3 g_tnormal;\n"
     UG_GLSL_FUNCS
+    UG_GLSL_PLACE
     "void main() {\n"
     "    uint ii = u_vis.i[gl_InstanceIndex];   /* the cull passes' list */\n"
-    "    Inst it = u_inst.v[ii];\n"
-    "    uint bi = 5u * it.q.w;\n"
-    "    vec4 b0 = u_blocks.b[bi], b1 = u_blocks.b[bi + 1u], b4 = u_blocks.b[bi + 4u];\n"
-    "    uint flags = uint(u_blocks.b[bi + 2u].z);\n"
-    "    vec3 n = normalize(unpackSnorm4x8(it.q.x).xyz + vec3(0.0, 1e-4, 0.0));\n"
-    "    float a = uintBitsToFloat(it.q.z), c = cos(a), s = sin(a);\n"
-    /* the distance fade (push patch_xz.x: the radius) */
-    "    float r = u_push.patch_xz.x, d = length(it.p.xz - u_frame.camera.xz);\n"
-    /* the LOD's growth (u_push.info.x: instances per cell) */
-    "    float grow = min(inversesqrt(u_lod.f[ii / u_push.info.x]), " LOD_GROW_S ");\n"
-    /* the growth widens, it does not raise: far cover, not a hedge */
-    "    vec3 p = a_pos * it.p.w * ug_fade_scale(it.p.xyz, d, r) * vec3(grow, 1.0, grow);\n"
-    "    p = vec3(c * p.x + s * p.z, p.y, -s * p.x + c * p.z);\n"
-    "    vec3 m = vec3(c * a_nrm.x + s * a_nrm.z, a_nrm.y, -s * a_nrm.x + c * a_nrm.z);\n"
-    "    if ((flags & 4u) != 0u) {   /* aligned to the terrain normal: a rotation (t, n, b) */\n"
-    "        vec3 t = normalize(cross(n, vec3(0.0, 0.0, 1.0)));\n"
-    "        vec3 bt = cross(t, n);\n"
-    "        p = t * p.x + n * p.y + bt * p.z;\n"
-    "        m = t * m.x + n * m.y + bt * m.z;\n"
-    "    }\n"
-    /* the wind (block vec4 3; push patch_xz.y: the time in seconds) */
-    "    p += ug_wind(it.p.xyz, p.y, u_blocks.b[bi + 3u], u_push.patch_xz.y);\n"
-    "    v_local = it.p.xyz + p;\n"
+    "    UgP q = ug_place(ii, u_inst.v[ii], a_pos, a_nrm, a_uv);\n"
+    "    v_local = q.local;\n"
     "    v_rel = v_local - u_frame.camera.xyz;\n"
     "    v_uv = v_local.xz / u_frame.terrain.xy;\n"
-    /* towards the radius the colour becomes the ground's (the cover thins
-     * into the terrain it stands on, the root darkening goes with it) */
-    "    float far = ug_far(d, r);\n"
-    "    float share = mix(mix(b4.x, b0.w, clamp(a_uv.y, 0.0, 1.0)), 1.0, far);\n"
-    "    g_far = far;\n"
-    "    g_color = mix(b1.rgb, unpackUnorm4x8(it.q.y).rgb, share);\n"
-    "    g_normal = (flags & 2u) != 0u ? n : m;\n"
-    "    g_tnormal = n;\n"
+    "    g_far = q.far;\n"
+    "    g_color = q.color;\n"
+    "    g_normal = q.nrm;\n"
+    "    g_tnormal = q.tnrm;\n"
     "    g_uv = a_uv;\n"
-    "    g_flags = flags;\n"
+    "    g_flags = q.flags;\n"
     "    gl_Position = u_frame.view_proj * vec4(v_rel, 1.0);\n"
     "}\n";
 

@@ -79,6 +79,47 @@ _Static_assert(UG_KEYINFO > UG_MAX_KEYS && UG_ENT0 == 1284, "the cull table's st
     "    float a = w.z * h * h * (1.0 - w.w + w.w * ug_gust(root.xz, w.xy, t));\n" \
     "    return vec3(w.x * a, -min(0.5 * a * a / max(h, 1e-3), 0.5 * h), w.y * a);\n" \
     "}\n"
+/* One blade vertex placed in the world, as the draw's vertex stage and the
+ * compute rasteriser's resolve both need it (after UG_GLSL_FUNCS, with
+ * Inst, u_blocks, u_lod, u_push and u_frame declared): the fade, the LOD's
+ * widening, the turn, the terrain alignment, the wind and the colour
+ * towards the ground's at the radius. */
+#define UG_GLSL_PLACE \
+    "struct UgP { vec3 local; vec3 color; vec3 nrm; vec3 tnrm; float far; uint flags; };\n" \
+    "UgP ug_place(uint ii, Inst it, vec3 a_pos, vec3 a_nrm, vec2 a_uv) {\n" \
+    "    uint bi = 5u * it.q.w;\n" \
+    "    vec4 b0 = u_blocks.b[bi], b1 = u_blocks.b[bi + 1u], b4 = u_blocks.b[bi + 4u];\n" \
+    "    uint flags = uint(u_blocks.b[bi + 2u].z);\n" \
+    "    vec3 n = normalize(unpackSnorm4x8(it.q.x).xyz + vec3(0.0, 1e-4, 0.0));\n" \
+    "    float a = uintBitsToFloat(it.q.z), c = cos(a), s = sin(a);\n" \
+    /* the distance fade (push patch_xz.x: the radius) */ \
+    "    float r = u_push.patch_xz.x, d = length(it.p.xz - u_frame.camera.xz);\n" \
+    /* the LOD's growth (u_push.info.x: instances per cell) */ \
+    "    float grow = min(inversesqrt(u_lod.f[ii / u_push.info.x]), " LOD_GROW_S ");\n" \
+    /* the growth widens, it does not raise: far cover, not a hedge */ \
+    "    vec3 p = a_pos * it.p.w * ug_fade_scale(it.p.xyz, d, r) * vec3(grow, 1.0, grow);\n" \
+    "    p = vec3(c * p.x + s * p.z, p.y, -s * p.x + c * p.z);\n" \
+    "    vec3 m = vec3(c * a_nrm.x + s * a_nrm.z, a_nrm.y, -s * a_nrm.x + c * a_nrm.z);\n" \
+    "    if ((flags & 4u) != 0u) {   /* aligned to the terrain normal: a rotation (t, n, b) */\n" \
+    "        vec3 t = normalize(cross(n, vec3(0.0, 0.0, 1.0)));\n" \
+    "        vec3 bt = cross(t, n);\n" \
+    "        p = t * p.x + n * p.y + bt * p.z;\n" \
+    "        m = t * m.x + n * m.y + bt * m.z;\n" \
+    "    }\n" \
+    /* the wind (block vec4 3; push patch_xz.y: the time in seconds) */ \
+    "    p += ug_wind(it.p.xyz, p.y, u_blocks.b[bi + 3u], u_push.patch_xz.y);\n" \
+    "    UgP o;\n" \
+    "    o.local = it.p.xyz + p;\n" \
+    /* towards the radius the colour becomes the ground's (the cover thins \
+     * into the terrain it stands on, the root darkening goes with it) */ \
+    "    o.far = ug_far(d, r);\n" \
+    "    float share = mix(mix(b4.x, b0.w, clamp(a_uv.y, 0.0, 1.0)), 1.0, o.far);\n" \
+    "    o.color = mix(b1.rgb, unpackUnorm4x8(it.q.y).rgb, share);\n" \
+    "    o.nrm = (flags & 2u) != 0u ? n : m;\n" \
+    "    o.tnrm = n;\n" \
+    "    o.flags = flags;\n" \
+    "    return o;\n" \
+    "}\n"
 #define UG_FADE_MARGIN_S "12.0"   /* 0.75 CELL */
 #define UG_FADE_START_S "0.6"
 
