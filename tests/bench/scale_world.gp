@@ -8,7 +8,7 @@
 #                     layers evaluated and needed per pixel, samples per
 #                     pixel, screen and forward paths).  With
 #                     scale_world_gpu.tsv beside it (tests/bench/
-#                     scale_world_gpu.sh's output, the H100 at 1920x1080)
+#                     scale_world_gpu.sh's output, the device tool's GPU at 1920x1080)
 #                     its steady GPU ms join the lavapipe's and a ninth panel
 #                     shows its first pictures.  Runs that timed out or
 #                     failed are left out.
@@ -80,8 +80,8 @@ set yrange [*:*]
 if (gpu) {
     plot "scale_world.tsv" skip 1 using 1:26 with linespoints lw 2 pt 7 title "lavapipe screen", \
          "" skip 1 using 1:31 with linespoints lw 2 pt 9 title "lavapipe forward", \
-         "scale_world_gpu.tsv" skip 1 using 1:11 with linespoints lw 2 dt 2 pt 6 title "H100 1920x1080 screen", \
-         "" skip 1 using 1:16 with linespoints lw 2 dt 2 pt 8 title "H100 1920x1080 forward"
+         "scale_world_gpu.tsv" skip 1 using 1:11 with linespoints lw 2 dt 2 pt 6 title "GPU 1920x1080 screen", \
+         "" skip 1 using 1:16 with linespoints lw 2 dt 2 pt 8 title "GPU 1920x1080 forward"
 } else {
     plot "scale_world.tsv" skip 1 using 1:26 with linespoints lw 2 pt 7 title "lavapipe screen", \
          "" skip 1 using 1:31 with linespoints lw 2 pt 9 title "lavapipe forward"
@@ -100,7 +100,7 @@ plot "scale_world.tsv" skip 1 using 1:27 with linespoints lw 2 pt 7 title "scree
      "" skip 1 using 1:34 with linespoints lw 2 pt 11 title "forward samples"
 
 set key inside top left
-set title "first picture, H100 1920x1080 (splatbench, process wall time)"
+set title "first picture, GPU 1920x1080 (splatbench, process wall time)"
 set ylabel "seconds"
 if (gpu) {
     plot "scale_world_gpu.tsv" skip 1 using 1:5 with linespoints lw 2 pt 7 title "screen, cold", \
