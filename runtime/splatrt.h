@@ -403,13 +403,17 @@ typedef struct rt_ug_stats {
     long   drawn;             /* instances drawn (after LOD, fade, frustum) */
     long   triangles;         /* triangles drawn, contact shadows included  */
     int    draws;             /* indirect draws                             */
-    long   drawn_compute;     /* of drawn, those drawn in compute (far
-                                 single triangles; undergrowth_compute)     */
-    long   cr_overflow;       /* compute triangles clipped to the cap (0)   */
-    /* per key (one draw: a block's near or far mesh, in the draw's order;
-     * the first RT_UG_KEYS_MAX): its block, index count, instances drawn */
+    long   drawn_compute;     /* of drawn, those drawn in compute (those
+                                 that fit the cap; undergrowth_compute)     */
+    long   cr_overflow;       /* compute triangles and contact shadows
+                                 clipped to the cap (0)                     */
+    /* per key (a block's near, far or single-triangle mesh, by the
+     * graphics pipeline or in compute; in the draw's order; the first
+     * RT_UG_KEYS_MAX): its block, index count, instances drawn, whether
+     * in compute */
     int    keys;
     int    key_block[RT_UG_KEYS_MAX];
+    bool   key_compute[RT_UG_KEYS_MAX];
     uint32_t key_indices[RT_UG_KEYS_MAX], key_drawn[RT_UG_KEYS_MAX];
     double gen_ms, draw_ms;   /* GPU ms (timestamps; < 0 if unsupported)    */
     size_t bytes_per_cell;    /* masks + instance capacity + draw arguments */

@@ -324,12 +324,12 @@ static bool make_buffers(rt_ug *u, rt_error *e)
                           &u->cnt, e) ||
         !rt_buffer_create(d, (VkDeviceSize)u->pool * u->cap * 4 + 4,
                           st | VK_BUFFER_USAGE_TRANSFER_SRC_BIT, false, &u->vis, e) ||
-        !rt_buffer_create(d, (VkDeviceSize)u->nblocks * 8 * 20,   /* + the shadows' */
+        !rt_buffer_create(d, (VkDeviceSize)u->nblocks * 4 * UG_LEVELS * 20,   /* + the shadows' */
                           st | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
                           false, &u->mdraw, e) ||
-        !rt_buffer_create(d, (VkDeviceSize)u->nblocks * 8 * 20, VK_BUFFER_USAGE_TRANSFER_DST_BIT,
+        !rt_buffer_create(d, (VkDeviceSize)u->nblocks * 4 * UG_LEVELS * 20, VK_BUFFER_USAGE_TRANSFER_DST_BIT,
                           true, &u->mdraw_host, e) ||
-        !rt_buffer_create(d, (VkDeviceSize)UG_MAX_KEYS * 12,   /* the compute keys' dispatches */
+        !rt_buffer_create(d, (VkDeviceSize)UG_MAX_KEYS * 2 * 12,   /* the compute keys' dispatches, their shadows' */
                           st | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT, false, &u->cdisp, e) ||
         !rt_buffer_create(d, (VkDeviceSize)u->pool * 4, st, true, &u->lod, e) ||
         !rt_buffer_create(d, (VkDeviceSize)u->nblocks * 16 * UG_BLOCK_VEC4, st, true, &u->blocks,
@@ -814,7 +814,7 @@ void rt_ug_draw(rt_ug *u, VkCommandBuffer cb, bool depth_read_only, VkDescriptor
     if (u->shadows) {   /* under the plants: before them */
         vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_GRAPHICS, u->shadow_pipe);
         for (int k = 0; k < u->nkeys; k++)
-            if (u->key_used[k] && pu->blocks[u->key_block[k]].shadow > 0 && !u->key_cs[k])
+            if (u->key_used[k] && u->key_sh[k])
                 vkCmdDrawIndexedIndirect(cb, u->mdraw.buf, 20 * (VkDeviceSize)(u->nkeys + k), 1, 20);
     }
     /* one draw per key (a block's near or far mesh), opaque first: they
@@ -856,16 +856,14 @@ void rt_ug_read_stats(rt_ug *u, rt_ug_stats *st)
         const uint32_t *m = md + 5 * k, *sh = md + 5 * (u->nkeys + k);
         st->drawn += m[1];
         st->triangles += (long)m[1] * (m[0] / 3) + (long)sh[1] * 2;
-        st->draws += u->key_used[k] ? !(u->key_cs[k] && u->cr_ran) +
-                                          (u->shadows && u->p->ug.blocks[u->key_block[k]].shadow > 0 &&
-                                           !u->key_cs[k])
-                                    : 0;
+        st->draws += u->key_used[k] ? !(u->key_cs[k] && u->cr_ran) + u->key_sh[k] : 0;
         if (u->key_cs[k] && u->cr_ran)
             st->drawn_compute += m[1];
         if (k < RT_UG_KEYS_MAX) {
             st->key_drawn[k] = m[1];
             st->key_indices[k] = m[0];
             st->key_block[k] = u->key_block[k];
+            st->key_compute[k] = u->key_cs[k] && u->cr_ran;
         }
     }
     if (u->compute && u->cr_ran)

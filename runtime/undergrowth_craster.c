@@ -61,7 +61,8 @@
     "layout(set = 2, binding = 9) uniform sampler2D u_zs;\n"                            \
     "layout(set = 2, binding = 10) uniform sampler2D u_ugtex[" SPLAT_STR(SPLAT_MAX_UG_TEXTURES) "];\n" \
     "layout(set = 2, binding = 11, std430) readonly buffer T { uvec4 t[]; } u_tri;\n"  \
-    "layout(set = 2, binding = 12, std430) buffer S { uint s[]; } u_stat;\n"
+    "layout(set = 2, binding = 12, std430) buffer S { uint s[]; } u_stat;\n"                 \
+    "layout(set = 2, binding = 13, std430) coherent buffer SH { uint s[]; } u_sh;\n"
 
 /* The raster passes need no more of set 0 than the frame block's first
  * two members (a block may be shorter than its buffer), so they are
@@ -79,8 +80,9 @@
     "} u_push;\n"
 
 /* u_push: patch_xz (radius, time, width, height), info (instances per
- * cell, key, triangles per instance, the pass: 0 depth, 1 id, 2 the
- * clear of the per-pixel buffers). */
+ * cell, key, the key's mesh level, the pass: 0 depth, 1 id, 2 the clear of
+ * the per-pixel buffers).  u_tri: per block and level its mesh (index
+ * count, first index, vertex offset). */
 static const char cr_glsl_main[] =
     UG_GLSL_FUNCS
     UG_GLSL_PLACE
@@ -102,12 +104,12 @@ static const char cr_glsl_main[] =
     "    o.clip = u_frame.view_proj * vec4(o.rel, 1.0);\n"
     "    return o;\n"
     "}\n"
-    /* triangle t of list position j: its three vertices */
+    /* triangle t of list position j, its mesh at level lv: its three vertices */
     /* three variables, no array: nothing indexed at run time */
-    "void ug_tri(uint j, uint t, out UgV v0, out UgV v1, out UgV v2) {\n"
+    "void ug_tri(uint j, uint lv, uint t, out UgV v0, out UgV v1, out UgV v2) {\n"
     "    uint ii = u_vis.i[j];\n"
     "    Inst it = u_inst.v[ii];\n"
-    "    uvec4 tm = u_tri.t[it.q.w];   /* index count, first index, vertex offset */\n"
+    "    uvec4 tm = u_tri.t[" SPLAT_STR(UG_LEVELS) "u * it.q.w + lv];   /* index count, first index, vertex offset */\n"
     "    uint i0 = tm.y + 3u * t;\n"
     "    v0 = ug_vertex(ii, it, u_ib.i[i0] + tm.z);\n"
     "    v1 = ug_vertex(ii, it, u_ib.i[i0 + 1u] + tm.z);\n"
@@ -116,10 +118,77 @@ static const char cr_glsl_main[] =
     "vec2 ug_screen(vec4 c) { return (c.xy / c.w * 0.5 + 0.5) * u_push.patch_xz.zw; }\n"
     "float ug_edge(vec2 a, vec2 b, vec2 p) { return (b.x - a.x) * (p.y - a.y) - (b.y - a.y) * (p.x - a.x); }\n"
     "#ifndef UG_RESOLVE\n"
+    /* A compute key's contact shadows (the graphics path's shadow quad and
+     * fragment stage, rt_ug_shadow_vert_main): a thread per instance of
+     * the key's entries that cast one, its quad's pixel centres (inside
+     * its first triangle, else its second: none counted twice) that pass
+     * the depth attachment (the terrain's, and the graphics blades' in
+     * front of it, which hide the shadow as they would have covered it)
+     * add -log2(1 - a) in fixed point to the pixel's sum; the resolve
+     * multiplies the colour by 2^-sum where no compute blade landed.  The
+     * same product as the blending's, in any order. */
+    "void ug_shadow(uint g) {\n"
+    "    uint k = u_push.info.y, s = 5u * (uint(u_push.patch_uv.x) + k);\n"
+    "    uint cnt = u_md.a[s + 1u], first = u_md.a[s + 4u];\n"
+    "    if (g >= cnt) return;\n"
+    "    uint ii = u_vis.i[first + g];\n"
+    "    Inst it = u_inst.v[ii];\n"
+    "    vec4 b4 = u_blocks.b[5u * it.q.w + 4u];\n"
+    "    vec3 n = normalize(unpackSnorm4x8(it.q.x).xyz + vec3(0.0, 1e-4, 0.0));\n"
+    "    float r = u_push.patch_xz.x, d = length(it.p.xz - u_frame.camera.xz);\n"
+    "    float grow = min(inversesqrt(u_lod.f[ii / u_push.info.x]), " LOD_GROW_S ");\n"
+    "    float size = 1.3 * b4.z * it.p.w * grow * ug_fade_scale(it.p.xyz, d, r);\n"
+    "    float sa = b4.y * (1.0 - ug_far(d, r));\n"
+    "    if (!(size > 0.0) || !(sa > 0.0)) return;\n"
+    "    vec3 t = normalize(cross(n, vec3(0.0, 0.0, 1.0))), bt = cross(t, n);\n"
+    "    vec3 o = it.p.xyz + n * 0.04;\n"
+    "    vec4 c0 = u_frame.view_proj * vec4(o + (-t - bt) * size - u_frame.camera.xyz, 1.0);\n"
+    "    vec4 c1 = u_frame.view_proj * vec4(o + (t - bt) * size - u_frame.camera.xyz, 1.0);\n"
+    "    vec4 c2 = u_frame.view_proj * vec4(o + (t + bt) * size - u_frame.camera.xyz, 1.0);\n"
+    "    vec4 c3 = u_frame.view_proj * vec4(o + (-t + bt) * size - u_frame.camera.xyz, 1.0);\n"
+    "    if (min(min(c0.w, c1.w), min(c2.w, c3.w)) <= 1e-4) return;\n"
+    "    vec2 s0 = ug_screen(c0), s1 = ug_screen(c1), s2 = ug_screen(c2), s3 = ug_screen(c3);\n"
+    "    vec4 z = vec4(c0.z / c0.w, c1.z / c1.w, c2.z / c2.w, c3.z / c3.w);\n"
+    "    vec4 iw = 1.0 / vec4(c0.w, c1.w, c2.w, c3.w);\n"
+    "    float aa = ug_edge(s0, s1, s2), ab = ug_edge(s0, s2, s3);\n"
+    "    if (abs(aa) < 1e-12 || abs(ab) < 1e-12) return;\n"
+    "    vec2 lo = min(min(s0, s1), min(s2, s3)), hi = max(max(s0, s1), max(s2, s3));\n"
+    "    ivec2 size2 = ivec2(u_push.patch_xz.zw);\n"
+    "    ivec2 a = max(ivec2(ceil(lo - 0.5)), ivec2(0)), b = min(ivec2(floor(hi - 0.5)), size2 - 1);\n"
+    "    if (any(greaterThan(b - a, ivec2(" UG_CR_CAP_S " - 1)))) {\n"
+    "        atomicAdd(u_stat.s[0], 1u);\n"
+    "        b = min(b, a + " UG_CR_CAP_S " - 1);\n"
+    "    }\n"
+    "    float ia = 1.0 / aa, ib = 1.0 / ab;\n"
+    "    for (int y = a.y; y <= b.y; y++)\n"
+    "        for (int x = a.x; x <= b.x; x++) {\n"
+    "            vec2 p = vec2(x, y) + 0.5;\n"
+    /* q: the quad's corner coordinates, (-1, -1) (1, -1) (1, 1) (-1, 1) */
+    "            vec3 w = vec3(ug_edge(s1, s2, p), ug_edge(s2, s0, p), ug_edge(s0, s1, p)) * ia;\n"
+    "            vec2 q;\n"
+    "            float dz;\n"
+    "            if (min(w.x, min(w.y, w.z)) >= 0.0) {\n"
+    "                vec3 pw = w * iw.xyz;\n"
+    "                q = mat3x2(vec2(-1.0, -1.0), vec2(1.0, -1.0), vec2(1.0, 1.0)) * (pw / (pw.x + pw.y + pw.z));\n"
+    "                dz = dot(w, z.xyz);\n"
+    "            } else {\n"
+    "                w = vec3(ug_edge(s2, s3, p), ug_edge(s3, s0, p), ug_edge(s0, s2, p)) * ib;\n"
+    "                if (min(w.x, min(w.y, w.z)) < 0.0) continue;\n"
+    "                vec3 pw = w * iw.xzw;\n"
+    "                q = mat3x2(vec2(-1.0, -1.0), vec2(1.0, 1.0), vec2(-1.0, 1.0)) * (pw / (pw.x + pw.y + pw.z));\n"
+    "                dz = dot(w, z.xzw);\n"
+    "            }\n"
+    "            if (!(dz > texelFetch(u_zs, ivec2(x, y), 0).r) || dz > 1.0) continue;\n"
+    "            float sh = sa * (1.0 - smoothstep(0.2, 1.0, dot(q, q)));\n"
+    "            if (sh > 0.0)\n"
+    "                atomicAdd(u_sh.s[uint(y) * uint(size2.x) + uint(x)], uint(-log2(1.0 - sh) * 262144.0 + 0.5));\n"
+    "        }\n"
+    "}\n"
     "void main() {\n"
     "    uint g = gl_WorkGroupID.x * 64u + gl_LocalInvocationIndex;\n"
     "    if (u_push.info.w == 2u) {   /* the clear, before the depth pass */\n"
     "        if (g >= uint(u_push.patch_xz.z) * uint(u_push.patch_xz.w)) return;\n"
+    "        u_sh.s[g] = 0u;\n"
     "#ifdef UG_I64\n"
     "        u_z.z[g] = uint64_t(0);\n"
     "#else\n"
@@ -128,12 +197,16 @@ static const char cr_glsl_main[] =
     "#endif\n"
     "        return;\n"
     "    }\n"
-    "    uint k = u_push.info.y, nt = u_push.info.z;\n"
+    "    if (u_push.info.w == 3u) {   /* the contact shadows */\n"
+    "        ug_shadow(g);\n"
+    "        return;\n"
+    "    }\n"
+    "    uint k = u_push.info.y, lv = u_push.info.z, nt = u_md.a[5u * k] / 3u;\n"
     "    uint cnt = u_md.a[5u * k + 1u], first = u_md.a[5u * k + 4u];\n"
     "    if (g >= cnt * nt) return;\n"
     "    uint j = first + g / nt, t = g % nt;\n"
     "    UgV v0, v1, v2;\n"
-    "    ug_tri(j, t, v0, v1, v2);\n"
+    "    ug_tri(j, lv, t, v0, v1, v2);\n"
     "    if (min(v0.clip.w, min(v1.clip.w, v2.clip.w)) <= 1e-4) return;\n"
     "    vec2 s0 = ug_screen(v0.clip), s1 = ug_screen(v1.clip), s2 = ug_screen(v2.clip);\n"
     "    vec3 z = vec3(v0.clip.z / v0.clip.w, v1.clip.z / v1.clip.w, v2.clip.z / v2.clip.w);\n"
@@ -147,7 +220,10 @@ static const char cr_glsl_main[] =
     "        b = min(b, a + " UG_CR_CAP_S " - 1);\n"
     "    }\n"
     "    float ia = 1.0 / area;\n"
-    "    uint payload = (j << " SPLAT_STR(UG_CR_TBITS) ") | t;\n"
+    "    uint payload = (j << " SPLAT_STR(UG_CR_PSHIFT) ") | (lv << " SPLAT_STR(UG_CR_TBITS) ") | t;\n"
+    /* a frond (a block cut out by its uv, the fragment stage's test) */
+    "    bool frond = (v0.flags & 1u) != 0u;\n"
+    "    vec3 iw = vec3(1.0 / v0.clip.w, 1.0 / v1.clip.w, 1.0 / v2.clip.w);\n"
     "    for (int y = a.y; y <= b.y; y++)\n"
     "        for (int x = a.x; x <= b.x; x++) {\n"
     "            vec2 p = vec2(x, y) + 0.5;\n"
@@ -155,6 +231,12 @@ static const char cr_glsl_main[] =
     "            if (min(w.x, min(w.y, w.z)) < 0.0) continue;\n"
     "            float d = dot(w, z);\n"
     "            if (!(d > texelFetch(u_zs, ivec2(x, y), 0).r) || d > 1.0) continue;\n"
+    "            if (frond) {\n"
+    "                vec3 pw = w * iw;\n"
+    "                vec2 uv = mat3x2(v0.uv, v1.uv, v2.uv) * (pw / (pw.x + pw.y + pw.z));\n"
+    "                float fx = abs(uv.x * 2.0 - 1.0), ft = clamp(uv.y, 0.0, 1.0);\n"
+    "                if (fx > 0.9 * sin(ft * 3.14159) || (fx > 0.08 && fract(ft * 7.0 - fx * 2.5) > 0.6)) continue;\n"
+    "            }\n"
     "            uint at = uint(y) * uint(size.x) + uint(x), du = floatBitsToUint(d);\n"
     /* one pipeline for both passes (u_push.info.w), so that the id pass
      * computes the very depth the depth pass stored */
@@ -192,14 +274,22 @@ static const char cr_glsl_main[] =
     "    uint at = uint(px.y) * uint(size.x) + uint(px.x);\n"
     "#ifdef UG_I64\n"
     "    uint64_t zv = u_z.z[at];\n"
-    "    if (zv == uint64_t(0)) return;\n"
+    "    bool hit = zv != uint64_t(0);\n"
     "    uint id = ~uint(zv & uint64_t(0xffffffffu));\n"
     "#else\n"
     "    uint id = u_id.i[at];\n"
-    "    if (id == 0xffffffffu) return;\n"
+    "    bool hit = id != 0xffffffffu;\n"
     "#endif\n"
+    "    if (!hit) {   /* the compute keys' contact shadows on what is there */\n"
+    "        uint sh = u_sh.s[at];\n"
+    "        if (sh != 0u) {\n"
+    "            vec4 c = imageLoad(u_out, px);\n"
+    "            imageStore(u_out, px, vec4(c.rgb * exp2(-float(sh) * (1.0 / 262144.0)), c.a));\n"
+    "        }\n"
+    "        return;\n"
+    "    }\n"
     "    UgV v0, v1, v2;\n"
-    "    ug_tri(id >> " SPLAT_STR(UG_CR_TBITS) ", id & ((1u << " SPLAT_STR(UG_CR_TBITS) "u) - 1u), v0, v1, v2);\n"
+    "    ug_tri(id >> " SPLAT_STR(UG_CR_PSHIFT) ", (id >> " SPLAT_STR(UG_CR_TBITS) ") & ((1u << " SPLAT_STR(UG_CR_PSHIFT) "u - " SPLAT_STR(UG_CR_TBITS) "u) - 1u), id & ((1u << " SPLAT_STR(UG_CR_TBITS) "u) - 1u), v0, v1, v2);\n"
     "    vec2 s0 = ug_screen(v0.clip), s1 = ug_screen(v1.clip), s2 = ug_screen(v2.clip);\n"
     "    float area = ug_edge(s0, s1, s2), ia = 1.0 / area;\n"
     "    vec3 iw = vec3(1.0 / v0.clip.w, 1.0 / v1.clip.w, 1.0 / v2.clip.w);\n"
@@ -230,7 +320,6 @@ static const char cr_glsl_main[] =
     "    n = normalize(mix(n, normalize(tn), far));\n"
     "    float ao = mix(mix(0.5, 1.0, clamp(uv.y, 0.0, 1.0)), 1.0, far);\n"
     "    imageStore(u_out, px, vec4(splat_light(color * tex.rgb * ao, n, 0.9, dist, vv), 1.0));\n"
-    "    atomicAdd(u_stat.s[1], 1u);\n"
     "}\n"
     "#endif\n";
 
@@ -248,15 +337,15 @@ bool rt_ug_craster_create(rt_ug *u, rt_error *e)
     const VkShaderStageFlags cs = VK_SHADER_STAGE_COMPUTE_BIT;
     const VkDescriptorType sb = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
     const VkDescriptorType cis = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
-    VkDescriptorSetLayoutBinding b[13];
-    for (uint32_t i = 0; i < 13; i++)
+    VkDescriptorSetLayoutBinding b[14];
+    for (uint32_t i = 0; i < 14; i++)
         b[i] = (VkDescriptorSetLayoutBinding){ i, sb, 1, cs, NULL };
     b[9].descriptorType = cis;
     b[10].descriptorType = cis;
     b[10].descriptorCount = SPLAT_MAX_UG_TEXTURES;
     size_t npx = (size_t)u->width * (size_t)u->height_px;
     const VkBufferUsageFlags st = VK_BUFFER_USAGE_STORAGE_BUFFER_BIT;
-    if (!rt_vk_set_layout(d, &u->keep, &(rt_vk_set_layout_desc){ "undergrowth compute raster", b, 13 },
+    if (!rt_vk_set_layout(d, &u->keep, &(rt_vk_set_layout_desc){ "undergrowth compute raster", b, 14 },
                           &u->set_cr, e))
         return false;
     VkDescriptorSetLayout sets[3] = { u->pl->set_terrain, u->pl->set_material, u->set_cr };
@@ -266,16 +355,21 @@ bool rt_ug_craster_create(rt_ug *u, rt_error *e)
         !rt_buffer_create(d, npx * (u->cr64 ? 8 : 4), st | VK_BUFFER_USAGE_TRANSFER_DST_BIT, false,
                           &u->zbuf, e) ||
         !rt_buffer_create(d, npx * 4, st | VK_BUFFER_USAGE_TRANSFER_DST_BIT, false, &u->idbuf, e) ||
-        !rt_buffer_create(d, (VkDeviceSize)SPLAT_MAX_UG_BLOCKS * 16, st, true, &u->crtab, e) ||
+        !rt_buffer_create(d, npx * 4, st, false, &u->shbuf, e) ||
+        !rt_buffer_create(d, (VkDeviceSize)SPLAT_MAX_UG_BLOCKS * UG_LEVELS * 16, st, true, &u->crtab, e) ||
         !rt_buffer_create(d, 16, st | VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
                           false, &u->crstat, e) ||
         !rt_buffer_create(d, 16, VK_BUFFER_USAGE_TRANSFER_DST_BIT, true, &u->crstat_host, e))
         return false;
     memset(u->crstat_host.map, 0, 16);
-    uint32_t *tab = u->crtab.map;
+    uint32_t *tab = u->crtab.map;   /* the levels a block has (the others: zeros) */
+    memset(tab, 0, (size_t)u->nblocks * UG_LEVELS * 16);
     for (int i = 0; i < u->nblocks; i++)
-        memcpy(tab + 4 * i, u->tri[i], sizeof u->tri[i]);
-    VkDescriptorPoolSize sizes[2] = { { sb, 11 }, { cis, 1 + SPLAT_MAX_UG_TEXTURES } };
+        for (int lv = 0; lv < UG_LEVELS; lv++)
+            if ((lv == 0 || u->p->ug.meshes[u->p->ug.blocks[i].mesh].far >= 0) &&
+                (lv < 2 || u->tri[i][0]))
+                rt_ug_level_mesh(u, i, lv, tab + 4 * (UG_LEVELS * i + lv));
+    VkDescriptorPoolSize sizes[2] = { { sb, 12 }, { cis, 1 + SPLAT_MAX_UG_TEXTURES } };
     VkDescriptorPool pool;
     if (!rt_vk_sets(d, &u->keep, &(rt_vk_sets_desc){ .label = "undergrowth compute raster",
                         .sizes = sizes, .nsizes = 2, .layouts = &u->set_cr, .nsets = 1 },
@@ -296,6 +390,7 @@ bool rt_ug_craster_create(rt_ug *u, rt_error *e)
         { u->cr_set, 9, cis, .sampler = u->cr_nearest, .view = u->depth->view },
         { u->cr_set, 10, cis, .images = ti, .count = SPLAT_MAX_UG_TEXTURES },
         { u->cr_set, 11, sb, u->crtab.buf }, { u->cr_set, 12, sb, u->crstat.buf },
+        { u->cr_set, 13, sb, u->shbuf.buf },
     };
     rt_vk_write_sets(d, w, sizeof w / sizeof *w);
     size_t n = strlen(SPLAT_GLSL_TERRAIN) + strlen(SPLAT_GLSL_LIGHTING) + strlen(cr_glsl_main) +
@@ -317,7 +412,7 @@ bool rt_ug_craster_create(rt_ug *u, rt_error *e)
         snprintf(src, n, "#version 450\n%s%s%s%s%s%s%s", i64, defs[k],
                  k ? "layout(local_size_x = 8, local_size_y = 8) in;\n" : CR_GLSL_RASTER_DECLS,
                  k ? SPLAT_GLSL_TERRAIN : "", k ? SPLAT_GLSL_LIGHTING : "",
-                 k ? "layout(set = 0, binding = 8, rgba32f) uniform writeonly image2D u_out;\n"
+                 k ? "layout(set = 0, binding = 8, rgba32f) uniform image2D u_out;\n"
                    : "",
                  CR_GLSL_DECLS);
         strncat(src, cr_glsl_main, n - strlen(src) - 1);
@@ -330,7 +425,7 @@ bool rt_ug_craster_create(rt_ug *u, rt_error *e)
 
 void rt_ug_craster_destroy(rt_ug *u)
 {
-    rt_buffer *bufs[] = { &u->zbuf, &u->idbuf, &u->crtab, &u->crstat, &u->crstat_host };
+    rt_buffer *bufs[] = { &u->zbuf, &u->idbuf, &u->shbuf, &u->crtab, &u->crstat, &u->crstat_host };
     for (size_t i = 0; i < sizeof bufs / sizeof *bufs; i++)
         rt_buffer_destroy(u->d, bufs[i]);
 }
@@ -400,9 +495,20 @@ void rt_ug_craster_record(rt_ug *u, VkCommandBuffer cb, VkDescriptorSet set0c, V
             if (!u->key_used[k] || !u->key_cs[k])
                 continue;
             push.info[1] = (uint32_t)k;
-            push.info[2] = u->tri[u->key_block[k]][0] / 3;
+            push.info[2] = u->key_level[k];
             vkCmdPushConstants(cb, u->cr_layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof push, &push);
             vkCmdDispatchIndirect(cb, u->cdisp.buf, 12 * (VkDeviceSize)k);
+        }
+        /* the compute keys' contact shadows: their own buffer, with the
+         * first pass */
+        push.info[3] = 3;
+        push.patch_uv[0] = (float)u->nkeys;
+        for (int k = 0; k < u->nkeys && pass == 0; k++) {
+            if (!u->key_used[k] || !u->key_shc[k])
+                continue;
+            push.info[1] = (uint32_t)k;
+            vkCmdPushConstants(cb, u->cr_layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof push, &push);
+            vkCmdDispatchIndirect(cb, u->cdisp.buf, 12 * (VkDeviceSize)(u->nkeys + k));
         }
         rt_cmd_barrier(cb, cs, VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_SHADER_READ_BIT, cs,
                        VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);

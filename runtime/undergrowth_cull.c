@@ -40,11 +40,38 @@ bool rt_ug_cull_pipelines(rt_ug *u, rt_error *e)
 
 /* The cull passes' table for this frame (UG_KEYINFO): keys in the draw's
  * order (opaque blocks first; a block's near mesh, then its far one, then
- * its single-triangle one, then with the compute rasteriser on its
- * single-triangle cells drawn in compute: rt_ug_craster_fits), each key's entries the visible generated
+ * its single-triangle one, then with the compute rasteriser on the same
+ * three levels drawn in compute), each key's entries the visible generated
  * cells front to back whose distance picks that mesh (their nearest point
  * beyond LOD_NEAR: the far mesh; beyond LOD_TRI LOD_NEAR: the single
- * triangles). */
+ * triangles) and, for a compute key, whose every instance fits the compute
+ * rasteriser's cap (rt_ug_craster_fits) where the block and that mesh can
+ * go there (cs_level). */
+void rt_ug_level_mesh(const rt_ug *u, int b, int lv, uint32_t out[3])
+{
+    const rt_pack_ug *pu = &u->p->ug;
+    int far = pu->meshes[pu->blocks[b].mesh].far;
+    if (lv == 2) {
+        memcpy(out, u->tri[b], 3 * sizeof *out);
+        return;
+    }
+    const rt_pack_ug_mesh *m = &pu->meshes[lv ? far : pu->blocks[b].mesh];
+    out[0] = m->nidx;
+    out[1] = m->first_index;
+    out[2] = m->first_vertex;
+}
+
+/* Whether block b's mesh at level lv (which it has) can be drawn in
+ * compute: opaque or a frond (an alpha cut-out samples its texture per
+ * pixel, which the raster pass does not), few enough triangles for the
+ * payload's bits. */
+static bool cs_level(const rt_ug *u, int b, int lv)
+{
+    uint32_t mesh[3];
+    rt_ug_level_mesh(u, b, lv, mesh);
+    return u->compute && u->p->ug.blocks[b].cutout != 2 && mesh[0] / 3 <= (1u << UG_CR_TBITS);
+}
+
 static void fill_entries(rt_ug *u)
 {
     const rt_pack_ug *pu = &u->p->ug;
@@ -59,35 +86,30 @@ static void fill_entries(rt_ug *u)
             if ((pu->blocks[b].cutout != 0) != cut)
                 continue;
             int far = pu->meshes[pu->blocks[b].mesh].far;
-            /* the compute rasteriser's key: opaque single triangles, few
-             * enough a mesh for the payload's bits */
-            bool cs = u->compute && !cut && u->tri[b][0] &&
-                      u->tri[b][0] / 3 <= (1u << UG_CR_TBITS);
-            for (int l = 0; l < 4; l++) {
-                if ((l == 1 && far < 0) || (l >= 2 && (far < 0 || !u->tri[b][0])) ||
-                    (l == 3 && !cs))
+            for (int l = 0; l < 2 * UG_LEVELS; l++) {
+                int lv = l % UG_LEVELS;
+                if ((lv == 1 && far < 0) || (lv == 2 && (far < 0 || !u->tri[b][0])) ||
+                    (l >= UG_CS_KEY && !cs_level(u, b, lv)))
                     continue;
-                const rt_pack_ug_mesh *m = &pu->meshes[l ? far : pu->blocks[b].mesh];
                 uint32_t *ki = e + UG_KEYINFO + 4 * k;
-                ki[0] = l >= 2 ? u->tri[b][0] : m->nidx;
-                ki[1] = l >= 2 ? u->tri[b][1] : m->first_index;
-                ki[2] = l >= 2 ? u->tri[b][2] : m->first_vertex;
-                /* the compute key's blades cast no contact shadow (a disc
-                 * of a pixel or less that far: its quads would cost the
-                 * graphics front end what the key saves) */
-                bool shadows = pu->blocks[b].shadow > 0 && u->shadows && l != 3;
+                rt_ug_level_mesh(u, b, lv, ki);
+                /* a compute key's contact shadows are drawn in compute
+                 * too (undergrowth_craster.c ug_shadow) */
+                bool has = pu->blocks[b].shadow > 0 && u->shadows;
+                bool shadows = has;
                 e[k] = (uint32_t)n;
                 u->key_block[k] = b;
                 for (int i = 0; i < u->pool; i++) {
                     int slot = u->order[i];
                     const ug_cell *cl = &u->cells[slot];
                     double near = cl->dist - CELL * 0.7071;   /* its nearest point, about */
-                    int lv = near > LOD_NEAR && far >= 0;
-                    if (lv && u->tri[b][0] && near > LOD_TRI * LOD_NEAR)
-                        lv = 2;
-                    if (lv == 2 && cs && rt_ug_craster_fits(u, b, near, ((float *)u->lod.map)[slot]))
-                        lv = 3;
-                    if (cl->state != CELL_READY || !cl->visible || lv != l)
+                    int cv = near > LOD_NEAR && far >= 0;
+                    if (cv && u->tri[b][0] && near > LOD_TRI * LOD_NEAR)
+                        cv = 2;
+                    if (cs_level(u, b, cv) &&
+                        rt_ug_craster_fits(u, b, near, ((float *)u->lod.map)[slot]))
+                        cv += UG_CS_KEY;
+                    if (cl->state != CELL_READY || !cl->visible || cv != l)
                         continue;
                     if (shadows && near >= shadow_end)   /* and every entry after */
                         shadows = false, ki[3] = (uint32_t)n;
@@ -95,10 +117,13 @@ static void fill_entries(rt_ug *u)
                 }
                 if (shadows)
                     ki[3] = (uint32_t)n;
-                else if (!(pu->blocks[b].shadow > 0 && u->shadows) || l == 3)
+                else if (!has)
                     ki[3] = e[k];
                 u->key_used[k] = e[k] != (uint32_t)n;
-                u->key_cs[k] = l == 3;
+                u->key_cs[k] = l >= UG_CS_KEY;
+                u->key_level[k] = (uint8_t)lv;
+                u->key_sh[k] = has && l < UG_CS_KEY;
+                u->key_shc[k] = has && l >= UG_CS_KEY;
                 k++;
             }
         }

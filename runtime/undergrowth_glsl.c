@@ -234,6 +234,10 @@ const char rt_ug_scan_glsl[] =
     "        u_ds.a[3u * k] = (cnt * (u_ent.e[ki] / 3u) + 63u) / 64u;\n"
     "        u_ds.a[3u * k + 1u] = 1u;\n"
     "        u_ds.a[3u * k + 2u] = 1u;\n"
+    /* and its contact shadows': a thread per instance */
+    "        u_ds.a[3u * (u_p.nkeys + k)] = (u_cnt.c[n + max(u_ent.e[ki + 3u], e0)] - f + 63u) / 64u;\n"
+    "        u_ds.a[3u * (u_p.nkeys + k) + 1u] = 1u;\n"
+    "        u_ds.a[3u * (u_p.nkeys + k) + 2u] = 1u;\n"
     "    }\n"
     "}\n";
 

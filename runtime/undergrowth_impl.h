@@ -26,28 +26,35 @@
 #define LOD_GROW_S "3.0"
 #define UG_BLOCK_VEC4 5   /* vec4s per block of the block table (fill_blocks) */
 /* The cull passes' table (host-visible, written each frame): key k's
- * entries are [e[k], e[k + 1]) (a key: a block's near or far mesh); its
- * mesh at e[UG_KEYINFO + 4k]: index count, first index, vertex offset,
- * the end of its entries with contact shadows; the entries from
- * e[UG_ENT0]: a cell's block,
- * slot * blocks + block (undergrowth.c "cull"). */
-#define UG_MAX_KEYS  (4 * SPLAT_MAX_UG_BLOCKS)   /* near, far, triangles, compute */
-#define UG_KEYINFO   260
-#define UG_KEYINFO_S "260u"
+ * entries are [e[k], e[k + 1]) (a key: a block's near, far or
+ * single-triangle mesh, drawn by the graphics pipeline or, UG_CS_KEY + the
+ * level, in compute); its mesh at e[UG_KEYINFO + 4k]: index count, first
+ * index, vertex offset, the end of its entries with contact shadows; the
+ * entries from e[UG_ENT0]: a cell's block, slot * blocks + block
+ * (undergrowth.c "cull"). */
+#define UG_LEVELS    3                           /* near, far, single triangles */
+#define UG_CS_KEY    UG_LEVELS                   /* a key's level + this: in compute */
+#define UG_MAX_KEYS  (2 * UG_LEVELS * SPLAT_MAX_UG_BLOCKS)
+#define UG_KEYINFO   388
+#define UG_KEYINFO_S "388u"
 #define UG_ENT0      (UG_KEYINFO + 4 * UG_MAX_KEYS)
-#define UG_ENT0_S    "1284u"
-_Static_assert(UG_KEYINFO > UG_MAX_KEYS && UG_ENT0 == 1284, "the cull table's strings");
+#define UG_ENT0_S    "1924u"
+_Static_assert(UG_KEYINFO > UG_MAX_KEYS && UG_ENT0 == 1924, "the cull table's strings");
 /* Beyond LOD_TRI times the LOD distance (a cell's nearest point) a block
  * whose far mesh is made of tapered quads draws them as single triangles
  * (undergrowth.c tri_mesh). */
 #define LOD_TRI 2.0
-/* The compute rasteriser (undergrowth_craster.c): a single-triangle cell
- * whose every blade projects within UG_CR_CAP pixels a side is drawn in
- * compute (a fourth key of its block); payloads carry a triangle index
- * below 1 << UG_CR_TBITS. */
-#define UG_CR_CAP    32
-#define UG_CR_CAP_S  "32"
+/* The compute rasteriser (undergrowth_craster.c): a cell whose every
+ * instance projects within UG_CR_CAP pixels a side is drawn in compute
+ * when its block is opaque or cut out as a frond and the mesh its distance
+ * picks has at most 1 << UG_CR_TBITS triangles; a payload is the cull
+ * list's position << UG_CR_PSHIFT | the mesh's level << UG_CR_TBITS | the
+ * triangle. */
+#define UG_CR_CAP    64
+#define UG_CR_CAP_S  "64"
 #define UG_CR_TBITS  4
+#define UG_CR_PSHIFT 6
+_Static_assert(UG_LEVELS <= 1 << (UG_CR_PSHIFT - UG_CR_TBITS), "the payload's level bits");
 
 /* The vertex stage's fade and wind (the top comment), shared by the draw,
  * the compute rasteriser and the probe pass so that the tests count what the draw keeps. */
@@ -187,6 +194,9 @@ struct rt_ug {
     bool                  compute;             /* asked for and possible     */
     bool                  cr64;                /* one pass, 64-bit atomics   */
     bool                  key_cs[UG_MAX_KEYS]; /* the key is drawn in compute */
+    bool                  key_sh[UG_MAX_KEYS]; /* its contact shadows are drawn */
+    bool                  key_shc[UG_MAX_KEYS];/* ... in compute                */
+    uint8_t               key_level[UG_MAX_KEYS];   /* its mesh: near, far, triangles */
     float                 cr_proj[3];          /* pixels per unit at depth 1,
                                                   cos of the half diagonal   */
     int                   width, height_px;    /* the colour target's        */
@@ -196,7 +206,7 @@ struct rt_ug {
     VkPipelineLayout      cr_layout;
     VkPipeline            cr_pipe[2];          /* depth and id, resolve      */
     VkDescriptorSet       cr_set;
-    rt_buffer             zbuf, idbuf, cdisp, crtab, crstat, crstat_host;
+    rt_buffer             zbuf, idbuf, shbuf, cdisp, crtab, crstat, crstat_host;
     bool                  cr_ran;              /* this frame's ran           */
     VkDescriptorSetLayout set_terrain;         /* set 0 of the mask pass     */
     VkDescriptorSetLayout set_mask, set_gen, set_draw, set_lod, set_cull, set_scan;
@@ -237,6 +247,10 @@ bool rt_ug_cull_pipelines(rt_ug *u, rt_error *e);
 /* This frame's keys and entries, then count, scan and write recorded
  * into cb, and the draws per key copied back for the stats. */
 void rt_ug_record_cull(rt_ug *u, VkCommandBuffer cb, const splat_frame *fr);
+
+/* Block b's mesh at level lv (0 near, 1 far, 2 single triangles; one it
+ * has): index count, first index, vertex offset. */
+void rt_ug_level_mesh(const rt_ug *u, int b, int lv, uint32_t out[3]);
 
 /* ---- undergrowth_craster.c: the far blades in compute ------------------- */
 
