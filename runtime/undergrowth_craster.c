@@ -1,37 +1,43 @@
-/* undergrowth_craster.c — far undergrowth blades drawn in compute, not
- * through the graphics pipeline (issue 33: on the H100 the graphics front
- * end paid about 23 ns an instance whatever its size, and a blade past
- * 28 m is a few pixels).
+/* undergrowth_craster.c — undergrowth drawn in compute, not through the
+ * graphics pipeline (issue 33: on the H100 the graphics front end paid
+ * about 23 ns an instance whatever its size, and a blade past 14 m is a
+ * few pixels).
  *
- * The cull passes give each opaque block whose far mesh has a
- * single-triangle version a fourth key: its single-triangle cells whose
- * every blade projects within UG_CR_CAP pixels a side
- * (rt_ug_craster_fits: the cull's own bounding sphere at the cell's
- * nearest point, seen at the corner of the view).  That key is not drawn;
- * after the graphics draw, a clear of the two per-pixel buffers, then
- * three compute passes over its instances (the cull's list, one thread per
- * instance and triangle, an indirect dispatch the scan pass writes):
- *   1. depth: each triangle's pixels (centres inside its edges, its
- *      bounding box clipped to the cap: a blade beyond it is counted in
- *      the stats' overflow, which the tests hold at 0) whose depth passes
- *      the depth attachment's (the terrain's and the graphics blades',
- *      reversed Z: greater is nearer) atomicMax their depth, as a uint
- *      (positive floats order as their bits), into a per-pixel buffer;
+ * The cull passes give each block, for each of its mesh levels (near, far,
+ * single triangles) that has at most 1 << UG_CR_TBITS triangles and is
+ * opaque or cut out as a frond, a compute key: the cells whose distance
+ * picks that level and whose every instance projects within UG_CR_CAP
+ * pixels a side (rt_ug_craster_fits: the cull's own bounding sphere, which
+ * holds the contact shadow too, at the cell's nearest point, seen at the
+ * corner of the view).  Those keys are not drawn; after the graphics
+ * draw, a clear of the per-pixel buffers, then compute passes over their
+ * instances (the cull's list, an indirect dispatch the scan pass writes):
+ *   1. depth: a thread per instance and triangle; the triangle's pixels
+ *      (centres inside its edges, its bounding box clipped to the cap: a
+ *      blade beyond it is counted in the stats' overflow, which the tests
+ *      hold at 0; a frond's pixels also inside the fragment stage's
+ *      outline, by perspective-correct uv) whose depth passes the depth
+ *      attachment's (the terrain's and the graphics blades', reversed Z:
+ *      greater is nearer) atomicMax their depth, as a uint (positive
+ *      floats order as their bits), into a per-pixel buffer;
  *   2. id: the same pixels whose depth equals the buffer's atomicMin a
- *      payload, the list position << UG_CR_TBITS | the triangle: the
- *      nearest blade per pixel, ties to the lowest payload (the same on
- *      every run, whatever the order the threads ran in);
+ *      payload, the list position << UG_CR_PSHIFT | the mesh level <<
+ *      UG_CR_TBITS | the triangle: the nearest blade per pixel, ties to
+ *      the lowest payload (the same on every run, whatever the order the
+ *      threads ran in);
+ *   with them, the contact shadows (ug_shadow): a thread per instance that
+ *      casts one, its quad's pixels that pass the depth attachment add
+ *      -log2(1 - a) in fixed point to a third per-pixel buffer;
  *   3. resolve, a thread per pixel: where a payload landed, the blade's
  *      three vertices again (the vertex stage's own transform: fade,
  *      widening, wind, colour, ug_far), perspective-correct barycentrics
  *      at the pixel's centre, the fragment stage's shading (texture by
  *      analytic gradients, root darkening, splat_light), stored into the
- *      colour.
+ *      colour; elsewhere the colour times 2^-(the shadows' sum).
  * With 64-bit storage buffer atomics passes 1 and 2 are one: atomicMax of
  * depth << 32 | ~payload ($SPLAT_UG_ATOMICS=32: the two passes anyway).
  * The compute blades are not written into the depth attachment (nothing
- * after the undergrowth reads it).  Contact shadows of the compute keys'
- * instances stay on the graphics path.  Screen path only (the depth is
+ * after the undergrowth reads it).  Screen path only (the depth is
  * sampled there); rt_render_desc.undergrowth_compute (splatbench
  * ugcompute=1) turns it on. */
 #include "undergrowth_impl.h"
