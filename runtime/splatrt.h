@@ -347,7 +347,7 @@ typedef struct rt_render_desc {
                                        drawing their tiles meanwhile (the
                                        viewer's default; headless waits)   */
     double       undergrowth_radius; /* m around the camera; 0: RT_UG_RADIUS    */
-    bool         undergrowth_compute; /* screen path: far single-triangle blades
+    bool         undergrowth_compute; /* screen path: instances that fit 64 px
                                        drawn in compute, not by the graphics
                                        pipeline (runtime/undergrowth_craster.c;
                                        splatbench ugcompute=1)              */

@@ -53,7 +53,7 @@ typedef struct opts {
     bool overlay;
     bool headless, stats, have_camera, have_look, no_stitch, no_cull, no_shadows;
     bool no_undergrowth;
-    bool ug_compute;       /* --ug-compute: far blades in compute          */
+    bool ug_compute;       /* --ug-compute: small instances in compute     */
     double ug_radius, ug_thin;   /* --ug-radius, --ug-thin (0: default)    */
     bool no_distance_classes;
     bool wait_pipelines;   /* --wait-pipelines */
@@ -354,8 +354,8 @@ static const splat_arg options[] = {
       "(default 96)", F(ug_radius), .min = 1, .max = 4096, .expects = "metres" },
     { "--ug-thin", SPLAT_ARG_FLOAT, "D", "undergrowth thinned (D / d)^2 beyond D metres "
       "(default 14)", F(ug_thin), .min = 1, .max = 1e6, .expects = "metres" },
-    { "--ug-compute", SPLAT_ARG_FLAG, NULL, "screen path: far single-triangle undergrowth "
-      "blades drawn in compute, not by the graphics pipeline", F(ug_compute) },
+    { "--ug-compute", SPLAT_ARG_FLAG, NULL, "screen path: undergrowth instances that fit 64 "
+      "pixels drawn in compute, not by the graphics pipeline", F(ug_compute) },
     { NULL, SPLAT_ARG_SECTION, .help = "Destruction:" },
     { "--crater", SPLAT_ARG_CUSTOM, "X,Z,R[,DEPTH]", "a crater before the frames (metres; "
       "repeatable; depth defaults to R/4)", .parse = parse_crater,

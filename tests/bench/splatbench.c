@@ -41,8 +41,8 @@
  *       noshadow renders without the terrain's shadows (--no-shadows); ug
  *       draws the pack's undergrowth (off otherwise, so the other groups
  *       time what they always timed), ugradius=R within R metres of the
- *       camera instead of the runtime's 96, ugcompute=1 draws the far
- *       single-triangle blades in compute (runtime/undergrowth_craster.c;
+ *       camera instead of the runtime's 96, ugcompute=1 draws the
+ *       instances that fit 64 pixels in compute (runtime/undergrowth_craster.c;
  *       ug_drawn_compute: how many of ug_drawn), ugthin=D thins it (the distance
  *       LOD's fraction (D / d)^2) from D metres instead of 14, the far
  *       meshes staying at 14 m (rt_render_desc.undergrowth_thin): its rows add
@@ -141,7 +141,7 @@ typedef struct variant {
     bool         ug;        /* draw the undergrowth                         */
     double       ug_radius; /* its radius (m); 0: the runtime's default     */
     double       ug_thin;   /* its thinning distance (m); 0: the runtime's  */
-    bool         ug_compute; /* far single-triangle blades drawn in compute */
+    bool         ug_compute; /* small instances drawn in compute           */
     double       far;       /* screen: the far atlas's distance (m); 0: off */
     int          preview;   /* the preview scale (2, 4); 0: full resolution */
     rt_shading_lod cpulod;  /* cpulod=on|off: the CPU shading LOD; default auto */
