@@ -10,8 +10,8 @@
  * pixels a side (rt_ug_craster_fits: the cull's own bounding sphere, which
  * holds the contact shadow too, at the cell's nearest point, seen at the
  * corner of the view).  Those keys are not drawn; after the graphics
- * draw, a clear of the per-pixel buffers, then compute passes over their
- * instances (the cull's list, an indirect dispatch the scan pass writes):
+ * draw, compute passes over their instances (the cull's list, an indirect dispatch the scan pass writes;
+ * the per-pixel buffers filled once, then left clear by the resolve):
  *   1. depth: a thread per instance and triangle; the triangle's pixels
  *      (centres inside its edges, its bounding box clipped to the cap: a
  *      blade beyond it is counted in the stats' overflow, which the tests
@@ -85,9 +85,10 @@
     "    uvec4 info;\n"                                                                \
     "} u_push;\n"
 
-/* u_push: patch_xz (radius, time, width, height), info (instances per
- * cell, key, the key's mesh level, the pass: 0 depth, 1 id, 2 the clear of
- * the per-pixel buffers).  u_tri: per block and level its mesh (index
+/* u_push: patch_xz (radius, time, width, height), patch_uv.x (the keys'
+ * count: where the shadows' draws start), info (instances per cell, key,
+ * the key's mesh level, the pass: 0 depth, 1 id, 3 the contact shadows).
+ * u_tri: per block and level its mesh (index
  * count, first index, vertex offset). */
 static const char cr_glsl_main[] =
     UG_GLSL_FUNCS
@@ -192,17 +193,7 @@ static const char cr_glsl_main[] =
     "}\n"
     "void main() {\n"
     "    uint g = gl_WorkGroupID.x * 64u + gl_LocalInvocationIndex;\n"
-    "    if (u_push.info.w == 2u) {   /* the clear, before the depth pass */\n"
-    "        if (g >= uint(u_push.patch_xz.z) * uint(u_push.patch_xz.w)) return;\n"
-    "        u_sh.s[g] = 0u;\n"
-    "#ifdef UG_I64\n"
-    "        u_z.z[g] = uint64_t(0);\n"
-    "#else\n"
-    "        u_z.z[g] = 0u;\n"
-    "        u_id.i[g] = 0xffffffffu;\n"
-    "#endif\n"
-    "        return;\n"
-    "    }\n"
+
     "    if (u_push.info.w == 3u) {   /* the contact shadows */\n"
     "        ug_shadow(g);\n"
     "        return;\n"
@@ -286,14 +277,23 @@ static const char cr_glsl_main[] =
     "    uint id = u_id.i[at];\n"
     "    bool hit = id != 0xffffffffu;\n"
     "#endif\n"
+    /* the buffers left clear for the next frame (no clear pass) */
     "    if (!hit) {   /* the compute keys' contact shadows on what is there */\n"
     "        uint sh = u_sh.s[at];\n"
     "        if (sh != 0u) {\n"
+    "            u_sh.s[at] = 0u;\n"
     "            vec4 c = imageLoad(u_out, px);\n"
     "            imageStore(u_out, px, vec4(c.rgb * exp2(-float(sh) * (1.0 / 262144.0)), c.a));\n"
     "        }\n"
     "        return;\n"
     "    }\n"
+    "    u_sh.s[at] = 0u;\n"
+    "#ifdef UG_I64\n"
+    "    u_z.z[at] = uint64_t(0);\n"
+    "#else\n"
+    "    u_z.z[at] = 0u;\n"
+    "    u_id.i[at] = 0xffffffffu;\n"
+    "#endif\n"
     "    UgV v0, v1, v2;\n"
     "    ug_tri(id >> " SPLAT_STR(UG_CR_PSHIFT) ", (id >> " SPLAT_STR(UG_CR_TBITS) ") & ((1u << " SPLAT_STR(UG_CR_PSHIFT) "u - " SPLAT_STR(UG_CR_TBITS) "u) - 1u), id & ((1u << " SPLAT_STR(UG_CR_TBITS) "u) - 1u), v0, v1, v2);\n"
     "    vec2 s0 = ug_screen(v0.clip), s1 = ug_screen(v1.clip), s2 = ug_screen(v2.clip);\n"
@@ -361,7 +361,7 @@ bool rt_ug_craster_create(rt_ug *u, rt_error *e)
         !rt_buffer_create(d, npx * (u->cr64 ? 8 : 4), st | VK_BUFFER_USAGE_TRANSFER_DST_BIT, false,
                           &u->zbuf, e) ||
         !rt_buffer_create(d, npx * 4, st | VK_BUFFER_USAGE_TRANSFER_DST_BIT, false, &u->idbuf, e) ||
-        !rt_buffer_create(d, npx * 4, st, false, &u->shbuf, e) ||
+        !rt_buffer_create(d, npx * 4, st | VK_BUFFER_USAGE_TRANSFER_DST_BIT, false, &u->shbuf, e) ||
         !rt_buffer_create(d, (VkDeviceSize)SPLAT_MAX_UG_BLOCKS * UG_LEVELS * 16, st, true, &u->crtab, e) ||
         !rt_buffer_create(d, 16, st | VK_BUFFER_USAGE_TRANSFER_DST_BIT | VK_BUFFER_USAGE_TRANSFER_SRC_BIT,
                           false, &u->crstat, e) ||
@@ -471,6 +471,12 @@ void rt_ug_craster_record(rt_ug *u, VkCommandBuffer cb, VkDescriptorSet set0c, V
         return;
     const VkPipelineStageFlags cs = VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT;
     vkCmdFillBuffer(cb, u->crstat.buf, 0, 16, 0);
+    if (!u->cr_clear) {   /* once: the resolve leaves them clear after */
+        vkCmdFillBuffer(cb, u->zbuf.buf, 0, VK_WHOLE_SIZE, 0);
+        vkCmdFillBuffer(cb, u->idbuf.buf, 0, VK_WHOLE_SIZE, 0xffffffffu);
+        vkCmdFillBuffer(cb, u->shbuf.buf, 0, VK_WHOLE_SIZE, 0);
+        u->cr_clear = true;
+    }
     /* the fills, and the cull passes' list and draws (their own barrier
      * reaches the graphics stages only) */
     rt_cmd_barrier(cb, VK_PIPELINE_STAGE_TRANSFER_BIT | cs,
@@ -482,19 +488,14 @@ void rt_ug_craster_record(rt_ug *u, VkCommandBuffer cb, VkDescriptorSet set0c, V
                    VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT, cs, VK_ACCESS_SHADER_READ_BIT);
     rt_cmd_image_barrier(cb, u->color->img, 0, 1, 1, VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
                          VK_IMAGE_LAYOUT_GENERAL, VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT,
-                         VK_ACCESS_SHADER_WRITE_BIT, VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT, cs);
+                         VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT,
+                         VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT, cs);
     VkDescriptorSet sets[3] = { set0c, set1, u->cr_set };
     vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, u->cr_layout, 0, 3, sets, 0, NULL);
     splat_push push = { .patch_xz = { (float)u->radius, (float)u->time, (float)u->width,
                                       (float)u->height_px },
                         .info = { u->cap, 0, 0, 0 } };
-    /* the clear: the raster pipeline, pass 2 */
     vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, u->cr_pipe[0]);
-    push.info[3] = 2;
-    vkCmdPushConstants(cb, u->cr_layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof push, &push);
-    vkCmdDispatch(cb, (uint32_t)(((size_t)u->width * (size_t)u->height_px + 63) / 64), 1, 1);
-    rt_cmd_barrier(cb, cs, VK_ACCESS_SHADER_WRITE_BIT, cs,
-                   VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
     for (int pass = 0; pass < (u->cr64 ? 1 : 2); pass++) {
         push.info[3] = (uint32_t)pass;
         for (int k = 0; k < u->nkeys; k++) {

@@ -208,6 +208,9 @@ struct rt_ug {
     VkDescriptorSet       cr_set;
     rt_buffer             zbuf, idbuf, shbuf, cdisp, crtab, crstat, crstat_host;
     bool                  cr_ran;              /* this frame's ran           */
+    bool                  cr_clear;            /* the per-pixel buffers were
+                                                  filled once (the resolve
+                                                  clears what it reads)      */
     VkDescriptorSetLayout set_terrain;         /* set 0 of the mask pass     */
     VkDescriptorSetLayout set_mask, set_gen, set_draw, set_lod, set_cull, set_scan;
     VkPipelineLayout      mask_layout, gen_layout, draw_layout, lod_layout, cull_layout,

@@ -23,8 +23,8 @@
  *   - the far blades are there: the compute frame differs from one with
  *     the far blades not drawn at all (radius 28 m) in as many pixels as
  *     the graphics frame does, within 2 %;
- *   - deterministic: a second renderer with the compute path gives the
- *     same picture bit for bit.
+ *   - deterministic: a second renderer with the compute path, which drew
+ *     another view before, gives the same picture bit for bit.
  * $SPLAT_UG_ATOMICS=32 runs the two-pass path where the device has 64-bit
  * atomics (the suite runs both). */
 #include "kit.h"
@@ -126,6 +126,13 @@ int main(int argc, char **argv)
 
     rt_camera cam = { .position = { 100, 1.7, 20 }, .look = { 130, 0, 200 } };
     rt_frame_stats sg_, sc, sc2, sn;
+    /* the second compute renderer looks elsewhere first: the per-pixel
+     * buffers that the resolve leaves clear must hold nothing of that
+     * frame (its picture is compared with the first's bit for bit) */
+    rt_camera away = { .position = { 100, 1.7, 20 }, .look = { 10, 0, 150 } };
+    free(frame(cs2, &away, &sc2));
+    CHECK(sc2.undergrowth.drawn_compute > 1000, "looking away: %ld drawn in compute",
+          sc2.undergrowth.drawn_compute);
     float *a = frame(gfx, &cam, &sg_), *b = frame(cs, &cam, &sc), *c = frame(cs2, &cam, &sc2);
     float *z = frame(near, &cam, &sn);
     const rt_ug_stats *ug = &sg_.undergrowth, *uc = &sc.undergrowth;
