@@ -416,6 +416,9 @@ typedef struct rt_ug_stats {
     bool   key_compute[RT_UG_KEYS_MAX];
     uint32_t key_indices[RT_UG_KEYS_MAX], key_drawn[RT_UG_KEYS_MAX];
     double gen_ms, draw_ms;   /* GPU ms (timestamps; < 0 if unsupported)    */
+    double draw_gfx_ms;       /* of draw_ms: the graphics pipeline's pass   */
+    double draw_cs_ms;        /* the compute raster and shadow passes, and  */
+    double resolve_ms;        /* the resolve (< 0: not run)                 */
     size_t bytes_per_cell;    /* masks + instance capacity + draw arguments */
 } rt_ug_stats;
 

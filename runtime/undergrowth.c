@@ -420,7 +420,7 @@ bool rt_ug_create(rt_device *d, const rt_pack *p, rt_pipelines *pl, const rt_qua
     u->shadows &= (fp.optimalTilingFeatures & VK_FORMAT_FEATURE_COLOR_ATTACHMENT_BLEND_BIT) != 0;
     VkQueryPoolCreateInfo qi = {
         .sType = VK_STRUCTURE_TYPE_QUERY_POOL_CREATE_INFO,
-        .queryType = VK_QUERY_TYPE_TIMESTAMP, .queryCount = 4,
+        .queryType = VK_QUERY_TYPE_TIMESTAMP, .queryCount = 6,
     };
     VkImageView views[2] = { t->color->view, t->depth->view };
     if (!make_layouts(u, e) || !make_buffers(u, e) || !make_textures(u, e) ||
@@ -698,7 +698,7 @@ bool rt_ug_generate(rt_ug *u, VkCommandBuffer cb, const splat_frame *fr, VkDescr
             uf->world[4 * k + a] = 0.0f;
     u->generated = 0;
     if (u->qpool) {
-        vkCmdResetQueryPool(cb, u->qpool, 0, 4);
+        vkCmdResetQueryPool(cb, u->qpool, 0, 6);
         vkCmdWriteTimestamp(cb, VK_PIPELINE_STAGE_TOP_OF_PIPE_BIT, u->qpool, 0);
     }
     int todo[UG_TODO], n = 0;
@@ -827,6 +827,8 @@ void rt_ug_draw(rt_ug *u, VkCommandBuffer cb, bool depth_read_only, VkDescriptor
                 vkCmdDrawIndexedIndirect(cb, u->mdraw.buf, 20 * (VkDeviceSize)k, 1, 20);
     }
     vkCmdEndRenderPass(cb);
+    if (u->qpool)   /* the graphics draw's end */
+        vkCmdWriteTimestamp(cb, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, u->qpool, 4);
     if (depth_read_only)   /* the far blades in compute (undergrowth_craster.c) */
         rt_ug_craster_record(u, cb, set0c, set1);
     if (u->qpool)
@@ -836,7 +838,7 @@ void rt_ug_draw(rt_ug *u, VkCommandBuffer cb, bool depth_read_only, VkDescriptor
 void rt_ug_read_stats(rt_ug *u, rt_ug_stats *st)
 {
     memset(st, 0, sizeof *st);
-    st->gen_ms = st->draw_ms = -1;
+    st->gen_ms = st->draw_ms = st->draw_gfx_ms = st->draw_cs_ms = st->resolve_ms = -1;
     if (!u)
         return;
     st->generated = u->generated;
@@ -873,7 +875,7 @@ void rt_ug_read_stats(rt_ug *u, rt_ug_stats *st)
                          (size_t)u->cap * (32 + 4) + (size_t)u->nblocks * 28;
     if (!u->qpool)
         return;
-    uint64_t q[4];
+    uint64_t q[6];
     const VkQueryResultFlags fl = VK_QUERY_RESULT_64_BIT | VK_QUERY_RESULT_WAIT_BIT;
     double ms = u->d->props.limits.timestampPeriod * 1e-6;
     if (vkGetQueryPoolResults(u->d->dev, u->qpool, 0, 2, sizeof q, q, sizeof q[0], fl) == VK_SUCCESS)
@@ -882,6 +884,17 @@ void rt_ug_read_stats(rt_ug *u, rt_ug_stats *st)
         vkGetQueryPoolResults(u->d->dev, u->qpool, 2, 2, 2 * sizeof q[0], q + 2, sizeof q[0], fl) ==
             VK_SUCCESS)
         st->draw_ms = (double)(q[3] - q[2]) * ms;
+    if (u->drawn &&
+        vkGetQueryPoolResults(u->d->dev, u->qpool, 4, 1, sizeof q[0], q + 4, sizeof q[0], fl) ==
+            VK_SUCCESS) {
+        st->draw_gfx_ms = (double)(q[4] - q[2]) * ms;
+        if (u->cr_ran &&
+            vkGetQueryPoolResults(u->d->dev, u->qpool, 5, 1, sizeof q[0], q + 5, sizeof q[0], fl) ==
+                VK_SUCCESS) {
+            st->draw_cs_ms = (double)(q[5] - q[4]) * ms;
+            st->resolve_ms = (double)(q[3] - q[5]) * ms;
+        }
+    }
     u->drawn = false;
 }
 

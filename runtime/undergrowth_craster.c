@@ -520,6 +520,8 @@ void rt_ug_craster_record(rt_ug *u, VkCommandBuffer cb, VkDescriptorSet set0c, V
         rt_cmd_barrier(cb, cs, VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_SHADER_READ_BIT, cs,
                        VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
     }
+    if (u->qpool)   /* the raster and shadow passes' end (the stats) */
+        vkCmdWriteTimestamp(cb, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, u->qpool, 5);
     vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, u->cr_pipe[1]);
     push.info[3] = 1;
     vkCmdPushConstants(cb, u->cr_layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof push, &push);

@@ -43,7 +43,9 @@
  *       time what they always timed), ugradius=R within R metres of the
  *       camera instead of the runtime's 96, ugcompute=1 draws the
  *       instances that fit 64 pixels in compute (runtime/undergrowth_craster.c;
- *       ug_drawn_compute: how many of ug_drawn), ugthin=D thins it (the distance
+ *       ug_drawn_compute: how many of ug_drawn; the draw's parts
+ *       ug_gfx_ms, ug_cs_raster_ms (and the contact shadows), ug_cs_resolve_ms,
+ *       -1 where not run), ugthin=D thins it (the distance
  *       LOD's fraction (D / d)^2) from D metres instead of 14, the far
  *       meshes staying at 14 m (rt_render_desc.undergrowth_thin): its rows add
  *       the generation GPU ms per frame and per generated cell, the draw GPU
@@ -147,6 +149,8 @@ typedef struct variant {
     rt_shading_lod cpulod;  /* cpulod=on|off: the CPU shading LOD; default auto */
     double       shadow_ms; /* ms of the shadow map (the first frame)       */
     double      *ug_gen, *ug_draw; /* per timed frame, GPU ms               */
+    double      *ug_part[3];       /* the draw's graphics pass, compute raster
+                                      and shadows, resolve (ms; < 0: none)  */
     long         ug_cells;  /* cells generated over the timed frames        */
     rt_ug_stats  ug_last;   /* the last frame's                             */
     rt_pack     *base;      /* loaded pack (shared by variants of one dir)  */
@@ -347,6 +351,8 @@ static void variant_free(variant *v)
     free(v->sel);
     free(v->ug_gen);
     free(v->ug_draw);
+    for (int k = 0; k < 3; k++)
+        free(v->ug_part[k]);
     for (int k = 0; k < 3; k++)
         free(v->pass[k]);
 }
@@ -691,6 +697,8 @@ static bool make_renderer(bench_run *b, int i, const char *cache, rt_error *e)
         v->pass[k] = xcalloc(n, sizeof(double));
     v->ug_gen = xcalloc(n, sizeof(double));
     v->ug_draw = xcalloc(n, sizeof(double));
+    for (int k = 0; k < 3; k++)
+        v->ug_part[k] = xcalloc(n, sizeof(double));
     rt_camera cam;
     rt_frame_stats st;
     for (int w = 0; w < (o->warmup < 0 ? o->frames : o->warmup); w++) {
@@ -729,6 +737,9 @@ static bool timed_frame(bench_run *b, int f, rt_error *e)
             v->pass[p][f] = st.pass_ms[p];
         v->ug_gen[f] = st.undergrowth.gen_ms;
         v->ug_draw[f] = st.undergrowth.draw_ms;
+        v->ug_part[0][f] = st.undergrowth.draw_gfx_ms;
+        v->ug_part[1][f] = st.undergrowth.draw_cs_ms;
+        v->ug_part[2][f] = st.undergrowth.resolve_ms;
         v->ug_cells += st.undergrowth.generated;
         v->ug_last = st.undergrowth;
         v->patches = st.patches;
@@ -827,17 +838,20 @@ static void csv_row(FILE *out, const bench_run *b, int i, const char *devname)
     for (int k = 0; k < 3 && IS_SCREEN(v->k); k++)
         percentiles(v->pass[k], frames, &pm[k], &lo, &hi);
     double px = v->tiles.pixels ? (double)v->tiles.pixels : 1.0;
-    double ugm = -1, ugd = -1, gen_sum = 0;
+    double ugm = -1, ugd = -1, gen_sum = 0, ugp[3] = { -1, -1, -1 };
     if (v->ug) {
         percentiles(v->ug_gen, frames, &ugm, &lo, &hi);
         percentiles(v->ug_draw, frames, &ugd, &lo, &hi);
+        for (int k = 0; k < 3; k++)
+            percentiles(v->ug_part[k], frames, &ugp[k], &lo, &hi);
         for (int f = 0; f < frames; f++)
             gen_sum += v->ug_gen[f];
     }
     const char *pk = strrchr(v->pack_dir, '/');
     fprintf(out, "\"%s\",%s,%s,%d,%d,%s,%s,%s,%g,%d,%.3f,%.3f,%.3f,%.3f,%.4f,%d,%d,"
                  "%.6g,%.6g,%.2f,%ld,%.1f,%s,%s,%.3f,%.3f,%.3f,%d,%d,%.4f,%.4f,%.3f,%.1f,"
-                 "%.2f,%.4f,%.4f,%.4f,%.2f,%ld,%zu,%g,%d,%d,%d,%.3f,%ld,%ld,%ld,%d,%.3f,%d,%d,%d,%ld\n",
+                 "%.2f,%.4f,%.4f,%.4f,%.2f,%ld,%zu,%g,%d,%d,%d,%.3f,%ld,%ld,%ld,%d,%.3f,%d,%d,%d,%ld,"
+                 "%.4f,%.4f,%.4f\n",
             devname, o->scene ? o->scene : v->base->name, o->pd.name, o->width, o->height,
             v->label, kind_names[v->k], pk ? pk + 1 : v->pack_dir,
             v->lod > 0 ? v->lod : 3.0, frames, gm, g10, g90, cm, sm,
@@ -853,7 +867,7 @@ static void csv_row(FILE *out, const bench_run *b, int i, const char *devname)
             v->ug_last.bytes_per_cell, v->far, v->tiles.tiles_far, !v->no_dclass,
             v->tiles.tiles_class, procm, v->ug_last.candidates, v->ug_last.drawn, v->ug_last.triangles,
             v->ug_last.draws, v->first_picture_s, v->stand_in[0], v->stand_in[1], v->stand_in[2],
-            v->ug_last.drawn_compute);
+            v->ug_last.drawn_compute, ugp[0], ugp[1], ugp[2]);
 }
 
 /* The rows, on stdout or appended to --csv (a header when it is new). */
@@ -880,7 +894,8 @@ static bool write_csv(const bench_run *b)
                      "ug_gen_med_ms,ug_gen_ms_per_cell,ug_draw_med_ms,ug_cells_per_frame,"
                      "ug_instances,ug_bytes_per_cell,far_distance,tiles_far,distclass,tiles_class,"
                      "proc_cpu_med_ms,ug_candidates,ug_drawn,ug_triangles,ug_draws,first_picture_s,"
-                     "stand_in_uber,stand_in_atlas,stand_in_flat,ug_drawn_compute\n");
+                     "stand_in_uber,stand_in_atlas,stand_in_flat,ug_drawn_compute,ug_gfx_ms,"
+                     "ug_cs_raster_ms,ug_cs_resolve_ms\n");
     /* the device name in CSV: its commas become ';' */
     char devname[VK_MAX_PHYSICAL_DEVICE_NAME_SIZE];
     snprintf(devname, sizeof devname, "%s", b->dev.props.deviceName);
