@@ -69,11 +69,48 @@ static bool cs_level(const rt_ug *u, int b, int lv)
 {
     uint32_t mesh[3];
     rt_ug_level_mesh(u, b, lv, mesh);
-    return u->compute && u->p->ug.blocks[b].cutout != 2 && mesh[0] / 3 <= (1u << UG_CR_TBITS);
+    return u->cr_frame && u->p->ug.blocks[b].cutout != 2 && mesh[0] / 3 <= (1u << UG_CR_TBITS);
+}
+
+/* The mesh level a cell whose nearest point is `near` metres away draws
+ * block b with (0 near, 1 far, 2 single triangles), + UG_CS_KEY where
+ * that goes to compute. */
+static int cell_level(const rt_ug *u, int b, int slot, double near)
+{
+    const rt_pack_ug *pu = &u->p->ug;
+    int far = pu->meshes[pu->blocks[b].mesh].far;
+    int cv = near > LOD_NEAR && far >= 0;
+    if (cv && u->tri[b][0] && near > LOD_TRI * LOD_NEAR)
+        cv = 2;
+    if (cs_level(u, b, cv) && rt_ug_craster_fits(u, b, near, ((float *)u->lod.map)[slot]))
+        cv += UG_CS_KEY;
+    return cv;
+}
+
+/* Whether this frame's compute keys would hold enough to pay for the
+ * compute passes (a resolve over every pixel, whatever they hold): their
+ * visible cells' candidates times the LOD's fraction, at least
+ * UG_CR_MIN.  From the cells alone, not from counts read back, so that a
+ * frame's picture does not depend on the frames before it. */
+static bool cs_worth(rt_ug *u)
+{
+    double cand = 0;
+    for (int i = 0; i < u->pool; i++) {
+        const ug_cell *cl = &u->cells[i];
+        if (cl->state != CELL_READY || !cl->visible)
+            continue;
+        double near = cl->dist - CELL * 0.7071;
+        for (int b = 0; b < u->nblocks; b++)
+            if (cell_level(u, b, i, near) >= UG_CS_KEY)
+                cand += (double)u->block_grid[b] * u->block_grid[b] * ((float *)u->lod.map)[i];
+    }
+    return cand >= UG_CR_MIN;
 }
 
 static void fill_entries(rt_ug *u)
 {
+    u->cr_frame = u->compute;   /* cs_worth's cell_level asks for them all */
+    u->cr_frame = u->compute && cs_worth(u);
     const rt_pack_ug *pu = &u->p->ug;
     uint32_t *e = u->ent.map;
     int k = 0, n = 0;
@@ -103,13 +140,7 @@ static void fill_entries(rt_ug *u)
                     int slot = u->order[i];
                     const ug_cell *cl = &u->cells[slot];
                     double near = cl->dist - CELL * 0.7071;   /* its nearest point, about */
-                    int cv = near > LOD_NEAR && far >= 0;
-                    if (cv && u->tri[b][0] && near > LOD_TRI * LOD_NEAR)
-                        cv = 2;
-                    if (cs_level(u, b, cv) &&
-                        rt_ug_craster_fits(u, b, near, ((float *)u->lod.map)[slot]))
-                        cv += UG_CS_KEY;
-                    if (cl->state != CELL_READY || !cl->visible || cv != l)
+                    if (cl->state != CELL_READY || !cl->visible || cell_level(u, b, slot, near) != l)
                         continue;
                     if (shadows && near >= shadow_end)   /* and every entry after */
                         shadows = false, ki[3] = (uint32_t)n;

@@ -54,6 +54,10 @@ _Static_assert(UG_KEYINFO > UG_MAX_KEYS && UG_ENT0 == 1924, "the cull table's st
 #define UG_CR_CAP_S  "64"
 #define UG_CR_TBITS  4
 #define UG_CR_PSHIFT 6
+/* The compute keys are made only when their visible cells hold at least
+ * UG_CR_MIN candidates (times the LOD's fraction): below it the resolve's
+ * pass over every pixel costs more than the graphics draw saves. */
+#define UG_CR_MIN    16384.0
 _Static_assert(UG_LEVELS <= 1 << (UG_CR_PSHIFT - UG_CR_TBITS), "the payload's level bits");
 
 /* The vertex stage's fade and wind (the top comment), shared by the draw,
@@ -193,6 +197,7 @@ struct rt_ug {
     /* the compute rasteriser (undergrowth_craster.c; NULL pipes: off) */
     bool                  compute;             /* asked for and possible     */
     bool                  cr64;                /* one pass, 64-bit atomics   */
+    bool                  cr_frame;            /* this frame has compute keys */
     bool                  key_cs[UG_MAX_KEYS]; /* the key is drawn in compute */
     bool                  key_sh[UG_MAX_KEYS]; /* its contact shadows are drawn */
     bool                  key_shc[UG_MAX_KEYS];/* ... in compute                */

@@ -23,6 +23,9 @@
  *   - the far blades are there: the compute frame differs from one with
  *     the far blades not drawn at all (radius 28 m) in as many pixels as
  *     the graphics frame does, within 2 %;
+ *   - at radius 40 m the few cells that would go to compute hold fewer
+ *     candidates than the compute passes pay for (UG_CR_MIN): none go,
+ *     the picture is the graphics path's bit for bit;
  *   - deterministic: a second renderer with the compute path, which drew
  *     another view before, gives the same picture bit for bit.
  * $SPLAT_UG_ATOMICS=32 runs the two-pass path where the device has 64-bit
@@ -135,6 +138,24 @@ int main(int argc, char **argv)
           sc2.undergrowth.drawn_compute);
     float *a = frame(gfx, &cam, &sg_), *b = frame(cs, &cam, &sc), *c = frame(cs2, &cam, &sc2);
     float *z = frame(near, &cam, &sn);
+    /* the compute keys only where they hold enough (UG_CR_MIN): at 40 m a
+     * few far cells, drawn by the graphics pipeline, the same picture */
+    rt_renderer *g40 = renderer(dev, p, false, 40), *c40 = renderer(dev, p, true, 40);
+    rt_frame_stats s40g, s40c;
+    float *y0 = g40 ? frame(g40, &cam, &s40g) : NULL, *y1 = c40 ? frame(c40, &cam, &s40c) : NULL;
+    if (y0 && y1) {
+        printf("radius 40: %ld drawn, %ld in compute\n", s40c.undergrowth.drawn,
+               s40c.undergrowth.drawn_compute);
+        CHECK(s40c.undergrowth.drawn == s40g.undergrowth.drawn && s40c.undergrowth.drawn > 100 &&
+                  s40c.undergrowth.drawn_compute == 0,
+              "radius 40: %ld drawn (graphics %ld), %ld in compute", s40c.undergrowth.drawn,
+              s40g.undergrowth.drawn, s40c.undergrowth.drawn_compute);
+        kit_image_equal(y0, y1, W, H, "radius 40, compute keys too few");
+    }
+    free(y0);
+    free(y1);
+    rt_renderer_destroy(g40);
+    rt_renderer_destroy(c40);
     const rt_ug_stats *ug = &sg_.undergrowth, *uc = &sc.undergrowth;
     printf("graphics: drawn %ld, triangles %ld, %d draws; compute: drawn %ld (%ld in compute), "
            "triangles %ld, %d draws, %ld clipped\n", ug->drawn, ug->triangles, ug->draws,
