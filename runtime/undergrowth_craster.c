@@ -340,6 +340,12 @@ bool rt_ug_craster_create(rt_ug *u, rt_error *e)
      * ($SPLAT_UG_ATOMICS=32: the two-pass fallback, for the tests) */
     const char *env = getenv("SPLAT_UG_ATOMICS");
     u->cr64 = d->int64_atomics && !(env && !strcmp(env, "32"));
+    /* the cap a cell's instances must fit (pixels a side): UG_CR_CAP, or
+     * $SPLAT_UG_CAP from 8 to UG_CR_CAP (the H100's A/B of the cap: a
+     * larger one takes nearer cells, whose triangles loop over more pixels
+     * in one thread) */
+    const char *cap = getenv("SPLAT_UG_CAP");
+    u->cr_cap = cap && atoi(cap) >= 8 && atoi(cap) <= UG_CR_CAP ? atoi(cap) : UG_CR_CAP;
     const VkShaderStageFlags cs = VK_SHADER_STAGE_COMPUTE_BIT;
     const VkDescriptorType sb = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
     const VkDescriptorType cis = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
@@ -458,7 +464,7 @@ bool rt_ug_craster_fits(const rt_ug *u, int b, double near, float f)
     double rad = h * grow + bl[14] * h * h + 0.05;
     double z = near * u->cr_proj[1] - rad;   /* the least view depth of the cell's spheres */
     /* the sphere's diameter in pixels, two pixels' margin for the rounding */
-    return z > 0 && 2.0 * rad * u->cr_proj[0] / z <= UG_CR_CAP - 2;
+    return z > 0 && 2.0 * rad * u->cr_proj[0] / z <= u->cr_cap - 2;
 }
 
 void rt_ug_craster_record(rt_ug *u, VkCommandBuffer cb, VkDescriptorSet set0c, VkDescriptorSet set1)

@@ -198,6 +198,8 @@ struct rt_ug {
     bool                  compute;             /* asked for and possible     */
     bool                  cr64;                /* one pass, 64-bit atomics   */
     bool                  cr_frame;            /* this frame has compute keys */
+    int                   cr_cap;              /* pixels a side a cell's
+                                                  instances fit (fits)       */
     bool                  key_cs[UG_MAX_KEYS]; /* the key is drawn in compute */
     bool                  key_sh[UG_MAX_KEYS]; /* its contact shadows are drawn */
     bool                  key_shc[UG_MAX_KEYS];/* ... in compute                */
