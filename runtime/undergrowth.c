@@ -814,7 +814,7 @@ void rt_ug_draw(rt_ug *u, VkCommandBuffer cb, bool depth_read_only, VkDescriptor
     if (u->shadows) {   /* under the plants: before them */
         vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_GRAPHICS, u->shadow_pipe);
         for (int k = 0; k < u->nkeys; k++)
-            if (u->key_used[k] && u->key_sh[k])
+            if (u->key_used[k] && (u->key_sh[k] || (u->key_shc[k] && !depth_read_only)))
                 vkCmdDrawIndexedIndirect(cb, u->mdraw.buf, 20 * (VkDeviceSize)(u->nkeys + k), 1, 20);
     }
     /* one draw per key (a block's near or far mesh), opaque first: they
@@ -858,7 +858,9 @@ void rt_ug_read_stats(rt_ug *u, rt_ug_stats *st)
         const uint32_t *m = md + 5 * k, *sh = md + 5 * (u->nkeys + k);
         st->drawn += m[1];
         st->triangles += (long)m[1] * (m[0] / 3) + (long)sh[1] * 2;
-        st->draws += u->key_used[k] ? !(u->key_cs[k] && u->cr_ran) + u->key_sh[k] : 0;
+        st->draws += u->key_used[k] ? !(u->key_cs[k] && u->cr_ran) +
+                                          (u->key_sh[k] || (u->key_shc[k] && !u->cr_ran))
+                                    : 0;
         if (u->key_cs[k] && u->cr_ran)
             st->drawn_compute += m[1];
         if (k < RT_UG_KEYS_MAX) {
