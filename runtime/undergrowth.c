@@ -406,10 +406,12 @@ bool rt_ug_create(rt_device *d, const rt_pack *p, rt_pipelines *pl, const rt_qua
     u->nw = (p->ug.nslots + 3) / 4;
     u->cells = calloc((size_t)u->pool, sizeof *u->cells);
     u->order = calloc((size_t)u->pool, sizeof *u->order);
+    u->cell_level = calloc((size_t)u->pool * (size_t)(u->nblocks > 0 ? u->nblocks : 1),
+                           sizeof *u->cell_level);
     u->block_base = calloc((size_t)u->nblocks, sizeof *u->block_base);
     u->block_grid = calloc((size_t)u->nblocks, sizeof *u->block_grid);
     u->mask_pipes = calloc((size_t)p->ncombos + 1, sizeof *u->mask_pipes);
-    if (!u->cells || !u->order || !u->block_base || !u->block_grid || !u->mask_pipes)
+    if (!u->cells || !u->order || !u->cell_level || !u->block_base || !u->block_grid || !u->mask_pipes)
         return rt_fail(e, RT_E_VULKAN, "undergrowth", "out of memory");
     rt_ug_fill_blocks(u, (float[4 * UG_BLOCK_VEC4 * SPLAT_MAX_UG_BLOCKS]){0});   /* u->cap first */
     /* contact shadows where the colour target blends (RGBA32F: most do) */
@@ -464,6 +466,7 @@ void rt_ug_destroy(rt_ug *u)
     free(u->mask_pipes);
     free(u->cells);
     free(u->order);
+    free(u->cell_level);
     free(u->block_base);
     free(u->block_grid);
     free(u);

@@ -87,30 +87,37 @@ static int cell_level(const rt_ug *u, int b, int slot, double near)
     return cv;
 }
 
-/* Whether this frame's compute keys would hold enough to pay for the
- * compute passes (a resolve over every pixel, whatever they hold): their
- * visible cells' candidates times the LOD's fraction, at least
+/* Each visible generated cell's level per block (u->cell_level; 0xff:
+ * none), then whether this frame's compute keys would hold enough to pay
+ * for the compute passes (a resolve over every pixel, whatever they
+ * hold): their cells' candidates times the LOD's fraction, at least
  * UG_CR_MIN.  From the cells alone, not from counts read back, so that a
- * frame's picture does not depend on the frames before it. */
-static bool cs_worth(rt_ug *u)
+ * frame's picture does not depend on the frames before it.  Without
+ * enough, the levels are those without compute. */
+static void cell_levels(rt_ug *u)
 {
     double cand = 0;
-    for (int i = 0; i < u->pool; i++) {
-        const ug_cell *cl = &u->cells[i];
-        if (cl->state != CELL_READY || !cl->visible)
-            continue;
-        double near = cl->dist - CELL * 0.7071;
-        for (int b = 0; b < u->nblocks; b++)
-            if (cell_level(u, b, i, near) >= UG_CS_KEY)
-                cand += (double)u->block_grid[b] * u->block_grid[b] * ((float *)u->lod.map)[i];
+    for (int pass = 0; pass < 2; pass++) {
+        u->cr_frame = u->compute && (pass == 0 || cand >= UG_CR_MIN);
+        for (int i = 0; i < u->pool; i++) {
+            const ug_cell *cl = &u->cells[i];
+            uint8_t *lv = u->cell_level + (size_t)i * u->nblocks;
+            bool on = cl->state == CELL_READY && cl->visible;
+            double near = cl->dist - CELL * 0.7071;   /* its nearest point, about */
+            for (int b = 0; b < u->nblocks; b++) {
+                lv[b] = on ? (uint8_t)cell_level(u, b, i, near) : 0xff;
+                if (pass == 0 && on && lv[b] >= UG_CS_KEY)
+                    cand += (double)u->block_grid[b] * u->block_grid[b] * ((float *)u->lod.map)[i];
+            }
+        }
+        if (!u->cr_frame || cand >= UG_CR_MIN)   /* the levels stand */
+            break;
     }
-    return cand >= UG_CR_MIN;
 }
 
 static void fill_entries(rt_ug *u)
 {
-    u->cr_frame = u->compute;   /* cs_worth's cell_level asks for them all */
-    u->cr_frame = u->compute && cs_worth(u);
+    cell_levels(u);
     const rt_pack_ug *pu = &u->p->ug;
     uint32_t *e = u->ent.map;
     int k = 0, n = 0;
@@ -140,7 +147,7 @@ static void fill_entries(rt_ug *u)
                     int slot = u->order[i];
                     const ug_cell *cl = &u->cells[slot];
                     double near = cl->dist - CELL * 0.7071;   /* its nearest point, about */
-                    if (cl->state != CELL_READY || !cl->visible || cell_level(u, b, slot, near) != l)
+                    if (u->cell_level[(size_t)slot * u->nblocks + b] != l)
                         continue;
                     if (shadows && near >= shadow_end)   /* and every entry after */
                         shadows = false, ki[3] = (uint32_t)n;

@@ -175,6 +175,9 @@ struct rt_ug {
                                                   or the renderer's          */
     ug_cell              *cells;
     int                  *order;               /* draw order, front to back  */
+    uint8_t              *cell_level;          /* this frame's, per slot and
+                                                  block: the key's level
+                                                  (undergrowth_cull.c)       */
     /* device-local: masks, instances, draw arguments (the GPU writes
      * them and reads them every frame); host-visible: args_host (the
      * arguments copied back after a generation, for the counts), blocks,
