@@ -85,8 +85,8 @@
     "    uvec4 info;\n"                                                                \
     "} u_push;\n"
 
-/* u_push: patch_xz (radius, time, width, height), patch_uv.x (the keys'
- * count: where the shadows' draws start), info (instances per cell, key,
+/* u_push: patch_xz (radius, time, width, height), patch_uv (the keys'
+ * count: where the shadows' draws start; the cap), info (instances per cell, key,
  * the key's mesh level, the pass: 0 depth, 1 id, 3 the contact shadows).
  * u_tri: per block and level its mesh (index
  * count, first index, vertex offset). */
@@ -162,9 +162,9 @@ static const char cr_glsl_main[] =
     "    vec2 lo = min(min(s0, s1), min(s2, s3)), hi = max(max(s0, s1), max(s2, s3));\n"
     "    ivec2 size2 = ivec2(u_push.patch_xz.zw);\n"
     "    ivec2 a = max(ivec2(ceil(lo - 0.5)), ivec2(0)), b = min(ivec2(floor(hi - 0.5)), size2 - 1);\n"
-    "    if (any(greaterThan(b - a, ivec2(" UG_CR_CAP_S " - 1)))) {\n"
+    "    if (any(greaterThan(b - a, ivec2(int(u_push.patch_uv.y) - 1)))) {\n"
     "        atomicAdd(u_stat.s[0], 1u);\n"
-    "        b = min(b, a + " UG_CR_CAP_S " - 1);\n"
+    "        b = min(b, a + int(u_push.patch_uv.y) - 1);\n"
     "    }\n"
     "    float ia = 1.0 / aa, ib = 1.0 / ab;\n"
     "    for (int y = a.y; y <= b.y; y++)\n"
@@ -212,9 +212,9 @@ static const char cr_glsl_main[] =
     "    vec2 lo = min(s0, min(s1, s2)), hi = max(s0, max(s1, s2));\n"
     "    ivec2 size = ivec2(u_push.patch_xz.zw);\n"
     "    ivec2 a = max(ivec2(ceil(lo - 0.5)), ivec2(0)), b = min(ivec2(floor(hi - 0.5)), size - 1);\n"
-    "    if (any(greaterThan(b - a, ivec2(" UG_CR_CAP_S " - 1)))) {\n"
+    "    if (any(greaterThan(b - a, ivec2(int(u_push.patch_uv.y) - 1)))) {\n"
     "        if (u_push.info.w == 0u) atomicAdd(u_stat.s[0], 1u);\n"
-    "        b = min(b, a + " UG_CR_CAP_S " - 1);\n"
+    "        b = min(b, a + int(u_push.patch_uv.y) - 1);\n"
     "    }\n"
     "    float ia = 1.0 / area;\n"
     "    uint payload = (j << " SPLAT_STR(UG_CR_PSHIFT) ") | (lv << " SPLAT_STR(UG_CR_TBITS) ") | t;\n"
@@ -341,11 +341,11 @@ bool rt_ug_craster_create(rt_ug *u, rt_error *e)
     const char *env = getenv("SPLAT_UG_ATOMICS");
     u->cr64 = d->int64_atomics && !(env && !strcmp(env, "32"));
     /* the cap a cell's instances must fit (pixels a side): UG_CR_CAP, or
-     * $SPLAT_UG_CAP from 8 to UG_CR_CAP (the H100's A/B of the cap: a
+     * $SPLAT_UG_CAP from 8 to UG_CR_CAP_MAX (the H100's A/B of the cap: a
      * larger one takes nearer cells, whose triangles loop over more pixels
      * in one thread) */
     const char *cap = getenv("SPLAT_UG_CAP");
-    u->cr_cap = cap && atoi(cap) >= 8 && atoi(cap) <= UG_CR_CAP ? atoi(cap) : UG_CR_CAP;
+    u->cr_cap = cap && atoi(cap) >= 8 && atoi(cap) <= UG_CR_CAP_MAX ? atoi(cap) : UG_CR_CAP;
     const VkShaderStageFlags cs = VK_SHADER_STAGE_COMPUTE_BIT;
     const VkDescriptorType sb = VK_DESCRIPTOR_TYPE_STORAGE_BUFFER;
     const VkDescriptorType cis = VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER;
@@ -500,6 +500,7 @@ void rt_ug_craster_record(rt_ug *u, VkCommandBuffer cb, VkDescriptorSet set0c, V
     vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, u->cr_layout, 0, 3, sets, 0, NULL);
     splat_push push = { .patch_xz = { (float)u->radius, (float)u->time, (float)u->width,
                                       (float)u->height_px },
+                        .patch_uv = { 0, (float)u->cr_cap, 0, 0 },
                         .info = { u->cap, 0, 0, 0 } };
     vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, u->cr_pipe[0]);
     for (int pass = 0; pass < (u->cr64 ? 1 : 2); pass++) {

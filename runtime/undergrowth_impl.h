@@ -50,8 +50,8 @@ _Static_assert(UG_KEYINFO > UG_MAX_KEYS && UG_ENT0 == 1924, "the cull table's st
  * picks has at most 1 << UG_CR_TBITS triangles; a payload is the cull
  * list's position << UG_CR_PSHIFT | the mesh's level << UG_CR_TBITS | the
  * triangle. */
-#define UG_CR_CAP    64
-#define UG_CR_CAP_S  "64"
+#define UG_CR_CAP    64      /* the default ($SPLAT_UG_CAP: up to UG_CR_CAP_MAX) */
+#define UG_CR_CAP_MAX   128
 #define UG_CR_TBITS  4
 #define UG_CR_PSHIFT 6
 /* The compute keys are made only when their visible cells hold at least
