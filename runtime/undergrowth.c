@@ -414,6 +414,10 @@ bool rt_ug_create(rt_device *d, const rt_pack *p, rt_pipelines *pl, const rt_qua
     if (!u->cells || !u->order || !u->cell_level || !u->block_base || !u->block_grid || !u->mask_pipes)
         return rt_fail(e, RT_E_VULKAN, "undergrowth", "out of memory");
     rt_ug_fill_blocks(u, (float[4 * UG_BLOCK_VEC4 * SPLAT_MAX_UG_BLOCKS]){0});   /* u->cap first */
+    /* the compute rasteriser's payload holds a list position below
+     * 2^(32 - UG_CR_PSHIFT): a larger pool draws by the graphics pipeline */
+    if ((uint64_t)u->pool * u->cap >= (uint64_t)1 << (32 - UG_CR_PSHIFT))
+        u->compute = false;
     /* contact shadows where the colour target blends (RGBA32F: most do) */
     VkFormatProperties fp;
     vkGetPhysicalDeviceFormatProperties(d->phys, VK_FORMAT_R32G32B32A32_SFLOAT, &fp);
