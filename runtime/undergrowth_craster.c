@@ -419,8 +419,8 @@ bool rt_ug_craster_create(rt_ug *u, rt_error *e)
                                            "undergrowth compute raster resolve" };
     for (int k = 0; k < 2 && ok; k++) {
         /* the resolve: the frame block, splat_light and the colour, not the
-         * whole prelude (lavapipe 22.3 dropped work of this file's passes
-         * compiled with it: runtime/DESIGN.md) */
+         * whole prelude, whose own main would run this one as a composite
+         * body on terrain pixels only (runtime/DESIGN.md) */
         snprintf(src, n, "#version 450\n%s%s%s%s%s%s%s", i64, defs[k],
                  k ? "layout(local_size_x = 8, local_size_y = 8) in;\n" : CR_GLSL_RASTER_DECLS,
                  k ? SPLAT_GLSL_TERRAIN : "", k ? SPLAT_GLSL_LIGHTING : "",
