@@ -15,6 +15,7 @@
 #include "splatrt.h"
 #include "cache.h"
 
+#include <pthread.h>
 #include <stdatomic.h>
 #include <vulkan/vulkan.h>
 
@@ -48,7 +49,19 @@ struct rt_device {
     int                      messages;   /* validation warnings + errors    */
     struct rt_vk_batch      *batch;      /* pipelines deferred to run on all
                                             cores (vk_build.c rt_vk_batch_*) */
+    pthread_t                glslang_warm; /* glslang's warm-up (below)     */
+    bool                     warming;    /* ... started, not joined yet     */
 };
+
+/* glslang's first compile in a process sets up its built-in symbol tables
+ * for every stage (85-174 ms on this project's 2-core machine: the
+ * first picture's largest compile at load once the pack brings every
+ * module it needs as SPIR-V).  rt_device_create starts a thread that
+ * compiles a trivial shader meanwhile, so that setup overlaps the
+ * device's creation and the pack's objects instead of delaying the
+ * renderer's first GLSL compile (its own shaders: the decal, sky,
+ * classification, undergrowth); rt_device_destroy joins it (device.c).
+ * SPLAT_GLSLANG_WARM_UP=0 leaves it out (timing). */
 
 /* In place, for the library's own devices (the viewer's, the far bake's);
  * rt_device_open allocates one around it. */
