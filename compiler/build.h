@@ -23,6 +23,9 @@ typedef enum job_kind {
     JOB_COMBO, JOB_FLAT, JOB_UBER, JOB_REF, JOB_VERTEX,
     JOB_COMBO_COMPUTE, JOB_UBER_COMPUTE,   /* abi.h "compute stage" */
     JOB_COMBO_UG,                          /* abi.h "undergrowth masks" */
+    JOB_STAND_IN,                          /* a stand-in of the screen path
+                                              (stand_in.h; index: its kind),
+                                              SPIR-V only */
     JOB_CLASS, JOB_CLASS_COMPUTE,          /* a distance class of a combination
                                               (distance.c): fragment, compute */
 } job_kind;

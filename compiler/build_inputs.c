@@ -18,6 +18,7 @@
 #include <xxhash.h>
 
 #include "abi.h"
+#include "stand_in.h"
 
 #ifndef SPLATC_VERSION
 #define SPLATC_VERSION "0"
@@ -192,6 +193,12 @@ bool build_up_to_date(build *b, int *ncombos)
          shader_files(b->out, json_object_get(json_object_get(m, "uber"), "compute"),
                       !b->desc->glsl_compute) &&
          has_files(b->out, json_object_get(m, "vertex"));
+    /* the stand-ins' modules (PACK.md "Stand-ins") */
+    json_t *si = json_object_get(json_object_get(m, "uber"), "stand_in");
+    for (int k = 0; ok && !b->desc->glsl_compute && k < SPLAT_STAND_IN_KINDS; k++)
+        if (k != SPLAT_STAND_IN_ATLAS || b->desc->far_atlas > 0)
+            ok = has_files(b->out,
+                           json_object_get(si, splat_stand_in_name((splat_stand_in_kind)k)));
     if (ok && b->desc->far_atlas > 0) {   /* the key says it was baked */
         char *fa = xasprintf("%s/far.atlas", b->out);
         ok = access(fa, R_OK) == 0;

@@ -17,6 +17,7 @@
 #include "abi.h"
 #include "progress.h"
 #include "spv.h"
+#include "stand_in.h"
 
 static job *job_add(build *b, job_kind kind, int index, char *file, int stage)
 {
@@ -277,6 +278,38 @@ static void composites_free(build *b)
         b->jobs[i].composite = NULL;
 }
 
+/* The stand-ins of the screen path (stand_in.h, PACK.md "Stand-ins"): the
+ * über-shader's compute GLSL cut at the prelude around the flat main, and
+ * the far atlas's main when the pack has an atlas; SPIR-V only (the
+ * runtime makes the text itself from the über-shader's for the counting
+ * variant), so with --glsl-compute none: the runtime compiles them. */
+static void add_stand_ins(build *b)
+{
+    if (b->desc->glsl_compute)
+        return;
+    const job *uber = NULL;
+    for (int i = 0; i < b->njobs && !uber; i++)
+        if (b->jobs[i].kind == JOB_UBER_COMPUTE)
+            uber = &b->jobs[i];
+    if (!uber)
+        return;
+    char *text = xstrdup(uber->glsl.s);   /* job_add may move the jobs */
+    for (int k = 0; k < SPLAT_STAND_IN_KINDS; k++) {
+        if (k == SPLAT_STAND_IN_ATLAS && b->desc->far_atlas <= 0)
+            continue;
+        char *src = splat_stand_in_glsl((splat_stand_in_kind)k, text, "");
+        if (!src)
+            abort();   /* the über-shader's GLSL always holds the prelude */
+        job *j = job_add(b, JOB_STAND_IN, k, xstrdup(splat_stand_in_file((splat_stand_in_kind)k)),
+                         SPV_STAGE_COMPUTE);
+        ir_buf_printf(&j->glsl, "%s", src);
+        free(src);
+        snprintf(j->title, sizeof j->title, "%s stand-in (compute)",
+                 splat_stand_in_name((splat_stand_in_kind)k));
+    }
+    free(text);
+}
+
 bool build_compose(build *b)
 {
     const splat_analysis *a = &b->analysis;
@@ -310,6 +343,7 @@ bool build_compose(build *b)
     run_pool(b, "glsl", emit_job, pending, b->desc->jobs);
     free(pending);
     composites_free(b);
+    add_stand_ins(b);
     job *v = job_add(b, JOB_VERTEX, 0, xasprintf("shaders/terrain.vert"), SPV_STAGE_VERTEX);
     ir_buf_printf(&v->glsl, "%s", SPLAT_GLSL_VERTEX);
     for (int i = 0; i < b->njobs; i++)

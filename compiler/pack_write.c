@@ -27,6 +27,7 @@
 
 #include "abi.h"
 #include "spv.h"
+#include "stand_in.h"
 #include "zst.h"
 
 #ifndef SPLATC_VERSION
@@ -657,6 +658,29 @@ static json_t *jquadtree(const splat_analysis *a)
     return qt;
 }
 
+/* "uber"."stand_in": {"flat": {"spirv", "hash"}, "atlas": …} (PACK.md
+ * "Stand-ins"); NULL without (--glsl-compute). */
+static json_t *jstand_ins(const build *b)
+{
+    json_t *o = NULL;
+    for (int k = 0; k < b->njobs; k++) {
+        const job *j = &b->jobs[k];
+        /* the atlas's with the far atlas only: not in the manifest the
+         * device bake reads before the atlas exists (build_write_pack) */
+        if (j->kind != JOB_STAND_IN || (j->index == SPLAT_STAND_IN_ATLAS && !b->far.data))
+            continue;
+        if (!o)
+            o = json_object();
+        json_t *e = json_object();
+        char *spv = spirv_file(j->file);
+        json_object_set_new(e, "spirv", json_string(spv));
+        free(spv);
+        json_object_set_new(e, "hash", json_string(j->key));
+        json_object_set_new(o, splat_stand_in_name((splat_stand_in_kind)j->index), e);
+    }
+    return o;
+}
+
 static json_t *manifest(build *b, char **tex_names, const char *dir)
 {
     const splat_layout *L = &b->layout;
@@ -683,6 +707,9 @@ static json_t *manifest(build *b, char **tex_names, const char *dir)
     for (int k = 0; k < b->njobs; k++)
         if (b->jobs[k].kind == JOB_UBER_COMPUTE)
             json_object_set_new(uber, "compute", jcompute(&b->jobs[k]));
+    json_t *stand_in = jstand_ins(b);
+    if (stand_in)
+        json_object_set_new(uber, "stand_in", stand_in);
     json_object_set_new(m, "uber", uber);
     json_object_set_new(m, "vertex", jshader("shaders/terrain.vert", false, true));
     json_object_set_new(m, "quadtree", jquadtree(&b->analysis));
@@ -844,7 +871,7 @@ static bool write_contents(build *b, const char *dir)
     for (int i = 0; ok && i < b->njobs; i++) {
         const job *j = &b->jobs[i];
         char *name;
-        if (j->kind != JOB_REF) {   /* a reference pass: SPIR-V only */
+        if (j->kind != JOB_REF && j->kind != JOB_STAND_IN) {   /* SPIR-V only */
             name = glsl_file(j->file, j->stage == SPV_STAGE_FRAGMENT);
             ok = write_compressed(b, dir, name, j->glsl.s, j->glsl.len);
             free(name);

@@ -8,8 +8,10 @@
  * (RT_E_NO_VALIDATION), never a silent run without it. */
 #include "rt_internal.h"
 #include "ir.h"
+#include "spv.h"
 
 #include <ctype.h>
+#include <pthread.h>
 #include <stdarg.h>
 #include <stdlib.h>
 #include <string.h>
@@ -260,12 +262,36 @@ static bool pick_device(rt_device *d, const rt_device_desc *desc, rt_error *e)
     return true;
 }
 
+/* glslang's one-time setup on a thread (rt_internal.h: why). */
+static void *warm_up(void *arg)
+{
+    (void)arg;
+    uint32_t *words = NULL;
+    size_t n = 0;
+    char *log = NULL;
+    /* any stage: glslang sets up the tables of all of them at once */
+    spv_compile("#version 450\nlayout(local_size_x = 1) in;\nvoid main() {}\n",
+                SPV_STAGE_COMPUTE, "glslang warm-up", &words, &n, &log);
+    free(words);
+    free(log);
+    return NULL;
+}
+
+static void glslang_warm_up(rt_device *d)
+{
+    const char *env = getenv("SPLAT_GLSLANG_WARM_UP");
+    if (d->warming || (env && !strcmp(env, "0")))
+        return;
+    d->warming = pthread_create(&d->glslang_warm, NULL, warm_up, NULL) == 0;
+}
+
 bool rt_device_create(rt_device *d, const rt_device_desc *desc, rt_error *e)
 {
     static const rt_device_desc zero;
     if (!desc)
         desc = &zero;
     memset(d, 0, sizeof *d);
+    glslang_warm_up(d);   /* beside the instance and device creation */
     if (!create_instance(d, desc, e) || !pick_device(d, desc, e)) {
         rt_device_destroy(d);
         return false;
@@ -347,6 +373,9 @@ bool rt_device_create(rt_device *d, const rt_device_desc *desc, rt_error *e)
 
 void rt_device_destroy(rt_device *d)
 {
+    if (d->warming)   /* before exit can tear glslang down under it */
+        pthread_join(d->glslang_warm, NULL);
+    d->warming = false;
     if (d->dev) {
         vkDeviceWaitIdle(d->dev);
         if (d->pool)

@@ -7,7 +7,11 @@
  * main that reads albedo, normal and roughness from the atlas with the
  * pixel's own gradients (FC5's plane-through-the-pixel derivatives, as the
  * composites take theirs) and calls splat_finish: the same lighting, fog
- * and views as the composites, from three samples. */
+ * and views as the composites, from three samples.  Its text, and the
+ * flat stand-in's, are the compiler's (compiler/stand_in.c): the pack
+ * carries their compute SPIR-V (rt_pipelines_stand_in_spirv); the forward
+ * path's fragment variant is made here from the über-shader's fragment
+ * GLSL. */
 #include "rt_internal.h"
 #include "vk_build.h"
 #include "far_atlas.h"
@@ -129,77 +133,6 @@ static bool upload(rt_device *d, const rt_pack *p, rt_image img[3], rt_error *e)
     return ok;
 }
 
-/* Set 2 bindings 5-7: the screen path's set (screen.c), the forward
- * path's own (rt_far_create). */
-static const char far_main[] =
-    "layout(set = 2, binding = 5) uniform sampler2D u_far_albedo;\n"
-    "layout(set = 2, binding = 6) uniform sampler2D u_far_normal;\n"
-    "layout(set = 2, binding = 7) uniform sampler2D u_far_rough;\n"
-    "void main() {\n"
-    "    vec2 gx = splat_dpdx.xz / u_frame.terrain.xy, gy = splat_dpdy.xz / u_frame.terrain.xy;\n"
-    "    vec3 albedo = textureGrad(u_far_albedo, v_uv, gx, gy).rgb;\n"
-    "    vec2 nxz = textureGrad(u_far_normal, v_uv, gx, gy).rg * 2.0 - 1.0;\n"
-    "    vec3 n = vec3(nxz.x, sqrt(max(1.0 - dot(nxz, nxz), 0.0)), nxz.y);\n"
-    "    float rough = textureGrad(u_far_rough, v_uv, gx, gy).r;\n"
-    "    splat_count_samples(3u);\n"
-    "    splat_finish(albedo, n, rough, 0.0, 1.0);\n"
-    "}\n";
-
-/* The flat stand-in's main (rt_flat_glsl): the terrain's own normal from
- * the heightfield (splat_begin_at's splat_nrm), lit, fogged and toned as
- * the composites are, over one neutral albedo (a warm mid grey): the
- * default material that Unreal shows while shaders compile, at the cost
- * of a handful of instructions.  One tint for all: a tint per combination
- * showed the classification's 8x8 tiles as a patchwork. */
-static const char flat_main[] =
-    "void main() {\n"
-    "    splat_finish(vec3(0.20, 0.19, 0.17), splat_nrm, 0.9, 0.0, 1.0);\n"
-    "}\n";
-
-/* `uber` (an über-shader's GLSL of the stage) cut at the prelude: its
- * head (its defines: painted storage and places) before the prelude, so
- * set 0 is declared as the composites do, then `defs`, the prelude and
- * `main_text` (far_main, flat_main). */
-static char *prelude_source(const char *uber, const char *defs, const char *main_text)
-{
-    const char *v = uber ? strstr(uber, "#version 450\n") : NULL;
-    const char *at = v ? strstr(v, SPLAT_GLSL_PRELUDE) : NULL;
-    if (!at)
-        return NULL;
-    v += strlen("#version 450\n");
-    size_t head = (size_t)(at - v);
-    size_t n = 64 + strlen(defs) + head + strlen(SPLAT_GLSL_PRELUDE) + strlen(main_text);
-    char *s = malloc(n);
-    if (!s)
-        return NULL;
-    snprintf(s, n, "#version 450\n%.*s%s%s%s", (int)head, v, defs, SPLAT_GLSL_PRELUDE, main_text);
-    return s;
-}
-
-static char *far_source(const char *uber, const char *defs)
-{
-    return prelude_source(uber, defs, far_main);
-}
-
-char *rt_flat_glsl(const rt_pack *p, bool count, rt_error *e)
-{
-    const char *uber = rt_pack_text(p, &p->uber_compute, e);
-    if (!uber)
-        return NULL;
-    char *s = prelude_source(uber, count ? "#define SPLAT_COUNT 1\n" : "", flat_main);
-    if (!s)
-        rt_fail(e, RT_E_VULKAN, "flat stand-in", "no prelude in the uber compute GLSL");
-    return s;
-}
-
-char *rt_far_glsl(const rt_pack *p, bool count)
-{
-    /* NULL where the über-shader's compute GLSL is absent or fails its
-     * checks (read on first use) */
-    return far_source(rt_pack_text(p, &p->uber_compute, NULL),
-                      count ? "#define SPLAT_COUNT 1\n" : "");
-}
-
 bool rt_far_create(rt_device *d, const rt_pack *p, const rt_pipelines *pl, rt_far **out,
                    rt_error *e)
 {
@@ -263,7 +196,7 @@ bool rt_far_bind_forward(rt_far *f, const rt_pack *p, const rt_passes *rp, rt_pi
         char defs[96];
         snprintf(defs, sizeof defs, "%s#ifndef SPLAT_GRADIENTS\n#define SPLAT_GRADIENTS 1\n#endif\n",
                  (variant & RT_VARIANT_COUNT) ? "#define SPLAT_COUNT 1\n" : "");
-        char *src = far_source(uber, defs);
+        char *src = splat_prelude_source(uber, defs, splat_stand_in_main(SPLAT_STAND_IN_ATLAS));
         free(uber);
         if (!src)
             return rt_fail(e, RT_E_VULKAN, "far atlas shader", "no prelude in the uber GLSL");

@@ -68,6 +68,7 @@ bool rt_pk_read_spirv(rt_pk_reader *r, json_t *obj, const char *where, rt_shader
 bool rt_pk_read_compute(rt_pk_reader *r, json_t *obj, const char *key, const char *where,
                         rt_shader_role role, rt_text *out, rt_spirv *spv);
 bool rt_pk_read_fragment_glsl(rt_pk_reader *r, json_t *c, const char *where, char **path);
+bool rt_pk_read_stand_ins(rt_pk_reader *r, json_t *uber);
 bool rt_pk_read_combos(rt_pk_reader *r, json_t *root);
 bool rt_pk_read_quadtree(rt_pk_reader *r, json_t *root);
 

@@ -88,7 +88,8 @@ bool rt_pack_load(rt_pack *p, const char *dir, rt_error *e)
             ok = rt_pk_read_spirv(&r, ub, "uber", RT_ROLE_COMPOSITE, &p->uber) &&
                  rt_pk_read_fragment_glsl(&r, ub, "uber", &p->uber_frag_path) &&
                  rt_pk_read_compute(&r, ub, "compute", "uber", RT_ROLE_COMPUTE,
-                                    &p->uber_compute, &p->uber_compute_spirv);
+                                    &p->uber_compute, &p->uber_compute_spirv) &&
+                 rt_pk_read_stand_ins(&r, ub);
     }
     /* the shaders: read, validated and checked on first use (pack_shaders.c) */
 done:
@@ -147,6 +148,8 @@ void rt_pack_free(rt_pack *p)
     free_spirv(&p->uber);
     free(p->uber_compute.path);
     free_spirv(&p->uber_compute_spirv);
+    for (int k = 0; k < SPLAT_STAND_IN_KINDS; k++)
+        free_spirv(&p->stand_in[k]);
     free(p->uber_frag_path);
     for (int i = 0; i < p->ug.ntextures; i++)
         free(p->ug.textures[i].rgba);

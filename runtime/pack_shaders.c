@@ -355,6 +355,49 @@ bool rt_pk_read_compute(rt_pk_reader *r, json_t *obj, const char *key, const cha
     return rt_pk_read_spirv(r, c, w, role, spv);
 }
 
+/* uber["stand_in"] (PACK.md "Stand-ins"): optional, and so is each of
+ * "flat" and "atlas" in it ({"spirv": …, "hash": …}, the module read on
+ * first use and checked against its role; "atlas" only in a pack with a
+ * far atlas); another key is refused.  Absent: the runtime compiles the
+ * stand-ins from the über-shader's compute GLSL. */
+bool rt_pk_read_stand_ins(rt_pk_reader *r, json_t *uber)
+{
+    json_t *si = rt_pk_get(r, uber, "stand_in", "uber", false);
+    if (!si)
+        return true;
+    if (!json_is_object(si))
+        return rt_pk_field_fail(r, "uber.stand_in:", "must be an object");
+    const char *key;
+    json_t *v;
+    json_object_foreach(si, key, v) {
+        int k = -1;
+        for (int i = 0; i < SPLAT_STAND_IN_KINDS; i++)
+            if (!strcmp(key, splat_stand_in_name((splat_stand_in_kind)i)))
+                k = i;
+        char where[64], what[160];
+        if (k < 0) {
+            snprintf(what, sizeof what, "'%.64s' is not a stand-in (\"flat\" or \"atlas\")", key);
+            return rt_pk_field_fail(r, "uber.stand_in:", what);
+        }
+        snprintf(where, sizeof where, "uber.stand_in.%s", key);
+        snprintf(what, sizeof what, "%s:", where);
+        if (!json_is_object(v))
+            return rt_pk_field_fail(r, what, "must be an object");
+        if (k == SPLAT_STAND_IN_ATLAS && !r->p->far.data)
+            return rt_pk_field_fail(r, what, "the pack has no far atlas (far_atlas)");
+        json_t *h = json_object_get(v, "hash");
+        if (h && !json_is_string(h)) {
+            snprintf(what, sizeof what, "%s.hash:", where);
+            return rt_pk_field_fail(r, what, "must be a string");
+        }
+        if (!rt_pk_read_spirv(r, v, where,
+                              k == SPLAT_STAND_IN_ATLAS ? RT_ROLE_FAR : RT_ROLE_COMPUTE,
+                              &r->p->stand_in[k]))
+            return false;
+    }
+    return true;
+}
+
 /* c["glsl"], the fragment GLSL beside c["spirv"]: optional, and only its
  * path is kept (the forward path's counting variant reads it on first use:
  * rt_pack_read_glsl). */

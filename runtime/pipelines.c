@@ -712,8 +712,53 @@ bool rt_pipelines_compute_make(rt_device *d, const rt_pack *p, rt_pipelines *pl,
     return ok;
 }
 
+bool rt_pipelines_stand_in_spirv(const rt_pack *p, rt_pipelines *pl, splat_stand_in_kind k,
+                                 bool count, uint32_t **words, size_t *n, rt_error *e)
+{
+    *words = NULL;
+    *n = 0;
+    const char *name = k == SPLAT_STAND_IN_ATLAS ? "atlas stand-in (compute)"
+                                                 : "flat stand-in (compute)";
+    const rt_spirv *built = &p->stand_in[k];
+    if (!count && rt_spirv_present(built)) {
+        /* the build's module: checked against its role by rt_pack_spirv */
+        const uint32_t *bw = rt_pack_spirv(p, built, n, e);
+        if (!bw)
+            return false;
+        if (!(*words = malloc(*n * 4)))
+            return rt_fail(e, RT_E_VULKAN, "pipelines", "out of memory");
+        memcpy(*words, bw, *n * 4);
+        atomic_fetch_add(&pl->spirv_cached, 1);
+        return true;
+    }
+    /* an older pack, --glsl-compute, or the counting variant: its GLSL */
+    const char *uber = rt_pack_text(p, &p->uber_compute, e);
+    if (!uber)
+        return false;
+    char *src = splat_stand_in_glsl(k, uber, count ? "#define SPLAT_COUNT 1\n" : "");
+    if (!src)
+        return rt_fail(e, RT_E_VULKAN, name, "no prelude in the uber compute GLSL");
+    bool ok = compute_spirv(pl, src, name, words, n, e);
+    free(src);
+    rt_interface in;
+    bool have_in = false;
+    if (ok) {
+        have_in = rt_interface_for(p, k == SPLAT_STAND_IN_ATLAS ? RT_ROLE_FAR : RT_ROLE_COMPUTE,
+                                   &in);
+        ok = have_in ? rt_spirv_check(*words, *n, name, &in, e)
+                     : rt_fail(e, RT_E_VULKAN, "pipelines", "out of memory");
+    }
+    if (have_in)
+        rt_interface_free(&in);
+    if (!ok) {
+        free(*words);
+        *words = NULL;
+    }
+    return ok;
+}
+
 bool rt_pipelines_flat(rt_device *d, const rt_pack *p, rt_pipelines *pl, unsigned variant,
-                       rt_glsl_source source, VkPipeline *out, rt_error *e)
+                       VkPipeline *out, rt_error *e)
 {
     VkPipeline *slot = &pl->flat[variant % RT_CVARIANTS];
     if (*slot) {
@@ -722,22 +767,10 @@ bool rt_pipelines_flat(rt_device *d, const rt_pack *p, rt_pipelines *pl, unsigne
     }
     /* the sorted variant's lists are dispatched a tile a workgroup here
      * (rt_screen_dispatch): the flat stand-in is never sorted */
-    char *src = source(p, (variant & RT_CVARIANT_COUNT) != 0, e);
-    if (!src)
-        return false;
     uint32_t *words = NULL;
     size_t n = 0;
-    rt_interface in;
-    bool have_in = false;
-    bool ok = compute_spirv(pl, src, "flat stand-in (compute)", &words, &n, e);
-    free(src);
-    if (ok) {
-        have_in = rt_interface_for(p, RT_ROLE_COMPUTE, &in);
-        ok = have_in ? rt_spirv_check(words, n, "flat stand-in (compute)", &in, e)
-                     : rt_fail(e, RT_E_VULKAN, "pipelines", "out of memory");
-    }
-    if (have_in)
-        rt_interface_free(&in);
+    bool ok = rt_pipelines_stand_in_spirv(p, pl, SPLAT_STAND_IN_FLAT,
+                                          (variant & RT_CVARIANT_COUNT) != 0, &words, &n, e);
     /* from the words (copied): inside a batch (renderer creation) the
      * driver's compile runs beside the fixed pipelines' */
     static const uint32_t final_view = SPLAT_VIEW_FINAL;

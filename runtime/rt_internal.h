@@ -15,11 +15,13 @@
 #include "splatrt.h"
 #include "cache.h"
 
+#include <pthread.h>
 #include <stdatomic.h>
 #include <vulkan/vulkan.h>
 
 #include "far_atlas.h"
 #include "sparse.h"
+#include "stand_in.h"
 
 /* ---- the device and the pack, behind splatrt.h's opaque handles ----------
  * (moved here from splatrt.h: the runtime's files and the tests of its
@@ -47,7 +49,19 @@ struct rt_device {
     int                      messages;   /* validation warnings + errors    */
     struct rt_vk_batch      *batch;      /* pipelines deferred to run on all
                                             cores (vk_build.c rt_vk_batch_*) */
+    pthread_t                glslang_warm; /* glslang's warm-up (below)     */
+    bool                     warming;    /* ... started, not joined yet     */
 };
+
+/* glslang's first compile in a process sets up its built-in symbol tables
+ * for every stage (85-174 ms on this project's 2-core machine: the
+ * first picture's largest compile at load once the pack brings every
+ * module it needs as SPIR-V).  rt_device_create starts a thread that
+ * compiles a trivial shader meanwhile, so that setup overlaps the
+ * device's creation and the pack's objects instead of delaying the
+ * renderer's first GLSL compile (its own shaders: the decal, sky,
+ * classification, undergrowth); rt_device_destroy joins it (device.c).
+ * SPLAT_GLSLANG_WARM_UP=0 leaves it out (timing). */
 
 /* In place, for the library's own devices (the viewer's, the far bake's);
  * rt_device_open allocates one around it. */
@@ -254,6 +268,10 @@ struct rt_pack {
                                         absent: read on first use          */
     rt_text          uber_compute;   /* its compute GLSL; mod NULL if absent */
     rt_spirv         uber_compute_spirv; /* its SPIR-V; may be absent       */
+    rt_spirv         stand_in[SPLAT_STAND_IN_KINDS]; /* "uber"."stand_in": the
+                                        stand-ins' SPIR-V (stand_in.h); mod
+                                        NULL if absent (the runtime then
+                                        compiles them from uber_compute)   */
     rt_spirv         vertex;
     rt_pack_level   *levels;    int nlevels;
     char            *scene_path;     /* scene.source: scene.sg relative to
@@ -446,6 +464,9 @@ typedef enum rt_shader_role {
     RT_ROLE_COMPUTE,      /* the compute variants (*.comp.spv, abi.h)       */
     RT_ROLE_UNDERGROWTH,  /* undergrowth mask shaders (*.ug.comp, abi.h)    */
     RT_ROLE_FAR_BAKE,     /* far atlas bake variants (abi.h, far_bake.c)    */
+    RT_ROLE_FAR,          /* the far atlas's compute shader (the far list, the
+                             atlas stand-in): the compute role's bindings and
+                             the atlas at set 2 bindings 5-7 (stand_in.h)  */
     RT_ROLE_COUNT,
 } rt_shader_role;
 
@@ -730,7 +751,7 @@ typedef enum rt_stand_in {
     RT_STAND_ATLAS,     /* the far atlas's shader (far.c), where the pack
                            has an atlas the device samples                 */
     RT_STAND_FLAT,      /* the flat stand-in: the lit terrain in one neutral
-                           albedo (rt_flat_glsl)                           */
+                           albedo (compiler/stand_in.h)                    */
 } rt_stand_in;
 /* The stand-in for compute pipelines ids[0..n) in `variant` (`atlas`: the
  * screen path can shade from a far atlas).  Before the frame (ids NULL,
@@ -750,13 +771,22 @@ typedef enum rt_stand_in {
  * unset: the default above. */
 rt_stand_in rt_pipelines_stand_in(const rt_device *d, const rt_pack *p, rt_pipelines *pl,
                                   const int *ids, int n, unsigned variant, bool atlas);
-/* The flat stand-in's compute pipeline in `variant` (compute layout, the
- * SPIR-V cache), made on first use from `source`'s GLSL (far.c's
- * rt_flat_glsl, passed in so that pipelines.c and far.c do not call each
- * other). */
-typedef char *(*rt_glsl_source)(const rt_pack *p, bool count, rt_error *e);
+/* The SPIR-V of stand-in k (compiler/stand_in.h: the flat one, or the far
+ * atlas's shader), `count`: its counting variant; *words malloc'd.  The
+ * plain variant comes from the pack ("uber"."stand_in", read, validated
+ * and checked against its role on first use) where the pack has it, so
+ * nothing is compiled for the first picture; else (an older pack,
+ * --glsl-compute, the counting variant) the über-shader's compute GLSL
+ * cut at the prelude around the stand-in's main, from the SPIR-V cache or
+ * glslang and spirv-val (counted in spirv_cached / spirv_compiled as the
+ * compute variants are), checked against RT_ROLE_COMPUTE (flat) or
+ * RT_ROLE_FAR (atlas). */
+bool rt_pipelines_stand_in_spirv(const rt_pack *p, rt_pipelines *pl, splat_stand_in_kind k,
+                                 bool count, uint32_t **words, size_t *n, rt_error *e);
+/* The flat stand-in's compute pipeline in `variant` (compute layout),
+ * made on first use from rt_pipelines_stand_in_spirv's module. */
 bool rt_pipelines_flat(rt_device *d, const rt_pack *p, rt_pipelines *pl, unsigned variant,
-                       rt_glsl_source source, VkPipeline *out, rt_error *e);
+                       VkPipeline *out, rt_error *e);
 /* Whether combination id's pipeline of `variant` is made already. */
 bool rt_pipelines_has_combo(const rt_pipelines *pl, int id, unsigned variant);
 bool rt_pipelines_combo(rt_device *d, const rt_pack *p, const rt_passes *rp,
@@ -966,13 +996,6 @@ bool  rt_far_create(rt_device *d, const rt_pack *p, const rt_pipelines *pl, rt_f
 void  rt_far_destroy(rt_far *f);
 /* Image k (0 albedo, 1 normal, 2 roughness) with the atlas's sampler. */
 VkDescriptorImageInfo rt_far_image_info(const rt_far *f, int k);
-/* The far shading compute shader (malloc'd; NULL without the über compute
- * GLSL whose head it reuses); `count`: the counting variant. */
-char *rt_far_glsl(const rt_pack *p, bool count);
-/* The flat stand-in's compute shader (rt_stand_in, malloc'd): the same
- * head and prelude around a main that lights the terrain's normal over a
- * neutral albedo; NULL with *e set. */
-char *rt_flat_glsl(const rt_pack *p, bool count, rt_error *e);
 /* Forward path, inside the main pass: binds the far shading fragment
  * pipeline of `variant` (made on first use) and its set 2. */
 bool  rt_far_bind_forward(rt_far *f, const rt_pack *p, const rt_passes *rp, rt_pipelines *pl,

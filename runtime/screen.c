@@ -804,18 +804,19 @@ static void dispatch_list(rt_screen *s, VkCommandBuffer cb, VkPipelineLayout lay
 }
 
 /* The far shader's compute pipeline (c: the counting variant), made on
- * first use: the far list's, and the atlas stand-in's. */
+ * first use: the far list's, and the atlas stand-in's; the plain one from
+ * the pack's SPIR-V where it has it (rt_pipelines_stand_in_spirv). */
 static bool far_pipeline(rt_screen *s, rt_pipelines *pl, int c, rt_error *e)
 {
     if (s->far_pipe[c])
         return true;
-    char *src = rt_far_glsl(s->p, c);
-    if (!src)
-        return rt_fail(e, RT_E_VULKAN, "far atlas shader", "no über compute GLSL");
-    bool ok = rt_vk_compute(s->d, &s->keep, &(rt_vk_compute_desc){ .label = "far.comp",
-                                .glsl = src, .layout = s->layout, .cache = pl->cache },
-                            &s->far_pipe[c], e);
-    free(src);
+    uint32_t *words = NULL;
+    size_t n = 0;
+    bool ok = rt_pipelines_stand_in_spirv(s->p, pl, SPLAT_STAND_IN_ATLAS, c != 0, &words, &n, e) &&
+              rt_vk_compute(s->d, &s->keep, &(rt_vk_compute_desc){ .label = "far.comp",
+                                .spirv = words, .nwords = n, .layout = s->layout,
+                                .cache = pl->cache }, &s->far_pipe[c], e);
+    free(words);
     return ok;
 }
 
@@ -826,7 +827,7 @@ bool rt_screen_prepare_stand_in(rt_screen *s, rt_pipelines *pl, rt_stand_in stan
     if (stand_in == RT_STAND_ATLAS && s->far_ok)
         return far_pipeline(s, pl, (variant & RT_CVARIANT_COUNT) != 0, e);
     if (stand_in == RT_STAND_ATLAS || stand_in == RT_STAND_FLAT)
-        return rt_pipelines_flat(s->d, s->p, pl, variant, rt_flat_glsl, &pipe, e);
+        return rt_pipelines_flat(s->d, s->p, pl, variant, &pipe, e);
     return true;
 }
 
@@ -861,7 +862,7 @@ bool rt_screen_dispatch(rt_screen *s, VkCommandBuffer cb, rt_pipelines *pl,
         }
         VkPipeline pipe;
         if (!have && stand_in == RT_STAND_FLAT
-                ? !rt_pipelines_flat(d, p, pl, variant, rt_flat_glsl, &pipe, e)
+                ? !rt_pipelines_flat(d, p, pl, variant, &pipe, e)
                 : !rt_pipelines_compute(d, p, pl, have ? k : p->ncombos, variant, &pipe, e))
             return false;
         s->stand_in[k] = have ? RT_STAND_NONE : (unsigned char)stand_in;

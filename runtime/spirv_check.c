@@ -66,12 +66,13 @@ static const char *const role_names[RT_ROLE_COUNT] = {
     [RT_ROLE_COMPUTE] = "a compute shading shader",
     [RT_ROLE_UNDERGROWTH] = "an undergrowth mask shader",
     [RT_ROLE_FAR_BAKE] = "a far atlas bake shader",
+    [RT_ROLE_FAR] = "the far atlas's compute shader",
 };
 
 bool rt_interface_for(const rt_pack *p, rt_shader_role role, rt_interface *out)
 {
     memset(out, 0, sizeof *out);
-    int n = rt_abi_nbindings + 2 + p->narrays;
+    int n = rt_abi_nbindings + 4 + p->narrays;
     rt_binding_rule *b = calloc((size_t)n, sizeof *b);
     if (!b)
         return false;
@@ -86,6 +87,10 @@ bool rt_interface_for(const rt_pack *p, rt_shader_role role, rt_interface *out)
     if (role == RT_ROLE_UNDERGROWTH || role == RT_ROLE_FAR_BAKE)
         b[k++] = (rt_binding_rule){ 2, 0, RT_RES_STORAGE_BUFFER, 0, false, 0, 0, CS,
                                     RT_PAINTED_ANY };
+    /* the far atlas's albedo, normal and roughness (stand_in.h, screen.c) */
+    for (uint32_t i = 0; role == RT_ROLE_FAR && i < 3; i++)
+        b[k++] = (rt_binding_rule){ 2, 5 + i, RT_RES_SAMPLED, RT_IMAGE_2D, false, RT_FLOAT, 0, CS,
+                                    RT_PAINTED_ANY };
     out->what = role_names[role];
     out->bindings = b;
     out->nbindings = k;
@@ -99,7 +104,7 @@ bool rt_interface_for(const rt_pack *p, rt_shader_role role, rt_interface *out)
         out->noutputs = 3;
         out->outputs_exact = true;
     } else if (role == RT_ROLE_COMPUTE || role == RT_ROLE_UNDERGROWTH ||
-               role == RT_ROLE_FAR_BAKE) {
+               role == RT_ROLE_FAR_BAKE || role == RT_ROLE_FAR) {
         out->stage = VK_SHADER_STAGE_COMPUTE_BIT;   /* no stage inputs or outputs */
         out->spec_ids = abi_spec_ids;
         out->nspec = 2;

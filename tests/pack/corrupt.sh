@@ -15,8 +15,9 @@
 # push constants, spec constants, varyings, outputs), forged or truncated
 # binary files (painted.sparse, combos.bin, heightfield, PNG), sizes over
 # the pack limits (heightfield, textures, mips, painted layers, destruction
-# grid, cells), painted_format against the shaders and the file, and
-# manifest fields of the wrong type or range.
+# grid, cells), painted_format against the shaders and the file,
+# manifest fields of the wrong type or range, and the stand-ins' modules
+# ("uber"."stand_in": types, files, roles, zstd frames).
 set -u
 SC=$1 SV=$2 PE=$3 OUT=$4
 ROOT=$(cd "$(dirname "$0")/../.." && pwd)
@@ -30,6 +31,9 @@ cd "$ROOT" || fail "no repository root"
 "$SC" build examples/minimal/scene.sg -o "$OUT/dense" --painted dense --no-cache > /dev/null ||
     fail "build dense"
 "$SC" build tests/destruction/scene.sg -o "$OUT/destr" --no-cache > /dev/null || fail "build destr"
+# with a far atlas: the atlas stand-in's module too (PACK.md "Stand-ins")
+"$SC" build examples/minimal/scene.sg -o "$OUT/far" --far-atlas --far-bake cpu --no-cache \
+    > /dev/null || fail "build far"
 "$SV" "$OUT/bc4" --headless --size 32x32 -o "$OUT/ok.png" || fail "the intact pack does not render"
 # The compiler writes each shader as a zstd frame (PACK.md "Compressed
 # shaders"); a pack may also hold plain files, named without ".zst".  The
@@ -41,7 +45,7 @@ unzst() {
     sed -i 's/\.zst"/"/g' "$1/manifest.json"
 }
 cp -r "$OUT/bc4" "$OUT/bc4z"
-for p in bc4 dense destr; do unzst "$OUT/$p"; done
+for p in bc4 dense destr far; do unzst "$OUT/$p"; done
 "$SV" "$OUT/bc4" --headless --size 32x32 -o "$OUT/ok_plain.png" || fail "the plain pack does not render"
 cmp -s "$OUT/ok.png" "$OUT/ok_plain.png" || fail "the plain pack renders another picture"
 
@@ -323,6 +327,54 @@ printf '\\377\\377\\377\\377' | dd of=shaders/0000.spv.zst bs=1 seek=\$((s - 4))
 EOF
 case_ zst_corrupt_spirv bc4z "0001.spv.zst: error: corrupt SPIR-V" <<EOF
 head -c 400 /dev/urandom | zstd -q --stream-size=400 -c > shaders/0001.spv.zst
+EOF
+
+# -- the stand-ins' SPIR-V ("uber"."stand_in", PACK.md "Stand-ins"):
+# optional, but what is there must be right
+case_ stand_in_type bc4 "uber.stand_in: must be an object" <<EOF
+"$PE" set $M uber.stand_in '"flat"'
+EOF
+case_ stand_in_flat_type bc4 "uber.stand_in.flat: must be an object" <<EOF
+"$PE" set $M uber.stand_in.flat '["shaders/flat_stand_in.comp.spv"]'
+EOF
+case_ stand_in_unknown bc4 "uber.stand_in: 'counting' is not a stand-in (\"flat\" or \"atlas\")" <<EOF
+"$PE" set $M uber.stand_in.counting '{"spirv": "shaders/flat_stand_in.comp.spv"}'
+EOF
+case_ stand_in_no_spirv bc4 "uber.stand_in.flat: missing field spirv" <<EOF
+"$PE" del $M uber.stand_in.flat.spirv
+EOF
+case_ stand_in_spirv_type bc4 "uber.stand_in.flat.spirv: must be a string" <<EOF
+"$PE" set $M uber.stand_in.flat.spirv 7
+EOF
+case_ stand_in_hash_type bc4 "uber.stand_in.flat.hash: must be a string" <<EOF
+"$PE" set $M uber.stand_in.flat.hash 7
+EOF
+case_ stand_in_missing_file bc4 "uber.stand_in.flat.spirv names 'shaders/flat_stand_in.comp.spv', which" <<EOF
+rm shaders/flat_stand_in.comp.spv
+EOF
+case_ stand_in_outside bc4 "uber.stand_in.flat.spirv names '../../outside.txt', which is outside the pack" <<EOF
+"$PE" set $M uber.stand_in.flat.spirv '"../../outside.txt"'
+EOF
+case_ stand_in_atlas_no_far bc4 "uber.stand_in.atlas: the pack has no far atlas (far_atlas)" <<EOF
+"$PE" set $M uber.stand_in.atlas '{"spirv": "shaders/flat_stand_in.comp.spv"}'
+EOF
+case_ stand_in_fragment bc4 "flat_stand_in.comp.spv: error: a compute shading shader does not fit the runtime: it has no compute entry point" <<EOF
+cp shaders/0000.spv shaders/flat_stand_in.comp.spv
+EOF
+case_ stand_in_atlas_as_flat far "flat_stand_in.comp.spv: error: a compute shading shader does not fit the runtime: 'u_far_albedo' is bound to set 2 binding 5, which the pipeline layout does not have" <<EOF
+cp shaders/atlas_stand_in.comp.spv shaders/flat_stand_in.comp.spv
+EOF
+case_ stand_in_atlas_foreign far "atlas_stand_in.comp.spv: error: the far atlas's compute shader does not fit the runtime: it has no compute entry point" <<EOF
+cp shaders/uber.spv shaders/atlas_stand_in.comp.spv
+EOF
+case_ stand_in_truncated bc4 "flat_stand_in.comp.spv: error: corrupt SPIR-V" <<EOF
+head -c 400 shaders/flat_stand_in.comp.spv > x && mv x shaders/flat_stand_in.comp.spv
+EOF
+case_ zst_stand_in_truncated bc4z "uber.stand_in.flat.spirv names 'shaders/flat_stand_in.comp.spv.zst', which is not exactly one zstd frame (the frame is cut short)" <<EOF
+head -c 100 shaders/flat_stand_in.comp.spv.zst > x && mv x shaders/flat_stand_in.comp.spv.zst
+EOF
+case_ zst_stand_in_bomb bc4z "names 'shaders/flat_stand_in.comp.spv.zst', which states 100000000 bytes of content, more than the limit" <<EOF
+head -c 100000000 /dev/zero | zstd -q --stream-size=100000000 -c > shaders/flat_stand_in.comp.spv.zst
 EOF
 
 # The fragment GLSL the forward counting variant reads when first needed

@@ -5,6 +5,7 @@
  *                                       keys and array indices) := JSON
  *   packedit repeat MANIFEST PATH N     array at PATH := N copies of its
  *                                       first element
+ *   packedit del MANIFEST PATH          the object key at PATH removed
  *   packedit png FILE W H               a W x H grey PNG
  *
  * The manifest is rewritten with jansson, indented as splatc writes it. */
@@ -17,7 +18,8 @@
 
 static int usage(void)
 {
-    fprintf(stderr, "usage: packedit set|repeat MANIFEST PATH VALUE, packedit png FILE W H\n");
+    fprintf(stderr, "usage: packedit set|repeat MANIFEST PATH VALUE, packedit del MANIFEST PATH, "
+            "packedit png FILE W H\n");
     return 2;
 }
 
@@ -49,7 +51,7 @@ static int set_at(json_t *parent, const char *key, json_t *v)
 
 int main(int argc, char **argv)
 {
-    if (argc != 5)
+    if (argc != 5 && !(argc == 4 && !strcmp(argv[1], "del")))
         return usage();
     if (!strcmp(argv[1], "png")) {
         int w = atoi(argv[3]), h = atoi(argv[4]);
@@ -78,6 +80,8 @@ int main(int argc, char **argv)
     if (!strcmp(argv[1], "set")) {
         json_t *v = json_loads(argv[4], JSON_DECODE_ANY, &je);
         rc = v ? set_at(parent, last, v) : -1;
+    } else if (!strcmp(argv[1], "del")) {
+        rc = json_is_object(parent) ? json_object_del(parent, last) : -1;
     } else if (!strcmp(argv[1], "repeat")) {
         json_t *a = json_is_array(parent) ? json_array_get(parent, (size_t)atoi(last))
                                           : json_object_get(parent, last);

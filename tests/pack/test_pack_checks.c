@@ -183,7 +183,7 @@ static void test_compute_role(void **state)
     snprintf(shaders, sizeof shaders, "%s/shaders", compute_dir);
     DIR *dir = opendir(shaders);
     assert_non_null(dir);
-    int ncomp = 0, nug = 0;
+    int ncomp = 0, nug = 0, nstand = 0;
     struct dirent *ent;
     while ((ent = readdir(dir)) != NULL) {
         size_t len = strlen(ent->d_name);
@@ -194,6 +194,18 @@ static void test_compute_role(void **state)
             assert_false(fits(&p, ent->d_name, RT_ROLE_COMPUTE, &e));
             rt_error_clear(&e);
             nug++;
+        } else if (!strcmp(ent->d_name, "atlas_stand_in.comp.spv.zst")) {
+            /* the far atlas's shader: the compute role and set 2's atlas */
+            if (!fits(&p, ent->d_name, RT_ROLE_FAR, &e))
+                fail_msg("%s", e.msg);
+            assert_false(fits(&p, ent->d_name, RT_ROLE_COMPUTE, &e));
+            rt_error_clear(&e);
+            nstand++;
+        } else if (!strcmp(ent->d_name, "flat_stand_in.comp.spv.zst")) {
+            /* the flat stand-in (PACK.md "Stand-ins"): compute shading's */
+            if (!fits(&p, ent->d_name, RT_ROLE_COMPUTE, &e))
+                fail_msg("%s", e.msg);
+            nstand++;
         } else if (len > 13 && !strcmp(ent->d_name + len - 13, ".comp.spv.zst")) {
             if (!fits(&p, ent->d_name, RT_ROLE_COMPUTE, &e))
                 fail_msg("%s", e.msg);
@@ -204,8 +216,11 @@ static void test_compute_role(void **state)
         }
     }
     closedir(dir);
-    printf("  %d compute variants fit the compute role, %d undergrowth mask shaders theirs\n",
-           ncomp, nug);
+    printf("  %d compute variants fit the compute role, %d undergrowth mask shaders theirs, "
+           "%d stand-ins theirs\n", ncomp, nug, nstand);
+    /* the flat stand-in in every pack with SPIR-V; the atlas's with a far atlas */
+    assert_non_null(p.stand_in[SPLAT_STAND_IN_FLAT].mod);
+    assert_int_equal(nstand, 1 + (p.stand_in[SPLAT_STAND_IN_ATLAS].mod != NULL));
     int want_ug = 0;
     for (int i = 0; i < p.ncombos; i++)
         want_ug += p.combos[i].ug_compute.mod != NULL;

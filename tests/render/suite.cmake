@@ -159,11 +159,13 @@ if(TARGET splatrt AND TARGET splatview)
     set_tests_properties(render.spirv_cache PROPERTIES LABELS "render;asan" TIMEOUT 300
       FIXTURES_REQUIRED "minimal_pack;minimal_glsl_pack")
     # the flat and far-atlas stand-ins of async pipelines: the first
-    # picture without the über-shader, the final one equal to the
-    # synchronous picture once the pipelines land (stand_in.sh)
+    # picture without the über-shader and without a compile (the pack's
+    # stand-in SPIR-V; without it, the GLSL-built one draws the same
+    # picture), the final one equal to the synchronous picture once the
+    # pipelines land (stand_in.sh)
     add_test(NAME render.stand_in
       COMMAND sh ${RENDER_DIR}/stand_in.sh $<TARGET_FILE:splatc_cli> $<TARGET_FILE:splatview>
-              $<TARGET_FILE:imgcheck> ${PROJECT_SOURCE_DIR} ${RENDER_OUT}/out)
+              $<TARGET_FILE:imgcheck> $<TARGET_FILE:packedit> ${PROJECT_SOURCE_DIR} ${RENDER_OUT}/out)
     set_tests_properties(render.stand_in PROPERTIES LABELS "render;asan" TIMEOUT 900
       ENVIRONMENT "SPLAT_VALIDATE=1")
     # SPLAT_VALIDATE=1 without the validation layer: a loud failure
