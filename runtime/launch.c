@@ -9,6 +9,7 @@
 #include "splatrt.h"
 
 #include <stdio.h>
+#include <stdlib.h>
 #include <string.h>
 #include <time.h>
 #include <unistd.h>
@@ -55,4 +56,14 @@ double rt_seconds_since_launch(void)
     if (start >= 0 && now >= start)
         return now - start;
     return now >= first ? now - first : 0;
+}
+
+bool rt_launch_mark(const char *what)
+{
+    static int on = -1;
+    if (on < 0)
+        on = getenv("SPLAT_LAUNCH_TRACE") != NULL;
+    if (on)
+        fprintf(stderr, "launch %.3f s: %s\n", rt_seconds_since_launch(), what);
+    return true;
 }

@@ -560,18 +560,20 @@ bool rt_renderer_create(rt_device *d, const rt_pack *p, const rt_render_desc *de
     double k = r->desc.height / (2.0 * tan(M_PI / 6.0));
     r->lod_distance = k / ((SPLAT_GRID - 1) * r->desc.lod_pixels);
 
+    /* rt_launch_mark: where the first picture's time goes ($SPLAT_LAUNCH_TRACE) */
     if (!rt_terrain_upload(d, p, &r->terrain, e) ||
         !rt_destruction_create(d, p, r->desc.destruction_pool, &r->terrain.height, &r->bounds,
                                &r->destr, e) ||
-        !make_targets(r, e) ||
+        !make_targets(r, e) || !rt_launch_mark("terrain and targets") ||
         !rt_pipelines_create(d, p, &r->rp, r->desc.reference, r->desc.pipeline_cache,
                              p->narrays, r->shading_lod, &r->pl, e) ||
-        !make_geometry(r, e) || !make_textures(r, e) || !make_descriptors(r, e) ||
+        !make_geometry(r, e) || !rt_launch_mark("pipelines and geometry") ||
+        !make_textures(r, e) || !rt_launch_mark("textures") || !make_descriptors(r, e) ||
         !make_commands(r, e) ||
         /* the workers first: the stand-in is chosen with them there */
         (r->set0c && r->desc.async_pipelines &&
          !rt_async_start(d, p, &r->pl, rt_pipelines_compute_make, e)) ||
-        !make_fixed_pipelines(r, e)) {
+        !make_fixed_pipelines(r, e) || !rt_launch_mark("fixed pipelines")) {
         rt_renderer_destroy(r);
         return false;
     }

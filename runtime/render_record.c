@@ -733,8 +733,10 @@ static bool draw_frame(rt_renderer *r, const rt_camera *c, rt_frame_stats *st,
  * the GPU (the fence waited for), before any readback. */
 static bool first_picture(rt_renderer *r, rt_frame_stats *st)
 {
-    if (r->first_picture_s <= 0)
+    if (r->first_picture_s <= 0) {
         r->first_picture_s = rt_seconds_since_launch();
+        rt_launch_mark("first picture");
+    }
     st->first_picture_s = r->first_picture_s;
     return true;
 }

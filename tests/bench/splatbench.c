@@ -932,9 +932,11 @@ static int cmd_render(int argc, char **argv)
     int status = load_variants(&b, &e);
     if (status)
         goto done;
+    rt_launch_mark("packs loaded");
     status = 1;
     if (!(b.have_dev = rt_device_create(&b.dev, NULL, &e)))
         goto done;
+    rt_launch_mark("device");
     char cache[4096];
     if (o.save)
         snprintf(cache, sizeof cache, "%s/pipeline-cache.bin", o.save);
