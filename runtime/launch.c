@@ -8,6 +8,7 @@
 #define _GNU_SOURCE
 #include "splatrt.h"
 
+#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -58,12 +59,23 @@ double rt_seconds_since_launch(void)
     return now >= first ? now - first : 0;
 }
 
-bool rt_launch_mark(const char *what)
+bool rt_launch_tracing(void)
 {
     static int on = -1;
     if (on < 0)
         on = getenv("SPLAT_LAUNCH_TRACE") != NULL;
-    if (on)
-        fprintf(stderr, "launch %.3f s: %s\n", rt_seconds_since_launch(), what);
+    return on;
+}
+
+bool rt_launch_mark(const char *fmt, ...)
+{
+    if (!rt_launch_tracing())
+        return true;
+    char what[256];
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(what, sizeof what, fmt, ap);
+    va_end(ap);
+    fprintf(stderr, "launch %.3f s: %s\n", rt_seconds_since_launch(), what);
     return true;
 }

@@ -461,10 +461,12 @@ typedef struct rt_frame_stats {
  * /proc/self/stat, 10 ms steps; where that cannot be read, since the first
  * call: call it first thing in main). */
 double rt_seconds_since_launch(void);
-/* With $SPLAT_LAUNCH_TRACE set, prints "launch S s: WHAT" to stderr (S:
- * rt_seconds_since_launch), so the first picture's time can be split by
- * phase.  Returns true, to sit in a chain of steps. */
-bool rt_launch_mark(const char *what);
+/* With $SPLAT_LAUNCH_TRACE set (rt_launch_tracing), prints "launch S s:
+ * WHAT" to stderr (S: rt_seconds_since_launch; WHAT printf's FMT), so the
+ * first picture's time can be split by phase.  Returns true, to sit in a
+ * chain of steps. */
+bool rt_launch_tracing(void);
+bool rt_launch_mark(const char *fmt, ...);
 
 typedef struct rt_renderer rt_renderer;
 

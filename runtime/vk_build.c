@@ -460,8 +460,13 @@ static bool run_job(void *ctx, int k, rt_error *e)
 {
     batch_run *r = ctx;
     batch_job *j = &r->jobs[k];
-    return j->gfx ? gfx_now(r->d, NULL, &j->g, j->out, e)
-                  : compute_now(r->d, NULL, &j->c, j->out, e);
+    double t0 = rt_launch_tracing() ? rt_seconds_since_launch() : 0;
+    bool ok = j->gfx ? gfx_now(r->d, NULL, &j->g, j->out, e)
+                     : compute_now(r->d, NULL, &j->c, j->out, e);
+    if (rt_launch_tracing())
+        rt_launch_mark("  pipeline %s: %.1f ms", j->gfx ? j->g.label : j->c.label,
+                       1e3 * (rt_seconds_since_launch() - t0));
+    return ok;
 }
 
 bool rt_vk_batch_end(rt_device *d, bool run, rt_error *e)
