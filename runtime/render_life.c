@@ -450,12 +450,13 @@ static bool make_pack_objects(rt_renderer *r, bool screen, rt_error *e)
 {
     rt_device *d = r->d;
     const rt_pack *p = r->p;
-    if (!rt_far_create(d, p, &r->pl, &r->far, e) ||
+    if (!rt_far_create(d, p, &r->pl, &r->far, e) || !rt_launch_mark("far") ||
         (screen && !rt_screen_create(d, p, &r->pl, &r->color, &r->depth,
                                      r->terrain.nearest_clamp, r->set0c, r->far,
                                      rt_render_use_raycast(r), r->desc.pixel_sort,
                                      r->desc.sort_tiles, &r->screen, e)) ||
-        !make_undergrowth(r, e) || !make_upscale(r, e)) {
+        !rt_launch_mark("screen path") ||
+        !make_undergrowth(r, e) || !make_upscale(r, e) || !rt_launch_mark("undergrowth, upscale")) {
         drop_pack_objects(r);
         return false;
     }
@@ -479,6 +480,7 @@ static bool make_fixed_pipelines(rt_renderer *r, rt_error *e)
     if (!rt_vk_batch_begin(r->d, e))
         return false;
     bool ok = make_pack_objects(r, r->set0c != VK_NULL_HANDLE, e);
+    rt_launch_mark("pack objects");
     /* and the stand-in of the first frame's lists, with async pipelines:
      * the flat one's or the far atlas's */
     if (ok && r->screen && r->pl.async)
@@ -487,6 +489,7 @@ static bool make_fixed_pipelines(rt_renderer *r, rt_error *e)
                                                               rt_render_compute_variant(r),
                                                               rt_screen_has_far(r->screen)),
                                         rt_render_compute_variant(r), e);
+    rt_launch_mark("stand-in");
     rt_error e2 = { 0 };
     if (!rt_vk_batch_end(r->d, ok, ok ? e : &e2)) {
         rt_error_clear(&e2);
@@ -569,10 +572,11 @@ bool rt_renderer_create(rt_device *d, const rt_pack *p, const rt_render_desc *de
                              p->narrays, r->shading_lod, &r->pl, e) ||
         !make_geometry(r, e) || !rt_launch_mark("pipelines and geometry") ||
         !make_textures(r, e) || !rt_launch_mark("textures") || !make_descriptors(r, e) ||
-        !make_commands(r, e) ||
+        !make_commands(r, e) || !rt_launch_mark("descriptors, commands") ||
         /* the workers first: the stand-in is chosen with them there */
         (r->set0c && r->desc.async_pipelines &&
          !rt_async_start(d, p, &r->pl, rt_pipelines_compute_make, e)) ||
+        !rt_launch_mark("pipeline workers") ||
         !make_fixed_pipelines(r, e) || !rt_launch_mark("fixed pipelines")) {
         rt_renderer_destroy(r);
         return false;

@@ -295,13 +295,56 @@ static bool make_maxmip(rt_screen *s, rt_error *e)
     /* a margin for the GPU's float rounding of texel * max_height */
     double margin = 1e-4 * (fabs(p->max_height) + fabs(p->height_offset)) + 1e-3;
     float *l0 = all;
-    for (int j = 0; j < PH; j++)
-        for (int i = 0; i < PW; i++) {
-            double m = -1e30;
-            for (int k = 0; k < 4 && i < W && j < H; k++)
-                m = fmax(m, corner_height(p, i + (k & 1), j + (k >> 1)));
-            l0[(size_t)j * (size_t)PW + (size_t)i] = (float)(m > -1e30 ? m + margin : -1e30);
+    /* Texel (i, j) holds the highest of its four corners, each the mean
+     * of the four texels around it (corner_height).  Metres grow with the
+     * corner's integer sum where max_height >= 0, so the highest sum is
+     * converted once, to the same double as the highest of the four
+     * conversions; corner rows are summed once each (two rows kept), not
+     * 16 reads a texel: colorado's 2401 x 1201 took 0.2-0.3 s on the H100's
+     * host, before the first picture. */
+    uint32_t *crow = p->max_height >= 0 ? malloc(2 * ((size_t)W + 1) * sizeof *crow) : NULL;
+    for (int j = 0; j < PH; j++) {
+        float *out = l0 + (size_t)j * (size_t)PW;
+        if (j >= H) {
+            for (int i = 0; i < PW; i++)
+                out[i] = -1e30f;
+            continue;
         }
+        if (!crow) {   /* a negative max_height: the plain definition */
+            for (int i = 0; i < PW; i++) {
+                double m = -1e30;
+                for (int k = 0; k < 4 && i < W; k++)
+                    m = fmax(m, corner_height(p, i + (k & 1), j + (k >> 1)));
+                out[i] = (float)(m > -1e30 ? m + margin : -1e30);
+            }
+            continue;
+        }
+        for (int r = 0; r < 2; r++) {   /* corner rows j and j + 1 */
+            uint32_t *c = crow + (size_t)r * ((size_t)W + 1);
+            int cz0 = j + r - 1, cz1 = j + r;
+            cz0 = cz0 < 0 ? 0 : cz0 >= H ? H - 1 : cz0;
+            cz1 = cz1 >= H ? H - 1 : cz1;
+            const uint16_t *a = p->heights + (size_t)cz0 * (size_t)W;
+            const uint16_t *b = p->heights + (size_t)cz1 * (size_t)W;
+            for (int x = 0; x <= W; x++) {
+                int x0 = x - 1 < 0 ? 0 : x - 1, x1 = x >= W ? W - 1 : x;
+                c[x] = (uint32_t)a[x0] + a[x1] + b[x0] + b[x1];
+            }
+        }
+        const uint32_t *c0 = crow, *c1 = crow + (size_t)W + 1;
+        for (int i = 0; i < PW; i++) {
+            if (i >= W) {
+                out[i] = -1e30f;
+                continue;
+            }
+            uint32_t m = c0[i] > c0[i + 1] ? c0[i] : c0[i + 1];
+            m = c1[i] > m ? c1[i] : m;
+            m = c1[i + 1] > m ? c1[i + 1] : m;
+            double h = (double)m / 4.0 / 65535.0 * p->max_height + p->height_offset;
+            out[i] = (float)(h + margin);
+        }
+    }
+    free(crow);
     levels[0] = (const uint8_t *)l0;
     float *prev = l0;
     for (int k = 1; k <= K; k++) {
