@@ -525,6 +525,7 @@ typedef struct render_opts {
     const char *specs[128];                      /* --variant LABEL=KIND,...  */
     int         nspecs;
     bool        lanes;                           /* --lanes                   */
+    bool        print_plan;                      /* --print-plan              */
     int         lanes_step;                      /* --lanes-step K            */
 } render_opts;
 
@@ -583,6 +584,8 @@ static const splat_arg render_rows[] = {
       "of stdout", F(csv) },
     { "--scene", SPLAT_ARG_STRING, "NAME", "the scene column (default the pack's name)",
       F(scene) },
+    { "--print-plan", SPLAT_ARG_FLAG, NULL, "print each variant's last timed frame's plan "
+      "with each pass's GPU time (as splatview --print-plan --stats) to stderr", F(print_plan) },
     { "--lanes", SPLAT_ARG_FLAG, NULL, "screen kinds: print the layer efficiency predicted "
       "for 8, 32 and 64 lanes per subgroup and other pixel orders (bench_lanes.c)", F(lanes) },
     { "--lanes-step", SPLAT_ARG_INT, "K", "--lanes: the frame before is 1/K of a frame step "
@@ -752,6 +755,10 @@ static bool timed_frame(bench_run *b, int f, rt_error *e)
         if (!rt_renderer_read(v->r, img, e))
             return false;
         err_add(&v->err, img, b->refimg, b->npx);
+        if (o->print_plan && f == o->frames - 1) {
+            fprintf(stderr, "variant %s:\n", v->label);
+            rt_renderer_print_plan(v->r, stderr, true);
+        }
         if (o->save && f == o->frames - 1) {
             char path[4096];
             snprintf(path, sizeof path, "%s/%s.f32", o->save, v->label);
