@@ -93,6 +93,7 @@
 static const char cr_glsl_main[] =
     UG_GLSL_FUNCS
     UG_GLSL_PLACE
+    UG_GLSL_SHADOW
     "struct UgV { vec4 clip; vec3 rel; vec3 color; vec3 nrm; vec3 tnrm; vec2 uv; float far; uint flags; };\n"
     /* the vertex stage's transform (undergrowth_glsl.c rt_ug_draw_vert_main) */
     "UgV ug_vertex(uint ii, Inst it, uint vi) {\n"
@@ -140,14 +141,10 @@ static const char cr_glsl_main[] =
     "    if (g >= cnt) return;\n"
     "    uint ii = u_vis.i[first + g];\n"
     "    Inst it = u_inst.v[ii];\n"
-    "    vec4 b4 = u_blocks.b[5u * it.q.w + 4u];\n"
-    "    vec3 n = normalize(unpackSnorm4x8(it.q.x).xyz + vec3(0.0, 1e-4, 0.0));\n"
-    "    float r = u_push.patch_xz.x, d = length(it.p.xz - u_frame.camera.xz);\n"
-    "    float grow = min(inversesqrt(u_lod.f[ii / u_push.info.x]), " LOD_GROW_S ");\n"
-    "    float size = 1.3 * b4.z * it.p.w * grow * ug_fade_scale(it.p.xyz, d, r);\n"
-    "    float sa = b4.y * (1.0 - ug_far(d, r));\n"
+    "    UgS sq = ug_shadow_square(ii, it);\n"
+    "    float size = sq.size, sa = sq.a;\n"
     "    if (!(size > 0.0) || !(sa > 0.0)) return;\n"
-    "    vec3 t = normalize(cross(n, vec3(0.0, 0.0, 1.0))), bt = cross(t, n);\n"
+    "    vec3 n = sq.n, t = sq.t, bt = sq.bt;\n"
     "    vec3 o = it.p.xyz + n * 0.04;\n"
     "    vec4 c0 = u_frame.view_proj * vec4(o + (-t - bt) * size - u_frame.camera.xyz, 1.0);\n"
     "    vec4 c1 = u_frame.view_proj * vec4(o + (t - bt) * size - u_frame.camera.xyz, 1.0);\n"

@@ -390,18 +390,14 @@ const char rt_ug_shadow_vert_main[] =
     "layout(location = 0) out vec2 s_q;\n"
     "layout(location = 1) out float s_a;\n"
     UG_GLSL_FUNCS
+    UG_GLSL_SHADOW
     "void main() {\n"
     "    uint ii = u_vis.i[gl_InstanceIndex];   /* the cull passes' list */\n"
     "    Inst it = u_inst.v[ii];\n"
-    "    vec4 b4 = u_blocks.b[5u * it.q.w + 4u];\n"
-    "    vec3 n = normalize(unpackSnorm4x8(it.q.x).xyz + vec3(0.0, 1e-4, 0.0));\n"
-    "    float r = u_push.patch_xz.x, d = length(it.p.xz - u_frame.camera.xz);\n"
-    "    float grow = min(inversesqrt(u_lod.f[ii / u_push.info.x]), " LOD_GROW_S ");\n"
-    "    float size = 1.3 * b4.z * it.p.w * grow * ug_fade_scale(it.p.xyz, d, r);\n"
-    "    vec3 t = normalize(cross(n, vec3(0.0, 0.0, 1.0))), bt = cross(t, n);\n"
-    "    vec3 p = it.p.xyz + (t * a_pos.x + bt * a_pos.z) * size + n * 0.04;\n"
+    "    UgS sq = ug_shadow_square(ii, it);\n"
+    "    vec3 p = it.p.xyz + (sq.t * a_pos.x + sq.bt * a_pos.z) * sq.size + sq.n * 0.04;\n"
     "    s_q = a_uv * 2.0 - 1.0;\n"
-    "    s_a = b4.y * (1.0 - ug_far(d, r));\n"
+    "    s_a = sq.a;\n"
     "    gl_Position = u_frame.view_proj * vec4(p - u_frame.camera.xyz, 1.0);\n"
     "}\n";
 

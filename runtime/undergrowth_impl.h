@@ -131,6 +131,25 @@ _Static_assert(UG_LEVELS <= 1 << (UG_CR_PSHIFT - UG_CR_TBITS), "the payload's le
     "    o.flags = flags;\n" \
     "    return o;\n" \
     "}\n"
+/* A blade's contact shadow, a square on the ground under it, as the
+ * graphics shadow draw and the compute rasteriser's shadow pass both need
+ * it (after UG_GLSL_FUNCS, with Inst, u_blocks, u_lod, u_push and u_frame
+ * declared): the terrain normal n, the square's axes t and bt, its half
+ * size (faded and widened with the blade) and its darkness a. */
+#define UG_GLSL_SHADOW \
+    "struct UgS { vec3 n; vec3 t; vec3 bt; float size; float a; };\n" \
+    "UgS ug_shadow_square(uint ii, Inst it) {\n" \
+    "    vec4 b4 = u_blocks.b[5u * it.q.w + 4u];\n" \
+    "    UgS s;\n" \
+    "    s.n = normalize(unpackSnorm4x8(it.q.x).xyz + vec3(0.0, 1e-4, 0.0));\n" \
+    "    float r = u_push.patch_xz.x, d = length(it.p.xz - u_frame.camera.xz);\n" \
+    "    float grow = min(inversesqrt(u_lod.f[ii / u_push.info.x]), " LOD_GROW_S ");\n" \
+    "    s.size = 1.3 * b4.z * it.p.w * grow * ug_fade_scale(it.p.xyz, d, r);\n" \
+    "    s.a = b4.y * (1.0 - ug_far(d, r));\n" \
+    "    s.t = normalize(cross(s.n, vec3(0.0, 0.0, 1.0)));\n" \
+    "    s.bt = cross(s.t, s.n);\n" \
+    "    return s;\n" \
+    "}\n"
 #define UG_FADE_MARGIN_S "12.0"   /* 0.75 CELL */
 #define UG_FADE_START_S "0.6"
 
