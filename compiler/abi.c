@@ -541,6 +541,10 @@ const char SPLAT_GLSL_PRELUDE[] =
     "vec2 splat_fp(vec2 d) { return splat_spec_lod != 0u ? vec2(0.0) : d; }\n"
     "vec3 splat_fp(vec3 d) { return splat_spec_lod != 0u ? vec3(0.0) : d; }\n"
     "vec4 splat_fp(vec4 d) { return splat_spec_lod != 0u ? vec4(0.0) : d; }\n"
+    /* view.shading_lod: 1 under the CPU shading LOD, else 0; a constant
+     * once the pipeline is made, so the side of a mix or select on it
+     * that the device does not draw is dead code (nodes/detile.sg) */
+    "float splat_shading_lod() { return splat_spec_lod != 0u ? 1.0 : 0.0; }\n"
     "uint splat_view() {\n"
     "    return splat_spec_view == " SPLAT_STR(SPLAT_SPEC_VIEW_DYNAMIC)
     " ? u_frame.view.x : splat_spec_view;\n"

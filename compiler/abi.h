@@ -386,8 +386,12 @@ static inline uint32_t splat_ug_pool(double radius)
  * then drops what costs much there and little in the picture, the
  * footprint filter's neighbour normals (splat_fp of splat_d_normal is 0:
  * fwidth of terrain.slope and of the normal's facing take no heightfield
- * gathers; runtime/DESIGN.md "CPU shading LOD").  Left at 0 the code is the same
- * as without it (GPUs). */
+ * gathers; runtime/DESIGN.md "CPU shading LOD"), and graphs read it as
+ * the input view.shading_lod (splat_shading_lod(): 1.0 or 0.0), so the
+ * node library can draw a cheaper version of itself there (nodes/detile.sg:
+ * one hex-tile read instead of three).  Left at 0 the code is the same
+ * as without it (GPUs): the LOD side of a mix or select on it is dead
+ * once the constant is known. */
 #define SPLAT_SPEC_LOD          1
 /* A macro's value as a GLSL literal string (the prelude pastes these). */
 #define SPLAT_STR_(x) #x
@@ -572,6 +576,8 @@ typedef struct splat_push {
  *     float splat_cavity()  terrain.cavity: the heightfield's mean at 4
  *                          diagonal taps 2 texels away minus the height
  *                          here, metres (4 more height reads)
+ *     float splat_shading_lod()  view.shading_lod: 1.0 under the CPU
+ *                          shading LOD (SPLAT_SPEC_LOD), else 0.0
  *     void splat_finish(vec3 albedo, vec3 normal, float roughness,
  *                       float height, float coverage)
  *     uint splat_view()   the debug view (SPLAT_SPEC_VIEW above)

@@ -364,14 +364,43 @@ void splat_composite_free(splat_composite *c)
     memset(c, 0, sizeof *c);
 }
 
+/* Whether `r` is view.shading_lod (or a splat of it). */
+static bool is_shading_lod(const ir *ir, ir_ref r)
+{
+    const ir_node *n = ir_get(ir, r);
+    if (n->op == IR_OP_SPLAT && n->nargs == 1)
+        n = ir_get(ir, n->arg[0]);
+    return n->op == IR_OP_INPUT && n->imm == IR_IN_SHADING_LOD;
+}
+
+/* ir_cost over the values a GPU computes (compose.h): a mix whose t, or a
+ * select whose c, is view.shading_lod is its side for 0, at no cost (the
+ * driver folds it once the constant is known). */
 double splat_composite_cost(const splat_composite *c)
 {
-    ir_ref *roots = xcalloc((size_t)c->ir.nroots, sizeof *roots);
-    for (int i = 0; i < c->ir.nroots; i++)
-        roots[i] = c->ir.roots[i].ref;
-    long cost = ir_cost(&c->ir, roots, c->ir.nroots);
-    free(roots);
-    return (double)cost;
+    const ir *ir = &c->ir;
+    bool *live = xcalloc(ir->nnodes, sizeof *live);
+    for (int i = 0; i < ir->nroots; i++)
+        live[ir->roots[i].ref.id] = ir_ref_ok(ir->roots[i].ref);
+    long total = 0;
+    for (uint32_t id = ir->nnodes; id-- > 1;) {   /* ids are topological */
+        if (!live[id])
+            continue;
+        const ir_node *n = &ir->nodes[id];
+        if (n->op == IR_OP_MIX && is_shading_lod(ir, n->arg[2])) {
+            live[n->arg[0].id] = true;   /* mix(a, b, 0) = a: folded, free */
+            continue;
+        }
+        if (n->op == IR_OP_SELECT && is_shading_lod(ir, n->arg[0])) {
+            live[n->arg[2].id] = true;   /* 0 != 0 ? a : b = b */
+            continue;
+        }
+        for (int a = 0; a < n->nargs; a++)
+            live[n->arg[a].id] = true;
+        total += ir_node_cost(ir, (ir_ref){id});
+    }
+    free(live);
+    return (double)total;
 }
 
 

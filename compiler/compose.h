@@ -131,8 +131,12 @@ void splat_composite_refresh(const splat_layout *L, splat_composite *c, sg_diags
 
 /* Estimated per-pixel cost of shading with `c` when every layer runs
  * (the most a pixel pays): ir_cost over all its values, in the op table's
- * cost units (ir.h IR_OPS).  The manifest's "cost": the runtime picks the
- * cheapest combination covering a tile. */
+ * cost units (ir.h IR_OPS), on a GPU: the side of a mix or select on
+ * view.shading_lod that a GPU does not draw (the CPU shading LOD's, dead
+ * code once its constant is 0) is not counted, so the LOD's cheaper
+ * versions in the node library leave the costs, the distance classes and
+ * the runtime's choices as they were.  The manifest's "cost": the runtime
+ * picks the cheapest combination covering a tile. */
 double splat_composite_cost(const splat_composite *c);
 
 typedef struct splat_glsl_desc {

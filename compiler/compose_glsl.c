@@ -706,8 +706,9 @@ static void differentiated(const splat_composite *c, ir *dst, splat_layer *layer
  * (PLAT_1) over an open set of pixels, not just at isolated points (a
  * noise's fade weight is 0 only on lattice lines: a branch on it would be
  * taken by every quad).  Clamping ops, steps, comparisons, selects, painted
- * masks and params make plateaus; products, sums and the like carry them;
- * anything else (an input, a texture, a sine) has none.  Always within the
+ * masks, params and view.shading_lod (a constant of the pipeline) make
+ * plateaus; products, sums and the like carry them; anything else (another
+ * input, a texture, a sine) has none.  Always within the
  * interval bounds. */
 static unsigned plateau_of(const ir *ir, uint32_t id, const ir_iv *iv, const uint8_t *p)
 {
@@ -719,6 +720,9 @@ static unsigned plateau_of(const ir *ir, uint32_t id, const ir_iv *iv, const uin
     case IR_OP_SATURATE: case IR_OP_CLAMP: case IR_OP_SMOOTHSTEP: case IR_OP_STEP:
     case IR_OP_LESS:
         r = PLAT_0 | PLAT_1;
+        break;
+    case IR_OP_INPUT:   /* view.shading_lod is 0 or 1 on every pixel */
+        r = n->imm == IR_IN_SHADING_LOD ? PLAT_0 | PLAT_1 : 0;
         break;
     case IR_OP_SPLAT: case IR_OP_SWIZZLE: case IR_OP_POW: case IR_OP_ABS: case IR_OP_NEG:
         r = a;

@@ -103,7 +103,10 @@ ir_type     ir_type_from_name(const char *s); /* IR_T_ERROR if unknown       */
       "splat_d_view_direction")                                        /* unit     */ \
     X(CAVITY,         "terrain.cavity",      IR_T_FLOAT, "splat_cavity()",        \
       "cavity",       cavity,         IV_NONE,           ALL,    1,               \
-      NULL)                                                            /* m, + in hollows */
+      NULL)                                                            /* m, + in hollows */ \
+    X(SHADING_LOD,    "view.shading_lod",    IR_T_FLOAT, "splat_shading_lod()",   \
+      "shading_lod",  shading_lod,    IV_NONE,           UNIT,   0,               \
+      NULL)                                                            /* 0 or 1   */
 
 /* The type is `enum ir_input` (alias ir_input_kind): the plain name
  * `ir_input` is the builder function below. */
@@ -589,6 +592,11 @@ typedef struct ir_env {
                                       mean at 4 diagonal taps 2 texels
                                       away minus the height here, metres
                                       (splat_terrain_cavity)             */
+    double shading_lod;            /* view.shading_lod: 1 where the renderer
+                                      draws the CPU shading LOD (abi.h
+                                      SPLAT_SPEC_LOD), else 0; the CPU
+                                      reference and the far-atlas bake
+                                      are the full shading: 0            */
     double d_input[2][IR_IN_COUNT][4]; /* DINPUT leaves: screen-space
                                       derivative of each input, per axis
                                       (d/dx, d/dy); 0 when unset          */

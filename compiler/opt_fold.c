@@ -15,7 +15,12 @@
  *     inputs, painted masks, params with a finite range, texture samples
  *     of a finite range, and finite constants.  Everything else keeps it;
  *   - saturate(saturate(x)) by saturate(x); select(c, a, b) with a
- *     constant c by a or b;
+ *     constant c by a or b, select(c, x, x) by x; mix(x, x, t) by x where
+ *     t is view.shading_lod, which is exactly 0 or 1 (the CPU shading
+ *     LOD's switch: a distance class that pins a node's full side to its
+ *     LOD side, as parallax's uv beyond its fade, then reads x itself, as
+ *     it did before the switch, and the driver folds the mix the same way
+ *     once the constant is known);
  *   - splat of a constant by a vector constant; swizzle of a constant, of
  *     a splat, of a swizzle, and of a construct whose picked components
  *     are all floats, by the picked values.
@@ -178,7 +183,16 @@ static ir_ref fold_identity(ir *dst, const ir_node *n)
         return N(dst, a)->op == IR_OP_NEG ? N(dst, a)->arg[0] : IR_NONE;
     case IR_OP_SATURATE:
         return N(dst, a)->op == IR_OP_SATURATE ? a : IR_NONE;
+    case IR_OP_MIX: {   /* mix(x, x, view.shading_lod): x */
+        const ir_node *t = N(dst, n->arg[2]);
+        if (t->op == IR_OP_SPLAT)
+            t = N(dst, t->arg[0]);
+        return ir_ref_eq(a, b) && t->op == IR_OP_INPUT && t->imm == IR_IN_SHADING_LOD
+                   ? a : IR_NONE;
+    }
     case IR_OP_SELECT: {
+        if (ir_ref_eq(n->arg[1], n->arg[2]))   /* select(c, x, x): x */
+            return n->arg[1];
         if (!is_const(dst, a))
             return IR_NONE;
         const ir_node *c = N(dst, a);

@@ -67,7 +67,10 @@ bool rt_far_bake_device(void *user, const char *pack_dir, int w, int h, float *a
                !cpu_device_pays(&p, w, h, d, msg, nmsg)) {
         rt_pack_free(&p);
     } else {
-        rt_render_desc rd = { .width = 8, .height = 8, .no_undergrowth = true, .no_shadows = true };
+        /* the atlas is the full shading on every device: not the CPU
+         * shading LOD's cheaper nodes, nearest mips and footprints */
+        rt_render_desc rd = { .width = 8, .height = 8, .no_undergrowth = true, .no_shadows = true,
+                              .shading_lod = RT_SHADING_LOD_OFF };
         if (!rt_renderer_create(d, &p, &rd, &r, &e))
             fail_msg(&e, msg, nmsg, d->props.deviceName);
         else if (!rt_renderer_bake_far(r, w, h, albedo, normal, rough, NULL, &e))

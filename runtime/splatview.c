@@ -321,7 +321,8 @@ static const splat_arg options[] = {
       "(faster, softer; the window's P key cycles it)", F(preview_scale), .choices = "1|2|4",
       .values = preview_values },
     { "--shading-lod", SPLAT_ARG_ENUM, NULL, "the CPU shading LOD: no footprint derivatives, "
-      "the nearest mip level, coarser geometry (auto: on CPU devices such as lavapipe only; "
+      "the nearest mip level, the node library's one-read detiling, tri-planar and parallax "
+      "(view.shading_lod), coarser geometry (auto: on CPU devices such as lavapipe only; "
       "$SPLAT_SHADING_LOD=0|1 sets auto's choice)", F(shading_lod), .choices = "auto|off|on",
       .values = shading_lod_values },
     { "--param", SPLAT_ARG_LIST, "NAME=V[,V,V,V]", "set a material param (repeatable)",

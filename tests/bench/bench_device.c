@@ -101,8 +101,9 @@ int bench_far_bake(int argc, char **argv)
     printf("device %s, far atlas %d x %d texels (N = %d)\n", dev.props.deviceName, w, h, n);
     printf("run,combos,compile_s,shade_s,total_s\n");
     for (int k = 0; k < runs; k++) {
+        /* the full shading, as splatc's device bake (far_bake_device.c) */
         rt_render_desc rd = { .width = 8, .height = 8, .no_undergrowth = true, .no_shadows = true,
-                              .pipeline_cache = cache };
+                              .pipeline_cache = cache, .shading_lod = RT_SHADING_LOD_OFF };
         rt_far_bake_stats st;
         if (!rt_renderer_create(&dev, &p, &rd, &r, &e) ||
             !rt_renderer_bake_far(r, w, h, al, no, ro, &st, &e))

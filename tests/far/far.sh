@@ -201,6 +201,12 @@ device|device_small)
     if [ "$CASE" = device_small ]; then
         bake "$GPU_PACK.2" gpu "$OUT/dev_again.log"
         cmp "$GPU_PACK/far.atlas" "$GPU_PACK.2/far.atlas" || fail "two device bakes differ"
+        # the atlas is the full shading whatever the CPU shading LOD (the
+        # suite runs with $SPLAT_SHADING_LOD=0; the viewer's LOD on lavapipe
+        # would sample the nearest mips and the library's cheaper nodes)
+        SPLAT_SHADING_LOD=1 bake "$GPU_PACK.lod" gpu "$OUT/dev_lod.log"
+        cmp "$GPU_PACK/far.atlas" "$GPU_PACK.lod/far.atlas" ||
+            fail "the device bake under SPLAT_SHADING_LOD=1 differs: the LOD reached the atlas"
         # auto on lavapipe: the device where the atlas pays for its compiles
         bake "$2_auto" auto "$OUT/dev_auto1.log"
         grep -q "^far atlas: .* on the device$" "$OUT/dev_auto1.log" ||

@@ -55,6 +55,7 @@ static const char INPUTS[] =
     "vec3 splat_position() { return h_in.rec[h_base + 2u].xyz; }\n"
     "vec2 splat_uv() { return h_in.rec[h_base + 3u].xy; }\n"
     "float splat_cavity() { return h_in.rec[h_base + 3u].w; }\n"
+    "float splat_shading_lod() { return 0.0; }\n"   /* the full shading */
     "vec3 splat_view_direction() {\n"
     "    return vec3(h_in.rec[h_base + 1u].w, h_in.rec[h_base + 2u].w, h_in.rec[h_base + 3u].z);\n"
     "}\n";
