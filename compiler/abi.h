@@ -198,7 +198,7 @@
 #include <math.h>
 #include <stdint.h>
 
-#define SPLAT_ABI_VERSION 6   /* 2: splat_frame.light; 3: GGX lighting, screen.w;
+#define SPLAT_ABI_VERSION 7   /* 2: splat_frame.light; 3: GGX lighting, screen.w;
                                  4: splat_surface / splat_opaque, SPLAT_SORT;
                                  5: set 1's textures are sampler2DArray layers;
                                     terrain vertices on the lattice (splat_push);
@@ -207,7 +207,9 @@
                                     and SPLAT_SPEC_LOD (the CPU shading LOD):
                                     the runtime cuts a pack's GLSL at the
                                     prelude it carries, so a new prelude is a
-                                    new ABI */
+                                    new ABI;
+                                 7: the prelude's splat_shading_lod()
+                                    (view.shading_lod) */
 /* The pack's format version (manifest.json "version", PACK.md): 2 adds
  * vectors.bin, the scene's spline and polygon shapes. */
 #define SPLAT_PACK_VERSION 3
