@@ -38,29 +38,6 @@ bool rt_ug_cull_pipelines(rt_ug *u, rt_error *e)
     return ok;
 }
 
-/* The cull passes' table for this frame (UG_KEYINFO): keys in the draw's
- * order (opaque blocks first; a block's near mesh, then its far one, then
- * its single-triangle one, then with the compute rasteriser on the same
- * three levels drawn in compute), each key's entries the visible generated
- * cells front to back whose distance picks that mesh (their nearest point
- * beyond LOD_NEAR: the far mesh; beyond LOD_TRI LOD_NEAR: the single
- * triangles) and, for a compute key, whose every instance fits the compute
- * rasteriser's cap (rt_ug_craster_fits) where the block and that mesh can
- * go there (cs_level). */
-void rt_ug_level_mesh(const rt_ug *u, int b, int lv, uint32_t out[3])
-{
-    const rt_pack_ug *pu = &u->p->ug;
-    int far = pu->meshes[pu->blocks[b].mesh].far;
-    if (lv == 2) {
-        memcpy(out, u->tri[b], 3 * sizeof *out);
-        return;
-    }
-    const rt_pack_ug_mesh *m = &pu->meshes[lv ? far : pu->blocks[b].mesh];
-    out[0] = m->nidx;
-    out[1] = m->first_index;
-    out[2] = m->first_vertex;
-}
-
 /* Whether block b's mesh at level lv (which it has) can be drawn in
  * compute: opaque or a frond (an alpha cut-out samples its texture per
  * pixel, which the raster pass does not), few enough triangles for the
@@ -115,6 +92,15 @@ static void cell_levels(rt_ug *u)
     }
 }
 
+/* The cull passes' table for this frame (UG_KEYINFO): keys in the draw's
+ * order (opaque blocks first; a block's near mesh, then its far one, then
+ * its single-triangle one, then with the compute rasteriser on the same
+ * three levels drawn in compute), each key's entries the visible generated
+ * cells front to back whose distance picks that mesh (their nearest point
+ * beyond LOD_NEAR: the far mesh; beyond LOD_TRI LOD_NEAR: the single
+ * triangles) and, for a compute key, whose every instance fits the compute
+ * rasteriser's cap (rt_ug_craster_fits) where the block and that mesh can
+ * go there (cs_level). */
 static void fill_entries(rt_ug *u)
 {
     cell_levels(u);

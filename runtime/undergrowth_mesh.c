@@ -151,3 +151,20 @@ void rt_ug_fill_blocks(rt_ug *u, float *b)
     }
     u->cap = at;
 }
+
+/* Block b's mesh at level lv (0 near, 1 far, 2 the single triangle): its
+ * index count, first index and vertex offset, as the draws and the
+ * compute rasteriser's triangle table name it. */
+void rt_ug_level_mesh(const rt_ug *u, int b, int lv, uint32_t out[3])
+{
+    const rt_pack_ug *pu = &u->p->ug;
+    int far = pu->meshes[pu->blocks[b].mesh].far;
+    if (lv == 2) {
+        memcpy(out, u->tri[b], 3 * sizeof *out);
+        return;
+    }
+    const rt_pack_ug_mesh *m = &pu->meshes[lv ? far : pu->blocks[b].mesh];
+    out[0] = m->nidx;
+    out[1] = m->first_index;
+    out[2] = m->first_vertex;
+}
