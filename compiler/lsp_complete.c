@@ -334,7 +334,7 @@ static void scope(ctx *c, int si)
     for (int k = 0; k < c->p->ntextures; k++)
         add(c, c->p->textures[k]->name, K_VALUE, "texture", NULL);
     add(c, "terrain", K_MODULE, "terrain inputs: terrain.slope, terrain.height, …", NULL);
-    add(c, "view", K_MODULE, "view inputs: view.distance, view.direction", NULL);
+    add(c, "view", K_MODULE, "view inputs: view.distance, view.direction, view.shading_lod", NULL);
     static const char *const vecs[] = { "vec2", "vec3", "vec4", NULL };
     add_words(c, vecs, K_TYPE);
 }
