@@ -13,14 +13,17 @@
  *      undergrowth material's composited weight, the terrain normal and
  *      the composite's albedo;
  *   2. the scatter pass, one workgroup per block (a material's
- *      `undergrowth`): a jittered grid at the block's density, Russian
- *      roulette on the material's weight, scale and rotation from a hash
+ *      `undergrowth`) and cell, one dispatch for the frame's new cells
+ *      (their positions and slots in gtab): a jittered grid at the
+ *      block's density, Russian roulette on the material's weight,
+ *      scale and rotation from a hash
  *      of the cell's integer position (the same instances on every run
  *      and from every camera), the root on the heightfield (bilinear as
  *      the terrain), the terrain's albedo at the root.
  *      Instances are compacted by a workgroup prefix sum in candidate
- *      order, so the buffer is deterministic (no atomics), and the count
- *      goes straight into the block's indirect draw arguments.
+ *      order, so the buffer is deterministic (no atomics), and the
+ *      workgroup writes the block's indirect draw arguments (its mesh from
+ *      gtab, the count).
  * Every frame a LOD pass scales each cell's counts by its distance, then
  * the cull passes ("cull", undergrowth_glsl.c rt_ug_cull_glsl) keep the
  * instances the fade leaves a size and whose bounds touch the frustum,
@@ -159,7 +162,7 @@ static bool make_sets(rt_ug *u, VkDescriptorSet set0_src, const rt_image *height
 {
     rt_device *d = u->d;
     VkDescriptorPoolSize sizes[3] = {
-        { VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 25 + 1 },   /* + set 0's vector shapes */
+        { VK_DESCRIPTOR_TYPE_STORAGE_BUFFER, 26 + 1 },   /* + set 0's vector shapes */
         { VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 16 + SPLAT_MAX_UG_TEXTURES },
         { VK_DESCRIPTOR_TYPE_UNIFORM_BUFFER, 2 },
     };
@@ -193,6 +196,7 @@ static bool make_sets(rt_ug *u, VkDescriptorSet set0_src, const rt_image *height
         { u->gen_set, 0, sb, u->masks.buf }, { u->gen_set, 1, sb, u->inst.buf },
         { u->gen_set, 2, sb, u->args.buf }, { u->gen_set, 3, sb, u->blocks.buf },
         { u->gen_set, 4, cis, .sampler = nearest, .view = height->view },
+        { u->gen_set, 5, sb, u->gtab.buf },
         { u->draw_set, 0, sb, u->blocks.buf }, { u->draw_set, 1, sb, u->inst.buf },
         { u->draw_set, 2, sb, u->lod.buf }, { u->draw_set, 4, sb, u->vis.buf },
         { u->lod_set, 0, sb, u->args.buf }, { u->lod_set, 1, sb, u->draw_args.buf },
@@ -245,6 +249,7 @@ static bool make_layouts(rt_ug *u, rt_error *e)
     VkDescriptorSetLayoutBinding gen[] = {
         { 0, sb, 1, cs, NULL }, { 1, sb, 1, cs, NULL }, { 2, sb, 1, cs, NULL },
         { 3, sb, 1, cs, NULL }, { 4, VK_DESCRIPTOR_TYPE_COMBINED_IMAGE_SAMPLER, 1, cs, NULL },
+        { 5, sb, 1, cs, NULL },
     };
     VkDescriptorSetLayoutBinding draw[] = {
         { 0, sb, 1, VK_SHADER_STAGE_VERTEX_BIT, NULL }, { 1, sb, 1, VK_SHADER_STAGE_VERTEX_BIT, NULL },
@@ -266,7 +271,7 @@ static bool make_layouts(rt_ug *u, rt_error *e)
         !rt_vk_keep(d, k, VK_OBJECT_TYPE_DESCRIPTOR_SET_LAYOUT, RT_VK_H(u->set_terrain), e) ||
         !rt_vk_set_layout(d, k, &(rt_vk_set_layout_desc){ "undergrowth masks", mask, 1 },
                           &u->set_mask, e) ||
-        !rt_vk_set_layout(d, k, &(rt_vk_set_layout_desc){ "undergrowth scatter", gen, 5 },
+        !rt_vk_set_layout(d, k, &(rt_vk_set_layout_desc){ "undergrowth scatter", gen, 6 },
                           &u->set_gen, e) ||
         !rt_vk_set_layout(d, k, &(rt_vk_set_layout_desc){ "undergrowth draw", draw, 5 },
                           &u->set_draw, e) ||
@@ -331,6 +336,7 @@ static bool make_buffers(rt_ug *u, rt_error *e)
                           true, &u->mdraw_host, e) ||
         !rt_buffer_create(d, (VkDeviceSize)UG_MAX_KEYS * 2 * 12,   /* the compute keys' dispatches, their shadows' */
                           st | VK_BUFFER_USAGE_INDIRECT_BUFFER_BIT, false, &u->cdisp, e) ||
+        !rt_buffer_create(d, (VkDeviceSize)(u->nblocks + UG_TODO) * 16, st, true, &u->gtab, e) ||
         !rt_buffer_create(d, (VkDeviceSize)u->pool * 4, st, true, &u->lod, e) ||
         !rt_buffer_create(d, (VkDeviceSize)u->nblocks * 16 * UG_BLOCK_VEC4, st, true, &u->blocks,
                           e) ||
@@ -371,6 +377,14 @@ static bool make_buffers(rt_ug *u, rt_error *e)
         ni += 3 * nt;
     }
     rt_ug_fill_blocks(u, u->blocks.map);
+    for (int b = 0; b < u->nblocks; b++) {
+        const rt_pack_ug_mesh *m = &pu->meshes[pu->blocks[b].mesh];
+        uint32_t *g = (uint32_t *)u->gtab.map + 4 * (size_t)b;
+        g[0] = m->nidx;
+        g[1] = m->first_index;
+        g[2] = m->first_vertex;
+        g[3] = 0;
+    }
     memset(u->args_host.map, 0, (size_t)u->args_host.size);
     memset(u->mdraw_host.map, 0, (size_t)u->mdraw_host.size);
     for (int i = 0; i < u->pool; i++)
@@ -460,7 +474,7 @@ void rt_ug_destroy(rt_ug *u)
     rt_vk_list_destroy(d, &u->keep);
     rt_buffer *bufs[] = { &u->masks, &u->inst, &u->args, &u->args_host, &u->draw_args, &u->lod,
                           &u->blocks, &u->vbuf, &u->ibuf, &u->frame, &u->ent,
-                          &u->cnt, &u->vis, &u->mdraw, &u->mdraw_host, &u->cdisp };
+                          &u->cnt, &u->vis, &u->mdraw, &u->mdraw_host, &u->cdisp, &u->gtab };
     for (size_t i = 0; i < sizeof bufs / sizeof *bufs; i++)
         rt_buffer_destroy(d, bufs[i]);
     rt_buffer_destroy(d, &u->probe_out);
@@ -629,59 +643,111 @@ static bool mask_pipeline(rt_ug *u, int combo, VkPipeline *out, rt_error *e)
     return true;
 }
 
-/* The mask dispatches of cell `cl` in pool slot `slot`: one per leaf cell
- * it overlaps, clipped to that leaf. */
-static bool record_masks(rt_ug *u, VkCommandBuffer cb, const ug_cell *cl, int slot,
-                         VkDescriptorSet set1, rt_error *e)
+/* One mask dispatch: a cell's texels inside one leaf cell. */
+typedef struct ug_mask_job {
+    VkPipeline pipe;
+    int        slot, lx, lz;
+    float      x0, z0;
+} ug_mask_job;
+
+/* The mask dispatches of cell `cl` (pool slot `slot`), one per leaf cell
+ * it overlaps, appended to `jobs`; returns whether they write every
+ * texel (else the cell's texels are cleared first: beyond the terrain, a
+ * hole, or a combination that grows nothing). */
+static bool mask_jobs(rt_ug *u, const ug_cell *cl, int slot, ug_mask_job *jobs, int *njobs,
+                      bool *covered, rt_error *e)
 {
-    const rt_pack *p = u->p;
-    const rt_pack_level *L0 = &p->levels[0];
+    const rt_pack_level *L0 = &u->p->levels[0];
     double lx0, lz0, lsx, lsz;
     rt_node_rect(u->qt, 0, 0, 0, &lx0, &lz0, &lsx, &lsz);
     double x0 = cl->ix * CELL, z0 = cl->iz * CELL;
     int ax = (int)floor(x0 / lsx), bx = (int)floor((x0 + CELL) / lsx);
     int az = (int)floor(z0 / lsz), bz = (int)floor((z0 + CELL) / lsz);
-    VkDescriptorSet sets[3] = { u->set0, set1, u->mask_set };
-    vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, u->mask_layout, 0, 3, sets, 0, NULL);
+    /* the texel centres' extent against the leaves' */
+    double half = 0.5 * CELL / TEXELS;
+    *covered = x0 + half >= 0 && z0 + half >= 0 && x0 + CELL - half < L0->width * lsx &&
+               z0 + CELL - half < L0->height * lsz;
     for (int lz = az; lz <= bz; lz++)
         for (int lx = ax; lx <= bx; lx++) {
             if (lx < 0 || lz < 0 || lx >= L0->width || lz >= L0->height)
                 continue;
+            /* a leaf reached only by the cell's far edge holds none of
+             * its texel centres: it needs no dispatch */
             unsigned id = L0->ids[(size_t)lz * (size_t)L0->width + (size_t)lx];
-            if (id == SPLAT_COMBO_HOLE)
-                continue;
-            VkPipeline pipe;
-            if (!mask_pipeline(u, (int)id, &pipe, e))
+            VkPipeline pipe = VK_NULL_HANDLE;
+            if (id != SPLAT_COMBO_HOLE && !mask_pipeline(u, (int)id, &pipe, e))
                 return false;
-            if (!pipe)
+            if (!pipe) {
+                *covered = false;
                 continue;
-            vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, pipe);
-            splat_push push = {
-                .patch_xz = { (float)x0, (float)z0, (float)CELL, 0 },
-                .patch_uv = { (float)(lx * lsx), (float)(lz * lsz), (float)((lx + 1) * lsx),
-                              (float)((lz + 1) * lsz) },
-                .info = { (uint32_t)slot * TEXELS * TEXELS * (uint32_t)(u->nw + 2), 0,
-                          (uint32_t)u->nw, 0 },
-            };
-            vkCmdPushConstants(cb, u->mask_layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof push, &push);
-            vkCmdDispatch(cb, TEXELS / 8, TEXELS / 8, 1);
+            }
+            jobs[(*njobs)++] = (ug_mask_job){ pipe, slot, lx, lz, (float)x0, (float)z0 };
         }
     return true;
 }
 
-/* The draw arguments of a slot's blocks (instance counts 0 until its
- * scatter pass writes them). */
-static void reset_args(rt_ug *u, VkCommandBuffer cb, int slot)
+static int job_order(const void *a, const void *b)
 {
-    uint32_t a[5 * 64];
-    for (int b = 0; b < u->nblocks; b++) {
-        const rt_pack_ug_mesh *m = &u->p->ug.meshes[u->p->ug.blocks[b].mesh];
-        uint32_t v[5] = { m->nidx, 0, m->first_index, m->first_vertex,
-                          (uint32_t)slot * u->cap + u->block_base[b] };
-        memcpy(a + 5 * b, v, sizeof v);
+    const ug_mask_job *x = a, *y = b;
+    uint64_t p = (uint64_t)(uintptr_t)x->pipe, q = (uint64_t)(uintptr_t)y->pipe;
+    if (p != q)
+        return p < q ? -1 : 1;
+    return x->slot != y->slot ? (x->slot < y->slot ? -1 : 1)
+         : x->lz != y->lz     ? (x->lz < y->lz ? -1 : 1)
+                              : (x->lx > y->lx) - (x->lx < y->lx);
+}
+
+/* The mask pass of the cells todo[0..n): the cells some texel of which
+ * no dispatch writes cleared, then every dispatch, grouped by pipeline. */
+static bool record_masks(rt_ug *u, VkCommandBuffer cb, const int *todo, int n,
+                         VkDescriptorSet set1, rt_error *e)
+{
+    double lx0, lz0, lsx, lsz;
+    rt_node_rect(u->qt, 0, 0, 0, &lx0, &lz0, &lsx, &lsz);
+    /* a 16 m cell overlaps at most 2 x 2 leaves of at least 16 m; more
+     * where the leaves are smaller */
+    int per = ((int)ceil(CELL / lsx) + 1) * ((int)ceil(CELL / lsz) + 1);
+    ug_mask_job *jobs = malloc((size_t)n * (size_t)per * sizeof *jobs);
+    if (!jobs)
+        return rt_fail(e, RT_E_VULKAN, "undergrowth", "out of memory");
+    int njobs = 0;
+    VkDeviceSize bytes = (VkDeviceSize)TEXELS * TEXELS * (u->nw + 2) * 4;
+    for (int i = 0; i < n; i++) {
+        bool covered;
+        if (!mask_jobs(u, &u->cells[todo[i]], todo[i], jobs, &njobs, &covered, e)) {
+            free(jobs);
+            return false;
+        }
+        if (!covered)
+            vkCmdFillBuffer(cb, u->masks.buf, bytes * (VkDeviceSize)todo[i], bytes, 0);
     }
-    vkCmdUpdateBuffer(cb, u->args.buf, (VkDeviceSize)slot * u->nblocks * 20,
-                      (VkDeviceSize)u->nblocks * 20, a);
+    /* after the clears, and after what read the slots before (the last
+     * draws, probes and copies) */
+    rt_cmd_barrier(cb, VK_PIPELINE_STAGE_TRANSFER_BIT | VK_PIPELINE_STAGE_DRAW_INDIRECT_BIT |
+                       VK_PIPELINE_STAGE_VERTEX_SHADER_BIT | VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+                   VK_ACCESS_TRANSFER_WRITE_BIT | VK_ACCESS_INDIRECT_COMMAND_READ_BIT |
+                       VK_ACCESS_SHADER_READ_BIT,
+                   VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
+                   VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_SHADER_READ_BIT);
+    qsort(jobs, (size_t)njobs, sizeof *jobs, job_order);
+    VkDescriptorSet sets[3] = { u->set0, set1, u->mask_set };
+    vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, u->mask_layout, 0, 3, sets, 0, NULL);
+    for (int j = 0; j < njobs; j++) {
+        const ug_mask_job *m = &jobs[j];
+        if (j == 0 || m->pipe != jobs[j - 1].pipe)
+            vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, m->pipe);
+        splat_push push = {
+            .patch_xz = { m->x0, m->z0, (float)CELL, 0 },
+            .patch_uv = { (float)(m->lx * lsx), (float)(m->lz * lsz), (float)((m->lx + 1) * lsx),
+                          (float)((m->lz + 1) * lsz) },
+            .info = { (uint32_t)m->slot * TEXELS * TEXELS * (uint32_t)(u->nw + 2), 0,
+                      (uint32_t)u->nw, 0 },
+        };
+        vkCmdPushConstants(cb, u->mask_layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof push, &push);
+        vkCmdDispatch(cb, TEXELS / 8, TEXELS / 8, 1);
+    }
+    free(jobs);
+    return true;
 }
 
 void rt_ug_prepare(rt_ug *u, const rt_camera *c, const splat_frame *fr)
@@ -696,10 +762,12 @@ bool rt_ug_generate(rt_ug *u, VkCommandBuffer cb, const splat_frame *fr, VkDescr
                     int budget, rt_error *e)
 {
     /* the mask pass's frame block: this frame's (the craters' table
-     * included), seen from the origin */
+     * included), seen from the origin, in the final view (a debug view's
+     * early return would leave the texels unwritten) */
     splat_frame *uf = u->frame.map;
     *uf = *fr;
     memset(uf->camera, 0, sizeof uf->camera);
+    memset(uf->view, 0, sizeof uf->view);
     for (int k = 0; k < u->p->nsites; k++)
         for (int a = 0; a < 4; a++)
             uf->world[4 * k + a] = 0.0f;
@@ -715,41 +783,32 @@ bool rt_ug_generate(rt_ug *u, VkCommandBuffer cb, const splat_frame *fr, VkDescr
             todo[n++] = k;
     }
     if (n > 0) {
-        VkDeviceSize per = (VkDeviceSize)TEXELS * TEXELS * (u->nw + 2) * 4;
-        for (int i = 0; i < n; i++) {
-            vkCmdFillBuffer(cb, u->masks.buf, per * (VkDeviceSize)todo[i], per, 0);
-            reset_args(u, cb, todo[i]);
-        }
-        rt_cmd_barrier(cb, VK_PIPELINE_STAGE_TRANSFER_BIT | VK_PIPELINE_STAGE_DRAW_INDIRECT_BIT |
-                           VK_PIPELINE_STAGE_VERTEX_SHADER_BIT,
-                       VK_ACCESS_TRANSFER_WRITE_BIT | VK_ACCESS_INDIRECT_COMMAND_READ_BIT |
-                           VK_ACCESS_SHADER_READ_BIT,
-                       VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT,
-                       VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_SHADER_READ_BIT);
-        for (int i = 0; i < n; i++)
-            if (!record_masks(u, cb, &u->cells[todo[i]], todo[i], set1, e))
-                return false;
+        if (!record_masks(u, cb, todo, n, set1, e))
+            return false;
         rt_cmd_barrier(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
                        VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_READ_BIT);
+        /* the scatter pass: a workgroup per block and cell */
+        uint32_t *g = (uint32_t *)u->gtab.map + 4 * (size_t)u->nblocks;
+        for (int i = 0; i < n; i++) {
+            const ug_cell *cl = &u->cells[todo[i]];
+            g[4 * i] = (uint32_t)cl->ix;
+            g[4 * i + 1] = (uint32_t)cl->iz;
+            g[4 * i + 2] = (uint32_t)todo[i];
+            g[4 * i + 3] = 0;
+            u->cells[todo[i]].state = CELL_READY;
+        }
+        const rt_pack *p = u->p;
+        ug_push push = {
+            .nw = (uint32_t)u->nw, .cap = u->cap, .nblocks = (uint32_t)u->nblocks,
+            .terrain = { (float)p->size[0], (float)p->size[1], (float)p->max_height,
+                         (float)p->height_offset },
+            .hf = { p->hf_width, p->hf_height },
+        };
         vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, u->gen_pipe);
         vkCmdBindDescriptorSets(cb, VK_PIPELINE_BIND_POINT_COMPUTE, u->gen_layout, 0, 1,
                                 &u->gen_set, 0, NULL);
-        const rt_pack *p = u->p;
-        for (int i = 0; i < n; i++) {
-            const ug_cell *cl = &u->cells[todo[i]];
-            ug_push push = {
-                .origin = { (float)(cl->ix * CELL), (float)(cl->iz * CELL) },
-                .cell = { cl->ix, cl->iz }, .slot = (uint32_t)todo[i], .nw = (uint32_t)u->nw,
-                .cap = u->cap,
-                .mask_base = (uint32_t)todo[i] * TEXELS * TEXELS * (uint32_t)(u->nw + 2),
-                .terrain = { (float)p->size[0], (float)p->size[1], (float)p->max_height,
-                             (float)p->height_offset },
-                .hf = { p->hf_width, p->hf_height }, .nblocks = (uint32_t)u->nblocks,
-            };
-            vkCmdPushConstants(cb, u->gen_layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof push, &push);
-            vkCmdDispatch(cb, (uint32_t)u->nblocks, 1, 1);
-            u->cells[todo[i]].state = CELL_READY;
-        }
+        vkCmdPushConstants(cb, u->gen_layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof push, &push);
+        vkCmdDispatch(cb, (uint32_t)u->nblocks, (uint32_t)n, 1);
         /* the draw, the copy below, the LOD pass and the probes read them */
         rt_cmd_barrier(cb, VK_PIPELINE_STAGE_COMPUTE_SHADER_BIT, VK_ACCESS_SHADER_WRITE_BIT,
                        VK_PIPELINE_STAGE_DRAW_INDIRECT_BIT | VK_PIPELINE_STAGE_VERTEX_SHADER_BIT |
@@ -818,12 +877,6 @@ void rt_ug_draw(rt_ug *u, VkCommandBuffer cb, bool depth_read_only, VkDescriptor
     vkCmdBindVertexBuffers(cb, 0, 1, &u->vbuf.buf, &zero);
     vkCmdBindIndexBuffer(cb, u->ibuf.buf, 0, VK_INDEX_TYPE_UINT32);
     const rt_pack_ug *pu = &u->p->ug;
-    if (u->shadows) {   /* under the plants: before them */
-        vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_GRAPHICS, u->shadow_pipe);
-        for (int k = 0; k < u->nkeys; k++)
-            if (u->key_used[k] && (u->key_sh[k] || (u->key_shc[k] && !depth_read_only)))
-                vkCmdDrawIndexedIndirect(cb, u->mdraw.buf, 20 * (VkDeviceSize)(u->nkeys + k), 1, 20);
-    }
     /* one draw per key (a block's near or far mesh), opaque first: they
      * hide the rest; within a key the cells front to back */
     for (int cut = 0; cut < 2; cut++) {
@@ -832,6 +885,18 @@ void rt_ug_draw(rt_ug *u, VkCommandBuffer cb, bool depth_read_only, VkDescriptor
             if (u->key_used[k] && !(u->key_cs[k] && depth_read_only) &&
                 (pu->blocks[u->key_block[k]].cutout != 0) == cut)
                 vkCmdDrawIndexedIndirect(cb, u->mdraw.buf, 20 * (VkDeviceSize)k, 1, 20);
+    }
+    /* the contact shadows on the ground the plants leave visible: after
+     * them, so that the depth test drops the shadow's fragments they
+     * cover before shading or blending (the same picture as shadows
+     * first, covered by the plants: the quad lies on the ground, behind
+     * every plant standing on it; the valley's draw took 0.95 ms with
+     * the shadows first, 0.75 ms after, on the H100) */
+    if (u->shadows) {
+        vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_GRAPHICS, u->shadow_pipe);
+        for (int k = 0; k < u->nkeys; k++)
+            if (u->key_used[k] && (u->key_sh[k] || (u->key_shc[k] && !depth_read_only)))
+                vkCmdDrawIndexedIndirect(cb, u->mdraw.buf, 20 * (VkDeviceSize)(u->nkeys + k), 1, 20);
     }
     vkCmdEndRenderPass(cb);
     if (u->qpool)   /* the graphics draw's end */

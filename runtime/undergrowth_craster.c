@@ -25,15 +25,16 @@
  *      UG_CR_TBITS | the triangle: the nearest blade per pixel, ties to
  *      the lowest payload (the same on every run, whatever the order the
  *      threads ran in);
- *   with them, the contact shadows (ug_shadow): a thread per instance that
- *      casts one, its quad's pixels that pass the depth attachment add
- *      -log2(1 - a) in fixed point to a third per-pixel buffer;
+ *   after them, the contact shadows (ug_shadow): a thread per instance
+ *      that casts one, its quad's pixels nearer than the depth attachment
+ *      and the compute blades' depth add -log2(1 - a) in fixed point to a
+ *      third per-pixel buffer;
  *   3. resolve, a thread per pixel: where a payload landed, the blade's
  *      three vertices again (the vertex stage's own transform: fade,
  *      widening, wind, colour, ug_far), perspective-correct barycentrics
  *      at the pixel's centre, the fragment stage's shading (texture by
  *      analytic gradients, root darkening, splat_light), stored into the
- *      colour; elsewhere the colour times 2^-(the shadows' sum).
+ *      colour; elsewhere the colour; both times 2^-(the shadows' sum).
  * With 64-bit storage buffer atomics passes 1 and 2 are one: atomicMax of
  * depth << 32 | ~payload ($SPLAT_UG_ATOMICS=32: the two passes anyway).
  * The compute blades are not written into the depth attachment (nothing
@@ -129,12 +130,13 @@ static const char cr_glsl_main[] =
     /* A compute key's contact shadows (the graphics path's shadow quad and
      * fragment stage, rt_ug_shadow_vert_main): a thread per instance of
      * the key's entries that cast one, its quad's pixel centres (inside
-     * its first triangle, else its second: none counted twice) that pass
-     * the depth attachment (the terrain's, and the graphics blades' in
-     * front of it, which hide the shadow as they would have covered it)
-     * add -log2(1 - a) in fixed point to the pixel's sum; the resolve
-     * multiplies the colour by 2^-sum where no compute blade landed.  The
-     * same product as the blending's, in any order. */
+     * its first triangle, else its second: none counted twice) nearer
+     * than the depth attachment (the terrain's, and the graphics blades'
+     * in front of it) and than the compute blades (their depth pass has
+     * finished) add -log2(1 - a) in fixed point to the pixel's sum; the
+     * resolve multiplies the pixel's colour by 2^-sum: the draw's shadows,
+     * drawn after its plants, hide behind them alike.  The same product
+     * as the blending's, in any order. */
     "void ug_shadow(uint g) {\n"
     "    uint k = u_push.info.y, s = 5u * (uint(u_push.patch_uv.x) + k);\n"
     "    uint cnt = u_md.a[s + 1u], first = u_md.a[s + 4u];\n"
@@ -182,10 +184,16 @@ static const char cr_glsl_main[] =
     "                q = mat3x2(vec2(-1.0, -1.0), vec2(1.0, 1.0), vec2(-1.0, 1.0)) * (pw / (pw.x + pw.y + pw.z));\n"
     "                dz = dot(w, z.xzw);\n"
     "            }\n"
-    "            if (!(dz > texelFetch(u_zs, ivec2(x, y), 0).r) || dz > 1.0) continue;\n"
+    "            uint at = uint(y) * uint(size2.x) + uint(x);\n"
+    "#ifdef UG_I64\n"
+    "            float bz = uintBitsToFloat(uint(u_z.z[at] >> 32));\n"
+    "#else\n"
+    "            float bz = uintBitsToFloat(u_z.z[at]);\n"
+    "#endif\n"
+    "            if (!(dz > max(texelFetch(u_zs, ivec2(x, y), 0).r, bz)) || dz > 1.0) continue;\n"
     "            float sh = sa * (1.0 - smoothstep(0.2, 1.0, dot(q, q)));\n"
     "            if (sh > 0.0)\n"
-    "                atomicAdd(u_sh.s[uint(y) * uint(size2.x) + uint(x)], uint(-log2(1.0 - sh) * 262144.0 + 0.5));\n"
+    "                atomicAdd(u_sh.s[at], uint(-log2(1.0 - sh) * 262144.0 + 0.5));\n"
     "        }\n"
     "}\n"
     "void main() {\n"
@@ -284,6 +292,7 @@ static const char cr_glsl_main[] =
     "        }\n"
     "        return;\n"
     "    }\n"
+    "    float shade = exp2(-float(u_sh.s[at]) * (1.0 / 262144.0));\n"
     "    u_sh.s[at] = 0u;\n"
     "#ifdef UG_I64\n"
     "    u_z.z[at] = uint64_t(0);\n"
@@ -322,7 +331,7 @@ static const char cr_glsl_main[] =
     "    if ((flags & 2u) == 0u && !(area < 0.0)) n = -n;\n"
     "    n = normalize(mix(n, normalize(tn), far));\n"
     "    float ao = mix(mix(0.5, 1.0, clamp(uv.y, 0.0, 1.0)), 1.0, far);\n"
-    "    imageStore(u_out, px, vec4(splat_light(color * tex.rgb * ao, n, 0.9, dist, vv), 1.0));\n"
+    "    imageStore(u_out, px, vec4(splat_light(color * tex.rgb * ao, n, 0.9, dist, vv) * shade, 1.0));\n"
     "}\n"
     "#endif\n";
 
@@ -510,20 +519,26 @@ void rt_ug_craster_record(rt_ug *u, VkCommandBuffer cb, VkDescriptorSet set0c, V
             vkCmdPushConstants(cb, u->cr_layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof push, &push);
             vkCmdDispatchIndirect(cb, u->cdisp.buf, 12 * (VkDeviceSize)k);
         }
-        /* the compute keys' contact shadows: their own buffer, with the
-         * first pass */
-        push.info[3] = 3;
-        push.patch_uv[0] = (float)u->nkeys;
-        for (int k = 0; k < u->nkeys && pass == 0; k++) {
-            if (!u->key_used[k] || !u->key_shc[k])
-                continue;
-            push.info[1] = (uint32_t)k;
-            vkCmdPushConstants(cb, u->cr_layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof push, &push);
-            vkCmdDispatchIndirect(cb, u->cdisp.buf, 12 * (VkDeviceSize)(u->nkeys + k));
-        }
         rt_cmd_barrier(cb, cs, VK_ACCESS_SHADER_WRITE_BIT | VK_ACCESS_SHADER_READ_BIT, cs,
                        VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
     }
+    /* the compute keys' contact shadows: their own buffer, on what is
+     * nearest after the passes (hidden by a nearer blade, as the graphics
+     * draw's shadows after its plants) */
+    push.info[3] = 3;
+    push.patch_uv[0] = (float)u->nkeys;
+    bool shadows = false;
+    for (int k = 0; k < u->nkeys; k++) {
+        if (!u->key_used[k] || !u->key_shc[k])
+            continue;
+        push.info[1] = (uint32_t)k;
+        vkCmdPushConstants(cb, u->cr_layout, VK_SHADER_STAGE_COMPUTE_BIT, 0, sizeof push, &push);
+        vkCmdDispatchIndirect(cb, u->cdisp.buf, 12 * (VkDeviceSize)(u->nkeys + k));
+        shadows = true;
+    }
+    if (shadows)
+        rt_cmd_barrier(cb, cs, VK_ACCESS_SHADER_WRITE_BIT, cs,
+                       VK_ACCESS_SHADER_READ_BIT | VK_ACCESS_SHADER_WRITE_BIT);
     if (u->qpool)   /* the raster and shadow passes' end (the stats) */
         vkCmdWriteTimestamp(cb, VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, u->qpool, 5);
     vkCmdBindPipeline(cb, VK_PIPELINE_BIND_POINT_COMPUTE, u->cr_pipe[1]);

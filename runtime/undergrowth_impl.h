@@ -163,14 +163,12 @@ typedef struct ug_cell {
     bool  visible;     /* in the frustum this frame                        */
 } ug_cell;
 
-/* Push constants of the scatter pass (std430, 64 bytes). */
+/* Push constants of the scatter pass (std430, 48 bytes); the cells it
+ * generates are in gtab (undergrowth.c rt_ug_generate). */
 typedef struct ug_push {
-    float    origin[2];
-    int32_t  cell[2];
-    uint32_t slot, nw, cap, mask_base;
+    uint32_t nw, cap, nblocks, pad;
     float    terrain[4];      /* size x, size z, max height, offset       */
-    int32_t  hf[2];
-    uint32_t nblocks, pad;
+    int32_t  hf[2], pad2[2];
 } ug_push;
 
 /* Push constants of the cull passes (std430, 112 bytes). */
@@ -208,6 +206,10 @@ struct rt_ug {
      * offsets, the drawn instances' indices, the draws per key (and a
      * host copy of them, for the stats) */
     rt_buffer             ent, cnt, vis, mdraw, mdraw_host;
+    /* the scatter pass's table (host): per block its mesh's index count,
+     * first index and first vertex, then per cell generated this frame
+     * its index x, z and slot (uvec4s) */
+    rt_buffer             gtab;
     uint32_t              tri[SPLAT_MAX_UG_BLOCKS][3];   /* per block: its single-
                                                triangle mesh's index count
                                                (0: none), first index, first
