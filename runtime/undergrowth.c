@@ -671,8 +671,10 @@ static bool mask_jobs(rt_ug *u, const ug_cell *cl, int slot, ug_mask_job *jobs, 
         for (int lx = ax; lx <= bx; lx++) {
             if (lx < 0 || lz < 0 || lx >= L0->width || lz >= L0->height)
                 continue;
-            /* a leaf reached only by the cell's far edge holds none of
-             * its texel centres: it needs no dispatch */
+            /* a leaf that starts at the cell's far edge holds none of its
+             * texel centres: it needs no dispatch */
+            if (lx * lsx >= x0 + CELL || lz * lsz >= z0 + CELL)
+                continue;
             unsigned id = L0->ids[(size_t)lz * (size_t)L0->width + (size_t)lx];
             VkPipeline pipe = VK_NULL_HANDLE;
             if (id != SPLAT_COMBO_HOLE && !mask_pipeline(u, (int)id, &pipe, e))
