@@ -24,7 +24,11 @@
  *     the same scene without undergrowth blocks;
  *   - the instances cover the same pixels (within 3 %) from a ground
  *     camera on the forward path and on the screen path with raster and
- *     with ray-cast depth. */
+ *     with ray-cast depth;
+ *   - with a 20 m radius, cells put into pool slots other cells used hold
+ *     no instance where their combination grows nothing (half.sg's west
+ *     half: their texels cleared, not left from the slot's last cell), and
+ *     the bytes they held fresh where it grows. */
 #include "kit.h"
 
 #include <math.h>
@@ -37,8 +41,9 @@
 enum { N = 129, W = 256, H = 192, CELLS = 8, MAXI = 4096 };
 static const double WEIGHT = 128.0 / 255.0;
 
-/* grass: the grass block's density (0: no undergrowth blocks at all) */
-static bool write_scene(const char *dir, const char *name, double grass)
+/* grass: the grass block's density (0: no undergrowth blocks at all);
+ * mask: the meadow's mask lines */
+static bool write_scene(const char *dir, const char *name, double grass, const char *mask)
 {
     char *sg = kit_join(dir, name);
     FILE *f = fopen(sg, "w");
@@ -52,13 +57,13 @@ static bool write_scene(const char *dir, const char *name, double grass)
                  "    undergrowth stone { density = 0.1, align = normal }\n", grass);
     fprintf(f, "import \"nodes/compositors.sg\"\nimport \"nodes/masks.sg\"\n"
                "material ground {\n    out albedo = vec3(0.30, 0.25, 0.20)\n}\n"
-               "material meadow {\n    out mask = 0.5\n    out albedo = vec3(0.2, 0.4, 0.1)\n%s}\n"
+               "material meadow {\n%s    out albedo = vec3(0.2, 0.4, 0.1)\n%s}\n"
                "material burnt {\n    node r : ramp { x = terrain.destruction, lo = 0.02, "
                "hi = 0.25 }\n    out mask = r.out\n    out albedo = vec3(0.03, 0.03, 0.03)\n}\n"
                "scene meadow {\n    heightfield = \"flat.png\"\n    size = 128 128\n"
                "    max_height = 10\n    materials = [ground, meadow, burnt]\n    cell = 16\n"
                "    destruction { origin = 0 0, size = 128 128, cell = 16 }\n}\n",
-            blocks);
+            mask, blocks);
     return fclose(f) == 0;
 }
 
@@ -68,8 +73,12 @@ static bool write_inputs(const char *dir)
     char *png = kit_join(dir, "flat.png");
     bool ok = stbi_write_png(png, N, N, 1, hf, N) != 0;
     free(png);
-    return ok && write_scene(dir, "meadow.sg", 2.0) && write_scene(dir, "bare.sg", 0) &&
-           write_scene(dir, "sparse.sg", 0.5);
+    static const char half[] = "    node h : ramp { x = terrain.position.x, lo = 63, hi = 65 }\n"
+                               "    out mask = h.out\n";
+    return ok && write_scene(dir, "meadow.sg", 2.0, "    out mask = 0.5\n") &&
+           write_scene(dir, "bare.sg", 0, "    out mask = 0.5\n") &&
+           write_scene(dir, "sparse.sg", 0.5, "    out mask = 0.5\n") &&
+           write_scene(dir, "half.sg", 2.0, half);
 }
 
 static rt_renderer *renderer_on(rt_device *dev, const rt_pack *p, bool off, rt_shading sh,
@@ -295,6 +304,60 @@ int main(int argc, char **argv)
         CHECK(covered[k] > W * H / 50 && labs(covered[k] - covered[0]) * 100 <= 3 * covered[0],
               "%s: undergrowth covers %ld pixels, forward %ld", path[k].name, covered[k],
               covered[0]);
+
+    /* recycled pool slots: at a 20 m radius the pool (25 slots) cannot
+     * hold the square, so a walk from the east half (meadow, its ramp
+     * 0 below x = 63 m and 1 above 65 m) to the west half and back puts
+     * cells into slots other cells used.  A west cell's leaves' combination
+     * grows nothing, so no mask dispatch writes its texels: they must be
+     * cleared, not left from the slot's last cell (no instance there); an
+     * east cell generated again holds the bytes it held fresh. */
+    char *hsg = kit_join(dir, "half.sg"), *hpackdir = kit_join(dir, "half.pack");
+    rt_pack *hp = kit_build_pack_ok(hsg, hpackdir) ? kit_pack(hpackdir) : NULL;
+    rt_render_desc hd = { .width = W, .height = H, .undergrowth_radius = 20 };
+    rt_renderer *rw = NULL;
+    CHECK(hp && rt_renderer_create(dev, hp, &hd, &rw, &e), "the half meadow's renderer: %s",
+          e.msg ? e.msg : "no pack");
+    rt_error_clear(&e);
+    enum { EAST = 6 };
+    rt_ug_instance *fresh = malloc(sizeof *fresh * MAXI * EAST);
+    int nfresh[EAST] = { 0 }, east_cells = 0, west_cells = 0, west_inst = 0, same_east = 0;
+    for (int step = 0; rw && fresh && step <= 26; step++) {
+        /* x: 104 m, west by 8 m a frame to 24 m (frames 0-10), three
+         * frames there, back east to 104 m (frames 14-23), three there */
+        double x = step <= 10 ? 104 - 8 * step : step <= 13 ? 24 : step <= 23 ? 24 + 8 * (step - 13) : 104;
+        rt_camera walk = { .position = { x, 5, 64 }, .look = { x - 1, 4, 64 } };
+        CHECK(rt_renderer_frame(rw, &walk, NULL, &e), "walk frame: %s", e.msg ? e.msg : "?");
+        rt_error_clear(&e);
+        for (int k = 0; k < EAST && (step == 0 || step == 26); k++) {
+            int ix = 5 + k % 3, iz = 3 + k / 3;   /* the cells within 20 m of (104, 64) */
+            int n = cell_of(rw, ix, iz, a);
+            if (step == 0) {
+                nfresh[k] = n;
+                memcpy(fresh + (size_t)k * MAXI, a, sizeof *a * (size_t)(n > 0 ? n : 0));
+                east_cells += n > 0;
+            } else {
+                same_east += n == nfresh[k] && n > 0 &&
+                             memcmp(a, fresh + (size_t)k * MAXI, sizeof *a * (size_t)n) == 0;
+            }
+        }
+        for (int k = 0; k < 6 && step == 13; k++) {   /* (0..2, 3..4): within 20 m of (24, 64) */
+            int n = cell_of(rw, k % 3, 3 + k / 3, a);
+            west_cells++;
+            west_inst += n > 0 ? n : 0;
+        }
+    }
+    printf("recycled slots: %d east cells grown fresh, %d the same after the walk; "
+           "%d instances in %d west cells\n", east_cells, same_east, west_inst, west_cells);
+    CHECK(east_cells == EAST && same_east == EAST, "east cells: %d grown, %d the same after the walk",
+          east_cells, same_east);
+    CHECK(west_cells == 6 && west_inst == 0, "%d instances in the west cells, which grow nothing",
+          west_inst);
+    free(fresh);
+    rt_renderer_destroy(rw);
+    rt_pack_close(hp);
+    free(hsg);
+    free(hpackdir);
 
     free(a);
     free(b);
