@@ -34,13 +34,6 @@ static double rnd(double lo, double hi)
     return lo + (hi - lo) * ((double)rand() / RAND_MAX);
 }
 
-#define CLOSE(a, b, tol)                                                            \
-    do {                                                                            \
-        double a_ = (a), b_ = (b);                                                  \
-        if (!(fabs(a_ - b_) <= (tol)))                                              \
-            fail_msg("%s = %.17g, want %.17g (line %d)", #a, a_, b_, __LINE__);     \
-    } while (0)
-
 /* material t's mask = `value`, after the nodes `nodes` (footprint.sg
  * imported) */
 static void load(lowered *l, const char *nodes, const char *value)

@@ -32,70 +32,14 @@ static double rnd(double lo, double hi)
     return lo + (hi - lo) * ((double)rand() / RAND_MAX);
 }
 
-/* A texture: a smooth, non-periodic function of the raw uv, per channel. */
-static void tex_fn(double u, double v, double rgba[4])
-{
-    for (int c = 0; c < 4; c++)
-        rgba[c] = 0.5 + 0.25 * sin(2.1 * u + 1.3 * c) * cos(1.7 * v - 0.6 * c) +
-                  0.2 * sin(0.37 * u * v + c);
-}
-
-static void sample_fn(void *user, int texture, double u, double v, double rgba[4])
-{
-    (void)user;
-    (void)texture;
-    tex_fn(u, v, rgba);
-}
-
-/* Evaluate `value` (a vecN) as material t's albedo or a float as its mask,
- * for node text `node` (instanced as n) after `import "nodes/FILE"`. */
-static void eval_node(const char *file, const ir_env *e, const char *output, const char *value,
-                      const char *node, double out[4])
-{
-    char text[2048];
-    snprintf(text, sizeof text,
-             "import \"nodes/%s\"\n"
-             "texture tx { file = \"graphs/textures/noise.png\" }\n"
-             "material t {\n"
-             "    node n : %s\n"
-             "    out %s = %s\n"
-             "}\n",
-             file, node, output, value);
-    lowered l;
-    lowered_load(&l, text);
-    char root[64];
-    snprintf(root, sizeof root, "t.%s", output);
-    ir_ref r = ir_find_root(&l.ir, root);
-    assert_true(ir_ref_ok(r));
-    ir_eval(&l.ir, r, e, out);
-    lowered_free(&l);
-}
-
 static ir_env env_at(double x, double y, double z, double dist)
 {
-    ir_env e;
-    memset(&e, 0, sizeof e);
-    e.normal[1] = 1;
-    e.position[0] = x;
-    e.position[1] = y;
-    e.position[2] = z;
+    ir_env e = lowered_env(x, y, z);
     e.view_distance = dist;
-    e.sample = sample_fn;
     return e;
 }
 
-#define CLOSE(a, b, tol)                                                            \
-    do {                                                                            \
-        double a_ = (a), b_ = (b);                                                  \
-        if (!(fabs(a_ - b_) <= (tol)))                                              \
-            fail_msg("%s = %.17g, want %.17g (line %d)", #a, a_, b_, __LINE__);     \
-    } while (0)
-
 /* ---- hex tiling ------------------------------------------------------------ */
-
-static double perm(double x) { return fmod((34 * x + 1) * x, 289); }
-static double pmod(double x) { return x - 289 * floor(x / 289); }
-static double hash_perm(double ix, double iy) { return perm(perm(pmod(ix)) + pmod(iy)) / 289; }
 
 /* Mikkelsen 2022, Listing 1 (TriangleGrid) and the blend of his hex2colTex
  * without rotation or contrast: three reads at per-vertex random offsets,
@@ -113,11 +57,11 @@ static void hex_ref(double u, double v, double grid, double sharp, double out[4]
     for (int c = 0; c < 4; c++)
         out[c] = 0;
     for (int k = 0; k < 3; k++) {
-        double h1 = hash_perm(vx[k], vy[k]);
+        double h1 = lowered_hash_perm(vx[k], vy[k]);
         double k1 = floor(289 * h1 + 0.5);        /* the integer h1 stands for */
-        double h2 = hash_perm(vy[k] + k1, vx[k] + k1);
+        double h2 = lowered_hash_perm(vy[k] + k1, vx[k] + k1);
         double c[4];
-        tex_fn(u + h1, v + h2, c);
+        lowered_texture(u + h1, v + h2, c);
         double p = pow(fabs(w[k]), sharp);
         sum += p;
         for (int j = 0; j < 4; j++)
@@ -141,13 +85,13 @@ static void test_hex_tile(void **state)
                  "hex_tile { tex = tx, uv = vec2(%.17g, %.17g), sharpness = %.17g }", u, v,
                  sharp);
         double got[4], want[4];
-        eval_node("detile.sg", &e, "albedo", "n.out.rgb", node, got);
+        lowered_eval_node("detile.sg", &e, "albedo", "n.out.rgb", node, got);
         hex_ref(u, v, 3.4641016, sharp, want);
         for (int c = 0; c < 3; c++)
             CLOSE(got[c], want[c], 1e-9);
         /* not the plain read: the offsets move it */
         double plain[4];
-        tex_fn(u, v, plain);
+        lowered_texture(u, v, plain);
         far_apart += fabs(plain[0] - want[0]) > 0.02;
     }
     assert_true(far_apart > 100);
@@ -161,10 +105,10 @@ static void test_hex_tile(void **state)
     char node[256];
     snprintf(node, sizeof node, "hex_tile { tex = tx, uv = vec2(%.17g, %.17g) }", u, v);
     double got[4], one[4];
-    eval_node("detile.sg", &e, "albedo", "n.out.rgb", node, got);
-    double h1 = hash_perm(3, 5), k1 = floor(289 * h1 + 0.5);
-    double h2 = hash_perm(5 + k1, 3 + k1);
-    tex_fn(u + h1, v + h2, one);
+    lowered_eval_node("detile.sg", &e, "albedo", "n.out.rgb", node, got);
+    double h1 = lowered_hash_perm(3, 5), k1 = floor(289 * h1 + 0.5);
+    double h2 = lowered_hash_perm(5 + k1, 3 + k1);
+    lowered_texture(u + h1, v + h2, one);
     for (int c = 0; c < 3; c++)
         CLOSE(got[c], one[c], 1e-6);
 }
@@ -182,7 +126,7 @@ static void test_detile(void **state)
         char node[256];
         snprintf(node, sizeof node, "detile { tex = tx, far_amount = %.17g }", amount);
         double got[4], near[4], far[4];
-        eval_node("detile.sg", &e, "albedo", "n.out.rgb", node, got);
+        lowered_eval_node("detile.sg", &e, "albedo", "n.out.rgb", node, got);
         hex_ref(x / 2.0, z / 2.0, 3.4641016, 4.0, near);
         hex_ref(x / 9.0, z / 9.0, 3.4641016, 4.0, far);
         double t = fmin(1, fmax(0, (d - 25.0) / 55.0));
@@ -202,8 +146,8 @@ static double fade(double f) { return f * f * (3 - 2 * f); }
 static double value_noise(double x, double y)
 {
     double ix = floor(x), iy = floor(y), fx = fade(x - ix), fy = fade(y - iy);
-    double a = hash_perm(ix, iy), b = hash_perm(ix + 1, iy);
-    double c = hash_perm(ix, iy + 1), d = hash_perm(ix + 1, iy + 1);
+    double a = lowered_hash_perm(ix, iy), b = lowered_hash_perm(ix + 1, iy);
+    double c = lowered_hash_perm(ix, iy + 1), d = lowered_hash_perm(ix + 1, iy + 1);
     double x0 = a + (b - a) * fx, x1 = c + (d - c) * fx;
     return fmin(1, fmax(0, x0 + (x1 - x0) * fy));
 }
@@ -223,7 +167,7 @@ static void test_macro_variation(void **state)
                  " tint = vec3(%g, %g, %g), tint_amount = 0.5, seed = 3.0 }",
                  alb[0], alb[1], alb[2], tint[0], tint[1], tint[2]);
         double got[4];
-        eval_node("variation.sg", &e, "albedo", "n.out", node, got);
+        lowered_eval_node("variation.sg", &e, "albedo", "n.out", node, got);
         double px = x / 150 + 3, pz = z / 150 + 3;
         double n = (value_noise(px, pz) + 0.5 * value_noise(2 * px + 17.31, 2 * pz + 9.77)) / 1.5;
         double f = 1 + 0.3 * (2 * n - 1);
@@ -239,7 +183,7 @@ static void test_macro_variation(void **state)
     /* brightness 0, tint_amount 0: unchanged */
     ir_env e = env_at(123, 0, 456, 0);
     double got[4];
-    eval_node("variation.sg", &e, "albedo", "n.out",
+    lowered_eval_node("variation.sg", &e, "albedo", "n.out",
               "macro_variation { albedo = vec3(0.3, 0.2, 0.1), brightness = 0.0 }", got);
     CLOSE(got[0], 0.3, 1e-12);
     CLOSE(got[2], 0.1, 1e-12);
@@ -294,14 +238,14 @@ static void test_normal_blend(void **state)
         snprintf(node, sizeof node,
                  "rnm_blend { base = vec3(%.17g, %.17g, %.17g), detail = vec3(%.17g, %.17g, %.17g) }",
                  b[0], b[1], b[2], d[0], d[1], d[2]);
-        eval_node("normal_blend.sg", &e, "albedo", "n.out", node, got);
+        lowered_eval_node("normal_blend.sg", &e, "albedo", "n.out", node, got);
         rotate_to(b, d, want);
         for (int c = 0; c < 3; c++)
             CLOSE(got[c], want[c], 1e-9);
         snprintf(node, sizeof node,
                  "whiteout_blend { a = vec3(%.17g, %.17g, %.17g), b = vec3(%.17g, %.17g, %.17g) }",
                  b[0], b[1], b[2], d[0], d[1], d[2]);
-        eval_node("normal_blend.sg", &e, "albedo", "n.out", node, got);
+        lowered_eval_node("normal_blend.sg", &e, "albedo", "n.out", node, got);
         double w[3] = {b[0] + d[0], b[1] + d[1], b[2] * d[2]};
         norm3(w);
         for (int c = 0; c < 3; c++)
@@ -309,16 +253,16 @@ static void test_normal_blend(void **state)
     }
     /* a flat detail leaves the base; a flat base gives the detail */
     double got[4];
-    eval_node("normal_blend.sg", &e, "albedo", "n.out",
+    lowered_eval_node("normal_blend.sg", &e, "albedo", "n.out",
               "rnm_blend { base = vec3(0.6, 0.0, 0.8), detail = vec3(0.0, 0.0, 1.0) }", got);
     CLOSE(got[0], 0.6, 1e-12);
     CLOSE(got[2], 0.8, 1e-12);
-    eval_node("normal_blend.sg", &e, "albedo", "n.out",
+    lowered_eval_node("normal_blend.sg", &e, "albedo", "n.out",
               "rnm_blend { base = vec3(0.0, 0.0, 1.0), detail = vec3(0.0, 0.6, 0.8) }", got);
     CLOSE(got[1], 0.6, 1e-12);
     CLOSE(got[2], 0.8, 1e-12);
     /* unpack: 2c - 1, slopes scaled */
-    eval_node("normal_blend.sg", &e, "albedo", "n.out",
+    lowered_eval_node("normal_blend.sg", &e, "albedo", "n.out",
               "unpack_normal { c = vec3(0.75, 0.25, 1.0), strength = 0.5 }", got);
     CLOSE(got[0], 0.25, 1e-12);
     CLOSE(got[1], -0.25, 1e-12);
@@ -328,11 +272,11 @@ static void test_normal_blend(void **state)
     e.normal[0] = -0.6;
     e.normal[1] = 0.8;
     e.normal[2] = 0;
-    eval_node("normal_blend.sg", &e, "albedo", "n.out",
+    lowered_eval_node("normal_blend.sg", &e, "albedo", "n.out",
               "tangent_to_world { n = vec3(0.0, 0.0, 1.0) }", got);
     CLOSE(got[0], -0.6, 1e-12);
     CLOSE(got[1], 0.8, 1e-12);
-    eval_node("normal_blend.sg", &e, "albedo", "n.out",
+    lowered_eval_node("normal_blend.sg", &e, "albedo", "n.out",
               "tangent_to_world { n = vec3(1.0, 0.0, 0.0) }", got);
     CLOSE(got[0], 0.8, 1e-12);
     CLOSE(got[1], 0.6, 1e-12);
@@ -348,11 +292,11 @@ static void test_cavity_ao(void **state)
         ir_env e = env_at(0, 0, 0, 0);
         e.cavity = cav[i];
         double got[4];
-        eval_node("cavity.sg", &e, "mask", "n.out",
+        lowered_eval_node("cavity.sg", &e, "mask", "n.out",
                   "cavity_ao { depth = 10.0, strength = 0.6, ridge = 0.2 }", got);
         double o = fmin(1, fmax(0, cav[i] / 10)), r = fmin(1, fmax(0, -cav[i] / 10));
         CLOSE(got[0], 1 - 0.6 * o + 0.2 * r, 1e-12);
-        eval_node("cavity.sg", &e, "albedo", "n.out",
+        lowered_eval_node("cavity.sg", &e, "albedo", "n.out",
                   "cavity_darken { albedo = vec3(0.5, 0.4, 0.3), depth = 10.0, strength = 0.6 }",
                   got);
         CLOSE(got[1], 0.4 * (1 - 0.6 * o), 1e-12);

@@ -30,67 +30,14 @@ static double rnd(double lo, double hi)
     return lo + (hi - lo) * ((double)rand() / RAND_MAX);
 }
 
-static void tex_fn(double u, double v, double rgba[4])
-{
-    for (int c = 0; c < 4; c++)
-        rgba[c] = 0.5 + 0.25 * sin(2.1 * u + 1.3 * c) * cos(1.7 * v - 0.6 * c) +
-                  0.2 * sin(0.37 * u * v + c);
-}
-
-static void sample_fn(void *user, int texture, double u, double v, double rgba[4])
-{
-    (void)user;
-    (void)texture;
-    tex_fn(u, v, rgba);
-}
-
-/* `value` of material t with node text `node` (instanced as n), after
- * `import "nodes/FILE"`, as its albedo. */
-static void eval_node(const char *file, const ir_env *e, const char *value, const char *node,
-                      double out[4])
-{
-    char text[2048];
-    snprintf(text, sizeof text,
-             "import \"nodes/%s\"\n"
-             "texture tx { file = \"graphs/textures/noise.png\" }\n"
-             "material t {\n"
-             "    node n : %s\n"
-             "    out albedo = %s\n"
-             "}\n",
-             file, node, value);
-    lowered l;
-    lowered_load(&l, text);
-    ir_ref r = ir_find_root(&l.ir, "t.albedo");
-    assert_true(ir_ref_ok(r));
-    ir_eval(&l.ir, r, e, out);
-    lowered_free(&l);
-}
-
 static ir_env env_at(double x, double y, double z, int lod)
 {
-    ir_env e;
-    memset(&e, 0, sizeof e);
-    e.normal[1] = 1;
-    e.position[0] = x;
-    e.position[1] = y;
-    e.position[2] = z;
+    ir_env e = lowered_env(x, y, z);
     e.shading_lod = lod;
-    e.sample = sample_fn;
     return e;
 }
 
-#define CLOSE(a, b, tol)                                                            \
-    do {                                                                            \
-        double a_ = (a), b_ = (b);                                                  \
-        if (!(fabs(a_ - b_) <= (tol)))                                              \
-            fail_msg("%s = %.17g, want %.17g (line %d)", #a, a_, b_, __LINE__);     \
-    } while (0)
-
 /* ---- hex tiling ------------------------------------------------------------ */
-
-static double perm(double x) { return fmod((34 * x + 1) * x, 289); }
-static double pmod(double x) { return x - 289 * floor(x / 289); }
-static double hash_perm(double ix, double iy) { return perm(perm(pmod(ix)) + pmod(iy)) / 289; }
 
 /* The copy of the vertex of the largest barycentric weight (Mikkelsen
  * 2022's triangle grid; ties to the first, then the second), and in *full
@@ -110,11 +57,11 @@ static void hex_lod_ref(double u, double v, double out[4], double full[4])
     for (int c = 0; c < 4; c++)
         full[c] = 0;
     for (int j = 0; j < 3; j++) {
-        double h1 = hash_perm(vx[j], vy[j]);
+        double h1 = lowered_hash_perm(vx[j], vy[j]);
         double k1 = floor(289 * h1 + 0.5);
-        double h2 = hash_perm(vy[j] + k1, vx[j] + k1);
+        double h2 = lowered_hash_perm(vy[j] + k1, vx[j] + k1);
         double c[4];
-        tex_fn(u + h1, v + h2, c);
+        lowered_texture(u + h1, v + h2, c);
         if (j == k)
             memcpy(out, c, sizeof c);
         double p = pow(w[j], 4.0);
@@ -137,8 +84,8 @@ static void test_hex_tile_lod(void **state)
         snprintf(node, sizeof node, "hex_tile { tex = tx, uv = vec2(%.17g, %.17g) }", u, v);
         double got[4], got_full[4], want[4], full[4];
         ir_env on = env_at(0, 0, 0, 1), off = env_at(0, 0, 0, 0);
-        eval_node("detile.sg", &on, "n.out.rgb", node, got);
-        eval_node("detile.sg", &off, "n.out.rgb", node, got_full);
+        lowered_eval_node("detile.sg", &on, "albedo", "n.out.rgb", node, got);
+        lowered_eval_node("detile.sg", &off, "albedo", "n.out.rgb", node, got_full);
         hex_lod_ref(u, v, want, full);
         for (int c = 0; c < 3; c++) {
             CLOSE(got[c], want[c], 1e-9);
@@ -167,14 +114,14 @@ static void test_triplanar_lod(void **state)
         for (int c = 0; c < 3; c++)
             e.normal[c] = n[c] / l;
         double got[4], want[4];
-        eval_node("projection.sg", &e, "n.out.rgb",
+        lowered_eval_node("projection.sg", &e, "albedo", "n.out.rgb",
                   "triplanar { tex = tx, scale = 8.0, sharpness = 4.0 }", got);
         /* the axis of the largest |n| (its weight |n|^4 / sum is the largest) */
         double a[3] = {fabs(e.normal[0]), fabs(e.normal[1]), fabs(e.normal[2])};
         int k = a[0] >= a[1] && a[0] >= a[2] ? 0 : a[1] >= a[2] ? 1 : 2;
         const double *p = e.position;
         double uv[3][2] = {{p[2], p[1]}, {p[0], p[2]}, {p[0], p[1]}};
-        tex_fn(uv[k][0] / 8.0, uv[k][1] / 8.0, want);
+        lowered_texture(uv[k][0] / 8.0, uv[k][1] / 8.0, want);
         for (int c = 0; c < 3; c++)
             CLOSE(got[c], want[c], 1e-9);
         picked[k]++;
@@ -200,8 +147,8 @@ static void test_parallax_lod(void **state)
                      steps[s], u, v);
             double got[4], full[4];
             ir_env on = env_at(0, 0, 0, 1), off = env_at(0, 0, 0, 0);
-            eval_node("parallax.sg", &on, "n.out.xyy", node, got);
-            eval_node("parallax.sg", &off, "n.out.xyy", node, full);
+            lowered_eval_node("parallax.sg", &on, "albedo", "n.out.xyy", node, got);
+            lowered_eval_node("parallax.sg", &off, "albedo", "n.out.xyy", node, full);
             CLOSE(got[0], u, 0);
             CLOSE(got[1], v, 0);
             moved += fabs(full[0] - u) > 1e-6;
