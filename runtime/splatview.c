@@ -284,7 +284,8 @@ static const splat_arg options[] = {
       .choices = "forward|screen", .given = GIVEN(shading_set) },
     { "--screen-depth", SPLAT_ARG_ENUM, NULL, "the screen path's depth: the patches drawn "
       "depth only, or the heightfield ray cast in compute (auto: ray cast on GPUs, for "
-      "terrains without holes)", F(screen_depth), .choices = "auto|raster|raycast" },
+      "terrains without holes; raster can be faster where few patches show a steep "
+      "terrain whole)", F(screen_depth), .choices = "auto|raster|raycast" },
     { "--pixel-sort", SPLAT_ARG_ENUM, NULL, "the screen path: sort each 16 tiles' pixels by "
       "the layers they need before shading them, so SIMD lanes skip the same surfaces "
       "(default off: the sort costs more than it saves on the devices measured)",
