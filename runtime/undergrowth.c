@@ -651,9 +651,9 @@ typedef struct ug_mask_job {
 } ug_mask_job;
 
 /* The mask dispatches of cell `cl` (pool slot `slot`), one per leaf cell
- * it overlaps, appended to `jobs`; returns whether they write every
+ * it overlaps, appended to `jobs`; *covered says whether they write every
  * texel (else the cell's texels are cleared first: beyond the terrain, a
- * hole, or a combination that grows nothing). */
+ * hole, or a combination that grows nothing).  False on an error. */
 static bool mask_jobs(rt_ug *u, const ug_cell *cl, int slot, ug_mask_job *jobs, int *njobs,
                       bool *covered, rt_error *e)
 {
